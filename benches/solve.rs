@@ -1,0 +1,92 @@
+//! Cost of solving: one parameter point's separation angle and time, through the planner and
+//! through the sweeps' lean per-point solver, and the paper's whole scene (`scenes/paper.yaml`,
+//! every quantity, 1000 samples per series) without writing files.
+//!
+//! Run: `cargo bench --bench solve -- --warm-up-time 1 --measurement-time 3`.
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use rodcube::plan::{self, Request};
+use rodcube::quantity::Quantity;
+use rodcube::report;
+use rodcube::scene::Scene;
+use rodcube::solve::lean::LeanSolver;
+use std::hint::black_box;
+use std::path::Path;
+
+/// The paper's case by name.
+const PAPER: [(&str, f64); 5] = [
+    ("m1", 1.0),
+    ("m2", 3.0),
+    ("ell", 1.0),
+    ("a", 0.25),
+    ("g", 9.81),
+];
+
+fn per_point(c: &mut Criterion) {
+    let model = rodcube::models::find("rod_cube").expect("rod_cube is generated");
+    let mut g = c.benchmark_group("per_point");
+    // The planner at its default tolerance (1e-10; at 1e-12 this point takes the same 30
+    // integrand evaluations): a `System`, the root, the quadrature and a results map.
+    for (label, want) in [
+        ("planner_separation_angle", vec![Quantity::SeparationAngle]),
+        (
+            "planner_separation_time",
+            vec![Quantity::SeparationAngle, Quantity::SeparationTime],
+        ),
+    ] {
+        let request = Request::new(model, PAPER).with_want(&want);
+        g.bench_function(label, |b| {
+            b.iter(|| plan::run(black_box(&request)).expect("the paper's point solves"))
+        });
+    }
+    // The sweeps' per-point solver: buffers reused, no results map, no counters per point.
+    let mut lean = LeanSolver::new(model).expect("rod_cube has a contact");
+    let values: Vec<f64> = PAPER.iter().map(|(_, v)| *v).collect();
+    g.bench_function("lean_solver_separation_time", |b| {
+        b.iter(|| {
+            lean.solve(black_box(&values))
+                .expect("the paper's point solves")
+        })
+    });
+    g.finish();
+}
+
+fn paper_scene(c: &mut Criterion) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/paper.yaml");
+    let solve = |scene: &Scene| {
+        let request = Request::new(scene.model, scene.parameters.clone())
+            .with_want(&scene.want)
+            .with_tolerance(scene.tolerance)
+            .with_samples(scene.samples);
+        plan::run(&request).expect("the paper's scene solves")
+    };
+    let mut g = c.benchmark_group("paper_scene");
+    g.sample_size(20);
+    g.bench_function("load_and_solve", |b| {
+        b.iter(|| {
+            let scene = Scene::load(black_box(&path)).expect("scenes/paper.yaml is valid");
+            solve(&scene)
+        })
+    });
+    // Everything `rodcube run` does except the writes: the table, results.json, CSVs and SVGs
+    // as strings.
+    g.bench_function("load_solve_and_render", |b| {
+        b.iter(|| {
+            let scene = Scene::load(black_box(&path)).expect("scenes/paper.yaml is valid");
+            let results = solve(&scene);
+            let mut bytes = report::table::render(&results, Some(scene.info())).len();
+            bytes += report::json::to_string(&results).expect("json").len();
+            for (name, series) in &results.series {
+                bytes += report::csv::to_string(name, series).expect("csv").len();
+                if let Some(svg) = report::plot::svg(name, series, &results.model).expect("svg") {
+                    bytes += svg.len();
+                }
+            }
+            bytes
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, per_point, paper_scene);
+criterion_main!(benches);

@@ -1,0 +1,1025 @@
+//! A small expression tree for the derivation tool: parsed from spec text and from Symbolica's
+//! printed output, printed back as plain infix, Rust and LaTeX, and evaluated for self-checks.
+
+use std::collections::BTreeSet;
+use std::fmt::Write as _;
+
+/// An expression over `f64` with named symbols and the elementary functions used by specs.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Expr {
+    /// A rational constant `num / den` (den > 0), kept exact for printing.
+    Rational(i128, i128),
+    /// A floating constant written in a spec (`0.5`).
+    Float(f64),
+    /// A symbol (parameter, coordinate, or an internal name).
+    Sym(String),
+    /// Sum of terms.
+    Add(Vec<Expr>),
+    /// Product of factors.
+    Mul(Vec<Expr>),
+    /// Power `base ^ exponent`.
+    Pow(Box<Expr>, Box<Expr>),
+    /// Function call (`sin`, `cos`, `sqrt`, `asin`, ...).
+    Fun(String, Vec<Expr>),
+}
+
+/// Functions a spec may use, with their arity.
+pub const FUNCTIONS: &[(&str, usize)] = &[
+    ("sin", 1),
+    ("cos", 1),
+    ("tan", 1),
+    ("asin", 1),
+    ("acos", 1),
+    ("atan", 1),
+    ("sqrt", 1),
+    ("exp", 1),
+    ("log", 1),
+];
+
+/// A parse error with the byte offset where it was found.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ParseError {
+    /// Byte offset in the parsed text.
+    pub offset: usize,
+    /// What went wrong.
+    pub message: String,
+}
+
+impl Expr {
+    /// Integer constant.
+    pub fn int(n: i128) -> Expr {
+        Expr::Rational(n, 1)
+    }
+
+    /// Symbol.
+    pub fn sym(name: &str) -> Expr {
+        Expr::Sym(name.to_string())
+    }
+
+    /// Parses infix text: numbers, identifiers, `+ - * / ^`, parentheses and function calls.
+    pub fn parse(text: &str) -> Result<Expr, ParseError> {
+        let mut p = Parser {
+            s: text.as_bytes(),
+            i: 0,
+        };
+        let e = p.expr()?;
+        p.ws();
+        if p.i < p.s.len() {
+            return Err(p.err(format!("unexpected `{}`", p.s[p.i] as char)));
+        }
+        Ok(e)
+    }
+
+    /// Flattens nested sums and products, folds numeric factors into one rational, and drops
+    /// factors of one and terms of zero.
+    pub fn tidy(&self) -> Expr {
+        match self {
+            Expr::Add(v) => {
+                let mut terms = Vec::new();
+                for t in v.iter().map(Expr::tidy) {
+                    match t {
+                        Expr::Add(inner) => terms.extend(inner),
+                        t if t.is_zero() => {}
+                        t => terms.push(t),
+                    }
+                }
+                sum(terms)
+            }
+            Expr::Mul(v) => {
+                let (mut n, mut d) = (1i128, 1i128);
+                let mut rest = Vec::new();
+                let mut flat = Vec::new();
+                for f in v.iter().map(Expr::tidy) {
+                    match f {
+                        Expr::Mul(inner) => flat.extend(inner),
+                        f => flat.push(f),
+                    }
+                }
+                for f in flat {
+                    match &f {
+                        Expr::Rational(a, b) => {
+                            n = n.saturating_mul(*a);
+                            d = d.saturating_mul(*b);
+                        }
+                        Expr::Pow(b, e)
+                            if e.as_integer() == Some(-1)
+                                && matches!(**b, Expr::Rational(_, 1)) =>
+                        {
+                            if let Expr::Rational(a, 1) = **b {
+                                d = d.saturating_mul(a);
+                            }
+                        }
+                        _ => rest.push(f),
+                    }
+                }
+                if n == 0 {
+                    return Expr::int(0);
+                }
+                if d < 0 {
+                    n = -n;
+                    d = -d;
+                }
+                let g = gcd(n.abs(), d);
+                let (n, d) = (n / g, d / g);
+                if !(n == 1 && d == 1) {
+                    rest.insert(0, Expr::Rational(n, d));
+                }
+                product(rest)
+            }
+            Expr::Pow(b, e) => {
+                let (b, e) = (b.tidy(), e.tidy());
+                match (&b, e.as_integer()) {
+                    (_, Some(1)) => b,
+                    (Expr::Rational(a, 1), Some(-1)) if *a != 0 => {
+                        if *a < 0 {
+                            Expr::Rational(-1, -a)
+                        } else {
+                            Expr::Rational(1, *a)
+                        }
+                    }
+                    _ => Expr::Pow(Box::new(b), Box::new(e)),
+                }
+            }
+            Expr::Fun(f, v) => Expr::Fun(f.clone(), v.iter().map(Expr::tidy).collect()),
+            e => e.clone(),
+        }
+    }
+
+    /// Every symbol the expression mentions.
+    pub fn symbols(&self) -> BTreeSet<String> {
+        let mut out = BTreeSet::new();
+        self.visit(&mut |e| {
+            if let Expr::Sym(s) = e {
+                out.insert(s.clone());
+            }
+        });
+        out
+    }
+
+    /// Every function name the expression calls, with the argument counts used.
+    pub fn functions(&self) -> Vec<(String, usize)> {
+        let mut out = Vec::new();
+        self.visit(&mut |e| {
+            if let Expr::Fun(f, args) = e {
+                out.push((f.clone(), args.len()));
+            }
+        });
+        out
+    }
+
+    fn visit(&self, f: &mut dyn FnMut(&Expr)) {
+        f(self);
+        match self {
+            Expr::Add(v) | Expr::Mul(v) | Expr::Fun(_, v) => v.iter().for_each(|e| e.visit(f)),
+            Expr::Pow(b, e) => {
+                b.visit(f);
+                e.visit(f);
+            }
+            _ => {}
+        }
+    }
+
+    /// Evaluates with a symbol lookup; unknown symbols and functions give NaN.
+    pub fn eval(&self, lookup: &dyn Fn(&str) -> Option<f64>) -> f64 {
+        match self {
+            Expr::Rational(n, d) => *n as f64 / *d as f64,
+            Expr::Float(x) => *x,
+            Expr::Sym(s) => lookup(s).unwrap_or(f64::NAN),
+            Expr::Add(v) => v.iter().map(|e| e.eval(lookup)).sum(),
+            Expr::Mul(v) => v.iter().map(|e| e.eval(lookup)).product(),
+            Expr::Pow(b, e) => {
+                let b = b.eval(lookup);
+                match e.as_integer() {
+                    Some(n) if n.abs() < 64 => b.powi(n as i32),
+                    _ => b.powf(e.eval(lookup)),
+                }
+            }
+            Expr::Fun(f, args) => {
+                let x = args.first().map(|a| a.eval(lookup)).unwrap_or(f64::NAN);
+                match f.as_str() {
+                    "sin" => x.sin(),
+                    "cos" => x.cos(),
+                    "tan" => x.tan(),
+                    "asin" => x.asin(),
+                    "acos" => x.acos(),
+                    "atan" => x.atan(),
+                    "sqrt" => x.sqrt(),
+                    "exp" => x.exp(),
+                    "log" => x.ln(),
+                    _ => f64::NAN,
+                }
+            }
+        }
+    }
+
+    /// The value if this is an integer constant.
+    pub fn as_integer(&self) -> Option<i128> {
+        match self {
+            Expr::Rational(n, 1) => Some(*n),
+            _ => None,
+        }
+    }
+
+    /// Whether this is the constant zero.
+    pub fn is_zero(&self) -> bool {
+        matches!(self, Expr::Rational(0, _))
+    }
+
+    /// Plain infix text (`sin(theta)^2`, `*`, `/`, `^`), readable by Symbolica and most CASes.
+    pub fn to_infix(&self) -> String {
+        let mut s = String::new();
+        self.infix(&mut s, 0);
+        s
+    }
+
+    fn infix(&self, out: &mut String, parent: u8) {
+        // precedence: 1 sum, 2 product, 3 unary minus, 4 power, 5 atom
+        match self {
+            Expr::Rational(n, 1) => {
+                let paren = *n < 0 && parent > 1;
+                wrap(out, paren, |o| {
+                    let _ = write!(o, "{n}");
+                });
+            }
+            Expr::Rational(n, d) => wrap(out, parent >= 2, |o| {
+                let _ = write!(o, "{n}/{d}");
+            }),
+            Expr::Float(x) => {
+                let paren = *x < 0.0 && parent > 1;
+                wrap(out, paren, |o| o.push_str(&float_literal(*x)));
+            }
+            Expr::Sym(s) => out.push_str(s),
+            Expr::Add(v) => wrap(out, parent > 1, |o| {
+                for (i, t) in v.iter().enumerate() {
+                    let (neg, mag) = t.split_sign();
+                    if i == 0 {
+                        if neg {
+                            o.push('-');
+                        }
+                    } else {
+                        o.push_str(if neg { " - " } else { " + " });
+                    }
+                    mag.infix(o, 2);
+                }
+            }),
+            Expr::Mul(_) => {
+                let (neg, mag) = self.split_sign();
+                if neg {
+                    wrap(out, parent > 1, |o| {
+                        o.push('-');
+                        mag.infix(o, 3);
+                    });
+                    return;
+                }
+                let (num, den) = self.num_den();
+                wrap(out, parent > 2, |o| {
+                    if num.is_empty() {
+                        o.push('1');
+                    }
+                    for (i, f) in num.iter().enumerate() {
+                        if i > 0 {
+                            o.push('*');
+                        }
+                        f.infix(o, 3);
+                    }
+                    if !den.is_empty() {
+                        o.push('/');
+                        let d = product(den);
+                        d.infix(o, 4);
+                    }
+                });
+            }
+            Expr::Pow(b, e) => {
+                if let Some(-1) = e.as_integer() {
+                    wrap(out, parent > 2, |o| {
+                        o.push_str("1/");
+                        b.infix(o, 4);
+                    });
+                    return;
+                }
+                wrap(out, parent > 4, |o| {
+                    b.infix(o, 5);
+                    o.push('^');
+                    e.infix(o, 5);
+                });
+            }
+            Expr::Fun(f, args) => {
+                out.push_str(f);
+                out.push('(');
+                for (i, a) in args.iter().enumerate() {
+                    if i > 0 {
+                        out.push_str(", ");
+                    }
+                    a.infix(out, 0);
+                }
+                out.push(')');
+            }
+        }
+    }
+
+    /// LaTeX, with `name` mapping each symbol to its LaTeX spelling.
+    pub fn to_latex(&self, name: &dyn Fn(&str) -> String) -> String {
+        let mut s = String::new();
+        self.latex(&mut s, 0, name);
+        s
+    }
+
+    fn latex(&self, out: &mut String, parent: u8, name: &dyn Fn(&str) -> String) {
+        match self {
+            Expr::Rational(n, 1) => {
+                wrap_latex(out, *n < 0 && parent > 1, |o| {
+                    let _ = write!(o, "{n}");
+                });
+            }
+            Expr::Rational(n, d) => wrap_latex(out, *n < 0 && parent > 1, |o| {
+                let _ = write!(
+                    o,
+                    "{}\\frac{{{}}}{{{d}}}",
+                    if *n < 0 { "-" } else { "" },
+                    n.abs()
+                );
+            }),
+            Expr::Float(x) => out.push_str(&format!("{x}")),
+            Expr::Sym(s) => out.push_str(&name(s)),
+            Expr::Add(v) => wrap_latex(out, parent > 1, |o| {
+                for (i, t) in v.iter().enumerate() {
+                    let (neg, mag) = t.split_sign();
+                    if i == 0 {
+                        if neg {
+                            o.push('-');
+                        }
+                    } else {
+                        o.push_str(if neg { " - " } else { " + " });
+                    }
+                    mag.latex(o, 2, name);
+                }
+            }),
+            Expr::Mul(_) => {
+                let (neg, mag) = self.split_sign();
+                let (num, den) = mag.num_den();
+                wrap_latex(out, neg && parent > 1, |o| {
+                    if neg {
+                        o.push('-');
+                    }
+                    let write_factors = |o: &mut String, fs: &[Expr]| {
+                        if fs.is_empty() {
+                            o.push('1');
+                        }
+                        for (i, f) in fs.iter().enumerate() {
+                            if i > 0 {
+                                let digit_next = matches!(f, Expr::Rational(..) | Expr::Float(_));
+                                o.push_str(if digit_next { " \\cdot " } else { " " });
+                            }
+                            f.latex(o, if fs.len() > 1 { 3 } else { 2 }, name);
+                        }
+                    };
+                    if den.is_empty() {
+                        write_factors(o, &num);
+                    } else {
+                        o.push_str("\\frac{");
+                        write_factors(o, &num);
+                        o.push_str("}{");
+                        write_factors(o, &den);
+                        o.push('}');
+                    }
+                });
+            }
+            Expr::Pow(b, e) => {
+                if let Some(n) = e.as_integer()
+                    && n < 0
+                {
+                    out.push_str("\\frac{1}{");
+                    Expr::Pow(b.clone(), Box::new(Expr::int(-n))).latex(out, 0, name);
+                    out.push('}');
+                    return;
+                }
+                if let Expr::Rational(1, 2) = **e {
+                    out.push_str("\\sqrt{");
+                    b.latex(out, 0, name);
+                    out.push('}');
+                    return;
+                }
+                if let Expr::Fun(f, args) = &**b
+                    && matches!(f.as_str(), "sin" | "cos" | "tan")
+                {
+                    let _ = write!(out, "\\{f}^{{");
+                    e.latex(out, 0, name);
+                    out.push('}');
+                    args[0].latex_fn_arg(out, name);
+                    return;
+                }
+                b.latex(out, 5, name);
+                out.push_str("^{");
+                e.latex(out, 0, name);
+                out.push('}');
+            }
+            Expr::Fun(f, args) => match f.as_str() {
+                "sqrt" => {
+                    out.push_str("\\sqrt{");
+                    args[0].latex(out, 0, name);
+                    out.push('}');
+                }
+                "sin" | "cos" | "tan" | "exp" | "log" => {
+                    let _ = write!(out, "\\{f}");
+                    args[0].latex_fn_arg(out, name);
+                }
+                _ => {
+                    let _ = write!(out, "\\operatorname{{{f}}}\\left(");
+                    args[0].latex(out, 0, name);
+                    out.push_str("\\right)");
+                }
+            },
+        }
+    }
+
+    fn latex_fn_arg(&self, out: &mut String, name: &dyn Fn(&str) -> String) {
+        if let Expr::Sym(_) = self {
+            out.push(' ');
+            self.latex(out, 5, name);
+        } else {
+            out.push_str("\\left(");
+            self.latex(out, 0, name);
+            out.push_str("\\right)");
+        }
+    }
+
+    /// Rough printed width of this expression's LaTeX, in characters of math italic: enough to
+    /// decide where a long display must break (a fraction counts its wider part only).
+    pub fn latex_width(&self, name: &dyn Fn(&str) -> String) -> usize {
+        let paren = |e: &Expr| e.latex_width(name) + if matches!(e, Expr::Add(_)) { 2 } else { 0 };
+        match self {
+            Expr::Rational(n, 1) => n.to_string().len(),
+            Expr::Rational(n, d) => n.to_string().len().max(d.to_string().len()) + 1,
+            Expr::Float(x) => format!("{x}").len(),
+            Expr::Sym(s) => visible_width(&name(s)),
+            Expr::Add(v) => v
+                .iter()
+                .map(|t| t.split_sign().1.latex_width(name) + 3)
+                .sum(),
+            Expr::Mul(_) => {
+                let (neg, mag) = self.split_sign();
+                let (num, den) = mag.num_den();
+                let wide = |fs: &[Expr]| fs.iter().map(paren).sum::<usize>().max(1);
+                let w = if den.is_empty() {
+                    wide(&num)
+                } else {
+                    wide(&num).max(wide(&den)) + 1
+                };
+                w + usize::from(neg)
+            }
+            Expr::Pow(b, e) => match e.as_integer() {
+                Some(n) if n < 0 => {
+                    Expr::Pow(b.clone(), Box::new(Expr::int(-n))).latex_width(name) + 1
+                }
+                _ if **e == Expr::Rational(1, 2) => b.latex_width(name) + 2,
+                _ => paren(b) + e.latex_width(name).div_ceil(2),
+            },
+            Expr::Fun(f, args) => {
+                let arg = args.first().map_or(0, |a| {
+                    a.latex_width(name) + if matches!(a, Expr::Sym(_)) { 1 } else { 2 }
+                });
+                match f.as_str() {
+                    "sqrt" => arg + 1,
+                    f => f.len() + arg,
+                }
+            }
+        }
+    }
+
+    /// This expression's LaTeX in display lines of about `width` characters (as counted by
+    /// [`Expr::latex_width`]), `first` of them already taken on the first line. A sum breaks
+    /// between its terms; a fraction whose numerator holds a long sum is written
+    /// `\frac{c}{d} \Bigl( ... \Bigr)` so that the sum can break. One line when it fits.
+    /// Join the lines with `\\` inside a `multline*`.
+    pub fn to_latex_lines(
+        &self,
+        name: &dyn Fn(&str) -> String,
+        width: usize,
+        first: usize,
+    ) -> Vec<String> {
+        if first + self.latex_width(name) <= width {
+            return vec![self.to_latex(name)];
+        }
+        match self {
+            Expr::Add(terms) => break_sum(terms, String::new(), first, "", name, width).0,
+            Expr::Mul(_) => {
+                let (neg, mag) = self.split_sign();
+                let (mut num, den) = mag.num_den();
+                // The numerator's widest sum breaks inside `\Bigl( \Bigr)`; so do long sums of
+                // the denominator, written after it as `\Bigl( \Bigr)^{-k}`.
+                let widest = num
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, f)| matches!(f, Expr::Add(_)))
+                    .max_by_key(|(_, f)| f.latex_width(name))
+                    .map(|(i, _)| i);
+                let top = widest.and_then(|i| match num.remove(i) {
+                    Expr::Add(terms) => Some(terms),
+                    _ => None,
+                });
+                // A denominator `(a b)^k` is the factors `a^k`, `b^k`.
+                let den = den.into_iter().flat_map(|d| match d {
+                    Expr::Mul(v) => v,
+                    Expr::Pow(b, k) if matches!(*b, Expr::Mul(_)) => match *b {
+                        Expr::Mul(v) => v
+                            .into_iter()
+                            .map(|f| Expr::Pow(Box::new(f), k.clone()))
+                            .collect(),
+                        b => vec![Expr::Pow(Box::new(b), k)],
+                    },
+                    d => vec![d],
+                });
+                let (long, short): (Vec<Expr>, Vec<Expr>) =
+                    den.partition(|f| sum_power(f).is_some() && f.latex_width(name) > width / 3);
+                if top.is_none() && long.is_empty() {
+                    return vec![self.to_latex(name)];
+                }
+                let mut factors = num;
+                factors.extend(
+                    short
+                        .into_iter()
+                        .map(|d| Expr::Pow(Box::new(d), Box::new(Expr::int(-1)))),
+                );
+                // Kept a product even of one factor, so that `1/d^2` prints as a fraction.
+                let coefficient = if factors.is_empty() {
+                    Expr::int(1)
+                } else {
+                    Expr::Mul(factors)
+                };
+                let mut line = String::from(if neg { "-" } else { "" });
+                let mut used = first + usize::from(neg);
+                if coefficient != Expr::int(1) {
+                    coefficient.latex(&mut line, 0, name);
+                    line.push(' ');
+                    used += coefficient.latex_width(name) + 1;
+                }
+                let mut lines = Vec::new();
+                if let Some(terms) = top {
+                    let (done, last) =
+                        break_sum(&terms, line + "\\Bigl(", used + 1, "\\Bigr)", name, width);
+                    lines = done;
+                    line = lines.pop().unwrap_or_default();
+                    used = last;
+                }
+                for f in &long {
+                    let Some((terms, k)) = sum_power(f) else {
+                        continue;
+                    };
+                    let (done, last) = break_sum(
+                        terms,
+                        line + " \\Bigl(",
+                        used + 1,
+                        &format!("\\Bigr)^{{-{k}}}"),
+                        name,
+                        width,
+                    );
+                    lines.extend(done);
+                    line = lines.pop().unwrap_or_default();
+                    used = last;
+                }
+                lines.push(line);
+                lines
+            }
+            _ => vec![self.to_latex(name)],
+        }
+    }
+
+    /// Splits a leading negative sign off a term: `-3*x` gives `(true, 3*x)`.
+    pub fn split_sign(&self) -> (bool, Expr) {
+        match self {
+            Expr::Rational(n, d) if *n < 0 => (true, Expr::Rational(-n, *d)),
+            Expr::Float(x) if *x < 0.0 => (true, Expr::Float(-x)),
+            Expr::Mul(v) => {
+                let mut neg = false;
+                let mut out = Vec::with_capacity(v.len());
+                for f in v {
+                    match f {
+                        Expr::Rational(n, d) if *n < 0 => {
+                            neg = !neg;
+                            if !(*n == -1 && *d == 1) {
+                                out.push(Expr::Rational(-n, *d));
+                            }
+                        }
+                        Expr::Float(x) if *x < 0.0 => {
+                            neg = !neg;
+                            out.push(Expr::Float(-x));
+                        }
+                        _ => out.push(f.clone()),
+                    }
+                }
+                (neg, product(out))
+            }
+            _ => (false, self.clone()),
+        }
+    }
+
+    /// Splits a product into numerator and denominator factors (negative powers and the
+    /// denominators of rational constants go below the line).
+    pub fn num_den(&self) -> (Vec<Expr>, Vec<Expr>) {
+        let factors: Vec<Expr> = match self {
+            Expr::Mul(v) => v.clone(),
+            e => vec![e.clone()],
+        };
+        let mut num = Vec::new();
+        let mut den = Vec::new();
+        for f in factors {
+            match &f {
+                Expr::Pow(b, e) => match e.as_integer() {
+                    Some(-1) => den.push((**b).clone()),
+                    Some(n) if n < 0 => den.push(Expr::Pow(b.clone(), Box::new(Expr::int(-n)))),
+                    _ => match &**e {
+                        Expr::Rational(n, d) if *n < 0 => {
+                            den.push(Expr::Pow(b.clone(), Box::new(Expr::Rational(-n, *d))))
+                        }
+                        _ => num.push(f.clone()),
+                    },
+                },
+                Expr::Rational(n, d) if *d != 1 => {
+                    if *n != 1 {
+                        num.push(Expr::int(*n));
+                    }
+                    den.push(Expr::int(*d));
+                }
+                _ => num.push(f.clone()),
+            }
+        }
+        (num, den)
+    }
+}
+
+/// A product of factors, simplified for 0 and 1 factors.
+pub fn product(mut v: Vec<Expr>) -> Expr {
+    match v.len() {
+        0 => Expr::int(1),
+        1 => v.pop().unwrap_or(Expr::int(1)),
+        _ => Expr::Mul(v),
+    }
+}
+
+/// A sum of terms, simplified for 0 and 1 terms.
+pub fn sum(mut v: Vec<Expr>) -> Expr {
+    match v.len() {
+        0 => Expr::int(0),
+        1 => v.pop().unwrap_or(Expr::int(0)),
+        _ => Expr::Add(v),
+    }
+}
+
+/// The terms of a sum on display lines of about `width` characters: the first line starts with
+/// `line` (`used` characters taken), the last ends with `close`; a continued line starts with
+/// `{}` so its leading sign is spaced as a binary operator. Also returns the width used on the
+/// last line.
+fn break_sum(
+    terms: &[Expr],
+    mut line: String,
+    mut used: usize,
+    close: &str,
+    name: &dyn Fn(&str) -> String,
+    width: usize,
+) -> (Vec<String>, usize) {
+    let mut lines = Vec::new();
+    let mut in_line = 0;
+    for (i, t) in terms.iter().enumerate() {
+        let (neg, mag) = t.split_sign();
+        let w = mag.latex_width(name) + 3;
+        if in_line > 0 && used + w > width {
+            lines.push(std::mem::replace(&mut line, String::from("{}")));
+            used = 0;
+            in_line = 0;
+        }
+        if i == 0 {
+            if neg {
+                line.push('-');
+            }
+        } else {
+            line.push_str(if neg { " - " } else { " + " });
+        }
+        mag.latex(&mut line, 2, name);
+        used += w;
+        in_line += 1;
+    }
+    line.push_str(close);
+    lines.push(line);
+    (lines, used + 2)
+}
+
+/// A sum or a sum raised to a positive integer power: its terms and the power.
+fn sum_power(e: &Expr) -> Option<(&[Expr], i128)> {
+    match e {
+        Expr::Add(terms) => Some((terms, 1)),
+        Expr::Pow(b, k) => match (&**b, k.as_integer()) {
+            (Expr::Add(terms), Some(k)) if k > 0 => Some((terms, k)),
+            _ => None,
+        },
+        _ => None,
+    }
+}
+
+/// Characters a LaTeX fragment shows: letters and digits count one each, `\sin`-like
+/// operators three, Greek letters one, and markup (`\mathrm`, `\dot`, braces, `_`) nothing.
+fn visible_width(latex: &str) -> usize {
+    let mut n = 0;
+    let mut chars = latex.chars().peekable();
+    while let Some(c) = chars.next() {
+        if c == '\\' {
+            let mut cmd = String::new();
+            while let Some(&d) = chars.peek() {
+                if !d.is_ascii_alphabetic() {
+                    break;
+                }
+                cmd.push(d);
+                chars.next();
+            }
+            n += match cmd.as_str() {
+                "sin" | "cos" | "tan" | "exp" | "log" => 3,
+                "mathrm" | "dot" | "ddot" | "operatorname" | "left" | "right" | "" => 0,
+                _ => 1,
+            };
+        } else if c.is_ascii_alphanumeric() {
+            n += 1;
+        }
+    }
+    n
+}
+
+fn wrap_latex(out: &mut String, paren: bool, f: impl FnOnce(&mut String)) {
+    if paren {
+        out.push_str("\\left(");
+    }
+    f(out);
+    if paren {
+        out.push_str("\\right)");
+    }
+}
+
+fn wrap(out: &mut String, paren: bool, f: impl FnOnce(&mut String)) {
+    if paren {
+        out.push('(');
+    }
+    f(out);
+    if paren {
+        out.push(')');
+    }
+}
+
+/// A float written so that Rust reads it back as the same `f64` and as a float literal.
+pub fn float_literal(x: f64) -> String {
+    let s = format!("{x:?}");
+    if s.contains('.') || s.contains('e') || s.contains("inf") || s.contains("NaN") {
+        s
+    } else {
+        format!("{s}.0")
+    }
+}
+
+struct Parser<'a> {
+    s: &'a [u8],
+    i: usize,
+}
+
+impl Parser<'_> {
+    fn err(&self, message: String) -> ParseError {
+        ParseError {
+            offset: self.i,
+            message,
+        }
+    }
+
+    fn ws(&mut self) {
+        while self.i < self.s.len() && self.s[self.i].is_ascii_whitespace() {
+            self.i += 1;
+        }
+    }
+
+    fn peek(&mut self) -> Option<u8> {
+        self.ws();
+        self.s.get(self.i).copied()
+    }
+
+    fn expr(&mut self) -> Result<Expr, ParseError> {
+        let mut terms = vec![self.term()?];
+        while let Some(c @ (b'+' | b'-')) = self.peek() {
+            self.i += 1;
+            let t = self.term()?;
+            terms.push(if c == b'-' { negate(t) } else { t });
+        }
+        Ok(sum(terms))
+    }
+
+    fn term(&mut self) -> Result<Expr, ParseError> {
+        let mut factors = vec![self.unary()?];
+        while let Some(c @ (b'*' | b'/')) = self.peek() {
+            self.i += 1;
+            let f = self.unary()?;
+            factors.push(if c == b'/' {
+                Expr::Pow(Box::new(f), Box::new(Expr::int(-1)))
+            } else {
+                f
+            });
+        }
+        Ok(product(factors))
+    }
+
+    fn unary(&mut self) -> Result<Expr, ParseError> {
+        match self.peek() {
+            Some(b'-') => {
+                self.i += 1;
+                Ok(negate(self.unary()?))
+            }
+            Some(b'+') => {
+                self.i += 1;
+                self.unary()
+            }
+            _ => self.power(),
+        }
+    }
+
+    fn power(&mut self) -> Result<Expr, ParseError> {
+        let base = self.atom()?;
+        if self.peek() == Some(b'^') {
+            self.i += 1;
+            let e = self.unary()?;
+            return Ok(Expr::Pow(Box::new(base), Box::new(e)));
+        }
+        Ok(base)
+    }
+
+    fn atom(&mut self) -> Result<Expr, ParseError> {
+        match self.peek() {
+            None => Err(self.err("expression ends too early".into())),
+            Some(b'(') => {
+                self.i += 1;
+                let e = self.expr()?;
+                if self.peek() != Some(b')') {
+                    return Err(self.err("missing `)`".into()));
+                }
+                self.i += 1;
+                Ok(e)
+            }
+            Some(c) if c.is_ascii_digit() || c == b'.' => self.number(),
+            Some(c) if c.is_ascii_alphabetic() || c == b'_' => {
+                let start = self.i;
+                while self.i < self.s.len()
+                    && (self.s[self.i].is_ascii_alphanumeric() || self.s[self.i] == b'_')
+                {
+                    self.i += 1;
+                }
+                let name = String::from_utf8_lossy(&self.s[start..self.i]).into_owned();
+                if self.peek() == Some(b'(') {
+                    self.i += 1;
+                    let mut args = vec![self.expr()?];
+                    while self.peek() == Some(b',') {
+                        self.i += 1;
+                        args.push(self.expr()?);
+                    }
+                    if self.peek() != Some(b')') {
+                        return Err(self.err(format!("missing `)` after arguments of `{name}`")));
+                    }
+                    self.i += 1;
+                    return Ok(Expr::Fun(name, args));
+                }
+                Ok(Expr::Sym(name))
+            }
+            Some(c) => Err(self.err(format!("unexpected `{}`", c as char))),
+        }
+    }
+
+    fn number(&mut self) -> Result<Expr, ParseError> {
+        let start = self.i;
+        let mut float = false;
+        while self.i < self.s.len() {
+            let c = self.s[self.i];
+            if c.is_ascii_digit() {
+                self.i += 1;
+            } else if c == b'.' {
+                float = true;
+                self.i += 1;
+            } else if (c == b'e' || c == b'E')
+                && self.s.get(self.i + 1).is_some_and(|d| {
+                    d.is_ascii_digit()
+                        || ((*d == b'-' || *d == b'+')
+                            && self.s.get(self.i + 2).is_some_and(u8::is_ascii_digit))
+                })
+            {
+                float = true;
+                self.i += 2;
+            } else {
+                break;
+            }
+        }
+        let text = std::str::from_utf8(&self.s[start..self.i]).unwrap_or("");
+        if float {
+            text.parse::<f64>()
+                .map(Expr::Float)
+                .map_err(|_| ParseError {
+                    offset: start,
+                    message: format!("bad number `{text}`"),
+                })
+        } else {
+            text.parse::<i128>().map(Expr::int).map_err(|_| ParseError {
+                offset: start,
+                message: format!("number `{text}` is too large"),
+            })
+        }
+    }
+}
+
+fn gcd(a: i128, b: i128) -> i128 {
+    if b == 0 { a.max(1) } else { gcd(b, a % b) }
+}
+
+fn negate(e: Expr) -> Expr {
+    match e {
+        Expr::Rational(n, d) => Expr::Rational(-n, d),
+        Expr::Float(x) => Expr::Float(-x),
+        Expr::Mul(mut v) => {
+            v.insert(0, Expr::int(-1));
+            Expr::Mul(v)
+        }
+        e => Expr::Mul(vec![Expr::int(-1), e]),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ev(text: &str) -> f64 {
+        Expr::parse(text).unwrap().eval(&|s| match s {
+            "x" => Some(0.3),
+            "y" => Some(-1.7),
+            _ => None,
+        })
+    }
+
+    #[test]
+    fn parses_precedence_and_functions() {
+        assert!(
+            (ev("1 + 2*x^2/y - sin(x)") - (1.0 + 2.0 * 0.09 / -1.7 - 0.3f64.sin())).abs() < 1e-15
+        );
+        assert!((ev("-x^2") + 0.09).abs() < 1e-15);
+        assert!((ev("2^-1*x") - 0.15).abs() < 1e-15);
+        assert!((ev("1.5e-3*x") - 4.5e-4).abs() < 1e-18);
+    }
+
+    #[test]
+    fn infix_round_trips_by_value() {
+        for text in [
+            "1 - x*(y + 2)^3/(x - y)",
+            "-(x + y)^(1/2)",
+            "x^-2 - 3/4*y",
+            "sin(x)^2*cos(y)/(1 + x)",
+        ] {
+            let e = Expr::parse(text).unwrap();
+            let back = Expr::parse(&e.to_infix()).unwrap();
+            let at = |s: &str| Some(if s == "x" { 0.7 } else { -0.3 });
+            let (a, b) = (e.eval(&at), back.eval(&at));
+            assert!(
+                (a - b).abs() <= 1e-14 * a.abs().max(1.0),
+                "{text} -> {}",
+                e.to_infix()
+            );
+        }
+    }
+
+    #[test]
+    fn long_displays_break_between_terms() {
+        let name = |s: &str| s.to_string();
+        let terms: Vec<String> = (1..=30).map(|i| format!("{i}*x^{i}")).collect();
+        let sum = Expr::parse(&terms.join(" + ")).unwrap();
+        assert_eq!(
+            Expr::parse("x + y")
+                .unwrap()
+                .to_latex_lines(&name, 40, 0)
+                .len(),
+            1
+        );
+        let lines = sum.to_latex_lines(&name, 40, 0);
+        assert!(lines.len() > 2, "{lines:?}");
+        assert!(
+            lines[1..].iter().all(|l| l.starts_with("{} + ")),
+            "{lines:?}"
+        );
+        // A fraction with a long numerator and denominator keeps both sums breakable.
+        let frac = Expr::parse(&format!(
+            "3*({})/(y*({})^2)",
+            terms.join(" + "),
+            terms.join(" - ")
+        ))
+        .unwrap()
+        .tidy();
+        let lines = frac.to_latex_lines(&name, 40, 0);
+        let text = lines.join(" ");
+        assert!(lines[0].starts_with("\\frac{3}{y} \\Bigl("), "{lines:?}");
+        assert!(text.ends_with("\\Bigr)^{-2}"), "{text}");
+        assert!(lines.iter().all(|l| !l.contains("\\left(")), "{lines:?}");
+    }
+
+    #[test]
+    fn reports_offsets() {
+        let err = Expr::parse("x + * y").unwrap_err();
+        assert_eq!(err.offset, 4);
+        assert!(Expr::parse("sin(x").is_err());
+        assert!(Expr::parse("x y").is_err());
+    }
+}

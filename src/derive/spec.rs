@@ -1,0 +1,624 @@
+//! Model specs (`derivations/*.yaml`): their schema, parsing, and checks that name file, line
+//! and field for every error.
+
+use super::expr::{Expr, FUNCTIONS};
+use crate::yaml_marks::{At, Step, locate_nearest};
+use serde::Deserialize;
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// An expression field: YAML may write it as a string or a bare number.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+pub enum Text {
+    /// `"ell/2*sin(theta)"`
+    Str(String),
+    /// `0`, `0.5`
+    Num(f64),
+}
+
+impl Text {
+    /// The expression text.
+    pub fn text(&self) -> String {
+        match self {
+            Text::Str(s) => s.clone(),
+            Text::Num(x) => super::expr::float_literal(*x),
+        }
+    }
+}
+
+/// A declared parameter.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParamSpec {
+    /// Symbol (`m1`).
+    pub name: String,
+    /// What it is.
+    pub meaning: String,
+    /// SI unit.
+    pub unit: String,
+    /// Whether it must be strictly positive (default true).
+    #[serde(default = "yes")]
+    pub positive: bool,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// A condition on the parameters: `expr` must be strictly positive.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RequirementSpec {
+    /// Identifier.
+    pub name: String,
+    /// Margin expression of the parameters.
+    pub expr: Text,
+    /// What it means when it fails.
+    pub meaning: String,
+}
+
+/// A generalized coordinate.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CoordSpec {
+    /// Symbol (`x1`, `theta`).
+    pub name: String,
+    /// What it is.
+    pub meaning: String,
+    /// SI unit.
+    pub unit: String,
+}
+
+/// A rigid body moving in the plane.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    /// Identifier.
+    pub name: String,
+    /// Mass.
+    pub mass: Text,
+    /// Moment of inertia about the centre of mass.
+    pub inertia: Text,
+    /// Centre of mass `[x, y]` (y up) as expressions of the coordinates.
+    pub position: [Text; 2],
+    /// Orientation angle (counter-clockwise).
+    pub angle: Text,
+}
+
+/// A named point whose trajectory can be reported.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointSpec {
+    /// Identifier.
+    pub name: String,
+    /// `[x, y]` as expressions of the coordinates.
+    pub position: [Text; 2],
+    /// What it is.
+    pub meaning: String,
+}
+
+/// A reaction force measured on one body along one direction.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ForceSpec {
+    /// Identifier.
+    pub name: String,
+    /// Body whose equation of motion gives the force.
+    pub body: String,
+    /// Unit direction; the force must be the only one on `body` with a component along it
+    /// (besides gravity, which is accounted for).
+    pub direction: [f64; 2],
+    /// What it is, with its sign convention.
+    pub meaning: String,
+}
+
+/// The separating contact.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// Name of the force (in `forces`) that is positive while touching.
+    pub force: String,
+    /// Point of the pusher that touches (in `points`).
+    pub point: String,
+    /// A point on the pushed surface (in `points`).
+    pub surface: String,
+    /// Unit normal of the surface, from the pusher into the pushed body.
+    pub normal: [f64; 2],
+}
+
+/// A physical assumption: `expr` must stay `>= 0` during the motion.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MonitorSpec {
+    /// Identifier.
+    pub name: String,
+    /// Expression of parameters, `theta` and force names.
+    pub expr: Text,
+    /// What it checks.
+    pub meaning: String,
+}
+
+/// Initial position and velocity of one coordinate.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InitialSpec {
+    /// Position (expression of parameters).
+    pub position: Text,
+    /// Velocity (expression of parameters).
+    pub velocity: Text,
+}
+
+/// The model that continues after separation, and where its parameters come from.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AfterSpec {
+    /// Next model's name.
+    pub model: String,
+    /// Next model's parameter -> a parameter of this model, a coordinate, or `<coordinate>_dot`.
+    pub parameters: BTreeMap<String, String>,
+}
+
+/// A whole model spec.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Spec {
+    /// Model name: a plain identifier, the stem of the generated files.
+    pub name: String,
+    /// One line for people.
+    pub description: String,
+    /// Parameters, in the order the generated functions take them.
+    pub parameters: Vec<ParamSpec>,
+    /// Conditions on the parameters.
+    #[serde(default)]
+    pub requirements: Vec<RequirementSpec>,
+    /// Name of the gravity parameter (gravity acts along -y).
+    pub gravity: String,
+    /// Generalized coordinates.
+    pub coordinates: Vec<CoordSpec>,
+    /// The coordinate kept after the cyclic ones are eliminated.
+    pub reduced: String,
+    /// Value of the reduced coordinate where the motion ends (the floor).
+    pub end_angle: f64,
+    /// Bodies.
+    pub bodies: Vec<BodySpec>,
+    /// Named points.
+    #[serde(default)]
+    pub points: Vec<PointSpec>,
+    /// Point whose initial height gives the reference free-fall time.
+    pub falling_point: String,
+    /// Reaction forces to evaluate.
+    #[serde(default)]
+    pub forces: Vec<ForceSpec>,
+    /// The separating contact, if any.
+    #[serde(default)]
+    pub contact: Option<ContactSpec>,
+    /// Monitored assumptions.
+    #[serde(default)]
+    pub monitors: Vec<MonitorSpec>,
+    /// Initial state, one entry per coordinate.
+    pub initial: BTreeMap<String, InitialSpec>,
+    /// The phase after separation.
+    #[serde(default)]
+    pub after_separation: Option<AfterSpec>,
+}
+
+/// A spec error with its place.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SpecError {
+    /// Spec file.
+    pub file: PathBuf,
+    /// 1-based line.
+    pub line: usize,
+    /// 1-based column.
+    pub column: usize,
+    /// Dotted field path (`bodies[0].position[1]`).
+    pub field: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl fmt::Display for SpecError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{}:{}:{}: field `{}`: {}",
+            self.file.display(),
+            self.line,
+            self.column,
+            self.field,
+            self.message
+        )
+    }
+}
+
+impl std::error::Error for SpecError {}
+
+/// A parsed and checked spec with its expressions parsed.
+#[derive(Debug, Clone)]
+pub struct Checked {
+    /// The raw spec.
+    pub spec: Spec,
+    /// Where it came from.
+    pub file: PathBuf,
+}
+
+/// Names the derivation uses internally; specs may not use them.
+pub const RESERVED_PREFIXES: &[&str] = &["rc_", "dot_", "ddot_"];
+
+/// Reads and checks a spec file.
+pub fn load(path: &Path) -> Result<Checked, SpecError> {
+    let text = std::fs::read_to_string(path).map_err(|e| SpecError {
+        file: path.to_path_buf(),
+        line: 0,
+        column: 0,
+        field: String::new(),
+        message: format!("cannot read: {e}"),
+    })?;
+    parse(path, &text)
+}
+
+/// Parses and checks spec text (`path` is used in messages).
+pub fn parse(path: &Path, text: &str) -> Result<Checked, SpecError> {
+    let spec: Spec = serde_yaml_ng::from_str(text).map_err(|e| {
+        let (line, column) = e
+            .location()
+            .map(|l| (l.line(), l.column()))
+            .unwrap_or((0, 0));
+        let message = e.to_string();
+        // serde_yaml_ng prefixes the path of the failing field: keep it as the field name.
+        let field = message
+            .split_once(": ")
+            .filter(|(p, _)| !p.contains(' ') || p.contains('.'))
+            .map(|(p, _)| p.to_string())
+            .unwrap_or_default();
+        SpecError {
+            file: path.to_path_buf(),
+            line,
+            column,
+            field,
+            message,
+        }
+    })?;
+    let checker = Checker {
+        path,
+        text,
+        spec: &spec,
+    };
+    checker.check()?;
+    Ok(Checked {
+        spec,
+        file: path.to_path_buf(),
+    })
+}
+
+struct Checker<'a> {
+    path: &'a Path,
+    text: &'a str,
+    spec: &'a Spec,
+}
+
+/// A field path as both YAML steps and a dotted name.
+#[derive(Clone)]
+struct Field(Vec<(Option<String>, Option<usize>)>);
+
+impl Field {
+    fn key(k: &str) -> Field {
+        Field(vec![(Some(k.to_string()), None)])
+    }
+    fn k(&self, k: &str) -> Field {
+        let mut v = self.0.clone();
+        v.push((Some(k.to_string()), None));
+        Field(v)
+    }
+    fn i(&self, i: usize) -> Field {
+        let mut v = self.0.clone();
+        v.push((None, Some(i)));
+        Field(v)
+    }
+    fn dotted(&self) -> String {
+        let mut s = String::new();
+        for (k, i) in &self.0 {
+            match (k, i) {
+                (Some(k), _) => {
+                    if !s.is_empty() {
+                        s.push('.');
+                    }
+                    s.push_str(k);
+                }
+                (None, Some(i)) => s.push_str(&format!("[{i}]")),
+                _ => {}
+            }
+        }
+        s
+    }
+}
+
+impl Checker<'_> {
+    fn err(&self, field: &Field, message: String) -> SpecError {
+        let steps: Vec<Step<'_>> = field
+            .0
+            .iter()
+            .map(|(k, i)| match (k, i) {
+                (Some(k), _) => Step::Key(k.as_str()),
+                (None, Some(i)) => Step::Index(*i),
+                _ => Step::Index(0),
+            })
+            .collect();
+        let (line, column) = locate_nearest(self.text, &steps, At::Key);
+        SpecError {
+            file: self.path.to_path_buf(),
+            line,
+            column,
+            field: field.dotted(),
+            message,
+        }
+    }
+
+    fn check(&self) -> Result<(), SpecError> {
+        let s = self.spec;
+        if !is_identifier(&s.name) {
+            return Err(self.err(
+                &Field::key("name"),
+                format!(
+                    "model name `{}` must be a plain identifier (letters, digits, `_`, not starting \
+                     with a digit): it becomes a file name",
+                    s.name
+                ),
+            ));
+        }
+        let mut seen = BTreeSet::new();
+        let params: BTreeSet<String> = s.parameters.iter().map(|p| p.name.clone()).collect();
+        let coords: BTreeSet<String> = s.coordinates.iter().map(|c| c.name.clone()).collect();
+        let named = |list: &str, i: usize| Field::key(list).i(i).k("name");
+        for (i, p) in s.parameters.iter().enumerate() {
+            self.identifier(&named("parameters", i), &p.name, &mut seen)?;
+        }
+        for (i, c) in s.coordinates.iter().enumerate() {
+            self.identifier(&named("coordinates", i), &c.name, &mut seen)?;
+        }
+        let mut names = BTreeSet::new();
+        for (i, b) in s.bodies.iter().enumerate() {
+            self.identifier(&named("bodies", i), &b.name, &mut names)?;
+        }
+        let mut point_names = BTreeSet::new();
+        for (i, p) in s.points.iter().enumerate() {
+            self.identifier(&named("points", i), &p.name, &mut point_names)?;
+        }
+        let mut force_names = BTreeSet::new();
+        for (i, f) in s.forces.iter().enumerate() {
+            self.identifier(&named("forces", i), &f.name, &mut force_names)?;
+            if seen.contains(&f.name) {
+                return Err(self.err(
+                    &named("forces", i),
+                    format!("`{}` is already a parameter or coordinate", f.name),
+                ));
+            }
+        }
+        let mut monitor_names = BTreeSet::new();
+        for (i, m) in s.monitors.iter().enumerate() {
+            self.identifier(&named("monitors", i), &m.name, &mut monitor_names)?;
+        }
+        let mut req_names = BTreeSet::new();
+        for (i, r) in s.requirements.iter().enumerate() {
+            self.identifier(&named("requirements", i), &r.name, &mut req_names)?;
+        }
+        if s.bodies.is_empty() {
+            return Err(self.err(
+                &Field::key("bodies"),
+                "a model needs at least one body".into(),
+            ));
+        }
+        if !params.contains(&s.gravity) {
+            return Err(self.err(
+                &Field::key("gravity"),
+                format!("`{}` is not a parameter", s.gravity),
+            ));
+        }
+        if !coords.contains(&s.reduced) {
+            return Err(self.err(
+                &Field::key("reduced"),
+                format!("`{}` is not a coordinate", s.reduced),
+            ));
+        }
+        if !point_names.contains(&s.falling_point) {
+            return Err(self.err(
+                &Field::key("falling_point"),
+                format!("`{}` is not one of the points", s.falling_point),
+            ));
+        }
+        let only_params: BTreeSet<String> = params.clone();
+        let mut kinematic = params.clone();
+        kinematic.extend(coords.iter().cloned());
+        for (i, r) in s.requirements.iter().enumerate() {
+            self.expr(
+                &Field::key("requirements").i(i).k("expr"),
+                &r.expr,
+                &only_params,
+            )?;
+        }
+        for (i, b) in s.bodies.iter().enumerate() {
+            let f = Field::key("bodies").i(i);
+            self.expr(&f.k("mass"), &b.mass, &only_params)?;
+            self.expr(&f.k("inertia"), &b.inertia, &only_params)?;
+            self.expr(&f.k("position").i(0), &b.position[0], &kinematic)?;
+            self.expr(&f.k("position").i(1), &b.position[1], &kinematic)?;
+            self.expr(&f.k("angle"), &b.angle, &kinematic)?;
+        }
+        for (i, p) in s.points.iter().enumerate() {
+            let f = Field::key("points").i(i).k("position");
+            self.expr(&f.i(0), &p.position[0], &kinematic)?;
+            self.expr(&f.i(1), &p.position[1], &kinematic)?;
+        }
+        let bodies: BTreeSet<String> = s.bodies.iter().map(|b| b.name.clone()).collect();
+        for (i, f) in s.forces.iter().enumerate() {
+            let field = Field::key("forces").i(i);
+            if !bodies.contains(&f.body) {
+                return Err(self.err(
+                    &field.k("body"),
+                    format!("`{}` is not one of the bodies", f.body),
+                ));
+            }
+            self.unit(&field.k("direction"), f.direction)?;
+        }
+        if let Some(c) = &s.contact {
+            let field = Field::key("contact");
+            if !force_names.contains(&c.force) {
+                return Err(self.err(
+                    &field.k("force"),
+                    format!("`{}` is not one of the forces", c.force),
+                ));
+            }
+            for (key, name) in [("point", &c.point), ("surface", &c.surface)] {
+                if !point_names.contains(name) {
+                    return Err(
+                        self.err(&field.k(key), format!("`{name}` is not one of the points"))
+                    );
+                }
+            }
+            self.unit(&field.k("normal"), c.normal)?;
+        }
+        let mut monitor_scope = params.clone();
+        monitor_scope.insert(s.reduced.clone());
+        monitor_scope.extend(force_names.iter().cloned());
+        for (i, m) in s.monitors.iter().enumerate() {
+            self.expr(
+                &Field::key("monitors").i(i).k("expr"),
+                &m.expr,
+                &monitor_scope,
+            )?;
+        }
+        for c in &s.coordinates {
+            let Some(init) = s.initial.get(&c.name) else {
+                return Err(self.err(
+                    &Field::key("initial"),
+                    format!(
+                        "no initial position and velocity for coordinate `{}`",
+                        c.name
+                    ),
+                ));
+            };
+            let f = Field::key("initial").k(&c.name);
+            self.expr(&f.k("position"), &init.position, &only_params)?;
+            self.expr(&f.k("velocity"), &init.velocity, &only_params)?;
+        }
+        if let Some(extra) = s.initial.keys().find(|k| !coords.contains(*k)) {
+            return Err(self.err(
+                &Field::key("initial").k(extra),
+                format!("`{extra}` is not a coordinate"),
+            ));
+        }
+        if let Some(after) = &s.after_separation {
+            let f = Field::key("after_separation");
+            if !is_identifier(&after.model) {
+                return Err(self.err(
+                    &f.k("model"),
+                    format!("`{}` is not a plain identifier", after.model),
+                ));
+            }
+            if s.contact.is_none() {
+                return Err(self.err(&f, "a phase after separation needs a `contact`".into()));
+            }
+            for (k, v) in &after.parameters {
+                let point = |p: &str| point_names.contains(p);
+                let ok = params.contains(v)
+                    || coords.contains(v)
+                    || v.strip_suffix("_dot").is_some_and(|c| coords.contains(c))
+                    || v.split_once('.').is_some_and(|(p, axis)| {
+                        point(p) && ["x", "y", "x_dot", "y_dot"].contains(&axis)
+                    });
+                if !ok {
+                    return Err(self.err(
+                        &f.k("parameters").k(k),
+                        format!(
+                            "`{v}` is none of: a parameter, a coordinate, `<coordinate>_dot`, \
+                             `<point>.x`, `<point>.y`, `<point>.x_dot`, `<point>.y_dot`"
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn identifier(
+        &self,
+        field: &Field,
+        name: &str,
+        seen: &mut BTreeSet<String>,
+    ) -> Result<(), SpecError> {
+        if !is_identifier(name) {
+            return Err(self.err(field, format!("`{name}` is not a plain identifier")));
+        }
+        if let Some(p) = RESERVED_PREFIXES.iter().find(|p| name.starts_with(*p)) {
+            return Err(self.err(
+                field,
+                format!("`{name}`: names starting with `{p}` are reserved"),
+            ));
+        }
+        if FUNCTIONS.iter().any(|(f, _)| *f == name) || name == "pi" {
+            return Err(self.err(field, format!("`{name}` is the name of a function")));
+        }
+        if !seen.insert(name.to_string()) {
+            return Err(self.err(field, format!("`{name}` is declared twice")));
+        }
+        Ok(())
+    }
+
+    fn unit(&self, field: &Field, v: [f64; 2]) -> Result<(), SpecError> {
+        let n = (v[0] * v[0] + v[1] * v[1]).sqrt();
+        if !n.is_finite() || (n - 1.0).abs() > 1e-12 {
+            return Err(self.err(field, format!("[{}, {}] is not a unit vector", v[0], v[1])));
+        }
+        Ok(())
+    }
+
+    fn expr(
+        &self,
+        field: &Field,
+        text: &Text,
+        scope: &BTreeSet<String>,
+    ) -> Result<Expr, SpecError> {
+        let src = text.text();
+        let e = Expr::parse(&src).map_err(|e| {
+            self.err(
+                field,
+                format!(
+                    "cannot parse `{src}`: {} at character {}",
+                    e.message,
+                    e.offset + 1
+                ),
+            )
+        })?;
+        for (f, n) in e.functions() {
+            match FUNCTIONS.iter().find(|(name, _)| *name == f) {
+                None => return Err(self.err(field, format!("unknown function `{f}` in `{src}`"))),
+                Some((_, arity)) if *arity != n => {
+                    return Err(
+                        self.err(field, format!("`{f}` takes {arity} argument(s) in `{src}`"))
+                    );
+                }
+                _ => {}
+            }
+        }
+        if let Some(sym) = e.symbols().into_iter().find(|s| !scope.contains(s)) {
+            let allowed: Vec<&str> = scope.iter().map(String::as_str).collect();
+            return Err(self.err(
+                field,
+                format!(
+                    "undefined symbol `{sym}` in `{src}` (allowed here: {})",
+                    allowed.join(", ")
+                ),
+            ));
+        }
+        Ok(e)
+    }
+}
+
+/// Whether `s` is a plain ASCII identifier.
+pub fn is_identifier(s: &str) -> bool {
+    let mut chars = s.chars();
+    matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+}

@@ -1,0 +1,53 @@
+//! rodcube: a rod leaning on a cube (and models like it), derived symbolically and solved fast.
+//!
+//! The runtime half of the project: it consumes the model code that `rodcube derive` emitted
+//! into `generated/` and never depends on Symbolica.
+//!
+//! # Guide
+//!
+//! Every model in `generated/` implements [`model::Model`] and is listed by [`models::all`].
+//! The usual entry point is the planner, which computes what you ask for and nothing else:
+//!
+//! ```
+//! use rodcube::{models, plan::{self, Request}, quantity::Quantity};
+//!
+//! let model = models::find("rod_cube").expect("generated model");
+//! let request = Request::new(model, [("m1", 1.0), ("m2", 3.0), ("ell", 1.0), ("a", 0.25), ("g", 9.81)])
+//!     .with_want(&[Quantity::SeparationAngle, Quantity::SeparationTime]);
+//! let results = plan::run(&request)?;
+//! let theta_sep = results.results["separation_angle"].value;
+//! let t_sep = results.results["separation_time"].value;
+//! assert!((theta_sep.to_degrees() - 9.61).abs() < 0.005);
+//! assert!((t_sep - 0.1085).abs() < 5e-4);
+//! assert_eq!(results.work.integrand_evals > 0, true);
+//! # Ok::<(), rodcube::plan::PlanError>(())
+//! ```
+//!
+//! - [`plan`]: [`plan::Request`] → [`results::RunResults`] (scalars, series, checks, work).
+//! - [`system::System`]: a model with validated parameters and its prepared constants, for
+//!   calling the generated functions directly.
+//! - [`solve`]: the numerical building blocks (separation root, quadrature of the time
+//!   integral, θ(t) series, Dormand–Prince integration of the unreduced equations, phases,
+//!   checks), each with typed errors.
+//! - [`scene`] and [`report`]: YAML scenes and their table, JSON, CSV and SVG outputs, as used
+//!   by the `rodcube` command line.
+//!
+//! `examples/paper.rs` reproduces the paper's numbers; `examples/sweep_n.rs` sweeps the mass
+//! ratio. The derivation tool lives behind the cargo feature `derive` (it needs Symbolica).
+
+pub mod accuracy;
+#[cfg(feature = "derive")]
+pub mod derive;
+pub mod io;
+pub mod model;
+pub mod models;
+pub mod plan;
+pub mod quantity;
+pub mod reference;
+pub mod report;
+pub mod results;
+pub mod scene;
+pub mod solve;
+pub mod sweep;
+pub mod system;
+pub mod yaml_marks;

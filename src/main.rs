@@ -1,0 +1,313 @@
+//! The `rodcube` command line: run a scene (table or JSON on stdout; results.json, CSVs and SVG
+//! plots in the output directory) and list the models. Results go to stdout, diagnostics to
+//! stderr; every failure is a message with a non-zero exit status, never a panic.
+
+use clap::{Args, Parser, Subcommand};
+use rodcube::io::{OutDir, check_name};
+use rodcube::plan::{self, PlanError, Request};
+use rodcube::report;
+use rodcube::results::RunResults;
+use rodcube::scene::{Kind, Scene, SceneError};
+use rodcube::system::SystemError;
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+mod numerics_cli;
+
+/// Exit status: the computation failed.
+const EXIT_FAILED: u8 = 1;
+/// Exit status: the scene is invalid (clap uses 2 for a bad command line).
+const EXIT_SCENE: u8 = 3;
+/// Exit status: an output could not be written.
+const EXIT_OUTPUT: u8 = 4;
+
+const EXAMPLES: &str = "\
+Examples:
+  rodcube run                                # the paper's case: scenes/paper.yaml -> out/paper/
+  rodcube run scenes/hinged.yaml             # another scene -> out/hinged/
+  rodcube run scenes/paper.yaml --json > r.json
+  rodcube run my_scene.yaml --out /tmp/mine  # choose the output directory
+  rodcube models                             # models, their parameters and quantities
+
+Exit status: 0 success, 1 the computation failed, 2 bad command line,
+3 invalid scene (the message names file:line:column and the field),
+4 an output could not be written.";
+
+const RUN_HELP: &str = "\
+A scene is a YAML file:
+  model: rod_cube
+  parameters: {m1: 1.0, m2: 3.0, ell: 1.0, a: 0.25, g: 9.81}   # SI units
+  want: [separation_angle, separation_time, theta_series, contact_force_series, tip_trajectory]
+  tolerance: 1.0e-12        # relative, optional
+  samples: 1000             # points in each series, optional
+`rodcube models` lists each model's parameters and the quantities `want` may name.
+
+Examples:
+  rodcube run
+  rodcube run scenes/ladder.yaml --out out/ladder-test
+  rodcube run scenes/angle_only.yaml --json";
+
+#[derive(Parser)]
+#[command(
+    name = "rodcube",
+    version,
+    about = "A rod leaning on a cube, released from rest: separation angle and time, \
+             contact force, trajectories, and the physics checks the paper skips",
+    after_help = EXAMPLES
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Solve a scene: print a table (or JSON) and write results.json, CSVs and SVG plots
+    #[command(after_help = RUN_HELP)]
+    Run(RunArgs),
+    /// List the models with their parameters (name, unit, meaning) and the quantities they offer
+    Models,
+    /// Sweep the separation angle and time over a grid of (n, a/ell) or a CSV of points
+    #[command(after_help = numerics_cli::SWEEP_HELP)]
+    Sweep(numerics_cli::SweepArgs),
+    /// Compare every method against a high-precision reference: error, evaluations, time
+    #[command(after_help = numerics_cli::ACCURACY_HELP)]
+    Accuracy(numerics_cli::AccuracyArgs),
+    // ---- `derive` subcommand: exists only with the cargo feature `derive` -----------------
+    // LEAD: wire `Command::Derive` (below, in `main`) to `rodcube::derive::run(...)` and put
+    // its arguments in `DeriveArgs`. Nothing else in this file depends on the feature.
+    /// Derive the models from derivations/*.yaml into generated/ (feature `derive`)
+    #[cfg(feature = "derive")]
+    Derive(DeriveArgs),
+}
+
+/// Arguments of `rodcube derive`.
+#[cfg(feature = "derive")]
+#[derive(Args)]
+struct DeriveArgs {
+    /// Specs to derive (default: every derivations/*.yaml)
+    specs: Vec<PathBuf>,
+    /// Write nothing; exit non-zero naming the files that regenerating would change
+    #[arg(long)]
+    check: bool,
+    /// Overwrite generated files even where they were edited by hand
+    #[arg(long)]
+    force: bool,
+}
+
+#[derive(Args)]
+struct RunArgs {
+    /// Scene file (YAML)
+    #[arg(default_value = "scenes/paper.yaml")]
+    scene: PathBuf,
+    /// Print results.json on stdout instead of the table
+    #[arg(long)]
+    json: bool,
+    /// Output directory [default: out/<scene stem>/]
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+}
+
+/// Why a command failed; each kind has its exit status.
+enum Failure {
+    /// The scene is invalid (or the planner found its parameters inconsistent).
+    Scene(SceneError),
+    /// The computation failed.
+    Solve(anyhow::Error),
+    /// An output could not be written.
+    Output(anyhow::Error),
+    /// A model spec is invalid (its message names file, line, column and field).
+    #[cfg(feature = "derive")]
+    Invalid(anyhow::Error),
+}
+
+impl Failure {
+    fn report(&self) -> ExitCode {
+        match self {
+            Failure::Scene(e) => {
+                note(&e.to_string());
+                ExitCode::from(EXIT_SCENE)
+            }
+            Failure::Solve(e) => {
+                note(&format!("error: {e:#}"));
+                ExitCode::from(EXIT_FAILED)
+            }
+            Failure::Output(e) => {
+                note(&format!("error: {e:#}"));
+                ExitCode::from(EXIT_OUTPUT)
+            }
+            #[cfg(feature = "derive")]
+            Failure::Invalid(e) => {
+                note(&format!("error: {e:#}"));
+                ExitCode::from(EXIT_SCENE)
+            }
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let outcome = match cli.command {
+        Command::Run(args) => run(args),
+        Command::Models => models(),
+        Command::Sweep(args) => numerics_cli::sweep(args),
+        Command::Accuracy(args) => numerics_cli::accuracy(args),
+        #[cfg(feature = "derive")]
+        Command::Derive(args) => derive(args),
+    };
+    match outcome {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(f) => f.report(),
+    }
+}
+
+/// `rodcube derive`: regenerate `generated/` (or check that it is fresh).
+#[cfg(feature = "derive")]
+fn derive(args: DeriveArgs) -> Result<(), Failure> {
+    use rodcube::derive::{Error, Options, run};
+    let opts = Options {
+        root: PathBuf::from("."),
+        specs: args.specs,
+        check: args.check,
+        force: args.force,
+    };
+    match run(&opts) {
+        Ok(outcome) => {
+            for (model, took) in &outcome.timings {
+                note(&format!(
+                    "derived {model} in {:.1} ms",
+                    took.as_secs_f64() * 1e3
+                ));
+            }
+            for f in &outcome.written {
+                note(&format!("wrote {}", f.display()));
+            }
+            if !outcome.stale.is_empty() {
+                let list: Vec<String> = outcome
+                    .stale
+                    .iter()
+                    .map(|p| p.display().to_string())
+                    .collect();
+                return Err(Failure::Solve(anyhow::anyhow!(
+                    "generated files are stale: {}; run `{}` and commit the result",
+                    list.join(", "),
+                    rodcube::derive::emit::COMMAND
+                )));
+            }
+            note(&format!(
+                "{} files up to date",
+                outcome.unchanged.len() + outcome.written.len()
+            ));
+            Ok(())
+        }
+        Err(Error::Spec(e)) => Err(Failure::Invalid(anyhow::anyhow!("{e}"))),
+        Err(e) => Err(Failure::Solve(anyhow::anyhow!("{e}"))),
+    }
+}
+
+/// `rodcube run`.
+fn run(args: RunArgs) -> Result<(), Failure> {
+    let scene = Scene::load(&args.scene).map_err(Failure::Scene)?;
+    let out_dir = match args.out {
+        Some(dir) => dir,
+        None => default_out_dir(&scene)?,
+    };
+    // Before solving, so an unwritable output fails at once.
+    let out = OutDir::create(&out_dir).map_err(|e| Failure::Output(e.into()))?;
+    let results = solve(&scene)?;
+    let text = if args.json {
+        report::json::to_string(&results).map_err(|e| Failure::Output(e.into()))?
+    } else {
+        report::table::render(&results, Some(scene.info()))
+    };
+    // Write the files first, print the results either way, then report a write failure.
+    let written = report::write_all(&out, &results);
+    print_stdout(&text)?;
+    match written {
+        Ok(paths) => {
+            note(&format!(
+                "wrote {} files to {}",
+                paths.len(),
+                out_dir.display()
+            ));
+            Ok(())
+        }
+        Err(e) => Err(Failure::Output(
+            anyhow::Error::from(e).context("the results were not all saved"),
+        )),
+    }
+}
+
+/// `out/<scene stem>/`, if the stem is a plain name.
+fn default_out_dir(scene: &Scene) -> Result<PathBuf, Failure> {
+    let stem = scene.stem().unwrap_or("");
+    check_name(stem).map_err(|e| {
+        Failure::Output(
+            anyhow::Error::from(e)
+                .context("cannot name the output directory after the scene; pass --out DIR"),
+        )
+    })?;
+    Ok(PathBuf::from("out").join(stem))
+}
+
+/// The one call into the planner ([`rodcube::plan::run`]).
+fn solve(scene: &Scene) -> Result<RunResults, Failure> {
+    let request = Request::new(scene.model, scene.parameters.clone())
+        .with_want(&scene.want)
+        .with_tolerance(scene.tolerance)
+        .with_samples(scene.samples);
+    plan::run(&request).map_err(|e| planner_failure(scene, e))
+}
+
+/// A planner error as a failure. The scene was validated against the same rules, so these
+/// are rare; those about the scene's own values are placed at their field in the file.
+fn planner_failure(scene: &Scene, error: PlanError) -> Failure {
+    let message = error.to_string();
+    let at = |field: String, kind| Failure::Scene(scene.error_at(&field, kind, message.clone()));
+    match &error {
+        PlanError::System(SystemError::Requirement { name, meaning, .. }) => {
+            Failure::Scene(scene.requirement_error(name, meaning, message))
+        }
+        PlanError::System(SystemError::NotFinite { name, .. }) => {
+            at(format!("parameters.{name}"), Kind::NotFinite)
+        }
+        PlanError::System(SystemError::NotPositive { name, .. }) => {
+            at(format!("parameters.{name}"), Kind::NotPositive)
+        }
+        PlanError::System(SystemError::MissingParameter { name, .. }) => {
+            at(format!("parameters.{name}"), Kind::MissingParameter)
+        }
+        PlanError::System(SystemError::UnknownParameter { name, .. }) => {
+            at(format!("parameters.{name}"), Kind::UnknownParameter)
+        }
+        PlanError::Unavailable { .. } => at("want".into(), Kind::UnavailableQuantity),
+        PlanError::BadTolerance { .. } => at("tolerance".into(), Kind::OutOfRange),
+        PlanError::TooFewSamples { .. } => at("samples".into(), Kind::OutOfRange),
+        _ => Failure::Solve(
+            anyhow::Error::from(error).context(format!("solving {} failed", scene.file.display())),
+        ),
+    }
+}
+
+/// `rodcube models`.
+fn models() -> Result<(), Failure> {
+    let infos: Vec<_> = rodcube::models::all().iter().map(|m| m.info()).collect();
+    print_stdout(&report::table::models(&infos))
+}
+
+/// A diagnostic line on stderr (ignoring a closed stderr rather than panicking like `eprintln!`).
+fn note(message: &str) {
+    let _ = writeln!(std::io::stderr().lock(), "{message}");
+}
+
+/// Writes to stdout; a closed pipe (`rodcube run | head`) is not an error.
+fn print_stdout(text: &str) -> Result<(), Failure> {
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(Failure::Output(
+            anyhow::Error::from(e).context("cannot write to stdout"),
+        )),
+        _ => Ok(()),
+    }
+}

@@ -1,0 +1,211 @@
+//! The contract between generated model code (`generated/*.rs`) and the runtime solvers.
+//!
+//! A model is a planar mechanical system with one *reduced* coordinate `theta` (the rod's angle
+//! to the floor) left after the cyclic coordinates were eliminated through their conserved
+//! momenta. Every function here is emitted by `rodcube derive` from a spec in
+//! `derivations/*.yaml`; the runtime never knows which model it is driving.
+//!
+//! # Conventions
+//! - `p`: parameter values in the order of [`ModelInfo::parameters`] (SI units).
+//! - `k`: the *prepared constants* returned by [`Model::prepare`]. `k[..n_params]` is `p`;
+//!   `k[ModelInfo::k_theta_initial]` is the initial angle and `k[ModelInfo::k_theta_dot_initial]`
+//!   its rate; the rest are parameter-only subexpressions hoisted out of the per-point functions.
+//! - `delta`: the angle fallen since the start, `delta = theta_initial - theta >= 0`. The reduced
+//!   functions take `delta` rather than `theta` so that `sin(theta_i) - sin(theta)` is formed
+//!   without cancellation near the start, where the energy integral vanishes.
+//! - `q`, `qd`, `qdd`: the full (unreduced) coordinates, velocities and accelerations in the order
+//!   of [`ModelInfo::coordinates`].
+//! - Forces are in newtons, positive in the sense documented by each force's [`NamedInfo`] in [`ModelInfo::forces`].
+
+/// A model parameter as declared in its spec.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ParamInfo {
+    /// Symbol used in the spec and in scenes (`m1`, `ell`, ...).
+    pub name: &'static str,
+    /// What it is, for people.
+    pub meaning: &'static str,
+    /// SI unit (`kg`, `m`, `m/s^2`, `rad`, ...).
+    pub unit: &'static str,
+    /// Whether the value must be strictly positive (masses, lengths, gravity).
+    pub positive: bool,
+}
+
+/// A named quantity emitted by the generator (force, point, monitor or requirement).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct NamedInfo {
+    /// Identifier used in results, CSV columns and JSON keys.
+    pub name: &'static str,
+    /// What it means, for people (sign conventions included).
+    pub meaning: &'static str,
+}
+
+/// The contact whose force vanishing means separation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactInfo {
+    /// Index into [`ModelInfo::forces`] of the contact force (positive while touching).
+    pub force: usize,
+    /// Index into [`ModelInfo::points`] of the pushing point (the rod's tip).
+    pub point: usize,
+    /// Index into [`ModelInfo::points`] of a point on the pushed surface.
+    pub surface: usize,
+    /// Unit normal of the pushed surface, pointing from the pusher into the pushed body.
+    pub normal: [f64; 2],
+    /// Whether the pushed surface belongs to a moving body (a cube) rather than a fixed wall.
+    /// After separation a moving surface keeps the velocity it had at separation.
+    pub surface_moves: bool,
+}
+
+/// Where a value passed to the next phase comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Binding {
+    /// A parameter of this model, by index.
+    Param(usize),
+    /// A coordinate of this model at the end of the phase, by index.
+    Coordinate(usize),
+    /// A velocity of this model at the end of the phase, by index.
+    Velocity(usize),
+    /// A coordinate (`axis` 0 = x, 1 = y) of a named point at the end of the phase.
+    Point { index: usize, axis: usize },
+    /// A velocity component of a named point at the end of the phase.
+    PointVelocity { index: usize, axis: usize },
+}
+
+/// The model that continues the motion after separation (e.g. the rod sliding freely).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct NextPhase {
+    /// Name of the next model in the registry.
+    pub model: &'static str,
+    /// One binding per parameter of the next model, in its parameter order.
+    pub bindings: &'static [Binding],
+}
+
+/// Static description of a generated model.
+#[derive(Debug, Clone, Copy)]
+pub struct ModelInfo {
+    /// Model name (a plain identifier; also the stem of its generated files).
+    pub name: &'static str,
+    /// One-line description from the spec.
+    pub description: &'static str,
+    /// Spec file the model was derived from, relative to the project root.
+    pub spec: &'static str,
+    /// Parameters in the order every function expects them.
+    pub parameters: &'static [ParamInfo],
+    /// Requirements on the parameters, each a margin that must be strictly positive.
+    pub requirements: &'static [NamedInfo],
+    /// Length of the prepared-constant vector `k`.
+    pub n_constants: usize,
+    /// Index in `k` of the initial reduced angle `theta_i`.
+    pub k_theta_initial: usize,
+    /// Index in `k` of the initial reduced rate `theta_dot_i`.
+    pub k_theta_dot_initial: usize,
+    /// Generalized coordinates of the unreduced system.
+    pub coordinates: &'static [&'static str],
+    /// Index in `coordinates` of the reduced coordinate (`theta`).
+    pub reduced: usize,
+    /// Indices in `coordinates` of the cyclic coordinates eliminated by conserved momenta.
+    pub cyclic: &'static [usize],
+    /// The angle at which the motion ends (the rod lies on the floor), in radians.
+    pub end_angle: f64,
+    /// Reaction forces evaluated along the motion (the contact force among them).
+    pub forces: &'static [NamedInfo],
+    /// The separating contact, if the model has one.
+    pub contact: Option<ContactInfo>,
+    /// Degree of the separation polynomial in `sin(theta)` (0 without a contact).
+    pub separation_degree: usize,
+    /// Named points whose trajectories can be asked for.
+    pub points: &'static [NamedInfo],
+    /// Index in `points` of the centre of mass whose free fall is the reference time.
+    pub falling_point: usize,
+    /// Index in `parameters` of the gravitational acceleration.
+    pub gravity: usize,
+    /// Physical assumptions to monitor; each value must stay `>= 0` during the motion.
+    pub monitors: &'static [NamedInfo],
+    /// The phase that follows separation, if any.
+    pub next_phase: Option<NextPhase>,
+}
+
+/// Evaluation functions of one generated model. All are allocation-free and evaluate each
+/// shared subexpression once per call.
+pub trait Model: Send + Sync {
+    /// Static description.
+    fn info(&self) -> &'static ModelInfo;
+
+    /// Requirement margins from the parameters alone (each must be `> 0`), in the order of
+    /// [`ModelInfo::requirements`]. `out.len()` must equal that list's length.
+    fn requirements(&self, p: &[f64], out: &mut [f64]);
+
+    /// Prepared constants for a parameter set: `k.len()` must be [`ModelInfo::n_constants`].
+    /// Call only after [`Model::requirements`] passed.
+    fn prepare(&self, p: &[f64], k: &mut [f64]);
+
+    /// Reduced state at `delta`: returns `(sin theta, cos theta, theta_dot^2, theta_ddot)`.
+    fn reduced(&self, k: &[f64], delta: f64) -> Reduced;
+
+    /// Reaction forces at `delta` along the reduced motion, in the order of [`ModelInfo::forces`].
+    fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]);
+
+    /// Monitor values at `delta` (each must stay `>= 0`), in the order of [`ModelInfo::monitors`].
+    fn monitors(&self, k: &[f64], delta: f64, out: &mut [f64]);
+
+    /// Coefficients of the separation polynomial in `s = sin(theta)`, lowest degree first
+    /// (`out.len() == separation_degree + 1`). Its root in `(0, sin theta_i)` is the separation.
+    fn separation_polynomial(&self, k: &[f64], out: &mut [f64]);
+
+    /// The full state on the reduced motion at time `t`, angle fallen `delta` and rate
+    /// `theta_dot` (negative while falling): fills `q` and `qd`.
+    fn full_state(
+        &self,
+        k: &[f64],
+        t: f64,
+        delta: f64,
+        theta_dot: f64,
+        q: &mut [f64],
+        qd: &mut [f64],
+    );
+
+    /// Positions and velocities of the named points for a full state.
+    fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]);
+
+    /// Total energy (kinetic plus potential) of a full state.
+    fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64;
+
+    /// Momenta conjugate to the cyclic coordinates, in the order of [`ModelInfo::cyclic`].
+    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]);
+
+    /// The unreduced Euler–Lagrange equations `M(q) qdd = F(q, qd)`: `mass` is row-major
+    /// `n x n`, `rhs` has length `n`, with `n` the number of coordinates.
+    fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]);
+
+    /// The reaction forces of [`ModelInfo::forces`] from an unreduced state and acceleration.
+    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]);
+}
+
+/// The reduced state at one angle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Reduced {
+    /// `sin(theta)`.
+    pub sin: f64,
+    /// `cos(theta)`.
+    pub cos: f64,
+    /// `theta_dot^2` from the energy integral (eq. 9 for the paper's model).
+    pub theta_dot_sq: f64,
+    /// `theta_ddot = (1/2) d(theta_dot^2)/d(theta)`.
+    pub theta_ddot: f64,
+}
+
+/// `(sin theta, cos theta, sin theta_i - sin theta, cos theta_i - cos theta)` at
+/// `theta = theta_i - delta`. `sin` and `cos` come from the angle itself (full relative
+/// accuracy down to the floor); the two differences are formed without cancellation as
+/// `sin theta_i - sin theta = sin theta_i (1 - cos delta) + cos theta_i sin delta` and
+/// `cos theta_i - cos theta = cos theta_i (1 - cos delta) - sin theta_i sin delta`, with
+/// `1 - cos delta = 2 sin^2(delta/2)`.
+#[inline]
+pub fn start_offsets(theta_i: f64, sin_i: f64, cos_i: f64, delta: f64) -> (f64, f64, f64, f64) {
+    let (sh, ch) = (0.5 * delta).sin_cos();
+    let sin_delta = 2.0 * sh * ch;
+    let vers = 2.0 * sh * sh;
+    let ds = sin_i * vers + cos_i * sin_delta;
+    let dc = cos_i * vers - sin_i * sin_delta;
+    let (s, c) = (theta_i - delta).sin_cos();
+    (s, c, ds, dc)
+}

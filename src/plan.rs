@@ -1,0 +1,784 @@
+//! The planner: turns a [`Request`] (model, parameters, wanted quantities) into [`RunResults`],
+//! computing each wanted quantity and its prerequisites and nothing else.
+//!
+//! Prerequisites, computed at most once each (lazily, through [`Plan`]'s caches):
+//! - `separation_angle`: the separation root (polynomial evaluations only);
+//! - `linearised_separation_angle`: the polynomial's two lowest coefficients (no evaluation);
+//! - `separation_time`: root + quadrature of the first phase;
+//! - `contact_time_to_floor`: quadrature to the end angle, keeping contact (no root);
+//! - `point_mass_fall_time`: the release state only;
+//! - `theta_series`, `<force>_series`, `<point>_trajectory`: root + quadrature + inversion at
+//!   `samples` uniform times over the first phase (release to separation, or to the floor);
+//! - `floor_impact`: the first phase and every next phase down to the floor;
+//! - `cross_check`: the first phase's quadrature and the unreduced ODE to the separation event;
+//! - `checks`: the sampled motion of every phase down to the floor (monitors, no recatch,
+//!   energy and momentum drift of each reduced path), plus the ODE path when `cross_check` is
+//!   also wanted.
+//!
+//! Result keys (SI units): `separation_angle`, `linearised_separation_angle` (rad);
+//! `separation_time`, `contact_time_to_floor`, `point_mass_fall_time`, `floor_impact_time` (s);
+//! `impact_angular_velocity` (rad/s); `surface_final_speed` (m/s); `cross_check_time` (s, the
+//! ODE's event time), `cross_check_relative_difference` (1, against the quadrature),
+//! `cross_check_time_deviation` (s, largest `|t_ode - t(theta_ode)|` over the ODE's steps),
+//! `cross_check_state_deviation` (1, largest relative difference between the ODE state and the
+//! reduced state at the same angle), `cross_check_rtol` (1, the ODE's tolerance after the
+//! conditioning floor of [`unreduced::CONDITION_SAFETY`]). Series: `theta_series` (`t, theta, theta_dot,
+//! theta_ddot`), `<force>_series` (`t, theta, <force>`), `<point>_trajectory`
+//! (`t, x, y, vx, vy`). A wanted quantity without a value (e.g. no separation, or a mass matrix
+//! too ill-conditioned for the cross-check) is explained in [`RunResults::notes`] under its key.
+
+use crate::model::Model;
+use crate::quantity::Quantity;
+use crate::results::{Check, Column, RunResults, Scalar, Series, Work};
+use crate::solve::SolveError;
+use crate::solve::checks;
+use crate::solve::phases::{Motion, PhaseRun, extend_to_floor, phase_end};
+use crate::solve::quadrature::TimeMesh;
+use crate::solve::separation::{Separation, SeparationOutcome, linearised_separation};
+use crate::solve::series::{PhaseSamples, sample_phase, theta_dot_at};
+use crate::solve::unreduced::{self, EndEvent, UnreducedRun};
+use crate::system::{System, SystemError};
+use std::collections::BTreeMap;
+
+/// Relative tolerance when a request gives none.
+pub const DEFAULT_TOLERANCE: f64 = 1e-10;
+/// Points per series when a request gives none.
+pub const DEFAULT_SAMPLES: usize = 500;
+/// Accepted relative tolerances (inclusive).
+pub const TOLERANCE_RANGE: (f64, f64) = (1e-14, 1e-2);
+/// The unreduced ODE is run at `tolerance * ODE_RTOL_FACTOR`, but never tighter than
+/// [`ODE_RTOL_FLOOR`] (below it DOPRI5's rounding dominates).
+pub const ODE_RTOL_FACTOR: f64 = 0.1;
+/// Tightest relative tolerance given to the ODE integrator.
+pub const ODE_RTOL_FLOOR: f64 = 1e-13;
+
+/// Parameter values for a request: in the model's order, or by name.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Parameters {
+    /// In the order of [`ModelInfo::parameters`](crate::model::ModelInfo::parameters).
+    Values(Vec<f64>),
+    /// By name, any order.
+    Named(Vec<(String, f64)>),
+}
+
+impl From<Vec<f64>> for Parameters {
+    fn from(v: Vec<f64>) -> Self {
+        Parameters::Values(v)
+    }
+}
+
+impl From<&[(&str, f64)]> for Parameters {
+    fn from(v: &[(&str, f64)]) -> Self {
+        Parameters::Named(v.iter().map(|(k, v)| (k.to_string(), *v)).collect())
+    }
+}
+
+impl<const N: usize> From<[(&str, f64); N]> for Parameters {
+    fn from(v: [(&str, f64); N]) -> Self {
+        Parameters::from(&v[..])
+    }
+}
+
+impl From<&BTreeMap<String, f64>> for Parameters {
+    fn from(v: &BTreeMap<String, f64>) -> Self {
+        Parameters::Named(v.iter().map(|(k, v)| (k.clone(), *v)).collect())
+    }
+}
+
+/// What to compute.
+#[derive(Clone)]
+pub struct Request<'m> {
+    /// The model of the first phase.
+    pub model: &'m dyn Model,
+    /// Its parameters.
+    pub parameters: Parameters,
+    /// The quantities wanted (duplicates are ignored).
+    pub want: Vec<Quantity>,
+    /// Relative tolerance of every numerical result (and of the drift checks).
+    pub tolerance: f64,
+    /// Points per series.
+    pub samples: usize,
+    /// Where next phases are looked up by name (default: [`crate::models::all`]).
+    pub registry: &'m [&'m dyn Model],
+}
+
+impl<'m> Request<'m> {
+    /// A request with the default tolerance, samples and registry, wanting nothing yet.
+    pub fn new(model: &'m dyn Model, parameters: impl Into<Parameters>) -> Self {
+        Request {
+            model,
+            parameters: parameters.into(),
+            want: Vec::new(),
+            tolerance: DEFAULT_TOLERANCE,
+            samples: DEFAULT_SAMPLES,
+            registry: crate::models::all(),
+        }
+    }
+
+    /// A request for a model found by name in `registry`.
+    pub fn by_name(
+        name: &str,
+        parameters: impl Into<Parameters>,
+        registry: &'m [&'m dyn Model],
+    ) -> Result<Self, PlanError> {
+        let model = registry
+            .iter()
+            .copied()
+            .find(|m| m.info().name == name)
+            .ok_or_else(|| PlanError::UnknownModel {
+                name: name.to_string(),
+            })?;
+        Ok(Request::new(model, parameters).with_registry(registry))
+    }
+
+    /// Sets the wanted quantities.
+    pub fn with_want(mut self, want: &[Quantity]) -> Self {
+        self.want = want.to_vec();
+        self
+    }
+
+    /// Sets the tolerance.
+    pub fn with_tolerance(mut self, tolerance: f64) -> Self {
+        self.tolerance = tolerance;
+        self
+    }
+
+    /// Sets the points per series.
+    pub fn with_samples(mut self, samples: usize) -> Self {
+        self.samples = samples;
+        self
+    }
+
+    /// Sets the registry for next phases.
+    pub fn with_registry(mut self, registry: &'m [&'m dyn Model]) -> Self {
+        self.registry = registry;
+        self
+    }
+}
+
+/// Why a request could not be run.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PlanError {
+    /// No model of that name.
+    #[error("no model `{name}` in the registry")]
+    UnknownModel {
+        /// The name asked.
+        name: String,
+    },
+    /// The model cannot provide a wanted quantity.
+    #[error("model `{model}` cannot provide `{quantity}` (it offers: {offers})")]
+    Unavailable {
+        /// The quantity's key.
+        quantity: String,
+        /// Model name.
+        model: &'static str,
+        /// What it offers, comma-separated.
+        offers: String,
+    },
+    /// Tolerance outside [`TOLERANCE_RANGE`].
+    #[error("tolerance {tolerance:e} is outside [{:e}, {:e}]", TOLERANCE_RANGE.0, TOLERANCE_RANGE.1)]
+    BadTolerance {
+        /// The tolerance given.
+        tolerance: f64,
+    },
+    /// Fewer than 2 samples while a series or check is wanted.
+    #[error("{samples} samples asked; series and checks need at least 2")]
+    TooFewSamples {
+        /// The samples given.
+        samples: usize,
+    },
+    /// The parameters were refused.
+    #[error(transparent)]
+    System(#[from] SystemError),
+    /// A solver failed.
+    #[error(transparent)]
+    Solve(#[from] SolveError),
+    /// A result came out NaN or infinite (a model function misbehaving).
+    #[error(
+        "result `{key}` is {value} (sample {index}): a model function returned a non-finite value"
+    )]
+    NonFinite {
+        /// The result key, or `<series>.<column>`.
+        key: String,
+        /// The sample index within a series (0 for a scalar).
+        index: usize,
+        /// The value.
+        value: f64,
+    },
+}
+
+/// Runs a request.
+pub fn run(request: &Request) -> Result<RunResults, PlanError> {
+    let info = request.model.info();
+    let mut want: Vec<Quantity> = Vec::new();
+    for q in &request.want {
+        if !q.available(info) {
+            return Err(PlanError::Unavailable {
+                quantity: q.name(info),
+                model: info.name,
+                offers: Quantity::names(info).join(", "),
+            });
+        }
+        if !want.contains(q) {
+            want.push(*q);
+        }
+    }
+    let tol = request.tolerance;
+    if !(tol >= TOLERANCE_RANGE.0 && tol <= TOLERANCE_RANGE.1) {
+        return Err(PlanError::BadTolerance { tolerance: tol });
+    }
+    let needs_samples = want.iter().any(|q| {
+        matches!(
+            q,
+            Quantity::ThetaSeries
+                | Quantity::ForceSeries(_)
+                | Quantity::Trajectory(_)
+                | Quantity::Checks
+        )
+    });
+    if needs_samples && request.samples < 2 {
+        return Err(PlanError::TooFewSamples {
+            samples: request.samples,
+        });
+    }
+    let sys = match &request.parameters {
+        Parameters::Values(v) => System::from_values(request.model, v)?,
+        Parameters::Named(v) => System::new(request.model, v)?,
+    };
+    let mut plan = Plan::new(sys, request.registry, tol, request.samples);
+    let mut out = RunResults {
+        model: info.name.to_string(),
+        parameters: plan.sys.parameter_map(),
+        ..RunResults::default()
+    };
+    // The ODE first, so that `checks` can include its path when both are wanted.
+    want.sort_by_key(|q| matches!(q, Quantity::Checks));
+    for q in &want {
+        plan.quantity(*q, &want, &mut out)?;
+    }
+    out.work = plan.work;
+    check_finite(&out)?;
+    Ok(out)
+}
+
+/// Refuses a result with a NaN or an infinity (a model function misbehaving), naming it.
+fn check_finite(out: &RunResults) -> Result<(), PlanError> {
+    for (key, s) in &out.results {
+        if !s.value.is_finite() {
+            return Err(PlanError::NonFinite {
+                key: key.clone(),
+                index: 0,
+                value: s.value,
+            });
+        }
+    }
+    for (key, series) in &out.series {
+        for c in &series.columns {
+            if let Some((index, &value)) = c.values.iter().enumerate().find(|(_, v)| !v.is_finite())
+            {
+                let key = format!("{key}.{}", c.name);
+                return Err(PlanError::NonFinite { key, index, value });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Caches of one run: each prerequisite is computed at most once, only when asked for.
+struct Plan<'m> {
+    sys: System<'m>,
+    registry: &'m [&'m dyn Model],
+    tol: f64,
+    samples: usize,
+    work: Work,
+    end: Option<(Option<Separation>, f64)>,
+    motion: Option<Motion<'m>>,
+    complete: bool,
+    floor_mesh: Option<TimeMesh>,
+    phase_samples: Vec<PhaseSamples>,
+    ode: Option<UnreducedRun>,
+}
+
+fn scalar(out: &mut RunResults, key: &str, value: f64, unit: &'static str, meaning: String) {
+    out.results.insert(
+        key.to_string(),
+        Scalar {
+            value,
+            unit,
+            meaning,
+        },
+    );
+}
+
+fn column(name: &str, unit: &'static str, values: Vec<f64>) -> Column {
+    Column {
+        name: name.to_string(),
+        unit,
+        values,
+    }
+}
+
+const NO_SEPARATION: &str = "no separation before the floor: the contact holds all the way down";
+
+impl<'m> Plan<'m> {
+    fn new(sys: System<'m>, registry: &'m [&'m dyn Model], tol: f64, samples: usize) -> Self {
+        Plan {
+            sys,
+            registry,
+            tol,
+            samples,
+            work: Work::default(),
+            end: None,
+            motion: None,
+            complete: false,
+            floor_mesh: None,
+            phase_samples: Vec::new(),
+            ode: None,
+        }
+    }
+
+    /// Where the first phase ends (separation root only).
+    fn end(&mut self) -> Result<(Option<Separation>, f64), SolveError> {
+        if let Some(end) = self.end {
+            return Ok(end);
+        }
+        let end = phase_end(&self.sys, &mut self.work)?;
+        self.end = Some(end);
+        Ok(end)
+    }
+
+    /// The motion with at least its first phase solved (root + quadrature). A first phase that
+    /// keeps contact to the floor reuses the contact-to-floor integral if it exists.
+    fn motion(&mut self) -> Result<&mut Motion<'m>, SolveError> {
+        let motion = match self.motion.take() {
+            Some(m) => m,
+            None => {
+                let (separation, delta_end) = self.end()?;
+                let run = match (&separation, &self.floor_mesh) {
+                    (None, Some(mesh)) => {
+                        self.work.phases.push(self.sys.name().to_string());
+                        PhaseRun {
+                            system: self.sys.clone(),
+                            t_start: 0.0,
+                            separation,
+                            mesh: mesh.clone(),
+                        }
+                    }
+                    _ => PhaseRun::with_end(
+                        self.sys.clone(),
+                        0.0,
+                        separation,
+                        delta_end,
+                        self.tol,
+                        &mut self.work,
+                    )?,
+                };
+                Motion::new(run)
+            }
+        };
+        Ok(self.motion.insert(motion))
+    }
+
+    /// The first phase solved to its end.
+    fn first(&mut self) -> Result<&PhaseRun<'m>, SolveError> {
+        Ok(&self.motion()?.phases[0])
+    }
+
+    /// Every phase down to the floor.
+    fn complete(&mut self) -> Result<&Motion<'m>, SolveError> {
+        self.motion()?;
+        if !self.complete {
+            if let Some(motion) = self.motion.as_mut() {
+                extend_to_floor(motion, self.registry, self.tol, &mut self.work)?;
+            }
+            self.complete = true;
+        }
+        Ok(self.motion()?)
+    }
+
+    /// Samples of the solved phases up to `i` (each sampled once).
+    fn samples_of(&mut self, i: usize) -> Result<&PhaseSamples, SolveError> {
+        self.motion()?;
+        if let Some(motion) = self.motion.as_ref() {
+            while self.phase_samples.len() <= i {
+                let Some(run) = motion.phases.get(self.phase_samples.len()) else {
+                    break;
+                };
+                let s = sample_phase(&run.system, &run.mesh, self.samples, &mut self.work)?;
+                self.phase_samples.push(s);
+            }
+        }
+        self.phase_samples
+            .get(i)
+            .ok_or(SolveError::TooManyPhases { limit: i })
+    }
+
+    fn first_samples(&mut self) -> Result<&PhaseSamples, SolveError> {
+        self.samples_of(0)
+    }
+
+    /// `t` to the floor keeping contact: the first phase itself when it does not separate.
+    fn floor_mesh(&mut self) -> Result<&TimeMesh, SolveError> {
+        let mesh = match self.floor_mesh.take() {
+            Some(mesh) => mesh,
+            None => match (&self.end, &self.motion) {
+                (Some((None, _)), Some(m)) => m.phases[0].mesh.clone(),
+                _ => TimeMesh::build(
+                    &self.sys,
+                    self.sys.delta_to_floor(),
+                    self.tol,
+                    &mut self.work,
+                )?,
+            },
+        };
+        Ok(self.floor_mesh.insert(mesh))
+    }
+
+    /// Relative tolerance given to the ODE integrator.
+    fn ode_rtol(&self) -> f64 {
+        (self.tol * ODE_RTOL_FACTOR).max(ODE_RTOL_FLOOR)
+    }
+
+    /// The unreduced ODE to the first phase's end event.
+    fn ode(&mut self) -> Result<&UnreducedRun, SolveError> {
+        let run = match self.ode.take() {
+            Some(run) => run,
+            None => {
+                let rtol = self.ode_rtol();
+                let duration = self.first()?.duration();
+                unreduced::integrate(&self.sys, rtol, None, 2.0 * duration, &mut self.work)?
+            }
+        };
+        Ok(self.ode.insert(run))
+    }
+
+    fn quantity(
+        &mut self,
+        q: Quantity,
+        want: &[Quantity],
+        out: &mut RunResults,
+    ) -> Result<(), SolveError> {
+        let info = self.sys.info();
+        let key = q.name(info);
+        match q {
+            Quantity::SeparationAngle => match self.end()?.0 {
+                Some(s) => scalar(
+                    out,
+                    &key,
+                    s.theta,
+                    "rad",
+                    "angle to the floor where the contact force vanishes".into(),
+                ),
+                None => {
+                    out.notes.insert(key, NO_SEPARATION.into());
+                }
+            },
+            Quantity::LinearisedSeparationAngle => match linearised_separation(&self.sys)? {
+                SeparationOutcome::Separates(s) => scalar(
+                    out,
+                    &key,
+                    s.theta,
+                    "rad",
+                    "separation angle with the polynomial's terms above degree 1 dropped".into(),
+                ),
+                SeparationOutcome::NoSeparationBeforeFloor => {
+                    out.notes.insert(
+                        key,
+                        "the linearised polynomial has no root between the floor and the start"
+                            .into(),
+                    );
+                }
+            },
+            Quantity::SeparationTime => {
+                if self.end()?.0.is_none() {
+                    out.notes.insert(key, NO_SEPARATION.into());
+                } else {
+                    let t = self.first()?.duration();
+                    scalar(
+                        out,
+                        &key,
+                        t,
+                        "s",
+                        "time from release to separation (eq. 15)".into(),
+                    );
+                }
+            }
+            Quantity::ContactTimeToFloor => {
+                let t = self.floor_mesh()?.duration;
+                scalar(
+                    out,
+                    &key,
+                    t,
+                    "s",
+                    "time to the floor if contact were kept all the way (eq. 10)".into(),
+                );
+            }
+            Quantity::PointMassFallTime => {
+                let pts = self.sys.points(&self.sys.initial_state());
+                let h = pts.pos[info.falling_point][1];
+                let g = self.sys.gravity();
+                if h > 0.0 {
+                    let meaning = format!(
+                        "free fall of a point mass from the initial height {h:.6e} m of `{}`",
+                        info.points[info.falling_point].name
+                    );
+                    scalar(out, &key, (2.0 * h / g).sqrt(), "s", meaning);
+                } else {
+                    out.notes.insert(
+                        key,
+                        format!("the falling point starts at height {h:e} m, not above the floor"),
+                    );
+                }
+            }
+            Quantity::ThetaSeries => {
+                let s = self.first_samples()?;
+                let series = Series {
+                    columns: vec![
+                        column("t", "s", s.t.clone()),
+                        column("theta", "rad", s.theta.clone()),
+                        column("theta_dot", "rad/s", s.theta_dot.clone()),
+                        column("theta_ddot", "rad/s^2", s.theta_ddot.clone()),
+                    ],
+                };
+                out.series.insert(key, series);
+            }
+            Quantity::ForceSeries(i) => {
+                self.first_samples()?;
+                let s = &self.phase_samples[0];
+                let force: Vec<f64> = s.delta.iter().map(|&d| self.sys.forces(d)[i]).collect();
+                let series = Series {
+                    columns: vec![
+                        column("t", "s", s.t.clone()),
+                        column("theta", "rad", s.theta.clone()),
+                        column(info.forces[i].name, "N", force),
+                    ],
+                };
+                out.series.insert(key, series);
+            }
+            Quantity::Trajectory(i) => {
+                self.first_samples()?;
+                let s = &self.phase_samples[0];
+                let mut cols: [Vec<f64>; 4] = Default::default();
+                for state in checks::sampled_states(&self.sys, s) {
+                    let pts = self.sys.points(&state);
+                    let (p, v) = (pts.pos[i], pts.vel[i]);
+                    for (c, x) in cols.iter_mut().zip([p[0], p[1], v[0], v[1]]) {
+                        c.push(x);
+                    }
+                }
+                let [x, y, vx, vy] = cols;
+                let series = Series {
+                    columns: vec![
+                        column("t", "s", s.t.clone()),
+                        column("x", "m", x),
+                        column("y", "m", y),
+                        column("vx", "m/s", vx),
+                        column("vy", "m/s", vy),
+                    ],
+                };
+                out.series.insert(key, series);
+            }
+            Quantity::FloorImpact => self.floor_impact(out)?,
+            Quantity::CrossCheck => self.cross_check(out)?,
+            Quantity::Checks => self.checks(want.contains(&Quantity::CrossCheck), out)?,
+        }
+        Ok(())
+    }
+
+    fn floor_impact(&mut self, out: &mut RunResults) -> Result<(), SolveError> {
+        let motion = self.complete()?;
+        let names: Vec<&str> = motion.phases.iter().map(|p| p.system.name()).collect();
+        let time = motion.floor_time();
+        let omega = motion.impact_angular_velocity();
+        let speed = match motion.transitions.first() {
+            Some(tr) => Ok(tr.surface_speed()),
+            None => {
+                // No separation: the surface is still pushed when the rod lands.
+                let first = &motion.phases[0];
+                match first.system.info().contact {
+                    Some(c) => {
+                        let v = first.system.points(&first.end_state()).vel[c.surface];
+                        let moves = if c.surface_moves { 1.0 } else { 0.0 };
+                        Err(moves * (c.normal[0] * v[0] + c.normal[1] * v[1]))
+                    }
+                    None => Err(0.0),
+                }
+            }
+        };
+        let path = names.join(" -> ");
+        scalar(
+            out,
+            "floor_impact_time",
+            time,
+            "s",
+            format!("time from release until the rod lies on the floor ({path})"),
+        );
+        scalar(
+            out,
+            "impact_angular_velocity",
+            omega,
+            "rad/s",
+            format!("theta_dot when the rod reaches the floor ({path})"),
+        );
+        match speed {
+            Ok(v) => scalar(
+                out,
+                "surface_final_speed",
+                v,
+                "m/s",
+                "speed of the pushed surface along the contact normal after separation".into(),
+            ),
+            Err(v) => {
+                scalar(
+                    out,
+                    "surface_final_speed",
+                    v,
+                    "m/s",
+                    "speed of the pushed surface along the contact normal when the rod lands (no separation)".into(),
+                );
+                out.notes
+                    .insert("floor_impact".into(), NO_SEPARATION.into());
+            }
+        }
+        Ok(())
+    }
+
+    fn cross_check(&mut self, out: &mut RunResults) -> Result<(), SolveError> {
+        self.first()?;
+        match self.ode() {
+            Ok(_) => {}
+            // Not an error of the run: the unreduced route has nothing to say here.
+            Err(e @ SolveError::IllConditioned { .. }) => {
+                out.notes.insert("cross_check".into(), e.to_string());
+                return Ok(());
+            }
+            Err(e) => return Err(e),
+        }
+        let (Some(motion), Some(ode)) = (self.motion.as_ref(), self.ode.as_ref()) else {
+            return Ok(());
+        };
+        let first = &motion.phases[0];
+        let sys = &first.system;
+        let t_quad = first.duration();
+        let rel = (ode.t_end - t_quad).abs() / t_quad;
+        let event = match ode.end {
+            EndEvent::Separation => "separation (contact force crossing zero)",
+            EndEvent::Floor => "the floor",
+        };
+        // Along the path: the quadrature's time and the reduced state at each ODE step's angle.
+        let n = sys.n_coordinates();
+        let reduced = sys.info().reduced;
+        let theta_i = sys.theta_initial();
+        let nodes = ode.nodes();
+        let mut scale = vec![0.0f64; 2 * n];
+        for (_, y) in &nodes {
+            for (s, v) in scale.iter_mut().zip(y.iter()) {
+                *s = s.max(v.abs());
+            }
+        }
+        let (mut dt_max, mut dy_max) = (0.0f64, 0.0f64);
+        let mut work = Work::default();
+        for (t, y) in &nodes {
+            let delta = (theta_i - y[reduced]).max(0.0);
+            let tq = first.mesh.time_at_delta(sys, delta, &mut work)?;
+            dt_max = dt_max.max((t - tq).abs());
+            let state = sys.full_state(*t, delta, theta_dot_at(sys, delta));
+            for (i, (a, b)) in state.q.iter().chain(&state.qd).zip(y.iter()).enumerate() {
+                if scale[i] > 0.0 {
+                    dy_max = dy_max.max((a - b).abs() / scale[i]);
+                }
+            }
+        }
+        self.work.integrand_evals += work.integrand_evals;
+        let steps = self.ode.as_ref().map_or(0, UnreducedRun::steps);
+        scalar(
+            out,
+            "cross_check_time",
+            ode.t_end,
+            "s",
+            format!("unreduced equations (DOPRI5, {steps} steps) integrated to {event}"),
+        );
+        scalar(
+            out,
+            "cross_check_relative_difference",
+            rel,
+            "1",
+            format!(
+                "|t_ode - t_quadrature| / t_quadrature at {event} (quadrature: {t_quad:.15e} s; ODE rtol {:.1e}, mass-matrix condition {:.1e})",
+                ode.rtol, ode.condition
+            ),
+        );
+        scalar(
+            out,
+            "cross_check_rtol",
+            ode.rtol,
+            "1",
+            "relative tolerance the ODE ran with: the one asked, raised to 10 eps cond(M) when the mass matrix is ill-conditioned".into(),
+        );
+        scalar(
+            out,
+            "cross_check_time_deviation",
+            dt_max,
+            "s",
+            format!(
+                "largest |t_ode - t(theta_ode)| over {} ODE steps",
+                nodes.len()
+            ),
+        );
+        scalar(
+            out,
+            "cross_check_state_deviation",
+            dy_max,
+            "1",
+            format!(
+                "largest relative difference between ODE and reduced states over {} steps",
+                nodes.len()
+            ),
+        );
+        Ok(())
+    }
+
+    fn checks(&mut self, with_ode: bool, out: &mut RunResults) -> Result<(), SolveError> {
+        let n_phases = self.complete()?.phases.len();
+        let tol = self.tol;
+        for i in 0..n_phases {
+            self.samples_of(i)?;
+            let (Some(motion), Some(samples)) = (self.motion.as_ref(), self.phase_samples.get(i))
+            else {
+                continue;
+            };
+            let run = &motion.phases[i];
+            let mut found: Vec<(String, Check)> = checks::monitors(&run.system, samples);
+            let states = checks::sampled_states(&run.system, samples);
+            found.extend(checks::drift(&run.system, &states, tol, run.system.name()));
+            if i > 0 {
+                let tr = &motion.transitions[i - 1];
+                found.extend(checks::no_recatch(
+                    &run.system,
+                    samples,
+                    run.t_start,
+                    tr,
+                    tol,
+                ));
+            }
+            out.checks.extend(found);
+        }
+        if with_ode && let Some(ode) = self.ode.as_ref() {
+            let n = self.sys.n_coordinates();
+            let states: Vec<_> = ode
+                .nodes()
+                .iter()
+                .map(|(_, y)| crate::system::State {
+                    q: y[..n].to_vec(),
+                    qd: y[n..].to_vec(),
+                })
+                .collect();
+            // The ODE path is held to its own accuracy: ten times its rtol at the least.
+            let ode_tol = tol.max(10.0 * ode.rtol);
+            let label = format!("{}.ode", self.sys.name());
+            out.checks
+                .extend(checks::drift(&self.sys, &states, ode_tol, &label));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,146 @@
+//! The vocabulary of quantities a scene can ask for (`want:`), resolved against a model.
+
+use crate::model::ModelInfo;
+
+/// One quantity a scene can want. Force series and trajectories are named after the model's
+/// forces and points, so every model gets the quantities its spec declares.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Quantity {
+    /// Angle at which the contact force vanishes (rad).
+    SeparationAngle,
+    /// The paper's approximation: the separation polynomial with its terms above degree 1 dropped.
+    LinearisedSeparationAngle,
+    /// Time from release to separation (s), eq. (15).
+    SeparationTime,
+    /// Time to the floor if the rod stayed in contact all the way (s), eq. (10).
+    ContactTimeToFloor,
+    /// Free-fall time of a point mass from the initial height of the falling centre of mass (s).
+    PointMassFallTime,
+    /// `t, theta, theta_dot, theta_ddot` from release to separation (or to the floor).
+    ThetaSeries,
+    /// A reaction force (index into `ModelInfo::forces`) along the motion: `<force>_series`.
+    ForceSeries(usize),
+    /// A point's path (index into `ModelInfo::points`): `<point>_trajectory`.
+    Trajectory(usize),
+    /// The free-sliding phase after separation, up to the rod lying on the floor.
+    FloorImpact,
+    /// The physical assumptions and conservation laws, each pass/fail with its margin.
+    Checks,
+    /// Integration of the unreduced equations `M(q) qdd = F(q, qd)` to the separation event.
+    CrossCheck,
+}
+
+/// Quantity names that do not depend on the model, with their meaning.
+pub const FIXED: &[(&str, Quantity, &str)] = &[
+    (
+        "separation_angle",
+        Quantity::SeparationAngle,
+        "angle where the contact force vanishes (rad)",
+    ),
+    (
+        "linearised_separation_angle",
+        Quantity::LinearisedSeparationAngle,
+        "separation angle with the polynomial's terms above degree 1 dropped (rad)",
+    ),
+    (
+        "separation_time",
+        Quantity::SeparationTime,
+        "time from release to separation (s)",
+    ),
+    (
+        "contact_time_to_floor",
+        Quantity::ContactTimeToFloor,
+        "time to the floor if contact were kept all the way (s), the paper's eq. (10)",
+    ),
+    (
+        "point_mass_fall_time",
+        Quantity::PointMassFallTime,
+        "free fall of a point mass from the initial height of the centre of mass (s)",
+    ),
+    (
+        "theta_series",
+        Quantity::ThetaSeries,
+        "t, theta, theta_dot, theta_ddot until separation",
+    ),
+    (
+        "floor_impact",
+        Quantity::FloorImpact,
+        "free-sliding phase after separation, to the floor",
+    ),
+    (
+        "checks",
+        Quantity::Checks,
+        "physical assumptions and conservation checks",
+    ),
+    (
+        "cross_check",
+        Quantity::CrossCheck,
+        "unreduced equations integrated to the separation event",
+    ),
+];
+
+impl Quantity {
+    /// Resolves a `want` entry for a model; the error lists what the model offers.
+    pub fn parse(name: &str, info: &ModelInfo) -> Result<Quantity, String> {
+        if let Some((_, q, _)) = FIXED.iter().find(|(n, _, _)| *n == name) {
+            return Ok(*q);
+        }
+        if let Some(force) = name.strip_suffix("_series")
+            && let Some(i) = info.forces.iter().position(|f| f.name == force)
+        {
+            return Ok(Quantity::ForceSeries(i));
+        }
+        if let Some(point) = name.strip_suffix("_trajectory")
+            && let Some(i) = info.points.iter().position(|p| p.name == point)
+        {
+            return Ok(Quantity::Trajectory(i));
+        }
+        Err(format!(
+            "unknown quantity `{name}` for model `{}`; it offers: {}",
+            info.name,
+            Quantity::names(info).join(", ")
+        ))
+    }
+
+    /// The key of this quantity in scenes and results.
+    pub fn name(&self, info: &ModelInfo) -> String {
+        match self {
+            Quantity::ForceSeries(i) => format!("{}_series", info.forces[*i].name),
+            Quantity::Trajectory(i) => format!("{}_trajectory", info.points[*i].name),
+            q => FIXED
+                .iter()
+                .find(|(_, f, _)| f == q)
+                .map(|(n, _, _)| n.to_string())
+                .unwrap_or_default(),
+        }
+    }
+
+    /// Every quantity name a model offers, in a stable order.
+    pub fn names(info: &ModelInfo) -> Vec<String> {
+        Quantity::all(info).iter().map(|q| q.name(info)).collect()
+    }
+
+    /// Every quantity a model can provide.
+    pub fn all(info: &ModelInfo) -> Vec<Quantity> {
+        let mut out: Vec<Quantity> = FIXED
+            .iter()
+            .map(|(_, q, _)| *q)
+            .filter(|q| q.available(info))
+            .collect();
+        out.extend((0..info.forces.len()).map(Quantity::ForceSeries));
+        out.extend((0..info.points.len()).map(Quantity::Trajectory));
+        out
+    }
+
+    /// Whether a model can provide this quantity (separation needs a contact, and the
+    /// floor impact needs a phase after it).
+    pub fn available(&self, info: &ModelInfo) -> bool {
+        match self {
+            Quantity::SeparationAngle
+            | Quantity::LinearisedSeparationAngle
+            | Quantity::SeparationTime => info.contact.is_some(),
+            Quantity::FloorImpact => info.contact.is_some() && info.next_phase.is_some(),
+            _ => true,
+        }
+    }
+}

@@ -1,0 +1,73 @@
+//! Reports of a run: the human table, results.json, one CSV per series and SVG plots.
+//!
+//! Every writer here is a pure function from [`RunResults`] to text; only [`write_all`] touches
+//! the file system, through [`OutDir`] (atomic writes, checked names).
+
+pub mod csv;
+pub mod json;
+pub mod plot;
+pub mod table;
+
+use crate::io::OutDir;
+use crate::results::RunResults;
+use std::path::PathBuf;
+
+/// Name of the JSON file written beside the series.
+pub const RESULTS_JSON: &str = "results.json";
+
+/// Why a report could not be produced or written.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// Writing a file failed or its name was refused.
+    #[error(transparent)]
+    Io(#[from] crate::io::Error),
+    /// JSON serialization failed.
+    #[error("cannot serialize the results to JSON: {0}")]
+    Json(#[from] serde_json::Error),
+    /// A series whose columns differ in length.
+    #[error("series `{series}`: column `{column}` has {len} values but `{first}` has {expected}")]
+    Ragged {
+        /// Series name.
+        series: String,
+        /// The first column.
+        first: String,
+        /// Its length.
+        expected: usize,
+        /// The offending column.
+        column: String,
+        /// Its length.
+        len: usize,
+    },
+    /// CSV encoding failed.
+    #[error("cannot write series `{series}` as CSV: {message}")]
+    Csv {
+        /// Series name.
+        series: String,
+        /// What went wrong.
+        message: String,
+    },
+    /// Drawing a plot failed.
+    #[error("cannot plot series `{series}`: {message}")]
+    Plot {
+        /// Series name.
+        series: String,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+/// Writes `results.json`, `<series>.csv` for every series and `<series>.svg` for every series
+/// that can be plotted. Returns the paths written, in that order.
+pub fn write_all(out: &OutDir, results: &RunResults) -> Result<Vec<PathBuf>, Error> {
+    let mut written = vec![out.write(RESULTS_JSON, json::to_string(results)?.as_bytes())?];
+    for (name, series) in &results.series {
+        written.push(out.write(
+            &format!("{name}.csv"),
+            csv::to_string(name, series)?.as_bytes(),
+        )?);
+        if let Some(svg) = plot::svg(name, series, &results.model)? {
+            written.push(out.write(&format!("{name}.svg"), svg.as_bytes())?);
+        }
+    }
+    Ok(written)
+}

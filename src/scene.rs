@@ -1,0 +1,820 @@
+//! Scenes: the YAML files that name a model, its parameters and the quantities wanted, validated
+//! against the model with errors that name the file, line, column and field.
+//!
+//! ```yaml
+//! model: rod_cube
+//! parameters: {m1: 1.0, m2: 3.0, ell: 1.0, a: 0.25, g: 9.81}   # SI units
+//! want: [separation_angle, separation_time, theta_series]
+//! tolerance: 1.0e-12        # relative, optional
+//! samples: 1000             # points in each series, optional
+//! ```
+//!
+//! Loading runs in three passes over the text, each with exact positions:
+//! 1. a structural walk that reports YAML syntax errors and duplicate keys (serde_yaml_ng's own
+//!    marks, taken from the failing event);
+//! 2. typed deserialization with `deny_unknown_fields` (unknown keys, wrong types, missing keys);
+//! 3. semantic checks against the model's [`ModelInfo`]. Their positions come from
+//!    [`crate::yaml_marks`], which re-reads the text and makes the YAML parser fail on purpose at the
+//!    field's key or value, so the mark is the parser's, whatever the layout (block or flow,
+//!    quoted keys, anchors).
+//!
+//! Semantic checks do not stop at the first problem: every diagnostic is collected and they
+//! are reported in file order.
+
+use crate::model::{Model, ModelInfo};
+use crate::quantity::Quantity;
+use crate::yaml_marks::{
+    At, SyntaxError, check_syntax, first_mark, is_path, join_key, locate, locate_nearest,
+    parse_path, strip_marks,
+};
+use serde::Deserialize;
+use std::collections::{BTreeMap, HashSet};
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// The planner's defaults and tolerance range are the scene's: one source of truth.
+pub use crate::plan::{DEFAULT_SAMPLES, DEFAULT_TOLERANCE, TOLERANCE_RANGE};
+/// Accepted number of points per series (inclusive).
+pub const SAMPLES_RANGE: (usize, usize) = (2, 1_000_000);
+/// The keys a scene may have, in the order they are documented.
+pub const KEYS: &[&str] = &["model", "parameters", "want", "tolerance", "samples"];
+
+/// A validated scene, ready for the planner.
+pub struct Scene {
+    /// The file it was read from (as given, for messages).
+    pub file: PathBuf,
+    /// The model to run.
+    pub model: &'static dyn Model,
+    /// Parameter values in the order of [`ModelInfo::parameters`] (SI units).
+    pub parameters: Vec<f64>,
+    /// The quantities wanted, in the order of the file, each once.
+    pub want: Vec<Quantity>,
+    /// Relative tolerance.
+    pub tolerance: f64,
+    /// Points in each series.
+    pub samples: usize,
+    /// The scene's text, kept to locate errors found later (e.g. by the planner).
+    source: String,
+}
+
+impl fmt::Debug for Scene {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Scene")
+            .field("file", &self.file)
+            .field("model", &self.info().name)
+            .field("parameters", &self.parameter_map())
+            .field("want", &self.want)
+            .field("tolerance", &self.tolerance)
+            .field("samples", &self.samples)
+            .finish()
+    }
+}
+
+/// What kind of problem a [`Diagnostic`] reports; each has a stable code for messages.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Kind {
+    /// The file could not be read (missing, unreadable, not UTF-8).
+    Read,
+    /// Not valid YAML, a duplicate key, or an empty file.
+    Syntax,
+    /// A key that scenes do not have.
+    UnknownKey,
+    /// A value of the wrong type, or a required key missing.
+    Structure,
+    /// A model that is not in the registry.
+    UnknownModel,
+    /// A `want` entry that no model quantity matches.
+    UnknownQuantity,
+    /// A quantity this model cannot provide (e.g. separation without a contact).
+    UnavailableQuantity,
+    /// A `want` entry listed twice.
+    DuplicateQuantity,
+    /// A parameter of the model that the scene does not give.
+    MissingParameter,
+    /// A parameter the model does not have.
+    UnknownParameter,
+    /// A parameter that must be strictly positive and is not.
+    NotPositive,
+    /// NaN or an infinity (`.nan`, `.inf`).
+    NotFinite,
+    /// `tolerance` or `samples` outside its range, or an empty `want`.
+    OutOfRange,
+    /// A requirement of the model on its parameters (e.g. `a < ell`) fails.
+    Requirement,
+}
+
+impl Kind {
+    /// Stable short code, shown as `error[code]`.
+    pub fn code(self) -> &'static str {
+        match self {
+            Kind::Read => "read",
+            Kind::Syntax => "syntax",
+            Kind::UnknownKey => "unknown-key",
+            Kind::Structure => "structure",
+            Kind::UnknownModel => "unknown-model",
+            Kind::UnknownQuantity => "unknown-quantity",
+            Kind::UnavailableQuantity => "unavailable-quantity",
+            Kind::DuplicateQuantity => "duplicate-quantity",
+            Kind::MissingParameter => "missing-parameter",
+            Kind::UnknownParameter => "unknown-parameter",
+            Kind::NotPositive => "not-positive",
+            Kind::NotFinite => "not-finite",
+            Kind::OutOfRange => "out-of-range",
+            Kind::Requirement => "requirement",
+        }
+    }
+}
+
+/// One problem in a scene, with its place.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Diagnostic {
+    /// The scene file, as given.
+    pub file: PathBuf,
+    /// 1-based line; 0 when the problem has no place in the text (e.g. unreadable file).
+    pub line: usize,
+    /// 1-based column in characters; 0 when `line` is 0.
+    pub column: usize,
+    /// The field, as a path: `parameters.m1`, `want[2]`, `tolerance`; empty when none applies.
+    pub field: String,
+    /// What kind of problem.
+    pub kind: Kind,
+    /// The message, without the place.
+    pub message: String,
+    /// The text of line `line` (for the snippet), empty when `line` is 0.
+    pub source_line: String,
+}
+
+impl Diagnostic {
+    /// `file:line:column` (or just `file` without a place).
+    pub fn place(&self) -> String {
+        if self.line == 0 {
+            self.file.display().to_string()
+        } else {
+            format!("{}:{}:{}", self.file.display(), self.line, self.column)
+        }
+    }
+
+    /// One line: `file:line:column: field: message`.
+    pub fn headline(&self) -> String {
+        if self.field.is_empty() {
+            format!("{}: {}", self.place(), self.message)
+        } else {
+            format!("{}: {}: {}", self.place(), self.field, self.message)
+        }
+    }
+}
+
+impl fmt::Display for Diagnostic {
+    /// rustc-style: headline with code, `--> file:line:column`, the line and a caret.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "error[{}]: ", self.kind.code())?;
+        if !self.field.is_empty() {
+            write!(f, "{}: ", self.field)?;
+        }
+        writeln!(f, "{}", self.message)?;
+        let gutter = self.line.to_string().len();
+        write!(f, "{:gutter$}--> {}", "", self.place())?;
+        if self.line > 0 {
+            let text = self.source_line.trim_end();
+            let start = self.column.saturating_sub(1);
+            let width = span_width(text, start);
+            write!(
+                f,
+                "\n{:gutter$} |\n{} | {}\n{:gutter$} | ",
+                "", self.line, text, ""
+            )?;
+            // Keep tabs so the caret lines up under them.
+            let pad: String = text
+                .chars()
+                .take(start)
+                .map(|c| if c == '\t' { '\t' } else { ' ' })
+                .collect();
+            write!(f, "{pad}{}", "^".repeat(width))?;
+        }
+        Ok(())
+    }
+}
+
+/// Everything wrong with a scene (at least one diagnostic), in file order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneError {
+    /// The problems found, sorted by line and column.
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+impl SceneError {
+    fn one(d: Diagnostic) -> Self {
+        SceneError {
+            diagnostics: vec![d],
+        }
+    }
+
+    /// Whether any diagnostic is of this kind.
+    pub fn has(&self, kind: Kind) -> bool {
+        self.diagnostics.iter().any(|d| d.kind == kind)
+    }
+}
+
+impl fmt::Display for SceneError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, d) in self.diagnostics.iter().enumerate() {
+            if i > 0 {
+                writeln!(f)?;
+                writeln!(f)?;
+            }
+            write!(f, "{d}")?;
+        }
+        if self.diagnostics.len() > 1 {
+            write!(f, "\n\n{} errors in this scene", self.diagnostics.len())?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for SceneError {}
+
+/// The scene's keys as written, before any check against a model.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a mapping of scene keys")]
+struct Raw {
+    model: String,
+    parameters: BTreeMap<String, f64>,
+    want: Vec<String>,
+    #[serde(default)]
+    tolerance: Option<f64>,
+    #[serde(default)]
+    samples: Option<i64>,
+}
+
+impl Scene {
+    /// Reads and validates a scene file against the generated models ([`crate::models::all`]).
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        Scene::load_with(path, crate::models::all())
+    }
+
+    /// Reads and validates a scene file against `registry`.
+    pub fn load_with(path: &Path, registry: &[&'static dyn Model]) -> Result<Scene, SceneError> {
+        let text = std::fs::read(path)
+            .map_err(|e| e.to_string())
+            .and_then(|bytes| String::from_utf8(bytes).map_err(|e| format!("not UTF-8 text ({e})")))
+            .map_err(|why| {
+                SceneError::one(Diagnostic {
+                    file: path.to_path_buf(),
+                    line: 0,
+                    column: 0,
+                    field: String::new(),
+                    kind: Kind::Read,
+                    message: format!("cannot read the scene: {why}"),
+                    source_line: String::new(),
+                })
+            })?;
+        Scene::parse(&text, path, registry)
+    }
+
+    /// Validates scene text; `file` is only used in messages.
+    pub fn parse(
+        text: &str,
+        file: &Path,
+        registry: &[&'static dyn Model],
+    ) -> Result<Scene, SceneError> {
+        let ctx = Ctx { text, file };
+        if text.lines().all(|l| {
+            let t = l.trim();
+            t.is_empty() || t.starts_with('#') || t == "---"
+        }) {
+            return Err(SceneError::one(ctx.at(
+                Kind::Syntax,
+                (1, 1),
+                "",
+                format!("the scene is empty; it needs the keys {}", KEYS.join(", ")),
+            )));
+        }
+        // Pass 1: syntax and duplicate keys.
+        if let Err(e) = check_syntax(text) {
+            return Err(SceneError::one(ctx.syntax_error(e)));
+        }
+        // Pass 2: keys and types.
+        let raw: Raw =
+            serde_yaml_ng::from_str(text).map_err(|e| SceneError::one(ctx.structure_error(&e)))?;
+        // Pass 3: against the model.
+        ctx.validate(raw, registry)
+    }
+
+    /// The model's static description.
+    pub fn info(&self) -> &'static ModelInfo {
+        self.model.info()
+    }
+
+    /// Parameters by name.
+    pub fn parameter_map(&self) -> BTreeMap<String, f64> {
+        self.info()
+            .parameters
+            .iter()
+            .zip(&self.parameters)
+            .map(|(p, v)| (p.name.to_string(), *v))
+            .collect()
+    }
+
+    /// A parameter's value by name.
+    pub fn parameter(&self, name: &str) -> Option<f64> {
+        let i = self.info().parameters.iter().position(|p| p.name == name)?;
+        self.parameters.get(i).copied()
+    }
+
+    /// The file name without extension (`paper` for `scenes/paper.yaml`).
+    pub fn stem(&self) -> Option<&str> {
+        self.file.file_stem().and_then(|s| s.to_str())
+    }
+
+    /// An error placed at a field of this scene (`parameters.a`, `want[1]`, `model`), for
+    /// problems found after loading, e.g. by the planner. A field that is not in the file is
+    /// placed at its nearest ancestor that is.
+    pub fn error_at(&self, field: &str, kind: Kind, message: impl Into<String>) -> SceneError {
+        let ctx = Ctx {
+            text: &self.source,
+            file: &self.file,
+        };
+        SceneError::one(ctx.diag(kind, field, At::Key, message.into()))
+    }
+
+    /// An error about some parameters (e.g. a failed requirement reported by the planner),
+    /// placed at the first of `names` that the scene gives, in file order.
+    pub fn error_at_parameters(
+        &self,
+        names: &[&str],
+        kind: Kind,
+        message: impl Into<String>,
+    ) -> SceneError {
+        let ctx = Ctx {
+            text: &self.source,
+            file: &self.file,
+        };
+        let field = ctx.first_in_file(names.iter().map(|n| format!("parameters.{n}")));
+        SceneError::one(ctx.diag(kind, &field, At::Key, message.into()))
+    }
+
+    /// A failed requirement of this scene's model (named `name`, demanding `meaning`), placed
+    /// at the first parameter it names that the file gives.
+    pub fn requirement_error(
+        &self,
+        name: &str,
+        meaning: &str,
+        message: impl Into<String>,
+    ) -> SceneError {
+        let involved = involved_parameters(name, meaning, self.info());
+        self.error_at_parameters(&involved, Kind::Requirement, message)
+    }
+}
+
+/// The text being validated and its file name.
+struct Ctx<'a> {
+    text: &'a str,
+    file: &'a Path,
+}
+
+impl Ctx<'_> {
+    fn line_text(&self, line: usize) -> String {
+        if line == 0 {
+            return String::new();
+        }
+        self.text.lines().nth(line - 1).unwrap_or("").to_string()
+    }
+
+    fn at(
+        &self,
+        kind: Kind,
+        (line, column): (usize, usize),
+        field: &str,
+        message: String,
+    ) -> Diagnostic {
+        Diagnostic {
+            file: self.file.to_path_buf(),
+            line,
+            column,
+            field: field.to_string(),
+            kind,
+            message,
+            source_line: self.line_text(line),
+        }
+    }
+
+    /// A diagnostic at `field` (a path such as `parameters.m1`), or at its nearest ancestor
+    /// found in the text, or at the start of the document.
+    fn diag(&self, kind: Kind, field: &str, at: At, message: String) -> Diagnostic {
+        let pos = locate_nearest(self.text, &parse_path(field), at);
+        self.at(kind, pos, field, message)
+    }
+
+    /// The field among `fields` that comes first in the file (the first one if none is found).
+    fn first_in_file(&self, fields: impl Iterator<Item = String>) -> String {
+        let fields: Vec<String> = fields.collect();
+        fields
+            .iter()
+            .filter_map(|f| locate(self.text, &parse_path(f)).map(|p| (p, f)))
+            .min()
+            .map(|(_, f)| f.clone())
+            .or_else(|| fields.first().cloned())
+            .unwrap_or_default()
+    }
+
+    /// A pass-1 error (YAML syntax, duplicate key, tag) as a diagnostic at the parser's mark.
+    fn syntax_error(&self, e: SyntaxError) -> Diagnostic {
+        let e = match e {
+            SyntaxError::DuplicateKey {
+                field,
+                key,
+                position,
+            } => {
+                let message = format!("duplicate key `{key}`");
+                return self.at(Kind::Syntax, position, &field, message);
+            }
+            SyntaxError::Tag { position } => {
+                let message = "invalid YAML: YAML tags (`!name value`) are not used in scenes";
+                let field = self.enclosing_key(position.0);
+                return self.at(Kind::Syntax, position, &field, message.into());
+            }
+            SyntaxError::Yaml(e) => e,
+        };
+        let pos = e
+            .location()
+            .map(|l| (l.line(), l.column()))
+            .unwrap_or((1, 1));
+        let raw = e.to_string();
+        // libyaml: "problem at MARK, while parsing CONTEXT at MARK". A flow collection's context
+        // mark (where it opened) names the field better than the problem's, which may be on a
+        // later key's line; a block context at column 1 is just the document.
+        let (problem, context) = match raw.split_once(", while ") {
+            Some((p, c)) => (strip_marks(p), Some(c)),
+            None => (strip_marks(&raw), None),
+        };
+        let context_mark = context.and_then(first_mark);
+        let field_line = match context_mark {
+            Some((line, column)) if column > 1 => line,
+            _ => pos.0,
+        };
+        let message = match (context, context_mark) {
+            (Some(c), Some((l, col))) => {
+                format!(
+                    "invalid YAML: {problem} (while {} that starts at {l}:{col})",
+                    strip_marks(c)
+                )
+            }
+            (Some(c), None) => format!("invalid YAML: {problem} (while {c})"),
+            _ => format!("invalid YAML: {problem}"),
+        };
+        self.at(Kind::Syntax, pos, &self.enclosing_key(field_line), message)
+    }
+
+    /// A pass-2 error (unknown key, wrong type, missing key) as a diagnostic at serde's mark.
+    fn structure_error(&self, e: &serde_yaml_ng::Error) -> Diagnostic {
+        let pos = e
+            .location()
+            .map(|l| (l.line(), l.column()))
+            .unwrap_or((1, 1));
+        let full = strip_marks(&e.to_string());
+        // serde_yaml_ng writes "path: message" when the path is not the root.
+        let (field, message) = match full.split_once(": ") {
+            Some((p, m)) if is_path(p) => (p.to_string(), m.to_string()),
+            _ => (String::new(), full.clone()),
+        };
+        let (kind, field, message) = if let Some(name) = message.strip_prefix("unknown field `") {
+            let name = name.split('`').next().unwrap_or("");
+            (
+                Kind::UnknownKey,
+                join_key(&field, name),
+                format!(
+                    "unknown key `{name}`; a scene has the keys {}",
+                    KEYS.join(", ")
+                ),
+            )
+        } else if let Some(name) = message.strip_prefix("missing field `") {
+            let name = name.split('`').next().unwrap_or("");
+            (
+                Kind::Structure,
+                join_key(&field, name),
+                format!("the required key `{name}` is missing"),
+            )
+        } else {
+            (Kind::Structure, field, message)
+        };
+        self.at(kind, pos, &field, message)
+    }
+
+    /// The top-level key whose block contains `line` (for syntax errors), or empty.
+    fn enclosing_key(&self, line: usize) -> String {
+        self.text
+            .lines()
+            .take(line)
+            .filter_map(|l| {
+                let first = l.chars().next()?;
+                if first.is_whitespace() || first == '#' || first == '-' {
+                    return None;
+                }
+                let key = l.split(':').next()?.trim().trim_matches(['"', '\'']);
+                KEYS.contains(&key).then(|| key.to_string())
+            })
+            .last()
+            .unwrap_or_default()
+    }
+
+    fn validate(&self, raw: Raw, registry: &[&'static dyn Model]) -> Result<Scene, SceneError> {
+        let mut out: Vec<Diagnostic> = Vec::new();
+
+        // tolerance and samples do not depend on the model.
+        let tolerance = raw.tolerance.unwrap_or(DEFAULT_TOLERANCE);
+        if !tolerance.is_finite() {
+            out.push(self.diag(
+                Kind::NotFinite,
+                "tolerance",
+                At::Value,
+                format!("must be a finite number, not {}", show(tolerance)),
+            ));
+        } else if !(TOLERANCE_RANGE.0..=TOLERANCE_RANGE.1).contains(&tolerance) {
+            out.push(self.diag(
+                Kind::OutOfRange,
+                "tolerance",
+                At::Value,
+                format!(
+                    "must be between {:e} and {:e} (relative), not {}",
+                    TOLERANCE_RANGE.0,
+                    TOLERANCE_RANGE.1,
+                    show(tolerance)
+                ),
+            ));
+        }
+        let samples = raw.samples.unwrap_or(DEFAULT_SAMPLES as i64);
+        let samples = match usize::try_from(samples) {
+            Ok(s) if (SAMPLES_RANGE.0..=SAMPLES_RANGE.1).contains(&s) => s,
+            _ => {
+                out.push(self.diag(
+                    Kind::OutOfRange,
+                    "samples",
+                    At::Value,
+                    format!(
+                        "must be between {} and {} points, not {samples}",
+                        SAMPLES_RANGE.0, SAMPLES_RANGE.1
+                    ),
+                ));
+                DEFAULT_SAMPLES
+            }
+        };
+
+        let Some(model) = registry
+            .iter()
+            .copied()
+            .find(|m| m.info().name == raw.model)
+        else {
+            let names: Vec<&str> = registry.iter().map(|m| m.info().name).collect();
+            let available = if names.is_empty() {
+                "none (no model has been generated yet)".to_string()
+            } else {
+                names.join(", ")
+            };
+            out.push(self.diag(
+                Kind::UnknownModel,
+                "model",
+                At::Value,
+                format!(
+                    "unknown model `{}`; available models: {available}",
+                    raw.model
+                ),
+            ));
+            return Err(finish(out));
+        };
+        let info = model.info();
+
+        // want
+        let mut want = Vec::new();
+        if raw.want.is_empty() {
+            out.push(self.diag(
+                Kind::OutOfRange,
+                "want",
+                At::Value,
+                format!(
+                    "nothing is wanted; model `{}` offers: {}",
+                    info.name,
+                    Quantity::names(info).join(", ")
+                ),
+            ));
+        }
+        let mut seen = HashSet::new();
+        for (i, name) in raw.want.iter().enumerate() {
+            let field = format!("want[{i}]");
+            match Quantity::parse(name, info) {
+                Err(message) => {
+                    out.push(self.diag(Kind::UnknownQuantity, &field, At::Value, message))
+                }
+                Ok(q) if !q.available(info) => out.push(self.diag(
+                    Kind::UnavailableQuantity,
+                    &field,
+                    At::Value,
+                    format!(
+                        "model `{}` cannot provide `{name}`: {}; it offers: {}",
+                        info.name,
+                        unavailable_reason(q, info),
+                        Quantity::names(info).join(", ")
+                    ),
+                )),
+                Ok(q) if !seen.insert(q) => out.push(self.diag(
+                    Kind::DuplicateQuantity,
+                    &field,
+                    At::Value,
+                    format!("`{name}` is wanted more than once"),
+                )),
+                Ok(q) => want.push(q),
+            }
+        }
+
+        // parameters
+        let expected: Vec<&str> = info.parameters.iter().map(|p| p.name).collect();
+        for name in raw.parameters.keys() {
+            if !expected.contains(&name.as_str()) {
+                out.push(self.diag(
+                    Kind::UnknownParameter,
+                    &format!("parameters.{name}"),
+                    At::Key,
+                    format!(
+                        "model `{}` has no parameter `{name}`; its parameters are {}",
+                        info.name,
+                        expected.join(", ")
+                    ),
+                ));
+            }
+        }
+        let mut values = Vec::with_capacity(info.parameters.len());
+        let mut all_good = true;
+        for p in info.parameters {
+            let field = format!("parameters.{}", p.name);
+            let Some(&v) = raw.parameters.get(p.name) else {
+                all_good = false;
+                out.push(self.diag(
+                    Kind::MissingParameter,
+                    &field,
+                    At::Key,
+                    format!(
+                        "missing parameter `{}` ({}, in {})",
+                        p.name, p.meaning, p.unit
+                    ),
+                ));
+                continue;
+            };
+            if !v.is_finite() {
+                all_good = false;
+                out.push(self.diag(
+                    Kind::NotFinite,
+                    &field,
+                    At::Value,
+                    format!("`{}` must be a finite number, not {}", p.name, show(v)),
+                ));
+            } else if p.positive && v <= 0.0 {
+                all_good = false;
+                out.push(self.diag(
+                    Kind::NotPositive,
+                    &field,
+                    At::Value,
+                    format!(
+                        "`{}` ({}) must be positive, not {}",
+                        p.name,
+                        p.meaning,
+                        show(v)
+                    ),
+                ));
+            }
+            values.push(v);
+        }
+
+        // requirements, once every parameter is there and valid
+        if all_good && !info.requirements.is_empty() {
+            let mut margins = vec![0.0; info.requirements.len()];
+            model.requirements(&values, &mut margins);
+            for (r, margin) in info.requirements.iter().zip(&margins) {
+                if margin.is_nan() || *margin <= 0.0 {
+                    let involved = involved_parameters(r.name, r.meaning, info);
+                    let field =
+                        self.first_in_file(involved.iter().map(|n| format!("parameters.{n}")));
+                    let field = if field.is_empty() {
+                        "parameters".to_string()
+                    } else {
+                        field
+                    };
+                    let list = if involved.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" (involves {})", involved.join(", "))
+                    };
+                    out.push(self.diag(
+                        Kind::Requirement,
+                        &field,
+                        At::Key,
+                        format!(
+                            "requirement `{}` fails: {}; margin {}{list}",
+                            r.name,
+                            r.meaning,
+                            show(*margin)
+                        ),
+                    ));
+                }
+            }
+        }
+
+        if !out.is_empty() {
+            return Err(finish(out));
+        }
+        Ok(Scene {
+            file: self.file.to_path_buf(),
+            model,
+            parameters: values,
+            want,
+            tolerance,
+            samples,
+            source: self.text.to_string(),
+        })
+    }
+}
+
+/// Sorts diagnostics into file order.
+fn finish(mut out: Vec<Diagnostic>) -> SceneError {
+    out.sort_by_key(|d| (d.line, d.column));
+    SceneError { diagnostics: out }
+}
+
+/// Why a model cannot provide a quantity it knows by name.
+fn unavailable_reason(q: Quantity, info: &ModelInfo) -> &'static str {
+    match q {
+        Quantity::FloorImpact if info.contact.is_some() => "it has no phase after separation",
+        _ => "it has no separating contact",
+    }
+}
+
+/// Parameters named (as whole words) in a requirement's name or meaning, in model order.
+fn involved_parameters(name: &str, meaning: &str, info: &ModelInfo) -> Vec<&'static str> {
+    let words: HashSet<&str> = name
+        .split(|c: char| !c.is_alphanumeric())
+        .chain(meaning.split(|c: char| !c.is_alphanumeric()))
+        .filter(|w| !w.is_empty())
+        .collect();
+    info.parameters
+        .iter()
+        .map(|p| p.name)
+        .filter(|n| words.contains(n))
+        .collect()
+}
+
+/// A number as a scene would write it (`.nan`, `.inf`, `-1`).
+fn show(v: f64) -> String {
+    if v.is_nan() {
+        ".nan".into()
+    } else if v.is_infinite() {
+        if v > 0.0 {
+            ".inf".into()
+        } else {
+            "-.inf".into()
+        }
+    } else {
+        format!("{v}")
+    }
+}
+
+/// Width in characters of the token starting at character `start` of `text` (at least 1).
+fn span_width(text: &str, start: usize) -> usize {
+    let rest: Vec<char> = text.chars().skip(start).collect();
+    let n = match rest.first() {
+        Some(&q @ ('"' | '\'')) => rest
+            .iter()
+            .skip(1)
+            .position(|&c| c == q)
+            .map_or(rest.len(), |i| i + 2),
+        _ => {
+            let mut n = 0;
+            while n < rest.len() {
+                let c = rest[n];
+                if matches!(c, ',' | ']' | '}' | '#')
+                    || (c == ':' && rest.get(n + 1).is_none_or(|c| c.is_whitespace()))
+                {
+                    break;
+                }
+                n += 1;
+            }
+            rest[..n]
+                .iter()
+                .rev()
+                .skip_while(|c| c.is_whitespace())
+                .count()
+        }
+    };
+    n.max(1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spans_cover_one_token() {
+        assert_eq!(span_width("  m1: -1.0  # c", 2), 2);
+        assert_eq!(span_width("  m1: -1.0  # c", 6), 4);
+        assert_eq!(span_width("p: {a: 1, b: 2}", 10), 1);
+        assert_eq!(span_width("x: \"a b\"", 3), 5);
+        assert_eq!(span_width("", 0), 1);
+    }
+}

@@ -1,0 +1,234 @@
+//! Numerical solvers for any [`Model`](crate::model::Model): separation root, time quadrature,
+//! `theta(t)` series, the unreduced ODE cross-check, phase chaining and physical checks.
+//!
+//! Data flows one way: [`separation`] finds where a phase ends, [`quadrature`] builds `t(theta)`
+//! on that phase, [`series`] inverts it at uniform times, [`phases`] chains a phase to the next
+//! model, [`unreduced`] integrates `M(q) qdd = F(q, qd)` with the generic [`ode`] integrator,
+//! and [`checks`] turns sampled motion into pass/fail margins.
+//!
+//! Architecture invariant: nothing here panics or returns NaN on bad numbers; every failure is
+//! a [`SolveError`] carrying the offending values. Every evaluation is counted in a
+//! [`Work`](crate::results::Work) passed down by the caller.
+
+pub mod checks;
+pub mod lean;
+pub mod ode;
+pub mod phases;
+pub mod quadrature;
+pub mod separation;
+pub mod series;
+pub mod unreduced;
+
+use crate::system::SystemError;
+
+/// Everything that can go wrong while solving a validated [`System`](crate::system::System).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SolveError {
+    /// The parameters handed to a next phase were refused.
+    #[error("next phase: {0}")]
+    System(#[from] SystemError),
+    /// Separation was asked of a model without a contact.
+    #[error("model `{model}` has no contact, so it cannot separate")]
+    NoContact {
+        /// Model name.
+        model: &'static str,
+    },
+    /// The separation polynomial is identically zero or has a non-finite coefficient.
+    #[error("separation polynomial of model `{model}` is unusable: {coefficients:?}")]
+    BadPolynomial {
+        /// Model name.
+        model: &'static str,
+        /// Its coefficients, lowest degree first.
+        coefficients: Vec<f64>,
+    },
+    /// Released from rest where the angular acceleration does not make it fall.
+    #[error(
+        "model `{model}` does not start falling: theta_dot_i = {theta_dot}, theta_ddot_i = {theta_ddot}"
+    )]
+    NoMotion {
+        /// Model name.
+        model: &'static str,
+        /// Initial rate.
+        theta_dot: f64,
+        /// Initial acceleration.
+        theta_ddot: f64,
+    },
+    /// The initial rate makes the angle grow, so `delta` would be negative.
+    #[error("model `{model}` starts rising (theta_dot_i = {theta_dot} > 0); phases must fall")]
+    Rising {
+        /// Model name.
+        model: &'static str,
+        /// Initial rate.
+        theta_dot: f64,
+    },
+    /// `theta_dot^2` reached zero (a turning point) before the end of the phase.
+    #[error(
+        "model `{model}`: theta_dot^2 = {theta_dot_sq:e} <= 0 at delta = {delta:e} before the phase end (delta_end = {delta_end:e})"
+    )]
+    TurningPoint {
+        /// Model name.
+        model: &'static str,
+        /// Where.
+        delta: f64,
+        /// The value.
+        theta_dot_sq: f64,
+        /// Where the phase should have ended.
+        delta_end: f64,
+    },
+    /// A model function returned NaN or an infinity.
+    #[error("model `{model}`: {what} is {value} at delta = {delta:e}")]
+    NonFinite {
+        /// Model name.
+        model: &'static str,
+        /// Which quantity.
+        what: &'static str,
+        /// Where.
+        delta: f64,
+        /// The value.
+        value: f64,
+    },
+    /// The phase end is not a positive, finite angle fallen.
+    #[error("model `{model}`: the phase would end at delta = {delta_end}, not a positive angle")]
+    BadPhaseEnd {
+        /// Model name.
+        model: &'static str,
+        /// The requested end.
+        delta_end: f64,
+    },
+    /// An angle outside the phase was asked of its time integral.
+    #[error("model `{model}`: delta = {delta:e} is outside the phase [0, {delta_end:e}]")]
+    OutsidePhase {
+        /// Model name.
+        model: &'static str,
+        /// The angle fallen asked (NaN if it was not a number).
+        delta: f64,
+        /// The phase's end.
+        delta_end: f64,
+    },
+    /// The adaptive quadrature did not converge.
+    #[error(
+        "quadrature on [{a:e}, {b:e}] missed relative tolerance {tol:e}: estimate {estimate}, error {error:e} after {panels} panels"
+    )]
+    QuadratureNotConverged {
+        /// Lower limit.
+        a: f64,
+        /// Upper limit.
+        b: f64,
+        /// Relative tolerance asked.
+        tol: f64,
+        /// Best estimate.
+        estimate: f64,
+        /// Its error estimate on the worst panel.
+        error: f64,
+        /// Panels used.
+        panels: usize,
+    },
+    /// `t(theta)` could not be inverted at a time.
+    #[error("cannot invert t(theta) at t = {target:e} s (phase lasts {duration:e} s): {reason}")]
+    Inversion {
+        /// The time asked.
+        target: f64,
+        /// The phase duration.
+        duration: f64,
+        /// Why.
+        reason: &'static str,
+    },
+    /// The mass matrix could not be solved.
+    #[error("singular mass matrix at t = {t:e} s, q = {q:?}")]
+    SingularMassMatrix {
+        /// Time.
+        t: f64,
+        /// Coordinates.
+        q: Vec<f64>,
+    },
+    /// The ODE right-hand side or an event function was not finite.
+    #[error("ODE: {what} not finite at t = {t:e} s, y = {y:?}")]
+    OdeNonFinite {
+        /// Which value.
+        what: &'static str,
+        /// Time.
+        t: f64,
+        /// State.
+        y: Vec<f64>,
+    },
+    /// The ODE step size fell below what `f64` can resolve.
+    #[error("ODE step size {h:e} s too small at t = {t:e} s")]
+    StepSizeTooSmall {
+        /// Time.
+        t: f64,
+        /// Step size.
+        h: f64,
+    },
+    /// The mass matrix is too ill-conditioned for the unreduced equations to mean anything.
+    #[error(
+        "model `{model}`: the mass matrix's condition number {condition:e} leaves the unreduced equations no accuracy (tolerance floor {rtol:e})"
+    )]
+    IllConditioned {
+        /// Model name.
+        model: &'static str,
+        /// Condition number at release.
+        condition: f64,
+        /// The tolerance it would need.
+        rtol: f64,
+    },
+    /// The ODE took too many steps.
+    #[error("ODE gave up after {steps} steps at t = {t:e} s (limit t = {t_max:e} s)")]
+    TooManySteps {
+        /// Time reached.
+        t: f64,
+        /// Steps taken.
+        steps: u64,
+        /// The time limit.
+        t_max: f64,
+    },
+    /// The ODE reached its time limit without an event.
+    #[error("ODE reached t = {t_max:e} s without the separation or floor event")]
+    NoEvent {
+        /// The time limit.
+        t_max: f64,
+    },
+    /// The next phase's model is not in the registry.
+    #[error("model `{from}` continues with `{name}`, which is not in the registry")]
+    UnknownNextModel {
+        /// This model.
+        from: &'static str,
+        /// The missing model.
+        name: &'static str,
+    },
+    /// A next-phase binding does not fit either model.
+    #[error(
+        "model `{from}` binds {got} values to `{name}`, which takes {expected} parameters (or a binding index is out of range)"
+    )]
+    BadBindings {
+        /// This model.
+        from: &'static str,
+        /// The next model.
+        name: &'static str,
+        /// Parameters of the next model.
+        expected: usize,
+        /// Bindings given.
+        got: usize,
+    },
+    /// The contact point is not a named point of the next phase.
+    #[error("the contact point `{point}` of `{from}` is not a point of the next phase `{name}`")]
+    MissingPoint {
+        /// This model.
+        from: &'static str,
+        /// The next model.
+        name: &'static str,
+        /// The point name.
+        point: &'static str,
+    },
+    /// Phases kept separating without reaching the floor.
+    #[error("more than {limit} phases without reaching the floor")]
+    TooManyPhases {
+        /// The limit.
+        limit: usize,
+    },
+    /// Fewer than two samples asked for a series.
+    #[error("a series needs at least 2 samples, got {samples}")]
+    TooFewSamples {
+        /// Samples asked.
+        samples: usize,
+    },
+}

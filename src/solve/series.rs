@@ -1,0 +1,175 @@
+//! `theta(t)` on a phase at uniform times, by inverting the quadrature `t(u)` (`delta = u^2`).
+//!
+//! The first-order form of the energy integral (the paper's eq. 17,
+//! `theta_dot = -sqrt(theta_dot^2(theta))`) is not integrated: released from rest it also has
+//! the solution `theta == theta_i`, and a step-by-step solver may follow it. Instead each sample
+//! time `T` is matched by safeguarded Newton on `u`, `t(u) = T`, with `dt/du` the quadrature
+//! integrand itself; `t(u)` is smooth in `u`, so Newton converges quadratically.
+
+use crate::results::Work;
+use crate::solve::SolveError;
+use crate::solve::quadrature::{TimeMesh, integrand};
+use crate::system::System;
+
+/// Samples of one phase, uniform in time from its start to its end (both included).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PhaseSamples {
+    /// Time from the phase start (s).
+    pub t: Vec<f64>,
+    /// Angle fallen, `theta_i - theta` (rad).
+    pub delta: Vec<f64>,
+    /// `theta` (rad).
+    pub theta: Vec<f64>,
+    /// `theta_dot` (rad/s, negative while falling).
+    pub theta_dot: Vec<f64>,
+    /// `theta_ddot` (rad/s^2).
+    pub theta_ddot: Vec<f64>,
+}
+
+impl PhaseSamples {
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.t.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.t.is_empty()
+    }
+}
+
+/// `theta_dot` at `delta` on a falling phase: `-sqrt(theta_dot^2)`, and exactly the initial rate
+/// at the start (zero from rest).
+pub fn theta_dot_at(sys: &System, delta: f64) -> f64 {
+    if delta == 0.0 {
+        return sys.theta_dot_initial();
+    }
+    -sys.reduced(delta).theta_dot_sq.max(0.0).sqrt()
+}
+
+/// `samples` points uniform in time over the phase described by `mesh`.
+pub fn sample_phase(
+    sys: &System,
+    mesh: &TimeMesh,
+    samples: usize,
+    work: &mut Work,
+) -> Result<PhaseSamples, SolveError> {
+    if samples < 2 {
+        return Err(SolveError::TooFewSamples { samples });
+    }
+    let mut out = PhaseSamples::default();
+    let (mut u_prev, mut t_prev) = (0.0, 0.0);
+    for j in 0..samples {
+        let (t, delta) = if j == 0 {
+            (0.0, 0.0)
+        } else if j == samples - 1 {
+            (mesh.duration, mesh.delta_end)
+        } else {
+            let target = mesh.duration * j as f64 / (samples - 1) as f64;
+            let u = invert(sys, mesh, target, u_prev, t_prev, work)?;
+            u_prev = u;
+            t_prev = target;
+            (target, u * u)
+        };
+        push(sys, &mut out, t, delta);
+    }
+    Ok(out)
+}
+
+/// The angle fallen at time `t` from the phase start.
+pub fn delta_at_time(
+    sys: &System,
+    mesh: &TimeMesh,
+    t: f64,
+    work: &mut Work,
+) -> Result<f64, SolveError> {
+    if !(t >= 0.0 && t <= mesh.duration) {
+        return Err(SolveError::Inversion {
+            target: t,
+            duration: mesh.duration,
+            reason: "time outside the phase",
+        });
+    }
+    if t == 0.0 {
+        return Ok(0.0);
+    }
+    if t == mesh.duration {
+        return Ok(mesh.delta_end);
+    }
+    let u = invert(sys, mesh, t, 0.0, 0.0, work)?;
+    Ok(u * u)
+}
+
+fn push(sys: &System, out: &mut PhaseSamples, t: f64, delta: f64) {
+    let reduced = sys.reduced(delta);
+    out.t.push(t);
+    out.delta.push(delta);
+    out.theta.push(sys.theta_initial() - delta);
+    out.theta_dot.push(theta_dot_at(sys, delta));
+    out.theta_ddot.push(reduced.theta_ddot);
+}
+
+/// Solves `t(u) = target` for `u` in `[u_lo, u_end]`, knowing `t(u_lo) = t_lo <= target`.
+fn invert(
+    sys: &System,
+    mesh: &TimeMesh,
+    target: f64,
+    u_lo: f64,
+    t_lo: f64,
+    work: &mut Work,
+) -> Result<f64, SolveError> {
+    let fail = |reason| SolveError::Inversion {
+        target,
+        duration: mesh.duration,
+        reason,
+    };
+    let (mut lo, mut hi) = (u_lo, mesh.u_end);
+    // First guess: a Taylor step in delta from the bracket's start.
+    let delta_lo = u_lo * u_lo;
+    let dt = target - t_lo;
+    let guess_delta = if delta_lo == 0.0 {
+        let theta_dot = sys.theta_dot_initial();
+        let theta_ddot = sys.reduced(0.0).theta_ddot;
+        -theta_dot * dt - 0.5 * theta_ddot * dt * dt
+    } else {
+        let r = sys.reduced(delta_lo);
+        delta_lo + r.theta_dot_sq.max(0.0).sqrt() * dt - 0.5 * r.theta_ddot * dt * dt
+    };
+    let mut u = if guess_delta.is_finite() && guess_delta > 0.0 {
+        guess_delta.sqrt()
+    } else {
+        0.5 * (lo + hi)
+    };
+    if !(u > lo && u < hi) {
+        u = 0.5 * (lo + hi);
+    }
+    for _ in 0..200 {
+        let t = mesh.time_at_u(sys, u, work)?;
+        let residual = t - target;
+        if residual == 0.0 {
+            return Ok(u);
+        }
+        if residual < 0.0 {
+            lo = u;
+        } else {
+            hi = u;
+        }
+        work.integrand_evals += 1;
+        let slope = integrand(sys, u, mesh.delta_end)?;
+        let newton = u - residual / slope;
+        let step = (newton - u).abs();
+        if step <= 2.0 * f64::EPSILON * u {
+            return Ok(newton.clamp(lo, hi));
+        }
+        let mid = 0.5 * (lo + hi);
+        if !(mid > lo && mid < hi) {
+            return Ok(u);
+        }
+        u = if newton > lo && newton < hi {
+            newton
+        } else {
+            mid
+        };
+    }
+    Err(fail("Newton on u did not converge in 200 steps"))
+}

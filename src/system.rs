@@ -1,0 +1,452 @@
+//! A model bound to one validated parameter set: the values `p`, the prepared constants `k`,
+//! and typed helpers around the raw [`Model`] calls.
+//!
+//! Architecture invariant: a [`System`] only exists for parameters that passed every check
+//! (all present, finite, positive where declared, every requirement margin `> 0`, every
+//! prepared constant finite), so the solvers never see a NaN that came from the input.
+
+use crate::model::{Model, ModelInfo, Reduced};
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+/// Why a parameter set was refused for a model.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SystemError {
+    /// A parameter the model declares was not given.
+    #[error("model `{model}` needs parameter `{name}`, which was not given")]
+    MissingParameter {
+        /// Model name.
+        model: &'static str,
+        /// The missing parameter.
+        name: &'static str,
+    },
+    /// A parameter the model does not declare was given.
+    #[error("model `{model}` has no parameter `{name}` (given {value}); it takes: {known}")]
+    UnknownParameter {
+        /// Model name.
+        model: &'static str,
+        /// The unknown name.
+        name: String,
+        /// Its value.
+        value: f64,
+        /// The parameters the model takes, comma-separated.
+        known: String,
+    },
+    /// The same parameter was given twice.
+    #[error("parameter `{name}` of model `{model}` given twice ({first} and {second})")]
+    DuplicateParameter {
+        /// Model name.
+        model: &'static str,
+        /// The repeated name.
+        name: String,
+        /// First value.
+        first: f64,
+        /// Second value.
+        second: f64,
+    },
+    /// Ordered values whose count does not match the model's parameter list.
+    #[error("model `{model}` takes {expected} parameters, got {got} values")]
+    WrongCount {
+        /// Model name.
+        model: &'static str,
+        /// Parameters declared.
+        expected: usize,
+        /// Values given.
+        got: usize,
+    },
+    /// NaN or infinite.
+    #[error("parameter `{name}` of model `{model}` is {value}, not a finite number")]
+    NotFinite {
+        /// Model name.
+        model: &'static str,
+        /// Parameter name.
+        name: &'static str,
+        /// The value.
+        value: f64,
+    },
+    /// Zero or negative where the model declares the parameter positive.
+    #[error("parameter `{name}` of model `{model}` is {value}; it must be strictly positive")]
+    NotPositive {
+        /// Model name.
+        model: &'static str,
+        /// Parameter name.
+        name: &'static str,
+        /// The value.
+        value: f64,
+    },
+    /// A requirement margin was not strictly positive (e.g. `a >= ell`).
+    #[error(
+        "model `{model}` requirement `{name}` ({meaning}) fails: margin {margin:e} <= 0 with {parameters}"
+    )]
+    Requirement {
+        /// Model name.
+        model: &'static str,
+        /// Requirement name.
+        name: &'static str,
+        /// What it demands.
+        meaning: &'static str,
+        /// The margin (`<= 0` or NaN).
+        margin: f64,
+        /// The parameters, `name = value` comma-separated.
+        parameters: String,
+    },
+    /// `Model::prepare` produced a non-finite constant (a bug in the model or an extreme input).
+    #[error(
+        "model `{model}` prepared a non-finite constant k[{index}] = {value} from {parameters}"
+    )]
+    BadConstant {
+        /// Model name.
+        model: &'static str,
+        /// Index in `k`.
+        index: usize,
+        /// The value.
+        value: f64,
+        /// The parameters, `name = value` comma-separated.
+        parameters: String,
+    },
+}
+
+/// A full (unreduced) state: coordinates and velocities in the order of
+/// [`ModelInfo::coordinates`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct State {
+    /// Coordinates.
+    pub q: Vec<f64>,
+    /// Velocities.
+    pub qd: Vec<f64>,
+}
+
+/// Positions and velocities of every named point of a model, in the order of
+/// [`ModelInfo::points`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Points {
+    /// Positions `[x, y]` (m).
+    pub pos: Vec<[f64; 2]>,
+    /// Velocities `[vx, vy]` (m/s).
+    pub vel: Vec<[f64; 2]>,
+}
+
+/// A model with a validated parameter set and its prepared constants.
+#[derive(Clone)]
+pub struct System<'m> {
+    model: &'m dyn Model,
+    p: Vec<f64>,
+    k: Vec<f64>,
+}
+
+impl std::fmt::Debug for System<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("System")
+            .field("model", &self.info().name)
+            .field("p", &self.p)
+            .field("k", &self.k)
+            .finish()
+    }
+}
+
+impl<'m> System<'m> {
+    /// Binds named parameter values (any order, each exactly once) to a model.
+    pub fn new<S: AsRef<str>>(
+        model: &'m dyn Model,
+        params: &[(S, f64)],
+    ) -> Result<Self, SystemError> {
+        let info = model.info();
+        let mut values: Vec<Option<f64>> = vec![None; info.parameters.len()];
+        for (name, value) in params {
+            let name = name.as_ref();
+            let Some(i) = info.parameters.iter().position(|p| p.name == name) else {
+                return Err(SystemError::UnknownParameter {
+                    model: info.name,
+                    name: name.to_string(),
+                    value: *value,
+                    known: info
+                        .parameters
+                        .iter()
+                        .map(|p| p.name)
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                });
+            };
+            if let Some(first) = values[i] {
+                return Err(SystemError::DuplicateParameter {
+                    model: info.name,
+                    name: name.to_string(),
+                    first,
+                    second: *value,
+                });
+            }
+            values[i] = Some(*value);
+        }
+        let mut p = Vec::with_capacity(values.len());
+        for (v, param) in values.iter().zip(info.parameters) {
+            match v {
+                Some(v) => p.push(*v),
+                None => {
+                    return Err(SystemError::MissingParameter {
+                        model: info.name,
+                        name: param.name,
+                    });
+                }
+            }
+        }
+        Self::from_values(model, &p)
+    }
+
+    /// Binds a map of named parameter values to a model.
+    pub fn from_map(
+        model: &'m dyn Model,
+        params: &BTreeMap<String, f64>,
+    ) -> Result<Self, SystemError> {
+        let pairs: Vec<(&str, f64)> = params.iter().map(|(k, v)| (k.as_str(), *v)).collect();
+        Self::new(model, &pairs)
+    }
+
+    /// Binds parameter values given in the order of [`ModelInfo::parameters`].
+    pub fn from_values(model: &'m dyn Model, p: &[f64]) -> Result<Self, SystemError> {
+        let info = model.info();
+        if p.len() != info.parameters.len() {
+            return Err(SystemError::WrongCount {
+                model: info.name,
+                expected: info.parameters.len(),
+                got: p.len(),
+            });
+        }
+        for (&value, param) in p.iter().zip(info.parameters) {
+            if !value.is_finite() {
+                return Err(SystemError::NotFinite {
+                    model: info.name,
+                    name: param.name,
+                    value,
+                });
+            }
+            if param.positive && value <= 0.0 {
+                return Err(SystemError::NotPositive {
+                    model: info.name,
+                    name: param.name,
+                    value,
+                });
+            }
+        }
+        let mut margins = vec![0.0; info.requirements.len()];
+        model.requirements(p, &mut margins);
+        for (&margin, req) in margins.iter().zip(info.requirements) {
+            if margin.is_nan() || margin <= 0.0 {
+                return Err(SystemError::Requirement {
+                    model: info.name,
+                    name: req.name,
+                    meaning: req.meaning,
+                    margin,
+                    parameters: describe(info, p),
+                });
+            }
+        }
+        let mut k = vec![0.0; info.n_constants];
+        model.prepare(p, &mut k);
+        if let Some((index, &value)) = k.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(SystemError::BadConstant {
+                model: info.name,
+                index,
+                value,
+                parameters: describe(info, p),
+            });
+        }
+        Ok(System {
+            model,
+            p: p.to_vec(),
+            k,
+        })
+    }
+
+    /// The model.
+    pub fn model(&self) -> &'m dyn Model {
+        self.model
+    }
+
+    /// The model's static description.
+    pub fn info(&self) -> &'static ModelInfo {
+        self.model.info()
+    }
+
+    /// Model name.
+    pub fn name(&self) -> &'static str {
+        self.info().name
+    }
+
+    /// Parameter values in the model's order.
+    pub fn p(&self) -> &[f64] {
+        &self.p
+    }
+
+    /// Prepared constants.
+    pub fn k(&self) -> &[f64] {
+        &self.k
+    }
+
+    /// The value of a parameter by name.
+    pub fn param(&self, name: &str) -> Option<f64> {
+        self.info()
+            .parameters
+            .iter()
+            .position(|p| p.name == name)
+            .map(|i| self.p[i])
+    }
+
+    /// The parameters by name.
+    pub fn parameter_map(&self) -> BTreeMap<String, f64> {
+        self.info()
+            .parameters
+            .iter()
+            .zip(&self.p)
+            .map(|(p, v)| (p.name.to_string(), *v))
+            .collect()
+    }
+
+    /// `name = value` pairs, comma-separated, for messages.
+    pub fn describe(&self) -> String {
+        describe(self.info(), &self.p)
+    }
+
+    /// Gravitational acceleration (m/s^2).
+    pub fn gravity(&self) -> f64 {
+        self.p[self.info().gravity]
+    }
+
+    /// Initial reduced angle `theta_i` (rad).
+    pub fn theta_initial(&self) -> f64 {
+        self.k[self.info().k_theta_initial]
+    }
+
+    /// Initial reduced rate `theta_dot_i` (rad/s); zero for a release from rest.
+    pub fn theta_dot_initial(&self) -> f64 {
+        self.k[self.info().k_theta_dot_initial]
+    }
+
+    /// Whether the motion starts from rest (`theta_dot_i == 0`).
+    pub fn starts_at_rest(&self) -> bool {
+        self.theta_dot_initial() == 0.0
+    }
+
+    /// The angle where the motion ends (rod on the floor).
+    pub fn end_angle(&self) -> f64 {
+        self.info().end_angle
+    }
+
+    /// `theta_i - end_angle`: the angle fallen when the rod reaches the floor.
+    pub fn delta_to_floor(&self) -> f64 {
+        self.theta_initial() - self.end_angle()
+    }
+
+    /// Reduced state at `delta = theta_i - theta`.
+    pub fn reduced(&self, delta: f64) -> Reduced {
+        self.model.reduced(&self.k, delta)
+    }
+
+    /// Reduced state at an angle `theta` (loses the cancellation-free form near the start:
+    /// prefer [`System::reduced`] with `delta`).
+    pub fn reduced_at_theta(&self, theta: f64) -> Reduced {
+        self.reduced(self.theta_initial() - theta)
+    }
+
+    /// Reaction forces at `delta` in the order of [`ModelInfo::forces`].
+    pub fn forces(&self, delta: f64) -> Vec<f64> {
+        let mut out = vec![0.0; self.info().forces.len()];
+        self.model.forces(&self.k, delta, &mut out);
+        out
+    }
+
+    /// Monitor values at `delta` in the order of [`ModelInfo::monitors`].
+    pub fn monitors(&self, delta: f64) -> Vec<f64> {
+        let mut out = vec![0.0; self.info().monitors.len()];
+        self.model.monitors(&self.k, delta, &mut out);
+        out
+    }
+
+    /// Coefficients of the separation polynomial in `sin(theta)`, lowest degree first.
+    pub fn separation_coefficients(&self) -> Vec<f64> {
+        let mut out = vec![0.0; self.info().separation_degree + 1];
+        self.model.separation_polynomial(&self.k, &mut out);
+        out
+    }
+
+    /// Number of unreduced coordinates.
+    pub fn n_coordinates(&self) -> usize {
+        self.info().coordinates.len()
+    }
+
+    /// The full state on the reduced motion at phase time `t`, angle fallen `delta` and rate
+    /// `theta_dot`.
+    pub fn full_state(&self, t: f64, delta: f64, theta_dot: f64) -> State {
+        let n = self.n_coordinates();
+        let mut state = State {
+            q: vec![0.0; n],
+            qd: vec![0.0; n],
+        };
+        self.model
+            .full_state(&self.k, t, delta, theta_dot, &mut state.q, &mut state.qd);
+        state
+    }
+
+    /// The state at release (`t = 0`, `delta = 0`, `theta_dot = theta_dot_i`).
+    pub fn initial_state(&self) -> State {
+        self.full_state(0.0, 0.0, self.theta_dot_initial())
+    }
+
+    /// Positions and velocities of the named points.
+    pub fn points(&self, state: &State) -> Points {
+        let m = self.info().points.len();
+        let mut pts = Points {
+            pos: vec![[0.0; 2]; m],
+            vel: vec![[0.0; 2]; m],
+        };
+        self.model
+            .points(&self.k, &state.q, &state.qd, &mut pts.pos, &mut pts.vel);
+        pts
+    }
+
+    /// Index of a named point.
+    pub fn point_index(&self, name: &str) -> Option<usize> {
+        self.info().points.iter().position(|p| p.name == name)
+    }
+
+    /// Total energy of a full state.
+    pub fn energy(&self, state: &State) -> f64 {
+        self.model.energy(&self.k, &state.q, &state.qd)
+    }
+
+    /// Momenta conjugate to the cyclic coordinates.
+    pub fn momenta(&self, state: &State) -> Vec<f64> {
+        let mut out = vec![0.0; self.info().cyclic.len()];
+        self.model.momenta(&self.k, &state.q, &state.qd, &mut out);
+        out
+    }
+
+    /// The mass matrix (row-major) and right-hand side of `M(q) qdd = F(q, qd)`.
+    pub fn equations(&self, state: &State) -> (Vec<f64>, Vec<f64>) {
+        let n = self.n_coordinates();
+        let mut mass = vec![0.0; n * n];
+        let mut rhs = vec![0.0; n];
+        self.model
+            .equations(&self.k, &state.q, &state.qd, &mut mass, &mut rhs);
+        (mass, rhs)
+    }
+
+    /// Reaction forces from a full state and its accelerations.
+    pub fn forces_full(&self, state: &State, qdd: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; self.info().forces.len()];
+        self.model
+            .forces_full(&self.k, &state.q, &state.qd, qdd, &mut out);
+        out
+    }
+}
+
+/// `name = value` pairs for messages.
+fn describe(info: &ModelInfo, p: &[f64]) -> String {
+    let mut out = String::new();
+    for (i, (param, v)) in info.parameters.iter().zip(p).enumerate() {
+        if i > 0 {
+            out.push_str(", ");
+        }
+        let _ = write!(out, "{} = {v}", param.name);
+    }
+    out
+}

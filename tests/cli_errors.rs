@@ -1,0 +1,232 @@
+//! The `rodcube` binary on invalid input that needs no generated model: each error exits with
+//! its documented status and names file:line:column and the field on stderr, with nothing on
+//! stdout; `--help` shows examples. (Errors that need a real model are in cli_end_to_end.rs.)
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const EXIT_USAGE: i32 = 2;
+const EXIT_SCENE: i32 = 3;
+
+/// A fresh, empty directory for one test.
+fn fresh(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("cli_errors")
+        .join(name);
+    let _ = fs::remove_dir_all(&dir);
+    fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Runs `rodcube run <scene>` on `text` written to `<test>/scene.yaml`, inside that directory.
+fn run_scene(test: &str, text: &str) -> Output {
+    let dir = fresh(test);
+    fs::write(dir.join("scene.yaml"), text).unwrap();
+    Command::new(env!("CARGO_BIN_EXE_rodcube"))
+        .current_dir(&dir)
+        .args(["run", "scene.yaml"])
+        .output()
+        .unwrap()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Asserts a scene error: status 3, empty stdout, and every `needle` on stderr.
+fn scene_error(o: &Output, needles: &[&str]) {
+    let err = stderr(o);
+    assert_eq!(o.status.code(), Some(EXIT_SCENE), "stderr:\n{err}");
+    assert!(o.stdout.is_empty(), "stdout must stay empty on error");
+    for n in needles {
+        assert!(err.contains(n), "missing {n:?} in stderr:\n{err}");
+    }
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+const PARAMS: &str = "parameters: {m1: 1.0, m2: 3.0, ell: 1.0, a: 0.25, g: 9.81}\n";
+
+#[test]
+fn yaml_syntax_error() {
+    let o = run_scene(
+        "syntax",
+        "model: rod_cube\nwant: [separation_angle\nsamples: 10\n",
+    );
+    scene_error(&o, &["error[syntax]", "--> scene.yaml:", "invalid YAML"]);
+}
+
+#[test]
+fn unknown_key() {
+    let o = run_scene(
+        "unknown_key",
+        &format!("model: rod_cube\n{PARAMS}want: [separation_angle]\nsample: 10\n"),
+    );
+    scene_error(
+        &o,
+        &[
+            "error[unknown-key]: sample: unknown key `sample`",
+            "--> scene.yaml:4:1",
+            "4 | sample: 10",
+        ],
+    );
+}
+
+#[test]
+fn unknown_model_lists_the_available_ones() {
+    let o = run_scene(
+        "unknown_model",
+        &format!("model: rod_cubo\n{PARAMS}want: [separation_angle]\n"),
+    );
+    scene_error(
+        &o,
+        &[
+            "error[unknown-model]: model: unknown model `rod_cubo`",
+            "--> scene.yaml:1:8",
+            "available models: ",
+        ],
+    );
+}
+
+#[test]
+fn tolerance_out_of_range() {
+    let o = run_scene(
+        "tolerance",
+        &format!("model: rod_cube\n{PARAMS}want: [separation_angle]\ntolerance: 2.0\n"),
+    );
+    scene_error(
+        &o,
+        &[
+            "error[out-of-range]: tolerance: must be between",
+            "--> scene.yaml:4:12",
+        ],
+    );
+}
+
+#[test]
+fn tolerance_not_finite() {
+    let o = run_scene(
+        "tolerance_nan",
+        &format!("model: rod_cube\n{PARAMS}want: [separation_angle]\n\ntolerance: .nan\n"),
+    );
+    scene_error(
+        &o,
+        &[
+            "error[not-finite]: tolerance: must be a finite number, not .nan",
+            "--> scene.yaml:5:12",
+        ],
+    );
+}
+
+#[test]
+fn samples_out_of_range() {
+    let o = run_scene(
+        "samples",
+        &format!("model: rod_cube\nsamples: 1\n{PARAMS}want: [separation_angle]\n"),
+    );
+    scene_error(
+        &o,
+        &[
+            "error[out-of-range]: samples: must be between 2 and",
+            "--> scene.yaml:2:10",
+        ],
+    );
+}
+
+#[test]
+fn wrong_type() {
+    let o = run_scene(
+        "wrong_type",
+        &format!("model: rod_cube\n{PARAMS}want: separation_angle\n"),
+    );
+    scene_error(&o, &["error[structure]: want: ", "--> scene.yaml:3:7"]);
+}
+
+#[test]
+fn missing_scene_file() {
+    let dir = fresh("missing");
+    let o = Command::new(env!("CARGO_BIN_EXE_rodcube"))
+        .current_dir(&dir)
+        .args(["run", "nope.yaml"])
+        .output()
+        .unwrap();
+    scene_error(
+        &o,
+        &["error[read]", "--> nope.yaml", "cannot read the scene"],
+    );
+}
+
+#[test]
+fn default_scene_is_scenes_paper_yaml() {
+    // From a directory without scenes/, the default scene cannot be read, and says which it is.
+    let dir = fresh("default_scene");
+    let o = Command::new(env!("CARGO_BIN_EXE_rodcube"))
+        .current_dir(&dir)
+        .arg("run")
+        .output()
+        .unwrap();
+    scene_error(&o, &["scenes/paper.yaml"]);
+}
+
+#[test]
+fn bad_command_line_is_a_usage_error() {
+    let o = Command::new(env!("CARGO_BIN_EXE_rodcube"))
+        .args(["run", "--colour"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(EXIT_USAGE), "{}", stderr(&o));
+    let o = Command::new(env!("CARGO_BIN_EXE_rodcube"))
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(EXIT_USAGE),
+        "no subcommand: {}",
+        stderr(&o)
+    );
+}
+
+#[test]
+fn help_shows_examples_and_exit_statuses() {
+    let o = Command::new(env!("CARGO_BIN_EXE_rodcube"))
+        .arg("--help")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0));
+    let out = String::from_utf8_lossy(&o.stdout);
+    for want in [
+        "Examples:",
+        "rodcube run scenes/hinged.yaml",
+        "rodcube models",
+        "3 invalid scene",
+        "run",
+        "models",
+    ] {
+        assert!(out.contains(want), "missing {want:?} in\n{out}");
+    }
+    let o = Command::new(env!("CARGO_BIN_EXE_rodcube"))
+        .args(["run", "--help"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0));
+    let out = String::from_utf8_lossy(&o.stdout);
+    for want in [
+        "--json",
+        "--out <DIR>",
+        "scenes/paper.yaml",
+        "want:",
+        "tolerance:",
+    ] {
+        assert!(out.contains(want), "missing {want:?} in\n{out}");
+    }
+}
+
+#[test]
+fn models_lists_without_failing() {
+    let o = Command::new(env!("CARGO_BIN_EXE_rodcube"))
+        .arg("models")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(!o.stdout.is_empty());
+}

@@ -1,0 +1,474 @@
+//! Hand-typed models of the seed paper, for testing the solvers before (and independently of)
+//! the generated ones: `rod_cube` from eqs. (5), (9), (12 as corrected in PHYSICS.md erratum 2),
+//! (14), (16), (18), (22), and `free_rod`, the rod sliding alone after it leaves the cube.
+//!
+//! Both follow the `k`/`delta` conventions of `rodcube::model`; every `sin(theta_i) - sin(theta)`
+//! and `cos(theta) - cos(theta_i)` is formed from `delta` without cancellation.
+
+use rodcube::model::{
+    Binding, ContactInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
+};
+
+const fn param(
+    name: &'static str,
+    meaning: &'static str,
+    unit: &'static str,
+    positive: bool,
+) -> ParamInfo {
+    ParamInfo {
+        name,
+        meaning,
+        unit,
+        positive,
+    }
+}
+
+const fn named(name: &'static str, meaning: &'static str) -> NamedInfo {
+    NamedInfo { name, meaning }
+}
+
+/// `sin(theta_i) - sin(theta_i - delta)` from `sin(theta_i)`, `cos(theta_i)`.
+fn sin_drop(s0: f64, c0: f64, delta: f64) -> f64 {
+    let h = (0.5 * delta).sin();
+    s0 * 2.0 * h * h + c0 * delta.sin()
+}
+
+/// `cos(theta_i - delta) - cos(theta_i)` from `sin(theta_i)`, `cos(theta_i)`.
+fn cos_rise(s0: f64, c0: f64, delta: f64) -> f64 {
+    let h = (0.5 * delta).sin();
+    s0 * delta.sin() - c0 * 2.0 * h * h
+}
+
+// ---------------------------------------------------------------------------------------------
+// rod_cube
+// ---------------------------------------------------------------------------------------------
+
+/// The rod leaning on a cube that slides on a frictionless floor (the paper's system).
+pub struct RodCube;
+
+/// The `rod_cube` model.
+pub static ROD_CUBE: RodCube = RodCube;
+
+// k layout
+const RC_THETA_I: usize = 5;
+const RC_THETA_DOT_I: usize = 6;
+const RC_R: usize = 7; // a / ell = sin(theta_i)
+const RC_C0: usize = 8; // cos(theta_i)
+const RC_MU: usize = 9; // 1 / (1 + n) = m1 / (m1 + m2)
+const RC_G_ELL: usize = 10; // g / ell
+const RC_KX: usize = 11; // (1 + 2n) / (2 (1 + n))
+
+static RC_INFO: ModelInfo = ModelInfo {
+    name: "rod_cube",
+    description: "uniform rod leaning on a sliding cube, frictionless floor (hand-typed from the paper)",
+    spec: "tests/common/paper.rs",
+    parameters: &[
+        param("m1", "rod mass", "kg", true),
+        param("m2", "cube mass", "kg", true),
+        param("ell", "rod length", "m", true),
+        param("a", "cube side", "m", true),
+        param("g", "gravitational acceleration", "m/s^2", true),
+    ],
+    requirements: &[named(
+        "a_below_ell",
+        "the cube is lower than the rod is long: (ell - a) / ell > 0",
+    )],
+    n_constants: 12,
+    k_theta_initial: RC_THETA_I,
+    k_theta_dot_initial: RC_THETA_DOT_I,
+    coordinates: &["x1", "theta"],
+    reduced: 1,
+    cyclic: &[0],
+    end_angle: 0.0,
+    forces: &[
+        named(
+            "contact_force",
+            "push of the rod on the cube (N), positive while touching, eq. (16)",
+        ),
+        named(
+            "floor_normal",
+            "floor reaction on the rod's foot (N), m1 (g + y_cm'')",
+        ),
+    ],
+    contact: Some(ContactInfo {
+        force: 0,
+        point: 1,
+        surface: 3,
+        normal: [1.0, 0.0],
+        surface_moves: true,
+    }),
+    separation_degree: 3,
+    points: &[
+        named("foot", "rod end on the floor"),
+        named("tip", "rod end on the cube"),
+        named("rod_centre", "rod centre of mass"),
+        named("cube", "cube's bottom-left corner"),
+    ],
+    falling_point: 2,
+    gravity: 4,
+    monitors: &[
+        named("foot_on_floor", "floor normal force on the foot >= 0 (N)"),
+        named("cube_does_not_tip", "m2 g a/2 - F (ell s - a/2) >= 0 (N m)"),
+    ],
+    next_phase: Some(NextPhase {
+        model: "free_rod",
+        bindings: &[
+            Binding::Param(0),
+            Binding::Param(2),
+            Binding::Param(4),
+            Binding::Coordinate(1),
+            Binding::Velocity(1),
+            Binding::Coordinate(0),
+            Binding::Velocity(0),
+        ],
+    }),
+};
+
+impl RodCube {
+    fn sc(k: &[f64], delta: f64) -> (f64, f64) {
+        let theta = k[RC_THETA_I] - delta;
+        (theta.sin(), theta.cos())
+    }
+
+    /// `M11, M12, M22` of the unreduced Lagrangian (eq. 3 with I = m1 ell^2 / 12).
+    fn mass(k: &[f64], s: f64) -> (f64, f64, f64) {
+        let (m1, m2, ell) = (k[0], k[1], k[2]);
+        (
+            m1 + m2,
+            -ell * s * (0.5 * m1 + m2),
+            m1 * ell * ell / 3.0 + m2 * ell * ell * s * s,
+        )
+    }
+}
+
+impl Model for RodCube {
+    fn info(&self) -> &'static ModelInfo {
+        &RC_INFO
+    }
+
+    fn requirements(&self, p: &[f64], out: &mut [f64]) {
+        out[0] = (p[2] - p[3]) / p[2];
+    }
+
+    fn prepare(&self, p: &[f64], k: &mut [f64]) {
+        let (m1, m2, ell, a, g) = (p[0], p[1], p[2], p[3], p[4]);
+        k[..5].copy_from_slice(p);
+        // cos(theta_i) = sqrt((ell - a)(ell + a)) / ell: no loss as a/ell -> 1.
+        let c0 = ((ell - a) * (ell + a)).sqrt() / ell;
+        k[RC_THETA_I] = a.atan2(((ell - a) * (ell + a)).sqrt());
+        k[RC_THETA_DOT_I] = 0.0;
+        k[RC_R] = a / ell;
+        k[RC_C0] = c0;
+        k[RC_MU] = m1 / (m1 + m2);
+        k[RC_G_ELL] = g / ell;
+        k[RC_KX] = (0.5 * m1 + m2) / (m1 + m2);
+    }
+
+    fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
+        let (s, c) = Self::sc(k, delta);
+        let (r, mu, g_ell) = (k[RC_R], k[RC_MU], k[RC_G_ELL]);
+        let drop = sin_drop(r, k[RC_C0], delta); // r - s
+        let d = 4.0 / 3.0 - mu * s * s;
+        let theta_dot_sq = 4.0 * g_ell * drop / d; // eq. (9)
+        // PHYSICS.md erratum 2: theta'' = (2g/ell) [ -c/D + (r - s) sin(2 theta) / ((1+n) D^2) ]
+        let theta_ddot = 2.0 * g_ell * (-c / d + drop * 2.0 * s * c * mu / (d * d));
+        Reduced {
+            sin: s,
+            cos: c,
+            theta_dot_sq,
+            theta_ddot,
+        }
+    }
+
+    fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
+        let (m1, m2, ell, g) = (k[0], k[1], k[2], k[4]);
+        let red = self.reduced(k, delta);
+        let (s, c) = (red.sin, red.cos);
+        let (r, mu) = (k[RC_R], k[RC_MU]);
+        // eq. (16) divided through by (1 + n)^2
+        let den = 4.0 - 3.0 * mu * s * s;
+        out[0] = -3.0 * g * m2 * mu * c * (8.0 * r - 12.0 * s + 3.0 * mu * s * s * s) / (den * den);
+        out[1] = m1 * (g + 0.5 * ell * (c * red.theta_ddot - s * red.theta_dot_sq));
+    }
+
+    fn monitors(&self, k: &[f64], delta: f64, out: &mut [f64]) {
+        let mut f = [0.0; 2];
+        self.forces(k, delta, &mut f);
+        let (m2, ell, a, g) = (k[1], k[2], k[3], k[4]);
+        let (s, _) = Self::sc(k, delta);
+        out[0] = f[1];
+        out[1] = m2 * g * a / 2.0 - f[0] * (ell * s - a / 2.0);
+    }
+
+    fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
+        // eq. (14) divided by (1 + n)
+        out.copy_from_slice(&[8.0 * k[RC_R], -12.0, 0.0, 3.0 * k[RC_MU]]);
+    }
+
+    fn full_state(
+        &self,
+        k: &[f64],
+        _t: f64,
+        delta: f64,
+        theta_dot: f64,
+        q: &mut [f64],
+        qd: &mut [f64],
+    ) {
+        let (s, _) = Self::sc(k, delta);
+        let ell = k[2];
+        // eq. (18): x1 = -(1+2n)/(2(1+n)) ell (cos theta - cos theta_i); eq. (5) for x1'.
+        q[0] = -k[RC_KX] * ell * cos_rise(k[RC_R], k[RC_C0], delta);
+        q[1] = k[RC_THETA_I] - delta;
+        qd[0] = k[RC_KX] * ell * s * theta_dot;
+        qd[1] = theta_dot;
+    }
+
+    fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
+        let ell = k[2];
+        let (x1, th, v1, w) = (q[0], q[1], qd[0], qd[1]);
+        let (s, c) = (th.sin(), th.cos());
+        pos[0] = [x1, 0.0];
+        vel[0] = [v1, 0.0];
+        pos[1] = [x1 + ell * c, ell * s];
+        vel[1] = [v1 - ell * s * w, ell * c * w];
+        pos[2] = [x1 + 0.5 * ell * c, 0.5 * ell * s];
+        vel[2] = [v1 - 0.5 * ell * s * w, 0.5 * ell * c * w];
+        pos[3] = [x1 + ell * c, 0.0];
+        vel[3] = [v1 - ell * s * w, 0.0];
+    }
+
+    fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
+        let (m1, m2, ell, a, g) = (k[0], k[1], k[2], k[3], k[4]);
+        let s = q[1].sin();
+        let (m11, m12, m22) = Self::mass(k, s);
+        let (v, w) = (qd[0], qd[1]);
+        0.5 * (m11 * v * v + 2.0 * m12 * v * w + m22 * w * w)
+            + m1 * g * ell * s / 2.0
+            + m2 * g * a / 2.0
+    }
+
+    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let (m11, m12, _) = Self::mass(k, q[1].sin());
+        out[0] = m11 * qd[0] + m12 * qd[1];
+    }
+
+    fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
+        let (m1, m2, ell, g) = (k[0], k[1], k[2], k[4]);
+        let (s, c) = (q[1].sin(), q[1].cos());
+        let (m11, m12, m22) = Self::mass(k, s);
+        let w = qd[1];
+        mass.copy_from_slice(&[m11, m12, m12, m22]);
+        rhs[0] = ell * c * (0.5 * m1 + m2) * w * w;
+        rhs[1] = -m2 * ell * ell * s * c * w * w - m1 * g * ell * c / 2.0;
+    }
+
+    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+        let (m1, m2, ell, g) = (k[0], k[1], k[2], k[4]);
+        let (s, c) = (q[1].sin(), q[1].cos());
+        let (w, x1dd, wd) = (qd[1], qdd[0], qdd[1]);
+        // F = m2 x2'', x2 = x1 + ell cos(theta)
+        out[0] = m2 * (x1dd - ell * s * wd - ell * c * w * w);
+        out[1] = m1 * (g + 0.5 * ell * (c * wd - s * w * w));
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// free_rod
+// ---------------------------------------------------------------------------------------------
+
+/// The rod alone, its foot sliding on the frictionless floor, after it left the cube.
+pub struct FreeRod;
+
+/// The `free_rod` model.
+pub static FREE_ROD: FreeRod = FreeRod;
+
+const FR_THETA_I: usize = 7;
+const FR_THETA_DOT_I: usize = 8;
+const FR_S0: usize = 9;
+const FR_C0: usize = 10;
+const FR_G_ELL: usize = 11;
+const FR_VCM: usize = 12; // constant horizontal velocity of the centre of mass
+const FR_A0: usize = 13; // omega_s^2 (1 + 3 cos^2 theta_s)
+
+static FR_INFO: ModelInfo = ModelInfo {
+    name: "free_rod",
+    description: "uniform rod sliding on a frictionless floor after leaving the cube (hand-typed)",
+    spec: "tests/common/paper.rs",
+    parameters: &[
+        param("m1", "rod mass", "kg", true),
+        param("ell", "rod length", "m", true),
+        param("g", "gravitational acceleration", "m/s^2", true),
+        param("theta_s", "angle at separation", "rad", false),
+        param("omega_s", "angular velocity at separation", "rad/s", false),
+        param("x1_s", "foot position at separation", "m", false),
+        param("v1_s", "foot velocity at separation", "m/s", false),
+    ],
+    requirements: &[
+        named("above_floor", "theta_s > 0"),
+        named("below_vertical", "pi/2 - theta_s > 0"),
+    ],
+    n_constants: 14,
+    k_theta_initial: FR_THETA_I,
+    k_theta_dot_initial: FR_THETA_DOT_I,
+    coordinates: &["x1", "theta"],
+    reduced: 1,
+    cyclic: &[0],
+    end_angle: 0.0,
+    forces: &[named(
+        "floor_normal",
+        "floor reaction on the rod's foot (N)",
+    )],
+    contact: None,
+    separation_degree: 0,
+    points: &[
+        named("foot", "rod end on the floor"),
+        named("tip", "free rod end"),
+        named("rod_centre", "rod centre of mass"),
+    ],
+    falling_point: 2,
+    gravity: 2,
+    monitors: &[named(
+        "foot_on_floor",
+        "floor normal force on the foot >= 0 (N)",
+    )],
+    next_phase: None,
+};
+
+impl FreeRod {
+    fn sc(k: &[f64], delta: f64) -> (f64, f64) {
+        let theta = k[FR_THETA_I] - delta;
+        (theta.sin(), theta.cos())
+    }
+}
+
+impl Model for FreeRod {
+    fn info(&self) -> &'static ModelInfo {
+        &FR_INFO
+    }
+
+    fn requirements(&self, p: &[f64], out: &mut [f64]) {
+        out[0] = p[3];
+        out[1] = std::f64::consts::FRAC_PI_2 - p[3];
+    }
+
+    fn prepare(&self, p: &[f64], k: &mut [f64]) {
+        let (ell, g, th, om, v1) = (p[1], p[2], p[3], p[4], p[6]);
+        k[..7].copy_from_slice(p);
+        let (s0, c0) = th.sin_cos();
+        k[FR_THETA_I] = th;
+        k[FR_THETA_DOT_I] = om;
+        k[FR_S0] = s0;
+        k[FR_C0] = c0;
+        k[FR_G_ELL] = g / ell;
+        k[FR_VCM] = v1 - 0.5 * ell * s0 * om;
+        k[FR_A0] = om * om * (1.0 + 3.0 * c0 * c0);
+    }
+
+    fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
+        let (s, c) = Self::sc(k, delta);
+        // Energy of the rod about its centre (the centre's horizontal velocity is constant):
+        // theta'^2 (1 + 3 c^2) = omega_s^2 (1 + 3 c_s^2) + 12 (g/ell) (s_s - s)
+        let b = 1.0 + 3.0 * c * c;
+        let theta_dot_sq =
+            (k[FR_A0] + 12.0 * k[FR_G_ELL] * sin_drop(k[FR_S0], k[FR_C0], delta)) / b;
+        let theta_ddot = c * (3.0 * s * theta_dot_sq - 6.0 * k[FR_G_ELL]) / b;
+        Reduced {
+            sin: s,
+            cos: c,
+            theta_dot_sq,
+            theta_ddot,
+        }
+    }
+
+    fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
+        let (m1, ell, g) = (k[0], k[1], k[2]);
+        let r = self.reduced(k, delta);
+        out[0] = m1 * (g + 0.5 * ell * (r.cos * r.theta_ddot - r.sin * r.theta_dot_sq));
+    }
+
+    fn monitors(&self, k: &[f64], delta: f64, out: &mut [f64]) {
+        self.forces(k, delta, out);
+    }
+
+    fn separation_polynomial(&self, _k: &[f64], out: &mut [f64]) {
+        out[0] = 1.0;
+    }
+
+    fn full_state(
+        &self,
+        k: &[f64],
+        t: f64,
+        delta: f64,
+        theta_dot: f64,
+        q: &mut [f64],
+        qd: &mut [f64],
+    ) {
+        let (s, _) = Self::sc(k, delta);
+        let (ell, x1s, vcm) = (k[1], k[5], k[FR_VCM]);
+        q[0] = x1s + vcm * t - 0.5 * ell * cos_rise(k[FR_S0], k[FR_C0], delta);
+        q[1] = k[FR_THETA_I] - delta;
+        qd[0] = vcm + 0.5 * ell * s * theta_dot;
+        qd[1] = theta_dot;
+    }
+
+    fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
+        let ell = k[1];
+        let (x1, th, v1, w) = (q[0], q[1], qd[0], qd[1]);
+        let (s, c) = (th.sin(), th.cos());
+        pos[0] = [x1, 0.0];
+        vel[0] = [v1, 0.0];
+        pos[1] = [x1 + ell * c, ell * s];
+        vel[1] = [v1 - ell * s * w, ell * c * w];
+        pos[2] = [x1 + 0.5 * ell * c, 0.5 * ell * s];
+        vel[2] = [v1 - 0.5 * ell * s * w, 0.5 * ell * c * w];
+    }
+
+    fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
+        let (m1, ell, g) = (k[0], k[1], k[2]);
+        let s = q[1].sin();
+        let (v, w) = (qd[0], qd[1]);
+        0.5 * m1 * v * v - 0.5 * m1 * ell * s * v * w
+            + m1 * ell * ell * w * w / 6.0
+            + m1 * g * ell * s / 2.0
+    }
+
+    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let (m1, ell) = (k[0], k[1]);
+        out[0] = m1 * qd[0] - 0.5 * m1 * ell * q[1].sin() * qd[1];
+    }
+
+    fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
+        let (m1, ell, g) = (k[0], k[1], k[2]);
+        let (s, c) = (q[1].sin(), q[1].cos());
+        let w = qd[1];
+        let m12 = -0.5 * m1 * ell * s;
+        mass.copy_from_slice(&[m1, m12, m12, m1 * ell * ell / 3.0]);
+        rhs[0] = 0.5 * m1 * ell * c * w * w;
+        rhs[1] = -0.5 * m1 * g * ell * c;
+    }
+
+    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+        let (m1, ell, g) = (k[0], k[1], k[2]);
+        let (s, c) = (q[1].sin(), q[1].cos());
+        out[0] = m1 * (g + 0.5 * ell * (c * qdd[1] - s * qd[1] * qd[1]));
+    }
+}
+
+/// The local registry: what `rodcube::models::all()` will hold once the generated models exist.
+pub static MODELS: &[&dyn Model] = &[&ROD_CUBE, &FREE_ROD];
+
+/// The paper's parameters (n = 3, r = 1/4, ell = 1 m) with a chosen `g`.
+pub fn paper(g: f64) -> [(&'static str, f64); 5] {
+    [
+        ("m1", 1.0),
+        ("m2", 3.0),
+        ("ell", 1.0),
+        ("a", 0.25),
+        ("g", g),
+    ]
+}
+
+/// Parameters for mass ratio `n` and `r = a/ell` (ell = 1 m, m1 = 1 kg, g = 9.81).
+pub fn ratios(n: f64, r: f64) -> [(&'static str, f64); 5] {
+    [("m1", 1.0), ("m2", n), ("ell", 1.0), ("a", r), ("g", 9.81)]
+}

@@ -1,0 +1,125 @@
+//! The unreduced ODE route (DOPRI5 with event location) against the quadrature route: the
+//! separation time, the state along the way, and conservation along the ODE path.
+
+mod common;
+
+use common::paper::{FREE_ROD, ROD_CUBE, paper, ratios};
+use rodcube::results::Work;
+use rodcube::solve::checks;
+use rodcube::solve::quadrature::TimeMesh;
+use rodcube::solve::separation::separation;
+use rodcube::solve::series::{delta_at_time, theta_dot_at};
+use rodcube::solve::unreduced::{EndEvent, integrate};
+use rodcube::system::{State, System};
+
+fn quadrature_separation(sys: &System) -> (f64, TimeMesh) {
+    let de = separation(sys, &mut Work::default())
+        .unwrap()
+        .separation()
+        .unwrap()
+        .delta;
+    let mesh = TimeMesh::build(sys, de, 1e-14, &mut Work::default()).unwrap();
+    (mesh.duration, mesh)
+}
+
+#[test]
+fn separation_time_agrees_with_quadrature_and_converges() {
+    let sys = System::new(&ROD_CUBE, &paper(9.81)).unwrap();
+    let (t_quad, _) = quadrature_separation(&sys);
+    let mut last = f64::INFINITY;
+    for rtol in [1e-6, 1e-8, 1e-10, 1e-12, 1e-13] {
+        let mut work = Work::default();
+        let run = integrate(&sys, rtol, None, 1.0, &mut work).unwrap();
+        assert_eq!(run.end, EndEvent::Separation);
+        let rel = ((run.t_end - t_quad) / t_quad).abs();
+        println!(
+            "rtol {rtol:.0e}: t_ode = {:.15} s, rel diff {rel:.2e}, {} accepted + {} rejected steps, {} event trials",
+            run.t_end, run.solution.accepted, run.solution.rejected, run.solution.event_trials
+        );
+        assert_eq!(work.ode_steps, run.solution.total_steps());
+        if rtol <= 1e-10 {
+            assert!(rel < 1e-9, "rtol {rtol}: {rel:e}");
+            assert!(
+                rel < last.max(1e-13),
+                "no convergence: {rel:e} after {last:e}"
+            );
+        }
+        last = rel;
+    }
+}
+
+#[test]
+fn the_contact_force_vanishes_at_the_event() {
+    let sys = System::new(&ROD_CUBE, &paper(9.81)).unwrap();
+    let run = integrate(&sys, 1e-12, None, 1.0, &mut Work::default()).unwrap();
+    let qdd = rodcube::solve::unreduced::accelerations(&sys, &run.state_end, run.t_end).unwrap();
+    let f = sys.forces_full(&run.state_end, &qdd)[0];
+    let f0 = sys.forces(0.0)[0];
+    assert!(f.abs() < 1e-10 * f0, "F = {f} N at the event (F0 = {f0} N)");
+}
+
+#[test]
+fn state_along_the_way_matches_the_reduced_motion() {
+    for (n, r) in [(3.0, 0.25), (0.1, 0.8), (50.0, 0.05)] {
+        let sys = System::new(&ROD_CUBE, &ratios(n, r)).unwrap();
+        let (t_quad, mesh) = quadrature_separation(&sys);
+        let run = integrate(&sys, 1e-12, None, 2.0 * t_quad, &mut Work::default()).unwrap();
+        assert!(((run.t_end - t_quad) / t_quad).abs() < 1e-9);
+        let scale = sys.theta_initial();
+        let mut worst = 0.0f64;
+        for i in 1..40 {
+            let t = t_quad * i as f64 / 40.0;
+            let y = run.state_at(t).unwrap();
+            let delta = delta_at_time(&sys, &mesh, t, &mut Work::default()).unwrap();
+            let reduced = sys.full_state(t, delta, theta_dot_at(&sys, delta));
+            let omega_scale = sys.reduced(mesh.delta_end).theta_dot_sq.sqrt();
+            worst = worst.max(((y[1] - reduced.q[1]) / scale).abs());
+            worst = worst.max(((y[3] - reduced.qd[1]) / omega_scale).abs());
+            worst = worst.max(((y[0] - reduced.q[0]) / scale).abs());
+        }
+        println!("n = {n}, r = {r}: worst relative state difference along the way {worst:.2e}");
+        assert!(worst < 1e-9, "n = {n}, r = {r}: {worst:e}");
+    }
+}
+
+#[test]
+fn ode_path_conserves_energy_and_momentum() {
+    let sys = System::new(&ROD_CUBE, &paper(9.81)).unwrap();
+    let run = integrate(&sys, 1e-12, None, 1.0, &mut Work::default()).unwrap();
+    let states: Vec<State> = run
+        .nodes()
+        .iter()
+        .map(|(_, y)| State {
+            q: y[..2].to_vec(),
+            qd: y[2..].to_vec(),
+        })
+        .collect();
+    let found = checks::drift(&sys, &states, 1e-10, "ode");
+    assert_eq!(found.len(), 2);
+    for (name, check) in &found {
+        println!("{name}: margin {:.3e} ({})", check.margin, check.meaning);
+        assert!(check.passed, "{name}: {check:?}");
+    }
+    // The drift measure can fail: a tolerance below the achieved drift does.
+    let strict = checks::drift(&sys, &states, 1e-18, "ode");
+    assert!(!strict[0].1.passed);
+}
+
+#[test]
+fn free_rod_reaches_the_floor_event() {
+    let params = [
+        ("m1", 1.0),
+        ("ell", 1.0),
+        ("g", 9.81),
+        ("theta_s", 0.1677),
+        ("omega_s", -1.4),
+        ("x1_s", -0.01),
+        ("v1_s", -0.2),
+    ];
+    let sys = System::new(&FREE_ROD, &params).unwrap();
+    let mesh = TimeMesh::build(&sys, sys.delta_to_floor(), 1e-14, &mut Work::default()).unwrap();
+    let run = integrate(&sys, 1e-12, None, 1.0, &mut Work::default()).unwrap();
+    assert_eq!(run.end, EndEvent::Floor);
+    assert!(((run.t_end - mesh.duration) / mesh.duration).abs() < 1e-9);
+    assert!(run.state_end.q[1].abs() < 1e-12);
+}

@@ -1,0 +1,368 @@
+//! The planner: the paper's figures end to end, each quantity computed with its prerequisites
+//! and nothing else (proved by the work counters), checks only when asked, typed errors.
+
+mod common;
+
+use common::paper::{FREE_ROD, MODELS, ROD_CUBE, paper};
+use rodcube::model::Model;
+use rodcube::plan::{PlanError, Request, run};
+use rodcube::quantity::Quantity;
+use rodcube::results::RunResults;
+use rodcube::solve::SolveError;
+use rodcube::system::SystemError;
+
+fn ask(want: &[Quantity]) -> RunResults {
+    ask_model(&ROD_CUBE, want)
+}
+
+fn ask_model(model: &'static dyn Model, want: &[Quantity]) -> RunResults {
+    let request = Request::new(model, paper(9.81))
+        .with_want(want)
+        .with_tolerance(1e-12)
+        .with_samples(101)
+        .with_registry(MODELS);
+    run(&request).unwrap()
+}
+
+fn value(r: &RunResults, key: &str) -> f64 {
+    r.results
+        .get(key)
+        .unwrap_or_else(|| panic!("no `{key}` in {:?}", r.results.keys()))
+        .value
+}
+
+#[test]
+fn paper_figures_end_to_end() {
+    let r = ask(&[
+        Quantity::SeparationAngle,
+        Quantity::LinearisedSeparationAngle,
+        Quantity::SeparationTime,
+        Quantity::ContactTimeToFloor,
+        Quantity::PointMassFallTime,
+    ]);
+    assert!((value(&r, "separation_angle").to_degrees() - 9.61).abs() < 0.005);
+    assert!((value(&r, "linearised_separation_angle").to_degrees() - 9.59).abs() < 0.005);
+    assert!((value(&r, "separation_time") - 0.10849).abs() < 5e-6);
+    assert!((value(&r, "contact_time_to_floor") - 0.18693).abs() < 5e-6);
+    assert!((value(&r, "point_mass_fall_time") - 0.15964).abs() < 5e-6);
+    assert_eq!(r.results["separation_time"].unit, "s");
+    assert_eq!(r.model, "rod_cube");
+    assert_eq!(r.parameters["a"], 0.25);
+    assert!(r.series.is_empty() && r.checks.is_empty() && r.notes.is_empty());
+}
+
+#[test]
+fn separation_angle_alone_evaluates_only_the_polynomial() {
+    let r = ask(&[Quantity::SeparationAngle]);
+    assert!(r.work.polynomial_evals > 0);
+    assert_eq!(r.work.integrand_evals, 0);
+    assert_eq!(r.work.ode_steps, 0);
+    assert!(r.work.phases.is_empty(), "{:?}", r.work.phases);
+    assert_eq!(
+        r.results.keys().collect::<Vec<_>>(),
+        vec!["separation_angle"]
+    );
+    assert!(r.series.is_empty() && r.checks.is_empty());
+}
+
+#[test]
+fn cheap_quantities_cost_nothing_they_do_not_need() {
+    let r = ask(&[
+        Quantity::LinearisedSeparationAngle,
+        Quantity::PointMassFallTime,
+    ]);
+    assert_eq!(r.work, Default::default());
+    let r = ask(&[Quantity::ContactTimeToFloor]);
+    assert_eq!(
+        r.work.polynomial_evals, 0,
+        "contact to the floor needs no separation root"
+    );
+    assert!(r.work.integrand_evals > 0);
+    assert_eq!(r.work.ode_steps, 0);
+    assert!(r.work.phases.is_empty());
+    let r = ask(&[Quantity::SeparationTime]);
+    assert!(r.work.polynomial_evals > 0 && r.work.integrand_evals > 0);
+    assert_eq!(r.work.ode_steps, 0);
+    assert_eq!(
+        r.work.phases,
+        vec!["rod_cube"],
+        "no free phase for the separation time"
+    );
+}
+
+#[test]
+fn series_share_one_set_of_samples() {
+    let theta = ask(&[Quantity::ThetaSeries]);
+    let all = ask(&[
+        Quantity::ThetaSeries,
+        Quantity::ForceSeries(0),
+        Quantity::ForceSeries(1),
+        Quantity::Trajectory(1),
+        Quantity::Trajectory(3),
+    ]);
+    assert_eq!(
+        theta.work, all.work,
+        "forces and trajectories reuse the theta samples"
+    );
+    assert_eq!(all.work.phases, vec!["rod_cube"]);
+    let s = &all.series["theta_series"];
+    let names: Vec<&str> = s.columns.iter().map(|c| c.name.as_str()).collect();
+    assert_eq!(names, ["t", "theta", "theta_dot", "theta_ddot"]);
+    assert!(s.columns.iter().all(|c| c.values.len() == 101));
+    // The contact force vanishes at the last sample (separation) and is largest at the start.
+    let f = &all.series["contact_force_series"].columns[2].values;
+    assert!(f[100].abs() < 1e-12 * f[0] && f.iter().all(|v| *v <= f[0]));
+    // The tip runs on the ellipse of PHYSICS.md erratum 3.
+    let tip = &all.series["tip_trajectory"];
+    let names: Vec<&str> = tip.columns.iter().map(|c| c.name.as_str()).collect();
+    assert_eq!(names, ["t", "x", "y", "vx", "vy"]);
+    let beta = (1.0f64 - 0.0625).sqrt();
+    for (x, y) in tip.columns[1].values.iter().zip(&tip.columns[2].values) {
+        let e = (8.0 * x - 7.0 * beta).powi(2) + y * y;
+        assert!((e - 1.0).abs() < 1e-13, "{e}");
+    }
+    assert!(
+        all.series.contains_key("cube_trajectory")
+            && all.series.contains_key("floor_normal_series")
+    );
+}
+
+#[test]
+fn floor_impact_simulates_the_free_phase_only_when_asked() {
+    let r = ask(&[Quantity::FloorImpact]);
+    assert_eq!(r.work.phases, vec!["rod_cube", "free_rod"]);
+    assert_eq!(r.work.ode_steps, 0);
+    let t = value(&r, "floor_impact_time");
+    assert!(t > 0.10849 && t < 0.2, "{t}");
+    assert!(value(&r, "impact_angular_velocity") < 0.0);
+    assert!(value(&r, "surface_final_speed") > 0.0);
+    assert!(r.notes.is_empty());
+}
+
+#[test]
+fn cross_check_agrees_to_1e_9_and_runs_no_free_phase() {
+    let r = ask(&[Quantity::CrossCheck]);
+    assert!(r.work.ode_steps > 0);
+    assert_eq!(r.work.phases, vec!["rod_cube"]);
+    let rel = value(&r, "cross_check_relative_difference");
+    println!(
+        "ODE {:.15} s, rel diff {rel:.2e}, time dev {:.2e} s, state dev {:.2e}, {} ODE steps",
+        value(&r, "cross_check_time"),
+        value(&r, "cross_check_time_deviation"),
+        value(&r, "cross_check_state_deviation"),
+        r.work.ode_steps
+    );
+    assert!(rel < 1e-9, "{rel:e}");
+    assert!(value(&r, "cross_check_time_deviation") < 1e-9 * 0.10849);
+    assert!(value(&r, "cross_check_state_deviation") < 1e-9);
+    assert!(r.checks.is_empty(), "checks only when asked");
+}
+
+#[test]
+fn checks_cover_every_phase_and_pass_for_the_paper() {
+    let r = ask(&[Quantity::Checks, Quantity::CrossCheck]);
+    let names: Vec<&str> = r.checks.keys().map(String::as_str).collect();
+    assert_eq!(
+        names,
+        [
+            "free_rod.energy",
+            "free_rod.foot_on_floor",
+            "free_rod.momentum_x1",
+            "free_rod.tip_clears_cube",
+            "rod_cube.cube_does_not_tip",
+            "rod_cube.energy",
+            "rod_cube.foot_on_floor",
+            "rod_cube.momentum_x1",
+            "rod_cube.ode.energy",
+            "rod_cube.ode.momentum_x1",
+        ]
+    );
+    for (name, c) in &r.checks {
+        println!("{name}: passed {}, margin {:.3e}", c.passed, c.margin);
+        assert!(c.passed, "{name}: {c:?}");
+    }
+    // PHYSICS.md: N >= 0.25 m1 g (to two digits) and the tipping ratio stays below 0.05.
+    let n_min = r.checks["rod_cube.foot_on_floor"].margin / 9.81;
+    assert!((n_min - 0.25).abs() < 5e-3, "{n_min}");
+    let restoring = 3.0 * 9.81 * 0.25 / 2.0;
+    assert!(1.0 - r.checks["rod_cube.cube_does_not_tip"].margin / restoring < 0.05);
+    assert!(r.checks["free_rod.tip_clears_cube"].margin > 0.0);
+    assert_eq!(r.work.phases, vec!["rod_cube", "free_rod"]);
+}
+
+#[test]
+fn unavailable_quantities_and_bad_requests_are_typed_errors() {
+    let free = [
+        ("m1", 1.0),
+        ("ell", 1.0),
+        ("g", 9.81),
+        ("theta_s", 0.2),
+        ("omega_s", -1.0),
+        ("x1_s", 0.0),
+        ("v1_s", 0.0),
+    ];
+    let request = Request::new(&FREE_ROD, free)
+        .with_want(&[Quantity::SeparationAngle])
+        .with_registry(MODELS);
+    let err = run(&request).unwrap_err();
+    assert!(
+        matches!(&err, PlanError::Unavailable { quantity, model: "free_rod", .. } if quantity == "separation_angle")
+    );
+    let request = Request::new(&FREE_ROD, free).with_want(&[Quantity::FloorImpact]);
+    assert!(matches!(run(&request), Err(PlanError::Unavailable { .. })));
+    // free_rod can still give its own time to the floor.
+    let request = Request::new(&FREE_ROD, free).with_want(&[Quantity::ContactTimeToFloor]);
+    assert!(run(&request).unwrap().results["contact_time_to_floor"].value > 0.0);
+
+    let mut p = paper(9.81);
+    p[3].1 = 2.0;
+    let err = run(&Request::new(&ROD_CUBE, p).with_want(&[Quantity::SeparationAngle])).unwrap_err();
+    assert!(
+        matches!(err, PlanError::System(SystemError::Requirement { .. })),
+        "{err}"
+    );
+    let err = run(&Request::new(&ROD_CUBE, paper(9.81)).with_tolerance(0.5)).unwrap_err();
+    assert_eq!(err, PlanError::BadTolerance { tolerance: 0.5 });
+    let err = run(&Request::new(&ROD_CUBE, paper(9.81))
+        .with_want(&[Quantity::ThetaSeries])
+        .with_samples(1))
+    .unwrap_err();
+    assert_eq!(err, PlanError::TooFewSamples { samples: 1 });
+    // Without `free_rod` in the registry the floor impact cannot be followed.
+    let err = run(&Request::new(&ROD_CUBE, paper(9.81))
+        .with_want(&[Quantity::FloorImpact])
+        .with_registry(&[]))
+    .unwrap_err();
+    assert_eq!(
+        err,
+        PlanError::Solve(SolveError::UnknownNextModel {
+            from: "rod_cube",
+            name: "free_rod"
+        })
+    );
+    assert!(matches!(
+        Request::by_name("nope", paper(9.81), MODELS),
+        Err(PlanError::UnknownModel { .. })
+    ));
+    assert!(Request::by_name("rod_cube", paper(9.81), MODELS).is_ok());
+}
+
+#[test]
+fn parameters_by_value_or_by_name_give_the_same_run() {
+    let want = [Quantity::SeparationTime];
+    let by_name = run(&Request::new(&ROD_CUBE, paper(9.81)).with_want(&want)).unwrap();
+    let by_value =
+        run(&Request::new(&ROD_CUBE, vec![1.0, 3.0, 1.0, 0.25, 9.81]).with_want(&want)).unwrap();
+    assert_eq!(by_name, by_value);
+}
+
+#[test]
+fn no_separation_is_a_note_and_the_floor_is_reached_in_contact() {
+    use common::tweaked::NEVER_SEPARATES;
+    let want = [
+        Quantity::SeparationAngle,
+        Quantity::SeparationTime,
+        Quantity::FloorImpact,
+        Quantity::ContactTimeToFloor,
+    ];
+    let r = ask_model(&NEVER_SEPARATES, &want);
+    assert!(
+        !r.results.contains_key("separation_angle") && !r.results.contains_key("separation_time")
+    );
+    assert!(r.notes["separation_angle"].contains("no separation"));
+    assert!(r.notes["separation_time"].contains("no separation"));
+    assert!(r.notes.contains_key("floor_impact"));
+    assert_eq!(r.work.phases, vec!["rod_cube"]);
+    // The contact phase to the floor is integrated once and serves both quantities.
+    assert_eq!(
+        value(&r, "floor_impact_time"),
+        value(&r, "contact_time_to_floor")
+    );
+    let alone = ask_model(&NEVER_SEPARATES, &[Quantity::ContactTimeToFloor]);
+    assert_eq!(r.work.integrand_evals, alone.work.integrand_evals);
+    // Kept in contact down to theta = 0 the cube stops there: x2' = -ell sin(theta) theta' / (2 (1+n)).
+    assert!(value(&r, "surface_final_speed").abs() < 1e-15);
+}
+
+#[test]
+fn without_separation_the_contact_integral_is_shared_in_either_order() {
+    use common::tweaked::NEVER_SEPARATES;
+    let a = ask_model(
+        &NEVER_SEPARATES,
+        &[Quantity::ContactTimeToFloor, Quantity::FloorImpact],
+    );
+    let b = ask_model(
+        &NEVER_SEPARATES,
+        &[Quantity::FloorImpact, Quantity::ContactTimeToFloor],
+    );
+    let alone = ask_model(&NEVER_SEPARATES, &[Quantity::ContactTimeToFloor]);
+    assert_eq!(a.work.integrand_evals, alone.work.integrand_evals);
+    assert_eq!(b.work.integrand_evals, alone.work.integrand_evals);
+    assert_eq!(a.results, b.results);
+}
+
+#[test]
+fn every_quantity_runs_across_extreme_ratios_and_tolerances() {
+    use common::paper::ratios;
+    let mut worst = 0.0f64;
+    for n in [1e-12, 3.0, 1e12] {
+        for r in [1e-10, 0.25, 1.0 - 1e-9] {
+            for tol in [1e-14, 1e-8, 1e-2] {
+                let model: &'static dyn Model = &ROD_CUBE;
+                let request = Request::new(model, ratios(n, r))
+                    .with_want(&Quantity::all(model.info()))
+                    .with_tolerance(tol)
+                    .with_samples(20)
+                    .with_registry(MODELS);
+                let r_ =
+                    run(&request).unwrap_or_else(|e| panic!("n = {n}, r = {r}, tol = {tol}: {e}"));
+                for (name, c) in &r_.checks {
+                    assert!(c.passed, "n = {n}, r = {r}, tol = {tol}: {name} {c:?}");
+                }
+                assert!(r_.results.values().all(|s| s.value.is_finite()));
+                assert!(value(&r_, "floor_impact_time") > value(&r_, "separation_time"));
+                // Conditioning of the ODE route: near upright (cos theta_i ~ 4e-5) the equations
+                // take the absolute angle, whose rounding limits it to ~1e-11; cond(M) grows like
+                // n, and the ODE's tolerance is raised to 10 eps cond(M).
+                let Some(rel) = r_
+                    .results
+                    .get("cross_check_relative_difference")
+                    .map(|s| s.value)
+                else {
+                    // Only the 1e12 cube is beyond the unreduced route (cond(M) ~ 1e13).
+                    let note = &r_.notes["cross_check"];
+                    assert!(n >= 1e12 && note.contains("condition"), "{note}");
+                    continue;
+                };
+                let wanted = if tol <= 1e-8 { 1e-9 } else { 10.0 * tol };
+                let rtol = value(&r_, "cross_check_rtol");
+                let bound = wanted.max(100.0 * rtol);
+                assert!(
+                    rel < bound,
+                    "n = {n}, r = {r}, tol = {tol}: ODE differs by {rel:e}"
+                );
+                println!(
+                    "n = {n:e}, r = {r:e}, tol = {tol:e}: ODE rtol {rtol:.1e}, rel diff {rel:.1e}"
+                );
+                if tol <= 1e-8 && n < 1e3 {
+                    worst = worst.max(rel);
+                }
+            }
+        }
+    }
+    println!("worst ODE/quadrature relative difference for n < 1e3, tol <= 1e-8: {worst:.2e}");
+}
+
+#[test]
+fn a_nan_from_the_model_is_an_error_naming_the_series() {
+    use common::tweaked::NAN_FORCE;
+    let request = Request::new(&NAN_FORCE, paper(9.81))
+        .with_want(&[Quantity::ForceSeries(1)])
+        .with_samples(5)
+        .with_registry(MODELS);
+    let err = run(&request).unwrap_err();
+    assert!(
+        matches!(&err, PlanError::NonFinite { key, index: 0, .. } if key == "floor_normal_series.floor_normal"),
+        "{err}"
+    );
+}

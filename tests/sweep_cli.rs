@@ -1,0 +1,318 @@
+//! `rodcube sweep` end to end: the CSV's header says whether results are dimensionless, its
+//! rows match the planner point by point, points files and heat maps work, and bad input (an
+//! upright rod, `n` for a model without `m2`, an unknown model) is a clear error.
+
+use rodcube::plan::{self, Request};
+use rodcube::quantity::Quantity;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn rodcube(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_rodcube"))
+        .args(args)
+        .output()
+        .expect("run rodcube")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("rodcube-sweep-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+/// The CSV's comment, header and rows (as numbers; NaN for an empty cell).
+fn read_csv(path: &Path) -> (String, Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let comment = lines.next().unwrap().to_string();
+    let header = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| {
+            l.split(',')
+                .map(|c| c.parse().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    (comment, header, rows)
+}
+
+fn planner(model: &str, p: Vec<f64>) -> (f64, f64) {
+    let m = rodcube::models::find(model).unwrap();
+    let res = plan::run(
+        &Request::new(m, p).with_want(&[Quantity::SeparationAngle, Quantity::SeparationTime]),
+    )
+    .unwrap();
+    (
+        res.results["separation_angle"].value,
+        res.results["separation_time"].value,
+    )
+}
+
+#[test]
+fn a_grid_sweep_matches_the_planner_and_says_it_is_dimensionless() {
+    let dir = temp_dir("grid");
+    let out = rodcube(&[
+        "sweep",
+        "--n",
+        "1e-3:1e3:log:4",
+        "--a-over-ell",
+        "0.01:0.99:lin:3",
+        "--heatmap",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("swept 12 points"), "{stdout}");
+    let (comment, header, rows) = read_csv(&dir.join("sweep.csv"));
+    assert!(
+        comment.starts_with('#') && comment.contains("dimensionless"),
+        "{comment}"
+    );
+    assert!(comment.contains("ell = 1, g = 1"), "{comment}");
+    assert_eq!(
+        header,
+        ["n", "a_over_ell", "separation_angle", "separation_time"]
+    );
+    assert_eq!(rows.len(), 12);
+    // Grid order: n outer, a/ell inner; the axes' ends are exact.
+    assert_eq!((rows[0][0], rows[0][1]), (1e-3, 0.01));
+    assert_eq!((rows[11][0], rows[11][1]), (1e3, 0.99));
+    for row in &rows {
+        let (theta, t) = planner("rod_cube", vec![1.0, row[0], 1.0, row[1], 1.0]);
+        assert!(
+            ((row[2] - theta) / theta).abs() < 1e-13,
+            "{row:?} vs {theta}"
+        );
+        assert!(((row[3] - t) / t).abs() < 1e-11, "{row:?} vs {t}");
+    }
+    for svg in ["separation_angle.svg", "separation_time.svg"] {
+        let text = std::fs::read_to_string(dir.join(svg)).unwrap();
+        assert!(
+            text.starts_with("<svg") && text.contains("log10(n = m2/m1)"),
+            "{svg}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn ell_and_g_give_si_units_and_extra_quantities_come_from_the_planner() {
+    let dir = temp_dir("si");
+    let out = rodcube(&[
+        "sweep",
+        "--n",
+        "3",
+        "--a-over-ell",
+        "0.25",
+        "--ell",
+        "1",
+        "--g",
+        "9.81",
+        "--want",
+        "point_mass_fall_time,linearised_separation_angle",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (comment, header, rows) = read_csv(&dir.join("sweep.csv"));
+    assert!(
+        comment.contains("SI units") && comment.contains("g = 9.81"),
+        "{comment}"
+    );
+    assert!(
+        header.contains(&"point_mass_fall_time".to_string()),
+        "{header:?}"
+    );
+    assert!(header.contains(&"linearised_separation_angle".to_string()));
+    let row = &rows[0];
+    // The paper's case: theta_sep = 9.61 deg, t_sep = 0.10849 s, point mass 0.15964 s.
+    assert!((row[2].to_degrees() - 9.61).abs() < 0.005);
+    assert!((row[3] - 0.10849).abs() < 5e-6, "{}", row[3]);
+    let k = header
+        .iter()
+        .position(|h| h == "point_mass_fall_time")
+        .unwrap();
+    assert!((row[k] - 0.15964).abs() < 5e-6, "{}", row[k]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_points_file_is_swept_in_its_order() {
+    let dir = temp_dir("points");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("points.csv");
+    std::fs::write(&file, "# my points\nn,a_over_ell,label\n3,0.25,paper\n1e12,0.5,heavy\n1e-12,0.999999999,upright\n").unwrap();
+    let out_dir = dir.join("out");
+    let out = rodcube(&[
+        "sweep",
+        "--model",
+        "hinged_rod",
+        "--points",
+        file.to_str().unwrap(),
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (_, _, rows) = read_csv(&out_dir.join("sweep.csv"));
+    assert_eq!(rows.len(), 3);
+    for (row, (n, r)) in rows
+        .iter()
+        .zip([(3.0, 0.25), (1e12, 0.5), (1e-12, 0.999999999)])
+    {
+        assert_eq!((row[0], row[1]), (n, r));
+        let (theta, t) = planner("hinged_rod", vec![1.0, n, 1.0, r, 1.0]);
+        assert!(((row[2] - theta) / theta).abs() < 1e-13);
+        assert!(((row[3] - t) / t).abs() < 1e-10, "{row:?} vs {t}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_wall_ladder_sweeps_a_over_ell_alone_and_refuses_n() {
+    let dir = temp_dir("wall");
+    let out = rodcube(&[
+        "sweep",
+        "--model",
+        "wall_ladder",
+        "--a-over-ell",
+        "0.3,0.6,0.9",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (_, header, rows) = read_csv(&dir.join("sweep.csv"));
+    assert_eq!(
+        header,
+        ["a_over_ell", "separation_angle", "separation_time"]
+    );
+    for row in &rows {
+        assert!((row[1].sin() - 2.0 * row[0] / 3.0).abs() < 1e-15);
+    }
+    let out = rodcube(&[
+        "sweep",
+        "--model",
+        "wall_ladder",
+        "--n",
+        "3",
+        "--a-over-ell",
+        "0.5",
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("no mass ratio"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_sweeps_fail_with_a_clear_message() {
+    let dir = temp_dir("bad");
+    let d = dir.to_str().unwrap();
+    for (args, needle) in [
+        (
+            vec![
+                "sweep",
+                "--n",
+                "3",
+                "--a-over-ell",
+                "0.5:1:lin:3",
+                "--out",
+                d,
+            ],
+            "a >= ell",
+        ),
+        (
+            vec!["sweep", "--n", "3", "--a-over-ell", "1.5", "--out", d],
+            "outside (0, 1)",
+        ),
+        (
+            vec!["sweep", "--a-over-ell", "0.5", "--out", d],
+            "needs the mass ratio",
+        ),
+        (
+            vec![
+                "sweep",
+                "--n",
+                "0:1:log:3",
+                "--a-over-ell",
+                "0.5",
+                "--out",
+                d,
+            ],
+            "positive ends",
+        ),
+        (
+            vec![
+                "sweep",
+                "--n",
+                "1:2:cubic:3",
+                "--a-over-ell",
+                "0.5",
+                "--out",
+                d,
+            ],
+            "neither lin nor log",
+        ),
+        (
+            vec![
+                "sweep",
+                "--model",
+                "free_rod",
+                "--a-over-ell",
+                "0.5",
+                "--out",
+                d,
+            ],
+            "no contact",
+        ),
+        (
+            vec![
+                "sweep",
+                "--model",
+                "nope",
+                "--a-over-ell",
+                "0.5",
+                "--out",
+                d,
+            ],
+            "no model `nope`",
+        ),
+        (
+            vec![
+                "sweep",
+                "--n",
+                "3",
+                "--a-over-ell",
+                "0.5",
+                "--want",
+                "theta_series",
+                "--out",
+                d,
+            ],
+            "not a number per point",
+        ),
+    ] {
+        let out = rodcube(&args);
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,0 +1,428 @@
+//! The symbolic derivation, run in-process on the specs in `derivations/`, reproduces the paper's
+//! equations (5), (9), (14), (16), (18) and the corrected (12) *by equivalence*: each difference
+//! is zero as a rational function of sin(theta), cos(theta) modulo sin^2 + cos^2 = 1 (never by
+//! comparing strings). Also the hinged rod, the ladder on a wall, and the loaded rod against
+//! hand computations, and negative controls showing a wrong formula is caught.
+#![cfg(feature = "derive")]
+
+use rodcube::derive::cas;
+use rodcube::derive::expr::Expr;
+use rodcube::derive::mechanics::{self, Derivation};
+use rodcube::derive::{derive_all, on_cas_thread, spec};
+use std::path::Path;
+
+/// Derives one model from its spec in `derivations/`.
+fn derive(name: &str) -> Derivation {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("derivations")
+        .join(format!("{name}.yaml"));
+    let checked = spec::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let mut out = derive_all(&[checked]).unwrap_or_else(|e| panic!("{e}"));
+    out.remove(0).0
+}
+
+/// Replaces `sin(theta)`, `cos(theta)` by the derivation's symbols `rc_s`, `rc_c`.
+fn sc(e: &Expr) -> Expr {
+    let rec = |v: &Vec<Expr>| v.iter().map(sc).collect::<Vec<_>>();
+    match e {
+        Expr::Fun(f, args) if args.len() == 1 && args[0] == Expr::sym("theta") => {
+            match f.as_str() {
+                "sin" => Expr::sym("rc_s"),
+                "cos" => Expr::sym("rc_c"),
+                _ => e.clone(),
+            }
+        }
+        Expr::Add(v) => Expr::Add(rec(v)),
+        Expr::Mul(v) => Expr::Mul(rec(v)),
+        Expr::Pow(b, x) => Expr::Pow(Box::new(sc(b)), Box::new(sc(x))),
+        Expr::Fun(f, v) => Expr::Fun(f.clone(), rec(v)),
+        _ => e.clone(),
+    }
+}
+
+/// A plain derived form over the parameters, `rc_s` and `rc_c`.
+fn plain(d: &Derivation, key: &str) -> Expr {
+    let e = d
+        .plain
+        .get(key)
+        .unwrap_or_else(|| panic!("no plain form `{key}`"));
+    let e = sc(e);
+    assert!(
+        !e.symbols().contains("theta"),
+        "`{key}` still has a bare theta: {}",
+        e.to_infix()
+    );
+    e
+}
+
+fn parse(text: &str) -> Expr {
+    Expr::parse(text).unwrap_or_else(|e| panic!("test formula `{text}`: {}", e.message))
+}
+
+/// Replaces shorthand symbols by their definitions.
+fn expand_shorthands(text: &str, defs: &[(&str, &str)]) -> Expr {
+    defs.iter().fold(parse(text), |e, (name, value)| {
+        subs(&e, name, &parse(value))
+    })
+}
+
+/// A formula in the paper's shorthands: `n = m2/m1`, `r = a/ell`, `S = sin`, `C = cos`.
+fn paper(text: &str) -> Expr {
+    expand_shorthands(
+        text,
+        &[("n", "m2/m1"), ("r", "a/ell"), ("S", "rc_s"), ("C", "rc_c")],
+    )
+}
+
+/// Whether `a - b` is zero as a rational function modulo sin^2 + cos^2 = 1.
+fn equivalent(a: &Expr, b: &Expr) -> bool {
+    let diff = Expr::Add(vec![a.clone(), Expr::Mul(vec![Expr::int(-1), b.clone()])]);
+    on_cas_thread(move || mechanics::is_zero_trig(&cas::atom(&diff)))
+        .expect("Symbolica worker")
+        .expect("is_zero_trig")
+}
+
+fn assert_equivalent(what: &str, derived: &Expr, expected: &Expr) {
+    assert!(
+        equivalent(derived, expected),
+        "{what}: derived\n  {}\nis not equivalent to\n  {}",
+        derived.to_infix(),
+        expected.to_infix()
+    );
+}
+
+/// Structurally positive for positive symbols: sums, products and powers of positive parts.
+fn positive(e: &Expr, pos: &[&str]) -> bool {
+    match e {
+        Expr::Rational(n, d) => *n > 0 && *d > 0,
+        Expr::Float(x) => *x > 0.0,
+        Expr::Sym(s) => pos.contains(&s.as_str()),
+        Expr::Add(v) | Expr::Mul(v) => v.iter().all(|x| positive(x, pos)),
+        Expr::Pow(b, _) => positive(b, pos),
+        Expr::Fun(..) => false,
+    }
+}
+
+/// `derived / expected` as one rational function, if it is free of theta (no `rc_s`, `rc_c`,
+/// and its derivative in `rc_s` vanishes) and structurally positive.
+fn positive_multiple(derived: &Expr, expected: &Expr, pos: &[&str]) -> Result<Expr, String> {
+    let quotient = Expr::Mul(vec![
+        derived.clone(),
+        Expr::Pow(Box::new(expected.clone()), Box::new(Expr::int(-1))),
+    ]);
+    let (ratio, d_ratio) = on_cas_thread(move || {
+        let q = cas::together(&cas::atom(&quotient));
+        let dq = cas::together(&cas::d(&q, "rc_s"));
+        (cas::expr(&q), mechanics::is_zero_trig(&dq))
+    })
+    .map_err(|e| e.to_string())?;
+    let ratio = ratio?;
+    let syms = ratio.symbols();
+    if syms.contains("rc_s") || syms.contains("rc_c") || d_ratio != Ok(true) {
+        return Err(format!("ratio depends on theta: {}", ratio.to_infix()));
+    }
+    if !positive(&ratio, pos) {
+        return Err(format!(
+            "ratio {} is not a positive expression of {pos:?}",
+            ratio.to_infix()
+        ));
+    }
+    Ok(ratio)
+}
+
+fn assert_positive_multiple(what: &str, derived: &Expr, expected: &Expr, pos: &[&str]) -> Expr {
+    positive_multiple(derived, expected, pos).unwrap_or_else(|e| {
+        panic!(
+            "{what}: {e}\n  derived  {}\n  expected {}",
+            derived.to_infix(),
+            expected.to_infix()
+        )
+    })
+}
+
+const MASSES: &[&str] = &["m1", "m2", "m3", "ell", "a", "g"];
+
+// ---------------------------------------------------------------------------------------------
+// rod_cube: the paper's model
+// ---------------------------------------------------------------------------------------------
+
+/// Eq (9): theta'^2 = 4 (g/ell) (a/ell - sin) / (4/3 - sin^2/(1+n)).
+const EQ9: &str = "4*(g/ell)*(r - S)/(4/3 - S^2/(1 + n))";
+/// Eq (14), the separation cubic.
+const EQ14: &str = "3*S^3 - 12*(1 + n)*S + 8*r*(1 + n)";
+/// Eq (16), the contact force.
+const EQ16: &str = "m2*(-3*g*C*(8*r*(1 + n) - 12*(1 + n)*S + 3*S^3)/(4*(1 + n) - 3*S^2)^2)";
+/// PHYSICS.md erratum 2: the corrected eq (12), with D = 4/3 - sin^2/(1+n), sin 2theta = 2 S C.
+const EQ12_CORRECTED: &str =
+    "(2*g/ell)*(-C/(4/3 - S^2/(1 + n)) + (r - S)*2*S*C/((1 + n)*(4/3 - S^2/(1 + n))^2))";
+/// Eq (12) as printed: its `(1 - 4 sin)` is `4 (r - sin)` at r = 1/4 only.
+const EQ12_PRINTED: &str =
+    "(g/(2*ell))*(-4*C/(4/3 - S^2/(1 + n)) + (1/(1 + n))*(1 - 4*S)*2*S*C/(4/3 - S^2/(1 + n))^2)";
+
+#[test]
+fn rod_cube_theta_dot_squared_is_eq_9() {
+    let d = derive("rod_cube");
+    assert_equivalent("theta_dot_sq", &plain(&d, "theta_dot_sq"), &paper(EQ9));
+}
+
+#[test]
+fn rod_cube_separation_condition_is_eq_14_up_to_a_positive_factor() {
+    let d = derive("rod_cube");
+    let ratio = assert_positive_multiple(
+        "separation_condition",
+        &plain(&d, "separation_condition"),
+        &paper(EQ14),
+        MASSES,
+    );
+    // The factor is the rod's mass (the cubic is m1 times eq 14).
+    assert_equivalent("the factor", &ratio, &Expr::sym("m1"));
+    // The generated coefficients are the same cubic: rc_si = sin(theta_i) = a/ell.
+    let sep = d.separation.as_ref().expect("rod_cube has a contact");
+    assert_eq!(sep.coefficients.len(), 4);
+    let poly = polynomial(&sep.coefficients);
+    let poly = subs(&poly, "rc_si", &parse("a/ell"));
+    assert_positive_multiple("coefficients", &poly, &paper(EQ14), MASSES);
+}
+
+/// The polynomial `sum c_k rc_s^k` from its coefficients.
+fn polynomial(coefficients: &[Expr]) -> Expr {
+    Expr::Add(
+        coefficients
+            .iter()
+            .enumerate()
+            .map(|(k, c)| {
+                Expr::Mul(vec![
+                    c.clone(),
+                    Expr::Pow(Box::new(Expr::sym("rc_s")), Box::new(Expr::int(k as i128))),
+                ])
+            })
+            .collect(),
+    )
+}
+
+/// Replaces a symbol by an expression.
+fn subs(e: &Expr, name: &str, value: &Expr) -> Expr {
+    let rec = |v: &Vec<Expr>| v.iter().map(|x| subs(x, name, value)).collect::<Vec<_>>();
+    match e {
+        Expr::Sym(s) if s == name => value.clone(),
+        Expr::Add(v) => Expr::Add(rec(v)),
+        Expr::Mul(v) => Expr::Mul(rec(v)),
+        Expr::Pow(b, x) => Expr::Pow(
+            Box::new(subs(b, name, value)),
+            Box::new(subs(x, name, value)),
+        ),
+        Expr::Fun(f, v) => Expr::Fun(f.clone(), rec(v)),
+        _ => e.clone(),
+    }
+}
+
+#[test]
+fn rod_cube_contact_force_is_eq_16() {
+    let d = derive("rod_cube");
+    assert_equivalent("contact_force", &plain(&d, "contact_force"), &paper(EQ16));
+}
+
+#[test]
+fn rod_cube_theta_ddot_is_the_corrected_eq_12() {
+    let d = derive("rod_cube");
+    let acc = plain(&d, "theta_ddot");
+    assert_equivalent("theta_ddot", &acc, &paper(EQ12_CORRECTED));
+    // theta'' = (1/2) d(theta'^2)/d(theta) holds for the derived pair as well.
+    let w2 = plain(&d, "theta_dot_sq");
+    let half_derivative = on_cas_thread(move || {
+        let a = cas::atom(&w2);
+        let dt = cas::d(&a, "rc_s") * cas::var("rc_c") - cas::d(&a, "rc_c") * cas::var("rc_s");
+        cas::expr(&cas::together(&(dt / cas::num(2))))
+    })
+    .unwrap()
+    .unwrap();
+    assert_equivalent("(1/2) d(theta_dot_sq)/dtheta", &acc, &half_derivative);
+}
+
+#[test]
+fn printed_eq_12_holds_only_at_a_over_ell_one_quarter() {
+    let d = derive("rod_cube");
+    let acc = plain(&d, "theta_ddot");
+    let printed = paper(EQ12_PRINTED);
+    assert!(
+        !equivalent(&acc, &printed),
+        "the printed eq (12) must not match for general a/ell"
+    );
+    for (a, matches) in [("ell/4", true), ("ell/3", false), ("ell/2", false)] {
+        let at = |e: &Expr| subs(e, "a", &parse(a));
+        assert_eq!(
+            equivalent(&at(&acc), &at(&printed)),
+            matches,
+            "printed eq (12) at a = {a}"
+        );
+    }
+    // The corrected form holds at every a/ell, including those.
+    for a in ["ell/4", "ell/3"] {
+        let at = |e: &Expr| subs(e, "a", &parse(a));
+        assert_equivalent("corrected eq (12)", &at(&acc), &at(&paper(EQ12_CORRECTED)));
+    }
+}
+
+#[test]
+fn cyclic_elimination_gives_eq_5_and_eq_18() {
+    let d = derive("rod_cube");
+    assert_eq!(d.coords, ["x1", "theta"]);
+    assert_eq!(d.cyclic, [0]);
+    // Eq (5): x1' = (1+2n)/(2(1+n)) ell sin(theta) theta', with rc_w = theta'.
+    assert_equivalent(
+        "x1_dot",
+        &d.cyclic_velocity[0],
+        &paper("(1 + 2*n)/(2*(1 + n))*ell*S*rc_w"),
+    );
+    // Eq (18): x1 = -(1+2n)/(2(1+n)) ell (cos(theta) - beta), beta = cos(theta_i), with
+    // rc_dc = cos(theta_i) - cos(theta); x1 starts at the spec's initial position.
+    let x1i = d
+        .constants
+        .iter()
+        .find(|c| c.symbol == "rc_x0i")
+        .expect("initial x1 constant");
+    assert_eq!(
+        x1i.value.eval(&|_| None),
+        0.0,
+        "x1 starts at {}",
+        x1i.value.to_infix()
+    );
+    let x1 = subs(&d.cyclic_position[0], "rc_x0i", &Expr::int(0));
+    assert_equivalent("x1", &x1, &paper("-(1 + 2*n)/(2*(1 + n))*ell*(-rc_dc)"));
+}
+
+#[test]
+fn a_wrong_formula_is_not_equivalent() {
+    // Negative controls: the comparison can fail.
+    let d = derive("rod_cube");
+    assert!(!equivalent(
+        &plain(&d, "theta_dot_sq"),
+        &paper("4*(g/ell)*(r - S)/(4/3 - S^2/(2 + n))")
+    ));
+    assert!(!equivalent(
+        &plain(&d, "contact_force"),
+        &paper("m2*(-3*g*C*(8*r*(1 + n) - 11*(1 + n)*S + 3*S^3)/(4*(1 + n) - 3*S^2)^2)")
+    ));
+    // cos^2 = 1 - sin^2 is used, but cos is not sin.
+    assert!(equivalent(&paper("C^2"), &paper("1 - S^2")));
+    assert!(!equivalent(&paper("C"), &paper("1 - S^2")));
+}
+
+#[test]
+fn a_theta_dependent_or_negative_factor_is_refused() {
+    let d = derive("rod_cube");
+    let derived = plain(&d, "separation_condition");
+    let ok = |expected: &str| positive_multiple(&derived, &paper(expected), MASSES).is_ok();
+    assert!(ok(EQ14));
+    assert!(!ok("-(3*S^3 - 12*(1 + n)*S + 8*r*(1 + n))"));
+    assert!(!ok("S*(3*S^3 - 12*(1 + n)*S + 8*r*(1 + n))"));
+    assert!(!ok("3*S^3 - 12*(1 + n)*S + 7*r*(1 + n)"));
+}
+
+// ---------------------------------------------------------------------------------------------
+// The other models
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn hinged_rod_separates_where_3_n_s3_plus_3_s_equals_2_r() {
+    let d = derive("hinged_rod");
+    assert_positive_multiple(
+        "hinged_rod separation_condition",
+        &plain(&d, "separation_condition"),
+        &paper("3*n*S^3 + 3*S - 2*r"),
+        MASSES,
+    );
+    // theta'^2 from energy: m1 g ell (r - s) / (ell^2 (m1/3 + m2 s^2)).
+    assert_equivalent(
+        "hinged_rod theta_dot_sq",
+        &plain(&d, "theta_dot_sq"),
+        &paper("3*(g/ell)*(r - S)/(1 + 3*n*S^2)"),
+    );
+    // Contact force: (3/2) m2 g cos (3 n s^3 + 3 s - 2 r) / (1 + 3 n s^2)^2.
+    assert_equivalent(
+        "hinged_rod contact_force",
+        &plain(&d, "contact_force"),
+        &paper("3/2*m2*g*C*(3*n*S^3 + 3*S - 2*r)/(1 + 3*n*S^2)^2"),
+    );
+}
+
+#[test]
+fn wall_ladder_separates_at_two_thirds_of_a_over_ell() {
+    let d = derive("wall_ladder");
+    assert_positive_multiple(
+        "wall_ladder separation_condition",
+        &plain(&d, "separation_condition"),
+        &paper("3*S - 2*r"),
+        MASSES,
+    );
+    assert_equivalent(
+        "wall_ladder theta_dot_sq",
+        &plain(&d, "theta_dot_sq"),
+        &paper("3*(g/ell)*(r - S)"),
+    );
+    assert_equivalent(
+        "wall_ladder contact_force",
+        &plain(&d, "contact_force"),
+        &paper("3/4*m1*g*C*(3*S - 2*r)"),
+    );
+}
+
+/// The loaded rod by hand. With M = m1+m2+m3, h = m1/2+m3, P = m1/3+m3 and
+/// K = ((m1/2+m3)^2 + m2 m3)/M, zero horizontal momentum gives the reduced inertia
+/// ell^2 (P - K s^2), so theta'^2 = 2 g h (r - s) / (ell (P - K s^2)). The cube moves with
+/// x2' = -(m1 ell / 2M) s theta', so F = -m2 (m1 ell/2M) (c theta'^2 + s theta'') and the
+/// contact ends where d(s^2 theta'^2)/ds = 0, i.e. K s^3 - 3 P s + 2 P r = 0.
+fn loaded(text: &str) -> Expr {
+    expand_shorthands(
+        text,
+        &[
+            ("K", "((m1/2 + m3)^2 + m2*m3)/M"),
+            ("P", "m1/3 + m3"),
+            ("H", "m1/2 + m3"),
+            ("M", "m1 + m2 + m3"),
+            ("r", "a/ell"),
+            ("S", "rc_s"),
+            ("C", "rc_c"),
+        ],
+    )
+}
+
+#[test]
+fn loaded_rod_matches_the_hand_computation() {
+    let d = derive("loaded_rod");
+    assert_equivalent(
+        "loaded_rod theta_dot_sq",
+        &plain(&d, "theta_dot_sq"),
+        &loaded("2*g*H*(r - S)/(ell*(P - K*S^2))"),
+    );
+    assert_positive_multiple(
+        "loaded_rod separation_condition",
+        &plain(&d, "separation_condition"),
+        &loaded("K*S^3 - 3*P*S + 2*P*r"),
+        MASSES,
+    );
+    // F = -m2 m1 g h c (K s^3 - 3 P s + 2 P r) / (2 M (P - K s^2)^2).
+    assert_equivalent(
+        "loaded_rod contact_force",
+        &plain(&d, "contact_force"),
+        &loaded("-m2*m1*g*H*C*(K*S^3 - 3*P*S + 2*P*r)/(2*M*(P - K*S^2)^2)"),
+    );
+    // With m3 = 0 the loaded rod is the paper's rod.
+    let at0 = |e: &Expr| subs(e, "m3", &Expr::int(0));
+    assert_equivalent(
+        "loaded_rod at m3 = 0",
+        &at0(&plain(&d, "theta_dot_sq")),
+        &paper(EQ9),
+    );
+    assert_equivalent(
+        "loaded_rod contact force at m3 = 0",
+        &at0(&plain(&d, "contact_force")),
+        &paper(EQ16),
+    );
+    // Its cube velocity x1' - ell s theta' is -(m1 ell/2M) s theta'.
+    assert_equivalent(
+        "loaded_rod x1_dot",
+        &d.cyclic_velocity[0],
+        &loaded("(1 - m1/(2*M))*ell*S*rc_w"),
+    );
+}
