@@ -84,9 +84,9 @@ fn eval(c: &mut Criterion) {
     let mut out = [0.0; 2];
     model.forces(&k, delta, &mut out);
     let hand = hand_forces(&PAPER, theta_i, delta);
-    for (g, h) in out.iter().zip(hand) {
+    for (x, h) in out.iter().zip(hand) {
         assert!(
-            (g - h).abs() <= 1e-12 * h.abs(),
+            (x - h).abs() <= 1e-12 * h.abs(),
             "generated {out:?} vs hand {hand:?}"
         );
     }
@@ -108,9 +108,9 @@ fn eval(c: &mut Criterion) {
     });
     let t = [theta_i, theta_i.sin(), theta_i.cos()];
     let hand = hand_forces_offsets(&PAPER, &t, delta);
-    for (g, h) in out.iter().zip(hand) {
+    for (x, h) in out.iter().zip(hand) {
         assert!(
-            (g - h).abs() <= 1e-12 * h.abs(),
+            (x - h).abs() <= 1e-12 * h.abs(),
             "generated {out:?} vs hand {hand:?}"
         );
     }

@@ -38,6 +38,8 @@
 pub mod accuracy;
 #[cfg(feature = "derive")]
 pub mod derive;
+#[doc(hidden)]
+pub mod fuzzing;
 pub mod io;
 pub mod model;
 pub mod models;
@@ -48,6 +50,7 @@ pub mod report;
 pub mod results;
 pub mod scene;
 pub mod solve;
+pub mod spec;
 pub mod sweep;
 pub mod system;
 pub mod yaml_marks;

@@ -24,7 +24,8 @@ const EXIT_OUTPUT: u8 = 4;
 
 const EXAMPLES: &str = "\
 Examples:
-  rodcube run                                # the paper's case: scenes/paper.yaml -> out/paper/
+  rodcube                                    # the same as `rodcube run`: the paper's case
+  rodcube run                                # scenes/paper.yaml -> out/paper/
   rodcube run scenes/hinged.yaml             # another scene -> out/hinged/
   rodcube run scenes/paper.yaml --json > r.json
   rodcube run my_scene.yaml --out /tmp/mine  # choose the output directory
@@ -58,7 +59,8 @@ Examples:
 )]
 struct Cli {
     #[command(subcommand)]
-    command: Command,
+    /// What to do (default: `run`, the paper's scene)
+    command: Option<Command>,
 }
 
 #[derive(Subcommand)]
@@ -109,6 +111,15 @@ struct RunArgs {
     out: Option<PathBuf>,
 }
 
+/// With no subcommand, `rodcube` runs the paper's scene (`rodcube run scenes/paper.yaml`).
+fn default_command() -> Command {
+    Command::Run(RunArgs {
+        scene: PathBuf::from("scenes/paper.yaml"),
+        json: false,
+        out: None,
+    })
+}
+
 /// Why a command failed; each kind has its exit status.
 enum Failure {
     /// The scene is invalid (or the planner found its parameters inconsistent).
@@ -148,7 +159,7 @@ impl Failure {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let outcome = match cli.command {
+    let outcome = match cli.command.unwrap_or_else(default_command) {
         Command::Run(args) => run(args),
         Command::Models => models(),
         Command::Sweep(args) => numerics_cli::sweep(args),

@@ -264,3 +264,19 @@ fn requirement_a_below_ell() {
         &["error[requirement]: parameters.a:", "--> s.yaml:5:3"],
     );
 }
+
+#[test]
+fn a_bare_rodcube_runs_the_papers_scene() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_rodcube"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("run rodcube");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(table.contains("model rod_cube"), "{table}");
+    assert!(table.contains("9.61097 deg"), "{table}");
+}

@@ -175,15 +175,13 @@ fn bad_command_line_is_a_usage_error() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(EXIT_USAGE), "{}", stderr(&o));
+    // A flag without a subcommand is refused too (no subcommand alone runs the paper scene).
     let o = Command::new(env!("CARGO_BIN_EXE_rodcube"))
+        .arg("--colour")
         .output()
         .unwrap();
-    assert_eq!(
-        o.status.code(),
-        Some(EXIT_USAGE),
-        "no subcommand: {}",
-        stderr(&o)
-    );
+    assert_eq!(o.status.code(), Some(EXIT_USAGE), "{}", stderr(&o));
+    assert!(o.stdout.is_empty(), "usage errors print nothing on stdout");
 }
 
 #[test]
@@ -229,4 +227,116 @@ fn models_lists_without_failing() {
         .unwrap();
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     assert!(!o.stdout.is_empty());
+}
+
+const EXIT_OUTPUT: i32 = 4;
+
+/// Runs `rodcube <args>` in `dir`.
+fn rodcube_in(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_rodcube"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// Asserts an output error: status 4, empty stdout, and every `needle` on stderr.
+fn output_error(o: &Output, needles: &[&str]) {
+    let err = stderr(o);
+    assert_eq!(o.status.code(), Some(EXIT_OUTPUT), "stderr:\n{err}");
+    assert!(o.stdout.is_empty(), "stdout must stay empty on error");
+    for n in needles {
+        assert!(err.contains(n), "missing {n:?} in stderr:\n{err}");
+    }
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+const VALID: &str = "model: rod_cube\nparameters: {m1: 1.0, m2: 3.0, ell: 1.0, a: 0.25, g: 9.81}\nwant: [separation_angle]\n";
+
+#[test]
+fn unknown_subcommand_is_a_usage_error() {
+    let o = rodcube_in(&fresh("unknown_subcommand"), &["frobnicate"]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(EXIT_USAGE), "{err}");
+    assert!(err.contains("frobnicate"), "{err}");
+    assert!(o.stdout.is_empty());
+}
+
+#[test]
+fn out_naming_a_file_is_an_output_error_naming_it() {
+    let dir = fresh("out_is_a_file");
+    fs::write(dir.join("scene.yaml"), VALID).unwrap();
+    fs::write(dir.join("taken"), b"not a directory").unwrap();
+    let o = rodcube_in(&dir, &["run", "scene.yaml", "--out", "taken"]);
+    output_error(&o, &["taken"]);
+    assert_eq!(fs::read(dir.join("taken")).unwrap(), b"not a directory");
+}
+
+#[test]
+fn a_scene_whose_name_is_not_a_plain_name_needs_out() {
+    // Without --out the output directory is out/<scene stem>/; a hidden stem is refused before
+    // anything is created, and the message says what to do.
+    let dir = fresh("hidden_stem");
+    fs::write(dir.join(".hidden.yaml"), VALID).unwrap();
+    let o = rodcube_in(&dir, &["run", ".hidden.yaml"]);
+    output_error(&o, &[".hidden", "pass --out DIR"]);
+    assert!(!dir.join("out").exists(), "nothing may be created");
+}
+
+#[test]
+fn a_scene_that_is_not_utf8_is_a_read_error_naming_the_file() {
+    let dir = fresh("not_utf8");
+    fs::write(dir.join("scene.yaml"), b"model: rod_cube\n\xff\xfe\n").unwrap();
+    let o = rodcube_in(&dir, &["run", "scene.yaml"]);
+    scene_error(&o, &["error[read]", "--> scene.yaml", "not UTF-8"]);
+}
+
+#[test]
+fn a_scene_that_is_a_directory_is_a_read_error_naming_it() {
+    let dir = fresh("scene_is_dir");
+    fs::create_dir_all(dir.join("scene.yaml")).unwrap();
+    let o = rodcube_in(&dir, &["run", "scene.yaml"]);
+    scene_error(
+        &o,
+        &["error[read]", "--> scene.yaml", "cannot read the scene"],
+    );
+}
+
+/// `rodcube derive` on specs that fail before any symbolic work (so no Symbolica runs).
+#[cfg(feature = "derive")]
+mod derive {
+    use super::*;
+
+    fn derive(specs: &[&Path]) -> Output {
+        let mut args = vec!["derive".to_string(), "--check".to_string()];
+        args.extend(specs.iter().map(|p| p.display().to_string()));
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        rodcube_in(Path::new(env!("CARGO_MANIFEST_DIR")), &args)
+    }
+
+    #[test]
+    fn a_missing_spec_is_named() {
+        let dir = fresh("derive_missing");
+        let spec = dir.join("nope.yaml");
+        let o = derive(&[&spec]);
+        scene_error(&o, &[&spec.display().to_string(), "cannot read"]);
+    }
+
+    #[test]
+    fn a_bad_spec_names_file_line_column_and_field() {
+        let dir = fresh("derive_bad");
+        let spec = dir.join("bad.yaml");
+        let text = fs::read_to_string(
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("derivations/rod_cube.yaml"),
+        )
+        .unwrap();
+        let line = 1 + text
+            .lines()
+            .position(|l| l == "gravity: g")
+            .expect("rod_cube.yaml declares `gravity: g`");
+        fs::write(&spec, text.replace("gravity: g\n", "gravity: gee\n")).unwrap();
+        let o = derive(&[&spec]);
+        let place = format!("{}:{line}:1: field `gravity`", spec.display());
+        scene_error(&o, &[&place, "`gee` is not a parameter"]);
+    }
 }

@@ -3,7 +3,7 @@
 //! rational normalisation, factorisation).
 //!
 //! Symbolica runs restricted without a licence: one thread per process. Every function here
-//! must run on the derivation thread started by [`super::run_on_cas_thread`].
+//! must run on the derivation thread started by [`super::on_cas_thread`].
 
 use super::expr::Expr;
 use symbolica::atom::{Atom, AtomCore};

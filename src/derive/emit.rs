@@ -429,16 +429,17 @@ pub fn rust_context(
         command: COMMAND.into(),
         name: spec.name.clone(),
         type_name: type_name(&spec.name),
-        description: spec.description.clone(),
+        // Comments in the generated code: one line, so no spec text can end them.
+        description: one_line(&spec.description),
         description_literal: format!("{:?}", spec.description),
-        spec: format!(
+        spec: one_line(&format!(
             "derivations/{}",
             checked
                 .file
                 .file_name()
                 .map(|f| f.to_string_lossy().into_owned())
                 .unwrap_or_default()
-        ),
+        )),
         params: spec
             .parameters
             .iter()
@@ -513,6 +514,33 @@ pub fn rust_context(
 
 fn scope_with_hoisted(scope: &Scope) -> Scope {
     scope.clone()
+}
+
+/// `text` on one line (runs of whitespace, newlines included, become one space), for a comment
+/// in generated code.
+pub fn one_line(text: &str) -> String {
+    text.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// `text` as LaTeX text on one line: every character TeX would read as a command or as
+/// markup is escaped, so spec text is printed, never run.
+pub fn tex_text(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in one_line(text).chars() {
+        match c {
+            '\\' => out.push_str("\\textbackslash{}"),
+            '{' | '}' | '$' | '&' | '#' | '_' | '%' => {
+                out.push('\\');
+                out.push(c);
+            }
+            '^' => out.push_str("\\^{}"),
+            '~' => out.push_str("\\~{}"),
+            '<' => out.push_str("\\textless{}"),
+            '>' => out.push_str("\\textgreater{}"),
+            c => out.push(c),
+        }
+    }
+    out
 }
 
 /// LaTeX spelling of a symbol: `m1` -> `m_{1}`, `ell` -> `\ell`, `dot_theta` -> `\dot{\theta}`.
@@ -747,8 +775,8 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> TexContext {
             eqs.push(display(
                 &format!(
                     "Force \\texttt{{{}}}: {}",
-                    f.name.replace('_', "\\_"),
-                    f.meaning
+                    tex_text(&f.name),
+                    tex_text(&f.meaning)
                 ),
                 "F = ".into(),
                 2,
@@ -770,25 +798,24 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> TexContext {
     }
     TexContext {
         command: COMMAND.into(),
-        name: checked.spec.name.replace('_', "\\_"),
-        description: checked.spec.description.clone(),
-        spec: format!(
+        name: tex_text(&checked.spec.name),
+        description: tex_text(&checked.spec.description),
+        spec: tex_text(&format!(
             "derivations/{}",
             checked
                 .file
                 .file_name()
                 .map(|f| f.to_string_lossy().into_owned())
                 .unwrap_or_default()
-        )
-        .replace('_', "\\_"),
+        )),
         params: checked
             .spec
             .parameters
             .iter()
             .map(|p| TexParam {
                 symbol: name(&p.name),
-                meaning: p.meaning.clone(),
-                unit: p.unit.replace('^', "\\^{}"),
+                meaning: tex_text(&p.meaning),
+                unit: tex_text(&p.unit),
             })
             .collect(),
         equations: eqs,
@@ -821,4 +848,19 @@ pub fn json_record(checked: &Checked, d: &Derivation) -> serde_json::Value {
         "velocity_symbols": "theta_dot, theta_ddot in the expressions below are eliminated; dot_q / ddot_q denote velocities and accelerations in `lagrangian`",
         "expressions": expressions,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{one_line, tex_text};
+
+    #[test]
+    fn spec_text_cannot_leave_a_comment_or_run_as_tex() {
+        assert_eq!(one_line("a\n  pub fn evil() {}\r\n"), "a pub fn evil() {}");
+        assert_eq!(
+            tex_text("\\input{/etc/passwd} 50% of m_1 & N >= 0\n\\end"),
+            "\\textbackslash{}input\\{/etc/passwd\\} 50\\% of m\\_1 \\& N \\textgreater{}= 0 \\textbackslash{}end"
+        );
+        assert_eq!(tex_text("m/s^2"), "m/s\\^{}2");
+    }
 }

@@ -1,8 +1,14 @@
 //! Model specs (`derivations/*.yaml`): their schema, parsing, and checks that name file, line
 //! and field for every error.
+//!
+//! Part of the runtime crate (no Symbolica), so that specs and their expressions can be parsed,
+//! checked and fuzzed without the `derive` feature; the derivation tool re-exports this module
+//! as `rodcube::derive::spec` (and [`expr`] as `rodcube::derive::expr`).
 
-use super::expr::{Expr, FUNCTIONS};
+pub mod expr;
+
 use crate::yaml_marks::{At, Step, locate_nearest};
+use expr::{Expr, FUNCTIONS};
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
@@ -23,7 +29,7 @@ impl Text {
     pub fn text(&self) -> String {
         match self {
             Text::Str(s) => s.clone(),
-            Text::Num(x) => super::expr::float_literal(*x),
+            Text::Num(x) => expr::float_literal(*x),
         }
     }
 }

@@ -61,13 +61,31 @@ impl Expr {
         let mut p = Parser {
             s: text.as_bytes(),
             i: 0,
+            depth: 0,
         };
         let e = p.expr()?;
         p.ws();
         if p.i < p.s.len() {
             return Err(p.err(format!("unexpected `{}`", p.s[p.i] as char)));
         }
+        if e.depth() > MAX_DEPTH {
+            return Err(ParseError {
+                offset: 0,
+                message: format!("the expression is nested more than {MAX_DEPTH} deep"),
+            });
+        }
         Ok(e)
+    }
+
+    /// Levels of the tree: 1 for a number or a symbol.
+    pub fn depth(&self) -> usize {
+        1 + match self {
+            Expr::Add(v) | Expr::Mul(v) | Expr::Fun(_, v) => {
+                v.iter().map(Expr::depth).max().unwrap_or(0)
+            }
+            Expr::Pow(b, e) => b.depth().max(e.depth()),
+            _ => 0,
+        }
     }
 
     /// Flattens nested sums and products, folds numeric factors into one rational, and drops
@@ -96,20 +114,21 @@ impl Expr {
                     }
                 }
                 for f in flat {
-                    match &f {
-                        Expr::Rational(a, b) => {
-                            n = n.saturating_mul(*a);
-                            d = d.saturating_mul(*b);
+                    // A factor whose folding would overflow `i128` stays a factor.
+                    let folded = match &f {
+                        Expr::Rational(a, b) => mul_exact(n, *a).zip(mul_exact(d, *b)),
+                        Expr::Pow(b, e) if e.as_integer() == Some(-1) => match **b {
+                            Expr::Rational(a, 1) if a != 0 => Some(n).zip(mul_exact(d, a)),
+                            _ => None,
+                        },
+                        _ => None,
+                    };
+                    match folded {
+                        Some((a, b)) => {
+                            let g = gcd(a.abs(), b.abs());
+                            (n, d) = (a / g, b / g);
                         }
-                        Expr::Pow(b, e)
-                            if e.as_integer() == Some(-1)
-                                && matches!(**b, Expr::Rational(_, 1)) =>
-                        {
-                            if let Expr::Rational(a, 1) = **b {
-                                d = d.saturating_mul(a);
-                            }
-                        }
-                        _ => rest.push(f),
+                        None => rest.push(f),
                     }
                 }
                 if n == 0 {
@@ -190,7 +209,7 @@ impl Expr {
             Expr::Pow(b, e) => {
                 let b = b.eval(lookup);
                 match e.as_integer() {
-                    Some(n) if n.abs() < 64 => b.powi(n as i32),
+                    Some(n) if n.unsigned_abs() < 64 => b.powi(n as i32),
                     _ => b.powf(e.eval(lookup)),
                 }
             }
@@ -772,9 +791,20 @@ pub fn float_literal(x: f64) -> String {
     }
 }
 
+/// How deeply parentheses, signs and exponents may nest in text: far below what would overflow
+/// the stack (a fuzzed `((((...` used to abort the process).
+pub const MAX_NESTING: usize = 600;
+
+/// How deep a parsed expression tree may be: far beyond any model, and shallow enough that its
+/// printed infix form (at most two levels of nesting per level of tree, as in `a^(b^(c))`)
+/// stays within [`MAX_NESTING`] and parses again.
+pub const MAX_DEPTH: usize = 250;
+
 struct Parser<'a> {
     s: &'a [u8],
     i: usize,
+    /// Open calls of `unary`, through which every recursion of the grammar passes.
+    depth: usize,
 }
 
 impl Parser<'_> {
@@ -821,6 +851,16 @@ impl Parser<'_> {
     }
 
     fn unary(&mut self) -> Result<Expr, ParseError> {
+        if self.depth >= MAX_NESTING {
+            return Err(self.err(format!("nested more than {MAX_NESTING} deep")));
+        }
+        self.depth += 1;
+        let e = self.unary_inner();
+        self.depth -= 1;
+        e
+    }
+
+    fn unary_inner(&mut self) -> Result<Expr, ParseError> {
         match self.peek() {
             Some(b'-') => {
                 self.i += 1;
@@ -922,6 +962,12 @@ impl Parser<'_> {
             })
         }
     }
+}
+
+/// `a * b`, or `None` when it overflows or is `i128::MIN`: every rational in an [`Expr`] keeps
+/// its numerator and denominator above `i128::MIN`, so that negating them cannot overflow.
+fn mul_exact(a: i128, b: i128) -> Option<i128> {
+    a.checked_mul(b).filter(|&p| p != i128::MIN)
 }
 
 fn gcd(a: i128, b: i128) -> i128 {
