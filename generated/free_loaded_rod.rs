@@ -65,7 +65,7 @@ static INFO: ModelInfo = ModelInfo {
         },
     ],
     requirements: &[],
-    n_constants: 82,
+    n_constants: 45,
     k_theta_initial: 8,
     k_theta_dot_initial: 9,
     coordinates: &["x1", "theta"],
@@ -138,189 +138,128 @@ impl Model for FreeLoadedRod {
             + (c6_t3 * c6_t0 / (k[0] + k[1])));
         let h15_t0 = (k[9] * k[9]);
         k[15] = ((k[0] * h15_t0 * k[14]) + (k[1] * h15_t0 * k[14]));
-        k[16] = (3.0 * k[3] * k[0] * k[1] * k[2]);
-        k[17] = (k[3] * (k[0] * k[0]) * k[2]);
-        k[18] = (2.0 * k[3] * (k[1] * k[1]) * k[2]);
-        k[19] = (k[2] * k[2]);
-        k[20] = (-(16.0 * k[0] * k[1]) - (4.0 * (k[0] * k[0])) - (12.0 * (k[1] * k[1])));
-        k[21] = (12.0 * k[0] * k[1]);
-        k[22] = (3.0 * (k[0] * k[0]));
-        k[23] = (12.0 * (k[1] * k[1]));
-        k[24] = (120.0 * k[3] * k[0] * k[1].powi(3) * k[2]);
-        k[25] = (-68.0 * k[3] * k[0] * k[1].powi(3) * k[2]);
-        k[26] = (60.0 * k[3] * k[0] * k[1].powi(3) * k[2]);
-        k[27] = (108.0 * k[3] * (k[0] * k[0]) * (k[1] * k[1]) * k[2]);
-        k[28] = (-68.0 * k[3] * (k[0] * k[0]) * (k[1] * k[1]) * k[2]);
-        k[29] = (54.0 * k[3] * (k[0] * k[0]) * (k[1] * k[1]) * k[2]);
-        k[30] = (42.0 * k[3] * k[0].powi(3) * k[1] * k[2]);
-        k[31] = (-28.0 * k[3] * k[0].powi(3) * k[1] * k[2]);
-        k[32] = (21.0 * k[3] * k[0].powi(3) * k[1] * k[2]);
-        k[33] = (6.0 * k[3] * k[0].powi(4) * k[2]);
-        k[34] = (-4.0 * k[3] * k[0].powi(4) * k[2]);
-        k[35] = (3.0 * k[3] * k[0].powi(4) * k[2]);
-        k[36] = (48.0 * k[3] * k[1].powi(4) * k[2]);
-        k[37] = (-24.0 * k[3] * k[1].powi(4) * k[2]);
-        k[38] = (24.0 * k[3] * k[1].powi(4) * k[2]);
-        k[39] = (48.0 * k[0] * (k[1] * k[1]) * (k[9] * k[9]) * k[14]);
-        k[40] = (30.0 * (k[0] * k[0]) * k[1] * (k[9] * k[9]) * k[14]);
-        k[41] = (6.0 * k[0].powi(3) * (k[9] * k[9]) * k[14]);
-        k[42] = (24.0 * k[1].powi(3) * (k[9] * k[9]) * k[14]);
-        k[43] = ((k[3] * k[0]) + (k[3] * k[1]));
-        k[44] = (-((k[0] * k[2]) + (2.0 * k[1] * k[2])) / 2.0);
-        k[45] = (((k[0] * k[2]) + (2.0 * k[1] * k[2])) / 2.0);
-        k[46] = k[12];
-        k[47] = (k[0] * k[2] / 2.0 / (k[0] + k[1]));
-        k[48] = (k[1] * k[2] / (k[0] + k[1]));
-        k[49] = (k[13] / (k[0] + k[1]));
-        k[50] = k[2];
-        k[51] = (k[2] / 2.0);
-        k[52] = (-k[2]);
-        k[53] = (-k[2] / 2.0);
-        k[54] = (-k[0] * k[2] / 2.0 / (k[0] + k[1]));
-        k[55] = (-k[1] * k[2] / (k[0] + k[1]));
-        k[56] = (-3.0 * k[0] * k[1] * k[2] / 2.0 / (k[0] + k[1]));
-        k[57] = (k[0] * k[1] * (k[2] * k[2]) / 8.0 / (k[0] + k[1]));
-        let h58_t0 = (k[1] * k[1]);
-        k[58] = (k[0] * h58_t0 * (k[2] * k[2]) / ((2.0 * k[0] * k[1]) + (k[0] * k[0]) + h58_t0));
-        k[59] = (k[0] * (k[2] * k[2]) / 24.0);
-        k[60] = (k[0] / 2.0);
-        k[61] = (k[1] / 2.0);
-        let h62_t0 = (k[0] * k[0]);
-        k[62] = (5.0 * h62_t0 * k[1] * (k[2] * k[2])
-            / 8.0
-            / ((2.0 * k[0] * k[1]) + h62_t0 + (k[1] * k[1])));
-        k[63] = (-(k[0] * k[0]) * k[2] / 2.0 / (k[0] + k[1]));
-        k[64] = (k[0].powi(3) * (k[2] * k[2])
-            / 8.0
-            / ((2.0 * k[0] * k[1]) + (k[0] * k[0]) + (k[1] * k[1])));
-        k[65] = (-(k[1] * k[1]) * k[2] / (k[0] + k[1]));
-        k[66] = (k[1].powi(3) * (k[2] * k[2])
-            / 2.0
-            / ((2.0 * k[0] * k[1]) + (k[0] * k[0]) + (k[1] * k[1])));
-        k[67] = (k[3] * k[0] * k[2] / 2.0);
-        k[68] = (k[3] * k[1] * k[2]);
-        k[69] = k[0];
-        k[70] = k[1];
-        k[71] = (k[0] + k[1]);
-        let h72_t0 = (k[2] * k[2]);
-        k[72] = ((k[0] * k[1] * h72_t0 / 4.0 / (k[0] + k[1])) + (k[0] * h72_t0 / 12.0));
-        let h73_t0 = (k[1] * k[1]);
-        k[73] =
-            (2.0 * k[0] * h73_t0 * (k[2] * k[2]) / ((2.0 * k[0] * k[1]) + (k[0] * k[0]) + h73_t0));
-        let h74_t0 = (k[0] * k[0]);
-        k[74] = (5.0 * h74_t0 * k[1] * (k[2] * k[2])
-            / 4.0
-            / ((2.0 * k[0] * k[1]) + h74_t0 + (k[1] * k[1])));
-        k[75] = (k[0].powi(3) * (k[2] * k[2])
-            / 4.0
-            / ((2.0 * k[0] * k[1]) + (k[0] * k[0]) + (k[1] * k[1])));
-        k[76] =
-            (k[1].powi(3) * (k[2] * k[2]) / ((2.0 * k[0] * k[1]) + (k[0] * k[0]) + (k[1] * k[1])));
-        k[77] = (3.0 * k[0] * k[1] * k[2] / 2.0 / (k[0] + k[1]));
-        k[78] = ((k[0] * k[0]) * k[2] / 2.0 / (k[0] + k[1]));
-        k[79] = ((k[1] * k[1]) * k[2] / (k[0] + k[1]));
-        k[80] = (-k[3] * k[0] * k[2] / 2.0);
-        k[81] = (-k[3] * k[1] * k[2]);
+        k[16] = ((3.0 * k[3] * k[0] * k[1] * k[2])
+            + (k[3] * (k[0] * k[0]) * k[2])
+            + (2.0 * k[3] * (k[1] * k[1]) * k[2]));
+        k[17] = (k[2] * k[2]);
+        k[18] = (-(16.0 * k[0] * k[1]) - (4.0 * (k[0] * k[0])) - (12.0 * (k[1] * k[1])));
+        k[19] = ((12.0 * k[0] * k[1]) + (3.0 * (k[0] * k[0])) + (12.0 * (k[1] * k[1])));
+        k[20] = ((120.0 * k[3] * k[0] * k[1].powi(3) * k[2])
+            + (108.0 * k[3] * (k[0] * k[0]) * (k[1] * k[1]) * k[2])
+            + (42.0 * k[3] * k[0].powi(3) * k[1] * k[2])
+            + (6.0 * k[3] * k[0].powi(4) * k[2])
+            + (48.0 * k[3] * k[1].powi(4) * k[2]));
+        k[21] = (-(68.0 * k[3] * k[0] * k[1].powi(3) * k[2])
+            - (68.0 * k[3] * (k[0] * k[0]) * (k[1] * k[1]) * k[2])
+            - (28.0 * k[3] * k[0].powi(3) * k[1] * k[2])
+            - (4.0 * k[3] * k[0].powi(4) * k[2])
+            - (24.0 * k[3] * k[1].powi(4) * k[2]));
+        k[22] = ((60.0 * k[3] * k[0] * k[1].powi(3) * k[2])
+            + (54.0 * k[3] * (k[0] * k[0]) * (k[1] * k[1]) * k[2])
+            + (21.0 * k[3] * k[0].powi(3) * k[1] * k[2])
+            + (3.0 * k[3] * k[0].powi(4) * k[2])
+            + (24.0 * k[3] * k[1].powi(4) * k[2]));
+        let h23_t0 = (k[9] * k[9]);
+        k[23] = ((48.0 * k[0] * (k[1] * k[1]) * h23_t0 * k[14])
+            + (30.0 * (k[0] * k[0]) * k[1] * h23_t0 * k[14])
+            + (6.0 * k[0].powi(3) * h23_t0 * k[14])
+            + (24.0 * k[1].powi(3) * h23_t0 * k[14]));
+        k[24] = ((k[3] * k[0]) + (k[3] * k[1]));
+        k[25] = (-((k[0] * k[2]) + (2.0 * k[1] * k[2])) / 2.0);
+        k[26] = (((k[0] * k[2]) + (2.0 * k[1] * k[2])) / 2.0);
+        k[27] = k[12];
+        k[28] = ((k[0] * k[2] / 2.0 / (k[0] + k[1])) + (k[1] * k[2] / (k[0] + k[1])));
+        k[29] = (k[13] / (k[0] + k[1]));
+        k[30] = k[2];
+        k[31] = (k[2] / 2.0);
+        k[32] = (-k[2]);
+        k[33] = (-k[2] / 2.0);
+        k[34] = (-(k[0] * k[2] / 2.0 / (k[0] + k[1])) - (k[1] * k[2] / (k[0] + k[1])));
+        k[35] = (-(3.0 * k[0] * k[1] * k[2] / 2.0 / (k[0] + k[1]))
+            - ((k[0] * k[0]) * k[2] / 2.0 / (k[0] + k[1]))
+            - ((k[1] * k[1]) * k[2] / (k[0] + k[1])));
+        let h36_t0 = (k[2] * k[2]);
+        k[36] = ((k[0] * k[1] * h36_t0 / 8.0 / (k[0] + k[1])) + (k[0] * h36_t0 / 24.0));
+        let h37_t0 = (k[1] * k[1]);
+        let h37_t1 = (k[2] * k[2]);
+        let h37_t2 = (k[0] * k[0]);
+        k[37] = ((k[0] * h37_t0 * h37_t1 / ((2.0 * k[0] * k[1]) + h37_t2 + h37_t0))
+            + (5.0 * h37_t2 * k[1] * h37_t1 / 8.0 / ((2.0 * k[0] * k[1]) + h37_t2 + h37_t0))
+            + (k[0].powi(3) * h37_t1 / 8.0 / ((2.0 * k[0] * k[1]) + h37_t2 + h37_t0))
+            + (k[1].powi(3) * h37_t1 / 2.0 / ((2.0 * k[0] * k[1]) + h37_t2 + h37_t0)));
+        k[38] = ((k[0] / 2.0) + (k[1] / 2.0));
+        k[39] = ((k[3] * k[0] * k[2] / 2.0) + (k[3] * k[1] * k[2]));
+        k[40] = (k[0] + k[1]);
+        let h41_t0 = (k[2] * k[2]);
+        k[41] = ((k[0] * k[1] * h41_t0 / 4.0 / (k[0] + k[1])) + (k[0] * h41_t0 / 12.0));
+        let h42_t0 = (k[1] * k[1]);
+        let h42_t1 = (k[2] * k[2]);
+        let h42_t2 = (k[0] * k[0]);
+        k[42] = ((2.0 * k[0] * h42_t0 * h42_t1 / ((2.0 * k[0] * k[1]) + h42_t2 + h42_t0))
+            + (5.0 * h42_t2 * k[1] * h42_t1 / 4.0 / ((2.0 * k[0] * k[1]) + h42_t2 + h42_t0))
+            + (k[0].powi(3) * h42_t1 / 4.0 / ((2.0 * k[0] * k[1]) + h42_t2 + h42_t0))
+            + (k[1].powi(3) * h42_t1 / ((2.0 * k[0] * k[1]) + h42_t2 + h42_t0)));
+        k[43] = ((3.0 * k[0] * k[1] * k[2] / 2.0 / (k[0] + k[1]))
+            + ((k[0] * k[0]) * k[2] / 2.0 / (k[0] + k[1]))
+            + ((k[1] * k[1]) * k[2] / (k[0] + k[1])));
+        k[44] = (-(k[3] * k[0] * k[2] / 2.0) - (k[3] * k[1] * k[2]));
     }
 
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
+        let k = &k[..45]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[8], k[10], k[11], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
-        let rt1 = (k[20] + (k[21] * rt0) + (k[22] * rt0) + (k[23] * rt0));
+        let rt1 = (k[18] + (k[19] * rt0));
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: (-12.0 * (k[15] + (k[16] * rc_ds) + (k[17] * rc_ds) + (k[18] * rc_ds))
-                / (k[19] * rt1)),
+            theta_dot_sq: (-12.0 * (k[15] + (k[16] * rc_ds)) / (k[17] * rt1)),
             theta_ddot: (6.0
-                * ((k[24] * rc_s * rc_c * rc_ds)
-                    + (k[25] * rc_c)
-                    + (k[26] * rt0 * rc_c)
-                    + (k[27] * rc_s * rc_c * rc_ds)
-                    + (k[28] * rc_c)
-                    + (k[29] * rt0 * rc_c)
-                    + (k[30] * rc_s * rc_c * rc_ds)
-                    + (k[31] * rc_c)
-                    + (k[32] * rt0 * rc_c)
-                    + (k[33] * rc_s * rc_c * rc_ds)
-                    + (k[34] * rc_c)
-                    + (k[35] * rt0 * rc_c)
-                    + (k[36] * rc_s * rc_c * rc_ds)
-                    + (k[37] * rc_c)
-                    + (k[38] * rt0 * rc_c)
-                    + (k[39] * rc_s * rc_c)
-                    + (k[40] * rc_s * rc_c)
-                    + (k[41] * rc_s * rc_c)
-                    + (k[42] * rc_s * rc_c))
-                / (k[19] * (rt1 * rt1))),
+                * ((k[20] * rc_s * rc_c * rc_ds)
+                    + (k[21] * rc_c)
+                    + (k[22] * rt0 * rc_c)
+                    + (k[23] * rc_s * rc_c))
+                / (k[17] * (rt1 * rt1))),
         }
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
+        let k = &k[..45]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[8], k[10], k[11], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
-        let rt1 = (k[20] + (k[21] * rt0) + (k[22] * rt0) + (k[23] * rt0));
-        let rc_w2 =
-            (-12.0 * (k[15] + (k[16] * rc_ds) + (k[17] * rc_ds) + (k[18] * rc_ds)) / (k[19] * rt1));
+        let rt1 = (k[18] + (k[19] * rt0));
+        let rc_w2 = (-12.0 * (k[15] + (k[16] * rc_ds)) / (k[17] * rt1));
         let rc_acc = (6.0
-            * ((k[24] * rc_s * rc_c * rc_ds)
-                + (k[25] * rc_c)
-                + (k[26] * rt0 * rc_c)
-                + (k[27] * rc_s * rc_c * rc_ds)
-                + (k[28] * rc_c)
-                + (k[29] * rt0 * rc_c)
-                + (k[30] * rc_s * rc_c * rc_ds)
-                + (k[31] * rc_c)
-                + (k[32] * rt0 * rc_c)
-                + (k[33] * rc_s * rc_c * rc_ds)
-                + (k[34] * rc_c)
-                + (k[35] * rt0 * rc_c)
-                + (k[36] * rc_s * rc_c * rc_ds)
-                + (k[37] * rc_c)
-                + (k[38] * rt0 * rc_c)
-                + (k[39] * rc_s * rc_c)
-                + (k[40] * rc_s * rc_c)
-                + (k[41] * rc_s * rc_c)
-                + (k[42] * rc_s * rc_c))
-            / (k[19] * (rt1 * rt1)));
-        out[0] = (k[43] + (k[44] * rc_s * rc_w2) + (k[45] * rc_c * rc_acc));
+            * ((k[20] * rc_s * rc_c * rc_ds)
+                + (k[21] * rc_c)
+                + (k[22] * rt0 * rc_c)
+                + (k[23] * rc_s * rc_c))
+            / (k[17] * (rt1 * rt1)));
+        out[0] = (k[24] + (k[25] * rc_s * rc_w2) + (k[26] * rc_c * rc_acc));
     }
 
     fn monitors(&self, k: &[f64], delta: f64, out: &mut [f64]) {
+        let k = &k[..45]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[8], k[10], k[11], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
-        let rt1 = (k[20] + (k[21] * rt0) + (k[22] * rt0) + (k[23] * rt0));
-        let rc_w2 =
-            (-12.0 * (k[15] + (k[16] * rc_ds) + (k[17] * rc_ds) + (k[18] * rc_ds)) / (k[19] * rt1));
+        let rt1 = (k[18] + (k[19] * rt0));
+        let rc_w2 = (-12.0 * (k[15] + (k[16] * rc_ds)) / (k[17] * rt1));
         let rc_acc = (6.0
-            * ((k[24] * rc_s * rc_c * rc_ds)
-                + (k[25] * rc_c)
-                + (k[26] * rt0 * rc_c)
-                + (k[27] * rc_s * rc_c * rc_ds)
-                + (k[28] * rc_c)
-                + (k[29] * rt0 * rc_c)
-                + (k[30] * rc_s * rc_c * rc_ds)
-                + (k[31] * rc_c)
-                + (k[32] * rt0 * rc_c)
-                + (k[33] * rc_s * rc_c * rc_ds)
-                + (k[34] * rc_c)
-                + (k[35] * rt0 * rc_c)
-                + (k[36] * rc_s * rc_c * rc_ds)
-                + (k[37] * rc_c)
-                + (k[38] * rt0 * rc_c)
-                + (k[39] * rc_s * rc_c)
-                + (k[40] * rc_s * rc_c)
-                + (k[41] * rc_s * rc_c)
-                + (k[42] * rc_s * rc_c))
-            / (k[19] * (rt1 * rt1)));
-        let rc_f0 = (k[43] + (k[44] * rc_s * rc_w2) + (k[45] * rc_c * rc_acc));
+            * ((k[20] * rc_s * rc_c * rc_ds)
+                + (k[21] * rc_c)
+                + (k[22] * rt0 * rc_c)
+                + (k[23] * rc_s * rc_c))
+            / (k[17] * (rt1 * rt1)));
+        let rc_f0 = (k[24] + (k[25] * rc_s * rc_w2) + (k[26] * rc_c * rc_acc));
         out[0] = rc_f0;
     }
 
-    fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {}
+    fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..45]; // one bounds check for all constant loads
+    }
 
     fn full_state(
         &self,
@@ -331,96 +270,61 @@ impl Model for FreeLoadedRod {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
+        let k = &k[..45]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[8], k[10], k[11], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[1] = k[8] - delta;
         qd[1] = theta_dot;
-        q[0] = (k[46] + (k[47] * rc_dc) + (k[48] * rc_dc) + (k[49] * rc_t));
-        qd[0] = (k[49] + (k[47] * rc_s * rc_w) + (k[48] * rc_s * rc_w));
+        q[0] = (k[27] + (k[28] * rc_dc) + (k[29] * rc_t));
+        qd[0] = (k[29] + (k[28] * rc_s * rc_w));
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
+        let k = &k[..45]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         pos[0] = [q[0], 0.0];
         vel[0] = [qd[0], 0.0];
-        pos[1] = [((k[50] * rc_c) + q[0]), (k[50] * rc_s)];
-        vel[1] = [((k[52] * qd[1] * rc_s) + qd[0]), (k[50] * qd[1] * rc_c)];
-        pos[2] = [((k[51] * rc_c) + q[0]), (k[51] * rc_s)];
-        vel[2] = [((k[53] * qd[1] * rc_s) + qd[0]), (k[51] * qd[1] * rc_c)];
-        pos[3] = [
-            ((k[47] * rc_c) + (k[48] * rc_c) + q[0]),
-            ((k[47] * rc_s) + (k[48] * rc_s)),
-        ];
-        vel[3] = [
-            ((k[54] * qd[1] * rc_s) + (k[55] * qd[1] * rc_s) + qd[0]),
-            ((k[47] * qd[1] * rc_c) + (k[48] * qd[1] * rc_c)),
-        ];
+        pos[1] = [((k[30] * rc_c) + q[0]), (k[30] * rc_s)];
+        vel[1] = [((k[32] * qd[1] * rc_s) + qd[0]), (k[30] * qd[1] * rc_c)];
+        pos[2] = [((k[31] * rc_c) + q[0]), (k[31] * rc_s)];
+        vel[2] = [((k[33] * qd[1] * rc_s) + qd[0]), (k[31] * qd[1] * rc_c)];
+        pos[3] = [((k[28] * rc_c) + q[0]), (k[28] * rc_s)];
+        vel[3] = [((k[34] * qd[1] * rc_s) + qd[0]), (k[28] * qd[1] * rc_c)];
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
+        let k = &k[..45]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = (qd[1] * qd[1]);
-        let et1 = (rc_s * rc_s);
-        let et2 = (rc_c * rc_c);
-        let et3 = (qd[0] * qd[0]);
-        (((k[56] * qd[0] * qd[1] * rc_s)
-            + (k[57] * et0)
-            + (k[58] * et0 * et1)
-            + (k[58] * et0 * et2)
-            + (k[59] * et0)
-            + (k[60] * et3)
-            + (k[61] * et3)
-            + (k[62] * et0 * et1)
-            + (k[62] * et0 * et2)
-            + (k[63] * qd[0] * qd[1] * rc_s)
-            + (k[64] * et0 * et1)
-            + (k[64] * et0 * et2)
-            + (k[65] * qd[0] * qd[1] * rc_s)
-            + (k[66] * et0 * et1)
-            + (k[66] * et0 * et2))
-            + ((k[67] * rc_s) + (k[68] * rc_s)))
+        (((k[35] * qd[0] * qd[1] * rc_s)
+            + (k[36] * et0)
+            + (k[37] * et0 * (rc_s * rc_s))
+            + (k[37] * et0 * (rc_c * rc_c))
+            + (k[38] * (qd[0] * qd[0])))
+            + (k[39] * rc_s))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let k = &k[..45]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        out[0] = ((k[56] * qd[1] * rc_s)
-            + (k[69] * qd[0])
-            + (k[70] * qd[0])
-            + (k[63] * qd[1] * rc_s)
-            + (k[65] * qd[1] * rc_s));
+        out[0] = ((k[35] * qd[1] * rc_s) + (k[40] * qd[0]));
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
+        let k = &k[..45]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let qt0 = ((k[56] * rc_s) + (k[63] * rc_s) + (k[65] * rc_s));
-        let qt1 = (rc_s * rc_s);
-        let qt2 = (rc_c * rc_c);
-        let qt3 = (qd[1] * qd[1]);
-        mass[0] = k[71];
+        let qt0 = (k[35] * rc_s);
+        mass[0] = k[40];
         mass[1] = qt0;
         mass[2] = qt0;
-        mass[3] = (k[72]
-            + (k[73] * qt1)
-            + (k[73] * qt2)
-            + (k[74] * qt1)
-            + (k[74] * qt2)
-            + (k[75] * qt1)
-            + (k[75] * qt2)
-            + (k[76] * qt1)
-            + (k[76] * qt2));
-        rhs[0] = ((k[77] * qt3 * rc_c) + (k[78] * qt3 * rc_c) + (k[79] * qt3 * rc_c));
-        rhs[1] = ((k[80] * rc_c) + (k[81] * rc_c));
+        mass[3] = (k[41] + (k[42] * (rc_s * rc_s)) + (k[42] * (rc_c * rc_c)));
+        rhs[0] = (k[43] * (qd[1] * qd[1]) * rc_c);
+        rhs[1] = (k[44] * rc_c);
     }
 
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+        let k = &k[..45]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let ft0 = (qd[1] * qd[1]);
-        out[0] = (k[43]
-            + (k[77] * qdd[1] * rc_c)
-            + (k[56] * ft0 * rc_s)
-            + (k[78] * qdd[1] * rc_c)
-            + (k[63] * ft0 * rc_s)
-            + (k[79] * qdd[1] * rc_c)
-            + (k[65] * ft0 * rc_s));
+        out[0] = (k[24] + (k[43] * qdd[1] * rc_c) + (k[35] * (qd[1] * qd[1]) * rc_s));
     }
 }

@@ -141,6 +141,7 @@ impl Model for FreeRod {
     }
 
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[7], k[9], k[10], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
@@ -159,6 +160,7 @@ impl Model for FreeRod {
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[7], k[9], k[10], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
@@ -174,6 +176,7 @@ impl Model for FreeRod {
     }
 
     fn monitors(&self, k: &[f64], delta: f64, out: &mut [f64]) {
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[7], k[9], k[10], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
@@ -189,7 +192,9 @@ impl Model for FreeRod {
         out[0] = rc_f0;
     }
 
-    fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {}
+    fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..38]; // one bounds check for all constant loads
+    }
 
     fn full_state(
         &self,
@@ -200,6 +205,7 @@ impl Model for FreeRod {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[7], k[9], k[10], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[1] = k[7] - delta;
@@ -209,6 +215,7 @@ impl Model for FreeRod {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         pos[0] = [q[0], 0.0];
         vel[0] = [qd[0], 0.0];
@@ -219,6 +226,7 @@ impl Model for FreeRod {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = (qd[1] * qd[1]);
         (((k[22] * qd[0] * qd[1] * rc_s)
@@ -230,11 +238,13 @@ impl Model for FreeRod {
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = ((k[22] * qd[1] * rc_s) + (k[34] * qd[0]));
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let qt0 = (k[22] * rc_s);
         mass[0] = k[0];
@@ -246,6 +256,7 @@ impl Model for FreeRod {
     }
 
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = (k[21] + (k[23] * qdd[1] * rc_c) + (k[22] * (qd[1] * qd[1]) * rc_s));
     }

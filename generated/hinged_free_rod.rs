@@ -116,6 +116,7 @@ impl Model for HingedFreeRod {
     }
 
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_delta = delta;
         Reduced {
@@ -127,6 +128,7 @@ impl Model for HingedFreeRod {
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_delta = delta;
         let rc_w2 = (k[10] * (k[11] + (k[12] * rc_ds)));
@@ -135,11 +137,14 @@ impl Model for HingedFreeRod {
     }
 
     fn monitors(&self, k: &[f64], delta: f64, out: &mut [f64]) {
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_delta = delta;
     }
 
-    fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {}
+    fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..27]; // one bounds check for all constant loads
+    }
 
     fn full_state(
         &self,
@@ -150,6 +155,7 @@ impl Model for HingedFreeRod {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[0] = k[5] - delta;
@@ -157,6 +163,7 @@ impl Model for HingedFreeRod {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         pos[0] = [0.0, 0.0];
         vel[0] = [0.0, 0.0];
@@ -167,6 +174,7 @@ impl Model for HingedFreeRod {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let et0 = (qd[0] * qd[0]);
         (((k[21] * et0) + (k[22] * et0 * (rc_s * rc_s)) + (k[22] * et0 * (rc_c * rc_c)))
@@ -174,16 +182,19 @@ impl Model for HingedFreeRod {
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         mass[0] = (k[24] + (k[25] * (rc_s * rc_s)) + (k[25] * (rc_c * rc_c)));
         rhs[0] = (k[26] * rc_c);
     }
 
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         out[0] = (k[14] + (k[16] * qdd[0] * rc_c) + (k[15] * (qd[0] * qd[0]) * rc_s));
     }

@@ -149,17 +149,20 @@ impl Model for HingedRod {
         k[26] = (-k[2]);
         k[27] = (-k[2] / 2.0);
         k[28] = (k[0] * (k[2] * k[2]) / 24.0);
-        k[29] = (k[0] * (k[2] * k[2]) / 8.0);
-        k[30] = ((k[2] * k[2]) * k[1] / 2.0);
+        let h29_t0 = (k[2] * k[2]);
+        k[29] = ((k[0] * h29_t0 / 8.0) + (h29_t0 * k[1] / 2.0));
+        k[30] = (k[0] * (k[2] * k[2]) / 8.0);
         k[31] = (k[4] * k[0] * k[2] / 2.0);
         k[32] = (k[0] * (k[2] * k[2]) / 12.0);
-        k[33] = (k[0] * (k[2] * k[2]) / 4.0);
-        k[34] = ((k[2] * k[2]) * k[1]);
+        let h33_t0 = (k[2] * k[2]);
+        k[33] = ((k[0] * h33_t0 / 4.0) + (h33_t0 * k[1]));
+        k[34] = (k[0] * (k[2] * k[2]) / 4.0);
         k[35] = (-k[4] * k[0] * k[2] / 2.0);
         k[36] = (-(k[2] * k[2]) * k[1]);
     }
 
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
@@ -176,6 +179,7 @@ impl Model for HingedRod {
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
@@ -190,6 +194,7 @@ impl Model for HingedRod {
     }
 
     fn monitors(&self, k: &[f64], delta: f64, out: &mut [f64]) {
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
@@ -205,6 +210,7 @@ impl Model for HingedRod {
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..37]; // one bounds check for all constant loads
         out[0] = k[23];
         out[1] = k[24];
         out[2] = 0.0;
@@ -220,6 +226,7 @@ impl Model for HingedRod {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[0] = k[5] - delta;
@@ -227,6 +234,7 @@ impl Model for HingedRod {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let pt0 = (k[11] * rc_c);
         let pt1 = (k[26] * qd[0] * rc_s);
@@ -241,28 +249,27 @@ impl Model for HingedRod {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let et0 = (qd[0] * qd[0]);
-        let et1 = (rc_s * rc_s);
-        (((k[28] * et0)
-            + (k[29] * et0 * et1)
-            + (k[29] * et0 * (rc_c * rc_c))
-            + (k[30] * et0 * et1))
+        (((k[28] * et0) + (k[29] * et0 * (rc_s * rc_s)) + (k[30] * et0 * (rc_c * rc_c)))
             + (k[21] + (k[31] * rc_s)))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        let qt0 = (rc_s * rc_s);
-        mass[0] = (k[32] + (k[33] * qt0) + (k[33] * (rc_c * rc_c)) + (k[34] * qt0));
+        mass[0] = (k[32] + (k[33] * (rc_s * rc_s)) + (k[34] * (rc_c * rc_c)));
         rhs[0] = ((k[35] * rc_c) + (k[36] * (qd[0] * qd[0]) * rc_s * rc_c));
     }
 
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ft0 = (qd[0] * qd[0]);
         out[0] = ((k[17] * qdd[0] * rc_s) + (k[17] * ft0 * rc_c));

@@ -50,7 +50,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 53,
+    n_constants: 47,
     k_theta_initial: 5,
     k_theta_dot_initial: 6,
     coordinates: &["x1", "theta"],
@@ -143,115 +143,99 @@ impl Model for RodCube {
         k[11] = ((k[0] * c6_t0 * k[1] / 3.0 / (k[0] + k[1]))
             - (c6_t1 * c6_t0 * (k[7] * k[7]) / 4.0 / (k[0] + k[1]))
             + (c6_t1 * c6_t0 / 3.0 / (k[0] + k[1])));
-        k[12] = (k[4] * k[0]);
-        k[13] = (k[4] * k[1]);
-        k[14] = k[2];
-        k[15] = (-(4.0 * k[0]) - (4.0 * k[1]));
-        k[16] = (3.0 * k[0]);
-        k[17] = (6.0 * k[4] * k[0] * k[1]);
-        k[18] = (-8.0 * k[4] * k[0] * k[1]);
-        k[19] = (3.0 * k[4] * k[0] * k[1]);
-        k[20] = (-4.0 * k[4] * (k[1] * k[1]));
-        k[21] = (6.0 * k[4] * (k[0] * k[0]));
-        k[22] = (-4.0 * k[4] * (k[0] * k[0]));
-        k[23] = (3.0 * k[4] * (k[0] * k[0]));
-        k[24] = (-k[0] * k[2] * k[1] / 2.0 / (k[0] + k[1]));
-        k[25] = (-k[0] * k[2] / 2.0);
-        k[26] = (k[0] * k[2] / 2.0);
-        k[27] = (k[4] * k[1] * k[3] / 2.0);
-        k[28] = (-k[3] / 2.0);
-        k[29] = ((8.0 * k[0] * k[7]) + (8.0 * k[7] * k[1]));
-        k[30] = (-(12.0 * k[0]) - (12.0 * k[1]));
-        k[31] = k[9];
-        k[32] = (k[0] * k[2] / 2.0 / (k[0] + k[1]));
-        k[33] = (k[2] * k[1] / (k[0] + k[1]));
-        k[34] = (k[2] / 2.0);
-        k[35] = (-k[2]);
-        k[36] = (-k[2] / 2.0);
-        k[37] = (k[0] * (k[2] * k[2]) / 24.0);
-        k[38] = (k[0] * (k[2] * k[2]) / 8.0);
-        k[39] = (k[0] / 2.0);
-        k[40] = (-k[2] * k[1]);
-        k[41] = ((k[2] * k[2]) * k[1] / 2.0);
-        k[42] = (k[1] / 2.0);
-        k[43] = (k[4] * k[0] * k[2] / 2.0);
-        k[44] = k[0];
-        k[45] = k[1];
-        k[46] = (k[0] + k[1]);
-        k[47] = (k[0] * (k[2] * k[2]) / 12.0);
-        k[48] = (k[0] * (k[2] * k[2]) / 4.0);
-        k[49] = ((k[2] * k[2]) * k[1]);
-        k[50] = (k[2] * k[1]);
-        k[51] = (-k[4] * k[0] * k[2] / 2.0);
-        k[52] = (-(k[2] * k[2]) * k[1]);
+        k[12] = ((k[4] * k[0]) + (k[4] * k[1]));
+        k[13] = k[2];
+        k[14] = (-(4.0 * k[0]) - (4.0 * k[1]));
+        k[15] = (3.0 * k[0]);
+        k[16] = ((6.0 * k[4] * k[0] * k[1]) + (6.0 * k[4] * (k[0] * k[0])));
+        k[17] = (-(8.0 * k[4] * k[0] * k[1])
+            - (4.0 * k[4] * (k[1] * k[1]))
+            - (4.0 * k[4] * (k[0] * k[0])));
+        k[18] = ((3.0 * k[4] * k[0] * k[1]) + (3.0 * k[4] * (k[0] * k[0])));
+        k[19] = (-k[0] * k[2] * k[1] / 2.0 / (k[0] + k[1]));
+        k[20] = (k[4] * k[0]);
+        k[21] = (-k[0] * k[2] / 2.0);
+        k[22] = (k[0] * k[2] / 2.0);
+        k[23] = (k[4] * k[1] * k[3] / 2.0);
+        k[24] = (-k[3] / 2.0);
+        k[25] = ((8.0 * k[0] * k[7]) + (8.0 * k[7] * k[1]));
+        k[26] = (-(12.0 * k[0]) - (12.0 * k[1]));
+        k[27] = k[9];
+        k[28] = ((k[0] * k[2] / 2.0 / (k[0] + k[1])) + (k[2] * k[1] / (k[0] + k[1])));
+        k[29] = (k[2] / 2.0);
+        k[30] = (-k[2]);
+        k[31] = (-k[2] / 2.0);
+        k[32] = (-(k[0] * k[2] / 2.0) - (k[2] * k[1]));
+        k[33] = (k[0] * (k[2] * k[2]) / 24.0);
+        let h34_t0 = (k[2] * k[2]);
+        k[34] = ((k[0] * h34_t0 / 8.0) + (h34_t0 * k[1] / 2.0));
+        k[35] = (k[0] * (k[2] * k[2]) / 8.0);
+        k[36] = ((k[0] / 2.0) + (k[1] / 2.0));
+        k[37] = (k[4] * k[0] * k[2] / 2.0);
+        k[38] = (k[0] + k[1]);
+        k[39] = (k[0] * (k[2] * k[2]) / 12.0);
+        let h40_t0 = (k[2] * k[2]);
+        k[40] = ((k[0] * h40_t0 / 4.0) + (h40_t0 * k[1]));
+        k[41] = (k[0] * (k[2] * k[2]) / 4.0);
+        k[42] = ((k[0] * k[2] / 2.0) + (k[2] * k[1]));
+        k[43] = (-k[4] * k[0] * k[2] / 2.0);
+        k[44] = (-(k[2] * k[2]) * k[1]);
+        k[45] = (-k[2] * k[1]);
+        k[46] = k[1];
     }
 
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
-        let rt1 = (k[15] + (k[16] * rt0));
+        let rt1 = (k[14] + (k[15] * rt0));
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: (-12.0 * ((k[12] * rc_ds) + (k[13] * rc_ds)) / (k[14] * rt1)),
+            theta_dot_sq: (-12.0 * (k[12] * rc_ds) / (k[13] * rt1)),
             theta_ddot: (6.0
-                * ((k[17] * rc_s * rc_c * rc_ds)
-                    + (k[18] * rc_c)
-                    + (k[19] * rt0 * rc_c)
-                    + (k[20] * rc_c)
-                    + (k[21] * rc_s * rc_c * rc_ds)
-                    + (k[22] * rc_c)
-                    + (k[23] * rt0 * rc_c))
-                / (k[14] * (rt1 * rt1))),
+                * ((k[16] * rc_s * rc_c * rc_ds) + (k[17] * rc_c) + (k[18] * rt0 * rc_c))
+                / (k[13] * (rt1 * rt1))),
         }
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
-        let rt1 = (k[15] + (k[16] * rt0));
-        let rc_w2 = (-12.0 * ((k[12] * rc_ds) + (k[13] * rc_ds)) / (k[14] * rt1));
+        let rt1 = (k[14] + (k[15] * rt0));
+        let rc_w2 = (-12.0 * (k[12] * rc_ds) / (k[13] * rt1));
         let rc_acc = (6.0
-            * ((k[17] * rc_s * rc_c * rc_ds)
-                + (k[18] * rc_c)
-                + (k[19] * rt0 * rc_c)
-                + (k[20] * rc_c)
-                + (k[21] * rc_s * rc_c * rc_ds)
-                + (k[22] * rc_c)
-                + (k[23] * rt0 * rc_c))
-            / (k[14] * (rt1 * rt1)));
-        out[0] = ((k[24] * rc_s * rc_acc) + (k[24] * rc_c * rc_w2));
-        out[1] = (k[12] + (k[25] * rc_s * rc_w2) + (k[26] * rc_c * rc_acc));
+            * ((k[16] * rc_s * rc_c * rc_ds) + (k[17] * rc_c) + (k[18] * rt0 * rc_c))
+            / (k[13] * (rt1 * rt1)));
+        out[0] = ((k[19] * rc_s * rc_acc) + (k[19] * rc_c * rc_w2));
+        out[1] = (k[20] + (k[21] * rc_s * rc_w2) + (k[22] * rc_c * rc_acc));
     }
 
     fn monitors(&self, k: &[f64], delta: f64, out: &mut [f64]) {
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
-        let rt1 = (k[15] + (k[16] * rt0));
-        let rc_w2 = (-12.0 * ((k[12] * rc_ds) + (k[13] * rc_ds)) / (k[14] * rt1));
+        let rt1 = (k[14] + (k[15] * rt0));
+        let rc_w2 = (-12.0 * (k[12] * rc_ds) / (k[13] * rt1));
         let rc_acc = (6.0
-            * ((k[17] * rc_s * rc_c * rc_ds)
-                + (k[18] * rc_c)
-                + (k[19] * rt0 * rc_c)
-                + (k[20] * rc_c)
-                + (k[21] * rc_s * rc_c * rc_ds)
-                + (k[22] * rc_c)
-                + (k[23] * rt0 * rc_c))
-            / (k[14] * (rt1 * rt1)));
-        let rc_f0 = ((k[24] * rc_s * rc_acc) + (k[24] * rc_c * rc_w2));
-        let rc_f1 = (k[12] + (k[25] * rc_s * rc_w2) + (k[26] * rc_c * rc_acc));
+            * ((k[16] * rc_s * rc_c * rc_ds) + (k[17] * rc_c) + (k[18] * rt0 * rc_c))
+            / (k[13] * (rt1 * rt1)));
+        let rc_f0 = ((k[19] * rc_s * rc_acc) + (k[19] * rc_c * rc_w2));
+        let rc_f1 = (k[20] + (k[21] * rc_s * rc_w2) + (k[22] * rc_c * rc_acc));
         out[0] = rc_f1;
-        out[1] = (k[27] - (rc_f0 * (k[28] + (k[14] * rc_s))));
+        out[1] = (k[23] - (rc_f0 * (k[24] + (k[13] * rc_s))));
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        out[0] = k[29];
-        out[1] = k[30];
+        let k = &k[..47]; // one bounds check for all constant loads
+        out[0] = k[25];
+        out[1] = k[26];
         out[2] = 0.0;
-        out[3] = k[16];
+        out[3] = k[15];
     }
 
     fn full_state(
@@ -263,67 +247,66 @@ impl Model for RodCube {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[1] = k[5] - delta;
         qd[1] = theta_dot;
-        q[0] = (k[31] + (k[32] * rc_dc) + (k[33] * rc_dc));
-        qd[0] = ((k[32] * rc_s * rc_w) + (k[33] * rc_s * rc_w));
+        q[0] = (k[27] + (k[28] * rc_dc));
+        qd[0] = (k[28] * rc_s * rc_w);
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let pt0 = ((k[14] * rc_c) + q[0]);
-        let pt1 = ((k[35] * qd[1] * rc_s) + qd[0]);
+        let pt0 = ((k[13] * rc_c) + q[0]);
+        let pt1 = ((k[30] * qd[1] * rc_s) + qd[0]);
         pos[0] = [q[0], 0.0];
         vel[0] = [qd[0], 0.0];
-        pos[1] = [pt0, (k[14] * rc_s)];
-        vel[1] = [pt1, (k[14] * qd[1] * rc_c)];
-        pos[2] = [((k[34] * rc_c) + q[0]), (k[34] * rc_s)];
-        vel[2] = [((k[36] * qd[1] * rc_s) + qd[0]), (k[34] * qd[1] * rc_c)];
+        pos[1] = [pt0, (k[13] * rc_s)];
+        vel[1] = [pt1, (k[13] * qd[1] * rc_c)];
+        pos[2] = [((k[29] * rc_c) + q[0]), (k[29] * rc_s)];
+        vel[2] = [((k[31] * qd[1] * rc_s) + qd[0]), (k[29] * qd[1] * rc_c)];
         pos[3] = [pt0, 0.0];
         vel[3] = [pt1, 0.0];
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = (qd[1] * qd[1]);
-        let et1 = (rc_s * rc_s);
-        let et2 = (qd[0] * qd[0]);
-        (((k[25] * qd[0] * qd[1] * rc_s)
-            + (k[37] * et0)
-            + (k[38] * et0 * et1)
-            + (k[38] * et0 * (rc_c * rc_c))
-            + (k[39] * et2)
-            + (k[40] * qd[0] * qd[1] * rc_s)
-            + (k[41] * et0 * et1)
-            + (k[42] * et2))
-            + (k[27] + (k[43] * rc_s)))
+        (((k[32] * qd[0] * qd[1] * rc_s)
+            + (k[33] * et0)
+            + (k[34] * et0 * (rc_s * rc_s))
+            + (k[35] * et0 * (rc_c * rc_c))
+            + (k[36] * (qd[0] * qd[0])))
+            + (k[23] + (k[37] * rc_s)))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        out[0] =
-            ((k[25] * qd[1] * rc_s) + (k[44] * qd[0]) + (k[40] * qd[1] * rc_s) + (k[45] * qd[0]));
+        out[0] = ((k[32] * qd[1] * rc_s) + (k[38] * qd[0]));
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let qt0 = ((k[25] * rc_s) + (k[40] * rc_s));
-        let qt1 = (rc_s * rc_s);
-        let qt2 = (qd[1] * qd[1]);
-        mass[0] = k[46];
+        let qt0 = (k[32] * rc_s);
+        let qt1 = (qd[1] * qd[1]);
+        mass[0] = k[38];
         mass[1] = qt0;
         mass[2] = qt0;
-        mass[3] = (k[47] + (k[48] * qt1) + (k[48] * (rc_c * rc_c)) + (k[49] * qt1));
-        rhs[0] = ((k[26] * qt2 * rc_c) + (k[50] * qt2 * rc_c));
-        rhs[1] = ((k[51] * rc_c) + (k[52] * qt2 * rc_s * rc_c));
+        mass[3] = (k[39] + (k[40] * (rc_s * rc_s)) + (k[41] * (rc_c * rc_c)));
+        rhs[0] = (k[42] * qt1 * rc_c);
+        rhs[1] = ((k[43] * rc_c) + (k[44] * qt1 * rc_s * rc_c));
     }
 
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let ft0 = (qd[1] * qd[1]);
-        out[0] = ((k[40] * qdd[1] * rc_s) + (k[40] * ft0 * rc_c) + (k[45] * qdd[0]));
-        out[1] = (k[12] + (k[26] * qdd[1] * rc_c) + (k[25] * ft0 * rc_s));
+        out[0] = ((k[45] * qdd[1] * rc_s) + (k[45] * ft0 * rc_c) + (k[46] * qdd[0]));
+        out[1] = (k[20] + (k[22] * qdd[1] * rc_c) + (k[21] * ft0 * rc_s));
     }
 }

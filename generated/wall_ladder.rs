@@ -144,6 +144,7 @@ impl Model for WallLadder {
     }
 
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
+        let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[4], k[6], k[7], delta);
         let rc_delta = delta;
         Reduced {
@@ -155,6 +156,7 @@ impl Model for WallLadder {
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
+        let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[4], k[6], k[7], delta);
         let rc_delta = delta;
         let rc_w2 = (k[9] * rc_ds);
@@ -164,6 +166,7 @@ impl Model for WallLadder {
     }
 
     fn monitors(&self, k: &[f64], delta: f64, out: &mut [f64]) {
+        let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[4], k[6], k[7], delta);
         let rc_delta = delta;
         let rc_w2 = (k[9] * rc_ds);
@@ -174,6 +177,7 @@ impl Model for WallLadder {
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..25]; // one bounds check for all constant loads
         out[0] = k[14];
         out[1] = 3.0;
     }
@@ -187,6 +191,7 @@ impl Model for WallLadder {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
+        let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[4], k[6], k[7], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[0] = k[4] - delta;
@@ -194,6 +199,7 @@ impl Model for WallLadder {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
+        let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         pos[0] = [(k[15] * rc_c), 0.0];
         vel[0] = [(k[16] * qd[0] * rc_s), 0.0];
@@ -206,6 +212,7 @@ impl Model for WallLadder {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
+        let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let et0 = (qd[0] * qd[0]);
         (((k[19] * et0) + (k[20] * et0 * (rc_s * rc_s)) + (k[20] * et0 * (rc_c * rc_c)))
@@ -213,16 +220,19 @@ impl Model for WallLadder {
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
+        let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         mass[0] = (k[22] + (k[23] * (rc_s * rc_s)) + (k[23] * (rc_c * rc_c)));
         rhs[0] = (k[24] * rc_c);
     }
 
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+        let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ft0 = (qd[0] * qd[0]);
         out[0] = ((k[11] * qdd[0] * rc_s) + (k[11] * ft0 * rc_c));

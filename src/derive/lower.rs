@@ -135,6 +135,32 @@ fn hoist_constants(e: &Expr, scope: &Scope, h: &mut Hoisted) -> Expr {
         let i = h.index_of(e);
         return Expr::Sym(format!("rc_k{i}"));
     }
+    // Sums: collect like terms first (`k1*s*c + k2*s*c` -> `(k1 + k2)*s*c`), so each
+    // monomial of the motion costs one hoisted coefficient.
+    if let Expr::Add(v) = e {
+        let mut groups: Vec<(String, Expr, Vec<Expr>)> = Vec::new();
+        for t in v {
+            let factors = match t {
+                Expr::Mul(f) => f.clone(),
+                x => vec![x.clone()],
+            };
+            let (coef, rest): (Vec<Expr>, Vec<Expr>) =
+                factors.into_iter().partition(|f| constant_only(f, scope));
+            let rest = super::expr::product(rest);
+            let key = rest.to_infix();
+            match groups.iter_mut().find(|g| g.0 == key) {
+                Some(g) => g.2.push(super::expr::product(coef)),
+                None => groups.push((key, rest, vec![super::expr::product(coef)])),
+            }
+        }
+        if groups.len() < v.len() {
+            let terms = groups
+                .into_iter()
+                .map(|(_, rest, coefs)| Expr::Mul(vec![super::expr::sum(coefs), rest]).tidy())
+                .collect();
+            return hoist_constants(&super::expr::sum(terms), scope, h);
+        }
+    }
     // Products and sums: hoist the constant part as one factor / term.
     match e {
         Expr::Mul(v) | Expr::Add(v) => {
