@@ -266,18 +266,7 @@ fn emit_node(
         }
         Expr::Add(v) => {
             let mut out = String::from("(");
-            for (i, t) in v.iter().enumerate() {
-                let (neg, mag) = t.split_sign();
-                let text = sub(&mag);
-                if i == 0 {
-                    if neg {
-                        out.push('-');
-                    }
-                } else {
-                    out.push_str(if neg { " - " } else { " + " });
-                }
-                out.push_str(&text);
-            }
+            super::expr::write_signed_sum(&mut out, v, |o, mag| o.push_str(&sub(mag)));
             out.push(')');
             out
         }

@@ -269,17 +269,7 @@ impl Expr {
             }
             Expr::Sym(s) => out.push_str(s),
             Expr::Add(v) => wrap(out, parent > 1, |o| {
-                for (i, t) in v.iter().enumerate() {
-                    let (neg, mag) = t.split_sign();
-                    if i == 0 {
-                        if neg {
-                            o.push('-');
-                        }
-                    } else {
-                        o.push_str(if neg { " - " } else { " + " });
-                    }
-                    mag.infix(o, 2);
-                }
+                write_signed_sum(o, v, |o, mag| mag.infix(o, 2));
             }),
             Expr::Mul(_) => {
                 let (neg, mag) = self.split_sign();
@@ -361,17 +351,7 @@ impl Expr {
             Expr::Float(x) => out.push_str(&format!("{x}")),
             Expr::Sym(s) => out.push_str(&name(s)),
             Expr::Add(v) => wrap_latex(out, parent > 1, |o| {
-                for (i, t) in v.iter().enumerate() {
-                    let (neg, mag) = t.split_sign();
-                    if i == 0 {
-                        if neg {
-                            o.push('-');
-                        }
-                    } else {
-                        o.push_str(if neg { " - " } else { " + " });
-                    }
-                    mag.latex(o, 2, name);
-                }
+                write_signed_sum(o, v, |o, mag| mag.latex(o, 2, name));
             }),
             Expr::Mul(_) => {
                 let (neg, mag) = self.split_sign();
@@ -663,6 +643,26 @@ impl Expr {
             }
         }
         (num, den)
+    }
+}
+
+/// Writes the terms of a sum as `t0 + t1 - t2 ...`, each term's leading minus sign moved into
+/// the operator; `term` writes a term's magnitude. Shared by the infix, LaTeX and Rust printers.
+pub fn write_signed_sum(
+    out: &mut String,
+    terms: &[Expr],
+    mut term: impl FnMut(&mut String, &Expr),
+) {
+    for (i, t) in terms.iter().enumerate() {
+        let (neg, mag) = t.split_sign();
+        if i == 0 {
+            if neg {
+                out.push('-');
+            }
+        } else {
+            out.push_str(if neg { " - " } else { " + " });
+        }
+        term(out, &mag);
     }
 }
 
