@@ -48,6 +48,16 @@ fn per_point(c: &mut Criterion) {
                 .expect("the paper's point solves")
         })
     });
+    // The same solver with one fixed pair of rules (8 against 12 nodes) on every panel instead
+    // of the schedule by panel length: what the schedule saves.
+    let mut fixed = LeanSolver::with_rules(model, 8, 12, 1e-12).expect("rod_cube has a contact");
+    g.bench_function("lean_solver_fixed_8_12", |b| {
+        b.iter(|| {
+            fixed
+                .solve(black_box(&values))
+                .expect("the paper's point solves")
+        })
+    });
     g.finish();
 }
 

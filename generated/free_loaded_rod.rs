@@ -68,6 +68,8 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 45,
     k_theta_initial: 8,
     k_theta_dot_initial: 9,
+    k_sin_initial: 10,
+    k_cos_initial: 11,
     coordinates: &["x1", "theta"],
     reduced: 1,
     cyclic: &[0],
@@ -222,6 +224,11 @@ impl Model for FreeLoadedRod {
                     + (k[23] * rc_s * rc_c))
                 / (k[17] * (rt1 * rt1))),
         }
+    }
+
+    fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
+        let k = &k[..45]; // one bounds check for all constant loads
+        (-12.0 * (k[15] + (k[16] * rc_ds)) / (k[17] * (k[18] + (k[19] * (rc_s * rc_s)))))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {

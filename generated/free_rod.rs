@@ -62,6 +62,8 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 38,
     k_theta_initial: 7,
     k_theta_dot_initial: 8,
+    k_sin_initial: 9,
+    k_cos_initial: 10,
     coordinates: &["x1", "theta"],
     reduced: 1,
     cyclic: &[0],
@@ -157,6 +159,11 @@ impl Model for FreeRod {
                     + (k[20] * rc_s * rc_c))
                 / (k[16] * (rt1 * rt1))),
         }
+    }
+
+    fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
+        let k = &k[..38]; // one bounds check for all constant loads
+        (-12.0 * (k[14] + (k[15] * rc_ds)) / (k[16] * (-4.0 + (3.0 * (rc_s * rc_s)))))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {

@@ -50,6 +50,8 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 27,
     k_theta_initial: 5,
     k_theta_dot_initial: 6,
+    k_sin_initial: 7,
+    k_cos_initial: 8,
     coordinates: &["theta"],
     reduced: 0,
     cyclic: &[],
@@ -125,6 +127,11 @@ impl Model for HingedFreeRod {
             theta_dot_sq: (k[10] * (k[11] + (k[12] * rc_ds))),
             theta_ddot: (k[13] * rc_c),
         }
+    }
+
+    fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
+        let k = &k[..27]; // one bounds check for all constant loads
+        (k[10] * (k[11] + (k[12] * rc_ds)))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {

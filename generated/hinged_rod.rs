@@ -53,6 +53,8 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 37,
     k_theta_initial: 5,
     k_theta_dot_initial: 6,
+    k_sin_initial: 7,
+    k_cos_initial: 8,
     coordinates: &["theta"],
     reduced: 0,
     cyclic: &[],
@@ -176,6 +178,11 @@ impl Model for HingedRod {
                 / 2.0
                 / (k[11] * (rt1 * rt1))),
         }
+    }
+
+    fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
+        let k = &k[..37]; // one bounds check for all constant loads
+        (k[10] * rc_ds / (k[11] * (k[12] + (k[13] * (rc_s * rc_s)))))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {

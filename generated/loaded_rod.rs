@@ -59,6 +59,8 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 52,
     k_theta_initial: 6,
     k_theta_dot_initial: 7,
+    k_sin_initial: 8,
+    k_cos_initial: 9,
     coordinates: &["x1", "theta"],
     reduced: 1,
     cyclic: &[0],
@@ -322,6 +324,11 @@ impl Model for LoadedRod {
                 * ((k[17] * rc_s * rc_c * rc_ds) + (k[18] * rc_c) + (k[19] * rt0 * rc_c))
                 / (k[14] * (rt1 * rt1))),
         }
+    }
+
+    fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
+        let k = &k[..52]; // one bounds check for all constant loads
+        (-12.0 * (k[13] * rc_ds) / (k[14] * (k[15] + (k[16] * (rc_s * rc_s)))))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {

@@ -53,6 +53,8 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 47,
     k_theta_initial: 5,
     k_theta_dot_initial: 6,
+    k_sin_initial: 7,
+    k_cos_initial: 8,
     coordinates: &["x1", "theta"],
     reduced: 1,
     cyclic: &[0],
@@ -198,6 +200,11 @@ impl Model for RodCube {
                 * ((k[16] * rc_s * rc_c * rc_ds) + (k[17] * rc_c) + (k[18] * rt0 * rc_c))
                 / (k[13] * (rt1 * rt1))),
         }
+    }
+
+    fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
+        let k = &k[..47]; // one bounds check for all constant loads
+        (-12.0 * (k[12] * rc_ds) / (k[13] * (k[14] + (k[15] * (rc_s * rc_s)))))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {

@@ -47,6 +47,8 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 25,
     k_theta_initial: 4,
     k_theta_dot_initial: 5,
+    k_sin_initial: 6,
+    k_cos_initial: 7,
     coordinates: &["theta"],
     reduced: 0,
     cyclic: &[],
@@ -153,6 +155,11 @@ impl Model for WallLadder {
             theta_dot_sq: (k[9] * rc_ds),
             theta_ddot: (k[10] * rc_c),
         }
+    }
+
+    fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
+        let k = &k[..25]; // one bounds check for all constant loads
+        (k[9] * rc_ds)
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {

@@ -98,6 +98,11 @@ pub struct ModelInfo {
     pub k_theta_initial: usize,
     /// Index in `k` of the initial reduced rate `theta_dot_i`.
     pub k_theta_dot_initial: usize,
+    /// Index in `k` of `sin(theta_i)`, formed from the parameters (exact where `theta_i` is
+    /// given by its sine, as for a rod leaning on a cube: `a / ell`).
+    pub k_sin_initial: usize,
+    /// Index in `k` of `cos(theta_i)`, formed from the parameters without cancellation.
+    pub k_cos_initial: usize,
     /// Generalized coordinates of the unreduced system.
     pub coordinates: &'static [&'static str],
     /// Index in `coordinates` of the reduced coordinate (`theta`).
@@ -140,6 +145,14 @@ pub trait Model: Send + Sync {
 
     /// Reduced state at `delta`: returns `(sin theta, cos theta, theta_dot^2, theta_ddot)`.
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced;
+
+    /// `theta_dot^2` alone, at the angle given by its sine `s` and cosine `c` and their drops from
+    /// the start, `ds = sin(theta_i) - s` and `dc = cos(theta_i) - c`: no trigonometric call and
+    /// no `theta_ddot`. This is the integrand of the per-point solver
+    /// [`LeanSolver`](crate::solve::lean::LeanSolver), which parametrises the motion by
+    /// `sin(theta)` and forms `ds` and `dc` exactly. Equal to
+    /// `reduced(k, delta).theta_dot_sq` at the same angle.
+    fn theta_dot_sq_sc(&self, k: &[f64], s: f64, c: f64, ds: f64, dc: f64) -> f64;
 
     /// Reaction forces at `delta` along the reduced motion, in the order of [`ModelInfo::forces`].
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]);

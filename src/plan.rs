@@ -1,7 +1,7 @@
 //! The planner: turns a [`Request`] (model, parameters, wanted quantities) into [`RunResults`],
 //! computing each wanted quantity and its prerequisites and nothing else.
 //!
-//! Prerequisites, computed at most once each (lazily, through [`Plan`]'s caches):
+//! Prerequisites, computed at most once each (lazily, through `Plan`'s caches):
 //! - `separation_angle`: the separation root (polynomial evaluations only);
 //! - `linearised_separation_angle`: the polynomial's two lowest coefficients (no evaluation);
 //! - `separation_time`: root + quadrature of the first phase;

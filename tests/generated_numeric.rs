@@ -214,6 +214,11 @@ fn rod_cube_agrees_with_the_papers_formulas_at_1000_random_points() {
         let dd = 4.0 / 3.0 - s * s / (1.0 + n);
         let w2 = 4.0 * (g / ell) * r_minus_s / dd;
         worst.check("eq9 theta_dot_sq", red.theta_dot_sq, w2, w2, &at);
+        // The same from sin, cos and their drops (the lean solver's integrand).
+        assert_eq!(k[info.k_sin_initial], r);
+        worst.check("cos theta_i", k[info.k_cos_initial], beta, 1.0, &at);
+        let w2_sc = model.theta_dot_sq_sc(&k, s, c, r_minus_s, -c_minus_beta);
+        worst.check("eq9 theta_dot_sq_sc", w2_sc, w2, w2, &at);
         // PHYSICS.md erratum 2, the corrected eq (12).
         let (t1, t2) = (-c / dd, r_minus_s * 2.0 * s * c / ((1.0 + n) * dd * dd));
         let acc = 2.0 * g / ell * (t1 + t2);

@@ -145,6 +145,50 @@ proptest! {
     }
 }
 
+/// `theta_dot_sq_sc` (the lean solver's integrand, fed `sin`, `cos` and their drops) equals
+/// `reduced(k, delta).theta_dot_sq` along the whole phase of every model.
+fn check_theta_dot_sq_sc(model: &'static dyn Model, u: &[f64], spread: u8, frac: f64) {
+    let info = model.info();
+    let p = parameters(model, u, spread);
+    let sys = rodcube::system::System::from_values(model, &p).expect("valid parameters");
+    let k = sys.k();
+    let (theta_i, sin_i, cos_i) = (
+        k[info.k_theta_initial],
+        k[info.k_sin_initial],
+        k[info.k_cos_initial],
+    );
+    assert!((sin_i - theta_i.sin()).abs() <= 1e-15 * sin_i.abs().max(1e-300));
+    assert!((cos_i - theta_i.cos()).abs() <= 1e-15);
+    let delta = frac * (theta_i - info.end_angle);
+    let (s, c, ds, dc) = rodcube::model::start_offsets(theta_i, sin_i, cos_i, delta);
+    let sc = model.theta_dot_sq_sc(k, s, c, ds, dc);
+    let full = model.reduced(k, delta).theta_dot_sq;
+    assert!(
+        (sc - full).abs() <= 1e-14 * full.abs().max(f64::MIN_POSITIVE),
+        "{}: {p:?}, delta = {delta}: {sc} vs {full}",
+        info.name
+    );
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: 200,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0x5c_5c),
+        ..ProptestConfig::default()
+    })]
+
+    #[test]
+    fn theta_dot_sq_from_sin_and_cos_equals_the_reduced_one(
+        u in proptest::collection::vec(0.0f64..1.0, 8),
+        spread in 0u8..3,
+        frac in 0.0f64..1.0,
+    ) {
+        for &model in rodcube::models::all() {
+            check_theta_dot_sq_sc(model, &u, spread, frac);
+        }
+    }
+}
+
 #[test]
 fn the_generator_covers_every_model() {
     // Every shipped model gets parameters it accepts (so the property above tests them all).

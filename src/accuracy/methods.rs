@@ -442,9 +442,18 @@ pub fn time_unreduced(sys: &System, rtol: f64, t_max: f64) -> Outcome<f64> {
     Ok((run.t_end, 6 * work.ode_steps))
 }
 
-/// The sweep's lean solver (root and time) comparing rules of 8 and 12 nodes on each panel.
+/// The sweep's lean solver (root and time) with its default rule schedule
+/// ([`LEAN_SCHEDULE`](crate::solve::lean::LEAN_SCHEDULE)).
 pub fn time_lean(sys: &System, accept: f64) -> Outcome<f64> {
-    let mut s = LeanSolver::with_rules(sys.model(), 8, 12, accept).map_err(err)?;
+    let schedule = crate::solve::lean::LEAN_SCHEDULE;
+    let mut s = LeanSolver::with_schedule(sys.model(), &schedule, accept).map_err(err)?;
+    let out = s.solve(sys.p()).map_err(err)?;
+    Ok((out.separation_time, s.evals))
+}
+
+/// The lean solver comparing fixed rules of `low` and `high` nodes on every panel.
+pub fn time_lean_fixed(sys: &System, low: usize, high: usize, accept: f64) -> Outcome<f64> {
+    let mut s = LeanSolver::with_rules(sys.model(), low, high, accept).map_err(err)?;
     let out = s.solve(sys.p()).map_err(err)?;
     Ok((out.separation_time, s.evals))
 }

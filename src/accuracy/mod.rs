@@ -1,7 +1,7 @@
 //! `rodcube accuracy`: what accuracy costs in time. Every method the project ships, and the
 //! ones a user would reach for, is run on the paper's case and on the hard cases (near upright,
 //! nearly flat, extreme mass ratios) and compared with the independent high-precision
-//! [`reference`](crate::reference): relative error, model evaluations and time per solve, as a
+//! [`reference`](mod@crate::reference): relative error, model evaluations and time per solve, as a
 //! table, a CSV and log–log SVG plots of error against time with the Pareto front marked.
 
 pub mod methods;
@@ -182,9 +182,16 @@ fn time_methods() -> Vec<(&'static str, String, TimeFn)> {
     }
     for accept in [1e-4, 1e-6, 1e-8, 1e-10, 1e-12, 1e-14] {
         out.push((
-            "sweep (default): sinh subst., GL 8 vs 12 per panel",
+            "sweep (default): sin/sinh subst., GL pairs by panel length",
             format!("accept {accept:.0e}"),
             Box::new(move |s, _, _| methods::time_lean(s, accept)),
+        ));
+    }
+    for (low, high) in [(6, 9), (8, 12)] {
+        out.push((
+            "sweep: sin/sinh subst., fixed GL pair per panel",
+            format!("GL {low} vs {high}"),
+            Box::new(move |s, _, _| methods::time_lean_fixed(s, low, high, 1e-12)),
         ));
     }
     for nodes in [5, 10, 20, 40, 80] {

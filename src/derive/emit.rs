@@ -83,6 +83,7 @@ pub struct RustContext {
     requirements: Code,
     prepare: Code,
     reduced_code: Code,
+    theta_dot_sq_code: Code,
     forces: Code,
     monitors: Code,
     separation: Code,
@@ -177,6 +178,32 @@ pub fn rust_context(
         "r",
     ));
     reduced_code.outputs = out;
+
+    // theta_dot^2 alone from sin, cos and their drops (the lean solver's integrand): the energy
+    // integral has no other dependence on theta, which `mechanics` has checked.
+    let mut sc_scope = scope.clone();
+    for s in ["rc_s", "rc_c", "rc_ds", "rc_dc"] {
+        sc_scope.locals.insert(s.into(), s.into());
+    }
+    let stray: Vec<String> = d
+        .theta_dot_sq
+        .symbols()
+        .into_iter()
+        .filter(|s| !sc_scope.locals.contains_key(s) && !scope.constants.contains_key(s))
+        .collect();
+    if !stray.is_empty() {
+        return Err(format!(
+            "theta_dot^2 depends on {} besides sin, cos and constants",
+            stray.join(", ")
+        ));
+    }
+    let mut theta_dot_sq_code = Code::default();
+    theta_dot_sq_code.outputs = theta_dot_sq_code.push_body(lower(
+        std::slice::from_ref(&d.theta_dot_sq),
+        &sc_scope,
+        Some(&mut hoisted),
+        "r",
+    ));
 
     // Forces: theta_dot^2 and theta_ddot first, then the forces over them.
     let mut force_scope = red_scope.clone();
@@ -500,6 +527,7 @@ pub fn rust_context(
         requirements,
         prepare,
         reduced_code,
+        theta_dot_sq_code,
         forces,
         monitors,
         separation,

@@ -53,6 +53,16 @@ pub enum SolveError {
         /// Initial acceleration.
         theta_ddot: f64,
     },
+    /// The phase starts at or beyond the vertical, where `sin(theta)` does not fall monotonically.
+    #[error(
+        "model `{model}` starts at theta_i = {theta_initial} rad, not below the vertical; the per-point solver needs 0 < cos(theta_i)"
+    )]
+    BeyondVertical {
+        /// Model name.
+        model: &'static str,
+        /// Initial angle (rad).
+        theta_initial: f64,
+    },
     /// The initial rate makes the angle grow, so `delta` would be negative.
     #[error("model `{model}` starts rising (theta_dot_i = {theta_dot} > 0); phases must fall")]
     Rising {

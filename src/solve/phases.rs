@@ -3,7 +3,7 @@
 //!
 //! A next phase gets its parameters from [`NextPhase::bindings`](crate::model::NextPhase): a
 //! parameter of this model, or a coordinate or velocity of the full state at separation
-//! ([`Model::full_state`](crate::model::Model::full_state)). Its clock restarts at zero; the
+//! ([`Model::full_state`]). Its clock restarts at zero; the
 //! absolute time of its start is kept in [`PhaseRun::t_start`].
 
 use crate::model::{Binding, Model};

@@ -104,9 +104,11 @@ fn at_sine(sys: &System, s: f64) -> Separation {
     }
 }
 
-/// `p(x)` by Horner's rule (coefficients lowest degree first).
+/// `p(x)` by Horner's rule (coefficients lowest degree first), with separate multiplies and
+/// adds (without a hardware FMA target feature `f64::mul_add` is a library call several times
+/// slower than the arithmetic).
 pub fn horner(coeffs: &[f64], x: f64) -> f64 {
-    coeffs.iter().rev().fold(0.0, |acc, &c| acc.mul_add(x, c))
+    coeffs.iter().rev().fold(0.0, |acc, &c| acc * x + c)
 }
 
 /// `p(x)` by compensated Horner (Graillat, Langlois, Louvet 2005): as accurate as Horner in
@@ -115,17 +117,40 @@ pub fn horner_compensated(coeffs: &[f64], x: f64) -> f64 {
     let Some((&last, rest)) = coeffs.split_last() else {
         return 0.0;
     };
+    let xs = split(x);
     let (mut s, mut c) = (last, 0.0f64);
     for &a in rest.iter().rev() {
-        let p = s * x;
-        let pi = s.mul_add(x, -p);
+        let (p, pi) = two_product(s, x, xs);
         let t = p + a;
         let bb = t - p;
         let sigma = (p - (t - bb)) + (a - bb);
         s = t;
-        c = c.mul_add(x, pi + sigma);
+        c = c * x + (pi + sigma);
     }
     s + c
+}
+
+/// `a` split into two halves of 26 significant bits whose products are exact (Veltkamp).
+#[inline]
+fn split(a: f64) -> (f64, f64) {
+    let t = 134_217_729.0 * a; // 2^27 + 1
+    let hi = t - (t - a);
+    (hi, a - hi)
+}
+
+/// `a * b` rounded and its exact rounding error (Dekker's TwoProduct), with `b` already
+/// [`split`]. Falls back to a fused multiply-add where the splitting overflows (`|a|` or `|b|`
+/// above about 1e299).
+#[inline]
+fn two_product(a: f64, b: f64, (bh, bl): (f64, f64)) -> (f64, f64) {
+    let p = a * b;
+    let (ah, al) = split(a);
+    let err = ((ah * bh - p) + ah * bl + al * bh) + al * bl;
+    if err.is_finite() {
+        (p, err)
+    } else {
+        (p, a.mul_add(b, -p))
+    }
 }
 
 /// Every real root of `p` in the open interval `(lo, hi)` at which `p` changes sign, ascending,
@@ -258,6 +283,21 @@ mod tests {
         let roots = real_roots(&c, 0.0, 1.0, &mut evals);
         assert_eq!(roots.len(), 1);
         assert!((roots[0] - 0.25).abs() < 1e-15);
+    }
+
+    #[test]
+    fn two_product_is_exact_and_falls_back_beyond_the_splitting_range() {
+        let mut x = 0.123_456_789_f64;
+        for _ in 0..1000 {
+            x = (x * 7.3 + 0.1).fract();
+            let (a, b) = (x * 1e5 - 3.0, (x * 13.1).fract() * 1e-3 + 1.0 / 3.0);
+            let (p, e) = two_product(a, b, split(b));
+            assert_eq!(p, a * b);
+            assert_eq!(e, a.mul_add(b, -p), "a = {a}, b = {b}");
+        }
+        let (a, b) = (1e305, 0.3);
+        let (p, e) = two_product(a, b, split(b));
+        assert_eq!((p, e), (a * b, a.mul_add(b, -p)));
     }
 
     #[test]

@@ -76,6 +76,8 @@ static RC_INFO: ModelInfo = ModelInfo {
     n_constants: 12,
     k_theta_initial: RC_THETA_I,
     k_theta_dot_initial: RC_THETA_DOT_I,
+    k_sin_initial: RC_R,
+    k_cos_initial: RC_C0,
     coordinates: &["x1", "theta"],
     reduced: 1,
     cyclic: &[0],
@@ -178,6 +180,11 @@ impl Model for RodCube {
             theta_dot_sq,
             theta_ddot,
         }
+    }
+
+    fn theta_dot_sq_sc(&self, k: &[f64], s: f64, _c: f64, ds: f64, _dc: f64) -> f64 {
+        // eq. (9) with sin(theta_i) - sin(theta) given
+        4.0 * k[RC_G_ELL] * ds / (4.0 / 3.0 - k[RC_MU] * s * s)
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
@@ -310,6 +317,8 @@ static FR_INFO: ModelInfo = ModelInfo {
     n_constants: 14,
     k_theta_initial: FR_THETA_I,
     k_theta_dot_initial: FR_THETA_DOT_I,
+    k_sin_initial: FR_S0,
+    k_cos_initial: FR_C0,
     coordinates: &["x1", "theta"],
     reduced: 1,
     cyclic: &[0],
@@ -378,6 +387,10 @@ impl Model for FreeRod {
             theta_dot_sq,
             theta_ddot,
         }
+    }
+
+    fn theta_dot_sq_sc(&self, k: &[f64], _s: f64, c: f64, ds: f64, _dc: f64) -> f64 {
+        (k[FR_A0] + 12.0 * k[FR_G_ELL] * ds) / (1.0 + 3.0 * c * c)
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {

@@ -1,5 +1,6 @@
-//! A model wrapper that changes one thing about a base model (its separation polynomial or its
-//! monitors), to drive the solvers into outcomes the paper's models never reach.
+//! A model wrapper that changes one thing about a base model (its separation polynomial, its
+//! monitors, a force or its `theta_dot^2`), to drive the solvers into outcomes the paper's
+//! models never reach.
 
 use rodcube::model::{Model, ModelInfo, Reduced};
 
@@ -13,6 +14,34 @@ pub struct Tweaked {
     pub monitor_shift: f64,
     /// Whether the last reaction force comes out NaN (a broken model function).
     pub nan_force: bool,
+    /// How `theta_dot^2` is broken, if at all.
+    pub theta_dot_sq: Fault,
+}
+
+/// A broken `theta_dot^2`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Fault {
+    /// Unchanged.
+    None,
+    /// Everything mirrored: the rod would rise (`theta_ddot_i > 0`).
+    Rises,
+    /// Negative where `sin(theta)` is below `below`.
+    TurnsBack { below: f64 },
+    /// NaN where `sin(theta)` is below `below` (1: everywhere).
+    Nan { below: f64 },
+}
+
+impl Tweaked {
+    /// `base` with only `theta_dot^2` broken.
+    pub fn with_fault(base: &'static dyn Model, fault: Fault) -> Self {
+        Tweaked {
+            base,
+            polynomial: None,
+            monitor_shift: 0.0,
+            nan_force: false,
+            theta_dot_sq: fault,
+        }
+    }
 }
 
 impl Model for Tweaked {
@@ -26,7 +55,21 @@ impl Model for Tweaked {
         self.base.prepare(p, k)
     }
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        self.base.reduced(k, delta)
+        let mut r = self.base.reduced(k, delta);
+        if self.theta_dot_sq == Fault::Rises {
+            r.theta_dot_sq = -r.theta_dot_sq;
+            r.theta_ddot = -r.theta_ddot;
+        }
+        r
+    }
+    fn theta_dot_sq_sc(&self, k: &[f64], s: f64, c: f64, ds: f64, dc: f64) -> f64 {
+        let w2 = self.base.theta_dot_sq_sc(k, s, c, ds, dc);
+        match self.theta_dot_sq {
+            Fault::Rises => -w2,
+            Fault::TurnsBack { below } if s < below => -w2,
+            Fault::Nan { below } if s < below => f64::NAN,
+            _ => w2,
+        }
     }
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
         self.base.forces(k, delta, out);
@@ -82,6 +125,7 @@ pub static NEVER_SEPARATES: Tweaked = Tweaked {
     polynomial: Some(&[1.0, 0.0, 1.0, 0.0]),
     monitor_shift: 0.0,
     nan_force: false,
+    theta_dot_sq: Fault::None,
 };
 
 /// `rod_cube` whose monitors are lowered by 3 (N or N m): the floor normal then dips below zero
@@ -91,6 +135,7 @@ pub static LOW_MONITORS: Tweaked = Tweaked {
     polynomial: None,
     monitor_shift: -3.0,
     nan_force: false,
+    theta_dot_sq: Fault::None,
 };
 
 /// `rod_cube` whose floor normal force is NaN.
@@ -99,4 +144,5 @@ pub static NAN_FORCE: Tweaked = Tweaked {
     polynomial: None,
     monitor_shift: 0.0,
     nan_force: true,
+    theta_dot_sq: Fault::None,
 };

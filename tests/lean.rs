@@ -1,0 +1,156 @@
+//! The sweep's per-point solver (`rodcube::solve::lean`): it agrees with the hand-typed paper
+//! model, with fixed rule pairs and with a much finer setting; its schedule spends fewer
+//! evaluations where short panels allow; and a model that does not fall, turns back or breaks
+//! inside the phase gets a typed error, never a number.
+
+mod common;
+
+use common::paper::ROD_CUBE;
+use common::tweaked::{Fault, Tweaked};
+use rodcube::model::Model;
+use rodcube::solve::SolveError;
+use rodcube::solve::lean::{LEAN_SCHEDULE, LeanSolver, RuleStep};
+
+/// The paper's case: m1, m2, ell, a, g.
+const PAPER: [f64; 5] = [1.0, 3.0, 1.0, 0.25, 9.81];
+
+fn rod_cube() -> &'static dyn Model {
+    rodcube::models::find("rod_cube").expect("rod_cube is generated")
+}
+
+fn rel(a: f64, b: f64) -> f64 {
+    ((a - b) / b).abs()
+}
+
+#[test]
+fn the_papers_point_and_the_hand_typed_model() {
+    let mut generated = LeanSolver::new(rod_cube()).unwrap();
+    let out = generated.solve(&PAPER).unwrap();
+    // Section 3 of the paper: 9.61 degrees and 0.108 s (0.108493254 s to the digits shown by
+    // `rodcube run`).
+    assert!((out.separation_angle.to_degrees() - 9.61097).abs() < 1e-5);
+    assert!((out.separation_time - 0.108_493_254).abs() < 1e-9);
+    let mut hand = LeanSolver::new(&ROD_CUBE).unwrap();
+    for n in [1e-3, 0.1, 1.0, 3.0, 10.0, 1e3] {
+        for r in [0.01, 0.25, 0.5, 0.9, 0.99] {
+            let p = [1.0, n, 1.0, r, 9.81];
+            let (a, b) = (generated.solve(&p).unwrap(), hand.solve(&p).unwrap());
+            assert!(
+                rel(a.separation_angle, b.separation_angle) < 1e-15,
+                "n = {n}, r = {r}: {a:?} vs {b:?}"
+            );
+            assert!(
+                rel(a.separation_time, b.separation_time) < 1e-14,
+                "n = {n}, r = {r}: {a:?} vs {b:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_schedule_agrees_with_fixed_pairs_and_is_cheaper_at_the_papers_point() {
+    let m = rod_cube();
+    let mut schedule = LeanSolver::new(m).unwrap();
+    let mut fixed = LeanSolver::with_rules(m, 8, 12, 1e-12).unwrap();
+    let mut fine = LeanSolver::with_rules(m, 24, 32, 1e-15).unwrap();
+    for i in 0..40 {
+        for j in 0..40 {
+            let n = 10f64.powf(-3.0 + 6.0 * i as f64 / 39.0);
+            let r = 0.01 + 0.98 * j as f64 / 39.0;
+            let p = [1.0, n, 1.0, r, 1.0];
+            let reference = fine.solve(&p).unwrap().separation_time;
+            for (who, solver) in [("schedule", &mut schedule), ("8 vs 12", &mut fixed)] {
+                let t = solver.solve(&p).unwrap().separation_time;
+                assert!(
+                    rel(t, reference) < 2e-15,
+                    "{who} at n = {n}, r = {r}: {t} vs {reference}"
+                );
+            }
+        }
+    }
+    let mut schedule = LeanSolver::new(m).unwrap();
+    let mut fixed = LeanSolver::with_rules(m, 8, 12, 1e-12).unwrap();
+    schedule.solve(&PAPER).unwrap();
+    fixed.solve(&PAPER).unwrap();
+    assert!(
+        schedule.evals < fixed.evals,
+        "{} vs {}",
+        schedule.evals,
+        fixed.evals
+    );
+}
+
+#[test]
+fn long_intervals_near_upright_are_cut_and_still_accurate() {
+    let m = rod_cube();
+    let mut fine = LeanSolver::with_rules(m, 24, 32, 1e-15).unwrap();
+    for r in [0.999, 1.0 - 1e-6, 1.0 - 1e-9] {
+        let p = [1.0, 3.0, 1.0, r, 1.0];
+        let mut schedule = LeanSolver::new(m).unwrap();
+        let t = schedule.solve(&p).unwrap().separation_time;
+        let reference = fine.solve(&p).unwrap().separation_time;
+        assert!(rel(t, reference) < 1e-14, "r = {r}: {t} vs {reference}");
+        // More than one panel of the longest step was needed.
+        let longest = LEAN_SCHEDULE[LEAN_SCHEDULE.len() - 1];
+        assert!(schedule.evals > (longest.low + longest.high) as u64);
+    }
+}
+
+#[test]
+fn a_custom_schedule_is_sorted_and_an_empty_one_is_the_default() {
+    let m = rod_cube();
+    let steps = [
+        RuleStep {
+            max_len: 1.0,
+            low: 8,
+            high: 12,
+        },
+        RuleStep {
+            max_len: 0.3,
+            low: 5,
+            high: 8,
+        },
+    ];
+    let mut custom = LeanSolver::with_schedule(m, &steps, 1e-12).unwrap();
+    let mut empty = LeanSolver::with_schedule(m, &[], 1e-12).unwrap();
+    let mut default = LeanSolver::new(m).unwrap();
+    let t = default.solve(&PAPER).unwrap().separation_time;
+    assert!(rel(custom.solve(&PAPER).unwrap().separation_time, t) < 1e-15);
+    assert_eq!(empty.solve(&PAPER).unwrap().separation_time, t);
+    assert_eq!(empty.evals, default.evals);
+}
+
+fn solve_broken(fault: Fault) -> SolveError {
+    let model = Tweaked::with_fault(rod_cube(), fault);
+    let mut solver = LeanSolver::new(&model).unwrap();
+    match solver.solve(&PAPER) {
+        Ok(out) => panic!("{fault:?} solved: {out:?}"),
+        Err(e) => e,
+    }
+}
+
+#[test]
+fn broken_models_get_typed_errors() {
+    // The paper's phase runs from sin(theta) = 0.25 down to 0.167.
+    match solve_broken(Fault::Rises) {
+        SolveError::NoMotion { theta_ddot, .. } => assert!(theta_ddot > 0.0),
+        e => panic!("{e}"),
+    }
+    match solve_broken(Fault::TurnsBack { below: 0.2 }) {
+        SolveError::TurningPoint {
+            delta, delta_end, ..
+        } => assert!(delta > 0.0 && delta < delta_end, "{delta} {delta_end}"),
+        e => panic!("{e}"),
+    }
+    match solve_broken(Fault::Nan { below: 0.2 }) {
+        SolveError::NonFinite { what, .. } => assert_eq!(what, "theta_dot^2"),
+        e => panic!("{e}"),
+    }
+    match solve_broken(Fault::Nan { below: 1.0 }) {
+        SolveError::NonFinite { what, .. } => assert!(what.contains("at the start"), "{what}"),
+        e => panic!("{e}"),
+    }
+    // A control: the same wrapper without a fault in reach solves.
+    let model = Tweaked::with_fault(rod_cube(), Fault::TurnsBack { below: 0.1 });
+    assert!(LeanSolver::new(&model).unwrap().solve(&PAPER).is_ok());
+}
