@@ -152,7 +152,18 @@ pub trait Model: Send + Sync {
     /// [`LeanSolver`](crate::solve::lean::LeanSolver), which parametrises the motion by
     /// `sin(theta)` and forms `ds` and `dc` exactly. Equal to
     /// `reduced(k, delta).theta_dot_sq` at the same angle.
-    fn theta_dot_sq_sc(&self, k: &[f64], s: f64, c: f64, ds: f64, dc: f64) -> f64;
+    ///
+    /// Generated models emit it straight from the energy integral. The default, for models
+    /// written by hand, recovers `delta` without cancellation,
+    /// `delta = atan2(cos(theta_i) ds - sin(theta_i) dc, cos(theta_i) c + sin(theta_i) s)`
+    /// (the sine term is a sum of two non-negative products while the angle falls below the
+    /// start), and calls [`Model::reduced`].
+    fn theta_dot_sq_sc(&self, k: &[f64], s: f64, c: f64, ds: f64, dc: f64) -> f64 {
+        let info = self.info();
+        let (si, ci) = (k[info.k_sin_initial], k[info.k_cos_initial]);
+        let delta = (ci * ds - si * dc).atan2(ci * c + si * s);
+        self.reduced(k, delta).theta_dot_sq
+    }
 
     /// Reaction forces at `delta` along the reduced motion, in the order of [`ModelInfo::forces`].
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]);

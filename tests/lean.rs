@@ -1,5 +1,6 @@
 //! The sweep's per-point solver (`rodcube::solve::lean`): it agrees with the hand-typed paper
-//! model, with fixed rule pairs and with a much finer setting; its schedule spends fewer
+//! model (which uses the trait's default `theta_dot_sq_sc` through `reduced`), with fixed rule
+//! pairs and with a much finer setting; its schedule spends fewer
 //! evaluations where short panels allow; and a model that does not fall, turns back or breaks
 //! inside the phase gets a typed error, never a number.
 
@@ -153,4 +154,80 @@ fn broken_models_get_typed_errors() {
     // A control: the same wrapper without a fault in reach solves.
     let model = Tweaked::with_fault(rod_cube(), Fault::TurnsBack { below: 0.1 });
     assert!(LeanSolver::new(&model).unwrap().solve(&PAPER).is_ok());
+}
+
+#[test]
+fn bad_parameters_are_refused_by_name_not_as_a_next_phase() {
+    let mut solver = LeanSolver::new(rod_cube()).unwrap();
+    for (p, needle) in [
+        (vec![1.0, 3.0, 1.0, 0.0, 9.81], "`a`"),
+        (vec![1.0, 3.0, 1.0, 1.5, 9.81], "a < ell"),
+        (vec![1.0, f64::NAN, 1.0, 0.25, 9.81], "`m2`"),
+        (vec![1.0, 3.0, 1.0, 0.25], "5"),
+    ] {
+        match solver.solve(&p) {
+            Err(e @ SolveError::Parameters(_)) => {
+                let text = e.to_string();
+                assert!(text.contains(needle), "{p:?}: {text}");
+                assert!(!text.contains("next phase"), "{text}");
+            }
+            other => panic!("{p:?}: {other:?}"),
+        }
+    }
+    // The solver is still usable afterwards.
+    assert!(solver.solve(&PAPER).is_ok());
+}
+
+#[test]
+fn a_polynomial_without_a_sign_change_is_named() {
+    // Masses of 1e-300 kg: the polynomial's coefficients (products of masses) underflow.
+    let mut solver = LeanSolver::new(rod_cube()).unwrap();
+    match solver.solve(&[1e-300, 1e-300, 1.0, 1e-300, 9.81]) {
+        Err(SolveError::NoSeparation { lo, hi, .. }) => assert!(lo < hi),
+        other => panic!("{other:?}"),
+    }
+    // A tweaked polynomial that never vanishes (the contact holds to the floor).
+    match LeanSolver::new(&common::tweaked::NEVER_SEPARATES)
+        .unwrap()
+        .solve(&PAPER)
+    {
+        Err(e @ SolveError::NoSeparation { .. }) => {
+            assert!(e.to_string().contains("holds to the floor"), "{e}")
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn the_default_theta_dot_sq_sc_keeps_its_digits_near_the_start() {
+    // The hand-typed models use the trait's default (delta recovered by atan2 from the drops);
+    // it must agree with `reduced` to the last digits even a hair below the start, where a
+    // plain `theta_i - atan2(s, c)` would have lost them.
+    let models: [(&dyn Model, Vec<f64>); 2] = [
+        (&ROD_CUBE, PAPER.to_vec()),
+        (
+            &common::paper::FREE_ROD,
+            vec![1.0, 1.0, 9.81, 0.1677, -1.5, 0.2, 0.3],
+        ),
+    ];
+    for (model, p) in models {
+        let info = model.info();
+        let mut k = vec![0.0; info.n_constants];
+        model.prepare(&p, &mut k);
+        let (ti, si, ci) = (
+            k[info.k_theta_initial],
+            k[info.k_sin_initial],
+            k[info.k_cos_initial],
+        );
+        for delta in [1e-14, 1e-9, 1e-4, 0.05, 0.9 * ti] {
+            let (s, c, ds, dc) = rodcube::model::start_offsets(ti, si, ci, delta);
+            let default = model.theta_dot_sq_sc(&k, s, c, ds, dc);
+            let direct = model.reduced(&k, delta).theta_dot_sq;
+            assert!(
+                rel(default, direct) < 1e-14,
+                "{} at delta = {delta}: {default} vs {direct}",
+                info.name
+            );
+        }
+    }
 }

@@ -230,7 +230,7 @@ impl<'m> LeanSolver<'m> {
     /// Validates `p` (in the model's parameter order) exactly as
     /// [`System::from_values`](crate::system::System::from_values) does, then solves.
     pub fn solve(&mut self, p: &[f64]) -> Result<LeanPoint, SolveError> {
-        self.bind(p)?;
+        self.bind(p).map_err(SolveError::Parameters)?;
         let (theta, drop) = self.separation()?;
         let delta = self.k[self.info.k_theta_initial] - theta;
         let t = self.time_to(drop, delta)?;
@@ -309,9 +309,11 @@ impl<'m> LeanSolver<'m> {
         let hi = self.k[info.k_sin_initial];
         match largest_root(&self.coeffs, self.sin_end, hi, &mut self.evals) {
             Some(s) => Ok((s.asin(), hi - s)),
-            None => Err(SolveError::BadPhaseEnd {
+            None => Err(SolveError::NoSeparation {
                 model: info.name,
-                delta_end: f64::NAN,
+                coefficients: self.coeffs.clone(),
+                lo: self.sin_end,
+                hi,
             }),
         }
     }

@@ -27,6 +27,10 @@ pub enum SolveError {
     /// The parameters handed to a next phase were refused.
     #[error("next phase: {0}")]
     System(#[from] SystemError),
+    /// The parameters handed to a per-point solver were refused (the same checks as
+    /// [`System::from_values`](crate::system::System::from_values)).
+    #[error("{0}")]
+    Parameters(SystemError),
     /// Separation was asked of a model without a contact.
     #[error("model `{model}` has no contact, so it cannot separate")]
     NoContact {
@@ -40,6 +44,21 @@ pub enum SolveError {
         model: &'static str,
         /// Its coefficients, lowest degree first.
         coefficients: Vec<f64>,
+    },
+    /// The separation polynomial has no sign change inside the phase (the per-point solver
+    /// needs a separation; the planner reports a contact kept to the floor instead).
+    #[error(
+        "model `{model}`: the separation polynomial {coefficients:?} (in sin(theta), lowest degree first) does not change sign between sin(theta) = {lo:e} and sin(theta_i) = {hi:e}: the contact holds to the floor, or the coefficients under- or overflowed"
+    )]
+    NoSeparation {
+        /// Model name.
+        model: &'static str,
+        /// The polynomial's coefficients, lowest degree first.
+        coefficients: Vec<f64>,
+        /// `sin(end_angle)`.
+        lo: f64,
+        /// `sin(theta_i)`.
+        hi: f64,
     },
     /// Released from rest where the angular acceleration does not make it fall.
     #[error(

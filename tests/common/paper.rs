@@ -3,7 +3,9 @@
 //! (14), (16), (18), (22), and `free_rod`, the rod sliding alone after it leaves the cube.
 //!
 //! Both follow the `k`/`delta` conventions of `rodcube::model`; every `sin(theta_i) - sin(theta)`
-//! and `cos(theta) - cos(theta_i)` is formed from `delta` without cancellation.
+//! and `cos(theta) - cos(theta_i)` is formed from `delta` without cancellation. Neither writes
+//! `theta_dot_sq_sc`: they use the trait's default (through `reduced`), which the tests compare
+//! with the generated one.
 
 use rodcube::model::{
     Binding, ContactInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
@@ -180,11 +182,6 @@ impl Model for RodCube {
             theta_dot_sq,
             theta_ddot,
         }
-    }
-
-    fn theta_dot_sq_sc(&self, k: &[f64], s: f64, _c: f64, ds: f64, _dc: f64) -> f64 {
-        // eq. (9) with sin(theta_i) - sin(theta) given
-        4.0 * k[RC_G_ELL] * ds / (4.0 / 3.0 - k[RC_MU] * s * s)
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
@@ -387,10 +384,6 @@ impl Model for FreeRod {
             theta_dot_sq,
             theta_ddot,
         }
-    }
-
-    fn theta_dot_sq_sc(&self, k: &[f64], _s: f64, c: f64, ds: f64, _dc: f64) -> f64 {
-        (k[FR_A0] + 12.0 * k[FR_G_ELL] * ds) / (1.0 + 3.0 * c * c)
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
