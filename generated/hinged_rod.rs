@@ -4,7 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced, start_offsets,
+    Binding, ContactInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced, Reduction,
+    ReductionInfo, start_offsets,
 };
 
 /// A uniform rod hinged at its foot, leaning on a free cube on a frictionless floor.
@@ -50,11 +51,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 37,
-    k_theta_initial: 5,
-    k_theta_dot_initial: 6,
-    k_sin_initial: 7,
-    k_cos_initial: 8,
+    n_constants: 39,
     coordinates: &["theta"],
     reduced: 0,
     cyclic: &[],
@@ -71,12 +68,9 @@ static INFO: ModelInfo = ModelInfo {
     ],
     contact: Some(ContactInfo {
         force: 0,
-        point: 1,
-        surface: 3,
-        normal: [1.0, 0.0],
-        surface_moves: true,
+        eliminated: "x2",
+        edge: false,
     }),
-    separation_degree: 3,
     points: &[
         NamedInfo {
             name: "foot",
@@ -102,15 +96,27 @@ static INFO: ModelInfo = ModelInfo {
         meaning: "the push's torque about the cube's far edge stays below gravity's",
     }],
     next_phase: Some(NextPhase {
-        model: "hinged_free_rod",
+        model: "hinged_rod_free",
         bindings: &[
             Binding::Param(0),
+            Binding::Param(1),
             Binding::Param(2),
+            Binding::Param(3),
             Binding::Param(4),
             Binding::Coordinate(0),
+            Binding::Eliminated,
             Binding::Velocity(0),
+            Binding::EliminatedRate,
         ],
     }),
+    reduction: Some(ReductionInfo {
+        k_theta_initial: 5,
+        k_theta_dot_initial: 6,
+        k_sin_initial: 7,
+        k_cos_initial: 8,
+        separation_degree: 3,
+    }),
+    route_note: "",
 };
 
 impl Model for HingedRod {
@@ -131,97 +137,157 @@ impl Model for HingedRod {
         let c3_t0 = (k[3] / k[2]);
         k[8] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
         let c4_t0 = (k[2] * k[2]);
-        k[9] = ((k[0] * c4_t0 / 3.0) + (c4_t0 * (k[7] * k[7]) * k[1]));
-        k[10] = (3.0 * k[4] * k[0]);
+        k[9] = ((c4_t0 * k[0] / 3.0) + (c4_t0 * k[1] * (k[7] * k[7])));
+        k[10] = (k[3] / k[2]).asin();
         k[11] = k[2];
-        k[12] = k[0];
-        k[13] = (3.0 * k[1]);
-        k[14] = (6.0 * k[4] * k[0] * k[1]);
-        k[15] = (3.0 * k[4] * k[0] * k[1]);
-        k[16] = (k[4] * (k[0] * k[0]));
-        k[17] = (-k[2] * k[1]);
-        k[18] = (k[4] * k[0]);
-        k[19] = (-k[0] * k[2] / 2.0);
-        k[20] = (k[0] * k[2] / 2.0);
-        k[21] = (k[4] * k[1] * k[3] / 2.0);
-        k[22] = (-k[3] / 2.0);
-        k[23] = (-2.0 * k[0] * k[7]);
-        k[24] = (3.0 * k[0]);
-        k[25] = (k[2] / 2.0);
-        k[26] = (-k[2]);
-        k[27] = (-k[2] / 2.0);
-        k[28] = (k[0] * (k[2] * k[2]) / 24.0);
-        let h29_t0 = (k[2] * k[2]);
-        k[29] = ((k[0] * h29_t0 / 8.0) + (h29_t0 * k[1] / 2.0));
-        k[30] = (k[0] * (k[2] * k[2]) / 8.0);
-        k[31] = (k[4] * k[0] * k[2] / 2.0);
-        k[32] = (k[0] * (k[2] * k[2]) / 12.0);
-        let h33_t0 = (k[2] * k[2]);
-        k[33] = ((k[0] * h33_t0 / 4.0) + (h33_t0 * k[1]));
-        k[34] = (k[0] * (k[2] * k[2]) / 4.0);
-        k[35] = (-k[4] * k[0] * k[2] / 2.0);
-        k[36] = (-(k[2] * k[2]) * k[1]);
+        k[12] = (k[2] / 2.0);
+        k[13] = (-k[2]);
+        k[14] = (-k[2] / 2.0);
+        k[15] = ((k[2] * k[2]) * k[0] / 24.0);
+        let h16_t0 = (k[2] * k[2]);
+        k[16] = ((h16_t0 * k[0] / 8.0) + (h16_t0 * k[1] / 2.0));
+        k[17] = ((k[2] * k[2]) * k[0] / 8.0);
+        k[18] = (k[4] * k[1] * k[3] / 2.0);
+        k[19] = (k[2] * k[4] * k[0] / 2.0);
+        k[20] = ((k[2] * k[2]) * k[0] / 12.0);
+        let h21_t0 = (k[2] * k[2]);
+        k[21] = ((h21_t0 * k[0] / 4.0) + (h21_t0 * k[1]));
+        k[22] = ((k[2] * k[2]) * k[0] / 4.0);
+        k[23] = (-k[2] * k[4] * k[0] / 2.0);
+        k[24] = (-(k[2] * k[2]) * k[1]);
+        k[25] = k[1];
+        k[26] = (k[4] * k[0]);
+        k[27] = (k[2] * k[0] / 2.0);
+        k[28] = (-k[2] * k[0] / 2.0);
+        k[29] = (-k[3] / 2.0);
+        k[30] = (3.0 * k[4] * k[0]);
+        k[31] = k[0];
+        k[32] = (3.0 * k[1]);
+        k[33] = (6.0 * k[4] * k[0] * k[1]);
+        k[34] = (3.0 * k[4] * k[0] * k[1]);
+        k[35] = (k[4] * (k[0] * k[0]));
+        k[36] = (-k[2] * k[1]);
+        k[37] = (-2.0 * k[0] * k[7]);
+        k[38] = (3.0 * k[0]);
     }
 
+    fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
+        let k = &k[..39]; // one bounds check for all constant loads
+        q[0] = k[10];
+        qd[0] = 0.0;
+    }
+
+    fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
+        let k = &k[..39]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
+        let pt0 = (k[11] * rc_c);
+        let pt1 = (k[13] * qd[0] * rc_s);
+        pos[0] = [0.0, 0.0];
+        vel[0] = [0.0, 0.0];
+        pos[1] = [pt0, (k[11] * rc_s)];
+        vel[1] = [pt1, (k[11] * qd[0] * rc_c)];
+        pos[2] = [(k[12] * rc_c), (k[12] * rc_s)];
+        vel[2] = [(k[14] * qd[0] * rc_s), (k[12] * qd[0] * rc_c)];
+        pos[3] = [pt0, 0.0];
+        vel[3] = [pt1, 0.0];
+    }
+
+    fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
+        let k = &k[..39]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
+        let et0 = (qd[0] * qd[0]);
+        (((k[15] * et0) + (k[16] * et0 * (rc_s * rc_s)) + (k[17] * et0 * (rc_c * rc_c)))
+            + (k[18] + (k[19] * rc_s)))
+    }
+
+    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let k = &k[..39]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
+    }
+
+    fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
+        let k = &k[..39]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
+        mass[0] = (k[20] + (k[21] * (rc_s * rc_s)) + (k[22] * (rc_c * rc_c)));
+        rhs[0] = ((k[23] * rc_c) + (k[24] * (qd[0] * qd[0]) * rc_s * rc_c));
+    }
+
+    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+        let k = &k[..39]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
+        let ft0 = (qd[0] * qd[0]);
+        out[0] = (k[25] * ((k[13] * qdd[0] * rc_s) + (k[13] * ft0 * rc_c)));
+        out[1] = (k[26] + (k[27] * qdd[0] * rc_c) + (k[28] * ft0 * rc_s));
+    }
+
+    fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
+        let k = &k[..39]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
+        out[0] = (k[18] - (forces[0] * (k[29] + (k[11] * rc_s))));
+    }
+
+    fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
+        let k = &k[..39]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
+        f64::INFINITY
+    }
+
+    fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let k = &k[..39]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
+        out[0] = (k[11] * rc_c);
+        out[1] = (k[13] * qd[0] * rc_s);
+    }
+
+    fn reduction(&self) -> Option<&dyn Reduction> {
+        Some(self)
+    }
+}
+
+impl Reduction for HingedRod {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
-        let rt1 = (k[12] + (k[13] * rt0));
+        let rt1 = (k[31] + (k[32] * rt0));
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: (k[10] * rc_ds / (k[11] * rt1)),
+            theta_dot_sq: (k[30] * rc_ds / (k[11] * rt1)),
             theta_ddot: (-3.0
-                * ((k[14] * rc_s * rc_c * rc_ds) + (k[15] * rt0 * rc_c) + (k[16] * rc_c))
+                * ((k[33] * rc_s * rc_c * rc_ds) + (k[34] * rt0 * rc_c) + (k[35] * rc_c))
                 / 2.0
                 / (k[11] * (rt1 * rt1))),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
-        let k = &k[..37]; // one bounds check for all constant loads
-        (k[10] * rc_ds / (k[11] * (k[12] + (k[13] * (rc_s * rc_s)))))
+        let k = &k[..39]; // one bounds check for all constant loads
+        (k[30] * rc_ds / (k[11] * (k[31] + (k[32] * (rc_s * rc_s)))))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
-        let rt1 = (k[12] + (k[13] * rt0));
-        let rc_w2 = (k[10] * rc_ds / (k[11] * rt1));
+        let rt1 = (k[31] + (k[32] * rt0));
+        let rc_w2 = (k[30] * rc_ds / (k[11] * rt1));
         let rc_acc = (-3.0
-            * ((k[14] * rc_s * rc_c * rc_ds) + (k[15] * rt0 * rc_c) + (k[16] * rc_c))
+            * ((k[33] * rc_s * rc_c * rc_ds) + (k[34] * rt0 * rc_c) + (k[35] * rc_c))
             / 2.0
             / (k[11] * (rt1 * rt1)));
-        out[0] = ((k[17] * rc_s * rc_acc) + (k[17] * rc_c * rc_w2));
-        out[1] = (k[18] + (k[19] * rc_s * rc_w2) + (k[20] * rc_c * rc_acc));
-    }
-
-    fn monitors(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
-        let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
-        let rc_delta = delta;
-        let rt0 = (rc_s * rc_s);
-        let rt1 = (k[12] + (k[13] * rt0));
-        let rc_w2 = (k[10] * rc_ds / (k[11] * rt1));
-        let rc_acc = (-3.0
-            * ((k[14] * rc_s * rc_c * rc_ds) + (k[15] * rt0 * rc_c) + (k[16] * rc_c))
-            / 2.0
-            / (k[11] * (rt1 * rt1)));
-        let rc_f0 = ((k[17] * rc_s * rc_acc) + (k[17] * rc_c * rc_w2));
-        let rc_f1 = (k[18] + (k[19] * rc_s * rc_w2) + (k[20] * rc_c * rc_acc));
-        out[0] = (k[21] - (rc_f0 * (k[22] + (k[11] * rc_s))));
+        out[0] = ((k[36] * rc_s * rc_acc) + (k[36] * rc_c * rc_w2));
+        out[1] = (k[26] + (k[28] * rc_s * rc_w2) + (k[27] * rc_c * rc_acc));
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
-        out[0] = k[23];
-        out[1] = k[24];
+        let k = &k[..39]; // one bounds check for all constant loads
+        out[0] = k[37];
+        out[1] = k[38];
         out[2] = 0.0;
-        out[3] = k[13];
+        out[3] = k[32];
     }
 
     fn full_state(
@@ -233,53 +299,10 @@ impl Model for HingedRod {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[0] = k[5] - delta;
         qd[0] = theta_dot;
-    }
-
-    fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..37]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        let pt0 = (k[11] * rc_c);
-        let pt1 = (k[26] * qd[0] * rc_s);
-        pos[0] = [0.0, 0.0];
-        vel[0] = [0.0, 0.0];
-        pos[1] = [pt0, (k[11] * rc_s)];
-        vel[1] = [pt1, (k[11] * qd[0] * rc_c)];
-        pos[2] = [(k[25] * rc_c), (k[25] * rc_s)];
-        vel[2] = [(k[27] * qd[0] * rc_s), (k[25] * qd[0] * rc_c)];
-        pos[3] = [pt0, 0.0];
-        vel[3] = [pt1, 0.0];
-    }
-
-    fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..37]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        let et0 = (qd[0] * qd[0]);
-        (((k[28] * et0) + (k[29] * et0 * (rc_s * rc_s)) + (k[30] * et0 * (rc_c * rc_c)))
-            + (k[21] + (k[31] * rc_s)))
-    }
-
-    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-    }
-
-    fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        mass[0] = (k[32] + (k[33] * (rc_s * rc_s)) + (k[34] * (rc_c * rc_c)));
-        rhs[0] = ((k[35] * rc_c) + (k[36] * (qd[0] * qd[0]) * rc_s * rc_c));
-    }
-
-    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        let ft0 = (qd[0] * qd[0]);
-        out[0] = ((k[17] * qdd[0] * rc_s) + (k[17] * ft0 * rc_c));
-        out[1] = (k[18] + (k[20] * qdd[0] * rc_c) + (k[19] * ft0 * rc_s));
     }
 }

@@ -4,7 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced, start_offsets,
+    Binding, ContactInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced, Reduction,
+    ReductionInfo, start_offsets,
 };
 
 /// A uniform rod leaning on a free cube on a frictionless floor, released from rest.
@@ -51,10 +52,6 @@ static INFO: ModelInfo = ModelInfo {
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
     n_constants: 47,
-    k_theta_initial: 5,
-    k_theta_dot_initial: 6,
-    k_sin_initial: 7,
-    k_cos_initial: 8,
     coordinates: &["x1", "theta"],
     reduced: 1,
     cyclic: &[0],
@@ -71,12 +68,9 @@ static INFO: ModelInfo = ModelInfo {
     ],
     contact: Some(ContactInfo {
         force: 0,
-        point: 1,
-        surface: 3,
-        normal: [1.0, 0.0],
-        surface_moves: true,
+        eliminated: "x2",
+        edge: false,
     }),
-    separation_degree: 3,
     points: &[
         NamedInfo {
             name: "foot",
@@ -108,17 +102,29 @@ static INFO: ModelInfo = ModelInfo {
         },
     ],
     next_phase: Some(NextPhase {
-        model: "free_rod",
+        model: "rod_cube_free",
         bindings: &[
             Binding::Param(0),
+            Binding::Param(1),
             Binding::Param(2),
+            Binding::Param(3),
             Binding::Param(4),
-            Binding::Coordinate(1),
-            Binding::Velocity(1),
             Binding::Coordinate(0),
+            Binding::Coordinate(1),
+            Binding::Eliminated,
             Binding::Velocity(0),
+            Binding::Velocity(1),
+            Binding::EliminatedRate,
         ],
     }),
+    reduction: Some(ReductionInfo {
+        k_theta_initial: 5,
+        k_theta_dot_initial: 6,
+        k_sin_initial: 7,
+        k_cos_initial: 8,
+        separation_degree: 3,
+    }),
+    route_note: "",
 };
 
 impl Model for RodCube {
@@ -142,69 +148,157 @@ impl Model for RodCube {
         k[10] = 0.0;
         let c6_t0 = (k[2] * k[2]);
         let c6_t1 = (k[0] * k[0]);
-        k[11] = ((k[0] * c6_t0 * k[1] / 3.0 / (k[0] + k[1]))
-            - (c6_t1 * c6_t0 * (k[7] * k[7]) / 4.0 / (k[0] + k[1]))
-            + (c6_t1 * c6_t0 / 3.0 / (k[0] + k[1])));
-        k[12] = ((k[4] * k[0]) + (k[4] * k[1]));
+        k[11] = ((c6_t0 * k[0] * k[1] / 3.0 / (k[0] + k[1]))
+            - (c6_t0 * c6_t1 * (k[7] * k[7]) / 4.0 / (k[0] + k[1]))
+            + (c6_t0 * c6_t1 / 3.0 / (k[0] + k[1])));
+        k[12] = (k[3] / k[2]).asin();
         k[13] = k[2];
-        k[14] = (-(4.0 * k[0]) - (4.0 * k[1]));
-        k[15] = (3.0 * k[0]);
-        k[16] = ((6.0 * k[4] * k[0] * k[1]) + (6.0 * k[4] * (k[0] * k[0])));
-        k[17] = (-(8.0 * k[4] * k[0] * k[1])
-            - (4.0 * k[4] * (k[1] * k[1]))
-            - (4.0 * k[4] * (k[0] * k[0])));
-        k[18] = ((3.0 * k[4] * k[0] * k[1]) + (3.0 * k[4] * (k[0] * k[0])));
-        k[19] = (-k[0] * k[2] * k[1] / 2.0 / (k[0] + k[1]));
-        k[20] = (k[4] * k[0]);
-        k[21] = (-k[0] * k[2] / 2.0);
-        k[22] = (k[0] * k[2] / 2.0);
-        k[23] = (k[4] * k[1] * k[3] / 2.0);
-        k[24] = (-k[3] / 2.0);
-        k[25] = ((8.0 * k[0] * k[7]) + (8.0 * k[7] * k[1]));
-        k[26] = (-(12.0 * k[0]) - (12.0 * k[1]));
-        k[27] = k[9];
-        k[28] = ((k[0] * k[2] / 2.0 / (k[0] + k[1])) + (k[2] * k[1] / (k[0] + k[1])));
-        k[29] = (k[2] / 2.0);
-        k[30] = (-k[2]);
-        k[31] = (-k[2] / 2.0);
-        k[32] = (-(k[0] * k[2] / 2.0) - (k[2] * k[1]));
-        k[33] = (k[0] * (k[2] * k[2]) / 24.0);
-        let h34_t0 = (k[2] * k[2]);
-        k[34] = ((k[0] * h34_t0 / 8.0) + (h34_t0 * k[1] / 2.0));
-        k[35] = (k[0] * (k[2] * k[2]) / 8.0);
-        k[36] = ((k[0] / 2.0) + (k[1] / 2.0));
-        k[37] = (k[4] * k[0] * k[2] / 2.0);
-        k[38] = (k[0] + k[1]);
-        k[39] = (k[0] * (k[2] * k[2]) / 12.0);
-        let h40_t0 = (k[2] * k[2]);
-        k[40] = ((k[0] * h40_t0 / 4.0) + (h40_t0 * k[1]));
-        k[41] = (k[0] * (k[2] * k[2]) / 4.0);
-        k[42] = ((k[0] * k[2] / 2.0) + (k[2] * k[1]));
-        k[43] = (-k[4] * k[0] * k[2] / 2.0);
-        k[44] = (-(k[2] * k[2]) * k[1]);
-        k[45] = (-k[2] * k[1]);
-        k[46] = k[1];
+        k[14] = (k[2] / 2.0);
+        k[15] = (-k[2]);
+        k[16] = (-k[2] / 2.0);
+        k[17] = (-(k[2] * k[0] / 2.0) - (k[2] * k[1]));
+        k[18] = ((k[0] / 2.0) + (k[1] / 2.0));
+        k[19] = ((k[2] * k[2]) * k[0] / 24.0);
+        let h20_t0 = (k[2] * k[2]);
+        k[20] = ((h20_t0 * k[0] / 8.0) + (h20_t0 * k[1] / 2.0));
+        k[21] = ((k[2] * k[2]) * k[0] / 8.0);
+        k[22] = (k[4] * k[1] * k[3] / 2.0);
+        k[23] = (k[2] * k[4] * k[0] / 2.0);
+        k[24] = (k[0] + k[1]);
+        k[25] = ((k[2] * k[2]) * k[0] / 12.0);
+        let h26_t0 = (k[2] * k[2]);
+        k[26] = ((h26_t0 * k[0] / 4.0) + (h26_t0 * k[1]));
+        k[27] = ((k[2] * k[2]) * k[0] / 4.0);
+        k[28] = ((k[2] * k[0] / 2.0) + (k[2] * k[1]));
+        k[29] = (-k[2] * k[4] * k[0] / 2.0);
+        k[30] = (-(k[2] * k[2]) * k[1]);
+        k[31] = k[1];
+        k[32] = (k[4] * k[0]);
+        k[33] = (k[2] * k[0] / 2.0);
+        k[34] = (-k[2] * k[0] / 2.0);
+        k[35] = (-k[3] / 2.0);
+        k[36] = ((k[4] * k[0]) + (k[4] * k[1]));
+        k[37] = (-(4.0 * k[0]) - (4.0 * k[1]));
+        k[38] = (3.0 * k[0]);
+        k[39] = ((6.0 * k[4] * k[0] * k[1]) + (6.0 * k[4] * (k[0] * k[0])));
+        k[40] = (-(8.0 * k[4] * k[0] * k[1])
+            - (4.0 * k[4] * (k[0] * k[0]))
+            - (4.0 * k[4] * (k[1] * k[1])));
+        k[41] = ((3.0 * k[4] * k[0] * k[1]) + (3.0 * k[4] * (k[0] * k[0])));
+        k[42] = (-k[2] * k[0] * k[1] / 2.0 / (k[0] + k[1]));
+        k[43] = ((8.0 * k[0] * k[7]) + (8.0 * k[1] * k[7]));
+        k[44] = (-(12.0 * k[0]) - (12.0 * k[1]));
+        k[45] = k[9];
+        k[46] = ((k[2] * k[0] / 2.0 / (k[0] + k[1])) + (k[2] * k[1] / (k[0] + k[1])));
     }
 
+    fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
+        let k = &k[..47]; // one bounds check for all constant loads
+        q[0] = 0.0;
+        qd[0] = 0.0;
+        q[1] = k[12];
+        qd[1] = 0.0;
+    }
+
+    fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
+        let k = &k[..47]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
+        let pt0 = ((k[13] * rc_c) + q[0]);
+        let pt1 = ((k[15] * qd[1] * rc_s) + qd[0]);
+        pos[0] = [q[0], 0.0];
+        vel[0] = [qd[0], 0.0];
+        pos[1] = [pt0, (k[13] * rc_s)];
+        vel[1] = [pt1, (k[13] * qd[1] * rc_c)];
+        pos[2] = [((k[14] * rc_c) + q[0]), (k[14] * rc_s)];
+        vel[2] = [((k[16] * qd[1] * rc_s) + qd[0]), (k[14] * qd[1] * rc_c)];
+        pos[3] = [pt0, 0.0];
+        vel[3] = [pt1, 0.0];
+    }
+
+    fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
+        let k = &k[..47]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
+        let et0 = (qd[1] * qd[1]);
+        (((k[17] * qd[1] * qd[0] * rc_s)
+            + (k[18] * (qd[0] * qd[0]))
+            + (k[19] * et0)
+            + (k[20] * et0 * (rc_s * rc_s))
+            + (k[21] * et0 * (rc_c * rc_c)))
+            + (k[22] + (k[23] * rc_s)))
+    }
+
+    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let k = &k[..47]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
+        out[0] = ((k[17] * qd[1] * rc_s) + (k[24] * qd[0]));
+    }
+
+    fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
+        let k = &k[..47]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
+        let qt0 = (k[17] * rc_s);
+        let qt1 = (qd[1] * qd[1]);
+        mass[0] = k[24];
+        mass[1] = qt0;
+        mass[2] = qt0;
+        mass[3] = (k[25] + (k[26] * (rc_s * rc_s)) + (k[27] * (rc_c * rc_c)));
+        rhs[0] = (k[28] * qt1 * rc_c);
+        rhs[1] = ((k[29] * rc_c) + (k[30] * qt1 * rc_s * rc_c));
+    }
+
+    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+        let k = &k[..47]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
+        let ft0 = (qd[1] * qd[1]);
+        out[0] = (k[31] * ((k[15] * qdd[1] * rc_s) + (k[15] * ft0 * rc_c) + qdd[0]));
+        out[1] = (k[32] + (k[33] * qdd[1] * rc_c) + (k[34] * ft0 * rc_s));
+    }
+
+    fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
+        let k = &k[..47]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
+        out[0] = forces[1];
+        out[1] = (k[22] - (forces[0] * (k[35] + (k[13] * rc_s))));
+    }
+
+    fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
+        let k = &k[..47]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
+        f64::INFINITY
+    }
+
+    fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let k = &k[..47]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
+        out[0] = ((k[13] * rc_c) + q[0]);
+        out[1] = ((k[15] * qd[1] * rc_s) + qd[0]);
+    }
+
+    fn reduction(&self) -> Option<&dyn Reduction> {
+        Some(self)
+    }
+}
+
+impl Reduction for RodCube {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
         let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
-        let rt1 = (k[14] + (k[15] * rt0));
+        let rt1 = (k[37] + (k[38] * rt0));
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: (-12.0 * (k[12] * rc_ds) / (k[13] * rt1)),
+            theta_dot_sq: (-12.0 * (k[36] * rc_ds) / (k[13] * rt1)),
             theta_ddot: (6.0
-                * ((k[16] * rc_s * rc_c * rc_ds) + (k[17] * rc_c) + (k[18] * rt0 * rc_c))
+                * ((k[39] * rc_s * rc_c * rc_ds) + (k[40] * rc_c) + (k[41] * rt0 * rc_c))
                 / (k[13] * (rt1 * rt1))),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
         let k = &k[..47]; // one bounds check for all constant loads
-        (-12.0 * (k[12] * rc_ds) / (k[13] * (k[14] + (k[15] * (rc_s * rc_s)))))
+        (-12.0 * (k[36] * rc_ds) / (k[13] * (k[37] + (k[38] * (rc_s * rc_s)))))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
@@ -212,37 +306,21 @@ impl Model for RodCube {
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
-        let rt1 = (k[14] + (k[15] * rt0));
-        let rc_w2 = (-12.0 * (k[12] * rc_ds) / (k[13] * rt1));
+        let rt1 = (k[37] + (k[38] * rt0));
+        let rc_w2 = (-12.0 * (k[36] * rc_ds) / (k[13] * rt1));
         let rc_acc = (6.0
-            * ((k[16] * rc_s * rc_c * rc_ds) + (k[17] * rc_c) + (k[18] * rt0 * rc_c))
+            * ((k[39] * rc_s * rc_c * rc_ds) + (k[40] * rc_c) + (k[41] * rt0 * rc_c))
             / (k[13] * (rt1 * rt1)));
-        out[0] = ((k[19] * rc_s * rc_acc) + (k[19] * rc_c * rc_w2));
-        out[1] = (k[20] + (k[21] * rc_s * rc_w2) + (k[22] * rc_c * rc_acc));
-    }
-
-    fn monitors(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..47]; // one bounds check for all constant loads
-        let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
-        let rc_delta = delta;
-        let rt0 = (rc_s * rc_s);
-        let rt1 = (k[14] + (k[15] * rt0));
-        let rc_w2 = (-12.0 * (k[12] * rc_ds) / (k[13] * rt1));
-        let rc_acc = (6.0
-            * ((k[16] * rc_s * rc_c * rc_ds) + (k[17] * rc_c) + (k[18] * rt0 * rc_c))
-            / (k[13] * (rt1 * rt1)));
-        let rc_f0 = ((k[19] * rc_s * rc_acc) + (k[19] * rc_c * rc_w2));
-        let rc_f1 = (k[20] + (k[21] * rc_s * rc_w2) + (k[22] * rc_c * rc_acc));
-        out[0] = rc_f1;
-        out[1] = (k[23] - (rc_f0 * (k[24] + (k[13] * rc_s))));
+        out[0] = ((k[42] * rc_s * rc_acc) + (k[42] * rc_c * rc_w2));
+        out[1] = (k[32] + (k[34] * rc_s * rc_w2) + (k[33] * rc_c * rc_acc));
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
         let k = &k[..47]; // one bounds check for all constant loads
-        out[0] = k[25];
-        out[1] = k[26];
+        out[0] = k[43];
+        out[1] = k[44];
         out[2] = 0.0;
-        out[3] = k[15];
+        out[3] = k[38];
     }
 
     fn full_state(
@@ -259,61 +337,7 @@ impl Model for RodCube {
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[1] = k[5] - delta;
         qd[1] = theta_dot;
-        q[0] = (k[27] + (k[28] * rc_dc));
-        qd[0] = (k[28] * rc_s * rc_w);
-    }
-
-    fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..47]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let pt0 = ((k[13] * rc_c) + q[0]);
-        let pt1 = ((k[30] * qd[1] * rc_s) + qd[0]);
-        pos[0] = [q[0], 0.0];
-        vel[0] = [qd[0], 0.0];
-        pos[1] = [pt0, (k[13] * rc_s)];
-        vel[1] = [pt1, (k[13] * qd[1] * rc_c)];
-        pos[2] = [((k[29] * rc_c) + q[0]), (k[29] * rc_s)];
-        vel[2] = [((k[31] * qd[1] * rc_s) + qd[0]), (k[29] * qd[1] * rc_c)];
-        pos[3] = [pt0, 0.0];
-        vel[3] = [pt1, 0.0];
-    }
-
-    fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..47]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let et0 = (qd[1] * qd[1]);
-        (((k[32] * qd[0] * qd[1] * rc_s)
-            + (k[33] * et0)
-            + (k[34] * et0 * (rc_s * rc_s))
-            + (k[35] * et0 * (rc_c * rc_c))
-            + (k[36] * (qd[0] * qd[0])))
-            + (k[23] + (k[37] * rc_s)))
-    }
-
-    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..47]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        out[0] = ((k[32] * qd[1] * rc_s) + (k[38] * qd[0]));
-    }
-
-    fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..47]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let qt0 = (k[32] * rc_s);
-        let qt1 = (qd[1] * qd[1]);
-        mass[0] = k[38];
-        mass[1] = qt0;
-        mass[2] = qt0;
-        mass[3] = (k[39] + (k[40] * (rc_s * rc_s)) + (k[41] * (rc_c * rc_c)));
-        rhs[0] = (k[42] * qt1 * rc_c);
-        rhs[1] = ((k[43] * rc_c) + (k[44] * qt1 * rc_s * rc_c));
-    }
-
-    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..47]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let ft0 = (qd[1] * qd[1]);
-        out[0] = ((k[45] * qdd[1] * rc_s) + (k[45] * ft0 * rc_c) + (k[46] * qdd[0]));
-        out[1] = (k[20] + (k[22] * qdd[1] * rc_c) + (k[21] * ft0 * rc_s));
+        q[0] = (k[45] + (k[46] * rc_dc));
+        qd[0] = (k[46] * rc_w * rc_s);
     }
 }

@@ -4,7 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced, start_offsets,
+    Binding, ContactInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced, Reduction,
+    ReductionInfo, start_offsets,
 };
 
 /// A uniform ladder sliding down a fixed frictionless wall on a frictionless floor.
@@ -44,11 +45,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "ladder_leans",
         meaning: "the top must start below the ladder's length (a < ell)",
     }],
-    n_constants: 25,
-    k_theta_initial: 4,
-    k_theta_dot_initial: 5,
-    k_sin_initial: 6,
-    k_cos_initial: 7,
+    n_constants: 27,
     coordinates: &["theta"],
     reduced: 0,
     cyclic: &[],
@@ -65,12 +62,9 @@ static INFO: ModelInfo = ModelInfo {
     ],
     contact: Some(ContactInfo {
         force: 0,
-        point: 1,
-        surface: 3,
-        normal: [1.0, 0.0],
-        surface_moves: false,
+        eliminated: "x1",
+        edge: false,
     }),
-    separation_degree: 1,
     points: &[
         NamedInfo {
             name: "foot",
@@ -78,7 +72,7 @@ static INFO: ModelInfo = ModelInfo {
         },
         NamedInfo {
             name: "tip",
-            meaning: "the ladder's top on the wall",
+            meaning: "the ladder's top (on the wall while they touch)",
         },
         NamedInfo {
             name: "rod_centre",
@@ -96,17 +90,26 @@ static INFO: ModelInfo = ModelInfo {
         meaning: "the ladder's foot stays on the floor (N >= 0)",
     }],
     next_phase: Some(NextPhase {
-        model: "free_rod",
+        model: "wall_ladder_free",
         bindings: &[
             Binding::Param(0),
             Binding::Param(1),
+            Binding::Param(2),
             Binding::Param(3),
+            Binding::Eliminated,
             Binding::Coordinate(0),
+            Binding::EliminatedRate,
             Binding::Velocity(0),
-            Binding::Point { index: 0, axis: 0 },
-            Binding::PointVelocity { index: 0, axis: 0 },
         ],
     }),
+    reduction: Some(ReductionInfo {
+        k_theta_initial: 4,
+        k_theta_dot_initial: 5,
+        k_sin_initial: 6,
+        k_cos_initial: 7,
+        separation_degree: 1,
+    }),
+    route_note: "",
 };
 
 impl Model for WallLadder {
@@ -126,66 +129,131 @@ impl Model for WallLadder {
         k[6] = (k[2] / k[1]);
         let c3_t0 = (k[2] / k[1]);
         k[7] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
-        k[8] = (k[0] * (k[1] * k[1]) / 3.0);
-        k[9] = (3.0 * k[3] / k[1]);
-        k[10] = (-3.0 * k[3] / 2.0 / k[1]);
-        k[11] = (-k[0] * k[1] / 2.0);
-        k[12] = (k[3] * k[0]);
-        k[13] = (k[0] * k[1] / 2.0);
-        k[14] = (-2.0 * k[6]);
-        k[15] = (-k[1]);
-        k[16] = k[1];
-        k[17] = (-k[1] / 2.0);
-        k[18] = (k[1] / 2.0);
-        k[19] = (k[0] * (k[1] * k[1]) / 24.0);
-        k[20] = (k[0] * (k[1] * k[1]) / 8.0);
-        k[21] = (k[3] * k[0] * k[1] / 2.0);
-        k[22] = (k[0] * (k[1] * k[1]) / 12.0);
-        k[23] = (k[0] * (k[1] * k[1]) / 4.0);
-        k[24] = (-k[3] * k[0] * k[1] / 2.0);
+        k[8] = ((k[1] * k[1]) * k[0] / 3.0);
+        k[9] = (k[2] / k[1]).asin();
+        k[10] = (-k[1]);
+        k[11] = k[1];
+        k[12] = (-k[1] / 2.0);
+        k[13] = (k[1] / 2.0);
+        k[14] = ((k[1] * k[1]) * k[0] / 24.0);
+        k[15] = ((k[1] * k[1]) * k[0] / 8.0);
+        k[16] = (k[1] * k[3] * k[0] / 2.0);
+        k[17] = ((k[1] * k[1]) * k[0] / 12.0);
+        k[18] = ((k[1] * k[1]) * k[0] / 4.0);
+        k[19] = (-k[1] * k[3] * k[0] / 2.0);
+        k[20] = (-k[1] * k[0] / 2.0);
+        k[21] = k[0];
+        k[22] = (k[3] * k[0]);
+        k[23] = (k[1] * k[0] / 2.0);
+        k[24] = (3.0 * k[3] / k[1]);
+        k[25] = (-3.0 * k[3] / 2.0 / k[1]);
+        k[26] = (-2.0 * k[6]);
     }
 
+    fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
+        let k = &k[..27]; // one bounds check for all constant loads
+        q[0] = k[9];
+        qd[0] = 0.0;
+    }
+
+    fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
+        let k = &k[..27]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
+        pos[0] = [(k[10] * rc_c), 0.0];
+        vel[0] = [(k[11] * qd[0] * rc_s), 0.0];
+        pos[1] = [0.0, (k[11] * rc_s)];
+        vel[1] = [0.0, (k[11] * qd[0] * rc_c)];
+        pos[2] = [(k[12] * rc_c), (k[13] * rc_s)];
+        vel[2] = [(k[13] * qd[0] * rc_s), (k[13] * qd[0] * rc_c)];
+        pos[3] = [0.0, 0.0];
+        vel[3] = [0.0, 0.0];
+    }
+
+    fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
+        let k = &k[..27]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
+        let et0 = (qd[0] * qd[0]);
+        (((k[14] * et0) + (k[15] * et0 * (rc_s * rc_s)) + (k[15] * et0 * (rc_c * rc_c)))
+            + (k[16] * rc_s))
+    }
+
+    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let k = &k[..27]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
+    }
+
+    fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
+        let k = &k[..27]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
+        mass[0] = (k[17] + (k[18] * (rc_s * rc_s)) + (k[18] * (rc_c * rc_c)));
+        rhs[0] = (k[19] * rc_c);
+    }
+
+    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+        let k = &k[..27]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
+        let ft0 = (qd[0] * qd[0]);
+        out[0] = (-((k[20] * qdd[0] * rc_s)
+            + (k[20] * ft0 * rc_c)
+            + (k[21] * ((k[11] * qdd[0] * rc_s) + (k[11] * ft0 * rc_c)))));
+        out[1] = (k[22] + (k[23] * qdd[0] * rc_c) + (k[20] * ft0 * rc_s));
+    }
+
+    fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
+        let k = &k[..27]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
+        out[0] = forces[1];
+    }
+
+    fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
+        let k = &k[..27]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
+        f64::INFINITY
+    }
+
+    fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let k = &k[..27]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
+        out[0] = (k[10] * rc_c);
+        out[1] = (k[11] * qd[0] * rc_s);
+    }
+
+    fn reduction(&self) -> Option<&dyn Reduction> {
+        Some(self)
+    }
+}
+
+impl Reduction for WallLadder {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..25]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[4], k[6], k[7], delta);
         let rc_delta = delta;
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: (k[9] * rc_ds),
-            theta_ddot: (k[10] * rc_c),
+            theta_dot_sq: (k[24] * rc_ds),
+            theta_ddot: (k[25] * rc_c),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
-        let k = &k[..25]; // one bounds check for all constant loads
-        (k[9] * rc_ds)
+        let k = &k[..27]; // one bounds check for all constant loads
+        (k[24] * rc_ds)
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..25]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[4], k[6], k[7], delta);
         let rc_delta = delta;
-        let rc_w2 = (k[9] * rc_ds);
-        let rc_acc = (k[10] * rc_c);
-        out[0] = ((k[11] * rc_s * rc_acc) + (k[11] * rc_c * rc_w2));
-        out[1] = (k[12] + (k[11] * rc_s * rc_w2) + (k[13] * rc_c * rc_acc));
-    }
-
-    fn monitors(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..25]; // one bounds check for all constant loads
-        let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[4], k[6], k[7], delta);
-        let rc_delta = delta;
-        let rc_w2 = (k[9] * rc_ds);
-        let rc_acc = (k[10] * rc_c);
-        let rc_f0 = ((k[11] * rc_s * rc_acc) + (k[11] * rc_c * rc_w2));
-        let rc_f1 = (k[12] + (k[11] * rc_s * rc_w2) + (k[13] * rc_c * rc_acc));
-        out[0] = rc_f1;
+        let rc_w2 = (k[24] * rc_ds);
+        let rc_acc = (k[25] * rc_c);
+        out[0] = ((k[20] * rc_s * rc_acc) + (k[20] * rc_c * rc_w2));
+        out[1] = (k[22] + (k[20] * rc_s * rc_w2) + (k[23] * rc_c * rc_acc));
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..25]; // one bounds check for all constant loads
-        out[0] = k[14];
+        let k = &k[..27]; // one bounds check for all constant loads
+        out[0] = k[26];
         out[1] = 3.0;
     }
 
@@ -198,51 +266,10 @@ impl Model for WallLadder {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..25]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[4], k[6], k[7], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[0] = k[4] - delta;
         qd[0] = theta_dot;
-    }
-
-    fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..25]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        pos[0] = [(k[15] * rc_c), 0.0];
-        vel[0] = [(k[16] * qd[0] * rc_s), 0.0];
-        pos[1] = [0.0, (k[16] * rc_s)];
-        vel[1] = [0.0, (k[16] * qd[0] * rc_c)];
-        pos[2] = [(k[17] * rc_c), (k[18] * rc_s)];
-        vel[2] = [(k[18] * qd[0] * rc_s), (k[18] * qd[0] * rc_c)];
-        pos[3] = [0.0, 0.0];
-        vel[3] = [0.0, 0.0];
-    }
-
-    fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..25]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        let et0 = (qd[0] * qd[0]);
-        (((k[19] * et0) + (k[20] * et0 * (rc_s * rc_s)) + (k[20] * et0 * (rc_c * rc_c)))
-            + (k[21] * rc_s))
-    }
-
-    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..25]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-    }
-
-    fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..25]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        mass[0] = (k[22] + (k[23] * (rc_s * rc_s)) + (k[23] * (rc_c * rc_c)));
-        rhs[0] = (k[24] * rc_c);
-    }
-
-    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..25]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        let ft0 = (qd[0] * qd[0]);
-        out[0] = ((k[11] * qdd[0] * rc_s) + (k[11] * ft0 * rc_c));
-        out[1] = (k[12] + (k[13] * qdd[0] * rc_c) + (k[11] * ft0 * rc_s));
     }
 }

@@ -1,5 +1,6 @@
 //! Output files: atomic writes into one output directory, with names checked before they
-//! become paths so that nothing is written outside it.
+//! become paths so that nothing is written outside it, and [`write_all_atomic`], which writes a
+//! set of files all or nothing (the derivation tool's `generated/` and its manifest).
 //!
 //! Architecture invariant: every file the CLI writes goes through [`OutDir::write`], which
 //! writes a temporary file in the same directory and renames it over the target. A reader sees
@@ -136,27 +137,143 @@ pub fn write_atomic_with(
         path: path.to_path_buf(),
         source,
     };
-    let (tmp, mut file) = create_temporary(path).map_err(fail)?;
+    let tmp = write_temporary(path, fill).map_err(fail)?;
+    if let Err(e) = fs::rename(&tmp, path) {
+        let _ = fs::remove_file(&tmp);
+        return Err(fail(e));
+    }
+    sync_parent(path);
+    Ok(())
+}
+
+/// Writes several files as one change: every target holds its new contents, or (on an error)
+/// every target is as it was.
+///
+/// First each file's new contents go to a temporary file beside its target (flushed to disk),
+/// and each target's old contents are kept in memory; if any of that fails, the temporaries
+/// are removed and no target was touched. Only then are the temporaries renamed over their
+/// targets, in the order given. If a rename fails, the remaining temporaries are removed and
+/// the targets already replaced get their old contents back (a target that did not exist is
+/// removed again); the error names the file whose rename failed, and says so if restoring
+/// failed too. A target that is a directory is not refused up front: no rename can replace
+/// it, so it fails there like any other rename. Other targets that are not regular files
+/// (symbolic links, devices) are refused before anything is written.
+pub fn write_all_atomic<P: AsRef<Path>, C: AsRef<[u8]>>(files: &[(P, C)]) -> Result<(), Error> {
+    let fail = |path: &Path, source| Error::Write {
+        path: path.to_path_buf(),
+        source,
+    };
+    // Staged files: (temporary, target, the target's old contents if it was a file).
+    let mut staged: Vec<(PathBuf, &Path, Option<Vec<u8>>)> = Vec::with_capacity(files.len());
+    for (path, contents) in files {
+        let path = path.as_ref();
+        let prepared = old_contents(path).and_then(|old| {
+            write_temporary(path, |w| w.write_all(contents.as_ref())).map(|tmp| (tmp, old))
+        });
+        match prepared {
+            Ok((tmp, old)) => staged.push((tmp, path, old)),
+            Err(source) => {
+                for (tmp, ..) in &staged {
+                    let _ = fs::remove_file(tmp);
+                }
+                return Err(fail(path, source));
+            }
+        }
+    }
+    for (i, (tmp, path, _)) in staged.iter().enumerate() {
+        if let Err(source) = fs::rename(tmp, path) {
+            for (tmp, ..) in &staged[i..] {
+                let _ = fs::remove_file(tmp);
+            }
+            let unrestored = restore(&staged[..i]);
+            if unrestored.is_empty() {
+                return Err(fail(path, source));
+            }
+            let message = format!(
+                "{source}; restoring the files already replaced failed too: {}",
+                unrestored.join("; ")
+            );
+            return Err(fail(path, io::Error::new(source.kind(), message)));
+        }
+    }
+    let mut synced: Vec<&Path> = Vec::new();
+    for (_, path, _) in &staged {
+        let dir = path.parent().unwrap_or(Path::new(""));
+        if !synced.contains(&dir) {
+            synced.push(dir);
+            sync_parent(path);
+        }
+    }
+    Ok(())
+}
+
+/// The contents of `path` before a transaction replaces it: `None` if there is no file to keep
+/// (it does not exist, or it is a directory, which no rename can replace).
+fn old_contents(path: &Path) -> io::Result<Option<Vec<u8>>> {
+    match fs::symlink_metadata(path) {
+        Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(e),
+        Ok(meta) if meta.is_dir() => Ok(None),
+        Ok(meta) if meta.is_file() => fs::read(path).map(Some),
+        Ok(_) => Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            "not a regular file; refusing to replace it",
+        )),
+    }
+}
+
+/// Puts back the old contents of targets already renamed over, last first; returns what could
+/// not be restored.
+fn restore(replaced: &[(PathBuf, &Path, Option<Vec<u8>>)]) -> Vec<String> {
+    let mut failed = Vec::new();
+    for (_, path, old) in replaced.iter().rev() {
+        let restored = match old {
+            Some(bytes) => write_atomic(path, bytes).map_err(|e| e.to_string()),
+            None => match fs::remove_file(path) {
+                Err(e) if e.kind() != io::ErrorKind::NotFound => {
+                    Err(format!("{}: {e}", path.display()))
+                }
+                _ => Ok(()),
+            },
+        };
+        if let Err(e) = restored {
+            failed.push(e);
+        }
+    }
+    failed
+}
+
+/// A new temporary file beside `path` holding what `fill` writes, flushed to disk; on any error
+/// it is removed again.
+fn write_temporary(
+    path: &Path,
+    fill: impl FnOnce(&mut dyn Write) -> io::Result<()>,
+) -> io::Result<PathBuf> {
+    let (tmp, mut file) = create_temporary(path)?;
     let written = (|| {
         let mut w = io::BufWriter::new(&mut file);
         fill(&mut w)?;
         w.flush()?;
         drop(w);
-        file.sync_all()?;
-        drop(file);
-        fs::rename(&tmp, path)
+        file.sync_all()
     })();
-    if let Err(e) = written {
-        let _ = fs::remove_file(&tmp);
-        return Err(fail(e));
+    drop(file);
+    match written {
+        Ok(()) => Ok(tmp),
+        Err(e) => {
+            let _ = fs::remove_file(&tmp);
+            Err(e)
+        }
     }
-    // Make the rename itself durable; failing here leaves a complete file either way.
+}
+
+/// Makes renames in `path`'s directory durable; failing here leaves complete files either way.
+fn sync_parent(path: &Path) {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty())
         && let Ok(d) = File::open(dir)
     {
         let _ = d.sync_all();
     }
-    Ok(())
 }
 
 /// A new, exclusively created temporary file beside `path`: `.<name>.<pid>.<n>.tmp`.

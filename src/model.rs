@@ -1,15 +1,18 @@
 //! The contract between generated model code (`generated/*.rs`) and the runtime solvers.
 //!
-//! A model is a planar mechanical system with one *reduced* coordinate `theta` (the rod's angle
-//! to the floor) left after the cyclic coordinates were eliminated through their conserved
-//! momenta. Every function here is emitted by `rodcube derive` from a spec in
-//! `derivations/*.yaml`; the runtime never knows which model it is driving.
+//! A model is one phase of a planar mechanical system: its Euler–Lagrange equations
+//! `M(q) qdd = F(q, qd)`, reaction forces, monitors and contact ([`Model`]), and, when every
+//! coordinate but the reduced one (`theta`, the rod's angle to the floor) is cyclic, a fast path
+//! on which the motion is a function of the angle ([`Reduction`]). Every function here is
+//! emitted by `rodcube derive` from a spec in `derivations/*.yaml`; the runtime never knows
+//! which model it is driving.
 //!
 //! # Conventions
 //! - `p`: parameter values in the order of [`ModelInfo::parameters`] (SI units).
 //! - `k`: the *prepared constants* returned by [`Model::prepare`]. `k[..n_params]` is `p`;
-//!   `k[ModelInfo::k_theta_initial]` is the initial angle and `k[ModelInfo::k_theta_dot_initial]`
-//!   its rate; the rest are parameter-only subexpressions hoisted out of the per-point functions.
+//!   on the fast path `k[ReductionInfo::k_theta_initial]` is the initial angle and
+//!   `k[ReductionInfo::k_theta_dot_initial]` its rate; the rest are parameter-only
+//!   subexpressions hoisted out of the per-point functions.
 //! - `delta`: the angle fallen since the start, `delta = theta_initial - theta >= 0`. The reduced
 //!   functions take `delta` rather than `theta` so that `sin(theta_i) - sin(theta)` is formed
 //!   without cancellation near the start, where the energy integral vanishes.
@@ -39,20 +42,19 @@ pub struct NamedInfo {
     pub meaning: &'static str,
 }
 
-/// The contact whose force vanishing means separation.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// The contact of a model: a unilateral constraint `gap(q) >= 0` that ties one coordinate
+/// while it holds. Its force (the Lagrange multiplier) is positive while the bodies push apart;
+/// the contact ends where the force reaches zero or, for a contact with an edge, where the
+/// edge margin [`Model::contact_edge`] reaches zero.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ContactInfo {
     /// Index into [`ModelInfo::forces`] of the contact force (positive while touching).
     pub force: usize,
-    /// Index into [`ModelInfo::points`] of the pushing point (the rod's tip).
-    pub point: usize,
-    /// Index into [`ModelInfo::points`] of a point on the pushed surface.
-    pub surface: usize,
-    /// Unit normal of the pushed surface, pointing from the pusher into the pushed body.
-    pub normal: [f64; 2],
-    /// Whether the pushed surface belongs to a moving body (a cube) rather than a fixed wall.
-    /// After separation a moving surface keeps the velocity it had at separation.
-    pub surface_moves: bool,
+    /// The coordinate the contact ties while it holds (free again in the next phase); its value
+    /// and rate come from [`Model::released`].
+    pub eliminated: &'static str,
+    /// Whether the contact can also end at an edge (a contact point running off a body).
+    pub edge: bool,
 }
 
 /// Where a value passed to the next phase comes from.
@@ -64,19 +66,37 @@ pub enum Binding {
     Coordinate(usize),
     /// A velocity of this model at the end of the phase, by index.
     Velocity(usize),
-    /// A coordinate (`axis` 0 = x, 1 = y) of a named point at the end of the phase.
-    Point { index: usize, axis: usize },
-    /// A velocity component of a named point at the end of the phase.
-    PointVelocity { index: usize, axis: usize },
+    /// The value of the coordinate the contact tied ([`ContactInfo::eliminated`]).
+    Eliminated,
+    /// The rate of that coordinate.
+    EliminatedRate,
 }
 
-/// The model that continues the motion after separation (e.g. the rod sliding freely).
+/// The model that continues the motion after the contact ends (derived from the same spec
+/// with the tied coordinate free).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct NextPhase {
     /// Name of the next model in the registry.
     pub model: &'static str,
     /// One binding per parameter of the next model, in its parameter order.
     pub bindings: &'static [Binding],
+}
+
+/// Where the fast path of a model keeps its start in `k`, and its separation polynomial's
+/// degree.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ReductionInfo {
+    /// Index in `k` of the initial reduced angle `theta_i`.
+    pub k_theta_initial: usize,
+    /// Index in `k` of the initial reduced rate `theta_dot_i`.
+    pub k_theta_dot_initial: usize,
+    /// Index in `k` of `sin(theta_i)`, formed from the parameters (exact where `theta_i` is
+    /// given by its sine, as for a rod leaning on a cube: `a / ell`).
+    pub k_sin_initial: usize,
+    /// Index in `k` of `cos(theta_i)`, formed from the parameters without cancellation.
+    pub k_cos_initial: usize,
+    /// Degree of the separation polynomial in `sin(theta)` (0 without a contact).
+    pub separation_degree: usize,
 }
 
 /// Static description of a generated model.
@@ -94,15 +114,6 @@ pub struct ModelInfo {
     pub requirements: &'static [NamedInfo],
     /// Length of the prepared-constant vector `k`.
     pub n_constants: usize,
-    /// Index in `k` of the initial reduced angle `theta_i`.
-    pub k_theta_initial: usize,
-    /// Index in `k` of the initial reduced rate `theta_dot_i`.
-    pub k_theta_dot_initial: usize,
-    /// Index in `k` of `sin(theta_i)`, formed from the parameters (exact where `theta_i` is
-    /// given by its sine, as for a rod leaning on a cube: `a / ell`).
-    pub k_sin_initial: usize,
-    /// Index in `k` of `cos(theta_i)`, formed from the parameters without cancellation.
-    pub k_cos_initial: usize,
     /// Generalized coordinates of the unreduced system.
     pub coordinates: &'static [&'static str],
     /// Index in `coordinates` of the reduced coordinate (`theta`).
@@ -113,10 +124,8 @@ pub struct ModelInfo {
     pub end_angle: f64,
     /// Reaction forces evaluated along the motion (the contact force among them).
     pub forces: &'static [NamedInfo],
-    /// The separating contact, if the model has one.
+    /// The contact, if the model has one.
     pub contact: Option<ContactInfo>,
-    /// Degree of the separation polynomial in `sin(theta)` (0 without a contact).
-    pub separation_degree: usize,
     /// Named points whose trajectories can be asked for.
     pub points: &'static [NamedInfo],
     /// Index in `points` of the centre of mass whose free fall is the reference time.
@@ -125,12 +134,17 @@ pub struct ModelInfo {
     pub gravity: usize,
     /// Physical assumptions to monitor; each value must stay `>= 0` during the motion.
     pub monitors: &'static [NamedInfo],
-    /// The phase that follows separation, if any.
+    /// The phase that follows the end of the contact, if any.
     pub next_phase: Option<NextPhase>,
+    /// The fast path's layout, when the model has one ([`Model::reduction`] is `Some`).
+    pub reduction: Option<ReductionInfo>,
+    /// Why the model has no fast path (empty when it has one): it is then solved by
+    /// integrating `M(q) qdd = F(q, qd)`.
+    pub route_note: &'static str,
 }
 
-/// Evaluation functions of one generated model. All are allocation-free and evaluate each
-/// shared subexpression once per call.
+/// Evaluation functions of one generated model over its full state. All are allocation-free
+/// and evaluate each shared subexpression once per call.
 pub trait Model: Send + Sync {
     /// Static description.
     fn info(&self) -> &'static ModelInfo;
@@ -143,6 +157,44 @@ pub trait Model: Send + Sync {
     /// Call only after [`Model::requirements`] passed.
     fn prepare(&self, p: &[f64], k: &mut [f64]);
 
+    /// The state at release (from the spec's `initial`, or a free phase's start parameters).
+    fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]);
+
+    /// Positions and velocities of the named points for a full state.
+    fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]);
+
+    /// Total energy (kinetic plus potential) of a full state.
+    fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64;
+
+    /// Momenta conjugate to the cyclic coordinates, in the order of [`ModelInfo::cyclic`].
+    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]);
+
+    /// The unreduced Euler–Lagrange equations `M(q) qdd = F(q, qd)`: `mass` is row-major
+    /// `n x n`, `rhs` has length `n`, with `n` the number of coordinates.
+    fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]);
+
+    /// The reaction forces of [`ModelInfo::forces`] from a full state and its acceleration.
+    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]);
+
+    /// Monitor values (each must stay `>= 0`), in the order of [`ModelInfo::monitors`], from a
+    /// full state and the forces at it (in the order of [`ModelInfo::forces`]).
+    fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]);
+
+    /// The margin to the contact's edge (`>= 0` while the contact can exist);
+    /// `f64::INFINITY` when the model has no contact or its contact has no edge.
+    fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64;
+
+    /// The value and rate of the coordinate the contact ties
+    /// ([`ContactInfo::eliminated`]); `out.len()` is 2 with a contact, 0 without.
+    fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]);
+
+    /// The fast path, if the model has one ([`ModelInfo::reduction`] describes it).
+    fn reduction(&self) -> Option<&dyn Reduction>;
+}
+
+/// The fast path of a model whose coordinates other than `theta` are cyclic: the motion as a
+/// function of the angle fallen `delta`, from the energy integral.
+pub trait Reduction: Send + Sync {
     /// Reduced state at `delta`: returns `(sin theta, cos theta, theta_dot^2, theta_ddot)`.
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced;
 
@@ -152,24 +204,10 @@ pub trait Model: Send + Sync {
     /// [`LeanSolver`](crate::solve::lean::LeanSolver), which parametrises the motion by
     /// `sin(theta)` and forms `ds` and `dc` exactly. Equal to
     /// `reduced(k, delta).theta_dot_sq` at the same angle.
-    ///
-    /// Generated models emit it straight from the energy integral. The default, for models
-    /// written by hand, recovers `delta` without cancellation,
-    /// `delta = atan2(cos(theta_i) ds - sin(theta_i) dc, cos(theta_i) c + sin(theta_i) s)`
-    /// (the sine term is a sum of two non-negative products while the angle falls below the
-    /// start), and calls [`Model::reduced`].
-    fn theta_dot_sq_sc(&self, k: &[f64], s: f64, c: f64, ds: f64, dc: f64) -> f64 {
-        let info = self.info();
-        let (si, ci) = (k[info.k_sin_initial], k[info.k_cos_initial]);
-        let delta = (ci * ds - si * dc).atan2(ci * c + si * s);
-        self.reduced(k, delta).theta_dot_sq
-    }
+    fn theta_dot_sq_sc(&self, k: &[f64], s: f64, c: f64, ds: f64, dc: f64) -> f64;
 
     /// Reaction forces at `delta` along the reduced motion, in the order of [`ModelInfo::forces`].
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]);
-
-    /// Monitor values at `delta` (each must stay `>= 0`), in the order of [`ModelInfo::monitors`].
-    fn monitors(&self, k: &[f64], delta: f64, out: &mut [f64]);
 
     /// Coefficients of the separation polynomial in `s = sin(theta)`, lowest degree first
     /// (`out.len() == separation_degree + 1`). Its root in `(0, sin theta_i)` is the separation.
@@ -186,22 +224,6 @@ pub trait Model: Send + Sync {
         q: &mut [f64],
         qd: &mut [f64],
     );
-
-    /// Positions and velocities of the named points for a full state.
-    fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]);
-
-    /// Total energy (kinetic plus potential) of a full state.
-    fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64;
-
-    /// Momenta conjugate to the cyclic coordinates, in the order of [`ModelInfo::cyclic`].
-    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]);
-
-    /// The unreduced Euler–Lagrange equations `M(q) qdd = F(q, qd)`: `mass` is row-major
-    /// `n x n`, `rhs` has length `n`, with `n` the number of coordinates.
-    fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]);
-
-    /// The reaction forces of [`ModelInfo::forces`] from an unreduced state and acceleration.
-    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]);
 }
 
 /// The reduced state at one angle.

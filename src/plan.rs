@@ -29,15 +29,15 @@
 
 use crate::model::Model;
 use crate::quantity::Quantity;
-use crate::results::{Check, Column, RunResults, Scalar, Series, Work};
+use crate::results::{Check, Column, Label, RunResults, Scalar, Series, Work};
 use crate::solve::SolveError;
 use crate::solve::checks;
-use crate::solve::phases::{Motion, PhaseRun, extend_to_floor, phase_end};
+use crate::solve::phases::{End, Motion, PhaseRun, ReducedRun, Route, extend_to_floor, phase_end};
 use crate::solve::quadrature::TimeMesh;
 use crate::solve::separation::{Separation, SeparationOutcome, linearised_separation};
-use crate::solve::series::{PhaseSamples, sample_phase, theta_dot_at};
+use crate::solve::series::{PhaseSamples, sample, sample_forces, theta_dot_at};
 use crate::solve::unreduced::{self, EndEvent, UnreducedRun};
-use crate::system::{System, SystemError};
+use crate::system::{Bound, System, SystemError};
 use std::collections::BTreeMap;
 
 /// Relative tolerance when a request gives none.
@@ -46,9 +46,10 @@ pub const DEFAULT_TOLERANCE: f64 = 1e-10;
 pub const DEFAULT_SAMPLES: usize = 500;
 /// Accepted relative tolerances (inclusive).
 pub const TOLERANCE_RANGE: (f64, f64) = (1e-14, 1e-2);
-/// The unreduced ODE is run at `tolerance * ODE_RTOL_FACTOR`, but never tighter than
-/// [`ODE_RTOL_FLOOR`] (below it DOPRI5's rounding dominates).
-pub const ODE_RTOL_FACTOR: f64 = 0.1;
+/// The integrator runs at `tolerance * ODE_RTOL_FACTOR`, but never tighter than
+/// [`ODE_RTOL_FLOOR`] (below it DOPRI5's rounding dominates): at the default tolerance its
+/// event times agree with the fast path's to about `1e-13` relative.
+pub const ODE_RTOL_FACTOR: f64 = 0.01;
 /// Tightest relative tolerance given to the ODE integrator.
 pub const ODE_RTOL_FLOOR: f64 = 1e-13;
 
@@ -100,6 +101,8 @@ pub struct Request<'m> {
     pub samples: usize,
     /// Where next phases are looked up by name (default: [`crate::models::all`]).
     pub registry: &'m [&'m dyn Model],
+    /// Which route solves the phases (default: the fast path where a model has one).
+    pub route: Route,
 }
 
 impl<'m> Request<'m> {
@@ -112,6 +115,7 @@ impl<'m> Request<'m> {
             tolerance: DEFAULT_TOLERANCE,
             samples: DEFAULT_SAMPLES,
             registry: crate::models::all(),
+            route: Route::Fastest,
         }
     }
 
@@ -146,6 +150,13 @@ impl<'m> Request<'m> {
     /// Sets the points per series.
     pub fn with_samples(mut self, samples: usize) -> Self {
         self.samples = samples;
+        self
+    }
+
+    /// Sets the route: [`Route::Integrated`] integrates every phase, even where a fast path
+    /// exists (the quantities of the energy integral are then unavailable).
+    pub fn with_route(mut self, route: Route) -> Self {
+        self.route = route;
         self
     }
 
@@ -241,14 +252,14 @@ pub fn run(request: &Request) -> Result<RunResults, PlanError> {
             samples: request.samples,
         });
     }
-    let sys = match &request.parameters {
-        Parameters::Values(v) => System::from_values(request.model, v)?,
-        Parameters::Named(v) => System::new(request.model, v)?,
+    let bound = match &request.parameters {
+        Parameters::Values(v) => Bound::from_values(request.model, v)?,
+        Parameters::Named(v) => Bound::new(request.model, v)?,
     };
-    let mut plan = Plan::new(sys, request.registry, tol, request.samples);
+    let mut plan = Plan::new(bound, request.registry, tol, request.samples, request.route);
     let mut out = RunResults {
         model: info.name.to_string(),
-        parameters: plan.sys.parameter_map(),
+        parameters: plan.bound.parameter_map(),
         ..RunResults::default()
     };
     // The ODE first, so that `checks` can include its path when both are wanted.
@@ -286,10 +297,14 @@ fn check_finite(out: &RunResults) -> Result<(), PlanError> {
 
 /// Caches of one run: each prerequisite is computed at most once, only when asked for.
 struct Plan<'m> {
-    sys: System<'m>,
+    /// The first phase's model and parameters.
+    bound: Bound<'m>,
+    /// The same with its fast path, when it has one.
+    sys: Option<System<'m>>,
     registry: &'m [&'m dyn Model],
     tol: f64,
     samples: usize,
+    route: Route,
     work: Work,
     end: Option<(Option<Separation>, f64)>,
     motion: Option<Motion<'m>>,
@@ -321,12 +336,24 @@ fn column(name: &str, unit: &'static str, values: Vec<f64>) -> Column {
 const NO_SEPARATION: &str = "no separation before the floor: the contact holds all the way down";
 
 impl<'m> Plan<'m> {
-    fn new(sys: System<'m>, registry: &'m [&'m dyn Model], tol: f64, samples: usize) -> Self {
+    fn new(
+        bound: Bound<'m>,
+        registry: &'m [&'m dyn Model],
+        tol: f64,
+        samples: usize,
+        route: Route,
+    ) -> Self {
+        let sys = match route {
+            Route::Fastest => System::reduce(bound.clone()).ok(),
+            Route::Integrated => None,
+        };
         Plan {
+            bound,
             sys,
             registry,
             tol,
             samples,
+            route,
             work: Work::default(),
             end: None,
             motion: None,
@@ -337,39 +364,65 @@ impl<'m> Plan<'m> {
         }
     }
 
-    /// Where the first phase ends (separation root only).
+    /// The first phase's fast path (a quantity that needs it is only offered with it).
+    fn fast(&self) -> Result<&System<'m>, SolveError> {
+        self.sys.as_ref().ok_or_else(|| {
+            let info = self.bound.info();
+            SolveError::Parameters(SystemError::NoReduction {
+                model: info.name,
+                why: info.route_note,
+            })
+        })
+    }
+
+    /// Where the first phase ends on the fast path (separation root only).
     fn end(&mut self) -> Result<(Option<Separation>, f64), SolveError> {
         if let Some(end) = self.end {
             return Ok(end);
         }
-        let end = phase_end(&self.sys, &mut self.work)?;
+        let sys = self.fast()?.clone();
+        let end = phase_end(&sys, &mut self.work)?;
         self.end = Some(end);
         Ok(end)
     }
 
-    /// The motion with at least its first phase solved (root + quadrature). A first phase that
-    /// keeps contact to the floor reuses the contact-to-floor integral if it exists.
+    /// The motion with at least its first phase solved: on the fast path root + quadrature
+    /// (a first phase that keeps contact to the floor reuses the contact-to-floor integral if
+    /// it exists), otherwise integrated to its first event.
     fn motion(&mut self) -> Result<&mut Motion<'m>, SolveError> {
         let motion = match self.motion.take() {
             Some(m) => m,
             None => {
-                let (separation, delta_end) = self.end()?;
-                let run = match (&separation, &self.floor_mesh) {
-                    (None, Some(mesh)) => {
-                        self.work.phases.push(self.sys.name().to_string());
-                        PhaseRun {
-                            system: self.sys.clone(),
-                            t_start: 0.0,
-                            separation,
-                            mesh: mesh.clone(),
+                let run = match self.sys.clone() {
+                    Some(sys) => {
+                        let (separation, delta_end) = self.end()?;
+                        match (&separation, &self.floor_mesh) {
+                            (None, Some(mesh)) => {
+                                self.work.phases.push(sys.name().to_string());
+                                ReducedRun {
+                                    system: sys,
+                                    t_start: 0.0,
+                                    separation,
+                                    mesh: mesh.clone(),
+                                }
+                            }
+                            _ => ReducedRun::with_end(
+                                sys,
+                                0.0,
+                                separation,
+                                delta_end,
+                                self.tol,
+                                &mut self.work,
+                            )?,
                         }
+                        .into_phase()
                     }
-                    _ => PhaseRun::with_end(
-                        self.sys.clone(),
+                    None => PhaseRun::solve(
+                        self.bound.clone(),
                         0.0,
-                        separation,
-                        delta_end,
                         self.tol,
+                        self.ode_rtol(),
+                        self.route,
                         &mut self.work,
                     )?,
                 };
@@ -388,8 +441,16 @@ impl<'m> Plan<'m> {
     fn complete(&mut self) -> Result<&Motion<'m>, SolveError> {
         self.motion()?;
         if !self.complete {
+            let rtol = self.ode_rtol();
             if let Some(motion) = self.motion.as_mut() {
-                extend_to_floor(motion, self.registry, self.tol, &mut self.work)?;
+                extend_to_floor(
+                    motion,
+                    self.registry,
+                    self.tol,
+                    rtol,
+                    self.route,
+                    &mut self.work,
+                )?;
             }
             self.complete = true;
         }
@@ -404,7 +465,7 @@ impl<'m> Plan<'m> {
                 let Some(run) = motion.phases.get(self.phase_samples.len()) else {
                     break;
                 };
-                let s = sample_phase(&run.system, &run.mesh, self.samples, &mut self.work)?;
+                let s = sample(run, self.samples, &mut self.work)?;
                 self.phase_samples.push(s);
             }
         }
@@ -421,14 +482,15 @@ impl<'m> Plan<'m> {
     fn floor_mesh(&mut self) -> Result<&TimeMesh, SolveError> {
         let mesh = match self.floor_mesh.take() {
             Some(mesh) => mesh,
-            None => match (&self.end, &self.motion) {
-                (Some((None, _)), Some(m)) => m.phases[0].mesh.clone(),
-                _ => TimeMesh::build(
-                    &self.sys,
-                    self.sys.delta_to_floor(),
-                    self.tol,
-                    &mut self.work,
-                )?,
+            None => match (
+                &self.end,
+                self.motion.as_ref().and_then(|m| m.phases[0].reduced()),
+            ) {
+                (Some((None, _)), Some(r)) => r.mesh.clone(),
+                _ => {
+                    let sys = self.fast()?.clone();
+                    TimeMesh::build(&sys, sys.delta_to_floor(), self.tol, &mut self.work)?
+                }
             },
         };
         Ok(self.floor_mesh.insert(mesh))
@@ -439,14 +501,14 @@ impl<'m> Plan<'m> {
         (self.tol * ODE_RTOL_FACTOR).max(ODE_RTOL_FLOOR)
     }
 
-    /// The unreduced ODE to the first phase's end event.
+    /// The unreduced ODE to the first phase's end event (the cross-check of the fast path).
     fn ode(&mut self) -> Result<&UnreducedRun, SolveError> {
         let run = match self.ode.take() {
             Some(run) => run,
             None => {
                 let rtol = self.ode_rtol();
                 let duration = self.first()?.duration();
-                unreduced::integrate(&self.sys, rtol, None, 2.0 * duration, &mut self.work)?
+                unreduced::integrate(&self.bound, rtol, None, 2.0 * duration, &mut self.work)?
             }
         };
         Ok(self.ode.insert(run))
@@ -458,14 +520,14 @@ impl<'m> Plan<'m> {
         want: &[Quantity],
         out: &mut RunResults,
     ) -> Result<(), SolveError> {
-        let info = self.sys.info();
+        let info = self.bound.info();
         let key = q.name(info);
         match q {
-            Quantity::SeparationAngle => match self.end()?.0 {
-                Some(s) => scalar(
+            Quantity::SeparationAngle => match self.separation_angle()? {
+                Some(theta) => scalar(
                     out,
                     &key,
-                    s.theta,
+                    theta,
                     "rad",
                     "angle to the floor where the contact force vanishes".into(),
                 ),
@@ -473,7 +535,7 @@ impl<'m> Plan<'m> {
                     out.notes.insert(key, NO_SEPARATION.into());
                 }
             },
-            Quantity::LinearisedSeparationAngle => match linearised_separation(&self.sys)? {
+            Quantity::LinearisedSeparationAngle => match linearised_separation(self.fast()?)? {
                 SeparationOutcome::Separates(s) => scalar(
                     out,
                     &key,
@@ -489,20 +551,13 @@ impl<'m> Plan<'m> {
                     );
                 }
             },
-            Quantity::SeparationTime => {
-                if self.end()?.0.is_none() {
+            Quantity::SeparationTime => match self.separation_time()? {
+                Some(t) => scalar(out, &key, t, "s", "time from release to separation".into()),
+                None => {
                     out.notes.insert(key, NO_SEPARATION.into());
-                } else {
-                    let t = self.first()?.duration();
-                    scalar(
-                        out,
-                        &key,
-                        t,
-                        "s",
-                        "time from release to separation (eq. 15)".into(),
-                    );
                 }
-            }
+            },
+            Quantity::ContactEnd => self.contact_end(out)?,
             Quantity::ContactTimeToFloor => {
                 let t = self.floor_mesh()?.duration;
                 scalar(
@@ -510,13 +565,13 @@ impl<'m> Plan<'m> {
                     &key,
                     t,
                     "s",
-                    "time to the floor if contact were kept all the way (eq. 10)".into(),
+                    "time to the floor if contact were kept all the way".into(),
                 );
             }
             Quantity::PointMassFallTime => {
-                let pts = self.sys.points(&self.sys.initial_state());
+                let pts = self.bound.points(&self.bound.initial_state());
                 let h = pts.pos[info.falling_point][1];
-                let g = self.sys.gravity();
+                let g = self.bound.gravity();
                 if h > 0.0 {
                     let meaning = format!(
                         "free fall of a point mass from the initial height {h:.6e} m of `{}`",
@@ -544,8 +599,12 @@ impl<'m> Plan<'m> {
             }
             Quantity::ForceSeries(i) => {
                 self.first_samples()?;
-                let s = &self.phase_samples[0];
-                let force: Vec<f64> = s.delta.iter().map(|&d| self.sys.forces(d)[i]).collect();
+                let (Some(motion), Some(s)) = (self.motion.as_ref(), self.phase_samples.first())
+                else {
+                    return Ok(());
+                };
+                let forces = sample_forces(&motion.phases[0], s)?;
+                let force: Vec<f64> = forces.iter().map(|f| f[i]).collect();
                 let series = Series {
                     columns: vec![
                         column("t", "s", s.t.clone()),
@@ -559,8 +618,8 @@ impl<'m> Plan<'m> {
                 self.first_samples()?;
                 let s = &self.phase_samples[0];
                 let mut cols: [Vec<f64>; 4] = Default::default();
-                for state in checks::sampled_states(&self.sys, s) {
-                    let pts = self.sys.points(&state);
+                for state in &s.states {
+                    let pts = self.bound.points(state);
                     let (p, v) = (pts.pos[i], pts.vel[i]);
                     for (c, x) in cols.iter_mut().zip([p[0], p[1], v[0], v[1]]) {
                         c.push(x);
@@ -585,27 +644,91 @@ impl<'m> Plan<'m> {
         Ok(())
     }
 
+    /// The angle where the contact force reaches zero, or `None` when the first phase ends
+    /// otherwise (the floor, or an edge). On the fast path this needs the root only.
+    fn separation_angle(&mut self) -> Result<Option<f64>, SolveError> {
+        if self.sys.is_some() {
+            return Ok(self.end()?.0.map(|s| s.theta));
+        }
+        let first = self.first()?;
+        Ok((first.end() == End::Separation).then(|| first.theta_end()))
+    }
+
+    /// The time from release to separation, or `None` without a separation.
+    fn separation_time(&mut self) -> Result<Option<f64>, SolveError> {
+        if self.sys.is_some() && self.end()?.0.is_none() {
+            return Ok(None);
+        }
+        let first = self.first()?;
+        Ok((first.end() == End::Separation).then(|| first.duration()))
+    }
+
+    /// How the first phase's contact ends: time, angle and cause (`force` or `edge`).
+    fn contact_end(&mut self, out: &mut RunResults) -> Result<(), SolveError> {
+        let first = self.first()?;
+        let end = first.end();
+        if end == End::Floor {
+            out.notes.insert("contact_end".into(), NO_SEPARATION.into());
+            return Ok(());
+        }
+        let (t, theta) = (first.duration(), first.theta_end());
+        let cause = match end {
+            End::Edge => "the contact point ran off the edge of a body",
+            _ => "the contact force reached zero",
+        };
+        scalar(
+            out,
+            "contact_end_time",
+            t,
+            "s",
+            format!("time from release until the contact ends: {cause}"),
+        );
+        scalar(
+            out,
+            "contact_end_angle",
+            theta,
+            "rad",
+            format!("angle to the floor where the contact ends: {cause}"),
+        );
+        out.labels.insert(
+            "contact_end_cause".into(),
+            Label {
+                value: end.name().to_string(),
+                meaning: "why the contact ended: `force` (the push reached zero) or `edge` (the contact point ran off a body)".into(),
+            },
+        );
+        Ok(())
+    }
+
     fn floor_impact(&mut self, out: &mut RunResults) -> Result<(), SolveError> {
         let motion = self.complete()?;
-        let names: Vec<&str> = motion.phases.iter().map(|p| p.system.name()).collect();
+        let names: Vec<&str> = motion.phases.iter().map(|p| p.bound().name()).collect();
+        let path = names.join(" -> ");
+        match motion.last_end() {
+            Some(End::Floor) => {}
+            Some(End::Edge) => {
+                out.notes.insert(
+                    "floor_impact".into(),
+                    format!(
+                        "the contact ran off an edge ({path}); the motion after that is not modelled"
+                    ),
+                );
+                return Ok(());
+            }
+            _ => {
+                out.notes.insert(
+                    "floor_impact".into(),
+                    format!("the motion ended before the floor ({path})"),
+                );
+                return Ok(());
+            }
+        }
         let time = motion.floor_time();
         let omega = motion.impact_angular_velocity();
-        let speed = match motion.transitions.first() {
-            Some(tr) => Ok(tr.surface_speed()),
-            None => {
-                // No separation: the surface is still pushed when the rod lands.
-                let first = &motion.phases[0];
-                match first.system.info().contact {
-                    Some(c) => {
-                        let v = first.system.points(&first.end_state()).vel[c.surface];
-                        let moves = if c.surface_moves { 1.0 } else { 0.0 };
-                        Err(moves * (c.normal[0] * v[0] + c.normal[1] * v[1]))
-                    }
-                    None => Err(0.0),
-                }
-            }
-        };
-        let path = names.join(" -> ");
+        if motion.phases.len() == 1 {
+            out.notes
+                .insert("floor_impact".into(), NO_SEPARATION.into());
+        }
         scalar(
             out,
             "floor_impact_time",
@@ -620,26 +743,6 @@ impl<'m> Plan<'m> {
             "rad/s",
             format!("theta_dot when the rod reaches the floor ({path})"),
         );
-        match speed {
-            Ok(v) => scalar(
-                out,
-                "surface_final_speed",
-                v,
-                "m/s",
-                "speed of the pushed surface along the contact normal after separation".into(),
-            ),
-            Err(v) => {
-                scalar(
-                    out,
-                    "surface_final_speed",
-                    v,
-                    "m/s",
-                    "speed of the pushed surface along the contact normal when the rod lands (no separation)".into(),
-                );
-                out.notes
-                    .insert("floor_impact".into(), NO_SEPARATION.into());
-            }
-        }
         Ok(())
     }
 
@@ -657,12 +760,15 @@ impl<'m> Plan<'m> {
         let (Some(motion), Some(ode)) = (self.motion.as_ref(), self.ode.as_ref()) else {
             return Ok(());
         };
-        let first = &motion.phases[0];
+        let Some(first) = motion.phases[0].reduced() else {
+            return Ok(());
+        };
         let sys = &first.system;
-        let t_quad = first.duration();
+        let t_quad = first.mesh.duration;
         let rel = (ode.t_end - t_quad).abs() / t_quad;
         let event = match ode.end {
             EndEvent::Separation => "separation (contact force crossing zero)",
+            EndEvent::Edge => "the contact's edge",
             EndEvent::Floor => "the floor",
         };
         // Along the path: the quadrature's time and the reduced state at each ODE step's angle.
@@ -748,36 +854,30 @@ impl<'m> Plan<'m> {
                 continue;
             };
             let run = &motion.phases[i];
-            let mut found: Vec<(String, Check)> = checks::monitors(&run.system, samples);
-            let states = checks::sampled_states(&run.system, samples);
-            found.extend(checks::drift(&run.system, &states, tol, run.system.name()));
-            if i > 0 {
-                let tr = &motion.transitions[i - 1];
-                found.extend(checks::no_recatch(
-                    &run.system,
-                    samples,
-                    run.t_start,
-                    tr,
-                    tol,
-                ));
+            let bound = run.bound();
+            let forces = sample_forces(run, samples)?;
+            let mut found: Vec<(String, Check)> = checks::monitors(bound, samples, &forces, tol);
+            match run {
+                PhaseRun::Reduced(_) => {
+                    found.extend(checks::drift(bound, &samples.states, tol, bound.name()));
+                }
+                // Along the integrator's own steps (not the interpolated samples), held to the
+                // integrator's accuracy: ten times its rtol at the least.
+                PhaseRun::Integrated(r) => {
+                    let states = r.run.states();
+                    let ode_tol = tol.max(10.0 * r.run.rtol);
+                    found.extend(checks::drift(bound, &states, ode_tol, bound.name()));
+                }
             }
             out.checks.extend(found);
         }
         if with_ode && let Some(ode) = self.ode.as_ref() {
-            let n = self.sys.n_coordinates();
-            let states: Vec<_> = ode
-                .nodes()
-                .iter()
-                .map(|(_, y)| crate::system::State {
-                    q: y[..n].to_vec(),
-                    qd: y[n..].to_vec(),
-                })
-                .collect();
+            let states = ode.states();
             // The ODE path is held to its own accuracy: ten times its rtol at the least.
             let ode_tol = tol.max(10.0 * ode.rtol);
-            let label = format!("{}.ode", self.sys.name());
+            let label = format!("{}.ode", self.bound.name());
             out.checks
-                .extend(checks::drift(&self.sys, &states, ode_tol, &label));
+                .extend(checks::drift(&self.bound, &states, ode_tol, &label));
         }
         Ok(())
     }

@@ -12,6 +12,8 @@ pub enum Quantity {
     LinearisedSeparationAngle,
     /// Time from release to separation (s), eq. (15).
     SeparationTime,
+    /// When, at which angle and why (`force` or `edge`) the contact ends.
+    ContactEnd,
     /// Time to the floor if the rod stayed in contact all the way (s), eq. (10).
     ContactTimeToFloor,
     /// Free-fall time of a point mass from the initial height of the falling centre of mass (s).
@@ -46,6 +48,11 @@ pub const FIXED: &[(&str, Quantity, &str)] = &[
         "separation_time",
         Quantity::SeparationTime,
         "time from release to separation (s)",
+    ),
+    (
+        "contact_end",
+        Quantity::ContactEnd,
+        "when, at which angle and why the contact ends (force or edge)",
     ),
     (
         "contact_time_to_floor",
@@ -132,14 +139,18 @@ impl Quantity {
         out
     }
 
-    /// Whether a model can provide this quantity (separation needs a contact, and the
-    /// floor impact needs a phase after it).
+    /// Whether a model can provide this quantity: separation needs a contact, the floor
+    /// impact a phase after it, and the quantities of the energy integral (the linearised
+    /// polynomial, the time to the floor in contact, the cross-check against the quadrature)
+    /// the fast path.
     pub fn available(&self, info: &ModelInfo) -> bool {
+        let contact = info.contact.is_some();
+        let fast = info.reduction.is_some();
         match self {
-            Quantity::SeparationAngle
-            | Quantity::LinearisedSeparationAngle
-            | Quantity::SeparationTime => info.contact.is_some(),
-            Quantity::FloorImpact => info.contact.is_some() && info.next_phase.is_some(),
+            Quantity::SeparationAngle | Quantity::SeparationTime | Quantity::ContactEnd => contact,
+            Quantity::LinearisedSeparationAngle => contact && fast,
+            Quantity::ContactTimeToFloor | Quantity::CrossCheck => fast,
+            Quantity::FloorImpact => contact && info.next_phase.is_some(),
             _ => true,
         }
     }

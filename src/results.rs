@@ -14,6 +14,15 @@ pub struct Scalar {
     pub meaning: String,
 }
 
+/// A result that is a word rather than a number (e.g. why a contact ended).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Label {
+    /// The word.
+    pub value: String,
+    /// What it is and which words it can be.
+    pub meaning: String,
+}
+
 /// One column of a series.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Column {
@@ -66,6 +75,9 @@ pub struct RunResults {
     pub parameters: BTreeMap<String, f64>,
     /// Scalar results by key.
     pub results: BTreeMap<String, Scalar>,
+    /// Word-valued results by key (written under `results` in JSON, beside the scalars).
+    #[serde(skip)]
+    pub labels: BTreeMap<String, Label>,
     /// Series by quantity name (`theta_series`, `tip_trajectory`, ...).
     pub series: BTreeMap<String, Series>,
     /// Checks by name.

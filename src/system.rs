@@ -1,11 +1,13 @@
 //! A model bound to one validated parameter set: the values `p`, the prepared constants `k`,
-//! and typed helpers around the raw [`Model`] calls.
+//! and typed helpers around the raw [`Model`] calls. [`Bound`] offers the full-state functions
+//! every model has; [`System`] is a bound model with a fast path ([`Reduction`]) and derefs to
+//! its [`Bound`].
 //!
-//! Architecture invariant: a [`System`] only exists for parameters that passed every check
+//! Architecture invariant: a [`Bound`] (and so a [`System`]) only exists for parameters that passed every check
 //! (all present, finite, positive where declared, every requirement margin `> 0`, every
 //! prepared constant finite), so the solvers never see a NaN that came from the input.
 
-use crate::model::{Model, ModelInfo, Reduced};
+use crate::model::{Model, ModelInfo, Reduced, Reduction, ReductionInfo};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
@@ -90,6 +92,14 @@ pub enum SystemError {
         /// The parameters, `name = value` comma-separated.
         parameters: String,
     },
+    /// The model has no fast path (a [`System`] needs one; use a [`Bound`]).
+    #[error("model `{model}` has no reduced fast path ({why}); it is solved by integration")]
+    NoReduction {
+        /// Model name.
+        model: &'static str,
+        /// Why, from the derivation.
+        why: &'static str,
+    },
     /// `Model::prepare` produced a non-finite constant (a bug in the model or an extreme input).
     #[error(
         "model `{model}` prepared a non-finite constant k[{index}] = {value} from {parameters}"
@@ -128,15 +138,15 @@ pub struct Points {
 
 /// A model with a validated parameter set and its prepared constants.
 #[derive(Clone)]
-pub struct System<'m> {
+pub struct Bound<'m> {
     model: &'m dyn Model,
     p: Vec<f64>,
     k: Vec<f64>,
 }
 
-impl std::fmt::Debug for System<'_> {
+impl std::fmt::Debug for Bound<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("System")
+        f.debug_struct("Bound")
             .field("model", &self.info().name)
             .field("p", &self.p)
             .field("k", &self.k)
@@ -144,7 +154,7 @@ impl std::fmt::Debug for System<'_> {
     }
 }
 
-impl<'m> System<'m> {
+impl<'m> Bound<'m> {
     /// Binds named parameter values (any order, each exactly once) to a model.
     pub fn new<S: AsRef<str>>(
         model: &'m dyn Model,
@@ -250,7 +260,7 @@ impl<'m> System<'m> {
                 parameters: describe(info, p),
             });
         }
-        Ok(System {
+        Ok(Bound {
             model,
             p: p.to_vec(),
             k,
@@ -311,61 +321,9 @@ impl<'m> System<'m> {
         self.p[self.info().gravity]
     }
 
-    /// Initial reduced angle `theta_i` (rad).
-    pub fn theta_initial(&self) -> f64 {
-        self.k[self.info().k_theta_initial]
-    }
-
-    /// Initial reduced rate `theta_dot_i` (rad/s); zero for a release from rest.
-    pub fn theta_dot_initial(&self) -> f64 {
-        self.k[self.info().k_theta_dot_initial]
-    }
-
-    /// Whether the motion starts from rest (`theta_dot_i == 0`).
-    pub fn starts_at_rest(&self) -> bool {
-        self.theta_dot_initial() == 0.0
-    }
-
     /// The angle where the motion ends (rod on the floor).
     pub fn end_angle(&self) -> f64 {
         self.info().end_angle
-    }
-
-    /// `theta_i - end_angle`: the angle fallen when the rod reaches the floor.
-    pub fn delta_to_floor(&self) -> f64 {
-        self.theta_initial() - self.end_angle()
-    }
-
-    /// Reduced state at `delta = theta_i - theta`.
-    pub fn reduced(&self, delta: f64) -> Reduced {
-        self.model.reduced(&self.k, delta)
-    }
-
-    /// Reduced state at an angle `theta` (loses the cancellation-free form near the start:
-    /// prefer [`System::reduced`] with `delta`).
-    pub fn reduced_at_theta(&self, theta: f64) -> Reduced {
-        self.reduced(self.theta_initial() - theta)
-    }
-
-    /// Reaction forces at `delta` in the order of [`ModelInfo::forces`].
-    pub fn forces(&self, delta: f64) -> Vec<f64> {
-        let mut out = vec![0.0; self.info().forces.len()];
-        self.model.forces(&self.k, delta, &mut out);
-        out
-    }
-
-    /// Monitor values at `delta` in the order of [`ModelInfo::monitors`].
-    pub fn monitors(&self, delta: f64) -> Vec<f64> {
-        let mut out = vec![0.0; self.info().monitors.len()];
-        self.model.monitors(&self.k, delta, &mut out);
-        out
-    }
-
-    /// Coefficients of the separation polynomial in `sin(theta)`, lowest degree first.
-    pub fn separation_coefficients(&self) -> Vec<f64> {
-        let mut out = vec![0.0; self.info().separation_degree + 1];
-        self.model.separation_polynomial(&self.k, &mut out);
-        out
     }
 
     /// Number of unreduced coordinates.
@@ -373,22 +331,16 @@ impl<'m> System<'m> {
         self.info().coordinates.len()
     }
 
-    /// The full state on the reduced motion at phase time `t`, angle fallen `delta` and rate
-    /// `theta_dot`.
-    pub fn full_state(&self, t: f64, delta: f64, theta_dot: f64) -> State {
+    /// The state at release.
+    pub fn initial_state(&self) -> State {
         let n = self.n_coordinates();
         let mut state = State {
             q: vec![0.0; n],
             qd: vec![0.0; n],
         };
         self.model
-            .full_state(&self.k, t, delta, theta_dot, &mut state.q, &mut state.qd);
+            .initial_state(&self.k, &mut state.q, &mut state.qd);
         state
-    }
-
-    /// The state at release (`t = 0`, `delta = 0`, `theta_dot = theta_dot_i`).
-    pub fn initial_state(&self) -> State {
-        self.full_state(0.0, 0.0, self.theta_dot_initial())
     }
 
     /// Positions and velocities of the named points.
@@ -436,6 +388,160 @@ impl<'m> System<'m> {
         self.model
             .forces_full(&self.k, &state.q, &state.qd, qdd, &mut out);
         out
+    }
+
+    /// Monitor values (each must stay `>= 0`) at a state with the forces there.
+    pub fn monitors_full(&self, state: &State, forces: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; self.info().monitors.len()];
+        self.model
+            .monitors_full(&self.k, &state.q, &state.qd, forces, &mut out);
+        out
+    }
+
+    /// The margin to the contact's edge (`+inf` without an edge).
+    pub fn contact_edge(&self, state: &State) -> f64 {
+        self.model.contact_edge(&self.k, &state.q)
+    }
+
+    /// The value and rate of the coordinate the contact ties (`None` without a contact).
+    pub fn released(&self, state: &State) -> Option<[f64; 2]> {
+        self.info().contact?;
+        let mut out = [0.0; 2];
+        self.model.released(&self.k, &state.q, &state.qd, &mut out);
+        Some(out)
+    }
+}
+
+/// A bound model with a fast path: the motion as a function of the angle fallen.
+#[derive(Clone)]
+pub struct System<'m> {
+    bound: Bound<'m>,
+    reduction: &'m dyn Reduction,
+    layout: &'static ReductionInfo,
+}
+
+impl std::fmt::Debug for System<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.bound.fmt(f)
+    }
+}
+
+impl<'m> std::ops::Deref for System<'m> {
+    type Target = Bound<'m>;
+    fn deref(&self) -> &Bound<'m> {
+        &self.bound
+    }
+}
+
+impl<'m> System<'m> {
+    /// Binds named parameter values (any order, each exactly once) to a model with a fast path.
+    pub fn new<S: AsRef<str>>(
+        model: &'m dyn Model,
+        params: &[(S, f64)],
+    ) -> Result<Self, SystemError> {
+        Self::reduce(Bound::new(model, params)?)
+    }
+
+    /// Binds a map of named parameter values to a model with a fast path.
+    pub fn from_map(
+        model: &'m dyn Model,
+        params: &BTreeMap<String, f64>,
+    ) -> Result<Self, SystemError> {
+        Self::reduce(Bound::from_map(model, params)?)
+    }
+
+    /// Binds parameter values given in the model's order to a model with a fast path.
+    pub fn from_values(model: &'m dyn Model, p: &[f64]) -> Result<Self, SystemError> {
+        Self::reduce(Bound::from_values(model, p)?)
+    }
+
+    /// The fast path of a bound model, or [`SystemError::NoReduction`].
+    pub fn reduce(bound: Bound<'m>) -> Result<Self, SystemError> {
+        let info = bound.info();
+        match (bound.model().reduction(), &info.reduction) {
+            (Some(reduction), Some(layout)) => Ok(System {
+                bound,
+                reduction,
+                layout,
+            }),
+            _ => Err(SystemError::NoReduction {
+                model: info.name,
+                why: info.route_note,
+            }),
+        }
+    }
+
+    /// The bound model underneath.
+    pub fn bound(&self) -> &Bound<'m> {
+        &self.bound
+    }
+
+    /// Where the fast path keeps its start in `k`.
+    pub fn layout(&self) -> &'static ReductionInfo {
+        self.layout
+    }
+
+    /// The fast path's functions.
+    pub fn reduction(&self) -> &'m dyn Reduction {
+        self.reduction
+    }
+
+    /// Initial reduced angle `theta_i` (rad).
+    pub fn theta_initial(&self) -> f64 {
+        self.k()[self.layout.k_theta_initial]
+    }
+
+    /// Initial reduced rate `theta_dot_i` (rad/s); zero for a release from rest.
+    pub fn theta_dot_initial(&self) -> f64 {
+        self.k()[self.layout.k_theta_dot_initial]
+    }
+
+    /// Whether the motion starts from rest (`theta_dot_i == 0`).
+    pub fn starts_at_rest(&self) -> bool {
+        self.theta_dot_initial() == 0.0
+    }
+
+    /// `theta_i - end_angle`: the angle fallen when the rod reaches the floor.
+    pub fn delta_to_floor(&self) -> f64 {
+        self.theta_initial() - self.end_angle()
+    }
+
+    /// Reduced state at `delta = theta_i - theta`.
+    pub fn reduced(&self, delta: f64) -> Reduced {
+        self.reduction.reduced(self.k(), delta)
+    }
+
+    /// Reduced state at an angle `theta` (loses the cancellation-free form near the start:
+    /// prefer [`System::reduced`] with `delta`).
+    pub fn reduced_at_theta(&self, theta: f64) -> Reduced {
+        self.reduced(self.theta_initial() - theta)
+    }
+
+    /// Reaction forces at `delta` in the order of [`ModelInfo::forces`].
+    pub fn forces(&self, delta: f64) -> Vec<f64> {
+        let mut out = vec![0.0; self.info().forces.len()];
+        self.reduction.forces(self.k(), delta, &mut out);
+        out
+    }
+
+    /// Coefficients of the separation polynomial in `sin(theta)`, lowest degree first.
+    pub fn separation_coefficients(&self) -> Vec<f64> {
+        let mut out = vec![0.0; self.layout.separation_degree + 1];
+        self.reduction.separation_polynomial(self.k(), &mut out);
+        out
+    }
+
+    /// The full state on the reduced motion at phase time `t`, angle fallen `delta` and rate
+    /// `theta_dot`.
+    pub fn full_state(&self, t: f64, delta: f64, theta_dot: f64) -> State {
+        let n = self.n_coordinates();
+        let mut state = State {
+            q: vec![0.0; n],
+            qd: vec![0.0; n],
+        };
+        self.reduction
+            .full_state(self.k(), t, delta, theta_dot, &mut state.q, &mut state.qd);
+        state
     }
 }
 

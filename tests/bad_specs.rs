@@ -19,6 +19,7 @@ parameters:
   - {name: g, meaning: gravity, unit: m/s^2}
 gravity: g
 coordinates:
+  - {name: x1, meaning: foot position, unit: m}
   - {name: theta, meaning: angle to the floor, unit: rad}
 reduced: theta
 end_angle: 0
@@ -26,17 +27,15 @@ bodies:
   - name: rod
     mass: m1
     inertia: m1*ell^2/12
-    position: [-ell/2*cos(theta), ell/2*sin(theta)]
+    position: [x1 + ell/2*cos(theta), ell/2*sin(theta)]
     angle: theta
 points:
-  - {name: foot, position: [-ell*cos(theta), 0], meaning: foot}
-  - {name: tip, position: [0, ell*sin(theta)], meaning: top}
-  - {name: centre, position: [-ell/2*cos(theta), ell/2*sin(theta)], meaning: centre}
+  - {name: foot, position: [x1, 0], meaning: foot}
+  - {name: tip, position: [x1 + ell*cos(theta), ell*sin(theta)], meaning: top}
+  - {name: centre, position: [x1 + ell/2*cos(theta), ell/2*sin(theta)], meaning: centre}
   - {name: wall, position: [0, 0], meaning: wall}
 falling_point: centre
-forces:
-  - {name: push, body: rod, direction: [-1, 0], meaning: wall push}
-contact: {force: push, point: tip, surface: wall, normal: [1, 0]}
+contact: {force: push, meaning: wall push, gap: -x1 - ell*cos(theta), eliminates: x1}
 initial:
   theta: {position: asin(a/ell), velocity: 0}
 ";
@@ -169,8 +168,8 @@ fn unknown_key() {
 #[test]
 fn undefined_symbol_in_an_expression() {
     let text = edit(
-        "position: [-ell/2*cos(theta), ell/2*sin(theta)]\n    angle",
-        "position: [-ell/2*cos(theta), ell/2*sin(phi)]\n    angle",
+        "position: [x1 + ell/2*cos(theta), ell/2*sin(theta)]\n    angle",
+        "position: [x1 + ell/2*cos(theta), ell/2*sin(phi)]\n    angle",
     );
     let (path, err) = error_of("undefined_symbol", &text);
     let (line, col) = place(&text, "sin(phi)", "ell/2*sin(phi)");
@@ -212,38 +211,69 @@ fn unknown_function() {
 }
 
 #[test]
-fn a_coordinate_that_cannot_be_eliminated() {
-    // A spring potential k x1^2 / 2, made as a bob whose height is x1^2: the Lagrangian depends
-    // on x1, so x1 is not cyclic and cannot be eliminated through a conserved momentum.
-    let text = edit(
-        "coordinates:\n",
-        "coordinates:\n  - {name: x1, meaning: spring stretch, unit: m}\n",
-    )
-    .replace(
-        "    angle: theta\n",
-        "    angle: theta\n  - name: bob\n    mass: m1\n    inertia: 0\n    position: [x1, x1^2]\n    angle: 0\n",
-    )
-    .replace(
-        "initial:\n",
-        "initial:\n  x1: {position: 0, velocity: 0}\n",
-    );
-    let (path, err) = error_of("not_cyclic", &text);
-    let (line, col) = place(&text, "name: x1", "{name: x1");
+fn a_gap_that_cannot_be_solved_for_its_coordinate() {
+    let text = edit("gap: -x1 - ell*cos(theta)", "gap: -x1^2 - ell*cos(theta)");
+    let (path, err) = error_of("gap_not_linear", &text);
+    let (line, _) = place(&text, "gap: -x1^2", "contact");
     check(
         &path,
         &err,
-        (line, Some(col)),
-        "coordinates[0]",
-        &["`x1` cannot be eliminated", "depends on it"],
+        (line, None),
+        "contact.gap",
+        &["linear in `x1`", "d(gap)/dx1"],
     );
     // The same through `derive_all` directly.
-    let (root, path) = write("not_cyclic_direct", &text);
+    let (root, path) = write("gap_not_linear_direct", &text);
     let checked = spec::load(&path).unwrap_or_else(|e| panic!("{e}"));
     match derive_all(&[checked]) {
-        Err(Error::Spec(e)) => check(&path, &e, (line, Some(col)), "coordinates[0]", &["x1"]),
+        Err(Error::Spec(e)) => check(&path, &e, (line, None), "contact.gap", &["x1"]),
         other => panic!("expected a spec error, got {other:?}"),
     }
     let _ = std::fs::remove_dir_all(&root);
+}
+
+#[test]
+fn a_coordinate_that_is_not_cyclic_is_integrated_not_refused() {
+    // A spring on the foot: the Lagrangian depends on x1 after the contact is dropped, so the
+    // free phase has no fast path; it is derived for the integrated route, with the reason.
+    let text = edit(
+        "falling_point: centre\n",
+        "falling_point: centre\npotentials:\n  - {name: spring, expr: m1*g/ell*x1^2, acts_on: [rod], meaning: a spring on the foot}\n",
+    );
+    let (root, _) = write("spring_on_foot", &text);
+    let (files, _) = render_all(&root, &[]).unwrap_or_else(|e| panic!("{e}"));
+    let record = files
+        .iter()
+        .find(|f| f.path == Path::new("generated/ladder_free.json"))
+        .expect("the free phase's record");
+    let v: serde_json::Value = serde_json::from_str(&record.text).unwrap();
+    assert_eq!(v["route"], "integrated");
+    assert!(
+        v["route_reason"]
+            .as_str()
+            .unwrap()
+            .contains("`x1` is not cyclic"),
+        "{}",
+        v["route_reason"]
+    );
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+#[test]
+fn a_potential_on_the_body_of_a_measured_force_is_refused() {
+    let text = edit(
+        "falling_point: centre\n",
+        "falling_point: centre\nforces:\n  - {name: floor_normal, body: rod, direction: [0, 1], meaning: floor push}\npotentials:\n  - {name: spring, expr: x1^2, acts_on: [rod], meaning: a spring on the foot}\n",
+    );
+    let (path, err) = error_of("potential_on_measured_body", &text);
+    let (line, _) = place(&text, "name: floor_normal", "floor_normal");
+    check(
+        &path,
+        &err,
+        (line, None),
+        "forces[0].body",
+        &["potential `spring` also acts on that body"],
+    );
 }
 
 #[test]
@@ -289,7 +319,7 @@ fn duplicate_names() {
         &path,
         &err,
         (line, Some(col)),
-        "coordinates[0].name",
+        "coordinates[1].name",
         &["`ell` is declared twice"],
     );
     // Two points of one name.
@@ -306,17 +336,18 @@ fn duplicate_names() {
 }
 
 #[test]
-fn after_separation_naming_a_missing_model() {
+fn a_hand_written_next_phase_is_an_unknown_field() {
+    // The phase after a contact is derived from the same spec; `after_separation` is gone.
     let text = format!(
         "{BASE}after_separation:\n  model: no_such_model\n  parameters: {{m1: m1, ell: ell}}\n"
     );
     let (path, err) = error_of("missing_next", &text);
-    let (line, col) = place(&text, "no_such_model", "no_such_model");
+    let (line, _) = place(&text, "after_separation:", "after_separation");
     check(
         &path,
         &err,
-        (line, Some(col)),
-        "after_separation.model",
-        &["no_such_model"],
+        (line, None),
+        "",
+        &["unknown field `after_separation`"],
     );
 }

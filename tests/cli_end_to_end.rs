@@ -1,5 +1,5 @@
 //! The `rodcube` binary end to end on the generated models (`rod_cube`, `hinged_rod`,
-//! `wall_ladder`, `free_rod`): every shipped scene runs, the paper's scene prints and writes the
+//! `wall_ladder`, `rod_cube_free`): every shipped scene runs, the paper's scene prints and writes the
 //! paper's figures, `--json` is valid JSON, `models` lists them, and scene errors that need a
 //! model's parameters name file:line:column and the field.
 //!
@@ -161,7 +161,9 @@ fn models_lists_every_model_with_parameters_and_quantities() {
         "rod_cube",
         "hinged_rod",
         "wall_ladder",
-        "free_rod",
+        "rod_cube_free",
+        "rod_cube_spring",
+        "rod_cylinder",
         "m1",
         "kg",
         "m/s^2",
@@ -247,7 +249,7 @@ fn unknown_quantity() {
 fn unavailable_quantity() {
     scene_error(
         "unavailable",
-        "model: free_rod\nparameters: {m1: 1, ell: 1, g: 9.81, theta_s: 0.2, omega_s: -1, x1_s: 0, v1_s: 0}\nwant: [separation_time]\n",
+        "model: rod_cube_free\nparameters: {m1: 1, m2: 3, ell: 1, a: 0.25, g: 9.81, x1_0: 0, theta_0: 0.2, x2_0: 1, x1_dot_0: 0, theta_dot_0: -1, x2_dot_0: 0}\nwant: [separation_time]\n",
         &[
             "error[unavailable-quantity]: want[0]:",
             "--> s.yaml:3:8",

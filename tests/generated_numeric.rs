@@ -156,7 +156,10 @@ fn state(model: &dyn Model, k: &[f64], t: f64, delta: f64, theta_dot: f64) -> St
     let info = model.info();
     let n = info.coordinates.len();
     let (mut q, mut qd) = (vec![f64::NAN; n], vec![f64::NAN; n]);
-    model.full_state(k, t, delta, theta_dot, &mut q, &mut qd);
+    model
+        .reduction()
+        .unwrap()
+        .full_state(k, t, delta, theta_dot, &mut q, &mut qd);
     let m = info.points.len();
     let (mut pos, mut vel) = (vec![[f64::NAN; 2]; m], vec![[f64::NAN; 2]; m]);
     model.points(k, &q, &qd, &mut pos, &mut vel);
@@ -170,7 +173,7 @@ fn rod_cube_agrees_with_the_papers_formulas_at_1000_random_points() {
     let model = find("rod_cube");
     let info = model.info();
     assert_eq!(info.coordinates, ["x1", "theta"]);
-    assert_eq!(info.separation_degree, 3);
+    assert_eq!(info.reduction.unwrap().separation_degree, 3);
     let (contact, floor) = (
         index(info.forces, "contact_force"),
         index(info.forces, "floor_normal"),
@@ -199,14 +202,14 @@ fn rod_cube_agrees_with_the_papers_formulas_at_1000_random_points() {
             &[("m1", m1), ("m2", m2), ("ell", ell), ("a", a), ("g", g)],
         );
         let k = prepare(model, &p);
-        assert!((k[info.k_theta_initial] - theta_i).abs() <= 1e-15 * theta_i);
-        assert_eq!(k[info.k_theta_dot_initial], 0.0);
+        assert!((k[info.reduction.unwrap().k_theta_initial] - theta_i).abs() <= 1e-15 * theta_i);
+        assert_eq!(k[info.reduction.unwrap().k_theta_dot_initial], 0.0);
 
         let theta = theta_i - delta;
         let (s, c) = theta.sin_cos();
         let (r_minus_s, c_minus_beta) = gaps(theta_i, delta);
         let beta = (1.0 - r * r).sqrt();
-        let red = model.reduced(&k, delta);
+        let red = model.reduction().unwrap().reduced(&k, delta);
         worst.check("sin", red.sin, s, 1.0, &at);
         worst.check("cos", red.cos, c, 1.0, &at);
 
@@ -215,9 +218,18 @@ fn rod_cube_agrees_with_the_papers_formulas_at_1000_random_points() {
         let w2 = 4.0 * (g / ell) * r_minus_s / dd;
         worst.check("eq9 theta_dot_sq", red.theta_dot_sq, w2, w2, &at);
         // The same from sin, cos and their drops (the lean solver's integrand).
-        assert_eq!(k[info.k_sin_initial], r);
-        worst.check("cos theta_i", k[info.k_cos_initial], beta, 1.0, &at);
-        let w2_sc = model.theta_dot_sq_sc(&k, s, c, r_minus_s, -c_minus_beta);
+        assert_eq!(k[info.reduction.unwrap().k_sin_initial], r);
+        worst.check(
+            "cos theta_i",
+            k[info.reduction.unwrap().k_cos_initial],
+            beta,
+            1.0,
+            &at,
+        );
+        let w2_sc = model
+            .reduction()
+            .unwrap()
+            .theta_dot_sq_sc(&k, s, c, r_minus_s, -c_minus_beta);
         worst.check("eq9 theta_dot_sq_sc", w2_sc, w2, w2, &at);
         // PHYSICS.md erratum 2, the corrected eq (12).
         let (t1, t2) = (-c / dd, r_minus_s * 2.0 * s * c / ((1.0 + n) * dd * dd));
@@ -227,7 +239,7 @@ fn rod_cube_agrees_with_the_papers_formulas_at_1000_random_points() {
 
         // Eq (16) and the floor's push N = m1 (g + y_cm'').
         let mut f = vec![f64::NAN; info.forces.len()];
-        model.forces(&k, delta, &mut f);
+        model.reduction().unwrap().forces(&k, delta, &mut f);
         let bracket = 8.0 * r * (1.0 + n) - 12.0 * (1.0 + n) * s + 3.0 * s.powi(3);
         let bracket_scale = 8.0 * r * (1.0 + n) + 12.0 * (1.0 + n) * s + 3.0 * s.powi(3);
         let den = (4.0 * (1.0 + n) - 3.0 * s * s).powi(2);
@@ -240,7 +252,10 @@ fn rod_cube_agrees_with_the_papers_formulas_at_1000_random_points() {
 
         // Eq (14): compare the polynomial up to scale (divided by 1+n) and its root in (0, r).
         let mut coef = vec![f64::NAN; 4];
-        model.separation_polynomial(&k, &mut coef);
+        model
+            .reduction()
+            .unwrap()
+            .separation_polynomial(&k, &mut coef);
         let eq14 = [8.0 * r, -12.0, 0.0, 3.0 / (1.0 + n)];
         let scale = coef[1] / eq14[1];
         for (j, (got, want)) in coef.iter().zip(eq14).enumerate() {
@@ -335,7 +350,7 @@ fn rod_cube_keeps_its_digits_at_extreme_mass_ratios() {
             let at = format!("n = {n:e}, r = {r}");
             let (s, c) = (theta_i - delta).sin_cos();
             let (r_minus_s, _) = gaps(theta_i, delta);
-            let red = model.reduced(&k, delta);
+            let red = model.reduction().unwrap().reduced(&k, delta);
             let dd = 4.0 / 3.0 - s * s / (1.0 + n);
             let w2 = 4.0 * (g / ell) * r_minus_s / dd;
             worst.check("theta_dot_sq", red.theta_dot_sq, w2, w2, &at);
@@ -343,14 +358,17 @@ fn rod_cube_keeps_its_digits_at_extreme_mass_ratios() {
             let acc = 2.0 * g / ell * (t1 + t2);
             worst.check("theta_ddot", red.theta_ddot, acc, acc, &at);
             let mut f = vec![f64::NAN; info.forces.len()];
-            model.forces(&k, delta, &mut f);
+            model.reduction().unwrap().forces(&k, delta, &mut f);
             // Eq (16) divided through by (1+n)^2, so that it is exact for any n.
             let cubic = 8.0 * r - 12.0 * s + 3.0 * s.powi(3) / (1.0 + n);
             let den = (4.0 - 3.0 * s * s / (1.0 + n)).powi(2);
             let f16 = -3.0 * g * c * cubic / den * (n * m1 / (1.0 + n));
             worst.check("contact_force", f[contact], f16, f16, &at);
             let mut coef = [f64::NAN; 4];
-            model.separation_polynomial(&k, &mut coef);
+            model
+                .reduction()
+                .unwrap()
+                .separation_polynomial(&k, &mut coef);
             let eq14 = [8.0 * r, -12.0, 0.0, 3.0 / (1.0 + n)];
             let s_sep = root(&coef, r);
             worst.check("separation root", s_sep, root(&eq14, r), s_sep, &at);
@@ -366,7 +384,7 @@ fn hinged_rod_agrees_with_its_closed_forms() {
     let model = find("hinged_rod");
     let info = model.info();
     assert_eq!(info.coordinates, ["theta"]);
-    assert_eq!(info.separation_degree, 3);
+    assert_eq!(info.reduction.unwrap().separation_degree, 3);
     let (contact, hinge) = (
         index(info.forces, "contact_force"),
         index(info.forces, "hinge_vertical"),
@@ -392,14 +410,14 @@ fn hinged_rod_agrees_with_its_closed_forms() {
         let k = prepare(model, &p);
         let (s, c) = (theta_i - delta).sin_cos();
         let (r_minus_s, _) = gaps(theta_i, delta);
-        let red = model.reduced(&k, delta);
+        let red = model.reduction().unwrap().reduced(&k, delta);
         let den = 1.0 + 3.0 * n * s * s;
         let w2 = 3.0 * (g / ell) * r_minus_s / den;
         worst.check("theta_dot_sq", red.theta_dot_sq, w2, w2, &at);
         let acc = 1.5 * g * c / ell * (-den - 6.0 * n * s * r_minus_s) / (den * den);
         worst.check("theta_ddot", red.theta_ddot, acc, acc, &at);
         let mut f = vec![f64::NAN; info.forces.len()];
-        model.forces(&k, delta, &mut f);
+        model.reduction().unwrap().forces(&k, delta, &mut f);
         let cubic = 3.0 * n * s.powi(3) + 3.0 * s - 2.0 * r;
         let cubic_scale = 3.0 * n * s.powi(3) + 3.0 * s + 2.0 * r;
         let lead = 1.5 * m2 * g * c / (den * den);
@@ -414,7 +432,10 @@ fn hinged_rod_agrees_with_its_closed_forms() {
         let normal_scale = m1 * (g + 0.5 * ell * (c * acc.abs() + s * w2));
         worst.check("hinge_vertical", f[hinge], normal, normal_scale, &at);
         let mut coef = vec![f64::NAN; 4];
-        model.separation_polynomial(&k, &mut coef);
+        model
+            .reduction()
+            .unwrap()
+            .separation_polynomial(&k, &mut coef);
         let want = [-2.0 * r, 3.0, 0.0, 3.0 * n];
         let scale = coef[1] / want[1];
         for (j, (got, w)) in coef.iter().zip(want).enumerate() {
@@ -444,7 +465,7 @@ fn wall_ladder_agrees_with_its_closed_forms() {
     // the ladder leaves the wall at s = 2r/3.
     let model = find("wall_ladder");
     let info = model.info();
-    assert_eq!(info.separation_degree, 1);
+    assert_eq!(info.reduction.unwrap().separation_degree, 1);
     let (contact, floor) = (
         index(info.forces, "contact_force"),
         index(info.forces, "floor_normal"),
@@ -469,13 +490,13 @@ fn wall_ladder_agrees_with_its_closed_forms() {
         let k = prepare(model, &p);
         let (s, c) = (theta_i - delta).sin_cos();
         let (r_minus_s, _) = gaps(theta_i, delta);
-        let red = model.reduced(&k, delta);
+        let red = model.reduction().unwrap().reduced(&k, delta);
         let w2 = 3.0 * g / ell * r_minus_s;
         worst.check("theta_dot_sq", red.theta_dot_sq, w2, w2, &at);
         let acc = -1.5 * g * c / ell;
         worst.check("theta_ddot", red.theta_ddot, acc, acc, &at);
         let mut f = vec![f64::NAN; info.forces.len()];
-        model.forces(&k, delta, &mut f);
+        model.reduction().unwrap().forces(&k, delta, &mut f);
         let push = 0.75 * m1 * g * c * (3.0 * s - 2.0 * r);
         let push_scale = 0.75 * m1 * g * c * (3.0 * s + 2.0 * r);
         worst.check("contact_force", f[contact], push, push_scale, &at);
@@ -483,7 +504,10 @@ fn wall_ladder_agrees_with_its_closed_forms() {
         let normal_scale = m1 * (g + 0.5 * ell * (c * acc.abs() + s * w2));
         worst.check("floor_normal", f[floor], normal, normal_scale, &at);
         let mut coef = vec![f64::NAN; 2];
-        model.separation_polynomial(&k, &mut coef);
+        model
+            .reduction()
+            .unwrap()
+            .separation_polynomial(&k, &mut coef);
         worst.check("separation root", -coef[0] / coef[1], 2.0 * r / 3.0, r, &at);
         let st = state(model, &k, 0.0, delta, -red.theta_dot_sq.sqrt());
         worst.check("foot x", st.pos[foot][0], -ell * c, ell, &at);
@@ -518,7 +542,7 @@ fn the_comparison_can_fail() {
     let (r_minus_s, _) = gaps(0.25f64.asin(), delta);
     let wrong = 4.0 * 9.81 * r_minus_s / (1.3 - s * s / 4.0);
     let mut worst = Worst::default();
-    let red = model.reduced(&k, delta);
+    let red = model.reduction().unwrap().reduced(&k, delta);
     worst.check("wrong eq9", red.theta_dot_sq, wrong, wrong, "paper case");
     let err = worst.0["wrong eq9"].0;
     assert!(err > 1e-3, "{err}");

@@ -200,14 +200,14 @@ fn a_polynomial_without_a_sign_change_is_named() {
 
 #[test]
 fn the_default_theta_dot_sq_sc_keeps_its_digits_near_the_start() {
-    // The hand-typed models use the trait's default (delta recovered by atan2 from the drops);
+    // The hand-typed models recover delta by atan2 from the drops;
     // it must agree with `reduced` to the last digits even a hair below the start, where a
     // plain `theta_i - atan2(s, c)` would have lost them.
     let models: [(&dyn Model, Vec<f64>); 2] = [
         (&ROD_CUBE, PAPER.to_vec()),
         (
             &common::paper::FREE_ROD,
-            vec![1.0, 1.0, 9.81, 0.1677, -1.5, 0.2, 0.3],
+            vec![1.0, 3.0, 1.0, 0.25, 9.81, 0.2, 0.1677, 1.0, 0.3, -1.5, 0.1],
         ),
     ];
     for (model, p) in models {
@@ -215,14 +215,14 @@ fn the_default_theta_dot_sq_sc_keeps_its_digits_near_the_start() {
         let mut k = vec![0.0; info.n_constants];
         model.prepare(&p, &mut k);
         let (ti, si, ci) = (
-            k[info.k_theta_initial],
-            k[info.k_sin_initial],
-            k[info.k_cos_initial],
+            k[info.reduction.unwrap().k_theta_initial],
+            k[info.reduction.unwrap().k_sin_initial],
+            k[info.reduction.unwrap().k_cos_initial],
         );
         for delta in [1e-14, 1e-9, 1e-4, 0.05, 0.9 * ti] {
             let (s, c, ds, dc) = rodcube::model::start_offsets(ti, si, ci, delta);
-            let default = model.theta_dot_sq_sc(&k, s, c, ds, dc);
-            let direct = model.reduced(&k, delta).theta_dot_sq;
+            let default = model.reduction().unwrap().theta_dot_sq_sc(&k, s, c, ds, dc);
+            let direct = model.reduction().unwrap().reduced(&k, delta).theta_dot_sq;
             assert!(
                 rel(default, direct) < 1e-14,
                 "{} at delta = {delta}: {default} vs {direct}",

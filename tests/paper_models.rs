@@ -98,12 +98,16 @@ fn rod_cube_matches_the_printed_equations_at_r_one_quarter() {
 fn free_rod_reduced_and_unreduced_forms_agree() {
     let params = [
         ("m1", 1.0),
+        ("m2", 3.0),
         ("ell", 1.0),
+        ("a", 0.25),
         ("g", 9.81),
-        ("theta_s", 0.17),
-        ("omega_s", -1.3),
-        ("x1_s", -0.01),
-        ("v1_s", -0.2),
+        ("x1_0", -0.01),
+        ("theta_0", 0.17),
+        ("x2_0", 1.0),
+        ("x1_dot_0", -0.2),
+        ("theta_dot_0", -1.3),
+        ("x2_dot_0", 0.1),
     ];
     let sys = System::new(&FREE_ROD, &params).unwrap();
     check_consistency(&sys, 0.17);

@@ -130,12 +130,11 @@ fn series_share_one_set_of_samples() {
 #[test]
 fn floor_impact_simulates_the_free_phase_only_when_asked() {
     let r = ask(&[Quantity::FloorImpact]);
-    assert_eq!(r.work.phases, vec!["rod_cube", "free_rod"]);
+    assert_eq!(r.work.phases, vec!["rod_cube", "rod_cube_free"]);
     assert_eq!(r.work.ode_steps, 0);
     let t = value(&r, "floor_impact_time");
     assert!(t > 0.10849 && t < 0.2, "{t}");
     assert!(value(&r, "impact_angular_velocity") < 0.0);
-    assert!(value(&r, "surface_final_speed") > 0.0);
     assert!(r.notes.is_empty());
 }
 
@@ -165,16 +164,17 @@ fn checks_cover_every_phase_and_pass_for_the_paper() {
     assert_eq!(
         names,
         [
-            "free_rod.energy",
-            "free_rod.foot_on_floor",
-            "free_rod.momentum_x1",
-            "free_rod.tip_clears_cube",
             "rod_cube.cube_does_not_tip",
             "rod_cube.energy",
             "rod_cube.foot_on_floor",
             "rod_cube.momentum_x1",
             "rod_cube.ode.energy",
             "rod_cube.ode.momentum_x1",
+            "rod_cube_free.contact_open",
+            "rod_cube_free.energy",
+            "rod_cube_free.foot_on_floor",
+            "rod_cube_free.momentum_x1",
+            "rod_cube_free.momentum_x2",
         ]
     );
     for (name, c) in &r.checks {
@@ -186,31 +186,35 @@ fn checks_cover_every_phase_and_pass_for_the_paper() {
     assert!((n_min - 0.25).abs() < 5e-3, "{n_min}");
     let restoring = 3.0 * 9.81 * 0.25 / 2.0;
     assert!(1.0 - r.checks["rod_cube.cube_does_not_tip"].margin / restoring < 0.05);
-    assert!(r.checks["free_rod.tip_clears_cube"].margin > 0.0);
-    assert_eq!(r.work.phases, vec!["rod_cube", "free_rod"]);
+    assert!(r.checks["rod_cube_free.contact_open"].passed);
+    assert_eq!(r.work.phases, vec!["rod_cube", "rod_cube_free"]);
 }
 
 #[test]
 fn unavailable_quantities_and_bad_requests_are_typed_errors() {
     let free = [
         ("m1", 1.0),
+        ("m2", 3.0),
         ("ell", 1.0),
+        ("a", 0.25),
         ("g", 9.81),
-        ("theta_s", 0.2),
-        ("omega_s", -1.0),
-        ("x1_s", 0.0),
-        ("v1_s", 0.0),
+        ("x1_0", 0.0),
+        ("theta_0", 0.2),
+        ("x2_0", 1.0),
+        ("x1_dot_0", 0.0),
+        ("theta_dot_0", -1.0),
+        ("x2_dot_0", 0.0),
     ];
     let request = Request::new(&FREE_ROD, free)
         .with_want(&[Quantity::SeparationAngle])
         .with_registry(MODELS);
     let err = run(&request).unwrap_err();
     assert!(
-        matches!(&err, PlanError::Unavailable { quantity, model: "free_rod", .. } if quantity == "separation_angle")
+        matches!(&err, PlanError::Unavailable { quantity, model: "rod_cube_free", .. } if quantity == "separation_angle")
     );
     let request = Request::new(&FREE_ROD, free).with_want(&[Quantity::FloorImpact]);
     assert!(matches!(run(&request), Err(PlanError::Unavailable { .. })));
-    // free_rod can still give its own time to the floor.
+    // The free phase can still give its own time to the floor.
     let request = Request::new(&FREE_ROD, free).with_want(&[Quantity::ContactTimeToFloor]);
     assert!(run(&request).unwrap().results["contact_time_to_floor"].value > 0.0);
 
@@ -228,7 +232,7 @@ fn unavailable_quantities_and_bad_requests_are_typed_errors() {
         .with_samples(1))
     .unwrap_err();
     assert_eq!(err, PlanError::TooFewSamples { samples: 1 });
-    // Without `free_rod` in the registry the floor impact cannot be followed.
+    // Without `rod_cube_free` in the registry the floor impact cannot be followed.
     let err = run(&Request::new(&ROD_CUBE, paper(9.81))
         .with_want(&[Quantity::FloorImpact])
         .with_registry(&[]))
@@ -237,7 +241,7 @@ fn unavailable_quantities_and_bad_requests_are_typed_errors() {
         err,
         PlanError::Solve(SolveError::UnknownNextModel {
             from: "rod_cube",
-            name: "free_rod"
+            name: "rod_cube_free"
         })
     );
     assert!(matches!(
@@ -280,8 +284,6 @@ fn no_separation_is_a_note_and_the_floor_is_reached_in_contact() {
     );
     let alone = ask_model(&NEVER_SEPARATES, &[Quantity::ContactTimeToFloor]);
     assert_eq!(r.work.integrand_evals, alone.work.integrand_evals);
-    // Kept in contact down to theta = 0 the cube stops there: x2' = -ell sin(theta) theta' / (2 (1+n)).
-    assert!(value(&r, "surface_final_speed").abs() < 1e-15);
 }
 
 #[test]

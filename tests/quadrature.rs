@@ -180,12 +180,16 @@ fn near_upright_time_grows_like_log_of_one_over_cos_theta_i() {
 fn free_phase_without_endpoint_singularity() {
     let params = [
         ("m1", 1.0),
+        ("m2", 3.0),
         ("ell", 1.0),
+        ("a", 0.25),
         ("g", 9.81),
-        ("theta_s", 0.1677),
-        ("omega_s", -1.4),
-        ("x1_s", -0.01),
-        ("v1_s", -0.2),
+        ("x1_0", -0.01),
+        ("theta_0", 0.1677),
+        ("x2_0", 1.0),
+        ("x1_dot_0", -0.2),
+        ("theta_dot_0", -1.4),
+        ("x2_dot_0", 0.1),
     ];
     let sys = System::new(&FREE_ROD, &params).unwrap();
     let mut work = Work::default();

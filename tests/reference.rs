@@ -133,7 +133,7 @@ fn bad_inputs_are_refused_with_a_reason() {
         matches!(e, ReferenceError::BadParameter { name: "m2", .. }),
         "{e}"
     );
-    let e = Inputs::from_named("free_rod", &[]).unwrap_err();
+    let e = Inputs::from_named("rod_cube_free", &[]).unwrap_err();
     assert!(matches!(e, ReferenceError::Unsupported(_)), "{e}");
     let e = Inputs::from_named("rod_cube", &[("m1", 1.0)]).unwrap_err();
     assert!(matches!(e, ReferenceError::BadParameter { .. }), "{e}");

@@ -136,13 +136,14 @@ fn paper_results(m2: f64) -> RunResults {
         .map(|(k, v)| (k.to_string(), v))
         .collect(),
         results,
+        labels: Default::default(),
         series,
         checks,
         work: Work {
             polynomial_evals: 7,
             integrand_evals: 40,
             ode_steps: 0,
-            phases: vec!["rod_cube".into(), "free_rod".into()],
+            phases: vec!["rod_cube".into(), "rod_cube_free".into()],
         },
         notes: BTreeMap::new(),
     }
@@ -263,7 +264,7 @@ fn results_json_has_the_documented_top_level_objects() {
     assert_eq!(v["results"]["separation_time"]["value"], 0.10849);
     assert_eq!(v["results"]["separation_time"]["unit"], "s");
     assert_eq!(v["checks"]["energy_drift"]["passed"], false);
-    assert_eq!(v["work"]["phases"][1], "free_rod");
+    assert_eq!(v["work"]["phases"][1], "rod_cube_free");
     let cols = v["series"]["theta_series"]["columns"].as_array().unwrap();
     assert_eq!(cols[1]["name"], "theta");
     assert_eq!(cols[1]["values"].as_array().unwrap().len(), N);
@@ -499,7 +500,7 @@ fn table_shows_units_degrees_paper_figures_checks_and_work() {
         "pass",
         "-3.00000e-9",
         "polynomial evaluations",
-        "rod_cube -> free_rod",
+        "rod_cube -> rod_cube_free",
         "t [s], theta [rad]",
     ] {
         assert!(text.contains(want), "missing {want:?} in\n{text}");

@@ -1,7 +1,7 @@
 //! Scene validation against models: every error class names the right file, line, column and
 //! field, and a valid scene comes out in the model's parameter order with its defaults.
 //!
-//! Runs on the hand-typed `rod_cube` and `free_rod` of `tests/common/paper.rs`, so it does not
+//! Runs on the hand-typed `rod_cube` and `rod_cube_free` of `tests/common/paper.rs`, so it does not
 //! wait for the generated models.
 
 mod common;
@@ -109,7 +109,7 @@ fn duplicate_key_points_at_the_second_occurrence() {
     );
     at(&d, Kind::Syntax, 5, 3, "parameters.m1");
     assert!(d.message.contains("duplicate key `m1`"), "{d}");
-    let d = only("model: rod_cube\nwant: [a]\nmodel: free_rod\n");
+    let d = only("model: rod_cube\nwant: [a]\nmodel: rod_cube_free\n");
     at(&d, Kind::Syntax, 3, 1, "model");
 }
 
@@ -143,7 +143,8 @@ fn unknown_model_lists_the_available_ones() {
     let d = only("# comment\nmodel: rod_cubee\nparameters: {}\nwant: [separation_angle]\n");
     at(&d, Kind::UnknownModel, 2, 8, "model");
     assert!(
-        d.message.contains("available models: rod_cube, free_rod"),
+        d.message
+            .contains("available models: rod_cube, rod_cube_free"),
         "{d}"
     );
 }
@@ -155,7 +156,8 @@ fn unknown_quantity_lists_what_the_model_offers() {
     at(&d, Kind::UnknownQuantity, 5, 5, "want[1]");
     assert!(d.message.contains("sepration_time"), "{d}");
     assert!(
-        d.message.contains("separation_time, contact_time_to_floor"),
+        d.message
+            .contains("separation_time, contact_end, contact_time_to_floor"),
         "{d}"
     );
     assert!(d.message.contains("tip_trajectory"), "{d}");
@@ -163,7 +165,7 @@ fn unknown_quantity_lists_what_the_model_offers() {
 
 #[test]
 fn a_quantity_the_model_cannot_provide_is_refused() {
-    let text = "model: free_rod\nparameters: {m1: 1, ell: 1, g: 9.81, theta_s: 0.2, omega_s: -1, x1_s: 0, v1_s: 0.1}\nwant: [theta_series, separation_angle]\n";
+    let text = "model: rod_cube_free\nparameters: {m1: 1, m2: 3, ell: 1, a: 0.25, g: 9.81, x1_0: 0, theta_0: 0.2, x2_0: 1, x1_dot_0: 0, theta_dot_0: -1, x2_dot_0: 0}\nwant: [theta_series, separation_angle]\n";
     let d = only(text);
     at(&d, Kind::UnavailableQuantity, 3, 22, "want[1]");
     assert!(d.message.contains("no separating contact"), "{d}");
@@ -235,7 +237,7 @@ fn nan_and_infinities_are_refused() {
 
 #[test]
 fn a_parameter_that_is_not_positive_by_declaration_may_be_negative() {
-    let text = "model: free_rod\nparameters: {m1: 1, ell: 1, g: 9.81, theta_s: 0.2, omega_s: -1, x1_s: -0.5, v1_s: 0.1}\nwant: [theta_series]\n";
+    let text = "model: rod_cube_free\nparameters: {m1: 1, m2: 3, ell: 1, a: 0.25, g: 9.81, x1_0: -0.5, theta_0: 0.2, x2_0: 1, x1_dot_0: 0, theta_dot_0: -1, x2_dot_0: 0}\nwant: [theta_series]\n";
     assert!(parse(text).is_ok());
 }
 

@@ -273,7 +273,7 @@ fn bad_sweeps_fail_with_a_clear_message() {
             vec![
                 "sweep",
                 "--model",
-                "free_rod",
+                "rod_cube_free",
                 "--a-over-ell",
                 "0.5",
                 "--out",

@@ -104,12 +104,16 @@ fn non_finite_and_non_positive_values() {
     // Parameters not declared positive may be zero or negative.
     let free = [
         ("m1", 1.0),
+        ("m2", 3.0),
         ("ell", 1.0),
+        ("a", 0.25),
         ("g", 9.81),
-        ("theta_s", 0.2),
-        ("omega_s", -1.0),
-        ("x1_s", -0.5),
-        ("v1_s", 0.0),
+        ("x1_0", -0.5),
+        ("theta_0", 0.2),
+        ("x2_0", 1.0),
+        ("x1_dot_0", 0.0),
+        ("theta_dot_0", -1.0),
+        ("x2_dot_0", 0.1),
     ];
     assert!(System::new(&FREE_ROD, &free).is_ok());
 }

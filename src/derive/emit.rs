@@ -3,7 +3,7 @@
 
 use super::expr::Expr;
 use super::lower::{Body, Hoisted, Scope, lower};
-use super::mechanics::{Derivation, from_sc};
+use super::mechanics::{self, Binding, Derivation, Reduction, from_sc};
 use super::spec::Checked;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -64,35 +64,47 @@ pub struct RustContext {
     requirements_info: Vec<Named>,
     n_params: usize,
     n_constants: usize,
-    k_theta_initial: usize,
-    k_theta_dot_initial: usize,
-    k_sin_initial: usize,
-    k_cos_initial: usize,
     coordinates: Vec<String>,
+    n_coordinates: usize,
     reduced: usize,
     cyclic: Vec<usize>,
     end_angle: String,
     forces_info: Vec<Named>,
     contact: Option<String>,
-    separation_degree: usize,
     points_info: Vec<Named>,
     falling_point: usize,
     gravity: usize,
     monitors_info: Vec<Named>,
     next_phase: Option<String>,
+    /// `ReductionInfo { .. }` when the phase has the fast path.
+    reduction_info: Option<String>,
+    /// Why the phase has no fast path (empty when it has one).
+    route_note: String,
     requirements: Code,
     prepare: Code,
-    reduced_code: Code,
-    theta_dot_sq_code: Code,
-    forces: Code,
-    monitors: Code,
-    separation: Code,
-    full_state: Code,
+    initial_state: Code,
     points: Code,
     energy: Code,
     momenta: Code,
     equations: Code,
     forces_full: Code,
+    monitors_full: Code,
+    contact_edge: Code,
+    released: Code,
+    reduction: Option<ReducedCode>,
+}
+
+/// The fast path's functions.
+#[derive(Debug, Clone, Serialize)]
+pub struct ReducedCode {
+    k_theta_initial: usize,
+    k_sin_initial: usize,
+    k_cos_initial: usize,
+    reduced_code: Code,
+    theta_dot_sq_code: Code,
+    forces: Code,
+    separation: Code,
+    full_state: Code,
 }
 
 /// Rust spelling of a model name as a type (`rod_cube` -> `RodCube`).
@@ -131,23 +143,41 @@ fn lit(x: f64) -> String {
     super::expr::float_literal(x)
 }
 
-/// Builds the Rust context. `next_params` gives, for the phase after separation, its
-/// parameter names in order (looked up in the other specs).
-pub fn rust_context(
-    checked: &Checked,
-    d: &Derivation,
-    next_params: Option<&[String]>,
-) -> Result<RustContext, String> {
+/// The Rust spelling of a binding to the next phase.
+fn binding(b: &Binding) -> String {
+    match b {
+        Binding::Param(i) => format!("Binding::Param({i})"),
+        Binding::Coordinate(i) => format!("Binding::Coordinate({i})"),
+        Binding::Velocity(i) => format!("Binding::Velocity({i})"),
+        Binding::Eliminated => "Binding::Eliminated".into(),
+        Binding::EliminatedRate => "Binding::EliminatedRate".into(),
+    }
+}
+
+/// `out[i] = <output i>;` lines.
+fn out_lines(outputs: &[String]) -> Vec<String> {
+    outputs
+        .iter()
+        .enumerate()
+        .map(|(i, o)| format!("out[{i}] = {o};"))
+        .collect()
+}
+
+/// Builds the Rust context of one derived phase.
+pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, String> {
     let spec = &checked.spec;
-    let theta = d.coords[d.reduced].clone();
     let np = d.params.len();
-    // Constant layout: parameters, then derived constants, then hoisted subexpressions.
+    // Constant layout: parameters, then the reduction's constants, then hoisted subexpressions.
     let mut scope = Scope::default();
     for (i, p) in d.params.iter().enumerate() {
-        scope.constants.insert(p.clone(), i);
+        scope.constants.insert(p.name.clone(), i);
     }
     let mut prepare = Code::default();
-    for (j, c) in d.constants.iter().enumerate() {
+    let constants = match &d.reduction {
+        Ok(r) => r.constants.as_slice(),
+        Err(_) => &[],
+    };
+    for (j, c) in constants.iter().enumerate() {
         let idx = np + j;
         let body = lower(
             std::slice::from_ref(&c.value),
@@ -159,132 +189,188 @@ pub fn rust_context(
         prepare.bind(&format!("k[{idx}]"), out[0].clone());
         scope.constants.insert(c.symbol.clone(), idx);
     }
-    let idx = |s: &str| scope.constants.get(s).copied().unwrap_or(0);
-    let mut hoisted = Hoisted::new(np + d.constants.len());
+    let mut hoisted = Hoisted::new(np + constants.len());
+    let general = full_state_code(d, &scope, &mut hoisted)?;
+    let reduction = match &d.reduction {
+        Ok(r) => Some(reduced_code(d, r, &scope, &mut hoisted)?),
+        Err(_) => None,
+    };
 
-    // Reduced motion: rc_s, rc_c, rc_ds, rc_dc are locals set by the template's preamble.
-    let mut red_scope = scope.clone();
-    for s in ["rc_s", "rc_c", "rc_ds", "rc_dc", "rc_delta", "rc_t", "rc_w"] {
-        red_scope.locals.insert(s.into(), s.into());
+    // Requirements over the parameters (no hoisting: they run before prepare).
+    let mut requirements = Code::default();
+    let mut req_scope = Scope::default();
+    for (i, p) in d.params.iter().enumerate() {
+        req_scope.constants.insert(p.name.clone(), i);
     }
-    red_scope
-        .locals
-        .insert(theta.clone(), format!("(k[{}] - rc_delta)", idx("rc_thi")));
-    let mut reduced_code = Code::default();
-    let out = reduced_code.push_body(lower(
-        &[d.theta_dot_sq.clone(), d.theta_ddot.clone()],
-        &red_scope,
-        Some(&mut hoisted),
-        "r",
-    ));
-    reduced_code.outputs = out;
+    let out = requirements.push_body(lower(&d.requirements, &req_scope, None, "q"));
+    requirements.outputs = out_lines(&out);
 
-    // theta_dot^2 alone from sin, cos and their drops (the lean solver's integrand): the energy
-    // integral has no other dependence on theta, which `mechanics` has checked.
-    let mut sc_scope = scope.clone();
-    for s in ["rc_s", "rc_c", "rc_ds", "rc_dc"] {
-        sc_scope.locals.insert(s.into(), s.into());
+    // Hoisted constants go to the end of prepare.
+    for (i, e) in hoisted.entries.clone() {
+        let body = lower(std::slice::from_ref(&e), &scope, None, &format!("h{i}_"));
+        let out = prepare.push_body(body);
+        prepare.bind(&format!("k[{i}]"), out[0].clone());
     }
-    let stray: Vec<String> = d
-        .theta_dot_sq
-        .symbols()
-        .into_iter()
-        .filter(|s| !sc_scope.locals.contains_key(s) && !scope.constants.contains_key(s))
-        .collect();
-    if !stray.is_empty() {
-        return Err(format!(
-            "theta_dot^2 depends on {} besides sin, cos and constants",
-            stray.join(", ")
-        ));
-    }
-    let mut theta_dot_sq_code = Code::default();
-    theta_dot_sq_code.outputs = theta_dot_sq_code.push_body(lower(
-        std::slice::from_ref(&d.theta_dot_sq),
-        &sc_scope,
-        Some(&mut hoisted),
-        "r",
-    ));
+    let n_constants = hoisted.len();
 
-    // Forces: theta_dot^2 and theta_ddot first, then the forces over them.
-    let mut force_scope = red_scope.clone();
-    force_scope.locals.insert("rc_w2".into(), "rc_w2".into());
-    force_scope.locals.insert("rc_acc".into(), "rc_acc".into());
-    let mut forces = Code::default();
-    let wa = forces.push_body(lower(
-        &[d.theta_dot_sq.clone(), d.theta_ddot.clone()],
-        &red_scope,
-        Some(&mut hoisted),
-        "r",
-    ));
-    forces.bind("rc_w2", wa[0].clone());
-    forces.bind("rc_acc", wa[1].clone());
-    let fo = forces.push_body(lower(
-        &d.forces_reduced,
-        &force_scope,
-        Some(&mut hoisted),
-        "f",
-    ));
-    forces.outputs = fo;
-
-    // Monitors: the forces first, then the monitors over them.
-    let mut monitors = Code::default();
-    if !d.monitors.is_empty() {
-        let wa = monitors.push_body(lower(
-            &[d.theta_dot_sq.clone(), d.theta_ddot.clone()],
-            &red_scope,
-            Some(&mut hoisted),
-            "r",
-        ));
-        monitors.bind("rc_w2", wa[0].clone());
-        monitors.bind("rc_acc", wa[1].clone());
-        let fo = monitors.push_body(lower(
-            &d.forces_reduced,
-            &force_scope,
-            Some(&mut hoisted),
-            "f",
-        ));
-        let mut mon_scope = force_scope.clone();
-        for (i, f) in fo.into_iter().enumerate() {
-            monitors.bind(&format!("rc_f{i}"), f);
-            mon_scope
-                .locals
-                .insert(format!("rc_f{i}"), format!("rc_f{i}"));
+    // Static info.
+    let point_index = |name: &str| {
+        spec.points
+            .iter()
+            .position(|p| p.name == name)
+            .ok_or_else(|| format!("`{name}` is not one of the points"))
+    };
+    let contact = d.contact.as_ref().map(|c| {
+        format!(
+            "ContactInfo {{ force: {}, eliminated: {:?}, edge: {} }}",
+            c.force,
+            c.eliminated,
+            c.edge.is_some()
+        )
+    });
+    let next_phase = d.next.as_ref().map(|n| {
+        format!(
+            "NextPhase {{ model: {:?}, bindings: &[{}] }}",
+            n.model,
+            n.bindings
+                .iter()
+                .map(binding)
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    });
+    let reduction_info = match (&d.reduction, &reduction) {
+        (Ok(r), Some(code)) => {
+            let k = |s: &str| {
+                scope
+                    .constants
+                    .get(s)
+                    .copied()
+                    .ok_or_else(|| format!("the reduction has no constant `{s}`"))
+            };
+            Some(format!(
+                "ReductionInfo {{ k_theta_initial: {}, k_theta_dot_initial: {}, k_sin_initial: {}, k_cos_initial: {}, separation_degree: {} }}",
+                code.k_theta_initial,
+                k("rc_wi")?,
+                code.k_sin_initial,
+                code.k_cos_initial,
+                r.separation
+                    .as_ref()
+                    .map_or(0, |s| s.coefficients.len() - 1)
+            ))
         }
-        monitors.outputs =
-            monitors.push_body(lower(&d.monitors, &mon_scope, Some(&mut hoisted), "m"));
-    }
+        _ => None,
+    };
+    let named = |v: &[mechanics::Named]| {
+        v.iter()
+            .map(|n| Named {
+                name: n.name.clone(),
+                meaning: format!("{:?}", n.meaning),
+            })
+            .collect()
+    };
+    Ok(RustContext {
+        command: COMMAND.into(),
+        name: d.name.clone(),
+        type_name: type_name(&d.name),
+        // Comments in the generated code: one line, so no spec text can end them.
+        description: one_line(&d.description),
+        description_literal: format!("{:?}", d.description),
+        spec: one_line(&spec_path(checked)),
+        params: d
+            .params
+            .iter()
+            .map(|p| Param {
+                name: p.name.clone(),
+                meaning: format!("{:?}", p.meaning),
+                unit: format!("{:?}", p.unit),
+                positive: p.positive,
+            })
+            .collect(),
+        requirements_info: spec
+            .requirements
+            .iter()
+            .map(|r| Named {
+                name: r.name.clone(),
+                meaning: format!("{:?}", r.meaning),
+            })
+            .collect(),
+        n_params: np,
+        n_constants,
+        coordinates: d.coords.clone(),
+        n_coordinates: d.coords.len(),
+        reduced: d.reduced,
+        cyclic: d.cyclic.clone(),
+        end_angle: lit(spec.end_angle),
+        forces_info: named(&d.forces),
+        contact,
+        points_info: spec
+            .points
+            .iter()
+            .map(|p| Named {
+                name: p.name.clone(),
+                meaning: format!("{:?}", p.meaning),
+            })
+            .collect(),
+        falling_point: point_index(&spec.falling_point)?,
+        gravity: d
+            .params
+            .iter()
+            .position(|p| p.name == spec.gravity)
+            .ok_or_else(|| format!("`{}` is not a parameter", spec.gravity))?,
+        monitors_info: named(&d.monitors),
+        next_phase,
+        reduction_info,
+        route_note: match &d.reduction {
+            Ok(_) => format!("{:?}", ""),
+            Err(why) => format!("{:?}", one_line(why)),
+        },
+        requirements,
+        prepare,
+        initial_state: general.initial_state,
+        points: general.points,
+        energy: general.energy,
+        momenta: general.momenta,
+        equations: general.equations,
+        forces_full: general.forces_full,
+        monitors_full: general.monitors_full,
+        contact_edge: general.contact_edge,
+        released: general.released,
+        reduction,
+    })
+}
 
-    // Separation polynomial: coefficients are constants, hoisted into k.
-    let mut separation = Code::default();
-    if let Some(sep) = &d.separation {
-        separation.outputs =
-            separation.push_body(lower(&sep.coefficients, &scope, Some(&mut hoisted), "p"));
-    }
+/// The spec file, relative to the project root.
+fn spec_path(checked: &Checked) -> String {
+    format!(
+        "derivations/{}",
+        checked
+            .file
+            .file_name()
+            .map(|f| f.to_string_lossy().into_owned())
+            .unwrap_or_default()
+    )
+}
 
-    // Full state on the reduced motion.
-    let mut full_state = Code::default();
-    {
-        let mut outs = Vec::new();
-        let cy = full_state.push_body(lower(
-            &d.cyclic_position,
-            &red_scope,
-            Some(&mut hoisted),
-            "x",
-        ));
-        let cv = full_state.push_body(lower(
-            &d.cyclic_velocity,
-            &red_scope,
-            Some(&mut hoisted),
-            "v",
-        ));
-        for (j, &ci) in d.cyclic.iter().enumerate() {
-            outs.push(format!("q[{ci}] = {};", cy[j]));
-            outs.push(format!("qd[{ci}] = {};", cv[j]));
-        }
-        full_state.outputs = outs;
-    }
+/// The functions of the full state, every model has them.
+struct FullStateCode {
+    initial_state: Code,
+    points: Code,
+    energy: Code,
+    momenta: Code,
+    equations: Code,
+    forces_full: Code,
+    monitors_full: Code,
+    contact_edge: Code,
+    released: Code,
+}
 
-    // Full-state functions: q, qd, qdd locals.
+fn full_state_code(
+    d: &Derivation,
+    scope: &Scope,
+    hoisted: &mut Hoisted,
+) -> Result<FullStateCode, String> {
+    let theta = d.theta().to_string();
     let mut full_scope = scope.clone();
     full_scope.locals.insert("rc_s".into(), "rc_s".into());
     full_scope.locals.insert("rc_c".into(), "rc_c".into());
@@ -298,250 +384,224 @@ pub fn rust_context(
             .insert(format!("ddot_{c}"), format!("qdd[{i}]"));
     }
     let sc = |e: &Expr| replace_sc(e, &theta);
-    let mut points = Code::default();
-    {
-        let mut exprs = Vec::new();
-        for p in &d.point_pos {
-            exprs.push(sc(&p[0]));
-            exprs.push(sc(&p[1]));
-        }
-        for v in &d.point_vel {
-            exprs.push(sc(&v[0]));
-            exprs.push(sc(&v[1]));
-        }
-        let out = points.push_body(lower(&exprs, &full_scope, Some(&mut hoisted), "p"));
-        let n = d.point_pos.len();
-        let mut lines = Vec::new();
-        for i in 0..n {
-            lines.push(format!("pos[{i}] = [{}, {}];", out[2 * i], out[2 * i + 1]));
-            lines.push(format!(
-                "vel[{i}] = [{}, {}];",
-                out[2 * n + 2 * i],
-                out[2 * n + 2 * i + 1]
-            ));
-        }
-        points.outputs = lines;
+    let single = |prefix: &str, exprs: &[Expr], scope: &Scope, hoisted: &mut Hoisted| {
+        let mut code = Code::default();
+        let out = code.push_body(lower(exprs, scope, Some(hoisted), prefix));
+        (code, out)
+    };
+
+    // The initial state is over parameters only: each value is hoisted into `k`.
+    let inits: Vec<Expr> = d
+        .initial
+        .iter()
+        .flat_map(|[p, v]| [p.clone(), v.clone()])
+        .collect();
+    let (mut initial_state, out) = single("i", &inits, scope, hoisted);
+    initial_state.outputs = (0..d.coords.len())
+        .flat_map(|i| {
+            [
+                format!("q[{i}] = {};", out[2 * i]),
+                format!("qd[{i}] = {};", out[2 * i + 1]),
+            ]
+        })
+        .collect();
+
+    let mut exprs = Vec::new();
+    for p in &d.point_pos {
+        exprs.push(sc(&p[0]));
+        exprs.push(sc(&p[1]));
     }
-    let mut energy = Code::default();
+    for v in &d.point_vel {
+        exprs.push(sc(&v[0]));
+        exprs.push(sc(&v[1]));
+    }
+    let (mut points, out) = single("p", &exprs, &full_scope, hoisted);
+    let n = d.point_pos.len();
+    points.outputs = (0..n)
+        .flat_map(|i| {
+            [
+                format!("pos[{i}] = [{}, {}];", out[2 * i], out[2 * i + 1]),
+                format!(
+                    "vel[{i}] = [{}, {}];",
+                    out[2 * n + 2 * i],
+                    out[2 * n + 2 * i + 1]
+                ),
+            ]
+        })
+        .collect();
+
     let total = Expr::Add(vec![sc(&d.kinetic), sc(&d.potential)]);
-    energy.outputs = energy.push_body(lower(&[total], &full_scope, Some(&mut hoisted), "e"));
-    let mut momenta = Code::default();
+    let (mut energy, out) = single("e", &[total], &full_scope, hoisted);
+    energy.outputs = out;
+
     let mo: Vec<Expr> = d.momenta.iter().map(sc).collect();
-    let out = momenta.push_body(lower(&mo, &full_scope, Some(&mut hoisted), "m"));
-    momenta.outputs = out
-        .iter()
-        .enumerate()
-        .map(|(i, o)| format!("out[{i}] = {o};"))
+    let (mut momenta, out) = single("m", &mo, &full_scope, hoisted);
+    momenta.outputs = out_lines(&out);
+
+    let nc = d.coords.len();
+    let mut exprs: Vec<Expr> = d.mass.iter().flat_map(|r| r.iter().map(sc)).collect();
+    exprs.extend(d.rhs.iter().map(sc));
+    let (mut equations, out) = single("q", &exprs, &full_scope, hoisted);
+    equations.outputs = (0..nc * nc)
+        .map(|i| format!("mass[{i}] = {};", out[i]))
+        .chain((0..nc).map(|i| format!("rhs[{i}] = {};", out[nc * nc + i])))
         .collect();
-    let mut equations = Code::default();
-    {
-        let n = d.coords.len();
-        let mut exprs: Vec<Expr> = d.mass.iter().flat_map(|r| r.iter().map(sc)).collect();
-        exprs.extend(d.rhs.iter().map(sc));
-        let out = equations.push_body(lower(&exprs, &full_scope, Some(&mut hoisted), "q"));
-        let mut lines = Vec::new();
-        for (i, o) in out.iter().take(n * n).enumerate() {
-            lines.push(format!("mass[{i}] = {o};"));
-        }
-        for i in 0..n {
-            lines.push(format!("rhs[{i}] = {};", out[n * n + i]));
-        }
-        equations.outputs = lines;
-    }
-    let mut forces_full = Code::default();
+
     let ff: Vec<Expr> = d.forces_full.iter().map(sc).collect();
-    let out = forces_full.push_body(lower(&ff, &full_scope, Some(&mut hoisted), "f"));
-    forces_full.outputs = out
-        .iter()
-        .enumerate()
-        .map(|(i, o)| format!("out[{i}] = {o};"))
-        .collect();
+    let (mut forces_full, out) = single("f", &ff, &full_scope, hoisted);
+    forces_full.outputs = out_lines(&out);
 
-    // Requirements over the parameters (no hoisting: they run before prepare).
-    let mut requirements = Code::default();
-    let mut req_scope = Scope::default();
-    for (i, p) in d.params.iter().enumerate() {
-        req_scope.constants.insert(p.clone(), i);
+    let mut mon_scope = full_scope.clone();
+    for i in 0..d.forces.len() {
+        mon_scope
+            .locals
+            .insert(format!("rc_f{i}"), format!("forces[{i}]"));
     }
-    let out = requirements.push_body(lower(&d.requirements, &req_scope, None, "q"));
-    requirements.outputs = out
-        .iter()
-        .enumerate()
-        .map(|(i, o)| format!("out[{i}] = {o};"))
-        .collect();
+    let mo: Vec<Expr> = d.monitors_full.iter().map(sc).collect();
+    let (mut monitors_full, out) = single("m", &mo, &mon_scope, hoisted);
+    monitors_full.outputs = out_lines(&out);
 
-    // Hoisted constants go to the end of prepare.
-    for (i, e) in hoisted.entries.clone() {
-        let body = lower(
-            std::slice::from_ref(&e),
-            &scope_with_hoisted(&scope),
-            None,
-            &format!("h{i}_"),
-        );
-        let out = prepare.push_body(body);
-        prepare.bind(&format!("k[{i}]"), out[0].clone());
-    }
-    let n_constants = hoisted.len();
-
-    // Static info.
-    let point_index = |name: &str| spec.points.iter().position(|p| p.name == name).unwrap_or(0);
-    let contact = spec.contact.as_ref().map(|c| {
-        let force = spec.forces.iter().position(|f| f.name == c.force).unwrap_or(0);
-        format!(
-            "ContactInfo {{ force: {force}, point: {}, surface: {}, normal: [{}, {}], surface_moves: {} }}",
-            point_index(&c.point),
-            point_index(&c.surface),
-            lit(c.normal[0]),
-            lit(c.normal[1]),
-            d.surface_moves
-        )
-    });
-    let next_phase = match (&spec.after_separation, next_params) {
-        (Some(after), Some(names)) => {
-            let mut bindings = Vec::new();
-            for n in names {
-                let src = after.parameters.get(n).ok_or_else(|| {
-                    format!(
-                        "after_separation.parameters: no value for `{n}`, a parameter of `{}`",
-                        after.model
-                    )
-                })?;
-                let b = if let Some(i) = d.params.iter().position(|p| p == src) {
-                    format!("Binding::Param({i})")
-                } else if let Some(i) = d.coords.iter().position(|c| c == src) {
-                    format!("Binding::Coordinate({i})")
-                } else if let Some(i) = src
-                    .strip_suffix("_dot")
-                    .and_then(|c| d.coords.iter().position(|x| x == c))
-                {
-                    format!("Binding::Velocity({i})")
-                } else if let Some((p, axis)) = src.split_once('.') {
-                    let index = point_index(p);
-                    match axis {
-                        "x" => format!("Binding::Point {{ index: {index}, axis: 0 }}"),
-                        "y" => format!("Binding::Point {{ index: {index}, axis: 1 }}"),
-                        "x_dot" => format!("Binding::PointVelocity {{ index: {index}, axis: 0 }}"),
-                        _ => format!("Binding::PointVelocity {{ index: {index}, axis: 1 }}"),
-                    }
-                } else {
-                    return Err(format!(
-                        "after_separation.parameters.{n}: cannot bind `{src}`"
-                    ));
-                };
-                bindings.push(b);
+    let mut contact_edge = Code::default();
+    let mut released = Code::default();
+    match &d.contact {
+        Some(c) => {
+            if let Some(edge) = &c.edge {
+                let (code, out) = single("g", &[sc(edge)], &full_scope, hoisted);
+                contact_edge = code;
+                contact_edge.outputs = out;
+            } else {
+                contact_edge.outputs = vec!["f64::INFINITY".into()];
             }
-            if let Some(extra) = after.parameters.keys().find(|k| !names.contains(k)) {
-                return Err(format!(
-                    "after_separation.parameters.{extra}: `{}` has no parameter `{extra}`",
-                    after.model
-                ));
-            }
-            Some(format!(
-                "NextPhase {{ model: {:?}, bindings: &[{}] }}",
-                after.model,
-                bindings.join(", ")
-            ))
+            let (code, out) = single(
+                "r",
+                &[sc(&c.released[0]), sc(&c.released[1])],
+                &full_scope,
+                hoisted,
+            );
+            released = code;
+            released.outputs = out_lines(&out);
         }
-        _ => None,
-    };
-    let named = |v: Vec<(String, String)>| {
-        v.into_iter()
-            .map(|(name, meaning)| Named {
-                name,
-                meaning: format!("{meaning:?}"),
-            })
-            .collect()
-    };
-    Ok(RustContext {
-        command: COMMAND.into(),
-        name: spec.name.clone(),
-        type_name: type_name(&spec.name),
-        // Comments in the generated code: one line, so no spec text can end them.
-        description: one_line(&spec.description),
-        description_literal: format!("{:?}", spec.description),
-        spec: one_line(&format!(
-            "derivations/{}",
-            checked
-                .file
-                .file_name()
-                .map(|f| f.to_string_lossy().into_owned())
-                .unwrap_or_default()
-        )),
-        params: spec
-            .parameters
-            .iter()
-            .map(|p| Param {
-                name: p.name.clone(),
-                meaning: format!("{:?}", p.meaning),
-                unit: format!("{:?}", p.unit),
-                positive: p.positive,
-            })
-            .collect(),
-        requirements_info: named(
-            spec.requirements
-                .iter()
-                .map(|r| (r.name.clone(), r.meaning.clone()))
-                .collect(),
-        ),
-        n_params: np,
-        n_constants,
-        k_theta_initial: idx("rc_thi"),
-        k_theta_dot_initial: idx("rc_wi"),
-        k_sin_initial: idx("rc_si"),
-        k_cos_initial: idx("rc_ci"),
-        coordinates: d.coords.clone(),
-        reduced: d.reduced,
-        cyclic: d.cyclic.clone(),
-        end_angle: lit(spec.end_angle),
-        forces_info: named(
-            spec.forces
-                .iter()
-                .map(|f| (f.name.clone(), f.meaning.clone()))
-                .collect(),
-        ),
-        contact,
-        separation_degree: d
-            .separation
-            .as_ref()
-            .map(|s| s.coefficients.len() - 1)
-            .unwrap_or(0),
-        points_info: named(
-            spec.points
-                .iter()
-                .map(|p| (p.name.clone(), p.meaning.clone()))
-                .collect(),
-        ),
-        falling_point: point_index(&spec.falling_point),
-        gravity: d
-            .params
-            .iter()
-            .position(|p| *p == spec.gravity)
-            .unwrap_or(0),
-        monitors_info: named(
-            spec.monitors
-                .iter()
-                .map(|m| (m.name.clone(), m.meaning.clone()))
-                .collect(),
-        ),
-        next_phase,
-        requirements,
-        prepare,
-        reduced_code,
-        theta_dot_sq_code,
-        forces,
-        monitors,
-        separation,
-        full_state,
+        None => contact_edge.outputs = vec!["f64::INFINITY".into()],
+    }
+    let stray = super::lower::unbound(&d.forces_full, &full_scope);
+    if !stray.is_empty() {
+        return Err(format!(
+            "the forces depend on {} besides the state and the parameters",
+            stray.into_iter().collect::<Vec<_>>().join(", ")
+        ));
+    }
+    Ok(FullStateCode {
+        initial_state,
         points,
         energy,
         momenta,
         equations,
         forces_full,
+        monitors_full,
+        contact_edge,
+        released,
     })
 }
 
-fn scope_with_hoisted(scope: &Scope) -> Scope {
-    scope.clone()
+/// The fast path's functions over the reduced motion.
+fn reduced_code(
+    d: &Derivation,
+    r: &Reduction,
+    scope: &Scope,
+    hoisted: &mut Hoisted,
+) -> Result<ReducedCode, String> {
+    let theta = d.theta().to_string();
+    let idx = |s: &str| {
+        scope
+            .constants
+            .get(s)
+            .copied()
+            .ok_or_else(|| format!("the reduction has no constant `{s}`"))
+    };
+    // rc_s, rc_c, rc_ds, rc_dc are locals set by the template's preamble.
+    let mut red_scope = scope.clone();
+    for s in ["rc_s", "rc_c", "rc_ds", "rc_dc", "rc_delta", "rc_t", "rc_w"] {
+        red_scope.locals.insert(s.into(), s.into());
+    }
+    red_scope
+        .locals
+        .insert(theta.clone(), format!("(k[{}] - rc_delta)", idx("rc_thi")?));
+    let mut reduced = Code::default();
+    reduced.outputs = reduced.push_body(lower(
+        &[r.theta_dot_sq.clone(), r.theta_ddot.clone()],
+        &red_scope,
+        Some(hoisted),
+        "r",
+    ));
+
+    // theta_dot^2 alone from sin, cos and their drops (the lean solver's integrand).
+    let mut sc_scope = scope.clone();
+    for s in ["rc_s", "rc_c", "rc_ds", "rc_dc"] {
+        sc_scope.locals.insert(s.into(), s.into());
+    }
+    let stray = super::lower::unbound(std::slice::from_ref(&r.theta_dot_sq), &sc_scope);
+    if !stray.is_empty() {
+        return Err(format!(
+            "theta_dot^2 depends on {} besides sin, cos and constants",
+            stray.into_iter().collect::<Vec<_>>().join(", ")
+        ));
+    }
+    let mut theta_dot_sq = Code::default();
+    theta_dot_sq.outputs = theta_dot_sq.push_body(lower(
+        std::slice::from_ref(&r.theta_dot_sq),
+        &sc_scope,
+        Some(hoisted),
+        "r",
+    ));
+
+    // Forces: theta_dot^2 and theta_ddot first, then the forces over them.
+    let mut force_scope = red_scope.clone();
+    force_scope.locals.insert("rc_w2".into(), "rc_w2".into());
+    force_scope.locals.insert("rc_acc".into(), "rc_acc".into());
+    let mut forces = Code::default();
+    let wa = forces.push_body(lower(
+        &[r.theta_dot_sq.clone(), r.theta_ddot.clone()],
+        &red_scope,
+        Some(hoisted),
+        "r",
+    ));
+    forces.bind("rc_w2", wa[0].clone());
+    forces.bind("rc_acc", wa[1].clone());
+    let fo = forces.push_body(lower(&r.forces_reduced, &force_scope, Some(hoisted), "f"));
+    forces.outputs = fo;
+
+    // Separation polynomial: coefficients are constants, hoisted into k.
+    let mut separation = Code::default();
+    if let Some(sep) = &r.separation {
+        separation.outputs =
+            separation.push_body(lower(&sep.coefficients, scope, Some(hoisted), "p"));
+    }
+
+    // Full state on the reduced motion.
+    let mut full_state = Code::default();
+    let cy = full_state.push_body(lower(&r.cyclic_position, &red_scope, Some(hoisted), "x"));
+    let cv = full_state.push_body(lower(&r.cyclic_velocity, &red_scope, Some(hoisted), "v"));
+    full_state.outputs = d
+        .cyclic
+        .iter()
+        .enumerate()
+        .flat_map(|(j, &ci)| {
+            [
+                format!("q[{ci}] = {};", cy[j]),
+                format!("qd[{ci}] = {};", cv[j]),
+            ]
+        })
+        .collect();
+    Ok(ReducedCode {
+        k_theta_initial: idx("rc_thi")?,
+        k_sin_initial: idx("rc_si")?,
+        k_cos_initial: idx("rc_ci")?,
+        reduced_code: reduced,
+        theta_dot_sq_code: theta_dot_sq,
+        forces,
+        separation,
+        full_state,
+    })
 }
 
 /// `text` on one line (runs of whitespace, newlines included, become one space), for a comment
@@ -699,10 +759,23 @@ pub struct TexContext {
 
 /// Builds the LaTeX context: the derivation's steps as displayed equations.
 pub fn tex_context(checked: &Checked, d: &Derivation) -> TexContext {
-    let theta = d.coords[d.reduced].clone();
+    let theta = d.theta().to_string();
     let name = |s: &str| latex_name(s, &theta);
     let sc = |e: &Expr| from_sc(e, &theta);
     let mut eqs = Vec::new();
+    if let Some(c) = &d.contact {
+        eqs.push(display(
+            &format!(
+                "Contact: the gap is zero while the bodies touch, which ties ${}$",
+                name(&c.eliminated)
+            ),
+            format!("{} = ", name(&c.eliminated)),
+            3,
+            &c.released[0],
+            None,
+            &name,
+        ));
+    }
     eqs.push(display(
         "Kinetic energy",
         "T = ".into(),
@@ -723,7 +796,7 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> TexContext {
         "Lagrangian",
         "L = T - V = ".into(),
         8,
-        &sc(&d.plain["lagrangian"]),
+        &sc(&d.lagrangian),
         None,
         &name,
     ));
@@ -741,9 +814,67 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> TexContext {
             &name,
         ));
     }
+    match &d.reduction {
+        Ok(r) => reduced_equations(d, r, &name, &mut eqs),
+        Err(why) => {
+            for (f, e) in d.forces.iter().zip(&d.forces_full) {
+                eqs.push(display(
+                    &format!(
+                        "Force \\texttt{{{}}}: {} (integrated route: {})",
+                        tex_text(&f.name),
+                        tex_text(&f.meaning),
+                        tex_text(why)
+                    ),
+                    "F = ".into(),
+                    2,
+                    &sc(e),
+                    None,
+                    &name,
+                ));
+            }
+        }
+    }
+    if let Some(edge) = d.contact.as_ref().and_then(|c| c.edge.as_ref()) {
+        eqs.push(display(
+            "Edge: the contact can exist while this margin is not negative",
+            String::new(),
+            0,
+            &sc(edge),
+            None,
+            &name,
+        ));
+    }
+    TexContext {
+        command: COMMAND.into(),
+        name: tex_text(&d.name),
+        description: tex_text(&d.description),
+        spec: tex_text(&spec_path(checked)),
+        params: d
+            .params
+            .iter()
+            .map(|p| TexParam {
+                symbol: name(&p.name),
+                meaning: tex_text(&p.meaning),
+                unit: tex_text(&p.unit),
+            })
+            .collect(),
+        equations: eqs,
+    }
+}
+
+/// The fast path's steps: conserved momenta, reduced inertia, energy integral, forces and
+/// the separation condition.
+fn reduced_equations(
+    d: &Derivation,
+    r: &Reduction,
+    name: &dyn Fn(&str) -> String,
+    eqs: &mut Vec<Equation>,
+) {
+    let theta = d.theta().to_string();
+    let sc = |e: &Expr| from_sc(e, &theta);
     for (j, &ci) in d.cyclic.iter().enumerate() {
         let c = &d.coords[ci];
-        let conserved = d
+        let conserved = r
             .constants
             .iter()
             .find(|k| k.symbol == format!("rc_p{j}"))
@@ -761,45 +892,41 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> TexContext {
             10,
             &sc(&d.momenta[j]),
             conserved.as_ref(),
-            &name,
+            name,
         ));
     }
-    eqs.push(display(
-        "Reduced inertia (kinetic energy $\\tfrac12 A(\\theta)\\dot\\theta^2$ after elimination)",
-        "A = ".into(),
-        2,
-        &sc(&d.plain["reduced_inertia"]),
-        None,
-        &name,
-    ));
-    eqs.push(display(
-        "Energy integral",
-        format!("{}^2 = ", name(&format!("dot_{theta}"))),
-        4,
-        &sc(&d.plain["theta_dot_sq"]),
-        None,
-        &name,
-    ));
-    eqs.push(display(
-        "Angular acceleration, $\\tfrac12\\,d(\\dot\\theta^2)/d\\theta$",
-        format!("{} = ", name(&format!("ddot_{theta}"))),
-        3,
-        &sc(&d.plain["theta_ddot"]),
-        None,
-        &name,
-    ));
-    for f in &checked.spec.forces {
-        let key = if checked
-            .spec
-            .contact
-            .as_ref()
-            .is_some_and(|c| c.force == f.name)
-        {
+    let steps = [
+        (
+            "reduced_inertia",
+            "Reduced inertia (kinetic energy $\\tfrac12 A(\\theta)\\dot\\theta^2$ after elimination)",
+            "A = ".to_string(),
+            2,
+        ),
+        (
+            "theta_dot_sq",
+            "Energy integral",
+            format!("{}^2 = ", name(&format!("dot_{theta}"))),
+            4,
+        ),
+        (
+            "theta_ddot",
+            "Angular acceleration, $\\tfrac12\\,d(\\dot\\theta^2)/d\\theta$",
+            format!("{} = ", name(&format!("ddot_{theta}"))),
+            3,
+        ),
+    ];
+    for (key, title, lhs, width) in steps {
+        if let Some(e) = r.plain.get(key) {
+            eqs.push(display(title, lhs, width, &sc(e), None, name));
+        }
+    }
+    for (i, f) in d.forces.iter().enumerate() {
+        let key = if i == 0 && d.contact.is_some() {
             "contact_force"
         } else {
             f.name.as_str()
         };
-        if let Some(e) = d.plain.get(key) {
+        if let Some(e) = r.plain.get(key) {
             eqs.push(display(
                 &format!(
                     "Force \\texttt{{{}}}: {}",
@@ -810,70 +937,60 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> TexContext {
                 2,
                 &sc(e),
                 None,
-                &name,
+                name,
             ));
         }
     }
-    if let Some(e) = d.plain.get("separation_condition") {
+    if let Some(e) = r.plain.get("separation_condition") {
         eqs.push(display(
             "Separation condition (contact force zero; positive factors and $\\cos\\theta$ removed)",
             String::new(),
             0,
             &sc(e),
             Some(&Expr::int(0)),
-            &name,
+            name,
         ));
-    }
-    TexContext {
-        command: COMMAND.into(),
-        name: tex_text(&checked.spec.name),
-        description: tex_text(&checked.spec.description),
-        spec: tex_text(&format!(
-            "derivations/{}",
-            checked
-                .file
-                .file_name()
-                .map(|f| f.to_string_lossy().into_owned())
-                .unwrap_or_default()
-        )),
-        params: checked
-            .spec
-            .parameters
-            .iter()
-            .map(|p| TexParam {
-                symbol: name(&p.name),
-                meaning: tex_text(&p.meaning),
-                unit: tex_text(&p.unit),
-            })
-            .collect(),
-        equations: eqs,
     }
 }
 
 /// The machine-readable record (`generated/<model>.json`).
 pub fn json_record(checked: &Checked, d: &Derivation) -> serde_json::Value {
-    let theta = d.coords[d.reduced].clone();
+    let theta = d.theta().to_string();
     let mut expressions = BTreeMap::new();
-    for (k, v) in &d.plain {
-        if *k == "reduced_inertia" || *k == "lagrangian" {
-            continue;
+    let (route, reason) = match &d.reduction {
+        Ok(r) => {
+            for (k, v) in &r.plain {
+                if k == "reduced_inertia" {
+                    continue;
+                }
+                expressions.insert(k.to_string(), from_sc(v, &theta).to_infix());
+            }
+            ("reduced", String::new())
         }
-        expressions.insert(k.to_string(), from_sc(v, &theta).to_infix());
-    }
+        Err(why) => {
+            for (f, e) in d.forces.iter().zip(&d.forces_full) {
+                expressions.insert(f.name.clone(), from_sc(e, &theta).to_infix());
+            }
+            ("integrated", why.clone())
+        }
+    };
     expressions.insert(
         "lagrangian".into(),
-        from_sc(&d.plain["lagrangian"], &theta).to_infix(),
+        from_sc(&d.lagrangian, &theta).to_infix(),
     );
     serde_json::json!({
         "generated_by": COMMAND,
         "note": "Generated file; do not edit by hand.",
-        "model": checked.spec.name,
-        "description": checked.spec.description,
-        "parameters": checked.spec.parameters.iter().map(|p| serde_json::json!({"name": p.name, "meaning": p.meaning, "unit": p.unit})).collect::<Vec<_>>(),
+        "model": d.name,
+        "spec": spec_path(checked),
+        "description": d.description,
+        "parameters": d.params.iter().map(|p| serde_json::json!({"name": p.name, "meaning": p.meaning, "unit": p.unit})).collect::<Vec<_>>(),
         "coordinates": d.coords,
         "reduced": theta,
         "cyclic": d.cyclic.iter().map(|&i| d.coords[i].clone()).collect::<Vec<_>>(),
-        "velocity_symbols": "theta_dot, theta_ddot in the expressions below are eliminated; dot_q / ddot_q denote velocities and accelerations in `lagrangian`",
+        "route": route,
+        "route_reason": reason,
+        "velocity_symbols": "theta_dot, theta_ddot in the reduced expressions are eliminated; dot_q / ddot_q denote velocities and accelerations in `lagrangian` and in integrated forces",
         "expressions": expressions,
     })
 }

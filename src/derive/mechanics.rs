@@ -1,6 +1,20 @@
-//! The derivation proper: Lagrangian, Euler–Lagrange equations, cyclic coordinates eliminated
-//! through their conserved momenta, the energy integral, reaction forces and the separation
-//! condition — every step by Symbolica from the spec.
+//! The derivation proper, in stages with typed results: a spec is read once ([`read`]), then
+//! each phase of its motion (the whole motion, or the contact phase and the free phase after
+//! it) goes through setup (which coordinates move, what the contact ties) → Lagrangian →
+//! Euler–Lagrange equations `M(q) qdd = F(q, qd)` → reaction forces as expressions of
+//! `(q, qd, qdd)` → monitors → the reduction (the fast path), every step by Symbolica.
+//!
+//! A contact is a unilateral constraint `gap(q) >= 0`. While it holds, `gap = 0` is solved for
+//! one coordinate `e` and substituted (the phase has one coordinate fewer); its force is the
+//! Lagrange multiplier `lambda = E_e / (d gap / d e)`, with `E_e` the Euler–Lagrange expression
+//! of `e` in the unconstrained Lagrangian, so that springs and every other force on `e` are
+//! accounted for. The free phase is the same spec with `e` free again and the gap monitored.
+//!
+//! The reduction applies when every coordinate but the reduced one is cyclic (its momentum is
+//! conserved) and the effective potential is `alpha + beta sin(theta) + gamma cos(theta)`; it
+//! gives the energy integral, the reduced forces and, with a contact, the separation polynomial.
+//! A phase outside that class is not an error: it is solved by integrating `M(q) qdd = F`, and
+//! the reason is recorded.
 //!
 //! Internal symbols (never allowed in specs): `dot_q`, `ddot_q` for velocities and
 //! accelerations; on the reduced motion `rc_s = sin(theta)`, `rc_c = cos(theta)`,
@@ -12,7 +26,7 @@
 
 use super::cas::{self, A};
 use super::expr::{Expr, product};
-use super::spec::{Checked, Text};
+use super::spec::{Checked, Spec, Text};
 use std::collections::BTreeMap;
 
 /// Where a derivation error belongs in the spec: a dotted field path and a message.
@@ -62,35 +76,79 @@ pub struct Separation {
     pub polynomial: Expr,
 }
 
-/// Everything derived for one model, as plain expressions.
+/// Which part of a spec's motion a derivation describes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Phase {
+    /// A spec without a contact: one phase.
+    Whole,
+    /// While the contact holds: the eliminated coordinate is tied by `gap = 0`.
+    Contact,
+    /// After the contact ended: every coordinate free (the model `<name>_free`).
+    Free,
+}
+
+/// A parameter of a derived model.
 #[derive(Debug, Clone)]
-pub struct Derivation {
-    /// Parameter names in order.
-    pub params: Vec<String>,
-    /// Coordinate names in order.
-    pub coords: Vec<String>,
-    /// Index of the reduced coordinate.
-    pub reduced: usize,
-    /// Indices of the cyclic coordinates.
-    pub cyclic: Vec<usize>,
-    /// Kinetic energy (full state).
-    pub kinetic: Expr,
-    /// Potential energy (full state).
-    pub potential: Expr,
-    /// Euler–Lagrange expressions `d/dt dL/dqd - dL/dq` (each `= 0`).
-    pub euler_lagrange: Vec<Expr>,
-    /// Mass matrix `M(q)`, row-major.
-    pub mass: Vec<Vec<Expr>>,
-    /// Right-hand side `F(q, qd)` of `M qdd = F`.
-    pub rhs: Vec<Expr>,
-    /// Conjugate momenta of the cyclic coordinates (full state).
-    pub momenta: Vec<Expr>,
-    /// Point positions (full state).
-    pub point_pos: Vec<[Expr; 2]>,
-    /// Point velocities (full state).
-    pub point_vel: Vec<[Expr; 2]>,
-    /// Reaction forces (full state with accelerations).
-    pub forces_full: Vec<Expr>,
+pub struct Param {
+    /// Symbol.
+    pub name: String,
+    /// What it is.
+    pub meaning: String,
+    /// SI unit.
+    pub unit: String,
+    /// Whether it must be strictly positive.
+    pub positive: bool,
+}
+
+/// A named output (force or monitor) with its meaning.
+#[derive(Debug, Clone)]
+pub struct Named {
+    /// Identifier.
+    pub name: String,
+    /// What it means.
+    pub meaning: String,
+}
+
+/// The contact of a contact phase.
+#[derive(Debug, Clone)]
+pub struct Contact {
+    /// Index of its force in [`Derivation::forces`].
+    pub force: usize,
+    /// The coordinate the contact eliminates.
+    pub eliminated: String,
+    /// That coordinate's value and rate while touching, over the phase's `q` and `dot_q`.
+    pub released: [Expr; 2],
+    /// The edge margin over `q` (`>= 0` while the contact can exist), if it can end at an edge.
+    pub edge: Option<Expr>,
+}
+
+/// Where a parameter of the next phase comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Binding {
+    /// A parameter of this phase, by index.
+    Param(usize),
+    /// A coordinate at the end of this phase, by index.
+    Coordinate(usize),
+    /// A velocity at the end of this phase, by index.
+    Velocity(usize),
+    /// The eliminated coordinate's value at the end of this phase.
+    Eliminated,
+    /// The eliminated coordinate's rate at the end of this phase.
+    EliminatedRate,
+}
+
+/// The phase after the contact ends.
+#[derive(Debug, Clone)]
+pub struct Next {
+    /// Its model name.
+    pub model: String,
+    /// One binding per parameter of that model, in its order.
+    pub bindings: Vec<Binding>,
+}
+
+/// The fast path of a phase: the cyclic coordinates eliminated through their conserved momenta.
+#[derive(Debug, Clone)]
+pub struct Reduction {
     /// Constants computed in `prepare`, in order.
     pub constants: Vec<Constant>,
     /// Reduced inertia `A(theta)` in `T = A theta_dot^2 / 2 + ...`.
@@ -107,16 +165,72 @@ pub struct Derivation {
     pub cyclic_position: Vec<Expr>,
     /// Reaction forces on the reduced motion (over `rc_s, rc_c, rc_w2, rc_acc`).
     pub forces_reduced: Vec<Expr>,
-    /// Monitors (over `rc_s, rc_c, rc_f<i>` and constants).
-    pub monitors: Vec<Expr>,
+    /// The separation condition, if the phase has a contact.
+    pub separation: Option<Separation>,
+    /// Fully substituted forms over parameters and `theta` for people and other tools.
+    pub plain: BTreeMap<String, Expr>,
+}
+
+/// Everything derived for one phase (one generated model), as plain expressions.
+#[derive(Debug, Clone)]
+pub struct Derivation {
+    /// Model name (`rod_cube`, or `rod_cube_free` for the phase after the contact).
+    pub name: String,
+    /// Which phase of the spec.
+    pub phase: Phase,
+    /// One line for people.
+    pub description: String,
+    /// Parameters in order (a free phase adds its start state).
+    pub params: Vec<Param>,
+    /// Coordinate names in order.
+    pub coords: Vec<String>,
+    /// Index of the reduced coordinate.
+    pub reduced: usize,
+    /// Indices of the cyclic coordinates (whose momenta are conserved).
+    pub cyclic: Vec<usize>,
+    /// Kinetic energy (full state).
+    pub kinetic: Expr,
+    /// Potential energy (full state), gravity and the spec's potentials.
+    pub potential: Expr,
+    /// The Lagrangian `T - V`.
+    pub lagrangian: Expr,
+    /// Euler–Lagrange expressions `d/dt dL/dqd - dL/dq` (each `= 0`).
+    pub euler_lagrange: Vec<Expr>,
+    /// Mass matrix `M(q)`, row-major.
+    pub mass: Vec<Vec<Expr>>,
+    /// Right-hand side `F(q, qd)` of `M qdd = F`.
+    pub rhs: Vec<Expr>,
+    /// Conjugate momenta of the cyclic coordinates (full state).
+    pub momenta: Vec<Expr>,
+    /// Initial position and velocity of every coordinate, over the parameters.
+    pub initial: Vec<[Expr; 2]>,
+    /// Point positions (full state).
+    pub point_pos: Vec<[Expr; 2]>,
+    /// Point velocities (full state).
+    pub point_vel: Vec<[Expr; 2]>,
+    /// Reaction forces: the contact's first, then the spec's `forces`.
+    pub forces: Vec<Named>,
+    /// Reaction forces over the full state and accelerations.
+    pub forces_full: Vec<Expr>,
+    /// Monitors (each `>= 0` while the assumption holds).
+    pub monitors: Vec<Named>,
+    /// Monitors over the full state, parameters and the forces `rc_f<i>`.
+    pub monitors_full: Vec<Expr>,
     /// Parameter requirements (over parameters).
     pub requirements: Vec<Expr>,
-    /// The separation condition, if the model has a contact.
-    pub separation: Option<Separation>,
-    /// Whether the contact surface point moves with the coordinates.
-    pub surface_moves: bool,
-    /// Fully substituted forms over parameters and `theta` for people and other tools.
-    pub plain: BTreeMap<&'static str, Expr>,
+    /// The contact, in a contact phase.
+    pub contact: Option<Contact>,
+    /// The phase after the contact, in a contact phase.
+    pub next: Option<Next>,
+    /// The fast path, or why the phase is integrated instead.
+    pub reduction: Result<Reduction, String>,
+}
+
+impl Derivation {
+    /// The reduced coordinate's name.
+    pub fn theta(&self) -> &str {
+        &self.coords[self.reduced]
+    }
 }
 
 fn parse_text(t: &Text, path: &[FieldStep]) -> Result<Expr, DeriveError> {
@@ -287,32 +401,197 @@ fn free_of(a: &A, names: &[&str]) -> bool {
     names.iter().all(|n| cas::is_zero(&cas::d(a, n)))
 }
 
-/// Runs the derivation for one checked spec.
-pub fn derive(checked: &Checked) -> Result<Derivation, DeriveError> {
-    let spec = &checked.spec;
-    let params: Vec<String> = spec.parameters.iter().map(|p| p.name.clone()).collect();
-    let coords: Vec<String> = spec.coordinates.iter().map(|c| c.name.clone()).collect();
-    let reduced = coords.iter().position(|c| *c == spec.reduced).unwrap_or(0);
-    let theta = coords[reduced].clone();
-    let kin = Kin {
-        coords: coords.clone(),
+/// One body's parsed expressions.
+struct BodyExprs {
+    name: String,
+    mass: Expr,
+    inertia: Expr,
+    position: [Expr; 2],
+    angle: Expr,
+}
+
+/// Every expression of a spec, parsed once.
+struct Parsed {
+    bodies: Vec<BodyExprs>,
+    points: Vec<[Expr; 2]>,
+    potentials: Vec<Expr>,
+    directions: Vec<[Expr; 2]>,
+    gap: Option<Expr>,
+    edge: Option<Expr>,
+    monitors: Vec<Expr>,
+    requirements: Vec<Expr>,
+    initial: BTreeMap<String, [Expr; 2]>,
+}
+
+/// Stage 0: parses every expression of the spec, each error placed at its field.
+fn read(spec: &Spec) -> Result<Parsed, DeriveError> {
+    let field = |k: &str, i: usize, sub: &str| [key(k), FieldStep::Index(i), key(sub)];
+    let mut bodies = Vec::new();
+    for (i, b) in spec.bodies.iter().enumerate() {
+        let pos = field("bodies", i, "position");
+        bodies.push(BodyExprs {
+            name: b.name.clone(),
+            mass: parse_text(&b.mass, &field("bodies", i, "mass"))?,
+            inertia: parse_text(&b.inertia, &field("bodies", i, "inertia"))?,
+            position: [
+                parse_text(&b.position[0], &pos)?,
+                parse_text(&b.position[1], &pos)?,
+            ],
+            angle: parse_text(&b.angle, &field("bodies", i, "angle"))?,
+        });
+    }
+    let pair = |t: &[Text; 2], path: &[FieldStep]| -> Result<[Expr; 2], DeriveError> {
+        Ok([parse_text(&t[0], path)?, parse_text(&t[1], path)?])
     };
+    let points = (spec.points.iter().enumerate())
+        .map(|(i, p)| pair(&p.position, &field("points", i, "position")))
+        .collect::<Result<_, _>>()?;
+    let potentials = (spec.potentials.iter().enumerate())
+        .map(|(i, p)| parse_text(&p.expr, &field("potentials", i, "expr")))
+        .collect::<Result<_, _>>()?;
+    let directions = (spec.forces.iter().enumerate())
+        .map(|(i, f)| pair(&f.direction, &field("forces", i, "direction")))
+        .collect::<Result<_, _>>()?;
+    let contact_field = |k: &str| [key("contact"), key(k)];
+    let gap = match &spec.contact {
+        Some(c) => Some(parse_text(&c.gap, &contact_field("gap"))?),
+        None => None,
+    };
+    let edge = match spec.contact.as_ref().and_then(|c| c.edge.as_ref()) {
+        Some(e) => Some(parse_text(e, &contact_field("edge"))?),
+        None => None,
+    };
+    let monitors = (spec.monitors.iter().enumerate())
+        .map(|(i, m)| parse_text(&m.expr, &field("monitors", i, "expr")))
+        .collect::<Result<_, _>>()?;
+    let requirements = (spec.requirements.iter().enumerate())
+        .map(|(i, r)| parse_text(&r.expr, &field("requirements", i, "expr")))
+        .collect::<Result<_, _>>()?;
+    let mut initial = BTreeMap::new();
+    for (c, s) in &spec.initial {
+        let path = [key("initial"), key(c)];
+        initial.insert(
+            c.clone(),
+            [
+                parse_text(&s.position, &path)?,
+                parse_text(&s.velocity, &path)?,
+            ],
+        );
+    }
+    Ok(Parsed {
+        bodies,
+        points,
+        potentials,
+        directions,
+        gap,
+        edge,
+        monitors,
+        requirements,
+        initial,
+    })
+}
+
+/// A phase's view of the spec: which coordinates move and what the contact ties.
+struct Setup {
+    phase: Phase,
+    coords: Vec<String>,
+    reduced: usize,
+    theta: String,
+    /// The eliminated coordinate and its value while the contact holds.
+    tie: Option<(String, A)>,
+    kin: Kin,
+}
+
+impl Setup {
+    /// An expression of the spec, with the contact's tie substituted.
+    fn at(&self, e: &Expr) -> A {
+        let a = cas::atom(e);
+        match &self.tie {
+            Some((name, value)) => cas::subs_var(&a, name, value),
+            None => a,
+        }
+    }
+}
+
+/// Stage 1: the coordinates of a phase and, in a contact phase, `gap = 0` solved for the
+/// eliminated coordinate (the gap must be linear in it with a coefficient free of coordinates).
+fn setup(spec: &Spec, parsed: &Parsed, phase: Phase) -> Result<Setup, DeriveError> {
+    let all: Vec<String> = spec.coordinates.iter().map(|c| c.name.clone()).collect();
+    let (coords, tie) = match (phase, &spec.contact, &parsed.gap) {
+        (Phase::Contact, Some(c), Some(gap)) => {
+            let e = c.eliminates.clone();
+            let path = [key("contact"), key("gap")];
+            let gap = cas::atom(gap);
+            let coef = cas::expand(&cas::d(&gap, &e));
+            let names: Vec<&str> = all.iter().map(String::as_str).collect();
+            if cas::is_zero(&coef) || !free_of(&coef, &names) {
+                let shown = to_expr(&coef, "gap coefficient")?.to_infix();
+                return Err(at(
+                    &path,
+                    format!(
+                        "the gap must be linear in `{e}` with a nonzero coefficient free of the \
+                         coordinates, so that `gap = 0` can be solved for it; d(gap)/d{e} = {shown}"
+                    ),
+                ));
+            }
+            let value = cas::expand(&cas::together(&(cas::var(&e) - gap / coef)));
+            let coords = all.iter().filter(|c| **c != e).cloned().collect();
+            (coords, Some((e, value)))
+        }
+        (Phase::Contact, ..) => {
+            return Err(at(
+                &[key("contact")],
+                "a contact phase needs a contact".into(),
+            ));
+        }
+        _ => (all, None),
+    };
+    let reduced = coords
+        .iter()
+        .position(|c| *c == spec.reduced)
+        .ok_or_else(|| {
+            at(
+                &[key("reduced")],
+                format!("`{}` is not a coordinate of the phase", spec.reduced),
+            )
+        })?;
+    Ok(Setup {
+        phase,
+        theta: coords[reduced].clone(),
+        kin: Kin {
+            coords: coords.clone(),
+        },
+        coords,
+        reduced,
+        tie,
+    })
+}
+
+/// Energies and the Lagrangian of a phase, with each body's position and mass.
+struct Lagrangian {
+    kinetic: A,
+    potential: A,
+    /// The spec's potentials (part of `potential`), unexpanded.
+    springs: A,
+    lag: A,
+    body_pos: BTreeMap<String, [A; 2]>,
+    body_mass: BTreeMap<String, A>,
+}
+
+/// Stage 2: `T`, `V` (gravity and the spec's potentials) and `L = T - V`.
+fn lagrangian(spec: &Spec, parsed: &Parsed, st: &Setup) -> Lagrangian {
     let g = cas::var(&spec.gravity);
     let half = cas::atom(&Expr::Rational(1, 2));
-
-    // --- Energies and the Lagrangian -------------------------------------------------------
     let mut t_kin = cas::num(0);
     let mut v_pot = cas::num(0);
-    let mut body_pos: BTreeMap<String, [A; 2]> = BTreeMap::new();
-    let mut body_mass: BTreeMap<String, A> = BTreeMap::new();
-    for (i, b) in spec.bodies.iter().enumerate() {
-        let path = [key("bodies"), FieldStep::Index(i)];
-        let m = cas::atom(&parse_text(&b.mass, &path)?);
-        let inertia = cas::atom(&parse_text(&b.inertia, &path)?);
-        let x = cas::atom(&parse_text(&b.position[0], &path)?);
-        let y = cas::atom(&parse_text(&b.position[1], &path)?);
-        let angle = cas::atom(&parse_text(&b.angle, &path)?);
-        let (vx, vy, w) = (kin.dt(&x), kin.dt(&y), kin.dt(&angle));
+    let mut body_pos = BTreeMap::new();
+    let mut body_mass = BTreeMap::new();
+    for b in &parsed.bodies {
+        let m = cas::atom(&b.mass);
+        let inertia = cas::atom(&b.inertia);
+        let (x, y) = (st.at(&b.position[0]), st.at(&b.position[1]));
+        let angle = st.at(&b.angle);
+        let (vx, vy, w) = (st.kin.dt(&x), st.kin.dt(&y), st.kin.dt(&angle));
         t_kin = t_kin
             + half.clone() * m.clone() * (vx.clone() * vx + vy.clone() * vy)
             + half.clone() * inertia * w.clone() * w;
@@ -320,576 +599,972 @@ pub fn derive(checked: &Checked) -> Result<Derivation, DeriveError> {
         body_pos.insert(b.name.clone(), [x, y]);
         body_mass.insert(b.name.clone(), m);
     }
-    let t_kin = cas::expand(&t_kin);
-    let v_pot = cas::expand(&v_pot);
-    let lag = t_kin.clone() - v_pot.clone();
+    // The spec's potentials stay as written: expanded, a spring's `(x - x0)^2` would be
+    // evaluated as `x^2 - 2 x x0 + x0^2`, which cancels to nothing near its rest length.
+    let mut springs = cas::num(0);
+    for p in &parsed.potentials {
+        springs += st.at(p);
+    }
+    let kinetic = cas::expand(&t_kin);
+    let potential = cas::expand(&v_pot) + springs.clone();
+    Lagrangian {
+        lag: kinetic.clone() - potential.clone(),
+        kinetic,
+        potential,
+        springs,
+        body_pos,
+        body_mass,
+    }
+}
 
-    // --- Euler–Lagrange equations: M(q) qdd = F(q, qd) -----------------------------------
-    let n = coords.len();
-    let dots: Vec<String> = coords.iter().map(|c| format!("dot_{c}")).collect();
-    let ddots: Vec<String> = coords.iter().map(|c| format!("ddot_{c}")).collect();
-    let mut el = Vec::new();
-    let mut mass = Vec::new();
-    let mut rhs = Vec::new();
-    for i in 0..n {
-        let e = cas::expand(&(kin.dt(&cas::d(&lag, &dots[i])) - cas::d(&lag, &coords[i])));
+impl Lagrangian {
+    /// The Euler–Lagrange expression `d/dt dL/dqd - dL/dq` of coordinate `c` in two parts:
+    /// the kinetic and gravitational part expanded, and the gradient of the spec's potentials
+    /// as differentiated (a spring's force `k (x - x0)`, not `k x - k x0`).
+    fn euler_lagrange(&self, kin: &Kin, c: &str) -> (A, A) {
+        let dot = format!("dot_{c}");
+        let inertial = self.kinetic.clone() - (self.potential.clone() - self.springs.clone());
+        let expanded = cas::expand(&(kin.dt(&cas::d(&inertial, &dot)) - cas::d(&inertial, c)));
+        (expanded, cas::d(&self.springs, c))
+    }
+}
+
+/// The Euler–Lagrange equations of a phase.
+struct Equations {
+    el: Vec<A>,
+    mass: Vec<Vec<A>>,
+    rhs: Vec<A>,
+    cyclic: Vec<usize>,
+    momenta: Vec<A>,
+}
+
+/// Stage 3: `M(q) qdd = F(q, qd)`, the cyclic coordinates and their momenta.
+fn equations(st: &Setup, lag: &Lagrangian) -> Equations {
+    let dots: Vec<String> = st.coords.iter().map(|c| format!("dot_{c}")).collect();
+    let ddots: Vec<String> = st.coords.iter().map(|c| format!("ddot_{c}")).collect();
+    let (mut el, mut mass, mut rhs) = (Vec::new(), Vec::new(), Vec::new());
+    for c in &st.coords {
+        let (e, spring) = lag.euler_lagrange(&st.kin, c);
         let mut row = Vec::new();
         let mut at_rest = e.clone();
         for dd in &ddots {
             row.push(cas::expand(&cas::d(&e, dd)));
             at_rest = cas::subs_var(&at_rest, dd, &cas::num(0));
         }
-        rhs.push(cas::expand(&(cas::num(0) - at_rest)));
+        rhs.push(cas::expand(&(cas::num(0) - at_rest)) - spring.clone());
+        let e = e + spring;
         mass.push(row);
         el.push(e);
     }
+    let cyclic: Vec<usize> = (0..st.coords.len())
+        .filter(|&i| i != st.reduced && cas::is_zero(&cas::d(&lag.lag, &st.coords[i])))
+        .collect();
+    let momenta = cyclic
+        .iter()
+        .map(|&i| cas::expand(&cas::d(&lag.lag, &dots[i])))
+        .collect();
+    Equations {
+        el,
+        mass,
+        rhs,
+        cyclic,
+        momenta,
+    }
+}
 
-    // --- Cyclic coordinates and their conserved momenta ----------------------------------
-    let mut cyclic = Vec::new();
-    for (i, c) in coords.iter().enumerate() {
-        if i == reduced {
+/// Stage 4: the reaction forces over `(q, qd, qdd)`: in a contact phase the contact's
+/// multiplier first, then each `forces` entry by a Newton balance of its body projected on its
+/// direction `d`, `F = m (d . a) + m g d_y`: the non-gravity force on the body dotted with `d`
+/// (the spec chooses `d` so that only the wanted force has a component along it).
+fn forces(
+    spec: &Spec,
+    parsed: &Parsed,
+    st: &Setup,
+    lag: &Lagrangian,
+) -> Result<(Vec<Named>, Vec<A>), DeriveError> {
+    let mut named = Vec::new();
+    let mut full = Vec::new();
+    if let (Some(c), Some((e, value))) = (&spec.contact, &st.tie) {
+        // E_e of the unconstrained Lagrangian, evaluated on the constrained motion.
+        let free = setup(spec, parsed, Phase::Free)?;
+        let free_lag = lagrangian(spec, parsed, &free);
+        let dot_e = format!("dot_{e}");
+        let (inertial, spring) = free_lag.euler_lagrange(&free.kin, e);
+        let e_e = inertial + spring;
+        let rate = st.kin.dt(value);
+        let accel = st.kin.dt(&rate);
+        let on_contact = cas::subs_var(
+            &cas::subs_var(
+                &cas::subs_var(&e_e, &format!("ddot_{e}"), &accel),
+                &dot_e,
+                &rate,
+            ),
+            e,
+            value,
+        );
+        let gap = cas::atom(
+            parsed
+                .gap
+                .as_ref()
+                .ok_or_else(|| at(&[key("contact")], "a contact needs a gap".into()))?,
+        );
+        let coef = cas::expand(&cas::d(&gap, e));
+        named.push(Named {
+            name: c.force.clone(),
+            meaning: c.meaning.clone(),
+        });
+        full.push(on_contact / coef);
+    }
+    let g = cas::var(&spec.gravity);
+    for (i, f) in spec.forces.iter().enumerate() {
+        let path = [key("forces"), FieldStep::Index(i)];
+        let [x, y] = lag
+            .body_pos
+            .get(&f.body)
+            .ok_or_else(|| at(&path, format!("`{}` is not one of the bodies", f.body)))?;
+        let m = lag
+            .body_mass
+            .get(&f.body)
+            .ok_or_else(|| at(&path, format!("`{}` is not one of the bodies", f.body)))?;
+        let [d0, d1] = &parsed.directions[i];
+        let (d0, d1) = (st.at(d0), st.at(d1));
+        let (ax, ay) = (st.kin.dt(&st.kin.dt(x)), st.kin.dt(&st.kin.dt(y)));
+        named.push(Named {
+            name: f.name.clone(),
+            meaning: f.meaning.clone(),
+        });
+        full.push(cas::expand(
+            &(m.clone() * (d0 * ax + d1.clone() * ay) + m.clone() * g.clone() * d1),
+        ));
+    }
+    Ok((named, full))
+}
+
+/// Stage 5: the monitors over the full state, parameters and the forces `rc_f<i>`. A free
+/// phase drops the monitors of its contact's force and watches the gap instead (the bodies
+/// must not meet again).
+fn monitors(
+    spec: &Spec,
+    parsed: &Parsed,
+    st: &Setup,
+    forces: &[Named],
+) -> Result<(Vec<Named>, Vec<A>), DeriveError> {
+    let mut named = Vec::new();
+    let mut exprs = Vec::new();
+    let contact_force = spec.contact.as_ref().map(|c| c.force.as_str());
+    for (m, e) in spec.monitors.iter().zip(&parsed.monitors) {
+        let symbols = e.symbols();
+        if st.phase == Phase::Free && contact_force.is_some_and(|f| symbols.contains(f)) {
             continue;
         }
-        let dl = cas::d(&lag, c);
-        if !cas::is_zero(&dl) {
-            let shown = to_expr(&cas::expand(&dl), "dL/dq")?.to_infix();
-            return Err(at(
-                &[key("coordinates"), FieldStep::Index(i)],
-                format!(
-                    "coordinate `{c}` cannot be eliminated: the Lagrangian depends on it \
-                     (dL/d{c} = {shown}); only cyclic coordinates besides `{theta}` are supported"
-                ),
-            ));
+        let mut a = st.at(e);
+        for (fi, f) in forces.iter().enumerate() {
+            a = cas::subs_var(&a, &f.name, &cas::var(&format!("rc_f{fi}")));
         }
-        cyclic.push(i);
+        named.push(Named {
+            name: m.name.clone(),
+            meaning: m.meaning.clone(),
+        });
+        exprs.push(a);
     }
-    let momenta: Vec<A> = cyclic
-        .iter()
-        .map(|&i| cas::expand(&cas::d(&lag, &dots[i])))
-        .collect();
-    for &i in &cyclic {
-        for &j in &cyclic {
-            if !free_of(&mass[i][j], &[theta.as_str()]) {
-                return Err(at(
-                    &[key("coordinates"), FieldStep::Index(i)],
-                    format!(
-                        "the inertia of cyclic coordinate `{}` depends on `{theta}`; the closed-form \
-                         reduction needs it constant",
-                        coords[i]
-                    ),
-                ));
-            }
-        }
+    if let (Phase::Free, Some(c), Some(gap)) = (st.phase, &spec.contact, &parsed.gap) {
+        named.push(Named {
+            name: "contact_open".into(),
+            meaning: format!(
+                "the contact of `{}` stays open after it ended (gap >= 0: the bodies do not meet again)",
+                c.force
+            ),
+        });
+        exprs.push(cas::atom(gap));
     }
+    Ok((named, exprs))
+}
 
-    // --- Constants of the motion -----------------------------------------------------------
-    let init = |c: &str, what: usize| -> Result<Expr, DeriveError> {
-        let s = &spec.initial[c];
-        let path = [key("initial"), key(c)];
-        parse_text(if what == 0 { &s.position } else { &s.velocity }, &path)
-    };
-    // sin and cos of the start are formed from the start's own expression where it is an
-    // inverse function (sin(asin(a/ell)) = a/ell exactly; cos(asin(x)) = sqrt((1-x)(1+x)),
-    // which keeps full relative accuracy near upright, unlike cos of an angle near pi/2).
-    let theta_i = init(&theta, 0)?;
-    let start_trig = |f: &str| match &theta_i {
-        Expr::Fun(g, _) if g == "asin" || g == "acos" => {
-            simplify_inverse_trig(&Expr::Fun(f.into(), vec![theta_i.clone()]))
-        }
-        _ => Expr::Fun(f.into(), vec![Expr::sym("rc_thi")]),
-    };
-    let mut constants = vec![
-        Constant {
-            symbol: "rc_thi".into(),
-            value: theta_i.clone(),
-        },
-        Constant {
-            symbol: "rc_wi".into(),
-            value: init(&theta, 1)?,
-        },
-        Constant {
-            symbol: "rc_si".into(),
-            value: start_trig("sin"),
-        },
-        Constant {
-            symbol: "rc_ci".into(),
-            value: start_trig("cos"),
-        },
-    ];
-    // A constant whose definition is a number (a start from rest) is used as that number, so
-    // that the derived forms simplify exactly as a person would simplify them.
-    let numeric = |c: &Constant| -> Option<A> {
-        let t = c.value.tidy();
-        t.symbols().is_empty().then(|| cas::atom(&t))
-    };
-    let wi = numeric(&constants[1]).unwrap_or_else(|| cas::var("rc_wi"));
-    // The initial full state as substitutions.
-    let initial_state = |a: &A| -> A {
-        let mut out = to_sc(a, &theta);
-        out = cas::subs_var(&out, "rc_s", &cas::var("rc_si"));
-        out = cas::subs_var(&out, "rc_c", &cas::var("rc_ci"));
-        out = cas::subs_var(&out, &theta, &cas::var("rc_thi"));
-        out = cas::subs_var(&out, &format!("dot_{theta}"), &wi);
-        for (j, &i) in cyclic.iter().enumerate() {
-            out = cas::subs_var(&out, &coords[i], &cas::var(&format!("rc_x{j}i")));
-        }
-        out
-    };
-    let mut cyclic_init_vel = Vec::new();
-    for (j, &i) in cyclic.iter().enumerate() {
-        constants.push(Constant {
-            symbol: format!("rc_x{j}i"),
-            value: init(&coords[i], 0)?,
-        });
-        cyclic_init_vel.push(cas::atom(&init(&coords[i], 1)?));
-    }
-    for (j, p) in momenta.iter().enumerate() {
-        let mut v = initial_state(p);
-        for (jj, &i) in cyclic.iter().enumerate() {
-            v = cas::subs_var(&v, &dots[i], &cyclic_init_vel[jj]);
-        }
-        constants.push(Constant {
-            symbol: format!("rc_p{j}"),
-            value: to_expr(&cas::expand(&v), "momentum")?,
-        });
-    }
-    let momentum_value: Vec<A> = (0..cyclic.len())
-        .map(|j| {
-            let c = constants.iter().find(|c| c.symbol == format!("rc_p{j}"));
-            c.and_then(&numeric)
-                .unwrap_or_else(|| cas::var(&format!("rc_p{j}")))
+/// The parameters of a phase: the spec's, and for a free phase its start state
+/// (`<q>_0`, then `<q>_dot_0`, for every coordinate).
+fn phase_params(spec: &Spec, phase: Phase) -> Result<Vec<Param>, DeriveError> {
+    let mut params: Vec<Param> = spec
+        .parameters
+        .iter()
+        .map(|p| Param {
+            name: p.name.clone(),
+            meaning: p.meaning.clone(),
+            unit: p.unit.clone(),
+            positive: p.positive,
         })
         .collect();
+    if phase == Phase::Free {
+        let mut rates = Vec::new();
+        for c in &spec.coordinates {
+            params.push(Param {
+                name: format!("{}_0", c.name),
+                meaning: format!("{} at the start of the phase", c.meaning),
+                unit: c.unit.clone(),
+                positive: false,
+            });
+            rates.push(Param {
+                name: format!("{}_dot_0", c.name),
+                meaning: format!(
+                    "rate of change of the {} at the start of the phase",
+                    c.meaning
+                ),
+                unit: format!("{}/s", c.unit),
+                positive: false,
+            });
+        }
+        params.extend(rates);
+        let taken: Vec<&str> = spec
+            .parameters
+            .iter()
+            .map(|p| p.name.as_str())
+            .chain(spec.coordinates.iter().map(|c| c.name.as_str()))
+            .collect();
+        if let Some(p) = params[spec.parameters.len()..]
+            .iter()
+            .find(|p| taken.contains(&p.name.as_str()))
+        {
+            return Err(at(
+                &[key("contact")],
+                format!(
+                    "the phase after the contact takes its start state as parameter `{}`, \
+                     which the spec already uses; rename it",
+                    p.name
+                ),
+            ));
+        }
+    }
+    Ok(params)
+}
 
-    // --- Cyclic velocities from the conserved momenta: M_CC qd_C = P - M_Cr w --------------
-    let w = cas::var("rc_w");
-    let k = cyclic.len();
-    let mut mat: Vec<Vec<A>> = cyclic
-        .iter()
-        .map(|&i| cyclic.iter().map(|&j| to_sc(&mass[i][j], &theta)).collect())
-        .collect();
-    let mut vec_b: Vec<A> = cyclic
-        .iter()
-        .enumerate()
-        .map(|(jj, &i)| momentum_value[jj].clone() - to_sc(&mass[i][reduced], &theta) * w.clone())
-        .collect();
-    for col in 0..k {
-        let pivot = (col..k)
-            .find(|&r| !cas::is_zero(&mat[r][col]))
-            .ok_or_else(|| {
+/// The initial state of every coordinate of a phase (in its order), over its parameters.
+fn phase_initial(parsed: &Parsed, st: &Setup) -> Result<Vec<[Expr; 2]>, DeriveError> {
+    let mut out = Vec::new();
+    for c in &st.coords {
+        let value = match st.phase {
+            Phase::Free => [
+                Expr::sym(&format!("{c}_0")),
+                Expr::sym(&format!("{c}_dot_0")),
+            ],
+            _ => parsed.initial.get(c).cloned().ok_or_else(|| {
                 at(
-                    &[key("coordinates")],
-                    "the cyclic velocities cannot be solved from their momenta (singular inertia)"
-                        .into(),
+                    &[key("initial")],
+                    format!("no initial position and velocity for coordinate `{c}`"),
                 )
-            })?;
-        mat.swap(col, pivot);
-        vec_b.swap(col, pivot);
-        let p = mat[col][col].clone();
-        let pivot_row = mat[col].clone();
-        for r in 0..k {
-            if r == col {
-                continue;
-            }
-            let f = cas::together(&(mat[r][col].clone() / p.clone()));
-            for (m, pc) in mat[r].iter_mut().zip(&pivot_row) {
-                *m = cas::together(&(m.clone() - f.clone() * pc.clone()));
-            }
-            vec_b[r] = cas::together(&(vec_b[r].clone() - f.clone() * vec_b[col].clone()));
-        }
+            })?,
+        };
+        out.push(value);
     }
-    let cyc_vel: Vec<A> = (0..k)
-        .map(|r| cas::expand(&cas::together(&(vec_b[r].clone() / mat[r][r].clone()))))
+    Ok(out)
+}
+
+/// Derives every phase of a checked spec: one model without a contact; with one, the contact
+/// phase (`name`) and the free phase after it (`<name>_free`).
+pub fn derive(checked: &Checked) -> Result<Vec<Derivation>, DeriveError> {
+    let spec = &checked.spec;
+    let parsed = read(spec)?;
+    match spec.contact {
+        None => Ok(vec![derive_phase(checked, &parsed, Phase::Whole)?]),
+        Some(_) => Ok(vec![
+            derive_phase(checked, &parsed, Phase::Contact)?,
+            derive_phase(checked, &parsed, Phase::Free)?,
+        ]),
+    }
+}
+
+/// The model names a spec derives: its own, and `<name>_free` when it has a contact.
+pub fn phase_names(spec: &Spec) -> Vec<String> {
+    match spec.contact {
+        None => vec![phase_name(spec, Phase::Whole)],
+        Some(_) => vec![
+            phase_name(spec, Phase::Contact),
+            phase_name(spec, Phase::Free),
+        ],
+    }
+}
+
+/// The name of the model of a phase.
+pub fn phase_name(spec: &Spec, phase: Phase) -> String {
+    match phase {
+        Phase::Free => format!("{}_free", spec.name),
+        _ => spec.name.clone(),
+    }
+}
+
+fn derive_phase(
+    checked: &Checked,
+    parsed: &Parsed,
+    phase: Phase,
+) -> Result<Derivation, DeriveError> {
+    let spec = &checked.spec;
+    let st = setup(spec, parsed, phase)?;
+    let params = phase_params(spec, phase)?;
+    let lag = lagrangian(spec, parsed, &st);
+    let eqs = equations(&st, &lag);
+    let (force_names, forces_full) = forces(spec, parsed, &st, &lag)?;
+    let (monitor_names, monitors_full) = monitors(spec, parsed, &st, &force_names)?;
+    let initial_list = phase_initial(parsed, &st)?;
+    let initial: BTreeMap<String, [Expr; 2]> = st
+        .coords
+        .iter()
+        .cloned()
+        .zip(initial_list.iter().cloned())
         .collect();
+    let positive: Vec<String> = params
+        .iter()
+        .filter(|p| p.positive)
+        .map(|p| p.name.clone())
+        .collect();
+    let has_edge = phase == Phase::Contact && parsed.edge.is_some();
+    let reduction = Reducer {
+        st: &st,
+        lag: &lag,
+        eqs: &eqs,
+        initial: &initial,
+        positive,
+    }
+    .reduce(
+        &force_names,
+        &forces_full,
+        phase == Phase::Contact,
+        has_edge,
+    )?;
 
-    // --- Reduced energy, inertia, effective potential -------------------------------------
-    let reduce_state = |a: &A| -> A {
-        let mut out = to_sc(a, &theta);
-        for (jj, &i) in cyclic.iter().enumerate() {
-            out = cas::subs_var(&out, &dots[i], &cyc_vel[jj]);
-        }
-        cas::subs_var(&out, &dots[reduced], &w)
-    };
-    let e_red = cas::expand(&reduce_state(&(t_kin.clone() + v_pot.clone())));
-    let e_red = cas::expand(&cas::together(&e_red));
-    let inertia = reduce_cos_sq(&cas::expand(&cas::d(&cas::d(&e_red, "rc_w"), "rc_w")));
-    let inertia = cas::expand(&cas::together(&inertia));
-    let linear = cas::subs_var(&cas::d(&e_red, "rc_w"), "rc_w", &cas::num(0));
-    if !is_zero_trig(&linear).map_err(|m| at(&[], m))? {
-        return Err(at(
-            &[key("coordinates")],
-            "the reduced energy has a term linear in the angular velocity".into(),
-        ));
-    }
-    let v_eff = cas::subs_var(&e_red, "rc_w", &cas::num(0));
-    let beta = cas::expand(&cas::d(&v_eff, "rc_s"));
-    let gamma = cas::expand(&cas::d(&v_eff, "rc_c"));
-    let rest = cas::expand(
-        &(v_eff.clone() - beta.clone() * cas::var("rc_s") - gamma.clone() * cas::var("rc_c")),
-    );
-    if !(free_of(&beta, &["rc_s", "rc_c", &theta])
-        && free_of(&gamma, &["rc_s", "rc_c", &theta])
-        && free_of(&rest, &["rc_s", "rc_c", &theta]))
-    {
-        return Err(at(
-            &[key("bodies")],
-            format!(
-                "the effective potential is not of the form alpha + beta sin({theta}) + gamma cos({theta}); such models are not supported"
-            ),
-        ));
-    }
-    let ai = cas::subs_var(
-        &cas::subs_var(&inertia, "rc_s", &cas::var("rc_si")),
-        "rc_c",
-        &cas::var("rc_ci"),
-    );
-    constants.push(Constant {
-        symbol: "rc_ai".into(),
-        value: to_expr(&cas::expand(&ai), "initial inertia")?,
-    });
-    let two = cas::num(2);
-    let wsq = (cas::var("rc_ai") * wi.clone() * wi.clone()
-        + two.clone() * beta.clone() * cas::var("rc_ds")
-        + two.clone() * gamma.clone() * cas::var("rc_dc"))
-        / inertia.clone();
-    let wsq = cas::together(&wsq);
-    let d_theta = |f: &A| -> A {
-        cas::d(f, "rc_s") * cas::var("rc_c")
-            - cas::d(f, "rc_c") * cas::var("rc_s")
-            - cas::d(f, "rc_ds") * cas::var("rc_c")
-            + cas::d(f, "rc_dc") * cas::var("rc_s")
-    };
-    let acc = cas::together(&(half.clone() * d_theta(&wsq)));
-
-    // --- Cyclic positions and accelerations on the reduced motion -------------------------
-    let mut cyclic_position = Vec::new();
-    let mut cyc_acc = Vec::new();
-    for (jj, v) in cyc_vel.iter().enumerate() {
-        let a0 = cas::expand(&cas::subs_var(v, "rc_w", &cas::num(0)));
-        let b = cas::expand(&cas::d(v, "rc_w"));
-        let bs = cas::expand(&cas::d(&b, "rc_s"));
-        let bc = cas::expand(&cas::d(&b, "rc_c"));
-        let b0 = cas::expand(
-            &(b.clone() - bs.clone() * cas::var("rc_s") - bc.clone() * cas::var("rc_c")),
-        );
-        let ok = free_of(&a0, &["rc_s", "rc_c", "rc_w"])
-            && free_of(&bs, &["rc_s", "rc_c", "rc_w"])
-            && free_of(&bc, &["rc_s", "rc_c", "rc_w"])
-            && free_of(&b0, &["rc_s", "rc_c", "rc_w"]);
-        if !ok {
-            return Err(at(
-                &[key("coordinates"), FieldStep::Index(cyclic[jj])],
-                format!(
-                    "the velocity of `{}` is not affine in sin/cos of `{theta}`; its position has no closed form here",
-                    coords[cyclic[jj]]
-                ),
-            ));
-        }
-        let pos = cas::var(&format!("rc_x{jj}i"))
-            + a0 * cas::var("rc_t")
-            + bs.clone() * cas::var("rc_dc")
-            - bc.clone() * cas::var("rc_ds")
-            - b0 * cas::var("rc_delta");
-        cyclic_position.push(to_expr(&cas::expand(&pos), "cyclic position")?);
-        let bprime = bs * cas::var("rc_c") - bc * cas::var("rc_s");
-        cyc_acc.push(cas::expand(
-            &(bprime * cas::var("rc_w2") + b * cas::var("rc_acc")),
-        ));
-    }
-
-    // --- Reaction forces ------------------------------------------------------------------
-    let mut forces_full = Vec::new();
-    let mut forces_reduced = Vec::new();
-    for (i, f) in spec.forces.iter().enumerate() {
-        let [x, y] = &body_pos[&f.body];
-        let m = &body_mass[&f.body];
-        let (ax, ay) = (kin.dt(&kin.dt(x)), kin.dt(&kin.dt(y)));
-        let d0 = cas::atom(&Expr::Float(f.direction[0]));
-        let d1 = cas::atom(&Expr::Float(f.direction[1]));
-        let d0 = rationalize(&d0, f.direction[0]);
-        let d1 = rationalize(&d1, f.direction[1]);
-        let full =
-            cas::expand(&(m.clone() * (d0 * ax + d1.clone() * ay) + m.clone() * g.clone() * d1));
-        // reduced: cyclic accelerations, then theta's
-        let mut r = to_sc(&full, &theta);
-        for (jj, &ci) in cyclic.iter().enumerate() {
-            r = cas::subs_var(&r, &ddots[ci], &cyc_acc[jj]);
-            r = cas::subs_var(&r, &dots[ci], &cyc_vel[jj]);
-        }
-        r = cas::subs_var(&r, &ddots[reduced], &cas::var("rc_acc"));
-        r = cas::expand(&cas::subs_var(&r, &dots[reduced], &w));
-        let f0 = cas::subs_var(&r, "rc_w", &cas::num(0));
-        let f1 = cas::subs_var(&cas::d(&r, "rc_w"), "rc_w", &cas::num(0));
-        let f2 = cas::expand(&(half.clone() * cas::d(&cas::d(&r, "rc_w"), "rc_w")));
-        let f3 = cas::d(&f2, "rc_w");
-        if !cas::is_zero(&f1) || !cas::is_zero(&f3) {
-            return Err(at(
-                &[key("forces"), FieldStep::Index(i)],
-                format!(
-                    "force `{}` is not of the form F0 + F2 theta_dot^2 on the reduced motion",
-                    f.name
-                ),
-            ));
-        }
-        let red = collect_over(
-            &cas::expand(&(f0 + f2 * cas::var("rc_w2"))),
-            &["rc_s", "rc_c", "rc_w2", "rc_acc"],
-        )?;
-        forces_full.push(to_expr(&full, "force")?);
-        forces_reduced.push(red);
-    }
-
-    // --- Monitors and requirements --------------------------------------------------------
-    let mut monitors = Vec::new();
-    for (i, m) in spec.monitors.iter().enumerate() {
-        let mut e = cas::atom(&parse_text(
-            &m.expr,
-            &[key("monitors"), FieldStep::Index(i)],
-        )?);
-        for (fi, f) in spec.forces.iter().enumerate() {
-            e = cas::subs_var(&e, &f.name, &cas::var(&format!("rc_f{fi}")));
-        }
-        e = to_sc(&e, &theta);
-        monitors.push(to_expr(&e, "monitor")?);
-    }
-    let mut requirements = Vec::new();
-    for (i, r) in spec.requirements.iter().enumerate() {
-        requirements.push(parse_text(
-            &r.expr,
-            &[key("requirements"), FieldStep::Index(i)],
-        )?);
-    }
-
-    // --- Points ---------------------------------------------------------------------------
     let mut point_pos = Vec::new();
     let mut point_vel = Vec::new();
-    for (i, p) in spec.points.iter().enumerate() {
-        let path = [key("points"), FieldStep::Index(i)];
-        let x = cas::atom(&parse_text(&p.position[0], &path)?);
-        let y = cas::atom(&parse_text(&p.position[1], &path)?);
+    for p in &parsed.points {
+        let (x, y) = (st.at(&p[0]), st.at(&p[1]));
         point_vel.push([
-            to_expr(&kin.dt(&x), "point velocity")?,
-            to_expr(&kin.dt(&y), "point velocity")?,
+            to_expr(&st.kin.dt(&x), "point velocity")?,
+            to_expr(&st.kin.dt(&y), "point velocity")?,
         ]);
         point_pos.push([
             to_expr(&cas::expand(&x), "point")?,
             to_expr(&cas::expand(&y), "point")?,
         ]);
     }
-    let surface_moves = spec.contact.as_ref().is_some_and(|c| {
-        let idx = spec
-            .points
-            .iter()
-            .position(|p| p.name == c.surface)
-            .unwrap_or(0);
-        point_pos[idx]
-            .iter()
-            .any(|e| e.symbols().iter().any(|s| coords.contains(s)))
-    });
-
-    // --- Separation condition -------------------------------------------------------------
-    let subst_reduced = |a: &A| -> A {
-        let mut out = cas::subs_var(a, "rc_w2", &wsq);
-        out = cas::subs_var(&out, "rc_acc", &acc);
-        out
-    };
-    let gap_vars = |a: &A| -> A {
-        let out = cas::subs_var(a, "rc_ds", &(cas::var("rc_si") - cas::var("rc_s")));
-        cas::subs_var(&out, "rc_dc", &(cas::var("rc_ci") - cas::var("rc_c")))
-    };
-    let separation = match &spec.contact {
+    let contact = match &st.tie {
+        Some((e, value)) => Some(Contact {
+            force: 0,
+            eliminated: e.clone(),
+            released: [
+                to_expr(value, "eliminated coordinate")?,
+                to_expr(&st.kin.dt(value), "eliminated rate")?,
+            ],
+            edge: match &parsed.edge {
+                Some(edge) => Some(to_expr(&cas::expand(&st.at(edge)), "edge")?),
+                None => None,
+            },
+        }),
         None => None,
-        Some(c) => {
-            let fi = spec
-                .forces
-                .iter()
-                .position(|f| f.name == c.force)
-                .unwrap_or(0);
-            let f = cas::together(&gap_vars(&subst_reduced(&forces_reduced[fi])));
-            let fe = to_expr(&f, "contact force")?;
-            let (num, _) = fe.num_den();
-            let numer = reduce_cos_sq(&cas::atom(&product(num)));
-            let p0 = cas::expand(&cas::subs_var(&numer, "rc_c", &cas::num(0)));
-            let p1 = cas::expand(&cas::subs_var(
-                &cas::d(&numer, "rc_c"),
-                "rc_c",
-                &cas::num(0),
-            ));
-            let check = cas::expand(&(numer.clone() - p0.clone() - p1.clone() * cas::var("rc_c")));
-            if !cas::is_zero(&check) {
-                return Err(at(&[key("contact")], "the contact force's numerator is not linear in cos(theta) after sin^2 + cos^2 = 1".into()));
-            }
-            let poly = if cas::is_zero(&p1) {
-                p0
-            } else if cas::is_zero(&p0) {
-                p1
-            } else {
-                return Err(at(
-                    &[key("contact")],
-                    "the separation condition mixes sin(theta) and cos(theta); it is not a polynomial in sin(theta)".into(),
-                ));
-            };
-            let poly = strip_positive_factors(&poly, &spec_positive(checked))?;
-            let mut coefficients = Vec::new();
-            let mut deriv = poly.clone();
-            let mut factorial: i64 = 1;
-            for deg in 0..=16i64 {
-                if deg > 0 {
-                    factorial *= deg;
-                }
-                let c0 = cas::expand(
-                    &(cas::subs_var(&deriv, "rc_s", &cas::num(0)) / cas::num(factorial)),
-                );
-                coefficients.push(c0);
-                deriv = cas::expand(&cas::d(&deriv, "rc_s"));
-                if cas::is_zero(&deriv) {
-                    break;
-                }
-            }
-            if !cas::is_zero(&deriv) {
-                return Err(at(
-                    &[key("contact")],
-                    "the separation polynomial has a degree above 16".into(),
-                ));
-            }
-            let coefficients = coefficients
-                .iter()
-                .map(|c| to_expr(c, "coefficient"))
-                .collect::<Result<Vec<_>, _>>()?;
-            Some(Separation {
-                coefficients,
-                polynomial: to_expr(&poly, "separation polynomial")?,
-            })
-        }
     };
-
-    // --- Plain forms over parameters and theta --------------------------------------------
-    let mut const_plain: Vec<(String, A)> = Vec::new();
-    for c in &constants {
-        let mut v = cas::atom(&simplify_inverse_trig(&c.value));
-        for (s, val) in &const_plain {
-            v = cas::subs_var(&v, s, val);
-        }
-        let v = cas::atom(&simplify_inverse_trig(&to_expr(&v, "constant")?));
-        const_plain.push((c.symbol.clone(), v));
-    }
-    let plainify = |a: &A| -> Result<Expr, DeriveError> {
-        let mut v = gap_vars(a);
-        for (s, val) in const_plain.iter().rev() {
-            v = cas::subs_var(&v, s, val);
-        }
-        let v = to_expr(&cas::together(&v), "plain form")?;
-        let (num, den) = v.num_den();
-        let num = reduce_cos_sq(&cas::atom(&product(num)));
-        let den = reduce_cos_sq(&cas::atom(&product(den)));
-        let v = cas::together(&cas::factor(&(num / den)));
-        Ok(from_sc(&to_expr(&v, "plain form")?, &theta))
+    let next = contact.as_ref().map(|_| next_phase(spec, &st));
+    let list = |v: &[A], what: &str| -> Result<Vec<Expr>, DeriveError> {
+        v.iter().map(|e| to_expr(e, what)).collect()
     };
-    let mut plain = BTreeMap::new();
-    plain.insert("theta_dot_sq", plainify(&wsq)?);
-    plain.insert("theta_ddot", plainify(&acc)?);
-    plain.insert("reduced_inertia", plainify(&inertia)?);
-    plain.insert("lagrangian", to_expr(&lag, "lagrangian")?);
-    if let Some(c) = &spec.contact {
-        let fi = spec
-            .forces
-            .iter()
-            .position(|f| f.name == c.force)
-            .unwrap_or(0);
-        plain.insert(
-            "contact_force",
-            plainify(&subst_reduced(&forces_reduced[fi]))?,
-        );
-    }
-    if let Some(sep) = &separation {
-        plain.insert(
-            "separation_condition",
-            plainify(&cas::atom(&sep.polynomial))?,
-        );
-    }
-    for (i, f) in spec.forces.iter().enumerate() {
-        if spec.contact.as_ref().is_some_and(|c| c.force == f.name) {
-            continue;
-        }
-        let key: &'static str = Box::leak(f.name.clone().into_boxed_str());
-        plain.insert(key, plainify(&subst_reduced(&forces_reduced[i]))?);
-    }
-
+    let description = match phase {
+        Phase::Free => format!(
+            "After the contact of `{}` ends: {}",
+            spec.name, spec.description
+        ),
+        _ => spec.description.clone(),
+    };
     Ok(Derivation {
+        name: phase_name(spec, phase),
+        phase,
+        description,
         params,
-        coords,
-        reduced,
-        cyclic,
-        kinetic: to_expr(&t_kin, "kinetic energy")?,
-        potential: to_expr(&v_pot, "potential energy")?,
-        euler_lagrange: el
+        coords: st.coords.clone(),
+        reduced: st.reduced,
+        cyclic: eqs.cyclic.clone(),
+        kinetic: to_expr(&lag.kinetic, "kinetic energy")?,
+        potential: to_expr(&lag.potential, "potential energy")?,
+        lagrangian: to_expr(&lag.lag, "lagrangian")?,
+        euler_lagrange: list(&eqs.el, "equation")?,
+        mass: eqs
+            .mass
             .iter()
-            .map(|e| to_expr(e, "equation"))
+            .map(|r| list(r, "mass matrix"))
             .collect::<Result<_, _>>()?,
-        mass: mass
-            .iter()
-            .map(|r| {
-                r.iter()
-                    .map(|e| to_expr(e, "mass matrix"))
-                    .collect::<Result<Vec<_>, _>>()
-            })
-            .collect::<Result<_, _>>()?,
-        rhs: rhs
-            .iter()
-            .map(|e| to_expr(e, "forces"))
-            .collect::<Result<_, _>>()?,
-        momenta: momenta
-            .iter()
-            .map(|e| to_expr(e, "momentum"))
-            .collect::<Result<_, _>>()?,
+        rhs: list(&eqs.rhs, "forces")?,
+        momenta: list(&eqs.momenta, "momentum")?,
+        initial: initial_list,
         point_pos,
         point_vel,
-        forces_full,
-        constants,
-        reduced_inertia: to_expr(&inertia, "inertia")?,
-        reduced_energy: to_expr(&e_red, "reduced energy")?,
-        theta_dot_sq: to_expr(&wsq, "theta_dot_sq")?,
-        theta_ddot: to_expr(&acc, "theta_ddot")?,
-        cyclic_velocity: cyc_vel
-            .iter()
-            .map(|e| to_expr(e, "cyclic velocity"))
-            .collect::<Result<_, _>>()?,
-        cyclic_position,
-        forces_reduced: forces_reduced
-            .iter()
-            .map(|e| to_expr(e, "force"))
-            .collect::<Result<_, _>>()?,
-        monitors,
-        requirements,
-        separation,
-        surface_moves,
-        plain,
+        forces: force_names,
+        forces_full: list(&forces_full, "force")?,
+        monitors: monitor_names,
+        monitors_full: list(&monitors_full, "monitor")?,
+        requirements: parsed.requirements.clone(),
+        contact,
+        next,
+        reduction,
     })
 }
 
-/// Exact rational for the small direction components specs use (0, ±1, ±1/2, ...).
-fn rationalize(a: &A, x: f64) -> A {
-    for den in 1..=12i64 {
-        let num = x * den as f64;
-        if (num - num.round()).abs() < 1e-14 {
-            return cas::atom(&Expr::Rational(num.round() as i128, den as i128));
+/// The bindings from a contact phase to its free phase: the spec's parameters, then every
+/// coordinate's value and rate at the end of the contact.
+fn next_phase(spec: &Spec, st: &Setup) -> Next {
+    let mut bindings: Vec<Binding> = (0..spec.parameters.len()).map(Binding::Param).collect();
+    for rate in [false, true] {
+        for c in &spec.coordinates {
+            let b = match st.coords.iter().position(|x| *x == c.name) {
+                Some(i) if rate => Binding::Velocity(i),
+                Some(i) => Binding::Coordinate(i),
+                None if rate => Binding::EliminatedRate,
+                None => Binding::Eliminated,
+            };
+            bindings.push(b);
         }
     }
-    a.clone()
+    Next {
+        model: phase_name(spec, Phase::Free),
+        bindings,
+    }
 }
 
-/// Symbols known to be strictly positive: positive parameters and the start's sin and cos.
-fn spec_positive(checked: &Checked) -> Vec<String> {
-    let mut v: Vec<String> = checked
-        .spec
-        .parameters
+/// Why a phase has no fast path: not an error, the phase is integrated instead.
+type Unreducible = String;
+
+/// Stage 6, the reduction: the fast path of a phase, from its Lagrangian and equations.
+struct Reducer<'a> {
+    st: &'a Setup,
+    lag: &'a Lagrangian,
+    eqs: &'a Equations,
+    initial: &'a BTreeMap<String, [Expr; 2]>,
+    /// Symbols known to be strictly positive (positive parameters).
+    positive: Vec<String>,
+}
+
+/// The reduced motion's building blocks, shared by the steps of the reduction.
+struct Reduced {
+    constants: Vec<Constant>,
+    cyc_vel: Vec<A>,
+    wsq: A,
+    acc: A,
+    inertia: A,
+    e_red: A,
+}
+
+impl Reducer<'_> {
+    fn theta(&self) -> &str {
+        &self.st.theta
+    }
+
+    fn init(&self, c: &str, what: usize) -> Result<Expr, DeriveError> {
+        self.initial.get(c).map(|v| v[what].clone()).ok_or_else(|| {
+            at(
+                &[key("initial")],
+                format!("no initial value for coordinate `{c}`"),
+            )
+        })
+    }
+
+    /// The fast path, or why there is none (an `Err` of the outer result is a real error).
+    fn reduce(
+        &self,
+        names: &[Named],
+        forces_full: &[A],
+        has_contact: bool,
+        has_edge: bool,
+    ) -> Result<Result<Reduction, Unreducible>, DeriveError> {
+        if has_edge {
+            return Ok(Err(
+                "the contact can end at an edge, which only the integrated path locates".into(),
+            ));
+        }
+        if let Some(why) = self.unreducible_coordinates() {
+            return Ok(Err(why));
+        }
+        let mut constants = self.start_constants()?;
+        let cyc_vel = match self.cyclic_velocities(&mut constants)? {
+            Ok(v) => v,
+            Err(why) => return Ok(Err(why)),
+        };
+        let red = match self.energy_integral(constants, cyc_vel)? {
+            Ok(r) => r,
+            Err(why) => return Ok(Err(why)),
+        };
+        let (cyclic_position, cyc_acc) = match self.cyclic_positions(&red.cyc_vel)? {
+            Ok(v) => v,
+            Err(why) => return Ok(Err(why)),
+        };
+        let mut forces_reduced = Vec::new();
+        for (i, f) in forces_full.iter().enumerate() {
+            match self.reduced_force(f, &red.cyc_vel, &cyc_acc)? {
+                Ok(r) => forces_reduced.push(r),
+                Err(why) => return Ok(Err(format!("force `{}`: {why}", names[i].name))),
+            }
+        }
+        let separation = if has_contact {
+            match self.separation(&red, &forces_reduced[0])? {
+                Ok(s) => Some(s),
+                Err(why) => return Ok(Err(why)),
+            }
+        } else {
+            None
+        };
+        let plain = self.plain_forms(
+            &red,
+            names,
+            &forces_reduced,
+            separation.as_ref(),
+            has_contact,
+        )?;
+        Ok(Ok(Reduction {
+            reduced_inertia: to_expr(&red.inertia, "inertia")?,
+            reduced_energy: to_expr(&red.e_red, "reduced energy")?,
+            theta_dot_sq: to_expr(&red.wsq, "theta_dot_sq")?,
+            theta_ddot: to_expr(&red.acc, "theta_ddot")?,
+            cyclic_velocity: (red.cyc_vel.iter())
+                .map(|e| to_expr(e, "cyclic velocity"))
+                .collect::<Result<_, _>>()?,
+            cyclic_position,
+            forces_reduced: (forces_reduced.iter())
+                .map(|e| to_expr(e, "force"))
+                .collect::<Result<_, _>>()?,
+            constants: red.constants,
+            separation,
+            plain,
+        }))
+    }
+
+    /// Every coordinate but the reduced one must be cyclic, with an inertia free of `theta`.
+    fn unreducible_coordinates(&self) -> Option<Unreducible> {
+        let (st, eqs) = (self.st, self.eqs);
+        for (i, c) in st.coords.iter().enumerate() {
+            if i != st.reduced && !eqs.cyclic.contains(&i) {
+                return Some(format!(
+                    "coordinate `{c}` is not cyclic (the Lagrangian depends on it), so it cannot \
+                     be eliminated through a conserved momentum"
+                ));
+            }
+        }
+        for &i in &eqs.cyclic {
+            for &j in &eqs.cyclic {
+                if !free_of(&eqs.mass[i][j], &[self.theta()]) {
+                    return Some(format!(
+                        "the inertia of cyclic coordinate `{}` depends on `{}`",
+                        st.coords[i],
+                        self.theta()
+                    ));
+                }
+            }
+        }
+        None
+    }
+
+    /// `theta_i`, `theta_dot_i`, their sine and cosine, the initial cyclic positions and the
+    /// conserved momenta, as constants over the parameters.
+    fn start_constants(&self) -> Result<Vec<Constant>, DeriveError> {
+        let theta = self.theta();
+        // sin and cos of the start are formed from the start's own expression where it is an
+        // inverse function (sin(asin(a/ell)) = a/ell exactly; cos(asin(x)) = sqrt((1-x)(1+x)),
+        // which keeps full relative accuracy near upright, unlike cos of an angle near pi/2).
+        let theta_i = self.init(theta, 0)?;
+        let start_trig = |f: &str| match &theta_i {
+            Expr::Fun(g, _) if g == "asin" || g == "acos" => {
+                simplify_inverse_trig(&Expr::Fun(f.into(), vec![theta_i.clone()]))
+            }
+            _ => Expr::Fun(f.into(), vec![Expr::sym("rc_thi")]),
+        };
+        let mut constants = vec![
+            Constant {
+                symbol: "rc_thi".into(),
+                value: theta_i.clone(),
+            },
+            Constant {
+                symbol: "rc_wi".into(),
+                value: self.init(theta, 1)?,
+            },
+            Constant {
+                symbol: "rc_si".into(),
+                value: start_trig("sin"),
+            },
+            Constant {
+                symbol: "rc_ci".into(),
+                value: start_trig("cos"),
+            },
+        ];
+        let (st, eqs) = (self.st, self.eqs);
+        let wi = self.start_rate(&constants);
+        let initial_state = |a: &A| -> A {
+            let mut out = to_sc(a, theta);
+            out = cas::subs_var(&out, "rc_s", &cas::var("rc_si"));
+            out = cas::subs_var(&out, "rc_c", &cas::var("rc_ci"));
+            out = cas::subs_var(&out, theta, &cas::var("rc_thi"));
+            out = cas::subs_var(&out, &format!("dot_{theta}"), &wi);
+            for (j, &i) in eqs.cyclic.iter().enumerate() {
+                out = cas::subs_var(&out, &st.coords[i], &cas::var(&format!("rc_x{j}i")));
+            }
+            out
+        };
+        let mut cyclic_init_vel = Vec::new();
+        for (j, &i) in eqs.cyclic.iter().enumerate() {
+            constants.push(Constant {
+                symbol: format!("rc_x{j}i"),
+                value: self.init(&st.coords[i], 0)?,
+            });
+            cyclic_init_vel.push(cas::atom(&self.init(&st.coords[i], 1)?));
+        }
+        for (j, p) in eqs.momenta.iter().enumerate() {
+            let mut v = initial_state(p);
+            for (jj, &i) in eqs.cyclic.iter().enumerate() {
+                v = cas::subs_var(&v, &format!("dot_{}", st.coords[i]), &cyclic_init_vel[jj]);
+            }
+            constants.push(Constant {
+                symbol: format!("rc_p{j}"),
+                value: to_expr(&cas::expand(&v), "momentum")?,
+            });
+        }
+        Ok(constants)
+    }
+
+    /// The start's rate: a number when it is one (a start from rest), so that the derived
+    /// forms simplify exactly as a person would simplify them.
+    fn start_rate(&self, constants: &[Constant]) -> A {
+        constant_value(constants, "rc_wi")
+    }
+
+    /// Cyclic velocities from the conserved momenta: `M_CC qd_C = P - M_Cr theta_dot`.
+    fn cyclic_velocities(
+        &self,
+        constants: &mut [Constant],
+    ) -> Result<Result<Vec<A>, Unreducible>, DeriveError> {
+        let (st, eqs, theta) = (self.st, self.eqs, self.theta());
+        let w = cas::var("rc_w");
+        let k = eqs.cyclic.len();
+        let momentum: Vec<A> = (0..k)
+            .map(|j| constant_value(constants, &format!("rc_p{j}")))
+            .collect();
+        let mut mat: Vec<Vec<A>> = (eqs.cyclic.iter())
+            .map(|&i| {
+                eqs.cyclic
+                    .iter()
+                    .map(|&j| to_sc(&eqs.mass[i][j], theta))
+                    .collect()
+            })
+            .collect();
+        let mut vec_b: Vec<A> = (eqs.cyclic.iter().enumerate())
+            .map(|(jj, &i)| {
+                momentum[jj].clone() - to_sc(&eqs.mass[i][st.reduced], theta) * w.clone()
+            })
+            .collect();
+        for col in 0..k {
+            let Some(pivot) = (col..k).find(|&r| !cas::is_zero(&mat[r][col])) else {
+                return Ok(Err(
+                    "the cyclic velocities cannot be solved from their momenta (singular inertia)"
+                        .into(),
+                ));
+            };
+            mat.swap(col, pivot);
+            vec_b.swap(col, pivot);
+            let p = mat[col][col].clone();
+            let pivot_row = mat[col].clone();
+            for r in 0..k {
+                if r == col {
+                    continue;
+                }
+                let f = cas::together(&(mat[r][col].clone() / p.clone()));
+                for (m, pc) in mat[r].iter_mut().zip(&pivot_row) {
+                    *m = cas::together(&(m.clone() - f.clone() * pc.clone()));
+                }
+                vec_b[r] = cas::together(&(vec_b[r].clone() - f.clone() * vec_b[col].clone()));
+            }
+        }
+        Ok(Ok((0..k)
+            .map(|r| cas::expand(&cas::together(&(vec_b[r].clone() / mat[r][r].clone()))))
+            .collect()))
+    }
+
+    /// The energy integral: `theta_dot^2` and `theta_ddot` over the start's drops, with the
+    /// reduced inertia `A(theta)` and the effective potential `alpha + beta s + gamma c`.
+    fn energy_integral(
+        &self,
+        mut constants: Vec<Constant>,
+        cyc_vel: Vec<A>,
+    ) -> Result<Result<Reduced, Unreducible>, DeriveError> {
+        let (st, eqs, theta) = (self.st, self.eqs, self.theta());
+        let w = cas::var("rc_w");
+        let reduce_state = |a: &A| -> A {
+            let mut out = to_sc(a, theta);
+            for (jj, &i) in eqs.cyclic.iter().enumerate() {
+                out = cas::subs_var(&out, &format!("dot_{}", st.coords[i]), &cyc_vel[jj]);
+            }
+            cas::subs_var(&out, &format!("dot_{theta}"), &w)
+        };
+        let total = self.lag.kinetic.clone() + self.lag.potential.clone();
+        let e_red = cas::expand(&reduce_state(&total));
+        let e_red = cas::expand(&cas::together(&e_red));
+        let inertia = reduce_cos_sq(&cas::expand(&cas::d(&cas::d(&e_red, "rc_w"), "rc_w")));
+        let inertia = cas::expand(&cas::together(&inertia));
+        let linear = cas::subs_var(&cas::d(&e_red, "rc_w"), "rc_w", &cas::num(0));
+        if !is_zero_trig(&linear).map_err(|m| at(&[], m))? {
+            return Ok(Err(
+                "the reduced energy has a term linear in the angular velocity".into(),
+            ));
+        }
+        let v_eff = cas::subs_var(&e_red, "rc_w", &cas::num(0));
+        let beta = cas::expand(&cas::d(&v_eff, "rc_s"));
+        let gamma = cas::expand(&cas::d(&v_eff, "rc_c"));
+        let rest = cas::expand(
+            &(v_eff.clone() - beta.clone() * cas::var("rc_s") - gamma.clone() * cas::var("rc_c")),
+        );
+        let names = ["rc_s", "rc_c", theta];
+        let mut coords: Vec<&str> = names.to_vec();
+        coords.extend(st.coords.iter().map(String::as_str));
+        if !(free_of(&beta, &coords) && free_of(&gamma, &coords) && free_of(&rest, &coords)) {
+            return Ok(Err(format!(
+                "the effective potential is not of the form alpha + beta sin({theta}) + gamma cos({theta})"
+            )));
+        }
+        let ai = cas::subs_var(
+            &cas::subs_var(&inertia, "rc_s", &cas::var("rc_si")),
+            "rc_c",
+            &cas::var("rc_ci"),
+        );
+        constants.push(Constant {
+            symbol: "rc_ai".into(),
+            value: to_expr(&cas::expand(&ai), "initial inertia")?,
+        });
+        let wi = self.start_rate(&constants);
+        let two = cas::num(2);
+        let wsq = (cas::var("rc_ai") * wi.clone() * wi
+            + two.clone() * beta * cas::var("rc_ds")
+            + two * gamma * cas::var("rc_dc"))
+            / inertia.clone();
+        let wsq = cas::together(&wsq);
+        let half = cas::atom(&Expr::Rational(1, 2));
+        let acc = cas::together(&(half * d_theta(&wsq)));
+        Ok(Ok(Reduced {
+            constants,
+            cyc_vel,
+            wsq,
+            acc,
+            inertia,
+            e_red,
+        }))
+    }
+
+    /// Cyclic positions in closed form (the velocities must be affine in sin and cos of
+    /// `theta`) and the cyclic accelerations, over the reduced motion.
+    #[allow(clippy::type_complexity)]
+    fn cyclic_positions(
+        &self,
+        cyc_vel: &[A],
+    ) -> Result<Result<(Vec<Expr>, Vec<A>), Unreducible>, DeriveError> {
+        let (st, eqs, theta) = (self.st, self.eqs, self.theta());
+        let mut positions = Vec::new();
+        let mut accelerations = Vec::new();
+        for (jj, v) in cyc_vel.iter().enumerate() {
+            let a0 = cas::expand(&cas::subs_var(v, "rc_w", &cas::num(0)));
+            let b = cas::expand(&cas::d(v, "rc_w"));
+            let bs = cas::expand(&cas::d(&b, "rc_s"));
+            let bc = cas::expand(&cas::d(&b, "rc_c"));
+            let b0 = cas::expand(
+                &(b.clone() - bs.clone() * cas::var("rc_s") - bc.clone() * cas::var("rc_c")),
+            );
+            let motion = ["rc_s", "rc_c", "rc_w"];
+            let ok = [&a0, &bs, &bc, &b0].iter().all(|x| free_of(x, &motion));
+            if !ok {
+                return Ok(Err(format!(
+                    "the velocity of `{}` is not affine in sin and cos of `{theta}`; its position \
+                     has no closed form",
+                    st.coords[eqs.cyclic[jj]]
+                )));
+            }
+            let pos = cas::var(&format!("rc_x{jj}i"))
+                + a0 * cas::var("rc_t")
+                + bs.clone() * cas::var("rc_dc")
+                - bc.clone() * cas::var("rc_ds")
+                - b0 * cas::var("rc_delta");
+            positions.push(to_expr(&cas::expand(&pos), "cyclic position")?);
+            let bprime = bs * cas::var("rc_c") - bc * cas::var("rc_s");
+            accelerations.push(cas::expand(
+                &(bprime * cas::var("rc_w2") + b * cas::var("rc_acc")),
+            ));
+        }
+        Ok(Ok((positions, accelerations)))
+    }
+
+    /// A force on the reduced motion, which must be `F0 + F2 theta_dot^2` (with `theta_ddot`
+    /// kept as a symbol), each coefficient collected over one denominator.
+    fn reduced_force(
+        &self,
+        full: &A,
+        cyc_vel: &[A],
+        cyc_acc: &[A],
+    ) -> Result<Result<A, Unreducible>, DeriveError> {
+        let (st, eqs, theta) = (self.st, self.eqs, self.theta());
+        let mut r = to_sc(full, theta);
+        for (jj, &ci) in eqs.cyclic.iter().enumerate() {
+            let c = &st.coords[ci];
+            r = cas::subs_var(&r, &format!("ddot_{c}"), &cyc_acc[jj]);
+            r = cas::subs_var(&r, &format!("dot_{c}"), &cyc_vel[jj]);
+        }
+        r = cas::subs_var(&r, &format!("ddot_{theta}"), &cas::var("rc_acc"));
+        r = cas::expand(&cas::subs_var(
+            &r,
+            &format!("dot_{theta}"),
+            &cas::var("rc_w"),
+        ));
+        let half = cas::atom(&Expr::Rational(1, 2));
+        let f0 = cas::subs_var(&r, "rc_w", &cas::num(0));
+        let f1 = cas::subs_var(&cas::d(&r, "rc_w"), "rc_w", &cas::num(0));
+        let f2 = cas::expand(&(half * cas::d(&cas::d(&r, "rc_w"), "rc_w")));
+        let f3 = cas::d(&f2, "rc_w");
+        if !cas::is_zero(&f1) || !cas::is_zero(&f3) {
+            return Ok(Err(
+                "not of the form F0 + F2 theta_dot^2 on the reduced motion".into(),
+            ));
+        }
+        Ok(Ok(collect_over(
+            &cas::expand(&(f0 + f2 * cas::var("rc_w2"))),
+            &["rc_s", "rc_c", "rc_w2", "rc_acc"],
+        )?))
+    }
+
+    /// The separation polynomial in `sin(theta)`: the contact force's numerator on the
+    /// reduced motion, with `sin^2 + cos^2 = 1` and positive factors removed.
+    fn separation(
+        &self,
+        red: &Reduced,
+        contact_force: &A,
+    ) -> Result<Result<Separation, Unreducible>, DeriveError> {
+        let f = cas::together(&gap_vars(&self.on_motion(red, contact_force)));
+        let fe = to_expr(&f, "contact force")?;
+        let (num, _) = fe.num_den();
+        let numer = reduce_cos_sq(&cas::atom(&product(num)));
+        let p0 = cas::expand(&cas::subs_var(&numer, "rc_c", &cas::num(0)));
+        let p1 = cas::expand(&cas::subs_var(
+            &cas::d(&numer, "rc_c"),
+            "rc_c",
+            &cas::num(0),
+        ));
+        let check = cas::expand(&(numer.clone() - p0.clone() - p1.clone() * cas::var("rc_c")));
+        if !cas::is_zero(&check) {
+            return Ok(Err(
+                "the contact force's numerator is not linear in cos(theta) after sin^2 + cos^2 = 1"
+                    .into(),
+            ));
+        }
+        let poly = if cas::is_zero(&p1) {
+            p0
+        } else if cas::is_zero(&p0) {
+            p1
+        } else {
+            return Ok(Err(
+                "the separation condition mixes sin(theta) and cos(theta); it is not a polynomial in sin(theta)"
+                    .into(),
+            ));
+        };
+        let mut positive = self.positive.clone();
+        positive.push("rc_si".into());
+        positive.push("rc_ci".into());
+        let poly = strip_positive_factors(&poly, &positive)?;
+        let mut coefficients = Vec::new();
+        let mut deriv = poly.clone();
+        let mut factorial: i64 = 1;
+        for deg in 0..=16i64 {
+            if deg > 0 {
+                factorial *= deg;
+            }
+            let c0 =
+                cas::expand(&(cas::subs_var(&deriv, "rc_s", &cas::num(0)) / cas::num(factorial)));
+            coefficients.push(to_expr(&c0, "coefficient")?);
+            deriv = cas::expand(&cas::d(&deriv, "rc_s"));
+            if cas::is_zero(&deriv) {
+                return Ok(Ok(Separation {
+                    coefficients,
+                    polynomial: to_expr(&poly, "separation polynomial")?,
+                }));
+            }
+        }
+        Ok(Err("the separation polynomial has a degree above 16".into()))
+    }
+
+    /// A reduced expression with `theta_dot^2` and `theta_ddot` substituted.
+    fn on_motion(&self, red: &Reduced, a: &A) -> A {
+        let out = cas::subs_var(a, "rc_w2", &red.wsq);
+        cas::subs_var(&out, "rc_acc", &red.acc)
+    }
+
+    /// Fully substituted forms over parameters and `theta`, for people and other tools.
+    fn plain_forms(
+        &self,
+        red: &Reduced,
+        names: &[Named],
+        forces_reduced: &[A],
+        separation: Option<&Separation>,
+        has_contact: bool,
+    ) -> Result<BTreeMap<String, Expr>, DeriveError> {
+        let theta = self.theta();
+        let mut const_plain: Vec<(String, A)> = Vec::new();
+        for c in &red.constants {
+            let mut v = cas::atom(&simplify_inverse_trig(&c.value));
+            for (s, val) in &const_plain {
+                v = cas::subs_var(&v, s, val);
+            }
+            let v = cas::atom(&simplify_inverse_trig(&to_expr(&v, "constant")?));
+            const_plain.push((c.symbol.clone(), v));
+        }
+        let plainify = |a: &A| -> Result<Expr, DeriveError> {
+            let mut v = gap_vars(a);
+            for (s, val) in const_plain.iter().rev() {
+                v = cas::subs_var(&v, s, val);
+            }
+            let v = to_expr(&cas::together(&v), "plain form")?;
+            let (num, den) = v.num_den();
+            let num = reduce_cos_sq(&cas::atom(&product(num)));
+            let den = reduce_cos_sq(&cas::atom(&product(den)));
+            let v = cas::together(&cas::factor(&(num / den)));
+            Ok(from_sc(&to_expr(&v, "plain form")?, theta))
+        };
+        let mut plain = BTreeMap::new();
+        plain.insert("theta_dot_sq".to_string(), plainify(&red.wsq)?);
+        plain.insert("theta_ddot".to_string(), plainify(&red.acc)?);
+        plain.insert("reduced_inertia".to_string(), plainify(&red.inertia)?);
+        for (i, (f, n)) in forces_reduced.iter().zip(names).enumerate() {
+            let key = if i == 0 && has_contact {
+                "contact_force".to_string()
+            } else {
+                n.name.clone()
+            };
+            plain.insert(key, plainify(&self.on_motion(red, f))?);
+        }
+        if let Some(sep) = separation {
+            plain.insert(
+                "separation_condition".to_string(),
+                plainify(&cas::atom(&sep.polynomial))?,
+            );
+        }
+        Ok(plain)
+    }
+}
+
+/// A constant's value where it is a plain number, its symbol otherwise.
+fn constant_value(constants: &[Constant], symbol: &str) -> A {
+    constants
         .iter()
-        .filter(|p| p.positive)
-        .map(|p| p.name.clone())
-        .collect();
-    v.push("rc_si".into());
-    v.push("rc_ci".into());
-    v
+        .find(|c| c.symbol == symbol)
+        .and_then(|c| {
+            let t = c.value.tidy();
+            t.symbols().is_empty().then(|| cas::atom(&t))
+        })
+        .unwrap_or_else(|| cas::var(symbol))
+}
+
+/// `d/dtheta` of an expression over `rc_s`, `rc_c`, `rc_ds`, `rc_dc`.
+fn d_theta(f: &A) -> A {
+    cas::d(f, "rc_s") * cas::var("rc_c")
+        - cas::d(f, "rc_c") * cas::var("rc_s")
+        - cas::d(f, "rc_ds") * cas::var("rc_c")
+        + cas::d(f, "rc_dc") * cas::var("rc_s")
+}
+
+/// `rc_ds`, `rc_dc` written as differences from the start.
+fn gap_vars(a: &A) -> A {
+    let out = cas::subs_var(a, "rc_ds", &(cas::var("rc_si") - cas::var("rc_s")));
+    cas::subs_var(&out, "rc_dc", &(cas::var("rc_ci") - cas::var("rc_c")))
 }
 
 fn positive(e: &Expr, pos: &[String]) -> bool {

@@ -16,6 +16,7 @@ pub use crate::spec::{self, expr};
 use crate::yaml_marks::{At, Step, locate_nearest};
 use mechanics::{Derivation, FieldStep};
 use spec::{Checked, SpecError};
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{Sender, channel};
 use std::sync::{Mutex, OnceLock};
@@ -201,8 +202,8 @@ fn to_spec_error(checked: &Checked, err: mechanics::DeriveError) -> SpecError {
     }
 }
 
-/// Derives checked specs on the Symbolica thread.
-pub fn derive_all(checked: &[Checked]) -> Result<Vec<(Derivation, Duration)>, Error> {
+/// Derives checked specs on the Symbolica thread: each spec's phases, with the time it took.
+pub fn derive_all(checked: &[Checked]) -> Result<Vec<(Vec<Derivation>, Duration)>, Error> {
     let owned: Vec<Checked> = checked.to_vec();
     let results = on_cas_thread(move || {
         owned
@@ -276,6 +277,40 @@ fn rustfmt(model: &str, text: &str) -> Result<String, Error> {
     String::from_utf8(out.stdout).map_err(|e| err(e.to_string()))
 }
 
+/// The Rust, LaTeX and JSON files of one derived phase.
+fn render_phase(root: &Path, c: &Checked, d: &Derivation) -> Result<Vec<Rendered>, Error> {
+    let ctx = emit::rust_context(c, d).map_err(|message| {
+        Error::Spec(SpecError {
+            file: c.file.clone(),
+            line: 0,
+            column: 0,
+            field: String::new(),
+            message: format!("model `{}`: {message}", d.name),
+        })
+    })?;
+    let rust = rustfmt(&d.name, &render(root, "model.rs.tera", &ctx)?)?;
+    let tex = render(root, "model.tex.tera", &emit::tex_context(c, d))?;
+    let json =
+        serde_json::to_string_pretty(&emit::json_record(c, d)).map_err(|e| Error::Template {
+            template: "json record".into(),
+            message: e.to_string(),
+        })? + "\n";
+    Ok(vec![
+        Rendered {
+            path: PathBuf::from(format!("generated/{}.rs", d.name)),
+            text: rust,
+        },
+        Rendered {
+            path: PathBuf::from(format!("generated/{}.tex", d.name)),
+            text: tex,
+        },
+        Rendered {
+            path: PathBuf::from(format!("generated/{}.json", d.name)),
+            text: json,
+        },
+    ])
+}
+
 /// Derives and renders every output file for the selected specs plus the registry.
 pub fn render_all(root: &Path, specs: &[PathBuf]) -> Result<(Vec<Rendered>, Timings), Error> {
     let all_files = spec_files(root)?;
@@ -291,83 +326,36 @@ pub fn render_all(root: &Path, specs: &[PathBuf]) -> Result<(Vec<Rendered>, Timi
             .map(|p| spec::load(p))
             .collect::<Result<_, _>>()?
     };
-    // Phase links need every spec's parameter order.
-    let lookup = |name: &str| -> Option<Vec<String>> {
-        all.iter()
-            .chain(selected.iter())
-            .find(|c| c.spec.name == name)
-            .map(|c| c.spec.parameters.iter().map(|p| p.name.clone()).collect())
-    };
-    for c in &selected {
-        if let Some(after) = &c.spec.after_separation
-            && lookup(&after.model).is_none()
-        {
-            let text = std::fs::read_to_string(&c.file).unwrap_or_default();
-            let path = [Step::Key("after_separation"), Step::Key("model")];
-            let (line, column) = locate_nearest(&text, &path, At::Value);
-            return Err(SpecError {
-                file: c.file.clone(),
-                line,
-                column,
-                field: "after_separation.model".into(),
-                message: format!(
-                    "no spec in derivations/ defines a model named `{}`",
-                    after.model
-                ),
-            }
-            .into());
-        }
-    }
     let derived = derive_all(&selected)?;
     let mut out = Vec::new();
     let mut timings = Vec::new();
-    for (c, (d, took)) in selected.iter().zip(derived) {
+    for (c, (phases, took)) in selected.iter().zip(derived) {
         timings.push((c.spec.name.clone(), took));
-        let next = c
-            .spec
-            .after_separation
-            .as_ref()
-            .and_then(|a| lookup(&a.model));
-        let ctx = emit::rust_context(c, &d, next.as_deref()).map_err(|message| {
-            let text = std::fs::read_to_string(&c.file).unwrap_or_default();
-            let path = [Step::Key("after_separation")];
-            let (line, column) = locate_nearest(&text, &path, At::Key);
-            Error::Spec(SpecError {
-                file: c.file.clone(),
-                line,
-                column,
-                field: "after_separation".into(),
-                message,
-            })
-        })?;
-        let rust = rustfmt(&c.spec.name, &render(root, "model.rs.tera", &ctx)?)?;
-        out.push(Rendered {
-            path: PathBuf::from(format!("generated/{}.rs", c.spec.name)),
-            text: rust,
-        });
-        let tex = render(root, "model.tex.tera", &emit::tex_context(c, &d))?;
-        out.push(Rendered {
-            path: PathBuf::from(format!("generated/{}.tex", c.spec.name)),
-            text: tex,
-        });
-        let json =
-            serde_json::to_string_pretty(&emit::json_record(c, &d)).unwrap_or_default() + "\n";
-        out.push(Rendered {
-            path: PathBuf::from(format!("generated/{}.json", c.spec.name)),
-            text: json,
-        });
+        for d in &phases {
+            out.extend(render_phase(root, c, d)?);
+        }
     }
-    // The registry lists every spec in derivations/ (and any named outside it).
-    let mut names: Vec<(String, String)> = all
+    // The registry lists only models whose Rust file exists once this run has written: those
+    // rendered now and, when only some specs were given, those generated before (recorded in
+    // the manifest). A spec that has not derived is never named, so the crate still builds.
+    let mut names: Vec<String> = out
         .iter()
-        .chain(selected.iter())
-        .map(|c| (c.spec.name.clone(), emit::type_name(&c.spec.name)))
+        .filter_map(|f| model_of(&f.path.to_string_lossy()).map(str::to_string))
         .collect();
+    if !specs.is_empty() {
+        let recorded = kept_rows(root, read_manifest(root)?);
+        names.extend(
+            recorded
+                .keys()
+                .filter_map(|p| model_of(p))
+                .map(str::to_string),
+        );
+    }
     names.sort();
     names.dedup();
     let models: Vec<serde_json::Value> = names
         .iter()
-        .map(|(n, t)| serde_json::json!({"name": n, "type_name": t}))
+        .map(|n| serde_json::json!({"name": n, "type_name": emit::type_name(n)}))
         .collect();
     let reg = render(
         root,
@@ -394,47 +382,110 @@ pub fn digest(text: &str) -> String {
     format!("{h:016x}")
 }
 
-fn manifest_text(files: &[Rendered]) -> String {
+/// The manifest of `files` as about to be written, keeping the rows of `kept` (other files
+/// already generated) except where `files` gives a new digest; sorted by path.
+fn manifest_text(files: &[Rendered], kept: BTreeMap<String, String>) -> String {
     let mut out = format!(
         "# Generated by `{}`; do not edit by hand.\n# FNV-1a digests of the generated files as \
          the tool wrote them: a file whose digest differs was edited by hand.\n",
         emit::COMMAND
     );
-    let mut rows: Vec<(String, String)> = files
-        .iter()
-        .map(|f| (f.path.display().to_string(), digest(&f.text)))
-        .collect();
-    rows.sort();
+    let mut rows = kept;
+    for f in files {
+        rows.insert(f.path.display().to_string(), digest(&f.text));
+    }
     for (path, d) in rows {
         out.push_str(&format!("{d}  {path}\n"));
     }
     out
 }
 
-fn read_manifest(root: &Path) -> std::collections::BTreeMap<String, String> {
-    std::fs::read_to_string(root.join(MANIFEST))
-        .unwrap_or_default()
+/// The rows of the manifest (path → digest); none if there is no manifest yet. Lines that are
+/// not `<digest>  <path>` are skipped.
+fn read_manifest(root: &Path) -> Result<BTreeMap<String, String>, Error> {
+    let path = root.join(MANIFEST);
+    let text = match std::fs::read_to_string(&path) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(BTreeMap::new()),
+        Err(source) => return Err(Error::Io { path, source }),
+    };
+    Ok(text
         .lines()
         .filter(|l| !l.starts_with('#'))
         .filter_map(|l| {
             l.split_once("  ")
                 .map(|(d, p)| (p.to_string(), d.to_string()))
         })
+        .collect())
+}
+
+/// The manifest rows that still describe a generated file: a plain file name in `generated/`
+/// (not the manifest itself) that exists.
+fn kept_rows(root: &Path, rows: BTreeMap<String, String>) -> BTreeMap<String, String> {
+    rows.into_iter()
+        .filter(|(path, _)| {
+            path.as_str() != MANIFEST
+                && path
+                    .strip_prefix("generated/")
+                    .is_some_and(|name| crate::io::check_name(name).is_ok())
+                && root.join(path).is_file()
+        })
         .collect()
+}
+
+/// The model whose Rust file is `path` (`generated/<model>.rs`, not the registry `mod.rs`).
+fn model_of(path: &str) -> Option<&str> {
+    path.strip_prefix("generated/")
+        .and_then(|p| p.strip_suffix(".rs"))
+        .filter(|name| *name != "mod" && spec::is_identifier(name))
+}
+
+/// The current content of an output, or `None` when there is none to compare (no file, or a
+/// directory in the way, which the write then reports).
+fn current_content(path: &Path) -> Result<Option<Vec<u8>>, Error> {
+    match std::fs::read(path) {
+        Ok(bytes) => Ok(Some(bytes)),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound || path.is_dir() => Ok(None),
+        Err(source) => Err(Error::Io {
+            path: path.to_path_buf(),
+            source,
+        }),
+    }
+}
+
+/// A failed write of the output files as this module's error.
+fn write_error(e: crate::io::Error, dir: &Path) -> Error {
+    match e {
+        crate::io::Error::Write { path, source } | crate::io::Error::CreateDir { path, source } => {
+            Error::Io { path, source }
+        }
+        other => Error::Io {
+            path: dir.to_path_buf(),
+            source: std::io::Error::other(other.to_string()),
+        },
+    }
 }
 
 /// Regenerates (or, with `check`, compares) the outputs. Without `force`, a generated file
 /// that was edited by hand (its digest differs from the manifest's) is never overwritten.
+///
+/// The write is all or nothing: every derivation and rendering happens first, then the
+/// changed files and the manifest are written together by [`crate::io::write_all_atomic`], so
+/// on any error `generated/` is left exactly as it was. The manifest is rewritten on every
+/// write; when only some specs are given, the rows of the other generated files are kept.
 pub fn run(opts: &Options) -> Result<Outcome, Error> {
     let (mut files, timings) = render_all(&opts.root, &opts.specs)?;
-    if opts.specs.is_empty() {
-        let manifest = manifest_text(&files);
-        files.push(Rendered {
-            path: PathBuf::from(MANIFEST),
-            text: manifest,
-        });
-    }
-    let recorded = read_manifest(&opts.root);
+    let recorded = read_manifest(&opts.root)?;
+    let kept = if opts.specs.is_empty() {
+        BTreeMap::new()
+    } else {
+        kept_rows(&opts.root, recorded.clone())
+    };
+    let manifest = manifest_text(&files, kept);
+    files.push(Rendered {
+        path: PathBuf::from(MANIFEST),
+        text: manifest,
+    });
     let mut outcome = Outcome {
         timings,
         ..Outcome::default()
@@ -442,9 +493,8 @@ pub fn run(opts: &Options) -> Result<Outcome, Error> {
     let mut to_write = Vec::new();
     let mut edited = Vec::new();
     for f in files {
-        let path = opts.root.join(&f.path);
-        let current = std::fs::read_to_string(&path).ok();
-        if current.as_deref() == Some(f.text.as_str()) {
+        let current = current_content(&opts.root.join(&f.path))?;
+        if current.as_deref() == Some(f.text.as_bytes()) {
             outcome.unchanged.push(f.path);
             continue;
         }
@@ -453,9 +503,15 @@ pub fn run(opts: &Options) -> Result<Outcome, Error> {
             continue;
         }
         let key = f.path.display().to_string();
+        // A file the tool wrote has the recorded digest (and is UTF-8).
+        let hand_edited = |cur: &[u8]| {
+            recorded
+                .get(&key)
+                .is_some_and(|d| std::str::from_utf8(cur).map_or(true, |text| *d != digest(text)))
+        };
         if let Some(cur) = &current
             && key != MANIFEST
-            && recorded.get(&key).is_some_and(|d| *d != digest(cur))
+            && hand_edited(cur)
             && !opts.force
         {
             edited.push(f.path.clone());
@@ -465,13 +521,12 @@ pub fn run(opts: &Options) -> Result<Outcome, Error> {
     if !edited.is_empty() {
         return Err(Error::HandEdited(edited));
     }
-    for f in to_write {
-        let path = opts.root.join(&f.path);
-        crate::io::write_atomic(&path, f.text.as_bytes()).map_err(|e| Error::Io {
-            path: path.clone(),
-            source: std::io::Error::other(e.to_string()),
-        })?;
-        outcome.written.push(f.path);
-    }
+    let targets: Vec<(PathBuf, &[u8])> = to_write
+        .iter()
+        .map(|f| (opts.root.join(&f.path), f.text.as_bytes()))
+        .collect();
+    crate::io::write_all_atomic(&targets)
+        .map_err(|e| write_error(e, &opts.root.join("generated")))?;
+    outcome.written = to_write.into_iter().map(|f| f.path).collect();
     Ok(outcome)
 }

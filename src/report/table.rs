@@ -130,7 +130,7 @@ pub fn render(results: &RunResults, info: Option<&ModelInfo>) -> String {
     out.push_str(&format!("\nParameters\n{t}\n"));
 
     // Results
-    if !results.results.is_empty() {
+    if !results.results.is_empty() || !results.labels.is_empty() {
         let paper = is_paper_case(results);
         let mut header = vec!["result", "value", "unit", "degrees"];
         if paper {
@@ -159,6 +159,19 @@ pub fn render(results: &RunResults, info: Option<&ModelInfo>) -> String {
                 row.push(fig.to_string());
             }
             row.push(s.meaning.clone());
+            t.add_row(row);
+        }
+        for (key, label) in &results.labels {
+            let mut row = vec![
+                key.clone(),
+                label.value.clone(),
+                String::new(),
+                String::new(),
+            ];
+            if paper {
+                row.push(String::new());
+            }
+            row.push(label.meaning.clone());
             t.add_row(row);
         }
         align_right(&mut t, &[1, 3]);

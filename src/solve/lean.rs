@@ -47,7 +47,7 @@
 //! high-precision [`reference`](crate::reference) across `n = m2/m1` from 1e-12 to 1e12 and
 //! `a/ell` from 1e-10 to `1 - 1e-9`.
 
-use crate::model::{Model, ModelInfo};
+use crate::model::{Model, ModelInfo, Reduction, ReductionInfo};
 use crate::solve::SolveError;
 use crate::solve::quadrature::gauss_legendre_rule;
 use crate::solve::separation::horner_compensated;
@@ -118,6 +118,9 @@ pub struct LeanPoint {
 pub struct LeanSolver<'m> {
     model: &'m dyn Model,
     info: &'static ModelInfo,
+    /// The model's fast path and where it keeps its start in `k`.
+    red: &'m dyn Reduction,
+    layout: &'static ReductionInfo,
     /// `sin(end_angle)`, the low end of the root's bracket.
     sin_end: f64,
     k: Vec<f64>,
@@ -184,7 +187,13 @@ impl<'m> LeanSolver<'m> {
         if info.contact.is_none() {
             return Err(SolveError::NoContact { model: info.name });
         }
-        if info.separation_degree > MAX_DEGREE {
+        let (Some(red), Some(layout)) = (model.reduction(), info.reduction.as_ref()) else {
+            return Err(SolveError::Parameters(SystemError::NoReduction {
+                model: info.name,
+                why: info.route_note,
+            }));
+        };
+        if layout.separation_degree > MAX_DEGREE {
             return Err(SolveError::BadPolynomial {
                 model: info.name,
                 coefficients: Vec::new(),
@@ -210,10 +219,12 @@ impl<'m> LeanSolver<'m> {
         Ok(LeanSolver {
             model,
             info,
+            red,
+            layout,
             sin_end: info.end_angle.sin(),
             k: vec![0.0; info.n_constants],
             margins: vec![0.0; info.requirements.len()],
-            coeffs: vec![0.0; info.separation_degree + 1],
+            coeffs: vec![0.0; layout.separation_degree + 1],
             rules,
             accept: accept.max(4.0 * f64::EPSILON),
             stack: Vec::with_capacity(64),
@@ -232,7 +243,7 @@ impl<'m> LeanSolver<'m> {
     pub fn solve(&mut self, p: &[f64]) -> Result<LeanPoint, SolveError> {
         self.bind(p).map_err(SolveError::Parameters)?;
         let (theta, drop) = self.separation()?;
-        let delta = self.k[self.info.k_theta_initial] - theta;
+        let delta = self.k[self.layout.k_theta_initial] - theta;
         let t = self.time_to(drop, delta)?;
         Ok(LeanPoint {
             separation_angle: theta,
@@ -299,14 +310,14 @@ impl<'m> LeanSolver<'m> {
     /// separation polynomial in `(sin(end_angle), sin(theta_i))`.
     fn separation(&mut self) -> Result<(f64, f64), SolveError> {
         let info = self.info;
-        self.model.separation_polynomial(&self.k, &mut self.coeffs);
+        self.red.separation_polynomial(&self.k, &mut self.coeffs);
         if self.coeffs.iter().any(|c| !c.is_finite()) || self.coeffs.iter().all(|&c| c == 0.0) {
             return Err(SolveError::BadPolynomial {
                 model: info.name,
                 coefficients: self.coeffs.clone(),
             });
         }
-        let hi = self.k[info.k_sin_initial];
+        let hi = self.k[self.layout.k_sin_initial];
         match largest_root(&self.coeffs, self.sin_end, hi, &mut self.evals) {
             Some(s) => Ok((s.asin(), hi - s)),
             None => Err(SolveError::NoSeparation {
@@ -326,20 +337,21 @@ impl<'m> LeanSolver<'m> {
         if !(drop_end > 0.0 && drop_end.is_finite() && delta_end > 0.0) {
             return Err(SolveError::BadPhaseEnd { model, delta_end });
         }
-        let theta_dot = self.k[info.k_theta_dot_initial];
-        let (si, ci) = (self.k[info.k_sin_initial], self.k[info.k_cos_initial]);
+        let layout = self.layout;
+        let theta_dot = self.k[layout.k_theta_dot_initial];
+        let (si, ci) = (self.k[layout.k_sin_initial], self.k[layout.k_cos_initial]);
         // Released from rest, theta_dot^2 is linear in the drops (ds, dc), which near the start
         // are in the ratio dc / ds -> -sin(theta_i) / cos(theta_i): its value per unit drop there
         // is -2 theta_ddot_i d(delta)/ds, so it must be positive for the rod to fall. (One
         // rational evaluation instead of the trigonometry of `reduced`, which only the error
         // message needs.)
         let slope = if theta_dot == 0.0 && ci > 0.0 {
-            self.model.theta_dot_sq_sc(&self.k, si, ci, 1.0, -si / ci)
+            self.red.theta_dot_sq_sc(&self.k, si, ci, 1.0, -si / ci)
         } else {
             f64::NAN
         };
         if !(slope > 0.0 && slope.is_finite()) {
-            let start = self.model.reduced(&self.k, 0.0);
+            let start = self.red.reduced(&self.k, 0.0);
             return Err(
                 if theta_dot != 0.0 || start.theta_ddot >= 0.0 || start.theta_ddot.is_nan() {
                     SolveError::NoMotion {
@@ -350,7 +362,7 @@ impl<'m> LeanSolver<'m> {
                 } else if ci <= 0.0 || ci.is_nan() {
                     SolveError::BeyondVertical {
                         model,
-                        theta_initial: self.k[info.k_theta_initial],
+                        theta_initial: self.k[layout.k_theta_initial],
                     }
                 } else {
                     SolveError::NonFinite {
@@ -367,7 +379,7 @@ impl<'m> LeanSolver<'m> {
         if !(e > 0.0 && si.abs() < 1.0) {
             return Err(SolveError::BeyondVertical {
                 model,
-                theta_initial: self.k[info.k_theta_initial],
+                theta_initial: self.k[layout.k_theta_initial],
             });
         }
         let root_e = e.sqrt();
@@ -378,6 +390,7 @@ impl<'m> LeanSolver<'m> {
         let v_end = (x + q / (1.0 + (1.0 + q).sqrt())).ln_1p();
         let at = Integrand {
             model: self.model,
+            red: self.red,
             k: &self.k,
             si,
             ci,
@@ -476,6 +489,7 @@ struct Nodes {
 /// The integrand of `t = integral dv` for one point (module docs).
 struct Integrand<'a> {
     model: &'a dyn Model,
+    red: &'a dyn Reduction,
     k: &'a [f64],
     si: f64,
     ci: f64,
@@ -543,7 +557,7 @@ impl Integrand<'_> {
         n.value.clear();
         for i in 0..count {
             n.value.push(
-                self.model
+                self.red
                     .theta_dot_sq_sc(self.k, n.s[i], n.c[i], n.ds[i], n.dc[i]),
             );
         }

@@ -1,10 +1,16 @@
-//! Phases of the motion: one model from its start to separation (or the floor), and the chain
-//! to the next model (e.g. the free rod after it leaves the cube) down to the floor.
+//! Phases of the motion: one model from its start until its contact ends (the force reaching
+//! zero, or the contact running off an edge) or the rod reaches the floor, and the chain to the
+//! next model (the same spec with the contact's coordinate free) down to the floor.
+//!
+//! A phase is solved on one of two routes. A model with a fast path ([`System`]) is solved by
+//! the separation root and the time quadrature of its energy integral; any other model
+//! ([`Bound`]) by integrating `M(q) qdd = F(q, qd)` with event location on the contact force,
+//! the contact's edge and the floor ([`unreduced::integrate`]).
 //!
 //! A next phase gets its parameters from [`NextPhase::bindings`](crate::model::NextPhase): a
-//! parameter of this model, or a coordinate or velocity of the full state at separation
-//! ([`Model::full_state`]). Its clock restarts at zero; the
-//! absolute time of its start is kept in [`PhaseRun::t_start`].
+//! parameter of this model, a coordinate or velocity at the end of the phase, or the value and
+//! rate of the coordinate the contact tied ([`Model::released`](crate::model::Model::released)).
+//! Its clock restarts at zero; the absolute time of its start is kept in [`PhaseRun::t_start`].
 
 use crate::model::{Binding, Model};
 use crate::results::Work;
@@ -12,12 +18,50 @@ use crate::solve::SolveError;
 use crate::solve::quadrature::TimeMesh;
 use crate::solve::separation::{Separation, SeparationOutcome, separation};
 use crate::solve::series::theta_dot_at;
-use crate::system::{State, System};
+use crate::solve::unreduced::{self, EndEvent, UnreducedRun};
+use crate::system::{Bound, State, System};
 
 /// Most phases chained before giving up.
 pub const MAX_PHASES: usize = 8;
 
-/// Where a phase ends: its separation if it has a contact that lets go, else the floor.
+/// An integrated phase that has not reached an event after this many free-fall times of its
+/// falling point is reported as [`SolveError::NoEvent`].
+pub const MAX_FALL_TIMES: f64 = 1000.0;
+
+/// Which route solves a phase.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Route {
+    /// The fast path where the model has one, integration otherwise.
+    #[default]
+    Fastest,
+    /// Integration of `M(q) qdd = F` for every phase, fast path or not (to compare the routes).
+    Integrated,
+}
+
+/// Why a phase ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum End {
+    /// The contact force reached zero: the bodies separate.
+    Separation,
+    /// The contact ran off an edge of a body.
+    Edge,
+    /// The reduced angle reached the model's end angle (the rod lies on the floor).
+    Floor,
+}
+
+impl End {
+    /// `"force"`, `"edge"` or `"floor"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            End::Separation => "force",
+            End::Edge => "edge",
+            End::Floor => "floor",
+        }
+    }
+}
+
+/// Where a phase on the fast path ends: its separation if it has a contact that lets go,
+/// else the floor.
 pub fn phase_end(sys: &System, work: &mut Work) -> Result<(Option<Separation>, f64), SolveError> {
     if sys.info().contact.is_some()
         && let SeparationOutcome::Separates(s) = separation(sys, work)?
@@ -27,9 +71,9 @@ pub fn phase_end(sys: &System, work: &mut Work) -> Result<(Option<Separation>, f
     Ok((None, sys.delta_to_floor()))
 }
 
-/// One phase solved to its end.
+/// A phase solved on the fast path.
 #[derive(Debug, Clone)]
-pub struct PhaseRun<'m> {
+pub struct ReducedRun<'m> {
     /// The model and its parameters for this phase.
     pub system: System<'m>,
     /// Absolute time of the phase start (s from release).
@@ -40,18 +84,7 @@ pub struct PhaseRun<'m> {
     pub mesh: TimeMesh,
 }
 
-impl<'m> PhaseRun<'m> {
-    /// Solves the phase of `sys` starting at absolute time `t_start` to its end.
-    pub fn solve(
-        sys: System<'m>,
-        t_start: f64,
-        tol: f64,
-        work: &mut Work,
-    ) -> Result<Self, SolveError> {
-        let (separation, delta_end) = phase_end(&sys, work)?;
-        Self::with_end(sys, t_start, separation, delta_end, tol, work)
-    }
-
+impl<'m> ReducedRun<'m> {
     /// Solves the phase when its end is already known.
     pub fn with_end(
         sys: System<'m>,
@@ -63,7 +96,7 @@ impl<'m> PhaseRun<'m> {
     ) -> Result<Self, SolveError> {
         let mesh = TimeMesh::build(&sys, delta_end, tol, work)?;
         work.phases.push(sys.name().to_string());
-        Ok(PhaseRun {
+        Ok(ReducedRun {
             system: sys,
             t_start,
             separation,
@@ -71,19 +104,14 @@ impl<'m> PhaseRun<'m> {
         })
     }
 
-    /// Phase duration (s).
-    pub fn duration(&self) -> f64 {
-        self.mesh.duration
-    }
-
-    /// Absolute end time (s from release).
-    pub fn t_end(&self) -> f64 {
-        self.t_start + self.mesh.duration
-    }
-
     /// `theta_dot` at the end of the phase (rad/s).
     pub fn theta_dot_end(&self) -> f64 {
         theta_dot_at(&self.system, self.mesh.delta_end)
+    }
+
+    /// This run as a phase of the motion.
+    pub fn into_phase(self) -> PhaseRun<'m> {
+        PhaseRun::Reduced(self)
     }
 
     /// The full state at the end of the phase.
@@ -96,71 +124,174 @@ impl<'m> PhaseRun<'m> {
     }
 }
 
-/// What the pushed surface does after a separation, for the no-recatch check.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Transition {
-    /// Absolute time of the separation (s).
-    pub t: f64,
-    /// Position of the surface point at separation.
-    pub surface_pos: [f64; 2],
-    /// Its velocity (zero for a fixed surface); it keeps it afterwards.
-    pub surface_vel: [f64; 2],
-    /// Unit normal from the pusher into the pushed body.
-    pub normal: [f64; 2],
-    /// Name of the pushing point (looked up by name in the next phase).
-    pub point: &'static str,
-    /// Name of the surface point.
-    pub surface: &'static str,
+/// A phase solved by integrating its equations of motion.
+#[derive(Debug, Clone)]
+pub struct IntegratedRun<'m> {
+    /// The model and its parameters for this phase.
+    pub bound: Bound<'m>,
+    /// Absolute time of the phase start (s from release).
+    pub t_start: f64,
+    /// The integration, ended by its event.
+    pub run: UnreducedRun,
 }
 
-impl Transition {
-    /// Speed of the pushed surface along the normal after separation (m/s).
-    pub fn surface_speed(&self) -> f64 {
-        self.normal[0] * self.surface_vel[0] + self.normal[1] * self.surface_vel[1]
+/// One phase of the motion on either route.
+#[derive(Debug, Clone)]
+pub enum PhaseRun<'m> {
+    /// On the fast path.
+    Reduced(ReducedRun<'m>),
+    /// Integrated.
+    Integrated(IntegratedRun<'m>),
+}
+
+impl<'m> PhaseRun<'m> {
+    /// Solves a phase starting at absolute time `t_start` to its end, on the fast path when the
+    /// model has one (and `route` allows it). `rtol` is the integrator's tolerance on the other
+    /// route.
+    pub fn solve(
+        bound: Bound<'m>,
+        t_start: f64,
+        tol: f64,
+        rtol: f64,
+        route: Route,
+        work: &mut Work,
+    ) -> Result<Self, SolveError> {
+        if route == Route::Fastest && bound.model().reduction().is_some() {
+            let sys = System::reduce(bound)?;
+            let (separation, delta_end) = phase_end(&sys, work)?;
+            let run = ReducedRun::with_end(sys, t_start, separation, delta_end, tol, work)?;
+            return Ok(PhaseRun::Reduced(run));
+        }
+        let time = fall_time_scale(&bound);
+        let scales = motion_scales(&bound, time)?;
+        let run = unreduced::integrate(&bound, rtol, Some(&scales), time * MAX_FALL_TIMES, work)?;
+        work.phases.push(bound.name().to_string());
+        Ok(PhaseRun::Integrated(IntegratedRun {
+            bound,
+            t_start,
+            run,
+        }))
     }
 
-    /// Gap between the surface (moving on at its separation velocity) and a point at absolute
-    /// time `t`, along the normal; positive while apart.
-    pub fn gap(&self, t: f64, point: [f64; 2]) -> f64 {
-        let dt = t - self.t;
-        let s = [
-            self.surface_pos[0] + self.surface_vel[0] * dt,
-            self.surface_pos[1] + self.surface_vel[1] * dt,
-        ];
-        self.normal[0] * (s[0] - point[0]) + self.normal[1] * (s[1] - point[1])
+    /// The model and its parameters.
+    pub fn bound(&self) -> &Bound<'m> {
+        match self {
+            PhaseRun::Reduced(r) => r.system.bound(),
+            PhaseRun::Integrated(r) => &r.bound,
+        }
+    }
+
+    /// Absolute time of the phase start (s from release).
+    pub fn t_start(&self) -> f64 {
+        match self {
+            PhaseRun::Reduced(r) => r.t_start,
+            PhaseRun::Integrated(r) => r.t_start,
+        }
+    }
+
+    /// Phase duration (s).
+    pub fn duration(&self) -> f64 {
+        match self {
+            PhaseRun::Reduced(r) => r.mesh.duration,
+            PhaseRun::Integrated(r) => r.run.t_end,
+        }
+    }
+
+    /// Absolute end time (s from release).
+    pub fn t_end(&self) -> f64 {
+        self.t_start() + self.duration()
+    }
+
+    /// Why the phase ended.
+    pub fn end(&self) -> End {
+        match self {
+            PhaseRun::Reduced(r) if r.separation.is_some() => End::Separation,
+            PhaseRun::Reduced(_) => End::Floor,
+            PhaseRun::Integrated(r) => match r.run.end {
+                EndEvent::Separation => End::Separation,
+                EndEvent::Edge => End::Edge,
+                EndEvent::Floor => End::Floor,
+            },
+        }
+    }
+
+    /// The full state at the end of the phase.
+    pub fn end_state(&self) -> State {
+        match self {
+            PhaseRun::Reduced(r) => r.end_state(),
+            PhaseRun::Integrated(r) => r.run.state_end.clone(),
+        }
+    }
+
+    /// The reduced angle at the end of the phase (rad).
+    pub fn theta_end(&self) -> f64 {
+        self.end_state().q[self.bound().info().reduced]
+    }
+
+    /// `theta_dot` at the end of the phase (rad/s).
+    pub fn theta_dot_end(&self) -> f64 {
+        match self {
+            PhaseRun::Reduced(r) => r.theta_dot_end(),
+            PhaseRun::Integrated(r) => r.run.state_end.qd[r.bound.info().reduced],
+        }
+    }
+
+    /// The phase on the fast path, if it is on it.
+    pub fn reduced(&self) -> Option<&ReducedRun<'m>> {
+        match self {
+            PhaseRun::Reduced(r) => Some(r),
+            PhaseRun::Integrated(_) => None,
+        }
     }
 }
 
-/// The pushed surface at the end of a phase that separated.
-pub fn transition(run: &PhaseRun) -> Option<Transition> {
-    let info = run.system.info();
-    let contact = info.contact?;
-    run.separation?;
-    let pts = run.system.points(&run.end_state());
-    let vel = if contact.surface_moves {
-        pts.vel[contact.surface]
-    } else {
-        [0.0; 2]
+/// `sqrt(2 h / g)` for the initial height `h` of the falling point (`sqrt(2 m / g)` when it
+/// starts on the floor): the time scale of the motion.
+fn fall_time_scale(bound: &Bound) -> f64 {
+    let info = bound.info();
+    let h = bound.points(&bound.initial_state()).pos[info.falling_point][1];
+    let h = if h > 0.0 { h } else { 1.0 };
+    (2.0 * h / bound.gravity()).sqrt()
+}
+
+/// Typical sizes of the motion's deviation from the release state over the time scale `time`,
+/// for the integrator's absolute tolerances: `|qd0| T + |qdd0| T^2 / 2` for the coordinates and
+/// `|qd0| + |qdd0| T` for the velocities, each at least `1e-8` of the largest of its kind, so
+/// that a tiny system (a rod of 1 cm nearly flat) is held to its own scale, not to one metre.
+fn motion_scales(bound: &Bound, time: f64) -> Result<Vec<f64>, SolveError> {
+    let start = bound.initial_state();
+    let qdd = unreduced::accelerations(bound, &start, 0.0)?;
+    let q: Vec<f64> = (start.qd.iter().zip(&qdd))
+        .map(|(v, a)| v.abs() * time + 0.5 * a.abs() * time * time)
+        .collect();
+    let v: Vec<f64> = (start.qd.iter().zip(&qdd))
+        .map(|(v, a)| v.abs() + a.abs() * time)
+        .collect();
+    let floor = |x: Vec<f64>| {
+        let top = x.iter().cloned().fold(0.0, f64::max);
+        x.into_iter()
+            .map(|s| s.max(1e-8 * top).max(f64::MIN_POSITIVE))
+            .collect::<Vec<f64>>()
     };
-    Some(Transition {
-        t: run.t_end(),
-        surface_pos: pts.pos[contact.surface],
-        surface_vel: vel,
-        normal: contact.normal,
-        point: info.points[contact.point].name,
-        surface: info.points[contact.surface].name,
-    })
+    let mut scales = floor(q);
+    scales.extend(floor(v));
+    Ok(scales)
 }
 
-/// The system of the phase after `run` (which must have separated), from the registry.
-pub fn next_system<'m>(
+/// The bound model of the phase after `run`, from the registry: only after a separation (the
+/// motion after a contact runs off an edge is not modelled).
+pub fn next_bound<'m>(
     run: &PhaseRun<'m>,
     registry: &[&'m dyn Model],
-) -> Result<Option<System<'m>>, SolveError> {
-    let info = run.system.info();
-    let (Some(next), Some(_)) = (info.next_phase, run.separation) else {
+) -> Result<Option<Bound<'m>>, SolveError> {
+    let bound = run.bound();
+    let info = bound.info();
+    let Some(next) = info.next_phase else {
         return Ok(None);
     };
+    if run.end() != End::Separation {
+        return Ok(None);
+    }
     let Some(model) = registry
         .iter()
         .copied()
@@ -182,8 +313,8 @@ pub fn next_system<'m>(
         return Err(bad());
     }
     let end = run.end_state();
-    let pts = run.system.points(&end);
-    let p = run.system.p();
+    let released = bound.released(&end);
+    let p = bound.p();
     let values = next
         .bindings
         .iter()
@@ -191,23 +322,19 @@ pub fn next_system<'m>(
             Binding::Param(i) => p.get(i).copied(),
             Binding::Coordinate(i) => end.q.get(i).copied(),
             Binding::Velocity(i) => end.qd.get(i).copied(),
-            Binding::Point { index, axis } => pts.pos.get(index).and_then(|v| v.get(axis)).copied(),
-            Binding::PointVelocity { index, axis } => {
-                pts.vel.get(index).and_then(|v| v.get(axis)).copied()
-            }
+            Binding::Eliminated => released.map(|r| r[0]),
+            Binding::EliminatedRate => released.map(|r| r[1]),
         })
         .collect::<Option<Vec<f64>>>()
         .ok_or_else(bad)?;
-    Ok(Some(System::from_values(model, &values)?))
+    Ok(Some(Bound::from_values(model, &values)?))
 }
 
 /// The whole motion from release to the floor, phase after phase.
 #[derive(Debug, Clone)]
 pub struct Motion<'m> {
-    /// The phases in order; the last one reaches the floor.
+    /// The phases in order; the last one reaches the floor (or ends at an edge).
     pub phases: Vec<PhaseRun<'m>>,
-    /// One per separation followed by a next phase (`transitions[i]` ends `phases[i]`).
-    pub transitions: Vec<Transition>,
 }
 
 impl<'m> Motion<'m> {
@@ -215,18 +342,22 @@ impl<'m> Motion<'m> {
     pub fn new(first: PhaseRun<'m>) -> Self {
         Motion {
             phases: vec![first],
-            transitions: Vec::new(),
         }
     }
 
-    /// Absolute time the rod reaches the floor (s).
+    /// Absolute time the last phase ends (s): the rod on the floor, unless it ended at an edge.
     pub fn floor_time(&self) -> f64 {
         self.phases.last().map_or(0.0, PhaseRun::t_end)
     }
 
-    /// `theta_dot` when the rod reaches the floor (rad/s).
+    /// `theta_dot` at the end of the last phase (rad/s).
     pub fn impact_angular_velocity(&self) -> f64 {
         self.phases.last().map_or(0.0, PhaseRun::theta_dot_end)
+    }
+
+    /// Why the last phase ended.
+    pub fn last_end(&self) -> Option<End> {
+        self.phases.last().map(PhaseRun::end)
     }
 }
 
@@ -235,29 +366,20 @@ pub fn extend_to_floor<'m>(
     motion: &mut Motion<'m>,
     registry: &[&'m dyn Model],
     tol: f64,
+    rtol: f64,
+    route: Route,
     work: &mut Work,
 ) -> Result<(), SolveError> {
     loop {
         let last = &motion.phases[motion.phases.len() - 1];
-        let Some(transition) = transition(last) else {
-            return Ok(());
-        };
-        let Some(next) = next_system(last, registry)? else {
+        let Some(next) = next_bound(last, registry)? else {
             return Ok(());
         };
         if motion.phases.len() >= MAX_PHASES {
             return Err(SolveError::TooManyPhases { limit: MAX_PHASES });
         }
-        if next.point_index(transition.point).is_none() {
-            return Err(SolveError::MissingPoint {
-                from: last.system.name(),
-                name: next.name(),
-                point: transition.point,
-            });
-        }
         let t_start = last.t_end();
-        let run = PhaseRun::solve(next, t_start, tol, work)?;
-        motion.transitions.push(transition);
+        let run = PhaseRun::solve(next, t_start, tol, rtol, route, work)?;
         motion.phases.push(run);
     }
 }

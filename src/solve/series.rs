@@ -1,4 +1,6 @@
-//! `theta(t)` on a phase at uniform times, by inverting the quadrature `t(u)` (`delta = u^2`).
+//! Samples of a phase at uniform times. On the fast path `theta(t)` comes from inverting the
+//! quadrature `t(u)` (`delta = u^2`); on the integrated route from the integrator's dense
+//! output.
 //!
 //! The first-order form of the energy integral (the paper's eq. 17,
 //! `theta_dot = -sqrt(theta_dot^2(theta))`) is not integrated: released from rest it also has
@@ -8,15 +10,17 @@
 
 use crate::results::Work;
 use crate::solve::SolveError;
+use crate::solve::phases::{IntegratedRun, PhaseRun};
 use crate::solve::quadrature::{TimeMesh, integrand};
-use crate::system::System;
+use crate::solve::unreduced::accelerations;
+use crate::system::{State, System};
 
 /// Samples of one phase, uniform in time from its start to its end (both included).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct PhaseSamples {
     /// Time from the phase start (s).
     pub t: Vec<f64>,
-    /// Angle fallen, `theta_i - theta` (rad).
+    /// Angle fallen, `theta_i - theta` (rad); on the fast path only (empty when integrated).
     pub delta: Vec<f64>,
     /// `theta` (rad).
     pub theta: Vec<f64>,
@@ -24,6 +28,8 @@ pub struct PhaseSamples {
     pub theta_dot: Vec<f64>,
     /// `theta_ddot` (rad/s^2).
     pub theta_ddot: Vec<f64>,
+    /// The full state at each sample.
+    pub states: Vec<State>,
 }
 
 impl PhaseSamples {
@@ -102,11 +108,74 @@ pub fn delta_at_time(
 
 fn push(sys: &System, out: &mut PhaseSamples, t: f64, delta: f64) {
     let reduced = sys.reduced(delta);
+    let theta_dot = theta_dot_at(sys, delta);
     out.t.push(t);
     out.delta.push(delta);
     out.theta.push(sys.theta_initial() - delta);
-    out.theta_dot.push(theta_dot_at(sys, delta));
+    out.theta_dot.push(theta_dot);
     out.theta_ddot.push(reduced.theta_ddot);
+    out.states.push(sys.full_state(t, delta, theta_dot));
+}
+
+/// `samples` points uniform in time over a phase on either route.
+pub fn sample(run: &PhaseRun, samples: usize, work: &mut Work) -> Result<PhaseSamples, SolveError> {
+    match run {
+        PhaseRun::Reduced(r) => sample_phase(&r.system, &r.mesh, samples, work),
+        PhaseRun::Integrated(r) => sample_integrated(r, samples),
+    }
+}
+
+/// `samples` points uniform in time over an integrated phase, from its dense output (the last
+/// one is the event state itself).
+pub fn sample_integrated(run: &IntegratedRun, samples: usize) -> Result<PhaseSamples, SolveError> {
+    if samples < 2 {
+        return Err(SolveError::TooFewSamples { samples });
+    }
+    let bound = &run.bound;
+    let n = bound.n_coordinates();
+    let r = bound.info().reduced;
+    let duration = run.run.t_end;
+    let mut out = PhaseSamples::default();
+    for j in 0..samples {
+        let t = duration * j as f64 / (samples - 1) as f64;
+        let state = if j == samples - 1 {
+            run.run.state_end.clone()
+        } else {
+            let y = run.run.state_at(t).ok_or(SolveError::Inversion {
+                target: t,
+                duration,
+                reason: "time outside the integrated phase",
+            })?;
+            State {
+                q: y[..n].to_vec(),
+                qd: y[n..].to_vec(),
+            }
+        };
+        let qdd = accelerations(bound, &state, t)?;
+        out.t.push(t);
+        out.theta.push(state.q[r]);
+        out.theta_dot.push(state.qd[r]);
+        out.theta_ddot.push(qdd[r]);
+        out.states.push(state);
+    }
+    Ok(out)
+}
+
+/// The reaction forces at every sample of a phase: from the energy integral on the fast path
+/// (its cancellation-free forms), from the accelerations of the equations of motion otherwise.
+pub fn sample_forces(run: &PhaseRun, s: &PhaseSamples) -> Result<Vec<Vec<f64>>, SolveError> {
+    match run {
+        PhaseRun::Reduced(r) => Ok(s.delta.iter().map(|&d| r.system.forces(d)).collect()),
+        PhaseRun::Integrated(r) => s
+            .states
+            .iter()
+            .zip(&s.t)
+            .map(|(state, &t)| {
+                let qdd = accelerations(&r.bound, state, t)?;
+                Ok(r.bound.forces_full(state, &qdd))
+            })
+            .collect(),
+    }
 }
 
 /// Solves `t(u) = target` for `u` in `[u_lo, u_end]`, knowing `t(u_lo) = t_lo <= target`.

@@ -1,7 +1,8 @@
 //! The unreduced equations `M(q) qdd = F(q, qd)` of a model as an ODE, integrated with
 //! [`ode::dopri5`](crate::solve::ode::dopri5) from the release state until the contact force
-//! crosses zero (separation) or the reduced angle reaches the floor: an independent route to
-//! the separation time that shares no code with the quadrature.
+//! crosses zero (separation), the contact runs off its edge, or the reduced angle reaches the
+//! floor: the route of every model without a fast path, and for the others an independent
+//! route to the separation time that shares no code with the quadrature.
 //!
 //! The integrator's state is the deviation `z = y - y0` from the release state `y0 = [q, qd]`,
 //! so its error control is relative to the motion itself rather than to the absolute angle: a
@@ -18,7 +19,7 @@
 use crate::results::Work;
 use crate::solve::SolveError;
 use crate::solve::ode::{OdeOptions, OdeProblem, OdeSolution, dopri5};
-use crate::system::{State, System};
+use crate::system::{Bound, State};
 use nalgebra::{DMatrix, DVector};
 
 /// The tolerance floor is this many times `eps * cond(M)` at release.
@@ -31,7 +32,7 @@ pub const MAX_RTOL: f64 = 1e-2;
 pub const MAX_STEPS: u64 = 200_000;
 
 /// The 2-norm condition number of the mass matrix at a state (infinite if singular).
-pub fn mass_condition(sys: &System, state: &State) -> f64 {
+pub fn mass_condition(sys: &Bound, state: &State) -> f64 {
     let n = sys.n_coordinates();
     let (mass, _) = sys.equations(state);
     let sv = DMatrix::from_row_slice(n, n, &mass).singular_values();
@@ -45,7 +46,7 @@ pub fn mass_condition(sys: &System, state: &State) -> f64 {
 }
 
 /// Accelerations `qdd` solving `M(q) qdd = F(q, qd)` at a state (`t` labels errors).
-pub fn accelerations(sys: &System, state: &State, t: f64) -> Result<Vec<f64>, SolveError> {
+pub fn accelerations(sys: &Bound, state: &State, t: f64) -> Result<Vec<f64>, SolveError> {
     let n = sys.n_coordinates();
     let (mass, rhs) = sys.equations(state);
     let m = DMatrix::from_row_slice(n, n, &mass);
@@ -64,6 +65,8 @@ pub fn accelerations(sys: &System, state: &State, t: f64) -> Result<Vec<f64>, So
 pub enum EndEvent {
     /// The contact force crossed zero.
     Separation,
+    /// The contact's edge margin crossed zero.
+    Edge,
     /// The reduced angle reached the model's end angle.
     Floor,
 }
@@ -103,6 +106,18 @@ impl UnreducedRun {
             .collect()
     }
 
+    /// The full state at the release and at the end of every accepted step.
+    pub fn states(&self) -> Vec<State> {
+        let n = self.state_end.q.len();
+        self.nodes()
+            .into_iter()
+            .map(|(_, y)| State {
+                q: y[..n].to_vec(),
+                qd: y[n..].to_vec(),
+            })
+            .collect()
+    }
+
     /// Every step taken (accepted, rejected and event trials).
     pub fn steps(&self) -> u64 {
         self.solution.total_steps()
@@ -114,9 +129,10 @@ impl UnreducedRun {
 }
 
 struct Problem<'a, 'm> {
-    sys: &'a System<'m>,
+    sys: &'a Bound<'m>,
     n: usize,
     contact: Option<usize>,
+    edge: bool,
     reduced: usize,
     end_angle: f64,
     y0: Vec<f64>,
@@ -149,15 +165,20 @@ impl OdeProblem for Problem<'_, '_> {
     }
 
     fn n_events(&self) -> usize {
-        1 + usize::from(self.contact.is_some())
+        1 + usize::from(self.contact.is_some()) + usize::from(self.edge)
     }
 
+    /// Events in order: the contact force, the edge margin, the floor.
     fn events(&mut self, _t: f64, z: &[f64], dz: &[f64], g: &mut [f64]) -> Result<(), SolveError> {
         self.load(z);
         let mut i = 0;
         if let Some(c) = self.contact {
-            g[0] = self.sys.forces_full(&self.state, &dz[self.n..])[c];
-            i = 1;
+            g[i] = self.sys.forces_full(&self.state, &dz[self.n..])[c];
+            i += 1;
+        }
+        if self.edge {
+            g[i] = self.sys.contact_edge(&self.state);
+            i += 1;
         }
         g[i] = self.state.q[self.reduced] - self.end_angle;
         Ok(())
@@ -170,7 +191,7 @@ impl OdeProblem for Problem<'_, '_> {
 /// the absolute tolerances; without them the control is relative to the largest deviation
 /// seen. `t_max` bounds the search. `rtol` is raised to [`CONDITION_SAFETY`]` * eps * cond(M)`.
 pub fn integrate(
-    sys: &System,
+    sys: &Bound,
     rtol: f64,
     scales: Option<&[f64]>,
     t_max: f64,
@@ -194,6 +215,7 @@ pub fn integrate(
         sys,
         n,
         contact: info.contact.map(|c| c.force),
+        edge: info.contact.is_some_and(|c| c.edge),
         reduced: info.reduced,
         end_angle: info.end_angle,
         y0: y0.clone(),
@@ -218,8 +240,11 @@ pub fn integrate(
     let Some(event) = solution.event.clone() else {
         return Err(SolveError::NoEvent { t_max });
     };
-    let end = if problem.contact.is_some() && event.index == 0 {
+    let n_contact = usize::from(problem.contact.is_some());
+    let end = if event.index < n_contact {
         EndEvent::Separation
+    } else if problem.edge && event.index == n_contact {
+        EndEvent::Edge
     } else {
         EndEvent::Floor
     };

@@ -113,25 +113,56 @@ pub struct ForceSpec {
     pub name: String,
     /// Body whose equation of motion gives the force.
     pub body: String,
-    /// Unit direction; the force must be the only one on `body` with a component along it
-    /// (besides gravity, which is accounted for).
-    pub direction: [f64; 2],
+    /// Direction `d`, numbers (a unit vector) or expressions of the coordinates: the force is
+    /// the body's Newton balance projected on `d`, `m (d . a) + m g d_y`, that is the sum of
+    /// the non-gravity forces on `body` dotted with `d`. It measures one force when every other
+    /// force on the body is perpendicular to `d`; a force along a direction that another force
+    /// also has a component on can be isolated with a `d` perpendicular to that other force,
+    /// scaled so that the wanted force comes out whole (the floor's push on a rod that also
+    /// leans on a cylinder: `d = [cos(theta)/sin(theta), 1]`, perpendicular to the push).
+    pub direction: [Text; 2],
     /// What it is, with its sign convention.
     pub meaning: String,
 }
 
-/// The separating contact.
+/// An extra potential-energy term besides gravity (a spring, say).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PotentialSpec {
+    /// Identifier.
+    pub name: String,
+    /// Energy as an expression of parameters and coordinates (J).
+    pub expr: Text,
+    /// The bodies its force acts on. A reaction force in `forces` is measured by a Newton
+    /// balance on one body, which is only right when no potential acts on that body besides
+    /// gravity: the spec check refuses such a pair.
+    pub acts_on: Vec<String>,
+    /// What it is.
+    pub meaning: String,
+}
+
+/// A unilateral contact: `gap(q) >= 0`, touching while `gap = 0` and its force is positive.
+///
+/// While touching, `gap = 0` is solved for the coordinate `eliminates` (the gap must be linear
+/// in it with a constant coefficient `c`), which is substituted everywhere; the contact force
+/// is the Lagrange multiplier `lambda = E_e / c`, where `E_e` is the Euler–Lagrange expression
+/// of that coordinate with every other force accounted for. The phase after the contact ends is
+/// derived from the same spec with the coordinate free again (the model `<name>_free`).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ContactSpec {
-    /// Name of the force (in `forces`) that is positive while touching.
+    /// Name of the contact force (a result key; not one of `forces`).
     pub force: String,
-    /// Point of the pusher that touches (in `points`).
-    pub point: String,
-    /// A point on the pushed surface (in `points`).
-    pub surface: String,
-    /// Unit normal of the surface, from the pusher into the pushed body.
-    pub normal: [f64; 2],
+    /// What the force is, with its sign convention (positive while the bodies push apart).
+    pub meaning: String,
+    /// Gap: positive when apart, zero when touching (expression of parameters and coordinates).
+    pub gap: Text,
+    /// The coordinate solved from `gap = 0` while touching.
+    pub eliminates: String,
+    /// Optional geometric end: an expression that stays `>= 0` while the contact can exist
+    /// (a contact point still on the body); its zero ends the contact at an edge.
+    #[serde(default)]
+    pub edge: Option<Text>,
 }
 
 /// A physical assumption: `expr` must stay `>= 0` during the motion.
@@ -156,16 +187,6 @@ pub struct InitialSpec {
     pub velocity: Text,
 }
 
-/// The model that continues after separation, and where its parameters come from.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct AfterSpec {
-    /// Next model's name.
-    pub model: String,
-    /// Next model's parameter -> a parameter of this model, a coordinate, or `<coordinate>_dot`.
-    pub parameters: BTreeMap<String, String>,
-}
-
 /// A whole model spec.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -183,7 +204,8 @@ pub struct Spec {
     pub gravity: String,
     /// Generalized coordinates.
     pub coordinates: Vec<CoordSpec>,
-    /// The coordinate kept after the cyclic ones are eliminated.
+    /// The coordinate reported as the angle of the motion (`theta`): the one kept when the
+    /// others are cyclic and eliminated, and the one whose `end_angle` ends the motion.
     pub reduced: String,
     /// Value of the reduced coordinate where the motion ends (the floor).
     pub end_angle: f64,
@@ -194,6 +216,9 @@ pub struct Spec {
     pub points: Vec<PointSpec>,
     /// Point whose initial height gives the reference free-fall time.
     pub falling_point: String,
+    /// Potential energy besides gravity.
+    #[serde(default)]
+    pub potentials: Vec<PotentialSpec>,
     /// Reaction forces to evaluate.
     #[serde(default)]
     pub forces: Vec<ForceSpec>,
@@ -203,11 +228,8 @@ pub struct Spec {
     /// Monitored assumptions.
     #[serde(default)]
     pub monitors: Vec<MonitorSpec>,
-    /// Initial state, one entry per coordinate.
+    /// Initial state, one entry per coordinate (except the one the contact eliminates).
     pub initial: BTreeMap<String, InitialSpec>,
-    /// The phase after separation.
-    #[serde(default)]
-    pub after_separation: Option<AfterSpec>,
 }
 
 /// A spec error with its place.
@@ -402,6 +424,20 @@ impl Checker<'_> {
                 ));
             }
         }
+        if let Some(c) = &s.contact {
+            let field = Field::key("contact").k("force");
+            self.identifier(&field, &c.force, &mut force_names)?;
+            if seen.contains(&c.force) {
+                return Err(self.err(
+                    &field,
+                    format!("`{}` is already a parameter or coordinate", c.force),
+                ));
+            }
+        }
+        let mut potential_names = BTreeSet::new();
+        for (i, p) in s.potentials.iter().enumerate() {
+            self.identifier(&named("potentials", i), &p.name, &mut potential_names)?;
+        }
         let mut monitor_names = BTreeSet::new();
         for (i, m) in s.monitors.iter().enumerate() {
             self.identifier(&named("monitors", i), &m.name, &mut monitor_names)?;
@@ -458,6 +494,18 @@ impl Checker<'_> {
             self.expr(&f.i(1), &p.position[1], &kinematic)?;
         }
         let bodies: BTreeSet<String> = s.bodies.iter().map(|b| b.name.clone()).collect();
+        for (i, p) in s.potentials.iter().enumerate() {
+            let field = Field::key("potentials").i(i);
+            self.expr(&field.k("expr"), &p.expr, &kinematic)?;
+            for (j, b) in p.acts_on.iter().enumerate() {
+                if !bodies.contains(b) {
+                    return Err(self.err(
+                        &field.k("acts_on").i(j),
+                        format!("`{b}` is not one of the bodies"),
+                    ));
+                }
+            }
+        }
         for (i, f) in s.forces.iter().enumerate() {
             let field = Field::key("forces").i(i);
             if !bodies.contains(&f.body) {
@@ -466,27 +514,54 @@ impl Checker<'_> {
                     format!("`{}` is not one of the bodies", f.body),
                 ));
             }
-            self.unit(&field.k("direction"), f.direction)?;
+            if let Some(p) = s.potentials.iter().find(|p| p.acts_on.contains(&f.body)) {
+                return Err(self.err(
+                    &field.k("body"),
+                    format!(
+                        "force `{}` is measured by a Newton balance on `{}`, but potential `{}` \
+                         also acts on that body, so the balance would not isolate the force; \
+                         measure it on another body or make it a contact",
+                        f.name, f.body, p.name
+                    ),
+                ));
+            }
+            let d = field.k("direction");
+            self.expr(&d.i(0), &f.direction[0], &kinematic)?;
+            self.expr(&d.i(1), &f.direction[1], &kinematic)?;
+            if let (Text::Num(x), Text::Num(y)) = (&f.direction[0], &f.direction[1]) {
+                self.unit(&d, [*x, *y])?;
+            }
         }
         if let Some(c) = &s.contact {
             let field = Field::key("contact");
-            if !force_names.contains(&c.force) {
+            self.expr(&field.k("gap"), &c.gap, &kinematic)?;
+            if !coords.contains(&c.eliminates) {
                 return Err(self.err(
-                    &field.k("force"),
-                    format!("`{}` is not one of the forces", c.force),
+                    &field.k("eliminates"),
+                    format!("`{}` is not a coordinate", c.eliminates),
                 ));
             }
-            for (key, name) in [("point", &c.point), ("surface", &c.surface)] {
-                if !point_names.contains(name) {
-                    return Err(
-                        self.err(&field.k(key), format!("`{name}` is not one of the points"))
-                    );
-                }
+            if c.eliminates == s.reduced {
+                return Err(self.err(
+                    &field.k("eliminates"),
+                    format!(
+                        "`{}` is the reduced coordinate, which the motion is reported in; \
+                         eliminate another one",
+                        c.eliminates
+                    ),
+                ));
             }
-            self.unit(&field.k("normal"), c.normal)?;
+            if s.coordinates.len() < 2 {
+                return Err(self.err(
+                    &field.k("eliminates"),
+                    "a contact needs a coordinate besides the reduced one to eliminate".into(),
+                ));
+            }
+            if let Some(edge) = &c.edge {
+                self.expr(&field.k("edge"), edge, &kinematic)?;
+            }
         }
-        let mut monitor_scope = params.clone();
-        monitor_scope.insert(s.reduced.clone());
+        let mut monitor_scope = kinematic.clone();
         monitor_scope.extend(force_names.iter().cloned());
         for (i, m) in s.monitors.iter().enumerate() {
             self.expr(
@@ -495,7 +570,21 @@ impl Checker<'_> {
                 &monitor_scope,
             )?;
         }
+        let eliminated = s.contact.as_ref().map(|c| c.eliminates.as_str());
         for c in &s.coordinates {
+            if Some(c.name.as_str()) == eliminated {
+                if s.initial.contains_key(&c.name) {
+                    return Err(self.err(
+                        &Field::key("initial").k(&c.name),
+                        format!(
+                            "`{}` starts where `gap = 0` puts it (the contact eliminates it); \
+                             remove its initial value",
+                            c.name
+                        ),
+                    ));
+                }
+                continue;
+            }
             let Some(init) = s.initial.get(&c.name) else {
                 return Err(self.err(
                     &Field::key("initial"),
@@ -514,36 +603,6 @@ impl Checker<'_> {
                 &Field::key("initial").k(extra),
                 format!("`{extra}` is not a coordinate"),
             ));
-        }
-        if let Some(after) = &s.after_separation {
-            let f = Field::key("after_separation");
-            if !is_identifier(&after.model) {
-                return Err(self.err(
-                    &f.k("model"),
-                    format!("`{}` is not a plain identifier", after.model),
-                ));
-            }
-            if s.contact.is_none() {
-                return Err(self.err(&f, "a phase after separation needs a `contact`".into()));
-            }
-            for (k, v) in &after.parameters {
-                let point = |p: &str| point_names.contains(p);
-                let ok = params.contains(v)
-                    || coords.contains(v)
-                    || v.strip_suffix("_dot").is_some_and(|c| coords.contains(c))
-                    || v.split_once('.').is_some_and(|(p, axis)| {
-                        point(p) && ["x", "y", "x_dot", "y_dot"].contains(&axis)
-                    });
-                if !ok {
-                    return Err(self.err(
-                        &f.k("parameters").k(k),
-                        format!(
-                            "`{v}` is none of: a parameter, a coordinate, `<coordinate>_dot`, \
-                             `<point>.x`, `<point>.y`, `<point>.x_dot`, `<point>.y_dot`"
-                        ),
-                    ));
-                }
-            }
         }
         Ok(())
     }

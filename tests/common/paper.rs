@@ -1,14 +1,16 @@
 //! Hand-typed models of the seed paper, for testing the solvers before (and independently of)
 //! the generated ones: `rod_cube` from eqs. (5), (9), (12 as corrected in PHYSICS.md erratum 2),
-//! (14), (16), (18), (22), and `free_rod`, the rod sliding alone after it leaves the cube.
+//! (14), (16), (18), (22), and `rod_cube_free`, the rod sliding alone and the cube gliding on
+//! after they part.
 //!
 //! Both follow the `k`/`delta` conventions of `rodcube::model`; every `sin(theta_i) - sin(theta)`
-//! and `cos(theta) - cos(theta_i)` is formed from `delta` without cancellation. Neither writes
-//! `theta_dot_sq_sc`: they use the trait's default (through `reduced`), which the tests compare
-//! with the generated one.
+//! and `cos(theta) - cos(theta_i)` is formed from `delta` without cancellation. Their
+//! `theta_dot_sq_sc` recovers `delta` from the drops and calls `reduced`, an independent route
+//! that the tests compare with the generated one.
 
 use rodcube::model::{
-    Binding, ContactInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
+    Binding, ContactInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced, Reduction,
+    ReductionInfo,
 };
 
 const fn param(
@@ -39,6 +41,12 @@ fn sin_drop(s0: f64, c0: f64, delta: f64) -> f64 {
 fn cos_rise(s0: f64, c0: f64, delta: f64) -> f64 {
     let h = (0.5 * delta).sin();
     s0 * delta.sin() - c0 * 2.0 * h * h
+}
+
+/// `delta` from the drops `ds = sin(theta_i) - s`, `dc = cos(theta_i) - c` without
+/// cancellation: `atan2(cos(theta_i) ds - sin(theta_i) dc, cos(theta_i) c + sin(theta_i) s)`.
+fn delta_from_drops(si: f64, ci: f64, s: f64, c: f64, ds: f64, dc: f64) -> f64 {
+    (ci * ds - si * dc).atan2(ci * c + si * s)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -76,10 +84,6 @@ static RC_INFO: ModelInfo = ModelInfo {
         "the cube is lower than the rod is long: (ell - a) / ell > 0",
     )],
     n_constants: 12,
-    k_theta_initial: RC_THETA_I,
-    k_theta_dot_initial: RC_THETA_DOT_I,
-    k_sin_initial: RC_R,
-    k_cos_initial: RC_C0,
     coordinates: &["x1", "theta"],
     reduced: 1,
     cyclic: &[0],
@@ -96,12 +100,9 @@ static RC_INFO: ModelInfo = ModelInfo {
     ],
     contact: Some(ContactInfo {
         force: 0,
-        point: 1,
-        surface: 3,
-        normal: [1.0, 0.0],
-        surface_moves: true,
+        eliminated: "x2",
+        edge: false,
     }),
-    separation_degree: 3,
     points: &[
         named("foot", "rod end on the floor"),
         named("tip", "rod end on the cube"),
@@ -115,17 +116,29 @@ static RC_INFO: ModelInfo = ModelInfo {
         named("cube_does_not_tip", "m2 g a/2 - F (ell s - a/2) >= 0 (N m)"),
     ],
     next_phase: Some(NextPhase {
-        model: "free_rod",
+        model: "rod_cube_free",
         bindings: &[
             Binding::Param(0),
+            Binding::Param(1),
             Binding::Param(2),
+            Binding::Param(3),
             Binding::Param(4),
-            Binding::Coordinate(1),
-            Binding::Velocity(1),
             Binding::Coordinate(0),
+            Binding::Coordinate(1),
+            Binding::Eliminated,
             Binding::Velocity(0),
+            Binding::Velocity(1),
+            Binding::EliminatedRate,
         ],
     }),
+    reduction: Some(ReductionInfo {
+        k_theta_initial: RC_THETA_I,
+        k_theta_dot_initial: RC_THETA_DOT_I,
+        k_sin_initial: RC_R,
+        k_cos_initial: RC_C0,
+        separation_degree: 3,
+    }),
+    route_note: "",
 };
 
 impl RodCube {
@@ -168,63 +181,9 @@ impl Model for RodCube {
         k[RC_KX] = (0.5 * m1 + m2) / (m1 + m2);
     }
 
-    fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let (s, c) = Self::sc(k, delta);
-        let (r, mu, g_ell) = (k[RC_R], k[RC_MU], k[RC_G_ELL]);
-        let drop = sin_drop(r, k[RC_C0], delta); // r - s
-        let d = 4.0 / 3.0 - mu * s * s;
-        let theta_dot_sq = 4.0 * g_ell * drop / d; // eq. (9)
-        // PHYSICS.md erratum 2: theta'' = (2g/ell) [ -c/D + (r - s) sin(2 theta) / ((1+n) D^2) ]
-        let theta_ddot = 2.0 * g_ell * (-c / d + drop * 2.0 * s * c * mu / (d * d));
-        Reduced {
-            sin: s,
-            cos: c,
-            theta_dot_sq,
-            theta_ddot,
-        }
-    }
-
-    fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let (m1, m2, ell, g) = (k[0], k[1], k[2], k[4]);
-        let red = self.reduced(k, delta);
-        let (s, c) = (red.sin, red.cos);
-        let (r, mu) = (k[RC_R], k[RC_MU]);
-        // eq. (16) divided through by (1 + n)^2
-        let den = 4.0 - 3.0 * mu * s * s;
-        out[0] = -3.0 * g * m2 * mu * c * (8.0 * r - 12.0 * s + 3.0 * mu * s * s * s) / (den * den);
-        out[1] = m1 * (g + 0.5 * ell * (c * red.theta_ddot - s * red.theta_dot_sq));
-    }
-
-    fn monitors(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let mut f = [0.0; 2];
-        self.forces(k, delta, &mut f);
-        let (m2, ell, a, g) = (k[1], k[2], k[3], k[4]);
-        let (s, _) = Self::sc(k, delta);
-        out[0] = f[1];
-        out[1] = m2 * g * a / 2.0 - f[0] * (ell * s - a / 2.0);
-    }
-
-    fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        // eq. (14) divided by (1 + n)
-        out.copy_from_slice(&[8.0 * k[RC_R], -12.0, 0.0, 3.0 * k[RC_MU]]);
-    }
-
-    fn full_state(
-        &self,
-        k: &[f64],
-        _t: f64,
-        delta: f64,
-        theta_dot: f64,
-        q: &mut [f64],
-        qd: &mut [f64],
-    ) {
-        let (s, _) = Self::sc(k, delta);
-        let ell = k[2];
-        // eq. (18): x1 = -(1+2n)/(2(1+n)) ell (cos theta - cos theta_i); eq. (5) for x1'.
-        q[0] = -k[RC_KX] * ell * cos_rise(k[RC_R], k[RC_C0], delta);
-        q[1] = k[RC_THETA_I] - delta;
-        qd[0] = k[RC_KX] * ell * s * theta_dot;
-        qd[1] = theta_dot;
+    fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
+        q.copy_from_slice(&[0.0, k[RC_THETA_I]]);
+        qd.copy_from_slice(&[0.0, 0.0]);
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
@@ -274,70 +233,163 @@ impl Model for RodCube {
         out[0] = m2 * (x1dd - ell * s * wd - ell * c * w * w);
         out[1] = m1 * (g + 0.5 * ell * (c * wd - s * w * w));
     }
+
+    fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], f: &[f64], out: &mut [f64]) {
+        let (m2, ell, a, g) = (k[1], k[2], k[3], k[4]);
+        out[0] = f[1];
+        out[1] = m2 * g * a / 2.0 - f[0] * (ell * q[1].sin() - a / 2.0);
+    }
+
+    fn contact_edge(&self, _k: &[f64], _q: &[f64]) -> f64 {
+        f64::INFINITY
+    }
+
+    fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let ell = k[2];
+        let (s, c) = q[1].sin_cos();
+        out[0] = q[0] + ell * c;
+        out[1] = qd[0] - ell * s * qd[1];
+    }
+
+    fn reduction(&self) -> Option<&dyn Reduction> {
+        Some(self)
+    }
+}
+
+impl Reduction for RodCube {
+    fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
+        let (s, c) = Self::sc(k, delta);
+        let (r, mu, g_ell) = (k[RC_R], k[RC_MU], k[RC_G_ELL]);
+        let drop = sin_drop(r, k[RC_C0], delta); // r - s
+        let d = 4.0 / 3.0 - mu * s * s;
+        let theta_dot_sq = 4.0 * g_ell * drop / d; // eq. (9)
+        // PHYSICS.md erratum 2: theta'' = (2g/ell) [ -c/D + (r - s) sin(2 theta) / ((1+n) D^2) ]
+        let theta_ddot = 2.0 * g_ell * (-c / d + drop * 2.0 * s * c * mu / (d * d));
+        Reduced {
+            sin: s,
+            cos: c,
+            theta_dot_sq,
+            theta_ddot,
+        }
+    }
+
+    fn theta_dot_sq_sc(&self, k: &[f64], s: f64, c: f64, ds: f64, dc: f64) -> f64 {
+        let delta = delta_from_drops(k[RC_R], k[RC_C0], s, c, ds, dc);
+        self.reduced(k, delta).theta_dot_sq
+    }
+
+    fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
+        let (m1, m2, ell, g) = (k[0], k[1], k[2], k[4]);
+        let red = self.reduced(k, delta);
+        let (s, c) = (red.sin, red.cos);
+        let (r, mu) = (k[RC_R], k[RC_MU]);
+        // eq. (16) divided through by (1 + n)^2
+        let den = 4.0 - 3.0 * mu * s * s;
+        out[0] = -3.0 * g * m2 * mu * c * (8.0 * r - 12.0 * s + 3.0 * mu * s * s * s) / (den * den);
+        out[1] = m1 * (g + 0.5 * ell * (c * red.theta_ddot - s * red.theta_dot_sq));
+    }
+
+    fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
+        // eq. (14) divided by (1 + n)
+        out.copy_from_slice(&[8.0 * k[RC_R], -12.0, 0.0, 3.0 * k[RC_MU]]);
+    }
+
+    fn full_state(
+        &self,
+        k: &[f64],
+        _t: f64,
+        delta: f64,
+        theta_dot: f64,
+        q: &mut [f64],
+        qd: &mut [f64],
+    ) {
+        let (s, _) = Self::sc(k, delta);
+        let ell = k[2];
+        // eq. (18): x1 = -(1+2n)/(2(1+n)) ell (cos theta - cos theta_i); eq. (5) for x1'.
+        q[0] = -k[RC_KX] * ell * cos_rise(k[RC_R], k[RC_C0], delta);
+        q[1] = k[RC_THETA_I] - delta;
+        qd[0] = k[RC_KX] * ell * s * theta_dot;
+        qd[1] = theta_dot;
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
-// free_rod
+// rod_cube_free
 // ---------------------------------------------------------------------------------------------
 
-/// The rod alone, its foot sliding on the frictionless floor, after it left the cube.
+/// The rod alone, its foot sliding on the frictionless floor, and the cube gliding on at the
+/// speed it had, after they part.
 pub struct FreeRod;
 
-/// The `free_rod` model.
+/// The `rod_cube_free` model.
 pub static FREE_ROD: FreeRod = FreeRod;
 
-const FR_THETA_I: usize = 7;
-const FR_THETA_DOT_I: usize = 8;
-const FR_S0: usize = 9;
-const FR_C0: usize = 10;
-const FR_G_ELL: usize = 11;
-const FR_VCM: usize = 12; // constant horizontal velocity of the centre of mass
-const FR_A0: usize = 13; // omega_s^2 (1 + 3 cos^2 theta_s)
+// k layout: the 11 parameters, then these.
+const FR_THETA_I: usize = 11;
+const FR_THETA_DOT_I: usize = 12;
+const FR_S0: usize = 13;
+const FR_C0: usize = 14;
+const FR_G_ELL: usize = 15;
+const FR_VCM: usize = 16; // constant horizontal velocity of the rod's centre of mass
+const FR_A0: usize = 17; // omega_s^2 (1 + 3 cos^2 theta_s)
 
 static FR_INFO: ModelInfo = ModelInfo {
-    name: "free_rod",
+    name: "rod_cube_free",
     description: "uniform rod sliding on a frictionless floor after leaving the cube (hand-typed)",
     spec: "tests/common/paper.rs",
     parameters: &[
         param("m1", "rod mass", "kg", true),
+        param("m2", "cube mass", "kg", true),
         param("ell", "rod length", "m", true),
+        param("a", "cube side", "m", true),
         param("g", "gravitational acceleration", "m/s^2", true),
-        param("theta_s", "angle at separation", "rad", false),
-        param("omega_s", "angular velocity at separation", "rad/s", false),
-        param("x1_s", "foot position at separation", "m", false),
-        param("v1_s", "foot velocity at separation", "m/s", false),
+        param("x1_0", "foot position at separation", "m", false),
+        param("theta_0", "angle at separation", "rad", false),
+        param("x2_0", "cube face position at separation", "m", false),
+        param("x1_dot_0", "foot velocity at separation", "m/s", false),
+        param(
+            "theta_dot_0",
+            "angular velocity at separation",
+            "rad/s",
+            false,
+        ),
+        param("x2_dot_0", "cube velocity at separation", "m/s", false),
     ],
-    requirements: &[
-        named("above_floor", "theta_s > 0"),
-        named("below_vertical", "pi/2 - theta_s > 0"),
-    ],
-    n_constants: 14,
-    k_theta_initial: FR_THETA_I,
-    k_theta_dot_initial: FR_THETA_DOT_I,
-    k_sin_initial: FR_S0,
-    k_cos_initial: FR_C0,
-    coordinates: &["x1", "theta"],
+    requirements: &[named("a_below_ell", "(ell - a) / ell > 0")],
+    n_constants: 18,
+    coordinates: &["x1", "theta", "x2"],
     reduced: 1,
-    cyclic: &[0],
+    cyclic: &[0, 2],
     end_angle: 0.0,
     forces: &[named(
         "floor_normal",
         "floor reaction on the rod's foot (N)",
     )],
     contact: None,
-    separation_degree: 0,
     points: &[
         named("foot", "rod end on the floor"),
         named("tip", "free rod end"),
         named("rod_centre", "rod centre of mass"),
+        named("cube", "cube's bottom-left corner"),
     ],
     falling_point: 2,
-    gravity: 2,
-    monitors: &[named(
-        "foot_on_floor",
-        "floor normal force on the foot >= 0 (N)",
-    )],
+    gravity: 4,
+    monitors: &[
+        named("foot_on_floor", "floor normal force on the foot >= 0 (N)"),
+        named(
+            "contact_open",
+            "the tip stays clear of the cube: x2 - x1 - ell cos >= 0",
+        ),
+    ],
     next_phase: None,
+    reduction: Some(ReductionInfo {
+        k_theta_initial: FR_THETA_I,
+        k_theta_dot_initial: FR_THETA_DOT_I,
+        k_sin_initial: FR_S0,
+        k_cos_initial: FR_C0,
+        separation_degree: 0,
+    }),
+    route_note: "",
 };
 
 impl FreeRod {
@@ -353,13 +405,12 @@ impl Model for FreeRod {
     }
 
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
-        out[0] = p[3];
-        out[1] = std::f64::consts::FRAC_PI_2 - p[3];
+        out[0] = (p[2] - p[3]) / p[2];
     }
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
-        let (ell, g, th, om, v1) = (p[1], p[2], p[3], p[4], p[6]);
-        k[..7].copy_from_slice(p);
+        let (ell, g, th, v1, om) = (p[2], p[4], p[6], p[8], p[9]);
+        k[..11].copy_from_slice(p);
         let (s0, c0) = th.sin_cos();
         k[FR_THETA_I] = th;
         k[FR_THETA_DOT_I] = om;
@@ -370,6 +421,76 @@ impl Model for FreeRod {
         k[FR_A0] = om * om * (1.0 + 3.0 * c0 * c0);
     }
 
+    fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
+        q.copy_from_slice(&[k[5], k[6], k[7]]);
+        qd.copy_from_slice(&[k[8], k[9], k[10]]);
+    }
+
+    fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
+        let ell = k[2];
+        let (x1, th, v1, w) = (q[0], q[1], qd[0], qd[1]);
+        let (s, c) = (th.sin(), th.cos());
+        pos[0] = [x1, 0.0];
+        vel[0] = [v1, 0.0];
+        pos[1] = [x1 + ell * c, ell * s];
+        vel[1] = [v1 - ell * s * w, ell * c * w];
+        pos[2] = [x1 + 0.5 * ell * c, 0.5 * ell * s];
+        vel[2] = [v1 - 0.5 * ell * s * w, 0.5 * ell * c * w];
+        pos[3] = [q[2], 0.0];
+        vel[3] = [qd[2], 0.0];
+    }
+
+    fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
+        let (m1, m2, ell, a, g) = (k[0], k[1], k[2], k[3], k[4]);
+        let s = q[1].sin();
+        let (v, w) = (qd[0], qd[1]);
+        0.5 * m1 * v * v - 0.5 * m1 * ell * s * v * w
+            + m1 * ell * ell * w * w / 6.0
+            + m1 * g * ell * s / 2.0
+            + 0.5 * m2 * qd[2] * qd[2]
+            + m2 * g * a / 2.0
+    }
+
+    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let (m1, m2, ell) = (k[0], k[1], k[2]);
+        out[0] = m1 * qd[0] - 0.5 * m1 * ell * q[1].sin() * qd[1];
+        out[1] = m2 * qd[2];
+    }
+
+    fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
+        let (m1, m2, ell, g) = (k[0], k[1], k[2], k[4]);
+        let (s, c) = (q[1].sin(), q[1].cos());
+        let w = qd[1];
+        let m12 = -0.5 * m1 * ell * s;
+        mass.copy_from_slice(&[m1, m12, 0.0, m12, m1 * ell * ell / 3.0, 0.0, 0.0, 0.0, m2]);
+        rhs[0] = 0.5 * m1 * ell * c * w * w;
+        rhs[1] = -0.5 * m1 * g * ell * c;
+        rhs[2] = 0.0;
+    }
+
+    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+        let (m1, ell, g) = (k[0], k[2], k[4]);
+        let (s, c) = (q[1].sin(), q[1].cos());
+        out[0] = m1 * (g + 0.5 * ell * (c * qdd[1] - s * qd[1] * qd[1]));
+    }
+
+    fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], f: &[f64], out: &mut [f64]) {
+        out[0] = f[0];
+        out[1] = q[2] - q[0] - k[2] * q[1].cos();
+    }
+
+    fn contact_edge(&self, _k: &[f64], _q: &[f64]) -> f64 {
+        f64::INFINITY
+    }
+
+    fn released(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
+
+    fn reduction(&self) -> Option<&dyn Reduction> {
+        Some(self)
+    }
+}
+
+impl Reduction for FreeRod {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
         let (s, c) = Self::sc(k, delta);
         // Energy of the rod about its centre (the centre's horizontal velocity is constant):
@@ -386,14 +507,15 @@ impl Model for FreeRod {
         }
     }
 
-    fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let (m1, ell, g) = (k[0], k[1], k[2]);
-        let r = self.reduced(k, delta);
-        out[0] = m1 * (g + 0.5 * ell * (r.cos * r.theta_ddot - r.sin * r.theta_dot_sq));
+    fn theta_dot_sq_sc(&self, k: &[f64], s: f64, c: f64, ds: f64, dc: f64) -> f64 {
+        let delta = delta_from_drops(k[FR_S0], k[FR_C0], s, c, ds, dc);
+        self.reduced(k, delta).theta_dot_sq
     }
 
-    fn monitors(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        self.forces(k, delta, out);
+    fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
+        let (m1, ell, g) = (k[0], k[2], k[4]);
+        let r = self.reduced(k, delta);
+        out[0] = m1 * (g + 0.5 * ell * (r.cos * r.theta_ddot - r.sin * r.theta_dot_sq));
     }
 
     fn separation_polynomial(&self, _k: &[f64], out: &mut [f64]) {
@@ -410,53 +532,13 @@ impl Model for FreeRod {
         qd: &mut [f64],
     ) {
         let (s, _) = Self::sc(k, delta);
-        let (ell, x1s, vcm) = (k[1], k[5], k[FR_VCM]);
+        let (ell, x1s, vcm) = (k[2], k[5], k[FR_VCM]);
         q[0] = x1s + vcm * t - 0.5 * ell * cos_rise(k[FR_S0], k[FR_C0], delta);
         q[1] = k[FR_THETA_I] - delta;
+        q[2] = k[7] + k[10] * t;
         qd[0] = vcm + 0.5 * ell * s * theta_dot;
         qd[1] = theta_dot;
-    }
-
-    fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let ell = k[1];
-        let (x1, th, v1, w) = (q[0], q[1], qd[0], qd[1]);
-        let (s, c) = (th.sin(), th.cos());
-        pos[0] = [x1, 0.0];
-        vel[0] = [v1, 0.0];
-        pos[1] = [x1 + ell * c, ell * s];
-        vel[1] = [v1 - ell * s * w, ell * c * w];
-        pos[2] = [x1 + 0.5 * ell * c, 0.5 * ell * s];
-        vel[2] = [v1 - 0.5 * ell * s * w, 0.5 * ell * c * w];
-    }
-
-    fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let (m1, ell, g) = (k[0], k[1], k[2]);
-        let s = q[1].sin();
-        let (v, w) = (qd[0], qd[1]);
-        0.5 * m1 * v * v - 0.5 * m1 * ell * s * v * w
-            + m1 * ell * ell * w * w / 6.0
-            + m1 * g * ell * s / 2.0
-    }
-
-    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let (m1, ell) = (k[0], k[1]);
-        out[0] = m1 * qd[0] - 0.5 * m1 * ell * q[1].sin() * qd[1];
-    }
-
-    fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let (m1, ell, g) = (k[0], k[1], k[2]);
-        let (s, c) = (q[1].sin(), q[1].cos());
-        let w = qd[1];
-        let m12 = -0.5 * m1 * ell * s;
-        mass.copy_from_slice(&[m1, m12, m12, m1 * ell * ell / 3.0]);
-        rhs[0] = 0.5 * m1 * ell * c * w * w;
-        rhs[1] = -0.5 * m1 * g * ell * c;
-    }
-
-    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let (m1, ell, g) = (k[0], k[1], k[2]);
-        let (s, c) = (q[1].sin(), q[1].cos());
-        out[0] = m1 * (g + 0.5 * ell * (c * qdd[1] - s * qd[1] * qd[1]));
+        qd[2] = k[10];
     }
 }
 

@@ -2,7 +2,7 @@
 //! monitors, a force or its `theta_dot^2`), to drive the solvers into outcomes the paper's
 //! models never reach.
 
-use rodcube::model::{Model, ModelInfo, Reduced};
+use rodcube::model::{Model, ModelInfo, Reduced, Reduction};
 
 /// `base` with an optional replacement separation polynomial and monitors shifted by a constant.
 pub struct Tweaked {
@@ -54,53 +54,8 @@ impl Model for Tweaked {
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
         self.base.prepare(p, k)
     }
-    fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let mut r = self.base.reduced(k, delta);
-        if self.theta_dot_sq == Fault::Rises {
-            r.theta_dot_sq = -r.theta_dot_sq;
-            r.theta_ddot = -r.theta_ddot;
-        }
-        r
-    }
-    fn theta_dot_sq_sc(&self, k: &[f64], s: f64, c: f64, ds: f64, dc: f64) -> f64 {
-        let w2 = self.base.theta_dot_sq_sc(k, s, c, ds, dc);
-        match self.theta_dot_sq {
-            Fault::Rises => -w2,
-            Fault::TurnsBack { below } if s < below => -w2,
-            Fault::Nan { below } if s < below => f64::NAN,
-            _ => w2,
-        }
-    }
-    fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        self.base.forces(k, delta, out);
-        if self.nan_force
-            && let Some(last) = out.last_mut()
-        {
-            *last = f64::NAN;
-        }
-    }
-    fn monitors(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        self.base.monitors(k, delta, out);
-        for v in out.iter_mut() {
-            *v += self.monitor_shift;
-        }
-    }
-    fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        match self.polynomial {
-            Some(c) => out.copy_from_slice(c),
-            None => self.base.separation_polynomial(k, out),
-        }
-    }
-    fn full_state(
-        &self,
-        k: &[f64],
-        t: f64,
-        delta: f64,
-        theta_dot: f64,
-        q: &mut [f64],
-        qd: &mut [f64],
-    ) {
-        self.base.full_state(k, t, delta, theta_dot, q, qd)
+    fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
+        self.base.initial_state(k, q, qd)
     }
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
         self.base.points(k, q, qd, pos, vel)
@@ -115,7 +70,83 @@ impl Model for Tweaked {
         self.base.equations(k, q, qd, mass, rhs)
     }
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        self.base.forces_full(k, q, qd, qdd, out)
+        self.base.forces_full(k, q, qd, qdd, out);
+        if self.nan_force
+            && let Some(last) = out.last_mut()
+        {
+            *last = f64::NAN;
+        }
+    }
+    fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], f: &[f64], out: &mut [f64]) {
+        self.base.monitors_full(k, q, qd, f, out);
+        for v in out.iter_mut() {
+            *v += self.monitor_shift;
+        }
+    }
+    fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
+        self.base.contact_edge(k, q)
+    }
+    fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        self.base.released(k, q, qd, out)
+    }
+    fn reduction(&self) -> Option<&dyn Reduction> {
+        self.base.reduction().map(|_| self as &dyn Reduction)
+    }
+}
+
+impl Reduction for Tweaked {
+    fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
+        let mut r = self.base().reduced(k, delta);
+        if self.theta_dot_sq == Fault::Rises {
+            r.theta_dot_sq = -r.theta_dot_sq;
+            r.theta_ddot = -r.theta_ddot;
+        }
+        r
+    }
+    fn theta_dot_sq_sc(&self, k: &[f64], s: f64, c: f64, ds: f64, dc: f64) -> f64 {
+        let w2 = self.base().theta_dot_sq_sc(k, s, c, ds, dc);
+        match self.theta_dot_sq {
+            Fault::Rises => -w2,
+            Fault::TurnsBack { below } if s < below => -w2,
+            Fault::Nan { below } if s < below => f64::NAN,
+            _ => w2,
+        }
+    }
+    fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
+        self.base().forces(k, delta, out);
+        if self.nan_force
+            && let Some(last) = out.last_mut()
+        {
+            *last = f64::NAN;
+        }
+    }
+    fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
+        match self.polynomial {
+            Some(c) => out.copy_from_slice(c),
+            None => self.base().separation_polynomial(k, out),
+        }
+    }
+    fn full_state(
+        &self,
+        k: &[f64],
+        t: f64,
+        delta: f64,
+        theta_dot: f64,
+        q: &mut [f64],
+        qd: &mut [f64],
+    ) {
+        self.base().full_state(k, t, delta, theta_dot, q, qd)
+    }
+}
+
+impl Tweaked {
+    /// The base model's fast path (every base used here has one; `reduction` above only
+    /// offers this wrapper's when the base does).
+    fn base(&self) -> &'static dyn Reduction {
+        match self.base.reduction() {
+            Some(r) => r,
+            None => &super::paper::ROD_CUBE,
+        }
     }
 }
 

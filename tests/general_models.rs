@@ -1,0 +1,286 @@
+//! Models outside the fast path, each one YAML file: `rod_cube_spring` (two coordinates move
+//! while in contact, a spring potential) and `rod_cylinder` (a curved contact whose point moves
+//! along the rod and can run off its end). Checked against independent references: the spring
+//! going slack reproduces the paper, a hand Newton–Euler balance of each body at random states
+//! agrees with the generated forces, the edge is where `R cot(theta/2) = ell`, and the
+//! integrated route agrees with the fast path where both apply.
+
+use rodcube::model::Model;
+use rodcube::models::find;
+use rodcube::plan::{Request, run};
+use rodcube::quantity::Quantity;
+use rodcube::results::RunResults;
+use rodcube::solve::phases::Route;
+use rodcube::solve::unreduced::accelerations;
+use rodcube::system::{Bound, State};
+
+/// The paper's separation time (g = 9.81), exact to f64 (tests/hard_cases.rs).
+const PAPER_T_SEP: f64 = 0.108493254170856;
+
+fn model(name: &str) -> &'static dyn Model {
+    find(name).unwrap_or_else(|| panic!("{name} was not generated"))
+}
+
+fn ask(name: &str, params: &[(&str, f64)], want: &[Quantity], route: Route) -> RunResults {
+    let request = Request::new(model(name), params)
+        .with_want(want)
+        .with_route(route);
+    run(&request).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+fn value(r: &RunResults, key: &str) -> f64 {
+    r.results
+        .get(key)
+        .unwrap_or_else(|| panic!("no {key} in {:?} (notes {:?})", r.results, r.notes))
+        .value
+}
+
+fn spring(k: f64) -> [(&'static str, f64); 6] {
+    [
+        ("m1", 1.0),
+        ("m2", 3.0),
+        ("ell", 1.0),
+        ("a", 0.25),
+        ("g", 9.81),
+        ("k", k),
+    ]
+}
+
+const CYLINDER: [(&str, f64); 6] = [
+    ("m1", 1.0),
+    ("m2", 3.0),
+    ("ell", 1.0),
+    ("R", 0.2),
+    ("th0", 0.9),
+    ("g", 9.81),
+];
+
+#[test]
+fn the_new_models_take_the_integrated_route_and_say_why() {
+    for name in ["rod_cube_spring", "rod_cube_spring_free", "rod_cylinder"] {
+        let info = model(name).info();
+        assert!(info.reduction.is_none(), "{name}");
+        assert!(!info.route_note.is_empty(), "{name}");
+    }
+    assert!(
+        model("rod_cube_spring")
+            .info()
+            .route_note
+            .contains("`x1` is not cyclic")
+    );
+    assert!(model("rod_cylinder").info().route_note.contains("edge"));
+    // After the cylinder the rod and cylinder move freely: both cyclic, the fast path again.
+    assert!(model("rod_cylinder_free").info().reduction.is_some());
+}
+
+#[test]
+fn a_slack_spring_gives_the_papers_separation() {
+    let want = [
+        Quantity::SeparationAngle,
+        Quantity::SeparationTime,
+        Quantity::ContactEnd,
+    ];
+    for (tol, bound) in [(1e-10, 1e-12), (1e-12, 1e-13)] {
+        let request = Request::new(model("rod_cube_spring"), spring(1e-12))
+            .with_want(&want)
+            .with_tolerance(tol);
+        let r = run(&request).unwrap();
+        let t = value(&r, "separation_time");
+        let rel = (t - PAPER_T_SEP).abs() / PAPER_T_SEP;
+        println!("k = 1e-12, tolerance {tol:e}: t_sep = {t:.15} s, {rel:.2e} from the paper");
+        assert!(rel < bound, "{t} vs {PAPER_T_SEP}: {rel:e}");
+        assert_eq!(value(&r, "contact_end_time"), t);
+        assert_eq!(r.labels["contact_end_cause"].value, "force");
+        // Eq. (14) with n = 3, r = 1/4: sin(theta_sep) = 0.166957...
+        let s = value(&r, "separation_angle").sin();
+        let eq14 = 3.0 * s.powi(3) - 48.0 * s + 8.0;
+        assert!(eq14.abs() < 1e-10, "{eq14}");
+    }
+}
+
+#[test]
+fn a_stiff_spring_holds_the_cube_and_delays_the_separation() {
+    let soft = ask(
+        "rod_cube_spring",
+        &spring(1e-12),
+        &[Quantity::SeparationTime],
+        Route::Fastest,
+    );
+    let stiff = ask(
+        "rod_cube_spring",
+        &spring(50.0),
+        &[
+            Quantity::SeparationTime,
+            Quantity::FloorImpact,
+            Quantity::Checks,
+        ],
+        Route::Fastest,
+    );
+    assert!(value(&stiff, "separation_time") > value(&soft, "separation_time"));
+    assert_eq!(
+        stiff.work.phases,
+        vec!["rod_cube_spring", "rod_cube_spring_free"]
+    );
+    for (name, c) in &stiff.checks {
+        assert!(c.passed, "{name}: {c:?}");
+    }
+    assert!(value(&stiff, "floor_impact_time") > value(&stiff, "separation_time"));
+}
+
+/// A state of the contact phase (x1, theta and their rates) and its accelerations.
+fn state_and_accelerations(bound: &Bound, theta: f64, omega: f64, v1: f64) -> (State, Vec<f64>) {
+    let state = State {
+        q: vec![0.1, theta],
+        qd: vec![v1, omega],
+    };
+    let qdd = accelerations(bound, &state, 0.0).unwrap();
+    (state, qdd)
+}
+
+#[test]
+fn the_cylinder_forces_balance_each_body_by_hand() {
+    let bound = Bound::new(model("rod_cylinder"), &CYLINDER).unwrap();
+    let (m1, m2, ell, r, g) = (1.0, 3.0, 1.0, 0.2, 9.81);
+    let inertia = m1 * ell * ell / 12.0;
+    let mut worst = 0.0f64;
+    for (theta, omega, v1) in [(0.9, 0.0, 0.0), (0.7, -1.3, 0.4), (0.5, -2.5, -0.3)] {
+        let (state, qdd) = state_and_accelerations(&bound, theta, omega, v1);
+        let f = bound.forces_full(&state, &qdd);
+        let (push, floor) = (f[0], f[1]);
+        let (s, c) = (theta.sin(), theta.cos());
+        let (x1dd, thdd) = (qdd[0], qdd[1]);
+        // The push is normal to the rod: on the cylinder N (sin, -cos), N = push / sin.
+        let n = push / s;
+        let d = r * (1.0 + c) / s; // contact point's distance from the foot
+        // The rod's centre of mass and its acceleration.
+        let ax = x1dd - 0.5 * ell * (s * thdd + c * omega * omega);
+        let ay = 0.5 * ell * (c * thdd - s * omega * omega);
+        // The cylinder's axis xc = x1 + R (1 + cos)/sin: d/dtheta = -R/(1 - cos),
+        // d2/dtheta2 = R sin/(1 - cos)^2.
+        let axc = x1dd - r / (1.0 - c) * thdd + r * s / (1.0 - c).powi(2) * omega * omega;
+        let residuals = [
+            (m1 * ax + n * s) / (m1 * g),
+            (m1 * ay - (n * c + floor - m1 * g)) / (m1 * g),
+            (inertia * thdd - ((d - 0.5 * ell) * n - 0.5 * ell * c * floor)) / (m1 * g * ell),
+            (m2 * axc - push) / (m1 * g),
+        ];
+        for (i, res) in residuals.iter().enumerate() {
+            assert!(
+                res.abs() < 1e-13,
+                "theta {theta}: balance {i} off by {res:e}"
+            );
+            worst = worst.max(res.abs());
+        }
+    }
+    println!("largest Newton-Euler residual: {worst:.1e} (relative to m1 g)");
+}
+
+#[test]
+fn the_spring_forces_balance_each_body_by_hand() {
+    let bound = Bound::new(model("rod_cube_spring"), &spring(50.0)).unwrap();
+    let (m1, m2, ell, a, g, k): (f64, f64, f64, f64, f64, f64) = (1.0, 3.0, 1.0, 0.25, 9.81, 50.0);
+    let inertia = m1 * ell * ell / 12.0;
+    let x2_rest = (ell * ell - a * a).sqrt();
+    for (theta, omega, v1) in [(0.25, 0.0, 0.0), (0.2, -1.1, -0.2), (0.15, -1.6, -0.45)] {
+        let (state, qdd) = state_and_accelerations(&bound, theta, omega, v1);
+        let f = bound.forces_full(&state, &qdd);
+        let (push, floor) = (f[0], f[1]);
+        let (s, c) = (theta.sin(), theta.cos());
+        let (x1, x1dd, thdd) = (state.q[0], qdd[0], qdd[1]);
+        let ax = x1dd - 0.5 * ell * (s * thdd + c * omega * omega);
+        let ay = 0.5 * ell * (c * thdd - s * omega * omega);
+        // The cube's face x2 = x1 + ell cos(theta), pushed by the tip and pulled by the spring.
+        let x2 = x1 + ell * c;
+        let ax2 = x1dd - ell * (s * thdd + c * omega * omega);
+        // On the rod: the cube pushes back at the tip (-push, 0), the floor up at the foot.
+        let residuals = [
+            (m1 * ax + push) / (m1 * g),
+            (m1 * ay - (floor - m1 * g)) / (m1 * g),
+            (inertia * thdd - (0.5 * ell * s * push - 0.5 * ell * c * floor)) / (m1 * g * ell),
+            (m2 * ax2 - (push - k * (x2 - x2_rest))) / (m1 * g),
+        ];
+        for (i, res) in residuals.iter().enumerate() {
+            assert!(
+                res.abs() < 1e-13,
+                "theta {theta}: balance {i} off by {res:e}"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_cylinder_runs_off_the_rods_end_where_r_cot_half_theta_is_ell() {
+    let r = ask(
+        "rod_cylinder",
+        &CYLINDER,
+        &[
+            Quantity::ContactEnd,
+            Quantity::FloorImpact,
+            Quantity::Checks,
+        ],
+        Route::Fastest,
+    );
+    assert_eq!(r.labels["contact_end_cause"].value, "edge");
+    let want = 2.0 * (0.2f64).atan();
+    let theta = value(&r, "contact_end_angle");
+    assert!(((theta - want) / want).abs() < 1e-12, "{theta} vs {want}");
+    // What follows an edge (the tip on the cylinder's surface) is not modelled: a note.
+    assert!(r.notes["floor_impact"].contains("edge"));
+    for (name, c) in &r.checks {
+        assert!(c.passed, "{name}: {c:?}");
+    }
+}
+
+#[test]
+fn a_short_rod_on_a_small_cylinder_separates_by_force_first() {
+    // A heavy cylinder and a rod released steeply: the push vanishes before the tangent point
+    // reaches the end (the classic separation), and the cause says so.
+    let params = [
+        ("m1", 1.0),
+        ("m2", 1.0),
+        ("ell", 1.0),
+        ("R", 0.05),
+        ("th0", 1.4),
+        ("g", 9.81),
+    ];
+    let r = ask(
+        "rod_cylinder",
+        &params,
+        &[Quantity::ContactEnd, Quantity::FloorImpact],
+        Route::Fastest,
+    );
+    let cause = &r.labels["contact_end_cause"].value;
+    let theta = value(&r, "contact_end_angle");
+    println!("rod_cylinder R = 0.05, th0 = 1.4: the contact ends by {cause} at {theta}");
+    if cause == "force" {
+        assert!(theta > 2.0 * 0.05f64.atan());
+        assert!(value(&r, "floor_impact_time") > value(&r, "contact_end_time"));
+        assert_eq!(r.work.phases, vec!["rod_cylinder", "rod_cylinder_free"]);
+    } else {
+        assert!((theta - 2.0 * 0.05f64.atan()).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn the_integrated_route_agrees_with_the_fast_path() {
+    let paper = [
+        ("m1", 1.0),
+        ("m2", 3.0),
+        ("ell", 1.0),
+        ("a", 0.25),
+        ("g", 9.81),
+    ];
+    let want = [Quantity::SeparationAngle, Quantity::SeparationTime];
+    for name in ["rod_cube", "hinged_rod"] {
+        let fast = ask(name, &paper, &want, Route::Fastest);
+        let slow = ask(name, &paper, &want, Route::Integrated);
+        for key in ["separation_time", "separation_angle"] {
+            let (a, b) = (value(&fast, key), value(&slow, key));
+            let rel = ((a - b) / a).abs();
+            println!("{name} {key}: fast {a:.15}, integrated {b:.15}, {rel:.1e}");
+            assert!(rel < 1e-12, "{name} {key}: {a} vs {b} ({rel:e})");
+        }
+        assert!(slow.work.ode_steps > 0 && slow.work.integrand_evals == 0);
+        assert!(fast.work.ode_steps == 0);
+    }
+}
