@@ -1,6 +1,7 @@
 //! Cost of solving: one parameter point's separation angle and time, through the planner and
-//! through the sweeps' lean per-point solver, and the paper's whole scene (`scenes/paper.yaml`,
-//! every quantity, 1000 samples per series) without writing files.
+//! through the sweeps' lean per-point solver, on the integrated route (the two-coordinate
+//! `rod_cube_spring`, and `rod_cube` forced onto it), and the paper's whole scene
+//! (`scenes/paper.yaml`, every quantity, 1000 samples per series) without writing files.
 //!
 //! Run: `cargo bench --bench solve -- --warm-up-time 1 --measurement-time 3`.
 
@@ -10,6 +11,7 @@ use rodcube::quantity::Quantity;
 use rodcube::report;
 use rodcube::scene::Scene;
 use rodcube::solve::lean::LeanSolver;
+use rodcube::solve::phases::Route;
 use std::hint::black_box;
 use std::path::Path;
 
@@ -98,5 +100,51 @@ fn paper_scene(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, per_point, paper_scene);
+/// The integrated route: `rod_cube_spring` (two coordinates move while in contact) and the
+/// paper's `rod_cube` forced onto it, separation time at a tolerance of 1e-12 (the integrator at
+/// 1e-13), against the fast path at the same tolerance.
+fn integrated(c: &mut Criterion) {
+    let want = [Quantity::SeparationAngle, Quantity::SeparationTime];
+    let spring = rodcube::models::find("rod_cube_spring").expect("rod_cube_spring is generated");
+    let cube = rodcube::models::find("rod_cube").expect("rod_cube is generated");
+    let spring_params = [
+        ("m1", 1.0),
+        ("m2", 3.0),
+        ("ell", 1.0),
+        ("a", 0.25),
+        ("g", 9.81),
+        ("k", 50.0),
+    ];
+    let mut g = c.benchmark_group("integrated");
+    let cases = [
+        (
+            "rod_cube_spring",
+            Request::new(spring, spring_params),
+            Route::Fastest,
+        ),
+        (
+            "rod_cube_integrated",
+            Request::new(cube, PAPER),
+            Route::Integrated,
+        ),
+        (
+            "rod_cube_fast_path",
+            Request::new(cube, PAPER),
+            Route::Fastest,
+        ),
+    ];
+    for (label, request, route) in cases {
+        let request = request
+            .with_want(&want)
+            .with_tolerance(1e-12)
+            .with_route(route);
+        plan::run(&request).expect("the point solves");
+        g.bench_function(label, |b| {
+            b.iter(|| plan::run(black_box(&request)).expect("the point solves"))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, per_point, integrated, paper_scene);
 criterion_main!(benches);

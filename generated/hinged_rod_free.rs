@@ -143,10 +143,10 @@ impl Model for HingedRodFree {
         k[17] = (k[2] / 2.0);
         k[18] = (-k[2]);
         k[19] = (-k[2] / 2.0);
-        k[20] = (k[1] / 2.0);
-        k[21] = ((k[2] * k[2]) * k[0] / 24.0);
-        k[22] = ((k[2] * k[2]) * k[0] / 8.0);
-        k[23] = (k[4] * k[1] * k[3] / 2.0);
+        k[20] = ((k[2] * k[2]) * k[0] / 24.0);
+        k[21] = ((k[2] * k[2]) * k[0] / 8.0);
+        k[22] = (k[1] / 2.0);
+        k[23] = (k[3] * k[4] * k[1] / 2.0);
         k[24] = (k[2] * k[4] * k[0] / 2.0);
         k[25] = k[1];
         k[26] = ((k[2] * k[2]) * k[0] / 12.0);
@@ -156,7 +156,7 @@ impl Model for HingedRodFree {
         k[30] = (k[2] * k[0] / 2.0);
         k[31] = (-k[2] * k[0] / 2.0);
         k[32] = (3.0 / ((k[2] * k[2]) * k[0]));
-        k[33] = (k[15] * (k[10] * k[10]));
+        k[33] = ((k[10] * k[10]) * k[15]);
         k[34] = (k[2] * k[4] * k[0]);
         k[35] = (-3.0 * k[4] / 2.0 / k[2]);
         k[36] = k[13];
@@ -188,10 +188,10 @@ impl Model for HingedRodFree {
         let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let et0 = (qd[0] * qd[0]);
-        (((k[20] * (qd[1] * qd[1]))
-            + (k[21] * et0)
-            + (k[22] * et0 * (rc_s * rc_s))
-            + (k[22] * et0 * (rc_c * rc_c)))
+        (((k[20] * et0)
+            + (k[21] * et0 * (rc_s * rc_s))
+            + (k[21] * et0 * (rc_c * rc_c))
+            + (k[22] * (qd[1] * qd[1])))
             + (k[23] + (k[24] * rc_s)))
     }
 
@@ -221,7 +221,7 @@ impl Model for HingedRodFree {
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
         let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        out[0] = (q[1] + (k[18] * rc_c));
+        out[0] = ((k[18] * rc_c) + q[1]);
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {

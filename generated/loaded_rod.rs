@@ -57,7 +57,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 53,
+    n_constants: 52,
     coordinates: &["x1", "theta"],
     reduced: 1,
     cyclic: &[0],
@@ -162,13 +162,13 @@ impl Model for LoadedRod {
         let c6_t2 = (k[0] * k[0]);
         let c6_t3 = (k[2] * k[2]);
         k[12] = ((c6_t0 * k[0] * k[1] / 3.0 / (k[0] + k[1] + k[2]))
+            - (c6_t0 * k[0] * k[2] * c6_t1 / (k[0] + k[1] + k[2]))
             + (4.0 * c6_t0 * k[0] * k[2] / 3.0 / (k[0] + k[1] + k[2]))
-            - (c6_t0 * k[0] * c6_t1 * k[2] / (k[0] + k[1] + k[2]))
+            - (c6_t0 * k[1] * k[2] * c6_t1 / (k[0] + k[1] + k[2]))
             + (c6_t0 * k[1] * k[2] / (k[0] + k[1] + k[2]))
-            - (c6_t0 * k[1] * c6_t1 * k[2] / (k[0] + k[1] + k[2]))
             - (c6_t0 * c6_t2 * c6_t1 / 4.0 / (k[0] + k[1] + k[2]))
             + (c6_t0 * c6_t2 / 3.0 / (k[0] + k[1] + k[2]))
-            - (c6_t0 * c6_t1 * c6_t3 / (k[0] + k[1] + k[2]))
+            - (c6_t0 * c6_t3 * c6_t1 / (k[0] + k[1] + k[2]))
             + (c6_t0 * c6_t3 / (k[0] + k[1] + k[2])));
         k[13] = (k[4] / k[3]).asin();
         k[14] = k[3];
@@ -179,149 +179,145 @@ impl Model for LoadedRod {
         k[19] = (-(k[3] * k[0] / 2.0 / (k[0] + k[2])) - (k[3] * k[2] / (k[0] + k[2])));
         k[20] = (-(3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
             - (k[3] * k[1])
-            - (k[3] * (k[2] * k[2]) / (k[0] + k[2]))
-            - (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2])));
-        k[21] = ((k[0] / 2.0) + (k[1] / 2.0) + (k[2] / 2.0));
+            - (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
+            - (k[3] * (k[2] * k[2]) / (k[0] + k[2])));
+        let h21_t0 = (k[3] * k[3]);
+        k[21] = ((h21_t0 * k[0] / 24.0) + (h21_t0 * k[0] * k[2] / 8.0 / (k[0] + k[2])));
         let h22_t0 = (k[3] * k[3]);
-        k[22] = ((h22_t0 * k[0] / 24.0) + (h22_t0 * k[0] * k[2] / 8.0 / (k[0] + k[2])));
+        let h22_t1 = (k[2] * k[2]);
+        let h22_t2 = (k[0] * k[0]);
+        k[22] = ((h22_t0 * k[0] * h22_t1 / ((2.0 * k[0] * k[2]) + h22_t2 + h22_t1))
+            + (h22_t0 * k[1] / 2.0)
+            + (5.0 * h22_t0 * h22_t2 * k[2] / 8.0 / ((2.0 * k[0] * k[2]) + h22_t2 + h22_t1))
+            + (h22_t0 * k[0].powi(3) / 8.0 / ((2.0 * k[0] * k[2]) + h22_t2 + h22_t1))
+            + (h22_t0 * k[2].powi(3) / 2.0 / ((2.0 * k[0] * k[2]) + h22_t2 + h22_t1)));
         let h23_t0 = (k[3] * k[3]);
         let h23_t1 = (k[2] * k[2]);
         let h23_t2 = (k[0] * k[0]);
         k[23] = ((h23_t0 * k[0] * h23_t1 / ((2.0 * k[0] * k[2]) + h23_t2 + h23_t1))
             + (5.0 * h23_t0 * h23_t2 * k[2] / 8.0 / ((2.0 * k[0] * k[2]) + h23_t2 + h23_t1))
             + (h23_t0 * k[0].powi(3) / 8.0 / ((2.0 * k[0] * k[2]) + h23_t2 + h23_t1))
-            + (h23_t0 * k[1] / 2.0)
             + (h23_t0 * k[2].powi(3) / 2.0 / ((2.0 * k[0] * k[2]) + h23_t2 + h23_t1)));
-        let h24_t0 = (k[3] * k[3]);
-        let h24_t1 = (k[2] * k[2]);
-        let h24_t2 = (k[0] * k[0]);
-        k[24] = ((h24_t0 * k[0] * h24_t1 / ((2.0 * k[0] * k[2]) + h24_t2 + h24_t1))
-            + (5.0 * h24_t0 * h24_t2 * k[2] / 8.0 / ((2.0 * k[0] * k[2]) + h24_t2 + h24_t1))
-            + (h24_t0 * k[0].powi(3) / 8.0 / ((2.0 * k[0] * k[2]) + h24_t2 + h24_t1))
-            + (h24_t0 * k[2].powi(3) / 2.0 / ((2.0 * k[0] * k[2]) + h24_t2 + h24_t1)));
-        k[25] = (k[5] * k[1] * k[4] / 2.0);
+        k[24] = ((k[0] / 2.0) + (k[1] / 2.0) + (k[2] / 2.0));
+        k[25] = (k[4] * k[5] * k[1] / 2.0);
         k[26] = ((k[3] * k[5] * k[0] / 2.0) + (k[3] * k[5] * k[2]));
         k[27] = (k[0] + k[1] + k[2]);
-        k[28] = (-(3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
-            - (k[3] * k[1])
-            - (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
-            - (k[3] * (k[2] * k[2]) / (k[0] + k[2])));
+        let h28_t0 = (k[3] * k[3]);
+        k[28] = ((h28_t0 * k[0] / 12.0) + (h28_t0 * k[0] * k[2] / 4.0 / (k[0] + k[2])));
         let h29_t0 = (k[3] * k[3]);
-        k[29] = ((h29_t0 * k[0] / 12.0) + (h29_t0 * k[0] * k[2] / 4.0 / (k[0] + k[2])));
+        let h29_t1 = (k[2] * k[2]);
+        let h29_t2 = (k[0] * k[0]);
+        k[29] = ((2.0 * h29_t0 * k[0] * h29_t1 / ((2.0 * k[0] * k[2]) + h29_t2 + h29_t1))
+            + (h29_t0 * k[1])
+            + (5.0 * h29_t0 * h29_t2 * k[2] / 4.0 / ((2.0 * k[0] * k[2]) + h29_t2 + h29_t1))
+            + (h29_t0 * k[0].powi(3) / 4.0 / ((2.0 * k[0] * k[2]) + h29_t2 + h29_t1))
+            + (h29_t0 * k[2].powi(3) / ((2.0 * k[0] * k[2]) + h29_t2 + h29_t1)));
         let h30_t0 = (k[3] * k[3]);
         let h30_t1 = (k[2] * k[2]);
         let h30_t2 = (k[0] * k[0]);
         k[30] = ((2.0 * h30_t0 * k[0] * h30_t1 / ((2.0 * k[0] * k[2]) + h30_t2 + h30_t1))
-            + (h30_t0 * k[1])
             + (5.0 * h30_t0 * h30_t2 * k[2] / 4.0 / ((2.0 * k[0] * k[2]) + h30_t2 + h30_t1))
             + (h30_t0 * k[0].powi(3) / 4.0 / ((2.0 * k[0] * k[2]) + h30_t2 + h30_t1))
             + (h30_t0 * k[2].powi(3) / ((2.0 * k[0] * k[2]) + h30_t2 + h30_t1)));
-        let h31_t0 = (k[3] * k[3]);
-        let h31_t1 = (k[2] * k[2]);
-        let h31_t2 = (k[0] * k[0]);
-        k[31] = ((2.0 * h31_t0 * k[0] * h31_t1 / ((2.0 * k[0] * k[2]) + h31_t2 + h31_t1))
-            + (5.0 * h31_t0 * h31_t2 * k[2] / 4.0 / ((2.0 * k[0] * k[2]) + h31_t2 + h31_t1))
-            + (h31_t0 * k[0].powi(3) / 4.0 / ((2.0 * k[0] * k[2]) + h31_t2 + h31_t1))
-            + (h31_t0 * k[2].powi(3) / ((2.0 * k[0] * k[2]) + h31_t2 + h31_t1)));
-        k[32] = ((3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
-            + (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
+        k[31] = ((3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
             + (k[3] * k[1])
+            + (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
             + (k[3] * (k[2] * k[2]) / (k[0] + k[2])));
-        k[33] = (-(k[3] * k[5] * k[0] / 2.0) - (k[3] * k[5] * k[2]));
-        k[34] = (-(k[3] * k[3]) * k[1]);
-        k[35] = k[1];
-        k[36] = ((k[5] * k[0]) + (k[5] * k[2]));
-        k[37] = ((3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
-            + (k[3] * (k[2] * k[2]) / (k[0] + k[2]))
-            + (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2])));
-        k[38] = (-(3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
+        k[32] = (-(k[3] * k[5] * k[0] / 2.0) - (k[3] * k[5] * k[2]));
+        k[33] = (-(k[3] * k[3]) * k[1]);
+        k[34] = k[1];
+        k[35] = ((k[5] * k[0]) + (k[5] * k[2]));
+        k[36] = ((3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
+            + (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
+            + (k[3] * (k[2] * k[2]) / (k[0] + k[2])));
+        k[37] = (-(3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
             - (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
             - (k[3] * (k[2] * k[2]) / (k[0] + k[2])));
-        k[39] = (-k[4] / 2.0);
-        k[40] = ((k[5] * k[0] * k[1])
+        k[38] = (-k[4] / 2.0);
+        k[39] = ((k[5] * k[0] * k[1])
             + (3.0 * k[5] * k[0] * k[2])
             + (2.0 * k[5] * k[1] * k[2])
-            + (2.0 * k[5] * (k[2] * k[2]))
-            + (k[5] * (k[0] * k[0])));
-        k[41] = (-(4.0 * k[0] * k[1])
+            + (k[5] * (k[0] * k[0]))
+            + (2.0 * k[5] * (k[2] * k[2])));
+        k[40] = (-(4.0 * k[0] * k[1])
             - (16.0 * k[0] * k[2])
             - (12.0 * k[1] * k[2])
             - (4.0 * (k[0] * k[0]))
             - (12.0 * (k[2] * k[2])));
-        k[42] = ((12.0 * k[0] * k[2])
+        k[41] = ((12.0 * k[0] * k[2])
             + (12.0 * k[1] * k[2])
             + (3.0 * (k[0] * k[0]))
             + (12.0 * (k[2] * k[2])));
+        let h42_t0 = (k[2] * k[2]);
+        let h42_t1 = (k[1] * k[1]);
+        let h42_t2 = k[2].powi(3);
+        let h42_t3 = (k[0] * k[0]);
+        let h42_t4 = k[0].powi(3);
+        k[42] = ((144.0 * k[5] * k[0] * k[1] * h42_t0)
+            + (24.0 * k[5] * k[0] * h42_t1 * k[2])
+            + (120.0 * k[5] * k[0] * h42_t2)
+            + (96.0 * k[5] * k[1] * h42_t2)
+            + (60.0 * k[5] * h42_t3 * k[1] * k[2])
+            + (108.0 * k[5] * h42_t3 * h42_t0)
+            + (6.0 * k[5] * h42_t4 * k[1])
+            + (42.0 * k[5] * h42_t4 * k[2])
+            + (6.0 * k[5] * k[0].powi(4))
+            + (48.0 * k[5] * h42_t1 * h42_t0)
+            + (48.0 * k[5] * k[2].powi(4)));
         let h43_t0 = (k[2] * k[2]);
-        let h43_t1 = k[2].powi(3);
-        let h43_t2 = (k[1] * k[1]);
+        let h43_t1 = (k[1] * k[1]);
+        let h43_t2 = k[2].powi(3);
         let h43_t3 = (k[0] * k[0]);
         let h43_t4 = k[0].powi(3);
-        k[43] = ((144.0 * k[5] * k[0] * k[1] * h43_t0)
-            + (120.0 * k[5] * k[0] * h43_t1)
-            + (24.0 * k[5] * k[0] * h43_t2 * k[2])
-            + (96.0 * k[5] * k[1] * h43_t1)
-            + (48.0 * k[5] * k[2].powi(4))
-            + (60.0 * k[5] * h43_t3 * k[1] * k[2])
-            + (108.0 * k[5] * h43_t3 * h43_t0)
-            + (6.0 * k[5] * h43_t4 * k[1])
-            + (42.0 * k[5] * h43_t4 * k[2])
-            + (6.0 * k[5] * k[0].powi(4))
-            + (48.0 * k[5] * h43_t2 * h43_t0));
+        k[43] = (-(88.0 * k[5] * k[0] * k[1] * h43_t0)
+            - (20.0 * k[5] * k[0] * h43_t1 * k[2])
+            - (68.0 * k[5] * k[0] * h43_t2)
+            - (48.0 * k[5] * k[1] * h43_t2)
+            - (48.0 * k[5] * h43_t3 * k[1] * k[2])
+            - (4.0 * k[5] * h43_t3 * h43_t1)
+            - (68.0 * k[5] * h43_t3 * h43_t0)
+            - (8.0 * k[5] * h43_t4 * k[1])
+            - (28.0 * k[5] * h43_t4 * k[2])
+            - (4.0 * k[5] * k[0].powi(4))
+            - (24.0 * k[5] * h43_t1 * h43_t0)
+            - (24.0 * k[5] * k[2].powi(4)));
         let h44_t0 = (k[2] * k[2]);
-        let h44_t1 = k[2].powi(3);
-        let h44_t2 = (k[1] * k[1]);
+        let h44_t1 = (k[1] * k[1]);
+        let h44_t2 = k[2].powi(3);
         let h44_t3 = (k[0] * k[0]);
         let h44_t4 = k[0].powi(3);
-        k[44] = (-(88.0 * k[5] * k[0] * k[1] * h44_t0)
-            - (68.0 * k[5] * k[0] * h44_t1)
-            - (20.0 * k[5] * k[0] * h44_t2 * k[2])
-            - (48.0 * k[5] * k[1] * h44_t1)
-            - (24.0 * k[5] * k[2].powi(4))
-            - (48.0 * k[5] * h44_t3 * k[1] * k[2])
-            - (68.0 * k[5] * h44_t3 * h44_t0)
-            - (4.0 * k[5] * h44_t3 * h44_t2)
-            - (8.0 * k[5] * h44_t4 * k[1])
-            - (28.0 * k[5] * h44_t4 * k[2])
-            - (4.0 * k[5] * k[0].powi(4))
-            - (24.0 * k[5] * h44_t2 * h44_t0));
-        let h45_t0 = (k[2] * k[2]);
-        let h45_t1 = (k[1] * k[1]);
-        let h45_t2 = k[2].powi(3);
-        let h45_t3 = (k[0] * k[0]);
-        let h45_t4 = k[0].powi(3);
-        k[45] = ((72.0 * k[5] * k[0] * k[1] * h45_t0)
-            + (12.0 * k[5] * k[0] * h45_t1 * k[2])
-            + (60.0 * k[5] * k[0] * h45_t2)
-            + (48.0 * k[5] * k[1] * h45_t2)
-            + (30.0 * k[5] * h45_t3 * k[1] * k[2])
-            + (54.0 * k[5] * h45_t3 * h45_t0)
-            + (3.0 * k[5] * h45_t4 * k[1])
-            + (21.0 * k[5] * h45_t4 * k[2])
+        k[44] = ((72.0 * k[5] * k[0] * k[1] * h44_t0)
+            + (12.0 * k[5] * k[0] * h44_t1 * k[2])
+            + (60.0 * k[5] * k[0] * h44_t2)
+            + (48.0 * k[5] * k[1] * h44_t2)
+            + (30.0 * k[5] * h44_t3 * k[1] * k[2])
+            + (54.0 * k[5] * h44_t3 * h44_t0)
+            + (3.0 * k[5] * h44_t4 * k[1])
+            + (21.0 * k[5] * h44_t4 * k[2])
             + (3.0 * k[5] * k[0].powi(4))
-            + (24.0 * k[5] * h45_t1 * h45_t0)
+            + (24.0 * k[5] * h44_t1 * h44_t0)
             + (24.0 * k[5] * k[2].powi(4)));
-        k[46] = (-k[3] * k[0] * k[1] / 2.0 / (k[0] + k[1] + k[2]));
-        k[47] = (-((k[3] * k[0]) + (2.0 * k[3] * k[2])) / 2.0);
-        k[48] = (((k[3] * k[0]) + (2.0 * k[3] * k[2])) / 2.0);
-        k[49] = ((8.0 * k[0] * k[1] * k[8])
-            + (32.0 * k[0] * k[8] * k[2])
-            + (24.0 * k[1] * k[8] * k[2])
-            + (24.0 * k[8] * (k[2] * k[2]))
-            + (8.0 * (k[0] * k[0]) * k[8]));
-        k[50] = (-(12.0 * k[0] * k[1])
+        k[45] = (-k[3] * k[0] * k[1] / 2.0 / (k[0] + k[1] + k[2]));
+        k[46] = (-((k[3] * k[0]) + (2.0 * k[3] * k[2])) / 2.0);
+        k[47] = (((k[3] * k[0]) + (2.0 * k[3] * k[2])) / 2.0);
+        k[48] = ((8.0 * k[0] * k[1] * k[8])
+            + (32.0 * k[0] * k[2] * k[8])
+            + (24.0 * k[1] * k[2] * k[8])
+            + (8.0 * (k[0] * k[0]) * k[8])
+            + (24.0 * (k[2] * k[2]) * k[8]));
+        k[49] = (-(12.0 * k[0] * k[1])
             - (48.0 * k[0] * k[2])
             - (36.0 * k[1] * k[2])
             - (12.0 * (k[0] * k[0]))
             - (36.0 * (k[2] * k[2])));
-        k[51] = k[10];
-        k[52] = ((k[3] * k[0] / 2.0 / (k[0] + k[1] + k[2]))
+        k[50] = k[10];
+        k[51] = ((k[3] * k[0] / 2.0 / (k[0] + k[1] + k[2]))
             + (k[3] * k[1] / (k[0] + k[1] + k[2]))
             + (k[3] * k[2] / (k[0] + k[1] + k[2])));
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..52]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = k[13];
@@ -329,7 +325,7 @@ impl Model for LoadedRod {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..52]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let pt0 = ((k[14] * rc_c) + q[0]);
         let pt1 = ((k[17] * qd[1] * rc_s) + qd[0]);
@@ -346,59 +342,59 @@ impl Model for LoadedRod {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..52]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = (qd[1] * qd[1]);
         (((k[20] * qd[1] * qd[0] * rc_s)
-            + (k[21] * (qd[0] * qd[0]))
-            + (k[22] * et0)
-            + (k[23] * et0 * (rc_s * rc_s))
-            + (k[24] * et0 * (rc_c * rc_c)))
+            + (k[21] * et0)
+            + (k[22] * et0 * (rc_s * rc_s))
+            + (k[23] * et0 * (rc_c * rc_c))
+            + (k[24] * (qd[0] * qd[0])))
             + (k[25] + (k[26] * rc_s)))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..52]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = ((k[20] * qd[1] * rc_s) + (k[27] * qd[0]));
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..52]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let qt0 = (k[28] * rc_s);
+        let qt0 = (k[20] * rc_s);
         let qt1 = (qd[1] * qd[1]);
         mass[0] = k[27];
         mass[1] = qt0;
         mass[2] = qt0;
-        mass[3] = (k[29] + (k[30] * (rc_s * rc_s)) + (k[31] * (rc_c * rc_c)));
-        rhs[0] = (k[32] * qt1 * rc_c);
-        rhs[1] = ((k[33] * rc_c) + (k[34] * qt1 * rc_s * rc_c));
+        mass[3] = (k[28] + (k[29] * (rc_s * rc_s)) + (k[30] * (rc_c * rc_c)));
+        rhs[0] = (k[31] * qt1 * rc_c);
+        rhs[1] = ((k[32] * rc_c) + (k[33] * qt1 * rc_s * rc_c));
     }
 
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..52]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let ft0 = (qd[1] * qd[1]);
-        out[0] = (k[35] * ((k[17] * qdd[1] * rc_s) + (k[17] * ft0 * rc_c) + qdd[0]));
-        out[1] = (k[36] + (k[37] * qdd[1] * rc_c) + (k[38] * ft0 * rc_s));
+        out[0] = (k[34] * ((k[17] * qdd[1] * rc_s) + qdd[0] + (k[17] * ft0 * rc_c)));
+        out[1] = (k[35] + (k[36] * qdd[1] * rc_c) + (k[37] * ft0 * rc_s));
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..52]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = forces[1];
-        out[1] = (k[25] - (forces[0] * (k[39] + (k[14] * rc_s))));
+        out[1] = (k[25] - (forces[0] * (k[38] + (k[14] * rc_s))));
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..52]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         f64::INFINITY
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..52]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = ((k[14] * rc_c) + q[0]);
         out[1] = ((k[17] * qd[1] * rc_s) + qd[0]);
@@ -411,46 +407,46 @@ impl Model for LoadedRod {
 
 impl Reduction for LoadedRod {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..52]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
-        let rt1 = (k[41] + (k[42] * rt0));
+        let rt1 = (k[40] + (k[41] * rt0));
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: (-12.0 * (k[40] * rc_ds) / (k[14] * rt1)),
+            theta_dot_sq: (-12.0 * (k[39] * rc_ds) / (k[14] * rt1)),
             theta_ddot: (6.0
-                * ((k[43] * rc_s * rc_c * rc_ds) + (k[44] * rc_c) + (k[45] * rt0 * rc_c))
+                * ((k[42] * rc_s * rc_c * rc_ds) + (k[43] * rc_c) + (k[44] * rt0 * rc_c))
                 / (k[14] * (rt1 * rt1))),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
-        let k = &k[..53]; // one bounds check for all constant loads
-        (-12.0 * (k[40] * rc_ds) / (k[14] * (k[41] + (k[42] * (rc_s * rc_s)))))
+        let k = &k[..52]; // one bounds check for all constant loads
+        (-12.0 * (k[39] * rc_ds) / (k[14] * (k[40] + (k[41] * (rc_s * rc_s)))))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..52]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
-        let rt1 = (k[41] + (k[42] * rt0));
-        let rc_w2 = (-12.0 * (k[40] * rc_ds) / (k[14] * rt1));
+        let rt1 = (k[40] + (k[41] * rt0));
+        let rc_w2 = (-12.0 * (k[39] * rc_ds) / (k[14] * rt1));
         let rc_acc = (6.0
-            * ((k[43] * rc_s * rc_c * rc_ds) + (k[44] * rc_c) + (k[45] * rt0 * rc_c))
+            * ((k[42] * rc_s * rc_c * rc_ds) + (k[43] * rc_c) + (k[44] * rt0 * rc_c))
             / (k[14] * (rt1 * rt1)));
-        out[0] = ((k[46] * rc_s * rc_acc) + (k[46] * rc_c * rc_w2));
-        out[1] = (k[36] + (k[47] * rc_s * rc_w2) + (k[48] * rc_c * rc_acc));
+        out[0] = ((k[45] * rc_s * rc_acc) + (k[45] * rc_c * rc_w2));
+        out[1] = (k[35] + (k[46] * rc_s * rc_w2) + (k[47] * rc_c * rc_acc));
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
-        out[0] = k[49];
-        out[1] = k[50];
+        let k = &k[..52]; // one bounds check for all constant loads
+        out[0] = k[48];
+        out[1] = k[49];
         out[2] = 0.0;
-        out[3] = k[42];
+        out[3] = k[41];
     }
 
     fn full_state(
@@ -462,12 +458,12 @@ impl Reduction for LoadedRod {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..52]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[1] = k[6] - delta;
         qd[1] = theta_dot;
-        q[0] = (k[51] + (k[52] * rc_dc));
-        qd[0] = (k[52] * rc_w * rc_s);
+        q[0] = (k[50] + (k[51] * rc_dc));
+        qd[0] = (k[51] * rc_s * rc_w);
     }
 }

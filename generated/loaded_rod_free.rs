@@ -93,7 +93,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 58,
+    n_constants: 56,
     coordinates: &["x1", "theta", "x2"],
     reduced: 1,
     cyclic: &[0, 2],
@@ -166,9 +166,9 @@ impl Model for LoadedRodFree {
         k[15] = k[12].cos();
         k[16] = k[6];
         k[17] = k[8];
-        k[18] = (-(3.0 * k[3] * k[0] * k[14] * k[13] * k[2] / 2.0 / (k[0] + k[2]))
-            - (k[3] * k[14] * k[13] * (k[2] * k[2]) / (k[0] + k[2]))
-            - (k[3] * (k[0] * k[0]) * k[14] * k[13] / 2.0 / (k[0] + k[2]))
+        k[18] = (-(3.0 * k[3] * k[0] * k[2] * k[13] * k[14] / 2.0 / (k[0] + k[2]))
+            - (k[3] * (k[0] * k[0]) * k[13] * k[14] / 2.0 / (k[0] + k[2]))
+            - (k[3] * (k[2] * k[2]) * k[13] * k[14] / (k[0] + k[2]))
             + (k[0] * k[9])
             + (k[2] * k[9]));
         k[19] = (k[1] * k[11]);
@@ -176,11 +176,11 @@ impl Model for LoadedRodFree {
         let c8_t1 = (k[14] * k[14]);
         let c8_t2 = (k[0] * k[0]);
         let c8_t3 = (k[2] * k[2]);
-        k[20] = ((4.0 * c8_t0 * k[0] * k[2] / 3.0 / (k[0] + k[2]))
-            - (c8_t0 * k[0] * c8_t1 * k[2] / (k[0] + k[2]))
+        k[20] = (-(c8_t0 * k[0] * k[2] * c8_t1 / (k[0] + k[2]))
+            + (4.0 * c8_t0 * k[0] * k[2] / 3.0 / (k[0] + k[2]))
             - (c8_t0 * c8_t2 * c8_t1 / 4.0 / (k[0] + k[2]))
             + (c8_t0 * c8_t2 / 3.0 / (k[0] + k[2]))
-            - (c8_t0 * c8_t1 * c8_t3 / (k[0] + k[2]))
+            - (c8_t0 * c8_t3 * c8_t1 / (k[0] + k[2]))
             + (c8_t0 * c8_t3 / (k[0] + k[2])));
         k[21] = k[3];
         k[22] = (k[3] / 2.0);
@@ -189,81 +189,75 @@ impl Model for LoadedRodFree {
         k[25] = (-k[3] / 2.0);
         k[26] = (-(k[3] * k[0] / 2.0 / (k[0] + k[2])) - (k[3] * k[2] / (k[0] + k[2])));
         k[27] = (-(3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
-            - (k[3] * (k[2] * k[2]) / (k[0] + k[2]))
-            - (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2])));
-        k[28] = ((k[0] / 2.0) + (k[2] / 2.0));
-        k[29] = (k[1] / 2.0);
-        let h30_t0 = (k[3] * k[3]);
-        k[30] = ((h30_t0 * k[0] / 24.0) + (h30_t0 * k[0] * k[2] / 8.0 / (k[0] + k[2])));
-        let h31_t0 = (k[3] * k[3]);
-        let h31_t1 = (k[2] * k[2]);
-        let h31_t2 = (k[0] * k[0]);
-        k[31] = ((h31_t0 * k[0] * h31_t1 / ((2.0 * k[0] * k[2]) + h31_t2 + h31_t1))
-            + (5.0 * h31_t0 * h31_t2 * k[2] / 8.0 / ((2.0 * k[0] * k[2]) + h31_t2 + h31_t1))
-            + (h31_t0 * k[0].powi(3) / 8.0 / ((2.0 * k[0] * k[2]) + h31_t2 + h31_t1))
-            + (h31_t0 * k[2].powi(3) / 2.0 / ((2.0 * k[0] * k[2]) + h31_t2 + h31_t1)));
-        k[32] = (k[5] * k[1] * k[4] / 2.0);
+            - (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
+            - (k[3] * (k[2] * k[2]) / (k[0] + k[2])));
+        let h28_t0 = (k[3] * k[3]);
+        k[28] = ((h28_t0 * k[0] / 24.0) + (h28_t0 * k[0] * k[2] / 8.0 / (k[0] + k[2])));
+        let h29_t0 = (k[3] * k[3]);
+        let h29_t1 = (k[2] * k[2]);
+        let h29_t2 = (k[0] * k[0]);
+        k[29] = ((h29_t0 * k[0] * h29_t1 / ((2.0 * k[0] * k[2]) + h29_t2 + h29_t1))
+            + (5.0 * h29_t0 * h29_t2 * k[2] / 8.0 / ((2.0 * k[0] * k[2]) + h29_t2 + h29_t1))
+            + (h29_t0 * k[0].powi(3) / 8.0 / ((2.0 * k[0] * k[2]) + h29_t2 + h29_t1))
+            + (h29_t0 * k[2].powi(3) / 2.0 / ((2.0 * k[0] * k[2]) + h29_t2 + h29_t1)));
+        k[30] = ((k[0] / 2.0) + (k[2] / 2.0));
+        k[31] = (k[1] / 2.0);
+        k[32] = (k[4] * k[5] * k[1] / 2.0);
         k[33] = ((k[3] * k[5] * k[0] / 2.0) + (k[3] * k[5] * k[2]));
         k[34] = (k[0] + k[2]);
         k[35] = k[1];
-        k[36] = (-(3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
-            - (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
-            - (k[3] * (k[2] * k[2]) / (k[0] + k[2])));
+        let h36_t0 = (k[3] * k[3]);
+        k[36] = ((h36_t0 * k[0] / 12.0) + (h36_t0 * k[0] * k[2] / 4.0 / (k[0] + k[2])));
         let h37_t0 = (k[3] * k[3]);
-        k[37] = ((h37_t0 * k[0] / 12.0) + (h37_t0 * k[0] * k[2] / 4.0 / (k[0] + k[2])));
-        let h38_t0 = (k[3] * k[3]);
-        let h38_t1 = (k[2] * k[2]);
-        let h38_t2 = (k[0] * k[0]);
-        k[38] = ((2.0 * h38_t0 * k[0] * h38_t1 / ((2.0 * k[0] * k[2]) + h38_t2 + h38_t1))
-            + (5.0 * h38_t0 * h38_t2 * k[2] / 4.0 / ((2.0 * k[0] * k[2]) + h38_t2 + h38_t1))
-            + (h38_t0 * k[0].powi(3) / 4.0 / ((2.0 * k[0] * k[2]) + h38_t2 + h38_t1))
-            + (h38_t0 * k[2].powi(3) / ((2.0 * k[0] * k[2]) + h38_t2 + h38_t1)));
-        k[39] = ((3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
+        let h37_t1 = (k[2] * k[2]);
+        let h37_t2 = (k[0] * k[0]);
+        k[37] = ((2.0 * h37_t0 * k[0] * h37_t1 / ((2.0 * k[0] * k[2]) + h37_t2 + h37_t1))
+            + (5.0 * h37_t0 * h37_t2 * k[2] / 4.0 / ((2.0 * k[0] * k[2]) + h37_t2 + h37_t1))
+            + (h37_t0 * k[0].powi(3) / 4.0 / ((2.0 * k[0] * k[2]) + h37_t2 + h37_t1))
+            + (h37_t0 * k[2].powi(3) / ((2.0 * k[0] * k[2]) + h37_t2 + h37_t1)));
+        k[38] = ((3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
             + (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
             + (k[3] * (k[2] * k[2]) / (k[0] + k[2])));
-        k[40] = (-(k[3] * k[5] * k[0] / 2.0) - (k[3] * k[5] * k[2]));
-        k[41] = ((k[5] * k[0]) + (k[5] * k[2]));
-        k[42] = ((3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
-            + (k[3] * (k[2] * k[2]) / (k[0] + k[2]))
-            + (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2])));
-        let h43_t0 = (k[13] * k[13]);
-        k[43] = ((k[0] * k[20] * h43_t0) + (k[20] * h43_t0 * k[2]));
-        k[44] = ((3.0 * k[3] * k[5] * k[0] * k[2])
-            + (2.0 * k[3] * k[5] * (k[2] * k[2]))
-            + (k[3] * k[5] * (k[0] * k[0])));
-        k[45] = (k[3] * k[3]);
-        k[46] = (-(16.0 * k[0] * k[2]) - (4.0 * (k[0] * k[0])) - (12.0 * (k[2] * k[2])));
-        k[47] = ((12.0 * k[0] * k[2]) + (3.0 * (k[0] * k[0])) + (12.0 * (k[2] * k[2])));
-        k[48] = ((120.0 * k[3] * k[5] * k[0] * k[2].powi(3))
-            + (48.0 * k[3] * k[5] * k[2].powi(4))
+        k[39] = (-(k[3] * k[5] * k[0] / 2.0) - (k[3] * k[5] * k[2]));
+        k[40] = ((k[5] * k[0]) + (k[5] * k[2]));
+        let h41_t0 = (k[13] * k[13]);
+        k[41] = ((k[0] * h41_t0 * k[20]) + (k[2] * h41_t0 * k[20]));
+        k[42] = ((3.0 * k[3] * k[5] * k[0] * k[2])
+            + (k[3] * k[5] * (k[0] * k[0]))
+            + (2.0 * k[3] * k[5] * (k[2] * k[2])));
+        k[43] = (k[3] * k[3]);
+        k[44] = (-(16.0 * k[0] * k[2]) - (4.0 * (k[0] * k[0])) - (12.0 * (k[2] * k[2])));
+        k[45] = ((12.0 * k[0] * k[2]) + (3.0 * (k[0] * k[0])) + (12.0 * (k[2] * k[2])));
+        k[46] = ((120.0 * k[3] * k[5] * k[0] * k[2].powi(3))
             + (108.0 * k[3] * k[5] * (k[0] * k[0]) * (k[2] * k[2]))
             + (42.0 * k[3] * k[5] * k[0].powi(3) * k[2])
-            + (6.0 * k[3] * k[5] * k[0].powi(4)));
-        k[49] = (-(68.0 * k[3] * k[5] * k[0] * k[2].powi(3))
-            - (24.0 * k[3] * k[5] * k[2].powi(4))
+            + (6.0 * k[3] * k[5] * k[0].powi(4))
+            + (48.0 * k[3] * k[5] * k[2].powi(4)));
+        k[47] = (-(68.0 * k[3] * k[5] * k[0] * k[2].powi(3))
             - (68.0 * k[3] * k[5] * (k[0] * k[0]) * (k[2] * k[2]))
             - (28.0 * k[3] * k[5] * k[0].powi(3) * k[2])
-            - (4.0 * k[3] * k[5] * k[0].powi(4)));
-        k[50] = ((60.0 * k[3] * k[5] * k[0] * k[2].powi(3))
+            - (4.0 * k[3] * k[5] * k[0].powi(4))
+            - (24.0 * k[3] * k[5] * k[2].powi(4)));
+        k[48] = ((60.0 * k[3] * k[5] * k[0] * k[2].powi(3))
             + (54.0 * k[3] * k[5] * (k[0] * k[0]) * (k[2] * k[2]))
             + (21.0 * k[3] * k[5] * k[0].powi(3) * k[2])
             + (3.0 * k[3] * k[5] * k[0].powi(4))
             + (24.0 * k[3] * k[5] * k[2].powi(4)));
-        let h51_t0 = (k[13] * k[13]);
-        k[51] = ((48.0 * k[0] * k[20] * h51_t0 * (k[2] * k[2]))
-            + (24.0 * k[20] * h51_t0 * k[2].powi(3))
-            + (30.0 * (k[0] * k[0]) * k[20] * h51_t0 * k[2])
-            + (6.0 * k[0].powi(3) * k[20] * h51_t0));
-        k[52] = (-((k[3] * k[0]) + (2.0 * k[3] * k[2])) / 2.0);
-        k[53] = (((k[3] * k[0]) + (2.0 * k[3] * k[2])) / 2.0);
-        k[54] = k[16];
-        k[55] = (k[18] / (k[0] + k[2]));
-        k[56] = k[17];
-        k[57] = (k[19] / k[1]);
+        let h49_t0 = (k[13] * k[13]);
+        k[49] = ((48.0 * k[0] * (k[2] * k[2]) * h49_t0 * k[20])
+            + (30.0 * (k[0] * k[0]) * k[2] * h49_t0 * k[20])
+            + (6.0 * k[0].powi(3) * h49_t0 * k[20])
+            + (24.0 * k[2].powi(3) * h49_t0 * k[20]));
+        k[50] = (-((k[3] * k[0]) + (2.0 * k[3] * k[2])) / 2.0);
+        k[51] = (((k[3] * k[0]) + (2.0 * k[3] * k[2])) / 2.0);
+        k[52] = k[16];
+        k[53] = (k[18] / (k[0] + k[2]));
+        k[54] = k[17];
+        k[55] = (k[19] / k[1]);
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..58]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         q[0] = k[6];
         qd[0] = k[9];
         q[1] = k[7];
@@ -273,7 +267,7 @@ impl Model for LoadedRodFree {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..58]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         pos[0] = [q[0], 0.0];
         vel[0] = [qd[0], 0.0];
@@ -288,64 +282,64 @@ impl Model for LoadedRodFree {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..58]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = (qd[1] * qd[1]);
         (((k[27] * qd[1] * qd[0] * rc_s)
-            + (k[28] * (qd[0] * qd[0]))
-            + (k[29] * (qd[2] * qd[2]))
-            + (k[30] * et0)
-            + (k[31] * et0 * (rc_s * rc_s))
-            + (k[31] * et0 * (rc_c * rc_c)))
+            + (k[28] * et0)
+            + (k[29] * et0 * (rc_s * rc_s))
+            + (k[29] * et0 * (rc_c * rc_c))
+            + (k[30] * (qd[0] * qd[0]))
+            + (k[31] * (qd[2] * qd[2])))
             + (k[32] + (k[33] * rc_s)))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..58]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = ((k[27] * qd[1] * rc_s) + (k[34] * qd[0]));
         out[1] = (k[35] * qd[2]);
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..58]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let qt0 = (k[36] * rc_s);
+        let qt0 = (k[27] * rc_s);
         mass[0] = k[34];
         mass[1] = qt0;
         mass[2] = 0.0;
         mass[3] = qt0;
-        mass[4] = (k[37] + (k[38] * (rc_s * rc_s)) + (k[38] * (rc_c * rc_c)));
+        mass[4] = (k[36] + (k[37] * (rc_s * rc_s)) + (k[37] * (rc_c * rc_c)));
         mass[5] = 0.0;
         mass[6] = 0.0;
         mass[7] = 0.0;
         mass[8] = k[1];
-        rhs[0] = (k[39] * (qd[1] * qd[1]) * rc_c);
-        rhs[1] = (k[40] * rc_c);
+        rhs[0] = (k[38] * (qd[1] * qd[1]) * rc_c);
+        rhs[1] = (k[39] * rc_c);
         rhs[2] = 0.0;
     }
 
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..58]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        out[0] = (k[41] + (k[42] * qdd[1] * rc_c) + (k[36] * (qd[1] * qd[1]) * rc_s));
+        out[0] = (k[40] + (k[38] * qdd[1] * rc_c) + (k[27] * (qd[1] * qd[1]) * rc_s));
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..58]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = forces[0];
-        out[1] = (q[2] + (k[24] * rc_c) - q[0]);
+        out[1] = ((k[24] * rc_c) - q[0] + q[2]);
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        let k = &k[..58]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         f64::INFINITY
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..58]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
     }
 
@@ -356,47 +350,47 @@ impl Model for LoadedRodFree {
 
 impl Reduction for LoadedRodFree {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..58]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[12], k[14], k[15], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
-        let rt1 = (k[46] + (k[47] * rt0));
+        let rt1 = (k[44] + (k[45] * rt0));
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: (-12.0 * (k[43] + (k[44] * rc_ds)) / (k[45] * rt1)),
+            theta_dot_sq: (-12.0 * (k[41] + (k[42] * rc_ds)) / (k[43] * rt1)),
             theta_ddot: (6.0
-                * ((k[48] * rc_s * rc_c * rc_ds)
-                    + (k[49] * rc_c)
-                    + (k[50] * rt0 * rc_c)
-                    + (k[51] * rc_s * rc_c))
-                / (k[45] * (rt1 * rt1))),
+                * ((k[46] * rc_s * rc_c * rc_ds)
+                    + (k[47] * rc_c)
+                    + (k[48] * rt0 * rc_c)
+                    + (k[49] * rc_s * rc_c))
+                / (k[43] * (rt1 * rt1))),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
-        let k = &k[..58]; // one bounds check for all constant loads
-        (-12.0 * (k[43] + (k[44] * rc_ds)) / (k[45] * (k[46] + (k[47] * (rc_s * rc_s)))))
+        let k = &k[..56]; // one bounds check for all constant loads
+        (-12.0 * (k[41] + (k[42] * rc_ds)) / (k[43] * (k[44] + (k[45] * (rc_s * rc_s)))))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..58]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[12], k[14], k[15], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
-        let rt1 = (k[46] + (k[47] * rt0));
-        let rc_w2 = (-12.0 * (k[43] + (k[44] * rc_ds)) / (k[45] * rt1));
+        let rt1 = (k[44] + (k[45] * rt0));
+        let rc_w2 = (-12.0 * (k[41] + (k[42] * rc_ds)) / (k[43] * rt1));
         let rc_acc = (6.0
-            * ((k[48] * rc_s * rc_c * rc_ds)
-                + (k[49] * rc_c)
-                + (k[50] * rt0 * rc_c)
-                + (k[51] * rc_s * rc_c))
-            / (k[45] * (rt1 * rt1)));
-        out[0] = (k[41] + (k[52] * rc_s * rc_w2) + (k[53] * rc_c * rc_acc));
+            * ((k[46] * rc_s * rc_c * rc_ds)
+                + (k[47] * rc_c)
+                + (k[48] * rt0 * rc_c)
+                + (k[49] * rc_s * rc_c))
+            / (k[43] * (rt1 * rt1)));
+        out[0] = (k[40] + (k[50] * rc_s * rc_w2) + (k[51] * rc_c * rc_acc));
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..58]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
     }
 
     fn full_state(
@@ -408,14 +402,14 @@ impl Reduction for LoadedRodFree {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..58]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[12], k[14], k[15], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[1] = k[12] - delta;
         qd[1] = theta_dot;
-        q[0] = (k[54] + (k[23] * rc_dc) + (k[55] * rc_t));
-        qd[0] = (k[55] + (k[23] * rc_w * rc_s));
-        q[2] = (k[56] + (k[57] * rc_t));
-        qd[2] = k[57];
+        q[0] = (k[52] + (k[23] * rc_dc) + (k[53] * rc_t));
+        qd[0] = (k[53] + (k[23] * rc_s * rc_w));
+        q[2] = (k[54] + (k[55] * rc_t));
+        qd[2] = k[55];
     }
 }

@@ -157,12 +157,12 @@ impl Model for RodCube {
         k[15] = (-k[2]);
         k[16] = (-k[2] / 2.0);
         k[17] = (-(k[2] * k[0] / 2.0) - (k[2] * k[1]));
-        k[18] = ((k[0] / 2.0) + (k[1] / 2.0));
-        k[19] = ((k[2] * k[2]) * k[0] / 24.0);
-        let h20_t0 = (k[2] * k[2]);
-        k[20] = ((h20_t0 * k[0] / 8.0) + (h20_t0 * k[1] / 2.0));
-        k[21] = ((k[2] * k[2]) * k[0] / 8.0);
-        k[22] = (k[4] * k[1] * k[3] / 2.0);
+        k[18] = ((k[2] * k[2]) * k[0] / 24.0);
+        let h19_t0 = (k[2] * k[2]);
+        k[19] = ((h19_t0 * k[0] / 8.0) + (h19_t0 * k[1] / 2.0));
+        k[20] = ((k[2] * k[2]) * k[0] / 8.0);
+        k[21] = ((k[0] / 2.0) + (k[1] / 2.0));
+        k[22] = (k[3] * k[4] * k[1] / 2.0);
         k[23] = (k[2] * k[4] * k[0] / 2.0);
         k[24] = (k[0] + k[1]);
         k[25] = ((k[2] * k[2]) * k[0] / 12.0);
@@ -220,10 +220,10 @@ impl Model for RodCube {
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = (qd[1] * qd[1]);
         (((k[17] * qd[1] * qd[0] * rc_s)
-            + (k[18] * (qd[0] * qd[0]))
-            + (k[19] * et0)
-            + (k[20] * et0 * (rc_s * rc_s))
-            + (k[21] * et0 * (rc_c * rc_c)))
+            + (k[18] * et0)
+            + (k[19] * et0 * (rc_s * rc_s))
+            + (k[20] * et0 * (rc_c * rc_c))
+            + (k[21] * (qd[0] * qd[0])))
             + (k[22] + (k[23] * rc_s)))
     }
 
@@ -250,7 +250,7 @@ impl Model for RodCube {
         let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let ft0 = (qd[1] * qd[1]);
-        out[0] = (k[31] * ((k[15] * qdd[1] * rc_s) + (k[15] * ft0 * rc_c) + qdd[0]));
+        out[0] = (k[31] * ((k[15] * qdd[1] * rc_s) + qdd[0] + (k[15] * ft0 * rc_c)));
         out[1] = (k[32] + (k[33] * qdd[1] * rc_c) + (k[34] * ft0 * rc_s));
     }
 
@@ -338,6 +338,6 @@ impl Reduction for RodCube {
         q[1] = k[5] - delta;
         qd[1] = theta_dot;
         q[0] = (k[45] + (k[46] * rc_dc));
-        qd[0] = (k[46] * rc_w * rc_s);
+        qd[0] = (k[46] * rc_s * rc_w);
     }
 }

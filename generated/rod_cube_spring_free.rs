@@ -155,14 +155,14 @@ impl Model for RodCubeSpringFree {
         k[14] = (-k[2]);
         k[15] = (-k[2] / 2.0);
         k[16] = (-k[2] * k[0] / 2.0);
-        k[17] = (k[0] / 2.0);
-        k[18] = (k[1] / 2.0);
-        k[19] = ((k[2] * k[2]) * k[0] / 24.0);
-        k[20] = ((k[2] * k[2]) * k[0] / 8.0);
-        k[21] = (k[4] * k[1] * k[3] / 2.0);
+        k[17] = ((k[2] * k[2]) * k[0] / 24.0);
+        k[18] = ((k[2] * k[2]) * k[0] / 8.0);
+        k[19] = (k[0] / 2.0);
+        k[20] = (k[1] / 2.0);
+        k[21] = (k[3] * k[4] * k[1] / 2.0);
         k[22] = (k[2] * k[4] * k[0] / 2.0);
         k[23] = (k[5] / 2.0);
-        k[24] = (-((k[2] * k[2]) - (k[3] * k[3])).sqrt());
+        k[24] = (-(-(k[3] * k[3]) + (k[2] * k[2])).sqrt());
         k[25] = k[0];
         k[26] = ((k[2] * k[2]) * k[0] / 12.0);
         k[27] = ((k[2] * k[2]) * k[0] / 4.0);
@@ -200,11 +200,11 @@ impl Model for RodCubeSpringFree {
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = (qd[1] * qd[1]);
         (((k[16] * qd[1] * qd[0] * rc_s)
-            + (k[17] * (qd[0] * qd[0]))
-            + (k[18] * (qd[2] * qd[2]))
-            + (k[19] * et0)
-            + (k[20] * et0 * (rc_s * rc_s))
-            + (k[20] * et0 * (rc_c * rc_c)))
+            + (k[17] * et0)
+            + (k[18] * et0 * (rc_s * rc_s))
+            + (k[18] * et0 * (rc_c * rc_c))
+            + (k[19] * (qd[0] * qd[0]))
+            + (k[20] * (qd[2] * qd[2])))
             + (k[21] + (k[22] * rc_s) + (k[23] * ((k[24] + q[2]) * (k[24] + q[2])))))
     }
 
@@ -242,7 +242,7 @@ impl Model for RodCubeSpringFree {
         let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = forces[0];
-        out[1] = (q[2] + (k[14] * rc_c) - q[0]);
+        out[1] = ((k[14] * rc_c) - q[0] + q[2]);
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {

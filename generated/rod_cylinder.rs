@@ -153,24 +153,24 @@ impl Model for RodCylinder {
         k[10] = (-k[2] / 2.0);
         k[11] = (-k[3]);
         k[12] = (-2.0 * k[3]);
-        k[13] = (-k[2] * k[0] / 2.0);
-        k[14] = ((k[0] / 2.0) + (k[1] / 2.0));
-        k[15] = (-k[1] * k[3]);
-        k[16] = (((k[2] * k[2]) * k[0] / 24.0) + (k[1] * (k[3] * k[3]) / 2.0));
-        k[17] = ((k[2] * k[2]) * k[0] / 8.0);
-        k[18] = (k[1] * (k[3] * k[3]));
-        k[19] = (k[1] * (k[3] * k[3]) / 2.0);
-        k[20] = (k[5] * k[1] * k[3]);
+        k[13] = (-k[3] * k[1]);
+        k[14] = (-k[2] * k[0] / 2.0);
+        k[15] = (((k[3] * k[3]) * k[1] / 2.0) + ((k[2] * k[2]) * k[0] / 24.0));
+        k[16] = ((k[3] * k[3]) * k[1]);
+        k[17] = ((k[3] * k[3]) * k[1] / 2.0);
+        k[18] = ((k[2] * k[2]) * k[0] / 8.0);
+        k[19] = ((k[0] / 2.0) + (k[1] / 2.0));
+        k[20] = (k[3] * k[5] * k[1]);
         k[21] = (k[2] * k[5] * k[0] / 2.0);
         k[22] = (k[0] + k[1]);
-        k[23] = ((k[1] * (k[3] * k[3])) + ((k[2] * k[2]) * k[0] / 12.0));
-        k[24] = (2.0 * k[1] * (k[3] * k[3]));
+        k[23] = (((k[3] * k[3]) * k[1]) + ((k[2] * k[2]) * k[0] / 12.0));
+        k[24] = (2.0 * (k[3] * k[3]) * k[1]);
         k[25] = ((k[2] * k[2]) * k[0] / 4.0);
-        k[26] = (k[2] * k[0] / 2.0);
-        k[27] = (-2.0 * k[1] * k[3]);
+        k[26] = (-2.0 * k[3] * k[1]);
+        k[27] = (k[2] * k[0] / 2.0);
         k[28] = (-k[2] * k[5] * k[0] / 2.0);
-        k[29] = (5.0 * k[1] * (k[3] * k[3]));
-        k[30] = (4.0 * k[1] * (k[3] * k[3]));
+        k[29] = (5.0 * (k[3] * k[3]) * k[1]);
+        k[30] = (4.0 * (k[3] * k[3]) * k[1]);
         k[31] = k[1];
         k[32] = (2.0 * k[3]);
         k[33] = (k[5] * k[0]);
@@ -198,12 +198,12 @@ impl Model for RodCylinder {
         vel[1] = [((k[9] * qd[1] * rc_s) + qd[0]), (k[6] * qd[1] * rc_c)];
         pos[2] = [((k[7] * rc_c) + q[0]), (k[7] * rc_s)];
         vel[2] = [((k[10] * qd[1] * rc_s) + qd[0]), (k[7] * qd[1] * rc_c)];
-        pos[3] = [(q[0] + (k[8] / rc_s) + pt0), k[3]];
+        pos[3] = [((k[8] / rc_s) + pt0 + q[0]), k[3]];
         vel[3] = [
             (pt2 + (k[11] * qd[1] * rc_c / (rc_s * rc_s)) + pt3 + qd[0]),
             0.0,
         ];
-        pos[4] = [(q[0] + pt0 + (k[8] * pt1 / rc_s)), (k[8] + (k[8] * rc_c))];
+        pos[4] = [(pt0 + (k[8] * pt1 / rc_s) + q[0]), (k[8] + (k[8] * rc_c))];
         vel[4] = [
             (pt2 + (k[12] * qd[1] * rc_c)
                 + pt3
@@ -219,30 +219,30 @@ impl Model for RodCylinder {
         let et0 = (rc_s * rc_s);
         let et1 = (rc_c * rc_c);
         let et2 = (qd[1] * qd[1]);
-        (((k[13] * qd[1] * qd[0] * rc_s)
-            + (k[14] * (qd[0] * qd[0]))
-            + (k[15] * qd[1] * qd[0])
-            + (k[15] * qd[1] * qd[0] * rc_c / et0)
-            + (k[15] * qd[1] * qd[0] * et1 / et0)
-            + (k[16] * et2)
-            + (k[17] * et2 * et0)
-            + (k[17] * et2 * et1)
-            + (k[18] * et2 * rc_c / et0)
-            + (k[18] * et2 * et1 / et0)
-            + (k[19] * et2 * et1 / rc_s.powi(4))
-            + (k[18] * et2 * rc_c.powi(3) / rc_s.powi(4))
-            + (k[19] * et2 * rc_c.powi(4) / rc_s.powi(4)))
+        (((k[13] * qd[1] * qd[0])
+            + (k[13] * qd[1] * qd[0] * rc_c / et0)
+            + (k[13] * qd[1] * qd[0] * et1 / et0)
+            + (k[14] * qd[1] * qd[0] * rc_s)
+            + (k[15] * et2)
+            + (k[16] * et2 * rc_c / et0)
+            + (k[16] * et2 * et1 / et0)
+            + (k[17] * et2 * et1 / rc_s.powi(4))
+            + (k[16] * et2 * rc_c.powi(3) / rc_s.powi(4))
+            + (k[17] * et2 * rc_c.powi(4) / rc_s.powi(4))
+            + (k[18] * et2 * et0)
+            + (k[18] * et2 * et1)
+            + (k[19] * (qd[0] * qd[0])))
             + (k[20] + (k[21] * rc_s)))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
         let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        out[0] = ((k[13] * qd[1] * rc_s)
-            + (k[22] * qd[0])
-            + (k[15] * qd[1])
-            + (k[15] * qd[1] * rc_c / (rc_s * rc_s))
-            + (k[15] * qd[1] * (rc_c * rc_c) / (rc_s * rc_s)));
+        out[0] = ((k[13] * qd[1])
+            + (k[13] * qd[1] * rc_c / (rc_s * rc_s))
+            + (k[13] * qd[1] * (rc_c * rc_c) / (rc_s * rc_s))
+            + (k[14] * qd[1] * rc_s)
+            + (k[22] * qd[0]));
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
@@ -250,7 +250,7 @@ impl Model for RodCylinder {
         let (rc_s, rc_c) = q[1].sin_cos();
         let qt0 = (rc_s * rc_s);
         let qt1 = (rc_c * rc_c);
-        let qt2 = (k[15] + (k[13] * rc_s) + (k[15] * rc_c / qt0) + (k[15] * qt1 / qt0));
+        let qt2 = (k[13] + (k[13] * rc_c / qt0) + (k[13] * qt1 / qt0) + (k[14] * rc_s));
         let qt3 = rc_c.powi(3);
         let qt4 = rc_c.powi(4);
         let qt5 = (qd[1] * qd[1]);
@@ -260,20 +260,20 @@ impl Model for RodCylinder {
         mass[3] = (k[23]
             + (k[24] * rc_c / qt0)
             + (k[24] * qt1 / qt0)
-            + (k[18] * qt1 / rc_s.powi(4))
+            + (k[16] * qt1 / rc_s.powi(4))
             + (k[24] * qt3 / rc_s.powi(4))
-            + (k[18] * qt4 / rc_s.powi(4))
+            + (k[16] * qt4 / rc_s.powi(4))
             + (k[25] * qt0)
             + (k[25] * qt1));
-        rhs[0] = ((k[26] * qt5 * rc_c)
-            + (k[15] * qt5 / rc_s)
-            + (k[27] * qt5 * rc_c / rc_s)
-            + (k[27] * qt5 * qt1 / rc_s.powi(3))
-            + (k[27] * qt5 * qt3 / rc_s.powi(3)));
+        rhs[0] = ((k[13] * qt5 / rc_s)
+            + (k[26] * qt5 * rc_c / rc_s)
+            + (k[26] * qt5 * qt1 / rc_s.powi(3))
+            + (k[26] * qt5 * qt3 / rc_s.powi(3))
+            + (k[27] * qt5 * rc_c));
         rhs[1] = ((k[28] * rc_c)
-            + (k[18] * qt5 / rc_s)
+            + (k[16] * qt5 / rc_s)
             + (k[24] * qt5 * rc_c / rc_s)
-            + (k[18] * qt5 * rc_c / rc_s.powi(3))
+            + (k[16] * qt5 * rc_c / rc_s.powi(3))
             + (k[29] * qt5 * qt1 / rc_s.powi(3))
             + (k[30] * qt5 * qt3 / rc_s.powi(3))
             + (k[24] * qt5 * qt3 / rc_s.powi(5))
@@ -290,15 +290,15 @@ impl Model for RodCylinder {
             * ((k[11] * qdd[1])
                 + (k[11] * qdd[1] * rc_c / (rc_s * rc_s))
                 + (k[11] * qdd[1] * ft0 / (rc_s * rc_s))
-                + qdd[0]
                 + (k[8] * ft1 / rc_s)
                 + (k[32] * ft1 * rc_c / rc_s)
                 + (k[32] * ft1 * ft0 / rc_s.powi(3))
-                + (k[32] * ft1 * rc_c.powi(3) / rc_s.powi(3))));
+                + (k[32] * ft1 * rc_c.powi(3) / rc_s.powi(3))
+                + qdd[0]));
         out[1] = (k[33]
-            + (k[13] * ft1 * rc_s)
-            + (k[13] * ft1 * ft0 / rc_s)
-            + (k[34] * qdd[0] * rc_c / rc_s));
+            + (k[34] * qdd[0] * rc_c / rc_s)
+            + (k[14] * ft1 * rc_s)
+            + (k[14] * ft1 * ft0 / rc_s));
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
@@ -316,7 +316,7 @@ impl Model for RodCylinder {
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
         let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        out[0] = (q[0] + (k[8] / rc_s) + (k[8] * rc_c / rc_s));
+        out[0] = ((k[8] / rc_s) + (k[8] * rc_c / rc_s) + q[0]);
         out[1] = ((k[11] * qd[1])
             + (k[11] * qd[1] * rc_c / (rc_s * rc_s))
             + (k[11] * qd[1] * (rc_c * rc_c) / (rc_s * rc_s))

@@ -174,7 +174,7 @@ impl Model for RodCylinderFree {
         k[15] = k[12].cos();
         k[16] = k[6];
         k[17] = k[8];
-        k[18] = (-(k[2] * k[0] * k[14] * k[13] / 2.0) + (k[0] * k[9]));
+        k[18] = (-(k[2] * k[0] * k[13] * k[14] / 2.0) + (k[0] * k[9]));
         k[19] = (k[1] * k[11]);
         let c8_t0 = (k[2] * k[2]);
         k[20] = ((c8_t0 * k[0] / 3.0) - (c8_t0 * k[0] * (k[14] * k[14]) / 4.0));
@@ -186,11 +186,11 @@ impl Model for RodCylinderFree {
         k[26] = (-k[3]);
         k[27] = (-2.0 * k[3]);
         k[28] = (-k[2] * k[0] / 2.0);
-        k[29] = (k[0] / 2.0);
-        k[30] = (k[1] / 2.0);
-        k[31] = ((k[2] * k[2]) * k[0] / 24.0);
-        k[32] = ((k[2] * k[2]) * k[0] / 8.0);
-        k[33] = (k[5] * k[1] * k[3]);
+        k[29] = ((k[2] * k[2]) * k[0] / 24.0);
+        k[30] = ((k[2] * k[2]) * k[0] / 8.0);
+        k[31] = (k[0] / 2.0);
+        k[32] = (k[1] / 2.0);
+        k[33] = (k[3] * k[5] * k[1]);
         k[34] = (k[2] * k[5] * k[0] / 2.0);
         k[35] = k[0];
         k[36] = k[1];
@@ -199,13 +199,13 @@ impl Model for RodCylinderFree {
         k[39] = (k[2] * k[0] / 2.0);
         k[40] = (-k[2] * k[5] * k[0] / 2.0);
         k[41] = (k[5] * k[0]);
-        k[42] = (k[20] * (k[13] * k[13]));
+        k[42] = ((k[13] * k[13]) * k[20]);
         k[43] = (k[2] * k[5] * k[0]);
         k[44] = ((k[2] * k[2]) * k[0]);
         k[45] = (6.0 * k[2] * k[5] * k[0]);
         k[46] = (-4.0 * k[2] * k[5] * k[0]);
         k[47] = (3.0 * k[2] * k[5] * k[0]);
-        k[48] = (6.0 * k[20] * (k[13] * k[13]));
+        k[48] = (6.0 * (k[13] * k[13]) * k[20]);
         k[49] = k[16];
         k[50] = (k[18] / k[0]);
         k[51] = k[17];
@@ -235,7 +235,7 @@ impl Model for RodCylinderFree {
         pos[3] = [q[2], k[3]];
         vel[3] = [qd[2], 0.0];
         pos[4] = [
-            (q[0] + (k[23] * rc_c / rc_s) + (k[23] * pt0 / rc_s)),
+            ((k[23] * rc_c / rc_s) + (k[23] * pt0 / rc_s) + q[0]),
             (k[23] + (k[23] * rc_c)),
         ];
         vel[4] = [
@@ -253,11 +253,11 @@ impl Model for RodCylinderFree {
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = (qd[1] * qd[1]);
         (((k[28] * qd[1] * qd[0] * rc_s)
-            + (k[29] * (qd[0] * qd[0]))
-            + (k[30] * (qd[2] * qd[2]))
-            + (k[31] * et0)
-            + (k[32] * et0 * (rc_s * rc_s))
-            + (k[32] * et0 * (rc_c * rc_c)))
+            + (k[29] * et0)
+            + (k[30] * et0 * (rc_s * rc_s))
+            + (k[30] * et0 * (rc_c * rc_c))
+            + (k[31] * (qd[0] * qd[0]))
+            + (k[32] * (qd[2] * qd[2])))
             + (k[33] + (k[34] * rc_s)))
     }
 
@@ -291,16 +291,16 @@ impl Model for RodCylinderFree {
         let (rc_s, rc_c) = q[1].sin_cos();
         let ft0 = (qd[1] * qd[1]);
         out[0] = (k[41]
+            + (k[35] * qdd[0] * rc_c / rc_s)
             + (k[28] * ft0 * rc_s)
-            + (k[28] * ft0 * (rc_c * rc_c) / rc_s)
-            + (k[35] * qdd[0] * rc_c / rc_s));
+            + (k[28] * ft0 * (rc_c * rc_c) / rc_s));
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
         let k = &k[..53]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = forces[0];
-        out[1] = (-q[0] + q[2] + (k[26] * (1.0 + rc_c) / rc_s));
+        out[1] = ((k[26] * (1.0 + rc_c) / rc_s) - q[0] + q[2]);
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
@@ -379,7 +379,7 @@ impl Reduction for RodCylinderFree {
         q[1] = k[12] - delta;
         qd[1] = theta_dot;
         q[0] = (k[49] + (k[22] * rc_dc) + (k[50] * rc_t));
-        qd[0] = (k[50] + (k[22] * rc_w * rc_s));
+        qd[0] = (k[50] + (k[22] * rc_s * rc_w));
         q[2] = (k[51] + (k[52] * rc_t));
         qd[2] = k[52];
     }

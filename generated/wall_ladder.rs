@@ -194,8 +194,8 @@ impl Model for WallLadder {
         let (rc_s, rc_c) = q[0].sin_cos();
         let ft0 = (qd[0] * qd[0]);
         out[0] = (-((k[20] * qdd[0] * rc_s)
-            + (k[20] * ft0 * rc_c)
-            + (k[21] * ((k[11] * qdd[0] * rc_s) + (k[11] * ft0 * rc_c)))));
+            + (k[21] * ((k[11] * qdd[0] * rc_s) + (k[11] * ft0 * rc_c)))
+            + (k[20] * ft0 * rc_c)));
         out[1] = (k[22] + (k[23] * qdd[0] * rc_c) + (k[20] * ft0 * rc_s));
     }
 

@@ -26,6 +26,16 @@ pub fn expr(a: &A) -> Result<Expr, String> {
         .map_err(|e| format!("cannot read back Symbolica output `{text}`: {}", e.message))
 }
 
+/// Defines symbols in the order given, before any expression uses them. Symbolica orders the
+/// terms of its normal form by the order in which the process first defined each symbol, so
+/// declaring every symbol of every spec in one canonical order first makes a derivation's
+/// output independent of which specs the process derived before.
+pub fn declare(names: &[String]) {
+    for n in names {
+        let _ = symbol!(n.as_str());
+    }
+}
+
 /// A symbol.
 pub fn var(name: &str) -> A {
     Atom::var(symbol!(name))

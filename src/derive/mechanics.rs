@@ -871,6 +871,45 @@ pub fn derive(checked: &Checked) -> Result<Vec<Derivation>, DeriveError> {
     }
 }
 
+/// Every symbol the derivation of these specs can define, in one canonical order (see
+/// [`cas::declare`]): the specs' parameters, the free phases' start parameters, coordinates
+/// with their rates and accelerations, sorted; then the internal symbols.
+pub fn canonical_symbols(specs: &[&Spec]) -> Vec<String> {
+    let mut names = std::collections::BTreeSet::new();
+    let (mut n_coords, mut n_forces) = (0, 0);
+    for spec in specs {
+        names.extend(spec.parameters.iter().map(|p| p.name.clone()));
+        for c in &spec.coordinates {
+            for name in [
+                c.name.clone(),
+                format!("dot_{}", c.name),
+                format!("ddot_{}", c.name),
+                format!("{}_0", c.name),
+                format!("{}_dot_0", c.name),
+            ] {
+                names.insert(name);
+            }
+        }
+        names.extend(spec.forces.iter().map(|f| f.name.clone()));
+        names.extend(spec.contact.iter().map(|c| c.force.clone()));
+        n_coords = n_coords.max(spec.coordinates.len());
+        n_forces = n_forces.max(spec.forces.len() + 1);
+    }
+    let mut out: Vec<String> = names.into_iter().collect();
+    for internal in [
+        "rc_s", "rc_c", "rc_ds", "rc_dc", "rc_delta", "rc_t", "rc_w", "rc_w2", "rc_acc", "rc_thi",
+        "rc_wi", "rc_si", "rc_ci", "rc_ai",
+    ] {
+        out.push(internal.to_string());
+    }
+    for j in 0..n_coords {
+        out.push(format!("rc_x{j}i"));
+        out.push(format!("rc_p{j}"));
+    }
+    out.extend((0..n_forces).map(|i| format!("rc_f{i}")));
+    out
+}
+
 /// The model names a spec derives: its own, and `<name>_free` when it has a contact.
 pub fn phase_names(spec: &Spec) -> Vec<String> {
     match spec.contact {

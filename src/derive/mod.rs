@@ -326,6 +326,11 @@ pub fn render_all(root: &Path, specs: &[PathBuf]) -> Result<(Vec<Rendered>, Timi
             .map(|p| spec::load(p))
             .collect::<Result<_, _>>()?
     };
+    // Every symbol of every spec first, in one order: the output then does not depend on
+    // which specs were selected (Symbolica orders terms by when a symbol was first defined).
+    let specs: Vec<&spec::Spec> = all.iter().chain(&selected).map(|c| &c.spec).collect();
+    let symbols = mechanics::canonical_symbols(&specs);
+    on_cas_thread(move || cas::declare(&symbols))?;
     let derived = derive_all(&selected)?;
     let mut out = Vec::new();
     let mut timings = Vec::new();
