@@ -1,7 +1,10 @@
 //! The planner: turns a [`Request`] (model, parameters, wanted quantities) into [`RunResults`],
 //! computing each wanted quantity and its prerequisites and nothing else.
 //!
-//! Prerequisites, computed at most once each (lazily, through `Plan`'s caches):
+//! Each phase is solved on the fast path where its model has one (the list below), otherwise
+//! integrated to its first event, which then gives the angle, time and states of every
+//! quantity ([`Route`]). Prerequisites, computed at most once each (lazily, through `Plan`'s
+//! caches):
 //! - `separation_angle`: the separation root (polynomial evaluations only);
 //! - `linearised_separation_angle`: the polynomial's two lowest coefficients (no evaluation);
 //! - `separation_time`: root + quadrature of the first phase;
@@ -9,15 +12,17 @@
 //! - `point_mass_fall_time`: the release state only;
 //! - `theta_series`, `<force>_series`, `<point>_trajectory`: root + quadrature + inversion at
 //!   `samples` uniform times over the first phase (release to separation, or to the floor);
+//! - `contact_end`: the first phase (where, when and why its contact ends);
 //! - `floor_impact`: the first phase and every next phase down to the floor;
 //! - `cross_check`: the first phase's quadrature and the unreduced ODE to the separation event;
-//! - `checks`: the sampled motion of every phase down to the floor (monitors, no recatch,
-//!   energy and momentum drift of each reduced path), plus the ODE path when `cross_check` is
+//! - `checks`: the sampled motion of every phase down to the floor (monitors, among them a free
+//!   phase's `contact_open`, and energy and momentum drift of each path), plus the ODE path when `cross_check` is
 //!   also wanted.
 //!
 //! Result keys (SI units): `separation_angle`, `linearised_separation_angle` (rad);
 //! `separation_time`, `contact_time_to_floor`, `point_mass_fall_time`, `floor_impact_time` (s);
-//! `impact_angular_velocity` (rad/s); `surface_final_speed` (m/s); `cross_check_time` (s, the
+//! `impact_angular_velocity` (rad/s); `contact_end_time` (s), `contact_end_angle` (rad) and the
+//! label `contact_end_cause` (`force` or `edge`); `cross_check_time` (s, the
 //! ODE's event time), `cross_check_relative_difference` (1, against the quadrature),
 //! `cross_check_time_deviation` (s, largest `|t_ode - t(theta_ode)|` over the ODE's steps),
 //! `cross_check_state_deviation` (1, largest relative difference between the ODE state and the

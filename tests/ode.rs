@@ -107,19 +107,7 @@ fn ode_path_conserves_energy_and_momentum() {
 
 #[test]
 fn free_rod_reaches_the_floor_event() {
-    let params = [
-        ("m1", 1.0),
-        ("m2", 3.0),
-        ("ell", 1.0),
-        ("a", 0.25),
-        ("g", 9.81),
-        ("x1_0", -0.01),
-        ("theta_0", 0.1677),
-        ("x2_0", 1.0),
-        ("x1_dot_0", -0.2),
-        ("theta_dot_0", -1.4),
-        ("x2_dot_0", 0.1),
-    ];
+    let params = common::paper::free_after(0.1677, -1.4, -0.01, -0.2);
     let sys = System::new(&FREE_ROD, &params).unwrap();
     let mesh = TimeMesh::build(&sys, sys.delta_to_floor(), 1e-14, &mut Work::default()).unwrap();
     let run = integrate(&sys, 1e-12, None, 1.0, &mut Work::default()).unwrap();

@@ -96,19 +96,7 @@ fn rod_cube_matches_the_printed_equations_at_r_one_quarter() {
 
 #[test]
 fn free_rod_reduced_and_unreduced_forms_agree() {
-    let params = [
-        ("m1", 1.0),
-        ("m2", 3.0),
-        ("ell", 1.0),
-        ("a", 0.25),
-        ("g", 9.81),
-        ("x1_0", -0.01),
-        ("theta_0", 0.17),
-        ("x2_0", 1.0),
-        ("x1_dot_0", -0.2),
-        ("theta_dot_0", -1.3),
-        ("x2_dot_0", 0.1),
-    ];
+    let params = common::paper::free_after(0.17, -1.3, -0.01, -0.2);
     let sys = System::new(&FREE_ROD, &params).unwrap();
     check_consistency(&sys, 0.17);
     // The centre of mass keeps its horizontal velocity.

@@ -178,19 +178,7 @@ fn near_upright_time_grows_like_log_of_one_over_cos_theta_i() {
 
 #[test]
 fn free_phase_without_endpoint_singularity() {
-    let params = [
-        ("m1", 1.0),
-        ("m2", 3.0),
-        ("ell", 1.0),
-        ("a", 0.25),
-        ("g", 9.81),
-        ("x1_0", -0.01),
-        ("theta_0", 0.1677),
-        ("x2_0", 1.0),
-        ("x1_dot_0", -0.2),
-        ("theta_dot_0", -1.4),
-        ("x2_dot_0", 0.1),
-    ];
+    let params = common::paper::free_after(0.1677, -1.4, -0.01, -0.2);
     let sys = System::new(&FREE_ROD, &params).unwrap();
     let mut work = Work::default();
     let mesh = TimeMesh::build(&sys, sys.delta_to_floor(), 1e-13, &mut work).unwrap();

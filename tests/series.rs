@@ -78,19 +78,7 @@ fn series_agrees_with_the_ode_dense_output() {
 
 #[test]
 fn moving_start_is_sampled_too() {
-    let params = [
-        ("m1", 1.0),
-        ("m2", 3.0),
-        ("ell", 1.0),
-        ("a", 0.25),
-        ("g", 9.81),
-        ("x1_0", -0.01),
-        ("theta_0", 0.1677),
-        ("x2_0", 1.0),
-        ("x1_dot_0", -0.2),
-        ("theta_dot_0", -1.4),
-        ("x2_dot_0", 0.1),
-    ];
+    let params = common::paper::free_after(0.1677, -1.4, -0.01, -0.2);
     let sys = System::new(&FREE_ROD, &params).unwrap();
     let mesh = TimeMesh::build(&sys, sys.delta_to_floor(), 1e-13, &mut Work::default()).unwrap();
     let s = sample_phase(&sys, &mesh, 50, &mut Work::default()).unwrap();

@@ -102,19 +102,7 @@ fn non_finite_and_non_positive_values() {
         );
     }
     // Parameters not declared positive may be zero or negative.
-    let free = [
-        ("m1", 1.0),
-        ("m2", 3.0),
-        ("ell", 1.0),
-        ("a", 0.25),
-        ("g", 9.81),
-        ("x1_0", -0.5),
-        ("theta_0", 0.2),
-        ("x2_0", 1.0),
-        ("x1_dot_0", 0.0),
-        ("theta_dot_0", -1.0),
-        ("x2_dot_0", 0.1),
-    ];
+    let free = common::paper::free_after(0.2, -1.0, -0.5, 0.0);
     assert!(System::new(&FREE_ROD, &free).is_ok());
 }
 

@@ -27,6 +27,7 @@
 use super::cas::{self, A};
 use super::expr::{Expr, product};
 use super::spec::{Checked, Spec, Text};
+pub use crate::model::Binding;
 use std::collections::BTreeMap;
 
 /// Where a derivation error belongs in the spec: a dotted field path and a message.
@@ -120,21 +121,6 @@ pub struct Contact {
     pub released: [Expr; 2],
     /// The edge margin over `q` (`>= 0` while the contact can exist), if it can end at an edge.
     pub edge: Option<Expr>,
-}
-
-/// Where a parameter of the next phase comes from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Binding {
-    /// A parameter of this phase, by index.
-    Param(usize),
-    /// A coordinate at the end of this phase, by index.
-    Coordinate(usize),
-    /// A velocity at the end of this phase, by index.
-    Velocity(usize),
-    /// The eliminated coordinate's value at the end of this phase.
-    Eliminated,
-    /// The eliminated coordinate's rate at the end of this phase.
-    EliminatedRate,
 }
 
 /// The phase after the contact ends.
@@ -301,12 +287,18 @@ pub fn reduce_cos_sq(a: &A) -> A {
     let mut cur = cas::expand(a);
     for _ in 0..16 {
         let mut next = cur.clone();
+        let pow =
+            |base: &str, n: i128| Expr::Pow(Box::new(Expr::sym(base)), Box::new(Expr::int(n)));
         for k in (2..=12).rev() {
-            let pat = cas::atom(&Expr::parse(&format!("rc_c^{k}")).unwrap_or(Expr::int(0)));
-            let rep = cas::atom(
-                &Expr::parse(&format!("rc_c^{}*(1 - rc_s^2)^{}", k % 2, k / 2))
-                    .unwrap_or(Expr::int(0)),
-            );
+            let pat = cas::atom(&pow("rc_c", k));
+            let one_minus_s2 = Expr::Add(vec![
+                Expr::int(1),
+                Expr::Mul(vec![Expr::int(-1), pow("rc_s", 2)]),
+            ]);
+            let rep = cas::atom(&Expr::Mul(vec![
+                pow("rc_c", k % 2),
+                Expr::Pow(Box::new(one_minus_s2), Box::new(Expr::int(k / 2))),
+            ]));
             next = cas::subs(&next, &pat, &rep);
         }
         next = cas::expand(&next);

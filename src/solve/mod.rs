@@ -238,16 +238,6 @@ pub enum SolveError {
         /// Bindings given.
         got: usize,
     },
-    /// The contact point is not a named point of the next phase.
-    #[error("the contact point `{point}` of `{from}` is not a point of the next phase `{name}`")]
-    MissingPoint {
-        /// This model.
-        from: &'static str,
-        /// The next model.
-        name: &'static str,
-        /// The point name.
-        point: &'static str,
-    },
     /// Phases kept separating without reaching the floor.
     #[error("more than {limit} phases without reaching the floor")]
     TooManyPhases {

@@ -556,6 +556,24 @@ pub fn paper(g: f64) -> [(&'static str, f64); 5] {
     ]
 }
 
+/// `rod_cube_free` from a state after separation (the paper's rod and cube, the cube's face at
+/// 1 m gliding at 0.1 m/s): angle and rate, foot position and velocity.
+pub fn free_after(theta: f64, omega: f64, x1: f64, v1: f64) -> [(&'static str, f64); 11] {
+    [
+        ("m1", 1.0),
+        ("m2", 3.0),
+        ("ell", 1.0),
+        ("a", 0.25),
+        ("g", 9.81),
+        ("x1_0", x1),
+        ("theta_0", theta),
+        ("x2_0", 1.0),
+        ("x1_dot_0", v1),
+        ("theta_dot_0", omega),
+        ("x2_dot_0", 0.1),
+    ]
+}
+
 /// Parameters for mass ratio `n` and `r = a/ell` (ell = 1 m, m1 = 1 kg, g = 9.81).
 pub fn ratios(n: f64, r: f64) -> [(&'static str, f64); 5] {
     [("m1", 1.0), ("m2", n), ("ell", 1.0), ("a", r), ("g", 9.81)]
