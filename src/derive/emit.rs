@@ -167,29 +167,8 @@ fn out_lines(outputs: &[String]) -> Vec<String> {
 pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, String> {
     let spec = &checked.spec;
     let np = d.params.len();
-    // Constant layout: parameters, then the reduction's constants, then hoisted subexpressions.
-    let mut scope = Scope::default();
-    for (i, p) in d.params.iter().enumerate() {
-        scope.constants.insert(p.name.clone(), i);
-    }
-    let mut prepare = Code::default();
-    let constants = match &d.reduction {
-        Ok(r) => r.constants.as_slice(),
-        Err(_) => &[],
-    };
-    for (j, c) in constants.iter().enumerate() {
-        let idx = np + j;
-        let body = lower(
-            std::slice::from_ref(&c.value),
-            &scope,
-            None,
-            &format!("c{j}_"),
-        );
-        let out = prepare.push_body(body);
-        prepare.bind(&format!("k[{idx}]"), out[0].clone());
-        scope.constants.insert(c.symbol.clone(), idx);
-    }
-    let mut hoisted = Hoisted::new(np + constants.len());
+    let (scope, mut prepare) = constant_layout(d);
+    let mut hoisted = Hoisted::new(scope.constants.len());
     let general = full_state_code(d, &scope, &mut hoisted)?;
     let reduction = match &d.reduction {
         Ok(r) => Some(reduced_code(d, r, &scope, &mut hoisted)?),
@@ -338,6 +317,34 @@ pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, St
         released: general.released,
         reduction,
     })
+}
+
+/// The constant layout of `k`: the parameters, then the reduction's constants (computed in
+/// `prepare`, which this starts); hoisted subexpressions follow them.
+fn constant_layout(d: &Derivation) -> (Scope, Code) {
+    let np = d.params.len();
+    let mut scope = Scope::default();
+    for (i, p) in d.params.iter().enumerate() {
+        scope.constants.insert(p.name.clone(), i);
+    }
+    let mut prepare = Code::default();
+    let constants = match &d.reduction {
+        Ok(r) => r.constants.as_slice(),
+        Err(_) => &[],
+    };
+    for (j, c) in constants.iter().enumerate() {
+        let idx = np + j;
+        let body = lower(
+            std::slice::from_ref(&c.value),
+            &scope,
+            None,
+            &format!("c{j}_"),
+        );
+        let out = prepare.push_body(body);
+        prepare.bind(&format!("k[{idx}]"), out[0].clone());
+        scope.constants.insert(c.symbol.clone(), idx);
+    }
+    (scope, prepare)
 }
 
 /// The spec file, relative to the project root.

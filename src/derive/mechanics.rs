@@ -902,17 +902,6 @@ pub fn canonical_symbols(specs: &[&Spec]) -> Vec<String> {
     out
 }
 
-/// The model names a spec derives: its own, and `<name>_free` when it has a contact.
-pub fn phase_names(spec: &Spec) -> Vec<String> {
-    match spec.contact {
-        None => vec![phase_name(spec, Phase::Whole)],
-        Some(_) => vec![
-            phase_name(spec, Phase::Contact),
-            phase_name(spec, Phase::Free),
-        ],
-    }
-}
-
 /// The name of the model of a phase.
 pub fn phase_name(spec: &Spec, phase: Phase) -> String {
     match phase {
