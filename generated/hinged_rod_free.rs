@@ -116,6 +116,7 @@ static INFO: ModelInfo = ModelInfo {
         k_sin_initial: 11,
         k_cos_initial: 12,
         separation_degree: 0,
+        polynomial_separation: false,
     }),
     route_note: "",
 };

@@ -134,6 +134,7 @@ static INFO: ModelInfo = ModelInfo {
         k_sin_initial: 8,
         k_cos_initial: 9,
         separation_degree: 3,
+        polynomial_separation: true,
     }),
     route_note: "",
 };

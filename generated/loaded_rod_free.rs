@@ -144,6 +144,7 @@ static INFO: ModelInfo = ModelInfo {
         k_sin_initial: 14,
         k_cos_initial: 15,
         separation_degree: 0,
+        polynomial_separation: false,
     }),
     route_note: "",
 };

@@ -123,6 +123,7 @@ static INFO: ModelInfo = ModelInfo {
         k_sin_initial: 7,
         k_cos_initial: 8,
         separation_degree: 3,
+        polynomial_separation: true,
     }),
     route_note: "",
 };

@@ -134,6 +134,7 @@ static INFO: ModelInfo = ModelInfo {
         k_sin_initial: 13,
         k_cos_initial: 14,
         separation_degree: 0,
+        polynomial_separation: false,
     }),
     route_note: "",
 };

@@ -129,7 +129,7 @@ static INFO: ModelInfo = ModelInfo {
         ],
     }),
     reduction: None,
-    route_note: "the contact can end at an edge, which only the integrated path locates",
+    route_note: "the velocity of `x1` is not affine in sin and cos of `theta`; its position has no closed form",
 };
 
 impl Model for RodCylinder {

@@ -108,6 +108,7 @@ static INFO: ModelInfo = ModelInfo {
         k_sin_initial: 6,
         k_cos_initial: 7,
         separation_degree: 1,
+        polynomial_separation: true,
     }),
     route_note: "",
 };

@@ -116,6 +116,7 @@ static INFO: ModelInfo = ModelInfo {
         k_sin_initial: 10,
         k_cos_initial: 11,
         separation_degree: 0,
+        polynomial_separation: false,
     }),
     route_note: "",
 };

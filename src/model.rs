@@ -95,8 +95,11 @@ pub struct ReductionInfo {
     pub k_sin_initial: usize,
     /// Index in `k` of `cos(theta_i)`, formed from the parameters without cancellation.
     pub k_cos_initial: usize,
-    /// Degree of the separation polynomial in `sin(theta)` (0 without a contact).
+    /// Degree of the separation polynomial in `sin(theta)` (0 without one).
     pub separation_degree: usize,
+    /// Whether the contact force's zero is a root of that polynomial; a model with a contact
+    /// and without one has it found as a bracketed root of its reduced contact force.
+    pub polynomial_separation: bool,
 }
 
 /// Static description of a generated model.

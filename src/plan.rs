@@ -37,9 +37,11 @@ use crate::quantity::Quantity;
 use crate::results::{Check, Column, Label, RunResults, Scalar, Series, Work};
 use crate::solve::SolveError;
 use crate::solve::checks;
-use crate::solve::phases::{End, Motion, PhaseRun, ReducedRun, Route, extend_to_floor, phase_end};
+use crate::solve::phases::{
+    End, Motion, PhaseRun, ReducedEnd, ReducedRun, Route, extend_to_floor, phase_end,
+};
 use crate::solve::quadrature::TimeMesh;
-use crate::solve::separation::{Separation, SeparationOutcome, linearised_separation};
+use crate::solve::separation::{SeparationOutcome, linearised_separation};
 use crate::solve::series::{PhaseSamples, sample, sample_forces, theta_dot_at};
 use crate::solve::unreduced::{self, EndEvent, UnreducedRun};
 use crate::system::{Bound, System, SystemError};
@@ -311,7 +313,7 @@ struct Plan<'m> {
     samples: usize,
     route: Route,
     work: Work,
-    end: Option<(Option<Separation>, f64)>,
+    end: Option<ReducedEnd>,
     motion: Option<Motion<'m>>,
     complete: bool,
     floor_mesh: Option<TimeMesh>,
@@ -380,8 +382,8 @@ impl<'m> Plan<'m> {
         })
     }
 
-    /// Where the first phase ends on the fast path (separation root only).
-    fn end(&mut self) -> Result<(Option<Separation>, f64), SolveError> {
+    /// Where the first phase ends on the fast path (roots only, no quadrature).
+    fn end(&mut self) -> Result<ReducedEnd, SolveError> {
         if let Some(end) = self.end {
             return Ok(end);
         }
@@ -400,25 +402,18 @@ impl<'m> Plan<'m> {
             None => {
                 let run = match self.sys.clone() {
                     Some(sys) => {
-                        let (separation, delta_end) = self.end()?;
-                        match (&separation, &self.floor_mesh) {
-                            (None, Some(mesh)) => {
+                        let end = self.end()?;
+                        match (end.end, &self.floor_mesh) {
+                            (End::Floor, Some(mesh)) => {
                                 self.work.phases.push(sys.name().to_string());
                                 ReducedRun {
                                     system: sys,
                                     t_start: 0.0,
-                                    separation,
+                                    end,
                                     mesh: mesh.clone(),
                                 }
                             }
-                            _ => ReducedRun::with_end(
-                                sys,
-                                0.0,
-                                separation,
-                                delta_end,
-                                self.tol,
-                                &mut self.work,
-                            )?,
+                            _ => ReducedRun::with_end(sys, 0.0, end, self.tol, &mut self.work)?,
                         }
                         .into_phase()
                     }
@@ -491,7 +486,12 @@ impl<'m> Plan<'m> {
                 &self.end,
                 self.motion.as_ref().and_then(|m| m.phases[0].reduced()),
             ) {
-                (Some((None, _)), Some(r)) => r.mesh.clone(),
+                (
+                    Some(ReducedEnd {
+                        end: End::Floor, ..
+                    }),
+                    Some(r),
+                ) => r.mesh.clone(),
                 _ => {
                     let sys = self.fast()?.clone();
                     TimeMesh::build(&sys, sys.delta_to_floor(), self.tol, &mut self.work)?
@@ -653,7 +653,11 @@ impl<'m> Plan<'m> {
     /// otherwise (the floor, or an edge). On the fast path this needs the root only.
     fn separation_angle(&mut self) -> Result<Option<f64>, SolveError> {
         if self.sys.is_some() {
-            return Ok(self.end()?.0.map(|s| s.theta));
+            let end = self.end()?;
+            return Ok(end
+                .at
+                .filter(|_| end.end == End::Separation)
+                .map(|s| s.theta));
         }
         let first = self.first()?;
         Ok((first.end() == End::Separation).then(|| first.theta_end()))
@@ -661,7 +665,7 @@ impl<'m> Plan<'m> {
 
     /// The time from release to separation, or `None` without a separation.
     fn separation_time(&mut self) -> Result<Option<f64>, SolveError> {
-        if self.sys.is_some() && self.end()?.0.is_none() {
+        if self.sys.is_some() && self.end()?.end != End::Separation {
             return Ok(None);
         }
         let first = self.first()?;

@@ -140,15 +140,17 @@ impl Quantity {
     }
 
     /// Whether a model can provide this quantity: separation needs a contact, the floor
-    /// impact a phase after it, and the quantities of the energy integral (the linearised
-    /// polynomial, the time to the floor in contact, the cross-check against the quadrature)
-    /// the fast path.
+    /// impact a phase after it, the quantities of the energy integral (the time to the floor in
+    /// contact, the cross-check against the quadrature) the fast path, and the linearised angle
+    /// a separation polynomial.
     pub fn available(&self, info: &ModelInfo) -> bool {
         let contact = info.contact.is_some();
         let fast = info.reduction.is_some();
         match self {
             Quantity::SeparationAngle | Quantity::SeparationTime | Quantity::ContactEnd => contact,
-            Quantity::LinearisedSeparationAngle => contact && fast,
+            Quantity::LinearisedSeparationAngle => {
+                contact && info.reduction.is_some_and(|r| r.polynomial_separation)
+            }
             Quantity::ContactTimeToFloor | Quantity::CrossCheck => fast,
             Quantity::FloorImpact => contact && info.next_phase.is_some(),
             _ => true,

@@ -249,12 +249,12 @@ fn a_coordinate_that_is_not_cyclic_is_integrated_not_refused() {
     let v: serde_json::Value = serde_json::from_str(&record.text).unwrap();
     assert_eq!(v["route"], "integrated");
     assert!(
-        v["route_reason"]
+        v["route_note"]
             .as_str()
             .unwrap()
             .contains("`x1` is not cyclic"),
         "{}",
-        v["route_reason"]
+        v["route_note"]
     );
     let _ = std::fs::remove_dir_all(&root);
 }

@@ -68,7 +68,12 @@ fn the_new_models_take_the_integrated_route_and_say_why() {
             .route_note
             .contains("`x1` is not cyclic")
     );
-    assert!(model("rod_cylinder").info().route_note.contains("edge"));
+    assert!(
+        model("rod_cylinder")
+            .info()
+            .route_note
+            .contains("not affine")
+    );
     // After the cylinder the rod and cylinder move freely: both cyclic, the fast path again.
     assert!(model("rod_cylinder_free").info().reduction.is_some());
 }
@@ -283,4 +288,46 @@ fn the_integrated_route_agrees_with_the_fast_path() {
         assert!(slow.work.ode_steps > 0 && slow.work.integrand_evals == 0);
         assert!(fast.work.ode_steps == 0);
     }
+}
+
+#[test]
+fn a_hinged_rod_on_a_cylinder_takes_the_fast_path_to_its_edge() {
+    // One coordinate left after the tie: the fast path applies although the push's zero is no
+    // polynomial root (it is looked for numerically) and the contact has an edge (a root in
+    // the angle). The integrated route, sharing no code with it, agrees.
+    let info = model("hinged_cylinder").info();
+    let layout = info.reduction.expect("hinged_cylinder has a fast path");
+    assert!(!layout.polynomial_separation && info.contact.is_some_and(|c| c.edge));
+    let want = [Quantity::ContactEnd, Quantity::SeparationAngle];
+    for (r, th0) in [(0.2, 0.9), (0.05, 1.4)] {
+        let params = [
+            ("m1", 1.0),
+            ("m2", 3.0),
+            ("ell", 1.0),
+            ("R", r),
+            ("th0", th0),
+            ("g", 9.81),
+        ];
+        let fast = ask("hinged_cylinder", &params, &want, Route::Fastest);
+        let slow = ask("hinged_cylinder", &params, &want, Route::Integrated);
+        assert_eq!(fast.labels["contact_end_cause"].value, "edge");
+        assert_eq!(slow.labels["contact_end_cause"].value, "edge");
+        let edge = 2.0 * (r / 1.0f64).atan();
+        let theta = value(&fast, "contact_end_angle");
+        assert!(((theta - edge) / edge).abs() < 1e-14, "{theta} vs {edge}");
+        let (t_fast, t_slow) = (
+            value(&fast, "contact_end_time"),
+            value(&slow, "contact_end_time"),
+        );
+        let rel = ((t_fast - t_slow) / t_fast).abs();
+        println!(
+            "hinged_cylinder R = {r}: edge at {t_fast:.15} s (integrated {t_slow:.15}, {rel:.1e})"
+        );
+        assert!(rel < 1e-12, "{t_fast} vs {t_slow}");
+        assert!(fast.notes.contains_key("separation_angle"));
+        assert_eq!(fast.work.ode_steps, 0);
+    }
+    // Its per-point solver is refused with the reason, not given a wrong answer.
+    let err = rodcube::solve::lean::LeanSolver::new(model("hinged_cylinder")).unwrap_err();
+    assert!(err.to_string().contains("edge"), "{err}");
 }

@@ -68,7 +68,7 @@ fn floor_impact_conserves_energy_and_momentum_across_the_boundary() {
     let v_cube = start.qd[2];
     assert!((m1 * v_cm + m2 * v_cube).abs() < 1e-15, "{v_cm} {v_cube}");
     // The cube's speed from eqs. (2) and (5): x2' = -ell s theta' / (2 (1 + n)).
-    let sep = rc.reduced().unwrap().separation.unwrap();
+    let sep = rc.reduced().unwrap().separation().unwrap();
     let omega_sep = rc.theta_dot_end();
     assert!((v_cube + ell * sep.sin_theta * omega_sep / 8.0).abs() < 1e-15);
     // At the floor all potential energy of the rod is kinetic: m1 v_cm^2 / 2 + m1 ell^2 w^2 / 6.

@@ -228,14 +228,15 @@ pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, St
                     .ok_or_else(|| format!("the reduction has no constant `{s}`"))
             };
             Some(format!(
-                "ReductionInfo {{ k_theta_initial: {}, k_theta_dot_initial: {}, k_sin_initial: {}, k_cos_initial: {}, separation_degree: {} }}",
+                "ReductionInfo {{ k_theta_initial: {}, k_theta_dot_initial: {}, k_sin_initial: {}, k_cos_initial: {}, separation_degree: {}, polynomial_separation: {} }}",
                 code.k_theta_initial,
                 k("rc_wi")?,
                 code.k_sin_initial,
                 code.k_cos_initial,
                 r.separation
                     .as_ref()
-                    .map_or(0, |s| s.coefficients.len() - 1)
+                    .map_or(0, |s| s.coefficients.len() - 1),
+                r.separation.is_some()
             ))
         }
         _ => None,
@@ -972,7 +973,12 @@ pub fn json_record(checked: &Checked, d: &Derivation) -> serde_json::Value {
                 }
                 expressions.insert(k.to_string(), from_sc(v, &theta).to_infix());
             }
-            ("reduced", String::new())
+            let how = match (&d.contact, &r.separation) {
+                (Some(_), Some(_)) => "separation: the root of a polynomial in sin(theta)",
+                (Some(_), None) => "separation: a bracketed root of the reduced contact force",
+                _ => "",
+            };
+            ("reduced", how.to_string())
         }
         Err(why) => {
             for (f, e) in d.forces.iter().zip(&d.forces_full) {
@@ -996,7 +1002,7 @@ pub fn json_record(checked: &Checked, d: &Derivation) -> serde_json::Value {
         "reduced": theta,
         "cyclic": d.cyclic.iter().map(|&i| d.coords[i].clone()).collect::<Vec<_>>(),
         "route": route,
-        "route_reason": reason,
+        "route_note": reason,
         "velocity_symbols": "theta_dot, theta_ddot in the reduced expressions are eliminated; dot_q / ddot_q denote velocities and accelerations in `lagrangian` and in integrated forces",
         "expressions": expressions,
     })

@@ -151,7 +151,8 @@ pub struct Reduction {
     pub cyclic_position: Vec<Expr>,
     /// Reaction forces on the reduced motion (over `rc_s, rc_c, rc_w2, rc_acc`).
     pub forces_reduced: Vec<Expr>,
-    /// The separation condition, if the phase has a contact.
+    /// The separation polynomial, if the phase has a contact whose force's zero is one (else
+    /// the runtime finds that zero numerically, from the reduced force).
     pub separation: Option<Separation>,
     /// Fully substituted forms over parameters and `theta` for people and other tools.
     pub plain: BTreeMap<String, Expr>,
@@ -934,7 +935,10 @@ fn derive_phase(
         .filter(|p| p.positive)
         .map(|p| p.name.clone())
         .collect();
-    let has_edge = phase == Phase::Contact && parsed.edge.is_some();
+    let edge = match (phase, &parsed.edge) {
+        (Phase::Contact, Some(e)) => Some(st.at(e)),
+        _ => None,
+    };
     let reduction = Reducer {
         st: &st,
         lag: &lag,
@@ -946,7 +950,7 @@ fn derive_phase(
         &force_names,
         &forces_full,
         phase == Phase::Contact,
-        has_edge,
+        edge.as_ref(),
     )?;
 
     let mut point_pos = Vec::new();
@@ -1085,12 +1089,23 @@ impl Reducer<'_> {
         names: &[Named],
         forces_full: &[A],
         has_contact: bool,
-        has_edge: bool,
+        edge: Option<&A>,
     ) -> Result<Result<Reduction, Unreducible>, DeriveError> {
-        if has_edge {
-            return Ok(Err(
-                "the contact can end at an edge, which only the integrated path locates".into(),
-            ));
+        // An edge is located on the fast path as a root in the angle: it may depend on theta
+        // and the parameters only.
+        if let Some(edge) = edge {
+            let others: Vec<&str> = (self.st.coords.iter())
+                .filter(|c| **c != self.st.theta)
+                .map(String::as_str)
+                .collect();
+            if !free_of(edge, &others) {
+                return Ok(Err(format!(
+                    "the contact's edge depends on {} besides `{}`, which only the integrated \
+                     path follows",
+                    others.join(", "),
+                    self.st.theta
+                )));
+            }
         }
         if let Some(why) = self.unreducible_coordinates() {
             return Ok(Err(why));
@@ -1115,11 +1130,10 @@ impl Reducer<'_> {
                 Err(why) => return Ok(Err(format!("force `{}`: {why}", names[i].name))),
             }
         }
+        // Where the contact force's zero is no polynomial root, the runtime finds it as a
+        // bracketed root of the reduced force itself.
         let separation = if has_contact {
-            match self.separation(&red, &forces_reduced[0])? {
-                Ok(s) => Some(s),
-                Err(why) => return Ok(Err(why)),
-            }
+            self.separation(&red, &forces_reduced[0])?.ok()
         } else {
             None
         };

@@ -193,6 +193,17 @@ impl<'m> LeanSolver<'m> {
                 why: info.route_note,
             }));
         };
+        let contact = info.contact.is_some_and(|c| c.edge);
+        if !layout.polynomial_separation || contact {
+            return Err(SolveError::NotPerPoint {
+                model: info.name,
+                why: if contact {
+                    "its contact can end at an edge"
+                } else {
+                    "its separation is no polynomial root"
+                },
+            });
+        }
         if layout.separation_degree > MAX_DEGREE {
             return Err(SolveError::BadPolynomial {
                 model: info.name,

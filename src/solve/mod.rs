@@ -15,6 +15,7 @@ pub mod lean;
 pub mod ode;
 pub mod phases;
 pub mod quadrature;
+pub mod roots;
 pub mod separation;
 pub mod series;
 pub mod unreduced;
@@ -237,6 +238,16 @@ pub enum SolveError {
         expected: usize,
         /// Bindings given.
         got: usize,
+    },
+    /// The per-point solver handles separations that are polynomial roots, without edges.
+    #[error(
+        "model `{model}` is not for the per-point solver: {why}; solve it with the planner (`rodcube run`)"
+    )]
+    NotPerPoint {
+        /// Model name.
+        model: &'static str,
+        /// What it lacks.
+        why: &'static str,
     },
     /// Phases kept separating without reaching the floor.
     #[error("more than {limit} phases without reaching the floor")]

@@ -7,6 +7,7 @@
 //! Dense output between steps uses Hairer's fourth-order continuous extension of DOPRI5.
 
 use crate::solve::SolveError;
+use crate::solve::roots::{changes_sign, illinois};
 
 /// A first-order system `y' = f(t, y)` with optional event functions.
 pub trait OdeProblem {
@@ -404,10 +405,6 @@ pub fn dopri5<P: OdeProblem>(
     }
 }
 
-fn changes_sign(a: f64, b: f64) -> bool {
-    (a > 0.0 && b <= 0.0) || (a < 0.0 && b >= 0.0)
-}
-
 /// Finds the earliest root among the crossed event functions by Illinois on re-steps.
 #[allow(clippy::too_many_arguments)]
 fn locate<P: OdeProblem>(
@@ -426,39 +423,16 @@ fn locate<P: OdeProblem>(
     let mut g = vec![0.0; m];
     let mut best = (h, crossed[0]);
     for &idx in crossed {
-        let (mut a, mut b) = (0.0, h);
-        let (mut fa, mut fb) = (g0[idx], g1[idx]);
-        let mut side = 0i8;
-        for _ in 0..200 {
-            if fb == 0.0 || (b - a) <= 2.0 * f64::EPSILON * (t + b).abs() {
-                break;
-            }
-            let mut x = (a * fb - b * fa) / (fb - fa);
-            if !(x > a && x < b) {
-                x = 0.5 * (a + b);
-            }
+        // Each trial is a genuine step from `y` to `t + x`, not the interpolant.
+        let value_at = |x: f64| -> Result<f64, SolveError> {
             st.k[0].copy_from_slice(k1);
             st.step(problem, t, y, x)?;
             sol.event_trials += 1;
             problem.events(t + x, &st.y1, &st.k[6], &mut g)?;
             check_finite("event function", t + x, &g)?;
-            let fx = g[idx];
-            if changes_sign(fa, fx) {
-                b = x;
-                fb = fx;
-                if side == -1 {
-                    fa *= 0.5;
-                }
-                side = -1;
-            } else {
-                a = x;
-                fa = fx;
-                if side == 1 {
-                    fb *= 0.5;
-                }
-                side = 1;
-            }
-        }
+            Ok(g[idx])
+        };
+        let b = illinois(value_at, (0.0, g0[idx]), (h, g1[idx]))?;
         if b < best.0 || (b == best.0 && idx < best.1) {
             best = (b, idx);
         }

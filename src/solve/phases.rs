@@ -16,7 +16,7 @@ use crate::model::{Binding, Model};
 use crate::results::Work;
 use crate::solve::SolveError;
 use crate::solve::quadrature::TimeMesh;
-use crate::solve::separation::{Separation, SeparationOutcome, separation};
+use crate::solve::separation::{Separation, SeparationOutcome, edge, separation};
 use crate::solve::series::theta_dot_at;
 use crate::solve::unreduced::{self, EndEvent, UnreducedRun};
 use crate::system::{Bound, State, System};
@@ -60,15 +60,49 @@ impl End {
     }
 }
 
-/// Where a phase on the fast path ends: its separation if it has a contact that lets go,
+/// Where a phase on the fast path ends.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReducedEnd {
+    /// Why: the contact force's zero, the contact's edge, or the floor.
+    pub end: End,
+    /// The angle where the contact ends (`None` at the floor).
+    pub at: Option<Separation>,
+    /// The angle fallen at the end.
+    pub delta: f64,
+}
+
+/// Where a phase on the fast path ends: the first of its separation and its contact's edge,
 /// else the floor.
-pub fn phase_end(sys: &System, work: &mut Work) -> Result<(Option<Separation>, f64), SolveError> {
-    if sys.info().contact.is_some()
-        && let SeparationOutcome::Separates(s) = separation(sys, work)?
-    {
-        return Ok((Some(s), s.delta));
+pub fn phase_end(sys: &System, work: &mut Work) -> Result<ReducedEnd, SolveError> {
+    let Some(contact) = sys.info().contact else {
+        return Ok(ReducedEnd {
+            end: End::Floor,
+            at: None,
+            delta: sys.delta_to_floor(),
+        });
+    };
+    let mut found: Option<(End, Separation)> = None;
+    if let SeparationOutcome::Separates(s) = separation(sys, work)? {
+        found = Some((End::Separation, s));
     }
-    Ok((None, sys.delta_to_floor()))
+    if contact.edge
+        && let SeparationOutcome::Separates(e) = edge(sys, work)?
+        && found.is_none_or(|(_, s)| e.delta < s.delta)
+    {
+        found = Some((End::Edge, e));
+    }
+    Ok(match found {
+        Some((end, at)) => ReducedEnd {
+            end,
+            at: Some(at),
+            delta: at.delta,
+        },
+        None => ReducedEnd {
+            end: End::Floor,
+            at: None,
+            delta: sys.delta_to_floor(),
+        },
+    })
 }
 
 /// A phase solved on the fast path.
@@ -78,8 +112,8 @@ pub struct ReducedRun<'m> {
     pub system: System<'m>,
     /// Absolute time of the phase start (s from release).
     pub t_start: f64,
-    /// The separation that ends it, or `None` when it reaches the floor.
-    pub separation: Option<Separation>,
+    /// Where and why it ends.
+    pub end: ReducedEnd,
     /// `t(delta)` over the phase.
     pub mesh: TimeMesh,
 }
@@ -89,19 +123,26 @@ impl<'m> ReducedRun<'m> {
     pub fn with_end(
         sys: System<'m>,
         t_start: f64,
-        separation: Option<Separation>,
-        delta_end: f64,
+        end: ReducedEnd,
         tol: f64,
         work: &mut Work,
     ) -> Result<Self, SolveError> {
-        let mesh = TimeMesh::build(&sys, delta_end, tol, work)?;
+        let mesh = TimeMesh::build(&sys, end.delta, tol, work)?;
         work.phases.push(sys.name().to_string());
         Ok(ReducedRun {
             system: sys,
             t_start,
-            separation,
+            end,
             mesh,
         })
+    }
+
+    /// The separation that ends it, if its contact force reached zero.
+    pub fn separation(&self) -> Option<Separation> {
+        match self.end.end {
+            End::Separation => self.end.at,
+            _ => None,
+        }
     }
 
     /// `theta_dot` at the end of the phase (rad/s).
@@ -158,8 +199,8 @@ impl<'m> PhaseRun<'m> {
     ) -> Result<Self, SolveError> {
         if route == Route::Fastest && bound.model().reduction().is_some() {
             let sys = System::reduce(bound)?;
-            let (separation, delta_end) = phase_end(&sys, work)?;
-            let run = ReducedRun::with_end(sys, t_start, separation, delta_end, tol, work)?;
+            let end = phase_end(&sys, work)?;
+            let run = ReducedRun::with_end(sys, t_start, end, tol, work)?;
             return Ok(PhaseRun::Reduced(run));
         }
         let time = fall_time_scale(&bound);
@@ -205,8 +246,7 @@ impl<'m> PhaseRun<'m> {
     /// Why the phase ended.
     pub fn end(&self) -> End {
         match self {
-            PhaseRun::Reduced(r) if r.separation.is_some() => End::Separation,
-            PhaseRun::Reduced(_) => End::Floor,
+            PhaseRun::Reduced(r) => r.end.end,
             PhaseRun::Integrated(r) => match r.run.end {
                 EndEvent::Separation => End::Separation,
                 EndEvent::Edge => End::Edge,

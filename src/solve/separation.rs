@@ -1,5 +1,8 @@
 //! Separation: the root of a model's separation polynomial in `s = sin(theta)` where the rod
-//! first loses contact coming down from `theta_i`, found to full `f64` precision.
+//! first loses contact coming down from `theta_i`, found to full `f64` precision; and, for a
+//! model whose contact force's zero is no polynomial root or whose contact has an edge, the
+//! first sign change of the reduced contact force (or of the edge margin) as a function of the
+//! angle fallen, bracketed on a grid and refined by [`roots::illinois`].
 //!
 //! Real roots in an interval are isolated generically (any degree) by recursive derivative
 //! isolation: the sign-changing roots of `p'` split the interval into pieces on which `p` is
@@ -10,7 +13,13 @@
 
 use crate::results::Work;
 use crate::solve::SolveError;
+use crate::solve::roots::{self, changes_sign};
 use crate::system::System;
+
+/// Grid cells over the fall, uniform in `u = sqrt(delta)`, on which a numeric root is
+/// bracketed (the first cell whose ends differ in sign; a pair of roots inside one cell, a
+/// touch without a crossing, is not seen).
+pub const BRACKET_CELLS: usize = 256;
 
 /// Where a phase with a contact separates.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -43,14 +52,83 @@ impl SeparationOutcome {
 }
 
 /// The separation of a system: the largest sign-changing root of its separation polynomial in
-/// `(sin(end_angle), sin(theta_i))`, i.e. the first met coming down from `theta_i`.
+/// `(sin(end_angle), sin(theta_i))`, i.e. the first met coming down from `theta_i`; or, without
+/// a polynomial, the first zero of the reduced contact force.
 pub fn separation(sys: &System, work: &mut Work) -> Result<SeparationOutcome, SolveError> {
+    let info = sys.info();
+    let Some(contact) = info.contact else {
+        return Err(SolveError::NoContact { model: info.name });
+    };
+    if !sys.layout().polynomial_separation {
+        let force = |sys: &System, delta: f64| sys.forces(delta)[contact.force];
+        return first_zero(sys, force, work);
+    }
     let (coeffs, lo, hi) = setup(sys)?;
     let roots = real_roots(&coeffs, lo, hi, &mut work.polynomial_evals);
     Ok(match roots.last() {
         Some(&s) => SeparationOutcome::Separates(at_sine(sys, s)),
         None => SeparationOutcome::NoSeparationBeforeFloor,
     })
+}
+
+/// Where the contact runs off its edge: the first zero of the edge margin, which on the fast
+/// path depends on the angle alone (the derivation checks it).
+pub fn edge(sys: &System, work: &mut Work) -> Result<SeparationOutcome, SolveError> {
+    let margin = |sys: &System, delta: f64| sys.contact_edge(&sys.full_state(0.0, delta, 0.0));
+    first_zero(sys, margin, work)
+}
+
+/// The first sign change of `f(delta)` coming down from the start: bracketed on
+/// [`BRACKET_CELLS`] cells uniform in `sqrt(delta)` (fine near the start, where the fall is
+/// slow), then refined to adjacent floats. Each evaluation counts as a polynomial evaluation.
+fn first_zero(
+    sys: &System,
+    f: impl Fn(&System, f64) -> f64,
+    work: &mut Work,
+) -> Result<SeparationOutcome, SolveError> {
+    let end = sys.delta_to_floor();
+    let model = sys.info().name;
+    let mut value = |delta: f64| -> Result<f64, SolveError> {
+        work.polynomial_evals += 1;
+        let v = f(sys, delta);
+        if v.is_nan() {
+            return Err(SolveError::NonFinite {
+                model,
+                what: "contact force or edge margin",
+                delta,
+                value: v,
+            });
+        }
+        Ok(v)
+    };
+    // At the start itself the contact holds (a force of zero there is no separation yet).
+    let u_end = end.sqrt();
+    let mut a = (0.0, value(0.0)?);
+    if a.1 == 0.0 {
+        let tiny = (u_end / BRACKET_CELLS as f64 * 1e-6).powi(2);
+        a = (tiny, value(tiny)?);
+    }
+    for i in 1..=BRACKET_CELLS {
+        let u = u_end * i as f64 / BRACKET_CELLS as f64;
+        let delta = if i == BRACKET_CELLS { end } else { u * u };
+        // A model may be singular at the floor itself (a cylinder's tangent point runs off to
+        // infinity as theta -> 0): no value there means no zero met before it.
+        if i == BRACKET_CELLS && f(sys, delta).is_nan() {
+            break;
+        }
+        let b = (delta, value(delta)?);
+        if changes_sign(a.1, b.1) {
+            let delta = roots::illinois(&mut value, a, b)?;
+            let theta = sys.theta_initial() - delta;
+            return Ok(SeparationOutcome::Separates(Separation {
+                sin_theta: theta.sin(),
+                theta,
+                delta,
+            }));
+        }
+        a = b;
+    }
+    Ok(SeparationOutcome::NoSeparationBeforeFloor)
 }
 
 /// The paper's approximation: the root of the polynomial with its terms above degree 1 dropped.

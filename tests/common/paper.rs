@@ -137,6 +137,7 @@ static RC_INFO: ModelInfo = ModelInfo {
         k_sin_initial: RC_R,
         k_cos_initial: RC_C0,
         separation_degree: 3,
+        polynomial_separation: true,
     }),
     route_note: "",
 };
@@ -388,6 +389,7 @@ static FR_INFO: ModelInfo = ModelInfo {
         k_sin_initial: FR_S0,
         k_cos_initial: FR_C0,
         separation_degree: 0,
+        polynomial_separation: false,
     }),
     route_note: "",
 };
