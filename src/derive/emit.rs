@@ -82,15 +82,8 @@ pub struct RustContext {
     route_note: String,
     requirements: Code,
     prepare: Code,
-    initial_state: Code,
-    points: Code,
-    energy: Code,
-    momenta: Code,
-    equations: Code,
-    forces_full: Code,
-    monitors_full: Code,
-    contact_edge: Code,
-    released: Code,
+    #[serde(flatten)]
+    general: FullStateCode,
     reduction: Option<ReducedCode>,
 }
 
@@ -307,15 +300,7 @@ pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, St
         },
         requirements,
         prepare,
-        initial_state: general.initial_state,
-        points: general.points,
-        energy: general.energy,
-        momenta: general.momenta,
-        equations: general.equations,
-        forces_full: general.forces_full,
-        monitors_full: general.monitors_full,
-        contact_edge: general.contact_edge,
-        released: general.released,
+        general,
         reduction,
     })
 }
@@ -361,6 +346,7 @@ fn spec_path(checked: &Checked) -> String {
 }
 
 /// The functions of the full state, every model has them.
+#[derive(Debug, Clone, Serialize)]
 struct FullStateCode {
     initial_state: Code,
     points: Code,
