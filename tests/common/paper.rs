@@ -43,6 +43,18 @@ fn cos_rise(s0: f64, c0: f64, delta: f64) -> f64 {
     s0 * delta.sin() - c0 * 2.0 * h * h
 }
 
+/// The rod's foot, tip and centre (points 0, 1, 2) from `x1 = q[0]`, `theta = q[1]`.
+fn rod_points(ell: f64, q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
+    let (x1, th, v1, w) = (q[0], q[1], qd[0], qd[1]);
+    let (s, c) = (th.sin(), th.cos());
+    pos[0] = [x1, 0.0];
+    vel[0] = [v1, 0.0];
+    pos[1] = [x1 + ell * c, ell * s];
+    vel[1] = [v1 - ell * s * w, ell * c * w];
+    pos[2] = [x1 + 0.5 * ell * c, 0.5 * ell * s];
+    vel[2] = [v1 - 0.5 * ell * s * w, 0.5 * ell * c * w];
+}
+
 /// `delta` from the drops `ds = sin(theta_i) - s`, `dc = cos(theta_i) - c` without
 /// cancellation: `atan2(cos(theta_i) ds - sin(theta_i) dc, cos(theta_i) c + sin(theta_i) s)`.
 fn delta_from_drops(si: f64, ci: f64, s: f64, c: f64, ds: f64, dc: f64) -> f64 {
@@ -188,17 +200,10 @@ impl Model for RodCube {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let ell = k[2];
-        let (x1, th, v1, w) = (q[0], q[1], qd[0], qd[1]);
-        let (s, c) = (th.sin(), th.cos());
-        pos[0] = [x1, 0.0];
-        vel[0] = [v1, 0.0];
-        pos[1] = [x1 + ell * c, ell * s];
-        vel[1] = [v1 - ell * s * w, ell * c * w];
-        pos[2] = [x1 + 0.5 * ell * c, 0.5 * ell * s];
-        vel[2] = [v1 - 0.5 * ell * s * w, 0.5 * ell * c * w];
-        pos[3] = [x1 + ell * c, 0.0];
-        vel[3] = [v1 - ell * s * w, 0.0];
+        rod_points(k[2], q, qd, pos, vel);
+        // The cube's corner is where the tip touches it.
+        pos[3] = [pos[1][0], 0.0];
+        vel[3] = [vel[1][0], 0.0];
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
@@ -429,15 +434,7 @@ impl Model for FreeRod {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let ell = k[2];
-        let (x1, th, v1, w) = (q[0], q[1], qd[0], qd[1]);
-        let (s, c) = (th.sin(), th.cos());
-        pos[0] = [x1, 0.0];
-        vel[0] = [v1, 0.0];
-        pos[1] = [x1 + ell * c, ell * s];
-        vel[1] = [v1 - ell * s * w, ell * c * w];
-        pos[2] = [x1 + 0.5 * ell * c, 0.5 * ell * s];
-        vel[2] = [v1 - 0.5 * ell * s * w, 0.5 * ell * c * w];
+        rod_points(k[2], q, qd, pos, vel);
         pos[3] = [q[2], 0.0];
         vel[3] = [qd[2], 0.0];
     }

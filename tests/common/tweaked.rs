@@ -8,6 +8,8 @@ use rodcube::model::{Model, ModelInfo, Reduced, Reduction};
 pub struct Tweaked {
     /// The model delegated to.
     pub base: &'static dyn Model,
+    /// Its fast path (every base tweaked here has one).
+    pub reduction: &'static dyn Reduction,
     /// Replacement coefficients (lowest degree first), if any.
     pub polynomial: Option<&'static [f64]>,
     /// Added to every monitor value.
@@ -36,6 +38,9 @@ impl Tweaked {
     pub fn with_fault(base: &'static dyn Model, fault: Fault) -> Self {
         Tweaked {
             base,
+            reduction: base
+                .reduction()
+                .expect("a tweaked model's base has a fast path"),
             polynomial: None,
             monitor_shift: 0.0,
             nan_force: false,
@@ -90,13 +95,13 @@ impl Model for Tweaked {
         self.base.released(k, q, qd, out)
     }
     fn reduction(&self) -> Option<&dyn Reduction> {
-        self.base.reduction().map(|_| self as &dyn Reduction)
+        Some(self)
     }
 }
 
 impl Reduction for Tweaked {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let mut r = self.base().reduced(k, delta);
+        let mut r = self.reduction.reduced(k, delta);
         if self.theta_dot_sq == Fault::Rises {
             r.theta_dot_sq = -r.theta_dot_sq;
             r.theta_ddot = -r.theta_ddot;
@@ -104,7 +109,7 @@ impl Reduction for Tweaked {
         r
     }
     fn theta_dot_sq_sc(&self, k: &[f64], s: f64, c: f64, ds: f64, dc: f64) -> f64 {
-        let w2 = self.base().theta_dot_sq_sc(k, s, c, ds, dc);
+        let w2 = self.reduction.theta_dot_sq_sc(k, s, c, ds, dc);
         match self.theta_dot_sq {
             Fault::Rises => -w2,
             Fault::TurnsBack { below } if s < below => -w2,
@@ -113,7 +118,7 @@ impl Reduction for Tweaked {
         }
     }
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        self.base().forces(k, delta, out);
+        self.reduction.forces(k, delta, out);
         if self.nan_force
             && let Some(last) = out.last_mut()
         {
@@ -123,7 +128,7 @@ impl Reduction for Tweaked {
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
         match self.polynomial {
             Some(c) => out.copy_from_slice(c),
-            None => self.base().separation_polynomial(k, out),
+            None => self.reduction.separation_polynomial(k, out),
         }
     }
     fn full_state(
@@ -135,24 +140,14 @@ impl Reduction for Tweaked {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        self.base().full_state(k, t, delta, theta_dot, q, qd)
-    }
-}
-
-impl Tweaked {
-    /// The base model's fast path (every base used here has one; `reduction` above only
-    /// offers this wrapper's when the base does).
-    fn base(&self) -> &'static dyn Reduction {
-        match self.base.reduction() {
-            Some(r) => r,
-            None => &super::paper::ROD_CUBE,
-        }
+        self.reduction.full_state(k, t, delta, theta_dot, q, qd)
     }
 }
 
 /// `rod_cube` whose separation polynomial `1 + s^2` never vanishes: contact to the floor.
 pub static NEVER_SEPARATES: Tweaked = Tweaked {
     base: &super::paper::ROD_CUBE,
+    reduction: &super::paper::ROD_CUBE,
     polynomial: Some(&[1.0, 0.0, 1.0, 0.0]),
     monitor_shift: 0.0,
     nan_force: false,
@@ -163,6 +158,7 @@ pub static NEVER_SEPARATES: Tweaked = Tweaked {
 /// near separation, while the tipping margin (>= 3.5) stays positive.
 pub static LOW_MONITORS: Tweaked = Tweaked {
     base: &super::paper::ROD_CUBE,
+    reduction: &super::paper::ROD_CUBE,
     polynomial: None,
     monitor_shift: -3.0,
     nan_force: false,
@@ -172,6 +168,7 @@ pub static LOW_MONITORS: Tweaked = Tweaked {
 /// `rod_cube` whose floor normal force is NaN.
 pub static NAN_FORCE: Tweaked = Tweaked {
     base: &super::paper::ROD_CUBE,
+    reduction: &super::paper::ROD_CUBE,
     polynomial: None,
     monitor_shift: 0.0,
     nan_force: true,
