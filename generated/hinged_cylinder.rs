@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced, Reduction,
-    ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
+    Reduction, ReductionInfo, start_offsets,
 };
 
 /// A uniform rod hinged at its foot, leaning on a cylinder that slides without spinning on a frictionless floor, released from rest.
@@ -77,6 +77,7 @@ static INFO: ModelInfo = ModelInfo {
         eliminated: "xc",
         edge: true,
     }),
+    frictions: &[],
     points: &[
         NamedInfo {
             name: "foot",
@@ -254,7 +255,15 @@ impl Model for HingedCylinder {
             + (k[24] * qt4 * rc_c.powi(5) / rc_s.powi(5)));
     }
 
-    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+    fn forces_full(
+        &self,
+        k: &[f64],
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        fr: &[f64],
+        out: &mut [f64],
+    ) {
         let k = &k[..43]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ft0 = (rc_c * rc_c);
@@ -267,6 +276,11 @@ impl Model for HingedCylinder {
                 + (k[30] * ft1 * rc_c / rc_s)
                 + (k[30] * ft1 * ft0 / rc_s.powi(3))
                 + (k[30] * ft1 * rc_c.powi(3) / rc_s.powi(3))));
+    }
+
+    fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        let k = &k[..43]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {

@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced, Reduction,
-    ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
+    Reduction, ReductionInfo, start_offsets,
 };
 
 /// After the contact of `hinged_cylinder` ends: A uniform rod hinged at its foot, leaning on a cylinder that slides without spinning on a frictionless floor, released from rest.
@@ -94,6 +94,7 @@ static INFO: ModelInfo = ModelInfo {
     end_angle: 0.0,
     forces: &[],
     contact: None,
+    frictions: &[],
     points: &[
         NamedInfo {
             name: "foot",
@@ -222,7 +223,20 @@ impl Model for HingedCylinderFree {
         rhs[1] = 0.0;
     }
 
-    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+    fn forces_full(
+        &self,
+        k: &[f64],
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        fr: &[f64],
+        out: &mut [f64],
+    ) {
+        let k = &k[..37]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
+    }
+
+    fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
         let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
     }

@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced, Reduction,
-    ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
+    Reduction, ReductionInfo, start_offsets,
 };
 
 /// A uniform rod hinged at its foot, leaning on a free cube on a frictionless floor.
@@ -71,6 +71,7 @@ static INFO: ModelInfo = ModelInfo {
         eliminated: "x2",
         edge: false,
     }),
+    frictions: &[],
     points: &[
         NamedInfo {
             name: "foot",
@@ -213,12 +214,25 @@ impl Model for HingedRod {
         rhs[0] = ((k[23] * rc_c) + (k[24] * (qd[0] * qd[0]) * rc_s * rc_c));
     }
 
-    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+    fn forces_full(
+        &self,
+        k: &[f64],
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        fr: &[f64],
+        out: &mut [f64],
+    ) {
         let k = &k[..39]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ft0 = (qd[0] * qd[0]);
         out[0] = (k[25] * ((k[13] * qdd[0] * rc_s) + (k[13] * ft0 * rc_c)));
         out[1] = (k[26] + (k[27] * qdd[0] * rc_c) + (k[28] * ft0 * rc_s));
+    }
+
+    fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        let k = &k[..39]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {

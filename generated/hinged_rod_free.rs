@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced, Reduction,
-    ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
+    Reduction, ReductionInfo, start_offsets,
 };
 
 /// After the contact of `hinged_rod` ends: A uniform rod hinged at its foot, leaning on a free cube on a frictionless floor.
@@ -85,6 +85,7 @@ static INFO: ModelInfo = ModelInfo {
         meaning: "vertical force of the hinge on the rod (the hinge also pushes sideways)",
     }],
     contact: None,
+    frictions: &[],
     points: &[
         NamedInfo {
             name: "foot",
@@ -213,10 +214,23 @@ impl Model for HingedRodFree {
         rhs[1] = 0.0;
     }
 
-    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+    fn forces_full(
+        &self,
+        k: &[f64],
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        fr: &[f64],
+        out: &mut [f64],
+    ) {
         let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         out[0] = (k[29] + (k[30] * qdd[0] * rc_c) + (k[31] * (qd[0] * qd[0]) * rc_s));
+    }
+
+    fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        let k = &k[..38]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {

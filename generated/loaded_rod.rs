@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced, Reduction,
-    ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
+    Reduction, ReductionInfo, start_offsets,
 };
 
 /// A uniform rod with a point load at its upper end, leaning on a free cube on a frictionless floor, released from rest.
@@ -77,6 +77,7 @@ static INFO: ModelInfo = ModelInfo {
         eliminated: "x2",
         edge: false,
     }),
+    frictions: &[],
     points: &[
         NamedInfo {
             name: "foot",
@@ -373,12 +374,25 @@ impl Model for LoadedRod {
         rhs[1] = ((k[32] * rc_c) + (k[33] * qt1 * rc_s * rc_c));
     }
 
-    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+    fn forces_full(
+        &self,
+        k: &[f64],
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        fr: &[f64],
+        out: &mut [f64],
+    ) {
         let k = &k[..52]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let ft0 = (qd[1] * qd[1]);
         out[0] = (k[34] * ((k[17] * qdd[1] * rc_s) + qdd[0] + (k[17] * ft0 * rc_c)));
         out[1] = (k[35] + (k[36] * qdd[1] * rc_c) + (k[37] * ft0 * rc_s));
+    }
+
+    fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        let k = &k[..52]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {

@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced, Reduction,
-    ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
+    Reduction, ReductionInfo, start_offsets,
 };
 
 /// After the contact of `loaded_rod` ends: A uniform rod with a point load at its upper end, leaning on a free cube on a frictionless floor, released from rest.
@@ -103,6 +103,7 @@ static INFO: ModelInfo = ModelInfo {
         meaning: "the floor's upward push on the rod's foot",
     }],
     contact: None,
+    frictions: &[],
     points: &[
         NamedInfo {
             name: "foot",
@@ -320,10 +321,23 @@ impl Model for LoadedRodFree {
         rhs[2] = 0.0;
     }
 
-    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+    fn forces_full(
+        &self,
+        k: &[f64],
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        fr: &[f64],
+        out: &mut [f64],
+    ) {
         let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = (k[40] + (k[38] * qdd[1] * rc_c) + (k[27] * (qd[1] * qd[1]) * rc_s));
+    }
+
+    fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        let k = &k[..56]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {

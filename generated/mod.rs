@@ -9,6 +9,8 @@ pub mod loaded_rod;
 pub mod loaded_rod_free;
 pub mod rod_cube;
 pub mod rod_cube_free;
+pub mod rod_cube_friction;
+pub mod rod_cube_friction_free;
 pub mod rod_cube_spring;
 pub mod rod_cube_spring_free;
 pub mod rod_cylinder;
@@ -26,6 +28,8 @@ pub static MODELS: &[&dyn crate::model::Model] = &[
     &loaded_rod_free::LoadedRodFree,
     &rod_cube::RodCube,
     &rod_cube_free::RodCubeFree,
+    &rod_cube_friction::RodCubeFriction,
+    &rod_cube_friction_free::RodCubeFrictionFree,
     &rod_cube_spring::RodCubeSpring,
     &rod_cube_spring_free::RodCubeSpringFree,
     &rod_cylinder::RodCylinder,

@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced, Reduction,
-    ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
+    Reduction, ReductionInfo, start_offsets,
 };
 
 /// A uniform rod leaning on a free cube on a frictionless floor, released from rest.
@@ -71,6 +71,7 @@ static INFO: ModelInfo = ModelInfo {
         eliminated: "x2",
         edge: false,
     }),
+    frictions: &[],
     points: &[
         NamedInfo {
             name: "foot",
@@ -247,12 +248,25 @@ impl Model for RodCube {
         rhs[1] = ((k[29] * rc_c) + (k[30] * qt1 * rc_s * rc_c));
     }
 
-    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+    fn forces_full(
+        &self,
+        k: &[f64],
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        fr: &[f64],
+        out: &mut [f64],
+    ) {
         let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let ft0 = (qd[1] * qd[1]);
         out[0] = (k[31] * ((k[15] * qdd[1] * rc_s) + qdd[0] + (k[15] * ft0 * rc_c)));
         out[1] = (k[32] + (k[33] * qdd[1] * rc_c) + (k[34] * ft0 * rc_s));
+    }
+
+    fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        let k = &k[..47]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {

@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced, Reduction,
-    ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
+    Reduction, ReductionInfo, start_offsets,
 };
 
 /// A uniform rod leaning on a cube that a horizontal spring ties to a fixed wall, all on a frictionless floor, released from rest.
@@ -77,6 +77,7 @@ static INFO: ModelInfo = ModelInfo {
         eliminated: "x2",
         edge: false,
     }),
+    frictions: &[],
     points: &[
         NamedInfo {
             name: "foot",
@@ -222,13 +223,26 @@ impl Model for RodCubeSpring {
         rhs[1] = ((k[26] * rc_c) + (k[27] * qt1 * rc_s) + (k[28] * qt2 * rc_s * rc_c));
     }
 
-    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+    fn forces_full(
+        &self,
+        k: &[f64],
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        fr: &[f64],
+        out: &mut [f64],
+    ) {
         let k = &k[..34]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let ft0 = (qd[1] * qd[1]);
         out[0] = ((k[29] * (k[19] + (k[7] * rc_c) + q[0]))
             + (k[30] * ((k[9] * qdd[1] * rc_s) + qdd[0] + (k[9] * ft0 * rc_c))));
         out[1] = (k[31] + (k[32] * qdd[1] * rc_c) + (k[33] * ft0 * rc_s));
+    }
+
+    fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        let k = &k[..34]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {

@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced, Reduction,
-    ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
+    Reduction, ReductionInfo, start_offsets,
 };
 
 /// A uniform rod leaning on a cylinder that slides without spinning on a frictionless floor, released from rest.
@@ -83,6 +83,7 @@ static INFO: ModelInfo = ModelInfo {
         eliminated: "xc",
         edge: true,
     }),
+    frictions: &[],
     points: &[
         NamedInfo {
             name: "foot",
@@ -281,7 +282,15 @@ impl Model for RodCylinder {
             + (k[24] * qt5 * rc_c.powi(5) / rc_s.powi(5)));
     }
 
-    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+    fn forces_full(
+        &self,
+        k: &[f64],
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        fr: &[f64],
+        out: &mut [f64],
+    ) {
         let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let ft0 = (rc_c * rc_c);
@@ -299,6 +308,11 @@ impl Model for RodCylinder {
             + (k[34] * qdd[0] * rc_c / rc_s)
             + (k[14] * ft1 * rc_s)
             + (k[14] * ft1 * ft0 / rc_s));
+    }
+
+    fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        let k = &k[..35]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {

@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced, Reduction,
-    ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
+    Reduction, ReductionInfo, start_offsets,
 };
 
 /// After the contact of `rod_cylinder` ends: A uniform rod leaning on a cylinder that slides without spinning on a frictionless floor, released from rest.
@@ -109,6 +109,7 @@ static INFO: ModelInfo = ModelInfo {
         meaning: "the floor's upward push on the rod's foot",
     }],
     contact: None,
+    frictions: &[],
     points: &[
         NamedInfo {
             name: "foot",
@@ -287,7 +288,15 @@ impl Model for RodCylinderFree {
         rhs[2] = 0.0;
     }
 
-    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+    fn forces_full(
+        &self,
+        k: &[f64],
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        fr: &[f64],
+        out: &mut [f64],
+    ) {
         let k = &k[..53]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let ft0 = (qd[1] * qd[1]);
@@ -295,6 +304,11 @@ impl Model for RodCylinderFree {
             + (k[35] * qdd[0] * rc_c / rc_s)
             + (k[28] * ft0 * rc_s)
             + (k[28] * ft0 * (rc_c * rc_c) / rc_s));
+    }
+
+    fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        let k = &k[..53]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {

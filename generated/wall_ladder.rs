@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced, Reduction,
-    ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
+    Reduction, ReductionInfo, start_offsets,
 };
 
 /// A uniform ladder sliding down a fixed frictionless wall on a frictionless floor.
@@ -65,6 +65,7 @@ static INFO: ModelInfo = ModelInfo {
         eliminated: "x1",
         edge: false,
     }),
+    frictions: &[],
     points: &[
         NamedInfo {
             name: "foot",
@@ -190,7 +191,15 @@ impl Model for WallLadder {
         rhs[0] = (k[19] * rc_c);
     }
 
-    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+    fn forces_full(
+        &self,
+        k: &[f64],
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        fr: &[f64],
+        out: &mut [f64],
+    ) {
         let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ft0 = (qd[0] * qd[0]);
@@ -198,6 +207,11 @@ impl Model for WallLadder {
             + (k[21] * ((k[11] * qdd[0] * rc_s) + (k[11] * ft0 * rc_c)))
             + (k[20] * ft0 * rc_c)));
         out[1] = (k[22] + (k[23] * qdd[0] * rc_c) + (k[20] * ft0 * rc_s));
+    }
+
+    fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        let k = &k[..27]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {

@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced, Reduction,
-    ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
+    Reduction, ReductionInfo, start_offsets,
 };
 
 /// After the contact of `wall_ladder` ends: A uniform ladder sliding down a fixed frictionless wall on a frictionless floor.
@@ -79,6 +79,7 @@ static INFO: ModelInfo = ModelInfo {
         meaning: "the floor's upward push on the ladder's foot",
     }],
     contact: None,
+    frictions: &[],
     points: &[
         NamedInfo {
             name: "foot",
@@ -218,10 +219,23 @@ impl Model for WallLadderFree {
         rhs[1] = (k[28] * rc_c);
     }
 
-    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+    fn forces_full(
+        &self,
+        k: &[f64],
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        fr: &[f64],
+        out: &mut [f64],
+    ) {
         let k = &k[..39]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = (k[29] + (k[27] * qdd[1] * rc_c) + (k[19] * (qd[1] * qd[1]) * rc_s));
+    }
+
+    fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        let k = &k[..39]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {

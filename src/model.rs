@@ -18,6 +18,7 @@
 //!   without cancellation near the start, where the energy integral vanishes.
 //! - `q`, `qd`, `qdd`: the full (unreduced) coordinates, velocities and accelerations in the order
 //!   of [`ModelInfo::coordinates`].
+//! - `fr`: the friction forces in the order of [`ModelInfo::frictions`].
 //! - Forces are in newtons, positive in the sense documented by each force's [`NamedInfo`] in [`ModelInfo::forces`].
 
 /// A model parameter as declared in its spec.
@@ -55,6 +56,25 @@ pub struct ContactInfo {
     pub eliminated: &'static str,
     /// Whether the contact can also end at an edge (a contact point running off a body).
     pub edge: bool,
+}
+
+/// Coulomb friction at a contact point ([`Model::friction`] gives its slip velocity).
+///
+/// While the contact slides with slip velocity `v`, the friction force is
+/// `f = -mu N sign(v)`; while it sticks (`v = 0`), `f` is the force that keeps it stuck, which
+/// must stay within `|f| <= mu N`. `N` is the normal force [`FrictionInfo::normal`] and
+/// `mu` the parameter [`FrictionInfo::coefficient`]. Its generalized force is `f J`, with `J`
+/// the row of [`Model::friction`]'s Jacobian (`v = J qd`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FrictionInfo {
+    /// Identifier of the friction force (a result key, in newtons).
+    pub name: &'static str,
+    /// What it is, with its sign convention.
+    pub meaning: &'static str,
+    /// Index in [`ModelInfo::parameters`] of the friction coefficient `mu` (`>= 0`).
+    pub coefficient: usize,
+    /// Index in [`ModelInfo::forces`] of the normal force `N`.
+    pub normal: usize,
 }
 
 /// Where a value passed to the next phase comes from.
@@ -129,6 +149,8 @@ pub struct ModelInfo {
     pub forces: &'static [NamedInfo],
     /// The contact, if the model has one.
     pub contact: Option<ContactInfo>,
+    /// Coulomb frictions (the reaction forces in [`Model::forces_full`] depend on their values).
+    pub frictions: &'static [FrictionInfo],
     /// Named points whose trajectories can be asked for.
     pub points: &'static [NamedInfo],
     /// Index in `points` of the centre of mass whose free fall is the reference time.
@@ -176,8 +198,22 @@ pub trait Model: Send + Sync {
     /// `n x n`, `rhs` has length `n`, with `n` the number of coordinates.
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]);
 
-    /// The reaction forces of [`ModelInfo::forces`] from a full state and its acceleration.
-    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]);
+    /// The reaction forces of [`ModelInfo::forces`] from a full state, its acceleration and the
+    /// friction forces `fr` (in the order of [`ModelInfo::frictions`]; empty without friction).
+    fn forces_full(
+        &self,
+        k: &[f64],
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        fr: &[f64],
+        out: &mut [f64],
+    );
+
+    /// The slip velocities of the frictions, `v = J(q) qd`, as the Jacobian `jac` (row-major
+    /// `m x n`, `m` frictions by `n` coordinates) and `bias = dJ/dt qd`, the part of the slip
+    /// acceleration `dv/dt = J qdd + bias` free of `qdd`. Both empty without friction.
+    fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]);
 
     /// Monitor values (each must stay `>= 0`), in the order of [`ModelInfo::monitors`], from a
     /// full state and the forces at it (in the order of [`ModelInfo::forces`]).

@@ -868,14 +868,28 @@ impl<'m> Plan<'m> {
             let mut found: Vec<(String, Check)> = checks::monitors(bound, samples, &forces, tol);
             match run {
                 PhaseRun::Reduced(_) => {
-                    found.extend(checks::drift(bound, &samples.states, tol, bound.name()));
+                    found.extend(checks::drift(
+                        bound,
+                        &samples.states,
+                        None,
+                        tol,
+                        bound.name(),
+                    ));
                 }
                 // Along the integrator's own steps (not the interpolated samples), held to the
                 // integrator's accuracy: ten times its rtol at the least.
                 PhaseRun::Integrated(r) => {
                     let states = r.run.states();
                     let ode_tol = tol.max(10.0 * r.run.rtol);
-                    found.extend(checks::drift(bound, &states, ode_tol, bound.name()));
+                    let friction_work = r.run.node_friction_work();
+                    let with_friction = !bound.info().frictions.is_empty();
+                    found.extend(checks::drift(
+                        bound,
+                        &states,
+                        with_friction.then_some(&friction_work[..]),
+                        ode_tol,
+                        bound.name(),
+                    ));
                 }
             }
             out.checks.extend(found);
@@ -886,7 +900,7 @@ impl<'m> Plan<'m> {
             let ode_tol = tol.max(10.0 * ode.rtol);
             let label = format!("{}.ode", self.bound.name());
             out.checks
-                .extend(checks::drift(&self.bound, &states, ode_tol, &label));
+                .extend(checks::drift(&self.bound, &states, None, ode_tol, &label));
         }
         Ok(())
     }

@@ -76,6 +76,20 @@ pub enum SystemError {
         /// The value.
         value: f64,
     },
+    /// A friction coefficient below zero.
+    #[error(
+        "parameter `{name}` of model `{model}` is {value}; it is the coefficient of friction `{friction}` and must not be negative"
+    )]
+    NegativeFriction {
+        /// Model name.
+        model: &'static str,
+        /// Parameter name.
+        name: &'static str,
+        /// The friction it is the coefficient of.
+        friction: &'static str,
+        /// The value.
+        value: f64,
+    },
     /// A requirement margin was not strictly positive (e.g. `a >= ell`).
     #[error(
         "model `{model}` requirement `{name}` ({meaning}) fails: margin {margin:e} <= 0 with {parameters}"
@@ -237,6 +251,25 @@ impl<'m> Bound<'m> {
                 });
             }
         }
+        for f in info.frictions {
+            let (Some(&value), Some(param)) =
+                (p.get(f.coefficient), info.parameters.get(f.coefficient))
+            else {
+                return Err(SystemError::WrongCount {
+                    model: info.name,
+                    expected: f.coefficient + 1,
+                    got: p.len(),
+                });
+            };
+            if value < 0.0 {
+                return Err(SystemError::NegativeFriction {
+                    model: info.name,
+                    name: param.name,
+                    friction: f.name,
+                    value,
+                });
+            }
+        }
         let mut margins = vec![0.0; info.requirements.len()];
         model.requirements(p, &mut margins);
         for (&margin, req) in margins.iter().zip(info.requirements) {
@@ -382,12 +415,32 @@ impl<'m> Bound<'m> {
         (mass, rhs)
     }
 
-    /// Reaction forces from a full state and its accelerations.
-    pub fn forces_full(&self, state: &State, qdd: &[f64]) -> Vec<f64> {
+    /// Reaction forces from a full state, its accelerations and the friction forces `fr` (in
+    /// the order of [`ModelInfo::frictions`](crate::model::ModelInfo::frictions); empty without
+    /// friction).
+    pub fn forces_full(&self, state: &State, qdd: &[f64], fr: &[f64]) -> Vec<f64> {
         let mut out = vec![0.0; self.info().forces.len()];
         self.model
-            .forces_full(&self.k, &state.q, &state.qd, qdd, &mut out);
+            .forces_full(&self.k, &state.q, &state.qd, qdd, fr, &mut out);
         out
+    }
+
+    /// The frictions' slip-velocity Jacobian `J` (row-major, one row per friction) and the
+    /// part of the slip acceleration free of `qdd`: `v = J qd`, `dv/dt = J qdd + bias`.
+    pub fn friction(&self, state: &State) -> (Vec<f64>, Vec<f64>) {
+        let m = self.info().frictions.len();
+        let mut jac = vec![0.0; m * self.n_coordinates()];
+        let mut bias = vec![0.0; m];
+        self.model
+            .friction(&self.k, &state.q, &state.qd, &mut jac, &mut bias);
+        (jac, bias)
+    }
+
+    /// The friction coefficient of each friction.
+    pub fn friction_coefficients(&self) -> Vec<f64> {
+        (self.info().frictions.iter())
+            .map(|f| self.p[f.coefficient])
+            .collect()
     }
 
     /// Monitor values (each must stay `>= 0`) at a state with the forces there.

@@ -150,7 +150,7 @@ fn the_cylinder_forces_balance_each_body_by_hand() {
     let mut worst = 0.0f64;
     for (theta, omega, v1) in [(0.9, 0.0, 0.0), (0.7, -1.3, 0.4), (0.5, -2.5, -0.3)] {
         let (state, qdd) = state_and_accelerations(&bound, theta, omega, v1);
-        let f = bound.forces_full(&state, &qdd);
+        let f = bound.forces_full(&state, &qdd, &[]);
         let (push, floor) = (f[0], f[1]);
         let (s, c) = (theta.sin(), theta.cos());
         let (x1dd, thdd) = (qdd[0], qdd[1]);
@@ -188,7 +188,7 @@ fn the_spring_forces_balance_each_body_by_hand() {
     let x2_rest = (ell * ell - a * a).sqrt();
     for (theta, omega, v1) in [(0.25, 0.0, 0.0), (0.2, -1.1, -0.2), (0.15, -1.6, -0.45)] {
         let (state, qdd) = state_and_accelerations(&bound, theta, omega, v1);
-        let f = bound.forces_full(&state, &qdd);
+        let f = bound.forces_full(&state, &qdd, &[]);
         let (push, floor) = (f[0], f[1]);
         let (s, c) = (theta.sin(), theta.cos());
         let (x1, x1dd, thdd) = (state.q[0], qdd[0], qdd[1]);

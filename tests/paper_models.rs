@@ -28,7 +28,7 @@ fn check_consistency(sys: &System, delta_end: f64) {
             qdd[1],
             red.theta_ddot
         );
-        let f_full = sys.forces_full(&state, &qdd);
+        let f_full = sys.forces_full(&state, &qdd, &[]);
         let f_red = sys.forces(delta);
         let f_scale = f_red.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         for (a, b) in f_full.iter().zip(&f_red) {

@@ -71,6 +71,8 @@ pub struct RustContext {
     end_angle: String,
     forces_info: Vec<Named>,
     contact: Option<String>,
+    /// `FrictionInfo { .. }` literals.
+    frictions_info: Vec<String>,
     points_info: Vec<Named>,
     falling_point: usize,
     gravity: usize,
@@ -277,6 +279,16 @@ pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, St
         end_angle: lit(spec.end_angle),
         forces_info: named(&d.forces),
         contact,
+        frictions_info: d
+            .frictions
+            .iter()
+            .map(|f| {
+                format!(
+                    "FrictionInfo {{ name: {:?}, meaning: {:?}, coefficient: {}, normal: {} }}",
+                    f.named.name, f.named.meaning, f.coefficient, f.normal
+                )
+            })
+            .collect(),
         points_info: spec
             .points
             .iter()
@@ -354,6 +366,7 @@ struct FullStateCode {
     momenta: Code,
     equations: Code,
     forces_full: Code,
+    friction: Code,
     monitors_full: Code,
     contact_edge: Code,
     released: Code,
@@ -441,9 +454,26 @@ fn full_state_code(
         .chain((0..nc).map(|i| format!("rhs[{i}] = {};", out[nc * nc + i])))
         .collect();
 
+    for j in 0..d.frictions.len() {
+        full_scope
+            .locals
+            .insert(format!("rc_fr{j}"), format!("fr[{j}]"));
+    }
     let ff: Vec<Expr> = d.forces_full.iter().map(sc).collect();
     let (mut forces_full, out) = single("f", &ff, &full_scope, hoisted);
     forces_full.outputs = out_lines(&out);
+
+    let mut exprs: Vec<Expr> = Vec::new();
+    for f in &d.frictions {
+        exprs.extend(f.jacobian.iter().map(sc));
+    }
+    exprs.extend(d.frictions.iter().map(|f| sc(&f.bias)));
+    let (mut friction, out) = single("s", &exprs, &full_scope, hoisted);
+    let n_jac = nc * d.frictions.len();
+    friction.outputs = (0..n_jac)
+        .map(|i| format!("jac[{i}] = {};", out[i]))
+        .chain((0..d.frictions.len()).map(|j| format!("bias[{j}] = {};", out[n_jac + j])))
+        .collect();
 
     let mut mon_scope = full_scope.clone();
     for i in 0..d.forces.len() {
@@ -491,6 +521,7 @@ fn full_state_code(
         momenta,
         equations,
         forces_full,
+        friction,
         monitors_full,
         contact_edge,
         released,
@@ -754,7 +785,14 @@ pub struct TexContext {
 /// Builds the LaTeX context: the derivation's steps as displayed equations.
 pub fn tex_context(checked: &Checked, d: &Derivation) -> TexContext {
     let theta = d.theta().to_string();
-    let name = |s: &str| latex_name(s, &theta);
+    let name = |s: &str| match s
+        .strip_prefix("rc_fr")
+        .and_then(|j| j.parse::<usize>().ok())
+        .and_then(|j| d.frictions.get(j))
+    {
+        Some(f) => format!("F_{{\\mathrm{{{}}}}}", tex_text(&f.named.name)),
+        None => latex_name(s, &theta),
+    };
     let sc = |e: &Expr| from_sc(e, &theta);
     let mut eqs = Vec::new();
     if let Some(c) = &d.contact {
@@ -805,6 +843,21 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> TexContext {
             14,
             &sc(&d.euler_lagrange[i]),
             Some(&Expr::int(0)),
+            &name,
+        ));
+    }
+    for f in &d.frictions {
+        eqs.push(display(
+            &format!(
+                "Friction \\texttt{{{}}}: {}. Slip velocity $v$; the friction force $F$ does the \\
+                 virtual work $F\\,\\delta v/\\delta\\dot q$ (sliding: $F = -\\mu N \\operatorname{{sign}} v$; sticking: $\\dot v = 0$, $|F| \\le \\mu N$)",
+                tex_text(&f.named.name),
+                tex_text(&f.named.meaning)
+            ),
+            "v = ".into(),
+            2,
+            &sc(&f.slip),
+            None,
             &name,
         ));
     }
@@ -977,7 +1030,7 @@ pub fn json_record(checked: &Checked, d: &Derivation) -> serde_json::Value {
         "lagrangian".into(),
         from_sc(&d.lagrangian, &theta).to_infix(),
     );
-    serde_json::json!({
+    let mut record = serde_json::json!({
         "generated_by": COMMAND,
         "note": "Generated file; do not edit by hand.",
         "model": d.name,
@@ -991,7 +1044,25 @@ pub fn json_record(checked: &Checked, d: &Derivation) -> serde_json::Value {
         "route_note": reason,
         "velocity_symbols": "theta_dot, theta_ddot in the reduced expressions are eliminated; dot_q / ddot_q denote velocities and accelerations in `lagrangian` and in integrated forces",
         "expressions": expressions,
-    })
+    });
+    if !d.frictions.is_empty() {
+        record["frictions"] = d
+            .frictions
+            .iter()
+            .enumerate()
+            .map(|(j, f)| {
+                serde_json::json!({
+                    "name": f.named.name,
+                    "meaning": f.named.meaning,
+                    "coefficient": d.params[f.coefficient].name,
+                    "normal": d.forces[f.normal].name,
+                    "slip_velocity": from_sc(&f.slip, &theta).to_infix(),
+                    "force_symbol": format!("rc_fr{j}"),
+                })
+            })
+            .collect();
+    }
+    record
 }
 
 #[cfg(test)]

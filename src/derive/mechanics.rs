@@ -16,11 +16,19 @@
 //! A phase outside that class is not an error: it is solved by integrating `M(q) qdd = F`, and
 //! the reason is recorded.
 //!
+//! Coulomb friction at a contact point acts on a body along a tangent `t`: its slip velocity
+//! `v = t . (v_body(p) - v_other(p))` (material velocities at the point) is linear in the
+//! velocities, `v = J qd`, and its generalized force is `f J` for a friction force `f` that the
+//! runtime solves for together with the accelerations (sliding: `f = -mu N sign v`; sticking:
+//! `dv/dt = 0`). Reaction forces then depend on `f` (symbols `rc_fr<i>`): a Newton balance on a
+//! body takes out the frictions that act on it, and a contact multiplier the frictions' part of
+//! `E_e`. A coordinate a friction acts on is not cyclic, and a phase with friction is integrated.
+//!
 //! Internal symbols (never allowed in specs): `dot_q`, `ddot_q` for velocities and
 //! accelerations; on the reduced motion `rc_s = sin(theta)`, `rc_c = cos(theta)`,
 //! `rc_ds = sin(theta_i) - sin(theta)`, `rc_dc = cos(theta_i) - cos(theta)`,
 //! `rc_delta = theta_i - theta`, `rc_t` time, `rc_w = theta_dot`, `rc_w2 = theta_dot^2`,
-//! `rc_acc = theta_ddot`, `rc_f<i>` the i-th force; constants `rc_thi`, `rc_wi`, `rc_si`,
+//! `rc_acc = theta_ddot`, `rc_f<i>` the i-th force, `rc_fr<i>` the i-th friction force; constants `rc_thi`, `rc_wi`, `rc_si`,
 //! `rc_ci`, `rc_ai` (reduced inertia at the start), `rc_x<j>i` (initial cyclic positions) and
 //! `rc_p<j>` (conserved momenta).
 
@@ -123,6 +131,23 @@ pub struct Contact {
     pub edge: Option<Expr>,
 }
 
+/// A Coulomb friction in one phase.
+#[derive(Debug, Clone)]
+pub struct Friction {
+    /// Identifier and meaning.
+    pub named: Named,
+    /// Index of the coefficient in [`Derivation::params`].
+    pub coefficient: usize,
+    /// Index of the normal force in [`Derivation::forces`].
+    pub normal: usize,
+    /// Slip velocity `v = J qd` over the full state.
+    pub slip: Expr,
+    /// `J`: `dv/dqd_j`, one per coordinate (the generalized force per unit friction force).
+    pub jacobian: Vec<Expr>,
+    /// `dv/dt` with the accelerations set to zero.
+    pub bias: Expr,
+}
+
 /// The phase after the contact ends.
 #[derive(Debug, Clone)]
 pub struct Next {
@@ -207,6 +232,9 @@ pub struct Derivation {
     pub requirements: Vec<Expr>,
     /// The contact, in a contact phase.
     pub contact: Option<Contact>,
+    /// The frictions acting in this phase (a free phase drops those whose normal force is the
+    /// contact's).
+    pub frictions: Vec<Friction>,
     /// The phase after the contact, in a contact phase.
     pub next: Option<Next>,
     /// The fast path, or why the phase is integrated instead.
@@ -409,6 +437,8 @@ struct Parsed {
     points: Vec<[Expr; 2]>,
     potentials: Vec<Expr>,
     directions: Vec<[Expr; 2]>,
+    /// Each friction's contact point and tangent.
+    friction: Vec<[[Expr; 2]; 2]>,
     gap: Option<Expr>,
     edge: Option<Expr>,
     monitors: Vec<Expr>,
@@ -445,6 +475,14 @@ fn read(spec: &Spec) -> Result<Parsed, DeriveError> {
     let directions = (spec.forces.iter().enumerate())
         .map(|(i, f)| pair(&f.direction, &field("forces", i, "direction")))
         .collect::<Result<_, _>>()?;
+    let friction = (spec.friction.iter().enumerate())
+        .map(|(i, f)| {
+            Ok([
+                pair(&f.point, &field("friction", i, "point"))?,
+                pair(&f.direction, &field("friction", i, "direction"))?,
+            ])
+        })
+        .collect::<Result<_, DeriveError>>()?;
     let contact_field = |k: &str| [key("contact"), key(k)];
     let gap = match &spec.contact {
         Some(c) => Some(parse_text(&c.gap, &contact_field("gap"))?),
@@ -476,6 +514,7 @@ fn read(spec: &Spec) -> Result<Parsed, DeriveError> {
         points,
         potentials,
         directions,
+        friction,
         gap,
         edge,
         monitors,
@@ -568,6 +607,7 @@ struct Lagrangian {
     springs: A,
     lag: A,
     body_pos: BTreeMap<String, [A; 2]>,
+    body_angle: BTreeMap<String, A>,
     body_mass: BTreeMap<String, A>,
 }
 
@@ -578,6 +618,7 @@ fn lagrangian(spec: &Spec, parsed: &Parsed, st: &Setup) -> Lagrangian {
     let mut t_kin = cas::num(0);
     let mut v_pot = cas::num(0);
     let mut body_pos = BTreeMap::new();
+    let mut body_angle = BTreeMap::new();
     let mut body_mass = BTreeMap::new();
     for b in &parsed.bodies {
         let m = cas::atom(&b.mass);
@@ -590,6 +631,7 @@ fn lagrangian(spec: &Spec, parsed: &Parsed, st: &Setup) -> Lagrangian {
             + half.clone() * inertia * w.clone() * w;
         v_pot += m.clone() * g.clone() * y.clone();
         body_pos.insert(b.name.clone(), [x, y]);
+        body_angle.insert(b.name.clone(), angle);
         body_mass.insert(b.name.clone(), m);
     }
     // The spec's potentials stay as written: expanded, a spring's `(x - x0)^2` would be
@@ -606,6 +648,7 @@ fn lagrangian(spec: &Spec, parsed: &Parsed, st: &Setup) -> Lagrangian {
         potential,
         springs,
         body_pos,
+        body_angle,
         body_mass,
     }
 }
@@ -614,12 +657,88 @@ impl Lagrangian {
     /// The Euler–Lagrange expression `d/dt dL/dqd - dL/dq` of coordinate `c` in two parts:
     /// the kinetic and gravitational part expanded, and the gradient of the spec's potentials
     /// as differentiated (a spring's force `k (x - x0)`, not `k x - k x0`).
+    /// The velocity of `body`'s material point at `p` (`v_cm + w x (p - cm)`).
+    fn material_velocity(&self, kin: &Kin, body: &str, p: &[A; 2]) -> Option<[A; 2]> {
+        let [x, y] = self.body_pos.get(body)?;
+        let w = kin.dt(self.body_angle.get(body)?);
+        Some([
+            kin.dt(x) - w.clone() * (p[1].clone() - y.clone()),
+            kin.dt(y) + w * (p[0].clone() - x.clone()),
+        ])
+    }
+
     fn euler_lagrange(&self, kin: &Kin, c: &str) -> (A, A) {
         let dot = format!("dot_{c}");
         let inertial = self.kinetic.clone() - (self.potential.clone() - self.springs.clone());
         let expanded = cas::expand(&(kin.dt(&cas::d(&inertial, &dot)) - cas::d(&inertial, c)));
         (expanded, cas::d(&self.springs, c))
     }
+}
+
+/// The slip of one friction in one phase.
+struct SlipKinematics {
+    /// Index in the spec's `friction`.
+    spec: usize,
+    /// Slip velocity over the full state.
+    slip: A,
+    /// `dv/dqd_j` per coordinate.
+    jacobian: Vec<A>,
+    /// `dv/dt` with the accelerations zero.
+    bias: A,
+}
+
+/// The spec's frictions that act in a phase: all of them, except in a free phase those whose
+/// normal force is the contact's (which is gone).
+fn active_frictions(spec: &Spec, phase: Phase) -> Vec<usize> {
+    let contact_force = spec.contact.as_ref().map(|c| c.force.as_str());
+    (0..spec.friction.len())
+        .filter(|&i| phase != Phase::Free || Some(spec.friction[i].normal.as_str()) != contact_force)
+        .collect()
+}
+
+/// Stage 2b: the slip velocity of each friction `indices` names, its Jacobian and its bias.
+fn slip_kinematics(
+    spec: &Spec,
+    parsed: &Parsed,
+    st: &Setup,
+    lag: &Lagrangian,
+    indices: &[usize],
+) -> Result<Vec<SlipKinematics>, DeriveError> {
+    let mut out = Vec::new();
+    for &i in indices {
+        let f = &spec.friction[i];
+        let path = [key("friction"), FieldStep::Index(i)];
+        let unknown = |b: &str| at(&path, format!("`{b}` is not one of the bodies"));
+        let [p, t] = &parsed.friction[i];
+        let p = [st.at(&p[0]), st.at(&p[1])];
+        let [va_x, va_y] = lag
+            .material_velocity(&st.kin, &f.body, &p)
+            .ok_or_else(|| unknown(&f.body))?;
+        let (rel_x, rel_y) = match &f.against {
+            Some(b) => {
+                let [vb_x, vb_y] = lag
+                    .material_velocity(&st.kin, b, &p)
+                    .ok_or_else(|| unknown(b))?;
+                (va_x - vb_x, va_y - vb_y)
+            }
+            None => (va_x, va_y),
+        };
+        let slip = cas::expand(&(st.at(&t[0]) * rel_x + st.at(&t[1]) * rel_y));
+        let jacobian = (st.coords.iter())
+            .map(|c| cas::expand(&cas::d(&slip, &format!("dot_{c}"))))
+            .collect();
+        let mut bias = st.kin.dt(&slip);
+        for c in &st.coords {
+            bias = cas::subs_var(&bias, &format!("ddot_{c}"), &cas::num(0));
+        }
+        out.push(SlipKinematics {
+            spec: i,
+            slip,
+            jacobian,
+            bias: cas::expand(&bias),
+        });
+    }
+    Ok(out)
 }
 
 /// The Euler–Lagrange equations of a phase.
@@ -632,7 +751,7 @@ struct Equations {
 }
 
 /// Stage 3: `M(q) qdd = F(q, qd)`, the cyclic coordinates and their momenta.
-fn equations(st: &Setup, lag: &Lagrangian) -> Equations {
+fn equations(st: &Setup, lag: &Lagrangian, frictions: &[SlipKinematics]) -> Equations {
     let dots: Vec<String> = st.coords.iter().map(|c| format!("dot_{c}")).collect();
     let ddots: Vec<String> = st.coords.iter().map(|c| format!("ddot_{c}")).collect();
     let (mut el, mut mass, mut rhs) = (Vec::new(), Vec::new(), Vec::new());
@@ -651,6 +770,7 @@ fn equations(st: &Setup, lag: &Lagrangian) -> Equations {
     }
     let cyclic: Vec<usize> = (0..st.coords.len())
         .filter(|&i| i != st.reduced && cas::is_zero(&cas::d(&lag.lag, &st.coords[i])))
+        .filter(|&i| frictions.iter().all(|f| cas::is_zero(&f.jacobian[i])))
         .collect();
     let momenta = cyclic
         .iter()
@@ -665,16 +785,19 @@ fn equations(st: &Setup, lag: &Lagrangian) -> Equations {
     }
 }
 
-/// Stage 4: the reaction forces over `(q, qd, qdd)`: in a contact phase the contact's
-/// multiplier first, then each `forces` entry by a Newton balance of its body projected on its
-/// direction `d`, `F = m (d . a) + m g d_y`: the non-gravity force on the body dotted with `d`
-/// (the spec chooses `d` so that only the wanted force has a component along it).
+/// Stage 4: the reaction forces over `(q, qd, qdd)` and the friction forces `rc_fr<j>`: in a
+/// contact phase the contact's multiplier first, then each `forces` entry by a Newton balance
+/// of its body projected on its direction `d`, `F = m (d . a) + m g d_y`: the non-gravity force
+/// on the body dotted with `d` (the spec chooses `d` so that only the wanted force has a
+/// component along it), less the frictions on the body along `d`.
 fn forces(
     spec: &Spec,
     parsed: &Parsed,
     st: &Setup,
     lag: &Lagrangian,
+    slips: &[SlipKinematics],
 ) -> Result<(Vec<Named>, Vec<A>), DeriveError> {
+    let fr = |j: usize| cas::var(&format!("rc_fr{j}"));
     let mut named = Vec::new();
     let mut full = Vec::new();
     if let (Some(c), Some((e, value))) = (&spec.contact, &st.tie) {
@@ -683,7 +806,15 @@ fn forces(
         let free_lag = lagrangian(spec, parsed, &free);
         let dot_e = format!("dot_{e}");
         let (inertial, spring) = free_lag.euler_lagrange(&free.kin, e);
-        let e_e = inertial + spring;
+        // E_e = lambda d(gap)/de + Q_e, with Q_e the frictions' generalized force on `e`.
+        let indices: Vec<usize> = slips.iter().map(|s| s.spec).collect();
+        let mut e_e = inertial + spring;
+        for (j, free_slip) in slip_kinematics(spec, parsed, &free, &free_lag, &indices)?
+            .iter()
+            .enumerate()
+        {
+            e_e = e_e - fr(j) * cas::d(&free_slip.slip, &dot_e);
+        }
         let rate = st.kin.dt(value);
         let accel = st.kin.dt(&rate);
         let on_contact = cas::subs_var(
@@ -722,12 +853,26 @@ fn forces(
         let [d0, d1] = &parsed.directions[i];
         let (d0, d1) = (st.at(d0), st.at(d1));
         let (ax, ay) = (st.kin.dt(&st.kin.dt(x)), st.kin.dt(&st.kin.dt(y)));
+        let mut frictions = cas::num(0);
+        for (j, sk) in slips.iter().enumerate() {
+            let rub = &spec.friction[sk.spec];
+            let sign = if rub.body == f.body {
+                1
+            } else if rub.against.as_deref() == Some(f.body.as_str()) {
+                -1
+            } else {
+                continue;
+            };
+            let [t0, t1] = &parsed.friction[sk.spec][1];
+            let along = st.at(t0) * d0.clone() + st.at(t1) * d1.clone();
+            frictions = frictions + cas::num(sign) * fr(j) * along;
+        }
         named.push(Named {
             name: f.name.clone(),
             meaning: f.meaning.clone(),
         });
         full.push(cas::expand(
-            &(m.clone() * (d0 * ax + d1.clone() * ay) + m.clone() * g.clone() * d1),
+            &(m.clone() * (d0 * ax + d1.clone() * ay) + m.clone() * g.clone() * d1 - frictions),
         ));
     }
     Ok((named, full))
@@ -869,7 +1014,7 @@ pub fn derive(checked: &Checked) -> Result<Vec<Derivation>, DeriveError> {
 /// with their rates and accelerations, sorted; then the internal symbols.
 pub fn canonical_symbols(specs: &[&Spec]) -> Vec<String> {
     let mut names = std::collections::BTreeSet::new();
-    let (mut n_coords, mut n_forces) = (0, 0);
+    let (mut n_coords, mut n_forces, mut n_frictions) = (0, 0, 0);
     for spec in specs {
         names.extend(spec.parameters.iter().map(|p| p.name.clone()));
         for c in &spec.coordinates {
@@ -887,6 +1032,7 @@ pub fn canonical_symbols(specs: &[&Spec]) -> Vec<String> {
         names.extend(spec.contact.iter().map(|c| c.force.clone()));
         n_coords = n_coords.max(spec.coordinates.len());
         n_forces = n_forces.max(spec.forces.len() + 1);
+        n_frictions = n_frictions.max(spec.friction.len());
     }
     let mut out: Vec<String> = names.into_iter().collect();
     for internal in [
@@ -900,6 +1046,7 @@ pub fn canonical_symbols(specs: &[&Spec]) -> Vec<String> {
         out.push(format!("rc_p{j}"));
     }
     out.extend((0..n_forces).map(|i| format!("rc_f{i}")));
+    out.extend((0..n_frictions).map(|i| format!("rc_fr{i}")));
     out
 }
 
@@ -920,8 +1067,10 @@ fn derive_phase(
     let st = setup(spec, parsed, phase)?;
     let params = phase_params(spec, phase)?;
     let lag = lagrangian(spec, parsed, &st);
-    let eqs = equations(&st, &lag);
-    let (force_names, forces_full) = forces(spec, parsed, &st, &lag)?;
+    let slips = slip_kinematics(spec, parsed, &st, &lag, &active_frictions(spec, phase))?;
+    let eqs = equations(&st, &lag, &slips);
+    let (force_names, forces_full) = forces(spec, parsed, &st, &lag, &slips)?;
+    let frictions = phase_frictions(spec, &params, &force_names, &slips)?;
     let (monitor_names, monitors_full) = monitors(spec, parsed, &st, &force_names)?;
     let initial_list = phase_initial(parsed, &st)?;
     let initial: BTreeMap<String, [Expr; 2]> = st
@@ -939,19 +1088,28 @@ fn derive_phase(
         (Phase::Contact, Some(e)) => Some(st.at(e)),
         _ => None,
     };
-    let reduction = Reducer {
-        st: &st,
-        lag: &lag,
-        eqs: &eqs,
-        initial: &initial,
-        positive,
-    }
-    .reduce(
-        &force_names,
-        &forces_full,
-        phase == Phase::Contact,
-        edge.as_ref(),
-    )?;
+    let reduction = if frictions.is_empty() {
+        Reducer {
+            st: &st,
+            lag: &lag,
+            eqs: &eqs,
+            initial: &initial,
+            positive,
+        }
+        .reduce(
+            &force_names,
+            &forces_full,
+            phase == Phase::Contact,
+            edge.as_ref(),
+        )?
+    } else {
+        let names: Vec<&str> = frictions.iter().map(|f| f.named.name.as_str()).collect();
+        Err(format!(
+            "Coulomb friction ({}) depends on the direction of slip and switches between \
+             sticking and sliding, so the motion is integrated with events at every switch",
+            names.join(", ")
+        ))
+    };
 
     let mut point_pos = Vec::new();
     let mut point_vel = Vec::new();
@@ -1020,9 +1178,43 @@ fn derive_phase(
         monitors_full: list(&monitors_full, "monitor")?,
         requirements: parsed.requirements.clone(),
         contact,
+        frictions,
         next,
         reduction,
     })
+}
+
+/// The frictions of a phase for the runtime: coefficient and normal force by index, slip
+/// velocity, Jacobian and bias as expressions.
+fn phase_frictions(
+    spec: &Spec,
+    params: &[Param],
+    forces: &[Named],
+    slips: &[SlipKinematics],
+) -> Result<Vec<Friction>, DeriveError> {
+    let mut out = Vec::new();
+    for sk in slips {
+        let f = &spec.friction[sk.spec];
+        let path = |k: &str| [key("friction"), FieldStep::Index(sk.spec), key(k)];
+        let coefficient = (params.iter().position(|p| p.name == f.coefficient))
+            .ok_or_else(|| at(&path("coefficient"), format!("`{}` is not a parameter", f.coefficient)))?;
+        let normal = (forces.iter().position(|n| n.name == f.normal))
+            .ok_or_else(|| at(&path("normal"), format!("`{}` is not a force of this phase", f.normal)))?;
+        out.push(Friction {
+            named: Named {
+                name: f.name.clone(),
+                meaning: f.meaning.clone(),
+            },
+            coefficient,
+            normal,
+            slip: to_expr(&sk.slip, "slip velocity")?,
+            jacobian: (sk.jacobian.iter())
+                .map(|j| to_expr(j, "slip Jacobian"))
+                .collect::<Result<_, _>>()?,
+            bias: to_expr(&sk.bias, "slip bias")?,
+        });
+    }
+    Ok(out)
 }
 
 /// The bindings from a contact phase to its free phase: the spec's parameters, then every

@@ -58,20 +58,34 @@ pub fn monitors(
 /// magnitudes `sum_j |M_cj qd_j|` (for momentum `c`) seen on the path. A check passes when the
 /// drift is at most `tolerance`; the margin is `tolerance - drift`. Keys: `<label>.energy`,
 /// `<label>.momentum_<coordinate>`.
-pub fn drift(sys: &Bound, states: &[State], tolerance: f64, label: &str) -> Vec<(String, Check)> {
+///
+/// With friction, `friction_work` holds the work friction has done by each state (`<= 0`) and
+/// the check is the energy balance `E - E(0) = W` instead of conservation.
+pub fn drift(
+    sys: &Bound,
+    states: &[State],
+    friction_work: Option<&[f64]>,
+    tolerance: f64,
+    label: &str,
+) -> Vec<(String, Check)> {
     let info = sys.info();
     let Some(first) = states.first() else {
         return Vec::new();
     };
     let n = sys.n_coordinates();
-    let e0 = sys.energy(first);
+    // A state without its work of friction counts as NaN, which fails the check.
+    let work_at = |i: usize| match friction_work {
+        Some(w) => w.get(i).copied().unwrap_or(f64::NAN),
+        None => 0.0,
+    };
+    let e0 = sys.energy(first) - work_at(0);
     let p0 = sys.momenta(first);
     let mut e_dev: f64 = 0.0;
     let mut e_scale: f64 = 0.0;
     let mut p_dev = vec![0.0f64; p0.len()];
     let mut p_scale = vec![0.0f64; p0.len()];
-    for s in states {
-        let e = sys.energy(s);
+    for (i, s) in states.iter().enumerate() {
+        let e = sys.energy(s) - work_at(i);
         let (mass, _) = sys.equations(s);
         let kinetic: f64 = 0.5
             * (0..n)
@@ -98,7 +112,12 @@ pub fn drift(sys: &Bound, states: &[State], tolerance: f64, label: &str) -> Vec<
             passed: e_rel <= tolerance,
             margin: tolerance - e_rel,
             meaning: format!(
-                "total energy drift over {} states of `{}` relative to {e_scale:.6e} J: {e_rel:.3e} (tolerance {tolerance:.1e})",
+                "{} over {} states of `{}` relative to {e_scale:.6e} J: {e_rel:.3e} (tolerance {tolerance:.1e})",
+                if friction_work.is_some() {
+                    "energy balance (energy lost minus the work of friction)"
+                } else {
+                    "total energy drift"
+                },
                 states.len(),
                 info.name
             ),

@@ -11,6 +11,7 @@
 //! [`Work`](crate::results::Work) passed down by the caller.
 
 pub mod checks;
+pub mod friction;
 pub mod lean;
 pub mod ode;
 pub mod phases;
@@ -162,6 +163,38 @@ pub enum SolveError {
         duration: f64,
         /// Why.
         reason: &'static str,
+    },
+    /// A friction model was solved with the wrong number of contact modes.
+    #[error("model `{model}` has {expected} friction contact(s), given {got} mode(s)")]
+    FrictionModes {
+        /// Model name.
+        model: &'static str,
+        /// Frictions of the model.
+        expected: usize,
+        /// Modes given.
+        got: usize,
+    },
+    /// No single consistent way for the friction contacts to move (stick or slide).
+    #[error("model `{model}` at t = {t:e} s: {why}")]
+    FrictionIndeterminate {
+        /// Model name.
+        model: &'static str,
+        /// Time in the phase.
+        t: f64,
+        /// What was found.
+        why: String,
+    },
+    /// The friction contacts switched between sticking and sliding too often (chatter).
+    #[error(
+        "model `{model}`: the friction contacts switched {switches} times by t = {t:e} s; stopped (the switches accumulate)"
+    )]
+    TooManySwitches {
+        /// Model name.
+        model: &'static str,
+        /// Switches made.
+        switches: usize,
+        /// Time reached.
+        t: f64,
     },
     /// The mass matrix could not be solved.
     #[error("singular mass matrix at t = {t:e} s, q = {q:?}")]

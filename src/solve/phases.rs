@@ -206,7 +206,14 @@ impl<'m> PhaseRun<'m> {
         let time = fall_time_scale(&bound);
         let scales = motion_scales(&bound, time)?;
         let run = unreduced::integrate(&bound, rtol, Some(&scales), time * MAX_FALL_TIMES, work)?;
-        work.phases.push(bound.name().to_string());
+        if bound.info().frictions.is_empty() {
+            work.phases.push(bound.name().to_string());
+        } else {
+            // One entry per stretch of constant contact modes: `rod_cube_friction (foot_friction sticks)`.
+            for (_, modes) in run.switches(&bound) {
+                work.phases.push(format!("{} ({modes})", bound.name()));
+            }
+        }
         Ok(PhaseRun::Integrated(IntegratedRun {
             bound,
             t_start,
@@ -296,11 +303,11 @@ fn fall_time_scale(bound: &Bound) -> f64 {
 
 /// Typical sizes of the motion's deviation from the release state over the time scale `time`,
 /// for the integrator's absolute tolerances: `|qd0| T + |qdd0| T^2 / 2` for the coordinates and
-/// `|qd0| + |qdd0| T` for the velocities, each at least `1e-8` of the largest of its kind, so
+/// `|qd0| + |qdd0| T` for the velocities, each at least `1e-5` of the largest of its kind, so
 /// that a tiny system (a rod of 1 cm nearly flat) is held to its own scale, not to one metre.
 fn motion_scales(bound: &Bound, time: f64) -> Result<Vec<f64>, SolveError> {
     let start = bound.initial_state();
-    let qdd = unreduced::accelerations(bound, &start, 0.0)?;
+    let qdd = unreduced::start_dynamics(bound)?.qdd;
     let q: Vec<f64> = (start.qd.iter().zip(&qdd))
         .map(|(v, a)| v.abs() * time + 0.5 * a.abs() * time * time)
         .collect();
@@ -310,7 +317,7 @@ fn motion_scales(bound: &Bound, time: f64) -> Result<Vec<f64>, SolveError> {
     let floor = |x: Vec<f64>| {
         let top = x.iter().cloned().fold(0.0, f64::max);
         x.into_iter()
-            .map(|s| s.max(1e-8 * top).max(f64::MIN_POSITIVE))
+            .map(|s| s.max(1e-5 * top).max(f64::MIN_POSITIVE))
             .collect::<Vec<f64>>()
     };
     let mut scales = floor(q);

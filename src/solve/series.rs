@@ -12,7 +12,6 @@ use crate::results::Work;
 use crate::solve::SolveError;
 use crate::solve::phases::{IntegratedRun, PhaseRun};
 use crate::solve::quadrature::{TimeMesh, integrand};
-use crate::solve::unreduced::accelerations;
 use crate::system::{State, System};
 
 /// Samples of one phase, uniform in time from its start to its end (both included).
@@ -148,10 +147,10 @@ pub fn sample_integrated(run: &IntegratedRun, samples: usize) -> Result<PhaseSam
             })?;
             State {
                 q: y[..n].to_vec(),
-                qd: y[n..].to_vec(),
+                qd: y[n..2 * n].to_vec(),
             }
         };
-        let qdd = accelerations(bound, &state, t)?;
+        let qdd = run.run.dynamics_at(bound, &state, t)?.qdd;
         out.t.push(t);
         out.theta.push(state.q[r]);
         out.theta_dot.push(state.qd[r]);
@@ -170,10 +169,7 @@ pub fn sample_forces(run: &PhaseRun, s: &PhaseSamples) -> Result<Vec<Vec<f64>>, 
             .states
             .iter()
             .zip(&s.t)
-            .map(|(state, &t)| {
-                let qdd = accelerations(&r.bound, state, t)?;
-                Ok(r.bound.forces_full(state, &qdd))
-            })
+            .map(|(state, &t)| Ok(r.run.dynamics_at(&r.bound, state, t)?.forces))
             .collect(),
     }
 }

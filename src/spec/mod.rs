@@ -165,6 +165,37 @@ pub struct ContactSpec {
     pub edge: Option<Text>,
 }
 
+/// Coulomb friction at a point where a body touches another body or the floor.
+///
+/// The friction force `f` acts on `body` at `point` along the unit tangent `direction` (and
+/// `-f` on `against`, when it is a body). Its slip velocity is
+/// `v = direction . (v_body(point) - v_against(point))`, the velocity of the body's material point
+/// there relative to the other surface's, and its generalized force is `f dv/dqd`. While the
+/// contact slides, `f = -mu N sign(v)`; while it sticks, `v` stays zero and `f` is whatever keeps
+/// it so, as long as `|f| <= mu N`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrictionSpec {
+    /// Identifier (a result key for the friction force, in newtons).
+    pub name: String,
+    /// What it is, with its sign convention.
+    pub meaning: String,
+    /// The friction coefficient: a parameter (declared `positive: false` if it may be zero; a
+    /// negative value is refused when the model is bound).
+    pub coefficient: String,
+    /// The normal force the friction is proportional to: one of `forces`, or the contact force.
+    pub normal: String,
+    /// The body the friction acts on.
+    pub body: String,
+    /// The other body at the contact (it feels `-f`); absent for the fixed floor or a wall.
+    #[serde(default)]
+    pub against: Option<String>,
+    /// The contact point `[x, y]` (expressions of the coordinates).
+    pub point: [Text; 2],
+    /// Unit tangent: the positive sense of the friction force on `body` and of the slip.
+    pub direction: [Text; 2],
+}
+
 /// A physical assumption: `expr` must stay `>= 0` during the motion.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -225,6 +256,9 @@ pub struct Spec {
     /// The separating contact, if any.
     #[serde(default)]
     pub contact: Option<ContactSpec>,
+    /// Coulomb friction at contacts.
+    #[serde(default)]
+    pub friction: Vec<FrictionSpec>,
     /// Monitored assumptions.
     #[serde(default)]
     pub monitors: Vec<MonitorSpec>,
@@ -438,6 +472,16 @@ impl Checker<'_> {
         for (i, p) in s.potentials.iter().enumerate() {
             self.identifier(&named("potentials", i), &p.name, &mut potential_names)?;
         }
+        let mut friction_names = force_names.clone();
+        for (i, f) in s.friction.iter().enumerate() {
+            self.identifier(&named("friction", i), &f.name, &mut friction_names)?;
+            if seen.contains(&f.name) {
+                return Err(self.err(
+                    &named("friction", i),
+                    format!("`{}` is already a parameter or coordinate", f.name),
+                ));
+            }
+        }
         let mut monitor_names = BTreeSet::new();
         for (i, m) in s.monitors.iter().enumerate() {
             self.identifier(&named("monitors", i), &m.name, &mut monitor_names)?;
@@ -561,6 +605,7 @@ impl Checker<'_> {
                 self.expr(&field.k("edge"), edge, &kinematic)?;
             }
         }
+        self.check_friction(&params, &bodies, &force_names, &kinematic)?;
         let mut monitor_scope = kinematic.clone();
         monitor_scope.extend(force_names.iter().cloned());
         for (i, m) in s.monitors.iter().enumerate() {
@@ -603,6 +648,76 @@ impl Checker<'_> {
                 &Field::key("initial").k(extra),
                 format!("`{extra}` is not a coordinate"),
             ));
+        }
+        Ok(())
+    }
+
+    /// Each friction names a parameter as its coefficient, a force or the contact force as its
+    /// normal force, bodies that exist (two different ones), a point and a unit tangent.
+    fn check_friction(
+        &self,
+        params: &BTreeSet<String>,
+        bodies: &BTreeSet<String>,
+        force_names: &BTreeSet<String>,
+        kinematic: &BTreeSet<String>,
+    ) -> Result<(), SpecError> {
+        for (i, f) in self.spec.friction.iter().enumerate() {
+            let field = Field::key("friction").i(i);
+            if !params.contains(&f.coefficient) {
+                return Err(self.err(
+                    &field.k("coefficient"),
+                    format!(
+                        "`{}` is not a parameter: a friction coefficient is a parameter of the \
+                         model (declared `positive: false` if it may be zero)",
+                        f.coefficient
+                    ),
+                ));
+            }
+            if !force_names.contains(&f.normal) {
+                let known: Vec<&str> = force_names.iter().map(String::as_str).collect();
+                return Err(self.err(
+                    &field.k("normal"),
+                    format!(
+                        "`{}` is not a normal force of the model; friction is proportional to \
+                         one of its forces or its contact force ({})",
+                        f.normal,
+                        if known.is_empty() {
+                            "it has none".to_string()
+                        } else {
+                            known.join(", ")
+                        }
+                    ),
+                ));
+            }
+            if !bodies.contains(&f.body) {
+                return Err(self.err(
+                    &field.k("body"),
+                    format!("`{}` is not one of the bodies", f.body),
+                ));
+            }
+            if let Some(other) = &f.against {
+                if !bodies.contains(other) {
+                    return Err(self.err(
+                        &field.k("against"),
+                        format!("`{other}` is not one of the bodies"),
+                    ));
+                }
+                if *other == f.body {
+                    return Err(self.err(
+                        &field.k("against"),
+                        format!("a body cannot rub against itself (`{other}`)"),
+                    ));
+                }
+            }
+            let p = field.k("point");
+            self.expr(&p.i(0), &f.point[0], kinematic)?;
+            self.expr(&p.i(1), &f.point[1], kinematic)?;
+            let d = field.k("direction");
+            self.expr(&d.i(0), &f.direction[0], kinematic)?;
+            self.expr(&d.i(1), &f.direction[1], kinematic)?;
+            if let (Text::Num(x), Text::Num(y)) = (&f.direction[0], &f.direction[1]) {
+                self.unit(&d, [*x, *y])?;
+            }
         }
         Ok(())
     }

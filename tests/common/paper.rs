@@ -115,6 +115,7 @@ static RC_INFO: ModelInfo = ModelInfo {
         eliminated: "x2",
         edge: false,
     }),
+    frictions: &[],
     points: &[
         named("foot", "rod end on the floor"),
         named("tip", "rod end on the cube"),
@@ -231,13 +232,26 @@ impl Model for RodCube {
         rhs[1] = -m2 * ell * ell * s * c * w * w - m1 * g * ell * c / 2.0;
     }
 
-    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+    fn forces_full(
+        &self,
+        k: &[f64],
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        _fr: &[f64],
+        out: &mut [f64],
+    ) {
         let (m1, m2, ell, g) = (k[0], k[1], k[2], k[4]);
         let (s, c) = (q[1].sin(), q[1].cos());
         let (w, x1dd, wd) = (qd[1], qdd[0], qdd[1]);
         // F = m2 x2'', x2 = x1 + ell cos(theta)
         out[0] = m2 * (x1dd - ell * s * wd - ell * c * w * w);
         out[1] = m1 * (g + 0.5 * ell * (c * wd - s * w * w));
+    }
+
+    fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        // Frictionless: no rows.
+        let _ = (k, q, qd, jac, bias);
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], f: &[f64], out: &mut [f64]) {
@@ -372,6 +386,7 @@ static FR_INFO: ModelInfo = ModelInfo {
         "floor reaction on the rod's foot (N)",
     )],
     contact: None,
+    frictions: &[],
     points: &[
         named("foot", "rod end on the floor"),
         named("tip", "free rod end"),
@@ -467,10 +482,23 @@ impl Model for FreeRod {
         rhs[2] = 0.0;
     }
 
-    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+    fn forces_full(
+        &self,
+        k: &[f64],
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        _fr: &[f64],
+        out: &mut [f64],
+    ) {
         let (m1, ell, g) = (k[0], k[2], k[4]);
         let (s, c) = (q[1].sin(), q[1].cos());
         out[0] = m1 * (g + 0.5 * ell * (c * qdd[1] - s * qd[1] * qd[1]));
+    }
+
+    fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        // Frictionless: no rows.
+        let _ = (k, q, qd, jac, bias);
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], f: &[f64], out: &mut [f64]) {

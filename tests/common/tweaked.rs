@@ -74,14 +74,26 @@ impl Model for Tweaked {
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
         self.base.equations(k, q, qd, mass, rhs)
     }
-    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        self.base.forces_full(k, q, qd, qdd, out);
+    fn forces_full(
+        &self,
+        k: &[f64],
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        fr: &[f64],
+        out: &mut [f64],
+    ) {
+        self.base.forces_full(k, q, qd, qdd, fr, out);
         if self.nan_force
             && let Some(last) = out.last_mut()
         {
             *last = f64::NAN;
         }
     }
+    fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        self.base.friction(k, q, qd, jac, bias);
+    }
+
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], f: &[f64], out: &mut [f64]) {
         self.base.monitors_full(k, q, qd, f, out);
         for v in out.iter_mut() {
