@@ -676,6 +676,7 @@ impl<'m> Plan<'m> {
     fn contact_end(&mut self, out: &mut RunResults) -> Result<(), SolveError> {
         let first = self.first()?;
         let end = first.end();
+        friction_report(first, "contact_end", "over the contact phase", out);
         if end == End::Floor {
             out.notes.insert("contact_end".into(), NO_SEPARATION.into());
             return Ok(());
@@ -710,7 +711,19 @@ impl<'m> Plan<'m> {
     }
 
     fn floor_impact(&mut self, out: &mut RunResults) -> Result<(), SolveError> {
+        let with_friction = !self.bound.info().frictions.is_empty();
         let motion = self.complete()?;
+        if with_friction {
+            let work: f64 = motion.phases.iter().map(PhaseRun::friction_work).sum();
+            scalar(
+                out,
+                "floor_impact_friction_work",
+                work,
+                "J",
+                "work done by friction from release until the rod lies on the floor (energy lost)"
+                    .into(),
+            );
+        }
         let names: Vec<&str> = motion.phases.iter().map(|p| p.bound().name()).collect();
         let path = names.join(" -> ");
         match motion.last_end() {
@@ -904,4 +917,34 @@ impl<'m> Plan<'m> {
         }
         Ok(())
     }
+}
+
+/// For a phase with friction: the work friction did over it (`<key>_friction_work`, J) and
+/// the sequence of contact modes with the time each began (`<key>_contact_modes`).
+fn friction_report(run: &PhaseRun, key: &str, until: &str, out: &mut RunResults) {
+    let modes = run.contact_modes();
+    if modes.is_empty() {
+        return;
+    }
+    scalar(
+        out,
+        &format!("{key}_friction_work"),
+        run.friction_work(),
+        "J",
+        format!("work done by friction {until} (energy lost)"),
+    );
+    let sequence = modes
+        .iter()
+        .map(|(t, m)| format!("{m} from t = {t:.15e} s"))
+        .collect::<Vec<_>>()
+        .join("; ");
+    out.labels.insert(
+        format!("{key}_contact_modes"),
+        Label {
+            value: sequence,
+            meaning: format!(
+                "how each friction contact moves {until}: sticks, or slides + / - along its direction, each from the time the mode began (switches located as events)"
+            ),
+        },
+    );
 }

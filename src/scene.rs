@@ -95,6 +95,8 @@ pub enum Kind {
     UnknownParameter,
     /// A parameter that must be strictly positive and is not.
     NotPositive,
+    /// A friction coefficient below zero.
+    NegativeFriction,
     /// NaN or an infinity (`.nan`, `.inf`).
     NotFinite,
     /// `tolerance` or `samples` outside its range, or an empty `want`.
@@ -118,6 +120,7 @@ impl Kind {
             Kind::MissingParameter => "missing-parameter",
             Kind::UnknownParameter => "unknown-parameter",
             Kind::NotPositive => "not-positive",
+            Kind::NegativeFriction => "negative-friction",
             Kind::NotFinite => "not-finite",
             Kind::OutOfRange => "out-of-range",
             Kind::Requirement => "requirement",
@@ -665,6 +668,27 @@ impl Ctx<'_> {
                     &field,
                     At::Value,
                     format!("`{}` must be a finite number, not {}", p.name, show(v)),
+                ));
+            } else if let Some(f) = (info.frictions.iter())
+                .find(|f| {
+                    info.parameters
+                        .get(f.coefficient)
+                        .is_some_and(|c| c.name == p.name)
+                })
+                .filter(|_| v < 0.0)
+            {
+                all_good = false;
+                out.push(self.diag(
+                    Kind::NegativeFriction,
+                    &field,
+                    At::Value,
+                    format!(
+                        "`{}` ({}) is the coefficient of friction `{}` and must not be negative, not {}",
+                        p.name,
+                        p.meaning,
+                        f.name,
+                        show(v)
+                    ),
                 ));
             } else if p.positive && v <= 0.0 {
                 all_good = false;

@@ -351,3 +351,99 @@ fn a_hand_written_next_phase_is_an_unknown_field() {
         &["unknown field `after_separation`"],
     );
 }
+
+/// BASE with a measured floor force and Coulomb friction at the foot, `friction` as given.
+fn with_friction(friction: &str) -> String {
+    edit(
+        "falling_point: centre\n",
+        &format!(
+            "falling_point: centre\nforces:\n  - {{name: floor_normal, body: rod, direction: [0, 1], meaning: floor push}}\nfriction:\n{friction}"
+        ),
+    )
+    .replace(
+        "  - {name: g, meaning: gravity, unit: m/s^2}\n",
+        "  - {name: g, meaning: gravity, unit: m/s^2}\n  - {name: mu, meaning: friction coefficient, unit: \"1\", positive: false}\n",
+    )
+}
+
+#[test]
+fn a_friction_with_a_well_formed_spec_is_accepted() {
+    let text = with_friction(
+        "  - {name: foot_friction, meaning: floor friction, coefficient: mu, normal: floor_normal, body: rod, point: [x1, 0], direction: [1, 0]}\n",
+    );
+    let (root, _) = write("friction_ok", &text);
+    let (rendered, _) = render_all(&root, &[]).unwrap_or_else(|e| panic!("refused: {e}"));
+    assert!(
+        rendered
+            .iter()
+            .any(|r| r.path.extension().is_some_and(|e| e == "rs")
+                && r.text.contains("FrictionInfo")
+                && r.text.contains("\"foot_friction\"")),
+        "no generated model carries the friction"
+    );
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+#[test]
+fn a_friction_that_names_no_normal_force_is_refused() {
+    let text = with_friction(
+        "  - {name: foot_friction, meaning: floor friction, coefficient: mu, normal: floor_push, body: rod, point: [x1, 0], direction: [1, 0]}\n",
+    );
+    let (path, err) = error_of("friction_no_normal", &text);
+    let (line, _) = place(&text, "name: foot_friction", "foot_friction");
+    check(
+        &path,
+        &err,
+        (line, None),
+        "friction[0].normal",
+        &["`floor_push` is not a normal force", "floor_normal"],
+    );
+}
+
+#[test]
+fn a_friction_coefficient_that_is_not_a_parameter_is_refused() {
+    let text = with_friction(
+        "  - {name: foot_friction, meaning: floor friction, coefficient: 0.3, normal: floor_normal, body: rod, point: [x1, 0], direction: [1, 0]}\n",
+    );
+    let (path, err) = error_of("friction_number", &text);
+    let (line, _) = place(&text, "name: foot_friction", "foot_friction");
+    check(
+        &path,
+        &err,
+        (line, None),
+        "friction[0].coefficient",
+        &["is not a parameter"],
+    );
+}
+
+#[test]
+fn a_friction_direction_that_is_not_a_unit_vector_is_refused() {
+    let text = with_friction(
+        "  - {name: foot_friction, meaning: floor friction, coefficient: mu, normal: floor_normal, body: rod, point: [x1, 0], direction: [2, 0]}\n",
+    );
+    let (path, err) = error_of("friction_direction", &text);
+    let (line, _) = place(&text, "name: foot_friction", "foot_friction");
+    check(
+        &path,
+        &err,
+        (line, None),
+        "friction[0].direction",
+        &["not a unit vector"],
+    );
+}
+
+#[test]
+fn a_body_rubbing_against_itself_is_refused() {
+    let text = with_friction(
+        "  - {name: foot_friction, meaning: floor friction, coefficient: mu, normal: floor_normal, body: rod, against: rod, point: [x1, 0], direction: [1, 0]}\n",
+    );
+    let (path, err) = error_of("friction_itself", &text);
+    let (line, _) = place(&text, "name: foot_friction", "foot_friction");
+    check(
+        &path,
+        &err,
+        (line, None),
+        "friction[0].against",
+        &["cannot rub against itself"],
+    );
+}

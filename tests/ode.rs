@@ -34,7 +34,10 @@ fn separation_time_agrees_with_quadrature_and_converges() {
         let rel = ((run.t_end - t_quad) / t_quad).abs();
         println!(
             "rtol {rtol:.0e}: t_ode = {:.15} s, rel diff {rel:.2e}, {} accepted + {} rejected steps, {} event trials",
-            run.t_end, run.segments[0].solution.accepted, run.segments[0].solution.rejected, run.segments[0].solution.event_trials
+            run.t_end,
+            run.segments[0].solution.accepted,
+            run.segments[0].solution.rejected,
+            run.segments[0].solution.event_trials
         );
         assert_eq!(work.ode_steps, run.steps());
         if rtol <= 1e-10 {

@@ -27,6 +27,9 @@ fn parameters(model: &dyn Model, u: &[f64], spread: u8) -> Vec<f64> {
             "g" => log(u[i], -1.0, 2.0),
             "theta_0" => lin(u[i], 0.01, 1.56),
             "theta_dot_0" => -lin(u[i], 0.0, 3.0),
+            // Friction from none to below Painlevé's 4/3 for a free rod sliding on its foot
+            // (above it the sliding equations can turn singular: tests/friction.rs).
+            "mu" => lin(u[i], 0.0, 1.3),
             _ if q.positive => log(u[i], -1.0, 1.0),
             _ => lin(u[i], -1.0, 1.0),
         };
@@ -48,6 +51,29 @@ fn parameters(model: &dyn Model, u: &[f64], spread: u8) -> Vec<f64> {
     // the energy check then reports (rightly) as failed.
     if let (Some(k), Some(m2), Some(ell), Some(g)) = (idx("k"), idx("m2"), idx("ell"), idx("g")) {
         p[k] = p[m2] * p[g] / p[ell] * log(u[k], -2.0, 2.0);
+    }
+    // With friction the floor must push the foot: a rod spinning fast enough to lift its foot
+    // (ell theta_dot^2 / 2 > g) has no consistent contact mode, a typed error by design.
+    if let (false, Some(w), Some(ell), Some(g)) = (
+        info.frictions.is_empty(),
+        idx("theta_dot_0"),
+        idx("ell"),
+        idx("g"),
+    ) {
+        p[w] = -lin(u[w], 0.0, 0.5) * (p[g] / p[ell]).sqrt();
+    }
+    // A free phase starts at the motion's own speed scale sqrt(g ell) (a foot thrown far
+    // faster can, with friction, tip the rod over backwards past upright, where no event
+    // waits)
+    if let (Some(ell), Some(g)) = (idx("ell"), idx("g")) {
+        for v in ["x1_dot_0", "x2_dot_0"].into_iter().filter_map(idx) {
+            p[v] = lin(u[v], -0.5, 0.5) * (p[g] * p[ell]).sqrt();
+        }
+        // and at the rod's own size: a cube a hundred rod lengths away on a stiff spring
+        // stores a hundred thousand times the rod's energy.
+        for x in ["x1_0", "x2_0"].into_iter().filter_map(idx) {
+            p[x] = lin(u[x], -1.0, 1.0) * p[ell];
+        }
     }
     // A rod on a cylinder: the tangent point R cot(th0/2) must lie on the rod, th0 < pi/2.
     if let (Some(ell), Some(r), Some(th0)) = (idx("ell"), idx("R"), idx("th0")) {

@@ -692,7 +692,9 @@ struct SlipKinematics {
 fn active_frictions(spec: &Spec, phase: Phase) -> Vec<usize> {
     let contact_force = spec.contact.as_ref().map(|c| c.force.as_str());
     (0..spec.friction.len())
-        .filter(|&i| phase != Phase::Free || Some(spec.friction[i].normal.as_str()) != contact_force)
+        .filter(|&i| {
+            phase != Phase::Free || Some(spec.friction[i].normal.as_str()) != contact_force
+        })
         .collect()
 }
 
@@ -1196,10 +1198,19 @@ fn phase_frictions(
     for sk in slips {
         let f = &spec.friction[sk.spec];
         let path = |k: &str| [key("friction"), FieldStep::Index(sk.spec), key(k)];
-        let coefficient = (params.iter().position(|p| p.name == f.coefficient))
-            .ok_or_else(|| at(&path("coefficient"), format!("`{}` is not a parameter", f.coefficient)))?;
-        let normal = (forces.iter().position(|n| n.name == f.normal))
-            .ok_or_else(|| at(&path("normal"), format!("`{}` is not a force of this phase", f.normal)))?;
+        let coefficient =
+            (params.iter().position(|p| p.name == f.coefficient)).ok_or_else(|| {
+                at(
+                    &path("coefficient"),
+                    format!("`{}` is not a parameter", f.coefficient),
+                )
+            })?;
+        let normal = (forces.iter().position(|n| n.name == f.normal)).ok_or_else(|| {
+            at(
+                &path("normal"),
+                format!("`{}` is not a force of this phase", f.normal),
+            )
+        })?;
         out.push(Friction {
             named: Named {
                 name: f.name.clone(),

@@ -12,9 +12,14 @@
 //! - sticking: `J qdd + bias = 0` (the slip velocity stays zero).
 //!
 //! A contact at rest sticks when the force that keeps it stuck is within `mu N`, and otherwise
-//! slides the way its slip then accelerates. Exactly one of these is consistent for an ordinary
-//! contact; none, or more than one (Painlevé's paradoxes, a normal force pulling), is
-//! [`SolveError::FrictionIndeterminate`], never a guess.
+//! slides the way its slip then accelerates; a stuck contact whose friction reaches `mu N`
+//! breaks loose against the friction that held it. Exactly one of these is consistent for an
+//! ordinary contact. With a large `mu` a sliding start can also be consistent beside sticking
+//! (Painlevé's indeterminacy, the normal force vanishing): a contact at rest that can stick
+//! then sticks, the rule of the rigid-body literature (a body at rest stays at rest while
+//! friction can hold it). No consistent mode (a normal force that would have to pull), or
+//! several with as many stuck contacts, is [`SolveError::FrictionIndeterminate`], never a
+//! guess.
 
 use crate::solve::SolveError;
 use crate::system::{Bound, State};
@@ -25,6 +30,12 @@ pub const MAX_COMBINATIONS: usize = 729;
 
 /// A contact at rest is one whose slip speed is below this fraction of the speeds it is made of.
 pub const REST: f64 = 1e-9;
+
+/// Where sliding is given up as Painlevé's singularity: the sliding system's determinant over
+/// the mass matrix's ([`Dynamics::painleve`], 1 without friction) has fallen to this, so the
+/// normal force answers the accelerations a thousand times more weakly than without friction
+/// and vanishes altogether a little further on.
+pub const PAINLEVE_FLOOR: f64 = 1e-3;
 
 /// How a friction contact moves.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -60,6 +71,9 @@ pub struct Dynamics {
     pub slip: Vec<f64>,
     /// Slip accelerations `J qdd + bias`.
     pub slip_acc: Vec<f64>,
+    /// `det(A) / det(M)` of the system solved (`A` with the friction rows): 1 without sliding
+    /// friction, zero at Painlevé's singularity, where sliding has no solution.
+    pub painleve: f64,
 }
 
 impl Dynamics {
@@ -107,10 +121,16 @@ pub fn dynamics(
         t,
         q: state.q.clone(),
     };
-    let x = a.lu().solve(&b).ok_or_else(singular)?;
+    let lu = a.lu();
+    let x = lu.solve(&b).ok_or_else(singular)?;
     if !x.iter().all(|v| v.is_finite()) {
         return Err(singular());
     }
+    let painleve = if modes.iter().any(|m| matches!(m, Mode::Slide(_))) {
+        lu.determinant() / DMatrix::from_row_slice(n, n, &mass).determinant()
+    } else {
+        1.0
+    };
     let qdd: Vec<f64> = x.iter().take(n).copied().collect();
     let fr: Vec<f64> = x.iter().skip(n).copied().collect();
     let forces = sys.forces_full(state, &qdd, &fr);
@@ -123,7 +143,24 @@ pub fn dynamics(
         forces,
         slip,
         slip_acc,
+        painleve,
     })
+}
+
+/// The error for sliding that has reached Painlevé's singularity ([`PAINLEVE_FLOOR`]).
+pub fn painleve_error(sys: &Bound, state: &State, modes: &[Mode], t: f64) -> SolveError {
+    SolveError::FrictionIndeterminate {
+        model: sys.info().name,
+        t,
+        why: format!(
+            "with {} the sliding equations approach a singularity at q = {:?} (their determinant \
+             fell to {PAINLEVE_FLOOR:e} of the frictionless one): the normal force stops \
+             resisting the sliding (Painlevé's paradox), and rigid bodies with Coulomb friction \
+             have no answer from here",
+            describe(sys.info(), modes),
+            state.q
+        ),
+    }
 }
 
 /// Fills the friction rows `n..n+m` of the system: the sliding law or the sticking constraint.
@@ -183,8 +220,9 @@ pub enum Options {
     AtRest,
     /// Its slip stopped while sliding with this sign: it sticks or slides back.
     Stopped(f64),
-    /// Its stuck friction reached `mu N`: it slides one way or the other.
-    Breaks,
+    /// Its stuck friction reached `mu N`: it slides with this sign, against the friction that
+    /// held it.
+    Breaks(f64),
 }
 
 impl Options {
@@ -193,21 +231,24 @@ impl Options {
             Options::Keep(m) => vec![m],
             Options::AtRest => vec![Mode::Stick, Mode::Slide(1.0), Mode::Slide(-1.0)],
             Options::Stopped(s) => vec![Mode::Stick, Mode::Slide(-s)],
-            Options::Breaks => vec![Mode::Slide(1.0), Mode::Slide(-1.0)],
+            Options::Breaks(s) => vec![Mode::Slide(s)],
         }
     }
 }
 
 /// The options of each contact at the start of a phase: at rest where its slip speed is below
-/// [`REST`] of the speeds it is made of, otherwise sliding the way it slips.
+/// [`REST`] of the state's speed scale (`sum_j |J_j|` times the largest `|qd_j|`: a contact
+/// that stuck in the phase before keeps only rounding noise), otherwise sliding the way it
+/// slips.
 pub fn start_options(sys: &Bound, state: &State) -> Vec<Options> {
     let n = sys.n_coordinates();
     let (jac, _) = sys.friction(state);
+    let fastest = state.qd.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     (0..sys.info().frictions.len())
         .map(|k| {
             let row = &jac[k * n..(k + 1) * n];
             let v: f64 = row.iter().zip(&state.qd).map(|(j, q)| j * q).sum();
-            let size: f64 = row.iter().zip(&state.qd).map(|(j, q)| (j * q).abs()).sum();
+            let size: f64 = fastest * row.iter().map(|j| j.abs()).sum::<f64>();
             if v == 0.0 || v.abs() <= REST * size {
                 Options::AtRest
             } else {
@@ -217,15 +258,18 @@ pub fn start_options(sys: &Bound, state: &State) -> Vec<Options> {
         .collect()
 }
 
-/// Whether a mode is consistent for a contact that could switch: a stuck contact's force is
-/// within `mu N`, a contact that starts sliding accelerates its slip the way it slides.
+/// Whether a mode is consistent for a contact that could switch: its normal force pushes
+/// (without friction a pull changes nothing here: the monitors report it), a stuck contact's
+/// force is within `mu N`, a contact that starts sliding from rest accelerates its slip the way
+/// it slides (one that breaks loose starts with zero slip acceleration).
 fn consistent(opt: &Options, mode: Mode, d: &Dynamics, i: usize, mu: f64, normal: f64) -> bool {
-    if matches!(opt, Options::Keep(_)) {
-        return true;
-    }
-    match mode {
-        Mode::Stick => d.fr[i].abs() <= mu * normal,
-        Mode::Slide(s) => s * d.slip_acc[i] > 0.0,
+    let frictionless = mu == 0.0 && matches!(mode, Mode::Slide(_));
+    match (opt, mode) {
+        (Options::Keep(_), _) => true,
+        _ if !frictionless && (normal.is_nan() || normal < 0.0) => false,
+        (_, Mode::Stick) => d.fr[i].abs() <= mu * normal,
+        (Options::Breaks(_), Mode::Slide(_)) => true,
+        (_, Mode::Slide(s)) => s * d.slip_acc[i] > 0.0,
     }
 }
 
@@ -260,13 +304,18 @@ pub fn decide(
         let Ok(d) = dynamics(sys, state, &modes, t) else {
             continue;
         };
-        let ok = (info.frictions.iter().enumerate()).all(|(i, f)| {
-            consistent(&options[i], modes[i], &d, i, mu[i], d.forces[f.normal])
-        });
+        let ok = d.painleve > PAINLEVE_FLOOR
+            && (info.frictions.iter().enumerate())
+                .all(|(i, f)| consistent(&options[i], modes[i], &d, i, mu[i], d.forces[f.normal]));
         if ok {
             found.push(modes);
         }
     }
+    // Among consistent choices, contacts at rest that can stick do stick.
+    let stuck = |m: &Vec<Mode>| m.iter().filter(|m| **m == Mode::Stick).count();
+    let most = found.iter().map(stuck).max().unwrap_or(0);
+    let all = found.len();
+    found.retain(|m| stuck(m) == most);
     match found.len() {
         1 => Ok(found.remove(0)),
         0 => Err(SolveError::FrictionIndeterminate {
@@ -281,8 +330,9 @@ pub fn decide(
             model: info.name,
             t,
             why: format!(
-                "{} contact modes are consistent ({}): the motion is not determined by rigid \
-                 bodies with Coulomb friction (Painlevé's indeterminacy)",
+                "{} of {all} consistent contact modes stick as many contacts ({}): the motion \
+                 is not determined by rigid bodies with Coulomb friction (Painlevé's \
+                 indeterminacy)",
                 found.len(),
                 found
                     .iter()

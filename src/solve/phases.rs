@@ -15,6 +15,7 @@
 use crate::model::{Binding, Model};
 use crate::results::Work;
 use crate::solve::SolveError;
+use crate::solve::friction::{self, Mode};
 use crate::solve::quadrature::TimeMesh;
 use crate::solve::separation::{Separation, SeparationOutcome, edge, separation};
 use crate::solve::series::theta_dot_at;
@@ -25,8 +26,10 @@ use crate::system::{Bound, State, System};
 pub const MAX_PHASES: usize = 8;
 
 /// An integrated phase that has not reached an event after this many free-fall times of its
-/// falling point is reported as [`SolveError::NoEvent`].
-pub const MAX_FALL_TIMES: f64 = 1000.0;
+/// falling point is reported as [`SolveError::NoEvent`]. Generous: a light rod that pushes a
+/// cube a million times heavier from nearly upright (a stuck foot makes it the hinged rod)
+/// takes some ten thousand.
+pub const MAX_FALL_TIMES: f64 = 1e5;
 
 /// Which route solves a phase.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -283,6 +286,26 @@ impl<'m> PhaseRun<'m> {
         }
     }
 
+    /// Work done by friction over the phase (J, `<= 0`; zero without friction).
+    pub fn friction_work(&self) -> f64 {
+        match self {
+            PhaseRun::Reduced(_) => 0.0,
+            PhaseRun::Integrated(r) => r.run.friction_work,
+        }
+    }
+
+    /// The friction contacts' modes over the phase: each stretch's start (s from release) and
+    /// its modes (`foot_friction sticks`); empty without friction.
+    pub fn contact_modes(&self) -> Vec<(f64, String)> {
+        match self {
+            PhaseRun::Integrated(r) if !r.bound.info().frictions.is_empty() => (r.run)
+                .switches(&r.bound)
+                .map(|(t, modes)| (r.t_start + t, modes))
+                .collect(),
+            _ => Vec::new(),
+        }
+    }
+
     /// The phase on the fast path, if it is on it.
     pub fn reduced(&self) -> Option<&ReducedRun<'m>> {
         match self {
@@ -303,11 +326,22 @@ fn fall_time_scale(bound: &Bound) -> f64 {
 
 /// Typical sizes of the motion's deviation from the release state over the time scale `time`,
 /// for the integrator's absolute tolerances: `|qd0| T + |qdd0| T^2 / 2` for the coordinates and
-/// `|qd0| + |qdd0| T` for the velocities, each at least `1e-5` of the largest of its kind, so
+/// `|qd0| + |qdd0| T` for the velocities, each at least `1e-8` of the largest of its kind, so
 /// that a tiny system (a rod of 1 cm nearly flat) is held to its own scale, not to one metre.
 fn motion_scales(bound: &Bound, time: f64) -> Result<Vec<f64>, SolveError> {
     let start = bound.initial_state();
-    let qdd = unreduced::start_dynamics(bound)?.qdd;
+    let mut qdd = unreduced::start_dynamics(bound)?.qdd;
+    // A stuck contact's coordinate has no acceleration at the start but may slide later: its
+    // scale is the one it would have sliding (else rounding noise in the stuck phase sets the
+    // step size).
+    let m = bound.info().frictions.len();
+    if m > 0
+        && let Ok(sliding) = friction::dynamics(bound, &start, &vec![Mode::Slide(1.0); m], 0.0)
+    {
+        for (a, s) in qdd.iter_mut().zip(&sliding.qdd) {
+            *a = a.abs().max(s.abs());
+        }
+    }
     let q: Vec<f64> = (start.qd.iter().zip(&qdd))
         .map(|(v, a)| v.abs() * time + 0.5 * a.abs() * time * time)
         .collect();
@@ -317,7 +351,7 @@ fn motion_scales(bound: &Bound, time: f64) -> Result<Vec<f64>, SolveError> {
     let floor = |x: Vec<f64>| {
         let top = x.iter().cloned().fold(0.0, f64::max);
         x.into_iter()
-            .map(|s| s.max(1e-5 * top).max(f64::MIN_POSITIVE))
+            .map(|s| s.max(1e-8 * top).max(f64::MIN_POSITIVE))
             .collect::<Vec<f64>>()
     };
     let mut scales = floor(q);

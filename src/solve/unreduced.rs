@@ -89,6 +89,19 @@ pub fn start_dynamics(sys: &Bound) -> Result<Dynamics, SolveError> {
     friction::dynamics(sys, &start, &modes, 0.0)
 }
 
+/// The slip velocity each friction's event measures from at a segment's start: its own slip
+/// for a contact that may have switched there, zero for one that keeps its mode.
+fn slip_offsets(sys: &Bound, state: &State, options: &[Options]) -> Vec<f64> {
+    let n = sys.n_coordinates();
+    let (jac, _) = sys.friction(state);
+    (options.iter().enumerate())
+        .map(|(k, o)| match o {
+            Options::Keep(_) => 0.0,
+            _ => (0..n).map(|j| jac[k * n + j] * state.qd[j]).sum(),
+        })
+        .collect()
+}
+
 /// How the unreduced integration ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum EndEvent {
@@ -141,12 +154,14 @@ pub struct UnreducedRun {
 }
 
 impl UnreducedRun {
-    /// The segment that covers time `t` (the later one at a switch).
+    /// The segment that covers time `t` (the later one at a switch; a few ulps past the end
+    /// count as the end, as a sample time `duration * j / (n - 1)` may round there).
     pub fn segment_at(&self, t: f64) -> Option<&Segment> {
+        let slack = 4.0 * f64::EPSILON * self.t_end.abs();
         self.segments
             .iter()
             .rev()
-            .find(|s| s.t_start <= t && t <= s.solution.t_final())
+            .find(|s| s.t_start <= t && t <= s.solution.t_final() + slack)
     }
 
     /// `y = [q, qd]` (and `W` with friction) at time `t` from dense output, if `t` lies in the
@@ -205,8 +220,7 @@ impl UnreducedRun {
 
     /// When each segment started, with its contact modes described.
     pub fn switches<'a>(&'a self, sys: &'a Bound) -> impl Iterator<Item = (f64, String)> + 'a {
-        (self.segments.iter())
-            .map(move |s| (s.t_start, friction::describe(sys.info(), &s.modes)))
+        (self.segments.iter()).map(move |s| (s.t_start, friction::describe(sys.info(), &s.modes)))
     }
 
     /// Every step taken (accepted, rejected and event trials).
@@ -219,6 +233,10 @@ struct Problem<'a, 'm> {
     sys: &'a Bound<'m>,
     n: usize,
     modes: Vec<Mode>,
+    /// Per friction, the slip velocity its event measures from: the rounding-level slip at the
+    /// start of a contact that just switched (so that it does not count as a crossing), zero
+    /// for one that keeps sliding.
+    slip_offset: Vec<f64>,
     contact: Option<usize>,
     edge: bool,
     reduced: usize,
@@ -268,11 +286,13 @@ impl OdeProblem for Problem<'_, '_> {
     }
 
     fn n_events(&self) -> usize {
-        self.n_end_events() + self.frictions()
+        let m = self.frictions();
+        self.n_end_events() + m + usize::from(m > 0)
     }
 
     /// Events in order: the contact force, the edge margin, the floor, then per friction its
-    /// slip velocity (sliding) or its margin `mu N - |f|` (stuck).
+    /// slip velocity (sliding) or its margin `mu N - |f|` (stuck), and last the sliding
+    /// system's distance from Painlevé's singularity.
     fn events(&mut self, t: f64, z: &[f64], dz: &[f64], g: &mut [f64]) -> Result<(), SolveError> {
         self.load(z);
         let d = if self.frictions() > 0 {
@@ -298,10 +318,11 @@ impl OdeProblem for Problem<'_, '_> {
             let mu = self.sys.friction_coefficients();
             for (k, (mode, f)) in self.modes.iter().zip(info.frictions).enumerate() {
                 g[i + 1 + k] = match mode {
-                    Mode::Slide(_) => d.slip[k],
+                    Mode::Slide(_) => d.slip[k] - self.slip_offset[k],
                     Mode::Stick => mu[k] * d.forces[f.normal] - d.fr[k].abs(),
                 };
             }
+            g[i + 1 + self.modes.len()] = d.painleve - friction::PAINLEVE_FLOOR;
         }
         Ok(())
     }
@@ -338,11 +359,14 @@ pub fn integrate(
     if m > 0 {
         y0.push(0.0);
     }
-    let modes = friction::decide(sys, &start, &friction::start_options(sys, &start), 0.0)?;
+    let options = friction::start_options(sys, &start);
+    let modes = friction::decide(sys, &start, &options, 0.0)?;
+    let slip_offset = slip_offsets(sys, &start, &options);
     let mut problem = Problem {
         sys,
         n,
         modes,
+        slip_offset,
         contact: info.contact.map(|c| c.force),
         edge: info.contact.is_some_and(|c| c.edge),
         reduced: info.reduced,
@@ -377,7 +401,9 @@ pub fn integrate(
         let Some(event) = solution.event.clone() else {
             return Err(SolveError::NoEvent { t_max });
         };
-        let y = (event.y.iter().zip(&y0)).map(|(z, y0)| y0 + z).collect::<Vec<f64>>();
+        let y = (event.y.iter().zip(&y0))
+            .map(|(z, y0)| y0 + z)
+            .collect::<Vec<f64>>();
         segments.push(Segment {
             t_start: t0,
             modes: problem.modes.clone(),
@@ -416,14 +442,25 @@ pub fn integrate(
             });
         }
         let k = event.index - n_end;
+        if k == m {
+            return Err(friction::painleve_error(
+                sys,
+                &state,
+                &problem.modes,
+                event.t,
+            ));
+        }
+        // A stuck contact breaks loose against the friction that held it.
+        let held = friction::dynamics(sys, &state, &problem.modes, event.t)?;
         let options: Vec<Options> = (problem.modes.iter().enumerate())
             .map(|(i, &mode)| match (i == k, mode) {
                 (false, mode) => Options::Keep(mode),
                 (true, Mode::Slide(s)) => Options::Stopped(s),
-                (true, Mode::Stick) => Options::Breaks,
+                (true, Mode::Stick) => Options::Breaks(-held.fr[i].signum()),
             })
             .collect();
         problem.modes = friction::decide(sys, &state, &options, event.t)?;
+        problem.slip_offset = slip_offsets(sys, &state, &options);
         problem.state = state;
         y0 = y;
         problem.y0 = y0.clone();

@@ -1,0 +1,303 @@
+//! Coulomb friction between the rod's foot and the floor (`rod_cube_friction`), checked against
+//! independent references: mu = 0 is the paper's frictionless case, a foot that never slips is
+//! the hinged rod (a different model, on the fast path), a hand Newton–Euler balance of each
+//! body agrees with the generated forces and the solved friction, energy lost equals the work of
+//! friction, stick/slip switches sit where their event functions vanish and do not move when the
+//! integrator is tightened, and a start with no single consistent mode is a typed error.
+
+use rodcube::model::Model;
+use rodcube::models::find;
+use rodcube::plan::{Request, run};
+use rodcube::quantity::Quantity;
+use rodcube::results::{RunResults, Work};
+use rodcube::solve::SolveError;
+use rodcube::solve::friction::{Mode, dynamics};
+use rodcube::solve::phases::{PhaseRun, Route};
+use rodcube::system::{Bound, State, SystemError};
+
+/// The paper's separation time (g = 9.81), exact to f64 (tests/hard_cases.rs).
+const PAPER_T_SEP: f64 = 0.108493254170856;
+
+fn model(name: &str) -> &'static dyn Model {
+    find(name).unwrap_or_else(|| panic!("{name} was not generated"))
+}
+
+fn paper(mu: f64) -> [(&'static str, f64); 6] {
+    [
+        ("m1", 1.0),
+        ("m2", 3.0),
+        ("ell", 1.0),
+        ("a", 0.25),
+        ("g", 9.81),
+        ("mu", mu),
+    ]
+}
+
+fn ask(name: &str, params: &[(&str, f64)], want: &[Quantity], tolerance: f64) -> RunResults {
+    let request = Request::new(model(name), params)
+        .with_want(want)
+        .with_tolerance(tolerance);
+    run(&request).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+fn value(r: &RunResults, key: &str) -> f64 {
+    r.results
+        .get(key)
+        .unwrap_or_else(|| panic!("no {key} in {:?} (notes {:?})", r.results, r.notes))
+        .value
+}
+
+const SEPARATION: &[Quantity] = &[
+    Quantity::SeparationAngle,
+    Quantity::SeparationTime,
+    Quantity::ContactEnd,
+];
+
+#[test]
+fn without_friction_the_foot_slides_as_in_the_paper() {
+    let r = ask("rod_cube_friction", &paper(0.0), SEPARATION, 1e-12);
+    let t = value(&r, "separation_time");
+    let rel = (t - PAPER_T_SEP).abs() / PAPER_T_SEP;
+    println!("mu = 0: t_sep = {t:.15e} s, {rel:.1e} from the paper");
+    assert!(rel < 1e-12, "{t} vs {PAPER_T_SEP}");
+    let frictionless = ask("rod_cube", &paper(0.0)[..5], SEPARATION, 1e-12);
+    let angle = value(&r, "separation_angle");
+    let want = value(&frictionless, "separation_angle");
+    assert!((angle - want).abs() < 1e-12 * want, "{angle} vs {want}");
+    assert_eq!(
+        r.work.phases,
+        ["rod_cube_friction (foot_friction slides -)"]
+    );
+    assert_eq!(value(&r, "contact_end_friction_work"), 0.0);
+}
+
+#[test]
+fn a_foot_that_never_slips_is_the_hinged_rod() {
+    let hinged = ask("hinged_rod", &paper(0.0)[..5], SEPARATION, 1e-12);
+    let (t_h, angle_h) = (
+        value(&hinged, "separation_time"),
+        value(&hinged, "separation_angle"),
+    );
+    for mu in [2.0, 10.0, 1e6] {
+        let r = ask("rod_cube_friction", &paper(mu), SEPARATION, 1e-12);
+        let (t, angle) = (value(&r, "separation_time"), value(&r, "separation_angle"));
+        println!(
+            "mu = {mu:e}: t_sep {t:.15e} (hinged {t_h:.15e}, {:.1e}), angle {:.1e} off",
+            (t - t_h).abs() / t_h,
+            (angle - angle_h).abs() / angle_h
+        );
+        assert!((t - t_h).abs() < 1e-12 * t_h, "mu {mu}: {t} vs {t_h}");
+        assert!((angle - angle_h).abs() < 1e-12 * angle_h, "mu {mu}");
+        assert_eq!(r.work.phases[0], "rod_cube_friction (foot_friction sticks)");
+        let label = &r.labels["contact_end_contact_modes"].value;
+        assert!(!label.contains("slides"), "{label}");
+    }
+}
+
+/// The solved accelerations and friction satisfy Newton's and Euler's laws for the rod and the
+/// cube, written by hand: the floor pushes the foot with (F, N), the cube pushes the tip with
+/// (-P, 0), and the cube alone feels P.
+#[test]
+fn the_forces_and_the_friction_balance_each_body_by_hand() {
+    let (m1, m2, ell, g) = (1.0, 3.0, 1.0, 9.81);
+    let inertia = m1 * ell * ell / 12.0;
+    let mut worst = 0.0f64;
+    for mu in [0.0, 0.4, 1.3] {
+        let bound = Bound::new(model("rod_cube_friction"), &paper(mu)).unwrap();
+        for (theta, omega, v1) in [(0.25, 0.0, 0.0), (0.2, -1.1, -0.2), (0.15, -1.6, 0.35)] {
+            let state = State {
+                q: vec![0.1, theta],
+                qd: vec![v1, omega],
+            };
+            let modes: &[Mode] = if v1 == 0.0 {
+                &[Mode::Stick]
+            } else {
+                &[Mode::Slide(v1.signum())]
+            };
+            let d = dynamics(&bound, &state, modes, 0.0).unwrap();
+            let (push, floor, friction) = (d.forces[0], d.forces[1], d.fr[0]);
+            let (s, c) = (theta.sin(), theta.cos());
+            let (x1dd, thdd) = (d.qdd[0], d.qdd[1]);
+            let ax = x1dd - 0.5 * ell * (s * thdd + c * omega * omega);
+            let ay = 0.5 * ell * (c * thdd - s * omega * omega);
+            let ax2 = x1dd - ell * (s * thdd + c * omega * omega);
+            // Torques about the centre: the foot at -(ell/2)(c, s), the tip at +(ell/2)(c, s).
+            let torque = -0.5 * ell * c * floor + 0.5 * ell * s * friction + 0.5 * ell * s * push;
+            let coulomb = match modes[0] {
+                Mode::Slide(sign) => friction + sign * mu * floor,
+                Mode::Stick => x1dd,
+            };
+            let residuals = [
+                (m1 * ax - (friction - push)) / (m1 * g),
+                (m1 * ay - (floor - m1 * g)) / (m1 * g),
+                (inertia * thdd - torque) / (m1 * g * ell),
+                (m2 * ax2 - push) / (m1 * g),
+                coulomb / (m1 * g),
+            ];
+            for (i, r) in residuals.iter().enumerate() {
+                assert!(
+                    r.abs() < 1e-13,
+                    "mu {mu}, theta {theta}: balance {i} off by {r:e}"
+                );
+                worst = worst.max(r.abs());
+            }
+        }
+    }
+    println!("largest Newton-Euler residual: {worst:.1e} (relative to m1 g)");
+}
+
+#[test]
+fn energy_lost_is_the_work_of_friction() {
+    for mu in [0.3, 0.8, 1.3, 1.45] {
+        let want = [Quantity::FloorImpact, Quantity::Checks];
+        let r = ask("rod_cube_friction", &paper(mu), &want, 1e-10);
+        let work = value(&r, "floor_impact_friction_work");
+        assert!(work < 0.0, "mu {mu}: friction did work {work}");
+        let energy: Vec<_> = r
+            .checks
+            .iter()
+            .filter(|(k, _)| k.ends_with(".energy"))
+            .collect();
+        assert!(!energy.is_empty());
+        for (k, c) in energy {
+            assert!(c.passed, "mu {mu}: {k}: {c:?}");
+            assert!(c.meaning.contains("work of friction"), "{k}: {}", c.meaning);
+        }
+        println!(
+            "mu = {mu}: friction work {work:.6e} J, phases {:?}",
+            r.work.phases
+        );
+    }
+}
+
+/// Switch times of the contact phase (s) at tolerance `tol`.
+fn switches(mu: f64, tol: f64) -> Vec<f64> {
+    let bound = Bound::new(model("rod_cube_friction"), &paper(mu)).unwrap();
+    let rtol = (tol * 0.01).max(1e-13);
+    let run = PhaseRun::solve(bound, 0.0, tol, rtol, Route::Fastest, &mut Work::default()).unwrap();
+    run.contact_modes().iter().map(|(t, _)| *t).collect()
+}
+
+#[test]
+fn switches_are_located_where_their_event_functions_vanish() {
+    // mu = 1.3: the foot slides back, sticks, then breaks loose forwards.
+    let bound = Bound::new(model("rod_cube_friction"), &paper(1.3)).unwrap();
+    let run = PhaseRun::solve(
+        bound.clone(),
+        0.0,
+        1e-12,
+        1e-14,
+        Route::Fastest,
+        &mut Work::default(),
+    )
+    .unwrap();
+    let PhaseRun::Integrated(r) = &run else {
+        panic!("friction is integrated")
+    };
+    let modes: Vec<String> = r.run.switches(&bound).map(|(_, m)| m).collect();
+    assert_eq!(
+        modes,
+        [
+            "foot_friction slides -",
+            "foot_friction sticks",
+            "foot_friction slides +"
+        ]
+    );
+    // Where the foot stopped, its speed is nothing next to the rod's tip speed.
+    let stop = &r.run.segments[1];
+    let tip_speed = stop.y0[3].abs(); // ell = 1
+    assert!(stop.y0[2].abs() < 1e-13 * tip_speed, "{:?}", stop.y0);
+    // Where it broke loose, the friction it needed was mu N.
+    let slip = &r.run.segments[2];
+    let state = State {
+        q: slip.y0[..2].to_vec(),
+        qd: slip.y0[2..4].to_vec(),
+    };
+    let d = dynamics(&bound, &state, &[Mode::Stick], slip.t_start).unwrap();
+    let margin = 1.3 * d.forces[1] - d.fr[0].abs();
+    assert!(margin.abs() < 1e-12 * d.forces[1], "margin {margin:e}");
+    // A tighter integrator moves the switches by less than 1e-12 of their time.
+    let (loose, tight) = (switches(1.3, 1e-10), switches(1.3, 1e-11));
+    assert_eq!(loose.len(), 3);
+    for (a, b) in loose.iter().zip(&tight).skip(1) {
+        let rel = (a - b).abs() / b;
+        println!("switch at {b:.15e} s moves by {rel:.1e} relative");
+        assert!(rel < 1e-12, "{a} vs {b}");
+    }
+}
+
+#[test]
+fn a_negative_coefficient_is_refused() {
+    let err = Bound::new(model("rod_cube_friction"), &paper(-0.1)).unwrap_err();
+    assert!(
+        matches!(err, SystemError::NegativeFriction { name: "mu", .. }),
+        "{err}"
+    );
+    assert!(err.to_string().contains("must not be negative"), "{err}");
+}
+
+/// A rod spinning fast enough that the floor would have to pull its foot down: with a foot at
+/// rest, sticking is impossible and, with mu large, sliding either way is consistent. The
+/// solver says so instead of choosing.
+#[test]
+fn a_start_with_no_single_consistent_mode_is_a_typed_error() {
+    let free = model("rod_cube_friction_free");
+    let mut params: Vec<(&str, f64)> = paper(5.0).to_vec();
+    params.extend([
+        ("x1_0", 0.0),
+        ("theta_0", 1.0),
+        ("x2_0", 2.0),
+        ("x1_dot_0", 0.0),
+        ("theta_dot_0", -12.0),
+        ("x2_dot_0", 0.0),
+    ]);
+    let bound = Bound::new(free, &params).unwrap();
+    match PhaseRun::solve(
+        bound,
+        0.0,
+        1e-10,
+        1e-12,
+        Route::Fastest,
+        &mut Work::default(),
+    ) {
+        Err(SolveError::FrictionIndeterminate { why, .. }) => {
+            assert!(why.contains("no contact mode is consistent"), "{why}");
+        }
+        Err(e) => panic!("not an indeterminate start: {e}"),
+        Ok(run) => panic!("solved, ending by {:?}", run.end()),
+    }
+}
+
+/// A free rod sliding on its foot with mu above Painlevé's 4/3, rising into the angles where
+/// `mu > (tan^2 + 4) / (3 tan)` (here 41.5 to 77.5 degrees): the sliding equations turn
+/// singular at the boundary and the solver says so, naming the paradox, rather than reporting a
+/// singular mass matrix, a step size too small or a made-up motion.
+#[test]
+fn a_sliding_rod_that_reaches_painleves_singularity_is_a_typed_error() {
+    let free = model("rod_cube_friction_free");
+    let mut params: Vec<(&str, f64)> = paper(1.8).to_vec();
+    params.extend([
+        ("x1_0", 0.0),
+        ("theta_0", 0.6),
+        ("x2_0", 3.0),
+        ("x1_dot_0", -4.0),
+        ("theta_dot_0", 2.0),
+        ("x2_dot_0", 0.0),
+    ]);
+    let bound = Bound::new(free, &params).unwrap();
+    match PhaseRun::solve(
+        bound,
+        0.0,
+        1e-10,
+        1e-12,
+        Route::Fastest,
+        &mut Work::default(),
+    ) {
+        Err(SolveError::FrictionIndeterminate { why, .. }) => {
+            assert!(why.contains("Painlevé's paradox"), "{why}");
+            assert!(why.contains("approach a singularity"), "{why}");
+        }
+        Err(e) => panic!("not Painlevé's singularity: {e}"),
+        Ok(run) => panic!("solved, ending by {:?}", run.end()),
+    }
+}
