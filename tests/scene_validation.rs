@@ -219,6 +219,24 @@ fn non_positive_values_are_refused_at_their_value() {
 }
 
 #[test]
+fn a_negative_friction_coefficient_is_refused_at_its_value() {
+    let text = "model: rod_cube_friction\nparameters:\n  m1: 1.0\n  m2: 3.0\n  ell: 1.0\n  a: 0.25\n  g: 9.81\n  mu: -0.2\nwant: [separation_angle]\n";
+    let registry = rodcube::models::all();
+    let err = Scene::parse(text, Path::new(FILE), registry).unwrap_err();
+    assert_eq!(err.diagnostics.len(), 1, "{err}");
+    let d = err.diagnostics[0].clone();
+    at(&d, Kind::NegativeFriction, 8, 7, "parameters.mu");
+    assert!(d.message.contains("foot_friction"), "{d}");
+    assert!(d.message.contains("-0.2"), "{d}");
+    // Zero is no friction, the paper's case.
+    let ok = "model: rod_cube_friction\nparameters: {m1: 1, m2: 3, ell: 1, a: 0.25, g: 9.81, mu: 0}\nwant: [separation_angle]\n";
+    assert!(
+        Scene::parse(ok, Path::new(FILE), registry).is_ok(),
+        "mu = 0 refused"
+    );
+}
+
+#[test]
 fn nan_and_infinities_are_refused() {
     for (value, shown) in [
         (".nan", ".nan"),

@@ -849,8 +849,10 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> TexContext {
     for f in &d.frictions {
         eqs.push(display(
             &format!(
-                "Friction \\texttt{{{}}}: {}. Slip velocity $v$; the friction force $F$ does the \\
-                 virtual work $F\\,\\delta v/\\delta\\dot q$ (sliding: $F = -\\mu N \\operatorname{{sign}} v$; sticking: $\\dot v = 0$, $|F| \\le \\mu N$)",
+                "Friction \\texttt{{{}}}: {}. Slip velocity $v$, whose friction force $F$ has \
+                 the generalized force $F\\,\\partial v/\\partial\\dot q$ (sliding: \
+                 $F = -\\mu N \\operatorname{{sign}} v$; sticking: $\\dot v = 0$ while \
+                 $|F| \\le \\mu N$)",
                 tex_text(&f.named.name),
                 tex_text(&f.named.meaning)
             ),

@@ -815,7 +815,7 @@ fn forces(
             .iter()
             .enumerate()
         {
-            e_e = e_e - fr(j) * cas::d(&free_slip.slip, &dot_e);
+            e_e -= fr(j) * cas::d(&free_slip.slip, &dot_e);
         }
         let rate = st.kin.dt(value);
         let accel = st.kin.dt(&rate);
@@ -867,7 +867,7 @@ fn forces(
             };
             let [t0, t1] = &parsed.friction[sk.spec][1];
             let along = st.at(t0) * d0.clone() + st.at(t1) * d1.clone();
-            frictions = frictions + cas::num(sign) * fr(j) * along;
+            frictions += cas::num(sign) * fr(j) * along;
         }
         named.push(Named {
             name: f.name.clone(),
