@@ -236,30 +236,35 @@ fn a_negative_coefficient_is_refused() {
     assert!(err.to_string().contains("must not be negative"), "{err}");
 }
 
-/// A rod spinning fast enough that the floor would have to pull its foot down: with a foot at
-/// rest, sticking is impossible and, with mu large, sliding either way is consistent. The
-/// solver says so instead of choosing.
-#[test]
-fn a_start_with_no_single_consistent_mode_is_a_typed_error() {
-    let free = model("rod_cube_friction_free");
-    let mut params: Vec<(&str, f64)> = paper(5.0).to_vec();
+/// The free rod after the cube has gone (paper's masses and sizes, the cube far away) from
+/// angle `theta`, foot speed `v1` and rate `omega`, with friction `mu`, solved to its end.
+fn free_rod<'m>(mu: f64, theta: f64, v1: f64, omega: f64) -> Result<PhaseRun<'m>, SolveError> {
+    let mut params: Vec<(&str, f64)> = paper(mu).to_vec();
     params.extend([
         ("x1_0", 0.0),
-        ("theta_0", 1.0),
-        ("x2_0", 2.0),
-        ("x1_dot_0", 0.0),
-        ("theta_dot_0", -12.0),
+        ("theta_0", theta),
+        ("x2_0", 3.0),
+        ("x1_dot_0", v1),
+        ("theta_dot_0", omega),
         ("x2_dot_0", 0.0),
     ]);
-    let bound = Bound::new(free, &params).unwrap();
-    match PhaseRun::solve(
+    let bound = Bound::new(model("rod_cube_friction_free"), &params).unwrap();
+    PhaseRun::solve(
         bound,
         0.0,
         1e-10,
         1e-12,
         Route::Fastest,
         &mut Work::default(),
-    ) {
+    )
+}
+
+/// A rod spinning fast enough that the floor would have to pull its foot down: with a foot at
+/// rest, sticking is impossible and, with mu large, sliding either way is consistent. The
+/// solver says so instead of choosing.
+#[test]
+fn a_start_with_no_single_consistent_mode_is_a_typed_error() {
+    match free_rod(5.0, 1.0, 0.0, -12.0) {
         Err(SolveError::FrictionIndeterminate { why, .. }) => {
             assert!(why.contains("no contact mode is consistent"), "{why}");
         }
@@ -274,25 +279,7 @@ fn a_start_with_no_single_consistent_mode_is_a_typed_error() {
 /// singular mass matrix, a step size too small or a made-up motion.
 #[test]
 fn a_sliding_rod_that_reaches_painleves_singularity_is_a_typed_error() {
-    let free = model("rod_cube_friction_free");
-    let mut params: Vec<(&str, f64)> = paper(1.8).to_vec();
-    params.extend([
-        ("x1_0", 0.0),
-        ("theta_0", 0.6),
-        ("x2_0", 3.0),
-        ("x1_dot_0", -4.0),
-        ("theta_dot_0", 2.0),
-        ("x2_dot_0", 0.0),
-    ]);
-    let bound = Bound::new(free, &params).unwrap();
-    match PhaseRun::solve(
-        bound,
-        0.0,
-        1e-10,
-        1e-12,
-        Route::Fastest,
-        &mut Work::default(),
-    ) {
+    match free_rod(1.8, 0.6, -4.0, 2.0) {
         Err(SolveError::FrictionIndeterminate { why, .. }) => {
             assert!(why.contains("Painlevé's paradox"), "{why}");
             assert!(why.contains("approach a singularity"), "{why}");

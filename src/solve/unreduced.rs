@@ -256,6 +256,26 @@ impl Problem<'_, '_> {
         self.state.qd.copy_from_slice(&self.y[self.n..2 * self.n]);
     }
 
+    /// At friction event `k` (a contact's slip stopped or its stuck friction reached `mu N`;
+    /// `k == m` is Painlevé's singularity), the next modes: the one consistent choice.
+    fn switch(&mut self, k: usize, state: &State, t: f64) -> Result<(), SolveError> {
+        if k == self.frictions() {
+            return Err(friction::painleve_error(self.sys, state, &self.modes, t));
+        }
+        // A stuck contact breaks loose against the friction that held it.
+        let held = friction::dynamics(self.sys, state, &self.modes, t)?;
+        let options: Vec<Options> = (self.modes.iter().enumerate())
+            .map(|(i, &mode)| match (i == k, mode) {
+                (false, mode) => Options::Keep(mode),
+                (true, Mode::Slide(s)) => Options::Stopped(s),
+                (true, Mode::Stick) => Options::Breaks(-held.fr[i].signum()),
+            })
+            .collect();
+        self.modes = friction::decide(self.sys, state, &options, t)?;
+        self.slip_offset = slip_offsets(self.sys, state, &options);
+        Ok(())
+    }
+
     fn frictions(&self) -> usize {
         self.modes.len()
     }
@@ -441,26 +461,7 @@ pub fn integrate(
                 t: event.t,
             });
         }
-        let k = event.index - n_end;
-        if k == m {
-            return Err(friction::painleve_error(
-                sys,
-                &state,
-                &problem.modes,
-                event.t,
-            ));
-        }
-        // A stuck contact breaks loose against the friction that held it.
-        let held = friction::dynamics(sys, &state, &problem.modes, event.t)?;
-        let options: Vec<Options> = (problem.modes.iter().enumerate())
-            .map(|(i, &mode)| match (i == k, mode) {
-                (false, mode) => Options::Keep(mode),
-                (true, Mode::Slide(s)) => Options::Stopped(s),
-                (true, Mode::Stick) => Options::Breaks(-held.fr[i].signum()),
-            })
-            .collect();
-        problem.modes = friction::decide(sys, &state, &options, event.t)?;
-        problem.slip_offset = slip_offsets(sys, &state, &options);
+        problem.switch(event.index - n_end, &state, event.t)?;
         problem.state = state;
         y0 = y;
         problem.y0 = y0.clone();
