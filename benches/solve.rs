@@ -1,6 +1,7 @@
 //! Cost of solving: one parameter point's separation angle and time, through the planner and
 //! through the sweeps' lean per-point solver, on the integrated route (the two-coordinate
-//! `rod_cube_spring`, and `rod_cube` forced onto it), and the paper's whole scene
+//! `rod_cube_spring`, `rod_cube_friction` sliding and sticking, and `rod_cube` forced onto it),
+//! and the paper's whole scene
 //! (`scenes/paper.yaml`, every quantity, 1000 samples per series) without writing files.
 //!
 //! Run: `cargo bench --bench solve -- --warm-up-time 1 --measurement-time 3`.
@@ -115,8 +116,26 @@ fn integrated(c: &mut Criterion) {
         ("g", 9.81),
         ("k", 50.0),
     ];
+    let friction = rodcube::models::find("rod_cube_friction").expect("rod_cube_friction is generated");
+    let with_mu = |mu: f64| {
+        let mut p = PAPER.to_vec();
+        p.push(("mu", mu));
+        p
+    };
     let mut g = c.benchmark_group("integrated");
     let cases = [
+        // mu = 0: the paper's motion through the friction machinery (one sliding segment).
+        (
+            "rod_cube_friction_mu0",
+            Request::new(friction, &with_mu(0.0)[..]),
+            Route::Fastest,
+        ),
+        // mu = 1.45: the foot slides back, stops and sticks (two segments, one switch).
+        (
+            "rod_cube_friction_mu1.45",
+            Request::new(friction, &with_mu(1.45)[..]),
+            Route::Fastest,
+        ),
         (
             "rod_cube_spring",
             Request::new(spring, spring_params),

@@ -244,6 +244,9 @@ struct Problem<'a, 'm> {
     y0: Vec<f64>,
     y: Vec<f64>,
     state: State,
+    /// With friction, the dynamics of the last right-hand side and the `z` it was at: the
+    /// integrator asks for the events at the state it has just evaluated.
+    last: Option<(Vec<f64>, Dynamics)>,
 }
 
 impl Problem<'_, '_> {
@@ -273,6 +276,7 @@ impl Problem<'_, '_> {
             .collect();
         self.modes = friction::decide(self.sys, state, &options, t)?;
         self.slip_offset = slip_offsets(self.sys, state, &options);
+        self.last = None;
         Ok(())
     }
 
@@ -301,6 +305,7 @@ impl OdeProblem for Problem<'_, '_> {
             let d = friction::dynamics(self.sys, &self.state, &self.modes, t)?;
             dz[self.n..2 * self.n].copy_from_slice(&d.qdd);
             dz[2 * self.n] = d.friction_power();
+            self.last = Some((z.to_vec(), d));
         }
         Ok(())
     }
@@ -315,10 +320,10 @@ impl OdeProblem for Problem<'_, '_> {
     /// system's distance from Painlevé's singularity.
     fn events(&mut self, t: f64, z: &[f64], dz: &[f64], g: &mut [f64]) -> Result<(), SolveError> {
         self.load(z);
-        let d = if self.frictions() > 0 {
-            Some(friction::dynamics(self.sys, &self.state, &self.modes, t)?)
-        } else {
-            None
+        let d = match self.last.take() {
+            _ if self.frictions() == 0 => None,
+            Some((at, d)) if at == z => Some(d),
+            _ => Some(friction::dynamics(self.sys, &self.state, &self.modes, t)?),
         };
         let mut i = 0;
         if let Some(c) = self.contact {
@@ -394,6 +399,7 @@ pub fn integrate(
         y0: y0.clone(),
         y: y0.clone(),
         state: start,
+        last: None,
     };
     let mut atol: Vec<f64> = match scales {
         Some(s) if s.len() == 2 * n => s
