@@ -116,7 +116,8 @@ fn integrated(c: &mut Criterion) {
         ("g", 9.81),
         ("k", 50.0),
     ];
-    let friction = rodcube::models::find("rod_cube_friction").expect("rod_cube_friction is generated");
+    let friction =
+        rodcube::models::find("rod_cube_friction").expect("rod_cube_friction is generated");
     let with_mu = |mu: f64| {
         let mut p = PAPER.to_vec();
         p.push(("mu", mu));

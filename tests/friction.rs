@@ -288,3 +288,36 @@ fn a_sliding_rod_that_reaches_painleves_singularity_is_a_typed_error() {
         Ok(run) => panic!("solved, ending by {:?}", run.end()),
     }
 }
+
+/// At release the foot needs `|F| / N` of friction to stay still, by a hand Newton–Euler
+/// balance of the rod hinged at its foot pushing the cube from rest: just above that mu it
+/// sticks, just below it slides.
+#[test]
+fn the_foot_sticks_at_release_exactly_above_the_friction_it_needs() {
+    let (m1, m2, ell, a, g): (f64, f64, f64, f64, f64) = (1.0, 3.0, 1.0, 0.25, 9.81);
+    let (s, c) = (a / ell, (1.0 - (a / ell).powi(2)).sqrt());
+    // (m1 ell^2/3 + m2 ell^2 s^2) theta'' = -m1 g ell c / 2 at rest.
+    let thdd = -m1 * g * ell * c / 2.0 / (m1 * ell * ell / 3.0 + m2 * ell * ell * s * s);
+    let push = m2 * (-ell * s * thdd); // the cube's x2 = ell cos(theta)
+    let friction = m1 * (-0.5 * ell * s * thdd) + push; // m1 a_x = F - P
+    let normal = m1 * (g + 0.5 * ell * c * thdd);
+    let critical = friction / normal;
+    println!("critical mu at release: {critical:.15}");
+    for (mu, want) in [
+        (critical * (1.0 + 1e-9), "sticks"),
+        (critical * (1.0 - 1e-9), "slides -"),
+    ] {
+        let bound = Bound::new(model("rod_cube_friction"), &paper(mu)).unwrap();
+        let run = PhaseRun::solve(
+            bound,
+            0.0,
+            1e-10,
+            1e-12,
+            Route::Fastest,
+            &mut Work::default(),
+        )
+        .unwrap();
+        let first = &run.contact_modes()[0].1;
+        assert_eq!(first, &format!("foot_friction {want}"), "mu {mu}");
+    }
+}
