@@ -42,7 +42,7 @@ use crate::solve::phases::{
 };
 use crate::solve::quadrature::TimeMesh;
 use crate::solve::separation::{SeparationOutcome, linearised_separation};
-use crate::solve::series::{PhaseSamples, sample, sample_forces, theta_dot_at};
+use crate::solve::series::{PhaseSamples, sample, sample_forces, sample_friction, theta_dot_at};
 use crate::solve::unreduced::{self, EndEvent, UnreducedRun};
 use crate::system::{Bound, System, SystemError};
 use std::collections::BTreeMap;
@@ -250,6 +250,7 @@ pub fn run(request: &Request) -> Result<RunResults, PlanError> {
             q,
             Quantity::ThetaSeries
                 | Quantity::ForceSeries(_)
+                | Quantity::FrictionSeries(_)
                 | Quantity::Trajectory(_)
                 | Quantity::Checks
         )
@@ -615,6 +616,26 @@ impl<'m> Plan<'m> {
                         column("t", "s", s.t.clone()),
                         column("theta", "rad", s.theta.clone()),
                         column(info.forces[i].name, "N", force),
+                    ],
+                };
+                out.series.insert(key, series);
+            }
+            Quantity::FrictionSeries(i) => {
+                self.first_samples()?;
+                let (Some(motion), Some(s)) = (self.motion.as_ref(), self.phase_samples.first())
+                else {
+                    return Ok(());
+                };
+                let f = &info.frictions[i];
+                let samples = sample_friction(&motion.phases[0], s)?;
+                let pick = |k: usize| samples.iter().map(|d| d[k][i]).collect::<Vec<f64>>();
+                let series = Series {
+                    columns: vec![
+                        column("t", "s", s.t.clone()),
+                        column("theta", "rad", s.theta.clone()),
+                        column(f.name, "N", pick(0)),
+                        column(info.forces[f.normal].name, "N", pick(1)),
+                        column("slip_velocity", "m/s", pick(2)),
                     ],
                 };
                 out.series.insert(key, series);

@@ -22,6 +22,9 @@ pub enum Quantity {
     ThetaSeries,
     /// A reaction force (index into `ModelInfo::forces`) along the motion: `<force>_series`.
     ForceSeries(usize),
+    /// A friction (index into `ModelInfo::frictions`) along the motion, with its normal force
+    /// and slip velocity: `<friction>_series`.
+    FrictionSeries(usize),
     /// A point's path (index into `ModelInfo::points`): `<point>_trajectory`.
     Trajectory(usize),
     /// The free-sliding phase after separation, up to the rod lying on the floor.
@@ -97,6 +100,11 @@ impl Quantity {
         {
             return Ok(Quantity::ForceSeries(i));
         }
+        if let Some(friction) = name.strip_suffix("_series")
+            && let Some(i) = info.frictions.iter().position(|f| f.name == friction)
+        {
+            return Ok(Quantity::FrictionSeries(i));
+        }
         if let Some(point) = name.strip_suffix("_trajectory")
             && let Some(i) = info.points.iter().position(|p| p.name == point)
         {
@@ -113,6 +121,7 @@ impl Quantity {
     pub fn name(&self, info: &ModelInfo) -> String {
         match self {
             Quantity::ForceSeries(i) => format!("{}_series", info.forces[*i].name),
+            Quantity::FrictionSeries(i) => format!("{}_series", info.frictions[*i].name),
             Quantity::Trajectory(i) => format!("{}_trajectory", info.points[*i].name),
             q => FIXED
                 .iter()
@@ -135,6 +144,7 @@ impl Quantity {
             .filter(|q| q.available(info))
             .collect();
         out.extend((0..info.forces.len()).map(Quantity::ForceSeries));
+        out.extend((0..info.frictions.len()).map(Quantity::FrictionSeries));
         out.extend((0..info.points.len()).map(Quantity::Trajectory));
         out
     }
@@ -153,6 +163,7 @@ impl Quantity {
             }
             Quantity::ContactTimeToFloor | Quantity::CrossCheck => fast,
             Quantity::FloorImpact => contact && info.next_phase.is_some(),
+            Quantity::FrictionSeries(i) => *i < info.frictions.len(),
             _ => true,
         }
     }

@@ -321,3 +321,58 @@ fn the_foot_sticks_at_release_exactly_above_the_friction_it_needs() {
         assert_eq!(first, &format!("foot_friction {want}"), "mu {mu}");
     }
 }
+
+/// The friction series follows Coulomb's law sample by sample: `F = -mu N sign(v)` while the
+/// foot slides, `|F| <= mu N` with no slip once it sticks.
+#[test]
+fn the_friction_series_obeys_coulombs_law() {
+    let mu = 1.45;
+    let r = ask(
+        "rod_cube_friction",
+        &paper(mu),
+        &[Quantity::parse("foot_friction_series", model("rod_cube_friction").info()).unwrap()],
+        1e-10,
+    );
+    let series = &r.series["foot_friction_series"];
+    let col = |name: &str| {
+        &series
+            .columns
+            .iter()
+            .find(|c| c.name == name)
+            .unwrap_or_else(|| panic!("no column {name}"))
+            .values
+    };
+    let (t, f, n, v) = (
+        col("t"),
+        col("foot_friction"),
+        col("floor_normal"),
+        col("slip_velocity"),
+    );
+    // When the foot stopped and stuck (the one switch at this mu).
+    let stick = switches(mu, 1e-10)[1];
+    let (mut sliding, mut stuck) = (0, 0);
+    for k in 0..t.len() {
+        if t[k] < stick - 1e-6 && v[k] != 0.0 {
+            assert!(
+                (f[k] + mu * n[k] * v[k].signum()).abs() < 1e-12 * mu * n[k],
+                "t {}",
+                t[k]
+            );
+            sliding += 1;
+        } else if t[k] > stick + 1e-6 {
+            assert!(
+                f[k].abs() <= mu * n[k],
+                "t {}: |F| {} > mu N {}",
+                t[k],
+                f[k],
+                mu * n[k]
+            );
+            assert!(v[k].abs() < 1e-9, "t {}: slip {}", t[k], v[k]);
+            stuck += 1;
+        }
+    }
+    assert!(
+        sliding > 10 && stuck > 10,
+        "{sliding} sliding, {stuck} stuck samples"
+    );
+}

@@ -174,6 +174,30 @@ pub fn sample_forces(run: &PhaseRun, s: &PhaseSamples) -> Result<Vec<Vec<f64>>, 
     }
 }
 
+/// The friction forces, their normal forces and slip velocities at every sample of a phase
+/// (`[f, N, v]`, each one value per friction), in the contact modes of the sample's time.
+pub fn sample_friction(run: &PhaseRun, s: &PhaseSamples) -> Result<Vec<[Vec<f64>; 3]>, SolveError> {
+    let info = run.bound().info();
+    match run {
+        PhaseRun::Reduced(_) if info.frictions.is_empty() => Ok(vec![Default::default(); s.len()]),
+        PhaseRun::Reduced(_) => Err(SolveError::FrictionModes {
+            model: info.name,
+            expected: info.frictions.len(),
+            got: 0,
+        }),
+        PhaseRun::Integrated(r) => s
+            .states
+            .iter()
+            .zip(&s.t)
+            .map(|(state, &t)| {
+                let d = r.run.dynamics_at(&r.bound, state, t)?;
+                let normals = info.frictions.iter().map(|f| d.forces[f.normal]).collect();
+                Ok([d.fr, normals, d.slip])
+            })
+            .collect(),
+    }
+}
+
 /// Solves `t(u) = target` for `u` in `[u_lo, u_end]`, knowing `t(u_lo) = t_lo <= target`.
 fn invert(
     sys: &System,
