@@ -23,6 +23,7 @@
 
 use crate::model::{Model, ModelInfo};
 use crate::quantity::Quantity;
+use crate::system::{SystemError, check_value, failed_requirements};
 use crate::yaml_marks::{
     At, SyntaxError, check_syntax, first_mark, is_path, join_key, locate, locate_nearest,
     parse_path, strip_marks,
@@ -646,7 +647,7 @@ impl Ctx<'_> {
         }
         let mut values = Vec::with_capacity(info.parameters.len());
         let mut all_good = true;
-        for p in info.parameters {
+        for (i, p) in info.parameters.iter().enumerate() {
             let field = format!("parameters.{}", p.name);
             let Some(&v) = raw.parameters.get(p.name) else {
                 all_good = false;
@@ -661,24 +662,12 @@ impl Ctx<'_> {
                 ));
                 continue;
             };
-            if !v.is_finite() {
-                all_good = false;
-                out.push(self.diag(
-                    Kind::NotFinite,
-                    &field,
-                    At::Value,
-                    format!("`{}` must be a finite number, not {}", p.name, show(v)),
-                ));
-            } else if let Some(f) = (info.frictions.iter())
-                .find(|f| {
-                    info.parameters
-                        .get(f.coefficient)
-                        .is_some_and(|c| c.name == p.name)
-                })
-                .filter(|_| v < 0.0)
-            {
-                all_good = false;
-                out.push(self.diag(
+            // The one value check ([`check_value`]); the scene renders its verdict.
+            let check = check_value(info, i, v);
+            all_good &= check.is_ok();
+            match check {
+                Ok(()) => {}
+                Err(SystemError::NegativeFriction { friction, .. }) => out.push(self.diag(
                     Kind::NegativeFriction,
                     &field,
                     At::Value,
@@ -686,13 +675,11 @@ impl Ctx<'_> {
                         "`{}` ({}) is the coefficient of friction `{}` and must not be negative, not {}",
                         p.name,
                         p.meaning,
-                        f.name,
+                        friction,
                         show(v)
                     ),
-                ));
-            } else if p.positive && v <= 0.0 {
-                all_good = false;
-                out.push(self.diag(
+                )),
+                Err(SystemError::NotPositive { .. }) => out.push(self.diag(
                     Kind::NotPositive,
                     &field,
                     At::Value,
@@ -702,7 +689,13 @@ impl Ctx<'_> {
                         p.meaning,
                         show(v)
                     ),
-                ));
+                )),
+                Err(_) => out.push(self.diag(
+                    Kind::NotFinite,
+                    &field,
+                    At::Value,
+                    format!("`{}` must be a finite number, not {}", p.name, show(v)),
+                )),
             }
             values.push(v);
         }
@@ -710,9 +703,8 @@ impl Ctx<'_> {
         // requirements, once every parameter is there and valid
         if all_good && !info.requirements.is_empty() {
             let mut margins = vec![0.0; info.requirements.len()];
-            model.requirements(&values, &mut margins);
-            for (r, margin) in info.requirements.iter().zip(&margins) {
-                if margin.is_nan() || *margin <= 0.0 {
+            for (r, margin) in failed_requirements(model, &values, &mut margins) {
+                {
                     let involved = involved_parameters(r.name, r.meaning, info);
                     let field =
                         self.first_in_file(involved.iter().map(|n| format!("parameters.{n}")));
@@ -734,7 +726,7 @@ impl Ctx<'_> {
                             "requirement `{}` fails: {}; margin {}{list}",
                             r.name,
                             r.meaning,
-                            show(*margin)
+                            show(margin)
                         ),
                     ));
                 }

@@ -225,74 +225,14 @@ impl<'m> Bound<'m> {
         Self::new(model, &pairs)
     }
 
-    /// Binds parameter values given in the order of [`ModelInfo::parameters`].
+    /// Binds parameter values given in the order of [`ModelInfo::parameters`], checked by
+    /// [`check_parameters`] and prepared by [`prepare_constants`].
     pub fn from_values(model: &'m dyn Model, p: &[f64]) -> Result<Self, SystemError> {
         let info = model.info();
-        if p.len() != info.parameters.len() {
-            return Err(SystemError::WrongCount {
-                model: info.name,
-                expected: info.parameters.len(),
-                got: p.len(),
-            });
-        }
-        for (&value, param) in p.iter().zip(info.parameters) {
-            if !value.is_finite() {
-                return Err(SystemError::NotFinite {
-                    model: info.name,
-                    name: param.name,
-                    value,
-                });
-            }
-            if param.positive && value <= 0.0 {
-                return Err(SystemError::NotPositive {
-                    model: info.name,
-                    name: param.name,
-                    value,
-                });
-            }
-        }
-        for f in info.frictions {
-            let (Some(&value), Some(param)) =
-                (p.get(f.coefficient), info.parameters.get(f.coefficient))
-            else {
-                return Err(SystemError::WrongCount {
-                    model: info.name,
-                    expected: f.coefficient + 1,
-                    got: p.len(),
-                });
-            };
-            if value < 0.0 {
-                return Err(SystemError::NegativeFriction {
-                    model: info.name,
-                    name: param.name,
-                    friction: f.name,
-                    value,
-                });
-            }
-        }
         let mut margins = vec![0.0; info.requirements.len()];
-        model.requirements(p, &mut margins);
-        for (&margin, req) in margins.iter().zip(info.requirements) {
-            if margin.is_nan() || margin <= 0.0 {
-                return Err(SystemError::Requirement {
-                    model: info.name,
-                    name: req.name,
-                    meaning: req.meaning,
-                    margin,
-                    parameters: describe(info, p),
-                });
-            }
-        }
+        check_parameters(model, p, &mut margins)?;
         let mut k = vec![0.0; info.n_constants];
-        model.prepare(p, &mut k);
-        if let Some((index, &value)) = k.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(SystemError::BadConstant {
-                model: info.name,
-                index,
-                value,
-                parameters: describe(info, p),
-            });
-        }
+        prepare_constants(model, p, &mut k)?;
         Ok(Bound {
             model,
             p: p.to_vec(),
@@ -595,6 +535,113 @@ impl<'m> System<'m> {
         self.reduction
             .full_state(self.k(), t, delta, theta_dot, &mut state.q, &mut state.qd);
         state
+    }
+}
+
+/// The one check of a single parameter value (index `i` of [`ModelInfo::parameters`]): finite,
+/// positive where declared so, and not negative when it is a coefficient of friction.
+/// [`check_parameters`], the per-point solver and the scene loader all use it.
+pub fn check_value(info: &'static ModelInfo, i: usize, value: f64) -> Result<(), SystemError> {
+    let Some(param) = info.parameters.get(i) else {
+        return Err(SystemError::WrongCount {
+            model: info.name,
+            expected: info.parameters.len(),
+            got: i + 1,
+        });
+    };
+    let model = info.name;
+    let name = param.name;
+    if !value.is_finite() {
+        return Err(SystemError::NotFinite { model, name, value });
+    }
+    if value < 0.0
+        && let Some(f) = info.frictions.iter().find(|f| f.coefficient == i)
+    {
+        return Err(SystemError::NegativeFriction {
+            model,
+            name,
+            friction: f.name,
+            value,
+        });
+    }
+    if param.positive && value <= 0.0 {
+        return Err(SystemError::NotPositive { model, name, value });
+    }
+    Ok(())
+}
+
+/// The requirements of [`ModelInfo::requirements`] that `p` fails, with their margins
+/// (`margins` is scratch of one entry per requirement; `p` must hold valid values).
+pub fn failed_requirements<'a>(
+    model: &dyn Model,
+    p: &[f64],
+    margins: &'a mut [f64],
+) -> impl Iterator<Item = (&'static crate::model::NamedInfo, f64)> + 'a {
+    let info = model.info();
+    model.requirements(p, margins);
+    info.requirements
+        .iter()
+        .zip(margins.iter())
+        .filter(|(_, m)| m.is_nan() || **m <= 0.0)
+        .map(|(r, m)| (r, *m))
+}
+
+/// The one validation of a model's parameter values, in the order of
+/// [`ModelInfo::parameters`]: their count, each value ([`check_value`]) and the model's
+/// requirements (`margins`: scratch of one entry per requirement). Used by [`Bound`] and by the
+/// per-point solver, so both refuse exactly the same points.
+pub fn check_parameters(
+    model: &dyn Model,
+    p: &[f64],
+    margins: &mut [f64],
+) -> Result<(), SystemError> {
+    let info = model.info();
+    if p.len() != info.parameters.len() || margins.len() != info.requirements.len() {
+        return Err(SystemError::WrongCount {
+            model: info.name,
+            expected: info.parameters.len(),
+            got: p.len(),
+        });
+    }
+    for (i, &value) in p.iter().enumerate() {
+        check_value(info, i, value)?;
+    }
+    if let Some((req, margin)) = failed_requirements(model, p, margins).next() {
+        return Err(SystemError::Requirement {
+            model: info.name,
+            name: req.name,
+            meaning: req.meaning,
+            margin,
+            parameters: describe(info, p),
+        });
+    }
+    Ok(())
+}
+
+/// Prepares the model's constants `k` (of length [`ModelInfo::n_constants`]) from checked
+/// parameters and refuses any that is not finite.
+pub fn prepare_constants(model: &dyn Model, p: &[f64], k: &mut [f64]) -> Result<(), SystemError> {
+    let info = model.info();
+    if k.len() != info.n_constants {
+        return Err(SystemError::WrongCount {
+            model: info.name,
+            expected: info.n_constants,
+            got: k.len(),
+        });
+    }
+    model.prepare(p, k);
+    // A branch-free scan first (it vectorises); the index only on failure.
+    if k.iter().fold(true, |ok, v| ok & v.is_finite()) {
+        return Ok(());
+    }
+    match k.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        Some((index, &value)) => Err(SystemError::BadConstant {
+            model: info.name,
+            index,
+            value,
+            parameters: describe(info, p),
+        }),
+        None => Ok(()),
     }
 }
 

@@ -33,7 +33,6 @@ fn separation_angle_methods_on_the_papers_case() {
         relative_error(theta, &r.angle).abs()
     };
     assert!(err(methods::angle_default) < 3e-16);
-    assert!(err(methods::angle_lean) < 3e-16);
     assert!(err(methods::angle_newton) < 3e-16);
     assert!(err(methods::angle_bisection) < 5e-16);
     assert!(err(methods::angle_closed_form) < 1e-13);
@@ -49,9 +48,9 @@ fn separation_time_methods_on_the_papers_case_and_near_upright() {
         let delta = methods::delta_sep(&sys).unwrap();
         let t_max = 100.0 * to_f64(&r.time);
         let err = |v: methods::Outcome<f64>| relative_error(v.unwrap().0, &r.time).abs();
-        // The defaults: the planner's adaptive rule and the sweep's lean solver.
-        assert!(err(methods::time_adaptive_u2(&sys, delta, 1e-10)) < 1e-12);
-        assert!(err(methods::time_lean(&sys, 1e-12)) < 1e-12);
+        // The default quadrature at the planner's default tolerance, and the per-point solver.
+        assert!(err(methods::time_default(&sys, delta, 1e-10)) < 1e-12);
+        assert!(err(methods::time_lean_fixed(&sys, 8, 12, 1e-12)) < 1e-12);
         // Tanh-sinh copes with the endpoint singularity by itself.
         assert!(err(methods::time_tanh_sinh(&sys, delta, 1.0 / 32.0)) < 1e-12);
         // Adaptive Gauss-Kronrod on the raw integrand converges, slowly.

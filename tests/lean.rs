@@ -10,7 +10,8 @@ use common::paper::ROD_CUBE;
 use common::tweaked::{Fault, Tweaked};
 use rodcube::model::Model;
 use rodcube::solve::SolveError;
-use rodcube::solve::lean::{LEAN_SCHEDULE, LeanSolver, RuleStep};
+use rodcube::solve::lean::LeanSolver;
+use rodcube::solve::quadrature::{RuleStep, SCHEDULE};
 
 /// The paper's case: m1, m2, ell, a, g.
 const PAPER: [f64; 5] = [1.0, 3.0, 1.0, 0.25, 9.81];
@@ -49,7 +50,7 @@ fn the_papers_point_and_the_hand_typed_model() {
 }
 
 #[test]
-fn the_schedule_agrees_with_fixed_pairs_and_is_cheaper_at_the_papers_point() {
+fn the_schedule_agrees_with_fixed_pairs_and_is_cheaper_over_the_sweep_range() {
     let m = rod_cube();
     let mut schedule = LeanSolver::new(m).unwrap();
     let mut fixed = LeanSolver::with_rules(m, 8, 12, 1e-12).unwrap();
@@ -69,10 +70,8 @@ fn the_schedule_agrees_with_fixed_pairs_and_is_cheaper_at_the_papers_point() {
             }
         }
     }
-    let mut schedule = LeanSolver::new(m).unwrap();
-    let mut fixed = LeanSolver::with_rules(m, 8, 12, 1e-12).unwrap();
-    schedule.solve(&PAPER).unwrap();
-    fixed.solve(&PAPER).unwrap();
+    // Short panels get cheaper rules, long ones are cut before they fail: fewer evaluations
+    // over the grid than one fixed pair.
     assert!(
         schedule.evals < fixed.evals,
         "{} vs {}",
@@ -92,7 +91,7 @@ fn long_intervals_near_upright_are_cut_and_still_accurate() {
         let reference = fine.solve(&p).unwrap().separation_time;
         assert!(rel(t, reference) < 1e-14, "r = {r}: {t} vs {reference}");
         // More than one panel of the longest step was needed.
-        let longest = LEAN_SCHEDULE[LEAN_SCHEDULE.len() - 1];
+        let longest = SCHEDULE[SCHEDULE.len() - 1];
         assert!(schedule.evals > (longest.low + longest.high) as u64);
     }
 }
@@ -148,7 +147,10 @@ fn broken_models_get_typed_errors() {
         e => panic!("{e}"),
     }
     match solve_broken(Fault::Nan { below: 1.0 }) {
-        SolveError::NonFinite { what, .. } => assert!(what.contains("at the start"), "{what}"),
+        SolveError::NonFinite { what, delta, .. } => {
+            assert_eq!(what, "theta_dot^2");
+            assert!(delta > 0.0 && delta < 0.01, "{delta}");
+        }
         e => panic!("{e}"),
     }
     // A control: the same wrapper without a fault in reach solves.

@@ -7,7 +7,7 @@ mod common;
 use common::paper::{FREE_ROD, ROD_CUBE, paper, ratios};
 use gauss_quad::{FiniteAboveNegOneF64, GaussJacobi, GaussLegendre};
 use rodcube::results::Work;
-use rodcube::solve::quadrature::{GL_ORDER, TimeMesh, gauss_legendre_rule, integrand, panel};
+use rodcube::solve::quadrature::{Control, Fall, RuleStep, TimeMesh, integrate};
 use rodcube::solve::separation::separation;
 use rodcube::system::System;
 
@@ -86,16 +86,24 @@ fn paper_times() {
 
 #[test]
 fn error_falls_with_nodes_per_panel() {
-    // One Gauss–Legendre panel in u over the paper's contact phase: spectral convergence.
+    // One symmetric Gauss–Legendre panel in v over the paper's contact phase: spectral
+    // convergence (n nodes on [-v_end, v_end] cost n/2 evaluations).
     let sys = System::new(&ROD_CUBE, &paper(9.81)).unwrap();
     let de = sep_delta(&sys);
     let reference = jacobi_time(&sys, de, 80);
+    let fall = Fall::of(&sys, de).unwrap();
+    let v_end = fall.v_at_delta(de);
     let mut errors = Vec::new();
-    for n in [2, 3, 4, 5, 6, 8, 10, 12, 16, 20] {
-        let rule = gauss_legendre_rule(n);
-        let mut evals = 0;
-        let mut f = |u: f64| integrand(&sys, u, de);
-        let t = panel(&rule, &mut f, 0.0, de.sqrt(), &mut evals).unwrap();
+    for n in [2, 4, 6, 8, 10, 12, 16, 20] {
+        // A tolerance of 1 accepts the first panel whatever its rules say.
+        let step = RuleStep {
+            max_len: f64::INFINITY,
+            low: 1,
+            high: n,
+        };
+        let control = Control::new(&[step], 1.0);
+        let (t, evals) = integrate(&fall, v_end, &control, &mut Vec::new(), |_| {}).unwrap();
+        assert_eq!(evals as usize, 1 + n / 2);
         let e = rel(t, reference);
         println!("GL nodes {n:2}: relative error {e:.2e}");
         errors.push((n, e));
@@ -107,7 +115,7 @@ fn error_falls_with_nodes_per_panel() {
     );
     let at = |n: usize| errors.iter().find(|e| e.0 == n).map(|e| e.1).unwrap();
     assert!(
-        at(4) < 1e-7 && at(8) < 1e-12 && at(GL_ORDER) < 1e-14,
+        at(4) < 1e-5 && at(8) < 1e-11 && at(12) < 1e-14,
         "{errors:?}"
     );
 }
@@ -191,8 +199,10 @@ fn free_phase_without_endpoint_singularity() {
         "{} vs {reference}",
         mesh.duration
     );
+    // A moving start puts branch points of the integrand at v = +-i theta_dot_i / sqrt(e F),
+    // near the start when the rate is small: more panels than from rest.
     assert!(
-        work.integrand_evals <= 3 * GL_ORDER as u64 * 3,
+        work.integrand_evals <= 200,
         "{} evals",
         work.integrand_evals
     );

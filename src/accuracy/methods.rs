@@ -7,8 +7,9 @@ use crate::results::Work;
 use crate::solve::SolveError;
 use crate::solve::lean::LeanSolver;
 use crate::solve::ode::{OdeOptions, OdeProblem, dopri5};
-use crate::solve::quadrature::{TimeMesh, gauss_legendre_rule, integrand};
-use crate::solve::separation::{horner, linearised_separation, separation};
+use crate::solve::poly::horner;
+use crate::solve::quadrature::{TimeMesh, gauss_legendre_rule};
+use crate::solve::separation::{linearised_separation, separation};
 use crate::solve::series::sample_phase;
 use crate::solve::unreduced;
 use crate::system::System;
@@ -43,14 +44,6 @@ pub fn angle_default(sys: &System) -> Outcome<f64> {
     let s = separation(sys, &mut work).map_err(err)?;
     let s = s.separation().ok_or("no separation")?;
     Ok((s.theta, work.polynomial_evals))
-}
-
-/// The sweep's lean root finder (plain Horner with a compensated fallback near zero).
-pub fn angle_lean(sys: &System) -> Outcome<f64> {
-    let (c, lo, hi) = polynomial(sys);
-    let mut evals = 0;
-    let s = crate::solve::lean::largest_root(&c, lo, hi, &mut evals).ok_or("no root")?;
-    Ok((s.asin(), evals))
 }
 
 /// The paper's linearised root (terms above degree 1 dropped).
@@ -163,8 +156,9 @@ pub fn delta_sep(sys: &System) -> Result<f64, String> {
         .delta)
 }
 
-/// The project's default: adaptive Gauss–Legendre (10 nodes) after `delta = u^2`.
-pub fn time_adaptive_u2(sys: &System, delta: f64, tol: f64) -> Outcome<f64> {
+/// The project's one quadrature (planner, per-point solver and sweeps): Gauss–Legendre pairs by
+/// panel length after the `sin`/`sinh` substitution, at a relative tolerance.
+pub fn time_default(sys: &System, delta: f64, tol: f64) -> Outcome<f64> {
     let mut work = Work::default();
     let mesh = TimeMesh::build(sys, delta, tol, &mut work).map_err(err)?;
     Ok((mesh.duration, work.integrand_evals))
@@ -177,9 +171,23 @@ pub fn time_gl_u2(sys: &System, delta: f64, nodes: usize) -> Outcome<f64> {
     let half = 0.5 * u_end;
     let mut sum = 0.0;
     for &(x, w) in &rule {
-        sum += w * integrand(sys, half * (1.0 + x), delta).map_err(err)?;
+        sum += w * u_integrand(sys, half * (1.0 + x))?;
     }
     Ok((half * sum, nodes as u64))
+}
+
+/// `2u / |theta_dot|` at `delta = u^2` (the integrand after `delta = u^2`), with its limit at
+/// `u = 0` released from rest.
+fn u_integrand(sys: &System, u: f64) -> Result<f64, String> {
+    if u == 0.0 {
+        let theta_ddot = sys.reduced(0.0).theta_ddot;
+        return if sys.starts_at_rest() && theta_ddot < 0.0 {
+            Ok(2.0 / (-2.0 * theta_ddot).sqrt())
+        } else {
+            Ok(0.0)
+        };
+    }
+    Ok(2.0 * u * raw(sys, u * u)?)
 }
 
 /// `1 / |theta_dot|` at `delta` (the raw integrand, singular at 0).
@@ -442,16 +450,8 @@ pub fn time_unreduced(sys: &System, rtol: f64, t_max: f64) -> Outcome<f64> {
     Ok((run.t_end, 6 * work.ode_steps))
 }
 
-/// The sweep's lean solver (root and time) with its default rule schedule
-/// ([`LEAN_SCHEDULE`](crate::solve::lean::LEAN_SCHEDULE)).
-pub fn time_lean(sys: &System, accept: f64) -> Outcome<f64> {
-    let schedule = crate::solve::lean::LEAN_SCHEDULE;
-    let mut s = LeanSolver::with_schedule(sys.model(), &schedule, accept).map_err(err)?;
-    let out = s.solve(sys.p()).map_err(err)?;
-    Ok((out.separation_time, s.evals))
-}
-
-/// The lean solver comparing fixed rules of `low` and `high` nodes on every panel.
+/// The per-point solver (root and time) comparing fixed rules of `low` and `high` nodes on
+/// every panel.
 pub fn time_lean_fixed(sys: &System, low: usize, high: usize, accept: f64) -> Outcome<f64> {
     let mut s = LeanSolver::with_rules(sys.model(), low, high, accept).map_err(err)?;
     let out = s.solve(sys.p()).map_err(err)?;

@@ -138,14 +138,9 @@ type SeriesFn = Box<dyn Fn(&System, f64, f64) -> methods::Outcome<methods::Sampl
 fn angle_methods() -> Vec<(&'static str, String, AngleFn)> {
     vec![
         (
-            "planner (default): isolation + bracketed Newton",
-            "compensated Horner".into(),
-            Box::new(methods::angle_default),
-        ),
-        (
-            "sweep: lean root",
+            "default: isolation + bracketed Halley",
             "filtered Horner".into(),
-            Box::new(methods::angle_lean),
+            Box::new(methods::angle_default),
         ),
         (
             "closed form (Viete)",
@@ -175,21 +170,14 @@ fn time_methods() -> Vec<(&'static str, String, TimeFn)> {
     let mut out: Vec<(&'static str, String, TimeFn)> = Vec::new();
     for tol in [1e-4, 1e-6, 1e-8, 1e-10, 1e-12, 1e-14] {
         out.push((
-            "planner (default): adaptive GL-10 after delta=u^2",
+            "default: sin/sinh subst., GL pairs by panel length",
             format!("tol {tol:.0e}"),
-            Box::new(move |s, d, _| methods::time_adaptive_u2(s, d, tol)),
-        ));
-    }
-    for accept in [1e-4, 1e-6, 1e-8, 1e-10, 1e-12, 1e-14] {
-        out.push((
-            "sweep (default): sin/sinh subst., GL pairs by panel length",
-            format!("accept {accept:.0e}"),
-            Box::new(move |s, _, _| methods::time_lean(s, accept)),
+            Box::new(move |s, d, _| methods::time_default(s, d, tol)),
         ));
     }
     for (low, high) in [(6, 9), (8, 12)] {
         out.push((
-            "sweep: sin/sinh subst., fixed GL pair per panel",
+            "per point: sin/sinh subst., fixed GL pair per panel",
             format!("GL {low} vs {high}"),
             Box::new(move |s, _, _| methods::time_lean_fixed(s, low, high, 1e-12)),
         ));
@@ -246,7 +234,7 @@ fn series_methods() -> Vec<(&'static str, String, SeriesFn)> {
     let mut out: Vec<(&'static str, String, SeriesFn)> = Vec::new();
     for tol in [1e-4, 1e-6, 1e-8, 1e-10, 1e-12] {
         out.push((
-            "planner (default): quadrature t(u) inverted by Newton",
+            "default: quadrature t(v) inverted by Newton",
             format!("tol {tol:.0e}"),
             Box::new(move |s, d, _| methods::series_quadrature(s, d, tol, SERIES_SAMPLES)),
         ));

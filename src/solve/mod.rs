@@ -15,6 +15,7 @@ pub mod friction;
 pub mod lean;
 pub mod ode;
 pub mod phases;
+pub mod poly;
 pub mod quadrature;
 pub mod roots;
 pub mod separation;

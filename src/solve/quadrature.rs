@@ -1,40 +1,103 @@
-//! Time along a phase, `t(delta) = integral of d(delta) / |theta_dot|`, by adaptive
-//! Gauss–Legendre quadrature after the substitution `delta = u^2`.
+//! The one time quadrature: `t = integral d(theta) / |theta_dot|` along a falling phase, used by
+//! the planner ([`TimeMesh`]), the per-point solver and the sweeps
+//! ([`lean`](crate::solve::lean)) and the accuracy report.
 //!
-//! Released from rest, `theta_dot^2 ~ -2 theta_ddot_i delta` near the start, so the integrand
-//! `1/|theta_dot|` has a `1/sqrt` endpoint singularity (the paper's eqs. 10 and 15). With
-//! `delta = u^2` the integral becomes `integral_0^sqrt(delta_end) 2u / sqrt(theta_dot^2(u^2)) du`,
-//! whose integrand is smooth and tends to `2 / sqrt(-2 theta_ddot_i)` at `u = 0`. The model
-//! functions take `delta` directly, so no `theta_i - theta` cancellation enters. The same
-//! substitution is harmless when the phase starts moving (`theta_dot_i != 0`, e.g. the free
-//! rod after separation): the integrand is then `~ 2u / |theta_dot_i|`, also smooth.
+//! # The substitution
+//! The fall is parametrised by `s = sin(theta)`, which is monotone on a phase
+//! (`0 < theta < pi/2`), so no trigonometric function is evaluated inside the integral: the
+//! generated [`Reduction::theta_dot_sq_sc`] takes `s`, `cos(theta)` and their drops from the
+//! start. With `dt = ds / (cos(theta) |theta_dot|)` the integrand has two square-root
+//! singularities: `theta_dot^2` vanishes like the drop `w = sin(theta_i) - s` at the start when
+//! released from rest, and `cos(theta) = sqrt((1 - s)(1 + s))` vanishes at `w = -e`,
+//! `e = 1 - sin(theta_i)`, just outside the interval when the rod starts nearly upright. With
+//! `w = e sinh^2(v)`, `dw / sqrt(w (w + e)) = 2 dv` and `1 - s = e cosh^2(v)` exactly, so
+//! `t = integral 2 sqrt(e) sinh(v) / sqrt((1 + s) theta_dot^2) dv` has a smooth integrand of
+//! one scale from the flat start (`e -> 1`, where `v ~ sqrt(w)`) to the upright one (`e -> 0`,
+//! where the time grows like `v_end ~ log(1/e)`). `cos(theta) = sqrt(e) cosh(v) sqrt(1 + s)` and
+//! `cos(theta_i) - cos(theta) = -w (sin(theta_i) + s) / (cos(theta_i) + cos(theta))` are formed
+//! without cancellation.
 //!
-//! Near-upright starts (`a/ell -> 1`) make `theta_ddot_i -> 0`, and the integrand varies on a
-//! scale `u ~ sqrt(cos theta_i)` near the start; the adaptive bisection grades the panels there
-//! by itself. Each accepted panel is kept, so `t(u)` at any `u` afterwards costs one partial
-//! panel (see [`TimeMesh::time_at_u`]).
+//! Released from rest, `theta_dot^2` vanishes like the drop `w = e sinh^2 v`, so the
+//! integrand is `2 / sqrt((1 + s) theta_dot^2 / w)`, an *even* analytic function of `v` (its
+//! value at `v = 0` is the limit `2 / sqrt(-2 theta_ddot_i (1 + sin theta_i) / cos theta_i)`),
+//! and the first panel `[0, b]` is half of a symmetric rule on `[-b, b]`: a rule of `2m` nodes
+//! costs `m` evaluations there. A phase that starts moving (`theta_dot_i < 0`, the free rod
+//! after separation) has an integrand that vanishes at `v = 0` and is not even.
+//!
+//! # Error control
+//! Each panel is integrated by two Gauss–Legendre rules chosen by the panel's length from a
+//! [`RuleStep`] schedule (the nearest complex singularities of the integrand lie about `pi/2`
+//! off the real `v` axis, or on it beyond the phase's end, so the panel's length sets the
+//! convergence rate); the finer value is kept when the two agree to the tolerance, otherwise the
+//! panel is halved. Two rules on the same panel do not agree by accident when a near-singularity
+//! sits at the panel's end, which is how comparing a panel with its halves is fooled (both then
+//! carry the same unresolved error): with the hinged rod and a heavy cube the integrand has
+//! complex singularities (`1 + 3 n s^2 = 0`) just past the end of the phase, and a
+//! panel-versus-halves test accepted panels with errors of 1e-10 there.
 
+use crate::model::{Reduction, ReductionInfo, start_offsets};
 use crate::results::Work;
 use crate::solve::SolveError;
 use crate::system::System;
 use gauss_quad::GaussLegendre;
+use std::collections::HashMap;
 use std::num::NonZeroUsize;
-use std::sync::OnceLock;
+use std::sync::{Mutex, OnceLock};
 
-/// Nodes per Gauss–Legendre panel.
-pub const GL_ORDER: usize = 10;
+/// One step of a rule schedule: panels up to `max_len` long (in `v`; a first panel `[0, b]`
+/// from rest counts as `[-b, b]`, `2b` long) are integrated by Gauss–Legendre rules of `low` and
+/// `high` nodes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RuleStep {
+    /// Longest panel (in `v`) this step applies to.
+    pub max_len: f64,
+    /// Nodes of the coarse rule (the error estimate).
+    pub low: usize,
+    /// Nodes of the fine rule (the value kept).
+    pub high: usize,
+}
+
+/// The default schedule. The steps were set so that the coarse rule alone is within about
+/// 1e-13 of the integral for the reduced models across `n` 1e-3..1e3 and `a/ell` 0.01..0.99
+/// (`rodcube accuracy` shows the cost of other settings); the schedule only sets the cost, as
+/// every panel is still accepted only by the agreement of its two rules.
+pub const SCHEDULE: [RuleStep; 3] = [
+    RuleStep {
+        max_len: 0.6,
+        low: 6,
+        high: 10,
+    },
+    RuleStep {
+        max_len: 1.0,
+        low: 8,
+        high: 12,
+    },
+    RuleStep {
+        max_len: 1.6,
+        low: 10,
+        high: 14,
+    },
+];
+
+/// The per-point solver's tolerance: the rules of a panel must agree to 1e-12 relative, which
+/// leaves the kept (finer) value within about 1e-15.
+pub const ACCEPT: f64 = 1e-12;
+
+/// A phase integrated to a relative tolerance `tol` has its panels accepted when their rules
+/// agree to `tol * TOL_SAFETY`: where a singularity sits just past a panel's end the kept rule
+/// is only a few times better than the agreement of the two (errors of 1.7e-10 were seen at an
+/// agreement of 1e-10 with the hinged rod and a heavy cube), so a hundredfold margin makes the
+/// result meet `tol` itself.
+pub const TOL_SAFETY: f64 = 1e-2;
 
 /// Smallest relative tolerance honoured (a few ulps: the rounding floor of one panel sum).
 pub const MIN_TOL: f64 = 4.0 * f64::EPSILON;
 
-/// Most panels one adaptive integral may use before giving up.
-pub const MAX_PANELS: usize = 20_000;
+/// Most nodes of a rule.
+pub const MAX_NODES: usize = 64;
 
-/// The Gauss–Legendre nodes and weights on `[-1, 1]` of order [`GL_ORDER`], computed once.
-pub fn rule() -> &'static [(f64, f64)] {
-    static RULE: OnceLock<Vec<(f64, f64)>> = OnceLock::new();
-    RULE.get_or_init(|| gauss_legendre_rule(GL_ORDER))
-}
+/// Most panels one integral may use before giving up.
+pub const MAX_PANELS: usize = 20_000;
 
 /// Gauss–Legendre nodes and weights on `[-1, 1]` of any order (0 is treated as 1).
 pub fn gauss_legendre_rule(order: usize) -> Vec<(f64, f64)> {
@@ -43,194 +106,482 @@ pub fn gauss_legendre_rule(order: usize) -> Vec<(f64, f64)> {
         .to_vec()
 }
 
-/// One panel of an adaptive integral.
+/// A Gauss–Legendre rule on `[-1, 1]` kept as its nodes `x > 0` with their weights (each used
+/// at `+x` and `-x`) and the weight of the node at 0 (0 for even orders).
+#[derive(Debug, Clone, PartialEq)]
+pub struct HalfRule {
+    /// Nodes in all.
+    pub nodes: usize,
+    /// `(x, w)` for `x > 0`, ascending.
+    pub pairs: Vec<(f64, f64)>,
+    /// Weight of the node at 0.
+    pub centre: f64,
+}
+
+/// The rule of `order` nodes (clamped to `1..=MAX_NODES`), computed once per process and kept
+/// for its life, so that making a solver is cheap enough to do per call.
+pub fn half_rule(order: usize) -> &'static HalfRule {
+    type Rules = Mutex<HashMap<usize, &'static HalfRule>>;
+    static RULES: OnceLock<Rules> = OnceLock::new();
+    let order = order.clamp(1, MAX_NODES);
+    let cache = RULES.get_or_init(|| Mutex::new(HashMap::new()));
+    let mut map = match cache.lock() {
+        Ok(map) => map,
+        Err(poisoned) => poisoned.into_inner(),
+    };
+    map.entry(order).or_insert_with(|| {
+        let full = gauss_legendre_rule(order);
+        // Nodes come in pairs +-x; an odd order adds x = 0 (within rounding).
+        let mut pairs: Vec<(f64, f64)> = full.iter().filter(|(x, _)| *x > 1e-12).copied().collect();
+        pairs.sort_by(|p, q| p.0.total_cmp(&q.0));
+        let centre = full
+            .iter()
+            .filter(|(x, _)| x.abs() <= 1e-12)
+            .map(|(_, w)| *w)
+            .sum();
+        Box::leak(Box::new(HalfRule {
+            nodes: full.len(),
+            pairs,
+            centre,
+        }))
+    })
+}
+
+/// The error control of the quadrature: a rule pair per panel length, and the relative
+/// agreement a panel's two rules must reach.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Control {
+    /// `(max_len, coarse, fine)`, shortest first.
+    steps: Vec<(f64, &'static HalfRule, &'static HalfRule)>,
+    /// Relative agreement asked of a panel's rules.
+    pub accept: f64,
+}
+
+impl Control {
+    /// A control from a schedule (steps in any order; an empty one means [`SCHEDULE`]) and a
+    /// relative tolerance (raised to [`MIN_TOL`]; not finite means [`MIN_TOL`]).
+    pub fn new(schedule: &[RuleStep], accept: f64) -> Control {
+        let schedule = if schedule.is_empty() {
+            &SCHEDULE[..]
+        } else {
+            schedule
+        };
+        let mut steps: Vec<_> = schedule
+            .iter()
+            .map(|st| {
+                let len = if st.max_len > 0.0 {
+                    st.max_len
+                } else {
+                    f64::INFINITY
+                };
+                (len, half_rule(st.low), half_rule(st.high))
+            })
+            .collect();
+        steps.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let accept = if accept.is_finite() {
+            accept.max(MIN_TOL)
+        } else {
+            MIN_TOL
+        };
+        Control { steps, accept }
+    }
+
+    /// The default schedule at a relative tolerance.
+    pub fn with_tolerance(accept: f64) -> Control {
+        Control::new(&SCHEDULE, accept)
+    }
+
+    /// `(max_len, low, high)` rule orders of the steps, shortest first.
+    pub fn steps(&self) -> Vec<(f64, usize, usize)> {
+        self.steps
+            .iter()
+            .map(|(len, lo, hi)| (*len, lo.nodes, hi.nodes))
+            .collect()
+    }
+
+    /// The step for a panel of this length (the longest step beyond its reach).
+    fn step_for(&self, len: f64) -> (&'static HalfRule, &'static HalfRule) {
+        let last = self.steps.len().saturating_sub(1);
+        let i = self.steps.iter().position(|s| len <= s.0).unwrap_or(last);
+        (self.steps[i].1, self.steps[i].2)
+    }
+
+    /// The longest panel of the schedule.
+    fn longest(&self) -> f64 {
+        self.steps.last().map_or(f64::INFINITY, |s| s.0)
+    }
+}
+
+/// One accepted panel `[a, b]` in `v`, its value and the length its rules were chosen for.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Panel {
-    /// Lower limit.
+    /// Lower limit (in `v`).
     pub a: f64,
-    /// Upper limit.
+    /// Upper limit (in `v`).
     pub b: f64,
     /// Integral over `[a, b]`.
     pub value: f64,
 }
 
-/// An adaptive integral and the panels it accepted, in ascending order.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Adaptive {
-    /// The integral.
-    pub value: f64,
-    /// Accepted panels, covering the interval in order.
-    pub panels: Vec<Panel>,
+/// `(sinh x, cosh x)` from one `exp_m1`, accurate for small and large `x` alike.
+#[inline]
+fn sinh_cosh(x: f64) -> (f64, f64) {
+    let em = x.exp_m1();
+    let inv = 1.0 / (1.0 + em);
+    (0.5 * (em + em * inv), 0.5 * (1.0 + em + inv))
 }
 
-/// One Gauss–Legendre panel over `[a, b]` with the given rule.
-pub fn panel<F>(
-    rule: &[(f64, f64)],
-    f: &mut F,
-    a: f64,
-    b: f64,
-    evals: &mut u64,
-) -> Result<f64, SolveError>
-where
-    F: FnMut(f64) -> Result<f64, SolveError>,
-{
-    let (half, centre) = (0.5 * (b - a), 0.5 * (a + b));
-    let mut sum = 0.0;
-    for &(x, w) in rule {
-        sum += w * f(centre + half * x)?;
-    }
-    *evals += rule.len() as u64;
-    Ok(half * sum)
+/// A falling phase in the variable `v` of the module docs: what the integrand needs.
+#[derive(Clone, Copy)]
+pub struct Fall<'a> {
+    model: &'static str,
+    red: &'a dyn Reduction,
+    k: &'a [f64],
+    si: f64,
+    ci: f64,
+    e: f64,
+    root_e: f64,
+    from_rest: bool,
+    /// The phase's end, for error messages.
+    delta_end: f64,
 }
 
-/// Adaptive bisection with a fixed Gauss–Legendre rule: a panel is accepted when its two halves
-/// agree with it to `tol` relative; the halves are kept. For an integrand of one sign the local
-/// relative test bounds the global relative error. `tol` below [`MIN_TOL`] is raised to it.
-pub fn adaptive<F>(
-    rule: &[(f64, f64)],
-    f: &mut F,
-    a: f64,
-    b: f64,
-    tol: f64,
-    evals: &mut u64,
-) -> Result<Adaptive, SolveError>
-where
-    F: FnMut(f64) -> Result<f64, SolveError>,
-{
-    let tol = if tol.is_finite() {
-        tol.max(MIN_TOL)
-    } else {
-        MIN_TOL
-    };
-    let mut panels = Vec::new();
-    if b == a {
-        return Ok(Adaptive { value: 0.0, panels });
+impl std::fmt::Debug for Fall<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Fall")
+            .field("model", &self.model)
+            .field("sin_theta_i", &self.si)
+            .field("e", &self.e)
+            .field("from_rest", &self.from_rest)
+            .finish()
     }
-    let whole = panel(rule, f, a, b, evals)?;
-    let mut stack = vec![(a, b, whole)];
-    while let Some((lo, hi, whole)) = stack.pop() {
-        let mid = 0.5 * (lo + hi);
-        let left = panel(rule, f, lo, mid, evals)?;
-        let right = panel(rule, f, mid, hi, evals)?;
-        let refined = left + right;
-        let error = (refined - whole).abs();
-        if refined.is_finite() && error <= tol * refined.abs() {
-            panels.push(Panel {
-                a: lo,
-                b: mid,
-                value: left,
+}
+
+impl<'a> Fall<'a> {
+    /// The phase of a reduced system, ending at `delta_end` (for messages; the integral's end is
+    /// given to [`integrate`]). Checks that it falls: from rest `theta_dot^2` must grow from the
+    /// start, moving `theta_dot_i` must be negative, and `theta_i` must be below the vertical.
+    pub fn new(
+        model: &'static str,
+        red: &'a dyn Reduction,
+        k: &'a [f64],
+        layout: &ReductionInfo,
+        delta_end: f64,
+    ) -> Result<Fall<'a>, SolveError> {
+        let theta_dot = k[layout.k_theta_dot_initial];
+        let (si, ci) = (k[layout.k_sin_initial], k[layout.k_cos_initial]);
+        let theta_initial = k[layout.k_theta_initial];
+        if theta_dot > 0.0 {
+            return Err(SolveError::Rising { model, theta_dot });
+        }
+        // 1 - sin(theta_i) without cancellation near upright.
+        let e = ci * ci / (1.0 + si);
+        if !(e > 0.0 && e.is_finite() && si.abs() < 1.0 && ci > 0.0) {
+            return Err(SolveError::BeyondVertical {
+                model,
+                theta_initial,
             });
-            panels.push(Panel {
-                a: mid,
+        }
+        let from_rest = theta_dot == 0.0;
+        let root_e = e.sqrt();
+        let fall = Fall {
+            model,
+            red,
+            k,
+            si,
+            ci,
+            e,
+            root_e,
+            from_rest,
+            delta_end,
+        };
+        if from_rest || theta_dot.is_nan() {
+            // The rod must start to fall: theta_dot^2 positive just past the start (at
+            // sinh v = 1e-4, a drop of 1e-8 e; one rational evaluation, the trigonometry of
+            // `reduced` only for the message).
+            let falls = fall.value(1e-4, (1.0f64 + 1e-8).sqrt());
+            if theta_dot.is_nan() || falls.is_err() {
+                let theta_ddot = red.reduced(k, 0.0).theta_ddot;
+                return Err(match falls {
+                    // It does start to fall, and theta_dot^2 itself is broken just past the start.
+                    Err(broken) if theta_ddot < 0.0 && !theta_dot.is_nan() => broken,
+                    _ => SolveError::NoMotion {
+                        model,
+                        theta_dot,
+                        theta_ddot,
+                    },
+                });
+            }
+        }
+        Ok(fall)
+    }
+    /// The phase of a reduced [`System`] from its start.
+    pub fn of(sys: &'a System, delta_end: f64) -> Result<Fall<'a>, SolveError> {
+        Fall::new(
+            sys.name(),
+            sys.reduction(),
+            sys.k(),
+            sys.layout(),
+            delta_end,
+        )
+    }
+
+    /// Whether the phase starts from rest (its integrand is then even in `v`).
+    pub fn from_rest(&self) -> bool {
+        self.from_rest
+    }
+
+    /// `v` where `sin(theta)` has dropped by `drop >= 0`: `asinh(sqrt(q))`, `q = drop / e`, as
+    /// `log1p(x + q / (1 + sqrt(1 + q)))`, exact for small and large `q` without `hypot`.
+    pub fn v_at_drop(&self, drop: f64) -> f64 {
+        let q = drop.max(0.0) / self.e;
+        (q.sqrt() + q / (1.0 + (1.0 + q).sqrt())).ln_1p()
+    }
+
+    /// `v` at the angle fallen `delta`.
+    pub fn v_at_delta(&self, delta: f64) -> f64 {
+        let theta_i = self.si.asin();
+        let (_, _, ds, _) = start_offsets(theta_i, self.si, self.ci, delta);
+        self.v_at_drop(ds)
+    }
+
+    /// The angle fallen at `v`: `atan2(sin(delta), cos(delta))` from the drops, without the
+    /// cancellation of `theta_i - theta`.
+    pub fn delta_at(&self, v: f64) -> f64 {
+        let (sh, ch) = sinh_cosh(v);
+        let ds = self.e * sh * sh;
+        let s = self.si - ds;
+        let c = self.root_e * ch * (1.0 + s).sqrt();
+        let dc = -ds * (self.si + s) / (self.ci + c);
+        (self.ci * ds - self.si * dc).atan2(self.ci * c + self.si * s)
+    }
+
+    /// `dt/dv` at `v`.
+    pub fn rate(&self, v: f64) -> Result<f64, SolveError> {
+        let (sh, ch) = sinh_cosh(v.abs());
+        self.value(sh, ch)
+    }
+
+    /// The integrand at `v = 0`: 0 when moving; from rest its limit
+    /// `2 / sqrt(-2 theta_ddot_i (1 + sin theta_i) / cos theta_i)` (`theta_dot^2 ~ -2
+    /// theta_ddot_i delta`, `delta ~ w / cos theta_i`), evaluated only by rules with a node
+    /// there.
+    fn centre_value(&self) -> Result<f64, SolveError> {
+        if !self.from_rest {
+            return Ok(0.0);
+        }
+        let theta_ddot = self.red.reduced(self.k, 0.0).theta_ddot;
+        let value = 2.0 / (-2.0 * theta_ddot * (1.0 + self.si) / self.ci).sqrt();
+        if value.is_finite() && value > 0.0 {
+            Ok(value)
+        } else {
+            Err(SolveError::NonFinite {
+                model: self.model,
+                what: "the time integrand's limit at the start",
+                delta: 0.0,
+                value,
+            })
+        }
+    }
+
+    /// The integrand at the node given by its `sinh v` and `cosh v` (`v >= 0`).
+    #[inline]
+    fn value(&self, sh: f64, ch: f64) -> Result<f64, SolveError> {
+        if sh == 0.0 {
+            return self.centre_value();
+        }
+        let (e, si, ci, root_e) = (self.e, self.si, self.ci, self.root_e);
+        let ds = e * sh * sh;
+        let s = si - ds;
+        let plus = 1.0 + s;
+        let c = root_e * ch * plus.sqrt();
+        let dc = -ds * (si + s) / (ci + c);
+        let w2 = self.red.theta_dot_sq_sc(self.k, s, c, ds, dc);
+        if !(w2 > 0.0 && w2.is_finite()) {
+            return Err(self.bad_value(s, w2));
+        }
+        Ok(2.0 * root_e * sh / (plus * w2).sqrt())
+    }
+
+    /// The error for a `theta_dot^2` that is not positive and finite at `sin(theta) = s`.
+    fn bad_value(&self, s: f64, w2: f64) -> SolveError {
+        let delta = self.si.asin() - s.asin();
+        if w2.is_finite() {
+            SolveError::TurningPoint {
+                model: self.model,
+                delta,
+                theta_dot_sq: w2,
+                delta_end: self.delta_end,
+            }
+        } else {
+            SolveError::NonFinite {
+                model: self.model,
+                what: "theta_dot^2",
+                delta,
+                value: w2,
+            }
+        }
+    }
+
+    /// Whether the panel `[a, b]` is the symmetric first panel of a phase from rest.
+    fn symmetric(&self, a: f64) -> bool {
+        self.from_rest && a == 0.0
+    }
+
+    /// The panel's length as its rules see it (a symmetric panel spans `[-b, b]`).
+    fn span(&self, a: f64, b: f64) -> f64 {
+        if self.symmetric(a) { 2.0 * b } else { b - a }
+    }
+
+    /// The rule on the panel `[a, b]`: `(integral, evaluations)`.
+    ///
+    /// On a symmetric panel the nodes are `b x` and the values serve `+x` and `-x`. Otherwise
+    /// the nodes `mid +- h x` share one exponential: `sinh(mid +- h x)` and `cosh(mid +- h x)`
+    /// follow from those of `mid` and of `h x` by the addition theorems (the difference loses at
+    /// most `log2(mid / v)` bits, which the integrand's ratio `sinh v / |theta_dot|` does not
+    /// feel). Iterations do not depend on each other but through the sum, so the divisions and
+    /// roots of different nodes overlap.
+    fn panel(&self, rule: &HalfRule, a: f64, b: f64) -> Result<(f64, u64), SolveError> {
+        let mut acc = 0.0;
+        if self.symmetric(a) {
+            if rule.centre != 0.0 {
+                acc = 0.5 * rule.centre * self.centre_value()?;
+            }
+            for &(x, w) in &rule.pairs {
+                let (sx, cx) = sinh_cosh(b * x);
+                acc += w * self.value(sx, cx)?;
+            }
+            // integral over [0, b] = half the rule over [-b, b].
+            let evals = rule.pairs.len() + usize::from(rule.centre != 0.0);
+            return Ok((b * acc, evals as u64));
+        }
+        let (half, mid) = (0.5 * (b - a), 0.5 * (a + b));
+        let (sm, cm) = sinh_cosh(mid);
+        let mut evals = 2 * rule.pairs.len() as u64;
+        if rule.centre != 0.0 {
+            acc = rule.centre * self.value(sm, cm)?;
+            evals += 1;
+        }
+        for &(x, w) in &rule.pairs {
+            let (sx, cx) = sinh_cosh(half * x);
+            let up = self.value(sm * cx + cm * sx, cm * cx + sm * sx)?;
+            let down = self.value(sm * cx - cm * sx, cm * cx - sm * sx)?;
+            acc += w * (up + down);
+        }
+        Ok((half * acc, evals))
+    }
+
+    /// The fine rule of the step for `span` on `[a, b]`, `a` the start of an accepted panel and
+    /// `b` inside it: the time from `a` to `b`.
+    fn partial(
+        &self,
+        control: &Control,
+        span: f64,
+        a: f64,
+        b: f64,
+    ) -> Result<(f64, u64), SolveError> {
+        let (_, fine) = control.step_for(span);
+        self.panel(fine, a, b)
+    }
+}
+
+/// `t` from the phase's start (`v = 0`) to `v_end`, panel by panel under `control`; each
+/// accepted panel goes to `keep`, in ascending order. Returns the integral and the integrand
+/// evaluations. `stack` is scratch, reused across calls.
+pub fn integrate(
+    fall: &Fall,
+    v_end: f64,
+    control: &Control,
+    stack: &mut Vec<(f64, f64)>,
+    mut keep: impl FnMut(Panel),
+) -> Result<(f64, u64), SolveError> {
+    if !(v_end >= 0.0 && v_end.is_finite()) {
+        return Err(SolveError::BadPhaseEnd {
+            model: fall.model,
+            delta_end: fall.delta_end,
+        });
+    }
+    stack.clear();
+    if v_end == 0.0 {
+        return Ok((0.0, 0));
+    }
+    // The a-priori cut: a first panel of span at most the longest step's, then equal pieces.
+    let longest = control.longest();
+    let first = if fall.from_rest {
+        v_end.min(0.5 * longest)
+    } else {
+        v_end.min(longest)
+    };
+    let rest = v_end - first;
+    let pieces = if rest > 0.0 {
+        ((rest / longest).ceil() as usize).clamp(1, MAX_PANELS)
+    } else {
+        0
+    };
+    for i in (0..pieces).rev() {
+        let lo = first + rest * i as f64 / pieces as f64;
+        let hi = if i + 1 == pieces {
+            v_end
+        } else {
+            first + rest * (i + 1) as f64 / pieces as f64
+        };
+        stack.push((lo, hi));
+    }
+    stack.push((0.0, first));
+    let (mut total, mut evals, mut panels) = (0.0, 0u64, 0usize);
+    while let Some((lo, hi)) = stack.pop() {
+        let (coarse, fine) = control.step_for(fall.span(lo, hi));
+        let (coarse, n_coarse) = fall.panel(coarse, lo, hi)?;
+        let (fine, n_fine) = fall.panel(fine, lo, hi)?;
+        evals += n_coarse + n_fine;
+        let error = (fine - coarse).abs();
+        panels += 1;
+        if fine.is_finite() && error <= control.accept * fine.abs() {
+            total += fine;
+            keep(Panel {
+                a: lo,
                 b: hi,
-                value: right,
+                value: fine,
             });
             continue;
         }
-        let splittable = 0.5 * (lo + mid) > lo && 0.5 * (mid + hi) < hi;
-        if !refined.is_finite()
-            || !error.is_finite()
-            || !splittable
-            || panels.len() + stack.len() + 2 > MAX_PANELS
-        {
-            let estimate = panels.iter().map(|p| p.value).sum::<f64>()
-                + refined
-                + stack.iter().map(|s| s.2).sum::<f64>();
+        let mid = 0.5 * (lo + hi);
+        if !(fine.is_finite() && mid > lo && mid < hi) || panels + stack.len() > MAX_PANELS {
             return Err(SolveError::QuadratureNotConverged {
-                a,
-                b,
-                tol,
-                estimate,
+                a: 0.0,
+                b: v_end,
+                tol: control.accept,
+                estimate: total + fine,
                 error,
-                panels: panels.len() + stack.len(),
+                panels,
             });
         }
-        stack.push((mid, hi, right));
-        stack.push((lo, mid, left));
+        stack.push((mid, hi));
+        stack.push((lo, mid));
     }
-    let value = panels.iter().map(|p| p.value).sum();
-    Ok(Adaptive { value, panels })
+    Ok((total, evals))
 }
 
-/// Checks that a phase can start falling: from rest it needs `theta_ddot_i < 0`, moving it
-/// needs `theta_dot_i < 0`.
-pub fn check_start(sys: &System) -> Result<(), SolveError> {
-    let theta_dot = sys.theta_dot_initial();
-    let model = sys.name();
-    if theta_dot > 0.0 {
-        return Err(SolveError::Rising { model, theta_dot });
-    }
-    if theta_dot == 0.0 {
-        let theta_ddot = sys.reduced(0.0).theta_ddot;
-        if theta_ddot.is_nan() || theta_ddot >= 0.0 {
-            return Err(SolveError::NoMotion {
-                model,
-                theta_dot,
-                theta_ddot,
-            });
-        }
-    }
-    Ok(())
-}
-
-/// The integrand `2u / |theta_dot|` at `delta = u^2`, with its limit at `u = 0`.
-/// `delta_end` only labels a turning-point error.
-pub fn integrand(sys: &System, u: f64, delta_end: f64) -> Result<f64, SolveError> {
-    let model = sys.name();
-    if u == 0.0 {
-        let theta_dot = sys.theta_dot_initial();
-        if theta_dot != 0.0 {
-            return Ok(0.0);
-        }
-        let theta_ddot = sys.reduced(0.0).theta_ddot;
-        return if theta_ddot < 0.0 {
-            Ok(2.0 / (-2.0 * theta_ddot).sqrt())
-        } else {
-            Err(SolveError::NoMotion {
-                model,
-                theta_dot,
-                theta_ddot,
-            })
-        };
-    }
-    let delta = u * u;
-    let theta_dot_sq = sys.reduced(delta).theta_dot_sq;
-    if !theta_dot_sq.is_finite() {
-        return Err(SolveError::NonFinite {
-            model,
-            what: "theta_dot^2",
-            delta,
-            value: theta_dot_sq,
-        });
-    }
-    if theta_dot_sq <= 0.0 {
-        return Err(SolveError::TurningPoint {
-            model,
-            delta,
-            theta_dot_sq,
-            delta_end,
-        });
-    }
-    Ok(2.0 * u / theta_dot_sq.sqrt())
-}
-
-/// `t(delta)` on one phase, from its start to `delta_end`, kept as adaptive panels in `u`.
+/// `t(delta)` on one phase, from its start to `delta_end`, kept as accepted panels in `v`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TimeMesh {
     /// Angle fallen at the end of the phase.
     pub delta_end: f64,
-    /// `sqrt(delta_end)`.
-    pub u_end: f64,
-    /// Accepted panels in `u`.
+    /// `v` at the end.
+    pub v_end: f64,
+    /// Accepted panels in `v`.
     pub panels: Vec<Panel>,
     /// Time at the start of each panel.
     starts: Vec<f64>,
     /// Time from the phase start to `delta_end` (s).
     pub duration: f64,
+    /// The error control the panels were accepted under.
+    control: Control,
 }
 
 impl TimeMesh {
-    /// Integrates the phase of `sys` from its start to `delta_end` to relative tolerance `tol`.
+    /// Integrates the phase of `sys` from its start to `delta_end` to relative tolerance `tol`
+    /// (the two rules of every panel agree to `tol * TOL_SAFETY`, raised to [`MIN_TOL`]).
     pub fn build(
         sys: &System,
         delta_end: f64,
@@ -243,46 +594,51 @@ impl TimeMesh {
                 delta_end,
             });
         }
-        check_start(sys)?;
-        let u_end = delta_end.sqrt();
-        let mut f = |u: f64| integrand(sys, u, delta_end);
-        let adaptive = adaptive(rule(), &mut f, 0.0, u_end, tol, &mut work.integrand_evals)?;
-        let mut starts = Vec::with_capacity(adaptive.panels.len());
+        let fall = Fall::of(sys, delta_end)?;
+        let control = Control::with_tolerance(tol * TOL_SAFETY);
+        let v_end = fall.v_at_delta(delta_end);
+        let mut panels = Vec::new();
+        let (duration, evals) =
+            integrate(&fall, v_end, &control, &mut Vec::new(), |p| panels.push(p))?;
+        work.integrand_evals += evals;
+        let mut starts = Vec::with_capacity(panels.len());
         let mut t = 0.0;
-        for p in &adaptive.panels {
+        for p in &panels {
             starts.push(t);
             t += p.value;
         }
         Ok(TimeMesh {
             delta_end,
-            u_end,
-            panels: adaptive.panels,
+            v_end,
+            panels,
             starts,
-            duration: t,
+            duration,
+            control,
         })
     }
 
-    /// Time from the phase start to `delta = u^2`, for `0 <= u <= u_end` (a relative overshoot of
-    /// up to 1e-6 past the end is extrapolated on the last panel). One partial panel.
-    pub fn time_at_u(&self, sys: &System, u: f64, work: &mut Work) -> Result<f64, SolveError> {
-        if !(u >= 0.0 && u <= self.u_end * (1.0 + 1e-6)) {
+    /// Time from the phase start to `v`, for `0 <= v <= v_end` (a relative overshoot of up to
+    /// 1e-6 past the end is extrapolated on the last panel). One partial panel.
+    pub fn time_at_v(&self, sys: &System, v: f64, work: &mut Work) -> Result<f64, SolveError> {
+        if !(v >= 0.0 && v <= self.v_end * (1.0 + 1e-6)) {
             return Err(SolveError::OutsidePhase {
                 model: sys.name(),
-                delta: u * u,
+                delta: self.delta_at_v(sys, v)?,
                 delta_end: self.delta_end,
             });
         }
-        if u == 0.0 {
+        if v == 0.0 || self.panels.is_empty() {
             return Ok(0.0);
         }
-        let i = self.panels.partition_point(|p| p.a < u).saturating_sub(1);
+        let i = self.panels.partition_point(|p| p.a < v).saturating_sub(1);
         let p = self.panels[i];
-        if u == p.b {
+        if v == p.b {
             return Ok(self.starts[i] + p.value);
         }
-        let delta_end = self.delta_end;
-        let mut f = |v: f64| integrand(sys, v, delta_end);
-        Ok(self.starts[i] + panel(rule(), &mut f, p.a, u, &mut work.integrand_evals)?)
+        let fall = Fall::of(sys, self.delta_end)?;
+        let (t, evals) = fall.partial(&self.control, fall.span(p.a, p.b), p.a, v)?;
+        work.integrand_evals += evals;
+        Ok(self.starts[i] + t)
     }
 
     /// Time from the phase start to the angle fallen `delta`.
@@ -292,7 +648,33 @@ impl TimeMesh {
         delta: f64,
         work: &mut Work,
     ) -> Result<f64, SolveError> {
-        self.time_at_u(sys, delta.max(0.0).sqrt(), work)
+        if delta.is_nan() || delta < 0.0 || delta > self.delta_end * (1.0 + 1e-6) {
+            return Err(SolveError::OutsidePhase {
+                model: sys.name(),
+                delta,
+                delta_end: self.delta_end,
+            });
+        }
+        let v = if delta == self.delta_end {
+            self.v_end
+        } else {
+            Fall::of(sys, self.delta_end)?.v_at_delta(delta)
+        };
+        self.time_at_v(sys, v, work)
+    }
+
+    /// The angle fallen at `v`.
+    pub fn delta_at_v(&self, sys: &System, v: f64) -> Result<f64, SolveError> {
+        if v == self.v_end {
+            return Ok(self.delta_end);
+        }
+        Ok(Fall::of(sys, self.delta_end)?.delta_at(v))
+    }
+
+    /// `dt/dv` at `v`.
+    pub fn rate_at_v(&self, sys: &System, v: f64, work: &mut Work) -> Result<f64, SolveError> {
+        work.integrand_evals += 1;
+        Fall::of(sys, self.delta_end)?.rate(v)
     }
 }
 
@@ -301,30 +683,41 @@ mod tests {
     use super::*;
 
     #[test]
-    fn adaptive_integrates_a_peaked_function() {
-        // integral_0^1 1/sqrt(eps + x^2) dx = asinh(1/sqrt(eps))
-        let eps: f64 = 1e-9;
-        let mut evals = 0;
-        let mut f = |x: f64| Ok(1.0 / (eps + x * x).sqrt());
-        let got = adaptive(rule(), &mut f, 0.0, 1.0, 1e-14, &mut evals).unwrap();
-        let want = (1.0 / eps.sqrt()).asinh();
-        assert!(
-            ((got.value - want) / want).abs() < 1e-13,
-            "{} vs {want}",
-            got.value
-        );
-        assert!(got.panels.windows(2).all(|w| w[0].b == w[1].a));
-        assert_eq!(evals % GL_ORDER as u64, 0);
+    fn half_rules_rebuild_the_gauss_legendre_rules() {
+        for order in 1..=24 {
+            let rule = half_rule(order);
+            let odd = usize::from(rule.centre != 0.0);
+            assert_eq!(rule.nodes, order);
+            assert_eq!(2 * rule.pairs.len() + odd, order, "order {order}");
+            // Exact for x^(2j), j < order (odd powers vanish by symmetry).
+            for j in 0..order {
+                let exact = 2.0 / (2 * j + 1) as f64;
+                let sum: f64 = rule.centre * if j == 0 { 1.0 } else { 0.0 }
+                    + rule
+                        .pairs
+                        .iter()
+                        .map(|&(x, w)| 2.0 * w * x.powi(2 * j as i32))
+                        .sum::<f64>();
+                assert!((sum - exact).abs() < 1e-14, "order {order}, x^{}", 2 * j);
+            }
+        }
     }
 
     #[test]
-    fn a_divergent_integral_is_an_error() {
-        let mut evals = 0;
-        let mut f = |x: f64| Ok(1.0 / x);
-        let err = adaptive(rule(), &mut f, 0.0, 1.0, 1e-12, &mut evals).unwrap_err();
-        assert!(
-            matches!(err, SolveError::QuadratureNotConverged { .. }),
-            "{err}"
-        );
+    fn the_schedule_picks_steps_by_length() {
+        let c = Control::with_tolerance(1e-12);
+        assert_eq!(c.step_for(0.1).1.nodes, SCHEDULE[0].high);
+        assert_eq!(c.step_for(0.8).1.nodes, SCHEDULE[1].high);
+        assert_eq!(c.step_for(100.0).1.nodes, SCHEDULE[2].high);
+        assert_eq!(Control::new(&[], f64::NAN).accept, MIN_TOL);
+    }
+
+    #[test]
+    fn sinh_cosh_is_accurate_small_and_large() {
+        for x in [1e-300, 1e-8, 0.3, 2.0, 30.0] {
+            let (s, c) = sinh_cosh(x);
+            assert!(((s - x.sinh()) / x.sinh()).abs() < 4e-16, "{x}");
+            assert!(((c - x.cosh()) / x.cosh()).abs() < 4e-16, "{x}");
+        }
     }
 }

@@ -1,17 +1,17 @@
 //! Samples of a phase at uniform times. On the fast path `theta(t)` comes from inverting the
-//! quadrature `t(u)` (`delta = u^2`); on the integrated route from the integrator's dense
-//! output.
+//! quadrature `t(v)` (the variable `v` of [`quadrature`](crate::solve::quadrature)); on the
+//! integrated route from the integrator's dense output.
 //!
 //! The first-order form of the energy integral (the paper's eq. 17,
 //! `theta_dot = -sqrt(theta_dot^2(theta))`) is not integrated: released from rest it also has
 //! the solution `theta == theta_i`, and a step-by-step solver may follow it. Instead each sample
-//! time `T` is matched by safeguarded Newton on `u`, `t(u) = T`, with `dt/du` the quadrature
-//! integrand itself; `t(u)` is smooth in `u`, so Newton converges quadratically.
+//! time `T` is matched by safeguarded Newton on `v`, `t(v) = T`, with `dt/dv` the quadrature
+//! integrand itself; `t(v)` is smooth in `v`, so Newton converges quadratically.
 
 use crate::results::Work;
 use crate::solve::SolveError;
 use crate::solve::phases::{IntegratedRun, PhaseRun};
-use crate::solve::quadrature::{TimeMesh, integrand};
+use crate::solve::quadrature::TimeMesh;
 use crate::system::{State, System};
 
 /// Samples of one phase, uniform in time from its start to its end (both included).
@@ -63,7 +63,7 @@ pub fn sample_phase(
         return Err(SolveError::TooFewSamples { samples });
     }
     let mut out = PhaseSamples::default();
-    let (mut u_prev, mut t_prev) = (0.0, 0.0);
+    let (mut v_prev, mut t_prev) = (0.0, 0.0);
     for j in 0..samples {
         let (t, delta) = if j == 0 {
             (0.0, 0.0)
@@ -71,10 +71,10 @@ pub fn sample_phase(
             (mesh.duration, mesh.delta_end)
         } else {
             let target = mesh.duration * j as f64 / (samples - 1) as f64;
-            let u = invert(sys, mesh, target, u_prev, t_prev, work)?;
-            u_prev = u;
+            let v = invert(sys, mesh, target, v_prev, t_prev, work)?;
+            v_prev = v;
             t_prev = target;
-            (target, u * u)
+            (target, mesh.delta_at_v(sys, v)?)
         };
         push(sys, &mut out, t, delta);
     }
@@ -101,8 +101,8 @@ pub fn delta_at_time(
     if t == mesh.duration {
         return Ok(mesh.delta_end);
     }
-    let u = invert(sys, mesh, t, 0.0, 0.0, work)?;
-    Ok(u * u)
+    let v = invert(sys, mesh, t, 0.0, 0.0, work)?;
+    mesh.delta_at_v(sys, v)
 }
 
 fn push(sys: &System, out: &mut PhaseSamples, t: f64, delta: f64) {
@@ -198,12 +198,12 @@ pub fn sample_friction(run: &PhaseRun, s: &PhaseSamples) -> Result<Vec<[Vec<f64>
     }
 }
 
-/// Solves `t(u) = target` for `u` in `[u_lo, u_end]`, knowing `t(u_lo) = t_lo <= target`.
+/// Solves `t(v) = target` for `v` in `[v_lo, v_end]`, knowing `t(v_lo) = t_lo <= target`.
 fn invert(
     sys: &System,
     mesh: &TimeMesh,
     target: f64,
-    u_lo: f64,
+    v_lo: f64,
     t_lo: f64,
     work: &mut Work,
 ) -> Result<f64, SolveError> {
@@ -212,53 +212,38 @@ fn invert(
         duration: mesh.duration,
         reason,
     };
-    let (mut lo, mut hi) = (u_lo, mesh.u_end);
-    // First guess: a Taylor step in delta from the bracket's start.
-    let delta_lo = u_lo * u_lo;
-    let dt = target - t_lo;
-    let guess_delta = if delta_lo == 0.0 {
-        let theta_dot = sys.theta_dot_initial();
-        let theta_ddot = sys.reduced(0.0).theta_ddot;
-        -theta_dot * dt - 0.5 * theta_ddot * dt * dt
-    } else {
-        let r = sys.reduced(delta_lo);
-        delta_lo + r.theta_dot_sq.max(0.0).sqrt() * dt - 0.5 * r.theta_ddot * dt * dt
-    };
-    let mut u = if guess_delta.is_finite() && guess_delta > 0.0 {
-        guess_delta.sqrt()
-    } else {
-        0.5 * (lo + hi)
-    };
-    if !(u > lo && u < hi) {
-        u = 0.5 * (lo + hi);
+    let (mut lo, mut hi) = (v_lo, mesh.v_end);
+    // First guess: a Newton step from the bracket's start (dt/dv is finite there).
+    let mut v = v_lo + (target - t_lo) / mesh.rate_at_v(sys, v_lo, work)?;
+    if !(v > lo && v < hi) {
+        v = 0.5 * (lo + hi);
     }
     for _ in 0..200 {
-        let t = mesh.time_at_u(sys, u, work)?;
+        let t = mesh.time_at_v(sys, v, work)?;
         let residual = t - target;
         if residual == 0.0 {
-            return Ok(u);
+            return Ok(v);
         }
         if residual < 0.0 {
-            lo = u;
+            lo = v;
         } else {
-            hi = u;
+            hi = v;
         }
-        work.integrand_evals += 1;
-        let slope = integrand(sys, u, mesh.delta_end)?;
-        let newton = u - residual / slope;
-        let step = (newton - u).abs();
-        if step <= 2.0 * f64::EPSILON * u {
+        let slope = mesh.rate_at_v(sys, v, work)?;
+        let newton = v - residual / slope;
+        let step = (newton - v).abs();
+        if step <= 2.0 * f64::EPSILON * v {
             return Ok(newton.clamp(lo, hi));
         }
         let mid = 0.5 * (lo + hi);
         if !(mid > lo && mid < hi) {
-            return Ok(u);
+            return Ok(v);
         }
-        u = if newton > lo && newton < hi {
+        v = if newton > lo && newton < hi {
             newton
         } else {
             mid
         };
     }
-    Err(fail("Newton on u did not converge in 200 steps"))
+    Err(fail("Newton on v did not converge in 200 steps"))
 }

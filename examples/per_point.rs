@@ -1,0 +1,63 @@
+//! Per-point cost probe: solves the first N points (default 1000) of a fixed set of the paper's
+//! model with the public per-point API, single-threaded, and prints the sum of the separation
+//! angles plus times to 17 significant digits (run it under `valgrind --tool=callgrind` to count
+//! instructions per point; see `benches/README.md`).
+//!
+//! The set: the 100 x 100 grid `n_i = 10^(-3 + 6 i / 99)`, `a/ell_j = 0.01 + 0.98 j / 99`
+//! (`ell = g = m1 = 1`, `m2 = n`), row-major by `i`; point `k` is grid index
+//! `(7919 k) mod 10000`.
+//!
+//! Usage: `cargo run --release --example per_point -- [N]`.
+
+use rodcube::models;
+use rodcube::solve::lean::LeanSolver;
+use std::process::ExitCode;
+
+/// Parameters `[m1, m2, ell, a, g]` of point `k` of the set (`n` holds the grid's 100 mass
+/// ratios, computed once).
+fn point(n: &[f64], k: usize) -> [f64; 5] {
+    let index = (7919 * k) % 10_000;
+    let (i, j) = (index / 100, index % 100);
+    let a = 0.01 + 0.98 * j as f64 / 99.0;
+    [1.0, n[i], 1.0, a, 1.0]
+}
+
+fn main() -> ExitCode {
+    let count = match std::env::args().nth(1) {
+        None => 1000,
+        Some(arg) => match arg.parse::<usize>() {
+            Ok(n) => n,
+            Err(_) => {
+                eprintln!("per_point: N must be a non-negative integer, got {arg:?}");
+                return ExitCode::from(2);
+            }
+        },
+    };
+    let Some(model) = models::find("rod_cube") else {
+        eprintln!("per_point: the model rod_cube is not generated");
+        return ExitCode::FAILURE;
+    };
+    let n: Vec<f64> = (0..100)
+        .map(|i| 10f64.powf(-3.0 + 6.0 * i as f64 / 99.0))
+        .collect();
+    let points: Vec<[f64; 5]> = (0..count).map(|k| point(&n, k)).collect();
+    let mut solver = match LeanSolver::new(model) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("per_point: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let mut sum = 0.0;
+    for (k, p) in points.iter().enumerate() {
+        match solver.solve(p) {
+            Ok(r) => sum += r.separation_angle + r.separation_time,
+            Err(e) => {
+                eprintln!("per_point: point {k} ({p:?}): {e}");
+                return ExitCode::FAILURE;
+            }
+        }
+    }
+    println!("{sum:.16e}");
+    ExitCode::SUCCESS
+}
