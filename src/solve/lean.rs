@@ -11,8 +11,9 @@
 
 use crate::model::{Model, ModelInfo, Reduction, ReductionInfo};
 use crate::solve::SolveError;
-use crate::solve::poly::{self, MAX_DEGREE};
+use crate::solve::poly::MAX_DEGREE;
 use crate::solve::quadrature::{self, ACCEPT, Control, Fall, RuleStep, SCHEDULE};
+use crate::solve::separation::separation_root;
 use crate::system::{SystemError, check_parameters, prepare_constants};
 
 /// One point's separation.
@@ -161,24 +162,15 @@ impl<'m> LeanSolver<'m> {
     fn separation(&mut self) -> Result<(f64, f64), SolveError> {
         let info = self.info;
         self.red.separation_polynomial(&self.k, &mut self.coeffs);
-        if self.coeffs.iter().any(|c| !c.is_finite()) || self.coeffs.iter().all(|&c| c == 0.0) {
-            return Err(SolveError::BadPolynomial {
-                model: info.name,
-                coefficients: self.coeffs.clone(),
-            });
-        }
         let hi = self.k[self.layout.k_sin_initial];
-        match poly::largest_root(&self.coeffs, self.sin_end, hi, &mut self.evals) {
-            Some(Some(s)) => Ok((s.asin(), hi - s)),
-            Some(None) => Err(SolveError::NoSeparation {
+        let root = separation_root(info.name, &self.coeffs, self.sin_end, hi, &mut self.evals)?;
+        match root {
+            Some(s) => Ok((s.asin(), hi - s)),
+            None => Err(SolveError::NoSeparation {
                 model: info.name,
                 coefficients: self.coeffs.clone(),
                 lo: self.sin_end,
                 hi,
-            }),
-            None => Err(SolveError::BadPolynomial {
-                model: info.name,
-                coefficients: self.coeffs.clone(),
             }),
         }
     }

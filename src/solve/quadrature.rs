@@ -231,6 +231,15 @@ fn sinh_cosh(x: f64) -> (f64, f64) {
     (0.5 * (em + em * inv), 0.5 * (1.0 + em + inv))
 }
 
+/// The angle at one node: `sin`, `cos`, their drops from the start, and `1 + sin`.
+struct Node {
+    s: f64,
+    c: f64,
+    ds: f64,
+    dc: f64,
+    plus: f64,
+}
+
 /// A falling phase in the variable `v` of the module docs: what the integrand needs.
 #[derive(Clone, Copy)]
 pub struct Fall<'a> {
@@ -268,6 +277,20 @@ impl<'a> Fall<'a> {
         layout: &ReductionInfo,
         delta_end: f64,
     ) -> Result<Fall<'a>, SolveError> {
+        let fall = Fall::geometry(model, red, k, layout, delta_end)?;
+        fall.check_falls(k[layout.k_theta_dot_initial])?;
+        Ok(fall)
+    }
+
+    /// The phase's constants, checking only that it does not rise and starts below the
+    /// vertical (what [`Fall::new`] checks before asking whether it falls).
+    fn geometry(
+        model: &'static str,
+        red: &'a dyn Reduction,
+        k: &'a [f64],
+        layout: &ReductionInfo,
+        delta_end: f64,
+    ) -> Result<Fall<'a>, SolveError> {
         let theta_dot = k[layout.k_theta_dot_initial];
         let (si, ci) = (k[layout.k_sin_initial], k[layout.k_cos_initial]);
         let theta_initial = k[layout.k_theta_initial];
@@ -283,23 +306,27 @@ impl<'a> Fall<'a> {
             });
         }
         let from_rest = theta_dot == 0.0;
-        let root_e = e.sqrt();
-        let fall = Fall {
+        Ok(Fall {
             model,
             red,
             k,
             si,
             ci,
             e,
-            root_e,
+            root_e: e.sqrt(),
             from_rest,
             delta_end,
-        };
-        if from_rest || theta_dot.is_nan() {
+        })
+    }
+
+    /// From rest (or with a rate that is not a number) the rod must start to fall.
+    fn check_falls(&self, theta_dot: f64) -> Result<(), SolveError> {
+        let (model, red, k) = (self.model, self.red, self.k);
+        if self.from_rest || theta_dot.is_nan() {
             // The rod must start to fall: theta_dot^2 positive just past the start (at
             // sinh v = 1e-4, a drop of 1e-8 e; one rational evaluation, the trigonometry of
             // `reduced` only for the message).
-            let falls = fall.value(1e-4, (1.0f64 + 1e-8).sqrt());
+            let falls = self.value(1e-4, (1.0f64 + 1e-8).sqrt());
             if theta_dot.is_nan() || falls.is_err() {
                 let theta_ddot = red.reduced(k, 0.0).theta_ddot;
                 return Err(match falls {
@@ -313,8 +340,9 @@ impl<'a> Fall<'a> {
                 });
             }
         }
-        Ok(fall)
+        Ok(())
     }
+
     /// The phase of a reduced [`System`] from its start.
     pub fn of(sys: &'a System, delta_end: f64) -> Result<Fall<'a>, SolveError> {
         Fall::new(
@@ -323,6 +351,17 @@ impl<'a> Fall<'a> {
             sys.k(),
             sys.layout(),
             delta_end,
+        )
+    }
+
+    /// The phase of a [`TimeMesh`] already built (and so checked) on `sys`: its constants only.
+    fn of_mesh(sys: &'a System, mesh: &TimeMesh) -> Result<Fall<'a>, SolveError> {
+        Fall::geometry(
+            sys.name(),
+            sys.reduction(),
+            sys.k(),
+            sys.layout(),
+            mesh.delta_end,
         )
     }
 
@@ -349,11 +388,8 @@ impl<'a> Fall<'a> {
     /// cancellation of `theta_i - theta`.
     pub fn delta_at(&self, v: f64) -> f64 {
         let (sh, ch) = sinh_cosh(v);
-        let ds = self.e * sh * sh;
-        let s = self.si - ds;
-        let c = self.root_e * ch * (1.0 + s).sqrt();
-        let dc = -ds * (self.si + s) / (self.ci + c);
-        (self.ci * ds - self.si * dc).atan2(self.ci * c + self.si * s)
+        let n = self.node(sh, ch);
+        (self.ci * n.ds - self.si * n.dc).atan2(self.ci * n.c + self.si * n.s)
     }
 
     /// `dt/dv` at `v`.
@@ -384,23 +420,30 @@ impl<'a> Fall<'a> {
         }
     }
 
+    /// The angle at `v` (given by `sinh v`, `cosh v`): `sin(theta)` and `cos(theta)` with their
+    /// drops from the start, formed without cancellation (module docs).
+    #[inline]
+    fn node(&self, sh: f64, ch: f64) -> Node {
+        let ds = self.e * sh * sh;
+        let s = self.si - ds;
+        let plus = 1.0 + s;
+        let c = self.root_e * ch * plus.sqrt();
+        let dc = -ds * (self.si + s) / (self.ci + c);
+        Node { s, c, ds, dc, plus }
+    }
+
     /// The integrand at the node given by its `sinh v` and `cosh v` (`v >= 0`).
     #[inline]
     fn value(&self, sh: f64, ch: f64) -> Result<f64, SolveError> {
         if sh == 0.0 {
             return self.centre_value();
         }
-        let (e, si, ci, root_e) = (self.e, self.si, self.ci, self.root_e);
-        let ds = e * sh * sh;
-        let s = si - ds;
-        let plus = 1.0 + s;
-        let c = root_e * ch * plus.sqrt();
-        let dc = -ds * (si + s) / (ci + c);
-        let w2 = self.red.theta_dot_sq_sc(self.k, s, c, ds, dc);
+        let n = self.node(sh, ch);
+        let w2 = self.red.theta_dot_sq_sc(self.k, n.s, n.c, n.ds, n.dc);
         if !(w2 > 0.0 && w2.is_finite()) {
-            return Err(self.bad_value(s, w2));
+            return Err(self.bad_value(n.s, w2));
         }
-        Ok(2.0 * root_e * sh / (plus * w2).sqrt())
+        Ok(2.0 * self.root_e * sh / (n.plus * w2).sqrt())
     }
 
     /// The error for a `theta_dot^2` that is not positive and finite at `sin(theta) = s`.
@@ -635,7 +678,7 @@ impl TimeMesh {
         if v == p.b {
             return Ok(self.starts[i] + p.value);
         }
-        let fall = Fall::of(sys, self.delta_end)?;
+        let fall = Fall::of_mesh(sys, self)?;
         let (t, evals) = fall.partial(&self.control, fall.span(p.a, p.b), p.a, v)?;
         work.integrand_evals += evals;
         Ok(self.starts[i] + t)
@@ -658,7 +701,7 @@ impl TimeMesh {
         let v = if delta == self.delta_end {
             self.v_end
         } else {
-            Fall::of(sys, self.delta_end)?.v_at_delta(delta)
+            Fall::of_mesh(sys, self)?.v_at_delta(delta)
         };
         self.time_at_v(sys, v, work)
     }
@@ -668,13 +711,13 @@ impl TimeMesh {
         if v == self.v_end {
             return Ok(self.delta_end);
         }
-        Ok(Fall::of(sys, self.delta_end)?.delta_at(v))
+        Ok(Fall::of_mesh(sys, self)?.delta_at(v))
     }
 
     /// `dt/dv` at `v`.
     pub fn rate_at_v(&self, sys: &System, v: f64, work: &mut Work) -> Result<f64, SolveError> {
         work.integrand_evals += 1;
-        Fall::of(sys, self.delta_end)?.rate(v)
+        Fall::of_mesh(sys, self)?.rate(v)
     }
 }
 

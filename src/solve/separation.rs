@@ -60,14 +60,34 @@ pub fn separation(sys: &System, work: &mut Work) -> Result<SeparationOutcome, So
         return first_zero(sys, force, work);
     }
     let (coeffs, lo, hi) = setup(sys)?;
-    match poly::largest_root(&coeffs, lo, hi, &mut work.polynomial_evals) {
-        Some(Some(s)) => Ok(SeparationOutcome::Separates(at_sine(sys, s))),
-        Some(None) => Ok(SeparationOutcome::NoSeparationBeforeFloor),
-        None => Err(SolveError::BadPolynomial {
-            model: info.name,
-            coefficients: coeffs,
-        }),
+    Ok(
+        match separation_root(info.name, &coeffs, lo, hi, &mut work.polynomial_evals)? {
+            Some(s) => SeparationOutcome::Separates(at_sine(sys, s)),
+            None => SeparationOutcome::NoSeparationBeforeFloor,
+        },
+    )
+}
+
+/// The separation root of a model's polynomial (coefficients lowest degree first): its largest
+/// sign-changing root in `(lo, hi)`, `None` when there is none; coefficients that are not all
+/// finite, all zero, or of a degree above [`poly::MAX_DEGREE`] are a
+/// [`SolveError::BadPolynomial`]. The planner and the per-point solver both call it.
+#[inline]
+pub fn separation_root(
+    model: &'static str,
+    coeffs: &[f64],
+    lo: f64,
+    hi: f64,
+    evals: &mut u64,
+) -> Result<Option<f64>, SolveError> {
+    let bad = || SolveError::BadPolynomial {
+        model,
+        coefficients: coeffs.to_vec(),
+    };
+    if coeffs.iter().any(|c| !c.is_finite()) || coeffs.iter().all(|&c| c == 0.0) {
+        return Err(bad());
     }
+    poly::largest_root(coeffs, lo, hi, evals).ok_or_else(bad)
 }
 
 /// Where the contact runs off its edge: the first zero of the edge margin, which on the fast
@@ -152,12 +172,6 @@ fn setup(sys: &System) -> Result<(Vec<f64>, f64, f64), SolveError> {
         return Err(SolveError::NoContact { model: info.name });
     }
     let coeffs = sys.separation_coefficients();
-    if coeffs.iter().any(|c| !c.is_finite()) || coeffs.iter().all(|&c| c == 0.0) {
-        return Err(SolveError::BadPolynomial {
-            model: info.name,
-            coefficients: coeffs,
-        });
-    }
     let hi = sys.reduced(0.0).sin;
     let lo = sys.end_angle().sin();
     if !hi.is_finite() {
