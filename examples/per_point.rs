@@ -59,5 +59,11 @@ fn main() -> ExitCode {
         }
     }
     println!("{sum:.16e}");
+    if std::env::var_os("PER_POINT_EVALS").is_some() {
+        eprintln!(
+            "evaluations per point: {:.2}",
+            solver.evals as f64 / count.max(1) as f64
+        );
+    }
     ExitCode::SUCCESS
 }

@@ -121,6 +121,8 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 9,
         separation_degree: 0,
         polynomial_separation: false,
+        fall_degree: None,
+        lean_constants: &[6, 7, 8, 9],
     }),
     route_note: "",
 };
@@ -139,10 +141,7 @@ impl Model for HingedCylinder {
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
         k[..6].copy_from_slice(p);
-        k[6] = k[4];
-        k[7] = 0.0;
-        k[8] = k[6].sin();
-        k[9] = k[6].cos();
+        Reduction::prepare_lean(self, p, k);
         let c4_t0 = (k[3] * k[3]);
         k[10] = (-(c4_t0 * k[1] / (k[8] * k[8]))
             + (2.0 * c4_t0 * k[1] / k[8].powi(4))
@@ -374,6 +373,18 @@ impl Reduction for HingedCylinder {
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..43]; // one bounds check for all constant loads
+    }
+
+    fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        k[..6].copy_from_slice(p);
+        k[6] = k[4];
+        k[7] = 0.0;
+        k[8] = k[6].sin();
+        k[9] = k[6].cos();
+    }
+
+    fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
         let k = &k[..43]; // one bounds check for all constant loads
     }
 

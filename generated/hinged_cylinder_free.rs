@@ -127,6 +127,8 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 13,
         separation_degree: 0,
         polynomial_separation: false,
+        fall_degree: None,
+        lean_constants: &[10, 11, 12, 13],
     }),
     route_note: "",
 };
@@ -145,10 +147,7 @@ impl Model for HingedCylinderFree {
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
         k[..10].copy_from_slice(p);
-        k[10] = k[6];
-        k[11] = k[8];
-        k[12] = k[10].sin();
-        k[13] = k[10].cos();
+        Reduction::prepare_lean(self, p, k);
         k[14] = k[7];
         k[15] = (k[1] * k[9]);
         k[16] = ((k[2] * k[2]) * k[0] / 3.0);
@@ -290,6 +289,18 @@ impl Reduction for HingedCylinderFree {
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..37]; // one bounds check for all constant loads
+    }
+
+    fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        k[..10].copy_from_slice(p);
+        k[10] = k[6];
+        k[11] = k[8];
+        k[12] = k[10].sin();
+        k[13] = k[10].cos();
+    }
+
+    fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
         let k = &k[..37]; // one bounds check for all constant loads
     }
 

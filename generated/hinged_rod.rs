@@ -51,7 +51,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 39,
+    n_constants: 40,
     coordinates: &["theta"],
     reduced: 0,
     cyclic: &[],
@@ -117,6 +117,8 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 8,
         separation_degree: 3,
         polynomial_separation: true,
+        fall_degree: Some(2),
+        lean_constants: &[5, 6, 7, 8, 31, 36, 37, 38, 39],
     }),
     route_note: "",
 };
@@ -133,85 +135,77 @@ impl Model for HingedRod {
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
         k[..5].copy_from_slice(p);
-        k[5] = (k[3] / k[2]).asin();
-        k[6] = 0.0;
-        k[7] = (k[3] / k[2]);
-        let c3_t0 = (k[3] / k[2]);
-        k[8] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
+        Reduction::prepare_lean(self, p, k);
         let c4_t0 = (k[2] * k[2]);
         k[9] = ((c4_t0 * k[0] / 3.0) + (c4_t0 * k[1] * (k[7] * k[7])));
-        k[10] = (k[3] / k[2]).asin();
-        k[11] = k[2];
-        k[12] = (k[2] / 2.0);
-        k[13] = (-k[2]);
-        k[14] = (-k[2] / 2.0);
-        k[15] = ((k[2] * k[2]) * k[0] / 24.0);
-        let h16_t0 = (k[2] * k[2]);
-        k[16] = ((h16_t0 * k[0] / 8.0) + (h16_t0 * k[1] / 2.0));
-        k[17] = ((k[2] * k[2]) * k[0] / 8.0);
-        k[18] = (k[3] * k[4] * k[1] / 2.0);
-        k[19] = (k[2] * k[4] * k[0] / 2.0);
-        k[20] = ((k[2] * k[2]) * k[0] / 12.0);
-        let h21_t0 = (k[2] * k[2]);
-        k[21] = ((h21_t0 * k[0] / 4.0) + (h21_t0 * k[1]));
-        k[22] = ((k[2] * k[2]) * k[0] / 4.0);
-        k[23] = (-k[2] * k[4] * k[0] / 2.0);
-        k[24] = (-(k[2] * k[2]) * k[1]);
-        k[25] = k[1];
-        k[26] = (k[4] * k[0]);
-        k[27] = (k[2] * k[0] / 2.0);
-        k[28] = (-k[2] * k[0] / 2.0);
-        k[29] = (-k[3] / 2.0);
-        k[30] = (3.0 * k[4] * k[0]);
-        k[31] = k[0];
-        k[32] = (3.0 * k[1]);
-        k[33] = (6.0 * k[4] * k[0] * k[1]);
-        k[34] = (3.0 * k[4] * k[0] * k[1]);
-        k[35] = (k[4] * (k[0] * k[0]));
-        k[36] = (-k[2] * k[1]);
-        k[37] = (-2.0 * k[0] * k[7]);
-        k[38] = (3.0 * k[0]);
+        k[10] = k[2];
+        k[11] = (k[2] / 2.0);
+        k[12] = (-k[2]);
+        k[13] = (-k[2] / 2.0);
+        k[14] = ((k[2] * k[2]) * k[0] / 24.0);
+        let h15_t0 = (k[2] * k[2]);
+        k[15] = ((h15_t0 * k[0] / 8.0) + (h15_t0 * k[1] / 2.0));
+        k[16] = ((k[2] * k[2]) * k[0] / 8.0);
+        k[17] = (k[3] * k[4] * k[1] / 2.0);
+        k[18] = (k[2] * k[4] * k[0] / 2.0);
+        k[19] = ((k[2] * k[2]) * k[0] / 12.0);
+        let h20_t0 = (k[2] * k[2]);
+        k[20] = ((h20_t0 * k[0] / 4.0) + (h20_t0 * k[1]));
+        k[21] = ((k[2] * k[2]) * k[0] / 4.0);
+        k[22] = (-k[2] * k[4] * k[0] / 2.0);
+        k[23] = (-(k[2] * k[2]) * k[1]);
+        k[24] = k[1];
+        k[25] = (k[4] * k[0]);
+        k[26] = (k[2] * k[0] / 2.0);
+        k[27] = (-k[2] * k[0] / 2.0);
+        k[28] = (-k[3] / 2.0);
+        k[29] = (3.0 * k[4] * k[0]);
+        k[30] = k[0];
+        k[32] = (6.0 * k[4] * k[0] * k[1]);
+        k[33] = (3.0 * k[4] * k[0] * k[1]);
+        k[34] = (k[4] * (k[0] * k[0]));
+        k[35] = (-k[2] * k[1]);
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
-        q[0] = k[10];
+        let k = &k[..40]; // one bounds check for all constant loads
+        q[0] = k[5];
         qd[0] = 0.0;
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        let pt0 = (k[11] * rc_c);
-        let pt1 = (k[13] * qd[0] * rc_s);
+        let pt0 = (k[10] * rc_c);
+        let pt1 = (k[12] * qd[0] * rc_s);
         pos[0] = [0.0, 0.0];
         vel[0] = [0.0, 0.0];
-        pos[1] = [pt0, (k[11] * rc_s)];
-        vel[1] = [pt1, (k[11] * qd[0] * rc_c)];
-        pos[2] = [(k[12] * rc_c), (k[12] * rc_s)];
-        vel[2] = [(k[14] * qd[0] * rc_s), (k[12] * qd[0] * rc_c)];
+        pos[1] = [pt0, (k[10] * rc_s)];
+        vel[1] = [pt1, (k[10] * qd[0] * rc_c)];
+        pos[2] = [(k[11] * rc_c), (k[11] * rc_s)];
+        vel[2] = [(k[13] * qd[0] * rc_s), (k[11] * qd[0] * rc_c)];
         pos[3] = [pt0, 0.0];
         vel[3] = [pt1, 0.0];
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let et0 = (qd[0] * qd[0]);
-        (((k[15] * et0) + (k[16] * et0 * (rc_s * rc_s)) + (k[17] * et0 * (rc_c * rc_c)))
-            + (k[18] + (k[19] * rc_s)))
+        (((k[14] * et0) + (k[15] * et0 * (rc_s * rc_s)) + (k[16] * et0 * (rc_c * rc_c)))
+            + (k[17] + (k[18] * rc_s)))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        mass[0] = (k[20] + (k[21] * (rc_s * rc_s)) + (k[22] * (rc_c * rc_c)));
-        rhs[0] = ((k[23] * rc_c) + (k[24] * (qd[0] * qd[0]) * rc_s * rc_c));
+        mass[0] = (k[19] + (k[20] * (rc_s * rc_s)) + (k[21] * (rc_c * rc_c)));
+        rhs[0] = ((k[22] * rc_c) + (k[23] * (qd[0] * qd[0]) * rc_s * rc_c));
     }
 
     fn forces_full(
@@ -223,35 +217,35 @@ impl Model for HingedRod {
         fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ft0 = (qd[0] * qd[0]);
-        out[0] = (k[25] * ((k[13] * qdd[0] * rc_s) + (k[13] * ft0 * rc_c)));
-        out[1] = (k[26] + (k[27] * qdd[0] * rc_c) + (k[28] * ft0 * rc_s));
+        out[0] = (k[24] * ((k[12] * qdd[0] * rc_s) + (k[12] * ft0 * rc_c)));
+        out[1] = (k[25] + (k[26] * qdd[0] * rc_c) + (k[27] * ft0 * rc_s));
     }
 
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        out[0] = (k[18] - (forces[0] * (k[29] + (k[11] * rc_s))));
+        out[0] = (k[17] - (forces[0] * (k[28] + (k[10] * rc_s))));
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         f64::INFINITY
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        out[0] = (k[11] * rc_c);
-        out[1] = (k[13] * qd[0] * rc_s);
+        out[0] = (k[10] * rc_c);
+        out[1] = (k[12] * qd[0] * rc_s);
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -261,48 +255,69 @@ impl Model for HingedRod {
 
 impl Reduction for HingedRod {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
-        let rt1 = (k[31] + (k[32] * rt0));
+        let rt1 = (k[30] + (k[31] * rt0));
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: (k[30] * rc_ds / (k[11] * rt1)),
+            theta_dot_sq: (k[29] * rc_ds / (k[10] * rt1)),
             theta_ddot: (-3.0
-                * ((k[33] * rc_s * rc_c * rc_ds) + (k[34] * rt0 * rc_c) + (k[35] * rc_c))
+                * ((k[32] * rc_s * rc_c * rc_ds) + (k[33] * rt0 * rc_c) + (k[34] * rc_c))
                 / 2.0
-                / (k[11] * (rt1 * rt1))),
+                / (k[10] * (rt1 * rt1))),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
-        let k = &k[..39]; // one bounds check for all constant loads
-        (k[30] * rc_ds / (k[11] * (k[31] + (k[32] * (rc_s * rc_s)))))
+        let k = &k[..40]; // one bounds check for all constant loads
+        (k[29] * rc_ds / (k[10] * (k[30] + (k[31] * (rc_s * rc_s)))))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
-        let rt1 = (k[31] + (k[32] * rt0));
-        let rc_w2 = (k[30] * rc_ds / (k[11] * rt1));
+        let rt1 = (k[30] + (k[31] * rt0));
+        let rc_w2 = (k[29] * rc_ds / (k[10] * rt1));
         let rc_acc = (-3.0
-            * ((k[33] * rc_s * rc_c * rc_ds) + (k[34] * rt0 * rc_c) + (k[35] * rc_c))
+            * ((k[32] * rc_s * rc_c * rc_ds) + (k[33] * rt0 * rc_c) + (k[34] * rc_c))
             / 2.0
-            / (k[11] * (rt1 * rt1)));
-        out[0] = ((k[36] * rc_s * rc_acc) + (k[36] * rc_c * rc_w2));
-        out[1] = (k[26] + (k[28] * rc_s * rc_w2) + (k[27] * rc_c * rc_acc));
+            / (k[10] * (rt1 * rt1)));
+        out[0] = ((k[35] * rc_s * rc_acc) + (k[35] * rc_c * rc_w2));
+        out[1] = (k[25] + (k[27] * rc_s * rc_w2) + (k[26] * rc_c * rc_acc));
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
-        out[0] = k[37];
-        out[1] = k[38];
+        let k = &k[..40]; // one bounds check for all constant loads
+        out[0] = k[36];
+        out[1] = k[37];
         out[2] = 0.0;
-        out[3] = k[32];
+        out[3] = k[31];
+    }
+
+    fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        k[..5].copy_from_slice(p);
+        k[5] = (k[3] / k[2]).asin();
+        k[6] = 0.0;
+        k[7] = (k[3] / k[2]);
+        let c3_t0 = (k[3] / k[2]);
+        k[8] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
+        k[31] = (3.0 * k[1]);
+        k[36] = (-2.0 * k[0] * k[7]);
+        k[37] = (3.0 * k[0]);
+        k[38] = (k[2] / 3.0 / k[4]);
+        k[39] = (k[2] * k[1] / (k[4] * k[0]));
+    }
+
+    fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..40]; // one bounds check for all constant loads
+        out[0] = k[38];
+        out[1] = 0.0;
+        out[2] = k[39];
     }
 
     fn full_state(
@@ -314,7 +329,7 @@ impl Reduction for HingedRod {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[0] = k[5] - delta;

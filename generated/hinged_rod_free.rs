@@ -118,6 +118,8 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 12,
         separation_degree: 0,
         polynomial_separation: false,
+        fall_degree: None,
+        lean_constants: &[9, 10, 11, 12],
     }),
     route_note: "",
 };
@@ -134,10 +136,7 @@ impl Model for HingedRodFree {
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
         k[..9].copy_from_slice(p);
-        k[9] = k[5];
-        k[10] = k[7];
-        k[11] = k[9].sin();
-        k[12] = k[9].cos();
+        Reduction::prepare_lean(self, p, k);
         k[13] = k[6];
         k[14] = (k[1] * k[8]);
         k[15] = ((k[2] * k[2]) * k[0] / 3.0);
@@ -283,6 +282,18 @@ impl Reduction for HingedRodFree {
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..38]; // one bounds check for all constant loads
+    }
+
+    fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        k[..9].copy_from_slice(p);
+        k[9] = k[5];
+        k[10] = k[7];
+        k[11] = k[9].sin();
+        k[12] = k[9].cos();
+    }
+
+    fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
         let k = &k[..38]; // one bounds check for all constant loads
     }
 

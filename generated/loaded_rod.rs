@@ -57,7 +57,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 52,
+    n_constants: 53,
     coordinates: &["x1", "theta"],
     reduced: 1,
     cyclic: &[0],
@@ -136,6 +136,8 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 9,
         separation_degree: 3,
         polynomial_separation: true,
+        fall_degree: Some(2),
+        lean_constants: &[6, 7, 8, 9, 40, 47, 48, 49, 50],
     }),
     route_note: "",
 };
@@ -152,11 +154,7 @@ impl Model for LoadedRod {
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
         k[..6].copy_from_slice(p);
-        k[6] = (k[4] / k[3]).asin();
-        k[7] = 0.0;
-        k[8] = (k[4] / k[3]);
-        let c3_t0 = (k[4] / k[3]);
-        k[9] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
+        Reduction::prepare_lean(self, p, k);
         k[10] = 0.0;
         k[11] = 0.0;
         let c6_t0 = (k[3] * k[3]);
@@ -172,206 +170,191 @@ impl Model for LoadedRod {
             + (c6_t0 * c6_t2 / 3.0 / (k[0] + k[1] + k[2]))
             - (c6_t0 * c6_t3 * c6_t1 / (k[0] + k[1] + k[2]))
             + (c6_t0 * c6_t3 / (k[0] + k[1] + k[2])));
-        k[13] = (k[4] / k[3]).asin();
-        k[14] = k[3];
-        k[15] = (k[3] / 2.0);
-        k[16] = ((k[3] * k[0] / 2.0 / (k[0] + k[2])) + (k[3] * k[2] / (k[0] + k[2])));
-        k[17] = (-k[3]);
-        k[18] = (-k[3] / 2.0);
-        k[19] = (-(k[3] * k[0] / 2.0 / (k[0] + k[2])) - (k[3] * k[2] / (k[0] + k[2])));
-        k[20] = (-(3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
+        k[13] = k[3];
+        k[14] = (k[3] / 2.0);
+        k[15] = ((k[3] * k[0] / 2.0 / (k[0] + k[2])) + (k[3] * k[2] / (k[0] + k[2])));
+        k[16] = (-k[3]);
+        k[17] = (-k[3] / 2.0);
+        k[18] = (-(k[3] * k[0] / 2.0 / (k[0] + k[2])) - (k[3] * k[2] / (k[0] + k[2])));
+        k[19] = (-(3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
             - (k[3] * k[1])
             - (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
             - (k[3] * (k[2] * k[2]) / (k[0] + k[2])));
+        let h20_t0 = (k[3] * k[3]);
+        k[20] = ((h20_t0 * k[0] / 24.0) + (h20_t0 * k[0] * k[2] / 8.0 / (k[0] + k[2])));
         let h21_t0 = (k[3] * k[3]);
-        k[21] = ((h21_t0 * k[0] / 24.0) + (h21_t0 * k[0] * k[2] / 8.0 / (k[0] + k[2])));
+        let h21_t1 = (k[2] * k[2]);
+        let h21_t2 = (k[0] * k[0]);
+        k[21] = ((h21_t0 * k[0] * h21_t1 / ((2.0 * k[0] * k[2]) + h21_t2 + h21_t1))
+            + (h21_t0 * k[1] / 2.0)
+            + (5.0 * h21_t0 * h21_t2 * k[2] / 8.0 / ((2.0 * k[0] * k[2]) + h21_t2 + h21_t1))
+            + (h21_t0 * k[0].powi(3) / 8.0 / ((2.0 * k[0] * k[2]) + h21_t2 + h21_t1))
+            + (h21_t0 * k[2].powi(3) / 2.0 / ((2.0 * k[0] * k[2]) + h21_t2 + h21_t1)));
         let h22_t0 = (k[3] * k[3]);
         let h22_t1 = (k[2] * k[2]);
         let h22_t2 = (k[0] * k[0]);
         k[22] = ((h22_t0 * k[0] * h22_t1 / ((2.0 * k[0] * k[2]) + h22_t2 + h22_t1))
-            + (h22_t0 * k[1] / 2.0)
             + (5.0 * h22_t0 * h22_t2 * k[2] / 8.0 / ((2.0 * k[0] * k[2]) + h22_t2 + h22_t1))
             + (h22_t0 * k[0].powi(3) / 8.0 / ((2.0 * k[0] * k[2]) + h22_t2 + h22_t1))
             + (h22_t0 * k[2].powi(3) / 2.0 / ((2.0 * k[0] * k[2]) + h22_t2 + h22_t1)));
-        let h23_t0 = (k[3] * k[3]);
-        let h23_t1 = (k[2] * k[2]);
-        let h23_t2 = (k[0] * k[0]);
-        k[23] = ((h23_t0 * k[0] * h23_t1 / ((2.0 * k[0] * k[2]) + h23_t2 + h23_t1))
-            + (5.0 * h23_t0 * h23_t2 * k[2] / 8.0 / ((2.0 * k[0] * k[2]) + h23_t2 + h23_t1))
-            + (h23_t0 * k[0].powi(3) / 8.0 / ((2.0 * k[0] * k[2]) + h23_t2 + h23_t1))
-            + (h23_t0 * k[2].powi(3) / 2.0 / ((2.0 * k[0] * k[2]) + h23_t2 + h23_t1)));
-        k[24] = ((k[0] / 2.0) + (k[1] / 2.0) + (k[2] / 2.0));
-        k[25] = (k[4] * k[5] * k[1] / 2.0);
-        k[26] = ((k[3] * k[5] * k[0] / 2.0) + (k[3] * k[5] * k[2]));
-        k[27] = (k[0] + k[1] + k[2]);
+        k[23] = ((k[0] / 2.0) + (k[1] / 2.0) + (k[2] / 2.0));
+        k[24] = (k[4] * k[5] * k[1] / 2.0);
+        k[25] = ((k[3] * k[5] * k[0] / 2.0) + (k[3] * k[5] * k[2]));
+        k[26] = (k[0] + k[1] + k[2]);
+        let h27_t0 = (k[3] * k[3]);
+        k[27] = ((h27_t0 * k[0] / 12.0) + (h27_t0 * k[0] * k[2] / 4.0 / (k[0] + k[2])));
         let h28_t0 = (k[3] * k[3]);
-        k[28] = ((h28_t0 * k[0] / 12.0) + (h28_t0 * k[0] * k[2] / 4.0 / (k[0] + k[2])));
+        let h28_t1 = (k[2] * k[2]);
+        let h28_t2 = (k[0] * k[0]);
+        k[28] = ((2.0 * h28_t0 * k[0] * h28_t1 / ((2.0 * k[0] * k[2]) + h28_t2 + h28_t1))
+            + (h28_t0 * k[1])
+            + (5.0 * h28_t0 * h28_t2 * k[2] / 4.0 / ((2.0 * k[0] * k[2]) + h28_t2 + h28_t1))
+            + (h28_t0 * k[0].powi(3) / 4.0 / ((2.0 * k[0] * k[2]) + h28_t2 + h28_t1))
+            + (h28_t0 * k[2].powi(3) / ((2.0 * k[0] * k[2]) + h28_t2 + h28_t1)));
         let h29_t0 = (k[3] * k[3]);
         let h29_t1 = (k[2] * k[2]);
         let h29_t2 = (k[0] * k[0]);
         k[29] = ((2.0 * h29_t0 * k[0] * h29_t1 / ((2.0 * k[0] * k[2]) + h29_t2 + h29_t1))
-            + (h29_t0 * k[1])
             + (5.0 * h29_t0 * h29_t2 * k[2] / 4.0 / ((2.0 * k[0] * k[2]) + h29_t2 + h29_t1))
             + (h29_t0 * k[0].powi(3) / 4.0 / ((2.0 * k[0] * k[2]) + h29_t2 + h29_t1))
             + (h29_t0 * k[2].powi(3) / ((2.0 * k[0] * k[2]) + h29_t2 + h29_t1)));
-        let h30_t0 = (k[3] * k[3]);
-        let h30_t1 = (k[2] * k[2]);
-        let h30_t2 = (k[0] * k[0]);
-        k[30] = ((2.0 * h30_t0 * k[0] * h30_t1 / ((2.0 * k[0] * k[2]) + h30_t2 + h30_t1))
-            + (5.0 * h30_t0 * h30_t2 * k[2] / 4.0 / ((2.0 * k[0] * k[2]) + h30_t2 + h30_t1))
-            + (h30_t0 * k[0].powi(3) / 4.0 / ((2.0 * k[0] * k[2]) + h30_t2 + h30_t1))
-            + (h30_t0 * k[2].powi(3) / ((2.0 * k[0] * k[2]) + h30_t2 + h30_t1)));
-        k[31] = ((3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
+        k[30] = ((3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
             + (k[3] * k[1])
             + (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
             + (k[3] * (k[2] * k[2]) / (k[0] + k[2])));
-        k[32] = (-(k[3] * k[5] * k[0] / 2.0) - (k[3] * k[5] * k[2]));
-        k[33] = (-(k[3] * k[3]) * k[1]);
-        k[34] = k[1];
-        k[35] = ((k[5] * k[0]) + (k[5] * k[2]));
-        k[36] = ((3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
+        k[31] = (-(k[3] * k[5] * k[0] / 2.0) - (k[3] * k[5] * k[2]));
+        k[32] = (-(k[3] * k[3]) * k[1]);
+        k[33] = k[1];
+        k[34] = ((k[5] * k[0]) + (k[5] * k[2]));
+        k[35] = ((3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
             + (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
             + (k[3] * (k[2] * k[2]) / (k[0] + k[2])));
-        k[37] = (-(3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
+        k[36] = (-(3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
             - (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
             - (k[3] * (k[2] * k[2]) / (k[0] + k[2])));
-        k[38] = (-k[4] / 2.0);
-        k[39] = ((k[5] * k[0] * k[1])
+        k[37] = (-k[4] / 2.0);
+        k[38] = ((k[5] * k[0] * k[1])
             + (3.0 * k[5] * k[0] * k[2])
             + (2.0 * k[5] * k[1] * k[2])
             + (k[5] * (k[0] * k[0]))
             + (2.0 * k[5] * (k[2] * k[2])));
-        k[40] = (-(4.0 * k[0] * k[1])
+        k[39] = (-(4.0 * k[0] * k[1])
             - (16.0 * k[0] * k[2])
             - (12.0 * k[1] * k[2])
             - (4.0 * (k[0] * k[0]))
             - (12.0 * (k[2] * k[2])));
-        k[41] = ((12.0 * k[0] * k[2])
-            + (12.0 * k[1] * k[2])
-            + (3.0 * (k[0] * k[0]))
-            + (12.0 * (k[2] * k[2])));
+        let h41_t0 = (k[2] * k[2]);
+        let h41_t1 = (k[1] * k[1]);
+        let h41_t2 = k[2].powi(3);
+        let h41_t3 = (k[0] * k[0]);
+        let h41_t4 = k[0].powi(3);
+        k[41] = ((144.0 * k[5] * k[0] * k[1] * h41_t0)
+            + (24.0 * k[5] * k[0] * h41_t1 * k[2])
+            + (120.0 * k[5] * k[0] * h41_t2)
+            + (96.0 * k[5] * k[1] * h41_t2)
+            + (60.0 * k[5] * h41_t3 * k[1] * k[2])
+            + (108.0 * k[5] * h41_t3 * h41_t0)
+            + (6.0 * k[5] * h41_t4 * k[1])
+            + (42.0 * k[5] * h41_t4 * k[2])
+            + (6.0 * k[5] * k[0].powi(4))
+            + (48.0 * k[5] * h41_t1 * h41_t0)
+            + (48.0 * k[5] * k[2].powi(4)));
         let h42_t0 = (k[2] * k[2]);
         let h42_t1 = (k[1] * k[1]);
         let h42_t2 = k[2].powi(3);
         let h42_t3 = (k[0] * k[0]);
         let h42_t4 = k[0].powi(3);
-        k[42] = ((144.0 * k[5] * k[0] * k[1] * h42_t0)
-            + (24.0 * k[5] * k[0] * h42_t1 * k[2])
-            + (120.0 * k[5] * k[0] * h42_t2)
-            + (96.0 * k[5] * k[1] * h42_t2)
-            + (60.0 * k[5] * h42_t3 * k[1] * k[2])
-            + (108.0 * k[5] * h42_t3 * h42_t0)
-            + (6.0 * k[5] * h42_t4 * k[1])
-            + (42.0 * k[5] * h42_t4 * k[2])
-            + (6.0 * k[5] * k[0].powi(4))
-            + (48.0 * k[5] * h42_t1 * h42_t0)
-            + (48.0 * k[5] * k[2].powi(4)));
+        k[42] = (-(88.0 * k[5] * k[0] * k[1] * h42_t0)
+            - (20.0 * k[5] * k[0] * h42_t1 * k[2])
+            - (68.0 * k[5] * k[0] * h42_t2)
+            - (48.0 * k[5] * k[1] * h42_t2)
+            - (48.0 * k[5] * h42_t3 * k[1] * k[2])
+            - (4.0 * k[5] * h42_t3 * h42_t1)
+            - (68.0 * k[5] * h42_t3 * h42_t0)
+            - (8.0 * k[5] * h42_t4 * k[1])
+            - (28.0 * k[5] * h42_t4 * k[2])
+            - (4.0 * k[5] * k[0].powi(4))
+            - (24.0 * k[5] * h42_t1 * h42_t0)
+            - (24.0 * k[5] * k[2].powi(4)));
         let h43_t0 = (k[2] * k[2]);
         let h43_t1 = (k[1] * k[1]);
         let h43_t2 = k[2].powi(3);
         let h43_t3 = (k[0] * k[0]);
         let h43_t4 = k[0].powi(3);
-        k[43] = (-(88.0 * k[5] * k[0] * k[1] * h43_t0)
-            - (20.0 * k[5] * k[0] * h43_t1 * k[2])
-            - (68.0 * k[5] * k[0] * h43_t2)
-            - (48.0 * k[5] * k[1] * h43_t2)
-            - (48.0 * k[5] * h43_t3 * k[1] * k[2])
-            - (4.0 * k[5] * h43_t3 * h43_t1)
-            - (68.0 * k[5] * h43_t3 * h43_t0)
-            - (8.0 * k[5] * h43_t4 * k[1])
-            - (28.0 * k[5] * h43_t4 * k[2])
-            - (4.0 * k[5] * k[0].powi(4))
-            - (24.0 * k[5] * h43_t1 * h43_t0)
-            - (24.0 * k[5] * k[2].powi(4)));
-        let h44_t0 = (k[2] * k[2]);
-        let h44_t1 = (k[1] * k[1]);
-        let h44_t2 = k[2].powi(3);
-        let h44_t3 = (k[0] * k[0]);
-        let h44_t4 = k[0].powi(3);
-        k[44] = ((72.0 * k[5] * k[0] * k[1] * h44_t0)
-            + (12.0 * k[5] * k[0] * h44_t1 * k[2])
-            + (60.0 * k[5] * k[0] * h44_t2)
-            + (48.0 * k[5] * k[1] * h44_t2)
-            + (30.0 * k[5] * h44_t3 * k[1] * k[2])
-            + (54.0 * k[5] * h44_t3 * h44_t0)
-            + (3.0 * k[5] * h44_t4 * k[1])
-            + (21.0 * k[5] * h44_t4 * k[2])
+        k[43] = ((72.0 * k[5] * k[0] * k[1] * h43_t0)
+            + (12.0 * k[5] * k[0] * h43_t1 * k[2])
+            + (60.0 * k[5] * k[0] * h43_t2)
+            + (48.0 * k[5] * k[1] * h43_t2)
+            + (30.0 * k[5] * h43_t3 * k[1] * k[2])
+            + (54.0 * k[5] * h43_t3 * h43_t0)
+            + (3.0 * k[5] * h43_t4 * k[1])
+            + (21.0 * k[5] * h43_t4 * k[2])
             + (3.0 * k[5] * k[0].powi(4))
-            + (24.0 * k[5] * h44_t1 * h44_t0)
+            + (24.0 * k[5] * h43_t1 * h43_t0)
             + (24.0 * k[5] * k[2].powi(4)));
-        k[45] = (-k[3] * k[0] * k[1] / 2.0 / (k[0] + k[1] + k[2]));
-        k[46] = (-((k[3] * k[0]) + (2.0 * k[3] * k[2])) / 2.0);
-        k[47] = (((k[3] * k[0]) + (2.0 * k[3] * k[2])) / 2.0);
-        k[48] = ((8.0 * k[0] * k[1] * k[8])
-            + (32.0 * k[0] * k[2] * k[8])
-            + (24.0 * k[1] * k[2] * k[8])
-            + (8.0 * (k[0] * k[0]) * k[8])
-            + (24.0 * (k[2] * k[2]) * k[8]));
-        k[49] = (-(12.0 * k[0] * k[1])
-            - (48.0 * k[0] * k[2])
-            - (36.0 * k[1] * k[2])
-            - (12.0 * (k[0] * k[0]))
-            - (36.0 * (k[2] * k[2])));
-        k[50] = k[10];
-        k[51] = ((k[3] * k[0] / 2.0 / (k[0] + k[1] + k[2]))
+        k[44] = (-k[3] * k[0] * k[1] / 2.0 / (k[0] + k[1] + k[2]));
+        k[45] = (-((k[3] * k[0]) + (2.0 * k[3] * k[2])) / 2.0);
+        k[46] = (((k[3] * k[0]) + (2.0 * k[3] * k[2])) / 2.0);
+        k[51] = k[10];
+        k[52] = ((k[3] * k[0] / 2.0 / (k[0] + k[1] + k[2]))
             + (k[3] * k[1] / (k[0] + k[1] + k[2]))
             + (k[3] * k[2] / (k[0] + k[1] + k[2])));
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..52]; // one bounds check for all constant loads
+        let k = &k[..53]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
-        q[1] = k[13];
+        q[1] = k[6];
         qd[1] = 0.0;
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..52]; // one bounds check for all constant loads
+        let k = &k[..53]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let pt0 = ((k[14] * rc_c) + q[0]);
-        let pt1 = ((k[17] * qd[1] * rc_s) + qd[0]);
+        let pt0 = ((k[13] * rc_c) + q[0]);
+        let pt1 = ((k[16] * qd[1] * rc_s) + qd[0]);
         pos[0] = [q[0], 0.0];
         vel[0] = [qd[0], 0.0];
-        pos[1] = [pt0, (k[14] * rc_s)];
-        vel[1] = [pt1, (k[14] * qd[1] * rc_c)];
-        pos[2] = [((k[15] * rc_c) + q[0]), (k[15] * rc_s)];
-        vel[2] = [((k[18] * qd[1] * rc_s) + qd[0]), (k[15] * qd[1] * rc_c)];
-        pos[3] = [((k[16] * rc_c) + q[0]), (k[16] * rc_s)];
-        vel[3] = [((k[19] * qd[1] * rc_s) + qd[0]), (k[16] * qd[1] * rc_c)];
+        pos[1] = [pt0, (k[13] * rc_s)];
+        vel[1] = [pt1, (k[13] * qd[1] * rc_c)];
+        pos[2] = [((k[14] * rc_c) + q[0]), (k[14] * rc_s)];
+        vel[2] = [((k[17] * qd[1] * rc_s) + qd[0]), (k[14] * qd[1] * rc_c)];
+        pos[3] = [((k[15] * rc_c) + q[0]), (k[15] * rc_s)];
+        vel[3] = [((k[18] * qd[1] * rc_s) + qd[0]), (k[15] * qd[1] * rc_c)];
         pos[4] = [pt0, 0.0];
         vel[4] = [pt1, 0.0];
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..52]; // one bounds check for all constant loads
+        let k = &k[..53]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = (qd[1] * qd[1]);
-        (((k[20] * qd[1] * qd[0] * rc_s)
-            + (k[21] * et0)
-            + (k[22] * et0 * (rc_s * rc_s))
-            + (k[23] * et0 * (rc_c * rc_c))
-            + (k[24] * (qd[0] * qd[0])))
-            + (k[25] + (k[26] * rc_s)))
+        (((k[19] * qd[1] * qd[0] * rc_s)
+            + (k[20] * et0)
+            + (k[21] * et0 * (rc_s * rc_s))
+            + (k[22] * et0 * (rc_c * rc_c))
+            + (k[23] * (qd[0] * qd[0])))
+            + (k[24] + (k[25] * rc_s)))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..52]; // one bounds check for all constant loads
+        let k = &k[..53]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        out[0] = ((k[20] * qd[1] * rc_s) + (k[27] * qd[0]));
+        out[0] = ((k[19] * qd[1] * rc_s) + (k[26] * qd[0]));
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..52]; // one bounds check for all constant loads
+        let k = &k[..53]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let qt0 = (k[20] * rc_s);
+        let qt0 = (k[19] * rc_s);
         let qt1 = (qd[1] * qd[1]);
-        mass[0] = k[27];
+        mass[0] = k[26];
         mass[1] = qt0;
         mass[2] = qt0;
-        mass[3] = (k[28] + (k[29] * (rc_s * rc_s)) + (k[30] * (rc_c * rc_c)));
-        rhs[0] = (k[31] * qt1 * rc_c);
-        rhs[1] = ((k[32] * rc_c) + (k[33] * qt1 * rc_s * rc_c));
+        mass[3] = (k[27] + (k[28] * (rc_s * rc_s)) + (k[29] * (rc_c * rc_c)));
+        rhs[0] = (k[30] * qt1 * rc_c);
+        rhs[1] = ((k[31] * rc_c) + (k[32] * qt1 * rc_s * rc_c));
     }
 
     fn forces_full(
@@ -383,36 +366,36 @@ impl Model for LoadedRod {
         fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..52]; // one bounds check for all constant loads
+        let k = &k[..53]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let ft0 = (qd[1] * qd[1]);
-        out[0] = (k[34] * ((k[17] * qdd[1] * rc_s) + qdd[0] + (k[17] * ft0 * rc_c)));
-        out[1] = (k[35] + (k[36] * qdd[1] * rc_c) + (k[37] * ft0 * rc_s));
+        out[0] = (k[33] * ((k[16] * qdd[1] * rc_s) + qdd[0] + (k[16] * ft0 * rc_c)));
+        out[1] = (k[34] + (k[35] * qdd[1] * rc_c) + (k[36] * ft0 * rc_s));
     }
 
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..52]; // one bounds check for all constant loads
+        let k = &k[..53]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..52]; // one bounds check for all constant loads
+        let k = &k[..53]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = forces[1];
-        out[1] = (k[25] - (forces[0] * (k[38] + (k[14] * rc_s))));
+        out[1] = (k[24] - (forces[0] * (k[37] + (k[13] * rc_s))));
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        let k = &k[..52]; // one bounds check for all constant loads
+        let k = &k[..53]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         f64::INFINITY
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..52]; // one bounds check for all constant loads
+        let k = &k[..53]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        out[0] = ((k[14] * rc_c) + q[0]);
-        out[1] = ((k[17] * qd[1] * rc_s) + qd[0]);
+        out[0] = ((k[13] * rc_c) + q[0]);
+        out[1] = ((k[16] * qd[1] * rc_s) + qd[0]);
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -422,46 +405,83 @@ impl Model for LoadedRod {
 
 impl Reduction for LoadedRod {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..52]; // one bounds check for all constant loads
+        let k = &k[..53]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
-        let rt1 = (k[40] + (k[41] * rt0));
+        let rt1 = (k[39] + (k[40] * rt0));
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: (-12.0 * (k[39] * rc_ds) / (k[14] * rt1)),
+            theta_dot_sq: (-12.0 * (k[38] * rc_ds) / (k[13] * rt1)),
             theta_ddot: (6.0
-                * ((k[42] * rc_s * rc_c * rc_ds) + (k[43] * rc_c) + (k[44] * rt0 * rc_c))
-                / (k[14] * (rt1 * rt1))),
+                * ((k[41] * rc_s * rc_c * rc_ds) + (k[42] * rc_c) + (k[43] * rt0 * rc_c))
+                / (k[13] * (rt1 * rt1))),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
-        let k = &k[..52]; // one bounds check for all constant loads
-        (-12.0 * (k[39] * rc_ds) / (k[14] * (k[40] + (k[41] * (rc_s * rc_s)))))
+        let k = &k[..53]; // one bounds check for all constant loads
+        (-12.0 * (k[38] * rc_ds) / (k[13] * (k[39] + (k[40] * (rc_s * rc_s)))))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..52]; // one bounds check for all constant loads
+        let k = &k[..53]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
-        let rt1 = (k[40] + (k[41] * rt0));
-        let rc_w2 = (-12.0 * (k[39] * rc_ds) / (k[14] * rt1));
+        let rt1 = (k[39] + (k[40] * rt0));
+        let rc_w2 = (-12.0 * (k[38] * rc_ds) / (k[13] * rt1));
         let rc_acc = (6.0
-            * ((k[42] * rc_s * rc_c * rc_ds) + (k[43] * rc_c) + (k[44] * rt0 * rc_c))
-            / (k[14] * (rt1 * rt1)));
-        out[0] = ((k[45] * rc_s * rc_acc) + (k[45] * rc_c * rc_w2));
-        out[1] = (k[35] + (k[46] * rc_s * rc_w2) + (k[47] * rc_c * rc_acc));
+            * ((k[41] * rc_s * rc_c * rc_ds) + (k[42] * rc_c) + (k[43] * rt0 * rc_c))
+            / (k[13] * (rt1 * rt1)));
+        out[0] = ((k[44] * rc_s * rc_acc) + (k[44] * rc_c * rc_w2));
+        out[1] = (k[34] + (k[45] * rc_s * rc_w2) + (k[46] * rc_c * rc_acc));
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..52]; // one bounds check for all constant loads
-        out[0] = k[48];
-        out[1] = k[49];
+        let k = &k[..53]; // one bounds check for all constant loads
+        out[0] = k[47];
+        out[1] = k[48];
         out[2] = 0.0;
-        out[3] = k[41];
+        out[3] = k[40];
+    }
+
+    fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        k[..6].copy_from_slice(p);
+        k[6] = (k[4] / k[3]).asin();
+        k[7] = 0.0;
+        k[8] = (k[4] / k[3]);
+        let c3_t0 = (k[4] / k[3]);
+        k[9] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
+        k[40] = ((12.0 * k[0] * k[2])
+            + (12.0 * k[1] * k[2])
+            + (3.0 * (k[0] * k[0]))
+            + (12.0 * (k[2] * k[2])));
+        k[47] = ((8.0 * k[0] * k[1] * k[8])
+            + (32.0 * k[0] * k[2] * k[8])
+            + (24.0 * k[1] * k[2] * k[8])
+            + (8.0 * (k[0] * k[0]) * k[8])
+            + (24.0 * (k[2] * k[2]) * k[8]));
+        k[48] = (-(12.0 * k[0] * k[1])
+            - (48.0 * k[0] * k[2])
+            - (36.0 * k[1] * k[2])
+            - (12.0 * (k[0] * k[0]))
+            - (36.0 * (k[2] * k[2])));
+        k[49] = (((k[3] * k[0]) + (3.0 * k[3] * k[2])) / 3.0 / (k[5] * (k[0] + (2.0 * k[2]))));
+        k[50] = (-((4.0 * k[3] * k[0] * k[2])
+            + (4.0 * k[3] * k[1] * k[2])
+            + (k[3] * (k[0] * k[0]))
+            + (4.0 * k[3] * (k[2] * k[2])))
+            / 4.0
+            / (k[5] * (k[0] + (2.0 * k[2])) * (k[0] + k[1] + k[2])));
+    }
+
+    fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..53]; // one bounds check for all constant loads
+        out[0] = k[49];
+        out[1] = 0.0;
+        out[2] = k[50];
     }
 
     fn full_state(
@@ -473,12 +493,12 @@ impl Reduction for LoadedRod {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..52]; // one bounds check for all constant loads
+        let k = &k[..53]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[1] = k[6] - delta;
         qd[1] = theta_dot;
-        q[0] = (k[50] + (k[51] * rc_dc));
-        qd[0] = (k[51] * rc_s * rc_w);
+        q[0] = (k[51] + (k[52] * rc_dc));
+        qd[0] = (k[52] * rc_s * rc_w);
     }
 }

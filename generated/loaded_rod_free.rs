@@ -146,6 +146,8 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 15,
         separation_degree: 0,
         polynomial_separation: false,
+        fall_degree: None,
+        lean_constants: &[12, 13, 14, 15],
     }),
     route_note: "",
 };
@@ -162,10 +164,7 @@ impl Model for LoadedRodFree {
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
         k[..12].copy_from_slice(p);
-        k[12] = k[7];
-        k[13] = k[10];
-        k[14] = k[12].sin();
-        k[15] = k[12].cos();
+        Reduction::prepare_lean(self, p, k);
         k[16] = k[6];
         k[17] = k[8];
         k[18] = (-(3.0 * k[3] * k[0] * k[2] * k[13] * k[14] / 2.0 / (k[0] + k[2]))
@@ -405,6 +404,18 @@ impl Reduction for LoadedRodFree {
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..56]; // one bounds check for all constant loads
+    }
+
+    fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        k[..12].copy_from_slice(p);
+        k[12] = k[7];
+        k[13] = k[10];
+        k[14] = k[12].sin();
+        k[15] = k[12].cos();
+    }
+
+    fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
         let k = &k[..56]; // one bounds check for all constant loads
     }
 

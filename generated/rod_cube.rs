@@ -51,7 +51,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 47,
+    n_constants: 48,
     coordinates: &["x1", "theta"],
     reduced: 1,
     cyclic: &[0],
@@ -125,6 +125,8 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 8,
         separation_degree: 3,
         polynomial_separation: true,
+        fall_degree: Some(2),
+        lean_constants: &[5, 6, 7, 8, 37, 42, 43, 44, 45],
     }),
     route_note: "",
 };
@@ -141,11 +143,7 @@ impl Model for RodCube {
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
         k[..5].copy_from_slice(p);
-        k[5] = (k[3] / k[2]).asin();
-        k[6] = 0.0;
-        k[7] = (k[3] / k[2]);
-        let c3_t0 = (k[3] / k[2]);
-        k[8] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
+        Reduction::prepare_lean(self, p, k);
         k[9] = 0.0;
         k[10] = 0.0;
         let c6_t0 = (k[2] * k[2]);
@@ -153,99 +151,95 @@ impl Model for RodCube {
         k[11] = ((c6_t0 * k[0] * k[1] / 3.0 / (k[0] + k[1]))
             - (c6_t0 * c6_t1 * (k[7] * k[7]) / 4.0 / (k[0] + k[1]))
             + (c6_t0 * c6_t1 / 3.0 / (k[0] + k[1])));
-        k[12] = (k[3] / k[2]).asin();
-        k[13] = k[2];
-        k[14] = (k[2] / 2.0);
-        k[15] = (-k[2]);
-        k[16] = (-k[2] / 2.0);
-        k[17] = (-(k[2] * k[0] / 2.0) - (k[2] * k[1]));
-        k[18] = ((k[2] * k[2]) * k[0] / 24.0);
-        let h19_t0 = (k[2] * k[2]);
-        k[19] = ((h19_t0 * k[0] / 8.0) + (h19_t0 * k[1] / 2.0));
-        k[20] = ((k[2] * k[2]) * k[0] / 8.0);
-        k[21] = ((k[0] / 2.0) + (k[1] / 2.0));
-        k[22] = (k[3] * k[4] * k[1] / 2.0);
-        k[23] = (k[2] * k[4] * k[0] / 2.0);
-        k[24] = (k[0] + k[1]);
-        k[25] = ((k[2] * k[2]) * k[0] / 12.0);
-        let h26_t0 = (k[2] * k[2]);
-        k[26] = ((h26_t0 * k[0] / 4.0) + (h26_t0 * k[1]));
-        k[27] = ((k[2] * k[2]) * k[0] / 4.0);
-        k[28] = ((k[2] * k[0] / 2.0) + (k[2] * k[1]));
-        k[29] = (-k[2] * k[4] * k[0] / 2.0);
-        k[30] = (-(k[2] * k[2]) * k[1]);
-        k[31] = k[1];
-        k[32] = (k[4] * k[0]);
-        k[33] = (k[2] * k[0] / 2.0);
-        k[34] = (-k[2] * k[0] / 2.0);
-        k[35] = (-k[3] / 2.0);
-        k[36] = ((k[4] * k[0]) + (k[4] * k[1]));
-        k[37] = (-(4.0 * k[0]) - (4.0 * k[1]));
-        k[38] = (3.0 * k[0]);
-        k[39] = ((6.0 * k[4] * k[0] * k[1]) + (6.0 * k[4] * (k[0] * k[0])));
-        k[40] = (-(8.0 * k[4] * k[0] * k[1])
+        k[12] = k[2];
+        k[13] = (k[2] / 2.0);
+        k[14] = (-k[2]);
+        k[15] = (-k[2] / 2.0);
+        k[16] = (-(k[2] * k[0] / 2.0) - (k[2] * k[1]));
+        k[17] = ((k[2] * k[2]) * k[0] / 24.0);
+        let h18_t0 = (k[2] * k[2]);
+        k[18] = ((h18_t0 * k[0] / 8.0) + (h18_t0 * k[1] / 2.0));
+        k[19] = ((k[2] * k[2]) * k[0] / 8.0);
+        k[20] = ((k[0] / 2.0) + (k[1] / 2.0));
+        k[21] = (k[3] * k[4] * k[1] / 2.0);
+        k[22] = (k[2] * k[4] * k[0] / 2.0);
+        k[23] = (k[0] + k[1]);
+        k[24] = ((k[2] * k[2]) * k[0] / 12.0);
+        let h25_t0 = (k[2] * k[2]);
+        k[25] = ((h25_t0 * k[0] / 4.0) + (h25_t0 * k[1]));
+        k[26] = ((k[2] * k[2]) * k[0] / 4.0);
+        k[27] = ((k[2] * k[0] / 2.0) + (k[2] * k[1]));
+        k[28] = (-k[2] * k[4] * k[0] / 2.0);
+        k[29] = (-(k[2] * k[2]) * k[1]);
+        k[30] = k[1];
+        k[31] = (k[4] * k[0]);
+        k[32] = (k[2] * k[0] / 2.0);
+        k[33] = (-k[2] * k[0] / 2.0);
+        k[34] = (-k[3] / 2.0);
+        k[35] = ((k[4] * k[0]) + (k[4] * k[1]));
+        k[36] = (-(4.0 * k[0]) - (4.0 * k[1]));
+        k[38] = ((6.0 * k[4] * k[0] * k[1]) + (6.0 * k[4] * (k[0] * k[0])));
+        k[39] = (-(8.0 * k[4] * k[0] * k[1])
             - (4.0 * k[4] * (k[0] * k[0]))
             - (4.0 * k[4] * (k[1] * k[1])));
-        k[41] = ((3.0 * k[4] * k[0] * k[1]) + (3.0 * k[4] * (k[0] * k[0])));
-        k[42] = (-k[2] * k[0] * k[1] / 2.0 / (k[0] + k[1]));
-        k[43] = ((8.0 * k[0] * k[7]) + (8.0 * k[1] * k[7]));
-        k[44] = (-(12.0 * k[0]) - (12.0 * k[1]));
-        k[45] = k[9];
-        k[46] = ((k[2] * k[0] / 2.0 / (k[0] + k[1])) + (k[2] * k[1] / (k[0] + k[1])));
+        k[40] = ((3.0 * k[4] * k[0] * k[1]) + (3.0 * k[4] * (k[0] * k[0])));
+        k[41] = (-k[2] * k[0] * k[1] / 2.0 / (k[0] + k[1]));
+        k[46] = k[9];
+        k[47] = ((k[2] * k[0] / 2.0 / (k[0] + k[1])) + (k[2] * k[1] / (k[0] + k[1])));
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..47]; // one bounds check for all constant loads
+        let k = &k[..48]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
-        q[1] = k[12];
+        q[1] = k[5];
         qd[1] = 0.0;
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..47]; // one bounds check for all constant loads
+        let k = &k[..48]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let pt0 = ((k[13] * rc_c) + q[0]);
-        let pt1 = ((k[15] * qd[1] * rc_s) + qd[0]);
+        let pt0 = ((k[12] * rc_c) + q[0]);
+        let pt1 = ((k[14] * qd[1] * rc_s) + qd[0]);
         pos[0] = [q[0], 0.0];
         vel[0] = [qd[0], 0.0];
-        pos[1] = [pt0, (k[13] * rc_s)];
-        vel[1] = [pt1, (k[13] * qd[1] * rc_c)];
-        pos[2] = [((k[14] * rc_c) + q[0]), (k[14] * rc_s)];
-        vel[2] = [((k[16] * qd[1] * rc_s) + qd[0]), (k[14] * qd[1] * rc_c)];
+        pos[1] = [pt0, (k[12] * rc_s)];
+        vel[1] = [pt1, (k[12] * qd[1] * rc_c)];
+        pos[2] = [((k[13] * rc_c) + q[0]), (k[13] * rc_s)];
+        vel[2] = [((k[15] * qd[1] * rc_s) + qd[0]), (k[13] * qd[1] * rc_c)];
         pos[3] = [pt0, 0.0];
         vel[3] = [pt1, 0.0];
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..47]; // one bounds check for all constant loads
+        let k = &k[..48]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = (qd[1] * qd[1]);
-        (((k[17] * qd[1] * qd[0] * rc_s)
-            + (k[18] * et0)
-            + (k[19] * et0 * (rc_s * rc_s))
-            + (k[20] * et0 * (rc_c * rc_c))
-            + (k[21] * (qd[0] * qd[0])))
-            + (k[22] + (k[23] * rc_s)))
+        (((k[16] * qd[1] * qd[0] * rc_s)
+            + (k[17] * et0)
+            + (k[18] * et0 * (rc_s * rc_s))
+            + (k[19] * et0 * (rc_c * rc_c))
+            + (k[20] * (qd[0] * qd[0])))
+            + (k[21] + (k[22] * rc_s)))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..47]; // one bounds check for all constant loads
+        let k = &k[..48]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        out[0] = ((k[17] * qd[1] * rc_s) + (k[24] * qd[0]));
+        out[0] = ((k[16] * qd[1] * rc_s) + (k[23] * qd[0]));
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..47]; // one bounds check for all constant loads
+        let k = &k[..48]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let qt0 = (k[17] * rc_s);
+        let qt0 = (k[16] * rc_s);
         let qt1 = (qd[1] * qd[1]);
-        mass[0] = k[24];
+        mass[0] = k[23];
         mass[1] = qt0;
         mass[2] = qt0;
-        mass[3] = (k[25] + (k[26] * (rc_s * rc_s)) + (k[27] * (rc_c * rc_c)));
-        rhs[0] = (k[28] * qt1 * rc_c);
-        rhs[1] = ((k[29] * rc_c) + (k[30] * qt1 * rc_s * rc_c));
+        mass[3] = (k[24] + (k[25] * (rc_s * rc_s)) + (k[26] * (rc_c * rc_c)));
+        rhs[0] = (k[27] * qt1 * rc_c);
+        rhs[1] = ((k[28] * rc_c) + (k[29] * qt1 * rc_s * rc_c));
     }
 
     fn forces_full(
@@ -257,36 +251,36 @@ impl Model for RodCube {
         fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..47]; // one bounds check for all constant loads
+        let k = &k[..48]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let ft0 = (qd[1] * qd[1]);
-        out[0] = (k[31] * ((k[15] * qdd[1] * rc_s) + qdd[0] + (k[15] * ft0 * rc_c)));
-        out[1] = (k[32] + (k[33] * qdd[1] * rc_c) + (k[34] * ft0 * rc_s));
+        out[0] = (k[30] * ((k[14] * qdd[1] * rc_s) + qdd[0] + (k[14] * ft0 * rc_c)));
+        out[1] = (k[31] + (k[32] * qdd[1] * rc_c) + (k[33] * ft0 * rc_s));
     }
 
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..47]; // one bounds check for all constant loads
+        let k = &k[..48]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..47]; // one bounds check for all constant loads
+        let k = &k[..48]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = forces[1];
-        out[1] = (k[22] - (forces[0] * (k[35] + (k[13] * rc_s))));
+        out[1] = (k[21] - (forces[0] * (k[34] + (k[12] * rc_s))));
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        let k = &k[..47]; // one bounds check for all constant loads
+        let k = &k[..48]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         f64::INFINITY
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..47]; // one bounds check for all constant loads
+        let k = &k[..48]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        out[0] = ((k[13] * rc_c) + q[0]);
-        out[1] = ((k[15] * qd[1] * rc_s) + qd[0]);
+        out[0] = ((k[12] * rc_c) + q[0]);
+        out[1] = ((k[14] * qd[1] * rc_s) + qd[0]);
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -296,46 +290,67 @@ impl Model for RodCube {
 
 impl Reduction for RodCube {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..47]; // one bounds check for all constant loads
+        let k = &k[..48]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
-        let rt1 = (k[37] + (k[38] * rt0));
+        let rt1 = (k[36] + (k[37] * rt0));
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: (-12.0 * (k[36] * rc_ds) / (k[13] * rt1)),
+            theta_dot_sq: (-12.0 * (k[35] * rc_ds) / (k[12] * rt1)),
             theta_ddot: (6.0
-                * ((k[39] * rc_s * rc_c * rc_ds) + (k[40] * rc_c) + (k[41] * rt0 * rc_c))
-                / (k[13] * (rt1 * rt1))),
+                * ((k[38] * rc_s * rc_c * rc_ds) + (k[39] * rc_c) + (k[40] * rt0 * rc_c))
+                / (k[12] * (rt1 * rt1))),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
-        let k = &k[..47]; // one bounds check for all constant loads
-        (-12.0 * (k[36] * rc_ds) / (k[13] * (k[37] + (k[38] * (rc_s * rc_s)))))
+        let k = &k[..48]; // one bounds check for all constant loads
+        (-12.0 * (k[35] * rc_ds) / (k[12] * (k[36] + (k[37] * (rc_s * rc_s)))))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..47]; // one bounds check for all constant loads
+        let k = &k[..48]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
-        let rt1 = (k[37] + (k[38] * rt0));
-        let rc_w2 = (-12.0 * (k[36] * rc_ds) / (k[13] * rt1));
+        let rt1 = (k[36] + (k[37] * rt0));
+        let rc_w2 = (-12.0 * (k[35] * rc_ds) / (k[12] * rt1));
         let rc_acc = (6.0
-            * ((k[39] * rc_s * rc_c * rc_ds) + (k[40] * rc_c) + (k[41] * rt0 * rc_c))
-            / (k[13] * (rt1 * rt1)));
-        out[0] = ((k[42] * rc_s * rc_acc) + (k[42] * rc_c * rc_w2));
-        out[1] = (k[32] + (k[34] * rc_s * rc_w2) + (k[33] * rc_c * rc_acc));
+            * ((k[38] * rc_s * rc_c * rc_ds) + (k[39] * rc_c) + (k[40] * rt0 * rc_c))
+            / (k[12] * (rt1 * rt1)));
+        out[0] = ((k[41] * rc_s * rc_acc) + (k[41] * rc_c * rc_w2));
+        out[1] = (k[31] + (k[33] * rc_s * rc_w2) + (k[32] * rc_c * rc_acc));
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..47]; // one bounds check for all constant loads
-        out[0] = k[43];
-        out[1] = k[44];
+        let k = &k[..48]; // one bounds check for all constant loads
+        out[0] = k[42];
+        out[1] = k[43];
         out[2] = 0.0;
-        out[3] = k[38];
+        out[3] = k[37];
+    }
+
+    fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        k[..5].copy_from_slice(p);
+        k[5] = (k[3] / k[2]).asin();
+        k[6] = 0.0;
+        k[7] = (k[3] / k[2]);
+        let c3_t0 = (k[3] / k[2]);
+        k[8] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
+        k[37] = (3.0 * k[0]);
+        k[42] = ((8.0 * k[0] * k[7]) + (8.0 * k[1] * k[7]));
+        k[43] = (-(12.0 * k[0]) - (12.0 * k[1]));
+        k[44] = (k[2] / 3.0 / k[4]);
+        k[45] = (-k[2] * k[0] / 4.0 / (k[4] * (k[0] + k[1])));
+    }
+
+    fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..48]; // one bounds check for all constant loads
+        out[0] = k[44];
+        out[1] = 0.0;
+        out[2] = k[45];
     }
 
     fn full_state(
@@ -347,12 +362,12 @@ impl Reduction for RodCube {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..47]; // one bounds check for all constant loads
+        let k = &k[..48]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[1] = k[5] - delta;
         qd[1] = theta_dot;
-        q[0] = (k[45] + (k[46] * rc_dc));
-        qd[0] = (k[46] * rc_s * rc_w);
+        q[0] = (k[46] + (k[47] * rc_dc));
+        qd[0] = (k[47] * rc_s * rc_w);
     }
 }

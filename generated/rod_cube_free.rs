@@ -136,6 +136,8 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 14,
         separation_degree: 0,
         polynomial_separation: false,
+        fall_degree: None,
+        lean_constants: &[11, 12, 13, 14],
     }),
     route_note: "",
 };
@@ -152,10 +154,7 @@ impl Model for RodCubeFree {
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
         k[..11].copy_from_slice(p);
-        k[11] = k[6];
-        k[12] = k[9];
-        k[13] = k[11].sin();
-        k[14] = k[11].cos();
+        Reduction::prepare_lean(self, p, k);
         k[15] = k[5];
         k[16] = k[7];
         k[17] = (-(k[2] * k[0] * k[12] * k[13] / 2.0) + (k[0] * k[8]));
@@ -338,6 +337,18 @@ impl Reduction for RodCubeFree {
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..49]; // one bounds check for all constant loads
+    }
+
+    fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        k[..11].copy_from_slice(p);
+        k[11] = k[6];
+        k[12] = k[9];
+        k[13] = k[11].sin();
+        k[14] = k[11].cos();
+    }
+
+    fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
         let k = &k[..49]; // one bounds check for all constant loads
     }
 

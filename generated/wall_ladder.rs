@@ -110,6 +110,8 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 7,
         separation_degree: 1,
         polynomial_separation: true,
+        fall_degree: Some(0),
+        lean_constants: &[4, 5, 6, 7, 25, 26],
     }),
     route_note: "",
 };
@@ -126,47 +128,41 @@ impl Model for WallLadder {
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
         k[..4].copy_from_slice(p);
-        k[4] = (k[2] / k[1]).asin();
-        k[5] = 0.0;
-        k[6] = (k[2] / k[1]);
-        let c3_t0 = (k[2] / k[1]);
-        k[7] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
+        Reduction::prepare_lean(self, p, k);
         k[8] = ((k[1] * k[1]) * k[0] / 3.0);
-        k[9] = (k[2] / k[1]).asin();
-        k[10] = (-k[1]);
-        k[11] = k[1];
-        k[12] = (-k[1] / 2.0);
-        k[13] = (k[1] / 2.0);
-        k[14] = ((k[1] * k[1]) * k[0] / 24.0);
-        k[15] = ((k[1] * k[1]) * k[0] / 8.0);
-        k[16] = (k[1] * k[3] * k[0] / 2.0);
-        k[17] = ((k[1] * k[1]) * k[0] / 12.0);
-        k[18] = ((k[1] * k[1]) * k[0] / 4.0);
-        k[19] = (-k[1] * k[3] * k[0] / 2.0);
-        k[20] = (-k[1] * k[0] / 2.0);
-        k[21] = k[0];
-        k[22] = (k[3] * k[0]);
-        k[23] = (k[1] * k[0] / 2.0);
-        k[24] = (3.0 * k[3] / k[1]);
-        k[25] = (-3.0 * k[3] / 2.0 / k[1]);
-        k[26] = (-2.0 * k[6]);
+        k[9] = (-k[1]);
+        k[10] = k[1];
+        k[11] = (-k[1] / 2.0);
+        k[12] = (k[1] / 2.0);
+        k[13] = ((k[1] * k[1]) * k[0] / 24.0);
+        k[14] = ((k[1] * k[1]) * k[0] / 8.0);
+        k[15] = (k[1] * k[3] * k[0] / 2.0);
+        k[16] = ((k[1] * k[1]) * k[0] / 12.0);
+        k[17] = ((k[1] * k[1]) * k[0] / 4.0);
+        k[18] = (-k[1] * k[3] * k[0] / 2.0);
+        k[19] = (-k[1] * k[0] / 2.0);
+        k[20] = k[0];
+        k[21] = (k[3] * k[0]);
+        k[22] = (k[1] * k[0] / 2.0);
+        k[23] = (3.0 * k[3] / k[1]);
+        k[24] = (-3.0 * k[3] / 2.0 / k[1]);
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
         let k = &k[..27]; // one bounds check for all constant loads
-        q[0] = k[9];
+        q[0] = k[4];
         qd[0] = 0.0;
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
         let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        pos[0] = [(k[10] * rc_c), 0.0];
-        vel[0] = [(k[11] * qd[0] * rc_s), 0.0];
-        pos[1] = [0.0, (k[11] * rc_s)];
-        vel[1] = [0.0, (k[11] * qd[0] * rc_c)];
-        pos[2] = [(k[12] * rc_c), (k[13] * rc_s)];
-        vel[2] = [(k[13] * qd[0] * rc_s), (k[13] * qd[0] * rc_c)];
+        pos[0] = [(k[9] * rc_c), 0.0];
+        vel[0] = [(k[10] * qd[0] * rc_s), 0.0];
+        pos[1] = [0.0, (k[10] * rc_s)];
+        vel[1] = [0.0, (k[10] * qd[0] * rc_c)];
+        pos[2] = [(k[11] * rc_c), (k[12] * rc_s)];
+        vel[2] = [(k[12] * qd[0] * rc_s), (k[12] * qd[0] * rc_c)];
         pos[3] = [0.0, 0.0];
         vel[3] = [0.0, 0.0];
     }
@@ -175,8 +171,8 @@ impl Model for WallLadder {
         let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let et0 = (qd[0] * qd[0]);
-        (((k[14] * et0) + (k[15] * et0 * (rc_s * rc_s)) + (k[15] * et0 * (rc_c * rc_c)))
-            + (k[16] * rc_s))
+        (((k[13] * et0) + (k[14] * et0 * (rc_s * rc_s)) + (k[14] * et0 * (rc_c * rc_c)))
+            + (k[15] * rc_s))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
@@ -187,8 +183,8 @@ impl Model for WallLadder {
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
         let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        mass[0] = (k[17] + (k[18] * (rc_s * rc_s)) + (k[18] * (rc_c * rc_c)));
-        rhs[0] = (k[19] * rc_c);
+        mass[0] = (k[16] + (k[17] * (rc_s * rc_s)) + (k[17] * (rc_c * rc_c)));
+        rhs[0] = (k[18] * rc_c);
     }
 
     fn forces_full(
@@ -203,10 +199,10 @@ impl Model for WallLadder {
         let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ft0 = (qd[0] * qd[0]);
-        out[0] = (-((k[20] * qdd[0] * rc_s)
-            + (k[21] * ((k[11] * qdd[0] * rc_s) + (k[11] * ft0 * rc_c)))
-            + (k[20] * ft0 * rc_c)));
-        out[1] = (k[22] + (k[23] * qdd[0] * rc_c) + (k[20] * ft0 * rc_s));
+        out[0] = (-((k[19] * qdd[0] * rc_s)
+            + (k[20] * ((k[10] * qdd[0] * rc_s) + (k[10] * ft0 * rc_c)))
+            + (k[19] * ft0 * rc_c)));
+        out[1] = (k[21] + (k[22] * qdd[0] * rc_c) + (k[19] * ft0 * rc_s));
     }
 
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
@@ -229,8 +225,8 @@ impl Model for WallLadder {
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
         let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        out[0] = (k[10] * rc_c);
-        out[1] = (k[11] * qd[0] * rc_s);
+        out[0] = (k[9] * rc_c);
+        out[1] = (k[10] * qd[0] * rc_s);
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -246,30 +242,46 @@ impl Reduction for WallLadder {
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: (k[24] * rc_ds),
-            theta_ddot: (k[25] * rc_c),
+            theta_dot_sq: (k[23] * rc_ds),
+            theta_ddot: (k[24] * rc_c),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
         let k = &k[..27]; // one bounds check for all constant loads
-        (k[24] * rc_ds)
+        (k[23] * rc_ds)
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
         let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[4], k[6], k[7], delta);
         let rc_delta = delta;
-        let rc_w2 = (k[24] * rc_ds);
-        let rc_acc = (k[25] * rc_c);
-        out[0] = ((k[20] * rc_s * rc_acc) + (k[20] * rc_c * rc_w2));
-        out[1] = (k[22] + (k[20] * rc_s * rc_w2) + (k[23] * rc_c * rc_acc));
+        let rc_w2 = (k[23] * rc_ds);
+        let rc_acc = (k[24] * rc_c);
+        out[0] = ((k[19] * rc_s * rc_acc) + (k[19] * rc_c * rc_w2));
+        out[1] = (k[21] + (k[19] * rc_s * rc_w2) + (k[22] * rc_c * rc_acc));
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
         let k = &k[..27]; // one bounds check for all constant loads
-        out[0] = k[26];
+        out[0] = k[25];
         out[1] = 3.0;
+    }
+
+    fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        k[..4].copy_from_slice(p);
+        k[4] = (k[2] / k[1]).asin();
+        k[5] = 0.0;
+        k[6] = (k[2] / k[1]);
+        let c3_t0 = (k[2] / k[1]);
+        k[7] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
+        k[25] = (-2.0 * k[6]);
+        k[26] = (k[1] / 3.0 / k[3]);
+    }
+
+    fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..27]; // one bounds check for all constant loads
+        out[0] = k[26];
     }
 
     fn full_state(

@@ -118,6 +118,8 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 11,
         separation_degree: 0,
         polynomial_separation: false,
+        fall_degree: None,
+        lean_constants: &[8, 9, 10, 11],
     }),
     route_note: "",
 };
@@ -134,10 +136,7 @@ impl Model for WallLadderFree {
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
         k[..8].copy_from_slice(p);
-        k[8] = k[5];
-        k[9] = k[7];
-        k[10] = k[8].sin();
-        k[11] = k[8].cos();
+        Reduction::prepare_lean(self, p, k);
         k[12] = k[4];
         k[13] = (-(k[1] * k[0] * k[9] * k[10] / 2.0) + (k[0] * k[6]));
         let c6_t0 = (k[1] * k[1]);
@@ -303,6 +302,18 @@ impl Reduction for WallLadderFree {
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..39]; // one bounds check for all constant loads
+    }
+
+    fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        k[..8].copy_from_slice(p);
+        k[8] = k[5];
+        k[9] = k[7];
+        k[10] = k[8].sin();
+        k[11] = k[8].cos();
+    }
+
+    fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
         let k = &k[..39]; // one bounds check for all constant loads
     }
 

@@ -120,6 +120,11 @@ pub struct ReductionInfo {
     /// Whether the contact force's zero is a root of that polynomial; a model with a contact
     /// and without one has it found as a bracketed root of its reduced contact force.
     pub polynomial_separation: bool,
+    /// Degree of the fall polynomial [`Reduction::fall_polynomial`], where the phase has one.
+    pub fall_degree: Option<usize>,
+    /// Indices in `k` (beyond the parameters) that [`Reduction::prepare_lean`] fills: the start
+    /// and the two polynomials' coefficients with what they are computed from.
+    pub lean_constants: &'static [usize],
 }
 
 /// Static description of a generated model.
@@ -251,6 +256,20 @@ pub trait Reduction: Send + Sync {
     /// Coefficients of the separation polynomial in `s = sin(theta)`, lowest degree first
     /// (`out.len() == separation_degree + 1`). Its root in `(0, sin theta_i)` is the separation.
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]);
+
+    /// Coefficients of the fall polynomial `P(s) = (sin theta_i - s) / theta_dot^2` in
+    /// `s = sin(theta)`, lowest degree first (`out.len() == fall_degree + 1`), for a phase
+    /// with [`ReductionInfo::fall_degree`]: one that starts from rest with a potential linear in
+    /// `sin(theta)` and a reduced inertia polynomial in it. The time integrand is then
+    /// `sqrt(P(s) / (1 + s))` up to the substitution's factor, singular only at the zeros of
+    /// `P` and at `s = -1`, which lets the per-point solver choose its rule a priori. Writes
+    /// nothing for a phase without one.
+    fn fall_polynomial(&self, k: &[f64], out: &mut [f64]);
+
+    /// [`Model::prepare`] for the per-point solver: copies the parameters into `k` and computes
+    /// only the constants of [`ReductionInfo::lean_constants`] (the start, the separation and
+    /// fall polynomials), leaving the others as they were.
+    fn prepare_lean(&self, p: &[f64], k: &mut [f64]);
 
     /// The full state on the reduced motion at time `t`, angle fallen `delta` and rate
     /// `theta_dot` (negative while falling): fills `q` and `qd`.

@@ -411,6 +411,8 @@ pub struct System<'m> {
     bound: Bound<'m>,
     reduction: &'m dyn Reduction,
     layout: &'static ReductionInfo,
+    /// The fall polynomial's coefficients (empty without one).
+    fall: Vec<f64>,
 }
 
 impl std::fmt::Debug for System<'_> {
@@ -452,11 +454,18 @@ impl<'m> System<'m> {
     pub fn reduce(bound: Bound<'m>) -> Result<Self, SystemError> {
         let info = bound.info();
         match (bound.model().reduction(), &info.reduction) {
-            (Some(reduction), Some(layout)) => Ok(System {
-                bound,
-                reduction,
-                layout,
-            }),
+            (Some(reduction), Some(layout)) => {
+                let mut fall = vec![0.0; layout.fall_degree.map_or(0, |d| d + 1)];
+                if !fall.is_empty() {
+                    reduction.fall_polynomial(bound.k(), &mut fall);
+                }
+                Ok(System {
+                    bound,
+                    reduction,
+                    layout,
+                    fall,
+                })
+            }
             _ => Err(SystemError::NoReduction {
                 model: info.name,
                 why: info.route_note,
@@ -522,6 +531,12 @@ impl<'m> System<'m> {
         let mut out = vec![0.0; self.layout.separation_degree + 1];
         self.reduction.separation_polynomial(self.k(), &mut out);
         out
+    }
+
+    /// Coefficients of the fall polynomial in `sin(theta)`, lowest degree first (empty when the
+    /// phase has none; see [`Reduction::fall_polynomial`]).
+    pub fn fall_coefficients(&self) -> &[f64] {
+        &self.fall
     }
 
     /// The full state on the reduced motion at phase time `t`, angle fallen `delta` and rate
@@ -603,8 +618,19 @@ pub fn check_parameters(
             got: p.len(),
         });
     }
-    for (i, &value) in p.iter().enumerate() {
-        check_value(info, i, value)?;
+    // Finite and positive values pass every value check; others get the detailed one.
+    // (Two comparisons each: NaN fails both, and `is_finite` compiles to bit tests.)
+    if !p
+        .iter()
+        .fold(true, |ok, &v| ok & (v > 0.0) & (v < f64::INFINITY))
+    {
+        for (i, &value) in p.iter().enumerate() {
+            check_value(info, i, value)?;
+        }
+    }
+    model.requirements(p, margins);
+    if margins.iter().fold(true, |ok, m| ok & (*m > 0.0)) {
+        return Ok(());
     }
     if let Some((req, margin)) = failed_requirements(model, p, margins).next() {
         return Err(SystemError::Requirement {
@@ -631,7 +657,7 @@ pub fn prepare_constants(model: &dyn Model, p: &[f64], k: &mut [f64]) -> Result<
     }
     model.prepare(p, k);
     // A branch-free scan first (it vectorises); the index only on failure.
-    if k.iter().fold(true, |ok, v| ok & v.is_finite()) {
+    if k.iter().fold(true, |ok, v| ok & (v.abs() < f64::INFINITY)) {
         return Ok(());
     }
     match k.iter().enumerate().find(|(_, v)| !v.is_finite()) {

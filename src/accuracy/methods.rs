@@ -8,7 +8,8 @@ use crate::solve::SolveError;
 use crate::solve::lean::LeanSolver;
 use crate::solve::ode::{OdeOptions, OdeProblem, dopri5};
 use crate::solve::poly::horner;
-use crate::solve::quadrature::{TimeMesh, gauss_legendre_rule};
+use crate::solve::prior::{Prior, integrate_prior};
+use crate::solve::quadrature::{Fall, TimeMesh, gauss_legendre_rule};
 use crate::solve::separation::{linearised_separation, separation};
 use crate::solve::series::sample_phase;
 use crate::solve::unreduced;
@@ -162,6 +163,17 @@ pub fn time_default(sys: &System, delta: f64, tol: f64) -> Outcome<f64> {
     let mut work = Work::default();
     let mesh = TimeMesh::build(sys, delta, tol, &mut work).map_err(err)?;
     Ok((mesh.duration, work.integrand_evals))
+}
+
+/// The per-point solver's a-priori rule ([`prior`](crate::solve::prior)): nodes chosen from
+/// where the integrand is singular, for a relative error `tol`, without an error estimate.
+pub fn time_prior(sys: &System, delta: f64, tol: f64) -> Outcome<f64> {
+    let fall = Fall::of(sys, delta).map_err(err)?;
+    let v_end = fall.v_at_delta(delta);
+    match integrate_prior(&fall, v_end, &Prior::new(tol)).map_err(err)? {
+        Some(done) => Ok(done),
+        None => Err("the model has no fall polynomial of degree 2 or less".into()),
+    }
 }
 
 /// One Gauss–Legendre panel of `nodes` after `delta = u^2`.

@@ -8,6 +8,7 @@ pub mod methods;
 pub mod plot;
 
 use crate::reference::{self, Family, Inputs, Reference, RootRoute, TimeRoute};
+use crate::solve::prior::PRIOR_TOL;
 use crate::system::System;
 use astro_float::BigFloat;
 use indicatif::ProgressBar;
@@ -173,6 +174,13 @@ fn time_methods() -> Vec<(&'static str, String, TimeFn)> {
             "default: sin/sinh subst., GL pairs by panel length",
             format!("tol {tol:.0e}"),
             Box::new(move |s, d, _| methods::time_default(s, d, tol)),
+        ));
+    }
+    for tol in [1e-6, 1e-10, 1e-14, PRIOR_TOL] {
+        out.push((
+            "per point: sin/sinh subst., GL nodes a priori from singularities",
+            format!("tol {tol:.0e}"),
+            Box::new(move |s, d, _| methods::time_prior(s, d, tol)),
         ));
     }
     for (low, high) in [(6, 9), (8, 12)] {

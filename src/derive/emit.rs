@@ -99,7 +99,11 @@ pub struct ReducedCode {
     theta_dot_sq_code: Code,
     forces: Code,
     separation: Code,
+    fall: Code,
     full_state: Code,
+    /// The constants the per-point solver reads, and the code computing only them.
+    prepare_lean: Code,
+    lean_constants: Vec<usize>,
 }
 
 /// Rust spelling of a model name as a type (`rod_cube` -> `RodCube`).
@@ -164,6 +168,11 @@ pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, St
     let np = d.params.len();
     let (scope, mut prepare) = constant_layout(d);
     let mut hoisted = Hoisted::new(scope.constants.len());
+    if let Ok(r) = &d.reduction {
+        for (j, c) in r.constants.iter().enumerate() {
+            hoisted.known(&c.value, np + j);
+        }
+    }
     let general = full_state_code(d, &scope, &mut hoisted)?;
     let reduction = match &d.reduction {
         Ok(r) => Some(reduced_code(d, r, &scope, &mut hoisted)?),
@@ -179,13 +188,32 @@ pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, St
     let out = requirements.push_body(lower(&d.requirements, &req_scope, None, "q"));
     requirements.outputs = out_lines(&out);
 
-    // Hoisted constants go to the end of prepare.
-    for (i, e) in hoisted.entries.clone() {
-        let body = lower(std::slice::from_ref(&e), &scope, None, &format!("h{i}_"));
-        let out = prepare.push_body(body);
-        prepare.bind(&format!("k[{i}]"), out[0].clone());
-    }
+    // With a fast path, prepare starts with the per-point solver's constants
+    // (`prepare_lean`) and computes the others after them, each once; hoisted constants go to
+    // the end.
     let n_constants = hoisted.len();
+    let mut reduction = reduction;
+    let mut lean_indices = Vec::new();
+    if let (Ok(r), Some(code)) = (&d.reduction, reduction.as_mut()) {
+        let (lean, indices) = lean_prepare(np, r, &scope, &hoisted, code)?;
+        code.prepare_lean = lean;
+        code.lean_constants = indices.clone();
+        prepare = Code::default();
+        prepare
+            .stmts
+            .push("Reduction::prepare_lean(self, p, k);".into());
+        for (j, c) in r.constants.iter().enumerate() {
+            if !indices.contains(&(np + j)) {
+                bind_constant(&mut prepare, np + j, &c.value, &scope, &format!("c{j}_"));
+            }
+        }
+        lean_indices = indices;
+    }
+    for (i, e) in &hoisted.entries {
+        if !lean_indices.contains(i) {
+            bind_constant(&mut prepare, *i, e, &scope, &format!("h{i}_"));
+        }
+    }
 
     // Static info.
     let point_index = |name: &str| {
@@ -223,7 +251,7 @@ pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, St
                     .ok_or_else(|| format!("the reduction has no constant `{s}`"))
             };
             Some(format!(
-                "ReductionInfo {{ k_theta_initial: {}, k_theta_dot_initial: {}, k_sin_initial: {}, k_cos_initial: {}, separation_degree: {}, polynomial_separation: {} }}",
+                "ReductionInfo {{ k_theta_initial: {}, k_theta_dot_initial: {}, k_sin_initial: {}, k_cos_initial: {}, separation_degree: {}, polynomial_separation: {}, fall_degree: {:?}, lean_constants: &{:?} }}",
                 code.k_theta_initial,
                 k("rc_wi")?,
                 code.k_sin_initial,
@@ -231,7 +259,9 @@ pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, St
                 r.separation
                     .as_ref()
                     .map_or(0, |s| s.coefficients.len() - 1),
-                r.separation.is_some()
+                r.separation.is_some(),
+                r.fall.as_ref().map(|f| f.len() - 1),
+                code.lean_constants
             ))
         }
         _ => None,
@@ -332,17 +362,86 @@ fn constant_layout(d: &Derivation) -> (Scope, Code) {
     };
     for (j, c) in constants.iter().enumerate() {
         let idx = np + j;
-        let body = lower(
-            std::slice::from_ref(&c.value),
-            &scope,
-            None,
-            &format!("c{j}_"),
-        );
-        let out = prepare.push_body(body);
-        prepare.bind(&format!("k[{idx}]"), out[0].clone());
+        bind_constant(&mut prepare, idx, &c.value, &scope, &format!("c{j}_"));
         scope.constants.insert(c.symbol.clone(), idx);
     }
     (scope, prepare)
+}
+
+/// `k[idx] = <value>;`, with the value's shared subexpressions as `let`s named by `prefix`.
+fn bind_constant(code: &mut Code, idx: usize, value: &Expr, scope: &Scope, prefix: &str) {
+    let out = code.push_body(lower(std::slice::from_ref(value), scope, None, prefix));
+    code.bind(&format!("k[{idx}]"), out[0].clone());
+}
+
+/// Indices `i` of every `k[i]` in a line of generated code.
+fn k_indices(text: &str) -> Vec<usize> {
+    text.match_indices("k[")
+        .filter_map(|(at, _)| {
+            let rest = &text[at + 2..];
+            let end = rest.find(']')?;
+            rest[..end].parse().ok()
+        })
+        .collect()
+}
+
+/// What the per-point solver reads: the start (`theta_i`, its rate, sine and cosine) and the
+/// separation and fall polynomials' coefficients, with every constant they are computed from.
+/// Returns the code that computes just those (after the parameters) and their indices.
+fn lean_prepare(
+    np: usize,
+    r: &Reduction,
+    scope: &Scope,
+    hoisted: &Hoisted,
+    code: &ReducedCode,
+) -> Result<(Code, Vec<usize>), String> {
+    let index = |name: &str| scope.constants.get(name).copied();
+    let definition = |i: usize| -> Option<&Expr> {
+        if i < np {
+            None
+        } else if i < np + r.constants.len() {
+            Some(&r.constants[i - np].value)
+        } else {
+            hoisted
+                .entries
+                .iter()
+                .find(|(j, _)| *j == i)
+                .map(|(_, e)| e)
+        }
+    };
+    let wi = index("rc_wi").ok_or("the reduction has no constant `rc_wi`")?;
+    let mut stack = vec![
+        code.k_theta_initial,
+        code.k_sin_initial,
+        code.k_cos_initial,
+        wi,
+    ];
+    for line in [&code.separation, &code.fall]
+        .into_iter()
+        .flat_map(|c| c.stmts.iter().chain(&c.outputs))
+    {
+        stack.extend(k_indices(line));
+    }
+    let mut needed = std::collections::BTreeSet::new();
+    while let Some(i) = stack.pop() {
+        if needed.insert(i)
+            && let Some(e) = definition(i)
+        {
+            stack.extend(e.symbols().iter().filter_map(|s| index(s)));
+        }
+    }
+    let mut lean = Code::default();
+    for (j, c) in r.constants.iter().enumerate() {
+        if needed.contains(&(np + j)) {
+            bind_constant(&mut lean, np + j, &c.value, scope, &format!("c{j}_"));
+        }
+    }
+    for (i, e) in &hoisted.entries {
+        if needed.contains(i) {
+            bind_constant(&mut lean, *i, e, scope, &format!("h{i}_"));
+        }
+    }
+    Ok((lean, needed.into_iter().filter(|&i| i >= np).collect()))
 }
 
 /// The spec file, relative to the project root.
@@ -601,6 +700,11 @@ fn reduced_code(
         separation.outputs =
             separation.push_body(lower(&sep.coefficients, scope, Some(hoisted), "p"));
     }
+    // Fall polynomial: coefficients are constants too.
+    let mut fall = Code::default();
+    if let Some(coefficients) = &r.fall {
+        fall.outputs = fall.push_body(lower(coefficients, scope, Some(hoisted), "p"));
+    }
 
     // Full state on the reduced motion.
     let mut full_state = Code::default();
@@ -625,7 +729,10 @@ fn reduced_code(
         theta_dot_sq_code: theta_dot_sq,
         forces,
         separation,
+        fall,
         full_state,
+        prepare_lean: Code::default(),
+        lean_constants: Vec::new(),
     })
 }
 

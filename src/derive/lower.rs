@@ -34,6 +34,12 @@ impl Hoisted {
         }
     }
 
+    /// Makes a subexpression equal to `e` read the constant already at `k[idx]` instead of
+    /// hoisting a copy (a start constant that an initial value repeats, say).
+    pub fn known(&mut self, e: &Expr, idx: usize) {
+        self.by_key.entry(e.to_infix()).or_insert(idx);
+    }
+
     /// Total length of `k` after hoisting.
     pub fn len(&self) -> usize {
         self.next

@@ -179,6 +179,13 @@ pub struct Reduction {
     /// The separation polynomial, if the phase has a contact whose force's zero is one (else
     /// the runtime finds that zero numerically, from the reduced force).
     pub separation: Option<Separation>,
+    /// Coefficients in `sin(theta)` (lowest degree first, over constants) of the fall
+    /// polynomial `P(s) = (sin theta_i - s) / theta_dot^2`, where that ratio is a polynomial in
+    /// `s` alone: the phase starts from rest, its potential is linear in `sin(theta)` and its
+    /// reduced inertia a polynomial in `sin(theta)`. Its zeros and `s = -1` are then the only
+    /// singularities of the time integrand, which lets the runtime choose its quadrature rule
+    /// a priori.
+    pub fall: Option<Vec<Expr>>,
     /// Fully substituted forms over parameters and `theta` for people and other tools.
     pub plain: BTreeMap<String, Expr>,
 }
@@ -1340,6 +1347,7 @@ impl Reducer<'_> {
         } else {
             None
         };
+        let fall = fall_polynomial(&red.wsq, &self.st.coords, self.theta())?;
         let plain = self.plain_forms(
             &red,
             names,
@@ -1361,6 +1369,7 @@ impl Reducer<'_> {
                 .collect::<Result<_, _>>()?,
             constants: red.constants,
             separation,
+            fall,
             plain,
         }))
     }
@@ -1698,25 +1707,13 @@ impl Reducer<'_> {
         positive.push("rc_si".into());
         positive.push("rc_ci".into());
         let poly = strip_positive_factors(&poly, &positive)?;
-        let mut coefficients = Vec::new();
-        let mut deriv = poly.clone();
-        let mut factorial: i64 = 1;
-        for deg in 0..=16i64 {
-            if deg > 0 {
-                factorial *= deg;
-            }
-            let c0 =
-                cas::expand(&(cas::subs_var(&deriv, "rc_s", &cas::num(0)) / cas::num(factorial)));
-            coefficients.push(to_expr(&c0, "coefficient")?);
-            deriv = cas::expand(&cas::d(&deriv, "rc_s"));
-            if cas::is_zero(&deriv) {
-                return Ok(Ok(Separation {
-                    coefficients,
-                    polynomial: to_expr(&poly, "separation polynomial")?,
-                }));
-            }
+        match coefficients_in_s(&poly, "coefficient")? {
+            Some(coefficients) => Ok(Ok(Separation {
+                coefficients,
+                polynomial: to_expr(&poly, "separation polynomial")?,
+            })),
+            None => Ok(Err("the separation polynomial has a degree above 16".into())),
         }
-        Ok(Err("the separation polynomial has a degree above 16".into()))
     }
 
     /// A reduced expression with `theta_dot^2` and `theta_ddot` substituted.
@@ -1796,6 +1793,64 @@ fn d_theta(f: &A) -> A {
         - cas::d(f, "rc_c") * cas::var("rc_s")
         - cas::d(f, "rc_ds") * cas::var("rc_c")
         + cas::d(f, "rc_dc") * cas::var("rc_s")
+}
+
+/// Most coefficients of a polynomial in `sin(theta)` the derivation writes (separation and fall
+/// polynomials).
+const MAX_POLY_COEFFICIENTS: usize = 17;
+
+/// The coefficients in `rc_s` of `a`, lowest degree first, if `a` is a polynomial in `rc_s` of
+/// degree below [`MAX_POLY_COEFFICIENTS`] over symbols free of `rc_s` (checked by comparing
+/// `a` with the sum of its Taylor terms).
+fn coefficients_in_s(a: &A, what: &str) -> Result<Option<Vec<Expr>>, DeriveError> {
+    let mut coefficients = Vec::new();
+    let mut terms = Vec::new();
+    let mut deriv = a.clone();
+    let mut factorial: i64 = 1;
+    for deg in 0..MAX_POLY_COEFFICIENTS as i64 {
+        if deg > 0 {
+            factorial *= deg;
+        }
+        let c0 = cas::expand(&(cas::subs_var(&deriv, "rc_s", &cas::num(0)) / cas::num(factorial)));
+        let power = (0..deg).fold(cas::num(1), |acc, _| acc * cas::var("rc_s"));
+        terms.push(c0.clone() * power);
+        coefficients.push(to_expr(&c0, what)?);
+        deriv = cas::expand(&cas::d(&deriv, "rc_s"));
+        if cas::is_zero(&deriv) {
+            let sum = terms.iter().fold(cas::num(0), |acc, t| acc + t.clone());
+            return Ok(cas::is_zero(&cas::expand(&(a.clone() - sum))).then_some(coefficients));
+        }
+    }
+    Ok(None)
+}
+
+/// The fall polynomial `(sin theta_i - s) / theta_dot^2` in `s = rc_s`, where it is one (see
+/// [`Reduction::fall`]); `None` for a phase that does not start from rest, whose potential
+/// has a `cos(theta)` term, or whose inertia is no polynomial in `sin(theta)`.
+fn fall_polynomial(
+    wsq: &A,
+    coords: &[String],
+    theta: &str,
+) -> Result<Option<Vec<Expr>>, DeriveError> {
+    if cas::is_zero(wsq) {
+        return Ok(None);
+    }
+    let ratio = reduce_cos_sq(&cas::together(&(cas::var("rc_ds") / wsq.clone())));
+    let ratio = cas::expand(&ratio);
+    let mut motion = vec!["rc_ds", "rc_dc", "rc_c", theta];
+    motion.extend(coords.iter().map(String::as_str));
+    if !free_of(&ratio, &motion) {
+        return Ok(None);
+    }
+    // Each coefficient over one denominator, common factors cancelled (`l (m1 + m2) / (3 g
+    // (m1 + m2))` is `l / (3 g)`).
+    let Some(coefficients) = coefficients_in_s(&ratio, "fall polynomial coefficient")? else {
+        return Ok(None);
+    };
+    let tidy = |c: &Expr| to_expr(&cas::together(&cas::atom(c)), "fall polynomial coefficient");
+    Ok(Some(
+        coefficients.iter().map(tidy).collect::<Result<_, _>>()?,
+    ))
 }
 
 /// `rc_ds`, `rc_dc` written as differences from the start.

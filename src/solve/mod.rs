@@ -16,6 +16,7 @@ pub mod lean;
 pub mod ode;
 pub mod phases;
 pub mod poly;
+pub mod prior;
 pub mod quadrature;
 pub mod roots;
 pub mod separation;

@@ -28,9 +28,60 @@ pub fn real_roots(coeffs: &[f64], lo: f64, hi: f64, evals: &mut u64) -> Option<V
 /// The largest sign-changing root of `coeffs` in `(lo, hi)`: `Some(None)` when there is none,
 /// `None` when the degree exceeds [`MAX_DEGREE`].
 pub fn largest_root(coeffs: &[f64], lo: f64, hi: f64, evals: &mut u64) -> Option<Option<f64>> {
+    let degree = coeffs.iter().rposition(|&c| c != 0.0).unwrap_or(0);
+    if (2..=3).contains(&degree) && lo < hi {
+        return Some(largest_low(&coeffs[..=degree], lo, hi, evals));
+    }
     let mut out = [0.0; MAX_DEGREE];
     let n = roots_in(coeffs, lo, hi, &mut out, evals)?;
     Some((n > 0).then(|| out[n - 1]))
+}
+
+/// [`largest_root`] for a quadratic or cubic (trimmed, `lo < hi`): the critical points by the
+/// quadratic formula, then only the highest piece with a sign change is refined.
+fn largest_low(coeffs: &[f64], lo: f64, hi: f64, evals: &mut u64) -> Option<f64> {
+    // As a cubic (a quadratic's leading coefficient 0) of known length, so that every
+    // evaluation below unrolls.
+    let mut c4 = [0.0; 4];
+    c4[..coeffs.len()].copy_from_slice(coeffs);
+    let c = &c4[..];
+    // Knots from the top: hi, the critical points inside (descending), lo.
+    let mut knots = [hi, lo, lo, lo];
+    let mut nk = 1;
+    if c[3] != 0.0 {
+        let mut crit = [0.0; MAX_DEGREE];
+        let nc = quadratic_roots(&[c[1], 2.0 * c[2], 3.0 * c[3]], lo, hi, &mut crit);
+        for &x in crit[..nc].iter().rev() {
+            knots[nk] = x;
+            nk += 1;
+        }
+    } else {
+        let x = -c[1] / (2.0 * c[2]);
+        if x > lo && x < hi {
+            knots[nk] = x;
+            nk += 1;
+        }
+    }
+    knots[nk] = lo;
+    nk += 1;
+    let mut upper = (knots[0], value(c, knots[0]));
+    *evals += 1;
+    for i in 1..nk {
+        let lower = (knots[i], value(c, knots[i]));
+        *evals += 1;
+        let (fa, fb) = (lower.1, upper.1);
+        if fb == 0.0 && i > 1 && fa != 0.0 {
+            // An exact zero at a critical point: a root if the sign changes through it.
+            let above = value(c, knots[i - 2]);
+            if above != 0.0 && above.signum() != fa.signum() {
+                return Some(upper.0);
+            }
+        } else if fa != 0.0 && fb != 0.0 && fa.signum() != fb.signum() {
+            return Some(refine(c, (lower.0, upper.0), (fa, fb), evals));
+        }
+        upper = lower;
+    }
+    None
 }
 
 /// The roots of [`real_roots`] into `out`, returning how many.
@@ -173,6 +224,7 @@ fn with_derivatives(c: &[f64], x: f64) -> (f64, f64, f64, f64) {
 
 /// `p(x)` by compensated Horner (Graillat, Langlois, Louvet 2005): as accurate as Horner in
 /// twice the working precision, then rounded.
+#[inline]
 pub fn horner_compensated(coeffs: &[f64], x: f64) -> f64 {
     let Some((&last, rest)) = coeffs.split_last() else {
         return 0.0;
@@ -218,6 +270,7 @@ fn two_product(a: f64, b: f64, (bh, bl): (f64, f64)) -> (f64, f64) {
 /// shrinking bracket (bisection when a step leaves it or does not halve); once a step is below
 /// 1e-7 relative (Halley's error is then far below an ulp) or the value is within its rounding
 /// bound, one Newton step on the compensated value lands within an ulp or two.
+#[inline(always)]
 fn refine(c: &[f64], (mut a, mut b): (f64, f64), (fa, fb): (f64, f64), evals: &mut u64) -> f64 {
     let sa = fa.signum();
     let secant = (a * fb - b * fa) / (fb - fa);

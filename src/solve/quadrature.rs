@@ -24,6 +24,15 @@
 //! costs `m` evaluations there. A phase that starts moving (`theta_dot_i < 0`, the free rod
 //! after separation) has an integrand that vanishes at `v = 0` and is not even.
 //!
+//! # With a fall polynomial
+//! Where the derivation found `theta_dot^2 = (sin theta_i - s) / P(s)` with a polynomial `P`
+//! ([`Reduction::fall_polynomial`]), the integrand is `2 sqrt(P(s) / (1 + s))`: one polynomial,
+//! one division and one root per node, no call to the model and no `cos(theta)`, and the same
+//! at `v = 0`. Each node then takes `sinh^2 v` by itself (a series below 1/2, one `exp`
+//! above), which also spares the addition theorem's cancellation on long panels. The
+//! per-point solver chooses its rules for such phases a priori
+//! ([`prior`](crate::solve::prior)); the verified pairs below serve everything else.
+//!
 //! # Error control
 //! Each panel is integrated by two Gauss–Legendre rules chosen by the panel's length from a
 //! [`RuleStep`] schedule (the nearest complex singularities of the integrand lie about `pi/2`
@@ -38,6 +47,7 @@
 use crate::model::{Reduction, ReductionInfo, start_offsets};
 use crate::results::Work;
 use crate::solve::SolveError;
+use crate::solve::poly::horner;
 use crate::system::System;
 use gauss_quad::GaussLegendre;
 use std::collections::HashMap;
@@ -223,6 +233,33 @@ pub struct Panel {
     pub value: f64,
 }
 
+/// `sinh(y)^2` within a few ulps: `y^2 (sinh(y) / y)^2` by the Taylor series of `sinh(y) / y`
+/// (to `y^14`, below 2^-55 relative) for `|y| < 1/2`, one `exp` beyond (which then loses at
+/// most a factor 1.6 to the difference `e^y - e^-y`).
+#[inline(always)]
+fn sinh_sq(y: f64) -> f64 {
+    let ay = y.abs();
+    if ay < 0.5 {
+        let z = y * y;
+        let r = 1.0
+            + z * (1.0 / 6.0
+                + z * (1.0 / 120.0
+                    + z * (1.0 / 5040.0
+                        + z * (1.0 / 362_880.0
+                            + z * (1.0 / 39_916_800.0
+                                + z * (1.0 / 6_227_020_800.0 + z / 1_307_674_368_000.0))))));
+        z * r * r
+    } else {
+        let e = ay.exp();
+        let sh = 0.5 * (e - 1.0 / e);
+        sh * sh
+    }
+}
+
+/// Largest `h x` at which a panel's node `mid - h x` is formed by the addition theorem (its
+/// rounding then grows by at most `exp(2 h x) = 2`).
+const ADDITION_REACH: f64 = 0.35;
+
 /// `(sinh x, cosh x)` from one `exp_m1`, accurate for small and large `x` alike.
 #[inline]
 fn sinh_cosh(x: f64) -> (f64, f64) {
@@ -251,6 +288,9 @@ pub struct Fall<'a> {
     e: f64,
     root_e: f64,
     from_rest: bool,
+    /// The fall polynomial's coefficients (empty without one): the integrand is then
+    /// `2 sqrt(P(s) / (1 + s))`, without `theta_dot^2`'s call.
+    fall: &'a [f64],
     /// The phase's end, for error messages.
     delta_end: f64,
 }
@@ -270,14 +310,18 @@ impl<'a> Fall<'a> {
     /// The phase of a reduced system, ending at `delta_end` (for messages; the integral's end is
     /// given to [`integrate`]). Checks that it falls: from rest `theta_dot^2` must grow from the
     /// start, moving `theta_dot_i` must be negative, and `theta_i` must be below the vertical.
+    ///
+    /// `fall` holds the coefficients of the model's fall polynomial
+    /// ([`Reduction::fall_polynomial`]) where it has one, else it is empty.
     pub fn new(
         model: &'static str,
         red: &'a dyn Reduction,
         k: &'a [f64],
         layout: &ReductionInfo,
+        fall: &'a [f64],
         delta_end: f64,
     ) -> Result<Fall<'a>, SolveError> {
-        let fall = Fall::geometry(model, red, k, layout, delta_end)?;
+        let fall = Fall::geometry(model, red, k, layout, fall, delta_end)?;
         fall.check_falls(k[layout.k_theta_dot_initial])?;
         Ok(fall)
     }
@@ -289,6 +333,7 @@ impl<'a> Fall<'a> {
         red: &'a dyn Reduction,
         k: &'a [f64],
         layout: &ReductionInfo,
+        fall: &'a [f64],
         delta_end: f64,
     ) -> Result<Fall<'a>, SolveError> {
         let theta_dot = k[layout.k_theta_dot_initial];
@@ -315,6 +360,7 @@ impl<'a> Fall<'a> {
             e,
             root_e: e.sqrt(),
             from_rest,
+            fall: if from_rest { fall } else { &[] },
             delta_end,
         })
     }
@@ -350,6 +396,7 @@ impl<'a> Fall<'a> {
             sys.reduction(),
             sys.k(),
             sys.layout(),
+            sys.fall_coefficients(),
             delta_end,
         )
     }
@@ -361,6 +408,7 @@ impl<'a> Fall<'a> {
             sys.reduction(),
             sys.k(),
             sys.layout(),
+            sys.fall_coefficients(),
             mesh.delta_end,
         )
     }
@@ -368,6 +416,21 @@ impl<'a> Fall<'a> {
     /// Whether the phase starts from rest (its integrand is then even in `v`).
     pub fn from_rest(&self) -> bool {
         self.from_rest
+    }
+
+    /// `sin(theta_i)`.
+    pub fn sin_initial(&self) -> f64 {
+        self.si
+    }
+
+    /// `e = 1 - sin(theta_i)`, the scale of the substitution `s = sin(theta_i) - e sinh^2 v`.
+    pub fn scale(&self) -> f64 {
+        self.e
+    }
+
+    /// The fall polynomial's coefficients (empty when the phase has none).
+    pub fn fall_polynomial(&self) -> &'a [f64] {
+        self.fall
     }
 
     /// `v` where `sin(theta)` has dropped by `drop >= 0`: `asinh(sqrt(q))`, `q = drop / e`, as
@@ -435,6 +498,13 @@ impl<'a> Fall<'a> {
     /// The integrand at the node given by its `sinh v` and `cosh v` (`v >= 0`).
     #[inline]
     fn value(&self, sh: f64, ch: f64) -> Result<f64, SolveError> {
+        if !self.fall.is_empty() {
+            let f = self.fall_value(sh * sh);
+            if f.is_nan() || f.is_infinite() || f <= 0.0 {
+                return Err(self.bad_fall(sh * sh));
+            }
+            return Ok(f);
+        }
         if sh == 0.0 {
             return self.centre_value();
         }
@@ -444,6 +514,76 @@ impl<'a> Fall<'a> {
             return Err(self.bad_value(n.s, w2));
         }
         Ok(2.0 * self.root_e * sh / (n.plus * w2).sqrt())
+    }
+
+    /// The integrand with a fall polynomial at the node where `sinh^2 v = sh2`:
+    /// `theta_dot^2 = w / P(s)` with `w = e sinh^2 v`, so `2 sqrt(e) sinh v / sqrt((1 + s)
+    /// theta_dot^2) = 2 sqrt(P(s) / (1 + s))`, also at `v = 0`. NaN where `P(s) < 0`.
+    #[inline(always)]
+    fn fall_value(&self, sh2: f64) -> f64 {
+        let s = self.si - self.e * sh2;
+        let p = match *self.fall {
+            [p0] => p0,
+            [p0, p1] => p0 + p1 * s,
+            [p0, p1, p2] => p0 + s * (p1 + s * p2),
+            _ => horner(self.fall, s),
+        };
+        2.0 * (p / (1.0 + s)).sqrt()
+    }
+
+    /// The error for a fall polynomial that is not positive and finite at `sinh^2 v = sh2`.
+    fn bad_fall(&self, sh2: f64) -> SolveError {
+        let ds = self.e * sh2;
+        let s = self.si - ds;
+        self.bad_value(s, ds / horner(self.fall, s))
+    }
+
+    /// [`Fall::panel`] with a fall polynomial: each node takes its own `sinh^2` (no trigonometry
+    /// and no call to the model), and the values are checked once for the whole panel.
+    fn panel_fall(&self, rule: &HalfRule, a: f64, b: f64) -> Result<(f64, u64), SolveError> {
+        let symmetric = self.symmetric(a);
+        let (centre, half) = if symmetric {
+            (0.0, b)
+        } else {
+            (0.5 * (a + b), 0.5 * (b - a))
+        };
+        let mut acc = 0.0;
+        let mut least = f64::INFINITY;
+        if rule.centre != 0.0 {
+            let f = self.fall_value(sinh_sq(centre));
+            least = least.min(f);
+            acc = rule.centre * f;
+        }
+        if symmetric {
+            acc *= 0.5;
+            for &(x, w) in &rule.pairs {
+                let f = self.fall_value(sinh_sq(half * x));
+                least = least.min(f);
+                acc += w * f;
+            }
+        } else {
+            for &(x, w) in &rule.pairs {
+                let up = self.fall_value(sinh_sq(centre + half * x));
+                let down = self.fall_value(sinh_sq(centre - half * x));
+                least = least.min(up.min(down));
+                acc += w * (up + down);
+            }
+        }
+        let evals = (usize::from(rule.centre != 0.0)
+            + rule.pairs.len() * if symmetric { 1 } else { 2 }) as u64;
+        // A NaN value (P < 0) also fails here: `min` skips NaN, the sum does not.
+        if !(least > 0.0 && acc.is_finite()) {
+            let nodes = std::iter::once(0.0).chain(rule.pairs.iter().flat_map(|&(x, _)| [x, -x]));
+            for x in nodes {
+                let v = if symmetric {
+                    half * x
+                } else {
+                    centre + half * x
+                };
+                self.value(sinh_sq(v).sqrt(), 1.0)?;
+            }
+        }
+        Ok((half * acc, evals))
     }
 
     /// The error for a `theta_dot^2` that is not positive and finite at `sin(theta) = s`.
@@ -480,15 +620,18 @@ impl<'a> Fall<'a> {
     ///
     /// On a symmetric panel the nodes are `b x` and the values serve `+x` and `-x`. Otherwise
     /// the nodes `mid +- h x` share one exponential: `sinh(mid +- h x)` and `cosh(mid +- h x)`
-    /// follow from those of `mid` and of `h x` by the addition theorems (the difference loses at
-    /// most `log2(mid / v)` bits, which the integrand's ratio `sinh v / |theta_dot|` does not
-    /// feel). Iterations do not depend on each other but through the sum, so the divisions and
+    /// follow from those of `mid` and of `h x` by the addition theorems. The difference
+    /// `sinh(mid - h x)` loses up to a factor `exp(2 h x)` to cancellation, so beyond
+    /// `h x = ADDITION_REACH` (a factor 2) that node takes its own exponential. Iterations do not depend on each other but through the sum, so the divisions and
     /// roots of different nodes overlap.
-    fn panel(&self, rule: &HalfRule, a: f64, b: f64) -> Result<(f64, u64), SolveError> {
+    pub(crate) fn panel(&self, rule: &HalfRule, a: f64, b: f64) -> Result<(f64, u64), SolveError> {
+        if !self.fall.is_empty() {
+            return self.panel_fall(rule, a, b);
+        }
         let mut acc = 0.0;
         if self.symmetric(a) {
             if rule.centre != 0.0 {
-                acc = 0.5 * rule.centre * self.centre_value()?;
+                acc = 0.5 * rule.centre * self.value(0.0, 1.0)?;
             }
             for &(x, w) in &rule.pairs {
                 let (sx, cx) = sinh_cosh(b * x);
@@ -506,9 +649,16 @@ impl<'a> Fall<'a> {
             evals += 1;
         }
         for &(x, w) in &rule.pairs {
-            let (sx, cx) = sinh_cosh(half * x);
+            let hx = half * x;
+            let (sx, cx) = sinh_cosh(hx);
             let up = self.value(sm * cx + cm * sx, cm * cx + sm * sx)?;
-            let down = self.value(sm * cx - cm * sx, cm * cx - sm * sx)?;
+            // The difference loses a factor up to exp(2 h x): beyond 2 its own exponential.
+            let (sd, cd) = if hx <= ADDITION_REACH {
+                (sm * cx - cm * sx, cm * cx - sm * sx)
+            } else {
+                sinh_cosh(mid - hx)
+            };
+            let down = self.value(sd, cd)?;
             acc += w * (up + down);
         }
         Ok((half * acc, evals))

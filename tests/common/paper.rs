@@ -151,6 +151,8 @@ static RC_INFO: ModelInfo = ModelInfo {
         k_cos_initial: RC_C0,
         separation_degree: 3,
         polynomial_separation: true,
+        fall_degree: Some(2),
+        lean_constants: &[5, 6, 7, 8, 9, 10, 11],
     }),
     route_note: "",
 };
@@ -314,6 +316,16 @@ impl Reduction for RodCube {
         out.copy_from_slice(&[8.0 * k[RC_R], -12.0, 0.0, 3.0 * k[RC_MU]]);
     }
 
+    fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        self.prepare(p, k);
+    }
+
+    fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
+        // (a/ell - sin theta) / theta_dot^2 from eq. (9): (ell / 4g) (4/3 - sin^2 theta / (1 + n))
+        let (ell, g) = (k[2], k[4]);
+        out.copy_from_slice(&[ell / (3.0 * g), 0.0, -ell * k[RC_MU] / (4.0 * g)]);
+    }
+
     fn full_state(
         &self,
         k: &[f64],
@@ -410,6 +422,8 @@ static FR_INFO: ModelInfo = ModelInfo {
         k_cos_initial: FR_C0,
         separation_degree: 0,
         polynomial_separation: false,
+        fall_degree: None,
+        lean_constants: &[],
     }),
     route_note: "",
 };
@@ -547,6 +561,12 @@ impl Reduction for FreeRod {
 
     fn separation_polynomial(&self, _k: &[f64], out: &mut [f64]) {
         out[0] = 1.0;
+    }
+
+    fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
+
+    fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        self.prepare(p, k);
     }
 
     fn full_state(

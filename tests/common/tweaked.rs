@@ -2,7 +2,9 @@
 //! monitors, a force or its `theta_dot^2`), to drive the solvers into outcomes the paper's
 //! models never reach.
 
-use rodcube::model::{Model, ModelInfo, Reduced, Reduction};
+use rodcube::model::{Model, ModelInfo, Reduced, Reduction, ReductionInfo};
+use std::collections::HashMap;
+use std::sync::{Mutex, OnceLock};
 
 /// `base` with an optional replacement separation polynomial and monitors shifted by a constant.
 pub struct Tweaked {
@@ -49,9 +51,30 @@ impl Tweaked {
     }
 }
 
+/// `info` without its fall polynomial: a broken `theta_dot^2` has none, so the solvers take
+/// the route that evaluates it (one leaked copy per model, for the test process's life).
+fn without_fall(info: &'static ModelInfo) -> &'static ModelInfo {
+    static COPIES: OnceLock<Mutex<HashMap<&'static str, &'static ModelInfo>>> = OnceLock::new();
+    let mut copies = COPIES
+        .get_or_init(Default::default)
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
+    copies.entry(info.name).or_insert_with(|| {
+        let reduction = info.reduction.map(|r| ReductionInfo {
+            fall_degree: None,
+            lean_constants: &[],
+            ..r
+        });
+        Box::leak(Box::new(ModelInfo { reduction, ..*info }))
+    })
+}
+
 impl Model for Tweaked {
     fn info(&self) -> &'static ModelInfo {
-        self.base.info()
+        match self.theta_dot_sq {
+            Fault::None => self.base.info(),
+            _ => without_fall(self.base.info()),
+        }
     }
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
         self.base.requirements(p, out)
@@ -142,6 +165,12 @@ impl Reduction for Tweaked {
             Some(c) => out.copy_from_slice(c),
             None => self.reduction.separation_polynomial(k, out),
         }
+    }
+    fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
+        self.reduction.fall_polynomial(k, out)
+    }
+    fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        self.reduction.prepare_lean(p, k)
     }
     fn full_state(
         &self,

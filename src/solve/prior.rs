@@ -1,0 +1,329 @@
+//! The a-priori rule: for a phase with a fall polynomial `P` of degree at most 2, the time
+//! integrand `2 sqrt(P(s) / (1 + s))` (see [`quadrature`](crate::solve::quadrature)) is
+//! singular only where `P(s) = 0` and at `s = -1`, so where its singularities lie in the
+//! variable `v` is known before any evaluation, and with it how many Gauss–Legendre nodes a
+//! panel needs.
+//!
+//! # The rule
+//! A function analytic inside the Bernstein ellipse of parameter `rho` around a panel (foci at
+//! the panel's ends, `rho = a + b` with semi-axes `a`, `b` over the half-length) is integrated by
+//! the Gauss–Legendre rule of `N` nodes with an error of order `rho^(-2N)` (Trefethen,
+//! *Approximation Theory and Approximation Practice*, ch. 19). The singularities in `s` map to
+//! `v` through `sinh^2 v = (sin theta_i - s) / e`; each gives one nearest point `v*` (the
+//! others are `-v*` and shifts by `i pi`, farther from a panel on `v >= 0`). A panel takes the
+//! fewest nodes `N` with `rho^(2N) >= PRIOR_MARGIN / tol` for the smallest `rho` over the points
+//! (a threshold table, no logarithm per point); a panel that would need more than
+//! [`PRIOR_MAX_NODES`] is halved. From rest the first panel `[0, b]` is half of the symmetric
+//! rule on `[-b, b]` and costs half its nodes.
+//!
+//! This replaces the verified pair of rules of [`integrate`](crate::solve::quadrature::integrate)
+//! by a bound: its margin was set by comparing with the verified quadrature and the 256-bit
+//! reference (`tests/hard_cases.rs`, `tests/prior.rs`) over every model with a fall polynomial
+//! and the hard-case ranges of `n` and `a/ell`. Models whose fall polynomial has a higher degree,
+//! or that have none, take the verified route.
+
+use crate::solve::SolveError;
+use crate::solve::quadrature::{Fall, HalfRule, half_rule};
+use std::f64::consts::FRAC_PI_2;
+
+/// Most nodes of a panel's rule before it is halved.
+pub const PRIOR_MAX_NODES: usize = 48;
+
+/// Fewest nodes of a panel's rule.
+pub const PRIOR_MIN_NODES: usize = 4;
+
+/// Most panels of one integral before the a-priori route gives way to the verified one.
+pub const PRIOR_MAX_PANELS: usize = 64;
+
+/// Depth of the halving (panels waiting at once; depth `d` leaves at most `d + 1`).
+const PRIOR_STACK: usize = 24;
+
+/// The factor on `rho^(-2N)` the rule guards against: the integrand's size on the ellipse
+/// relative to its mean (it grows like `|v - v*|^(-1/2)` near `s = -1`) and the bound's
+/// constant `64 / (15 (rho^2 - 1))`. Set from the comparisons of the module docs with a
+/// hundredfold margin over the largest factor seen.
+pub const PRIOR_MARGIN: f64 = 1e2;
+
+/// The relative error the per-point solver asks of the a-priori rule (`2^-53`).
+pub const PRIOR_TOL: f64 = f64::EPSILON / 2.0;
+
+/// Rules and node-count thresholds for one tolerance, made once per solver.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Prior {
+    /// `thresholds[j]`: the least `rho` for which `PRIOR_MIN_NODES + j` nodes suffice.
+    thresholds: Vec<f64>,
+    /// The Gauss–Legendre rules of `PRIOR_MIN_NODES + j` nodes.
+    rules: Vec<&'static HalfRule>,
+    /// Relative error asked.
+    pub tol: f64,
+}
+
+impl Prior {
+    /// Rules for a relative error `tol` (raised to `2^-53`; not finite means `2^-53`).
+    pub fn new(tol: f64) -> Prior {
+        let tol = if tol.is_finite() {
+            tol.max(PRIOR_TOL)
+        } else {
+            PRIOR_TOL
+        };
+        let log_ratio = (PRIOR_MARGIN / tol).ln();
+        let counts = PRIOR_MIN_NODES..=PRIOR_MAX_NODES;
+        Prior {
+            thresholds: counts
+                .clone()
+                .map(|n| (log_ratio / (2.0 * n as f64)).exp())
+                .collect(),
+            rules: counts.map(half_rule).collect(),
+            tol,
+        }
+    }
+
+    /// The rule for a panel whose nearest singularity has Bernstein parameter `rho`, if one of
+    /// at most [`PRIOR_MAX_NODES`] nodes suffices.
+    fn rule_for(&self, rho: f64) -> Option<&'static HalfRule> {
+        // Thresholds fall with the node count: the first one `rho` reaches.
+        let j = self.thresholds.partition_point(|&t| rho < t);
+        self.rules.get(j).copied()
+    }
+}
+
+/// The points of the `v` plane where a fall's integrand is singular, one per singular value
+/// of `s`, as `(x, y)` for `v* = x + i y` with `x >= 0` and `0 <= y <= pi/2`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Singularities {
+    points: [(f64, f64); 3],
+    len: usize,
+}
+
+impl Singularities {
+    /// The singular points of the integrand of a phase starting at `sin(theta_i) = si` with
+    /// scale `e = 1 - si` and a fall polynomial `coeffs` (lowest degree first), or `None` when
+    /// the polynomial has a degree above 2 or a zero at the start.
+    pub fn of(si: f64, e: f64, coeffs: &[f64]) -> Option<Singularities> {
+        let mut out = Singularities {
+            points: [(0.0, 0.0); 3],
+            len: 0,
+        };
+        // Real singularities below the start lie on the real v axis, the nearest (largest s)
+        // hiding the others: s = -1 and the real zeros of P below sin(theta_i).
+        let mut below = -1.0f64;
+        let mut real = |s: f64, out: &mut Singularities| -> Option<()> {
+            if s < si {
+                below = below.max(s);
+                Some(())
+            } else if s > si {
+                out.push(above(si, e, s));
+                Some(())
+            } else {
+                None
+            }
+        };
+        match *coeffs {
+            [] | [_] => {}
+            [p0, p1] => real(-p0 / p1, &mut out)?,
+            [p0, p1, 0.0] => real(-p0 / p1, &mut out)?,
+            [p0, p1, p2] => {
+                let disc = p1 * p1 - 4.0 * p0 * p2;
+                if disc >= 0.0 {
+                    // Both real, without cancellation.
+                    let q = -0.5 * (p1 + disc.sqrt().copysign(p1));
+                    real(q / p2, &mut out)?;
+                    real(p0 / q, &mut out)?;
+                } else {
+                    // A conjugate pair: one representative (the ellipses are symmetric).
+                    out.push(complex(
+                        si,
+                        e,
+                        -0.5 * p1 / p2,
+                        0.5 * (-disc).sqrt() / p2.abs(),
+                    ));
+                }
+            }
+            _ => return None,
+        }
+        let z = (si - below) / e;
+        out.push((asinh_sqrt(z), 0.0));
+        (out.points[..out.len].iter())
+            .all(|&(x, y)| x.is_finite() && y.is_finite())
+            .then_some(out)
+    }
+
+    fn push(&mut self, p: (f64, f64)) {
+        if self.len < self.points.len() {
+            self.points[self.len] = p;
+            self.len += 1;
+        }
+    }
+
+    /// The Bernstein parameter of the nearest point for the panel of centre `c` and
+    /// half-length `h`: `rho = alpha + sqrt(alpha^2 - 1)`, `alpha` the mean distance to the
+    /// panel's ends over `h`.
+    fn rho(&self, c: f64, h: f64) -> f64 {
+        let mut alpha = f64::INFINITY;
+        for &(x, y) in &self.points[..self.len] {
+            let (u, w) = ((x - c) / h, y / h);
+            let w2 = w * w;
+            let a =
+                0.5 * (((u - 1.0) * (u - 1.0) + w2).sqrt() + ((u + 1.0) * (u + 1.0) + w2).sqrt());
+            alpha = alpha.min(a);
+        }
+        alpha + ((alpha - 1.0) * (alpha + 1.0)).max(0.0).sqrt()
+    }
+}
+
+/// `asinh(sqrt(z))` for `z >= 0`, as `log1p(sqrt(z) + z / (1 + sqrt(1 + z)))`.
+fn asinh_sqrt(z: f64) -> f64 {
+    (z.sqrt() + z / (1.0 + (1.0 + z).sqrt())).ln_1p()
+}
+
+/// The point for a real singular `s > sin(theta_i)`: `sinh v = i y`, `y = sqrt((s - si) / e)`,
+/// so `v = i asin(y)` for `y <= 1` and `v = acosh(y) + i pi/2` beyond.
+fn above(si: f64, e: f64, s: f64) -> (f64, f64) {
+    let y = ((s - si) / e).sqrt();
+    if y <= 1.0 {
+        (0.0, y.asin())
+    } else {
+        ((y + ((y - 1.0) * (y + 1.0)).sqrt()).ln(), FRAC_PI_2)
+    }
+}
+
+/// The point for a complex singular `s = re + i im`: `v* = asinh(sqrt(z))`, `z = (si - s) / e`,
+/// as `log(sqrt(z) + sqrt(z + 1))`, then brought to `x >= 0`, `0 <= y <= pi/2`.
+fn complex(si: f64, e: f64, re: f64, im: f64) -> (f64, f64) {
+    let z = ((si - re) / e, -im / e);
+    let a = csqrt(z);
+    let b = csqrt((z.0 + 1.0, z.1));
+    let (sr, si_) = (a.0 + b.0, a.1 + b.1);
+    let (mut x, mut y) = ((sr * sr + si_ * si_).sqrt().ln(), si_.atan2(sr));
+    if x < 0.0 {
+        (x, y) = (-x, -y);
+    }
+    // y modulo pi into (-pi/2, pi/2], then its size (the conjugate is a singularity too).
+    y -= std::f64::consts::PI * (y / std::f64::consts::PI).round();
+    (x, y.abs())
+}
+
+/// Principal square root of `re + i im`.
+fn csqrt((re, im): (f64, f64)) -> (f64, f64) {
+    let r = (re * re + im * im).sqrt();
+    let a = (0.5 * (r + re.abs())).sqrt();
+    if a == 0.0 {
+        return (0.0, 0.0);
+    }
+    if re >= 0.0 {
+        (a, 0.5 * im / a)
+    } else {
+        (0.5 * im.abs() / a, a.copysign(im))
+    }
+}
+
+/// `t` from the start of a fall (from rest, with a fall polynomial) to `v_end` by the a-priori
+/// rule: `Ok(None)` when the rule does not apply (no fall polynomial of degree at most 2, a
+/// singularity on the path, or more than [`PRIOR_MAX_PANELS`] panels), so that the caller
+/// takes the verified route. Returns the integral and the integrand evaluations.
+pub fn integrate_prior(
+    fall: &Fall,
+    v_end: f64,
+    prior: &Prior,
+) -> Result<Option<(f64, u64)>, SolveError> {
+    if !(fall.from_rest() && v_end > 0.0 && v_end.is_finite()) {
+        return Ok(None);
+    }
+    if fall.fall_polynomial().is_empty() {
+        return Ok(None);
+    }
+    let Some(sing) = Singularities::of(fall.sin_initial(), fall.scale(), fall.fall_polynomial())
+    else {
+        return Ok(None);
+    };
+    // Most phases take one panel; the others are halved, depth first.
+    if let Some(rule) = prior.rule_for(sing.rho(0.0, v_end)) {
+        return fall.panel(rule, 0.0, v_end).map(Some);
+    }
+    let mut stack = [(0.0, 0.0); PRIOR_STACK];
+    stack[0] = (0.0, 0.5 * v_end);
+    stack[1] = (0.5 * v_end, v_end);
+    let (mut top, mut panels) = (2usize, 1usize);
+    let (mut total, mut evals) = (0.0, 0u64);
+    while top > 0 {
+        top -= 1;
+        let (a, b) = stack[top];
+        // The first panel from rest is the symmetric one [-b, b].
+        let (c, h) = if a == 0.0 {
+            (0.0, b)
+        } else {
+            (0.5 * (a + b), 0.5 * (b - a))
+        };
+        panels += 1;
+        match prior.rule_for(sing.rho(c, h)) {
+            Some(rule) => {
+                let (value, n) = fall.panel(rule, a, b)?;
+                total += value;
+                evals += n;
+            }
+            None => {
+                let mid = 0.5 * (a + b);
+                if !(mid > a && mid < b) || top + 2 > PRIOR_STACK || panels > PRIOR_MAX_PANELS {
+                    return Ok(None);
+                }
+                stack[top] = (mid, b);
+                stack[top + 1] = (a, mid);
+                top += 2;
+            }
+        }
+    }
+    Ok(Some((total, evals)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `sinh^2(v*)` must give back `(si - s) / e` at every point found.
+    fn sinh_sq(x: f64, y: f64) -> (f64, f64) {
+        // sinh(x + i y) = sinh x cos y + i cosh x sin y.
+        let (a, b) = (x.sinh() * y.cos(), x.cosh() * y.sin());
+        (a * a - b * b, 2.0 * a * b)
+    }
+
+    #[test]
+    fn points_map_back_to_their_singular_sine() {
+        let (si, e) = (0.7, 0.3);
+        for s in [1.5, 0.9, -0.4] {
+            let (x, y) = if s > si {
+                above(si, e, s)
+            } else {
+                (asinh_sqrt((si - s) / e), 0.0)
+            };
+            let (re, im) = sinh_sq(x, y);
+            assert!((re - (si - s) / e).abs() < 1e-12 && im.abs() < 1e-12, "{s}");
+        }
+        for (re_s, im_s) in [(0.2, 0.05), (-3.0, 2.0), (0.69, 1e-3)] {
+            let (x, y) = complex(si, e, re_s, im_s);
+            assert!(x >= 0.0 && (0.0..=FRAC_PI_2 + 1e-15).contains(&y));
+            let (re, im) = sinh_sq(x, y);
+            let (zr, zi) = ((si - re_s) / e, -im_s / e);
+            // v* or its conjugate.
+            assert!(
+                (re - zr).abs() < 1e-9 && (im.abs() - zi.abs()).abs() < 1e-9,
+                "{re_s} {im_s}"
+            );
+        }
+    }
+
+    #[test]
+    fn more_nodes_for_nearer_singularities_and_none_on_the_path() {
+        let prior = Prior::new(PRIOR_TOL);
+        let far = prior.rule_for(10.0).map(|r| r.nodes);
+        let near = prior.rule_for(2.0).map(|r| r.nodes);
+        assert!(far.is_some() && far < near, "{far:?} {near:?}");
+        assert_eq!(prior.rule_for(1.2), None, "too near: halve the panel");
+        assert_eq!(prior.rule_for(1.0), None);
+        // A singular point on the panel gives rho = 1.
+        let sing = Singularities::of(0.5, 0.5, &[]).expect("no polynomial: s = -1 alone");
+        assert_eq!(sing.points[0], (asinh_sqrt(3.0), 0.0));
+        assert!((sing.rho(0.0, asinh_sqrt(3.0)) - 1.0).abs() < 1e-7);
+        assert_eq!(Singularities::of(0.5, 0.5, &[1.0, 0.0, 0.0, 1.0]), None);
+        assert_eq!(Singularities::of(0.5, 0.5, &[-0.5, 1.0]), None);
+    }
+}
