@@ -21,14 +21,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         FloorImpact,
     ];
     let r = run(&Request::new(model, params).with_want(&want))?;
-    let deg = |k: &str| r.results[k].value.to_degrees();
+    let value = |key: &str| -> Result<f64, String> {
+        r.get(key)
+            .map(|s| s.value)
+            .ok_or_else(|| format!("no `{key}` in the results"))
+    };
     println!(
         "theta_sep            {:.4} deg (paper 9.61)",
-        deg("separation_angle")
+        value("separation_angle")?.to_degrees()
     );
     println!(
         "linearised theta_sep {:.4} deg (paper 9.59)",
-        deg("linearised_separation_angle")
+        value("linearised_separation_angle")?.to_degrees()
     );
     for key in [
         "separation_time",
@@ -36,7 +40,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "point_mass_fall_time",
         "floor_impact_time",
     ] {
-        println!("{key:<20} {:.6} s", r.results[key].value);
+        println!("{key:<20} {:.6} s", value(key)?);
     }
     Ok(())
 }

@@ -16,10 +16,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ("g", 9.81),
         ];
         let r = run(&Request::new(model, params).with_want(&[SeparationAngle, SeparationTime]))?;
-        let (theta, t) = (
-            r.results["separation_angle"].value,
-            r.results["separation_time"].value,
-        );
+        let (Some(theta), Some(t)) = (r.separation_angle(), r.separation_time()) else {
+            println!("{n:>10.3e}  no separation before the floor");
+            continue;
+        };
         println!("{n:>10.3e} {:>9.4} deg {t:>10.6} s", theta.to_degrees());
     }
     Ok(())

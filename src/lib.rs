@@ -15,8 +15,8 @@
 //! let request = Request::new(model, [("m1", 1.0), ("m2", 3.0), ("ell", 1.0), ("a", 0.25), ("g", 9.81)])
 //!     .with_want(&[Quantity::SeparationAngle, Quantity::SeparationTime]);
 //! let results = plan::run(&request)?;
-//! let theta_sep = results.results["separation_angle"].value;
-//! let t_sep = results.results["separation_time"].value;
+//! let theta_sep = results.separation_angle().expect("the paper's rod separates");
+//! let t_sep = results.separation_time().expect("wanted");
 //! assert!((theta_sep.to_degrees() - 9.61).abs() < 0.005);
 //! assert!((t_sep - 0.1085).abs() < 5e-4);
 //! assert_eq!(results.work.integrand_evals > 0, true);
@@ -54,9 +54,12 @@
 //! `examples/paper.rs` reproduces the paper's numbers; `examples/sweep_n.rs` sweeps the mass
 //! ratio. The derivation tool lives behind the cargo feature `derive` (it needs Symbolica).
 
+#[cfg(feature = "cli")]
 pub mod accuracy;
 #[cfg(feature = "derive")]
 pub mod derive;
+#[cfg(feature = "capi")]
+pub mod ffi;
 #[doc(hidden)]
 pub mod fuzzing;
 pub mod io;
@@ -64,12 +67,19 @@ pub mod model;
 pub mod models;
 pub mod plan;
 pub mod quantity;
+#[cfg(feature = "cli")]
 pub mod reference;
 pub mod report;
 pub mod results;
 pub mod scene;
 pub mod solve;
 pub mod spec;
+#[cfg(feature = "cli")]
 pub mod sweep;
 pub mod system;
 pub mod yaml_marks;
+
+/// The README's Rust examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

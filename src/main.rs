@@ -294,7 +294,9 @@ fn planner_failure(scene: &Scene, error: PlanError) -> Failure {
         }
         PlanError::Unavailable { .. } => at("want".into(), Kind::UnavailableQuantity),
         PlanError::BadTolerance { .. } => at("tolerance".into(), Kind::OutOfRange),
-        PlanError::TooFewSamples { .. } => at("samples".into(), Kind::OutOfRange),
+        PlanError::TooFewSamples { .. } | PlanError::TooManySamples { .. } => {
+            at("samples".into(), Kind::OutOfRange)
+        }
         _ => Failure::Solve(
             anyhow::Error::from(error).context(format!("solving {} failed", scene.file.display())),
         ),

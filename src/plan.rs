@@ -51,6 +51,9 @@ use std::collections::BTreeMap;
 pub const DEFAULT_TOLERANCE: f64 = 1e-10;
 /// Points per series when a request gives none.
 pub const DEFAULT_SAMPLES: usize = 500;
+/// Most points per series a request may ask for (each series holds `samples` values per
+/// column in memory).
+pub const MAX_SAMPLES: usize = 10_000_000;
 /// Accepted relative tolerances (inclusive).
 pub const TOLERANCE_RANGE: (f64, f64) = (1e-14, 1e-2);
 /// The integrator runs at `tolerance * ODE_RTOL_FACTOR`, but never tighter than
@@ -205,6 +208,12 @@ pub enum PlanError {
         /// The samples given.
         samples: usize,
     },
+    /// More than [`MAX_SAMPLES`] samples.
+    #[error("{samples} samples asked; at most {MAX_SAMPLES} per series")]
+    TooManySamples {
+        /// The samples given.
+        samples: usize,
+    },
     /// The parameters were refused.
     #[error(transparent)]
     System(#[from] SystemError),
@@ -257,6 +266,11 @@ pub fn run(request: &Request) -> Result<RunResults, PlanError> {
     });
     if needs_samples && request.samples < 2 {
         return Err(PlanError::TooFewSamples {
+            samples: request.samples,
+        });
+    }
+    if request.samples > MAX_SAMPLES {
+        return Err(PlanError::TooManySamples {
             samples: request.samples,
         });
     }

@@ -117,18 +117,32 @@ impl Quantity {
         ))
     }
 
-    /// The key of this quantity in scenes and results.
+    /// The key of this quantity in scenes and results. An index the model does not have is
+    /// named for error messages (`force #7_series`); [`Quantity::available`] refuses it.
     pub fn name(&self, info: &ModelInfo) -> String {
+        let named = |names: Option<&'static str>, what: &str, i: usize| {
+            names.map_or_else(|| format!("{what} #{i}"), str::to_string)
+        };
         match self {
-            Quantity::ForceSeries(i) => format!("{}_series", info.forces[*i].name),
-            Quantity::FrictionSeries(i) => format!("{}_series", info.frictions[*i].name),
-            Quantity::Trajectory(i) => format!("{}_trajectory", info.points[*i].name),
-            q => FIXED
-                .iter()
-                .find(|(_, f, _)| f == q)
-                .map(|(n, _, _)| n.to_string())
-                .unwrap_or_default(),
+            Quantity::ForceSeries(i) => {
+                let force = named(info.forces.get(*i).map(|f| f.name), "force", *i);
+                format!("{force}_series")
+            }
+            Quantity::FrictionSeries(i) => {
+                let friction = named(info.frictions.get(*i).map(|f| f.name), "friction", *i);
+                format!("{friction}_series")
+            }
+            Quantity::Trajectory(i) => {
+                let point = named(info.points.get(*i).map(|p| p.name), "point", *i);
+                format!("{point}_trajectory")
+            }
+            q => q.fixed_name().unwrap_or("unnamed").to_string(),
         }
+    }
+
+    /// The key of a quantity that does not depend on the model (`None` for the indexed ones).
+    pub fn fixed_name(&self) -> Option<&'static str> {
+        FIXED.iter().find(|(_, f, _)| f == self).map(|(n, _, _)| *n)
     }
 
     /// Every quantity name a model offers, in a stable order.
@@ -151,8 +165,8 @@ impl Quantity {
 
     /// Whether a model can provide this quantity: separation needs a contact, the floor
     /// impact a phase after it, the quantities of the energy integral (the time to the floor in
-    /// contact, the cross-check against the quadrature) the fast path, and the linearised angle
-    /// a separation polynomial.
+    /// contact, the cross-check against the quadrature) the fast path, the linearised angle
+    /// a separation polynomial, and an indexed quantity an index the model has.
     pub fn available(&self, info: &ModelInfo) -> bool {
         let contact = info.contact.is_some();
         let fast = info.reduction.is_some();
@@ -163,8 +177,10 @@ impl Quantity {
             }
             Quantity::ContactTimeToFloor | Quantity::CrossCheck => fast,
             Quantity::FloorImpact => contact && info.next_phase.is_some(),
+            Quantity::ForceSeries(i) => *i < info.forces.len(),
             Quantity::FrictionSeries(i) => *i < info.frictions.len(),
-            _ => true,
+            Quantity::Trajectory(i) => *i < info.points.len(),
+            Quantity::ThetaSeries | Quantity::Checks | Quantity::PointMassFallTime => true,
         }
     }
 }

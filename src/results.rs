@@ -1,5 +1,7 @@
 //! The results of a run: scalars, series, checks and the work done, ready for any report.
 
+use crate::model::ModelInfo;
+use crate::quantity::Quantity;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -88,4 +90,59 @@ pub struct RunResults {
     /// before the floor). A quantity is either in `results`/`series` or explained here.
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
     pub notes: BTreeMap<String, String>,
+}
+
+impl RunResults {
+    /// A scalar result by its quantity (`None` when it was not wanted, or has no value: then
+    /// [`RunResults::note`] says why). Only quantities that do not depend on the model's names
+    /// are scalars: the separation angle and time, the linearised angle, the contact time to
+    /// the floor and the point mass's fall time.
+    pub fn scalar(&self, quantity: Quantity) -> Option<&Scalar> {
+        self.results.get(quantity.fixed_name()?)
+    }
+
+    /// A scalar result by its key in `results` (`floor_impact_time`, say: the quantities that
+    /// give several scalars name each).
+    pub fn get(&self, key: &str) -> Option<&Scalar> {
+        self.results.get(key)
+    }
+
+    /// A scalar's value by its quantity.
+    pub fn value(&self, quantity: Quantity) -> Option<f64> {
+        self.scalar(quantity).map(|s| s.value)
+    }
+
+    /// The separation angle (rad), if it was wanted and the contact ended by its force.
+    pub fn separation_angle(&self) -> Option<f64> {
+        self.value(Quantity::SeparationAngle)
+    }
+
+    /// The time from release to separation (s), if it was wanted and the contact ended.
+    pub fn separation_time(&self) -> Option<f64> {
+        self.value(Quantity::SeparationTime)
+    }
+
+    /// A series by its quantity, resolved against the model that made it (`None` when it was
+    /// not wanted, has no samples, or the quantity is not the model's).
+    pub fn series_of(&self, quantity: Quantity, info: &ModelInfo) -> Option<&Series> {
+        if !quantity.available(info) || info.name != self.model {
+            return None;
+        }
+        self.series.get(&quantity.name(info))
+    }
+
+    /// Why a wanted quantity has no value, if it has none.
+    pub fn note(&self, quantity: Quantity, info: &ModelInfo) -> Option<&str> {
+        self.notes.get(&quantity.name(info)).map(String::as_str)
+    }
+}
+
+impl Series {
+    /// A column by name (`t`, `theta`, ...).
+    pub fn column(&self, name: &str) -> Option<&[f64]> {
+        self.columns
+            .iter()
+            .find(|c| c.name == name)
+            .map(|c| c.values.as_slice())
+    }
 }

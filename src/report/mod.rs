@@ -1,15 +1,22 @@
 //! Reports of a run: the human table, results.json, one CSV per series and SVG plots.
 //!
-//! Every writer here is a pure function from [`RunResults`] to text; only [`write_all`] touches
-//! the file system, through [`OutDir`] (atomic writes, checked names).
+//! Every writer here is a pure function from `RunResults` to text; only `write_all` touches
+//! the file system, through `OutDir` (atomic writes, checked names). Only [`json`] is built
+//! without the `cli` feature (the C ABI returns it).
 
+#[cfg(feature = "cli")]
 pub mod csv;
 pub mod json;
+#[cfg(feature = "cli")]
 pub mod plot;
+#[cfg(feature = "cli")]
 pub mod table;
 
+#[cfg(feature = "cli")]
 use crate::io::OutDir;
+#[cfg(feature = "cli")]
 use crate::results::RunResults;
+#[cfg(feature = "cli")]
 use std::path::PathBuf;
 
 /// Name of the JSON file written beside the series.
@@ -58,6 +65,7 @@ pub enum Error {
 
 /// Writes `results.json`, `<series>.csv` for every series and `<series>.svg` for every series
 /// that can be plotted. Returns the paths written, in that order.
+#[cfg(feature = "cli")]
 pub fn write_all(out: &OutDir, results: &RunResults) -> Result<Vec<PathBuf>, Error> {
     let mut written = vec![out.write(RESULTS_JSON, json::to_string(results)?.as_bytes())?];
     for (name, series) in &results.series {

@@ -1,18 +1,18 @@
 //! A lean per-point solve of the separation angle and time, for sweeps of millions of points:
 //! every buffer is allocated once per solver and reused, nothing is kept per point, and the
 //! numerics are the project's one copy of each: parameters checked by
-//! [`check_parameters`], the root by the isolator of [`poly`], the time by the quadrature of
+//! [`check_parameters`], the root by the isolator of [`poly`](crate::solve::poly), the time by the quadrature of
 //! [`quadrature`] (its module docs give the substitution that makes a few Gauss–Legendre nodes
 //! reach `f64` accuracy across the whole parameter range, and its error control).
 //!
 //! Where the model has a fall polynomial of degree at most 2 (rod_cube, hinged_rod, loaded_rod,
 //! wall_ladder), the solver prepares only the constants it reads
-//! ([`Reduction::prepare_lean`](crate::model::Reduction::prepare_lean)) and takes the node
+//! ([`Reduction::prepare_lean`]) and takes the node
 //! counts a priori from the integrand's singularities ([`prior`](crate::solve::prior)): about
 //! 7 evaluations per point instead of 19, at `2^-53` relative.
 //!
 //! `rodcube accuracy` and the tests in `tests/hard_cases.rs` check the result against the
-//! high-precision [`reference`](crate::reference) across `n = m2/m1` from 1e-12 to 1e12 and
+//! high-precision reference (`rodcube::reference`, feature `cli`) across `n = m2/m1` from 1e-12 to 1e12 and
 //! `a/ell` from 1e-10 to `1 - 1e-9`.
 
 use crate::model::{Model, ModelInfo, Reduction, ReductionInfo};
@@ -157,7 +157,7 @@ impl<'m> LeanSolver<'m> {
     /// [`System::from_values`](crate::system::System::from_values) does, then solves.
     ///
     /// With the a-priori rule only the constants it reads are prepared
-    /// ([`Reduction::prepare_lean`](crate::model::Reduction::prepare_lean)); a point that fails
+    /// ([`Reduction::prepare_lean`]); a point that fails
     /// that way is solved again from every constant, so that its error is the one the full
     /// preparation reports.
     pub fn solve(&mut self, p: &[f64]) -> Result<LeanPoint, SolveError> {

@@ -9,7 +9,7 @@
 //!
 //! A next phase gets its parameters from [`NextPhase::bindings`](crate::model::NextPhase): a
 //! parameter of this model, a coordinate or velocity at the end of the phase, or the value and
-//! rate of the coordinate the contact tied ([`Model::released`](crate::model::Model::released)).
+//! rate of the coordinate the contact tied ([`Model::released`]).
 //! Its clock restarts at zero; the absolute time of its start is kept in [`PhaseRun::t_start`].
 
 use crate::model::{Binding, Model};

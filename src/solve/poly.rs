@@ -191,7 +191,7 @@ pub fn horner(coeffs: &[f64], x: f64) -> f64 {
 
 /// `p(x)` with a reliable sign: plain Horner, redone by [`horner_compensated`] when the result
 /// is within the plain evaluation's rounding bound `4 (d+1) eps sum |c_i| |x|^i` of zero (the
-/// loop of [`with_derivatives`] without the derivatives, which the knots do not need).
+/// loop of `with_derivatives` without the derivatives, which the knots do not need).
 #[inline]
 pub fn value(c: &[f64], x: f64) -> f64 {
     let ax = x.abs();
