@@ -17,6 +17,7 @@ use crate::plan::{self, Request};
 use crate::scene::Scene;
 use crate::solve::SolveError;
 use crate::solve::lean::LeanSolver;
+use crate::system::ordered_values;
 use std::ffi::{CStr, CString, c_char, c_int};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
@@ -318,38 +319,12 @@ pub unsafe extern "C" fn rodcube_solve_named(
                 .ok_or_else(|| failure(RODCUBE_ERR_ARGUMENT, "the solver is NULL"))?;
             let given = slice(names, n, "the names")?;
             let vals = slice(values, n, "the values")?;
-            let info = s.solver.model().info();
-            let mut seen = vec![false; info.parameters.len()];
+            let mut pairs = Vec::with_capacity(n);
             for (i, (&name, &value)) in given.iter().zip(vals).enumerate() {
-                let name = text(name, &format!("name {i}"))?;
-                let Some(j) = info.parameters.iter().position(|p| p.name == name) else {
-                    let known: Vec<&str> = info.parameters.iter().map(|p| p.name).collect();
-                    return Err(failure(
-                        RODCUBE_ERR_PARAMETERS,
-                        format!(
-                            "model `{}` has no parameter `{name}`; it takes {}",
-                            info.name,
-                            known.join(", ")
-                        ),
-                    ));
-                };
-                if std::mem::replace(&mut seen[j], true) {
-                    return Err(failure(
-                        RODCUBE_ERR_PARAMETERS,
-                        format!("parameter `{name}` is given twice"),
-                    ));
-                }
-                s.values[j] = value;
+                pairs.push((text(name, &format!("name {i}"))?, value));
             }
-            if let Some(j) = seen.iter().position(|s| !s) {
-                return Err(failure(
-                    RODCUBE_ERR_PARAMETERS,
-                    format!(
-                        "model `{}` needs parameter `{}`",
-                        info.name, info.parameters[j].name
-                    ),
-                ));
-            }
+            ordered_values(s.solver.model().info(), &pairs, &mut s.values)
+                .map_err(|e| failure(RODCUBE_ERR_PARAMETERS, e.to_string()))?;
             let out = out
                 .as_mut()
                 .ok_or_else(|| failure(RODCUBE_ERR_ARGUMENT, "the output is NULL"))?;

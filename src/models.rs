@@ -1,7 +1,10 @@
 //! The registry of generated models: every model in `generated/`, found without hand edits.
 
+/// The generated models as types, one module per model: `generated::rod_cube::RodCube`
+/// names the paper's model (a unit struct implementing [`Model`]), for programs that want
+/// the compiler to check the name rather than [`find`] at run time.
 #[path = "../generated/mod.rs"]
-mod generated;
+pub mod generated;
 
 use crate::model::Model;
 

@@ -174,45 +174,8 @@ impl<'m> Bound<'m> {
         model: &'m dyn Model,
         params: &[(S, f64)],
     ) -> Result<Self, SystemError> {
-        let info = model.info();
-        let mut values: Vec<Option<f64>> = vec![None; info.parameters.len()];
-        for (name, value) in params {
-            let name = name.as_ref();
-            let Some(i) = info.parameters.iter().position(|p| p.name == name) else {
-                return Err(SystemError::UnknownParameter {
-                    model: info.name,
-                    name: name.to_string(),
-                    value: *value,
-                    known: info
-                        .parameters
-                        .iter()
-                        .map(|p| p.name)
-                        .collect::<Vec<_>>()
-                        .join(", "),
-                });
-            };
-            if let Some(first) = values[i] {
-                return Err(SystemError::DuplicateParameter {
-                    model: info.name,
-                    name: name.to_string(),
-                    first,
-                    second: *value,
-                });
-            }
-            values[i] = Some(*value);
-        }
-        let mut p = Vec::with_capacity(values.len());
-        for (v, param) in values.iter().zip(info.parameters) {
-            match v {
-                Some(v) => p.push(*v),
-                None => {
-                    return Err(SystemError::MissingParameter {
-                        model: info.name,
-                        name: param.name,
-                    });
-                }
-            }
-        }
+        let mut p = vec![0.0; model.info().parameters.len()];
+        ordered_values(model.info(), params, &mut p)?;
         Self::from_values(model, &p)
     }
 
@@ -550,6 +513,58 @@ impl<'m> System<'m> {
         self.reduction
             .full_state(self.k(), t, delta, theta_dot, &mut state.q, &mut state.qd);
         state
+    }
+}
+
+/// Named parameter values (any order, each exactly once) put into `out` in the model's order
+/// (`out` holds one entry per parameter): the one place names become positions, for [`Bound`],
+/// the per-point solver and the C interface.
+pub fn ordered_values<S: AsRef<str>>(
+    info: &'static ModelInfo,
+    params: &[(S, f64)],
+    out: &mut [f64],
+) -> Result<(), SystemError> {
+    let n = info.parameters.len();
+    if out.len() != n {
+        return Err(SystemError::WrongCount {
+            model: info.name,
+            expected: n,
+            got: out.len(),
+        });
+    }
+    let mut seen = vec![false; n];
+    for (name, value) in params {
+        let name = name.as_ref();
+        let Some(i) = info.parameters.iter().position(|p| p.name == name) else {
+            return Err(SystemError::UnknownParameter {
+                model: info.name,
+                name: name.to_string(),
+                value: *value,
+                known: info
+                    .parameters
+                    .iter()
+                    .map(|p| p.name)
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            });
+        };
+        if seen[i] {
+            return Err(SystemError::DuplicateParameter {
+                model: info.name,
+                name: name.to_string(),
+                first: out[i],
+                second: *value,
+            });
+        }
+        seen[i] = true;
+        out[i] = *value;
+    }
+    match seen.iter().position(|s| !s) {
+        Some(i) => Err(SystemError::MissingParameter {
+            model: info.name,
+            name: info.parameters[i].name,
+        }),
+        None => Ok(()),
     }
 }
 

@@ -234,3 +234,61 @@ fn results_are_read_through_typed_accessors() {
     assert!(results.series_of(Quantity::ForceSeries(5), info).is_none());
     assert!(results.series_of(Quantity::ThetaSeries, info).is_none());
 }
+
+#[test]
+fn the_per_point_solver_takes_parameters_by_name() {
+    use rodcube::solve::SolveError;
+    use rodcube::system::SystemError;
+    let model = rodcube::models::find("rod_cube").expect("generated model");
+    let mut solver = LeanSolver::new(model).expect("rod_cube solves per point");
+    let named = solver
+        .solve_named(&[
+            ("g", 9.81),
+            ("a", 0.25),
+            ("ell", 1.0),
+            ("m2", 3.0),
+            ("m1", 1.0),
+        ])
+        .expect("paper's case");
+    let ordered = solver
+        .solve(&[1.0, 3.0, 1.0, 0.25, 9.81])
+        .expect("paper's case");
+    assert_eq!(named, ordered);
+    let mut refused = |params: &[(&str, f64)]| match solver.solve_named(params) {
+        Err(SolveError::Parameters(e)) => e,
+        other => panic!("{params:?}: {other:?}"),
+    };
+    assert!(matches!(
+        refused(&[("m1", 1.0), ("m2", 3.0), ("ell", 1.0), ("a", 0.25)]),
+        SystemError::MissingParameter { name: "g", .. }
+    ));
+    assert!(matches!(
+        refused(&[
+            ("m1", 1.0),
+            ("m1", 2.0),
+            ("ell", 1.0),
+            ("a", 0.25),
+            ("g", 1.0)
+        ]),
+        SystemError::DuplicateParameter { .. }
+    ));
+    assert!(matches!(
+        refused(&[("mass", 1.0)]),
+        SystemError::UnknownParameter { .. }
+    ));
+}
+
+#[test]
+fn models_can_be_named_as_types() {
+    use rodcube::models::generated::rod_cube::RodCube;
+    let mut solver = LeanSolver::new(&RodCube).expect("rod_cube solves per point");
+    let by_type = solver
+        .solve(&[1.0, 3.0, 1.0, 0.25, 9.81])
+        .expect("paper's case");
+    let model = rodcube::models::find("rod_cube").expect("generated model");
+    let by_name = LeanSolver::new(model)
+        .and_then(|mut s| s.solve(&[1.0, 3.0, 1.0, 0.25, 9.81]))
+        .expect("paper's case");
+    assert_eq!(by_type, by_name);
+    assert_eq!(RodCube.info().name, "rod_cube");
+}

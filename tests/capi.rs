@@ -38,6 +38,46 @@ fn the_c_example_prints_the_rust_solvers_numbers() {
         value("separation_time").to_bits(),
         rust.separation_time.to_bits()
     );
+
+    // The README's C example, inside a `main`, against the library run.sh built: it prints the
+    // same line.
+    let readme = std::fs::read_to_string(root.join("README.md")).expect("README.md");
+    let snippet = readme
+        .split("```c\n")
+        .nth(1)
+        .and_then(|rest| rest.split("```").next())
+        .expect("a C example in the README");
+    let dir = target.join("readme-c");
+    std::fs::create_dir_all(&dir).expect("scratch directory");
+    let source = dir.join("readme.c");
+    let program = format!(
+        "#include <stdio.h>\n#include \"rodcube.h\"\nint main(void) {{\n{snippet}return 0;\n}}\n"
+    );
+    std::fs::write(&source, program).expect("write readme.c");
+    let lib = target.join("release");
+    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
+    let built = Command::new(cc)
+        .args(["-std=c11", "-Wall", "-Wextra", "-Werror", "-pedantic"])
+        .arg(format!("-I{}", root.join("include").display()))
+        .arg(&source)
+        .arg(format!("-L{}", lib.display()))
+        .arg("-lrodcube")
+        .arg(format!("-Wl,-rpath,{}", lib.display()))
+        .arg("-o")
+        .arg(dir.join("readme"))
+        .output()
+        .expect("the C compiler runs");
+    assert!(
+        built.status.success(),
+        "the README's C example does not compile:\n{}",
+        String::from_utf8_lossy(&built.stderr)
+    );
+    let ran = Command::new(dir.join("readme")).output().expect("it runs");
+    assert!(ran.status.success());
+    assert_eq!(
+        String::from_utf8_lossy(&ran.stdout).lines().next(),
+        Some(line)
+    );
 }
 
 #[cfg(feature = "capi")]

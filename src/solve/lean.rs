@@ -21,7 +21,7 @@ use crate::solve::poly::MAX_DEGREE;
 use crate::solve::prior::{PRIOR_TOL, Prior, integrate_prior};
 use crate::solve::quadrature::{self, ACCEPT, Control, Fall, RuleStep, SCHEDULE};
 use crate::solve::separation::separation_root;
-use crate::system::{SystemError, check_parameters, prepare_constants};
+use crate::system::{SystemError, check_parameters, ordered_values, prepare_constants};
 
 /// One point's separation.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -51,6 +51,8 @@ pub struct LeanSolver<'m> {
     control: Control,
     /// The a-priori rule, where the model's fall polynomial allows it and no rules were asked.
     prior: Option<Prior>,
+    /// Scratch for parameters given by name.
+    named: Vec<f64>,
     stack: Vec<(f64, f64)>,
     /// Evaluations of `theta_dot^2` and of the polynomial since the solver was made.
     pub evals: u64,
@@ -143,6 +145,7 @@ impl<'m> LeanSolver<'m> {
             fall: vec![0.0; layout.fall_degree.map_or(0, |d| d + 1)],
             control: Control::new(schedule, accept),
             prior: None,
+            named: Vec::new(),
             stack: Vec::with_capacity(64),
             evals: 0,
         })
@@ -174,6 +177,22 @@ impl<'m> LeanSolver<'m> {
         }
         prepare_constants(self.model, p, &mut self.k).map_err(SolveError::Parameters)?;
         self.solve_prepared()
+    }
+
+    /// [`LeanSolver::solve`] with the parameters by name (any order, each exactly once), put
+    /// in the model's order by [`ordered_values`] (unknown, missing and repeated names are
+    /// typed errors).
+    pub fn solve_named<S: AsRef<str>>(
+        &mut self,
+        params: &[(S, f64)],
+    ) -> Result<LeanPoint, SolveError> {
+        let mut p = std::mem::take(&mut self.named);
+        p.resize(self.info.parameters.len(), 0.0);
+        let outcome = ordered_values(self.info, params, &mut p)
+            .map_err(SolveError::Parameters)
+            .and_then(|()| self.solve(&p));
+        self.named = p;
+        outcome
     }
 
     /// The separation angle and time from prepared constants.

@@ -1,0 +1,15 @@
+"""rodcube from Python: the separation of a rod leaning on a cube, and models like it.
+
+- ``solve(model, want=[...], **parameters)``: one parameter point through rodcube's planner;
+  returns a dict of floats (scalars), strings (words such as ``contact_end_cause``) and dicts
+  of NumPy arrays (series, by column).
+- ``sweep(n, a_over_ell, model="rod_cube", **fixed)``: separation angle and time over NumPy
+  arrays, in parallel with the GIL released; NaN where a point has no solution.
+- ``models()`` and ``parameters(model)``: the registry.
+
+Errors are ``RodcubeError`` (a ``ValueError``) with rodcube's own messages.
+"""
+
+from ._rodcube import RodcubeError, models, parameters, solve, sweep
+
+__all__ = ["RodcubeError", "models", "parameters", "solve", "sweep"]
