@@ -17,6 +17,8 @@ mod numerics_cli;
 
 /// Exit status: the computation failed.
 const EXIT_FAILED: u8 = 1;
+/// Exit status: a bad command line (clap uses it too).
+const EXIT_USAGE: u8 = 2;
 /// Exit status: the scene is invalid (clap uses 2 for a bad command line).
 const EXIT_SCENE: u8 = 3;
 /// Exit status: an output could not be written.
@@ -25,14 +27,14 @@ const EXIT_OUTPUT: u8 = 4;
 const EXAMPLES: &str = "\
 Examples:
   rodcube                                    # the same as `rodcube run`: the paper's case
-  rodcube run                                # scenes/paper.yaml -> out/paper/
+  rodcube run                                # the paper's scene (built in) -> out/paper/
   rodcube run scenes/hinged.yaml             # another scene -> out/hinged/
   rodcube run scenes/paper.yaml --json > r.json
   rodcube run my_scene.yaml --out /tmp/mine  # choose the output directory
   rodcube models                             # models, their parameters and quantities
 
 Exit status: 0 success, 1 the computation failed, 2 bad command line,
-3 invalid scene (the message names file:line:column and the field),
+3 invalid scene or input file (the message names file:line:column and the field),
 4 an output could not be written.";
 
 const RUN_HELP: &str = "\
@@ -100,9 +102,8 @@ struct DeriveArgs {
 
 #[derive(Args)]
 struct RunArgs {
-    /// Scene file (YAML)
-    #[arg(default_value = "scenes/paper.yaml")]
-    scene: PathBuf,
+    /// Scene file (YAML) [default: the paper's scene, scenes/paper.yaml as built in]
+    scene: Option<PathBuf>,
     /// Print results.json on stdout instead of the table
     #[arg(long)]
     json: bool,
@@ -111,13 +112,31 @@ struct RunArgs {
     out: Option<PathBuf>,
 }
 
-/// With no subcommand, `rodcube` runs the paper's scene (`rodcube run scenes/paper.yaml`).
+/// With no subcommand, `rodcube` runs the paper's scene (`rodcube run`).
 fn default_command() -> Command {
     Command::Run(RunArgs {
-        scene: PathBuf::from("scenes/paper.yaml"),
+        scene: None,
         json: false,
         out: None,
     })
+}
+
+/// The paper's scene, built into the binary so that a bare `rodcube` works from any directory.
+const PAPER_SCENE: &str = include_str!("../scenes/paper.yaml");
+
+/// The scene of `rodcube run`: the file given, or the built-in paper's scene (named as the
+/// file it was built from, so its messages and its output directory, `out/paper/`, are the
+/// same as the file's).
+fn load_scene(path: Option<&PathBuf>) -> Result<Scene, Failure> {
+    match path {
+        Some(path) => Scene::load(path),
+        None => Scene::parse(
+            PAPER_SCENE,
+            std::path::Path::new("scenes/paper.yaml"),
+            rodcube::models::all(),
+        ),
+    }
+    .map_err(Failure::Scene)
 }
 
 /// Why a command failed; each kind has its exit status.
@@ -126,10 +145,13 @@ enum Failure {
     Scene(SceneError),
     /// The computation failed.
     Solve(anyhow::Error),
+    /// The command line asks for something that cannot be (an unknown model, an axis a model
+    /// lacks): exit status 2, as for the errors clap reports.
+    Usage(anyhow::Error),
     /// An output could not be written.
     Output(anyhow::Error),
-    /// A model spec is invalid (its message names file, line, column and field).
-    #[cfg(feature = "derive")]
+    /// An input file is invalid: a model spec or a sweep's points (its message names the file
+    /// and the line).
     Invalid(anyhow::Error),
 }
 
@@ -144,11 +166,14 @@ impl Failure {
                 note(&format!("error: {e:#}"));
                 ExitCode::from(EXIT_FAILED)
             }
+            Failure::Usage(e) => {
+                note(&format!("error: {e:#}"));
+                ExitCode::from(EXIT_USAGE)
+            }
             Failure::Output(e) => {
                 note(&format!("error: {e:#}"));
                 ExitCode::from(EXIT_OUTPUT)
             }
-            #[cfg(feature = "derive")]
             Failure::Invalid(e) => {
                 note(&format!("error: {e:#}"));
                 ExitCode::from(EXIT_SCENE)
@@ -219,7 +244,7 @@ fn derive(args: DeriveArgs) -> Result<(), Failure> {
 
 /// `rodcube run`.
 fn run(args: RunArgs) -> Result<(), Failure> {
-    let scene = Scene::load(&args.scene).map_err(Failure::Scene)?;
+    let scene = load_scene(args.scene.as_ref())?;
     let out_dir = match args.out {
         Some(dir) => dir,
         None => default_out_dir(&scene)?,

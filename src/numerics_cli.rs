@@ -86,6 +86,11 @@ fn bad(e: impl std::fmt::Display) -> Failure {
     Failure::Solve(anyhow::anyhow!("{e}"))
 }
 
+/// A command-line argument that cannot be honoured (exit status 2).
+fn usage(e: impl std::fmt::Display) -> Failure {
+    Failure::Usage(anyhow::anyhow!("{e}"))
+}
+
 fn output(e: impl Into<anyhow::Error>) -> Failure {
     Failure::Output(e.into())
 }
@@ -97,32 +102,33 @@ pub fn sweep(args: SweepArgs) -> Result<(), Failure> {
             .iter()
             .map(|m| m.info().name)
             .collect();
-        bad(format!(
+        usage(format!(
             "no model `{}`; the models are: {}",
             args.model,
             names.join(", ")
         ))
     })?;
-    let mapping = Mapping::new(model, args.ell, args.g).map_err(bad)?;
-    let extra = sweep::parse_want(model, &args.want).map_err(bad)?;
+    let mapping = Mapping::new(model, args.ell, args.g).map_err(usage)?;
+    let extra = sweep::parse_want(model, &args.want).map_err(usage)?;
     let (points, has_n, grid): (Vec<Point>, bool, Option<(Axis, Axis)>) = match &args.points {
         Some(path) => {
-            let (points, has_n) = sweep::read_points(path).map_err(bad)?;
+            let (points, has_n) =
+                sweep::read_points(path).map_err(|e| Failure::Invalid(anyhow::anyhow!("{e}")))?;
             (points, has_n, None)
         }
         None => {
             let r_spec = args.a_over_ell.as_deref().ok_or_else(|| {
-                bad("give --a-over-ell (and --n for a model with m2), or --points FILE")
+                usage("give --a-over-ell (and --n for a model with m2), or --points FILE")
             })?;
-            let r = sweep::parse_axis("a-over-ell", r_spec).map_err(bad)?;
+            let r = sweep::parse_axis("a-over-ell", r_spec).map_err(usage)?;
             let n = match &args.n {
-                Some(spec) => Some(sweep::parse_axis("n", spec).map_err(bad)?),
+                Some(spec) => Some(sweep::parse_axis("n", spec).map_err(usage)?),
                 None => None,
             };
             let ns = n.as_ref().map_or(vec![f64::NAN], |a| a.values.clone());
             let total = ns.len().saturating_mul(r.values.len());
             if total > sweep::MAX_POINTS {
-                return Err(bad(format!(
+                return Err(usage(format!(
                     "{total} points is more than {}",
                     sweep::MAX_POINTS
                 )));
@@ -141,7 +147,7 @@ pub fn sweep(args: SweepArgs) -> Result<(), Failure> {
             (points, has_n, grid)
         }
     };
-    mapping.check(&points, has_n).map_err(bad)?;
+    mapping.check(&points, has_n).map_err(usage)?;
     if args.heatmap && grid.is_none() {
         note("note: no heat maps: they need a grid over both n and a/ell");
     }
@@ -223,7 +229,7 @@ fn time_unit(mapping: &Mapping) -> &'static str {
 /// `rodcube accuracy`.
 pub fn accuracy(args: AccuracyArgs) -> Result<(), Failure> {
     let family = rodcube::reference::Family::of(&args.model).ok_or_else(|| {
-        bad(format!(
+        usage(format!(
             "`rodcube accuracy` needs a model with a closed-form reference (rod_cube, hinged_rod, wall_ladder), not `{}`",
             args.model
         ))

@@ -268,17 +268,23 @@ fn requirement_a_below_ell() {
 }
 
 #[test]
-fn a_bare_rodcube_runs_the_papers_scene() {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_rodcube"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("run rodcube");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let table = String::from_utf8_lossy(&out.stdout);
+fn a_bare_rodcube_runs_the_papers_scene_from_any_directory() {
+    // An empty directory: the paper's scene is built into the binary, and the outputs go to
+    // out/paper/ under the working directory (never into the repository).
+    let dir = fresh("bare");
+    let out = rodcube(&dir, &[]);
+    let table = ok(&out);
     assert!(table.contains("model rod_cube"), "{table}");
     assert!(table.contains("9.61097 deg"), "{table}");
+    assert!(dir.join("out/paper/results.json").is_file());
+    // A file still overrides it.
+    let scene = dir.join("light.yaml");
+    fs::write(
+        &scene,
+        "model: rod_cube\nparameters: {m1: 1, m2: 0.5, ell: 1, a: 0.25, g: 9.81}\nwant: [separation_angle]\n",
+    )
+    .unwrap();
+    let light = ok(&rodcube(&dir, &["run", "light.yaml"]));
+    assert!(!light.contains("9.61097 deg"), "{light}");
+    assert!(dir.join("out/light/results.json").is_file());
 }

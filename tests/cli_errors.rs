@@ -157,15 +157,23 @@ fn missing_scene_file() {
 }
 
 #[test]
-fn default_scene_is_scenes_paper_yaml() {
-    // From a directory without scenes/, the default scene cannot be read, and says which it is.
+fn the_default_scene_is_built_in_and_a_missing_file_is_named() {
+    // From a directory without scenes/, `rodcube run` runs the built-in paper's scene...
     let dir = fresh("default_scene");
     let o = Command::new(env!("CARGO_BIN_EXE_rodcube"))
         .current_dir(&dir)
         .arg("run")
         .output()
         .unwrap();
-    scene_error(&o, &["scenes/paper.yaml"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(stderr(&o).contains("out/paper"), "{}", stderr(&o));
+    // ...while a scene file that is not there is a read error naming it.
+    let o = Command::new(env!("CARGO_BIN_EXE_rodcube"))
+        .current_dir(&dir)
+        .args(["run", "scenes/paper.yaml"])
+        .output()
+        .unwrap();
+    scene_error(&o, &["scenes/paper.yaml", "cannot read"]);
 }
 
 #[test]

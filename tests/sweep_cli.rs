@@ -245,6 +245,21 @@ fn bad_sweeps_fail_with_a_clear_message() {
             vec!["sweep", "--a-over-ell", "0.5", "--out", d],
             "needs the mass ratio",
         ),
+        (vec!["sweep", "--out", d], "give --a-over-ell"),
+        (
+            vec![
+                "sweep",
+                "--model",
+                "wall_ladder",
+                "--n",
+                "3",
+                "--a-over-ell",
+                "0.5",
+                "--out",
+                d,
+            ],
+            "wall_ladder",
+        ),
         (
             vec![
                 "sweep",
@@ -308,8 +323,9 @@ fn bad_sweeps_fail_with_a_clear_message() {
             "not a number per point",
         ),
     ] {
+        // Each is a command line that cannot be honoured: exit status 2, as clap's own errors.
         let out = rodcube(&args);
-        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.contains(needle), "{args:?}: {err}");
         assert!(!err.contains("panicked"), "{err}");
