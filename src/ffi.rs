@@ -16,7 +16,7 @@ use crate::model::Model;
 use crate::plan::{self, Request};
 use crate::scene::Scene;
 use crate::solve::SolveError;
-use crate::solve::lean::LeanSolver;
+use crate::solve::lean::{LeanPoint, LeanSolver};
 use crate::system::ordered_values;
 use std::ffi::{CStr, CString, c_char, c_int};
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -156,6 +156,34 @@ unsafe fn slice<'a, T>(p: *const T, n: usize, what: &str) -> Result<&'a [T], Fai
     Ok(unsafe { std::slice::from_raw_parts(p, n) })
 }
 
+/// The solver behind a handle.
+///
+/// # Safety
+/// `solver` is NULL or a live pointer from [`rodcube_solver_new`].
+unsafe fn solver_mut<'a>(solver: *mut RodcubeSolver) -> Result<&'a mut RodcubeSolver, Failure> {
+    // SAFETY: as the caller promises.
+    unsafe { solver.as_mut() }.ok_or_else(|| failure(RODCUBE_ERR_ARGUMENT, "the solver is NULL"))
+}
+
+/// The caller's output.
+///
+/// # Safety
+/// `out` is NULL or points to one writable [`RodcubePoint`].
+unsafe fn output<'a>(out: *mut RodcubePoint) -> Result<&'a mut RodcubePoint, Failure> {
+    // SAFETY: as the caller promises.
+    unsafe { out.as_mut() }.ok_or_else(|| failure(RODCUBE_ERR_ARGUMENT, "the output is NULL"))
+}
+
+impl From<LeanPoint> for RodcubePoint {
+    fn from(point: LeanPoint) -> Self {
+        RodcubePoint {
+            separation_angle: point.separation_angle,
+            separation_time: point.separation_time,
+            delta: point.delta,
+        }
+    }
+}
+
 fn find_model(name: &str) -> Result<&'static dyn Model, Failure> {
     crate::models::find(name).ok_or_else(|| {
         let names: Vec<&str> = crate::models::all().iter().map(|m| m.info().name).collect();
@@ -277,19 +305,10 @@ pub unsafe extern "C" fn rodcube_solve(
     // SAFETY: forwarded from the caller.
     unsafe {
         guarded(err, err_len, || {
-            let s = solver
-                .as_mut()
-                .ok_or_else(|| failure(RODCUBE_ERR_ARGUMENT, "the solver is NULL"))?;
-            let out = out
-                .as_mut()
-                .ok_or_else(|| failure(RODCUBE_ERR_ARGUMENT, "the output is NULL"))?;
+            let s = solver_mut(solver)?;
+            let out = output(out)?;
             let p = slice(params, n_params, "the parameters")?;
-            let point = s.solver.solve(p).map_err(solve_failure)?;
-            *out = RodcubePoint {
-                separation_angle: point.separation_angle,
-                separation_time: point.separation_time,
-                delta: point.delta,
-            };
+            *out = s.solver.solve(p).map_err(solve_failure)?.into();
             Ok(())
         })
     }
@@ -314,9 +333,7 @@ pub unsafe extern "C" fn rodcube_solve_named(
     // SAFETY: forwarded from the caller.
     unsafe {
         guarded(err, err_len, || {
-            let s = solver
-                .as_mut()
-                .ok_or_else(|| failure(RODCUBE_ERR_ARGUMENT, "the solver is NULL"))?;
+            let s = solver_mut(solver)?;
             let given = slice(names, n, "the names")?;
             let vals = slice(values, n, "the values")?;
             let mut pairs = Vec::with_capacity(n);
@@ -325,15 +342,8 @@ pub unsafe extern "C" fn rodcube_solve_named(
             }
             ordered_values(s.solver.model().info(), &pairs, &mut s.values)
                 .map_err(|e| failure(RODCUBE_ERR_PARAMETERS, e.to_string()))?;
-            let out = out
-                .as_mut()
-                .ok_or_else(|| failure(RODCUBE_ERR_ARGUMENT, "the output is NULL"))?;
-            let point = s.solver.solve(&s.values).map_err(solve_failure)?;
-            *out = RodcubePoint {
-                separation_angle: point.separation_angle,
-                separation_time: point.separation_time,
-                delta: point.delta,
-            };
+            let out = output(out)?;
+            *out = s.solver.solve(&s.values).map_err(solve_failure)?.into();
             Ok(())
         })
     }

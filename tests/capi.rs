@@ -190,67 +190,39 @@ mod calls {
         let names = ["m1", "m2", "ell", "a", "g"].map(|n| CString::new(n).unwrap());
         let bad = ["m1", "m2", "ell", "a", "mass"].map(|n| CString::new(n).unwrap());
         let twice = ["m1", "m1", "ell", "a", "g"].map(|n| CString::new(n).unwrap());
-        let mut err = [0 as c_char; 256];
-        let mut out = RodcubePoint::default();
-        let ptrs = |v: &[CString; 5]| v.each_ref().map(|c| c.as_ptr());
-        // SAFETY: valid pointers and counts.
-        unsafe {
-            let p = ptrs(&names);
-            let code = rodcube_solve_named(
-                s,
-                p.as_ptr(),
-                PAPER.as_ptr(),
-                5,
-                &mut out,
-                err.as_mut_ptr(),
-                256,
-            );
-            assert_eq!(code, RODCUBE_OK, "{}", message(&err));
-            let code = rodcube_solve_named(
-                s,
-                p.as_ptr(),
-                PAPER.as_ptr(),
-                4,
-                &mut out,
-                err.as_mut_ptr(),
-                256,
-            );
-            assert_eq!(code, RODCUBE_ERR_PARAMETERS);
-            assert!(
-                message(&err).contains("needs parameter `g`"),
-                "{}",
-                message(&err)
-            );
-            let p = ptrs(&bad);
-            let code = rodcube_solve_named(
-                s,
-                p.as_ptr(),
-                PAPER.as_ptr(),
-                5,
-                &mut out,
-                err.as_mut_ptr(),
-                256,
-            );
-            assert_eq!(code, RODCUBE_ERR_PARAMETERS);
-            assert!(
-                message(&err).contains("no parameter `mass`"),
-                "{}",
-                message(&err)
-            );
-            let p = ptrs(&twice);
-            let code = rodcube_solve_named(
-                s,
-                p.as_ptr(),
-                PAPER.as_ptr(),
-                5,
-                &mut out,
-                err.as_mut_ptr(),
-                256,
-            );
-            assert_eq!(code, RODCUBE_ERR_PARAMETERS);
-            assert!(message(&err).contains("twice"), "{}", message(&err));
-            rodcube_solver_free(s);
-        }
+        // `rodcube_solve_named` on the first `n` of `names` with the paper's values: its code
+        // and message.
+        let named = |names: &[CString; 5], n: usize| {
+            let p = names.each_ref().map(|c| c.as_ptr());
+            let mut err = [0 as c_char; 256];
+            let mut out = RodcubePoint::default();
+            // SAFETY: valid pointers and counts.
+            let code = unsafe {
+                rodcube_solve_named(
+                    s,
+                    p.as_ptr(),
+                    PAPER.as_ptr(),
+                    n,
+                    &mut out,
+                    err.as_mut_ptr(),
+                    256,
+                )
+            };
+            (code, message(&err))
+        };
+        let (code, err) = named(&names, 5);
+        assert_eq!(code, RODCUBE_OK, "{err}");
+        let (code, err) = named(&names, 4);
+        assert_eq!(code, RODCUBE_ERR_PARAMETERS);
+        assert!(err.contains("needs parameter `g`"), "{err}");
+        let (code, err) = named(&bad, 5);
+        assert_eq!(code, RODCUBE_ERR_PARAMETERS);
+        assert!(err.contains("no parameter `mass`"), "{err}");
+        let (code, err) = named(&twice, 5);
+        assert_eq!(code, RODCUBE_ERR_PARAMETERS);
+        assert!(err.contains("twice"), "{err}");
+        // SAFETY: made by rodcube_solver_new, released once.
+        unsafe { rodcube_solver_free(s) };
     }
 
     #[test]

@@ -45,43 +45,51 @@ fn largest_low(coeffs: &[f64], lo: f64, hi: f64, evals: &mut u64) -> Option<f64>
     let mut c4 = [0.0; 4];
     c4[..coeffs.len()].copy_from_slice(coeffs);
     let c = &c4[..];
-    // Knots from the top: hi, the critical points inside (descending), lo.
-    let mut knots = [hi, lo, lo, lo];
-    let mut nk = 1;
-    if c[3] != 0.0 {
-        let mut crit = [0.0; MAX_DEGREE];
-        let nc = quadratic_roots(&[c[1], 2.0 * c[2], 3.0 * c[3]], lo, hi, &mut crit);
-        for &x in crit[..nc].iter().rev() {
-            knots[nk] = x;
-            nk += 1;
-        }
+    // Knots ascending: lo, the critical points inside, hi.
+    let mut crit = [0.0; MAX_DEGREE];
+    let nc = if c[3] != 0.0 {
+        quadratic_roots(&[c[1], 2.0 * c[2], 3.0 * c[3]], lo, hi, &mut crit)
     } else {
         let x = -c[1] / (2.0 * c[2]);
-        if x > lo && x < hi {
-            knots[nk] = x;
-            nk += 1;
-        }
+        crit[0] = x;
+        usize::from(x > lo && x < hi)
+    };
+    let mut knots = [lo; 4];
+    knots[1..=nc].copy_from_slice(&crit[..nc]);
+    knots[nc + 1] = hi;
+    let nk = nc + 2;
+    let mut values = [0.0; 4];
+    for (v, &x) in values.iter_mut().zip(&knots[..nk]) {
+        *v = value(c, x);
     }
-    knots[nk] = lo;
-    nk += 1;
-    let mut upper = (knots[0], value(c, knots[0]));
-    *evals += 1;
-    for i in 1..nk {
-        let lower = (knots[i], value(c, knots[i]));
-        *evals += 1;
-        let (fa, fb) = (lower.1, upper.1);
-        if fb == 0.0 && i > 1 && fa != 0.0 {
-            // An exact zero at a critical point: a root if the sign changes through it.
-            let above = value(c, knots[i - 2]);
-            if above != 0.0 && above.signum() != fa.signum() {
-                return Some(upper.0);
-            }
-        } else if fa != 0.0 && fb != 0.0 && fa.signum() != fb.signum() {
-            return Some(refine(c, (lower.0, upper.0), (fa, fb), evals));
+    *evals += nk as u64;
+    // From the top: the first piece with a root holds the largest.
+    for i in (0..nk - 1).rev() {
+        if let Some(root) = piece_root(c, &knots[..nk], &values[..nk], i, evals) {
+            return Some(root);
         }
-        upper = lower;
     }
     None
+}
+
+/// The sign-changing root of `c` on piece `i` of a monotone split (from `knots[i]` to
+/// `knots[i + 1]`, with `values` at the knots): an exact zero at the interior knot `knots[i]`
+/// is a root when the sign changes through it; otherwise a sign change over the piece is
+/// refined. The one rule of [`isolate`] and the quadratic and cubic path.
+#[inline(always)]
+fn piece_root(c: &[f64], knots: &[f64], values: &[f64], i: usize, evals: &mut u64) -> Option<f64> {
+    let (fa, fb) = (values[i], values[i + 1]);
+    if fa == 0.0 {
+        let before = if i > 0 { values[i - 1] } else { 0.0 };
+        return (before != 0.0 && fb != 0.0 && before.signum() != fb.signum()).then(|| knots[i]);
+    }
+    // An `if`, not `bool::then` with a closure: `refine` must inline into its caller for the
+    // quadratic and cubic path's evaluations to unroll.
+    if fb != 0.0 && fa.signum() != fb.signum() {
+        Some(refine(c, (knots[i], knots[i + 1]), (fa, fb), evals))
+    } else {
+        None
+    }
 }
 
 /// The roots of [`real_roots`] into `out`, returning how many.
@@ -140,18 +148,8 @@ fn isolate(c: &[f64], lo: f64, hi: f64, out: &mut [f64; MAX_DEGREE], evals: &mut
     *evals += nk as u64;
     let mut count = 0;
     for i in 0..nk - 1 {
-        let (fa, fb) = (values[i], values[i + 1]);
-        if fa == 0.0 && i > 0 {
-            // An exact zero at a critical point: a sign change through it is a root.
-            let before = values[i - 1];
-            if before != 0.0 && fb != 0.0 && before.signum() != fb.signum() {
-                out[count] = knots[i];
-                count += 1;
-            }
-            continue;
-        }
-        if fa != 0.0 && fb != 0.0 && fa.signum() != fb.signum() {
-            out[count] = refine(c, (knots[i], knots[i + 1]), (fa, fb), evals);
+        if let Some(root) = piece_root(c, &knots[..nk], &values[..nk], i, evals) {
+            out[count] = root;
             count += 1;
         }
     }
