@@ -87,7 +87,12 @@ fn paper_scene(c: &mut Criterion) {
         b.iter(|| {
             let scene = Scene::load(black_box(&path)).expect("scenes/paper.yaml is valid");
             let results = solve(&scene);
-            let mut bytes = report::table::render(&results, Some(scene.info())).len();
+            let mut bytes = report::table::render(
+                &results,
+                Some(scene.info()),
+                &report::table::Layout::default(),
+            )
+            .len();
             bytes += report::json::to_string(&results).expect("json").len();
             for (name, series) in &results.series {
                 bytes += report::csv::to_string(name, series).expect("csv").len();

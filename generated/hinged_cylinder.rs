@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
-    Reduction, ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, NextPhase,
+    ParamInfo, Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
 };
 
 /// A uniform rod hinged at its foot, leaning on a cylinder that slides without spinning on a frictionless floor, released from rest.
@@ -63,7 +63,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 43,
+    n_constants: 44,
     coordinates: &["theta"],
     reduced: 0,
     cyclic: &[],
@@ -99,6 +99,19 @@ static INFO: ModelInfo = ModelInfo {
     falling_point: 2,
     gravity: 5,
     monitors: &[],
+    bodies: &["rod", "cylinder"],
+    shapes: &[
+        ShapeInfo {
+            kind: ShapeKind::Segment,
+            body: Some(0),
+            first: 0,
+        },
+        ShapeInfo {
+            kind: ShapeKind::Circle,
+            body: Some(1),
+            first: 4,
+        },
+    ],
     next_phase: Some(NextPhase {
         model: "hinged_cylinder_free",
         bindings: &[
@@ -179,16 +192,17 @@ impl Model for HingedCylinder {
         k[40] = (-k[3] * k[1]);
         k[41] = (2.0 * k[3] * k[1]);
         k[42] = (k[3] * k[1]);
+        k[43] = ((-k[2]) / 2.0);
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..43]; // one bounds check for all constant loads
+        let k = &k[..44]; // one bounds check for all constant loads
         q[0] = k[4];
         qd[0] = 0.0;
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..43]; // one bounds check for all constant loads
+        let k = &k[..44]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         pos[0] = [0.0, 0.0];
         vel[0] = [0.0, 0.0];
@@ -206,7 +220,7 @@ impl Model for HingedCylinder {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..43]; // one bounds check for all constant loads
+        let k = &k[..44]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let et0 = (qd[0] * qd[0]);
         let et1 = (rc_s * rc_s);
@@ -223,12 +237,12 @@ impl Model for HingedCylinder {
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..43]; // one bounds check for all constant loads
+        let k = &k[..44]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..43]; // one bounds check for all constant loads
+        let k = &k[..44]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let qt0 = (rc_s * rc_s);
         let qt1 = (rc_c * rc_c);
@@ -263,7 +277,7 @@ impl Model for HingedCylinder {
         fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..43]; // one bounds check for all constant loads
+        let k = &k[..44]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ft0 = (rc_c * rc_c);
         let ft1 = (qd[0] * qd[0]);
@@ -278,28 +292,42 @@ impl Model for HingedCylinder {
     }
 
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..43]; // one bounds check for all constant loads
+        let k = &k[..44]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..43]; // one bounds check for all constant loads
+        let k = &k[..44]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        let k = &k[..43]; // one bounds check for all constant loads
+        let k = &k[..44]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         (k[11] + (k[16] / rc_s) + (k[16] * rc_c / rc_s))
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..43]; // one bounds check for all constant loads
+        let k = &k[..44]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         out[0] = ((k[13] / rc_s) + (k[13] * rc_c / rc_s));
         out[1] = ((k[16] * qd[0])
             + (k[16] * qd[0] * rc_c / (rc_s * rc_s))
             + (k[16] * qd[0] * (rc_c * rc_c) / (rc_s * rc_s)));
+    }
+
+    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
+        let k = &k[..44]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
+        poses[0] = [(k[12] * rc_c), (k[12] * rc_s), q[0]];
+        poses[1] = [((k[13] / rc_s) + (k[13] * rc_c / rc_s)), k[3], 0.0];
+        sizes[0] = k[43];
+        sizes[1] = 0.0;
+        sizes[2] = k[12];
+        sizes[3] = 0.0;
+        sizes[4] = 0.0;
+        sizes[5] = 0.0;
+        sizes[6] = k[3];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -309,7 +337,7 @@ impl Model for HingedCylinder {
 
 impl Reduction for HingedCylinder {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..43]; // one bounds check for all constant loads
+        let k = &k[..44]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let rc_delta = delta;
         let rt0 = rc_s.powi(4);
@@ -336,13 +364,13 @@ impl Reduction for HingedCylinder {
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
-        let k = &k[..43]; // one bounds check for all constant loads
+        let k = &k[..44]; // one bounds check for all constant loads
         let rt0 = rc_s.powi(4);
         (k[31] * rt0 * rc_ds / (k[32] + (k[32] * rc_c) + (k[33] * (rc_s * rc_s)) + (k[34] * rt0)))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..43]; // one bounds check for all constant loads
+        let k = &k[..44]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let rc_delta = delta;
         let rt0 = rc_s.powi(4);
@@ -373,7 +401,7 @@ impl Reduction for HingedCylinder {
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..43]; // one bounds check for all constant loads
+        let k = &k[..44]; // one bounds check for all constant loads
     }
 
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
@@ -385,7 +413,7 @@ impl Reduction for HingedCylinder {
     }
 
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..43]; // one bounds check for all constant loads
+        let k = &k[..44]; // one bounds check for all constant loads
     }
 
     fn full_state(
@@ -397,7 +425,7 @@ impl Reduction for HingedCylinder {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..43]; // one bounds check for all constant loads
+        let k = &k[..44]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[0] = k[6] - delta;

@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
-    Reduction, ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, NextPhase,
+    ParamInfo, Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
 };
 
 /// After the contact of `hinged_cylinder` ends: A uniform rod hinged at its foot, leaning on a cylinder that slides without spinning on a frictionless floor, released from rest.
@@ -87,7 +87,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 37,
+    n_constants: 38,
     coordinates: &["theta", "xc"],
     reduced: 0,
     cyclic: &[1],
@@ -115,10 +115,24 @@ static INFO: ModelInfo = ModelInfo {
     ],
     falling_point: 2,
     gravity: 5,
-    monitors: &[NamedInfo {
+    monitors: &[MonitorInfo {
         name: "contact_open",
         meaning: "the contact of `contact_force` stays open after it ended (gap >= 0: the bodies do not meet again)",
+        unit: "m",
     }],
+    bodies: &["rod", "cylinder"],
+    shapes: &[
+        ShapeInfo {
+            kind: ShapeKind::Segment,
+            body: Some(0),
+            first: 0,
+        },
+        ShapeInfo {
+            kind: ShapeKind::Circle,
+            body: Some(1),
+            first: 4,
+        },
+    ],
     next_phase: None,
     reduction: Some(ReductionInfo {
         k_theta_initial: 10,
@@ -171,10 +185,11 @@ impl Model for HingedCylinderFree {
         k[34] = (-3.0 * k[5] / 2.0 / k[2]);
         k[35] = k[14];
         k[36] = (k[15] / k[1]);
+        k[37] = ((-k[2]) / 2.0);
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         q[0] = k[6];
         qd[0] = k[8];
         q[1] = k[7];
@@ -182,7 +197,7 @@ impl Model for HingedCylinderFree {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         pos[0] = [0.0, 0.0];
         vel[0] = [0.0, 0.0];
@@ -195,7 +210,7 @@ impl Model for HingedCylinderFree {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let et0 = (qd[0] * qd[0]);
         (((k[21] * et0)
@@ -206,13 +221,13 @@ impl Model for HingedCylinderFree {
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         out[0] = (k[26] * qd[1]);
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         mass[0] = (k[27] + (k[28] * (rc_s * rc_s)) + (k[28] * (rc_c * rc_c)));
         mass[1] = 0.0;
@@ -231,30 +246,44 @@ impl Model for HingedCylinderFree {
         fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
     }
 
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         out[0] = ((k[30] * (1.0 + rc_c) / rc_s) + q[1]);
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         f64::INFINITY
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
+    }
+
+    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
+        let k = &k[..38]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
+        poses[0] = [(k[18] * rc_c), (k[18] * rc_s), q[0]];
+        poses[1] = [q[1], k[3], 0.0];
+        sizes[0] = k[37];
+        sizes[1] = 0.0;
+        sizes[2] = k[18];
+        sizes[3] = 0.0;
+        sizes[4] = 0.0;
+        sizes[5] = 0.0;
+        sizes[6] = k[3];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -264,7 +293,7 @@ impl Model for HingedCylinderFree {
 
 impl Reduction for HingedCylinderFree {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[10], k[12], k[13], delta);
         let rc_delta = delta;
         Reduced {
@@ -276,12 +305,12 @@ impl Reduction for HingedCylinderFree {
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         (k[31] * (k[32] + (k[33] * rc_ds)))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[10], k[12], k[13], delta);
         let rc_delta = delta;
         let rc_w2 = (k[31] * (k[32] + (k[33] * rc_ds)));
@@ -289,7 +318,7 @@ impl Reduction for HingedCylinderFree {
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
     }
 
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
@@ -301,7 +330,7 @@ impl Reduction for HingedCylinderFree {
     }
 
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
     }
 
     fn full_state(
@@ -313,7 +342,7 @@ impl Reduction for HingedCylinderFree {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[10], k[12], k[13], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[0] = k[10] - delta;

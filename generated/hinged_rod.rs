@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
-    Reduction, ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, NextPhase,
+    ParamInfo, Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
 };
 
 /// A uniform rod hinged at its foot, leaning on a free cube on a frictionless floor.
@@ -51,7 +51,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 40,
+    n_constants: 42,
     coordinates: &["theta"],
     reduced: 0,
     cyclic: &[],
@@ -92,10 +92,24 @@ static INFO: ModelInfo = ModelInfo {
     ],
     falling_point: 2,
     gravity: 4,
-    monitors: &[NamedInfo {
+    monitors: &[MonitorInfo {
         name: "cube_does_not_tip",
         meaning: "the push's torque about the cube's far edge stays below gravity's",
+        unit: "N m",
     }],
+    bodies: &["rod", "cube"],
+    shapes: &[
+        ShapeInfo {
+            kind: ShapeKind::Segment,
+            body: Some(0),
+            first: 0,
+        },
+        ShapeInfo {
+            kind: ShapeKind::Rectangle,
+            body: Some(1),
+            first: 4,
+        },
+    ],
     next_phase: Some(NextPhase {
         model: "hinged_rod_free",
         bindings: &[
@@ -165,16 +179,18 @@ impl Model for HingedRod {
         k[33] = (3.0 * k[4] * k[0] * k[1]);
         k[34] = (k[4] * (k[0] * k[0]));
         k[35] = (-k[2] * k[1]);
+        k[40] = (k[3] / 2.0);
+        k[41] = ((-k[2]) / 2.0);
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         q[0] = k[5];
         qd[0] = 0.0;
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let pt0 = (k[10] * rc_c);
         let pt1 = (k[12] * qd[0] * rc_s);
@@ -189,7 +205,7 @@ impl Model for HingedRod {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let et0 = (qd[0] * qd[0]);
         (((k[14] * et0) + (k[15] * et0 * (rc_s * rc_s)) + (k[16] * et0 * (rc_c * rc_c)))
@@ -197,12 +213,12 @@ impl Model for HingedRod {
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         mass[0] = (k[19] + (k[20] * (rc_s * rc_s)) + (k[21] * (rc_c * rc_c)));
         rhs[0] = ((k[22] * rc_c) + (k[23] * (qd[0] * qd[0]) * rc_s * rc_c));
@@ -217,7 +233,7 @@ impl Model for HingedRod {
         fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ft0 = (qd[0] * qd[0]);
         out[0] = (k[24] * ((k[12] * qdd[0] * rc_s) + (k[12] * ft0 * rc_c)));
@@ -225,27 +241,42 @@ impl Model for HingedRod {
     }
 
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         out[0] = (k[17] - (forces[0] * (k[28] + (k[10] * rc_s))));
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         f64::INFINITY
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         out[0] = (k[10] * rc_c);
         out[1] = (k[12] * qd[0] * rc_s);
+    }
+
+    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
+        let k = &k[..42]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
+        poses[0] = [(k[11] * rc_c), (k[11] * rc_s), q[0]];
+        poses[1] = [(k[40] + (k[10] * rc_c)), k[40], 0.0];
+        sizes[0] = k[41];
+        sizes[1] = 0.0;
+        sizes[2] = k[11];
+        sizes[3] = 0.0;
+        sizes[4] = 0.0;
+        sizes[5] = 0.0;
+        sizes[6] = k[3];
+        sizes[7] = k[3];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -255,7 +286,7 @@ impl Model for HingedRod {
 
 impl Reduction for HingedRod {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
@@ -272,12 +303,12 @@ impl Reduction for HingedRod {
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         (k[29] * rc_ds / (k[10] * (k[30] + (k[31] * (rc_s * rc_s)))))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
@@ -292,7 +323,7 @@ impl Reduction for HingedRod {
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         out[0] = k[36];
         out[1] = k[37];
         out[2] = 0.0;
@@ -314,7 +345,7 @@ impl Reduction for HingedRod {
     }
 
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         out[0] = k[38];
         out[1] = 0.0;
         out[2] = k[39];
@@ -329,7 +360,7 @@ impl Reduction for HingedRod {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[0] = k[5] - delta;

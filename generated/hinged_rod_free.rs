@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
-    Reduction, ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, NextPhase,
+    ParamInfo, Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
 };
 
 /// After the contact of `hinged_rod` ends: A uniform rod hinged at its foot, leaning on a free cube on a frictionless floor.
@@ -75,7 +75,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 38,
+    n_constants: 40,
     coordinates: &["theta", "x2"],
     reduced: 0,
     cyclic: &[1],
@@ -106,10 +106,24 @@ static INFO: ModelInfo = ModelInfo {
     ],
     falling_point: 2,
     gravity: 4,
-    monitors: &[NamedInfo {
+    monitors: &[MonitorInfo {
         name: "contact_open",
         meaning: "the contact of `contact_force` stays open after it ended (gap >= 0: the bodies do not meet again)",
+        unit: "m",
     }],
+    bodies: &["rod", "cube"],
+    shapes: &[
+        ShapeInfo {
+            kind: ShapeKind::Segment,
+            body: Some(0),
+            first: 0,
+        },
+        ShapeInfo {
+            kind: ShapeKind::Rectangle,
+            body: Some(1),
+            first: 4,
+        },
+    ],
     next_phase: None,
     reduction: Some(ReductionInfo {
         k_theta_initial: 9,
@@ -162,10 +176,12 @@ impl Model for HingedRodFree {
         k[35] = (-3.0 * k[4] / 2.0 / k[2]);
         k[36] = k[13];
         k[37] = (k[14] / k[1]);
+        k[38] = (k[3] / 2.0);
+        k[39] = ((-k[2]) / 2.0);
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         q[0] = k[5];
         qd[0] = k[7];
         q[1] = k[6];
@@ -173,7 +189,7 @@ impl Model for HingedRodFree {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         pos[0] = [0.0, 0.0];
         vel[0] = [0.0, 0.0];
@@ -186,7 +202,7 @@ impl Model for HingedRodFree {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let et0 = (qd[0] * qd[0]);
         (((k[20] * et0)
@@ -197,13 +213,13 @@ impl Model for HingedRodFree {
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         out[0] = (k[25] * qd[1]);
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         mass[0] = (k[26] + (k[27] * (rc_s * rc_s)) + (k[27] * (rc_c * rc_c)));
         mass[1] = 0.0;
@@ -222,31 +238,46 @@ impl Model for HingedRodFree {
         fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         out[0] = (k[29] + (k[30] * qdd[0] * rc_c) + (k[31] * (qd[0] * qd[0]) * rc_s));
     }
 
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         out[0] = ((k[18] * rc_c) + q[1]);
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         f64::INFINITY
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
+    }
+
+    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
+        let k = &k[..40]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
+        poses[0] = [(k[17] * rc_c), (k[17] * rc_s), q[0]];
+        poses[1] = [(k[38] + q[1]), k[38], 0.0];
+        sizes[0] = k[39];
+        sizes[1] = 0.0;
+        sizes[2] = k[17];
+        sizes[3] = 0.0;
+        sizes[4] = 0.0;
+        sizes[5] = 0.0;
+        sizes[6] = k[3];
+        sizes[7] = k[3];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -256,7 +287,7 @@ impl Model for HingedRodFree {
 
 impl Reduction for HingedRodFree {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[9], k[11], k[12], delta);
         let rc_delta = delta;
         Reduced {
@@ -268,12 +299,12 @@ impl Reduction for HingedRodFree {
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         (k[32] * (k[33] + (k[34] * rc_ds)))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[9], k[11], k[12], delta);
         let rc_delta = delta;
         let rc_w2 = (k[32] * (k[33] + (k[34] * rc_ds)));
@@ -282,7 +313,7 @@ impl Reduction for HingedRodFree {
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
     }
 
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
@@ -294,7 +325,7 @@ impl Reduction for HingedRodFree {
     }
 
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
     }
 
     fn full_state(
@@ -306,7 +337,7 @@ impl Reduction for HingedRodFree {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[9], k[11], k[12], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[0] = k[9] - delta;

@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
-    Reduction, ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, NextPhase,
+    ParamInfo, Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
 };
 
 /// A uniform rod with a point load at its upper end, leaning on a free cube on a frictionless floor, released from rest.
@@ -57,7 +57,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 53,
+    n_constants: 56,
     coordinates: &["x1", "theta"],
     reduced: 1,
     cyclic: &[0],
@@ -103,13 +103,28 @@ static INFO: ModelInfo = ModelInfo {
     falling_point: 3,
     gravity: 5,
     monitors: &[
-        NamedInfo {
+        MonitorInfo {
             name: "foot_on_floor",
             meaning: "the rod's foot stays on the floor (N >= 0)",
+            unit: "N",
         },
-        NamedInfo {
+        MonitorInfo {
             name: "cube_does_not_tip",
             meaning: "the push's torque about the cube's far edge stays below gravity's",
+            unit: "N m",
+        },
+    ],
+    bodies: &["loaded_rod", "cube"],
+    shapes: &[
+        ShapeInfo {
+            kind: ShapeKind::Segment,
+            body: Some(0),
+            first: 0,
+        },
+        ShapeInfo {
+            kind: ShapeKind::Rectangle,
+            body: Some(1),
+            first: 4,
         },
     ],
     next_phase: Some(NextPhase {
@@ -299,10 +314,13 @@ impl Model for LoadedRod {
         k[52] = ((k[3] * k[0] / 2.0 / (k[0] + k[1] + k[2]))
             + (k[3] * k[1] / (k[0] + k[1] + k[2]))
             + (k[3] * k[2] / (k[0] + k[1] + k[2])));
+        k[53] = (k[4] / 2.0);
+        k[54] = ((-k[3]) * ((k[0] / 2.0) + k[2]) / (k[0] + k[2]));
+        k[55] = (k[3] * k[0] / (2.0 * (k[0] + k[2])));
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = k[6];
@@ -310,7 +328,7 @@ impl Model for LoadedRod {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let pt0 = ((k[13] * rc_c) + q[0]);
         let pt1 = ((k[16] * qd[1] * rc_s) + qd[0]);
@@ -327,7 +345,7 @@ impl Model for LoadedRod {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = (qd[1] * qd[1]);
         (((k[19] * qd[1] * qd[0] * rc_s)
@@ -339,13 +357,13 @@ impl Model for LoadedRod {
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = ((k[19] * qd[1] * rc_s) + (k[26] * qd[0]));
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let qt0 = (k[19] * rc_s);
         let qt1 = (qd[1] * qd[1]);
@@ -366,7 +384,7 @@ impl Model for LoadedRod {
         fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let ft0 = (qd[1] * qd[1]);
         out[0] = (k[33] * ((k[16] * qdd[1] * rc_s) + qdd[0] + (k[16] * ft0 * rc_c)));
@@ -374,28 +392,43 @@ impl Model for LoadedRod {
     }
 
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = forces[1];
         out[1] = (k[24] - (forces[0] * (k[37] + (k[13] * rc_s))));
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         f64::INFINITY
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = ((k[13] * rc_c) + q[0]);
         out[1] = ((k[16] * qd[1] * rc_s) + qd[0]);
+    }
+
+    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
+        let k = &k[..56]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
+        poses[0] = [((k[15] * rc_c) + q[0]), (k[15] * rc_s), q[1]];
+        poses[1] = [(k[53] + (k[13] * rc_c) + q[0]), k[53], 0.0];
+        sizes[0] = k[54];
+        sizes[1] = 0.0;
+        sizes[2] = k[55];
+        sizes[3] = 0.0;
+        sizes[4] = 0.0;
+        sizes[5] = 0.0;
+        sizes[6] = k[4];
+        sizes[7] = k[4];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -405,7 +438,7 @@ impl Model for LoadedRod {
 
 impl Reduction for LoadedRod {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
@@ -421,12 +454,12 @@ impl Reduction for LoadedRod {
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         (-12.0 * (k[38] * rc_ds) / (k[13] * (k[39] + (k[40] * (rc_s * rc_s)))))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
@@ -440,7 +473,7 @@ impl Reduction for LoadedRod {
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         out[0] = k[47];
         out[1] = k[48];
         out[2] = 0.0;
@@ -478,7 +511,7 @@ impl Reduction for LoadedRod {
     }
 
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         out[0] = k[49];
         out[1] = 0.0;
         out[2] = k[50];
@@ -493,7 +526,7 @@ impl Reduction for LoadedRod {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..56]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[1] = k[6] - delta;

@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
-    Reduction, ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, NextPhase,
+    ParamInfo, Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
 };
 
 /// After the contact of `loaded_rod` ends: A uniform rod with a point load at its upper end, leaning on a free cube on a frictionless floor, released from rest.
@@ -93,7 +93,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 56,
+    n_constants: 59,
     coordinates: &["x1", "theta", "x2"],
     reduced: 1,
     cyclic: &[0, 2],
@@ -129,13 +129,28 @@ static INFO: ModelInfo = ModelInfo {
     falling_point: 3,
     gravity: 5,
     monitors: &[
-        NamedInfo {
+        MonitorInfo {
             name: "foot_on_floor",
             meaning: "the rod's foot stays on the floor (N >= 0)",
+            unit: "N",
         },
-        NamedInfo {
+        MonitorInfo {
             name: "contact_open",
             meaning: "the contact of `contact_force` stays open after it ended (gap >= 0: the bodies do not meet again)",
+            unit: "m",
+        },
+    ],
+    bodies: &["loaded_rod", "cube"],
+    shapes: &[
+        ShapeInfo {
+            kind: ShapeKind::Segment,
+            body: Some(0),
+            first: 0,
+        },
+        ShapeInfo {
+            kind: ShapeKind::Rectangle,
+            body: Some(1),
+            first: 4,
         },
     ],
     next_phase: None,
@@ -255,10 +270,13 @@ impl Model for LoadedRodFree {
         k[53] = (k[18] / (k[0] + k[2]));
         k[54] = k[17];
         k[55] = (k[19] / k[1]);
+        k[56] = (k[4] / 2.0);
+        k[57] = ((-k[3]) * ((k[0] / 2.0) + k[2]) / (k[0] + k[2]));
+        k[58] = (k[3] * k[0] / (2.0 * (k[0] + k[2])));
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..56]; // one bounds check for all constant loads
+        let k = &k[..59]; // one bounds check for all constant loads
         q[0] = k[6];
         qd[0] = k[9];
         q[1] = k[7];
@@ -268,7 +286,7 @@ impl Model for LoadedRodFree {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..56]; // one bounds check for all constant loads
+        let k = &k[..59]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         pos[0] = [q[0], 0.0];
         vel[0] = [qd[0], 0.0];
@@ -283,7 +301,7 @@ impl Model for LoadedRodFree {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..56]; // one bounds check for all constant loads
+        let k = &k[..59]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = (qd[1] * qd[1]);
         (((k[27] * qd[1] * qd[0] * rc_s)
@@ -296,14 +314,14 @@ impl Model for LoadedRodFree {
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..56]; // one bounds check for all constant loads
+        let k = &k[..59]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = ((k[27] * qd[1] * rc_s) + (k[34] * qd[0]));
         out[1] = (k[35] * qd[2]);
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..56]; // one bounds check for all constant loads
+        let k = &k[..59]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let qt0 = (k[27] * rc_s);
         mass[0] = k[34];
@@ -329,32 +347,47 @@ impl Model for LoadedRodFree {
         fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..56]; // one bounds check for all constant loads
+        let k = &k[..59]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = (k[40] + (k[38] * qdd[1] * rc_c) + (k[27] * (qd[1] * qd[1]) * rc_s));
     }
 
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..56]; // one bounds check for all constant loads
+        let k = &k[..59]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..56]; // one bounds check for all constant loads
+        let k = &k[..59]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = forces[0];
         out[1] = ((k[24] * rc_c) - q[0] + q[2]);
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        let k = &k[..56]; // one bounds check for all constant loads
+        let k = &k[..59]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         f64::INFINITY
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..56]; // one bounds check for all constant loads
+        let k = &k[..59]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
+    }
+
+    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
+        let k = &k[..59]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
+        poses[0] = [((k[23] * rc_c) + q[0]), (k[23] * rc_s), q[1]];
+        poses[1] = [(k[56] + q[2]), k[56], 0.0];
+        sizes[0] = k[57];
+        sizes[1] = 0.0;
+        sizes[2] = k[58];
+        sizes[3] = 0.0;
+        sizes[4] = 0.0;
+        sizes[5] = 0.0;
+        sizes[6] = k[4];
+        sizes[7] = k[4];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -364,7 +397,7 @@ impl Model for LoadedRodFree {
 
 impl Reduction for LoadedRodFree {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..56]; // one bounds check for all constant loads
+        let k = &k[..59]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[12], k[14], k[15], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
@@ -383,12 +416,12 @@ impl Reduction for LoadedRodFree {
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
-        let k = &k[..56]; // one bounds check for all constant loads
+        let k = &k[..59]; // one bounds check for all constant loads
         (-12.0 * (k[41] + (k[42] * rc_ds)) / (k[43] * (k[44] + (k[45] * (rc_s * rc_s)))))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..56]; // one bounds check for all constant loads
+        let k = &k[..59]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[12], k[14], k[15], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
@@ -404,7 +437,7 @@ impl Reduction for LoadedRodFree {
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..56]; // one bounds check for all constant loads
+        let k = &k[..59]; // one bounds check for all constant loads
     }
 
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
@@ -416,7 +449,7 @@ impl Reduction for LoadedRodFree {
     }
 
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..56]; // one bounds check for all constant loads
+        let k = &k[..59]; // one bounds check for all constant loads
     }
 
     fn full_state(
@@ -428,7 +461,7 @@ impl Reduction for LoadedRodFree {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..56]; // one bounds check for all constant loads
+        let k = &k[..59]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[12], k[14], k[15], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[1] = k[12] - delta;

@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
-    Reduction, ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, NextPhase,
+    ParamInfo, Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
 };
 
 /// A uniform rod leaning on a free cube on a frictionless floor, released from rest.
@@ -51,7 +51,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 48,
+    n_constants: 50,
     coordinates: &["x1", "theta"],
     reduced: 1,
     cyclic: &[0],
@@ -93,13 +93,28 @@ static INFO: ModelInfo = ModelInfo {
     falling_point: 2,
     gravity: 4,
     monitors: &[
-        NamedInfo {
+        MonitorInfo {
             name: "foot_on_floor",
             meaning: "the rod's foot stays on the floor (N >= 0)",
+            unit: "N",
         },
-        NamedInfo {
+        MonitorInfo {
             name: "cube_does_not_tip",
             meaning: "the push's torque about the cube's far edge stays below gravity's",
+            unit: "N m",
+        },
+    ],
+    bodies: &["rod", "cube"],
+    shapes: &[
+        ShapeInfo {
+            kind: ShapeKind::Segment,
+            body: Some(0),
+            first: 0,
+        },
+        ShapeInfo {
+            kind: ShapeKind::Rectangle,
+            body: Some(1),
+            first: 4,
         },
     ],
     next_phase: Some(NextPhase {
@@ -186,10 +201,12 @@ impl Model for RodCube {
         k[41] = (-k[2] * k[0] * k[1] / 2.0 / (k[0] + k[1]));
         k[46] = k[9];
         k[47] = ((k[2] * k[0] / 2.0 / (k[0] + k[1])) + (k[2] * k[1] / (k[0] + k[1])));
+        k[48] = (k[3] / 2.0);
+        k[49] = ((-k[2]) / 2.0);
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..48]; // one bounds check for all constant loads
+        let k = &k[..50]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = k[5];
@@ -197,7 +214,7 @@ impl Model for RodCube {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..48]; // one bounds check for all constant loads
+        let k = &k[..50]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let pt0 = ((k[12] * rc_c) + q[0]);
         let pt1 = ((k[14] * qd[1] * rc_s) + qd[0]);
@@ -212,7 +229,7 @@ impl Model for RodCube {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..48]; // one bounds check for all constant loads
+        let k = &k[..50]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = (qd[1] * qd[1]);
         (((k[16] * qd[1] * qd[0] * rc_s)
@@ -224,13 +241,13 @@ impl Model for RodCube {
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..48]; // one bounds check for all constant loads
+        let k = &k[..50]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = ((k[16] * qd[1] * rc_s) + (k[23] * qd[0]));
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..48]; // one bounds check for all constant loads
+        let k = &k[..50]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let qt0 = (k[16] * rc_s);
         let qt1 = (qd[1] * qd[1]);
@@ -251,7 +268,7 @@ impl Model for RodCube {
         fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..48]; // one bounds check for all constant loads
+        let k = &k[..50]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let ft0 = (qd[1] * qd[1]);
         out[0] = (k[30] * ((k[14] * qdd[1] * rc_s) + qdd[0] + (k[14] * ft0 * rc_c)));
@@ -259,28 +276,43 @@ impl Model for RodCube {
     }
 
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..48]; // one bounds check for all constant loads
+        let k = &k[..50]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..48]; // one bounds check for all constant loads
+        let k = &k[..50]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = forces[1];
         out[1] = (k[21] - (forces[0] * (k[34] + (k[12] * rc_s))));
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        let k = &k[..48]; // one bounds check for all constant loads
+        let k = &k[..50]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         f64::INFINITY
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..48]; // one bounds check for all constant loads
+        let k = &k[..50]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = ((k[12] * rc_c) + q[0]);
         out[1] = ((k[14] * qd[1] * rc_s) + qd[0]);
+    }
+
+    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
+        let k = &k[..50]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
+        poses[0] = [((k[13] * rc_c) + q[0]), (k[13] * rc_s), q[1]];
+        poses[1] = [(k[48] + (k[12] * rc_c) + q[0]), k[48], 0.0];
+        sizes[0] = k[49];
+        sizes[1] = 0.0;
+        sizes[2] = k[13];
+        sizes[3] = 0.0;
+        sizes[4] = 0.0;
+        sizes[5] = 0.0;
+        sizes[6] = k[3];
+        sizes[7] = k[3];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -290,7 +322,7 @@ impl Model for RodCube {
 
 impl Reduction for RodCube {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..48]; // one bounds check for all constant loads
+        let k = &k[..50]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
@@ -306,12 +338,12 @@ impl Reduction for RodCube {
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
-        let k = &k[..48]; // one bounds check for all constant loads
+        let k = &k[..50]; // one bounds check for all constant loads
         (-12.0 * (k[35] * rc_ds) / (k[12] * (k[36] + (k[37] * (rc_s * rc_s)))))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..48]; // one bounds check for all constant loads
+        let k = &k[..50]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
@@ -325,7 +357,7 @@ impl Reduction for RodCube {
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..48]; // one bounds check for all constant loads
+        let k = &k[..50]; // one bounds check for all constant loads
         out[0] = k[42];
         out[1] = k[43];
         out[2] = 0.0;
@@ -347,7 +379,7 @@ impl Reduction for RodCube {
     }
 
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..48]; // one bounds check for all constant loads
+        let k = &k[..50]; // one bounds check for all constant loads
         out[0] = k[44];
         out[1] = 0.0;
         out[2] = k[45];
@@ -362,7 +394,7 @@ impl Reduction for RodCube {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..48]; // one bounds check for all constant loads
+        let k = &k[..50]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[1] = k[5] - delta;

@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
-    Reduction, ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, NextPhase,
+    ParamInfo, Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
 };
 
 /// After the contact of `rod_cube` ends: A uniform rod leaning on a free cube on a frictionless floor, released from rest.
@@ -87,7 +87,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 49,
+    n_constants: 51,
     coordinates: &["x1", "theta", "x2"],
     reduced: 1,
     cyclic: &[0, 2],
@@ -119,13 +119,28 @@ static INFO: ModelInfo = ModelInfo {
     falling_point: 2,
     gravity: 4,
     monitors: &[
-        NamedInfo {
+        MonitorInfo {
             name: "foot_on_floor",
             meaning: "the rod's foot stays on the floor (N >= 0)",
+            unit: "N",
         },
-        NamedInfo {
+        MonitorInfo {
             name: "contact_open",
             meaning: "the contact of `contact_force` stays open after it ended (gap >= 0: the bodies do not meet again)",
+            unit: "m",
+        },
+    ],
+    bodies: &["rod", "cube"],
+    shapes: &[
+        ShapeInfo {
+            kind: ShapeKind::Segment,
+            body: Some(0),
+            first: 0,
+        },
+        ShapeInfo {
+            kind: ShapeKind::Rectangle,
+            body: Some(1),
+            first: 4,
         },
     ],
     next_phase: None,
@@ -190,10 +205,12 @@ impl Model for RodCubeFree {
         k[46] = (k[17] / k[0]);
         k[47] = k[16];
         k[48] = (k[18] / k[1]);
+        k[49] = (k[3] / 2.0);
+        k[50] = ((-k[2]) / 2.0);
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..51]; // one bounds check for all constant loads
         q[0] = k[5];
         qd[0] = k[8];
         q[1] = k[6];
@@ -203,7 +220,7 @@ impl Model for RodCubeFree {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..51]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         pos[0] = [q[0], 0.0];
         vel[0] = [qd[0], 0.0];
@@ -216,7 +233,7 @@ impl Model for RodCubeFree {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..51]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = (qd[1] * qd[1]);
         (((k[24] * qd[1] * qd[0] * rc_s)
@@ -229,14 +246,14 @@ impl Model for RodCubeFree {
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..51]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = ((k[24] * qd[1] * rc_s) + (k[31] * qd[0]));
         out[1] = (k[32] * qd[2]);
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..51]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let qt0 = (k[24] * rc_s);
         mass[0] = k[0];
@@ -262,32 +279,47 @@ impl Model for RodCubeFree {
         fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..51]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = (k[37] + (k[35] * qdd[1] * rc_c) + (k[24] * (qd[1] * qd[1]) * rc_s));
     }
 
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..51]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..51]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = forces[0];
         out[1] = ((k[22] * rc_c) - q[0] + q[2]);
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..51]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         f64::INFINITY
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..51]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
+    }
+
+    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
+        let k = &k[..51]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
+        poses[0] = [((k[21] * rc_c) + q[0]), (k[21] * rc_s), q[1]];
+        poses[1] = [(k[49] + q[2]), k[49], 0.0];
+        sizes[0] = k[50];
+        sizes[1] = 0.0;
+        sizes[2] = k[21];
+        sizes[3] = 0.0;
+        sizes[4] = 0.0;
+        sizes[5] = 0.0;
+        sizes[6] = k[3];
+        sizes[7] = k[3];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -297,7 +329,7 @@ impl Model for RodCubeFree {
 
 impl Reduction for RodCubeFree {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..51]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[11], k[13], k[14], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
@@ -316,12 +348,12 @@ impl Reduction for RodCubeFree {
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..51]; // one bounds check for all constant loads
         (-12.0 * (k[38] + (k[39] * rc_ds)) / (k[40] * (-4.0 + (3.0 * (rc_s * rc_s)))))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..51]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[11], k[13], k[14], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
@@ -337,7 +369,7 @@ impl Reduction for RodCubeFree {
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..51]; // one bounds check for all constant loads
     }
 
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
@@ -349,7 +381,7 @@ impl Reduction for RodCubeFree {
     }
 
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..51]; // one bounds check for all constant loads
     }
 
     fn full_state(
@@ -361,7 +393,7 @@ impl Reduction for RodCubeFree {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..51]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[11], k[13], k[14], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[1] = k[11] - delta;

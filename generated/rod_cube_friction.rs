@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
-    Reduction, ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, NextPhase,
+    ParamInfo, Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
 };
 
 /// A uniform rod leaning on a free cube, with Coulomb friction between the rod's foot and the floor, released from rest.
@@ -57,7 +57,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 30,
+    n_constants: 32,
     coordinates: &["x1", "theta"],
     reduced: 1,
     cyclic: &[],
@@ -104,13 +104,28 @@ static INFO: ModelInfo = ModelInfo {
     falling_point: 2,
     gravity: 4,
     monitors: &[
-        NamedInfo {
+        MonitorInfo {
             name: "foot_on_floor",
             meaning: "the rod's foot stays on the floor (N >= 0)",
+            unit: "N",
         },
-        NamedInfo {
+        MonitorInfo {
             name: "cube_does_not_tip",
             meaning: "the push's torque about the cube's far edge stays below gravity's",
+            unit: "N m",
+        },
+    ],
+    bodies: &["rod", "cube"],
+    shapes: &[
+        ShapeInfo {
+            kind: ShapeKind::Segment,
+            body: Some(0),
+            first: 0,
+        },
+        ShapeInfo {
+            kind: ShapeKind::Rectangle,
+            body: Some(1),
+            first: 4,
         },
     ],
     next_phase: Some(NextPhase {
@@ -172,10 +187,12 @@ impl Model for RodCubeFriction {
         k[27] = (k[2] * k[0] / 2.0);
         k[28] = (-k[2] * k[0] / 2.0);
         k[29] = (-k[3] / 2.0);
+        k[30] = (k[3] / 2.0);
+        k[31] = ((-k[2]) / 2.0);
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = k[6];
@@ -183,7 +200,7 @@ impl Model for RodCubeFriction {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let pt0 = ((k[7] * rc_c) + q[0]);
         let pt1 = ((k[9] * qd[1] * rc_s) + qd[0]);
@@ -198,7 +215,7 @@ impl Model for RodCubeFriction {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = (qd[1] * qd[1]);
         (((k[11] * qd[1] * qd[0] * rc_s)
@@ -210,12 +227,12 @@ impl Model for RodCubeFriction {
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let qt0 = (k[11] * rc_s);
         let qt1 = (qd[1] * qd[1]);
@@ -236,7 +253,7 @@ impl Model for RodCubeFriction {
         fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let ft0 = (qd[1] * qd[1]);
         out[0] = (k[25] * ((k[9] * qdd[1] * rc_s) + qdd[0] + (k[9] * ft0 * rc_c)));
@@ -244,7 +261,7 @@ impl Model for RodCubeFriction {
     }
 
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         jac[0] = 1.0;
         jac[1] = 0.0;
@@ -252,23 +269,38 @@ impl Model for RodCubeFriction {
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = forces[1];
         out[1] = (k[16] - (forces[0] * (k[29] + (k[7] * rc_s))));
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         f64::INFINITY
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = ((k[7] * rc_c) + q[0]);
         out[1] = ((k[9] * qd[1] * rc_s) + qd[0]);
+    }
+
+    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
+        let k = &k[..32]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
+        poses[0] = [((k[8] * rc_c) + q[0]), (k[8] * rc_s), q[1]];
+        poses[1] = [(k[30] + (k[7] * rc_c) + q[0]), k[30], 0.0];
+        sizes[0] = k[31];
+        sizes[1] = 0.0;
+        sizes[2] = k[8];
+        sizes[3] = 0.0;
+        sizes[4] = 0.0;
+        sizes[5] = 0.0;
+        sizes[6] = k[3];
+        sizes[7] = k[3];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {

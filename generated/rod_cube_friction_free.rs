@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
-    Reduction, ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, NextPhase,
+    ParamInfo, Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
 };
 
 /// After the contact of `rod_cube_friction` ends: A uniform rod leaning on a free cube, with Coulomb friction between the rod's foot and the floor, released from rest.
@@ -93,7 +93,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 29,
+    n_constants: 31,
     coordinates: &["x1", "theta", "x2"],
     reduced: 1,
     cyclic: &[2],
@@ -130,13 +130,28 @@ static INFO: ModelInfo = ModelInfo {
     falling_point: 2,
     gravity: 4,
     monitors: &[
-        NamedInfo {
+        MonitorInfo {
             name: "foot_on_floor",
             meaning: "the rod's foot stays on the floor (N >= 0)",
+            unit: "N",
         },
-        NamedInfo {
+        MonitorInfo {
             name: "contact_open",
             meaning: "the contact of `contact_force` stays open after it ended (gap >= 0: the bodies do not meet again)",
+            unit: "m",
+        },
+    ],
+    bodies: &["rod", "cube"],
+    shapes: &[
+        ShapeInfo {
+            kind: ShapeKind::Segment,
+            body: Some(0),
+            first: 0,
+        },
+        ShapeInfo {
+            kind: ShapeKind::Rectangle,
+            body: Some(1),
+            first: 4,
         },
     ],
     next_phase: None,
@@ -173,10 +188,12 @@ impl Model for RodCubeFrictionFree {
         k[26] = (k[2] * k[0] / 2.0);
         k[27] = (-k[2] * k[4] * k[0] / 2.0);
         k[28] = (k[4] * k[0]);
+        k[29] = (k[3] / 2.0);
+        k[30] = ((-k[2]) / 2.0);
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         q[0] = k[6];
         qd[0] = k[9];
         q[1] = k[7];
@@ -186,7 +203,7 @@ impl Model for RodCubeFrictionFree {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         pos[0] = [q[0], 0.0];
         vel[0] = [qd[0], 0.0];
@@ -199,7 +216,7 @@ impl Model for RodCubeFrictionFree {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = (qd[1] * qd[1]);
         (((k[16] * qd[1] * qd[0] * rc_s)
@@ -212,13 +229,13 @@ impl Model for RodCubeFrictionFree {
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = (k[23] * qd[2]);
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let qt0 = (k[16] * rc_s);
         mass[0] = k[0];
@@ -244,13 +261,13 @@ impl Model for RodCubeFrictionFree {
         fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = (k[28] + (k[26] * qdd[1] * rc_c) + (k[16] * (qd[1] * qd[1]) * rc_s));
     }
 
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         jac[0] = 1.0;
         jac[1] = 0.0;
@@ -259,21 +276,36 @@ impl Model for RodCubeFrictionFree {
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = forces[0];
         out[1] = ((k[14] * rc_c) - q[0] + q[2]);
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         f64::INFINITY
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
+    }
+
+    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
+        let k = &k[..31]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
+        poses[0] = [((k[13] * rc_c) + q[0]), (k[13] * rc_s), q[1]];
+        poses[1] = [(k[29] + q[2]), k[29], 0.0];
+        sizes[0] = k[30];
+        sizes[1] = 0.0;
+        sizes[2] = k[13];
+        sizes[3] = 0.0;
+        sizes[4] = 0.0;
+        sizes[5] = 0.0;
+        sizes[6] = k[3];
+        sizes[7] = k[3];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {

@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
-    Reduction, ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, NextPhase,
+    ParamInfo, Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
 };
 
 /// A uniform rod leaning on a cube that a horizontal spring ties to a fixed wall, all on a frictionless floor, released from rest.
@@ -57,7 +57,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 34,
+    n_constants: 36,
     coordinates: &["x1", "theta"],
     reduced: 1,
     cyclic: &[],
@@ -98,10 +98,24 @@ static INFO: ModelInfo = ModelInfo {
     ],
     falling_point: 2,
     gravity: 4,
-    monitors: &[NamedInfo {
+    monitors: &[MonitorInfo {
         name: "foot_on_floor",
         meaning: "the rod's foot stays on the floor (N >= 0)",
+        unit: "N",
     }],
+    bodies: &["rod", "cube"],
+    shapes: &[
+        ShapeInfo {
+            kind: ShapeKind::Segment,
+            body: Some(0),
+            first: 0,
+        },
+        ShapeInfo {
+            kind: ShapeKind::Rectangle,
+            body: Some(1),
+            first: 4,
+        },
+    ],
     next_phase: Some(NextPhase {
         model: "rod_cube_spring_free",
         bindings: &[
@@ -165,10 +179,12 @@ impl Model for RodCubeSpring {
         k[31] = (k[4] * k[0]);
         k[32] = (k[2] * k[0] / 2.0);
         k[33] = (-k[2] * k[0] / 2.0);
+        k[34] = (k[3] / 2.0);
+        k[35] = ((-k[2]) / 2.0);
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..34]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = k[6];
@@ -176,7 +192,7 @@ impl Model for RodCubeSpring {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..34]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let pt0 = ((k[7] * rc_c) + q[0]);
         let pt1 = ((k[9] * qd[1] * rc_s) + qd[0]);
@@ -191,7 +207,7 @@ impl Model for RodCubeSpring {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..34]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = (qd[1] * qd[1]);
         (((k[11] * qd[1] * qd[0] * rc_s)
@@ -205,12 +221,12 @@ impl Model for RodCubeSpring {
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..34]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..34]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let qt0 = (k[11] * rc_s);
         let qt1 = (k[19] + (k[7] * rc_c) + q[0]);
@@ -232,7 +248,7 @@ impl Model for RodCubeSpring {
         fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..34]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let ft0 = (qd[1] * qd[1]);
         out[0] = ((k[29] * (k[19] + (k[7] * rc_c) + q[0]))
@@ -241,27 +257,42 @@ impl Model for RodCubeSpring {
     }
 
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..34]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..34]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = forces[1];
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        let k = &k[..34]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         f64::INFINITY
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..34]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = ((k[7] * rc_c) + q[0]);
         out[1] = ((k[9] * qd[1] * rc_s) + qd[0]);
+    }
+
+    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
+        let k = &k[..36]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
+        poses[0] = [((k[8] * rc_c) + q[0]), (k[8] * rc_s), q[1]];
+        poses[1] = [(k[34] + (k[7] * rc_c) + q[0]), k[34], 0.0];
+        sizes[0] = k[35];
+        sizes[1] = 0.0;
+        sizes[2] = k[8];
+        sizes[3] = 0.0;
+        sizes[4] = 0.0;
+        sizes[5] = 0.0;
+        sizes[6] = k[3];
+        sizes[7] = k[3];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {

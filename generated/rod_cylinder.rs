@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
-    Reduction, ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, NextPhase,
+    ParamInfo, Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
 };
 
 /// A uniform rod leaning on a cylinder that slides without spinning on a frictionless floor, released from rest.
@@ -63,7 +63,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 35,
+    n_constants: 36,
     coordinates: &["x1", "theta"],
     reduced: 1,
     cyclic: &[0],
@@ -108,10 +108,24 @@ static INFO: ModelInfo = ModelInfo {
     ],
     falling_point: 2,
     gravity: 5,
-    monitors: &[NamedInfo {
+    monitors: &[MonitorInfo {
         name: "foot_on_floor",
         meaning: "the rod's foot stays on the floor (N >= 0)",
+        unit: "N",
     }],
+    bodies: &["rod", "cylinder"],
+    shapes: &[
+        ShapeInfo {
+            kind: ShapeKind::Segment,
+            body: Some(0),
+            first: 0,
+        },
+        ShapeInfo {
+            kind: ShapeKind::Circle,
+            body: Some(1),
+            first: 4,
+        },
+    ],
     next_phase: Some(NextPhase {
         model: "rod_cylinder_free",
         bindings: &[
@@ -176,10 +190,11 @@ impl Model for RodCylinder {
         k[32] = (2.0 * k[3]);
         k[33] = (k[5] * k[0]);
         k[34] = k[0];
+        k[35] = ((-k[2]) / 2.0);
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = k[4];
@@ -187,7 +202,7 @@ impl Model for RodCylinder {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let pt0 = (k[8] * rc_c / rc_s);
         let pt1 = (rc_c * rc_c);
@@ -215,7 +230,7 @@ impl Model for RodCylinder {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = (rc_s * rc_s);
         let et1 = (rc_c * rc_c);
@@ -237,7 +252,7 @@ impl Model for RodCylinder {
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = ((k[13] * qd[1])
             + (k[13] * qd[1] * rc_c / (rc_s * rc_s))
@@ -247,7 +262,7 @@ impl Model for RodCylinder {
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let qt0 = (rc_s * rc_s);
         let qt1 = (rc_c * rc_c);
@@ -291,7 +306,7 @@ impl Model for RodCylinder {
         fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let ft0 = (rc_c * rc_c);
         let ft1 = (qd[1] * qd[1]);
@@ -311,30 +326,44 @@ impl Model for RodCylinder {
     }
 
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = forces[1];
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         (k[6] + (k[11] / rc_s) + (k[11] * rc_c / rc_s))
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = ((k[8] / rc_s) + (k[8] * rc_c / rc_s) + q[0]);
         out[1] = ((k[11] * qd[1])
             + (k[11] * qd[1] * rc_c / (rc_s * rc_s))
             + (k[11] * qd[1] * (rc_c * rc_c) / (rc_s * rc_s))
             + qd[0]);
+    }
+
+    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
+        let k = &k[..36]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
+        poses[0] = [((k[7] * rc_c) + q[0]), (k[7] * rc_s), q[1]];
+        poses[1] = [((k[8] / rc_s) + (k[8] * rc_c / rc_s) + q[0]), k[3], 0.0];
+        sizes[0] = k[35];
+        sizes[1] = 0.0;
+        sizes[2] = k[7];
+        sizes[3] = 0.0;
+        sizes[4] = 0.0;
+        sizes[5] = 0.0;
+        sizes[6] = k[3];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {

@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
-    Reduction, ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, NextPhase,
+    ParamInfo, Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
 };
 
 /// After the contact of `rod_cylinder` ends: A uniform rod leaning on a cylinder that slides without spinning on a frictionless floor, released from rest.
@@ -99,7 +99,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 53,
+    n_constants: 54,
     coordinates: &["x1", "theta", "xc"],
     reduced: 1,
     cyclic: &[0, 2],
@@ -135,13 +135,28 @@ static INFO: ModelInfo = ModelInfo {
     falling_point: 2,
     gravity: 5,
     monitors: &[
-        NamedInfo {
+        MonitorInfo {
             name: "foot_on_floor",
             meaning: "the rod's foot stays on the floor (N >= 0)",
+            unit: "N",
         },
-        NamedInfo {
+        MonitorInfo {
             name: "contact_open",
             meaning: "the contact of `contact_force` stays open after it ended (gap >= 0: the bodies do not meet again)",
+            unit: "m",
+        },
+    ],
+    bodies: &["rod", "cylinder"],
+    shapes: &[
+        ShapeInfo {
+            kind: ShapeKind::Segment,
+            body: Some(0),
+            first: 0,
+        },
+        ShapeInfo {
+            kind: ShapeKind::Circle,
+            body: Some(1),
+            first: 4,
         },
     ],
     next_phase: None,
@@ -211,10 +226,11 @@ impl Model for RodCylinderFree {
         k[50] = (k[18] / k[0]);
         k[51] = k[17];
         k[52] = (k[19] / k[1]);
+        k[53] = ((-k[2]) / 2.0);
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..54]; // one bounds check for all constant loads
         q[0] = k[6];
         qd[0] = k[9];
         q[1] = k[7];
@@ -224,7 +240,7 @@ impl Model for RodCylinderFree {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..54]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let pt0 = (rc_c * rc_c);
         pos[0] = [q[0], 0.0];
@@ -250,7 +266,7 @@ impl Model for RodCylinderFree {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..54]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = (qd[1] * qd[1]);
         (((k[28] * qd[1] * qd[0] * rc_s)
@@ -263,14 +279,14 @@ impl Model for RodCylinderFree {
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..54]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = ((k[28] * qd[1] * rc_s) + (k[35] * qd[0]));
         out[1] = (k[36] * qd[2]);
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..54]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let qt0 = (k[28] * rc_s);
         mass[0] = k[0];
@@ -296,7 +312,7 @@ impl Model for RodCylinderFree {
         fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..54]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let ft0 = (qd[1] * qd[1]);
         out[0] = (k[41]
@@ -306,26 +322,40 @@ impl Model for RodCylinderFree {
     }
 
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..54]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..54]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = forces[0];
         out[1] = ((k[26] * (1.0 + rc_c) / rc_s) - q[0] + q[2]);
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..54]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         f64::INFINITY
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..54]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
+    }
+
+    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
+        let k = &k[..54]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
+        poses[0] = [((k[22] * rc_c) + q[0]), (k[22] * rc_s), q[1]];
+        poses[1] = [q[2], k[3], 0.0];
+        sizes[0] = k[53];
+        sizes[1] = 0.0;
+        sizes[2] = k[22];
+        sizes[3] = 0.0;
+        sizes[4] = 0.0;
+        sizes[5] = 0.0;
+        sizes[6] = k[3];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -335,7 +365,7 @@ impl Model for RodCylinderFree {
 
 impl Reduction for RodCylinderFree {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..54]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[12], k[14], k[15], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
@@ -354,12 +384,12 @@ impl Reduction for RodCylinderFree {
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..54]; // one bounds check for all constant loads
         (-12.0 * (k[42] + (k[43] * rc_ds)) / (k[44] * (-4.0 + (3.0 * (rc_s * rc_s)))))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..54]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[12], k[14], k[15], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
@@ -375,7 +405,7 @@ impl Reduction for RodCylinderFree {
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..54]; // one bounds check for all constant loads
     }
 
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
@@ -387,7 +417,7 @@ impl Reduction for RodCylinderFree {
     }
 
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..54]; // one bounds check for all constant loads
     }
 
     fn full_state(
@@ -399,7 +429,7 @@ impl Reduction for RodCylinderFree {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..53]; // one bounds check for all constant loads
+        let k = &k[..54]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[12], k[14], k[15], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[1] = k[12] - delta;

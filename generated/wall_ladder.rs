@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
-    Reduction, ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, NextPhase,
+    ParamInfo, Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
 };
 
 /// A uniform ladder sliding down a fixed frictionless wall on a frictionless floor.
@@ -45,7 +45,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "ladder_leans",
         meaning: "the top must start below the ladder's length (a < ell)",
     }],
-    n_constants: 27,
+    n_constants: 28,
     coordinates: &["theta"],
     reduced: 0,
     cyclic: &[],
@@ -86,10 +86,24 @@ static INFO: ModelInfo = ModelInfo {
     ],
     falling_point: 2,
     gravity: 3,
-    monitors: &[NamedInfo {
+    monitors: &[MonitorInfo {
         name: "foot_on_floor",
         meaning: "the ladder's foot stays on the floor (N >= 0)",
+        unit: "N",
     }],
+    bodies: &["rod"],
+    shapes: &[
+        ShapeInfo {
+            kind: ShapeKind::Segment,
+            body: Some(0),
+            first: 0,
+        },
+        ShapeInfo {
+            kind: ShapeKind::Segment,
+            body: None,
+            first: 4,
+        },
+    ],
     next_phase: Some(NextPhase {
         model: "wall_ladder_free",
         bindings: &[
@@ -146,16 +160,17 @@ impl Model for WallLadder {
         k[22] = (k[1] * k[0] / 2.0);
         k[23] = (3.0 * k[3] / k[1]);
         k[24] = (-3.0 * k[3] / 2.0 / k[1]);
+        k[27] = ((-k[1]) / 2.0);
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..27]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         q[0] = k[4];
         qd[0] = 0.0;
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..27]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         pos[0] = [(k[9] * rc_c), 0.0];
         vel[0] = [(k[10] * qd[0] * rc_s), 0.0];
@@ -168,7 +183,7 @@ impl Model for WallLadder {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..27]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let et0 = (qd[0] * qd[0]);
         (((k[13] * et0) + (k[14] * et0 * (rc_s * rc_s)) + (k[14] * et0 * (rc_c * rc_c)))
@@ -176,12 +191,12 @@ impl Model for WallLadder {
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..27]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..27]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         mass[0] = (k[16] + (k[17] * (rc_s * rc_s)) + (k[17] * (rc_c * rc_c)));
         rhs[0] = (k[18] * rc_c);
@@ -196,7 +211,7 @@ impl Model for WallLadder {
         fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..27]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ft0 = (qd[0] * qd[0]);
         out[0] = (-((k[19] * qdd[0] * rc_s)
@@ -206,27 +221,41 @@ impl Model for WallLadder {
     }
 
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..27]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..27]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         out[0] = forces[1];
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        let k = &k[..27]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         f64::INFINITY
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..27]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         out[0] = (k[9] * rc_c);
         out[1] = (k[10] * qd[0] * rc_s);
+    }
+
+    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
+        let k = &k[..28]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[0].sin_cos();
+        poses[0] = [(k[11] * rc_c), (k[12] * rc_s), q[0]];
+        sizes[0] = k[27];
+        sizes[1] = 0.0;
+        sizes[2] = k[12];
+        sizes[3] = 0.0;
+        sizes[4] = 0.0;
+        sizes[5] = 0.0;
+        sizes[6] = 0.0;
+        sizes[7] = k[1];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -236,7 +265,7 @@ impl Model for WallLadder {
 
 impl Reduction for WallLadder {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..27]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[4], k[6], k[7], delta);
         let rc_delta = delta;
         Reduced {
@@ -248,12 +277,12 @@ impl Reduction for WallLadder {
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
-        let k = &k[..27]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         (k[23] * rc_ds)
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..27]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[4], k[6], k[7], delta);
         let rc_delta = delta;
         let rc_w2 = (k[23] * rc_ds);
@@ -263,7 +292,7 @@ impl Reduction for WallLadder {
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..27]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         out[0] = k[25];
         out[1] = 3.0;
     }
@@ -280,7 +309,7 @@ impl Reduction for WallLadder {
     }
 
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..27]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         out[0] = k[26];
     }
 
@@ -293,7 +322,7 @@ impl Reduction for WallLadder {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..27]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[4], k[6], k[7], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[0] = k[4] - delta;

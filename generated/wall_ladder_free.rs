@@ -4,8 +4,8 @@
 
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
-    Reduction, ReductionInfo, start_offsets,
+    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, NextPhase,
+    ParamInfo, Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
 };
 
 /// After the contact of `wall_ladder` ends: A uniform ladder sliding down a fixed frictionless wall on a frictionless floor.
@@ -69,7 +69,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "ladder_leans",
         meaning: "the top must start below the ladder's length (a < ell)",
     }],
-    n_constants: 39,
+    n_constants: 40,
     coordinates: &["x1", "theta"],
     reduced: 1,
     cyclic: &[0],
@@ -101,13 +101,28 @@ static INFO: ModelInfo = ModelInfo {
     falling_point: 2,
     gravity: 3,
     monitors: &[
-        NamedInfo {
+        MonitorInfo {
             name: "foot_on_floor",
             meaning: "the ladder's foot stays on the floor (N >= 0)",
+            unit: "N",
         },
-        NamedInfo {
+        MonitorInfo {
             name: "contact_open",
             meaning: "the contact of `contact_force` stays open after it ended (gap >= 0: the bodies do not meet again)",
+            unit: "m",
+        },
+    ],
+    bodies: &["rod"],
+    shapes: &[
+        ShapeInfo {
+            kind: ShapeKind::Segment,
+            body: Some(0),
+            first: 0,
+        },
+        ShapeInfo {
+            kind: ShapeKind::Segment,
+            body: None,
+            first: 4,
         },
     ],
     next_phase: None,
@@ -165,10 +180,11 @@ impl Model for WallLadderFree {
         k[36] = (6.0 * (k[9] * k[9]) * k[14]);
         k[37] = k[12];
         k[38] = (k[13] / k[0]);
+        k[39] = ((-k[1]) / 2.0);
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         q[0] = k[4];
         qd[0] = k[6];
         q[1] = k[5];
@@ -176,7 +192,7 @@ impl Model for WallLadderFree {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         pos[0] = [q[0], 0.0];
         vel[0] = [qd[0], 0.0];
@@ -189,7 +205,7 @@ impl Model for WallLadderFree {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = (qd[1] * qd[1]);
         (((k[19] * qd[1] * qd[0] * rc_s)
@@ -201,13 +217,13 @@ impl Model for WallLadderFree {
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = ((k[19] * qd[1] * rc_s) + (k[24] * qd[0]));
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let qt0 = (k[19] * rc_s);
         mass[0] = k[0];
@@ -227,32 +243,46 @@ impl Model for WallLadderFree {
         fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = (k[29] + (k[27] * qdd[1] * rc_c) + (k[19] * (qd[1] * qd[1]) * rc_s));
     }
 
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = forces[0];
         out[1] = ((k[17] * rc_c) - q[0]);
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         f64::INFINITY
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
+    }
+
+    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
+        let k = &k[..40]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[1].sin_cos();
+        poses[0] = [((k[16] * rc_c) + q[0]), (k[16] * rc_s), q[1]];
+        sizes[0] = k[39];
+        sizes[1] = 0.0;
+        sizes[2] = k[16];
+        sizes[3] = 0.0;
+        sizes[4] = 0.0;
+        sizes[5] = 0.0;
+        sizes[6] = 0.0;
+        sizes[7] = k[1];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -262,7 +292,7 @@ impl Model for WallLadderFree {
 
 impl Reduction for WallLadderFree {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[8], k[10], k[11], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
@@ -281,12 +311,12 @@ impl Reduction for WallLadderFree {
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         (-12.0 * (k[30] + (k[31] * rc_ds)) / (k[32] * (-4.0 + (3.0 * (rc_s * rc_s)))))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[8], k[10], k[11], delta);
         let rc_delta = delta;
         let rt0 = (rc_s * rc_s);
@@ -302,7 +332,7 @@ impl Reduction for WallLadderFree {
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
     }
 
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
@@ -314,7 +344,7 @@ impl Reduction for WallLadderFree {
     }
 
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
     }
 
     fn full_state(
@@ -326,7 +356,7 @@ impl Reduction for WallLadderFree {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[8], k[10], k[11], delta);
         let (rc_delta, rc_t, rc_w) = (delta, t, theta_dot);
         q[1] = k[8] - delta;

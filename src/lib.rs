@@ -56,6 +56,7 @@
 
 #[cfg(feature = "cli")]
 pub mod accuracy;
+pub mod axes;
 #[cfg(feature = "derive")]
 pub mod derive;
 #[cfg(feature = "capi")]
@@ -77,7 +78,7 @@ pub mod spec;
 #[cfg(feature = "cli")]
 pub mod sweep;
 pub mod system;
-pub mod yaml_marks;
+pub mod yaml;
 
 /// The README's Rust examples, compiled and run as doctests.
 #[cfg(doctest)]

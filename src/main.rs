@@ -71,7 +71,7 @@ enum Command {
     #[command(after_help = RUN_HELP)]
     Run(RunArgs),
     /// List the models with their parameters (name, unit, meaning) and the quantities they offer
-    Models,
+    Models(LayoutArgs),
     /// Sweep the separation angle and time over a grid of (n, a/ell) or a CSV of points
     #[command(after_help = numerics_cli::SWEEP_HELP)]
     Sweep(numerics_cli::SweepArgs),
@@ -110,6 +110,25 @@ struct RunArgs {
     /// Output directory [default: out/<scene stem>/]
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
+    #[command(flatten)]
+    layout: LayoutArgs,
+}
+
+/// How the printed tables are laid out.
+#[derive(Args, Clone, Copy, Default)]
+struct LayoutArgs {
+    /// Follow each table with the meaning of every row
+    #[arg(long, short)]
+    verbose: bool,
+    /// Do not wrap lines (by default they fit $COLUMNS, the terminal, or 100 columns)
+    #[arg(long)]
+    wide: bool,
+}
+
+impl LayoutArgs {
+    fn layout(self) -> report::table::Layout {
+        report::table::Layout::detect(self.wide, self.verbose)
+    }
 }
 
 /// With no subcommand, `rodcube` runs the paper's scene (`rodcube run`).
@@ -118,6 +137,7 @@ fn default_command() -> Command {
         scene: None,
         json: false,
         out: None,
+        layout: LayoutArgs::default(),
     })
 }
 
@@ -186,7 +206,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let outcome = match cli.command.unwrap_or_else(default_command) {
         Command::Run(args) => run(args),
-        Command::Models => models(),
+        Command::Models(args) => models(args),
         Command::Sweep(args) => numerics_cli::sweep(args),
         Command::Accuracy(args) => numerics_cli::accuracy(args),
         #[cfg(feature = "derive")]
@@ -255,7 +275,7 @@ fn run(args: RunArgs) -> Result<(), Failure> {
     let text = if args.json {
         report::json::to_string(&results).map_err(|e| Failure::Output(e.into()))?
     } else {
-        report::table::render(&results, Some(scene.info()))
+        report::table::render(&results, Some(scene.info()), &args.layout.layout())
     };
     // Write the files first, print the results either way, then report a write failure.
     let written = report::write_all(&out, &results);
@@ -329,9 +349,9 @@ fn planner_failure(scene: &Scene, error: PlanError) -> Failure {
 }
 
 /// `rodcube models`.
-fn models() -> Result<(), Failure> {
+fn models(args: LayoutArgs) -> Result<(), Failure> {
     let infos: Vec<_> = rodcube::models::all().iter().map(|m| m.info()).collect();
-    print_stdout(&report::table::models(&infos))
+    print_stdout(&report::table::models(&infos, &args.layout()))
 }
 
 /// A diagnostic line on stderr (ignoring a closed stderr rather than panicking like `eprintln!`).

@@ -43,6 +43,51 @@ pub struct NamedInfo {
     pub meaning: &'static str,
 }
 
+/// A monitored assumption: its value must stay `>= 0` during the motion.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MonitorInfo {
+    /// Identifier used in check keys (`<phase>.<name>`).
+    pub name: &'static str,
+    /// What it checks, for people.
+    pub meaning: &'static str,
+    /// The unit its value is in (`N`, `N m`, `m`, ...); empty when the spec gives none.
+    pub unit: &'static str,
+}
+
+/// What a shape of the drawing is; the numbers [`Model::drawing`] writes for it, in order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ShapeKind {
+    /// A line: `x1, y1, x2, y2`.
+    Segment,
+    /// A rectangle with its sides along its frame's axes: centre `x, y`, `width, height`.
+    Rectangle,
+    /// A circle: centre `x, y`, `radius`.
+    Circle,
+}
+
+impl ShapeKind {
+    /// How many numbers describe a shape of this kind.
+    pub const fn numbers(self) -> usize {
+        match self {
+            ShapeKind::Segment | ShapeKind::Rectangle => 4,
+            ShapeKind::Circle => 3,
+        }
+    }
+}
+
+/// A shape of the drawing (a spec's body `shape` or `scenery`): its numbers are
+/// `sizes[first..first + kind.numbers()]` of [`Model::drawing`], in its body's frame (the centre
+/// of mass at the origin, x along the body's angle) or, for scenery, in world coordinates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ShapeInfo {
+    /// What it is.
+    pub kind: ShapeKind,
+    /// Index in [`ModelInfo::bodies`] of the body it moves with; `None` for fixed scenery.
+    pub body: Option<usize>,
+    /// Index of its first number in the `sizes` of [`Model::drawing`].
+    pub first: usize,
+}
+
 /// The contact of a model: a unilateral constraint `gap(q) >= 0` that ties one coordinate
 /// while it holds. Its force (the Lagrange multiplier) is positive while the bodies push apart;
 /// the contact ends where the force reaches zero or, for a contact with an edge, where the
@@ -163,7 +208,11 @@ pub struct ModelInfo {
     /// Index in `parameters` of the gravitational acceleration.
     pub gravity: usize,
     /// Physical assumptions to monitor; each value must stay `>= 0` during the motion.
-    pub monitors: &'static [NamedInfo],
+    pub monitors: &'static [MonitorInfo],
+    /// The bodies, in the order of the poses [`Model::drawing`] writes.
+    pub bodies: &'static [&'static str],
+    /// The shapes that draw the bodies and the scenery (the floor `y = 0` is not among them).
+    pub shapes: &'static [ShapeInfo],
     /// The phase that follows the end of the contact, if any.
     pub next_phase: Option<NextPhase>,
     /// The fast path's layout, when the model has one ([`Model::reduction`] is `Some`).
@@ -171,6 +220,17 @@ pub struct ModelInfo {
     /// Why the model has no fast path (empty when it has one): it is then solved by
     /// integrating `M(q) qdd = F(q, qd)`.
     pub route_note: &'static str,
+}
+
+impl ModelInfo {
+    /// How many numbers [`Model::drawing`] writes into `sizes`.
+    pub fn drawing_sizes(&self) -> usize {
+        self.shapes
+            .iter()
+            .map(|s| s.first + s.kind.numbers())
+            .max()
+            .unwrap_or(0)
+    }
 }
 
 /// Evaluation functions of one generated model over its full state. All are allocation-free
@@ -231,6 +291,12 @@ pub trait Model: Send + Sync {
     /// The value and rate of the coordinate the contact ties
     /// ([`ContactInfo::eliminated`]); `out.len()` is 2 with a contact, 0 without.
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]);
+
+    /// The drawing of a full state: each body's pose `[x, y, angle]` (its centre of mass and
+    /// orientation, in the order of [`ModelInfo::bodies`]) and the numbers of every shape of
+    /// [`ModelInfo::shapes`] (parameter-only: the same for every state).
+    /// `poses.len()` is the number of bodies, `sizes.len()` [`ModelInfo::drawing_sizes`].
+    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]);
 
     /// The fast path, if the model has one ([`ModelInfo::reduction`] describes it).
     fn reduction(&self) -> Option<&dyn Reduction>;

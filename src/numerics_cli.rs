@@ -6,22 +6,25 @@ use super::{Failure, note, print_stdout};
 use clap::Args;
 use rodcube::accuracy::{self, Measured};
 use rodcube::io::OutDir;
-use rodcube::sweep::{self, Axis, Mapping, Point};
+use rodcube::sweep;
 use std::path::PathBuf;
 
 pub const SWEEP_HELP: &str = "\
-Parameters are set as m1 = 1, m2 = n, a = a_over_ell * ell, with ell = g = 1 unless --ell/--g
-are given: results are then dimensionless (times in units of sqrt(ell/g)), as the CSV's first
-line says. An axis is START:STOP:lin|log:COUNT, a single value, or values separated by commas.
-The CSV has columns n,a_over_ell,separation_angle,separation_time (no n for a model without m2)
-plus the result keys of each --want quantity (computed by the planner, much slower).
+An axis is named by a parameter of the model (m2, R, ...) or by a ratio of two parameters of
+the same unit, written p_over_q (a_over_ell sets a = value * ell); n stands for m2_over_m1.
+Its values are START:STOP:lin|log:COUNT, a single value, or values separated by commas. A grid
+takes every combination, the first axis varying slowest. Parameters on no axis are fixed with
+--set (default 1), so with the paper's model m1 = ell = g = 1 and the results read in units of
+sqrt(ell/g). The CSV's first line says how each parameter was set; its columns are the axes,
+separation_angle, separation_time, then the result keys of each --want quantity (computed by
+the planner, much slower). --heatmap draws a two-axis grid.
 
 Examples:
   rodcube sweep --n 1e-3:1e3:log:200 --a-over-ell 0.01:0.99:lin:200 --heatmap
   rodcube sweep --model hinged_rod --n 0.1,1,10 --a-over-ell 0.05:0.95:lin:19
-  rodcube sweep --model wall_ladder --a-over-ell 0.1:0.9:lin:9
-  rodcube sweep --points points.csv --want point_mass_fall_time --ell 1 --g 9.81
-  rodcube sweep --n 3 --a-over-ell 0.25 --out /tmp/one";
+  rodcube sweep --model rod_cylinder --axis m2_over_m1=0.5:8:log:20 --axis R=0.05:0.3:lin:20 --heatmap
+  rodcube sweep --model wall_ladder --a-over-ell 0.1:0.9:lin:9 --set ell=5,g=9.81
+  rodcube sweep --points points.csv --want point_mass_fall_time --set ell=1,g=9.81";
 
 pub const ACCURACY_HELP: &str = "\
 Runs every method on the paper's case (n = 3, a/ell = 1/4) and the hard cases (near upright,
@@ -36,31 +39,36 @@ Examples:
 /// Arguments of `rodcube sweep`.
 #[derive(Args)]
 pub struct SweepArgs {
-    /// Model to sweep (one with parameters m1, [m2,] ell, a, g)
+    /// Model to sweep (any model with a contact; `rodcube models` lists them)
     #[arg(long, default_value = "rod_cube")]
     model: String,
-    /// Mass ratios n = m2/m1: START:STOP:lin|log:COUNT, a value, or a list
+    /// An axis: NAME=SPEC, NAME a parameter or a ratio p_over_q (repeat for a grid)
+    #[arg(long, value_name = "NAME=SPEC", allow_hyphen_values = true)]
+    axis: Vec<String>,
+    /// The axis n = m2/m1 (same as --axis n=SPEC)
     #[arg(long, value_name = "SPEC", allow_hyphen_values = true)]
     n: Option<String>,
-    /// Values of a/ell in (0, 1): START:STOP:lin|log:COUNT, a value, or a list
+    /// The axis a/ell (same as --axis a_over_ell=SPEC)
     #[arg(long = "a-over-ell", value_name = "SPEC", allow_hyphen_values = true)]
     a_over_ell: Option<String>,
-    /// CSV of points with columns n,a_over_ell (instead of a grid)
-    #[arg(long, value_name = "FILE", conflicts_with_all = ["n", "a_over_ell", "heatmap"])]
+    /// Parameters on no axis: NAME=VALUE, comma-separated or repeated (default 1 each)
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_name = "NAME=VALUE",
+        allow_hyphen_values = true
+    )]
+    set: Vec<String>,
+    /// CSV of points whose header names the axes (instead of a grid)
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["axis", "n", "a_over_ell", "heatmap"])]
     points: Option<PathBuf>,
     /// More quantities per point, comma-separated (through the planner; slower)
     #[arg(long, value_delimiter = ',', value_name = "QUANTITY")]
     want: Vec<String>,
-    /// Rod length ell in m (default 1: dimensionless)
-    #[arg(long)]
-    ell: Option<f64>,
-    /// Gravitational acceleration g in m/s^2 (default 1: dimensionless)
-    #[arg(long)]
-    g: Option<f64>,
     /// Relative tolerance of the --want quantities
-    #[arg(long, default_value_t = rodcube::plan::DEFAULT_TOLERANCE)]
+    #[arg(long, default_value = rodcube::plan::DEFAULT_TOLERANCE_TEXT)]
     tolerance: f64,
-    /// Also write heat maps separation_angle.svg and separation_time.svg (grids only)
+    /// Also write heat maps separation_angle.svg and separation_time.svg (two-axis grids)
     #[arg(long)]
     heatmap: bool,
     /// Worker threads (default: one per core)
@@ -108,48 +116,31 @@ pub fn sweep(args: SweepArgs) -> Result<(), Failure> {
             names.join(", ")
         ))
     })?;
-    let mapping = Mapping::new(model, args.ell, args.g).map_err(usage)?;
+    let info = model.info();
+    if info.contact.is_none() {
+        return Err(usage(sweep::SweepError::NoContact { model: info.name }));
+    }
     let extra = sweep::parse_want(model, &args.want).map_err(usage)?;
-    let (points, has_n, grid): (Vec<Point>, bool, Option<(Axis, Axis)>) = match &args.points {
+    let fixed = parse_set(&args.set)?;
+    let (points, grid) = match &args.points {
         Some(path) => {
-            let (points, has_n) =
-                sweep::read_points(path).map_err(|e| Failure::Invalid(anyhow::anyhow!("{e}")))?;
-            (points, has_n, None)
+            let points = sweep::read_points(path, info)
+                .map_err(|e| Failure::Invalid(anyhow::anyhow!("{e}")))?;
+            (points, None)
         }
         None => {
-            let r_spec = args.a_over_ell.as_deref().ok_or_else(|| {
-                usage("give --a-over-ell (and --n for a model with m2), or --points FILE")
-            })?;
-            let r = sweep::parse_axis("a-over-ell", r_spec).map_err(usage)?;
-            let n = match &args.n {
-                Some(spec) => Some(sweep::parse_axis("n", spec).map_err(usage)?),
-                None => None,
-            };
-            let ns = n.as_ref().map_or(vec![f64::NAN], |a| a.values.clone());
-            let total = ns.len().saturating_mul(r.values.len());
-            if total > sweep::MAX_POINTS {
-                return Err(usage(format!(
-                    "{total} points is more than {}",
-                    sweep::MAX_POINTS
-                )));
-            }
-            let mut points = Vec::with_capacity(total);
-            for &nv in &ns {
-                for &rv in &r.values {
-                    points.push(Point {
-                        n: nv,
-                        a_over_ell: rv,
-                    });
-                }
-            }
-            let has_n = n.is_some();
-            let grid = n.map(|n| (n, r));
-            (points, has_n, grid)
+            let axes = grid_axes(&args)?;
+            let points = sweep::Points::grid(&axes).map_err(usage)?;
+            (points, Some(axes))
         }
     };
-    mapping.check(&points, has_n).map_err(usage)?;
-    if args.heatmap && grid.is_none() {
-        note("note: no heat maps: they need a grid over both n and a/ell");
+    let names: Vec<&str> = points.names.iter().map(String::as_str).collect();
+    let fixed_ref: Vec<(&str, f64)> = fixed.iter().map(|(n, v)| (n.as_str(), *v)).collect();
+    let mapping = rodcube::axes::Mapping::new(info, &names, &fixed_ref).map_err(usage)?;
+    sweep::check(&mapping, model, &points).map_err(usage)?;
+    let heat_axes = grid.as_ref().filter(|a| a.len() == 2);
+    if args.heatmap && heat_axes.is_none() {
+        note("note: no heat maps: they need a grid over two axes");
     }
     let out_dir = args
         .out
@@ -162,7 +153,7 @@ pub fn sweep(args: SweepArgs) -> Result<(), Failure> {
             .map_err(bad)?;
     }
     let bar = sweep::progress_bar(points.len());
-    let results = sweep::run(&mapping, &points, &extra, args.tolerance, &bar);
+    let results = sweep::run(model, &mapping, &points, &extra, args.tolerance, &bar);
     bar.finish_and_clear();
     let write_start = std::time::Instant::now();
     let text = sweep::to_csv(&mapping, &points, &results);
@@ -170,25 +161,29 @@ pub fn sweep(args: SweepArgs) -> Result<(), Failure> {
     let write_seconds = write_start.elapsed().as_secs_f64();
     let mut written = vec![csv_path];
     if args.heatmap
-        && let Some((n, r)) = &grid
+        && let Some([y, x]) = heat_axes.map(Vec::as_slice)
     {
         for (name, unit, values) in [
             ("separation_angle", "rad", &results.angle),
-            ("separation_time", time_unit(&mapping), &results.time),
+            ("separation_time", "s", &results.time),
         ] {
-            let title = format!("{}: {name} ({unit})", model.info().name);
-            let svg = sweep::heatmap_svg(&title, unit, n, r, values).map_err(bad)?;
-            written.push(
-                out.write(&format!("{name}.svg"), svg.as_bytes())
-                    .map_err(output)?,
-            );
+            let title = format!("{}: {name} ({unit})", info.name);
+            // A map with no finite value (every point failed) is skipped: the failures are
+            // reported below.
+            if values.iter().any(|v| v.is_finite()) {
+                let svg = sweep::heatmap_svg(&title, unit, y, x, values).map_err(bad)?;
+                written.push(
+                    out.write(&format!("{name}.svg"), svg.as_bytes())
+                        .map_err(output)?,
+                );
+            }
         }
     }
     let n_points = points.len();
     let threads = rayon::current_num_threads();
     let summary = format!(
         "swept {n_points} points of {} in {:.3} s on {threads} threads: {:.3e} points/s solving ({:.3e} points/s with the CSV, written in {:.3} s)\nwrote {}\n",
-        model.info().name,
+        info.name,
         results.seconds,
         n_points as f64 / results.seconds,
         n_points as f64 / (results.seconds + write_seconds),
@@ -202,12 +197,10 @@ pub fn sweep(args: SweepArgs) -> Result<(), Failure> {
     print_stdout(&summary)?;
     if !results.errors.is_empty() {
         for (i, message) in results.errors.iter().take(5) {
-            let p = points[*i];
             note(&format!(
-                "point {} (n = {}, a_over_ell = {}): {message}",
+                "point {} ({}): {message}",
                 i + 1,
-                p.n,
-                p.a_over_ell
+                points.describe(*i)
             ));
         }
         return Err(bad(format!(
@@ -218,12 +211,49 @@ pub fn sweep(args: SweepArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-fn time_unit(mapping: &Mapping) -> &'static str {
-    if mapping.dimensionless {
-        "sqrt(ell/g)"
-    } else {
-        "s"
+/// The grid's axes, in the order given: `--n`, `--a-over-ell`, then each `--axis`.
+fn grid_axes(args: &SweepArgs) -> Result<Vec<sweep::Axis>, Failure> {
+    let mut specs: Vec<(String, String)> = Vec::new();
+    if let Some(spec) = &args.n {
+        specs.push(("n".into(), spec.clone()));
     }
+    if let Some(spec) = &args.a_over_ell {
+        specs.push(("a_over_ell".into(), spec.clone()));
+    }
+    for a in &args.axis {
+        let (name, spec) = a.split_once('=').ok_or_else(|| {
+            usage(format!(
+                "--axis {a:?}: expected NAME=SPEC (e.g. --axis m2=0.5:8:log:20)"
+            ))
+        })?;
+        specs.push((name.trim().to_string(), spec.to_string()));
+    }
+    if specs.is_empty() {
+        return Err(usage(
+            "give the axes (--axis NAME=SPEC, or --n / --a-over-ell), or --points FILE",
+        ));
+    }
+    specs
+        .iter()
+        .map(|(name, spec)| sweep::parse_axis(name, spec).map_err(usage))
+        .collect()
+}
+
+/// `--set NAME=VALUE` entries.
+fn parse_set(entries: &[String]) -> Result<Vec<(String, f64)>, Failure> {
+    entries
+        .iter()
+        .map(|e| {
+            let (name, value) = e
+                .split_once('=')
+                .ok_or_else(|| usage(format!("--set {e:?}: expected NAME=VALUE")))?;
+            let v = value
+                .trim()
+                .parse::<f64>()
+                .map_err(|_| usage(format!("--set {e:?}: {value:?} is not a number")))?;
+            Ok((name.trim().to_string(), v))
+        })
+        .collect()
 }
 
 /// `rodcube accuracy`.

@@ -12,6 +12,8 @@
 //! - `point_mass_fall_time`: the release state only;
 //! - `theta_series`, `<force>_series`, `<point>_trajectory`: root + quadrature + inversion at
 //!   `samples` uniform times over the first phase (release to separation, or to the floor);
+//! - any `<point>_trajectory` also gives the bodies' motion ([`RunResults::motion`], drawn
+//!   into `motion.svg`) over every phase the run solved anyway, each sampled once;
 //! - `contact_end`: the first phase (where, when and why its contact ends);
 //! - `floor_impact`: the first phase and every next phase down to the floor;
 //! - `cross_check`: the first phase's quadrature and the unreduced ODE to the separation event;
@@ -32,9 +34,12 @@
 //! (`t, x, y, vx, vy`). A wanted quantity without a value (e.g. no separation, or a mass matrix
 //! too ill-conditioned for the cross-check) is explained in [`RunResults::notes`] under its key.
 
-use crate::model::Model;
+use crate::model::{Model, ModelInfo};
 use crate::quantity::Quantity;
-use crate::results::{Check, Column, Label, RunResults, Scalar, Series, Work};
+use crate::report::motion::{Animation, PhaseInput};
+use crate::results::{
+    Check, CheckKind, Column, Label, RunResults, Scalar, Series, Work, format_number,
+};
 use crate::solve::SolveError;
 use crate::solve::checks;
 use crate::solve::phases::{
@@ -49,6 +54,8 @@ use std::collections::BTreeMap;
 
 /// Relative tolerance when a request gives none.
 pub const DEFAULT_TOLERANCE: f64 = 1e-10;
+/// [`DEFAULT_TOLERANCE`] as the command line shows it (a test checks that they agree).
+pub const DEFAULT_TOLERANCE_TEXT: &str = "1e-10";
 /// Points per series when a request gives none.
 pub const DEFAULT_SAMPLES: usize = 500;
 /// Most points per series a request may ask for (each series holds `samples` values per
@@ -289,6 +296,9 @@ pub fn run(request: &Request) -> Result<RunResults, PlanError> {
     for q in &want {
         plan.quantity(*q, &want, &mut out)?;
     }
+    if want.iter().any(|q| matches!(q, Quantity::Trajectory(_))) {
+        plan.animation(&want, &mut out)?;
+    }
     out.work = plan.work;
     check_finite(&out)?;
     Ok(out)
@@ -355,7 +365,35 @@ fn column(name: &str, unit: &'static str, values: Vec<f64>) -> Column {
     }
 }
 
-const NO_SEPARATION: &str = "no separation before the floor: the contact holds all the way down";
+/// Why there is no separation: the contact holds until the reduced coordinate reaches its end.
+fn no_separation(info: &ModelInfo) -> String {
+    format!(
+        "no separation before {}: the contact holds all the way",
+        motion_end(info)
+    )
+}
+
+/// The end of a model's motion in its own terms: `` `theta` = 0 rad `` (the reduced coordinate
+/// at its `end_angle`).
+fn motion_end(info: &ModelInfo) -> String {
+    let name = info
+        .coordinates
+        .get(info.reduced)
+        .copied()
+        .unwrap_or("theta");
+    format!("`{name}` = {} rad", format_number(info.end_angle, 6))
+}
+
+/// The reduced coordinate's name, in backquotes.
+fn angle_name(info: &ModelInfo) -> String {
+    format!(
+        "`{}`",
+        info.coordinates
+            .get(info.reduced)
+            .copied()
+            .unwrap_or("theta")
+    )
+}
 
 impl<'m> Plan<'m> {
     fn new(
@@ -489,6 +527,44 @@ impl<'m> Plan<'m> {
             .ok_or(SolveError::TooManyPhases { limit: i })
     }
 
+    /// The bodies' motion for `motion.svg`: every phase this run solved (the first always, the
+    /// next ones when `floor_impact` or `checks` asked for them), each sampled once, with the
+    /// path of the first point whose trajectory is wanted. A later phase that cannot be sampled
+    /// ends the animation there, with a note in it.
+    fn animation(&mut self, want: &[Quantity], out: &mut RunResults) -> Result<(), SolveError> {
+        let n = self.motion()?.phases.len();
+        let mut notes = Vec::new();
+        for i in 0..n {
+            if let Err(e) = self.samples_of(i) {
+                notes.push(format!("the animation stops before phase {}: {e}", i + 1));
+                break;
+            }
+        }
+        let Some(motion) = self.motion.as_ref() else {
+            return Ok(());
+        };
+        let info = self.bound.info();
+        let traced = want.iter().find_map(|q| match q {
+            Quantity::Trajectory(i) => info.points.get(*i).map(|p| p.name),
+            _ => None,
+        });
+        let phases: Vec<PhaseInput> = motion
+            .phases
+            .iter()
+            .zip(&self.phase_samples)
+            .map(|(run, samples)| PhaseInput {
+                bound: run.bound(),
+                samples,
+                t_start: run.t_start(),
+                end: run.end(),
+            })
+            .collect();
+        let mut animation = Animation::build(&phases, traced);
+        animation.notes.extend(notes);
+        out.motion = Some(animation);
+        Ok(())
+    }
+
     fn first_samples(&mut self) -> Result<&PhaseSamples, SolveError> {
         self.samples_of(0)
     }
@@ -534,14 +610,15 @@ impl<'m> Plan<'m> {
         Ok(self.ode.insert(run))
     }
 
-    fn quantity(
+    /// The separation angle, its linearised approximation or the separation time, or a note
+    /// saying why there is none.
+    fn separation_quantity(
         &mut self,
         q: Quantity,
-        want: &[Quantity],
+        key: String,
         out: &mut RunResults,
     ) -> Result<(), SolveError> {
         let info = self.bound.info();
-        let key = q.name(info);
         match q {
             Quantity::SeparationAngle => match self.separation_angle()? {
                 Some(theta) => scalar(
@@ -549,10 +626,11 @@ impl<'m> Plan<'m> {
                     &key,
                     theta,
                     "rad",
-                    "angle to the floor where the contact force vanishes".into(),
+                    format!("{} where the contact force vanishes", angle_name(info)),
                 ),
                 None => {
-                    out.notes.insert(key, NO_SEPARATION.into());
+                    let why = self.why_no_separation()?;
+                    out.notes.insert(key, why);
                 }
             },
             Quantity::LinearisedSeparationAngle => match linearised_separation(self.fast()?)? {
@@ -574,9 +652,28 @@ impl<'m> Plan<'m> {
             Quantity::SeparationTime => match self.separation_time()? {
                 Some(t) => scalar(out, &key, t, "s", "time from release to separation".into()),
                 None => {
-                    out.notes.insert(key, NO_SEPARATION.into());
+                    let why = self.why_no_separation()?;
+                    out.notes.insert(key, why);
                 }
             },
+            // `quantity` sends only the three above here.
+            _ => {}
+        }
+        Ok(())
+    }
+
+    fn quantity(
+        &mut self,
+        q: Quantity,
+        want: &[Quantity],
+        out: &mut RunResults,
+    ) -> Result<(), SolveError> {
+        let info = self.bound.info();
+        let key = q.name(info);
+        match q {
+            Quantity::SeparationAngle
+            | Quantity::LinearisedSeparationAngle
+            | Quantity::SeparationTime => self.separation_quantity(q, key, out)?,
             Quantity::ContactEnd => self.contact_end(out)?,
             Quantity::ContactTimeToFloor => {
                 let t = self.floor_mesh()?.duration;
@@ -585,7 +682,10 @@ impl<'m> Plan<'m> {
                     &key,
                     t,
                     "s",
-                    "time to the floor if contact were kept all the way".into(),
+                    format!(
+                        "time to {} if the contact held all the way",
+                        motion_end(info)
+                    ),
                 );
             }
             Quantity::PointMassFallTime => {
@@ -594,14 +694,18 @@ impl<'m> Plan<'m> {
                 let g = self.bound.gravity();
                 if h > 0.0 {
                     let meaning = format!(
-                        "free fall of a point mass from the initial height {h:.6e} m of `{}`",
+                        "free fall of a point mass from the initial height {} m of `{}`",
+                        format_number(h, 6),
                         info.points[info.falling_point].name
                     );
                     scalar(out, &key, (2.0 * h / g).sqrt(), "s", meaning);
                 } else {
                     out.notes.insert(
                         key,
-                        format!("the falling point starts at height {h:e} m, not above the floor"),
+                        format!(
+                            "the falling point starts at height {} m, not above y = 0",
+                            format_number(h, 6)
+                        ),
                     );
                 }
             }
@@ -698,6 +802,23 @@ impl<'m> Plan<'m> {
         Ok((first.end() == End::Separation).then(|| first.theta_end()))
     }
 
+    /// Why the contact does not separate: it holds to the end of the motion, or its contact
+    /// point runs off a body first.
+    fn why_no_separation(&mut self) -> Result<String, SolveError> {
+        let info = self.bound.info();
+        let end = if self.sys.is_some() {
+            self.end()?.end
+        } else {
+            self.first()?.end()
+        };
+        Ok(match end {
+            End::Edge => "no separation: the contact point runs off the edge of a body before \
+                          the contact force vanishes (`contact_end` says when)"
+                .to_string(),
+            _ => no_separation(info),
+        })
+    }
+
     /// The time from release to separation, or `None` without a separation.
     fn separation_time(&mut self) -> Result<Option<f64>, SolveError> {
         if self.sys.is_some() && self.end()?.end != End::Separation {
@@ -709,11 +830,12 @@ impl<'m> Plan<'m> {
 
     /// How the first phase's contact ends: time, angle and cause (`force` or `edge`).
     fn contact_end(&mut self, out: &mut RunResults) -> Result<(), SolveError> {
+        let info = self.bound.info();
         let first = self.first()?;
         let end = first.end();
         friction_report(first, "contact_end", "over the contact phase", out);
         if end == End::Floor {
-            out.notes.insert("contact_end".into(), NO_SEPARATION.into());
+            out.notes.insert("contact_end".into(), no_separation(info));
             return Ok(());
         }
         let (t, theta) = (first.duration(), first.theta_end());
@@ -733,7 +855,7 @@ impl<'m> Plan<'m> {
             "contact_end_angle",
             theta,
             "rad",
-            format!("angle to the floor where the contact ends: {cause}"),
+            format!("{} where the contact ends: {cause}", angle_name(info)),
         );
         out.labels.insert(
             "contact_end_cause".into(),
@@ -746,7 +868,8 @@ impl<'m> Plan<'m> {
     }
 
     fn floor_impact(&mut self, out: &mut RunResults) -> Result<(), SolveError> {
-        let with_friction = !self.bound.info().frictions.is_empty();
+        let info = self.bound.info();
+        let with_friction = !info.frictions.is_empty();
         let motion = self.complete()?;
         if with_friction {
             let work: f64 = motion.phases.iter().map(PhaseRun::friction_work).sum();
@@ -755,8 +878,10 @@ impl<'m> Plan<'m> {
                 "floor_impact_friction_work",
                 work,
                 "J",
-                "work done by friction from release until the rod lies on the floor (energy lost)"
-                    .into(),
+                format!(
+                    "work done by friction from release until {} (energy lost)",
+                    motion_end(info)
+                ),
             );
         }
         let names: Vec<&str> = motion.phases.iter().map(|p| p.bound().name()).collect();
@@ -783,22 +908,24 @@ impl<'m> Plan<'m> {
         let time = motion.floor_time();
         let omega = motion.impact_angular_velocity();
         if motion.phases.len() == 1 {
-            out.notes
-                .insert("floor_impact".into(), NO_SEPARATION.into());
+            out.notes.insert("floor_impact".into(), no_separation(info));
         }
         scalar(
             out,
             "floor_impact_time",
             time,
             "s",
-            format!("time from release until the rod lies on the floor ({path})"),
+            format!("time from release until {} ({path})", motion_end(info)),
         );
         scalar(
             out,
             "impact_angular_velocity",
             omega,
             "rad/s",
-            format!("theta_dot when the rod reaches the floor ({path})"),
+            format!(
+                "rate of {} when it reaches its end ({path})",
+                angle_name(info)
+            ),
         );
         Ok(())
     }
@@ -913,7 +1040,14 @@ impl<'m> Plan<'m> {
             let run = &motion.phases[i];
             let bound = run.bound();
             let forces = sample_forces(run, samples)?;
-            let mut found: Vec<(String, Check)> = checks::monitors(bound, samples, &forces, tol);
+            let ctx = checks::Context {
+                phase: bound.name().to_string(),
+                key: bound.name().to_string(),
+                order: 2 * i,
+                t_start: run.t_start(),
+            };
+            let mut found: Vec<(String, Check)> =
+                checks::monitors(bound, samples, &forces, tol, &ctx);
             match run {
                 PhaseRun::Reduced(_) => {
                     found.extend(checks::drift(
@@ -921,7 +1055,8 @@ impl<'m> Plan<'m> {
                         &samples.states,
                         None,
                         tol,
-                        bound.name(),
+                        &ctx,
+                        CheckKind::Identity,
                     ));
                 }
                 // Along the integrator's own steps (not the interpolated samples), held to the
@@ -936,7 +1071,8 @@ impl<'m> Plan<'m> {
                         &states,
                         with_friction.then_some(&friction_work[..]),
                         ode_tol,
-                        bound.name(),
+                        &ctx,
+                        CheckKind::Drift,
                     ));
                 }
             }
@@ -944,11 +1080,24 @@ impl<'m> Plan<'m> {
         }
         if with_ode && let Some(ode) = self.ode.as_ref() {
             let states = ode.states();
-            // The ODE path is held to its own accuracy: ten times its rtol at the least.
+            // The ODE path is held to its own accuracy: ten times its rtol at the least. It
+            // integrates the first phase's equations, so its checks come right after that
+            // phase's.
             let ode_tol = tol.max(10.0 * ode.rtol);
-            let label = format!("{}.ode", self.bound.name());
-            out.checks
-                .extend(checks::drift(&self.bound, &states, None, ode_tol, &label));
+            let ctx = checks::Context {
+                phase: format!("{} (ODE cross-check)", self.bound.name()),
+                key: format!("{}.ode", self.bound.name()),
+                order: 1,
+                t_start: 0.0,
+            };
+            out.checks.extend(checks::drift(
+                &self.bound,
+                &states,
+                None,
+                ode_tol,
+                &ctx,
+                CheckKind::Drift,
+            ));
         }
         Ok(())
     }
@@ -970,7 +1119,7 @@ fn friction_report(run: &PhaseRun, key: &str, until: &str, out: &mut RunResults)
     );
     let sequence = modes
         .iter()
-        .map(|(t, m)| format!("{m} from t = {t:.15e} s"))
+        .map(|(t, m)| format!("{m} from t = {} s", format_number(*t, 6)))
         .collect::<Vec<_>>()
         .join("; ");
     out.labels.insert(

@@ -40,7 +40,7 @@ pub const FIXED: &[(&str, Quantity, &str)] = &[
     (
         "separation_angle",
         Quantity::SeparationAngle,
-        "angle where the contact force vanishes (rad)",
+        "value of the reduced coordinate where the contact force vanishes (rad)",
     ),
     (
         "linearised_separation_angle",
@@ -60,7 +60,7 @@ pub const FIXED: &[(&str, Quantity, &str)] = &[
     (
         "contact_time_to_floor",
         Quantity::ContactTimeToFloor,
-        "time to the floor if contact were kept all the way (s), the paper's eq. (10)",
+        "time to the end of the motion if the contact held all the way (s)",
     ),
     (
         "point_mass_fall_time",

@@ -43,15 +43,51 @@ pub struct Series {
     pub columns: Vec<Column>,
 }
 
+/// What a [`Check`] tests.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CheckKind {
+    /// A physical assumption of the model (a spec's `monitors`): its smallest value over the
+    /// samples must stay `>= 0` (up to rounding). `value` is that smallest value, in `unit`.
+    Monitor,
+    /// A conservation law along a path that does not have it built in (an integrated phase,
+    /// the ODE cross-check): the largest relative drift, `value`, must stay `<= limit`.
+    Drift,
+    /// A conservation law that the path has by construction (the reduced path takes
+    /// `theta_dot` from the energy integral and the cyclic velocities from the conserved
+    /// momenta): what is left to test is that the generated energy and momentum functions
+    /// agree with the reduced motion, to rounding. `value` is the relative difference, which
+    /// must stay `<= limit`.
+    Identity,
+}
+
 /// A monitored assumption or conservation law.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Check {
     /// Whether it held.
     pub passed: bool,
-    /// How much room was left (the smallest monitor value, or tolerance minus drift);
-    /// negative when it failed.
+    /// What is tested, and so how `value` and `limit` read.
+    pub kind: CheckKind,
+    /// The phase (model name) the check ran on; `<model> (ODE cross-check)`
+    /// for the unreduced equations.
+    pub phase: String,
+    /// Position in the order the phases happen (the report sorts by it).
+    pub order: usize,
+    /// What was measured: a monitor's smallest value (in `unit`), or a relative drift.
+    pub value: f64,
+    /// The bound: `value >= 0` for a monitor (up to rounding), `value <= limit` otherwise.
+    pub limit: f64,
+    /// Unit of `value` and `margin` (`1` for relative drifts; empty when the spec gives none).
+    pub unit: String,
+    /// How much room was left, in `unit`: a monitor's smallest value, `limit - value` for a
+    /// drift; negative when it failed.
     pub margin: f64,
-    /// What was checked and against what.
+    /// Time from release (s) where a monitor took its smallest value.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub at_time: Option<f64>,
+    /// How many samples or states it looked at.
+    pub samples: usize,
+    /// What was checked and against what, in a sentence.
     pub meaning: String,
 }
 
@@ -90,6 +126,10 @@ pub struct RunResults {
     /// before the floor). A quantity is either in `results`/`series` or explained here.
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
     pub notes: BTreeMap<String, String>,
+    /// The bodies' motion over every phase the run solved, drawn into `motion.svg`; present
+    /// when a trajectory was wanted. Not part of results.json.
+    #[serde(skip)]
+    pub motion: Option<crate::report::motion::Animation>,
 }
 
 impl RunResults {
@@ -144,5 +184,57 @@ impl Series {
             .iter()
             .find(|c| c.name == name)
             .map(|c| c.values.as_slice())
+    }
+}
+
+/// `v` with `sig` significant digits, for people: plain between 0.001 and 10^6, otherwise in
+/// engineering notation (the exponent a multiple of 3, as the SI prefixes: `251.1e-15`,
+/// `3.5e9`); trailing zeros dropped, never an `e0`.
+pub fn format_number(v: f64, sig: usize) -> String {
+    if !v.is_finite() {
+        return format!("{v}");
+    }
+    if v == 0.0 {
+        return "0".into();
+    }
+    let sig = sig.max(1);
+    // Rounded once, by the standard library; then only the decimal point moves.
+    let scientific = format!("{:.*e}", sig - 1, v.abs());
+    let Some((mantissa, exponent)) = scientific.split_once('e') else {
+        return scientific;
+    };
+    let Ok(exponent) = exponent.parse::<i32>() else {
+        return scientific;
+    };
+    let digits: String = mantissa.chars().filter(char::is_ascii_digit).collect();
+    let sign = if v < 0.0 { "-" } else { "" };
+    let (point, shown_exponent) = if (-3..6).contains(&exponent) {
+        (exponent, 0)
+    } else {
+        let shift = exponent.rem_euclid(3);
+        (shift, exponent - shift)
+    };
+    // Digits with the decimal point after position `point + 1` (zeros padded either side).
+    let body = if point < 0 {
+        format!("0.{}{digits}", "0".repeat((-point - 1) as usize))
+    } else {
+        let int_len = point as usize + 1;
+        let padded = format!("{digits:0<int_len$}");
+        let (int, frac) = padded.split_at(int_len);
+        if frac.is_empty() {
+            int.to_string()
+        } else {
+            format!("{int}.{frac}")
+        }
+    };
+    let body = if body.contains('.') {
+        body.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        &body
+    };
+    if shown_exponent == 0 {
+        format!("{sign}{body}")
+    } else {
+        format!("{sign}{body}e{shown_exponent}")
     }
 }

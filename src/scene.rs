@@ -9,25 +9,24 @@
 //! samples: 1000             # points in each series, optional
 //! ```
 //!
-//! Loading runs in three passes over the text, each with exact positions:
-//! 1. a structural walk that reports YAML syntax errors and duplicate keys (serde_yaml_ng's own
-//!    marks, taken from the failing event);
-//! 2. typed deserialization with `deny_unknown_fields` (unknown keys, wrong types, missing keys);
-//! 3. semantic checks against the model's [`ModelInfo`]. Their positions come from
-//!    [`crate::yaml_marks`], which re-reads the text and makes the YAML parser fail on purpose at the
-//!    field's key or value, so the mark is the parser's, whatever the layout (block or flow,
-//!    quoted keys, anchors).
+//! Loading runs in three passes over the text, each with exact positions ([`crate::yaml`]):
+//! 1. every node is read: YAML syntax errors, duplicate keys and tags, at the parser's marks;
+//! 2. typed deserialization with `deny_unknown_fields` (unknown keys, wrong types, missing keys),
+//!    each a typed error at the parser's mark with the field serde was in;
+//! 3. semantic checks against the model's [`ModelInfo`], placed by looking the field's path up
+//!    in the document's tree of spanned nodes, at its key or its value, whatever the layout
+//!    (block or flow, quoted keys, anchors).
 //!
 //! Semantic checks do not stop at the first problem: every diagnostic is collected and they
-//! are reported in file order.
+//! are reported in file order. A [`Diagnostic`] shows as a one-line `file:line:column: field:
+//! message` ([`Diagnostic::headline`]) or, rendered by annotate-snippets, rustc-style with the
+//! line and the token underlined.
 
 use crate::model::{Model, ModelInfo};
 use crate::quantity::Quantity;
 use crate::system::{SystemError, check_value, failed_requirements};
-use crate::yaml_marks::{
-    At, SyntaxError, check_syntax, first_mark, is_path, join_key, locate, locate_nearest,
-    parse_path, strip_marks,
-};
+use crate::yaml::{At, Document, Mark, Problem, ReadError, excerpt, parse_path};
+use annotate_snippets::{Level, Origin, Renderer};
 use serde::Deserialize;
 use std::collections::{BTreeMap, HashSet};
 use std::fmt;
@@ -146,6 +145,9 @@ pub struct Diagnostic {
     pub message: String,
     /// The text of line `line` (for the snippet), empty when `line` is 0.
     pub source_line: String,
+    /// Characters of `source_line` from `column` that the problem covers (the token there);
+    /// 0 when `line` is 0.
+    pub width: usize,
 }
 
 impl Diagnostic {
@@ -169,33 +171,24 @@ impl Diagnostic {
 }
 
 impl fmt::Display for Diagnostic {
-    /// rustc-style: headline with code, `--> file:line:column`, the line and a caret.
+    /// rustc-style, by annotate-snippets: `error[code]: field: message`,
+    /// `--> file:line:column`, the line and the token underlined.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "error[{}]: ", self.kind.code())?;
-        if !self.field.is_empty() {
-            write!(f, "{}: ", self.field)?;
-        }
-        writeln!(f, "{}", self.message)?;
-        let gutter = self.line.to_string().len();
-        write!(f, "{:gutter$}--> {}", "", self.place())?;
-        if self.line > 0 {
-            let text = self.source_line.trim_end();
-            let start = self.column.saturating_sub(1);
-            let width = span_width(text, start);
-            write!(
-                f,
-                "\n{:gutter$} |\n{} | {}\n{:gutter$} | ",
-                "", self.line, text, ""
-            )?;
-            // Keep tabs so the caret lines up under them.
-            let pad: String = text
-                .chars()
-                .take(start)
-                .map(|c| if c == '\t' { '\t' } else { ' ' })
-                .collect();
-            write!(f, "{pad}{}", "^".repeat(width))?;
-        }
-        Ok(())
+        let title = if self.field.is_empty() {
+            self.message.clone()
+        } else {
+            format!("{}: {}", self.field, self.message)
+        };
+        let file = self.file.display().to_string();
+        let title = Level::ERROR.primary_title(title).id(self.kind.code());
+        let group = if self.line == 0 {
+            title.element(Origin::path(file))
+        } else {
+            title.element(excerpt(&self.source_line, self.line, self.column, self.width).path(file))
+        };
+        // No terminal is narrower than a scene line is worth showing whole.
+        let renderer = Renderer::plain().term_width(usize::from(u16::MAX));
+        f.write_str(&renderer.render(&[group]))
     }
 }
 
@@ -270,6 +263,7 @@ impl Scene {
                     kind: Kind::Read,
                     message: format!("cannot read the scene: {why}"),
                     source_line: String::new(),
+                    width: 0,
                 })
             })?;
         Scene::parse(&text, path, registry)
@@ -281,25 +275,35 @@ impl Scene {
         file: &Path,
         registry: &[&'static dyn Model],
     ) -> Result<Scene, SceneError> {
-        let ctx = Ctx { text, file };
         if text.lines().all(|l| {
             let t = l.trim();
             t.is_empty() || t.starts_with('#') || t == "---"
         }) {
+            let ctx = Ctx {
+                doc: Document::index(text),
+                file,
+            };
             return Err(SceneError::one(ctx.at(
                 Kind::Syntax,
-                (1, 1),
+                Mark::START,
                 "",
                 format!("the scene is empty; it needs the keys {}", KEYS.join(", ")),
             )));
         }
-        // Pass 1: syntax and duplicate keys.
-        if let Err(e) = check_syntax(text) {
-            return Err(SceneError::one(ctx.syntax_error(e)));
-        }
+        // Pass 1: syntax, duplicate keys and tags.
+        let doc = Document::parse(text).map_err(|e| {
+            let ctx = Ctx {
+                doc: Document::index(text),
+                file,
+            };
+            SceneError::one(ctx.read_error(e))
+        })?;
+        let ctx = Ctx { doc, file };
         // Pass 2: keys and types.
-        let raw: Raw =
-            serde_yaml_ng::from_str(text).map_err(|e| SceneError::one(ctx.structure_error(&e)))?;
+        let raw: Raw = ctx
+            .doc
+            .deserialize()
+            .map_err(|e| SceneError::one(ctx.read_error(e)))?;
         // Pass 3: against the model.
         ctx.validate(raw, registry)
     }
@@ -334,11 +338,7 @@ impl Scene {
     /// problems found after loading, e.g. by the planner. A field that is not in the file is
     /// placed at its nearest ancestor that is.
     pub fn error_at(&self, field: &str, kind: Kind, message: impl Into<String>) -> SceneError {
-        let ctx = Ctx {
-            text: &self.source,
-            file: &self.file,
-        };
-        SceneError::one(ctx.diag(kind, field, At::Key, message.into()))
+        SceneError::one(self.ctx().diag(kind, field, At::Key, message.into()))
     }
 
     /// An error about some parameters (e.g. a failed requirement reported by the planner),
@@ -349,10 +349,7 @@ impl Scene {
         kind: Kind,
         message: impl Into<String>,
     ) -> SceneError {
-        let ctx = Ctx {
-            text: &self.source,
-            file: &self.file,
-        };
+        let ctx = self.ctx();
         let field = ctx.first_in_file(names.iter().map(|n| format!("parameters.{n}")));
         SceneError::one(ctx.diag(kind, &field, At::Key, message.into()))
     }
@@ -368,45 +365,41 @@ impl Scene {
         let involved = involved_parameters(name, meaning, self.info());
         self.error_at_parameters(&involved, Kind::Requirement, message)
     }
+
+    /// The scene's text, read again to place an error found after loading (errors are rare).
+    fn ctx(&self) -> Ctx<'_> {
+        Ctx {
+            doc: Document::index(&self.source),
+            file: &self.file,
+        }
+    }
 }
 
-/// The text being validated and its file name.
+/// The document being validated and its file name.
 struct Ctx<'a> {
-    text: &'a str,
+    doc: Document<'a>,
     file: &'a Path,
 }
 
 impl Ctx<'_> {
-    fn line_text(&self, line: usize) -> String {
-        if line == 0 {
-            return String::new();
-        }
-        self.text.lines().nth(line - 1).unwrap_or("").to_string()
-    }
-
-    fn at(
-        &self,
-        kind: Kind,
-        (line, column): (usize, usize),
-        field: &str,
-        message: String,
-    ) -> Diagnostic {
+    fn at(&self, kind: Kind, mark: Mark, field: &str, message: String) -> Diagnostic {
         Diagnostic {
             file: self.file.to_path_buf(),
-            line,
-            column,
+            line: mark.line,
+            column: mark.column,
             field: field.to_string(),
             kind,
             message,
-            source_line: self.line_text(line),
+            source_line: self.doc.line_text(mark.line).to_string(),
+            width: mark.width,
         }
     }
 
     /// A diagnostic at `field` (a path such as `parameters.m1`), or at its nearest ancestor
     /// found in the text, or at the start of the document.
     fn diag(&self, kind: Kind, field: &str, at: At, message: String) -> Diagnostic {
-        let pos = locate_nearest(self.text, &parse_path(field), at);
-        self.at(kind, pos, field, message)
+        let mark = self.doc.locate_nearest(&parse_path(field), at);
+        self.at(kind, mark, field, message)
     }
 
     /// The field among `fields` that comes first in the file (the first one if none is found).
@@ -414,111 +407,52 @@ impl Ctx<'_> {
         let fields: Vec<String> = fields.collect();
         fields
             .iter()
-            .filter_map(|f| locate(self.text, &parse_path(f)).map(|p| (p, f)))
+            .filter_map(|f| {
+                let mark = self.doc.locate(&parse_path(f), At::Key)?;
+                Some(((mark.line, mark.column), f))
+            })
             .min()
             .map(|(_, f)| f.clone())
             .or_else(|| fields.first().cloned())
             .unwrap_or_default()
     }
 
-    /// A pass-1 error (YAML syntax, duplicate key, tag) as a diagnostic at the parser's mark.
-    fn syntax_error(&self, e: SyntaxError) -> Diagnostic {
-        let e = match e {
-            SyntaxError::DuplicateKey {
-                field,
-                key,
-                position,
-            } => {
-                let message = format!("duplicate key `{key}`");
-                return self.at(Kind::Syntax, position, &field, message);
-            }
-            SyntaxError::Tag { position } => {
-                let message = "invalid YAML: YAML tags (`!name value`) are not used in scenes";
-                let field = self.enclosing_key(position.0);
-                return self.at(Kind::Syntax, position, &field, message.into());
-            }
-            SyntaxError::Yaml(e) => e,
-        };
-        let pos = e
-            .location()
-            .map(|l| (l.line(), l.column()))
-            .unwrap_or((1, 1));
-        let raw = e.to_string();
-        // libyaml: "problem at MARK, while parsing CONTEXT at MARK". A flow collection's context
-        // mark (where it opened) names the field better than the problem's, which may be on a
-        // later key's line; a block context at column 1 is just the document.
-        let (problem, context) = match raw.split_once(", while ") {
-            Some((p, c)) => (strip_marks(p), Some(c)),
-            None => (strip_marks(&raw), None),
-        };
-        let context_mark = context.and_then(first_mark);
-        let field_line = match context_mark {
-            Some((line, column)) if column > 1 => line,
-            _ => pos.0,
-        };
-        let message = match (context, context_mark) {
-            (Some(c), Some((l, col))) => {
-                format!(
-                    "invalid YAML: {problem} (while {} that starts at {l}:{col})",
-                    strip_marks(c)
-                )
-            }
-            (Some(c), None) => format!("invalid YAML: {problem} (while {c})"),
-            _ => format!("invalid YAML: {problem}"),
-        };
-        self.at(Kind::Syntax, pos, &self.enclosing_key(field_line), message)
-    }
-
-    /// A pass-2 error (unknown key, wrong type, missing key) as a diagnostic at serde's mark.
-    fn structure_error(&self, e: &serde_yaml_ng::Error) -> Diagnostic {
-        let pos = e
-            .location()
-            .map(|l| (l.line(), l.column()))
-            .unwrap_or((1, 1));
-        let full = strip_marks(&e.to_string());
-        // serde_yaml_ng writes "path: message" when the path is not the root.
-        let (field, message) = match full.split_once(": ") {
-            Some((p, m)) if is_path(p) => (p.to_string(), m.to_string()),
-            _ => (String::new(), full.clone()),
-        };
-        let (kind, field, message) = if let Some(name) = message.strip_prefix("unknown field `") {
-            let name = name.split('`').next().unwrap_or("");
-            (
+    /// A pass-1 or pass-2 error (YAML syntax, duplicate key, tag; unknown key, wrong type,
+    /// missing key) as a diagnostic at the parser's mark, named by the field serde was in.
+    fn read_error(&self, e: ReadError) -> Diagnostic {
+        let field = e.field();
+        let (kind, message) = match &e.problem {
+            Problem::Syntax => (Kind::Syntax, format!("invalid YAML: {}", e.message)),
+            Problem::DuplicateKey(key) => (Kind::Syntax, format!("duplicate key `{key}`")),
+            Problem::Tag(tag) => (
+                Kind::Syntax,
+                format!("invalid YAML: YAML tags (here `{tag}`) are not used in scenes"),
+            ),
+            Problem::UnknownField(key) => (
                 Kind::UnknownKey,
-                join_key(&field, name),
                 format!(
-                    "unknown key `{name}`; a scene has the keys {}",
+                    "unknown key `{key}`; a scene has the keys {}",
                     KEYS.join(", ")
                 ),
-            )
-        } else if let Some(name) = message.strip_prefix("missing field `") {
-            let name = name.split('`').next().unwrap_or("");
-            (
+            ),
+            Problem::MissingField(key) => (
                 Kind::Structure,
-                join_key(&field, name),
-                format!("the required key `{name}` is missing"),
-            )
-        } else {
-            (Kind::Structure, field, message)
+                format!("the required key `{key}` is missing"),
+            ),
+            // Only the document itself has no path: it is not a mapping.
+            Problem::Type if field.is_empty() => {
+                let keys = KEYS.join(", ");
+                let message = match self.doc.shape(&[]) {
+                    Some(shape) => {
+                        format!("a scene is a mapping of scene keys ({keys}), not {shape}")
+                    }
+                    None => format!("a scene is a mapping of scene keys ({keys}): {}", e.message),
+                };
+                (Kind::Structure, message)
+            }
+            Problem::Type => (Kind::Structure, e.message.clone()),
         };
-        self.at(kind, pos, &field, message)
-    }
-
-    /// The top-level key whose block contains `line` (for syntax errors), or empty.
-    fn enclosing_key(&self, line: usize) -> String {
-        self.text
-            .lines()
-            .take(line)
-            .filter_map(|l| {
-                let first = l.chars().next()?;
-                if first.is_whitespace() || first == '#' || first == '-' {
-                    return None;
-                }
-                let key = l.split(':').next()?.trim().trim_matches(['"', '\'']);
-                KEYS.contains(&key).then(|| key.to_string())
-            })
-            .last()
-            .unwrap_or_default()
+        self.at(kind, e.mark, &field, message)
     }
 
     fn validate(&self, raw: Raw, registry: &[&'static dyn Model]) -> Result<Scene, SceneError> {
@@ -743,7 +677,7 @@ impl Ctx<'_> {
             want,
             tolerance,
             samples,
-            source: self.text.to_string(),
+            source: self.doc.text().to_string(),
         })
     }
 }
@@ -788,49 +722,5 @@ fn show(v: f64) -> String {
         }
     } else {
         format!("{v}")
-    }
-}
-
-/// Width in characters of the token starting at character `start` of `text` (at least 1).
-fn span_width(text: &str, start: usize) -> usize {
-    let rest: Vec<char> = text.chars().skip(start).collect();
-    let n = match rest.first() {
-        Some(&q @ ('"' | '\'')) => rest
-            .iter()
-            .skip(1)
-            .position(|&c| c == q)
-            .map_or(rest.len(), |i| i + 2),
-        _ => {
-            let mut n = 0;
-            while n < rest.len() {
-                let c = rest[n];
-                if matches!(c, ',' | ']' | '}' | '#')
-                    || (c == ':' && rest.get(n + 1).is_none_or(|c| c.is_whitespace()))
-                {
-                    break;
-                }
-                n += 1;
-            }
-            rest[..n]
-                .iter()
-                .rev()
-                .skip_while(|c| c.is_whitespace())
-                .count()
-        }
-    };
-    n.max(1)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn spans_cover_one_token() {
-        assert_eq!(span_width("  m1: -1.0  # c", 2), 2);
-        assert_eq!(span_width("  m1: -1.0  # c", 6), 4);
-        assert_eq!(span_width("p: {a: 1, b: 2}", 10), 1);
-        assert_eq!(span_width("x: \"a b\"", 3), 5);
-        assert_eq!(span_width("", 0), 1);
     }
 }

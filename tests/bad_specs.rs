@@ -447,3 +447,99 @@ fn a_body_rubbing_against_itself_is_refused() {
         &["cannot rub against itself"],
     );
 }
+
+#[test]
+fn a_shape_over_the_coordinates_is_refused() {
+    let text = edit(
+        "    angle: theta\n",
+        "    angle: theta\n    shape: {segment: [[0, 0], [ell*cos(theta), 0]]}\n",
+    );
+    let (path, err) = error_of("shape_coordinates", &text);
+    let (line, _) = place(&text, "shape:", "shape");
+    check(
+        &path,
+        &err,
+        (line, None),
+        "bodies[0].shape.segment[1][0]",
+        &["undefined symbol `theta`", "allowed here: a, ell, g, m1"],
+    );
+}
+
+#[test]
+fn a_shape_of_two_kinds_or_an_unknown_kind_is_refused() {
+    let text = edit(
+        "    angle: theta\n",
+        "    angle: theta\n    shape: {rectangle: [ell, a], circle: a}\n",
+    );
+    let (path, err) = error_of("shape_two_kinds", &text);
+    let (line, _) = place(&text, "shape:", "shape");
+    check(
+        &path,
+        &err,
+        (line, None),
+        "bodies[0].shape",
+        &["exactly one of", "found rectangle and circle"],
+    );
+    let text = edit(
+        "    angle: theta\n",
+        "    angle: theta\n    shape: {polygon: [[0, 0], [ell, 0]]}\n",
+    );
+    let (path, err) = error_of("shape_unknown_kind", &text);
+    let (line, _) = place(&text, "shape:", "shape");
+    check(
+        &path,
+        &err,
+        (line, None),
+        "bodies[0].shape",
+        &["unknown field `polygon`"],
+    );
+}
+
+#[test]
+fn scenery_over_the_coordinates_is_refused() {
+    let text = edit(
+        "initial:\n",
+        "scenery:\n  - {segment: [[0, 0], [x1, ell]]}\ninitial:\n",
+    );
+    let (path, err) = error_of("scenery_coordinates", &text);
+    let (line, _) = place(&text, "[x1, ell]", "segment");
+    check(
+        &path,
+        &err,
+        (line, None),
+        "scenery[0].segment[1][0]",
+        &["undefined symbol `x1`"],
+    );
+}
+
+#[test]
+fn shapes_scenery_and_monitor_units_reach_the_generated_code() {
+    let text = edit(
+        "initial:\n",
+        "scenery:\n  - {rectangle: [a, ell], at: [a/2, ell/2]}\nmonitors:\n  - {name: leaning, expr: theta, meaning: the ladder leans, unit: rad}\ninitial:\n",
+    )
+    .replace(
+        "    angle: theta\n",
+        "    angle: theta\n    shape: {segment: [[-ell/2, 0], [ell/2, 0]]}\n",
+    );
+    let (root, _) = write("shapes", &text);
+    let (files, _) = render_all(&root, &[]).unwrap_or_else(|e| panic!("{e}"));
+    let _ = std::fs::remove_dir_all(&root);
+    for model in ["ladder", "ladder_free"] {
+        let rust = files
+            .iter()
+            .find(|f| f.path == Path::new("generated").join(format!("{model}.rs")))
+            .unwrap_or_else(|| panic!("no generated/{model}.rs"));
+        let code = rust.text.split_whitespace().collect::<Vec<_>>().join(" ");
+        for want in [
+            "bodies: &[\"rod\"]",
+            "kind: ShapeKind::Segment, body: Some(0), first: 0",
+            "kind: ShapeKind::Rectangle, body: None, first: 4",
+            "unit: \"rad\"",
+            "fn drawing(",
+            "sizes[7] =",
+        ] {
+            assert!(code.contains(want), "{model}: no `{want}` in\n{code}");
+        }
+    }
+}

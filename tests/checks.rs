@@ -27,7 +27,13 @@ fn a_monitor_below_zero_fails_with_its_minimum_as_margin() {
     .unwrap();
     let samples = sample(&phase, 50, &mut Work::default()).unwrap();
     let forces = sample_forces(&phase, &samples).unwrap();
-    let found = checks::monitors(&bound, &samples, &forces, 1e-12);
+    let found = checks::monitors(
+        &bound,
+        &samples,
+        &forces,
+        1e-12,
+        &checks::Context::new("rod_cube"),
+    );
     let foot = &found
         .iter()
         .find(|(k, _)| k == "rod_cube.foot_on_floor")
@@ -39,6 +45,10 @@ fn a_monitor_below_zero_fails_with_its_minimum_as_margin() {
         .unwrap()
         .1;
     assert!(!foot.passed && foot.margin < 0.0, "{foot:?}");
+    // A monitor's margin is its smallest value, in its own unit, with the time it was taken.
+    assert_eq!(foot.kind, rodcube::results::CheckKind::Monitor);
+    assert_eq!(foot.value, foot.margin);
+    assert!(foot.at_time.is_some_and(|t| t >= 0.0), "{foot:?}");
     assert!(tip.passed && tip.margin > 0.0, "{tip:?}");
     // Through the planner too.
     let request = Request::new(&LOW_MONITORS, paper(9.81))
@@ -60,11 +70,17 @@ fn a_cube_running_into_the_tip_is_a_catch() {
     let mut samples = sample(free, 50, &mut work).unwrap();
     let forces = sample_forces(free, &samples).unwrap();
     let open = |samples: &_| {
-        checks::monitors(free.bound(), samples, &forces, 1e-12)
-            .into_iter()
-            .find(|(k, _)| k == "rod_cube_free.contact_open")
-            .unwrap()
-            .1
+        checks::monitors(
+            free.bound(),
+            samples,
+            &forces,
+            1e-12,
+            &checks::Context::new("rod_cube_free"),
+        )
+        .into_iter()
+        .find(|(k, _)| k == "rod_cube_free.contact_open")
+        .unwrap()
+        .1
     };
     let ok = open(&samples);
     assert!(ok.passed && ok.margin > -1e-15, "{ok:?}");

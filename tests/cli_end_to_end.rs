@@ -90,12 +90,12 @@ fn the_paper_scene_by_default_prints_the_papers_figures_and_writes_out_paper() {
     let o = rodcube(&dir, &["run"]);
     let stdout = ok(&o);
     for want in [
-        "9.61 deg",
-        "9.59 deg",
+        "9.61°",
+        "9.59°",
         "0.108 s",
         "0.187 s",
         "0.159 s",
-        "9.61097 deg",
+        "9.61097°",
         "0.10849",
         "0.18692",
         "0.15963",
@@ -275,7 +275,7 @@ fn a_bare_rodcube_runs_the_papers_scene_from_any_directory() {
     let out = rodcube(&dir, &[]);
     let table = ok(&out);
     assert!(table.contains("model rod_cube"), "{table}");
-    assert!(table.contains("9.61097 deg"), "{table}");
+    assert!(table.contains("9.61097°"), "{table}");
     assert!(dir.join("out/paper/results.json").is_file());
     // A file still overrides it.
     let scene = dir.join("light.yaml");
@@ -285,6 +285,6 @@ fn a_bare_rodcube_runs_the_papers_scene_from_any_directory() {
     )
     .unwrap();
     let light = ok(&rodcube(&dir, &["run", "light.yaml"]));
-    assert!(!light.contains("9.61097 deg"), "{light}");
+    assert!(!light.contains("9.61097°"), "{light}");
     assert!(dir.join("out/light/results.json").is_file());
 }

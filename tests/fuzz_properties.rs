@@ -1,12 +1,12 @@
 //! Property tests (proptest) that no generated text makes a public parser panic: arbitrary
 //! YAML-ish text, structured random scenes and mutated specs, and random expressions go through
 //! `Scene::parse`, `spec::parse`, `Expr::parse` (via the fuzz harnesses of `rodcube::fuzzing`)
-//! and `yaml_marks`; every error they return is placed in the file it names.
+//! and `rodcube::yaml`; every error they return is placed in the file it names.
 
 use proptest::prelude::*;
 use rodcube::scene::{Kind, Scene};
 use rodcube::spec::{self, expr::Expr};
-use rodcube::yaml_marks;
+use rodcube::yaml;
 use std::path::Path;
 
 const SCENE_FILE: &str = "prop_scene.yaml";
@@ -184,10 +184,24 @@ proptest! {
         rodcube::fuzzing::scene(text.as_bytes());
         rodcube::fuzzing::spec(text.as_bytes());
         rodcube::fuzzing::expr(text.as_bytes());
-        let _ = yaml_marks::check_syntax(&text);
-        let steps = yaml_marks::parse_path("parameters.m1");
-        let (line, column) = yaml_marks::locate_nearest(&text, &steps, yaml_marks::At::Key);
-        prop_assert!(line >= 1 && column >= 1, "({line}, {column})");
+        // Inside the text: at most one line past the last (the end of a text that ends in a
+        // line break), at most one column past the end of its line.
+        let inside = |m: yaml::Mark| {
+            let lines = text.lines().count();
+            let width = yaml::line_text(&text, m.line).chars().count();
+            m.line >= 1 && m.line <= lines + 1 && m.column >= 1 && m.column <= width + 1
+        };
+        match yaml::Document::parse(&text) {
+            Err(e) => prop_assert!(inside(e.mark), "{:?}\n{:?}", e, text),
+            Ok(doc) => {
+                if let Err(e) = doc.deserialize::<std::collections::BTreeMap<String, f64>>() {
+                    prop_assert!(inside(e.mark), "{:?}\n{:?}", e, text);
+                }
+            }
+        }
+        let steps = yaml::parse_path("parameters.m1");
+        let (mark, _) = yaml::locate_nearest(&text, &steps, yaml::At::Key);
+        prop_assert!(inside(mark), "{:?}\n{:?}", mark, text);
     }
 
     #[test]

@@ -4,7 +4,7 @@
 mod common;
 
 use common::paper::{FREE_ROD, ROD_CUBE, paper, ratios};
-use rodcube::results::Work;
+use rodcube::results::{CheckKind, Work};
 use rodcube::solve::checks;
 use rodcube::solve::quadrature::TimeMesh;
 use rodcube::solve::separation::separation;
@@ -97,14 +97,16 @@ fn ode_path_conserves_energy_and_momentum() {
             qd: y[2..].to_vec(),
         })
         .collect();
-    let found = checks::drift(&sys, &states, None, 1e-10, "ode");
+    let ctx = checks::Context::new("ode");
+    let found = checks::drift(&sys, &states, None, 1e-10, &ctx, CheckKind::Drift);
     assert_eq!(found.len(), 2);
     for (name, check) in &found {
-        println!("{name}: margin {:.3e} ({})", check.margin, check.meaning);
+        println!("{name}: drift {:.3e} ({})", check.value, check.meaning);
+        assert_eq!(check.margin, check.limit - check.value);
         assert!(check.passed, "{name}: {check:?}");
     }
     // The drift measure can fail: a tolerance below the achieved drift does.
-    let strict = checks::drift(&sys, &states, None, 1e-18, "ode");
+    let strict = checks::drift(&sys, &states, None, 1e-18, &ctx, CheckKind::Drift);
     assert!(!strict[0].1.passed);
 }
 

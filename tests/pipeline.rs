@@ -53,7 +53,7 @@ fn the_paper_scene_wants_every_quantity_of_its_model() {
 fn the_paper_scene_reproduces_the_papers_figures() {
     let s = scene("paper.yaml");
     let r = run(&s);
-    // PHYSICS.md, g = 9.81: 9.61 deg, 9.59 deg, 0.10849 s, 0.18693 s, 0.15964 s.
+    // PHYSICS.md, g = 9.81: 9.61°, 9.59°, 0.10849 s, 0.18693 s, 0.15964 s.
     assert_eq!(
         format!("{:.2}", value(&r, "separation_angle").to_degrees()),
         "9.61"
@@ -75,14 +75,14 @@ fn the_paper_scene_reproduces_the_papers_figures() {
         "0.15964"
     );
 
-    let text = report::table::render(&r, Some(s.info()));
+    let text = report::table::render(&r, Some(s.info()), &report::table::Layout::default());
     let ours = format!(
-        "{} deg",
-        report::table::format_sig(value(&r, "separation_angle").to_degrees(), 6)
+        "{}°",
+        report::table::format_number(value(&r, "separation_angle").to_degrees(), 6)
     );
     for want in [
-        "9.61 deg",
-        "9.59 deg",
+        "9.61°",
+        "9.59°",
         "0.108 s",
         "0.187 s",
         "0.159 s",
@@ -130,9 +130,6 @@ fn the_angle_only_scene_does_only_polynomial_work() {
     assert!(r.series.is_empty() && r.checks.is_empty());
     assert!(r.work.polynomial_evals > 0);
     assert_eq!((r.work.integrand_evals, r.work.ode_steps), (0, 0));
-    let text = report::table::render(&r, None);
-    assert!(
-        text.contains("9.61 deg") && !text.contains("Series"),
-        "{text}"
-    );
+    let text = report::table::render(&r, None, &report::table::Layout::default());
+    assert!(text.contains("9.61°") && !text.contains("Series"), "{text}");
 }

@@ -5,7 +5,7 @@
 
 use rodcube::io::OutDir;
 use rodcube::report::{self, csv, json, plot, table};
-use rodcube::results::{Check, Column, RunResults, Scalar, Series, Work};
+use rodcube::results::{Check, CheckKind, Column, RunResults, Scalar, Series, Work};
 use std::collections::BTreeMap;
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -111,7 +111,15 @@ fn paper_results(m2: f64) -> RunResults {
         "foot_on_floor".into(),
         Check {
             passed: true,
+            kind: CheckKind::Monitor,
+            phase: "rod_cube".into(),
+            order: 0,
+            value: 2.45,
+            limit: 0.0,
+            unit: "N".into(),
             margin: 2.45,
+            at_time: Some(0.1085),
+            samples: 1000,
             meaning: "floor normal force >= 0 (N)".into(),
         },
     );
@@ -119,7 +127,15 @@ fn paper_results(m2: f64) -> RunResults {
         "energy_drift".into(),
         Check {
             passed: false,
+            kind: CheckKind::Drift,
+            phase: "rod_cube_free".into(),
+            order: 2,
+            value: 3e-9 + 1e-12,
+            limit: 1e-12,
+            unit: "1".into(),
             margin: -3e-9,
+            at_time: None,
+            samples: 79,
             meaning: "relative energy drift below tolerance".into(),
         },
     );
@@ -146,6 +162,7 @@ fn paper_results(m2: f64) -> RunResults {
             phases: vec!["rod_cube".into(), "rod_cube_free".into()],
         },
         notes: BTreeMap::new(),
+        motion: None,
     }
 }
 
@@ -486,11 +503,11 @@ fn constant_and_partly_non_finite_series_still_plot() {
 
 #[test]
 fn table_shows_units_degrees_paper_figures_checks_and_work() {
-    let text = table::render(&paper_results(3.0), None);
+    let text = table::render(&paper_results(3.0), None, &table::Layout::default());
     for want in [
-        "9.6114 deg",
-        "9.61 deg",
-        "9.59 deg",
+        "9.6114°",
+        "9.61°",
+        "9.59°",
         "0.108 s",
         "0.187 s",
         "0.159 s",
@@ -498,7 +515,10 @@ fn table_shows_units_degrees_paper_figures_checks_and_work() {
         "0.1989",
         "FAIL",
         "pass",
-        "-3.00000e-9",
+        "drift 3e-9",
+        "<= 1e-12",
+        "min 2.45 N",
+        "0.1085 s",
         "polynomial evaluations",
         "rod_cube -> rod_cube_free",
         "t [s], theta [rad]",
@@ -513,11 +533,8 @@ fn paper_figures_appear_only_for_the_papers_case() {
     assert!(table::is_paper_case(&paper_results(3.0)));
     let other = paper_results(4.0);
     assert!(!table::is_paper_case(&other));
-    let text = table::render(&other, None);
-    assert!(
-        !text.contains("9.61 deg") && !text.contains("paper"),
-        "{text}"
-    );
+    let text = table::render(&other, None, &table::Layout::default());
+    assert!(!text.contains("9.61°") && !text.contains("paper"), "{text}");
 }
 
 #[test]
@@ -527,7 +544,7 @@ fn table_explains_quantities_without_a_value() {
         "separation_angle".into(),
         "the rod reaches the floor before separating".into(),
     );
-    let text = table::render(&r, None);
+    let text = table::render(&r, None, &table::Layout::default());
     assert!(
         text.contains("Notes") && text.contains("reaches the floor before"),
         "{text}"
@@ -535,13 +552,25 @@ fn table_explains_quantities_without_a_value() {
 }
 
 #[test]
-fn significant_digits() {
-    assert_eq!(table::format_sig(0.108487, 3), "0.108");
-    assert_eq!(table::format_sig(9.611361, 6), "9.61136");
-    assert_eq!(table::format_sig(1.0, 12), "1");
-    assert_eq!(table::format_sig(-3e-9, 6), "-3.00000e-9");
-    assert_eq!(table::format_sig(0.0, 6), "0");
-    assert_eq!(table::format_sig(f64::NAN, 6), "NaN");
+fn numbers_are_plain_or_in_engineering_notation() {
+    assert_eq!(table::format_number(0.108487, 3), "0.108");
+    assert_eq!(table::format_number(9.611361, 6), "9.61136");
+    assert_eq!(table::format_number(1.0, 12), "1");
+    assert_eq!(table::format_number(4.905, 12), "4.905");
+    assert_eq!(table::format_number(-3e-9, 6), "-3e-9");
+    assert_eq!(table::format_number(2.511e-13, 4), "251.1e-15");
+    assert_eq!(table::format_number(3.4583e-12, 3), "3.46e-12");
+    assert_eq!(table::format_number(1e-10, 3), "100e-12");
+    assert_eq!(table::format_number(0.001, 3), "0.001");
+    assert_eq!(table::format_number(0.000999, 3), "999e-6");
+    assert_eq!(table::format_number(123456.0, 3), "123000");
+    assert_eq!(table::format_number(1234567.0, 3), "1.23e6");
+    assert_eq!(table::format_number(-9.9999e5, 3), "-1e6");
+    assert_eq!(table::format_number(0.0, 6), "0");
+    assert_eq!(table::format_number(f64::NAN, 6), "NaN");
+    assert_eq!(table::format_number(f64::INFINITY, 6), "inf");
+    // The rounding carries into the exponent: 999.96e-6 to 4 digits is 1e-3, plain.
+    assert_eq!(table::format_number(9.9996e-4, 4), "0.001");
 }
 
 #[test]

@@ -1,6 +1,7 @@
-//! `rodcube sweep` end to end: the CSV's header says whether results are dimensionless, its
-//! rows match the planner point by point, points files and heat maps work, and bad input (an
-//! upright rod, `n` for a model without `m2`, an unknown model) is a clear error.
+//! `rodcube sweep` end to end: the CSV's first line says how every parameter was set, its rows
+//! match the planner point by point, axes are any model's parameters or their ratios (a model
+//! off the per-point solver goes through the planner), points files and heat maps work, and
+//! bad input (an upright rod, `n` for a model without `m2`, an unknown model) is a clear error.
 
 use rodcube::plan::{self, Request};
 use rodcube::quantity::Quantity;
@@ -70,10 +71,11 @@ fn a_grid_sweep_matches_the_planner_and_says_it_is_dimensionless() {
     assert!(stdout.contains("swept 12 points"), "{stdout}");
     let (comment, header, rows) = read_csv(&dir.join("sweep.csv"));
     assert!(
-        comment.starts_with('#') && comment.contains("dimensionless"),
+        comment.starts_with('#')
+            && comment.contains("m1 = 1*, m2 = n * m1, ell = 1*, a = a_over_ell * ell, g = 1*")
+            && comment.contains("not given: 1"),
         "{comment}"
     );
-    assert!(comment.contains("ell = 1, g = 1"), "{comment}");
     assert_eq!(
         header,
         ["n", "a_over_ell", "separation_angle", "separation_time"]
@@ -101,7 +103,7 @@ fn a_grid_sweep_matches_the_planner_and_says_it_is_dimensionless() {
 }
 
 #[test]
-fn ell_and_g_give_si_units_and_extra_quantities_come_from_the_planner() {
+fn set_fixes_parameters_and_extra_quantities_come_from_the_planner() {
     let dir = temp_dir("si");
     let out = rodcube(&[
         "sweep",
@@ -109,10 +111,8 @@ fn ell_and_g_give_si_units_and_extra_quantities_come_from_the_planner() {
         "3",
         "--a-over-ell",
         "0.25",
-        "--ell",
-        "1",
-        "--g",
-        "9.81",
+        "--set",
+        "ell=1,g=9.81",
         "--want",
         "point_mass_fall_time,linearised_separation_angle",
         "--out",
@@ -125,7 +125,7 @@ fn ell_and_g_give_si_units_and_extra_quantities_come_from_the_planner() {
     );
     let (comment, header, rows) = read_csv(&dir.join("sweep.csv"));
     assert!(
-        comment.contains("SI units") && comment.contains("g = 9.81"),
+        comment.contains("SI units") && comment.contains("ell = 1, a = a_over_ell * ell, g = 9.81"),
         "{comment}"
     );
     assert!(
@@ -216,7 +216,7 @@ fn the_wall_ladder_sweeps_a_over_ell_alone_and_refuses_n() {
     ]);
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("no mass ratio"), "{err}");
+    assert!(err.contains("no parameter or ratio `n`"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -235,17 +235,33 @@ fn bad_sweeps_fail_with_a_clear_message() {
                 "--out",
                 d,
             ],
-            "a >= ell",
+            "a < ell",
         ),
         (
             vec!["sweep", "--n", "3", "--a-over-ell", "1.5", "--out", d],
-            "outside (0, 1)",
+            "point 1 (n = 3, a_over_ell = 1.5)",
         ),
         (
-            vec!["sweep", "--a-over-ell", "0.5", "--out", d],
-            "needs the mass ratio",
+            vec!["sweep", "--axis", "m2=1", "--n", "3", "--out", d],
+            "set twice",
         ),
-        (vec!["sweep", "--out", d], "give --a-over-ell"),
+        (
+            vec!["sweep", "--axis", "a_over_m1=0.5", "--out", d],
+            "not dimensionless",
+        ),
+        (
+            vec!["sweep", "--axis", "m2", "--out", d],
+            "expected NAME=SPEC",
+        ),
+        (
+            vec!["sweep", "--n", "3", "--set", "mass=2", "--out", d],
+            "no parameter `mass`",
+        ),
+        (
+            vec!["sweep", "--n", "3", "--set", "g=down", "--out", d],
+            "is not a number",
+        ),
+        (vec!["sweep", "--out", d], "give the axes"),
         (
             vec![
                 "sweep",
@@ -331,4 +347,59 @@ fn bad_sweeps_fail_with_a_clear_message() {
         assert!(!err.contains("panicked"), "{err}");
     }
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn any_model_sweeps_over_its_own_parameters_and_ratios() {
+    // rod_cylinder has no per-point solver (its separation condition is not polynomial): the
+    // sweep goes through the planner, and its axes are its own parameters.
+    let dir = temp_dir("cylinder");
+    let out = rodcube(&[
+        "sweep",
+        "--model",
+        "rod_cylinder",
+        "--axis",
+        "m2_over_m1=1,3",
+        "--axis",
+        "R=0.05,0.1",
+        "--set",
+        "th0=0.9,g=9.81",
+        "--heatmap",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (comment, header, rows) = read_csv(&dir.join("sweep.csv"));
+    assert!(
+        comment.contains("m2 = m2_over_m1 * m1") && comment.contains("R = R"),
+        "{comment}"
+    );
+    assert_eq!(
+        header,
+        ["m2_over_m1", "R", "separation_angle", "separation_time"]
+    );
+    assert_eq!(rows.len(), 4);
+    for row in &rows {
+        // m1, m2, ell, R, th0, g
+        let (theta, t) = planner("rod_cylinder", vec![1.0, row[0], 1.0, row[1], 0.9, 9.81]);
+        assert_eq!((row[2], row[3]), (theta, t), "{row:?}");
+    }
+    let svg = std::fs::read_to_string(dir.join("separation_time.svg")).unwrap();
+    assert!(
+        svg.contains("\nm2/m1\n") && svg.contains("\nR\n"),
+        "axis labels"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_tolerance_shown_in_help_is_the_planners_default() {
+    let shown: f64 = rodcube::plan::DEFAULT_TOLERANCE_TEXT.parse().unwrap();
+    assert_eq!(shown, rodcube::plan::DEFAULT_TOLERANCE);
+    let help = String::from_utf8_lossy(&rodcube(&["sweep", "--help"]).stdout).into_owned();
+    assert!(help.contains("[default: 1e-10]"), "{help}");
 }

@@ -9,6 +9,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
+use rodcube::axes::Mapping;
 use rodcube::model::Model;
 use rodcube::plan::{self, Parameters, Request};
 use rodcube::quantity::Quantity;
@@ -127,116 +128,88 @@ fn solve<'py>(
     Ok(out)
 }
 
-/// How a sweep point's `(n, a/ell)` become a model's parameters: `m2 = n m1`,
-/// `a = (a/ell) ell`, the others fixed.
-struct Mapping {
-    base: Vec<f64>,
-    m1: usize,
-    m2: usize,
-    ell: usize,
-    a: usize,
-}
-
-impl Mapping {
-    fn new(m: &dyn Model, fixed: Option<&Bound<'_, PyDict>>) -> PyResult<Mapping> {
-        let info = m.info();
-        let index = |name: &str| {
-            info.parameters
-                .iter()
-                .position(|p| p.name == name)
-                .ok_or_else(|| {
-                    error(format!(
-                        "a sweep over n = m2/m1 and a/ell needs the parameters m1, m2, ell and a; \
-                         model `{}` has no `{name}`",
-                        info.name
-                    ))
-                })
-        };
-        let (m1, m2, ell, a) = (index("m1")?, index("m2")?, index("ell")?, index("a")?);
-        // Dimensionless by default: m1 = ell = g = 1, every other parameter given.
-        let mut base: Vec<Option<f64>> = info.parameters.iter().map(|_| None).collect();
-        for name in ["m1", "ell", "g"] {
-            if let Some(i) = info.parameters.iter().position(|p| p.name == name) {
-                base[i] = Some(1.0);
-            }
-        }
-        if let Some(dict) = fixed {
-            for (key, value) in dict.iter() {
-                let name: String = key.extract()?;
-                let i = index(&name)?;
-                if i == m2 || i == a {
-                    return Err(error(format!(
-                        "`{name}` is set by the sweep's n and a_over_ell"
-                    )));
-                }
-                base[i] = Some(
-                    value
-                        .extract()
-                        .map_err(|_| error(format!("parameter `{name}` must be a number")))?,
-                );
-            }
-        }
-        let mut values = Vec::with_capacity(base.len());
-        for (i, v) in base.iter().enumerate() {
-            match v {
-                Some(v) => values.push(*v),
-                None if i == m2 || i == a => values.push(0.0),
-                None => {
-                    return Err(error(format!(
-                        "model `{}` needs parameter `{}` fixed for the sweep",
-                        info.name, info.parameters[i].name
-                    )));
-                }
-            }
-        }
-        Ok(Mapping {
-            base: values,
-            m1,
-            m2,
-            ell,
-            a,
-        })
-    }
-
-    fn point(&self, p: &mut [f64], n: f64, a_over_ell: f64) {
-        p[self.m2] = n * p[self.m1];
-        p[self.a] = a_over_ell * p[self.ell];
-    }
-}
-
 /// Points per parallel task.
 const CHUNK: usize = 4096;
 
-/// Separation angle and time over arrays of `n = m2/m1` and `a/ell` (same length), in
-/// parallel with the GIL released. Other parameters are `m1 = ell = g = 1` unless given; a
-/// point that has no solution (no separation, refused values) is NaN in both arrays.
+/// The sweep's axes in order: `n`, `a_over_ell`, then the `axes` dict's entries; all of one
+/// length.
+fn sweep_axes(
+    n: Option<PyReadonlyArray1<'_, f64>>,
+    a_over_ell: Option<PyReadonlyArray1<'_, f64>>,
+    axes: Option<&Bound<'_, PyDict>>,
+) -> PyResult<(Vec<String>, Vec<Vec<f64>>)> {
+    let mut names = Vec::new();
+    let mut columns: Vec<Vec<f64>> = Vec::new();
+    for (name, values) in [("n", n), ("a_over_ell", a_over_ell)] {
+        if let Some(v) = values {
+            names.push(name.to_string());
+            columns.push(v.as_array().to_vec());
+        }
+    }
+    if let Some(dict) = axes {
+        for (key, value) in dict.iter() {
+            names.push(key.extract()?);
+            columns.push(value.extract().map_err(|_| {
+                error(format!("axis `{key}` must be a 1-D array or a sequence of numbers"))
+            })?);
+        }
+    }
+    let Some(first) = columns.first() else {
+        return Err(error(
+            "give the axes: n, a_over_ell, or axes={name: values} (a parameter or a ratio p_over_q)",
+        ));
+    };
+    let len = first.len();
+    if let Some((name, c)) = names.iter().zip(&columns).find(|(_, c)| c.len() != len) {
+        return Err(error(format!(
+            "axis `{}` has {len} values and `{name}` {}; they must have as many",
+            names[0],
+            c.len()
+        )));
+    }
+    Ok((names, columns))
+}
+
+/// Separation angle and time over arrays of axis values (all of one length), in parallel with
+/// the GIL released. Axes are `n = m2/m1`, `a_over_ell`, or any parameter or ratio `p_over_q`
+/// of two parameters in `axes`; other parameters are 1 unless given as keywords. A point that
+/// has no solution (no separation, refused values) is NaN in both arrays.
 #[pyfunction]
-#[pyo3(signature = (n, a_over_ell, model="rod_cube", **fixed))]
+#[pyo3(signature = (n=None, a_over_ell=None, model="rod_cube", axes=None, **fixed))]
 fn sweep<'py>(
     py: Python<'py>,
-    n: PyReadonlyArray1<'py, f64>,
-    a_over_ell: PyReadonlyArray1<'py, f64>,
+    n: Option<PyReadonlyArray1<'py, f64>>,
+    a_over_ell: Option<PyReadonlyArray1<'py, f64>>,
     model: &str,
+    axes: Option<&Bound<'py, PyDict>>,
     fixed: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = find(model)?;
     LeanSolver::new(m).map_err(error)?;
-    let mapping = Mapping::new(m, fixed)?;
-    let ns = n.as_array();
-    let rs = a_over_ell.as_array();
-    if ns.len() != rs.len() {
-        return Err(error(format!(
-            "n has {} values and a_over_ell {}; they must have as many",
-            ns.len(),
-            rs.len()
-        )));
+    let (names, columns) = sweep_axes(n, a_over_ell, axes)?;
+    let mut values: Vec<(String, f64)> = Vec::new();
+    if let Some(dict) = fixed {
+        for (key, value) in dict.iter() {
+            let name: String = key.extract()?;
+            let v = value
+                .extract()
+                .map_err(|_| error(format!("parameter `{name}` must be a number")))?;
+            values.push((name, v));
+        }
     }
-    let points: Vec<(f64, f64)> = ns.iter().copied().zip(rs.iter().copied()).collect();
-    let mut angle = vec![f64::NAN; points.len()];
-    let mut time = vec![f64::NAN; points.len()];
+    let axis_names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let fixed_ref: Vec<(&str, f64)> = values.iter().map(|(n, v)| (n.as_str(), *v)).collect();
+    let mapping = Mapping::new(m.info(), &axis_names, &fixed_ref).map_err(error)?;
+    let len = columns[0].len();
+    let dims = columns.len();
+    let points: Vec<f64> = (0..len)
+        .flat_map(|k| columns.iter().map(move |c| c[k]))
+        .collect();
+    let mut angle = vec![f64::NAN; len];
+    let mut time = vec![f64::NAN; len];
     py.detach(|| {
         (
-            points.par_chunks(CHUNK),
+            points.par_chunks(CHUNK * dims),
             angle.par_chunks_mut(CHUNK),
             time.par_chunks_mut(CHUNK),
         )
@@ -245,9 +218,9 @@ fn sweep<'py>(
                 let Ok(mut solver) = LeanSolver::new(m) else {
                     return;
                 };
-                let mut p = mapping.base.clone();
-                for (k, &(n, r)) in chunk.iter().enumerate() {
-                    mapping.point(&mut p, n, r);
+                let mut p = vec![0.0; m.info().parameters.len()];
+                for (k, point) in chunk.chunks(dims).enumerate() {
+                    mapping.fill(point, &mut p);
                     if let Ok(out) = solver.solve(&p) {
                         angles[k] = out.separation_angle;
                         times[k] = out.separation_time;

@@ -54,6 +54,16 @@ def test_the_sweep_agrees_with_single_solves_and_marks_failures_nan():
     assert g["separation_time"][0] == pytest.approx(one["separation_time"], rel=2e-15)
 
 
+def test_axes_are_named_by_the_models_parameters_or_ratios():
+    m2 = np.array([0.5, 2.0, 8.0])
+    ell = np.array([1.0, 2.0, 4.0])
+    s = rodcube.sweep(axes={"m2": m2, "ell": ell, "a_over_ell": np.full(3, 0.25)}, g=9.81)
+    for i in range(3):
+        one = rodcube.solve("rod_cube", m1=1.0, m2=m2[i], ell=ell[i], a=0.25 * ell[i], g=9.81)
+        assert s["separation_angle"][i] == one["separation_angle"]
+        assert s["separation_time"][i] == pytest.approx(one["separation_time"], rel=2e-15)
+
+
 def test_a_large_sweep_runs_in_parallel():
     n = np.logspace(-3, 3, 300).repeat(300)
     a = np.tile(np.linspace(0.01, 0.99, 300), 300)
@@ -83,8 +93,10 @@ def test_errors_are_exceptions_with_rodcubes_messages():
         rodcube.solve("rod_cube", **dict(PAPER, g="down"))
     with pytest.raises(rodcube.RodcubeError, match="as many"):
         rodcube.sweep(np.ones(3), np.ones(2))
-    with pytest.raises(rodcube.RodcubeError, match="no `m2`"):
+    with pytest.raises(rodcube.RodcubeError, match="no parameter or ratio `n`"):
         rodcube.sweep(np.ones(3), np.ones(3), model="wall_ladder")
+    with pytest.raises(rodcube.RodcubeError, match="set twice"):
+        rodcube.sweep(np.ones(3), np.ones(3), axes={"m2": np.ones(3)})
     assert issubclass(rodcube.RodcubeError, ValueError)
 
 

@@ -43,6 +43,14 @@ struct Named {
     meaning: String,
 }
 
+/// A monitor's name, meaning and unit, as Rust literals.
+#[derive(Debug, Clone, Serialize)]
+struct Monitor {
+    name: String,
+    meaning: String,
+    unit: String,
+}
+
 #[derive(Debug, Clone, Serialize)]
 struct Param {
     name: String,
@@ -76,7 +84,13 @@ pub struct RustContext {
     points_info: Vec<Named>,
     falling_point: usize,
     gravity: usize,
-    monitors_info: Vec<Named>,
+    monitors_info: Vec<Monitor>,
+    /// The bodies' names, as Rust string literals.
+    bodies: Vec<String>,
+    /// `ShapeInfo { .. }` literals.
+    shapes_info: Vec<String>,
+    /// `Model::drawing`: the bodies' poses and the shapes' numbers.
+    drawing: Code,
     next_phase: Option<String>,
     /// `ReductionInfo { .. }` when the phase has the fast path.
     reduction_info: Option<String>,
@@ -178,6 +192,7 @@ pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, St
         Ok(r) => Some(reduced_code(d, r, &scope, &mut hoisted)?),
         Err(_) => None,
     };
+    let (drawing, shapes_info) = drawing_code(d, &scope, &mut hoisted);
 
     // Requirements over the parameters (no hoisting: they run before prepare).
     let mut requirements = Code::default();
@@ -333,7 +348,18 @@ pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, St
             .iter()
             .position(|p| p.name == spec.gravity)
             .ok_or_else(|| format!("`{}` is not a parameter", spec.gravity))?,
-        monitors_info: named(&d.monitors),
+        monitors_info: d
+            .monitors
+            .iter()
+            .map(|m| Monitor {
+                name: format!("{:?}", m.name),
+                meaning: format!("{:?}", m.meaning),
+                unit: format!("{:?}", m.unit),
+            })
+            .collect(),
+        bodies: d.bodies.iter().map(|b| format!("{b:?}")).collect(),
+        shapes_info,
+        drawing,
         next_phase,
         reduction_info,
         route_note: match &d.reduction {
@@ -471,12 +497,9 @@ struct FullStateCode {
     released: Code,
 }
 
-fn full_state_code(
-    d: &Derivation,
-    scope: &Scope,
-    hoisted: &mut Hoisted,
-) -> Result<FullStateCode, String> {
-    let theta = d.theta().to_string();
+/// The scope of the full-state functions: the constants, `rc_s`, `rc_c` (the template's
+/// preamble) and the state `q`, `qd`, `qdd`.
+fn state_scope(d: &Derivation, scope: &Scope) -> Scope {
     let mut full_scope = scope.clone();
     full_scope.locals.insert("rc_s".into(), "rc_s".into());
     full_scope.locals.insert("rc_c".into(), "rc_c".into());
@@ -489,6 +512,58 @@ fn full_state_code(
             .locals
             .insert(format!("ddot_{c}"), format!("qdd[{i}]"));
     }
+    full_scope
+}
+
+/// `Model::drawing` (every body's pose from `q`, then every shape's numbers, which are
+/// parameter-only and so hoisted into `k`) and the `ShapeInfo` literals that say where each
+/// shape's numbers start.
+fn drawing_code(d: &Derivation, scope: &Scope, hoisted: &mut Hoisted) -> (Code, Vec<String>) {
+    let theta = d.theta();
+    let mut exprs: Vec<Expr> = d
+        .body_pose
+        .iter()
+        .flat_map(|pose| pose.iter().map(|e| replace_sc(e, theta)))
+        .collect();
+    let mut infos = Vec::new();
+    let mut first = 0;
+    for shape in &d.shapes {
+        infos.push(format!(
+            "ShapeInfo {{ kind: ShapeKind::{:?}, body: {:?}, first: {first} }}",
+            shape.kind, shape.body
+        ));
+        first += shape.numbers.len();
+        exprs.extend(shape.numbers.iter().cloned());
+    }
+    let mut code = Code::default();
+    let out = code.push_body(lower(&exprs, &state_scope(d, scope), Some(hoisted), "d"));
+    let n_bodies = d.body_pose.len();
+    code.outputs = (0..n_bodies)
+        .map(|i| {
+            format!(
+                "poses[{i}] = [{}, {}, {}];",
+                out[3 * i],
+                out[3 * i + 1],
+                out[3 * i + 2]
+            )
+        })
+        .chain(
+            out[3 * n_bodies..]
+                .iter()
+                .enumerate()
+                .map(|(j, o)| format!("sizes[{j}] = {o};")),
+        )
+        .collect();
+    (code, infos)
+}
+
+fn full_state_code(
+    d: &Derivation,
+    scope: &Scope,
+    hoisted: &mut Hoisted,
+) -> Result<FullStateCode, String> {
+    let theta = d.theta().to_string();
+    let mut full_scope = state_scope(d, scope);
     let sc = |e: &Expr| replace_sc(e, &theta);
     let single = |prefix: &str, exprs: &[Expr], scope: &Scope, hoisted: &mut Hoisted| {
         let mut code = Code::default();

@@ -34,8 +34,8 @@
 
 use super::cas::{self, A};
 use super::expr::{Expr, product};
-use super::spec::{Checked, Spec, Text};
-pub use crate::model::Binding;
+use super::spec::{Checked, ShapeSpec, Spec, Text};
+pub use crate::model::{Binding, ShapeKind};
 use std::collections::BTreeMap;
 
 /// Where a derivation error belongs in the spec: a dotted field path and a message.
@@ -116,6 +116,28 @@ pub struct Named {
     pub name: String,
     /// What it means.
     pub meaning: String,
+}
+
+/// A monitored assumption of a phase.
+#[derive(Debug, Clone)]
+pub struct Monitor {
+    /// Identifier.
+    pub name: String,
+    /// What it checks.
+    pub meaning: String,
+    /// The unit of its value (empty when the spec gives none).
+    pub unit: String,
+}
+
+/// A shape of the drawing, from a body's `shape` or the spec's `scenery`.
+#[derive(Debug, Clone)]
+pub struct Shape {
+    /// What it is.
+    pub kind: ShapeKind,
+    /// Index in [`Derivation::bodies`] of the body it moves with (`None`: scenery).
+    pub body: Option<usize>,
+    /// Its numbers over the parameters, in the order [`ShapeKind`] documents.
+    pub numbers: Vec<Expr>,
 }
 
 /// The contact of a contact phase.
@@ -232,11 +254,17 @@ pub struct Derivation {
     /// Reaction forces over the full state and accelerations.
     pub forces_full: Vec<Expr>,
     /// Monitors (each `>= 0` while the assumption holds).
-    pub monitors: Vec<Named>,
+    pub monitors: Vec<Monitor>,
     /// Monitors over the full state, parameters and the forces `rc_f<i>`.
     pub monitors_full: Vec<Expr>,
     /// Parameter requirements (over parameters).
     pub requirements: Vec<Expr>,
+    /// The bodies' names, in the spec's order.
+    pub bodies: Vec<String>,
+    /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the full state.
+    pub body_pose: Vec<[Expr; 3]>,
+    /// The shapes of the drawing: the bodies' (in their order), then the scenery.
+    pub shapes: Vec<Shape>,
     /// The contact, in a contact phase.
     pub contact: Option<Contact>,
     /// The frictions acting in this phase (a free phase drops those whose normal force is the
@@ -451,6 +479,7 @@ struct Parsed {
     monitors: Vec<Expr>,
     requirements: Vec<Expr>,
     initial: BTreeMap<String, [Expr; 2]>,
+    shapes: Vec<Shape>,
 }
 
 /// Stage 0: parses every expression of the spec, each error placed at its field.
@@ -516,7 +545,19 @@ fn read(spec: &Spec) -> Result<Parsed, DeriveError> {
             ],
         );
     }
+    let mut shapes = Vec::new();
+    for (i, b) in spec.bodies.iter().enumerate() {
+        if let Some(shape) = &b.shape {
+            let path = field("bodies", i, "shape");
+            shapes.push(read_shape(shape, Some(i), &path)?);
+        }
+    }
+    for (i, shape) in spec.scenery.iter().enumerate() {
+        let path = [key("scenery"), FieldStep::Index(i)];
+        shapes.push(read_shape(shape, None, &path)?);
+    }
     Ok(Parsed {
+        shapes,
         bodies,
         points,
         potentials,
@@ -527,6 +568,42 @@ fn read(spec: &Spec) -> Result<Parsed, DeriveError> {
         monitors,
         requirements,
         initial,
+    })
+}
+
+/// A shape's numbers (see [`ShapeKind`]): a rectangle's and a circle's centre first (`at`, or
+/// the origin), then its size.
+fn read_shape(
+    shape: &ShapeSpec,
+    body: Option<usize>,
+    path: &[FieldStep],
+) -> Result<Shape, DeriveError> {
+    let parse = |t: &Text| parse_text(t, path);
+    let centre = match &shape.at {
+        Some([x, y]) => vec![parse(x)?, parse(y)?],
+        None => vec![Expr::int(0), Expr::int(0)],
+    };
+    let (kind, numbers) = match (&shape.segment, &shape.rectangle, &shape.circle) {
+        (Some([[x1, y1], [x2, y2]]), None, None) => (
+            ShapeKind::Segment,
+            vec![parse(x1)?, parse(y1)?, parse(x2)?, parse(y2)?],
+        ),
+        (None, Some([w, h]), None) => (
+            ShapeKind::Rectangle,
+            [centre, vec![parse(w)?, parse(h)?]].concat(),
+        ),
+        (None, None, Some(r)) => (ShapeKind::Circle, [centre, vec![parse(r)?]].concat()),
+        _ => {
+            return Err(at(
+                path,
+                "a shape is exactly one of `segment`, `rectangle` or `circle`".into(),
+            ));
+        }
+    };
+    Ok(Shape {
+        kind,
+        body,
+        numbers,
     })
 }
 
@@ -895,7 +972,7 @@ fn monitors(
     parsed: &Parsed,
     st: &Setup,
     forces: &[Named],
-) -> Result<(Vec<Named>, Vec<A>), DeriveError> {
+) -> Result<(Vec<Monitor>, Vec<A>), DeriveError> {
     let mut named = Vec::new();
     let mut exprs = Vec::new();
     let contact_force = spec.contact.as_ref().map(|c| c.force.as_str());
@@ -908,19 +985,27 @@ fn monitors(
         for (fi, f) in forces.iter().enumerate() {
             a = cas::subs_var(&a, &f.name, &cas::var(&format!("rc_f{fi}")));
         }
-        named.push(Named {
+        named.push(Monitor {
             name: m.name.clone(),
             meaning: m.meaning.clone(),
+            unit: m.unit.clone().unwrap_or_default(),
         });
         exprs.push(a);
     }
     if let (Phase::Free, Some(c), Some(gap)) = (st.phase, &spec.contact, &parsed.gap) {
-        named.push(Named {
+        named.push(Monitor {
             name: "contact_open".into(),
             meaning: format!(
                 "the contact of `{}` stays open after it ended (gap >= 0: the bodies do not meet again)",
                 c.force
             ),
+            // The gap is linear in the eliminated coordinate: read as a distance along it.
+            unit: spec
+                .coordinates
+                .iter()
+                .find(|q| q.name == c.eliminates)
+                .map(|q| q.unit.clone())
+                .unwrap_or_default(),
         });
         exprs.push(cas::atom(gap));
     }
@@ -1133,6 +1218,7 @@ fn derive_phase(
             to_expr(&cas::expand(&y), "point")?,
         ]);
     }
+    let body_pose = body_poses(parsed, &lag)?;
     let contact = match &st.tie {
         Some((e, value)) => Some(Contact {
             force: 0,
@@ -1186,11 +1272,30 @@ fn derive_phase(
         monitors: monitor_names,
         monitors_full: list(&monitors_full, "monitor")?,
         requirements: parsed.requirements.clone(),
+        bodies: parsed.bodies.iter().map(|b| b.name.clone()).collect(),
+        body_pose,
+        shapes: parsed.shapes.clone(),
         contact,
         frictions,
         next,
         reduction,
     })
+}
+
+/// Each body's pose `[x, y, angle]` in a phase (the contact's tie substituted), for the drawing.
+fn body_poses(parsed: &Parsed, lag: &Lagrangian) -> Result<Vec<[Expr; 3]>, DeriveError> {
+    let mut poses = Vec::new();
+    for b in &parsed.bodies {
+        let missing = || at(&[key("bodies")], format!("no pose for body `{}`", b.name));
+        let [x, y] = lag.body_pos.get(&b.name).ok_or_else(missing)?;
+        let angle = lag.body_angle.get(&b.name).ok_or_else(missing)?;
+        poses.push([
+            to_expr(&cas::expand(x), "body position")?,
+            to_expr(&cas::expand(y), "body position")?,
+            to_expr(&cas::expand(angle), "body angle")?,
+        ]);
+    }
+    Ok(poses)
 }
 
 /// The frictions of a phase for the runtime: coefficient and normal force by index, slip

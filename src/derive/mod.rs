@@ -13,7 +13,7 @@ pub mod mechanics;
 // Spec parsing and expressions need no Symbolica: they live in the runtime crate.
 pub use crate::spec::{self, expr};
 
-use crate::yaml_marks::{At, Step, locate_nearest};
+use crate::yaml::{At, Step, locate_nearest};
 use mechanics::{Derivation, FieldStep};
 use spec::{Checked, SpecError};
 use std::collections::BTreeMap;
@@ -182,7 +182,7 @@ fn to_spec_error(checked: &Checked, err: mechanics::DeriveError) -> SpecError {
             FieldStep::Index(i) => Step::Index(*i),
         })
         .collect();
-    let (line, column) = locate_nearest(&text, &steps, At::Key);
+    let (mark, source_line) = locate_nearest(&text, &steps, At::Key);
     let field = err
         .field
         .iter()
@@ -195,10 +195,12 @@ fn to_spec_error(checked: &Checked, err: mechanics::DeriveError) -> SpecError {
         .to_string();
     SpecError {
         file: checked.file.clone(),
-        line,
-        column,
+        line: mark.line,
+        column: mark.column,
         field,
         message: err.message,
+        source_line,
+        width: mark.width,
     }
 }
 
@@ -286,6 +288,8 @@ fn render_phase(root: &Path, c: &Checked, d: &Derivation) -> Result<Vec<Rendered
             column: 0,
             field: String::new(),
             message: format!("model `{}`: {message}", d.name),
+            source_line: String::new(),
+            width: 0,
         })
     })?;
     let rust = rustfmt(&d.name, &render(root, "model.rs.tera", &ctx)?)?;

@@ -1,12 +1,15 @@
-//! Reports of a run: the human table, results.json, one CSV per series and SVG plots.
+//! Reports of a run: the human table, results.json, one CSV per series, SVG plots and the
+//! animated motion (`motion.svg`).
 //!
 //! Every writer here is a pure function from `RunResults` to text; only `write_all` touches
-//! the file system, through `OutDir` (atomic writes, checked names). Only [`json`] is built
-//! without the `cli` feature (the C ABI returns it).
+//! the file system, through `OutDir` (atomic writes, checked names). Only [`json`] and
+//! [`motion`] (hand-written SVG text, no dependency) are built without the `cli` feature (the C
+//! ABI returns results.json; [`crate::results::RunResults`] holds the animation).
 
 #[cfg(feature = "cli")]
 pub mod csv;
 pub mod json;
+pub mod motion;
 #[cfg(feature = "cli")]
 pub mod plot;
 #[cfg(feature = "cli")]
@@ -21,6 +24,8 @@ use std::path::PathBuf;
 
 /// Name of the JSON file written beside the series.
 pub const RESULTS_JSON: &str = "results.json";
+/// Name of the animation of the bodies' motion ([`motion::svg`]).
+pub const MOTION_SVG: &str = "motion.svg";
 
 /// Why a report could not be produced or written.
 #[derive(Debug, thiserror::Error)]
@@ -64,7 +69,8 @@ pub enum Error {
 }
 
 /// Writes `results.json`, `<series>.csv` for every series and `<series>.svg` for every series
-/// that can be plotted. Returns the paths written, in that order.
+/// that can be plotted, then `motion.svg` when the run has the bodies' motion
+/// ([`RunResults::motion`]: it wanted a trajectory). Returns the paths written, in that order.
 #[cfg(feature = "cli")]
 pub fn write_all(out: &OutDir, results: &RunResults) -> Result<Vec<PathBuf>, Error> {
     let mut written = vec![out.write(RESULTS_JSON, json::to_string(results)?.as_bytes())?];
@@ -76,6 +82,9 @@ pub fn write_all(out: &OutDir, results: &RunResults) -> Result<Vec<PathBuf>, Err
         if let Some(svg) = plot::svg(name, series, &results.model)? {
             written.push(out.write(&format!("{name}.svg"), svg.as_bytes())?);
         }
+    }
+    if let Some(animation) = &results.motion {
+        written.push(out.write(MOTION_SVG, motion::svg(animation).as_bytes())?);
     }
     Ok(written)
 }

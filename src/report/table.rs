@@ -4,13 +4,14 @@
 
 use crate::model::ModelInfo;
 use crate::quantity::{FIXED, Quantity};
-use crate::results::RunResults;
-use comfy_table::{CellAlignment, ColumnConstraint, ContentArrangement, Table, presets};
+pub use crate::results::format_number;
+use crate::results::{Check, CheckKind, RunResults};
+use comfy_table::{CellAlignment, ColumnConstraint, ContentArrangement, Table, Width, presets};
 
 /// The paper's published figures (Section 3, three digits), by result key.
 pub const PAPER_FIGURES: &[(&str, &str)] = &[
-    ("separation_angle", "9.61 deg"),
-    ("linearised_separation_angle", "9.59 deg"),
+    ("separation_angle", "9.61°"),
+    ("linearised_separation_angle", "9.59°"),
     ("separation_time", "0.108 s"),
     ("contact_time_to_floor", "0.187 s"),
     ("point_mass_fall_time", "0.159 s"),
@@ -34,36 +35,74 @@ pub fn is_paper_case(results: &RunResults) -> bool {
         && (9.8 - 1e-9..=9.81 + 1e-9).contains(&g)
 }
 
-/// `v` with `sig` significant digits: plain notation between 1e-4 and 1e7, exponent otherwise.
-pub fn format_sig(v: f64, sig: usize) -> String {
-    if !v.is_finite() {
-        return format!("{v}");
-    }
-    if v == 0.0 {
-        return "0".into();
-    }
-    let sig = sig.max(1);
-    let a = v.abs();
-    if (1e-4..1e7).contains(&a) {
-        let exponent = a.log10().floor() as i32;
-        let decimals = (sig as i32 - 1 - exponent).max(0) as usize;
-        let s = format!("{v:.decimals$}");
-        if s.contains('.') {
-            s.trim_end_matches('0').trim_end_matches('.').to_string()
+/// How wide the report may be, and how much it says.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Layout {
+    /// Largest line length in characters; `None` for no limit (`--wide`).
+    pub width: Option<usize>,
+    /// Whether each table is followed by a legend with the meaning of every row.
+    pub verbose: bool,
+}
+
+impl Layout {
+    /// The width of piped output (and of a terminal whose width cannot be read).
+    pub const PIPE_WIDTH: usize = 100;
+
+    /// The layout of stdout: `COLUMNS` when set to a number, else the terminal's width, else
+    /// [`Layout::PIPE_WIDTH`]; no limit with `wide`.
+    pub fn detect(wide: bool, verbose: bool) -> Layout {
+        let width = if wide {
+            None
         } else {
-            s
-        }
-    } else {
-        format!("{v:.*e}", sig - 1)
+            let columns = std::env::var("COLUMNS")
+                .ok()
+                .and_then(|c| c.trim().parse::<usize>().ok())
+                .filter(|&c| c > 0);
+            let terminal = || {
+                use std::io::IsTerminal;
+                std::io::stdout()
+                    .is_terminal()
+                    .then(|| Table::new().width().map(usize::from))
+                    .flatten()
+            };
+            Some(columns.or_else(terminal).unwrap_or(Self::PIPE_WIDTH))
+        };
+        Layout { width, verbose }
     }
 }
 
-fn new_table(header: &[&str]) -> Table {
+impl Default for Layout {
+    /// [`Layout::PIPE_WIDTH`] columns, no legends.
+    fn default() -> Self {
+        Layout {
+            width: Some(Self::PIPE_WIDTH),
+            verbose: false,
+        }
+    }
+}
+
+/// `v` and its unit (`0.1085 s`; a pure number without one).
+fn with_unit(v: f64, sig: usize, unit: &str) -> String {
+    match unit {
+        "" | "1" => format_number(v, sig),
+        _ => format!("{} {unit}", format_number(v, sig)),
+    }
+}
+
+fn new_table(header: &[&str], layout: &Layout) -> Table {
     let mut t = Table::new();
     t.load_style(presets::UTF8_FULL_CONDENSED)
-        // Wraps long meanings to the terminal's width on a terminal; one line per row otherwise.
-        .set_content_arrangement(ContentArrangement::Dynamic)
         .set_header(header.to_vec());
+    match layout.width {
+        // Wraps the free-text columns (at spaces) so that no line is longer than `width`.
+        Some(w) => {
+            t.set_content_arrangement(ContentArrangement::Dynamic)
+                .set_width(u16::try_from(w).unwrap_or(u16::MAX));
+        }
+        None => {
+            t.set_content_arrangement(ContentArrangement::Disabled);
+        }
+    }
     t
 }
 
@@ -96,16 +135,86 @@ fn align_right(t: &mut Table, columns: &[usize]) {
     }
 }
 
-/// The full report of a run. `info` supplies parameter units and meanings when known.
-pub fn render(results: &RunResults, info: Option<&ModelInfo>) -> String {
+/// `text` broken at spaces into lines of at most `width` characters (a longer word stays
+/// whole), each line after the first indented by `indent` spaces.
+pub fn wrap(text: &str, width: Option<usize>, indent: usize) -> String {
+    let Some(width) = width else {
+        return text.to_string();
+    };
     let mut out = String::new();
-    match info {
-        Some(i) => out.push_str(&format!("model {}: {}\n", results.model, i.description)),
-        None => out.push_str(&format!("model {}\n", results.model)),
+    let mut line_len = 0;
+    for word in text.split_whitespace() {
+        let len = word.chars().count();
+        if line_len > indent && line_len + 1 + len > width {
+            out.push('\n');
+            out.push_str(&" ".repeat(indent));
+            line_len = indent;
+        } else if !out.is_empty() {
+            out.push(' ');
+            line_len += 1;
+        }
+        out.push_str(word);
+        line_len += len;
     }
+    out
+}
 
-    // Parameters
-    let mut t = new_table(&["parameter", "value", "unit", "meaning"]);
+/// A section: its title, the table, and with `verbose` a legend of what each row means.
+fn section(
+    out: &mut String,
+    title: &str,
+    table: &Table,
+    legend: &[(String, String)],
+    layout: &Layout,
+) {
+    out.push_str(&format!("\n{title}\n{table}\n"));
+    if layout.verbose && legend.iter().any(|(_, m)| !m.is_empty()) {
+        let mut t = new_table(&["", "meaning"], layout);
+        for (name, meaning) in legend.iter().filter(|(_, m)| !m.is_empty()) {
+            t.add_row(vec![name.clone(), meaning.clone()]);
+        }
+        no_wrap(&mut t, &[0]);
+        out.push_str(&format!("{t}\n"));
+    }
+}
+
+/// The full report of a run. `info` supplies parameter units and meanings when known.
+pub fn render(results: &RunResults, info: Option<&ModelInfo>, layout: &Layout) -> String {
+    let mut out = match info {
+        Some(i) => wrap(
+            &format!("model {}: {}", results.model, i.description),
+            layout.width,
+            2,
+        ),
+        None => format!("model {}", results.model),
+    };
+    out.push('\n');
+    parameters(&mut out, results, info, layout);
+    if !results.results.is_empty() || !results.labels.is_empty() {
+        scalars(&mut out, results, layout);
+    }
+    // Wanted quantities without a value, and why.
+    if !results.notes.is_empty() {
+        let mut t = new_table(&["quantity", "why it has no value"], layout);
+        for (key, why) in &results.notes {
+            t.add_row(vec![key.clone(), why.clone()]);
+        }
+        no_wrap(&mut t, &[0]);
+        out.push_str(&format!("\nNotes\n{t}\n"));
+    }
+    if !results.checks.is_empty() {
+        checks(&mut out, results, layout);
+    }
+    series(&mut out, results, layout);
+    work(&mut out, results, layout);
+    if !layout.verbose {
+        out.push_str("\nEach row's meaning: rodcube run --verbose. Units are SI; angles in rad.\n");
+    }
+    out
+}
+
+fn parameters(out: &mut String, results: &RunResults, info: Option<&ModelInfo>, layout: &Layout) {
+    let mut t = new_table(&["parameter", "value", "unit", "meaning"], layout);
     // In the model's order when it is known, else by name.
     let mut rows: Vec<(&String, &f64)> = results.parameters.iter().collect();
     if let Some(i) = info {
@@ -120,7 +229,7 @@ pub fn render(results: &RunResults, info: Option<&ModelInfo>) -> String {
         let p = info.and_then(|i| i.parameters.iter().find(|p| p.name == name));
         t.add_row(vec![
             name.clone(),
-            format_sig(*value, 12),
+            format_number(*value, 12),
             p.map_or("", |p| p.unit).to_string(),
             p.map_or("", |p| p.meaning).to_string(),
         ]);
@@ -128,121 +237,159 @@ pub fn render(results: &RunResults, info: Option<&ModelInfo>) -> String {
     align_right(&mut t, &[1]);
     no_wrap(&mut t, &[0, 1, 2]);
     out.push_str(&format!("\nParameters\n{t}\n"));
+}
 
-    // Results
-    if !results.results.is_empty() || !results.labels.is_empty() {
-        let paper = is_paper_case(results);
-        let mut header = vec!["result", "value", "unit", "degrees"];
-        if paper {
-            header.push("paper");
-        }
-        header.push("meaning");
-        let mut t = new_table(&header);
-        let mut rows: Vec<_> = results.results.iter().collect();
-        rows.sort_by_key(|(k, _)| result_order(k));
-        for (key, s) in rows {
-            let mut row = vec![
-                key.clone(),
-                format_sig(s.value, 12),
-                s.unit.to_string(),
-                if s.unit == "rad" {
-                    format!("{} deg", format_sig(s.value.to_degrees(), 6))
-                } else {
-                    String::new()
-                },
-            ];
-            if paper {
-                let fig = PAPER_FIGURES
-                    .iter()
-                    .find(|(k, _)| k == key)
-                    .map_or("", |(_, f)| f);
-                row.push(fig.to_string());
-            }
-            row.push(s.meaning.clone());
-            t.add_row(row);
-        }
-        for (key, label) in &results.labels {
-            let mut row = vec![
-                key.clone(),
-                label.value.clone(),
-                String::new(),
-                String::new(),
-            ];
-            if paper {
-                row.push(String::new());
-            }
-            row.push(label.meaning.clone());
-            t.add_row(row);
-        }
-        align_right(&mut t, &[1, 3]);
-        no_wrap(
-            &mut t,
-            if paper {
-                &[0, 1, 2, 3, 4]
+fn scalars(out: &mut String, results: &RunResults, layout: &Layout) {
+    let paper = is_paper_case(results);
+    let mut header = vec!["result", "value", "unit", "degrees"];
+    if paper {
+        header.push("paper");
+    }
+    let mut t = new_table(&header, layout);
+    let mut legend = Vec::new();
+    let mut rows: Vec<_> = results.results.iter().collect();
+    rows.sort_by_key(|(k, _)| result_order(k));
+    for (key, s) in rows {
+        let mut row = vec![
+            key.clone(),
+            format_number(s.value, 12),
+            if s.unit == "1" { "" } else { s.unit }.to_string(),
+            if s.unit == "rad" {
+                format!("{}°", format_number(s.value.to_degrees(), 6))
             } else {
-                &[0, 1, 2, 3]
+                String::new()
             },
-        );
-        out.push_str(&format!("\nResults\n{t}\n"));
+        ];
         if paper {
-            out.push_str(
-                "paper: the seed paper's Section 3 figures for n = 3, a/ell = 1/4, ell = 1 m, to three \
-                 digits (contact_time_to_floor is its eq. 10, point_mass_fall_time its sqrt(a/g); \
-                 it does not say whether g is 9.8 or 9.81 m/s^2)\n",
-            );
-        }
-    }
-
-    // Wanted quantities without a value, and why.
-    if !results.notes.is_empty() {
-        let mut t = new_table(&["quantity", "why it has no value"]);
-        for (key, why) in &results.notes {
-            t.add_row(vec![key.clone(), why.clone()]);
-        }
-        no_wrap(&mut t, &[0]);
-        out.push_str(&format!("\nNotes\n{t}\n"));
-    }
-
-    // Checks
-    if !results.checks.is_empty() {
-        let mut t = new_table(&["check", "status", "margin", "meaning"]);
-        for (name, c) in &results.checks {
-            t.add_row(vec![
-                name.clone(),
-                if c.passed { "pass" } else { "FAIL" }.to_string(),
-                format_sig(c.margin, 6),
-                c.meaning.clone(),
-            ]);
-        }
-        align_right(&mut t, &[2]);
-        no_wrap(&mut t, &[0, 1, 2]);
-        let failed = results.checks.values().filter(|c| !c.passed).count();
-        out.push_str(&format!(
-            "\nChecks ({} passed, {failed} failed)\n{t}\n",
-            results.checks.len() - failed
-        ));
-    }
-
-    // Series
-    if !results.series.is_empty() {
-        let mut t = new_table(&["series", "points", "columns"]);
-        for (name, s) in &results.series {
-            let points = s.columns.first().map_or(0, |c| c.values.len());
-            let columns: Vec<String> = s
-                .columns
+            let fig = PAPER_FIGURES
                 .iter()
-                .map(|c| super::csv::header(&c.name, c.unit))
-                .collect();
-            t.add_row(vec![name.clone(), points.to_string(), columns.join(", ")]);
+                .find(|(k, _)| k == key)
+                .map_or("", |(_, f)| f);
+            row.push(fig.to_string());
         }
-        align_right(&mut t, &[1]);
-        no_wrap(&mut t, &[0, 1]);
-        out.push_str(&format!("\nSeries\n{t}\n"));
+        t.add_row(row);
+        legend.push((key.clone(), s.meaning.clone()));
     }
+    for (key, label) in &results.labels {
+        let mut row = vec![
+            key.clone(),
+            label.value.clone(),
+            String::new(),
+            String::new(),
+        ];
+        if paper {
+            row.push(String::new());
+        }
+        t.add_row(row);
+        legend.push((key.clone(), label.meaning.clone()));
+    }
+    align_right(&mut t, &[1, 3]);
+    no_wrap(&mut t, if paper { &[0, 2, 3, 4] } else { &[0, 2, 3] });
+    section(out, "Results", &t, &legend, layout);
+    if paper {
+        out.push_str(&wrap(
+            "paper: the seed paper's Section 3 figures for n = 3, a/ell = 1/4, ell = 1 m, to three \
+             digits (contact_time_to_floor is its eq. 10, point_mass_fall_time its sqrt(a/g); \
+             it does not say whether g is 9.8 or 9.81 m/s^2)",
+            layout.width,
+            7,
+        ));
+        out.push('\n');
+    }
+}
 
-    // Work
+/// Checks grouped by phase, in the order the phases happen (each group its own table, all with
+/// the same column widths); each with what it measured, in its own unit, the bound it is held
+/// to and, for a monitor, when it came closest.
+fn checks(out: &mut String, results: &RunResults, layout: &Layout) {
+    let mut rows: Vec<(&String, &Check)> = results.checks.iter().collect();
+    rows.sort_by_key(|(key, c)| (c.order, c.kind != CheckKind::Monitor, key.as_str()));
+    let cells: Vec<(&Check, [String; 5])> = rows
+        .iter()
+        .map(|(key, c)| (*c, check_cells(key, c)))
+        .collect();
+    let header = ["check", "status", "measured", "held to", "at t"];
+    let mut widths: Vec<usize> = header.iter().map(|h| h.chars().count()).collect();
+    for (_, row) in &cells {
+        for (w, cell) in widths.iter_mut().zip(row) {
+            *w = (*w).max(cell.chars().count());
+        }
+    }
+    let failed = results.checks.values().filter(|c| !c.passed).count();
+    out.push_str(&format!(
+        "\nChecks ({} passed, {failed} failed), phase by phase\n",
+        results.checks.len() - failed
+    ));
+    let mut legend = Vec::new();
+    let mut group = 0;
+    while group < cells.len() {
+        let phase = &cells[group].0.phase;
+        let end = cells[group..]
+            .iter()
+            .position(|(c, _)| &c.phase != phase)
+            .map_or(cells.len(), |n| group + n);
+        let mut t = new_table(&header, layout);
+        for (c, row) in &cells[group..end] {
+            t.add_row(row.to_vec());
+            legend.push((row[0].clone(), c.meaning.clone()));
+        }
+        for (i, w) in widths.iter().enumerate() {
+            if let Some(col) = t.column_mut(i) {
+                let w = u16::try_from(*w + 2).unwrap_or(u16::MAX);
+                col.set_constraint(ColumnConstraint::LowerBoundary(Width::Fixed(w)));
+            }
+        }
+        align_right(&mut t, &[4]);
+        section(out, &format!("{phase}:"), &t, &legend, layout);
+        legend.clear();
+        group = end;
+    }
+}
+
+/// A check's row: name, status, what was measured, the bound, and when.
+fn check_cells(key: &str, c: &Check) -> [String; 5] {
+    let name = key.rsplit('.').next().unwrap_or(key).to_string();
+    let status = if c.passed { "pass" } else { "FAIL" }.to_string();
+    let (measured, held_to) = match c.kind {
+        CheckKind::Monitor => (
+            format!("min {}", with_unit(c.value, 5, &c.unit)),
+            ">= 0".to_string(),
+        ),
+        CheckKind::Drift => (
+            format!("drift {}", format_number(c.value, 3)),
+            format!("<= {}", format_number(c.limit, 3)),
+        ),
+        CheckKind::Identity => (
+            format!("drift {}", format_number(c.value, 3)),
+            format!("<= {} (built in)", format_number(c.limit, 3)),
+        ),
+    };
+    let at = c.at_time.map_or(String::new(), |t| with_unit(t, 4, "s"));
+    [name, status, measured, held_to, at]
+}
+
+fn series(out: &mut String, results: &RunResults, layout: &Layout) {
+    if results.series.is_empty() {
+        return;
+    }
+    let mut t = new_table(&["series", "points", "columns"], layout);
+    for (name, s) in &results.series {
+        let points = s.columns.first().map_or(0, |c| c.values.len());
+        let columns: Vec<String> = s
+            .columns
+            .iter()
+            .map(|c| super::csv::header(&c.name, c.unit))
+            .collect();
+        t.add_row(vec![name.clone(), points.to_string(), columns.join(", ")]);
+    }
+    align_right(&mut t, &[1]);
+    no_wrap(&mut t, &[0, 1]);
+    out.push_str(&format!("\nSeries\n{t}\n"));
+}
+
+fn work(out: &mut String, results: &RunResults, layout: &Layout) {
     let w = &results.work;
-    let mut t = new_table(&["work", "count"]);
+    let mut t = new_table(&["work", "count"], layout);
     t.add_row(vec![
         "polynomial evaluations".to_string(),
         w.polynomial_evals.to_string(),
@@ -262,7 +409,6 @@ pub fn render(results: &RunResults, info: Option<&ModelInfo>) -> String {
     ]);
     align_right(&mut t, &[1]);
     out.push_str(&format!("\nWork\n{t}\n"));
-    out
 }
 
 /// What a quantity means, for the `models` listing.
@@ -286,7 +432,7 @@ pub fn quantity_meaning(q: Quantity, info: &ModelInfo) -> String {
 }
 
 /// The `rodcube models` listing: each model with its parameters and the quantities it offers.
-pub fn models(infos: &[&ModelInfo]) -> String {
+pub fn models(infos: &[&ModelInfo], layout: &Layout) -> String {
     if infos.is_empty() {
         return "no models are generated yet (run `rodcube derive` with the `derive` feature)\n"
             .into();
@@ -296,11 +442,13 @@ pub fn models(infos: &[&ModelInfo]) -> String {
         if n > 0 {
             out.push('\n');
         }
-        out.push_str(&format!(
-            "{}: {}\n  spec: {}\n",
-            info.name, info.description, info.spec
+        out.push_str(&wrap(
+            &format!("{}: {}", info.name, info.description),
+            layout.width,
+            2,
         ));
-        let mut t = new_table(&["parameter", "unit", "meaning"]);
+        out.push_str(&format!("\n  spec: {}\n", info.spec));
+        let mut t = new_table(&["parameter", "unit", "meaning"], layout);
         for p in info.parameters {
             let meaning = if p.positive {
                 format!("{} (must be > 0)", p.meaning)
@@ -311,13 +459,13 @@ pub fn models(infos: &[&ModelInfo]) -> String {
         }
         out.push_str(&format!("{t}\n"));
         if !info.requirements.is_empty() {
-            let mut t = new_table(&["requirement", "meaning"]);
+            let mut t = new_table(&["requirement", "meaning"], layout);
             for r in info.requirements {
                 t.add_row(vec![r.name, r.meaning]);
             }
             out.push_str(&format!("{t}\n"));
         }
-        let mut t = new_table(&["quantity (want:)", "meaning"]);
+        let mut t = new_table(&["quantity (want:)", "meaning"], layout);
         for q in Quantity::all(info) {
             t.add_row(vec![q.name(info), quantity_meaning(q, info)]);
         }

@@ -2,20 +2,47 @@
 //! (after a contact ends, the free phase's `contact_open` monitor says the bodies do not meet
 //! again), and energy and cyclic momenta do not drift along a path.
 
-use crate::results::Check;
+use crate::results::{Check, CheckKind, format_number};
 use crate::solve::series::PhaseSamples;
 use crate::system::{Bound, State};
 
-/// One check per monitor of a phase: its smallest value over the samples (the margin) must be
-/// `>= 0`, up to rounding: `tolerance` times the largest magnitude the monitor takes (a
-/// monitor that starts at zero, as a gap that has just opened, may round to `-1e-17`).
-/// `forces` are the reaction forces at each sample (`series::sample_forces`). Keys are
-/// `<model>.<monitor>`.
+/// Where a group of checks ran: the phase's label, its place in the order of the run, and the
+/// absolute time its clock starts at (so monitor times read from release).
+#[derive(Debug, Clone)]
+pub struct Context {
+    /// `<model>` for a phase, `<model> (ODE cross-check)` for the unreduced equations.
+    pub phase: String,
+    /// Key prefix: `<model>` or `<model>.ode`.
+    pub key: String,
+    /// Position of the group in the run (phases in the order they happen).
+    pub order: usize,
+    /// Absolute time of the phase start (s from release).
+    pub t_start: f64,
+}
+
+impl Context {
+    /// A phase that starts at release and comes first, labelled and keyed `label`.
+    pub fn new(label: &str) -> Context {
+        Context {
+            phase: label.to_string(),
+            key: label.to_string(),
+            order: 0,
+            t_start: 0.0,
+        }
+    }
+}
+
+/// One check per monitor of a phase: its smallest value over the samples (the margin, in the
+/// monitor's unit) must be `>= 0`, up to rounding: `tolerance` times the largest magnitude the
+/// monitor takes (a monitor that starts at zero, as a gap that has just opened, may round to
+/// `-1e-17`). `forces` are the reaction forces at each sample (`series::sample_forces`). Keys
+/// are `<key>.<monitor>`.
 pub fn monitors(
     sys: &Bound,
     samples: &PhaseSamples,
     forces: &[Vec<f64>],
     tolerance: f64,
+    ctx: &Context,
 ) -> Vec<(String, Check)> {
     let info = sys.info();
     let mut min = vec![(f64::INFINITY, 0.0); info.monitors.len()];
@@ -40,15 +67,23 @@ pub fn monitors(
         .map(|((mon, (margin, t)), scale)| {
             let check = Check {
                 passed: margin >= -tolerance * scale,
+                kind: CheckKind::Monitor,
+                phase: ctx.phase.clone(),
+                order: ctx.order,
+                value: margin,
+                limit: 0.0,
+                unit: mon.unit.to_string(),
                 margin,
+                at_time: Some(ctx.t_start + t),
+                samples: samples.len(),
                 meaning: format!(
-                    "{} (model `{}`): smallest value over {} samples, at t = {t:.6e} s from the phase start",
+                    "{}: the smallest value over {} samples of `{}` must be >= 0",
                     mon.meaning,
+                    samples.len(),
                     info.name,
-                    samples.len()
                 ),
             };
-            (format!("{}.{}", info.name, mon.name), check)
+            (format!("{}.{}", ctx.key, mon.name), check)
         })
         .collect()
 }
@@ -56,8 +91,12 @@ pub fn monitors(
 /// Energy and cyclic-momentum drift along a path of full states: the largest deviation from the
 /// first state, relative to the largest of `|E|` and the kinetic energy (for energy) or of the
 /// magnitudes `sum_j |M_cj qd_j|` (for momentum `c`) seen on the path. A check passes when the
-/// drift is at most `tolerance`; the margin is `tolerance - drift`. Keys: `<label>.energy`,
-/// `<label>.momentum_<coordinate>`.
+/// drift is at most `tolerance`; the margin is `tolerance - drift`. Keys: `<key>.energy`,
+/// `<key>.momentum_<coordinate>`.
+///
+/// `kind` says what the drift means: [`CheckKind::Drift`] on a path that must conserve on its
+/// own (an integration), [`CheckKind::Identity`] on one that conserves by construction (the
+/// reduced path), where it tests that the generated energy and momenta agree with it.
 ///
 /// With friction, `friction_work` holds the work friction has done by each state (`<= 0`) and
 /// the check is the energy balance `E - E(0) = W` instead of conservation.
@@ -66,7 +105,8 @@ pub fn drift(
     states: &[State],
     friction_work: Option<&[f64]>,
     tolerance: f64,
-    label: &str,
+    ctx: &Context,
+    kind: CheckKind,
 ) -> Vec<(String, Check)> {
     let info = sys.info();
     let Some(first) = states.first() else {
@@ -103,41 +143,59 @@ pub fn drift(
             p_scale[c] = p_scale[c].max(terms);
         }
     }
-    let mut out = Vec::new();
     let rel = |dev: f64, scale: f64| if scale > 0.0 { dev / scale } else { dev };
-    let e_rel = rel(e_dev, e_scale);
-    out.push((
-        format!("{label}.energy"),
-        Check {
-            passed: e_rel <= tolerance,
-            margin: tolerance - e_rel,
-            meaning: format!(
-                "{} over {} states of `{}` relative to {e_scale:.6e} J: {e_rel:.3e} (tolerance {tolerance:.1e})",
-                if friction_work.is_some() {
-                    "energy balance (energy lost minus the work of friction)"
-                } else {
-                    "total energy drift"
-                },
+    let check = |drift: f64, what: String| Check {
+        passed: drift <= tolerance,
+        kind,
+        phase: ctx.phase.clone(),
+        order: ctx.order,
+        value: drift,
+        limit: tolerance,
+        unit: "1".into(),
+        margin: tolerance - drift,
+        at_time: None,
+        samples: states.len(),
+        meaning: match kind {
+            CheckKind::Identity => format!(
+                "{what} is conserved by construction on the reduced path of `{}`; this checks that the generated function agrees with it over {} states: relative difference <= {}",
+                info.name,
                 states.len(),
-                info.name
+                format_number(tolerance, 3)
+            ),
+            _ => format!(
+                "{what} along the {} integrated states of `{}`: largest relative drift <= {}",
+                states.len(),
+                info.name,
+                format_number(tolerance, 3)
             ),
         },
-    ));
+    };
+    let energy = if friction_work.is_some() {
+        format!(
+            "the energy balance (energy lost = work of friction), relative to {} J,",
+            format_number(e_scale, 5)
+        )
+    } else {
+        format!(
+            "the total energy, relative to {} J,",
+            format_number(e_scale, 5)
+        )
+    };
+    let mut out = vec![(
+        format!("{}.energy", ctx.key),
+        check(rel(e_dev, e_scale), energy),
+    )];
     for (c, &ci) in info.cyclic.iter().enumerate() {
-        let r = rel(p_dev[c], p_scale[c]);
+        let coordinate = info.coordinates[ci];
         out.push((
-            format!("{label}.momentum_{}", info.coordinates[ci]),
-            Check {
-                passed: r <= tolerance,
-                margin: tolerance - r,
-                meaning: format!(
-                    "drift of the momentum conjugate to `{}` over {} states of `{}`, relative to {:.6e}: {r:.3e} (tolerance {tolerance:.1e})",
-                    info.coordinates[ci],
-                    states.len(),
-                    info.name,
-                    p_scale[c]
+            format!("{}.momentum_{coordinate}", ctx.key),
+            check(
+                rel(p_dev[c], p_scale[c]),
+                format!(
+                    "the momentum conjugate to `{coordinate}`, relative to {},",
+                    format_number(p_scale[c], 5)
                 ),
-            },
+            ),
         ));
     }
     out

@@ -7,7 +7,8 @@
 
 pub mod expr;
 
-use crate::yaml_marks::{At, Step, locate_nearest};
+use crate::yaml::{At, Document, ReadError, Step, excerpt, line_text};
+use annotate_snippets::{Group, Level, Renderer};
 use expr::{Expr, FUNCTIONS};
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
@@ -91,6 +92,34 @@ pub struct BodySpec {
     pub position: [Text; 2],
     /// Orientation angle (counter-clockwise).
     pub angle: Text,
+    /// How to draw the body (in `motion.svg`), in its own frame: its centre of mass at the
+    /// origin, x along its `angle`. None: the body is not drawn.
+    #[serde(default)]
+    pub shape: Option<ShapeSpec>,
+}
+
+/// A shape to draw, with its sizes as expressions of the parameters: exactly one of `segment`,
+/// `rectangle` and `circle`. On a body it is in the body's own frame (its centre of mass at the
+/// origin, x along its `angle`); in `scenery`, in world coordinates (y up, the floor at y = 0).
+///
+/// `{segment: [[-ell/2, 0], [ell/2, 0]]}` (a rod), `{rectangle: [a, a]}` (a cube),
+/// `{circle: R}` (a cylinder); a rectangle or circle is centred at the origin of its frame
+/// unless `at: [x, y]` moves it.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShapeSpec {
+    /// A line between two points `[[x1, y1], [x2, y2]]`.
+    #[serde(default)]
+    pub segment: Option<[[Text; 2]; 2]>,
+    /// A rectangle `[width, height]` with its sides along the frame's axes.
+    #[serde(default)]
+    pub rectangle: Option<[Text; 2]>,
+    /// A circle of this radius.
+    #[serde(default)]
+    pub circle: Option<Text>,
+    /// The centre of a rectangle or circle (default: the origin of the frame).
+    #[serde(default)]
+    pub at: Option<[Text; 2]>,
 }
 
 /// A named point whose trajectory can be reported.
@@ -206,6 +235,9 @@ pub struct MonitorSpec {
     pub expr: Text,
     /// What it checks.
     pub meaning: String,
+    /// The unit its value is in (`N`, `N m`, `m`, ...); none when omitted.
+    #[serde(default)]
+    pub unit: Option<String>,
 }
 
 /// Initial position and velocity of one coordinate.
@@ -262,6 +294,10 @@ pub struct Spec {
     /// Monitored assumptions.
     #[serde(default)]
     pub monitors: Vec<MonitorSpec>,
+    /// Fixed shapes drawn in world coordinates besides the floor (a wall, say); sizes are
+    /// expressions of the parameters.
+    #[serde(default)]
+    pub scenery: Vec<ShapeSpec>,
     /// Initial state, one entry per coordinate (except the one the contact eliminates).
     pub initial: BTreeMap<String, InitialSpec>,
 }
@@ -279,9 +315,31 @@ pub struct SpecError {
     pub field: String,
     /// What is wrong.
     pub message: String,
+    /// The text of line `line` (for the snippet), empty when `line` is 0.
+    pub source_line: String,
+    /// Characters of `source_line` from `column` that the problem covers; 0 without a place.
+    pub width: usize,
+}
+
+impl SpecError {
+    /// A read error (syntax, duplicate key, tag, unknown or missing key, wrong type) named by
+    /// the path serde was at: the mapping's for a key problem (`bodies[0]`).
+    fn read(file: &Path, text: &str, e: ReadError) -> SpecError {
+        SpecError {
+            file: file.to_path_buf(),
+            line: e.mark.line,
+            column: e.mark.column,
+            field: e.path,
+            message: e.message,
+            source_line: line_text(text, e.mark.line).to_string(),
+            width: e.mark.width,
+        }
+    }
 }
 
 impl fmt::Display for SpecError {
+    /// `file:line:column: field `name`: message`, then (with a place) the line with the token
+    /// underlined, rendered by annotate-snippets.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
@@ -291,7 +349,14 @@ impl fmt::Display for SpecError {
             self.column,
             self.field,
             self.message
-        )
+        )?;
+        if self.line > 0 {
+            let snippet = excerpt(&self.source_line, self.line, self.column, self.width);
+            let group = Group::with_level(Level::ERROR).element(snippet);
+            let renderer = Renderer::plain().term_width(usize::from(u16::MAX));
+            write!(f, "\n{}", renderer.render(&[group]))?;
+        }
+        Ok(())
     }
 }
 
@@ -317,35 +382,23 @@ pub fn load(path: &Path) -> Result<Checked, SpecError> {
         column: 0,
         field: String::new(),
         message: format!("cannot read: {e}"),
+        source_line: String::new(),
+        width: 0,
     })?;
     parse(path, &text)
 }
 
 /// Parses and checks spec text (`path` is used in messages).
 pub fn parse(path: &Path, text: &str) -> Result<Checked, SpecError> {
-    let spec: Spec = serde_yaml_ng::from_str(text).map_err(|e| {
-        let (line, column) = e
-            .location()
-            .map(|l| (l.line(), l.column()))
-            .unwrap_or((0, 0));
-        let message = e.to_string();
-        // serde_yaml_ng prefixes the path of the failing field: keep it as the field name.
-        let field = message
-            .split_once(": ")
-            .filter(|(p, _)| !p.contains(' ') || p.contains('.'))
-            .map(|(p, _)| p.to_string())
-            .unwrap_or_default();
-        SpecError {
-            file: path.to_path_buf(),
-            line,
-            column,
-            field,
-            message,
-        }
-    })?;
+    // Every node first (syntax, duplicate keys, tags), then the schema: each error typed and
+    // at the parser's mark (crate::yaml).
+    let doc = Document::parse(text).map_err(|e| SpecError::read(path, text, e))?;
+    let spec: Spec = doc
+        .deserialize()
+        .map_err(|e| SpecError::read(path, text, e))?;
     let checker = Checker {
         path,
-        text,
+        doc: &doc,
         spec: &spec,
     };
     checker.check()?;
@@ -357,7 +410,7 @@ pub fn parse(path: &Path, text: &str) -> Result<Checked, SpecError> {
 
 struct Checker<'a> {
     path: &'a Path,
-    text: &'a str,
+    doc: &'a Document<'a>,
     spec: &'a Spec,
 }
 
@@ -408,13 +461,15 @@ impl Checker<'_> {
                 _ => Step::Index(0),
             })
             .collect();
-        let (line, column) = locate_nearest(self.text, &steps, At::Key);
+        let mark = self.doc.locate_nearest(&steps, At::Key);
         SpecError {
             file: self.path.to_path_buf(),
-            line,
-            column,
+            line: mark.line,
+            column: mark.column,
             field: field.dotted(),
             message,
+            source_line: self.doc.line_text(mark.line).to_string(),
+            width: mark.width,
         }
     }
 
@@ -606,6 +661,7 @@ impl Checker<'_> {
             }
         }
         self.check_friction(&params, &bodies, &force_names, &kinematic)?;
+        self.check_drawing(&only_params)?;
         let mut monitor_scope = kinematic.clone();
         monitor_scope.extend(force_names.iter().cloned());
         for (i, m) in s.monitors.iter().enumerate() {
@@ -718,6 +774,76 @@ impl Checker<'_> {
             if let (Text::Num(x), Text::Num(y)) = (&f.direction[0], &f.direction[1]) {
                 self.unit(&d, [*x, *y])?;
             }
+        }
+        Ok(())
+    }
+
+    /// The bodies' shapes and the scenery, drawn in `motion.svg`.
+    fn check_drawing(&self, params: &BTreeSet<String>) -> Result<(), SpecError> {
+        for (i, b) in self.spec.bodies.iter().enumerate() {
+            if let Some(shape) = &b.shape {
+                self.shape(&Field::key("bodies").i(i).k("shape"), shape, params)?;
+            }
+        }
+        for (i, shape) in self.spec.scenery.iter().enumerate() {
+            self.shape(&Field::key("scenery").i(i), shape, params)?;
+        }
+        Ok(())
+    }
+
+    /// A shape has exactly one kind, `at` only with a rectangle or circle, and every size an
+    /// expression of the parameters.
+    fn shape(
+        &self,
+        field: &Field,
+        shape: &ShapeSpec,
+        params: &BTreeSet<String>,
+    ) -> Result<(), SpecError> {
+        let kinds = [
+            ("segment", shape.segment.is_some()),
+            ("rectangle", shape.rectangle.is_some()),
+            ("circle", shape.circle.is_some()),
+        ];
+        let given: Vec<&str> = kinds.iter().filter(|k| k.1).map(|k| k.0).collect();
+        if given.len() != 1 {
+            return Err(self.err(
+                field,
+                format!(
+                    "a shape is exactly one of `segment: [[x1, y1], [x2, y2]]`, \
+                     `rectangle: [width, height]` or `circle: radius` (found {})",
+                    if given.is_empty() {
+                        "none".to_string()
+                    } else {
+                        given.join(" and ")
+                    }
+                ),
+            ));
+        }
+        if let Some(ends) = &shape.segment {
+            for (j, end) in ends.iter().enumerate() {
+                let f = field.k("segment").i(j);
+                self.expr(&f.i(0), &end[0], params)?;
+                self.expr(&f.i(1), &end[1], params)?;
+            }
+            if shape.at.is_some() {
+                return Err(self.err(
+                    &field.k("at"),
+                    "`at` places a rectangle or a circle; a segment gives its ends itself".into(),
+                ));
+            }
+        }
+        if let Some(size) = &shape.rectangle {
+            let f = field.k("rectangle");
+            self.expr(&f.i(0), &size[0], params)?;
+            self.expr(&f.i(1), &size[1], params)?;
+        }
+        if let Some(radius) = &shape.circle {
+            self.expr(&field.k("circle"), radius, params)?;
+        }
+        if let Some(at) = &shape.at {
+            let f = field.k("at");
+            self.expr(&f.i(0), &at[0], params)?;
+            self.expr(&f.i(1), &at[1], params)?;
         }
         Ok(())
     }

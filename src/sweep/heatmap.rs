@@ -1,4 +1,4 @@
-//! Heat maps of a swept quantity over the `(a/ell, n)` grid as SVG (plotters): one cell per
+//! Heat maps of a swept quantity over a two-axis grid as SVG (plotters): one cell per
 //! grid point, a viridis-like colour scale with its colour bar; log-spaced axes are drawn in
 //! `log10`.
 
@@ -58,31 +58,39 @@ fn edges(axis: &Axis) -> (Vec<f64>, Vec<f64>) {
     (c, e)
 }
 
-/// The SVG heat map of `values` (`values[i * a_over_ell.len() + j]` at `n[i]`,
-/// `a_over_ell[j]`); NaN cells are left white.
-pub fn svg(
-    title: &str,
-    unit: &str,
-    n: &Axis,
-    a_over_ell: &Axis,
-    values: &[f64],
-) -> Result<String, String> {
-    draw(title, unit, n, a_over_ell, values).map_err(|e| e.to_string())
+/// The SVG heat map of `values` (`values[i * x.len() + j]` at `y[i]`, `x[j]`); NaN cells are
+/// left white.
+pub fn svg(title: &str, unit: &str, y: &Axis, x: &Axis, values: &[f64]) -> Result<String, String> {
+    draw(title, unit, y, x, values).map_err(|e| e.to_string())
+}
+
+/// An axis's label: its name with `_over_` written as `/` (`a/ell`), `n` spelt out as the mass
+/// ratio, under `log10(...)` when the axis is logarithmic.
+fn label(axis: &Axis) -> String {
+    let name = match axis.name.as_str() {
+        "n" => "n = m2/m1".to_string(),
+        other => other.replace("_over_", "/"),
+    };
+    if axis.log {
+        format!("log10({name})")
+    } else {
+        name
+    }
 }
 
 fn draw(
     title: &str,
     unit: &str,
-    n: &Axis,
-    a_over_ell: &Axis,
+    y: &Axis,
+    x: &Axis,
     values: &[f64],
 ) -> Result<String, Box<dyn std::error::Error>> {
-    let (nx, ny) = (a_over_ell.values.len(), n.values.len());
+    let (nx, ny) = (x.values.len(), y.values.len());
     if values.len() != nx * ny || nx == 0 || ny == 0 {
         return Err(format!("{} values for a {ny} x {nx} grid", values.len()).into());
     }
-    let (_, xe) = edges(a_over_ell);
-    let (_, ye) = edges(n);
+    let (_, xe) = edges(x);
+    let (_, ye) = edges(y);
     let finite: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
     let lo = finite.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = finite.iter().copied().fold(f64::NEG_INFINITY, f64::max);
@@ -101,16 +109,7 @@ fn draw(
         root.fill(&WHITE)?;
         let root = root.titled(title, (FONT, 20))?;
         let (main, bar) = root.split_horizontally(WIDTH - 150);
-        let x_desc = if a_over_ell.log {
-            "log10(a/ell)"
-        } else {
-            "a/ell"
-        };
-        let y_desc = if n.log {
-            "log10(n = m2/m1)"
-        } else {
-            "n = m2/m1"
-        };
+        let (x_desc, y_desc) = (label(x), label(y));
         let mut chart = ChartBuilder::on(&main)
             .margin(10)
             .x_label_area_size(45)
@@ -184,10 +183,12 @@ mod tests {
     #[test]
     fn a_small_grid_draws_one_rectangle_per_cell() {
         let n = Axis {
+            name: "n".into(),
             values: vec![0.1, 1.0, 10.0],
             log: true,
         };
         let r = Axis {
+            name: "a_over_ell".into(),
             values: vec![0.2, 0.5],
             log: false,
         };
@@ -196,6 +197,6 @@ mod tests {
         assert!(svg.starts_with("<svg"));
         // 5 finite cells plus 200 colour-bar steps plus the background rectangles.
         assert!(svg.matches("<rect").count() >= 205);
-        assert!(svg.contains("log10(n = m2/m1)"));
+        assert!(svg.contains("log10(n = m2/m1)") && svg.contains("a/ell"));
     }
 }

@@ -1,17 +1,19 @@
-//! `rodcube sweep`: separation angle and time over a grid of `(n, a/ell)` or a list of points,
-//! on every core, with the lean per-point solver ([`LeanSolver`]); more quantities per point
-//! through the planner; CSV out, and heat maps of a grid.
+//! `rodcube sweep`: separation angle and time over a grid or a list of points, on every core,
+//! with the lean per-point solver ([`LeanSolver`]); more quantities per point through the
+//! planner; CSV out, and heat maps of a two-axis grid.
 //!
-//! Parameters map as `m1 = 1`, `m2 = n`, `ell`, `a = a_over_ell * ell`, `g` with `ell = g = 1`
-//! unless given, so results are dimensionless (times in units of `sqrt(ell/g)`); the CSV's
-//! first line says which. A model without `m2` (the wall ladder) refuses `n`.
+//! Axes are named by the model's own parameters or by ratios of two of them
+//! ([`crate::axes`]: `a_over_ell`, and `n` for `m2_over_m1`); every other parameter is fixed
+//! (`--set`, default 1). The CSV's first line says how each parameter was set.
 
 pub mod heatmap;
 
-use crate::model::Model;
+use crate::axes::{AxisError, Mapping};
+use crate::model::{Model, ModelInfo};
 use crate::plan::{self, Request};
 use crate::quantity::Quantity;
 use crate::solve::lean::LeanSolver;
+use crate::system::check_parameters;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use std::fmt::Write as _;
@@ -28,11 +30,11 @@ pub const MAX_POINTS: usize = 100_000_000;
 pub enum SweepError {
     /// An axis specification could not be read.
     #[error(
-        "--{axis} {spec:?}: {reason} (expected START:STOP:lin|log:COUNT, a single value, or values separated by commas)"
+        "axis `{axis}` = {spec:?}: {reason} (expected START:STOP:lin|log:COUNT, a single value, or values separated by commas)"
     )]
     BadAxis {
-        /// Which axis (`n` or `a-over-ell`).
-        axis: &'static str,
+        /// Which axis (`n`, `a_over_ell`, a parameter).
+        axis: String,
         /// The text given.
         spec: String,
         /// What is wrong.
@@ -56,29 +58,18 @@ pub enum SweepError {
         /// What went wrong (with line numbers).
         reason: String,
     },
-    /// The model's parameters are not `m1, m2, ell, a, g` (or a subset with `a` and `ell`).
-    #[error(
-        "model `{model}` cannot be swept over n and a/ell: its parameters are {params} (a sweep sets m1 = 1, m2 = n, ell, a = a_over_ell * ell, g)"
-    )]
-    NotSweepable {
-        /// Model name.
-        model: &'static str,
-        /// Its parameters.
-        params: String,
-    },
-    /// `n` given to a model without a second mass.
-    #[error(
-        "model `{model}` has no mass ratio (no parameter m2), so n does not apply; drop --n (or the n column)"
-    )]
-    NoMassRatio {
-        /// Model name.
-        model: &'static str,
-    },
-    /// `n` missing for a model with a second mass.
-    #[error("model `{model}` needs the mass ratio n = m2/m1: give --n (or an n column)")]
-    NeedsMassRatio {
-        /// Model name.
-        model: &'static str,
+    /// An axis or a fixed value does not fit the model.
+    #[error(transparent)]
+    Axes(#[from] AxisError),
+    /// A point whose parameters the model refuses.
+    #[error("point {index} ({coordinates}): {reason}")]
+    Point {
+        /// 1-based index of the point (its line in a points file is given in `coordinates`).
+        index: usize,
+        /// The point's coordinates, `name = value` each.
+        coordinates: String,
+        /// Why the model refuses it.
+        reason: String,
     },
     /// A wanted quantity that is not a scalar or not offered.
     #[error("{0}")]
@@ -97,6 +88,8 @@ pub enum SweepError {
 /// Values along one axis of a grid.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Axis {
+    /// The axis's name: a parameter or a ratio ([`crate::axes::resolve`]).
+    pub name: String,
     /// The values, in the order given.
     pub values: Vec<f64>,
     /// Whether they are spaced logarithmically (for plotting).
@@ -104,9 +97,9 @@ pub struct Axis {
 }
 
 /// Reads `START:STOP:lin|log:COUNT`, a single value, or a comma-separated list.
-pub fn parse_axis(axis: &'static str, spec: &str) -> Result<Axis, SweepError> {
+pub fn parse_axis(axis: &str, spec: &str) -> Result<Axis, SweepError> {
     let bad = |reason: String| SweepError::BadAxis {
-        axis,
+        axis: axis.to_string(),
         spec: spec.to_string(),
         reason,
     };
@@ -152,30 +145,95 @@ pub fn parse_axis(axis: &'static str, spec: &str) -> Result<Axis, SweepError> {
                 }
             };
             Ok(Axis {
+                name: axis.to_string(),
                 values: (0..count).map(at).collect(),
                 log,
             })
         }
         [_] => {
             let values = spec.split(',').map(num).collect::<Result<Vec<_>, _>>()?;
-            Ok(Axis { values, log: false })
+            Ok(Axis {
+                name: axis.to_string(),
+                values,
+                log: false,
+            })
         }
         _ => Err(bad("wrong number of `:` fields".into())),
     }
 }
 
-/// One point of a sweep.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Point {
-    /// Mass ratio `m2/m1` (ignored, and NaN, for a model without `m2`).
-    pub n: f64,
-    /// `a/ell`.
-    pub a_over_ell: f64,
+/// The points of a sweep: one coordinate per axis, point after point.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Points {
+    /// The axes' names (parameters or ratios).
+    pub names: Vec<String>,
+    /// `names.len()` values per point, row after row.
+    pub values: Vec<f64>,
+    /// Where each point came from, for messages (`line 7` of a points file); empty for a grid.
+    pub lines: Vec<usize>,
 }
 
-/// Reads a CSV with a header naming `a_over_ell` and (for a model with `m2`) `n`; other
-/// columns are ignored. Lines starting with `#` are comments.
-pub fn read_points(path: &Path) -> Result<(Vec<Point>, bool), SweepError> {
+impl Points {
+    /// The grid of all combinations, the first axis varying slowest.
+    pub fn grid(axes: &[Axis]) -> Result<Points, SweepError> {
+        let total = axes
+            .iter()
+            .try_fold(1usize, |n, a| n.checked_mul(a.values.len()))
+            .filter(|&n| n <= MAX_POINTS)
+            .ok_or_else(|| SweepError::Layout(format!("more than {MAX_POINTS} points")))?;
+        let mut values = Vec::with_capacity(total * axes.len());
+        for k in 0..total {
+            let mut rest = k;
+            let start = values.len();
+            values.resize(start + axes.len(), 0.0);
+            for (j, axis) in axes.iter().enumerate().rev() {
+                let n = axis.values.len();
+                values[start + j] = axis.values[rest % n];
+                rest /= n;
+            }
+        }
+        Ok(Points {
+            names: axes.iter().map(|a| a.name.clone()).collect(),
+            values,
+            lines: Vec::new(),
+        })
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.values.len().checked_div(self.names.len()).unwrap_or(0)
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Point `k`'s coordinates.
+    pub fn point(&self, k: usize) -> &[f64] {
+        let d = self.names.len();
+        &self.values[k * d..(k + 1) * d]
+    }
+
+    /// Point `k` for people: `n = 3, a_over_ell = 0.25` (and its line in a file).
+    pub fn describe(&self, k: usize) -> String {
+        let coordinates: Vec<String> = self
+            .names
+            .iter()
+            .zip(self.point(k))
+            .map(|(n, v)| format!("{n} = {v}"))
+            .collect();
+        match self.lines.get(k) {
+            Some(line) => format!("line {line}: {}", coordinates.join(", ")),
+            None => coordinates.join(", "),
+        }
+    }
+}
+
+/// Reads a CSV whose header names the axes: every column that is a parameter of the model or a
+/// ratio of two ([`crate::axes::resolve`]) is one; other columns are ignored. Lines starting
+/// with `#` are comments.
+pub fn read_points(path: &Path, info: &'static ModelInfo) -> Result<Points, SweepError> {
     let fail = |reason: String| SweepError::Points {
         path: path.display().to_string(),
         reason,
@@ -189,188 +247,71 @@ pub fn read_points(path: &Path) -> Result<(Vec<Point>, bool), SweepError> {
         .headers()
         .map_err(|e| fail(format!("cannot read the header: {e}")))?
         .clone();
-    let col = |name: &str| headers.iter().position(|h| h == name);
-    let r_col = col("a_over_ell").ok_or_else(|| {
-        fail(format!(
-            "no `a_over_ell` column (the header has: {})",
+    let columns: Vec<(usize, &str)> = headers
+        .iter()
+        .enumerate()
+        .filter(|(_, h)| crate::axes::resolve(h, info).is_ok())
+        .collect();
+    if columns.is_empty() {
+        return Err(fail(format!(
+            "no column names a parameter of `{}` or a ratio of two (the header has: {})",
+            info.name,
             headers.iter().collect::<Vec<_>>().join(", ")
-        ))
-    })?;
-    let n_col = col("n");
-    let mut points = Vec::new();
+        )));
+    }
+    let mut points = Points {
+        names: columns.iter().map(|(_, h)| h.to_string()).collect(),
+        ..Points::default()
+    };
     for (i, record) in reader.records().enumerate() {
         let record = record.map_err(|e| fail(e.to_string()))?;
         let line = record.position().map_or(i + 2, |p| p.line() as usize);
-        let field = |c: usize, name: &str| -> Result<f64, SweepError> {
+        for &(c, name) in &columns {
             let s = record
                 .get(c)
                 .ok_or_else(|| fail(format!("line {line}: no `{name}` value")))?;
-            s.parse::<f64>()
-                .map_err(|_| fail(format!("line {line}: `{name}` = {s:?} is not a number")))
-        };
-        let a_over_ell = field(r_col, "a_over_ell")?;
-        let n = match n_col {
-            Some(c) => field(c, "n")?,
-            None => f64::NAN,
-        };
-        points.push(Point { n, a_over_ell });
-        if points.len() > MAX_POINTS {
+            let v = s
+                .parse::<f64>()
+                .map_err(|_| fail(format!("line {line}: `{name}` = {s:?} is not a number")))?;
+            points.values.push(v);
+        }
+        points.lines.push(line);
+        if points.lines.len() > MAX_POINTS {
             return Err(fail(format!("more than {MAX_POINTS} points")));
         }
     }
     if points.is_empty() {
         return Err(fail("no points".into()));
     }
-    Ok((points, n_col.is_some()))
+    Ok(points)
 }
 
-/// How a sweep's model parameters are formed from a point.
-#[derive(Clone)]
-pub struct Mapping {
-    /// The model.
-    pub model: &'static dyn Model,
-    /// Index of `m2`, if the model has it.
-    pub m2: Option<usize>,
-    /// Index of `a`.
-    pub a: usize,
-    /// The parameter vector with everything but `m2` and `a` filled in.
-    pub template: Vec<f64>,
-    /// `ell` used.
-    pub ell: f64,
-    /// `g` used.
-    pub g: f64,
-    /// Whether `ell` and `g` are both 1 (the default: dimensionless results).
-    pub dimensionless: bool,
+/// Checks every point against the model's rules (the one validation,
+/// [`check_parameters`]) before anything is solved: the first point refused is the error.
+pub fn check(mapping: &Mapping, model: &dyn Model, points: &Points) -> Result<(), SweepError> {
+    let info = model.info();
+    let mut p = vec![0.0; info.parameters.len()];
+    let mut margins = vec![0.0; info.requirements.len()];
+    for k in 0..points.len() {
+        mapping.fill(points.point(k), &mut p);
+        if let Err(e) = check_parameters(model, &p, &mut margins) {
+            return Err(SweepError::Point {
+                index: k + 1,
+                coordinates: points.describe(k),
+                reason: e.to_string(),
+            });
+        }
+    }
+    Ok(())
 }
 
-impl std::fmt::Debug for Mapping {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Mapping")
-            .field("model", &self.model.info().name)
-            .field("template", &self.template)
-            .finish()
-    }
-}
-
-impl Mapping {
-    /// The mapping for a model, with `ell` and `g` (default 1).
-    pub fn new(
-        model: &'static dyn Model,
-        ell: Option<f64>,
-        g: Option<f64>,
-    ) -> Result<Mapping, SweepError> {
-        let info = model.info();
-        if info.contact.is_none() {
-            return Err(SweepError::NoContact { model: info.name });
-        }
-        let not = || SweepError::NotSweepable {
-            model: info.name,
-            params: info
-                .parameters
-                .iter()
-                .map(|p| p.name)
-                .collect::<Vec<_>>()
-                .join(", "),
-        };
-        let (ell_v, g_v) = (ell.unwrap_or(1.0), g.unwrap_or(1.0));
-        for (what, v) in [("--ell", ell_v), ("--g", g_v)] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(SweepError::OutOfDomain {
-                    what: what.into(),
-                    value: v,
-                    domain: "(0, infinity)",
-                });
-            }
-        }
-        let mut template = vec![0.0; info.parameters.len()];
-        let (mut m2, mut a, mut has_ell) = (None, None, false);
-        for (i, p) in info.parameters.iter().enumerate() {
-            match p.name {
-                "m1" => template[i] = 1.0,
-                "m2" => m2 = Some(i),
-                "ell" => {
-                    template[i] = ell_v;
-                    has_ell = true;
-                }
-                "a" => a = Some(i),
-                "g" => template[i] = g_v,
-                _ => return Err(not()),
-            }
-        }
-        let a = match (a, has_ell) {
-            (Some(a), true) => a,
-            _ => return Err(not()),
-        };
-        Ok(Mapping {
-            model,
-            m2,
-            a,
-            template,
-            ell: ell_v,
-            g: g_v,
-            dimensionless: ell.is_none() && g.is_none(),
-        })
-    }
-
-    /// Fills `p` (the template's length) for a point.
-    pub fn fill(&self, point: &Point, p: &mut [f64]) {
-        p.copy_from_slice(&self.template);
-        if let Some(i) = self.m2 {
-            p[i] = point.n;
-        }
-        p[self.a] = point.a_over_ell * self.ell;
-    }
-
-    /// Checks that the points fit the model: `n` present (and positive) exactly when the model
-    /// has `m2`, `a/ell` in `(0, 1)`. `has_n` says whether the input gave `n` at all.
-    pub fn check(&self, points: &[Point], has_n: bool) -> Result<(), SweepError> {
-        let name = self.model.info().name;
-        match (self.m2.is_some(), has_n) {
-            (true, false) => return Err(SweepError::NeedsMassRatio { model: name }),
-            (false, true) => return Err(SweepError::NoMassRatio { model: name }),
-            _ => {}
-        }
-        for (i, p) in points.iter().enumerate() {
-            if !(p.a_over_ell > 0.0 && p.a_over_ell < 1.0) {
-                return Err(SweepError::OutOfDomain {
-                    what: format!(
-                        "point {} a_over_ell (a >= ell: the rod stands upright or cannot lean)",
-                        i + 1
-                    ),
-                    value: p.a_over_ell,
-                    domain: "(0, 1)",
-                });
-            }
-            if self.m2.is_some() && !(p.n > 0.0 && p.n.is_finite()) {
-                return Err(SweepError::OutOfDomain {
-                    what: format!("point {} n", i + 1),
-                    value: p.n,
-                    domain: "(0, infinity)",
-                });
-            }
-        }
-        Ok(())
-    }
-
-    /// The CSV's comment line: the mapping and the units.
-    pub fn header_comment(&self) -> String {
-        let name = self.model.info().name;
-        let m2 = if self.m2.is_some() {
-            "m2 = n, "
-        } else {
-            "(no m2: n does not apply), "
-        };
-        if self.dimensionless {
-            format!(
-                "# rodcube sweep, model {name}: m1 = 1, {m2}a = a_over_ell * ell, ell = 1, g = 1; dimensionless results: times in units of sqrt(ell/g), angles in rad"
-            )
-        } else {
-            format!(
-                "# rodcube sweep, model {name}: m1 = 1 kg, {m2}a = a_over_ell * ell, ell = {} m, g = {} m/s^2; SI units: times in s, angles in rad",
-                self.ell, self.g
-            )
-        }
-    }
+/// The CSV's comment line: how each parameter was set, and the units.
+pub fn header_comment(mapping: &Mapping) -> String {
+    format!(
+        "# rodcube sweep, model {}: {}; SI units of the parameters (times in s, angles in rad)",
+        mapping.info().name,
+        mapping.describe()
+    )
 }
 
 /// The results of a sweep, one entry per point in the order given.
@@ -429,20 +370,21 @@ type ChunkResult = (Vec<f64>, Vec<f64>, Vec<f64>, Vec<(usize, String)>);
 
 /// Solves every point in parallel (rayon), advancing `progress` per chunk.
 pub fn run(
+    model: &'static dyn Model,
     mapping: &Mapping,
-    points: &[Point],
+    points: &Points,
     extra: &[Quantity],
     tolerance: f64,
     progress: &ProgressBar,
 ) -> SweepResults {
     let start = std::time::Instant::now();
-    let model = mapping.model;
-    let np = mapping.template.len();
+    let np = model.info().parameters.len();
+    let dims = points.names.len().max(1);
     // The extra columns' names, from the first point the planner solves.
     let mut extra_names: Vec<String> = Vec::new();
     if !extra.is_empty() {
         let mut p = vec![0.0; np];
-        for point in points.iter().take(16) {
+        for point in points.values.chunks(dims).take(16) {
             mapping.fill(point, &mut p);
             let request = Request::new(model, p.clone())
                 .with_want(extra)
@@ -455,36 +397,34 @@ pub fn run(
     }
     let ne = extra_names.len();
     let chunks: Vec<ChunkResult> = points
-        .par_chunks(CHUNK)
+        .values
+        .par_chunks(CHUNK * dims)
         .enumerate()
         .map(|(c, chunk)| {
             let mut solver = LeanSolver::new(model).ok();
             let mut p = vec![0.0; np];
             let (mut angle, mut time) = (
-                Vec::with_capacity(chunk.len()),
-                Vec::with_capacity(chunk.len()),
+                Vec::with_capacity(chunk.len() / dims),
+                Vec::with_capacity(chunk.len() / dims),
             );
-            let mut values = Vec::with_capacity(chunk.len() * ne);
+            let mut values = Vec::with_capacity(chunk.len() / dims * ne);
             let mut errors = Vec::new();
-            for (i, point) in chunk.iter().enumerate() {
+            for (i, point) in chunk.chunks(dims).enumerate() {
                 let index = c * CHUNK + i;
                 mapping.fill(point, &mut p);
-                match solver.as_mut().map(|s| s.solve(&p)) {
-                    Some(Ok(r)) => {
-                        angle.push(r.separation_angle);
-                        time.push(r.separation_time);
-                    }
-                    Some(Err(e)) => {
-                        angle.push(f64::NAN);
-                        time.push(f64::NAN);
-                        errors.push((index, e.to_string()));
-                    }
-                    None => {
-                        angle.push(f64::NAN);
-                        time.push(f64::NAN);
-                        errors.push((index, "the lean solver does not apply to this model".into()));
-                    }
+                let (a, t) = match solver.as_mut() {
+                    Some(s) => s
+                        .solve(&p)
+                        .map(|r| (r.separation_angle, r.separation_time))
+                        .map_err(|e| e.to_string()),
+                    None => separation_by_planner(model, &p, tolerance),
                 }
+                .unwrap_or_else(|e| {
+                    errors.push((index, e));
+                    (f64::NAN, f64::NAN)
+                });
+                angle.push(a);
+                time.push(t);
                 if ne > 0 {
                     let request = Request::new(model, p.clone())
                         .with_want(extra)
@@ -502,7 +442,7 @@ pub fn run(
                     }
                 }
             }
-            progress.inc(chunk.len() as u64);
+            progress.inc((chunk.len() / dims) as u64);
             (angle, time, values, errors)
         })
         .collect();
@@ -522,6 +462,30 @@ pub fn run(
     out
 }
 
+/// The separation angle and time through the planner, for a model the per-point solver does
+/// not take (no polynomial separation condition, several coordinates): slower, but any model
+/// with a contact. A point without a separation is an error saying why.
+fn separation_by_planner(
+    model: &'static dyn Model,
+    p: &[f64],
+    tolerance: f64,
+) -> Result<(f64, f64), String> {
+    let want = [Quantity::SeparationAngle, Quantity::SeparationTime];
+    let request = Request::new(model, p.to_vec())
+        .with_want(&want)
+        .with_tolerance(tolerance);
+    let res = plan::run(&request).map_err(|e| e.to_string())?;
+    match (res.separation_angle(), res.separation_time()) {
+        (Some(a), Some(t)) => Ok((a, t)),
+        _ => Err(res
+            .notes
+            .values()
+            .next()
+            .cloned()
+            .unwrap_or_else(|| "no separation".into())),
+    }
+}
+
 /// A progress bar on stderr for `len` points (drawn only when stderr is a terminal).
 pub fn progress_bar(len: usize) -> ProgressBar {
     let bar = ProgressBar::new(len as u64);
@@ -533,34 +497,30 @@ pub fn progress_bar(len: usize) -> ProgressBar {
     bar
 }
 
-/// The CSV text: the comment line, the header
-/// `n,a_over_ell,separation_angle,separation_time[,extra...]` (no `n` for a model without `m2`),
-/// then one row per point in shortest round-trip scientific notation; a failed value is empty.
-pub fn to_csv(mapping: &Mapping, points: &[Point], results: &SweepResults) -> String {
-    let with_n = mapping.m2.is_some();
-    let mut header = String::new();
-    if with_n {
-        header.push_str("n,");
-    }
-    header.push_str("a_over_ell,separation_angle,separation_time");
+/// The CSV text: the comment line, the header (the axes' names, then
+/// `separation_angle,separation_time` and the extra quantities), then one row per point in
+/// shortest round-trip scientific notation; a failed value is empty.
+pub fn to_csv(mapping: &Mapping, points: &Points, results: &SweepResults) -> String {
+    let mut header = points.names.join(",");
+    header.push_str(",separation_angle,separation_time");
     for name in &results.extra_names {
         header.push(',');
         header.push_str(name);
     }
     let ne = results.extra_names.len();
+    let dims = points.names.len().max(1);
     let rows: Vec<String> = points
-        .par_chunks(CHUNK)
+        .values
+        .par_chunks(CHUNK * dims)
         .enumerate()
         .map(|(c, chunk)| {
-            let mut s = String::with_capacity(chunk.len() * 96);
-            for (i, point) in chunk.iter().enumerate() {
+            let mut s = String::with_capacity(chunk.len() / dims * 96);
+            for (i, point) in chunk.chunks(dims).enumerate() {
                 let k = c * CHUNK + i;
-                if with_n {
-                    cell(&mut s, point.n);
+                for v in point {
+                    cell(&mut s, *v);
                     s.push(',');
                 }
-                cell(&mut s, point.a_over_ell);
-                s.push(',');
                 cell(&mut s, results.angle[k]);
                 s.push(',');
                 cell(&mut s, results.time[k]);
@@ -574,7 +534,7 @@ pub fn to_csv(mapping: &Mapping, points: &[Point], results: &SweepResults) -> St
         })
         .collect();
     let mut out = String::with_capacity(rows.iter().map(String::len).sum::<usize>() + 512);
-    out.push_str(&mapping.header_comment());
+    out.push_str(&header_comment(mapping));
     out.push('\n');
     out.push_str(&header);
     out.push('\n');
@@ -591,13 +551,14 @@ fn cell(s: &mut String, v: f64) {
     }
 }
 
-/// A heat map SVG of `values` over a grid (`values[i * a.len() + j]` at `n[i]`, `a_over_ell[j]`).
+/// A heat map SVG of `values` over a two-axis grid (`values[i * x.len() + j]` at `y[i]`,
+/// `x[j]`).
 pub fn heatmap_svg(
     title: &str,
     unit: &str,
-    n: &Axis,
-    a_over_ell: &Axis,
+    y: &Axis,
+    x: &Axis,
     values: &[f64],
 ) -> Result<String, String> {
-    heatmap::svg(title, unit, n, a_over_ell, values)
+    heatmap::svg(title, unit, y, x, values)
 }

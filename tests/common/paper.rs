@@ -9,8 +9,8 @@
 //! that the tests compare with the generated one.
 
 use rodcube::model::{
-    Binding, ContactInfo, Model, ModelInfo, NamedInfo, NextPhase, ParamInfo, Reduced, Reduction,
-    ReductionInfo,
+    Binding, ContactInfo, Model, ModelInfo, MonitorInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
+    Reduction, ReductionInfo, ShapeInfo, ShapeKind,
 };
 
 const fn param(
@@ -29,6 +29,36 @@ const fn param(
 
 const fn named(name: &'static str, meaning: &'static str) -> NamedInfo {
     NamedInfo { name, meaning }
+}
+
+const fn monitor(name: &'static str, meaning: &'static str, unit: &'static str) -> MonitorInfo {
+    MonitorInfo {
+        name,
+        meaning,
+        unit,
+    }
+}
+
+/// The rod (a segment from end to end through its centre) and the cube (a square of side `a`).
+const SHAPES: &[ShapeInfo] = &[
+    ShapeInfo {
+        kind: ShapeKind::Segment,
+        body: Some(0),
+        first: 0,
+    },
+    ShapeInfo {
+        kind: ShapeKind::Rectangle,
+        body: Some(1),
+        first: 4,
+    },
+];
+
+/// The drawing of rod and cube from the rod's centre, its angle and the cube's near face.
+fn draw(k: &[f64], rod: [f64; 3], x2: f64, poses: &mut [[f64; 3]], sizes: &mut [f64]) {
+    let (ell, a) = (k[2], k[3]);
+    poses[0] = rod;
+    poses[1] = [x2 + 0.5 * a, 0.5 * a, 0.0];
+    sizes[..8].copy_from_slice(&[-0.5 * ell, 0.0, 0.5 * ell, 0.0, 0.0, 0.0, a, a]);
 }
 
 /// `sin(theta_i) - sin(theta_i - delta)` from `sin(theta_i)`, `cos(theta_i)`.
@@ -125,9 +155,15 @@ static RC_INFO: ModelInfo = ModelInfo {
     falling_point: 2,
     gravity: 4,
     monitors: &[
-        named("foot_on_floor", "floor normal force on the foot >= 0 (N)"),
-        named("cube_does_not_tip", "m2 g a/2 - F (ell s - a/2) >= 0 (N m)"),
+        monitor("foot_on_floor", "floor normal force on the foot >= 0", "N"),
+        monitor(
+            "cube_does_not_tip",
+            "m2 g a/2 - F (ell s - a/2) >= 0",
+            "N m",
+        ),
     ],
+    bodies: &["rod", "cube"],
+    shapes: SHAPES,
     next_phase: Some(NextPhase {
         model: "rod_cube_free",
         bindings: &[
@@ -273,6 +309,12 @@ impl Model for RodCube {
         out[1] = qd[0] - ell * s * qd[1];
     }
 
+    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
+        let (x1, th, ell) = (q[0], q[1], k[2]);
+        let rod = [x1 + 0.5 * ell * th.cos(), 0.5 * ell * th.sin(), th];
+        draw(k, rod, x1 + ell * th.cos(), poses, sizes);
+    }
+
     fn reduction(&self) -> Option<&dyn Reduction> {
         Some(self)
     }
@@ -408,12 +450,15 @@ static FR_INFO: ModelInfo = ModelInfo {
     falling_point: 2,
     gravity: 4,
     monitors: &[
-        named("foot_on_floor", "floor normal force on the foot >= 0 (N)"),
-        named(
+        monitor("foot_on_floor", "floor normal force on the foot >= 0", "N"),
+        monitor(
             "contact_open",
             "the tip stays clear of the cube: x2 - x1 - ell cos >= 0",
+            "m",
         ),
     ],
+    bodies: &["rod", "cube"],
+    shapes: SHAPES,
     next_phase: None,
     reduction: Some(ReductionInfo {
         k_theta_initial: FR_THETA_I,
@@ -525,6 +570,12 @@ impl Model for FreeRod {
     }
 
     fn released(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
+
+    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
+        let (x1, th, ell) = (q[0], q[1], k[2]);
+        let rod = [x1 + 0.5 * ell * th.cos(), 0.5 * ell * th.sin(), th];
+        draw(k, rod, q[2], poses, sizes);
+    }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
         Some(self)

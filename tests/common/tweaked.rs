@@ -129,6 +129,9 @@ impl Model for Tweaked {
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
         self.base.released(k, q, qd, out)
     }
+    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
+        self.base.drawing(k, q, poses, sizes)
+    }
     fn reduction(&self) -> Option<&dyn Reduction> {
         Some(self)
     }

@@ -1,0 +1,151 @@
+//! The printed report fits a terminal: with `COLUMNS=100` (or piped, without it) no line of
+//! `rodcube run` or `rodcube models` is longer than 100 characters, for every shipped scene;
+//! `--wide` lifts the limit and `--verbose` adds the meanings; checks come phase by phase in
+//! the order the phases happen; numbers never carry an `e0`; the paper's figures and equation
+//! numbers appear only on the paper's case.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Runs `rodcube` with `COLUMNS` set to `columns` (or unset), stdout piped; returns stdout.
+fn rodcube(args: &[&str], columns: Option<&str>) -> String {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_rodcube"));
+    cmd.args(args);
+    match columns {
+        Some(c) => cmd.env("COLUMNS", c),
+        None => cmd.env_remove("COLUMNS"),
+    };
+    let out = cmd.output().expect("run rodcube");
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).expect("UTF-8 output")
+}
+
+fn out_dir(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("cli_layout")
+        .join(name)
+}
+
+fn scenes() -> Vec<PathBuf> {
+    let mut all: Vec<PathBuf> =
+        std::fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes"))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "yaml"))
+            .collect();
+    all.sort();
+    all
+}
+
+/// The longest line, in characters (not bytes: the tables' borders are multi-byte).
+fn widest(text: &str) -> (usize, &str) {
+    text.lines()
+        .map(|l| (l.chars().count(), l))
+        .max_by_key(|(n, _)| *n)
+        .unwrap_or((0, ""))
+}
+
+#[test]
+fn every_scene_fits_100_columns_plain_and_verbose() {
+    for scene in scenes() {
+        let stem = scene.file_stem().unwrap().to_str().unwrap().to_string();
+        let dir = out_dir(&stem);
+        let path = scene.to_str().unwrap();
+        let out = dir.to_str().unwrap();
+        for (columns, verbose) in [(Some("100"), false), (None, false), (Some("100"), true)] {
+            let mut args = vec!["run", path, "--out", out];
+            if verbose {
+                args.push("--verbose");
+            }
+            let text = rodcube(&args, columns);
+            let (n, line) = widest(&text);
+            assert!(
+                n <= 100,
+                "{stem} {args:?}: a line of {n} characters:\n{line}"
+            );
+            assert!(
+                !text.contains("e0 ") && !text.contains("e0\n"),
+                "{stem}: an `e0` exponent in\n{text}"
+            );
+        }
+    }
+}
+
+#[test]
+fn narrow_terminals_and_wide_output() {
+    let dir = out_dir("paper-width");
+    let out = dir.to_str().unwrap();
+    let text = rodcube(&["run", "--out", out, "--verbose"], Some("80"));
+    assert!(widest(&text).0 <= 80, "{}", widest(&text).1);
+    // --wide: nothing is wrapped, so the verbose legend's long meanings run past 100.
+    let wide = rodcube(&["run", "--out", out, "--verbose", "--wide"], Some("100"));
+    assert!(widest(&wide).0 > 100, "--wide still wrapped:\n{wide}");
+}
+
+#[test]
+fn the_models_listing_fits_100_columns() {
+    let text = rodcube(&["models"], Some("100"));
+    let (n, line) = widest(&text);
+    assert!(n <= 100, "{n} characters:\n{line}");
+    // The paper's equation numbers belong to the paper's case, not to every model's list.
+    assert!(!text.contains("eq. ("), "{text}");
+}
+
+#[test]
+fn meanings_go_to_the_verbose_legend() {
+    let dir = out_dir("paper-verbose");
+    let out = dir.to_str().unwrap();
+    let plain = rodcube(&["run", "--out", out], Some("100"));
+    let verbose = rodcube(&["run", "--out", out, "--verbose"], Some("100"));
+    let meaning = "is conserved by construction on the reduced path";
+    assert!(!plain.contains(meaning), "{plain}");
+    assert!(plain.contains("rodcube run --verbose"), "{plain}");
+    // Wrapped, so the sentence may break across lines: compare without line breaks.
+    let flat: String = verbose
+        .lines()
+        .map(|l| l.trim_matches(|c: char| c == '│' || c.is_whitespace()))
+        .collect::<Vec<_>>()
+        .join(" ");
+    assert!(flat.contains("conserved by construction"), "{verbose}");
+}
+
+#[test]
+fn checks_come_phase_by_phase_with_their_own_units_and_bounds() {
+    let dir = out_dir("paper-checks");
+    let text = rodcube(&["run", "--out", dir.to_str().unwrap()], Some("100"));
+    let at = |needle: &str| {
+        text.find(needle)
+            .unwrap_or_else(|| panic!("no {needle:?} in\n{text}"))
+    };
+    // The contact phase, its ODE cross-check, then the free phase.
+    assert!(at("\nrod_cube:\n") < at("\nrod_cube (ODE cross-check):\n"));
+    assert!(at("\nrod_cube (ODE cross-check):\n") < at("\nrod_cube_free:\n"));
+    // A monitor reports its smallest value with its unit and when; a conservation law on the
+    // reduced path says it holds by construction; the integrated one, its drift and bound.
+    assert!(text.contains("min 2.4525 N"), "{text}");
+    assert!(text.contains("(built in)"), "{text}");
+    assert!(text.contains("<= 1e-12"), "{text}");
+}
+
+#[test]
+fn other_models_get_no_paper_figures_or_floor_wording() {
+    let dir = out_dir("ladder-words");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/ladder.yaml");
+    let text = rodcube(
+        &[
+            "run",
+            scene.to_str().unwrap(),
+            "--out",
+            dir.to_str().unwrap(),
+            "--verbose",
+        ],
+        None,
+    );
+    for word in ["paper", "eq.", "rod lies"] {
+        assert!(!text.contains(word), "{word:?} in\n{text}");
+    }
+}
