@@ -162,29 +162,53 @@ impl Model for HingedCylinderFree {
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
         k[..10].copy_from_slice(p);
         Reduction::prepare_lean(self, p, k);
+        // k[14] = rc_x0i = xc_0
         k[14] = k[7];
+        // k[15] = rc_p0 = m2*xc_dot_0
         k[15] = (k[1] * k[9]);
+        // k[16] = rc_ai = ell^2*m1/3
         k[16] = ((k[2] * k[2]) * k[0] / 3.0);
+        // k[17] = ell
         k[17] = k[2];
+        // k[18] = ell/2
         k[18] = (k[2] / 2.0);
+        // k[19] = -ell
         k[19] = (-k[2]);
+        // k[20] = -(ell/2)
         k[20] = (-k[2] / 2.0);
+        // k[21] = ell^2*m1/24
         k[21] = ((k[2] * k[2]) * k[0] / 24.0);
+        // k[22] = ell^2*m1/8
         k[22] = ((k[2] * k[2]) * k[0] / 8.0);
+        // k[23] = m2/2
         k[23] = (k[1] / 2.0);
+        // k[24] = R*g*m2
         k[24] = (k[3] * k[5] * k[1]);
+        // k[25] = ell*g*m1/2
         k[25] = (k[2] * k[5] * k[0] / 2.0);
+        // k[26] = m2
         k[26] = k[1];
+        // k[27] = ell^2*m1/12
         k[27] = ((k[2] * k[2]) * k[0] / 12.0);
+        // k[28] = ell^2*m1/4
         k[28] = ((k[2] * k[2]) * k[0] / 4.0);
+        // k[29] = -(ell*g*m1/2)
         k[29] = (-k[2] * k[5] * k[0] / 2.0);
+        // k[30] = -R
         k[30] = (-k[3]);
+        // k[31] = 3/(ell^2*m1)
         k[31] = (3.0 / ((k[2] * k[2]) * k[0]));
+        // k[32] = rc_wi^2*rc_ai
         k[32] = ((k[11] * k[11]) * k[16]);
+        // k[33] = ell*g*m1
         k[33] = (k[2] * k[5] * k[0]);
+        // k[34] = -(3*g/(2*ell))
         k[34] = (-3.0 * k[5] / 2.0 / k[2]);
+        // k[35] = rc_x0i
         k[35] = k[14];
+        // k[36] = rc_p0/m2
         k[36] = (k[15] / k[1]);
+        // k[37] = -(ell/2)
         k[37] = ((-k[2]) / 2.0);
     }
 
@@ -323,9 +347,13 @@ impl Reduction for HingedCylinderFree {
 
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
         k[..10].copy_from_slice(p);
+        // k[10] = rc_thi = theta_0
         k[10] = k[6];
+        // k[11] = rc_wi = theta_dot_0
         k[11] = k[8];
+        // k[12] = rc_si = sin(rc_thi)
         k[12] = k[10].sin();
+        // k[13] = rc_ci = cos(rc_thi)
         k[13] = k[10].cos();
     }
 

@@ -219,14 +219,21 @@ pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, St
             .push("Reduction::prepare_lean(self, p, k);".into());
         for (j, c) in r.constants.iter().enumerate() {
             if !indices.contains(&(np + j)) {
-                bind_constant(&mut prepare, np + j, &c.value, &scope, &format!("c{j}_"));
+                bind_constant(
+                    &mut prepare,
+                    np + j,
+                    Some(&c.symbol),
+                    &c.value,
+                    &scope,
+                    &format!("c{j}_"),
+                );
             }
         }
         lean_indices = indices;
     }
     for (i, e) in &hoisted.entries {
         if !lean_indices.contains(i) {
-            bind_constant(&mut prepare, *i, e, &scope, &format!("h{i}_"));
+            bind_constant(&mut prepare, *i, None, e, &scope, &format!("h{i}_"));
         }
     }
 
@@ -388,14 +395,33 @@ fn constant_layout(d: &Derivation) -> (Scope, Code) {
     };
     for (j, c) in constants.iter().enumerate() {
         let idx = np + j;
-        bind_constant(&mut prepare, idx, &c.value, &scope, &format!("c{j}_"));
+        bind_constant(
+            &mut prepare,
+            idx,
+            Some(&c.symbol),
+            &c.value,
+            &scope,
+            &format!("c{j}_"),
+        );
         scope.constants.insert(c.symbol.clone(), idx);
     }
     (scope, prepare)
 }
 
-/// `k[idx] = <value>;`, with the value's shared subexpressions as `let`s named by `prefix`.
-fn bind_constant(code: &mut Code, idx: usize, value: &Expr, scope: &Scope, prefix: &str) {
+/// `k[idx] = <value>;`, with the value's shared subexpressions as `let`s named by `prefix`,
+/// after a comment saying what it holds in the spec's own symbols (`// k[20] = m1/2 + m2/2`).
+/// A named constant (a start value, say) is introduced by its name: `// k[7] = rc_si = a/ell`.
+fn bind_constant(
+    code: &mut Code,
+    idx: usize,
+    name: Option<&str>,
+    value: &Expr,
+    scope: &Scope,
+    prefix: &str,
+) {
+    let named = name.map_or(String::new(), |n| format!("{n} = "));
+    code.stmts
+        .push(format!("// k[{idx}] = {named}{}", value.tidy().to_infix()));
     let out = code.push_body(lower(std::slice::from_ref(value), scope, None, prefix));
     code.bind(&format!("k[{idx}]"), out[0].clone());
 }
@@ -459,12 +485,19 @@ fn lean_prepare(
     let mut lean = Code::default();
     for (j, c) in r.constants.iter().enumerate() {
         if needed.contains(&(np + j)) {
-            bind_constant(&mut lean, np + j, &c.value, scope, &format!("c{j}_"));
+            bind_constant(
+                &mut lean,
+                np + j,
+                Some(&c.symbol),
+                &c.value,
+                scope,
+                &format!("c{j}_"),
+            );
         }
     }
     for (i, e) in &hoisted.entries {
         if needed.contains(i) {
-            bind_constant(&mut lean, *i, e, scope, &format!("h{i}_"));
+            bind_constant(&mut lean, *i, None, e, scope, &format!("h{i}_"));
         }
     }
     Ok((lean, needed.into_iter().filter(|&i| i >= np).collect()))
