@@ -257,11 +257,6 @@ impl Mapping {
         &self.names
     }
 
-    /// What each axis sets.
-    pub fn targets(&self) -> &[Target] {
-        &self.targets
-    }
-
     /// Fills the parameter vector `p` (one entry per parameter) for a point with one
     /// coordinate per axis: parameter axes first, then ratios against the values set.
     pub fn fill(&self, point: &[f64], p: &mut [f64]) {

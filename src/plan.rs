@@ -376,15 +376,15 @@ fn no_separation(info: &ModelInfo) -> String {
 /// The end of a model's motion in its own terms: `` `theta` = 0 rad `` (the reduced coordinate
 /// at its `end_angle`).
 fn motion_end(info: &ModelInfo) -> String {
-    let name = info
-        .coordinates
-        .get(info.reduced)
-        .copied()
-        .unwrap_or("theta");
-    format!("`{name}` = {} rad", format_number(info.end_angle, 6))
+    format!(
+        "{} = {} rad",
+        angle_name(info),
+        format_number(info.end_angle, 6)
+    )
 }
 
-/// The reduced coordinate's name, in backquotes.
+/// The reduced coordinate's name, in backquotes (the derivation tool writes `reduced` as an
+/// index into `coordinates`; `theta` names it should a hand-made `ModelInfo` get it wrong).
 fn angle_name(info: &ModelInfo) -> String {
     format!(
         "`{}`",

@@ -729,21 +729,22 @@ fn write_body(
     );
     let moves = poses.iter().any(|p| p[0] != start[0] || p[1] != start[1]);
     let turns = poses.iter().any(|p| p[2] != start[2]);
-    let hold = |v: &mut Vec<String>| {
-        if let Some(last) = v.last().cloned() {
-            v.push(last);
+    // One animation per transform, over the keyframes; the last value holds through the pause.
+    let animate = |out: &mut String, kind: &str, mut values: Vec<String>, c: &Clock| {
+        if let Some(last) = values.last().cloned() {
+            values.push(last);
         }
-    };
-    if let (Some(c), true) = (clock, moves) {
-        let mut values: Vec<String> = poses.iter().map(|p| view.pt([p[0], p[1]])).collect();
-        hold(&mut values);
         let _ = writeln!(
             out,
-            r#"<animateTransform attributeName="transform" type="translate" calcMode="linear" {} keyTimes="{}" values="{}"/>"#,
+            r#"<animateTransform attributeName="transform" type="{kind}" calcMode="linear" {} keyTimes="{}" values="{}"/>"#,
             c.timing(),
             frame_keys(anim, keys, c),
             values.join(";")
         );
+    };
+    if let (Some(c), true) = (clock, moves) {
+        let values = poses.iter().map(|p| view.pt([p[0], p[1]])).collect();
+        animate(out, "translate", values, c);
     }
     let _ = writeln!(
         out,
@@ -751,15 +752,7 @@ fn write_body(
         deg(&start)
     );
     if let (Some(c), true) = (clock, turns) {
-        let mut values: Vec<String> = poses.iter().map(deg).collect();
-        hold(&mut values);
-        let _ = writeln!(
-            out,
-            r#"<animateTransform attributeName="transform" type="rotate" calcMode="linear" {} keyTimes="{}" values="{}"/>"#,
-            c.timing(),
-            frame_keys(anim, keys, c),
-            values.join(";")
-        );
+        animate(out, "rotate", poses.iter().map(deg).collect(), c);
     }
     for shape in shapes {
         out.push_str(&shape_svg(shape, view, colour, "#ffffffb0", 2.0));

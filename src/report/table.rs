@@ -137,7 +137,7 @@ fn align_right(t: &mut Table, columns: &[usize]) {
 
 /// `text` broken at spaces into lines of at most `width` characters (a longer word stays
 /// whole), each line after the first indented by `indent` spaces.
-pub fn wrap(text: &str, width: Option<usize>, indent: usize) -> String {
+fn wrap(text: &str, width: Option<usize>, indent: usize) -> String {
     let Some(width) = width else {
         return text.to_string();
     };

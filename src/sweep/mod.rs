@@ -40,16 +40,6 @@ pub enum SweepError {
         /// What is wrong.
         reason: String,
     },
-    /// A value outside its domain.
-    #[error("{what} = {value} is outside {domain}")]
-    OutOfDomain {
-        /// Which value (with its line for a points file).
-        what: String,
-        /// The value.
-        value: f64,
-        /// The allowed range.
-        domain: &'static str,
-    },
     /// The points file could not be read.
     #[error("{path}: {reason}")]
     Points {
