@@ -634,17 +634,13 @@ pub fn check_parameters(
         });
     }
     // Finite and positive values pass every value check; others get the detailed one.
-    // (Two comparisons each: NaN fails both, and `is_finite` compiles to bit tests.)
-    if !p
-        .iter()
-        .fold(true, |ok, &v| ok & (v > 0.0) & (v < f64::INFINITY))
-    {
+    if !p.iter().all(|&v| positive_finite(v)) {
         for (i, &value) in p.iter().enumerate() {
             check_value(info, i, value)?;
         }
     }
     model.requirements(p, margins);
-    if margins.iter().fold(true, |ok, m| ok & (*m > 0.0)) {
+    if margins.iter().all(|&m| m > 0.0) {
         return Ok(());
     }
     if let Some((req, margin)) = failed_requirements(model, p, margins).next() {
@@ -657,6 +653,14 @@ pub fn check_parameters(
         });
     }
     Ok(())
+}
+
+/// Whether `v` is positive and finite, by one integer comparison: as bits, the positive finite
+/// floats are exactly `1..=f64::MAX.to_bits()` (zero is 0, negatives have the sign bit set,
+/// infinity and NaN lie above `f64::MAX`).
+#[inline(always)]
+fn positive_finite(v: f64) -> bool {
+    v.to_bits().wrapping_sub(1) < f64::MAX.to_bits()
 }
 
 /// Prepares the model's constants `k` (of length [`ModelInfo::n_constants`]) from checked
@@ -696,4 +700,31 @@ fn describe(info: &ModelInfo, p: &[f64]) -> String {
         let _ = write!(out, "{} = {v}", param.name);
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::positive_finite;
+
+    #[test]
+    fn positive_finite_is_the_two_comparisons() {
+        let values = [
+            0.0,
+            -0.0,
+            f64::MIN_POSITIVE,
+            f64::from_bits(1),
+            1.0,
+            f64::MAX,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            -f64::NAN,
+            -1.0,
+            -f64::from_bits(1),
+            -f64::MAX,
+        ];
+        for v in values {
+            assert_eq!(positive_finite(v), v > 0.0 && v < f64::INFINITY, "{v:e}");
+        }
+    }
 }

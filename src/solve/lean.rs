@@ -168,9 +168,8 @@ impl<'m> LeanSolver<'m> {
         if self.prior.is_some() {
             self.red.prepare_lean(p, &mut self.k);
             let k = &self.k;
-            let finite = (self.layout.lean_constants.iter()).fold(true, |ok, &i| {
-                ok & k.get(i).is_some_and(|v| v.abs() < f64::INFINITY)
-            });
+            let finite = (self.layout.lean_constants.iter())
+                .all(|&i| k.get(i).is_some_and(|v| v.abs() < f64::INFINITY));
             if finite && let Ok(point) = self.solve_prepared() {
                 return Ok(point);
             }

@@ -8,6 +8,11 @@
 //! rounding bound of zero is redone by compensated Horner (twice the working precision), so a
 //! root is located to within an ulp or two whenever it is well conditioned, whatever the scale of
 //! the coefficients (e.g. `n = m2/m1` from 1e-12 to 1e12).
+//!
+//! The largest root of a quadratic or cubic (every separation polynomial of the per-point
+//! solver) is first sought without the split: Halley from the root of the linear part, kept
+//! when deflation shows the other roots clear of it and of the interval above it
+//! (`certified_low`); else the split decides.
 
 /// Highest degree solved (on the stack; higher degrees are refused with `None`).
 pub const MAX_DEGREE: usize = 16;
@@ -44,6 +49,9 @@ fn largest_low(coeffs: &[f64], lo: f64, hi: f64, evals: &mut u64) -> Option<f64>
     // evaluation below unrolls.
     let mut c4 = [0.0; 4];
     c4[..coeffs.len()].copy_from_slice(coeffs);
+    if let Some(root) = certified_low(c4, lo, hi, evals) {
+        return Some(root);
+    }
     let c = &c4[..];
     // Knots ascending: lo, the critical points inside, hi.
     let mut crit = [0.0; MAX_DEGREE];
@@ -71,6 +79,83 @@ fn largest_low(coeffs: &[f64], lo: f64, hi: f64, evals: &mut u64) -> Option<f64>
     }
     None
 }
+
+/// The largest sign-changing root of a quadratic or cubic `c` in `(lo, hi)` when it can be
+/// certified cheaply, else `None` (the caller then isolates by the bracketed path, which also
+/// decides that there is no root).
+///
+/// Halley's method on plain Horner values from the root of the linear part `-c0 / c1` (most
+/// separation polynomials are dominated by it near their root), stopped once a step is below
+/// 1e-7 relative, then one Newton step on the compensated value, as in [`refine`]. The result
+/// is certified by deflation: `p(s) = (s - x) q(s)` up to the remainder, and the real roots of
+/// the quadratic (or linear) `q` must all lie clear of `(x - gap, hi + gap)`, so that `x` is a
+/// simple root (a sign change) and none larger lies in the interval. Anything less clear (a
+/// root near an end of the interval or near another root, no convergence) is left to the
+/// bracketed path.
+#[inline(always)]
+fn certified_low(c: [f64; 4], lo: f64, hi: f64, evals: &mut u64) -> Option<f64> {
+    let [c0, c1, c2, c3] = c;
+    let width = hi - lo;
+    let linear = -c0 / c1;
+    let mut x = if linear > lo && linear < hi {
+        linear
+    } else {
+        lo + 0.5 * width
+    };
+    let mut converged = false;
+    for _ in 0..CERTIFIED_STEPS {
+        *evals += 1;
+        let p = ((c3 * x + c2) * x + c1) * x + c0;
+        let d1 = (3.0 * c3 * x + 2.0 * c2) * x + c1;
+        let d2 = 6.0 * c3 * x + 2.0 * c2;
+        let step = 2.0 * p * d1 / (2.0 * d1 * d1 - p * d2);
+        x -= step;
+        // NaN fails both tests and leaves the loop unconverged.
+        if step.abs() <= 1e-7 * x.abs() {
+            converged = true;
+            break;
+        }
+        if !step.is_finite() {
+            break;
+        }
+    }
+    // Clear of the ends by more than the deflated roots' uncertainty.
+    let gap = 1e-6 * width;
+    if !(converged && x > lo + gap && x < hi - gap) {
+        return None;
+    }
+    *evals += 1;
+    let f = horner_compensated(&c, x);
+    let d1 = (3.0 * c3 * x + 2.0 * c2) * x + c1;
+    let newton = x - f / d1;
+    if !(newton > lo && newton < hi && polish(x, newton)) {
+        return None;
+    }
+    x = newton;
+    // q(s) = c3 s^2 + q1 s + q0: the other roots.
+    let (q1, q0) = (c2 + x * c3, c1 + x * (c2 + x * c3));
+    let clear = |y: f64| !(y > x - gap && y < hi + gap);
+    let certified = if c3 == 0.0 {
+        q1 != 0.0 && clear(-q0 / q1)
+    } else {
+        // A discriminant near zero (a near double root, real or not up to rounding) must
+        // also lie clear.
+        let disc = q1 * q1 - 4.0 * c3 * q0;
+        let doubt = 1e-8 * (q1 * q1 + (4.0 * c3 * q0).abs());
+        if disc < -doubt {
+            true
+        } else if disc >= -doubt {
+            let q = -0.5 * (q1 + disc.max(0.0).sqrt().copysign(q1));
+            q != 0.0 && clear(q / c3) && clear(q0 / q)
+        } else {
+            false
+        }
+    };
+    certified.then_some(x)
+}
+
+/// Most Halley steps of [`certified_low`] before it leaves the root to the bracketed path.
+const CERTIFIED_STEPS: usize = 8;
 
 /// The sign-changing root of `c` on piece `i` of a monotone split (from `knots[i]` to
 /// `knots[i + 1]`, with `values` at the knots): an exact zero at the interior knot `knots[i]`
@@ -314,11 +399,20 @@ fn refine(c: &[f64], (mut a, mut b): (f64, f64), (fa, fb): (f64, f64), evals: &m
     }
     let (_, d1, _, _) = with_derivatives(c, x);
     let newton = x - fx / d1;
-    if newton >= a && newton <= b {
+    // A polishing step only: near a multiple root the derivative vanishes, and a long step
+    // would leave the root for a point of the bracket that is none.
+    if newton >= a && newton <= b && polish(x, newton) {
         newton
     } else {
         x.clamp(a, b)
     }
+}
+
+/// Whether the last Newton step from `x` to `newton` is a polish (below `1e-6` relative, as
+/// after a Halley step below `1e-7`), not a jump off a vanishing derivative.
+#[inline(always)]
+fn polish(x: f64, newton: f64) -> bool {
+    (newton - x).abs() <= 1e-6 * x.abs() + f64::MIN_POSITIVE
 }
 
 #[cfg(test)]
@@ -338,6 +432,104 @@ mod tests {
         assert_eq!(largest_root(&c, 0.0, 0.7, &mut evals), Some(Some(roots[1])));
         assert_eq!(largest_root(&c, 0.95, 1.0, &mut evals), Some(None));
         assert!(evals > 0);
+    }
+
+    #[test]
+    fn the_certified_path_agrees_with_the_bracketed_isolator() {
+        // Random cubics and quadratics (many with several roots in the interval, double roots
+        // and roots at the ends): the largest root is the bracketed isolator's last one.
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut certified = 0;
+        for case in 0..20_000 {
+            // Roots r1 <= r2 <= r3 in [-0.5, 1.5]; some repeated, some on an end.
+            let mut r = [next() * 2.0 - 0.5, next() * 2.0 - 0.5, next() * 2.0 - 0.5];
+            r.sort_by(f64::total_cmp);
+            let double = case % 7 == 0;
+            match case % 7 {
+                0 => r[1] = r[2],
+                1 => r[2] = 1.0,
+                _ => {}
+            }
+            let scale = 10f64.powf(next() * 24.0 - 12.0);
+            let [a, b, c] = r;
+            let cubic = [
+                -a * b * c * scale,
+                (a * b + b * c + a * c) * scale,
+                -(a + b + c) * scale,
+                scale,
+            ];
+            let quadratic = [a * b * scale, -(a + b) * scale, scale, 0.0];
+            for coeffs in [cubic, quadratic] {
+                let (mut e1, mut e2) = (0, 0);
+                let mut out = [0.0; MAX_DEGREE];
+                let n = roots_in(&coeffs, 0.0, 1.0, &mut out, &mut e1).expect("degree <= 3");
+                let want = (n > 0).then(|| out[n - 1]);
+                let got = largest_root(&coeffs, 0.0, 1.0, &mut e2).expect("degree <= 3");
+                if certified_low(coeffs, 0.0, 1.0, &mut 0).is_some() {
+                    certified += 1;
+                }
+                // A double root splits by rounding into two or none: both paths must then
+                // land on it to about sqrt(eps), or agree that there is none.
+                let tol = if double { 2e-7 } else { 1e-12 };
+                match (got, want) {
+                    (Some(g), Some(w)) => {
+                        let e = (g - w).abs() / w.abs().max(1e-3);
+                        assert!(e <= tol, "{coeffs:?}: {g} vs {w}");
+                        assert!(horner(&coeffs, g).abs() <= 1e-6 * scale, "{coeffs:?}: {g}");
+                    }
+                    (None, None) => {}
+                    _ if double => {}
+                    _ => panic!("{coeffs:?}: {got:?} vs {want:?}"),
+                }
+            }
+        }
+        // Most cases take the certified path; the rest fall back.
+        assert!((10_000..38_000).contains(&certified), "{certified}");
+    }
+
+    #[test]
+    fn the_certified_path_leaves_unclear_roots_to_the_bracketed_one() {
+        let mut evals = 0;
+        // Three roots in (0, 1), the linear part's root (0.0763) near the smallest: Halley
+        // finds 0.1, the deflation sees 0.5 and 0.9 above it.
+        let c = [-0.045, 0.59, -1.5, 1.0];
+        assert_eq!(certified_low(c, 0.0, 1.0, &mut evals), None);
+        let root = largest_root(&c, 0.0, 1.0, &mut evals).flatten();
+        assert!(root.is_some_and(|r| (r - 0.9).abs() < 1e-15), "{root:?}");
+        // A double root at 0.5 beside a simple one at 0.25: near another root, not certified.
+        let c = [-0.0625, 0.5, -1.25, 1.0];
+        assert_eq!(
+            certified_low([c[0], c[1], c[2], c[3]], 0.0, 0.6, &mut evals),
+            None
+        );
+        // The rod on the cube (n = 1, a/ell = 1/2): certified, and a root of the cubic.
+        let c = [8.0, -24.0, 0.0, 3.0];
+        let root = certified_low(c, 0.0, 0.5, &mut evals).expect("one clear root");
+        assert!(horner(&c, root).abs() < 1e-14 && root > 0.33 && root < 0.34);
+    }
+
+    #[test]
+    fn a_rounded_double_root_gives_no_root_off_it() {
+        // (x - 0.167) (x - 0.958)^2 rounded: its derivative vanishes at the double root, where
+        // a last Newton step once jumped to points that are no roots (0.79 and 0.98).
+        let c = [
+            -0.000_137_417_567_662_949_5,
+            0.001_109_804_544_969_235_6,
+            -0.001_867_390_865_559_559_8,
+            0.000_896_306_762_819_939_1,
+        ];
+        let mut evals = 0;
+        let roots = real_roots(&c, 0.0, 1.0, &mut evals).expect("a cubic");
+        assert!(!roots.is_empty() && (roots[0] - 0.166_973_904_032_291_98).abs() < 1e-15);
+        for r in &roots[1..] {
+            assert!((r - 0.958_227_19).abs() < 1e-7, "{roots:?}");
+        }
     }
 
     #[test]

@@ -291,6 +291,10 @@ pub struct Fall<'a> {
     /// The fall polynomial's coefficients (empty without one): the integrand is then
     /// `2 sqrt(P(s) / (1 + s))`, without `theta_dot^2`'s call.
     fall: &'a [f64],
+    /// A fall polynomial of degree at most 2 padded with zeros, for an evaluation of fixed
+    /// shape at every node (`low` says whether it holds the polynomial).
+    quadratic: [f64; 3],
+    low: bool,
     /// The phase's end, for error messages.
     delta_end: f64,
 }
@@ -351,6 +355,13 @@ impl<'a> Fall<'a> {
             });
         }
         let from_rest = theta_dot == 0.0;
+        let fall = if from_rest { fall } else { &[] };
+        let (quadratic, low) = match *fall {
+            [p0] => ([p0, 0.0, 0.0], true),
+            [p0, p1] => ([p0, p1, 0.0], true),
+            [p0, p1, p2] => ([p0, p1, p2], true),
+            _ => ([0.0; 3], false),
+        };
         Ok(Fall {
             model,
             red,
@@ -360,7 +371,9 @@ impl<'a> Fall<'a> {
             e,
             root_e: e.sqrt(),
             from_rest,
-            fall: if from_rest { fall } else { &[] },
+            fall,
+            quadratic,
+            low,
             delta_end,
         })
     }
@@ -368,11 +381,16 @@ impl<'a> Fall<'a> {
     /// From rest (or with a rate that is not a number) the rod must start to fall.
     fn check_falls(&self, theta_dot: f64) -> Result<(), SolveError> {
         let (model, red, k) = (self.model, self.red, self.k);
+        // With a fall polynomial, one value of fixed shape settles the usual case.
+        let sh2 = 1e-8;
+        if self.low && theta_dot == 0.0 && self.fall_value(sh2) > 0.0 {
+            return Ok(());
+        }
         if self.from_rest || theta_dot.is_nan() {
             // The rod must start to fall: theta_dot^2 positive just past the start (at
             // sinh v = 1e-4, a drop of 1e-8 e; one rational evaluation, the trigonometry of
             // `reduced` only for the message).
-            let falls = self.value(1e-4, (1.0f64 + 1e-8).sqrt());
+            let falls = self.value(sh2.sqrt(), (1.0 + sh2).sqrt());
             if theta_dot.is_nan() || falls.is_err() {
                 let theta_ddot = red.reduced(k, 0.0).theta_ddot;
                 return Err(match falls {
@@ -522,11 +540,11 @@ impl<'a> Fall<'a> {
     #[inline(always)]
     fn fall_value(&self, sh2: f64) -> f64 {
         let s = self.si - self.e * sh2;
-        let p = match *self.fall {
-            [p0] => p0,
-            [p0, p1] => p0 + p1 * s,
-            [p0, p1, p2] => p0 + s * (p1 + s * p2),
-            _ => horner(self.fall, s),
+        let p = if self.low {
+            let [p0, p1, p2] = self.quadratic;
+            p0 + s * (p1 + s * p2)
+        } else {
+            horner(self.fall, s)
         };
         2.0 * (p / (1.0 + s)).sqrt()
     }
