@@ -1178,35 +1178,18 @@ fn tex_dimensionless(
     let mut results = Vec::new();
     for (i, r) in dim.results.iter().enumerate() {
         let form = from_sc(&r.form, theta);
-        let (lhs, width, rhs) = match (&r.unit, r.key.as_str()) {
-            (Some(u), "theta_dot_sq") => (
-                format!(
-                    "\\frac{{{}^2}}{{{}}} = ",
-                    name(&format!("dot_{theta}")),
-                    inline_unit(u, name)
-                ),
+        let quantity = match r.key.as_str() {
+            "theta_dot_sq" => format!("{}^2", name(&format!("dot_{theta}"))),
+            "theta_ddot" => name(&format!("ddot_{theta}")),
+            key => format!("F_{{\\mathrm{{{}}}}}", tex_text(key)),
+        };
+        let (lhs, width, rhs) = match &r.unit {
+            Some(u) => (
+                format!("\\frac{{{quantity}}}{{{}}} = ", inline_unit(u, name)),
                 6,
                 None,
             ),
-            (Some(u), "theta_ddot") => (
-                format!(
-                    "\\frac{{{}}}{{{}}} = ",
-                    name(&format!("ddot_{theta}")),
-                    inline_unit(u, name)
-                ),
-                6,
-                None,
-            ),
-            (Some(u), key) => (
-                format!(
-                    "\\frac{{F_{{\\mathrm{{{}}}}}}}{{{}}} = ",
-                    tex_text(key),
-                    inline_unit(u, name)
-                ),
-                6,
-                None,
-            ),
-            (None, _) => (String::new(), 0, Some(Expr::int(0))),
+            None => (String::new(), 0, Some(Expr::int(0))),
         };
         let unit = match &r.unit {
             Some(u) => format!(", in units of ${}$", inline_unit(u, name)),
