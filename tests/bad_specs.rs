@@ -543,3 +543,91 @@ fn shapes_scenery_and_monitor_units_reach_the_generated_code() {
         }
     }
 }
+
+/// `BASE` with a `dimensionless:` block of these groups and force scale.
+fn with_dimensionless(groups: &str, force: &str, paper: &str) -> String {
+    format!(
+        "{BASE}dimensionless:\n  groups:\n{groups}  scales: {{time: sqrt(ell/g), force: {force}}}\n{paper}"
+    )
+}
+
+#[test]
+fn well_formed_groups_and_scales_are_accepted() {
+    let text = with_dimensionless(
+        "    - {name: r, expr: a/ell, meaning: start height over length}\n",
+        "m1*g",
+        "  paper: {separation_condition: \"7\"}\n",
+    );
+    let (root, _) = write("groups_ok", &text);
+    render_all(&root, &[]).unwrap_or_else(|e| panic!("{e}"));
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+#[test]
+fn a_group_that_is_a_sum_is_refused() {
+    let text = with_dimensionless(
+        "    - {name: r, expr: a + ell, meaning: not a ratio}\n",
+        "m1*g",
+        "",
+    );
+    let (path, err) = error_of("group_sum", &text);
+    let (line, col) = place(&text, "a + ell", "expr");
+    check(
+        &path,
+        &err,
+        (line, Some(col)),
+        "dimensionless.groups[0].expr",
+        &["not a product of powers of parameters"],
+    );
+}
+
+#[test]
+fn a_group_without_a_parameter_to_solve_for_is_refused() {
+    let text = with_dimensionless(
+        "    - {name: r, expr: a/ell, meaning: ratio}\n    - {name: s, expr: a^2/g^2, meaning: squares only}\n",
+        "m1*g",
+        "",
+    );
+    let (path, err) = error_of("group_unsolvable", &text);
+    let (line, col) = place(&text, "a^2/g^2", "expr");
+    check(
+        &path,
+        &err,
+        (line, Some(col)),
+        "dimensionless.groups[1].expr",
+        &["no parameter to the first power"],
+    );
+}
+
+#[test]
+fn scales_that_leave_a_unit_are_refused() {
+    // Forces in units of g alone keep the mass m1.
+    let text = with_dimensionless("    - {name: r, expr: a/ell, meaning: ratio}\n", "g", "");
+    let (path, err) = error_of("scales_units", &text);
+    let (line, col) = place(&text, "dimensionless:", "dimensionless");
+    check(
+        &path,
+        &err,
+        (line, Some(col)),
+        "dimensionless",
+        &["still depends on `m1`", "do not make it dimensionless"],
+    );
+}
+
+#[test]
+fn a_paper_number_for_an_unknown_result_is_refused() {
+    let text = with_dimensionless(
+        "    - {name: r, expr: a/ell, meaning: ratio}\n",
+        "m1*g",
+        "  paper: {energy: \"9\"}\n",
+    );
+    let (path, err) = error_of("paper_key", &text);
+    let (line, col) = place(&text, "paper:", "energy");
+    check(
+        &path,
+        &err,
+        (line, Some(col)),
+        "dimensionless.paper.energy",
+        &["`energy` is not a result of this model"],
+    );
+}

@@ -1,9 +1,11 @@
 //! Turns a [`Derivation`] into template contexts (flat data, computed here) and renders the
 //! tera templates of `templates/` into Rust, LaTeX and JSON text.
 
+use super::dimensionless::Dimensionless;
 use super::expr::Expr;
 use super::lower::{Body, Hoisted, Scope, lower};
-use super::mechanics::{self, Binding, Derivation, Reduction, from_sc};
+use super::mechanics::{self, Binding, Derivation, Reduction, from_sc, to_sc_expr};
+use super::present;
 use super::spec::Checked;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -131,25 +133,6 @@ pub fn type_name(name: &str) -> String {
                 .unwrap_or_default()
         })
         .collect()
-}
-
-fn replace_sc(e: &Expr, theta: &str) -> Expr {
-    match e {
-        Expr::Fun(f, args) if args.len() == 1 && args[0] == Expr::sym(theta) && f == "sin" => {
-            Expr::sym("rc_s")
-        }
-        Expr::Fun(f, args) if args.len() == 1 && args[0] == Expr::sym(theta) && f == "cos" => {
-            Expr::sym("rc_c")
-        }
-        Expr::Add(v) => Expr::Add(v.iter().map(|x| replace_sc(x, theta)).collect()),
-        Expr::Mul(v) => Expr::Mul(v.iter().map(|x| replace_sc(x, theta)).collect()),
-        Expr::Pow(b, x) => Expr::Pow(
-            Box::new(replace_sc(b, theta)),
-            Box::new(replace_sc(x, theta)),
-        ),
-        Expr::Fun(f, v) => Expr::Fun(f.clone(), v.iter().map(|x| replace_sc(x, theta)).collect()),
-        _ => e.clone(),
-    }
 }
 
 fn lit(x: f64) -> String {
@@ -556,7 +539,7 @@ fn drawing_code(d: &Derivation, scope: &Scope, hoisted: &mut Hoisted) -> (Code, 
     let mut exprs: Vec<Expr> = d
         .body_pose
         .iter()
-        .flat_map(|pose| pose.iter().map(|e| replace_sc(e, theta)))
+        .flat_map(|pose| pose.iter().map(|e| to_sc_expr(e, theta)))
         .collect();
     let mut infos = Vec::new();
     let mut first = 0;
@@ -597,7 +580,7 @@ fn full_state_code(
 ) -> Result<FullStateCode, String> {
     let theta = d.theta().to_string();
     let mut full_scope = state_scope(d, scope);
-    let sc = |e: &Expr| replace_sc(e, &theta);
+    let sc = |e: &Expr| to_sc_expr(e, &theta);
     let single = |prefix: &str, exprs: &[Expr], scope: &Scope, hoisted: &mut Hoisted| {
         let mut code = Code::default();
         let out = code.push_body(lower(exprs, scope, Some(hoisted), prefix));
@@ -930,6 +913,10 @@ pub struct Equation {
     env: &'static str,
     /// The lines, joined by `\\`.
     latex: String,
+    /// The number printed beside it (`(3)`, `(3) = paper (9)`), if any.
+    tag: Option<String>,
+    /// Set in a smaller type, because a term too wide for a line cannot be broken.
+    small: bool,
 }
 
 /// Characters of math that fit on one display line of the LaTeX page (A4, 2 cm margins,
@@ -975,6 +962,21 @@ fn display(
             "equation*"
         },
         latex: lines.join(" \\\\\n"),
+        tag: None,
+        small: false,
+    }
+}
+
+/// The widest term of the sums of `e` (outside fractions' denominators), which the line
+/// breaker cannot split, as counted by [`Expr::latex_width`].
+fn widest_term(e: &Expr, name: &dyn Fn(&str) -> String) -> usize {
+    match e {
+        Expr::Add(terms) => (terms.iter())
+            .map(|t| t.split_sign().1.latex_width(name))
+            .max()
+            .unwrap_or(0),
+        Expr::Mul(v) => v.iter().map(|f| widest_term(f, name)).max().unwrap_or(0),
+        _ => 0,
     }
 }
 
@@ -995,6 +997,12 @@ pub struct TexContext {
     spec: String,
     params: Vec<TexParam>,
     equations: Vec<Equation>,
+    /// The dimensionless groups (`n = m_2/m_1`) with their meanings.
+    groups: Vec<TexParam>,
+    /// The scales and the rule of the presentation forms, in words.
+    scales: String,
+    /// The results without units, numbered.
+    results: Vec<Equation>,
 }
 
 /// Builds the LaTeX context: the derivation's steps as displayed equations.
@@ -1108,6 +1116,10 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> TexContext {
             &name,
         ));
     }
+    let (dim_groups, dim_scales, dim_results) = match &d.dimensionless {
+        Some(dim) => tex_dimensionless(dim, &theta, &name),
+        None => (Vec::new(), String::new(), Vec::new()),
+    };
     TexContext {
         command: COMMAND.into(),
         name: tex_text(&d.name),
@@ -1123,6 +1135,88 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> TexContext {
             })
             .collect(),
         equations: eqs,
+        groups: dim_groups,
+        scales: dim_scales,
+        results: dim_results,
+    }
+}
+
+/// A unit as inline LaTeX, `g/\ell` rather than a display fraction.
+fn inline_unit(unit: &Expr, name: &dyn Fn(&str) -> String) -> String {
+    let (num, den) = unit.num_den();
+    let part = |v: Vec<Expr>| super::expr::product(v).to_latex(name);
+    if den.is_empty() {
+        part(num)
+    } else {
+        format!("{}/{}", part(num), part(den))
+    }
+}
+
+/// The LaTeX of the results without units: the groups, the scales in words and the
+/// numbered results (the paper's number beside each that the spec gives one for).
+fn tex_dimensionless(
+    dim: &Dimensionless,
+    theta: &str,
+    name: &dyn Fn(&str) -> String,
+) -> (Vec<TexParam>, String, Vec<Equation>) {
+    let groups = (dim.groups.iter())
+        .map(|g| TexParam {
+            symbol: format!("{} = {}", name(&g.name), g.definition.to_latex(name)),
+            meaning: tex_text(&g.meaning),
+            unit: format!("solved for ${}$", name(&g.solves)),
+        })
+        .collect();
+    let scales = format!(
+        "Time is in units of $T = {}$ and forces in units of ${}$. Each result below is written \
+         in the groups and ${}$ alone; its form was chosen by the derivation tool among \
+         candidates by {}.",
+        dim.time.to_latex(name),
+        dim.force.to_latex(name),
+        name(theta),
+        tex_text(present::RULE)
+    );
+    let mut results = Vec::new();
+    for (i, r) in dim.results.iter().enumerate() {
+        let form = from_sc(&r.form, theta);
+        let quantity = match r.key.as_str() {
+            "theta_dot_sq" => format!("{}^2", name(&format!("dot_{theta}"))),
+            "theta_ddot" => name(&format!("ddot_{theta}")),
+            key => format!("F_{{\\mathrm{{{}}}}}", tex_text(key)),
+        };
+        let (lhs, width, rhs) = match &r.unit {
+            Some(u) => (
+                format!("\\frac{{{quantity}}}{{{}}} = ", inline_unit(u, name)),
+                6,
+                None,
+            ),
+            None => (String::new(), 0, Some(Expr::int(0))),
+        };
+        let unit = match &r.unit {
+            Some(u) => format!(", in units of ${}$", inline_unit(u, name)),
+            None => String::new(),
+        };
+        let paper = match &r.paper {
+            Some(p) => format!(" (the paper's eq.~({}))", tex_text(p)),
+            None => String::new(),
+        };
+        let title = format!("{}{unit}{paper}", upper_first(&tex_text(&r.meaning)));
+        let mut eq = display(&title, lhs, width, &form, rhs.as_ref(), name);
+        eq.small = widest_term(&form, name) + width > TEX_LINE;
+        eq.tag = Some(match &r.paper {
+            Some(p) => format!("({})\\quad\\text{{paper ({})}}", i + 1, tex_text(p)),
+            None => format!("({})", i + 1),
+        });
+        results.push(eq);
+    }
+    (groups, scales, results)
+}
+
+/// `text` with its first letter upper case.
+fn upper_first(text: &str) -> String {
+    let mut c = text.chars();
+    match c.next() {
+        Some(f) => f.to_uppercase().collect::<String>() + c.as_str(),
+        None => String::new(),
     }
 }
 
@@ -1262,6 +1356,9 @@ pub fn json_record(checked: &Checked, d: &Derivation) -> serde_json::Value {
         "velocity_symbols": "theta_dot, theta_ddot in the reduced expressions are eliminated; dot_q / ddot_q denote velocities and accelerations in `lagrangian` and in integrated forces",
         "expressions": expressions,
     });
+    if let Some(dim) = &d.dimensionless {
+        record["dimensionless"] = dimensionless_record(dim, &theta);
+    }
     if !d.frictions.is_empty() {
         record["frictions"] = d
             .frictions
@@ -1280,6 +1377,50 @@ pub fn json_record(checked: &Checked, d: &Derivation) -> serde_json::Value {
             .collect();
     }
     record
+}
+
+/// The JSON record's `dimensionless` block: groups, scales, and each result's form, unit and
+/// (where the spec gives one) the paper's equation number.
+fn dimensionless_record(dim: &Dimensionless, theta: &str) -> serde_json::Value {
+    let groups: Vec<serde_json::Value> = (dim.groups.iter())
+        .map(|g| {
+            serde_json::json!({
+                "name": g.name,
+                "definition": g.definition.to_infix(),
+                "meaning": g.meaning,
+                "solved_for": g.solves,
+            })
+        })
+        .collect();
+    let mut expressions = serde_json::Map::new();
+    let mut units = serde_json::Map::new();
+    let mut paper = serde_json::Map::new();
+    for r in &dim.results {
+        let form = from_sc(&r.form, theta).to_infix();
+        expressions.insert(r.key.clone(), form.into());
+        let unit = match &r.unit {
+            Some(u) => u.to_infix(),
+            None => "none: a condition = 0, written up to a constant factor".into(),
+        };
+        units.insert(r.key.clone(), unit.into());
+        if let Some(p) = &r.paper {
+            paper.insert(r.key.clone(), format!("({p})").into());
+        }
+    }
+    let mut block = serde_json::json!({
+        "groups": groups,
+        "scales": {"time": dim.time.to_infix(), "force": dim.force.to_infix()},
+        "expressions": expressions,
+        "units": units,
+        "forms": present::RULE,
+    });
+    if !paper.is_empty() {
+        block["paper_equations"] = paper.into();
+    }
+    if dim.results.is_empty() {
+        block["note"] = "the integrated route has no closed-form results".into();
+    }
+    block
 }
 
 #[cfg(test)]

@@ -274,6 +274,8 @@ pub struct Derivation {
     pub next: Option<Next>,
     /// The fast path, or why the phase is integrated instead.
     pub reduction: Result<Reduction, String>,
+    /// The results without units, if the spec gives groups and scales.
+    pub dimensionless: Option<super::dimensionless::Dimensionless>,
 }
 
 impl Derivation {
@@ -407,6 +409,28 @@ pub fn from_sc(e: &Expr, theta: &str) -> Expr {
         Expr::Mul(v) => Expr::Mul(v.iter().map(|x| from_sc(x, theta)).collect()),
         Expr::Pow(b, x) => Expr::Pow(Box::new(from_sc(b, theta)), Box::new(from_sc(x, theta))),
         Expr::Fun(f, v) => Expr::Fun(f.clone(), v.iter().map(|x| from_sc(x, theta)).collect()),
+        _ => e.clone(),
+    }
+}
+
+/// Replaces `sin(theta)`, `cos(theta)` by `rc_s`, `rc_c` in a plain expression (the inverse
+/// of [`from_sc`]).
+pub fn to_sc_expr(e: &Expr, theta: &str) -> Expr {
+    let rec = |v: &Vec<Expr>| v.iter().map(|x| to_sc_expr(x, theta)).collect();
+    match e {
+        Expr::Fun(f, args) if args.len() == 1 && args[0] == Expr::sym(theta) && f == "sin" => {
+            Expr::sym("rc_s")
+        }
+        Expr::Fun(f, args) if args.len() == 1 && args[0] == Expr::sym(theta) && f == "cos" => {
+            Expr::sym("rc_c")
+        }
+        Expr::Add(v) => Expr::Add(rec(v)),
+        Expr::Mul(v) => Expr::Mul(rec(v)),
+        Expr::Pow(b, x) => Expr::Pow(
+            Box::new(to_sc_expr(b, theta)),
+            Box::new(to_sc_expr(x, theta)),
+        ),
+        Expr::Fun(f, v) => Expr::Fun(f.clone(), rec(v)),
         _ => e.clone(),
     }
 }
@@ -1094,13 +1118,17 @@ fn phase_initial(parsed: &Parsed, st: &Setup) -> Result<Vec<[Expr; 2]>, DeriveEr
 pub fn derive(checked: &Checked) -> Result<Vec<Derivation>, DeriveError> {
     let spec = &checked.spec;
     let parsed = read(spec)?;
-    match spec.contact {
-        None => Ok(vec![derive_phase(checked, &parsed, Phase::Whole)?]),
-        Some(_) => Ok(vec![
-            derive_phase(checked, &parsed, Phase::Contact)?,
-            derive_phase(checked, &parsed, Phase::Free)?,
-        ]),
+    let phases: &[Phase] = match spec.contact {
+        None => &[Phase::Whole],
+        Some(_) => &[Phase::Contact, Phase::Free],
+    };
+    let mut out = Vec::new();
+    for &phase in phases {
+        let mut d = derive_phase(checked, &parsed, phase)?;
+        d.dimensionless = super::dimensionless::derive(spec, &d)?;
+        out.push(d);
     }
+    Ok(out)
 }
 
 /// Every symbol the derivation of these specs can define, in one canonical order (see
@@ -1279,6 +1307,7 @@ fn derive_phase(
         frictions,
         next,
         reduction,
+        dimensionless: None,
     })
 }
 
@@ -1964,7 +1993,8 @@ fn gap_vars(a: &A) -> A {
     cas::subs_var(&out, "rc_dc", &(cas::var("rc_ci") - cas::var("rc_c")))
 }
 
-fn positive(e: &Expr, pos: &[String]) -> bool {
+/// Whether an expression is structurally positive when the symbols `pos` are.
+pub(super) fn positive(e: &Expr, pos: &[String]) -> bool {
     match e {
         Expr::Rational(n, _) => *n > 0,
         Expr::Float(x) => *x > 0.0,
@@ -1977,7 +2007,7 @@ fn positive(e: &Expr, pos: &[String]) -> bool {
 
 /// Factorises and drops the factors free of `rc_s` that are strictly positive (or negative
 /// constants), so that what is left is the separation polynomial up to a positive factor.
-fn strip_positive_factors(poly: &A, pos: &[String]) -> Result<A, DeriveError> {
+pub(super) fn strip_positive_factors(poly: &A, pos: &[String]) -> Result<A, DeriveError> {
     let f = to_expr(&cas::factor(poly), "factorised separation polynomial")?;
     let factors = match f {
         Expr::Mul(v) => v,

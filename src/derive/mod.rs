@@ -6,9 +6,11 @@
 //! rustfmt → `generated/`. In check mode nothing is written; stale files are reported.
 
 pub mod cas;
+pub mod dimensionless;
 pub mod emit;
 pub mod lower;
 pub mod mechanics;
+pub mod present;
 
 // Spec parsing and expressions need no Symbolica: they live in the runtime crate.
 pub use crate::spec::{self, expr};

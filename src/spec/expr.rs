@@ -260,7 +260,7 @@ impl Expr {
                     let _ = write!(o, "{n}");
                 });
             }
-            Expr::Rational(n, d) => wrap(out, parent >= 2, |o| {
+            Expr::Rational(n, d) => wrap(out, parent > 2 || (*n < 0 && parent > 1), |o| {
                 let _ = write!(o, "{n}/{d}");
             }),
             Expr::Float(x) => {
@@ -369,7 +369,9 @@ impl Expr {
                                 let digit_next = matches!(f, Expr::Rational(..) | Expr::Float(_));
                                 o.push_str(if digit_next { " \\cdot " } else { " " });
                             }
-                            f.latex(o, if fs.len() > 1 { 3 } else { 2 }, name);
+                            // Alone above or below the line, a sum needs no brackets.
+                            let alone = if den.is_empty() { 2 } else { 0 };
+                            f.latex(o, if fs.len() > 1 { 3 } else { alone }, name);
                         }
                     };
                     if den.is_empty() {
@@ -970,7 +972,8 @@ fn mul_exact(a: i128, b: i128) -> Option<i128> {
     a.checked_mul(b).filter(|&p| p != i128::MIN)
 }
 
-fn gcd(a: i128, b: i128) -> i128 {
+/// Greatest common divisor of two non-negative integers, at least 1.
+pub(crate) fn gcd(a: i128, b: i128) -> i128 {
     if b == 0 { a.max(1) } else { gcd(b, a % b) }
 }
 

@@ -9,7 +9,7 @@ pub mod expr;
 
 use crate::yaml::{At, Document, ReadError, Step, excerpt, line_text};
 use annotate_snippets::{Group, Level, Renderer};
-use expr::{Expr, FUNCTIONS};
+use expr::{Expr, FUNCTIONS, gcd};
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
@@ -250,6 +250,113 @@ pub struct InitialSpec {
     pub velocity: Text,
 }
 
+/// A dimensionless group: a product of powers of parameters (`m2/m1`, `k*ell/(m1*g)`), named
+/// so that results can be written in it. The derivation tool solves each group for its first
+/// parameter that appears to the first power and that no earlier group was solved for (`m2`
+/// in `n = m2/m1`, giving `m2 = n m1`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GroupSpec {
+    /// Symbol of the group (`n`).
+    pub name: String,
+    /// Its definition over the parameters (`m2/m1`).
+    pub expr: Text,
+    /// What it is.
+    pub meaning: String,
+}
+
+/// The units in which the dimensionless results are written: expressions of the parameters.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScalesSpec {
+    /// A time (`sqrt(ell/g)`): rates are in units of its inverse, `theta_dot^2` of its inverse
+    /// square.
+    pub time: Text,
+    /// A force (`m2*g`): every reaction force is in units of it.
+    pub force: Text,
+}
+
+/// How a model's results are written without units: its groups, its scales and, where the
+/// results are a paper's, that paper's equation numbers.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DimensionlessSpec {
+    /// The dimensionless groups, in the order they are solved and listed.
+    pub groups: Vec<GroupSpec>,
+    /// The time and force scales.
+    pub scales: ScalesSpec,
+    /// The paper's equation number of a result (`theta_dot_sq: "9"`), printed beside it.
+    #[serde(default)]
+    pub paper: BTreeMap<String, String>,
+}
+
+/// The results a dimensionless block can hold besides the forces (whose names are the spec's).
+pub const DIMENSIONLESS_RESULTS: &[&str] = &["theta_dot_sq", "theta_ddot", "separation_condition"];
+
+/// The factors of a monomial `c * p1^e1 * p2^e2 ...` with `c > 0` rational and rational
+/// exponents, in the order written; `None` for anything else (a sum, a function, a negative
+/// coefficient).
+pub fn monomial(e: &Expr) -> Option<Vec<(String, Expr)>> {
+    fn walk(e: &Expr, power: (i128, i128), out: &mut Vec<(String, (i128, i128))>) -> bool {
+        match e {
+            Expr::Rational(n, _) => *n > 0,
+            Expr::Sym(s) => {
+                match out.iter_mut().find(|(name, _)| name == s) {
+                    Some((_, p)) => {
+                        let sum = (p.0.checked_mul(power.1))
+                            .zip(power.0.checked_mul(p.1))
+                            .and_then(|(a, b)| a.checked_add(b));
+                        let (Some(n), Some(d)) = (sum, p.1.checked_mul(power.1)) else {
+                            return false;
+                        };
+                        let g = gcd(n.abs(), d.abs());
+                        *p = (n / g, d / g);
+                    }
+                    None => out.push((s.clone(), power)),
+                }
+                true
+            }
+            Expr::Mul(v) => v.iter().all(|f| walk(f, power, out)),
+            Expr::Pow(b, x) => match **x {
+                Expr::Rational(n, d) => match (power.0.checked_mul(n), power.1.checked_mul(d)) {
+                    (Some(pn), Some(pd)) => {
+                        let g = gcd(pn.abs(), pd.abs());
+                        walk(b, (pn / g, pd / g), out)
+                    }
+                    _ => false,
+                },
+                _ => false,
+            },
+            _ => false,
+        }
+    }
+    let mut out = Vec::new();
+    walk(&e.tidy(), (1, 1), &mut out).then(|| {
+        out.into_iter()
+            .filter(|(_, p)| p.0 != 0)
+            .map(|(s, (n, d))| (s, Expr::Rational(n, d)))
+            .collect()
+    })
+}
+
+/// The parameter each group is solved for (see [`GroupSpec`]), in the groups' order; `Err`
+/// with the index of the first group that has none.
+pub fn solved_parameters(groups: &[GroupSpec]) -> Result<Vec<String>, usize> {
+    let mut solved: Vec<String> = Vec::new();
+    for (i, g) in groups.iter().enumerate() {
+        let factors = Expr::parse(&g.expr.text())
+            .ok()
+            .and_then(|e| monomial(&e))
+            .ok_or(i)?;
+        let p = factors
+            .into_iter()
+            .find(|(p, x)| *x == Expr::int(1) && !solved.contains(p))
+            .ok_or(i)?;
+        solved.push(p.0);
+    }
+    Ok(solved)
+}
+
 /// A whole model spec.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -300,6 +407,10 @@ pub struct Spec {
     pub scenery: Vec<ShapeSpec>,
     /// Initial state, one entry per coordinate (except the one the contact eliminates).
     pub initial: BTreeMap<String, InitialSpec>,
+    /// Dimensionless groups and scales in which the results are also written (none: the
+    /// results are written in the parameters only).
+    #[serde(default)]
+    pub dimensionless: Option<DimensionlessSpec>,
 }
 
 /// A spec error with its place.
@@ -704,6 +815,71 @@ impl Checker<'_> {
                 &Field::key("initial").k(extra),
                 format!("`{extra}` is not a coordinate"),
             ));
+        }
+        self.check_dimensionless(&only_params, &force_names, &mut seen)
+    }
+
+    /// Each group a new identifier and a monomial of the parameters that can be solved for
+    /// one of them; the scales expressions of the parameters; the paper's equation numbers
+    /// attached to results the model has.
+    fn check_dimensionless(
+        &self,
+        params: &BTreeSet<String>,
+        force_names: &BTreeSet<String>,
+        seen: &mut BTreeSet<String>,
+    ) -> Result<(), SpecError> {
+        let Some(dim) = &self.spec.dimensionless else {
+            return Ok(());
+        };
+        let field = Field::key("dimensionless");
+        for (i, g) in dim.groups.iter().enumerate() {
+            let f = field.k("groups").i(i);
+            self.identifier(&f.k("name"), &g.name, seen)?;
+            let e = self.expr(&f.k("expr"), &g.expr, params)?;
+            if monomial(&e).is_none() {
+                return Err(self.err(
+                    &f.k("expr"),
+                    format!(
+                        "`{}` is not a product of powers of parameters with a positive \
+                         coefficient (such as `m2/m1` or `k*ell/(m1*g)`)",
+                        g.expr.text()
+                    ),
+                ));
+            }
+        }
+        if let Err(i) = solved_parameters(&dim.groups) {
+            return Err(self.err(
+                &field.k("groups").i(i).k("expr"),
+                format!(
+                    "`{}` has no parameter to the first power that an earlier group was not \
+                     solved for; each group is solved for one parameter (`m2 = n m1` from \
+                     `n: m2/m1`)",
+                    dim.groups[i].expr.text()
+                ),
+            ));
+        }
+        let scales = field.k("scales");
+        self.expr(&scales.k("time"), &dim.scales.time, params)?;
+        self.expr(&scales.k("force"), &dim.scales.force, params)?;
+        for (key, label) in &dim.paper {
+            let known = DIMENSIONLESS_RESULTS.contains(&key.as_str()) || force_names.contains(key);
+            if !known {
+                let mut names: Vec<&str> = DIMENSIONLESS_RESULTS.to_vec();
+                names.extend(force_names.iter().map(String::as_str));
+                return Err(self.err(
+                    &field.k("paper").k(key),
+                    format!(
+                        "`{key}` is not a result of this model (one of: {})",
+                        names.join(", ")
+                    ),
+                ));
+            }
+            if label.trim().is_empty() {
+                return Err(self.err(
+                    &field.k("paper").k(key),
+                    "an equation number cannot be empty".into(),
+                ));
+            }
         }
         Ok(())
     }
