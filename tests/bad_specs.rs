@@ -127,6 +127,14 @@ fn check(
     }
 }
 
+/// Writes `text` as the spec of test `test`, expects it refused, and [`check`]s the error at
+/// the line where `marker` holds `at`, with no column asked.
+fn refused(test: &str, text: &str, (marker, at): (&str, &str), field: &str, words: &[&str]) {
+    let (path, err) = error_of(test, text);
+    let (line, _) = place(text, marker, at);
+    check(&path, &err, (line, None), field, words);
+}
+
 #[test]
 fn the_base_spec_is_valid() {
     // The control for every test below: only the edit makes a spec invalid.
@@ -213,15 +221,14 @@ fn unknown_function() {
 #[test]
 fn a_gap_that_cannot_be_solved_for_its_coordinate() {
     let text = edit("gap: -x1 - ell*cos(theta)", "gap: -x1^2 - ell*cos(theta)");
-    let (path, err) = error_of("gap_not_linear", &text);
-    let (line, _) = place(&text, "gap: -x1^2", "contact");
-    check(
-        &path,
-        &err,
-        (line, None),
+    refused(
+        "gap_not_linear",
+        &text,
+        ("gap: -x1^2", "contact"),
         "contact.gap",
         &["linear in `x1`", "d(gap)/dx1"],
     );
+    let (line, _) = place(&text, "gap: -x1^2", "contact");
     // The same through `derive_all` directly.
     let (root, path) = write("gap_not_linear_direct", &text);
     let checked = spec::load(&path).unwrap_or_else(|e| panic!("{e}"));
@@ -265,12 +272,10 @@ fn a_potential_on_the_body_of_a_measured_force_is_refused() {
         "falling_point: centre\n",
         "falling_point: centre\nforces:\n  - {name: floor_normal, body: rod, direction: [0, 1], meaning: floor push}\npotentials:\n  - {name: spring, expr: x1^2, acts_on: [rod], meaning: a spring on the foot}\n",
     );
-    let (path, err) = error_of("potential_on_measured_body", &text);
-    let (line, _) = place(&text, "name: floor_normal", "floor_normal");
-    check(
-        &path,
-        &err,
-        (line, None),
+    refused(
+        "potential_on_measured_body",
+        &text,
+        ("name: floor_normal", "floor_normal"),
         "forces[0].body",
         &["potential `spring` also acts on that body"],
     );
@@ -341,12 +346,10 @@ fn a_hand_written_next_phase_is_an_unknown_field() {
     let text = format!(
         "{BASE}after_separation:\n  model: no_such_model\n  parameters: {{m1: m1, ell: ell}}\n"
     );
-    let (path, err) = error_of("missing_next", &text);
-    let (line, _) = place(&text, "after_separation:", "after_separation");
-    check(
-        &path,
-        &err,
-        (line, None),
+    refused(
+        "missing_next",
+        &text,
+        ("after_separation:", "after_separation"),
         "",
         &["unknown field `after_separation`"],
     );
@@ -389,12 +392,10 @@ fn a_friction_that_names_no_normal_force_is_refused() {
     let text = with_friction(
         "  - {name: foot_friction, meaning: floor friction, coefficient: mu, normal: floor_push, body: rod, point: [x1, 0], direction: [1, 0]}\n",
     );
-    let (path, err) = error_of("friction_no_normal", &text);
-    let (line, _) = place(&text, "name: foot_friction", "foot_friction");
-    check(
-        &path,
-        &err,
-        (line, None),
+    refused(
+        "friction_no_normal",
+        &text,
+        ("name: foot_friction", "foot_friction"),
         "friction[0].normal",
         &["`floor_push` is not a normal force", "floor_normal"],
     );
@@ -405,12 +406,10 @@ fn a_friction_coefficient_that_is_not_a_parameter_is_refused() {
     let text = with_friction(
         "  - {name: foot_friction, meaning: floor friction, coefficient: 0.3, normal: floor_normal, body: rod, point: [x1, 0], direction: [1, 0]}\n",
     );
-    let (path, err) = error_of("friction_number", &text);
-    let (line, _) = place(&text, "name: foot_friction", "foot_friction");
-    check(
-        &path,
-        &err,
-        (line, None),
+    refused(
+        "friction_number",
+        &text,
+        ("name: foot_friction", "foot_friction"),
         "friction[0].coefficient",
         &["is not a parameter"],
     );
@@ -421,12 +420,10 @@ fn a_friction_direction_that_is_not_a_unit_vector_is_refused() {
     let text = with_friction(
         "  - {name: foot_friction, meaning: floor friction, coefficient: mu, normal: floor_normal, body: rod, point: [x1, 0], direction: [2, 0]}\n",
     );
-    let (path, err) = error_of("friction_direction", &text);
-    let (line, _) = place(&text, "name: foot_friction", "foot_friction");
-    check(
-        &path,
-        &err,
-        (line, None),
+    refused(
+        "friction_direction",
+        &text,
+        ("name: foot_friction", "foot_friction"),
         "friction[0].direction",
         &["not a unit vector"],
     );
@@ -437,12 +434,10 @@ fn a_body_rubbing_against_itself_is_refused() {
     let text = with_friction(
         "  - {name: foot_friction, meaning: floor friction, coefficient: mu, normal: floor_normal, body: rod, against: rod, point: [x1, 0], direction: [1, 0]}\n",
     );
-    let (path, err) = error_of("friction_itself", &text);
-    let (line, _) = place(&text, "name: foot_friction", "foot_friction");
-    check(
-        &path,
-        &err,
-        (line, None),
+    refused(
+        "friction_itself",
+        &text,
+        ("name: foot_friction", "foot_friction"),
         "friction[0].against",
         &["cannot rub against itself"],
     );
@@ -454,12 +449,10 @@ fn a_shape_over_the_coordinates_is_refused() {
         "    angle: theta\n",
         "    angle: theta\n    shape: {segment: [[0, 0], [ell*cos(theta), 0]]}\n",
     );
-    let (path, err) = error_of("shape_coordinates", &text);
-    let (line, _) = place(&text, "shape:", "shape");
-    check(
-        &path,
-        &err,
-        (line, None),
+    refused(
+        "shape_coordinates",
+        &text,
+        ("shape:", "shape"),
         "bodies[0].shape.segment[1][0]",
         &["undefined symbol `theta`", "allowed here: a, ell, g, m1"],
     );
@@ -471,12 +464,10 @@ fn a_shape_of_two_kinds_or_an_unknown_kind_is_refused() {
         "    angle: theta\n",
         "    angle: theta\n    shape: {rectangle: [ell, a], circle: a}\n",
     );
-    let (path, err) = error_of("shape_two_kinds", &text);
-    let (line, _) = place(&text, "shape:", "shape");
-    check(
-        &path,
-        &err,
-        (line, None),
+    refused(
+        "shape_two_kinds",
+        &text,
+        ("shape:", "shape"),
         "bodies[0].shape",
         &["exactly one of", "found rectangle and circle"],
     );
@@ -484,12 +475,10 @@ fn a_shape_of_two_kinds_or_an_unknown_kind_is_refused() {
         "    angle: theta\n",
         "    angle: theta\n    shape: {polygon: [[0, 0], [ell, 0]]}\n",
     );
-    let (path, err) = error_of("shape_unknown_kind", &text);
-    let (line, _) = place(&text, "shape:", "shape");
-    check(
-        &path,
-        &err,
-        (line, None),
+    refused(
+        "shape_unknown_kind",
+        &text,
+        ("shape:", "shape"),
         "bodies[0].shape",
         &["unknown field `polygon`"],
     );
@@ -501,12 +490,10 @@ fn scenery_over_the_coordinates_is_refused() {
         "initial:\n",
         "scenery:\n  - {segment: [[0, 0], [x1, ell]]}\ninitial:\n",
     );
-    let (path, err) = error_of("scenery_coordinates", &text);
-    let (line, _) = place(&text, "[x1, ell]", "segment");
-    check(
-        &path,
-        &err,
-        (line, None),
+    refused(
+        "scenery_coordinates",
+        &text,
+        ("[x1, ell]", "segment"),
         "scenery[0].segment[1][0]",
         &["undefined symbol `x1`"],
     );
