@@ -179,7 +179,7 @@ impl From<LeanPoint> for RodcubePoint {
         RodcubePoint {
             separation_angle: point.separation_angle,
             separation_time: point.separation_time,
-            delta: point.delta,
+            delta: point.delta(),
         }
     }
 }

@@ -240,3 +240,24 @@ fn the_default_theta_dot_sq_sc_keeps_its_digits_near_the_start() {
         }
     }
 }
+
+#[test]
+fn the_angle_fallen_agrees_with_the_difference_of_the_angles() {
+    // `delta()` is formed from the sines without the subtraction; where delta is a good part
+    // of theta_i the subtraction `theta_i - theta_sep` loses little and the two must agree to
+    // its rounding (a few ulps of theta_i, relative to delta).
+    let mut solver = LeanSolver::new(rod_cube()).unwrap();
+    for n in [1e-3, 0.3, 3.0, 1e3] {
+        for r in [0.01, 0.2, 0.5, 0.8, 0.99] {
+            let out = solver.solve(&[1.0, n, 1.0, r, 9.81]).unwrap();
+            let theta_i = r.asin();
+            let difference = theta_i - out.separation_angle;
+            let allowed = 4.0 * f64::EPSILON * theta_i / difference;
+            assert!(
+                rel(out.delta(), difference) <= allowed,
+                "n = {n}, r = {r}: {} vs {difference}",
+                out.delta()
+            );
+        }
+    }
+}

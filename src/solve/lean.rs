@@ -30,8 +30,29 @@ pub struct LeanPoint {
     pub separation_angle: f64,
     /// Time from release to separation (s).
     pub separation_time: f64,
-    /// `theta_i - theta_sep` (rad).
-    pub delta: f64,
+    /// `sin(theta_i)`, `cos(theta_i)`, `sin(theta_sep)` and the drop `sin(theta_i) -
+    /// sin(theta_sep)`, from which [`LeanPoint::delta`] is formed when asked.
+    sines: [f64; 4],
+}
+
+impl LeanPoint {
+    /// `delta = theta_i - theta_sep` (rad), the angle fallen, formed only when asked (its
+    /// `atan2` is not part of the per-point cost): `atan2(sin delta, cos delta)` with
+    /// `sin delta = (s_i - s)(s_i + s) / (s_i c + c_i s)` from the drop, without the
+    /// cancellation of `theta_i - theta_sep` or of `s_i c - c_i s` when `delta` is small.
+    pub fn delta(&self) -> f64 {
+        let [si, ci, s, drop] = self.sines;
+        let c = ((1.0 - s) * (1.0 + s)).sqrt();
+        // sin(theta_i + theta_sep): the identity's denominator; near zero (theta_sep near
+        // -theta_i, delta far from small) the plain difference is as accurate.
+        let sum = si * c + ci * s;
+        let sin_delta = if sum > 0.5 * (si * c).abs() {
+            drop * (si + s) / sum
+        } else {
+            si * c - ci * s
+        };
+        sin_delta.atan2(ci * c + si * s)
+    }
 }
 
 /// A reusable per-point solver of one model's separation angle and time.
@@ -196,25 +217,55 @@ impl<'m> LeanSolver<'m> {
 
     /// The separation angle and time from prepared constants.
     fn solve_prepared(&mut self) -> Result<LeanPoint, SolveError> {
-        let (theta, drop) = self.separation()?;
-        let delta = self.k[self.layout.k_theta_initial] - theta;
+        let (s, drop) = self.separation()?;
+        let (si, ci) = (
+            self.k[self.layout.k_sin_initial],
+            self.k[self.layout.k_cos_initial],
+        );
+        let point = |separation_time| LeanPoint {
+            separation_angle: s.asin(),
+            separation_time,
+            sines: [si, ci, s, drop],
+        };
+        // The phase's end for messages, formed only for one.
+        let delta_end = || point(f64::NAN).delta();
+        if !(drop > 0.0 && drop.is_finite()) {
+            return Err(SolveError::BadPhaseEnd {
+                model: self.info.name,
+                delta_end: delta_end(),
+            });
+        }
+        match self.time(drop) {
+            Ok(t) => Ok(point(t)),
+            Err(SolveError::TurningPoint {
+                model,
+                delta,
+                theta_dot_sq,
+                ..
+            }) => Err(SolveError::TurningPoint {
+                model,
+                delta,
+                theta_dot_sq,
+                delta_end: delta_end(),
+            }),
+            Err(e) => Err(e),
+        }
+    }
+
+    /// The time from the start to the drop `sin(theta_i) - sin(theta_sep) = drop > 0`.
+    fn time(&mut self, drop: f64) -> Result<f64, SolveError> {
         if !self.fall.is_empty() {
             self.red.fall_polynomial(&self.k, &mut self.fall);
         }
+        // The phase's end is given to messages by the caller.
         let fall = Fall::new(
             self.info.name,
             self.red,
             &self.k,
             self.layout,
             &self.fall,
-            delta,
+            f64::NAN,
         )?;
-        if !(drop > 0.0 && drop.is_finite() && delta > 0.0) {
-            return Err(SolveError::BadPhaseEnd {
-                model: self.info.name,
-                delta_end: delta,
-            });
-        }
         let v_end = fall.v_at_drop(drop);
         let prior = match &self.prior {
             Some(prior) => integrate_prior(&fall, v_end, prior)?,
@@ -225,28 +276,67 @@ impl<'m> LeanSolver<'m> {
             None => quadrature::integrate(&fall, v_end, &self.control, &mut self.stack, |_| {})?,
         };
         self.evals += evals;
-        Ok(LeanPoint {
-            separation_angle: theta,
-            separation_time: t,
-            delta,
-        })
+        Ok(t)
     }
 
-    /// `(theta_sep, sin(theta_i) - sin(theta_sep))` from the largest sign-changing root of the
-    /// separation polynomial in `(sin(end_angle), sin(theta_i))`.
+    /// `(sin(theta_sep), sin(theta_i) - sin(theta_sep))` from the largest sign-changing root of
+    /// the separation polynomial in `(sin(end_angle), sin(theta_i))`.
     fn separation(&mut self) -> Result<(f64, f64), SolveError> {
         let info = self.info;
         self.red.separation_polynomial(&self.k, &mut self.coeffs);
         let hi = self.k[self.layout.k_sin_initial];
         let root = separation_root(info.name, &self.coeffs, self.sin_end, hi, &mut self.evals)?;
         match root {
-            Some(s) => Ok((s.asin(), hi - s)),
+            Some(s) => Ok((s, hi - s)),
             None => Err(SolveError::NoSeparation {
                 model: info.name,
                 coefficients: self.coeffs.clone(),
                 lo: self.sin_end,
                 hi,
             }),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::LeanPoint;
+
+    fn point(si: f64, s: f64) -> LeanPoint {
+        LeanPoint {
+            separation_angle: s.asin(),
+            separation_time: 0.0,
+            sines: [si, ((1.0 - si) * (1.0 + si)).sqrt(), s, si - s],
+        }
+    }
+
+    #[test]
+    fn a_tiny_angle_fallen_keeps_its_digits() {
+        // delta = asin(si) - asin(si - d) = d / c - d^2 si / (2 c^3) + d^3 (1 + 2 si^2) /
+        // (6 c^5) + O(d^4): with d = 1e-9 si the series is exact to 1e-20 relative, while
+        // `theta_i - theta_sep` would keep only about 7 digits.
+        for si in [0.01f64, 0.3, 0.7, 0.99] {
+            // The drop as the floats hold it (exact, by Sterbenz's lemma).
+            let s = si - 1e-9 * si;
+            let d = si - s;
+            let c = ((1.0 - si) * (1.0 + si)).sqrt();
+            let u = d / (c * c);
+            let series = d / c * (1.0 - u * si / 2.0 + u * u * (1.0 + 2.0 * si * si) / 6.0);
+            let got = point(si, s).delta();
+            assert!(
+                ((got - series) / series).abs() < 4.0 * f64::EPSILON,
+                "si = {si}: {got} vs {series}"
+            );
+        }
+        // A large angle fallen, and one past theta_sep = -theta_i (the identity's denominator
+        // vanishes there; the plain difference of products serves).
+        for (si, s) in [(0.9f64, 0.1f64), (0.5, -0.5), (0.6, -0.59)] {
+            let want = si.asin() - s.asin();
+            let got = point(si, s).delta();
+            assert!(
+                ((got - want) / want).abs() < 1e-15,
+                "{si} {s}: {got} vs {want}"
+            );
         }
     }
 }

@@ -34,8 +34,17 @@ pub fn real_roots(coeffs: &[f64], lo: f64, hi: f64, evals: &mut u64) -> Option<V
 /// `None` when the degree exceeds [`MAX_DEGREE`].
 pub fn largest_root(coeffs: &[f64], lo: f64, hi: f64, evals: &mut u64) -> Option<Option<f64>> {
     let degree = coeffs.iter().rposition(|&c| c != 0.0).unwrap_or(0);
-    if (2..=3).contains(&degree) && lo < hi {
-        return Some(largest_low(&coeffs[..=degree], lo, hi, evals));
+    // A quadratic or cubic, as a cubic (a quadratic's leading coefficient 0) of known length,
+    // so that every evaluation below unrolls.
+    let low = match coeffs.get(..=degree) {
+        Some(&[c0, c1, c2]) => Some([c0, c1, c2, 0.0]),
+        Some(&[c0, c1, c2, c3]) => Some([c0, c1, c2, c3]),
+        _ => None,
+    };
+    if let Some(c4) = low
+        && lo < hi
+    {
+        return Some(largest_low(c4, lo, hi, evals));
     }
     let mut out = [0.0; MAX_DEGREE];
     let n = roots_in(coeffs, lo, hi, &mut out, evals)?;
@@ -44,11 +53,7 @@ pub fn largest_root(coeffs: &[f64], lo: f64, hi: f64, evals: &mut u64) -> Option
 
 /// [`largest_root`] for a quadratic or cubic (trimmed, `lo < hi`): the critical points by the
 /// quadratic formula, then only the highest piece with a sign change is refined.
-fn largest_low(coeffs: &[f64], lo: f64, hi: f64, evals: &mut u64) -> Option<f64> {
-    // As a cubic (a quadratic's leading coefficient 0) of known length, so that every
-    // evaluation below unrolls.
-    let mut c4 = [0.0; 4];
-    c4[..coeffs.len()].copy_from_slice(coeffs);
+fn largest_low(c4: [f64; 4], lo: f64, hi: f64, evals: &mut u64) -> Option<f64> {
     if let Some(root) = certified_low(c4, lo, hi, evals) {
         return Some(root);
     }

@@ -82,8 +82,11 @@ impl Prior {
     /// The rule for a panel whose nearest singularity has Bernstein parameter `rho`, if one of
     /// at most [`PRIOR_MAX_NODES`] nodes suffices.
     fn rule_for(&self, rho: f64) -> Option<&'static HalfRule> {
-        // Thresholds fall with the node count: the first one `rho` reaches.
-        let j = self.thresholds.partition_point(|&t| rho < t);
+        // Thresholds fall with the node count: the first one `rho` reaches (a scan from the
+        // fewest nodes, as most panels need few).
+        let j = (self.thresholds.iter())
+            .position(|&t| rho >= t)
+            .unwrap_or(self.thresholds.len());
         self.rules.get(j).copied()
     }
 }

@@ -241,13 +241,7 @@ fn sinh_sq(y: f64) -> f64 {
     let ay = y.abs();
     if ay < 0.5 {
         let z = y * y;
-        let r = 1.0
-            + z * (1.0 / 6.0
-                + z * (1.0 / 120.0
-                    + z * (1.0 / 5040.0
-                        + z * (1.0 / 362_880.0
-                            + z * (1.0 / 39_916_800.0
-                                + z * (1.0 / 6_227_020_800.0 + z / 1_307_674_368_000.0))))));
+        let r = sinh_ratio_series(z);
         z * r * r
     } else {
         let e = ay.exp();
@@ -255,6 +249,33 @@ fn sinh_sq(y: f64) -> f64 {
         sh * sh
     }
 }
+
+/// [`sinh_sq`] of two arguments in the same arithmetic (the compiler packs the lanes).
+#[inline(always)]
+fn sinh_sq2(y: [f64; 2]) -> [f64; 2] {
+    if y[0].abs() < 0.5 && y[1].abs() < 0.5 {
+        let z = [y[0] * y[0], y[1] * y[1]];
+        let r = [sinh_ratio_series(z[0]), sinh_ratio_series(z[1])];
+        [z[0] * r[0] * r[0], z[1] * r[1] * r[1]]
+    } else {
+        [sinh_sq(y[0]), sinh_sq(y[1])]
+    }
+}
+
+/// `sinh(y) / y` for `z = y^2 < 1/4` by its Taylor series to `y^14` (below 2^-55 relative).
+#[inline(always)]
+fn sinh_ratio_series(z: f64) -> f64 {
+    1.0 + z
+        * (1.0 / 6.0
+            + z * (1.0 / 120.0
+                + z * (1.0 / 5040.0
+                    + z * (1.0 / 362_880.0
+                        + z * (1.0 / 39_916_800.0
+                            + z * (1.0 / 6_227_020_800.0 + z / 1_307_674_368_000.0))))))
+}
+
+/// `sinh^2 v` just past the start where [`Fall::new`] asks whether the phase falls.
+const FALL_CHECK_SH2: f64 = 1e-8;
 
 /// Largest `h x` at which a panel's node `mid - h x` is formed by the addition theorem (its
 /// rounding then grows by at most `exp(2 h x) = 2`).
@@ -317,6 +338,7 @@ impl<'a> Fall<'a> {
     ///
     /// `fall` holds the coefficients of the model's fall polynomial
     /// ([`Reduction::fall_polynomial`]) where it has one, else it is empty.
+    #[inline(always)]
     pub fn new(
         model: &'static str,
         red: &'a dyn Reduction,
@@ -332,6 +354,7 @@ impl<'a> Fall<'a> {
 
     /// The phase's constants, checking only that it does not rise and starts below the
     /// vertical (what [`Fall::new`] checks before asking whether it falls).
+    #[inline(always)]
     fn geometry(
         model: &'static str,
         red: &'a dyn Reduction,
@@ -342,7 +365,6 @@ impl<'a> Fall<'a> {
     ) -> Result<Fall<'a>, SolveError> {
         let theta_dot = k[layout.k_theta_dot_initial];
         let (si, ci) = (k[layout.k_sin_initial], k[layout.k_cos_initial]);
-        let theta_initial = k[layout.k_theta_initial];
         if theta_dot > 0.0 {
             return Err(SolveError::Rising { model, theta_dot });
         }
@@ -351,7 +373,7 @@ impl<'a> Fall<'a> {
         if !(e > 0.0 && e.is_finite() && si.abs() < 1.0 && ci > 0.0) {
             return Err(SolveError::BeyondVertical {
                 model,
-                theta_initial,
+                theta_initial: k[layout.k_theta_initial],
             });
         }
         let from_rest = theta_dot == 0.0;
@@ -379,13 +401,20 @@ impl<'a> Fall<'a> {
     }
 
     /// From rest (or with a rate that is not a number) the rod must start to fall.
+    #[inline(always)]
     fn check_falls(&self, theta_dot: f64) -> Result<(), SolveError> {
-        let (model, red, k) = (self.model, self.red, self.k);
         // With a fall polynomial, one value of fixed shape settles the usual case.
-        let sh2 = 1e-8;
-        if self.low && theta_dot == 0.0 && self.fall_value(sh2) > 0.0 {
+        if self.low && theta_dot == 0.0 && self.fall_value(FALL_CHECK_SH2) > 0.0 {
             return Ok(());
         }
+        self.check_falls_by_value(theta_dot)
+    }
+
+    /// [`Fall::check_falls`] by the integrand's value just past the start.
+    #[cold]
+    fn check_falls_by_value(&self, theta_dot: f64) -> Result<(), SolveError> {
+        let (model, red, k) = (self.model, self.red, self.k);
+        let sh2 = FALL_CHECK_SH2;
         if self.from_rest || theta_dot.is_nan() {
             // The rod must start to fall: theta_dot^2 positive just past the start (at
             // sinh v = 1e-4, a drop of 1e-8 e; one rational evaluation, the trigonometry of
@@ -549,6 +578,22 @@ impl<'a> Fall<'a> {
         2.0 * (p / (1.0 + s)).sqrt()
     }
 
+    /// [`Fall::fall_value`] at two nodes in the same arithmetic (the compiler packs the lanes).
+    #[inline(always)]
+    fn fall_value2(&self, sh2: [f64; 2]) -> [f64; 2] {
+        let [p0, p1, p2] = self.quadratic;
+        let s = [self.si - self.e * sh2[0], self.si - self.e * sh2[1]];
+        if self.low {
+            let p = [p0 + s[0] * (p1 + s[0] * p2), p0 + s[1] * (p1 + s[1] * p2)];
+            [
+                2.0 * (p[0] / (1.0 + s[0])).sqrt(),
+                2.0 * (p[1] / (1.0 + s[1])).sqrt(),
+            ]
+        } else {
+            [self.fall_value(sh2[0]), self.fall_value(sh2[1])]
+        }
+    }
+
     /// The error for a fall polynomial that is not positive and finite at `sinh^2 v = sh2`.
     fn bad_fall(&self, sh2: f64) -> SolveError {
         let ds = self.e * sh2;
@@ -574,15 +619,23 @@ impl<'a> Fall<'a> {
         }
         if symmetric {
             acc *= 0.5;
-            for &(x, w) in &rule.pairs {
+            let mut chunks = rule.pairs.chunks_exact(2);
+            let (mut acc2, mut least2) = ([acc, 0.0], [least, f64::INFINITY]);
+            for c in &mut chunks {
+                let f = self.fall_value2(sinh_sq2([half * c[0].0, half * c[1].0]));
+                least2 = [least2[0].min(f[0]), least2[1].min(f[1])];
+                acc2 = [acc2[0] + c[0].1 * f[0], acc2[1] + c[1].1 * f[1]];
+            }
+            (acc, least) = (acc2[0] + acc2[1], least2[0].min(least2[1]));
+            for &(x, w) in chunks.remainder() {
                 let f = self.fall_value(sinh_sq(half * x));
                 least = least.min(f);
                 acc += w * f;
             }
         } else {
             for &(x, w) in &rule.pairs {
-                let up = self.fall_value(sinh_sq(centre + half * x));
-                let down = self.fall_value(sinh_sq(centre - half * x));
+                let hx = half * x;
+                let [up, down] = self.fall_value2(sinh_sq2([centre + hx, centre - hx]));
                 least = least.min(up.min(down));
                 acc += w * (up + down);
             }
