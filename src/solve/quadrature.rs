@@ -29,7 +29,9 @@
 //! ([`Reduction::fall_polynomial`]), the integrand is `2 sqrt(P(s) / (1 + s))`: one polynomial,
 //! one division and one root per node, no call to the model and no `cos(theta)`, and the same
 //! at `v = 0`. Each node then takes `sinh^2 v` by itself (a series below 1/2, one `exp`
-//! above), which also spares the addition theorem's cancellation on long panels. The
+//! above), which also spares the addition theorem's cancellation on long panels. Nodes are
+//! taken two at a time in the same arithmetic (`sinh_sq2`, `Fall::fall_value2`), which the
+//! compiler packs into SSE2 pairs (`sqrtpd`, `divpd`) where the target allows. The
 //! per-point solver chooses its rules for such phases a priori
 //! ([`prior`](crate::solve::prior)); the verified pairs below serve everything else.
 //!
