@@ -167,8 +167,9 @@ pub struct ReductionInfo {
     pub polynomial_separation: bool,
     /// Degree of the fall polynomial [`Reduction::fall_polynomial`], where the phase has one.
     pub fall_degree: Option<usize>,
-    /// Indices in `k` (beyond the parameters) that [`Reduction::prepare_lean`] fills: the start
-    /// and the two polynomials' coefficients with what they are computed from.
+    /// Indices in `k` (beyond the parameters) that [`Reduction::prepare_lean`] fills: the start's
+    /// sine, cosine and rate (not the angle `theta_i`, which only [`Model::prepare`] forms) and
+    /// the two polynomials' coefficients with what they are computed from.
     pub lean_constants: &'static [usize],
 }
 
@@ -333,8 +334,8 @@ pub trait Reduction: Send + Sync {
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]);
 
     /// [`Model::prepare`] for the per-point solver: copies the parameters into `k` and computes
-    /// only the constants of [`ReductionInfo::lean_constants`] (the start, the separation and
-    /// fall polynomials), leaving the others as they were.
+    /// only the constants of [`ReductionInfo::lean_constants`] (the start's sine, cosine and rate,
+    /// and the separation and fall polynomials), leaving the others as they were.
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]);
 
     /// The full state on the reduced motion at time `t`, angle fallen `delta` and rate

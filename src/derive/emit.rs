@@ -5,6 +5,7 @@ use super::dimensionless::Dimensionless;
 use super::expr::Expr;
 use super::lower::{Body, Hoisted, Scope, lower};
 use super::mechanics::{self, Binding, Derivation, Reduction, from_sc, to_sc_expr};
+use super::method::{Preamble, method};
 use super::present;
 use super::spec::Checked;
 use serde::Serialize;
@@ -13,14 +14,33 @@ use std::collections::BTreeMap;
 /// The command that regenerates `generated/`, named in every file header.
 pub const COMMAND: &str = "cargo run --release --features derive -- derive";
 
-/// A straight-line function body: statements, then outputs.
+/// A straight-line function body: statements, then outputs; [`Code::finish`] makes it a
+/// method's argument list and lines.
 #[derive(Debug, Clone, Serialize, Default)]
 pub struct Code {
     stmts: Vec<String>,
     outputs: Vec<String>,
+    /// The method's arguments after `&self`, an unread one spelled with a leading `_`.
+    args: String,
+    /// The method's body: the preamble it reads, the statements and the outputs.
+    lines: Vec<String>,
 }
 
+/// Arguments of the generated methods (name, Rust type).
+const K: (&str, &str) = ("k", "&[f64]");
+const Q: (&str, &str) = ("q", "&[f64]");
+const QD: (&str, &str) = ("qd", "&[f64]");
+const OUT: (&str, &str) = ("out", "&mut [f64]");
+const DELTA: (&str, &str) = ("delta", "f64");
+
 impl Code {
+    /// Fills `args` and `lines` for a method with arguments `args`, whose body may start with
+    /// `preamble` (see [`method::method`]).
+    fn finish(&mut self, args: &[(&str, &str)], preamble: &[Preamble]) {
+        let body = self.stmts.iter().chain(&self.outputs).cloned().collect();
+        (self.args, self.lines) = method(args, preamble, body);
+    }
+
     fn push_body(&mut self, body: Body) -> Vec<String> {
         self.stmts.extend(
             body.lets
@@ -163,11 +183,11 @@ fn out_lines(outputs: &[String]) -> Vec<String> {
 pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, String> {
     let spec = &checked.spec;
     let np = d.params.len();
-    let (scope, mut prepare) = constant_layout(d);
-    let mut hoisted = Hoisted::new(scope.constants.len());
+    let (scope, mut prepare, own) = constant_layout(d);
+    let mut hoisted = Hoisted::new(np + own.len());
     if let Ok(r) = &d.reduction {
-        for (j, c) in r.constants.iter().enumerate() {
-            hoisted.known(&c.value, np + j);
+        for &(j, slot) in &own {
+            hoisted.known(&r.constants[j].value, slot);
         }
     }
     let general = full_state_code(d, &scope, &mut hoisted)?;
@@ -193,18 +213,19 @@ pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, St
     let mut reduction = reduction;
     let mut lean_indices = Vec::new();
     if let (Ok(r), Some(code)) = (&d.reduction, reduction.as_mut()) {
-        let (lean, indices) = lean_prepare(np, r, &scope, &hoisted, code)?;
+        let (lean, indices) = lean_prepare(np, r, &own, &scope, &hoisted, code)?;
         code.prepare_lean = lean;
         code.lean_constants = indices.clone();
         prepare = Code::default();
         prepare
             .stmts
             .push("Reduction::prepare_lean(self, p, k);".into());
-        for (j, c) in r.constants.iter().enumerate() {
-            if !indices.contains(&(np + j)) {
+        for &(j, slot) in &own {
+            if !indices.contains(&slot) {
+                let c = &r.constants[j];
                 bind_constant(
                     &mut prepare,
-                    np + j,
+                    slot,
                     Some(&c.symbol),
                     &c.value,
                     &scope,
@@ -218,6 +239,24 @@ pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, St
         if !lean_indices.contains(i) {
             bind_constant(&mut prepare, *i, None, e, &scope, &format!("h{i}_"));
         }
+    }
+    // A named constant that is another one lives in its slot: `prepare` starts by saying so.
+    if let Ok(r) = &d.reduction {
+        let notes = r
+            .constants
+            .iter()
+            .enumerate()
+            .filter(|(j, _)| !own.iter().any(|&(o, _)| o == *j))
+            .filter_map(|(_, c)| {
+                let i = scope.constants.get(&c.symbol)?;
+                Some(format!(
+                    "// k[{i}] also holds {} = {}",
+                    c.symbol,
+                    c.value.to_infix()
+                ))
+            })
+            .collect::<Vec<_>>();
+        prepare.stmts.splice(0..0, notes);
     }
 
     // Static info.
@@ -271,6 +310,24 @@ pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, St
         }
         _ => None,
     };
+    // Every method's arguments and lines, now that the code is complete.
+    prepare
+        .stmts
+        .insert(0, format!("k[..{np}].copy_from_slice(p);"));
+    prepare.finish(&[("p", "&[f64]"), ("k", "&mut [f64]")], &[]);
+    requirements.finish(&[("p", "&[f64]"), OUT], &[Preamble::Let("k", "p")]);
+    let mut general = general;
+    general.finish(n_constants, d.reduced);
+    if let Some(code) = reduction.as_mut() {
+        code.finish(n_constants, np, d.reduced);
+    }
+    let mut drawing = drawing;
+    let poses = ("poses", "&mut [[f64; 3]]");
+    let sizes = ("sizes", "&mut [f64]");
+    drawing.finish(
+        &[K, Q, poses, sizes],
+        &[Preamble::Slice(n_constants), Preamble::Angle(d.reduced)],
+    );
     let named = |v: &[mechanics::Named]| {
         v.iter()
             .map(|n| Named {
@@ -363,9 +420,11 @@ pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, St
     })
 }
 
-/// The constant layout of `k`: the parameters, then the reduction's constants (computed in
-/// `prepare`, which this starts); hoisted subexpressions follow them.
-fn constant_layout(d: &Derivation) -> (Scope, Code) {
+/// The constant layout of `k`: the parameters, then the reduction's constants that hold a
+/// slot of their own (computed in `prepare`, which this starts); hoisted subexpressions follow
+/// them. Returns the scope, the start of `prepare` and, for each reduction constant with a slot
+/// of its own (all but an [`alias`]), its position in the reduction and its slot.
+fn constant_layout(d: &Derivation) -> (Scope, Code, Vec<(usize, usize)>) {
     let np = d.params.len();
     let mut scope = Scope::default();
     for (i, p) in d.params.iter().enumerate() {
@@ -376,19 +435,36 @@ fn constant_layout(d: &Derivation) -> (Scope, Code) {
         Ok(r) => r.constants.as_slice(),
         Err(_) => &[],
     };
+    let mut own = Vec::new();
     for (j, c) in constants.iter().enumerate() {
-        let idx = np + j;
+        if let Some(i) = alias(&c.value, &scope) {
+            // Another constant under a new name (a start value that is a parameter, say):
+            // read where that one is.
+            scope.constants.insert(c.symbol.clone(), i);
+            continue;
+        }
+        let slot = np + own.len();
         bind_constant(
             &mut prepare,
-            idx,
+            slot,
             Some(&c.symbol),
             &c.value,
             &scope,
             &format!("c{j}_"),
         );
-        scope.constants.insert(c.symbol.clone(), idx);
+        scope.constants.insert(c.symbol.clone(), slot);
+        own.push((j, slot));
     }
-    (scope, prepare)
+    (scope, prepare, own)
+}
+
+/// The slot of the constant that `value` is, when it is just one (a parameter or an earlier
+/// constant).
+fn alias(value: &Expr, scope: &Scope) -> Option<usize> {
+    match value {
+        Expr::Sym(s) => scope.constants.get(s).copied(),
+        _ => None,
+    }
 }
 
 /// `k[idx] = <value>;`, with the value's shared subexpressions as `let`s named by `prefix`,
@@ -426,31 +502,28 @@ fn k_indices(text: &str) -> Vec<usize> {
 fn lean_prepare(
     np: usize,
     r: &Reduction,
+    own: &[(usize, usize)],
     scope: &Scope,
     hoisted: &Hoisted,
     code: &ReducedCode,
 ) -> Result<(Code, Vec<usize>), String> {
     let index = |name: &str| scope.constants.get(name).copied();
     let definition = |i: usize| -> Option<&Expr> {
-        if i < np {
-            None
-        } else if i < np + r.constants.len() {
-            Some(&r.constants[i - np].value)
-        } else {
-            hoisted
-                .entries
-                .iter()
-                .find(|(j, _)| *j == i)
-                .map(|(_, e)| e)
-        }
+        own.iter()
+            .find(|&&(_, slot)| slot == i)
+            .map(|&(j, _)| &r.constants[j].value)
+            .or_else(|| {
+                hoisted
+                    .entries
+                    .iter()
+                    .find(|(j, _)| *j == i)
+                    .map(|(_, e)| e)
+            })
     };
     let wi = index("rc_wi").ok_or("the reduction has no constant `rc_wi`")?;
-    let mut stack = vec![
-        code.k_theta_initial,
-        code.k_sin_initial,
-        code.k_cos_initial,
-        wi,
-    ];
+    // The start enters the lean path through its sine, cosine and rate only: the angle itself
+    // (an `asin`) is left to the full `prepare`.
+    let mut stack = vec![code.k_sin_initial, code.k_cos_initial, wi];
     for line in [&code.separation, &code.fall]
         .into_iter()
         .flat_map(|c| c.stmts.iter().chain(&c.outputs))
@@ -466,11 +539,12 @@ fn lean_prepare(
         }
     }
     let mut lean = Code::default();
-    for (j, c) in r.constants.iter().enumerate() {
-        if needed.contains(&(np + j)) {
+    for &(j, slot) in own {
+        let c = &r.constants[j];
+        if needed.contains(&slot) {
             bind_constant(
                 &mut lean,
-                np + j,
+                slot,
                 Some(&c.symbol),
                 &c.value,
                 scope,
@@ -511,6 +585,88 @@ struct FullStateCode {
     monitors_full: Code,
     contact_edge: Code,
     released: Code,
+}
+
+impl FullStateCode {
+    /// Each method's arguments and lines; `n` is the length of `k`, `reduced` the index of the
+    /// reduced coordinate.
+    fn finish(&mut self, n: usize, reduced: usize) {
+        let (slice, angle) = (Preamble::Slice(n), Preamble::Angle(reduced));
+        let state = [slice, angle];
+        let qm = ("q", "&mut [f64]");
+        let qdm = ("qd", "&mut [f64]");
+        self.initial_state.finish(&[K, qm, qdm], &[slice]);
+        let pos = ("pos", "&mut [[f64; 2]]");
+        let vel = ("vel", "&mut [[f64; 2]]");
+        self.points.finish(&[K, Q, QD, pos, vel], &state);
+        self.energy.finish(&[K, Q, QD], &state);
+        self.momenta.finish(&[K, Q, QD, OUT], &state);
+        let mass = ("mass", "&mut [f64]");
+        let rhs = ("rhs", "&mut [f64]");
+        self.equations.finish(&[K, Q, QD, mass, rhs], &state);
+        let qdd = ("qdd", "&[f64]");
+        let fr = ("fr", "&[f64]");
+        self.forces_full.finish(&[K, Q, QD, qdd, fr, OUT], &state);
+        let jac = ("jac", "&mut [f64]");
+        let bias = ("bias", "&mut [f64]");
+        self.friction.finish(&[K, Q, QD, jac, bias], &state);
+        let forces = ("forces", "&[f64]");
+        self.monitors_full.finish(&[K, Q, QD, forces, OUT], &state);
+        self.contact_edge.finish(&[K, Q], &state);
+        self.released.finish(&[K, Q, QD, OUT], &state);
+    }
+}
+
+impl ReducedCode {
+    /// Each method's arguments and lines; `n` is the length of `k`, `np` the number of
+    /// parameters, `reduced` the index of the reduced coordinate.
+    fn finish(&mut self, n: usize, np: usize, reduced: usize) {
+        let slice = Preamble::Slice(n);
+        let start =
+            Preamble::Offsets([self.k_theta_initial, self.k_sin_initial, self.k_cos_initial]);
+        let delta = Preamble::Let("rc_delta", "delta");
+        if let [w2, acc] = &self.reduced_code.outputs[..] {
+            self.reduced_code.outputs = vec![format!(
+                "Reduced {{ sin: rc_s, cos: rc_c, theta_dot_sq: {w2}, theta_ddot: {acc} }}"
+            )];
+        }
+        self.reduced_code
+            .finish(&[K, DELTA], &[slice, start, delta]);
+        let sc = ["rc_s", "rc_c", "rc_ds", "rc_dc"].map(|s| (s, "f64"));
+        self.theta_dot_sq_code
+            .finish(&[K, sc[0], sc[1], sc[2], sc[3]], &[slice]);
+        self.forces.outputs = out_lines(&self.forces.outputs);
+        self.forces.finish(&[K, DELTA, OUT], &[slice, start, delta]);
+        self.separation.outputs = out_lines(&self.separation.outputs);
+        self.separation.finish(&[K, OUT], &[slice]);
+        self.fall.outputs = out_lines(&self.fall.outputs);
+        self.fall.finish(&[K, OUT], &[slice]);
+        self.prepare_lean
+            .stmts
+            .insert(0, format!("k[..{np}].copy_from_slice(p);"));
+        self.prepare_lean
+            .finish(&[("p", "&[f64]"), ("k", "&mut [f64]")], &[]);
+        let head = [
+            format!("q[{reduced}] = k[{}] - delta;", self.k_theta_initial),
+            format!("qd[{reduced}] = theta_dot;"),
+        ];
+        self.full_state.stmts.splice(0..0, head);
+        let args = [
+            K,
+            ("t", "f64"),
+            DELTA,
+            ("theta_dot", "f64"),
+            ("q", "&mut [f64]"),
+            ("qd", "&mut [f64]"),
+        ];
+        let lets = [
+            delta,
+            Preamble::Let("rc_t", "t"),
+            Preamble::Let("rc_w", "theta_dot"),
+        ];
+        self.full_state
+            .finish(&args, &[slice, start, lets[0], lets[1], lets[2]]);
+    }
 }
 
 /// The scope of the full-state functions: the constants, `rc_s`, `rc_c` (the template's

@@ -16,11 +16,16 @@ pub struct Scope {
 
 /// Parameter-only subexpressions collected across all functions, to be computed once in
 /// `prepare` and read from `k`.
+///
+/// A constant is held once up to its sign: `-(ell/2)` reads the slot of `ell/2`, negated; one
+/// that is another constant (`ell`, a start value) or its negative is read from that constant's
+/// slot rather than copied.
 #[derive(Debug, Clone, Default)]
 pub struct Hoisted {
     /// (k index, defining expression over earlier constants) in evaluation order.
     pub entries: Vec<(usize, Expr)>,
-    by_key: HashMap<String, usize>,
+    /// Magnitude's key -> (its slot, whether the slot holds its negative).
+    by_key: HashMap<String, (usize, bool)>,
     next: usize,
 }
 
@@ -34,10 +39,11 @@ impl Hoisted {
         }
     }
 
-    /// Makes a subexpression equal to `e` read the constant already at `k[idx]` instead of
-    /// hoisting a copy (a start constant that an initial value repeats, say).
+    /// Makes a subexpression equal to `e` (or to its negative) read the constant already at
+    /// `k[idx]` instead of hoisting a copy (a start constant that an initial value repeats, say).
     pub fn known(&mut self, e: &Expr, idx: usize) {
-        self.by_key.entry(e.to_infix()).or_insert(idx);
+        let (neg, magnitude) = signed(e);
+        self.by_key.entry(key(&magnitude)).or_insert((idx, neg));
     }
 
     /// Total length of `k` after hoisting.
@@ -50,16 +56,85 @@ impl Hoisted {
         self.entries.is_empty()
     }
 
-    fn index_of(&mut self, e: &Expr) -> usize {
-        let key = e.to_infix();
-        if let Some(i) = self.by_key.get(&key) {
-            return *i;
+    /// The symbol that reads the constant `e` (over constants only), and whether it is to be
+    /// negated: an existing constant's own symbol, an earlier hoisted slot, or a new slot.
+    fn constant(&mut self, e: &Expr, scope: &Scope) -> (bool, Expr) {
+        let (neg, magnitude) = signed(e);
+        if let Expr::Sym(s) = &magnitude
+            && (scope.constants.contains_key(s) || s.starts_with("rc_k"))
+        {
+            return (neg, magnitude);
         }
-        let i = self.next;
-        self.next += 1;
-        self.by_key.insert(key, i);
-        self.entries.push((i, e.clone()));
-        i
+        let (i, held_negated) = *self.by_key.entry(key(&magnitude)).or_insert_with(|| {
+            let i = self.next;
+            self.next += 1;
+            self.entries.push((i, magnitude));
+            (i, false)
+        });
+        (neg != held_negated, Expr::Sym(format!("rc_k{i}")))
+    }
+}
+
+/// The key two constants share when they are equal up to flattening and folded numbers.
+fn key(magnitude: &Expr) -> String {
+    magnitude.tidy().to_infix()
+}
+
+/// Whether `e` reads as negative: a negative number, a product with an odd number of negative
+/// numeric factors (in nested products too), a sum whose first term is negative.
+fn reads_negative(e: &Expr) -> bool {
+    match e {
+        Expr::Rational(n, _) => *n < 0,
+        Expr::Float(x) => *x < 0.0,
+        Expr::Mul(v) => v
+            .iter()
+            .filter(|f| matches!(f, Expr::Rational(..) | Expr::Float(_) | Expr::Mul(_)))
+            .fold(false, |neg, f| neg != reads_negative(f)),
+        Expr::Add(v) => v.first().is_some_and(reads_negative),
+        _ => false,
+    }
+}
+
+/// `-e`, formed by flipping a sign already written (a numeric factor, every term of a sum)
+/// rather than by a new factor where one exists; exact in floating point either way.
+fn negated(e: &Expr) -> Expr {
+    match e {
+        Expr::Rational(n, d) => Expr::Rational(-n, *d),
+        Expr::Float(x) => Expr::Float(-x),
+        Expr::Add(v) => Expr::Add(v.iter().map(negated).collect()),
+        Expr::Mul(v) => {
+            let flip = v.iter().position(|f| {
+                matches!(f, Expr::Rational(..) | Expr::Float(_) | Expr::Mul(_)) && reads_negative(f)
+            });
+            let mut v = v.clone();
+            match flip {
+                Some(i) if v[i] == Expr::int(-1) => {
+                    v.remove(i);
+                }
+                Some(i) => v[i] = negated(&v[i]),
+                None => v.insert(0, Expr::int(-1)),
+            }
+            super::expr::product(v)
+        }
+        _ => Expr::Mul(vec![Expr::int(-1), e.clone()]),
+    }
+}
+
+/// `e` as a sign and a magnitude that does not read as negative.
+fn signed(e: &Expr) -> (bool, Expr) {
+    if reads_negative(e) {
+        (true, negated(e))
+    } else {
+        (false, e.clone())
+    }
+}
+
+/// `-x` where `neg`, else `x`.
+fn with_sign(neg: bool, x: Expr) -> Expr {
+    if neg {
+        Expr::Mul(vec![Expr::int(-1), x])
+    } else {
+        x
     }
 }
 
@@ -96,12 +171,32 @@ pub fn lower(outputs: &[Expr], scope: &Scope, hoist: Option<&mut Hoisted>, prefi
     let mut lowered = Vec::new();
     for e in &outputs {
         let text = emit(e, scope, &counts, &mut named, &mut lets, prefix);
-        lowered.push(text);
+        lowered.push(bare(text));
     }
     Body {
-        lets,
+        lets: lets.into_iter().map(|(n, v)| (n, bare(v))).collect(),
         outputs: lowered,
     }
+}
+
+/// `text` without the parentheses around the whole of it, if it has them: a `let`'s value or
+/// an assignment's right-hand side needs none.
+fn bare(text: String) -> String {
+    let inner = match text.strip_prefix('(').and_then(|t| t.strip_suffix(')')) {
+        Some(inner) => inner,
+        None => return text,
+    };
+    // The outer pair encloses everything only if the depth never returns to zero inside.
+    let mut depth = 0usize;
+    for c in inner.chars() {
+        match c {
+            '(' => depth += 1,
+            ')' if depth == 0 => return text,
+            ')' => depth -= 1,
+            _ => {}
+        }
+    }
+    inner.to_string()
 }
 
 fn is_trivial(e: &Expr) -> bool {
@@ -138,8 +233,8 @@ fn hoist_constants(e: &Expr, scope: &Scope, h: &mut Hoisted) -> Expr {
         return e.clone();
     }
     if constant_only(e, scope) && !e.symbols().is_empty() {
-        let i = h.index_of(e);
-        return Expr::Sym(format!("rc_k{i}"));
+        let (neg, x) = h.constant(e, scope);
+        return with_sign(neg, x);
     }
     // Sums: collect like terms first (`k1*s*c + k2*s*c` -> `(k1 + k2)*s*c`), so each
     // monomial of the motion costs one hoisted coefficient.
@@ -192,8 +287,15 @@ fn hoist_constants(e: &Expr, scope: &Scope, h: &mut Hoisted) -> Expr {
                 } else {
                     super::expr::sum(group)
                 };
-                let i = h.index_of(&g);
-                out.push(Expr::Sym(format!("rc_k{i}")));
+                let (neg, x) = h.constant(&g, scope);
+                if matches!(e, Expr::Mul(_)) {
+                    if neg {
+                        out.push(Expr::int(-1));
+                    }
+                    out.push(x);
+                } else {
+                    out.push(with_sign(neg, x));
+                }
             } else {
                 out.extend(group);
             }

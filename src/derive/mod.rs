@@ -10,6 +10,7 @@ pub mod dimensionless;
 pub mod emit;
 pub mod lower;
 pub mod mechanics;
+pub mod method;
 pub mod present;
 
 // Spec parsing and expressions need no Symbolica: they live in the runtime crate.

@@ -375,7 +375,8 @@ impl<'a> Fall<'a> {
         if !(e > 0.0 && e.is_finite() && si.abs() < 1.0 && ci > 0.0) {
             return Err(SolveError::BeyondVertical {
                 model,
-                theta_initial: k[layout.k_theta_initial],
+                // The lean path prepares the start's sine and cosine, not the angle.
+                theta_initial: si.atan2(ci),
             });
         }
         let from_rest = theta_dot == 0.0;
