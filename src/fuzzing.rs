@@ -45,20 +45,24 @@ pub fn spec(data: &[u8]) {
 }
 
 /// The spec expression parser, then everything the derivation tool does with a parsed
-/// expression that needs no Symbolica: print (infix, LaTeX, broken into lines), tidy,
-/// evaluate. The infix form must parse again, since Symbolica reads it back.
+/// expression that needs no Symbolica: print (infix; LaTeX, broken into lines, with the
+/// `derive` feature), tidy, evaluate. The infix form must parse again, since Symbolica reads it back.
 pub fn expr(data: &[u8]) {
     let Some(text) = text(data) else { return };
     let Ok(e) = Expr::parse(text) else { return };
-    let name = |s: &str| s.to_string();
     let value = |_: &str| Some(0.5);
     for e in [e.clone(), e.tidy()] {
         let infix = e.to_infix();
         if let Err(err) = Expr::parse(&infix) {
             panic!("`{text}` prints as `{infix}`, which does not parse: {err:?}");
         }
-        let _ = e.to_latex(&name);
-        let _ = e.to_latex_lines(&name, 60, 0);
+        // The LaTeX printer belongs to the derivation tool.
+        #[cfg(feature = "derive")]
+        {
+            let name = |s: &str| s.to_string();
+            let _ = e.to_latex(&name);
+            let _ = e.to_latex_lines(&name, 60, 0);
+        }
         let _ = e.eval(&value);
         let _ = (e.symbols(), e.functions());
     }

@@ -8,6 +8,7 @@
 pub mod cas;
 pub mod dimensionless;
 pub mod emit;
+pub mod latex;
 pub mod lower;
 pub mod mechanics;
 pub mod method;
