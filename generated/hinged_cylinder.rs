@@ -239,16 +239,15 @@ impl Model for HingedCylinder {
         let k = &k[..33]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let et0 = qd[0] * qd[0];
-        let et1 = rc_s * rc_s;
-        let et2 = rc_c * rc_c;
+        let et1 = rc_c * rc_c;
         ((k[11] * et0)
-            + (k[12] * et0 * rc_c / et1)
-            + (k[12] * et0 * et2 / et1)
-            + (k[13] * et0 * et2 / rc_s.powi(4))
+            + (k[12] * et0 * rc_c / (rc_s * rc_s))
+            + (k[12] * et0 * et1 / (rc_s * rc_s))
+            + (k[13] * et0 * et1 / rc_s.powi(4))
             + (k[12] * et0 * rc_c.powi(3) / rc_s.powi(4))
             + (k[13] * et0 * rc_c.powi(4) / rc_s.powi(4))
-            + (k[14] * et0 * et1)
-            + (k[14] * et0 * et2))
+            + (k[14] * et0 * (rc_s * rc_s))
+            + (k[14] * et0 * et1))
             + (k[15] + (k[16] * rc_s))
     }
 
@@ -257,28 +256,27 @@ impl Model for HingedCylinder {
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
         let k = &k[..33]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        let qt0 = rc_s * rc_s;
-        let qt1 = rc_c * rc_c;
-        let qt2 = rc_c.powi(3);
-        let qt3 = rc_c.powi(4);
-        let qt4 = qd[0] * qd[0];
+        let qt0 = rc_c * rc_c;
+        let qt1 = rc_c.powi(3);
+        let qt2 = rc_c.powi(4);
+        let qt3 = qd[0] * qd[0];
         mass[0] = k[17]
-            + (k[18] * rc_c / qt0)
-            + (k[18] * qt1 / qt0)
-            + (k[12] * qt1 / rc_s.powi(4))
-            + (k[18] * qt2 / rc_s.powi(4))
-            + (k[12] * qt3 / rc_s.powi(4))
-            + (k[19] * qt0)
-            + (k[19] * qt1);
+            + (k[18] * rc_c / (rc_s * rc_s))
+            + (k[18] * qt0 / (rc_s * rc_s))
+            + (k[12] * qt0 / rc_s.powi(4))
+            + (k[18] * qt1 / rc_s.powi(4))
+            + (k[12] * qt2 / rc_s.powi(4))
+            + (k[19] * (rc_s * rc_s))
+            + (k[19] * qt0);
         rhs[0] = -(k[16] * rc_c)
-            + (k[12] * qt4 / rc_s)
-            + (k[18] * qt4 * rc_c / rc_s)
-            + (k[12] * qt4 * rc_c / rc_s.powi(3))
-            + (k[20] * qt4 * qt1 / rc_s.powi(3))
-            + (k[21] * qt4 * qt2 / rc_s.powi(3))
-            + (k[18] * qt4 * qt2 / rc_s.powi(5))
-            + (k[21] * qt4 * qt3 / rc_s.powi(5))
-            + (k[18] * qt4 * rc_c.powi(5) / rc_s.powi(5));
+            + (k[12] * qt3 / rc_s)
+            + (k[18] * qt3 * rc_c / rc_s)
+            + (k[12] * qt3 * rc_c / rc_s.powi(3))
+            + (k[20] * qt3 * qt0 / rc_s.powi(3))
+            + (k[21] * qt3 * qt1 / rc_s.powi(3))
+            + (k[18] * qt3 * qt1 / rc_s.powi(5))
+            + (k[21] * qt3 * qt2 / rc_s.powi(5))
+            + (k[18] * qt3 * rc_c.powi(5) / rc_s.powi(5));
     }
 
     fn forces_full(

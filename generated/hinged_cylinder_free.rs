@@ -187,7 +187,7 @@ impl Model for HingedCylinderFree {
         // k[21] = ell^2*m1/4
         k[21] = (k[2] * k[2]) * k[0] / 4.0;
         // k[22] = 3/(ell^2*m1)
-        k[22] = 3.0 / ((k[2] * k[2]) * k[0]);
+        k[22] = 3.0 / (k[2] * k[2]) / k[0];
         // k[23] = rc_wi^2*rc_ai
         k[23] = (k[8] * k[8]) * k[13];
         // k[24] = ell*g*m1

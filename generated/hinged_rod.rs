@@ -52,7 +52,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 33,
+    n_constants: 34,
     coordinates: &["theta"],
     reduced: 0,
     cyclic: &[],
@@ -133,7 +133,7 @@ static INFO: ModelInfo = ModelInfo {
         separation_degree: 3,
         polynomial_separation: true,
         fall_degree: Some(2),
-        lean_constants: &[6, 7, 8, 24, 29, 30, 31, 32],
+        lean_constants: &[6, 7, 8, 24, 30, 31, 32, 33],
     }),
     route_note: "",
 };
@@ -184,26 +184,28 @@ impl Model for HingedRod {
         k[21] = k[2] * k[0] / 2.0;
         // k[22] = a/2
         k[22] = k[3] / 2.0;
-        // k[23] = 3*g*m1
-        k[23] = 3.0 * k[4] * k[0];
-        // k[25] = 6*g*m1*m2
-        k[25] = 6.0 * k[4] * k[0] * k[1];
-        // k[26] = 3*g*m1*m2
-        k[26] = 3.0 * k[4] * k[0] * k[1];
-        // k[27] = g*m1^2
-        k[27] = k[4] * (k[0] * k[0]);
-        // k[28] = ell*m2
-        k[28] = k[2] * k[1];
+        // k[23] = 3*g*m1/ell
+        k[23] = 3.0 * k[4] * k[0] / k[2];
+        // k[25] = 3/(2*ell)
+        k[25] = 3.0 / 2.0 / k[2];
+        // k[26] = 6*g*m1*m2
+        k[26] = 6.0 * k[4] * k[0] * k[1];
+        // k[27] = 3*g*m1*m2
+        k[27] = 3.0 * k[4] * k[0] * k[1];
+        // k[28] = g*m1^2
+        k[28] = k[4] * (k[0] * k[0]);
+        // k[29] = ell*m2
+        k[29] = k[2] * k[1];
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..34]; // one bounds check for all constant loads
         q[0] = k[5];
         qd[0] = 0.0;
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..34]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let pt0 = k[2] * rc_c;
         let pt1 = -k[2] * qd[0] * rc_s;
@@ -218,7 +220,7 @@ impl Model for HingedRod {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..34]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let et0 = qd[0] * qd[0];
         ((k[11] * et0) + (k[12] * et0 * (rc_s * rc_s)) + (k[13] * et0 * (rc_c * rc_c)))
@@ -228,7 +230,7 @@ impl Model for HingedRod {
     fn momenta(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..34]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         mass[0] = k[16] + (k[17] * (rc_s * rc_s)) + (k[18] * (rc_c * rc_c));
         rhs[0] = -(k[15] * rc_c) - (k[19] * (qd[0] * qd[0]) * rc_s * rc_c);
@@ -243,7 +245,7 @@ impl Model for HingedRod {
         _fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..34]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ft0 = qd[0] * qd[0];
         out[0] = k[1] * (-(k[2] * qdd[0] * rc_s) - (k[2] * ft0 * rc_c));
@@ -253,7 +255,7 @@ impl Model for HingedRod {
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..34]; // one bounds check for all constant loads
         let rc_s = q[0].sin();
         out[0] = k[14] - (forces[0] * (-k[22] + (k[2] * rc_s)));
     }
@@ -263,14 +265,14 @@ impl Model for HingedRod {
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..34]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         out[0] = k[2] * rc_c;
         out[1] = -k[2] * qd[0] * rc_s;
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..34]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         poses[0] = [k[10] * rc_c, k[10] * rc_s, q[0]];
         poses[1] = [k[22] + (k[2] * rc_c), k[22], 0.0];
@@ -291,43 +293,42 @@ impl Model for HingedRod {
 
 impl Reduction for HingedRod {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..34]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[7], k[8], delta);
         let rt0 = rc_s * rc_s;
         let rt1 = k[0] + (k[24] * rt0);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: k[23] * rc_ds / (k[2] * rt1),
-            theta_ddot: -3.0
-                * ((k[25] * rc_s * rc_c * rc_ds) + (k[26] * rt0 * rc_c) + (k[27] * rc_c))
-                / 2.0
-                / (k[2] * (rt1 * rt1)),
+            theta_dot_sq: k[23] * rc_ds / rt1,
+            theta_ddot: -k[25]
+                * ((k[26] * rc_s * rc_c * rc_ds) + (k[27] * rt0 * rc_c) + (k[28] * rc_c))
+                / (rt1 * rt1),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..33]; // one bounds check for all constant loads
-        k[23] * rc_ds / (k[2] * (k[0] + (k[24] * (rc_s * rc_s))))
+        let k = &k[..34]; // one bounds check for all constant loads
+        k[23] * rc_ds / (k[0] + (k[24] * (rc_s * rc_s)))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..34]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[7], k[8], delta);
         let rt0 = rc_s * rc_s;
         let rt1 = k[0] + (k[24] * rt0);
-        let rc_w2 = k[23] * rc_ds / (k[2] * rt1);
-        let rc_acc = -3.0 * ((k[25] * rc_s * rc_c * rc_ds) + (k[26] * rt0 * rc_c) + (k[27] * rc_c))
-            / 2.0
-            / (k[2] * (rt1 * rt1));
-        out[0] = -(k[28] * rc_s * rc_acc) - (k[28] * rc_c * rc_w2);
+        let rc_w2 = k[23] * rc_ds / rt1;
+        let rc_acc = -k[25]
+            * ((k[26] * rc_s * rc_c * rc_ds) + (k[27] * rt0 * rc_c) + (k[28] * rc_c))
+            / (rt1 * rt1);
+        out[0] = -(k[29] * rc_s * rc_acc) - (k[29] * rc_c * rc_w2);
         out[1] = k[20] - (k[21] * rc_s * rc_w2) + (k[21] * rc_c * rc_acc);
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
-        out[0] = -k[29];
-        out[1] = k[30];
+        let k = &k[..34]; // one bounds check for all constant loads
+        out[0] = -k[30];
+        out[1] = k[31];
         out[2] = 0.0;
         out[3] = k[24];
     }
@@ -343,21 +344,21 @@ impl Reduction for HingedRod {
         k[8] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
         // k[24] = 3*m2
         k[24] = 3.0 * k[1];
-        // k[29] = 2*m1*rc_si
-        k[29] = 2.0 * k[0] * k[7];
-        // k[30] = 3*m1
-        k[30] = 3.0 * k[0];
-        // k[31] = ell/(3*g)
-        k[31] = k[2] / 3.0 / k[4];
-        // k[32] = ell*m2/(g*m1)
-        k[32] = k[2] * k[1] / (k[4] * k[0]);
+        // k[30] = 2*m1*rc_si
+        k[30] = 2.0 * k[0] * k[7];
+        // k[31] = 3*m1
+        k[31] = 3.0 * k[0];
+        // k[32] = ell/(3*g)
+        k[32] = k[2] / 3.0 / k[4];
+        // k[33] = ell*m2/(g*m1)
+        k[33] = k[2] * k[1] / k[4] / k[0];
     }
 
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
-        out[0] = k[31];
+        let k = &k[..34]; // one bounds check for all constant loads
+        out[0] = k[32];
         out[1] = 0.0;
-        out[2] = k[32];
+        out[2] = k[33];
     }
 
     fn full_state(
@@ -369,7 +370,7 @@ impl Reduction for HingedRod {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..34]; // one bounds check for all constant loads
         q[0] = k[5] - delta;
         qd[0] = theta_dot;
     }

@@ -94,7 +94,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 45,
+    n_constants: 46,
     coordinates: &["x1", "theta", "x2"],
     reduced: 1,
     cyclic: &[0, 2],
@@ -246,59 +246,61 @@ impl Model for LoadedRodFree {
             + (h28_t0 * k[2].powi(3) / ((2.0 * k[0] * k[2]) + h28_t2 + h28_t1));
         // k[29] = g*m1 + g*m3
         k[29] = (k[5] * k[0]) + (k[5] * k[2]);
-        // k[30] = m1*rc_wi^2*rc_ai + m3*rc_wi^2*rc_ai
-        let h30_t0 = k[10] * k[10];
-        k[30] = (k[0] * h30_t0 * k[16]) + (k[2] * h30_t0 * k[16]);
-        // k[31] = 3*ell*g*m1*m3 + ell*g*m1^2 + 2*ell*g*m3^2
-        k[31] = (3.0 * k[3] * k[5] * k[0] * k[2])
+        // k[30] = 12/ell^2
+        k[30] = 12.0 / (k[3] * k[3]);
+        // k[31] = m1*rc_wi^2*rc_ai + m3*rc_wi^2*rc_ai
+        let h31_t0 = k[10] * k[10];
+        k[31] = (k[0] * h31_t0 * k[16]) + (k[2] * h31_t0 * k[16]);
+        // k[32] = 3*ell*g*m1*m3 + ell*g*m1^2 + 2*ell*g*m3^2
+        k[32] = (3.0 * k[3] * k[5] * k[0] * k[2])
             + (k[3] * k[5] * (k[0] * k[0]))
             + (2.0 * k[3] * k[5] * (k[2] * k[2]));
-        // k[32] = ell^2
-        k[32] = k[3] * k[3];
         // k[33] = 16*m1*m3 + 4*m1^2 + 12*m3^2
         k[33] = (16.0 * k[0] * k[2]) + (4.0 * (k[0] * k[0])) + (12.0 * (k[2] * k[2]));
         // k[34] = 12*m1*m3 + 3*m1^2 + 12*m3^2
         k[34] = (12.0 * k[0] * k[2]) + (3.0 * (k[0] * k[0])) + (12.0 * (k[2] * k[2]));
-        // k[35] = 120*ell*g*m1*m3^3 + 108*ell*g*m1^2*m3^2 + 42*ell*g*m1^3*m3 + 6*ell*g*m1^4 + 48*ell*g*m3^4
-        k[35] = (120.0 * k[3] * k[5] * k[0] * k[2].powi(3))
+        // k[35] = 6/ell^2
+        k[35] = 6.0 / (k[3] * k[3]);
+        // k[36] = 120*ell*g*m1*m3^3 + 108*ell*g*m1^2*m3^2 + 42*ell*g*m1^3*m3 + 6*ell*g*m1^4 + 48*ell*g*m3^4
+        k[36] = (120.0 * k[3] * k[5] * k[0] * k[2].powi(3))
             + (108.0 * k[3] * k[5] * (k[0] * k[0]) * (k[2] * k[2]))
             + (42.0 * k[3] * k[5] * k[0].powi(3) * k[2])
             + (6.0 * k[3] * k[5] * k[0].powi(4))
             + (48.0 * k[3] * k[5] * k[2].powi(4));
-        // k[36] = 68*ell*g*m1*m3^3 + 68*ell*g*m1^2*m3^2 + 28*ell*g*m1^3*m3 + 4*ell*g*m1^4 + 24*ell*g*m3^4
-        k[36] = (68.0 * k[3] * k[5] * k[0] * k[2].powi(3))
+        // k[37] = 68*ell*g*m1*m3^3 + 68*ell*g*m1^2*m3^2 + 28*ell*g*m1^3*m3 + 4*ell*g*m1^4 + 24*ell*g*m3^4
+        k[37] = (68.0 * k[3] * k[5] * k[0] * k[2].powi(3))
             + (68.0 * k[3] * k[5] * (k[0] * k[0]) * (k[2] * k[2]))
             + (28.0 * k[3] * k[5] * k[0].powi(3) * k[2])
             + (4.0 * k[3] * k[5] * k[0].powi(4))
             + (24.0 * k[3] * k[5] * k[2].powi(4));
-        // k[37] = 60*ell*g*m1*m3^3 + 54*ell*g*m1^2*m3^2 + 21*ell*g*m1^3*m3 + 3*ell*g*m1^4 + 24*ell*g*m3^4
-        k[37] = (60.0 * k[3] * k[5] * k[0] * k[2].powi(3))
+        // k[38] = 60*ell*g*m1*m3^3 + 54*ell*g*m1^2*m3^2 + 21*ell*g*m1^3*m3 + 3*ell*g*m1^4 + 24*ell*g*m3^4
+        k[38] = (60.0 * k[3] * k[5] * k[0] * k[2].powi(3))
             + (54.0 * k[3] * k[5] * (k[0] * k[0]) * (k[2] * k[2]))
             + (21.0 * k[3] * k[5] * k[0].powi(3) * k[2])
             + (3.0 * k[3] * k[5] * k[0].powi(4))
             + (24.0 * k[3] * k[5] * k[2].powi(4));
-        // k[38] = 48*m1*m3^2*rc_wi^2*rc_ai + 30*m1^2*m3*rc_wi^2*rc_ai + 6*m1^3*rc_wi^2*rc_ai + 24*m3^3*rc_wi^2*rc_ai
-        let h38_t0 = k[10] * k[10];
-        k[38] = (48.0 * k[0] * (k[2] * k[2]) * h38_t0 * k[16])
-            + (30.0 * (k[0] * k[0]) * k[2] * h38_t0 * k[16])
-            + (6.0 * k[0].powi(3) * h38_t0 * k[16])
-            + (24.0 * k[2].powi(3) * h38_t0 * k[16]);
-        // k[39] = (ell*m1 + 2*ell*m3)/2
-        k[39] = ((k[3] * k[0]) + (2.0 * k[3] * k[2])) / 2.0;
-        // k[40] = rc_p0/(m1 + m3)
-        k[40] = k[14] / (k[0] + k[2]);
-        // k[41] = rc_p1/m2
-        k[41] = k[15] / k[1];
-        // k[42] = a/2
-        k[42] = k[4] / 2.0;
-        // k[43] = ell*(m1/2 + m3)/(m1 + m3)
-        k[43] = k[3] * ((k[0] / 2.0) + k[2]) / (k[0] + k[2]);
-        // k[44] = ell*m1/(2*(m1 + m3))
-        k[44] = k[3] * k[0] / (2.0 * (k[0] + k[2]));
+        // k[39] = 48*m1*m3^2*rc_wi^2*rc_ai + 30*m1^2*m3*rc_wi^2*rc_ai + 6*m1^3*rc_wi^2*rc_ai + 24*m3^3*rc_wi^2*rc_ai
+        let h39_t0 = k[10] * k[10];
+        k[39] = (48.0 * k[0] * (k[2] * k[2]) * h39_t0 * k[16])
+            + (30.0 * (k[0] * k[0]) * k[2] * h39_t0 * k[16])
+            + (6.0 * k[0].powi(3) * h39_t0 * k[16])
+            + (24.0 * k[2].powi(3) * h39_t0 * k[16]);
+        // k[40] = (ell*m1 + 2*ell*m3)/2
+        k[40] = ((k[3] * k[0]) + (2.0 * k[3] * k[2])) / 2.0;
+        // k[41] = rc_p0/(m1 + m3)
+        k[41] = k[14] / (k[0] + k[2]);
+        // k[42] = rc_p1/m2
+        k[42] = k[15] / k[1];
+        // k[43] = a/2
+        k[43] = k[4] / 2.0;
+        // k[44] = ell*(m1/2 + m3)/(m1 + m3)
+        k[44] = k[3] * ((k[0] / 2.0) + k[2]) / (k[0] + k[2]);
+        // k[45] = ell*m1/(2*(m1 + m3))
+        k[45] = k[3] * k[0] / (2.0 * (k[0] + k[2]));
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..45]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         q[0] = k[6];
         qd[0] = k[9];
         q[1] = k[7];
@@ -308,7 +310,7 @@ impl Model for LoadedRodFree {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..45]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         pos[0] = [q[0], 0.0];
         vel[0] = [qd[0], 0.0];
@@ -323,7 +325,7 @@ impl Model for LoadedRodFree {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..45]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = qd[1] * qd[1];
         (-(k[19] * qd[1] * qd[0] * rc_s)
@@ -336,14 +338,14 @@ impl Model for LoadedRodFree {
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..45]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
         out[0] = -(k[19] * qd[1] * rc_s) + (k[26] * qd[0]);
         out[1] = k[1] * qd[2];
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..45]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let qt0 = -k[19] * rc_s;
         mass[0] = k[26];
@@ -369,7 +371,7 @@ impl Model for LoadedRodFree {
         _fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..45]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = k[29] + (k[19] * qdd[1] * rc_c) - (k[19] * (qd[1] * qd[1]) * rc_s);
     }
@@ -377,7 +379,7 @@ impl Model for LoadedRodFree {
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..45]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let rc_c = q[1].cos();
         out[0] = forces[0];
         out[1] = -(k[3] * rc_c) - q[0] + q[2];
@@ -390,13 +392,13 @@ impl Model for LoadedRodFree {
     fn released(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..45]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         poses[0] = [(k[18] * rc_c) + q[0], k[18] * rc_s, q[1]];
-        poses[1] = [k[42] + q[2], k[42], 0.0];
-        sizes[0] = -k[43];
+        poses[1] = [k[43] + q[2], k[43], 0.0];
+        sizes[0] = -k[44];
         sizes[1] = 0.0;
-        sizes[2] = k[44];
+        sizes[2] = k[45];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
@@ -411,39 +413,39 @@ impl Model for LoadedRodFree {
 
 impl Reduction for LoadedRodFree {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..45]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[7], k[12], k[13], delta);
         let rt0 = rc_s * rc_s;
         let rt1 = -k[33] + (k[34] * rt0);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: -12.0 * (k[30] + (k[31] * rc_ds)) / (k[32] * rt1),
-            theta_ddot: 6.0
-                * ((k[35] * rc_s * rc_c * rc_ds) - (k[36] * rc_c)
-                    + (k[37] * rt0 * rc_c)
-                    + (k[38] * rc_s * rc_c))
-                / (k[32] * (rt1 * rt1)),
+            theta_dot_sq: -k[30] * (k[31] + (k[32] * rc_ds)) / rt1,
+            theta_ddot: k[35]
+                * ((k[36] * rc_s * rc_c * rc_ds) - (k[37] * rc_c)
+                    + (k[38] * rt0 * rc_c)
+                    + (k[39] * rc_s * rc_c))
+                / (rt1 * rt1),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..45]; // one bounds check for all constant loads
-        -12.0 * (k[30] + (k[31] * rc_ds)) / (k[32] * (-k[33] + (k[34] * (rc_s * rc_s))))
+        let k = &k[..46]; // one bounds check for all constant loads
+        -k[30] * (k[31] + (k[32] * rc_ds)) / (-k[33] + (k[34] * (rc_s * rc_s)))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..45]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[7], k[12], k[13], delta);
         let rt0 = rc_s * rc_s;
         let rt1 = -k[33] + (k[34] * rt0);
-        let rc_w2 = -12.0 * (k[30] + (k[31] * rc_ds)) / (k[32] * rt1);
-        let rc_acc = 6.0
-            * ((k[35] * rc_s * rc_c * rc_ds) - (k[36] * rc_c)
-                + (k[37] * rt0 * rc_c)
-                + (k[38] * rc_s * rc_c))
-            / (k[32] * (rt1 * rt1));
-        out[0] = k[29] - (k[39] * rc_s * rc_w2) + (k[39] * rc_c * rc_acc);
+        let rc_w2 = -k[30] * (k[31] + (k[32] * rc_ds)) / rt1;
+        let rc_acc = k[35]
+            * ((k[36] * rc_s * rc_c * rc_ds) - (k[37] * rc_c)
+                + (k[38] * rt0 * rc_c)
+                + (k[39] * rc_s * rc_c))
+            / (rt1 * rt1);
+        out[0] = k[29] - (k[40] * rc_s * rc_w2) + (k[40] * rc_c * rc_acc);
     }
 
     fn separation_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
@@ -467,15 +469,15 @@ impl Reduction for LoadedRodFree {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..45]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, _, _, rc_dc) = start_offsets(k[7], k[12], k[13], delta);
         let rc_t = t;
         let rc_w = theta_dot;
         q[1] = k[7] - delta;
         qd[1] = theta_dot;
-        q[0] = k[6] + (k[18] * rc_dc) + (k[40] * rc_t);
-        qd[0] = k[40] + (k[18] * rc_s * rc_w);
-        q[2] = k[8] + (k[41] * rc_t);
-        qd[2] = k[41];
+        q[0] = k[6] + (k[18] * rc_dc) + (k[41] * rc_t);
+        qd[0] = k[41] + (k[18] * rc_s * rc_w);
+        q[2] = k[8] + (k[42] * rc_t);
+        qd[2] = k[42];
     }
 }

@@ -88,7 +88,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 37,
+    n_constants: 38,
     coordinates: &["x1", "theta", "x2"],
     reduced: 1,
     cyclic: &[0, 2],
@@ -204,30 +204,32 @@ impl Model for RodCubeFree {
         k[25] = (k[2] * k[2]) * k[0] / 4.0;
         // k[26] = g*m1
         k[26] = k[4] * k[0];
-        // k[27] = rc_wi^2*rc_ai
-        k[27] = (k[9] * k[9]) * k[15];
-        // k[28] = ell*g*m1
-        k[28] = k[2] * k[4] * k[0];
-        // k[29] = ell^2*m1
-        k[29] = (k[2] * k[2]) * k[0];
-        // k[30] = 6*ell*g*m1
-        k[30] = 6.0 * k[2] * k[4] * k[0];
-        // k[31] = 4*ell*g*m1
-        k[31] = 4.0 * k[2] * k[4] * k[0];
-        // k[32] = 3*ell*g*m1
-        k[32] = 3.0 * k[2] * k[4] * k[0];
-        // k[33] = 6*rc_wi^2*rc_ai
-        k[33] = 6.0 * (k[9] * k[9]) * k[15];
-        // k[34] = rc_p0/m1
-        k[34] = k[13] / k[0];
-        // k[35] = rc_p1/m2
-        k[35] = k[14] / k[1];
-        // k[36] = a/2
-        k[36] = k[3] / 2.0;
+        // k[27] = 12/(ell^2*m1)
+        k[27] = 12.0 / (k[2] * k[2]) / k[0];
+        // k[28] = rc_wi^2*rc_ai
+        k[28] = (k[9] * k[9]) * k[15];
+        // k[29] = ell*g*m1
+        k[29] = k[2] * k[4] * k[0];
+        // k[30] = 6/(ell^2*m1)
+        k[30] = 6.0 / (k[2] * k[2]) / k[0];
+        // k[31] = 6*ell*g*m1
+        k[31] = 6.0 * k[2] * k[4] * k[0];
+        // k[32] = 4*ell*g*m1
+        k[32] = 4.0 * k[2] * k[4] * k[0];
+        // k[33] = 3*ell*g*m1
+        k[33] = 3.0 * k[2] * k[4] * k[0];
+        // k[34] = 6*rc_wi^2*rc_ai
+        k[34] = 6.0 * (k[9] * k[9]) * k[15];
+        // k[35] = rc_p0/m1
+        k[35] = k[13] / k[0];
+        // k[36] = rc_p1/m2
+        k[36] = k[14] / k[1];
+        // k[37] = a/2
+        k[37] = k[3] / 2.0;
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         q[0] = k[5];
         qd[0] = k[8];
         q[1] = k[6];
@@ -237,7 +239,7 @@ impl Model for RodCubeFree {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         pos[0] = [q[0], 0.0];
         vel[0] = [qd[0], 0.0];
@@ -250,7 +252,7 @@ impl Model for RodCubeFree {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = qd[1] * qd[1];
         (-(k[17] * qd[1] * qd[0] * rc_s)
@@ -263,14 +265,14 @@ impl Model for RodCubeFree {
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
         out[0] = -(k[17] * qd[1] * rc_s) + (k[0] * qd[0]);
         out[1] = k[1] * qd[2];
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let qt0 = -k[17] * rc_s;
         mass[0] = k[0];
@@ -296,7 +298,7 @@ impl Model for RodCubeFree {
         _fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = k[26] + (k[17] * qdd[1] * rc_c) - (k[17] * (qd[1] * qd[1]) * rc_s);
     }
@@ -304,7 +306,7 @@ impl Model for RodCubeFree {
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let rc_c = q[1].cos();
         out[0] = forces[0];
         out[1] = -(k[2] * rc_c) - q[0] + q[2];
@@ -317,10 +319,10 @@ impl Model for RodCubeFree {
     fn released(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         poses[0] = [(k[16] * rc_c) + q[0], k[16] * rc_s, q[1]];
-        poses[1] = [k[36] + q[2], k[36], 0.0];
+        poses[1] = [k[37] + q[2], k[37], 0.0];
         sizes[0] = -k[16];
         sizes[1] = 0.0;
         sizes[2] = k[16];
@@ -338,38 +340,38 @@ impl Model for RodCubeFree {
 
 impl Reduction for RodCubeFree {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[6], k[11], k[12], delta);
         let rt0 = rc_s * rc_s;
         let rt1 = -4.0 + (3.0 * rt0);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: -12.0 * (k[27] + (k[28] * rc_ds)) / (k[29] * rt1),
-            theta_ddot: 6.0
-                * ((k[30] * rc_s * rc_c * rc_ds) - (k[31] * rc_c)
-                    + (k[32] * rt0 * rc_c)
-                    + (k[33] * rc_s * rc_c))
-                / (k[29] * (rt1 * rt1)),
+            theta_dot_sq: -k[27] * (k[28] + (k[29] * rc_ds)) / rt1,
+            theta_ddot: k[30]
+                * ((k[31] * rc_s * rc_c * rc_ds) - (k[32] * rc_c)
+                    + (k[33] * rt0 * rc_c)
+                    + (k[34] * rc_s * rc_c))
+                / (rt1 * rt1),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..37]; // one bounds check for all constant loads
-        -12.0 * (k[27] + (k[28] * rc_ds)) / (k[29] * (-4.0 + (3.0 * (rc_s * rc_s))))
+        let k = &k[..38]; // one bounds check for all constant loads
+        -k[27] * (k[28] + (k[29] * rc_ds)) / (-4.0 + (3.0 * (rc_s * rc_s)))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[6], k[11], k[12], delta);
         let rt0 = rc_s * rc_s;
         let rt1 = -4.0 + (3.0 * rt0);
-        let rc_w2 = -12.0 * (k[27] + (k[28] * rc_ds)) / (k[29] * rt1);
-        let rc_acc = 6.0
-            * ((k[30] * rc_s * rc_c * rc_ds) - (k[31] * rc_c)
-                + (k[32] * rt0 * rc_c)
-                + (k[33] * rc_s * rc_c))
-            / (k[29] * (rt1 * rt1));
+        let rc_w2 = -k[27] * (k[28] + (k[29] * rc_ds)) / rt1;
+        let rc_acc = k[30]
+            * ((k[31] * rc_s * rc_c * rc_ds) - (k[32] * rc_c)
+                + (k[33] * rt0 * rc_c)
+                + (k[34] * rc_s * rc_c))
+            / (rt1 * rt1);
         out[0] = k[26] - (k[17] * rc_s * rc_w2) + (k[17] * rc_c * rc_acc);
     }
 
@@ -394,15 +396,15 @@ impl Reduction for RodCubeFree {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, _, _, rc_dc) = start_offsets(k[6], k[11], k[12], delta);
         let rc_t = t;
         let rc_w = theta_dot;
         q[1] = k[6] - delta;
         qd[1] = theta_dot;
-        q[0] = k[5] + (k[16] * rc_dc) + (k[34] * rc_t);
-        qd[0] = k[34] + (k[16] * rc_s * rc_w);
-        q[2] = k[7] + (k[35] * rc_t);
-        qd[2] = k[35];
+        q[0] = k[5] + (k[16] * rc_dc) + (k[35] * rc_t);
+        qd[0] = k[35] + (k[16] * rc_s * rc_w);
+        q[2] = k[7] + (k[36] * rc_t);
+        qd[2] = k[36];
     }
 }

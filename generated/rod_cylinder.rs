@@ -243,21 +243,20 @@ impl Model for RodCylinder {
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
         let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let et0 = rc_s * rc_s;
-        let et1 = rc_c * rc_c;
-        let et2 = qd[1] * qd[1];
+        let et0 = rc_c * rc_c;
+        let et1 = qd[1] * qd[1];
         (-(k[8] * qd[1] * qd[0])
-            - (k[8] * qd[1] * qd[0] * rc_c / et0)
-            - (k[8] * qd[1] * qd[0] * et1 / et0)
+            - (k[8] * qd[1] * qd[0] * rc_c / (rc_s * rc_s))
+            - (k[8] * qd[1] * qd[0] * et0 / (rc_s * rc_s))
             - (k[9] * qd[1] * qd[0] * rc_s)
-            + (k[10] * et2)
-            + (k[11] * et2 * rc_c / et0)
-            + (k[11] * et2 * et1 / et0)
-            + (k[12] * et2 * et1 / rc_s.powi(4))
-            + (k[11] * et2 * rc_c.powi(3) / rc_s.powi(4))
-            + (k[12] * et2 * rc_c.powi(4) / rc_s.powi(4))
-            + (k[13] * et2 * et0)
-            + (k[13] * et2 * et1)
+            + (k[10] * et1)
+            + (k[11] * et1 * rc_c / (rc_s * rc_s))
+            + (k[11] * et1 * et0 / (rc_s * rc_s))
+            + (k[12] * et1 * et0 / rc_s.powi(4))
+            + (k[11] * et1 * rc_c.powi(3) / rc_s.powi(4))
+            + (k[12] * et1 * rc_c.powi(4) / rc_s.powi(4))
+            + (k[13] * et1 * (rc_s * rc_s))
+            + (k[13] * et1 * et0)
             + (k[14] * (qd[0] * qd[0])))
             + (k[15] + (k[16] * rc_s))
     }
@@ -275,37 +274,37 @@ impl Model for RodCylinder {
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
         let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let qt0 = rc_s * rc_s;
-        let qt1 = rc_c * rc_c;
-        let qt2 = -k[8] - (k[8] * rc_c / qt0) - (k[8] * qt1 / qt0) - (k[9] * rc_s);
-        let qt3 = rc_c.powi(3);
-        let qt4 = rc_c.powi(4);
-        let qt5 = qd[1] * qd[1];
+        let qt0 = rc_c * rc_c;
+        let qt1 =
+            -k[8] - (k[8] * rc_c / (rc_s * rc_s)) - (k[8] * qt0 / (rc_s * rc_s)) - (k[9] * rc_s);
+        let qt2 = rc_c.powi(3);
+        let qt3 = rc_c.powi(4);
+        let qt4 = qd[1] * qd[1];
         mass[0] = k[17];
-        mass[1] = qt2;
-        mass[2] = qt2;
+        mass[1] = qt1;
+        mass[2] = qt1;
         mass[3] = k[18]
-            + (k[19] * rc_c / qt0)
-            + (k[19] * qt1 / qt0)
-            + (k[11] * qt1 / rc_s.powi(4))
-            + (k[19] * qt3 / rc_s.powi(4))
-            + (k[11] * qt4 / rc_s.powi(4))
-            + (k[20] * qt0)
-            + (k[20] * qt1);
-        rhs[0] = -(k[8] * qt5 / rc_s)
-            - (k[21] * qt5 * rc_c / rc_s)
-            - (k[21] * qt5 * qt1 / rc_s.powi(3))
-            - (k[21] * qt5 * qt3 / rc_s.powi(3))
-            + (k[9] * qt5 * rc_c);
+            + (k[19] * rc_c / (rc_s * rc_s))
+            + (k[19] * qt0 / (rc_s * rc_s))
+            + (k[11] * qt0 / rc_s.powi(4))
+            + (k[19] * qt2 / rc_s.powi(4))
+            + (k[11] * qt3 / rc_s.powi(4))
+            + (k[20] * (rc_s * rc_s))
+            + (k[20] * qt0);
+        rhs[0] = -(k[8] * qt4 / rc_s)
+            - (k[21] * qt4 * rc_c / rc_s)
+            - (k[21] * qt4 * qt0 / rc_s.powi(3))
+            - (k[21] * qt4 * qt2 / rc_s.powi(3))
+            + (k[9] * qt4 * rc_c);
         rhs[1] = -(k[16] * rc_c)
-            + (k[11] * qt5 / rc_s)
-            + (k[19] * qt5 * rc_c / rc_s)
-            + (k[11] * qt5 * rc_c / rc_s.powi(3))
-            + (k[22] * qt5 * qt1 / rc_s.powi(3))
-            + (k[23] * qt5 * qt3 / rc_s.powi(3))
-            + (k[19] * qt5 * qt3 / rc_s.powi(5))
-            + (k[23] * qt5 * qt4 / rc_s.powi(5))
-            + (k[19] * qt5 * rc_c.powi(5) / rc_s.powi(5));
+            + (k[11] * qt4 / rc_s)
+            + (k[19] * qt4 * rc_c / rc_s)
+            + (k[11] * qt4 * rc_c / rc_s.powi(3))
+            + (k[22] * qt4 * qt0 / rc_s.powi(3))
+            + (k[23] * qt4 * qt2 / rc_s.powi(3))
+            + (k[19] * qt4 * qt2 / rc_s.powi(5))
+            + (k[23] * qt4 * qt3 / rc_s.powi(5))
+            + (k[19] * qt4 * rc_c.powi(5) / rc_s.powi(5));
     }
 
     fn forces_full(

@@ -100,7 +100,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 38,
+    n_constants: 39,
     coordinates: &["x1", "theta", "xc"],
     reduced: 1,
     cyclic: &[0, 2],
@@ -224,28 +224,30 @@ impl Model for RodCylinderFree {
         k[27] = (k[2] * k[2]) * k[0] / 4.0;
         // k[28] = g*m1
         k[28] = k[5] * k[0];
-        // k[29] = rc_wi^2*rc_ai
-        k[29] = (k[10] * k[10]) * k[16];
-        // k[30] = ell*g*m1
-        k[30] = k[2] * k[5] * k[0];
-        // k[31] = ell^2*m1
-        k[31] = (k[2] * k[2]) * k[0];
-        // k[32] = 6*ell*g*m1
-        k[32] = 6.0 * k[2] * k[5] * k[0];
-        // k[33] = 4*ell*g*m1
-        k[33] = 4.0 * k[2] * k[5] * k[0];
-        // k[34] = 3*ell*g*m1
-        k[34] = 3.0 * k[2] * k[5] * k[0];
-        // k[35] = 6*rc_wi^2*rc_ai
-        k[35] = 6.0 * (k[10] * k[10]) * k[16];
-        // k[36] = rc_p0/m1
-        k[36] = k[14] / k[0];
-        // k[37] = rc_p1/m2
-        k[37] = k[15] / k[1];
+        // k[29] = 12/(ell^2*m1)
+        k[29] = 12.0 / (k[2] * k[2]) / k[0];
+        // k[30] = rc_wi^2*rc_ai
+        k[30] = (k[10] * k[10]) * k[16];
+        // k[31] = ell*g*m1
+        k[31] = k[2] * k[5] * k[0];
+        // k[32] = 6/(ell^2*m1)
+        k[32] = 6.0 / (k[2] * k[2]) / k[0];
+        // k[33] = 6*ell*g*m1
+        k[33] = 6.0 * k[2] * k[5] * k[0];
+        // k[34] = 4*ell*g*m1
+        k[34] = 4.0 * k[2] * k[5] * k[0];
+        // k[35] = 3*ell*g*m1
+        k[35] = 3.0 * k[2] * k[5] * k[0];
+        // k[36] = 6*rc_wi^2*rc_ai
+        k[36] = 6.0 * (k[10] * k[10]) * k[16];
+        // k[37] = rc_p0/m1
+        k[37] = k[14] / k[0];
+        // k[38] = rc_p1/m2
+        k[38] = k[15] / k[1];
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         q[0] = k[6];
         qd[0] = k[9];
         q[1] = k[7];
@@ -255,7 +257,7 @@ impl Model for RodCylinderFree {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let pt0 = rc_c * rc_c;
         pos[0] = [q[0], 0.0];
@@ -281,7 +283,7 @@ impl Model for RodCylinderFree {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = qd[1] * qd[1];
         (-(k[19] * qd[1] * qd[0] * rc_s)
@@ -294,14 +296,14 @@ impl Model for RodCylinderFree {
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
         out[0] = -(k[19] * qd[1] * rc_s) + (k[0] * qd[0]);
         out[1] = k[1] * qd[2];
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let qt0 = -k[19] * rc_s;
         mass[0] = k[0];
@@ -327,7 +329,7 @@ impl Model for RodCylinderFree {
         _fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let ft0 = qd[1] * qd[1];
         out[0] = k[28] + (k[0] * qdd[0] * rc_c / rc_s)
@@ -338,7 +340,7 @@ impl Model for RodCylinderFree {
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = forces[0];
         out[1] = -(k[3] * (1.0 + rc_c) / rc_s) - q[0] + q[2];
@@ -351,7 +353,7 @@ impl Model for RodCylinderFree {
     fn released(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         poses[0] = [(k[17] * rc_c) + q[0], k[17] * rc_s, q[1]];
         poses[1] = [q[2], k[3], 0.0];
@@ -371,38 +373,38 @@ impl Model for RodCylinderFree {
 
 impl Reduction for RodCylinderFree {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[7], k[12], k[13], delta);
         let rt0 = rc_s * rc_s;
         let rt1 = -4.0 + (3.0 * rt0);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: -12.0 * (k[29] + (k[30] * rc_ds)) / (k[31] * rt1),
-            theta_ddot: 6.0
-                * ((k[32] * rc_s * rc_c * rc_ds) - (k[33] * rc_c)
-                    + (k[34] * rt0 * rc_c)
-                    + (k[35] * rc_s * rc_c))
-                / (k[31] * (rt1 * rt1)),
+            theta_dot_sq: -k[29] * (k[30] + (k[31] * rc_ds)) / rt1,
+            theta_ddot: k[32]
+                * ((k[33] * rc_s * rc_c * rc_ds) - (k[34] * rc_c)
+                    + (k[35] * rt0 * rc_c)
+                    + (k[36] * rc_s * rc_c))
+                / (rt1 * rt1),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..38]; // one bounds check for all constant loads
-        -12.0 * (k[29] + (k[30] * rc_ds)) / (k[31] * (-4.0 + (3.0 * (rc_s * rc_s))))
+        let k = &k[..39]; // one bounds check for all constant loads
+        -k[29] * (k[30] + (k[31] * rc_ds)) / (-4.0 + (3.0 * (rc_s * rc_s)))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[7], k[12], k[13], delta);
         let rt0 = rc_s * rc_s;
         let rt1 = -4.0 + (3.0 * rt0);
-        let rc_w2 = -12.0 * (k[29] + (k[30] * rc_ds)) / (k[31] * rt1);
-        let rc_acc = 6.0
-            * ((k[32] * rc_s * rc_c * rc_ds) - (k[33] * rc_c)
-                + (k[34] * rt0 * rc_c)
-                + (k[35] * rc_s * rc_c))
-            / (k[31] * (rt1 * rt1));
+        let rc_w2 = -k[29] * (k[30] + (k[31] * rc_ds)) / rt1;
+        let rc_acc = k[32]
+            * ((k[33] * rc_s * rc_c * rc_ds) - (k[34] * rc_c)
+                + (k[35] * rt0 * rc_c)
+                + (k[36] * rc_s * rc_c))
+            / (rt1 * rt1);
         out[0] = k[28] - (k[19] * rc_s * rc_w2) + (k[19] * rc_c * rc_acc);
     }
 
@@ -427,15 +429,15 @@ impl Reduction for RodCylinderFree {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..38]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         let (rc_s, _, _, rc_dc) = start_offsets(k[7], k[12], k[13], delta);
         let rc_t = t;
         let rc_w = theta_dot;
         q[1] = k[7] - delta;
         qd[1] = theta_dot;
-        q[0] = k[6] + (k[17] * rc_dc) + (k[36] * rc_t);
-        qd[0] = k[36] + (k[17] * rc_s * rc_w);
-        q[2] = k[8] + (k[37] * rc_t);
-        qd[2] = k[37];
+        q[0] = k[6] + (k[17] * rc_dc) + (k[37] * rc_t);
+        qd[0] = k[37] + (k[17] * rc_s * rc_w);
+        q[2] = k[8] + (k[38] * rc_t);
+        qd[2] = k[38];
     }
 }

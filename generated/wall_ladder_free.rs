@@ -70,7 +70,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "ladder_leans",
         meaning: "the top must start below the ladder's length (a < ell)",
     }],
-    n_constants: 29,
+    n_constants: 30,
     coordinates: &["x1", "theta"],
     reduced: 1,
     cyclic: &[0],
@@ -179,26 +179,28 @@ impl Model for WallLadderFree {
         k[19] = (k[1] * k[1]) * k[0] / 4.0;
         // k[20] = g*m1
         k[20] = k[3] * k[0];
-        // k[21] = rc_wi^2*rc_ai
-        k[21] = (k[7] * k[7]) * k[11];
-        // k[22] = ell*g*m1
-        k[22] = k[1] * k[3] * k[0];
-        // k[23] = ell^2*m1
-        k[23] = (k[1] * k[1]) * k[0];
-        // k[24] = 6*ell*g*m1
-        k[24] = 6.0 * k[1] * k[3] * k[0];
-        // k[25] = 4*ell*g*m1
-        k[25] = 4.0 * k[1] * k[3] * k[0];
-        // k[26] = 3*ell*g*m1
-        k[26] = 3.0 * k[1] * k[3] * k[0];
-        // k[27] = 6*rc_wi^2*rc_ai
-        k[27] = 6.0 * (k[7] * k[7]) * k[11];
-        // k[28] = rc_p0/m1
-        k[28] = k[10] / k[0];
+        // k[21] = 12/(ell^2*m1)
+        k[21] = 12.0 / (k[1] * k[1]) / k[0];
+        // k[22] = rc_wi^2*rc_ai
+        k[22] = (k[7] * k[7]) * k[11];
+        // k[23] = ell*g*m1
+        k[23] = k[1] * k[3] * k[0];
+        // k[24] = 6/(ell^2*m1)
+        k[24] = 6.0 / (k[1] * k[1]) / k[0];
+        // k[25] = 6*ell*g*m1
+        k[25] = 6.0 * k[1] * k[3] * k[0];
+        // k[26] = 4*ell*g*m1
+        k[26] = 4.0 * k[1] * k[3] * k[0];
+        // k[27] = 3*ell*g*m1
+        k[27] = 3.0 * k[1] * k[3] * k[0];
+        // k[28] = 6*rc_wi^2*rc_ai
+        k[28] = 6.0 * (k[7] * k[7]) * k[11];
+        // k[29] = rc_p0/m1
+        k[29] = k[10] / k[0];
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         q[0] = k[4];
         qd[0] = k[6];
         q[1] = k[5];
@@ -206,7 +208,7 @@ impl Model for WallLadderFree {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         pos[0] = [q[0], 0.0];
         vel[0] = [qd[0], 0.0];
@@ -219,7 +221,7 @@ impl Model for WallLadderFree {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = qd[1] * qd[1];
         (-(k[13] * qd[1] * qd[0] * rc_s)
@@ -231,13 +233,13 @@ impl Model for WallLadderFree {
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
         out[0] = -(k[13] * qd[1] * rc_s) + (k[0] * qd[0]);
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let qt0 = -k[13] * rc_s;
         mass[0] = k[0];
@@ -257,7 +259,7 @@ impl Model for WallLadderFree {
         _fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = k[20] + (k[13] * qdd[1] * rc_c) - (k[13] * (qd[1] * qd[1]) * rc_s);
     }
@@ -265,7 +267,7 @@ impl Model for WallLadderFree {
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let rc_c = q[1].cos();
         out[0] = forces[0];
         out[1] = -(k[1] * rc_c) - q[0];
@@ -278,7 +280,7 @@ impl Model for WallLadderFree {
     fn released(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         poses[0] = [(k[12] * rc_c) + q[0], k[12] * rc_s, q[1]];
         sizes[0] = -k[12];
@@ -298,38 +300,38 @@ impl Model for WallLadderFree {
 
 impl Reduction for WallLadderFree {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[8], k[9], delta);
         let rt0 = rc_s * rc_s;
         let rt1 = -4.0 + (3.0 * rt0);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: -12.0 * (k[21] + (k[22] * rc_ds)) / (k[23] * rt1),
-            theta_ddot: 6.0
-                * ((k[24] * rc_s * rc_c * rc_ds) - (k[25] * rc_c)
-                    + (k[26] * rt0 * rc_c)
-                    + (k[27] * rc_s * rc_c))
-                / (k[23] * (rt1 * rt1)),
+            theta_dot_sq: -k[21] * (k[22] + (k[23] * rc_ds)) / rt1,
+            theta_ddot: k[24]
+                * ((k[25] * rc_s * rc_c * rc_ds) - (k[26] * rc_c)
+                    + (k[27] * rt0 * rc_c)
+                    + (k[28] * rc_s * rc_c))
+                / (rt1 * rt1),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..29]; // one bounds check for all constant loads
-        -12.0 * (k[21] + (k[22] * rc_ds)) / (k[23] * (-4.0 + (3.0 * (rc_s * rc_s))))
+        let k = &k[..30]; // one bounds check for all constant loads
+        -k[21] * (k[22] + (k[23] * rc_ds)) / (-4.0 + (3.0 * (rc_s * rc_s)))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[8], k[9], delta);
         let rt0 = rc_s * rc_s;
         let rt1 = -4.0 + (3.0 * rt0);
-        let rc_w2 = -12.0 * (k[21] + (k[22] * rc_ds)) / (k[23] * rt1);
-        let rc_acc = 6.0
-            * ((k[24] * rc_s * rc_c * rc_ds) - (k[25] * rc_c)
-                + (k[26] * rt0 * rc_c)
-                + (k[27] * rc_s * rc_c))
-            / (k[23] * (rt1 * rt1));
+        let rc_w2 = -k[21] * (k[22] + (k[23] * rc_ds)) / rt1;
+        let rc_acc = k[24]
+            * ((k[25] * rc_s * rc_c * rc_ds) - (k[26] * rc_c)
+                + (k[27] * rt0 * rc_c)
+                + (k[28] * rc_s * rc_c))
+            / (rt1 * rt1);
         out[0] = k[20] - (k[13] * rc_s * rc_w2) + (k[13] * rc_c * rc_acc);
     }
 
@@ -354,13 +356,13 @@ impl Reduction for WallLadderFree {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, _, _, rc_dc) = start_offsets(k[5], k[8], k[9], delta);
         let rc_t = t;
         let rc_w = theta_dot;
         q[1] = k[5] - delta;
         qd[1] = theta_dot;
-        q[0] = k[4] + (k[12] * rc_dc) + (k[28] * rc_t);
-        qd[0] = k[28] + (k[12] * rc_s * rc_w);
+        q[0] = k[4] + (k[12] * rc_dc) + (k[29] * rc_t);
+        qd[0] = k[29] + (k[12] * rc_s * rc_w);
     }
 }

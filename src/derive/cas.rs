@@ -1,4 +1,5 @@
-//! The only module that calls Symbolica: conversions between [`Expr`] and Symbolica atoms and
+//! The only module that calls Symbolica: conversions between [`Expr`] and Symbolica atoms (by
+//! building and walking their structure, never through printed text) and
 //! the handful of operations the derivation needs (derivative, expansion, substitution,
 //! rational normalisation, factorisation).
 //!
@@ -6,24 +7,89 @@
 //! must run on the derivation thread started by [`super::on_cas_thread`].
 
 use super::expr::Expr;
-use symbolica::atom::{Atom, AtomCore};
-use symbolica::{parse, symbol};
+use symbolica::atom::{Atom, AtomCore, AtomView, FunctionBuilder, Symbol};
+use symbolica::coefficient::CoefficientView;
+use symbolica::prelude::RealLike;
+use symbolica::symbol;
 
 /// A Symbolica expression.
 pub type A = Atom;
 
-/// Converts an expression to Symbolica.
+/// Converts an expression to Symbolica, node by node (no text in between).
 pub fn atom(e: &Expr) -> A {
-    let text = e.to_infix();
-    parse!(&text)
+    match e {
+        Expr::Rational(n, d) => Atom::num((*n, *d)),
+        Expr::Float(x) => Atom::num(*x),
+        Expr::Sym(s) => var(s),
+        Expr::Add(v) => v.iter().fold(num(0), |sum, t| sum + atom(t)),
+        Expr::Mul(v) => v.iter().fold(num(1), |product, f| product * atom(f)),
+        Expr::Pow(b, x) => atom(b).pow(atom(x)),
+        Expr::Fun(f, args) => args
+            .iter()
+            .fold(FunctionBuilder::new(function(f)), |call, a| {
+                call.add_arg(atom(a))
+            })
+            .finish(),
+    }
 }
 
-/// Converts a Symbolica expression back (through its plain-text form).
+/// Symbolica's own symbol for a function it knows (so that it differentiates and simplifies
+/// it), a new one for any other.
+fn function(name: &str) -> Symbol {
+    match name {
+        "sin" => Symbol::SIN,
+        "cos" => Symbol::COS,
+        "sqrt" => Symbol::SQRT,
+        "exp" => Symbol::EXP,
+        "log" => Symbol::LOG,
+        other => symbol!(other),
+    }
+}
+
+/// Converts a Symbolica expression back by walking its structure (its public atom views), so
+/// that no change in how Symbolica prints can change what the tool reads.
 pub fn expr(a: &A) -> Result<Expr, String> {
-    let text = format!("{a}");
-    Expr::parse(&text)
+    view(a.as_view())
         .map(|e| e.tidy())
-        .map_err(|e| format!("cannot read back Symbolica output `{text}`: {}", e.message))
+        .map_err(|m| format!("cannot read back Symbolica's `{a}`: {m}"))
+}
+
+fn view(v: AtomView) -> Result<Expr, String> {
+    let all = |items: &mut dyn Iterator<Item = AtomView>| -> Result<Vec<Expr>, String> {
+        items.map(view).collect()
+    };
+    Ok(match v {
+        AtomView::Num(n) => number(n.get_coeff_view())?,
+        AtomView::Var(x) => Expr::Sym(x.get_symbol().get_stripped_name().to_string()),
+        AtomView::Fun(f) => Expr::Fun(
+            f.get_symbol().get_stripped_name().to_string(),
+            all(&mut f.iter())?,
+        ),
+        AtomView::Pow(p) => {
+            let (base, exponent) = p.get_base_exp();
+            Expr::Pow(Box::new(view(base)?), Box::new(view(exponent)?))
+        }
+        AtomView::Mul(m) => Expr::Mul(all(&mut m.iter())?),
+        AtomView::Add(s) => Expr::Add(all(&mut s.iter())?),
+    })
+}
+
+/// A real rational (or float) coefficient; anything else (complex, infinite, undefined, a
+/// finite-field element) has no place in a mechanics derivation and is an error.
+fn number(c: CoefficientView) -> Result<Expr, String> {
+    let too_large = |_| "a rational beyond 128 bits".to_string();
+    match c {
+        CoefficientView::Natural(n, d, 0, _) => Ok(Expr::Rational(n.into(), d.into())),
+        CoefficientView::Large(re, im) if im.is_zero() => {
+            let r = re.to_rat();
+            Ok(Expr::Rational(
+                i128::try_from(r.numerator()).map_err(too_large)?,
+                i128::try_from(r.denominator()).map_err(too_large)?,
+            ))
+        }
+        CoefficientView::Float(re, im) if im.is_zero() => Ok(Expr::Float(re.to_float().to_f64())),
+        _ => Err("a number that is not real and finite".into()),
+    }
 }
 
 /// Defines symbols in the order given, before any expression uses them. Symbolica orders the
