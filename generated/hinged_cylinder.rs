@@ -64,7 +64,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 33,
+    n_constants: 32,
     coordinates: &["theta"],
     reduced: 0,
     cyclic: &[],
@@ -157,75 +157,69 @@ impl Model for HingedCylinder {
         k[..6].copy_from_slice(p);
         // k[4] also holds rc_thi = th0
         Reduction::prepare_lean(self, p, k);
-        // k[9] = rc_ai = -R^2*m2/rc_si^2 + 2*R^2*m2/rc_si^4 + 2*R^2*m2*rc_ci/rc_si^4 + ell^2*m1/3
-        let c4_t0 = k[3] * k[3];
-        k[9] = -(c4_t0 * k[1] / (k[7] * k[7]))
-            + (2.0 * c4_t0 * k[1] / k[7].powi(4))
-            + (2.0 * c4_t0 * k[1] * k[8] / k[7].powi(4))
-            + ((k[2] * k[2]) * k[0] / 3.0);
-        // k[10] = ell/2
-        k[10] = k[2] / 2.0;
-        // k[11] = R^2*m2/2 + ell^2*m1/24
-        k[11] = ((k[3] * k[3]) * k[1] / 2.0) + ((k[2] * k[2]) * k[0] / 24.0);
-        // k[12] = R^2*m2
-        k[12] = (k[3] * k[3]) * k[1];
-        // k[13] = R^2*m2/2
-        k[13] = (k[3] * k[3]) * k[1] / 2.0;
-        // k[14] = ell^2*m1/8
-        k[14] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[15] = R*g*m2
-        k[15] = k[3] * k[5] * k[1];
-        // k[16] = ell*g*m1/2
-        k[16] = k[2] * k[5] * k[0] / 2.0;
-        // k[17] = R^2*m2 + ell^2*m1/12
-        k[17] = ((k[3] * k[3]) * k[1]) + ((k[2] * k[2]) * k[0] / 12.0);
-        // k[18] = 2*R^2*m2
-        k[18] = 2.0 * (k[3] * k[3]) * k[1];
-        // k[19] = ell^2*m1/4
-        k[19] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[20] = 5*R^2*m2
-        k[20] = 5.0 * (k[3] * k[3]) * k[1];
-        // k[21] = 4*R^2*m2
-        k[21] = 4.0 * (k[3] * k[3]) * k[1];
-        // k[22] = 2*R
-        k[22] = 2.0 * k[3];
-        // k[23] = 3*ell*g*m1
-        k[23] = 3.0 * k[2] * k[5] * k[0];
-        // k[24] = 6*R^2*m2
-        k[24] = 6.0 * (k[3] * k[3]) * k[1];
-        // k[25] = 3*R^2*m2
-        k[25] = 3.0 * (k[3] * k[3]) * k[1];
-        // k[26] = ell^2*m1
-        k[26] = (k[2] * k[2]) * k[0];
-        // k[27] = 24*R^2*ell*g*m1*m2
-        k[27] = 24.0 * (k[3] * k[3]) * k[2] * k[5] * k[0] * k[1];
-        // k[28] = 6*R^2*ell*g*m1*m2
-        k[28] = 6.0 * (k[3] * k[3]) * k[2] * k[5] * k[0] * k[1];
-        // k[29] = 3*R^2*ell*g*m1*m2
-        k[29] = 3.0 * (k[3] * k[3]) * k[2] * k[5] * k[0] * k[1];
-        // k[30] = ell^3*g*m1^2
-        k[30] = k[2].powi(3) * k[5] * (k[0] * k[0]);
-        // k[31] = R*m2
-        k[31] = k[3] * k[1];
-        // k[32] = 2*R*m2
-        k[32] = 2.0 * k[3] * k[1];
+        // k[9] = ell/2
+        k[9] = k[2] / 2.0;
+        // k[10] = R^2*m2/2 + ell^2*m1/24
+        k[10] = ((k[3] * k[3]) * k[1] / 2.0) + ((k[2] * k[2]) * k[0] / 24.0);
+        // k[11] = R^2*m2
+        k[11] = (k[3] * k[3]) * k[1];
+        // k[12] = R^2*m2/2
+        k[12] = (k[3] * k[3]) * k[1] / 2.0;
+        // k[13] = ell^2*m1/8
+        k[13] = (k[2] * k[2]) * k[0] / 8.0;
+        // k[14] = R*g*m2
+        k[14] = k[3] * k[5] * k[1];
+        // k[15] = ell*g*m1/2
+        k[15] = k[2] * k[5] * k[0] / 2.0;
+        // k[16] = R^2*m2 + ell^2*m1/12
+        k[16] = ((k[3] * k[3]) * k[1]) + ((k[2] * k[2]) * k[0] / 12.0);
+        // k[17] = 2*R^2*m2
+        k[17] = 2.0 * (k[3] * k[3]) * k[1];
+        // k[18] = ell^2*m1/4
+        k[18] = (k[2] * k[2]) * k[0] / 4.0;
+        // k[19] = 5*R^2*m2
+        k[19] = 5.0 * (k[3] * k[3]) * k[1];
+        // k[20] = 4*R^2*m2
+        k[20] = 4.0 * (k[3] * k[3]) * k[1];
+        // k[21] = 2*R
+        k[21] = 2.0 * k[3];
+        // k[22] = 3*ell*g*m1
+        k[22] = 3.0 * k[2] * k[5] * k[0];
+        // k[23] = 6*R^2*m2
+        k[23] = 6.0 * (k[3] * k[3]) * k[1];
+        // k[24] = 3*R^2*m2
+        k[24] = 3.0 * (k[3] * k[3]) * k[1];
+        // k[25] = ell^2*m1
+        k[25] = (k[2] * k[2]) * k[0];
+        // k[26] = 24*R^2*ell*g*m1*m2
+        k[26] = 24.0 * (k[3] * k[3]) * k[2] * k[5] * k[0] * k[1];
+        // k[27] = 6*R^2*ell*g*m1*m2
+        k[27] = 6.0 * (k[3] * k[3]) * k[2] * k[5] * k[0] * k[1];
+        // k[28] = 3*R^2*ell*g*m1*m2
+        k[28] = 3.0 * (k[3] * k[3]) * k[2] * k[5] * k[0] * k[1];
+        // k[29] = ell^3*g*m1^2
+        k[29] = k[2].powi(3) * k[5] * (k[0] * k[0]);
+        // k[30] = R*m2
+        k[30] = k[3] * k[1];
+        // k[31] = 2*R*m2
+        k[31] = 2.0 * k[3] * k[1];
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         q[0] = k[4];
         qd[0] = 0.0;
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         pos[0] = [0.0, 0.0];
         vel[0] = [0.0, 0.0];
         pos[1] = [k[2] * rc_c, k[2] * rc_s];
         vel[1] = [-k[2] * qd[0] * rc_s, k[2] * qd[0] * rc_c];
-        pos[2] = [k[10] * rc_c, k[10] * rc_s];
-        vel[2] = [-k[10] * qd[0] * rc_s, k[10] * qd[0] * rc_c];
+        pos[2] = [k[9] * rc_c, k[9] * rc_s];
+        vel[2] = [-k[9] * qd[0] * rc_s, k[9] * qd[0] * rc_c];
         pos[3] = [(k[3] / rc_s) + (k[3] * rc_c / rc_s), k[3]];
         vel[3] = [
             -(k[3] * qd[0])
@@ -236,47 +230,47 @@ impl Model for HingedCylinder {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let et0 = qd[0] * qd[0];
         let et1 = rc_c * rc_c;
-        ((k[11] * et0)
-            + (k[12] * et0 * rc_c / (rc_s * rc_s))
-            + (k[12] * et0 * et1 / (rc_s * rc_s))
-            + (k[13] * et0 * et1 / rc_s.powi(4))
-            + (k[12] * et0 * rc_c.powi(3) / rc_s.powi(4))
-            + (k[13] * et0 * rc_c.powi(4) / rc_s.powi(4))
-            + (k[14] * et0 * (rc_s * rc_s))
-            + (k[14] * et0 * et1))
-            + (k[15] + (k[16] * rc_s))
+        ((k[10] * et0)
+            + (k[11] * et0 * rc_c / (rc_s * rc_s))
+            + (k[11] * et0 * et1 / (rc_s * rc_s))
+            + (k[12] * et0 * et1 / rc_s.powi(4))
+            + (k[11] * et0 * rc_c.powi(3) / rc_s.powi(4))
+            + (k[12] * et0 * rc_c.powi(4) / rc_s.powi(4))
+            + (k[13] * et0 * (rc_s * rc_s))
+            + (k[13] * et0 * et1))
+            + (k[14] + (k[15] * rc_s))
     }
 
     fn momenta(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let qt0 = rc_c * rc_c;
         let qt1 = rc_c.powi(3);
         let qt2 = rc_c.powi(4);
         let qt3 = qd[0] * qd[0];
-        mass[0] = k[17]
-            + (k[18] * rc_c / (rc_s * rc_s))
-            + (k[18] * qt0 / (rc_s * rc_s))
-            + (k[12] * qt0 / rc_s.powi(4))
-            + (k[18] * qt1 / rc_s.powi(4))
-            + (k[12] * qt2 / rc_s.powi(4))
-            + (k[19] * (rc_s * rc_s))
-            + (k[19] * qt0);
-        rhs[0] = -(k[16] * rc_c)
-            + (k[12] * qt3 / rc_s)
-            + (k[18] * qt3 * rc_c / rc_s)
-            + (k[12] * qt3 * rc_c / rc_s.powi(3))
-            + (k[20] * qt3 * qt0 / rc_s.powi(3))
-            + (k[21] * qt3 * qt1 / rc_s.powi(3))
-            + (k[18] * qt3 * qt1 / rc_s.powi(5))
-            + (k[21] * qt3 * qt2 / rc_s.powi(5))
-            + (k[18] * qt3 * rc_c.powi(5) / rc_s.powi(5));
+        mass[0] = k[16]
+            + (k[17] * rc_c / (rc_s * rc_s))
+            + (k[17] * qt0 / (rc_s * rc_s))
+            + (k[11] * qt0 / rc_s.powi(4))
+            + (k[17] * qt1 / rc_s.powi(4))
+            + (k[11] * qt2 / rc_s.powi(4))
+            + (k[18] * (rc_s * rc_s))
+            + (k[18] * qt0);
+        rhs[0] = -(k[15] * rc_c)
+            + (k[11] * qt3 / rc_s)
+            + (k[17] * qt3 * rc_c / rc_s)
+            + (k[11] * qt3 * rc_c / rc_s.powi(3))
+            + (k[19] * qt3 * qt0 / rc_s.powi(3))
+            + (k[20] * qt3 * qt1 / rc_s.powi(3))
+            + (k[17] * qt3 * qt1 / rc_s.powi(5))
+            + (k[20] * qt3 * qt2 / rc_s.powi(5))
+            + (k[17] * qt3 * rc_c.powi(5) / rc_s.powi(5));
     }
 
     fn forces_full(
@@ -288,7 +282,7 @@ impl Model for HingedCylinder {
         _fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ft0 = rc_c * rc_c;
         let ft1 = qd[0] * qd[0];
@@ -297,9 +291,9 @@ impl Model for HingedCylinder {
                 - (k[3] * qdd[0] * rc_c / (rc_s * rc_s))
                 - (k[3] * qdd[0] * ft0 / (rc_s * rc_s))
                 + (k[3] * ft1 / rc_s)
-                + (k[22] * ft1 * rc_c / rc_s)
-                + (k[22] * ft1 * ft0 / rc_s.powi(3))
-                + (k[22] * ft1 * rc_c.powi(3) / rc_s.powi(3)));
+                + (k[21] * ft1 * rc_c / rc_s)
+                + (k[21] * ft1 * ft0 / rc_s.powi(3))
+                + (k[21] * ft1 * rc_c.powi(3) / rc_s.powi(3)));
     }
 
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
@@ -315,13 +309,13 @@ impl Model for HingedCylinder {
     }
 
     fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         k[2] - (k[3] / rc_s) - (k[3] * rc_c / rc_s)
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         out[0] = (k[3] / rc_s) + (k[3] * rc_c / rc_s);
         out[1] = -(k[3] * qd[0])
@@ -330,13 +324,13 @@ impl Model for HingedCylinder {
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        poses[0] = [k[10] * rc_c, k[10] * rc_s, q[0]];
+        poses[0] = [k[9] * rc_c, k[9] * rc_s, q[0]];
         poses[1] = [(k[3] / rc_s) + (k[3] * rc_c / rc_s), k[3], 0.0];
-        sizes[0] = -k[10];
+        sizes[0] = -k[9];
         sizes[1] = 0.0;
-        sizes[2] = k[10];
+        sizes[2] = k[9];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
@@ -350,61 +344,61 @@ impl Model for HingedCylinder {
 
 impl Reduction for HingedCylinder {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[4], k[7], k[8], delta);
         let rt0 = rc_s.powi(4);
-        let rt1 = k[24] + (k[24] * rc_c) - (k[25] * (rc_s * rc_s)) + (k[26] * rt0);
+        let rt1 = k[23] + (k[23] * rc_c) - (k[24] * (rc_s * rc_s)) + (k[25] * rt0);
         let rt2 = rc_s.powi(3);
         let rt3 = rc_c * rc_c;
         let rt4 = rc_s.powi(5);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: k[23] * rt0 * rc_ds / rt1,
+            theta_dot_sq: k[22] * rt0 * rc_ds / rt1,
             theta_ddot: -3.0
-                * (-(k[27] * rt2 * rc_c * rc_ds) - (k[27] * rt2 * rt3 * rc_ds)
-                    + (k[28] * rt0 * rc_c)
-                    + (k[28] * rt0 * rt3)
-                    + (k[28] * rt4 * rc_c * rc_ds)
-                    - (k[28] * rt4 * rc_ds)
-                    - (k[29] * rc_s.powi(6) * rc_c)
-                    + (k[30] * rc_s.powi(8) * rc_c))
+                * (-(k[26] * rt2 * rc_c * rc_ds) - (k[26] * rt2 * rt3 * rc_ds)
+                    + (k[27] * rt0 * rc_c)
+                    + (k[27] * rt0 * rt3)
+                    + (k[27] * rt4 * rc_c * rc_ds)
+                    - (k[27] * rt4 * rc_ds)
+                    - (k[28] * rc_s.powi(6) * rc_c)
+                    + (k[29] * rc_s.powi(8) * rc_c))
                 / 2.0
                 / (rt1 * rt1),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let rt0 = rc_s.powi(4);
-        k[23] * rt0 * rc_ds / (k[24] + (k[24] * rc_c) - (k[25] * (rc_s * rc_s)) + (k[26] * rt0))
+        k[22] * rt0 * rc_ds / (k[23] + (k[23] * rc_c) - (k[24] * (rc_s * rc_s)) + (k[25] * rt0))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[4], k[7], k[8], delta);
         let rt0 = rc_s.powi(4);
-        let rt1 = k[24] + (k[24] * rc_c) - (k[25] * (rc_s * rc_s)) + (k[26] * rt0);
+        let rt1 = k[23] + (k[23] * rc_c) - (k[24] * (rc_s * rc_s)) + (k[25] * rt0);
         let rt2 = rc_s.powi(3);
         let rt3 = rc_c * rc_c;
         let rt4 = rc_s.powi(5);
-        let rc_w2 = k[23] * rt0 * rc_ds / rt1;
+        let rc_w2 = k[22] * rt0 * rc_ds / rt1;
         let rc_acc = -3.0
-            * (-(k[27] * rt2 * rc_c * rc_ds) - (k[27] * rt2 * rt3 * rc_ds)
-                + (k[28] * rt0 * rc_c)
-                + (k[28] * rt0 * rt3)
-                + (k[28] * rt4 * rc_c * rc_ds)
-                - (k[28] * rt4 * rc_ds)
-                - (k[29] * rc_s.powi(6) * rc_c)
-                + (k[30] * rc_s.powi(8) * rc_c))
+            * (-(k[26] * rt2 * rc_c * rc_ds) - (k[26] * rt2 * rt3 * rc_ds)
+                + (k[27] * rt0 * rc_c)
+                + (k[27] * rt0 * rt3)
+                + (k[27] * rt4 * rc_c * rc_ds)
+                - (k[27] * rt4 * rc_ds)
+                - (k[28] * rc_s.powi(6) * rc_c)
+                + (k[29] * rc_s.powi(8) * rc_c))
             / 2.0
             / (rt1 * rt1);
         let ft0 = rc_c * rc_c;
-        out[0] = -(k[31] * rc_acc) + (k[32] * rc_c * rc_w2 / rc_s) + (k[31] * rc_w2 / rc_s)
-            - (k[31] * rc_c * rc_acc / (rc_s * rc_s))
-            - (k[31] * ft0 * rc_acc / (rc_s * rc_s))
-            + (k[32] * ft0 * rc_w2 / rc_s.powi(3))
-            + (k[32] * rc_c.powi(3) * rc_w2 / rc_s.powi(3));
+        out[0] = -(k[30] * rc_acc) + (k[31] * rc_c * rc_w2 / rc_s) + (k[30] * rc_w2 / rc_s)
+            - (k[30] * rc_c * rc_acc / (rc_s * rc_s))
+            - (k[30] * ft0 * rc_acc / (rc_s * rc_s))
+            + (k[31] * ft0 * rc_w2 / rc_s.powi(3))
+            + (k[31] * rc_c.powi(3) * rc_w2 / rc_s.powi(3));
     }
 
     fn separation_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
@@ -430,7 +424,7 @@ impl Reduction for HingedCylinder {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         q[0] = k[4] - delta;
         qd[0] = theta_dot;
     }

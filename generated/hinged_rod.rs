@@ -52,7 +52,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 34,
+    n_constants: 33,
     coordinates: &["theta"],
     reduced: 0,
     cyclic: &[],
@@ -133,7 +133,7 @@ static INFO: ModelInfo = ModelInfo {
         separation_degree: 3,
         polynomial_separation: true,
         fall_degree: Some(2),
-        lean_constants: &[6, 7, 8, 24, 30, 31, 32, 33],
+        lean_constants: &[6, 7, 8, 23, 29, 30, 31, 32],
     }),
     route_note: "",
 };
@@ -153,59 +153,56 @@ impl Model for HingedRod {
         Reduction::prepare_lean(self, p, k);
         // k[5] = rc_thi = asin(a/ell)
         k[5] = (k[3] / k[2]).asin();
-        // k[9] = rc_ai = ell^2*m1/3 + ell^2*m2*rc_si^2
-        let c4_t0 = k[2] * k[2];
-        k[9] = (c4_t0 * k[0] / 3.0) + (c4_t0 * k[1] * (k[7] * k[7]));
-        // k[10] = ell/2
-        k[10] = k[2] / 2.0;
-        // k[11] = ell^2*m1/24
-        k[11] = (k[2] * k[2]) * k[0] / 24.0;
-        // k[12] = ell^2*m1/8 + ell^2*m2/2
-        let h12_t0 = k[2] * k[2];
-        k[12] = (h12_t0 * k[0] / 8.0) + (h12_t0 * k[1] / 2.0);
-        // k[13] = ell^2*m1/8
-        k[13] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[14] = a*g*m2/2
-        k[14] = k[3] * k[4] * k[1] / 2.0;
-        // k[15] = ell*g*m1/2
-        k[15] = k[2] * k[4] * k[0] / 2.0;
-        // k[16] = ell^2*m1/12
-        k[16] = (k[2] * k[2]) * k[0] / 12.0;
-        // k[17] = ell^2*m1/4 + ell^2*m2
-        let h17_t0 = k[2] * k[2];
-        k[17] = (h17_t0 * k[0] / 4.0) + (h17_t0 * k[1]);
-        // k[18] = ell^2*m1/4
-        k[18] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[19] = ell^2*m2
-        k[19] = (k[2] * k[2]) * k[1];
-        // k[20] = g*m1
-        k[20] = k[4] * k[0];
-        // k[21] = ell*m1/2
-        k[21] = k[2] * k[0] / 2.0;
-        // k[22] = a/2
-        k[22] = k[3] / 2.0;
-        // k[23] = 3*g*m1/ell
-        k[23] = 3.0 * k[4] * k[0] / k[2];
-        // k[25] = 3/(2*ell)
-        k[25] = 3.0 / 2.0 / k[2];
-        // k[26] = 6*g*m1*m2
-        k[26] = 6.0 * k[4] * k[0] * k[1];
-        // k[27] = 3*g*m1*m2
-        k[27] = 3.0 * k[4] * k[0] * k[1];
-        // k[28] = g*m1^2
-        k[28] = k[4] * (k[0] * k[0]);
-        // k[29] = ell*m2
-        k[29] = k[2] * k[1];
+        // k[9] = ell/2
+        k[9] = k[2] / 2.0;
+        // k[10] = ell^2*m1/24
+        k[10] = (k[2] * k[2]) * k[0] / 24.0;
+        // k[11] = ell^2*m1/8 + ell^2*m2/2
+        let h11_t0 = k[2] * k[2];
+        k[11] = (h11_t0 * k[0] / 8.0) + (h11_t0 * k[1] / 2.0);
+        // k[12] = ell^2*m1/8
+        k[12] = (k[2] * k[2]) * k[0] / 8.0;
+        // k[13] = a*g*m2/2
+        k[13] = k[3] * k[4] * k[1] / 2.0;
+        // k[14] = ell*g*m1/2
+        k[14] = k[2] * k[4] * k[0] / 2.0;
+        // k[15] = ell^2*m1/12
+        k[15] = (k[2] * k[2]) * k[0] / 12.0;
+        // k[16] = ell^2*m1/4 + ell^2*m2
+        let h16_t0 = k[2] * k[2];
+        k[16] = (h16_t0 * k[0] / 4.0) + (h16_t0 * k[1]);
+        // k[17] = ell^2*m1/4
+        k[17] = (k[2] * k[2]) * k[0] / 4.0;
+        // k[18] = ell^2*m2
+        k[18] = (k[2] * k[2]) * k[1];
+        // k[19] = g*m1
+        k[19] = k[4] * k[0];
+        // k[20] = ell*m1/2
+        k[20] = k[2] * k[0] / 2.0;
+        // k[21] = a/2
+        k[21] = k[3] / 2.0;
+        // k[22] = 3*g*m1/ell
+        k[22] = 3.0 * k[4] * k[0] / k[2];
+        // k[24] = 3/(2*ell)
+        k[24] = 3.0 / 2.0 / k[2];
+        // k[25] = 6*g*m1*m2
+        k[25] = 6.0 * k[4] * k[0] * k[1];
+        // k[26] = 3*g*m1*m2
+        k[26] = 3.0 * k[4] * k[0] * k[1];
+        // k[27] = g*m1^2
+        k[27] = k[4] * (k[0] * k[0]);
+        // k[28] = ell*m2
+        k[28] = k[2] * k[1];
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..34]; // one bounds check for all constant loads
+        let k = &k[..33]; // one bounds check for all constant loads
         q[0] = k[5];
         qd[0] = 0.0;
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..34]; // one bounds check for all constant loads
+        let k = &k[..33]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let pt0 = k[2] * rc_c;
         let pt1 = -k[2] * qd[0] * rc_s;
@@ -213,27 +210,27 @@ impl Model for HingedRod {
         vel[0] = [0.0, 0.0];
         pos[1] = [pt0, k[2] * rc_s];
         vel[1] = [pt1, k[2] * qd[0] * rc_c];
-        pos[2] = [k[10] * rc_c, k[10] * rc_s];
-        vel[2] = [-k[10] * qd[0] * rc_s, k[10] * qd[0] * rc_c];
+        pos[2] = [k[9] * rc_c, k[9] * rc_s];
+        vel[2] = [-k[9] * qd[0] * rc_s, k[9] * qd[0] * rc_c];
         pos[3] = [pt0, 0.0];
         vel[3] = [pt1, 0.0];
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..34]; // one bounds check for all constant loads
+        let k = &k[..33]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let et0 = qd[0] * qd[0];
-        ((k[11] * et0) + (k[12] * et0 * (rc_s * rc_s)) + (k[13] * et0 * (rc_c * rc_c)))
-            + (k[14] + (k[15] * rc_s))
+        ((k[10] * et0) + (k[11] * et0 * (rc_s * rc_s)) + (k[12] * et0 * (rc_c * rc_c)))
+            + (k[13] + (k[14] * rc_s))
     }
 
     fn momenta(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..34]; // one bounds check for all constant loads
+        let k = &k[..33]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        mass[0] = k[16] + (k[17] * (rc_s * rc_s)) + (k[18] * (rc_c * rc_c));
-        rhs[0] = -(k[15] * rc_c) - (k[19] * (qd[0] * qd[0]) * rc_s * rc_c);
+        mass[0] = k[15] + (k[16] * (rc_s * rc_s)) + (k[17] * (rc_c * rc_c));
+        rhs[0] = -(k[14] * rc_c) - (k[18] * (qd[0] * qd[0]) * rc_s * rc_c);
     }
 
     fn forces_full(
@@ -245,19 +242,19 @@ impl Model for HingedRod {
         _fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..34]; // one bounds check for all constant loads
+        let k = &k[..33]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ft0 = qd[0] * qd[0];
         out[0] = k[1] * (-(k[2] * qdd[0] * rc_s) - (k[2] * ft0 * rc_c));
-        out[1] = k[20] + (k[21] * qdd[0] * rc_c) - (k[21] * ft0 * rc_s);
+        out[1] = k[19] + (k[20] * qdd[0] * rc_c) - (k[20] * ft0 * rc_s);
     }
 
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..34]; // one bounds check for all constant loads
+        let k = &k[..33]; // one bounds check for all constant loads
         let rc_s = q[0].sin();
-        out[0] = k[14] - (forces[0] * (-k[22] + (k[2] * rc_s)));
+        out[0] = k[13] - (forces[0] * (-k[21] + (k[2] * rc_s)));
     }
 
     fn contact_edge(&self, _k: &[f64], _q: &[f64]) -> f64 {
@@ -265,20 +262,20 @@ impl Model for HingedRod {
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..34]; // one bounds check for all constant loads
+        let k = &k[..33]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         out[0] = k[2] * rc_c;
         out[1] = -k[2] * qd[0] * rc_s;
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..34]; // one bounds check for all constant loads
+        let k = &k[..33]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        poses[0] = [k[10] * rc_c, k[10] * rc_s, q[0]];
-        poses[1] = [k[22] + (k[2] * rc_c), k[22], 0.0];
-        sizes[0] = -k[10];
+        poses[0] = [k[9] * rc_c, k[9] * rc_s, q[0]];
+        poses[1] = [k[21] + (k[2] * rc_c), k[21], 0.0];
+        sizes[0] = -k[9];
         sizes[1] = 0.0;
-        sizes[2] = k[10];
+        sizes[2] = k[9];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
@@ -293,44 +290,44 @@ impl Model for HingedRod {
 
 impl Reduction for HingedRod {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..34]; // one bounds check for all constant loads
+        let k = &k[..33]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[7], k[8], delta);
         let rt0 = rc_s * rc_s;
-        let rt1 = k[0] + (k[24] * rt0);
+        let rt1 = k[0] + (k[23] * rt0);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: k[23] * rc_ds / rt1,
-            theta_ddot: -k[25]
-                * ((k[26] * rc_s * rc_c * rc_ds) + (k[27] * rt0 * rc_c) + (k[28] * rc_c))
+            theta_dot_sq: k[22] * rc_ds / rt1,
+            theta_ddot: -k[24]
+                * ((k[25] * rc_s * rc_c * rc_ds) + (k[26] * rt0 * rc_c) + (k[27] * rc_c))
                 / (rt1 * rt1),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..34]; // one bounds check for all constant loads
-        k[23] * rc_ds / (k[0] + (k[24] * (rc_s * rc_s)))
+        let k = &k[..33]; // one bounds check for all constant loads
+        k[22] * rc_ds / (k[0] + (k[23] * (rc_s * rc_s)))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..34]; // one bounds check for all constant loads
+        let k = &k[..33]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[7], k[8], delta);
         let rt0 = rc_s * rc_s;
-        let rt1 = k[0] + (k[24] * rt0);
-        let rc_w2 = k[23] * rc_ds / rt1;
-        let rc_acc = -k[25]
-            * ((k[26] * rc_s * rc_c * rc_ds) + (k[27] * rt0 * rc_c) + (k[28] * rc_c))
+        let rt1 = k[0] + (k[23] * rt0);
+        let rc_w2 = k[22] * rc_ds / rt1;
+        let rc_acc = -k[24]
+            * ((k[25] * rc_s * rc_c * rc_ds) + (k[26] * rt0 * rc_c) + (k[27] * rc_c))
             / (rt1 * rt1);
-        out[0] = -(k[29] * rc_s * rc_acc) - (k[29] * rc_c * rc_w2);
-        out[1] = k[20] - (k[21] * rc_s * rc_w2) + (k[21] * rc_c * rc_acc);
+        out[0] = -(k[28] * rc_s * rc_acc) - (k[28] * rc_c * rc_w2);
+        out[1] = k[19] - (k[20] * rc_s * rc_w2) + (k[20] * rc_c * rc_acc);
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..34]; // one bounds check for all constant loads
-        out[0] = -k[30];
-        out[1] = k[31];
+        let k = &k[..33]; // one bounds check for all constant loads
+        out[0] = -k[29];
+        out[1] = k[30];
         out[2] = 0.0;
-        out[3] = k[24];
+        out[3] = k[23];
     }
 
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
@@ -342,23 +339,23 @@ impl Reduction for HingedRod {
         // k[8] = rc_ci = ((1 - a/ell)*(1 + a/ell))^(1/2)
         let c3_t0 = k[3] / k[2];
         k[8] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
-        // k[24] = 3*m2
-        k[24] = 3.0 * k[1];
-        // k[30] = 2*m1*rc_si
-        k[30] = 2.0 * k[0] * k[7];
-        // k[31] = 3*m1
-        k[31] = 3.0 * k[0];
-        // k[32] = ell/(3*g)
-        k[32] = k[2] / 3.0 / k[4];
-        // k[33] = ell*m2/(g*m1)
-        k[33] = k[2] * k[1] / k[4] / k[0];
+        // k[23] = 3*m2
+        k[23] = 3.0 * k[1];
+        // k[29] = 2*m1*rc_si
+        k[29] = 2.0 * k[0] * k[7];
+        // k[30] = 3*m1
+        k[30] = 3.0 * k[0];
+        // k[31] = ell/(3*g)
+        k[31] = k[2] / 3.0 / k[4];
+        // k[32] = ell*m2/(g*m1)
+        k[32] = k[2] * k[1] / k[4] / k[0];
     }
 
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..34]; // one bounds check for all constant loads
-        out[0] = k[32];
+        let k = &k[..33]; // one bounds check for all constant loads
+        out[0] = k[31];
         out[1] = 0.0;
-        out[2] = k[33];
+        out[2] = k[32];
     }
 
     fn full_state(
@@ -370,7 +367,7 @@ impl Reduction for HingedRod {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..34]; // one bounds check for all constant loads
+        let k = &k[..33]; // one bounds check for all constant loads
         q[0] = k[5] - delta;
         qd[0] = theta_dot;
     }

@@ -52,7 +52,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 42,
+    n_constants: 40,
     coordinates: &["x1", "theta"],
     reduced: 1,
     cyclic: &[0],
@@ -60,7 +60,7 @@ static INFO: ModelInfo = ModelInfo {
     forces: &[
         NamedInfo {
             name: "contact_force",
-            meaning: "push of the rod's tip on the cube (eq. 16), positive while they touch",
+            meaning: "push of the rod's tip on the cube, positive while they touch",
         },
         NamedInfo {
             name: "floor_normal",
@@ -142,7 +142,7 @@ static INFO: ModelInfo = ModelInfo {
         separation_degree: 3,
         polynomial_separation: true,
         fall_degree: Some(2),
-        lean_constants: &[6, 7, 8, 31, 37, 38, 39, 40],
+        lean_constants: &[6, 7, 8, 29, 35, 36, 37, 38],
     }),
     route_note: "",
 };
@@ -164,72 +164,64 @@ impl Model for RodCube {
         k[5] = (k[3] / k[2]).asin();
         // k[9] = rc_x0i = 0.0
         k[9] = 0.0;
-        // k[10] = rc_p0 = 0
-        k[10] = 0.0;
-        // k[11] = rc_ai = ell^2*m1*m2/(3*(m1 + m2)) - ell^2*m1^2*rc_si^2/(4*(m1 + m2)) + ell^2*m1^2/(3*(m1 + m2))
-        let c6_t0 = k[2] * k[2];
-        let c6_t1 = k[0] * k[0];
-        k[11] = (c6_t0 * k[0] * k[1] / 3.0 / (k[0] + k[1]))
-            - (c6_t0 * c6_t1 * (k[7] * k[7]) / 4.0 / (k[0] + k[1]))
-            + (c6_t0 * c6_t1 / 3.0 / (k[0] + k[1]));
-        // k[12] = ell/2
-        k[12] = k[2] / 2.0;
-        // k[13] = ell*m1/2 + ell*m2
-        k[13] = (k[2] * k[0] / 2.0) + (k[2] * k[1]);
-        // k[14] = ell^2*m1/24
-        k[14] = (k[2] * k[2]) * k[0] / 24.0;
-        // k[15] = ell^2*m1/8 + ell^2*m2/2
-        let h15_t0 = k[2] * k[2];
-        k[15] = (h15_t0 * k[0] / 8.0) + (h15_t0 * k[1] / 2.0);
-        // k[16] = ell^2*m1/8
-        k[16] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[17] = m1/2 + m2/2
-        k[17] = (k[0] / 2.0) + (k[1] / 2.0);
-        // k[18] = a*g*m2/2
-        k[18] = k[3] * k[4] * k[1] / 2.0;
-        // k[19] = ell*g*m1/2
-        k[19] = k[2] * k[4] * k[0] / 2.0;
-        // k[20] = m1 + m2
-        k[20] = k[0] + k[1];
-        // k[21] = ell^2*m1/12
-        k[21] = (k[2] * k[2]) * k[0] / 12.0;
-        // k[22] = ell^2*m1/4 + ell^2*m2
-        let h22_t0 = k[2] * k[2];
-        k[22] = (h22_t0 * k[0] / 4.0) + (h22_t0 * k[1]);
-        // k[23] = ell^2*m1/4
-        k[23] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[24] = ell^2*m2
-        k[24] = (k[2] * k[2]) * k[1];
-        // k[25] = g*m1
-        k[25] = k[4] * k[0];
-        // k[26] = ell*m1/2
-        k[26] = k[2] * k[0] / 2.0;
-        // k[27] = a/2
-        k[27] = k[3] / 2.0;
-        // k[28] = 12/ell
-        k[28] = 12.0 / k[2];
-        // k[29] = g*m1 + g*m2
-        k[29] = (k[4] * k[0]) + (k[4] * k[1]);
-        // k[30] = 4*m1 + 4*m2
-        k[30] = (4.0 * k[0]) + (4.0 * k[1]);
-        // k[32] = 6/ell
-        k[32] = 6.0 / k[2];
-        // k[33] = 6*g*m1*m2 + 6*g*m1^2
-        k[33] = (6.0 * k[4] * k[0] * k[1]) + (6.0 * k[4] * (k[0] * k[0]));
-        // k[34] = 8*g*m1*m2 + 4*g*m1^2 + 4*g*m2^2
-        k[34] = (8.0 * k[4] * k[0] * k[1])
+        // k[10] = ell/2
+        k[10] = k[2] / 2.0;
+        // k[11] = ell*m1/2 + ell*m2
+        k[11] = (k[2] * k[0] / 2.0) + (k[2] * k[1]);
+        // k[12] = ell^2*m1/24
+        k[12] = (k[2] * k[2]) * k[0] / 24.0;
+        // k[13] = ell^2*m1/8 + ell^2*m2/2
+        let h13_t0 = k[2] * k[2];
+        k[13] = (h13_t0 * k[0] / 8.0) + (h13_t0 * k[1] / 2.0);
+        // k[14] = ell^2*m1/8
+        k[14] = (k[2] * k[2]) * k[0] / 8.0;
+        // k[15] = m1/2 + m2/2
+        k[15] = (k[0] / 2.0) + (k[1] / 2.0);
+        // k[16] = a*g*m2/2
+        k[16] = k[3] * k[4] * k[1] / 2.0;
+        // k[17] = ell*g*m1/2
+        k[17] = k[2] * k[4] * k[0] / 2.0;
+        // k[18] = m1 + m2
+        k[18] = k[0] + k[1];
+        // k[19] = ell^2*m1/12
+        k[19] = (k[2] * k[2]) * k[0] / 12.0;
+        // k[20] = ell^2*m1/4 + ell^2*m2
+        let h20_t0 = k[2] * k[2];
+        k[20] = (h20_t0 * k[0] / 4.0) + (h20_t0 * k[1]);
+        // k[21] = ell^2*m1/4
+        k[21] = (k[2] * k[2]) * k[0] / 4.0;
+        // k[22] = ell^2*m2
+        k[22] = (k[2] * k[2]) * k[1];
+        // k[23] = g*m1
+        k[23] = k[4] * k[0];
+        // k[24] = ell*m1/2
+        k[24] = k[2] * k[0] / 2.0;
+        // k[25] = a/2
+        k[25] = k[3] / 2.0;
+        // k[26] = 12/ell
+        k[26] = 12.0 / k[2];
+        // k[27] = g*m1 + g*m2
+        k[27] = (k[4] * k[0]) + (k[4] * k[1]);
+        // k[28] = 4*m1 + 4*m2
+        k[28] = (4.0 * k[0]) + (4.0 * k[1]);
+        // k[30] = 6/ell
+        k[30] = 6.0 / k[2];
+        // k[31] = 6*g*m1*m2 + 6*g*m1^2
+        k[31] = (6.0 * k[4] * k[0] * k[1]) + (6.0 * k[4] * (k[0] * k[0]));
+        // k[32] = 8*g*m1*m2 + 4*g*m1^2 + 4*g*m2^2
+        k[32] = (8.0 * k[4] * k[0] * k[1])
             + (4.0 * k[4] * (k[0] * k[0]))
             + (4.0 * k[4] * (k[1] * k[1]));
-        // k[35] = 3*g*m1*m2 + 3*g*m1^2
-        k[35] = (3.0 * k[4] * k[0] * k[1]) + (3.0 * k[4] * (k[0] * k[0]));
-        // k[36] = ell*m1*m2/(2*(m1 + m2))
-        k[36] = k[2] * k[0] * k[1] / 2.0 / (k[0] + k[1]);
-        // k[41] = ell*m1/(2*(m1 + m2)) + ell*m2/(m1 + m2)
-        k[41] = (k[2] * k[0] / 2.0 / (k[0] + k[1])) + (k[2] * k[1] / (k[0] + k[1]));
+        // k[33] = 3*g*m1*m2 + 3*g*m1^2
+        k[33] = (3.0 * k[4] * k[0] * k[1]) + (3.0 * k[4] * (k[0] * k[0]));
+        // k[34] = ell*m1*m2/(2*(m1 + m2))
+        k[34] = k[2] * k[0] * k[1] / 2.0 / (k[0] + k[1]);
+        // k[39] = ell*m1/(2*(m1 + m2)) + ell*m2/(m1 + m2)
+        k[39] = (k[2] * k[0] / 2.0 / (k[0] + k[1])) + (k[2] * k[1] / (k[0] + k[1]));
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..42]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = k[5];
@@ -237,7 +229,7 @@ impl Model for RodCube {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..42]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let pt0 = (k[2] * rc_c) + q[0];
         let pt1 = -(k[2] * qd[1] * rc_s) + qd[0];
@@ -245,41 +237,41 @@ impl Model for RodCube {
         vel[0] = [qd[0], 0.0];
         pos[1] = [pt0, k[2] * rc_s];
         vel[1] = [pt1, k[2] * qd[1] * rc_c];
-        pos[2] = [(k[12] * rc_c) + q[0], k[12] * rc_s];
-        vel[2] = [-(k[12] * qd[1] * rc_s) + qd[0], k[12] * qd[1] * rc_c];
+        pos[2] = [(k[10] * rc_c) + q[0], k[10] * rc_s];
+        vel[2] = [-(k[10] * qd[1] * rc_s) + qd[0], k[10] * qd[1] * rc_c];
         pos[3] = [pt0, 0.0];
         vel[3] = [pt1, 0.0];
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..42]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let et0 = qd[1] * qd[1];
-        (-(k[13] * qd[1] * qd[0] * rc_s)
-            + (k[14] * et0)
-            + (k[15] * et0 * (rc_s * rc_s))
-            + (k[16] * et0 * (rc_c * rc_c))
-            + (k[17] * (qd[0] * qd[0])))
-            + (k[18] + (k[19] * rc_s))
+        (-(k[11] * qd[1] * qd[0] * rc_s)
+            + (k[12] * et0)
+            + (k[13] * et0 * (rc_s * rc_s))
+            + (k[14] * et0 * (rc_c * rc_c))
+            + (k[15] * (qd[0] * qd[0])))
+            + (k[16] + (k[17] * rc_s))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..42]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
-        out[0] = -(k[13] * qd[1] * rc_s) + (k[20] * qd[0]);
+        out[0] = -(k[11] * qd[1] * rc_s) + (k[18] * qd[0]);
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..42]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let qt0 = -k[13] * rc_s;
+        let qt0 = -k[11] * rc_s;
         let qt1 = qd[1] * qd[1];
-        mass[0] = k[20];
+        mass[0] = k[18];
         mass[1] = qt0;
         mass[2] = qt0;
-        mass[3] = k[21] + (k[22] * (rc_s * rc_s)) + (k[23] * (rc_c * rc_c));
-        rhs[0] = k[13] * qt1 * rc_c;
-        rhs[1] = -(k[19] * rc_c) - (k[24] * qt1 * rc_s * rc_c);
+        mass[3] = k[19] + (k[20] * (rc_s * rc_s)) + (k[21] * (rc_c * rc_c));
+        rhs[0] = k[11] * qt1 * rc_c;
+        rhs[1] = -(k[17] * rc_c) - (k[22] * qt1 * rc_s * rc_c);
     }
 
     fn forces_full(
@@ -291,20 +283,20 @@ impl Model for RodCube {
         _fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..42]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let ft0 = qd[1] * qd[1];
         out[0] = k[1] * (-(k[2] * qdd[1] * rc_s) + qdd[0] - (k[2] * ft0 * rc_c));
-        out[1] = k[25] + (k[26] * qdd[1] * rc_c) - (k[26] * ft0 * rc_s);
+        out[1] = k[23] + (k[24] * qdd[1] * rc_c) - (k[24] * ft0 * rc_s);
     }
 
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..42]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
         out[0] = forces[1];
-        out[1] = k[18] - (forces[0] * (-k[27] + (k[2] * rc_s)));
+        out[1] = k[16] - (forces[0] * (-k[25] + (k[2] * rc_s)));
     }
 
     fn contact_edge(&self, _k: &[f64], _q: &[f64]) -> f64 {
@@ -312,20 +304,20 @@ impl Model for RodCube {
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..42]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = (k[2] * rc_c) + q[0];
         out[1] = -(k[2] * qd[1] * rc_s) + qd[0];
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..42]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        poses[0] = [(k[12] * rc_c) + q[0], k[12] * rc_s, q[1]];
-        poses[1] = [k[27] + (k[2] * rc_c) + q[0], k[27], 0.0];
-        sizes[0] = -k[12];
+        poses[0] = [(k[10] * rc_c) + q[0], k[10] * rc_s, q[1]];
+        poses[1] = [k[25] + (k[2] * rc_c) + q[0], k[25], 0.0];
+        sizes[0] = -k[10];
         sizes[1] = 0.0;
-        sizes[2] = k[12];
+        sizes[2] = k[10];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
@@ -340,44 +332,44 @@ impl Model for RodCube {
 
 impl Reduction for RodCube {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..42]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[7], k[8], delta);
         let rt0 = rc_s * rc_s;
-        let rt1 = -k[30] + (k[31] * rt0);
+        let rt1 = -k[28] + (k[29] * rt0);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: -k[28] * (k[29] * rc_ds) / rt1,
-            theta_ddot: k[32]
-                * ((k[33] * rc_s * rc_c * rc_ds) - (k[34] * rc_c) + (k[35] * rt0 * rc_c))
+            theta_dot_sq: -k[26] * (k[27] * rc_ds) / rt1,
+            theta_ddot: k[30]
+                * ((k[31] * rc_s * rc_c * rc_ds) - (k[32] * rc_c) + (k[33] * rt0 * rc_c))
                 / (rt1 * rt1),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..42]; // one bounds check for all constant loads
-        -k[28] * (k[29] * rc_ds) / (-k[30] + (k[31] * (rc_s * rc_s)))
+        let k = &k[..40]; // one bounds check for all constant loads
+        -k[26] * (k[27] * rc_ds) / (-k[28] + (k[29] * (rc_s * rc_s)))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..42]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[7], k[8], delta);
         let rt0 = rc_s * rc_s;
-        let rt1 = -k[30] + (k[31] * rt0);
-        let rc_w2 = -k[28] * (k[29] * rc_ds) / rt1;
-        let rc_acc = k[32]
-            * ((k[33] * rc_s * rc_c * rc_ds) - (k[34] * rc_c) + (k[35] * rt0 * rc_c))
+        let rt1 = -k[28] + (k[29] * rt0);
+        let rc_w2 = -k[26] * (k[27] * rc_ds) / rt1;
+        let rc_acc = k[30]
+            * ((k[31] * rc_s * rc_c * rc_ds) - (k[32] * rc_c) + (k[33] * rt0 * rc_c))
             / (rt1 * rt1);
-        out[0] = -(k[36] * rc_s * rc_acc) - (k[36] * rc_c * rc_w2);
-        out[1] = k[25] - (k[26] * rc_s * rc_w2) + (k[26] * rc_c * rc_acc);
+        out[0] = -(k[34] * rc_s * rc_acc) - (k[34] * rc_c * rc_w2);
+        out[1] = k[23] - (k[24] * rc_s * rc_w2) + (k[24] * rc_c * rc_acc);
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..42]; // one bounds check for all constant loads
-        out[0] = k[37];
-        out[1] = -k[38];
+        let k = &k[..40]; // one bounds check for all constant loads
+        out[0] = k[35];
+        out[1] = -k[36];
         out[2] = 0.0;
-        out[3] = k[31];
+        out[3] = k[29];
     }
 
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
@@ -389,23 +381,23 @@ impl Reduction for RodCube {
         // k[8] = rc_ci = ((1 - a/ell)*(1 + a/ell))^(1/2)
         let c3_t0 = k[3] / k[2];
         k[8] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
-        // k[31] = 3*m1
-        k[31] = 3.0 * k[0];
-        // k[37] = 8*m1*rc_si + 8*m2*rc_si
-        k[37] = (8.0 * k[0] * k[7]) + (8.0 * k[1] * k[7]);
-        // k[38] = 12*m1 + 12*m2
-        k[38] = (12.0 * k[0]) + (12.0 * k[1]);
-        // k[39] = ell/(3*g)
-        k[39] = k[2] / 3.0 / k[4];
-        // k[40] = ell*m1/(4*g*(m1 + m2))
-        k[40] = k[2] * k[0] / 4.0 / k[4] / (k[0] + k[1]);
+        // k[29] = 3*m1
+        k[29] = 3.0 * k[0];
+        // k[35] = 8*m1*rc_si + 8*m2*rc_si
+        k[35] = (8.0 * k[0] * k[7]) + (8.0 * k[1] * k[7]);
+        // k[36] = 12*m1 + 12*m2
+        k[36] = (12.0 * k[0]) + (12.0 * k[1]);
+        // k[37] = ell/(3*g)
+        k[37] = k[2] / 3.0 / k[4];
+        // k[38] = ell*m1/(4*g*(m1 + m2))
+        k[38] = k[2] * k[0] / 4.0 / k[4] / (k[0] + k[1]);
     }
 
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..42]; // one bounds check for all constant loads
-        out[0] = k[39];
+        let k = &k[..40]; // one bounds check for all constant loads
+        out[0] = k[37];
         out[1] = 0.0;
-        out[2] = -k[40];
+        out[2] = -k[38];
     }
 
     fn full_state(
@@ -417,12 +409,12 @@ impl Reduction for RodCube {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..42]; // one bounds check for all constant loads
+        let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, _, _, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_w = theta_dot;
         q[1] = k[5] - delta;
         qd[1] = theta_dot;
-        q[0] = k[9] + (k[41] * rc_dc);
-        qd[0] = k[41] * rc_s * rc_w;
+        q[0] = k[9] + (k[39] * rc_dc);
+        qd[0] = k[39] * rc_s * rc_w;
     }
 }

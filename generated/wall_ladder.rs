@@ -46,7 +46,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "ladder_leans",
         meaning: "the top must start below the ladder's length (a < ell)",
     }],
-    n_constants: 21,
+    n_constants: 20,
     coordinates: &["theta"],
     reduced: 0,
     cyclic: &[],
@@ -126,7 +126,7 @@ static INFO: ModelInfo = ModelInfo {
         separation_degree: 1,
         polynomial_separation: true,
         fall_degree: Some(0),
-        lean_constants: &[5, 6, 7, 19, 20],
+        lean_constants: &[5, 6, 7, 18, 19],
     }),
     route_note: "",
 };
@@ -146,64 +146,62 @@ impl Model for WallLadder {
         Reduction::prepare_lean(self, p, k);
         // k[4] = rc_thi = asin(a/ell)
         k[4] = (k[2] / k[1]).asin();
-        // k[8] = rc_ai = ell^2*m1/3
-        k[8] = (k[1] * k[1]) * k[0] / 3.0;
-        // k[9] = ell/2
-        k[9] = k[1] / 2.0;
-        // k[10] = ell^2*m1/24
-        k[10] = (k[1] * k[1]) * k[0] / 24.0;
-        // k[11] = ell^2*m1/8
-        k[11] = (k[1] * k[1]) * k[0] / 8.0;
-        // k[12] = ell*g*m1/2
-        k[12] = k[1] * k[3] * k[0] / 2.0;
-        // k[13] = ell^2*m1/12
-        k[13] = (k[1] * k[1]) * k[0] / 12.0;
-        // k[14] = ell^2*m1/4
-        k[14] = (k[1] * k[1]) * k[0] / 4.0;
-        // k[15] = ell*m1/2
-        k[15] = k[1] * k[0] / 2.0;
-        // k[16] = g*m1
-        k[16] = k[3] * k[0];
-        // k[17] = 3*g/ell
-        k[17] = 3.0 * k[3] / k[1];
-        // k[18] = 3*g/(2*ell)
-        k[18] = 3.0 * k[3] / 2.0 / k[1];
+        // k[8] = ell/2
+        k[8] = k[1] / 2.0;
+        // k[9] = ell^2*m1/24
+        k[9] = (k[1] * k[1]) * k[0] / 24.0;
+        // k[10] = ell^2*m1/8
+        k[10] = (k[1] * k[1]) * k[0] / 8.0;
+        // k[11] = ell*g*m1/2
+        k[11] = k[1] * k[3] * k[0] / 2.0;
+        // k[12] = ell^2*m1/12
+        k[12] = (k[1] * k[1]) * k[0] / 12.0;
+        // k[13] = ell^2*m1/4
+        k[13] = (k[1] * k[1]) * k[0] / 4.0;
+        // k[14] = ell*m1/2
+        k[14] = k[1] * k[0] / 2.0;
+        // k[15] = g*m1
+        k[15] = k[3] * k[0];
+        // k[16] = 3*g/ell
+        k[16] = 3.0 * k[3] / k[1];
+        // k[17] = 3*g/(2*ell)
+        k[17] = 3.0 * k[3] / 2.0 / k[1];
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..21]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         q[0] = k[4];
         qd[0] = 0.0;
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..21]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         pos[0] = [-k[1] * rc_c, 0.0];
         vel[0] = [k[1] * qd[0] * rc_s, 0.0];
         pos[1] = [0.0, k[1] * rc_s];
         vel[1] = [0.0, k[1] * qd[0] * rc_c];
-        pos[2] = [-k[9] * rc_c, k[9] * rc_s];
-        vel[2] = [k[9] * qd[0] * rc_s, k[9] * qd[0] * rc_c];
+        pos[2] = [-k[8] * rc_c, k[8] * rc_s];
+        vel[2] = [k[8] * qd[0] * rc_s, k[8] * qd[0] * rc_c];
         pos[3] = [0.0, 0.0];
         vel[3] = [0.0, 0.0];
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..21]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let et0 = qd[0] * qd[0];
-        ((k[10] * et0) + (k[11] * et0 * (rc_s * rc_s)) + (k[11] * et0 * (rc_c * rc_c)))
-            + (k[12] * rc_s)
+        ((k[9] * et0) + (k[10] * et0 * (rc_s * rc_s)) + (k[10] * et0 * (rc_c * rc_c)))
+            + (k[11] * rc_s)
     }
 
     fn momenta(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
 
     fn equations(&self, k: &[f64], q: &[f64], _qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..21]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        mass[0] = k[13] + (k[14] * (rc_s * rc_s)) + (k[14] * (rc_c * rc_c));
-        rhs[0] = -k[12] * rc_c;
+        mass[0] = k[12] + (k[13] * (rc_s * rc_s)) + (k[13] * (rc_c * rc_c));
+        rhs[0] = -k[11] * rc_c;
     }
 
     fn forces_full(
@@ -215,13 +213,13 @@ impl Model for WallLadder {
         _fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..21]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ft0 = qd[0] * qd[0];
-        out[0] = -(-(k[15] * qdd[0] * rc_s)
+        out[0] = -(-(k[14] * qdd[0] * rc_s)
             + (k[0] * ((k[1] * qdd[0] * rc_s) + (k[1] * ft0 * rc_c)))
-            - (k[15] * ft0 * rc_c));
-        out[1] = k[16] + (k[15] * qdd[0] * rc_c) - (k[15] * ft0 * rc_s);
+            - (k[14] * ft0 * rc_c));
+        out[1] = k[15] + (k[14] * qdd[0] * rc_c) - (k[14] * ft0 * rc_s);
     }
 
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
@@ -235,19 +233,19 @@ impl Model for WallLadder {
     }
 
     fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..21]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         out[0] = -k[1] * rc_c;
         out[1] = k[1] * qd[0] * rc_s;
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..21]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        poses[0] = [-k[9] * rc_c, k[9] * rc_s, q[0]];
-        sizes[0] = -k[9];
+        poses[0] = [-k[8] * rc_c, k[8] * rc_s, q[0]];
+        sizes[0] = -k[8];
         sizes[1] = 0.0;
-        sizes[2] = k[9];
+        sizes[2] = k[8];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
@@ -262,33 +260,33 @@ impl Model for WallLadder {
 
 impl Reduction for WallLadder {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..21]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[4], k[6], k[7], delta);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: k[17] * rc_ds,
-            theta_ddot: -k[18] * rc_c,
+            theta_dot_sq: k[16] * rc_ds,
+            theta_ddot: -k[17] * rc_c,
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], _rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..21]; // one bounds check for all constant loads
-        k[17] * rc_ds
+        let k = &k[..20]; // one bounds check for all constant loads
+        k[16] * rc_ds
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..21]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[4], k[6], k[7], delta);
-        let rc_w2 = k[17] * rc_ds;
-        let rc_acc = -k[18] * rc_c;
-        out[0] = -(k[15] * rc_s * rc_acc) - (k[15] * rc_c * rc_w2);
-        out[1] = k[16] - (k[15] * rc_s * rc_w2) + (k[15] * rc_c * rc_acc);
+        let rc_w2 = k[16] * rc_ds;
+        let rc_acc = -k[17] * rc_c;
+        out[0] = -(k[14] * rc_s * rc_acc) - (k[14] * rc_c * rc_w2);
+        out[1] = k[15] - (k[14] * rc_s * rc_w2) + (k[14] * rc_c * rc_acc);
     }
 
     fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..21]; // one bounds check for all constant loads
-        out[0] = -k[19];
+        let k = &k[..20]; // one bounds check for all constant loads
+        out[0] = -k[18];
         out[1] = 3.0;
     }
 
@@ -301,15 +299,15 @@ impl Reduction for WallLadder {
         // k[7] = rc_ci = ((1 - a/ell)*(1 + a/ell))^(1/2)
         let c3_t0 = k[2] / k[1];
         k[7] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
-        // k[19] = 2*rc_si
-        k[19] = 2.0 * k[6];
-        // k[20] = ell/(3*g)
-        k[20] = k[1] / 3.0 / k[3];
+        // k[18] = 2*rc_si
+        k[18] = 2.0 * k[6];
+        // k[19] = ell/(3*g)
+        k[19] = k[1] / 3.0 / k[3];
     }
 
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..21]; // one bounds check for all constant loads
-        out[0] = k[20];
+        let k = &k[..20]; // one bounds check for all constant loads
+        out[0] = k[19];
     }
 
     fn full_state(
@@ -321,7 +319,7 @@ impl Reduction for WallLadder {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..21]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         q[0] = k[4] - delta;
         qd[0] = theta_dot;
     }

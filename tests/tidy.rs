@@ -70,3 +70,58 @@ fn no_trailing_whitespace() {
     }
     assert!(bad.is_empty(), "trailing whitespace at {bad:?}");
 }
+
+/// The generated models (`generated/*.rs`, not the registry): no blanket `allow`, no constant
+/// slot that copies another (`k[12] = k[2];`) or holds a negated copy, and every slot written
+/// is read somewhere (by the generated code, or by the runtime through the model's
+/// `ReductionInfo`: the start's angle, rate, sine and cosine).
+#[test]
+fn generated_models_hold_each_constant_once_and_need_no_blanket_allow() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("generated");
+    let mut checked = 0;
+    for entry in std::fs::read_dir(&root).expect("generated/").flatten() {
+        let p = entry.path();
+        if p.extension().is_none_or(|x| x != "rs") || p.ends_with("mod.rs") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&p).expect("readable");
+        let file = p.display();
+        assert!(!text.contains("#![allow("), "{file}: a blanket allow");
+        assert!(
+            !text.contains("allow(unused_variables") && !text.contains("allow(unused_parens"),
+            "{file}: unused variables or parentheses allowed"
+        );
+        let slot =
+            |s: &str| -> Option<usize> { s.strip_prefix("k[")?.strip_suffix(']')?.parse().ok() };
+        let mut written = Vec::new();
+        for line in text.lines().map(str::trim) {
+            let Some((lhs, rhs)) = line.split_once(" = ") else {
+                continue;
+            };
+            let Some(i) = slot(lhs) else { continue };
+            written.push(i);
+            let value = rhs.trim_end_matches(';').trim_start_matches('-');
+            assert!(
+                slot(value).is_none(),
+                "{file}: `{line}` copies a constant another slot holds"
+            );
+        }
+        let stem = p.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
+        let model = rodcube::models::find(stem).unwrap_or_else(|| panic!("{file}: no model"));
+        let runtime: Vec<usize> = model.info().reduction.map_or(Vec::new(), |r| {
+            vec![
+                r.k_theta_initial,
+                r.k_theta_dot_initial,
+                r.k_sin_initial,
+                r.k_cos_initial,
+            ]
+        });
+        for i in written.into_iter().filter(|i| !runtime.contains(i)) {
+            let reads = text.matches(&format!("k[{i}]")).count();
+            let writes = text.matches(&format!("k[{i}] = ")).count();
+            assert!(reads > writes, "{file}: k[{i}] is written and never read");
+        }
+        checked += 1;
+    }
+    assert!(checked >= 7, "checked only {checked} generated models");
+}

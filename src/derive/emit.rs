@@ -8,8 +8,9 @@ use super::mechanics::{self, Binding, Derivation, Reduction, from_sc, to_sc_expr
 use super::method::{Preamble, method};
 use super::present;
 use super::spec::Checked;
+use super::steps::{Shown, Steps};
 use serde::Serialize;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// The command that regenerates `generated/`, named in every file header.
 pub const COMMAND: &str = "cargo run --release --features derive -- derive";
@@ -123,6 +124,9 @@ pub struct RustContext {
     #[serde(flatten)]
     general: FullStateCode,
     reduction: Option<ReducedCode>,
+    /// The reduction's named constants that nothing reads (see [`rust_context`]).
+    #[serde(skip)]
+    unread: BTreeSet<String>,
 }
 
 /// The fast path's functions.
@@ -180,10 +184,34 @@ fn out_lines(outputs: &[String]) -> Vec<String> {
 }
 
 /// Builds the Rust context of one derived phase.
+///
+/// A named constant of the reduction that no generated line reads and the runtime does not
+/// read either (`ReductionInfo`'s start slots) gets no slot: the context is built once to find
+/// such constants, and again without them.
 pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, String> {
+    let first = context_without(checked, d, &BTreeSet::new())?;
+    if first.unread.is_empty() {
+        return Ok(first);
+    }
+    let second = context_without(checked, d, &first.unread)?;
+    match second.unread.is_empty() {
+        true => Ok(second),
+        false => Err(format!(
+            "constants still unread after dropping the unread ones: {:?}",
+            second.unread
+        )),
+    }
+}
+
+/// [`rust_context`] with the reduction constants `skip` left out of `k`.
+fn context_without(
+    checked: &Checked,
+    d: &Derivation,
+    skip: &BTreeSet<String>,
+) -> Result<RustContext, String> {
     let spec = &checked.spec;
     let np = d.params.len();
-    let (scope, mut prepare, own) = constant_layout(d);
+    let (scope, mut prepare, own) = constant_layout(d, skip);
     let mut hoisted = Hoisted::new(np + own.len());
     if let Ok(r) = &d.reduction {
         for &(j, slot) in &own {
@@ -336,6 +364,10 @@ pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, St
             })
             .collect()
     };
+    let mut codes: Vec<&Code> = vec![&requirements, &prepare, &drawing];
+    codes.extend(general.codes());
+    codes.extend(reduction.iter().flat_map(ReducedCode::codes));
+    let unread = unread_constants(d, &own, &codes);
     Ok(RustContext {
         command: COMMAND.into(),
         name: d.name.clone(),
@@ -417,6 +449,7 @@ pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, St
         prepare,
         general,
         reduction,
+        unread,
     })
 }
 
@@ -424,7 +457,7 @@ pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, St
 /// slot of their own (computed in `prepare`, which this starts); hoisted subexpressions follow
 /// them. Returns the scope, the start of `prepare` and, for each reduction constant with a slot
 /// of its own (all but an [`alias`]), its position in the reduction and its slot.
-fn constant_layout(d: &Derivation) -> (Scope, Code, Vec<(usize, usize)>) {
+fn constant_layout(d: &Derivation, skip: &BTreeSet<String>) -> (Scope, Code, Vec<(usize, usize)>) {
     let np = d.params.len();
     let mut scope = Scope::default();
     for (i, p) in d.params.iter().enumerate() {
@@ -437,6 +470,9 @@ fn constant_layout(d: &Derivation) -> (Scope, Code, Vec<(usize, usize)>) {
     };
     let mut own = Vec::new();
     for (j, c) in constants.iter().enumerate() {
+        if skip.contains(&c.symbol) {
+            continue;
+        }
         if let Some(i) = alias(&c.value, &scope) {
             // Another constant under a new name (a start value that is a parameter, say):
             // read where that one is.
@@ -587,7 +623,44 @@ struct FullStateCode {
     released: Code,
 }
 
+/// The reduction's constants with a slot of their own (`own`) that no line of `codes` reads
+/// and that the runtime does not read through `ReductionInfo` (the start's angle, rate, sine
+/// and cosine).
+fn unread_constants(d: &Derivation, own: &[(usize, usize)], codes: &[&Code]) -> BTreeSet<String> {
+    let Ok(r) = &d.reduction else {
+        return BTreeSet::new();
+    };
+    let runtime = ["rc_thi", "rc_wi", "rc_si", "rc_ci"];
+    let lines =
+        || (codes.iter().flat_map(|c| &c.lines)).filter(|l| !l.trim_start().starts_with("//"));
+    own.iter()
+        .map(|&(j, slot)| (&r.constants[j].symbol, slot))
+        .filter(|(symbol, _)| !runtime.contains(&symbol.as_str()))
+        .filter(|&(_, slot)| {
+            let (read, write) = (format!("k[{slot}]"), format!("k[{slot}] = "));
+            lines().all(|l| l.matches(&read).count() == l.matches(&write).count())
+        })
+        .map(|(symbol, _)| symbol.clone())
+        .collect()
+}
+
 impl FullStateCode {
+    /// Every method's code.
+    fn codes(&self) -> [&Code; 10] {
+        [
+            &self.initial_state,
+            &self.points,
+            &self.energy,
+            &self.momenta,
+            &self.equations,
+            &self.forces_full,
+            &self.friction,
+            &self.monitors_full,
+            &self.contact_edge,
+            &self.released,
+        ]
+    }
+
     /// Each method's arguments and lines; `n` is the length of `k`, `reduced` the index of the
     /// reduced coordinate.
     fn finish(&mut self, n: usize, reduced: usize) {
@@ -618,6 +691,19 @@ impl FullStateCode {
 }
 
 impl ReducedCode {
+    /// Every method's code.
+    fn codes(&self) -> [&Code; 7] {
+        [
+            &self.reduced_code,
+            &self.theta_dot_sq_code,
+            &self.forces,
+            &self.separation,
+            &self.fall,
+            &self.full_state,
+            &self.prepare_lean,
+        ]
+    }
+
     /// Each method's arguments and lines; `n` is the length of `k`, `np` the number of
     /// parameters, `reduced` the index of the reduced coordinate.
     fn finish(&mut self, n: usize, np: usize, reduced: usize) {
@@ -1162,7 +1248,11 @@ pub struct TexContext {
 }
 
 /// Builds the LaTeX context: the derivation's steps as displayed equations.
-pub fn tex_context(checked: &Checked, d: &Derivation) -> TexContext {
+pub fn tex_context(checked: &Checked, d: &Derivation) -> Result<TexContext, String> {
+    let steps = d
+        .steps
+        .as_ref()
+        .ok_or("the steps were not presented before the LaTeX")?;
     let theta = d.theta().to_string();
     let name = |s: &str| match s
         .strip_prefix("rc_fr")
@@ -1187,40 +1277,30 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> TexContext {
             &name,
         ));
     }
-    eqs.push(display(
-        "Kinetic energy",
-        "T = ".into(),
-        2,
-        &sc(&d.kinetic),
-        None,
-        &name,
-    ));
-    eqs.push(display(
-        "Potential energy",
-        "V = ".into(),
-        2,
-        &sc(&d.potential),
-        None,
-        &name,
-    ));
-    eqs.push(display(
-        "Lagrangian",
-        "L = T - V = ".into(),
-        8,
-        &sc(&d.lagrangian),
-        None,
-        &name,
-    ));
-    for (i, c) in d.coords.iter().enumerate() {
-        eqs.push(display(
+    let energies = [
+        ("Kinetic energy", "T = ", 2, &steps.kinetic),
+        ("Potential energy", "V = ", 2, &steps.potential),
+        ("Lagrangian", "L = T - V = ", 8, &steps.lagrangian),
+    ];
+    for (title, lhs, width, shown) in energies {
+        let (title, e) = step(title, shown, &name);
+        eqs.push(display(&title, lhs.into(), width, &sc(&e), None, &name));
+    }
+    for (c, shown) in d.coords.iter().zip(&steps.euler_lagrange) {
+        let (title, e) = step(
             &format!("Euler--Lagrange equation for ${}$", name(c)),
+            shown,
+            &name,
+        );
+        eqs.push(display(
+            &title,
             format!(
                 "\\frac{{d}}{{dt}}\\frac{{\\partial L}}{{\\partial {}}} - \\frac{{\\partial L}}{{\\partial {}}} = ",
                 name(&format!("dot_{c}")),
                 name(c),
             ),
             14,
-            &sc(&d.euler_lagrange[i]),
+            &sc(&e),
             Some(&Expr::int(0)),
             &name,
         ));
@@ -1243,7 +1323,7 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> TexContext {
         ));
     }
     match &d.reduction {
-        Ok(r) => reduced_equations(d, r, &name, &mut eqs),
+        Ok(r) => reduced_equations(d, r, steps, &name, &mut eqs)?,
         Err(why) => {
             for (f, e) in d.forces.iter().zip(&d.forces_full) {
                 eqs.push(display(
@@ -1276,7 +1356,7 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> TexContext {
         Some(dim) => tex_dimensionless(dim, &theta, &name),
         None => (Vec::new(), String::new(), Vec::new()),
     };
-    TexContext {
+    Ok(TexContext {
         command: COMMAND.into(),
         name: tex_text(&d.name),
         description: tex_text(&d.description),
@@ -1294,6 +1374,27 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> TexContext {
         groups: dim_groups,
         scales: dim_scales,
         results: dim_results,
+    })
+}
+
+/// A step's title and the form to print (over `rc_s`, `rc_c`): its presented form, unless
+/// that holds a term wider than the page which the derived form does not; the title says
+/// when the derived form is printed, and why.
+fn step(title: &str, shown: &Shown, name: &dyn Fn(&str) -> String) -> (String, Expr) {
+    let too_wide = |e: &Expr| widest_term(e, name) > TEX_LINE;
+    let why = match &shown.as_derived {
+        Some(why) => Some(why.as_str()),
+        None if too_wide(&shown.expr) && !too_wide(&shown.derived) => {
+            Some("the grouped form has a term wider than the page")
+        }
+        None => None,
+    };
+    match why {
+        None => (title.to_string(), shown.expr.clone()),
+        Some(why) => (
+            format!("{title} (as derived: {})", tex_text(why)),
+            shown.derived.clone(),
+        ),
     }
 }
 
@@ -1381,35 +1482,49 @@ fn upper_first(text: &str) -> String {
 fn reduced_equations(
     d: &Derivation,
     r: &Reduction,
+    steps: &Steps,
     name: &dyn Fn(&str) -> String,
     eqs: &mut Vec<Equation>,
-) {
+) -> Result<(), String> {
+    // Every result the reduction derived is shown in its presented form.
+    let shown = |key: &str| -> Result<Option<&Shown>, String> {
+        match (r.plain.get(key), steps.reduced.get(key)) {
+            (None, _) => Ok(None),
+            (Some(_), Some(s)) => Ok(Some(s)),
+            (Some(_), None) => Err(format!("the result `{key}` was not presented")),
+        }
+    };
     let theta = d.theta().to_string();
     let sc = |e: &Expr| from_sc(e, &theta);
-    for (j, &ci) in d.cyclic.iter().enumerate() {
+    for ((j, &ci), momentum) in d.cyclic.iter().enumerate().zip(&steps.momenta) {
         let c = &d.coords[ci];
         let conserved = r
             .constants
             .iter()
             .find(|k| k.symbol == format!("rc_p{j}"))
             .map(|k| sc(&k.value));
-        eqs.push(display(
+        let (title, e) = step(
             &format!(
                 "${}$ is cyclic: its conjugate momentum is conserved",
                 name(c)
             ),
+            momentum,
+            name,
+        );
+        eqs.push(display(
+            &title,
             format!(
                 "p_{{{}}} = \\frac{{\\partial L}}{{\\partial {}}} = ",
                 name(c),
                 name(&format!("dot_{c}")),
             ),
             10,
-            &sc(&d.momenta[j]),
+            &sc(&e),
             conserved.as_ref(),
             name,
         ));
     }
-    let steps = [
+    let results = [
         (
             "reduced_inertia",
             "Reduced inertia (kinetic energy $\\tfrac12 A(\\theta)\\dot\\theta^2$ after elimination)",
@@ -1429,9 +1544,10 @@ fn reduced_equations(
             3,
         ),
     ];
-    for (key, title, lhs, width) in steps {
-        if let Some(e) = r.plain.get(key) {
-            eqs.push(display(title, lhs, width, &sc(e), None, name));
+    for (key, title, lhs, width) in results {
+        if let Some(s) = shown(key)? {
+            let (title, e) = step(title, s, name);
+            eqs.push(display(&title, lhs, width, &sc(&e), None, name));
         }
     }
     for (i, f) in d.forces.iter().enumerate() {
@@ -1440,31 +1556,32 @@ fn reduced_equations(
         } else {
             f.name.as_str()
         };
-        if let Some(e) = r.plain.get(key) {
-            eqs.push(display(
-                &format!(
-                    "Force \\texttt{{{}}}: {}",
-                    tex_text(&f.name),
-                    tex_text(&f.meaning)
-                ),
-                "F = ".into(),
-                2,
-                &sc(e),
-                None,
-                name,
-            ));
+        if let Some(s) = shown(key)? {
+            let title = format!(
+                "Force \\texttt{{{}}}: {}",
+                tex_text(&f.name),
+                tex_text(&f.meaning)
+            );
+            let (title, e) = step(&title, s, name);
+            eqs.push(display(&title, "F = ".into(), 2, &sc(&e), None, name));
         }
     }
-    if let Some(e) = r.plain.get("separation_condition") {
-        eqs.push(display(
+    if let Some(s) = shown("separation_condition")? {
+        let (title, e) = step(
             "Separation condition (contact force zero; positive factors and $\\cos\\theta$ removed)",
+            s,
+            name,
+        );
+        eqs.push(display(
+            &title,
             String::new(),
             0,
-            &sc(e),
+            &sc(&e),
             Some(&Expr::int(0)),
             name,
         ));
     }
+    Ok(())
 }
 
 /// The machine-readable record (`generated/<model>.json`).

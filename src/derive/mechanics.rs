@@ -276,6 +276,8 @@ pub struct Derivation {
     pub reduction: Result<Reduction, String>,
     /// The results without units, if the spec gives groups and scales.
     pub dimensionless: Option<super::dimensionless::Dimensionless>,
+    /// The steps as the LaTeX derivation shows them ([`super::steps`]), once presented.
+    pub steps: Option<super::steps::Steps>,
 }
 
 impl Derivation {
@@ -1126,6 +1128,7 @@ pub fn derive(checked: &Checked) -> Result<Vec<Derivation>, DeriveError> {
     for &phase in phases {
         let mut d = derive_phase(checked, &parsed, phase)?;
         d.dimensionless = super::dimensionless::derive(spec, &d)?;
+        d.steps = Some(super::steps::derive(&d));
         out.push(d);
     }
     Ok(out)
@@ -1308,6 +1311,7 @@ fn derive_phase(
         next,
         reduction,
         dimensionless: None,
+        steps: None,
     })
 }
 

@@ -13,6 +13,7 @@ pub mod lower;
 pub mod mechanics;
 pub mod method;
 pub mod present;
+pub mod steps;
 
 // Spec parsing and expressions need no Symbolica: they live in the runtime crate.
 pub use crate::spec::{self, expr};
@@ -297,7 +298,18 @@ fn render_phase(root: &Path, c: &Checked, d: &Derivation) -> Result<Vec<Rendered
         })
     })?;
     let rust = rustfmt(&d.name, &render(root, "model.rs.tera", &ctx)?)?;
-    let tex = render(root, "model.tex.tera", &emit::tex_context(c, d))?;
+    let tex_ctx = emit::tex_context(c, d).map_err(|message| {
+        Error::Spec(SpecError {
+            file: c.file.clone(),
+            line: 0,
+            column: 0,
+            field: String::new(),
+            message: format!("model `{}`: {message}", d.name),
+            source_line: String::new(),
+            width: 0,
+        })
+    })?;
+    let tex = render(root, "model.tex.tera", &tex_ctx)?;
     let json =
         serde_json::to_string_pretty(&emit::json_record(c, d)).map_err(|e| Error::Template {
             template: "json record".into(),

@@ -1,0 +1,155 @@
+//! The derivation's steps as the LaTeX shows them (`derive::steps`): rod_cube's kinetic energy,
+//! Euler–Lagrange equations and conserved momentum equal a hand Newton–Euler/Koenig
+//! derivation and are grouped in the velocities with `sin^2 + cos^2 = 1` applied; in every
+//! model every shown step equals the derived one and has no more operations. Formulas are
+//! compared by equivalence (difference zero modulo sin^2 + cos^2 = 1), never as strings.
+#![cfg(feature = "derive")]
+
+use rodcube::derive::cas;
+use rodcube::derive::expr::Expr;
+use rodcube::derive::mechanics::{self, Derivation, to_sc_expr};
+use rodcube::derive::present::operations;
+use rodcube::derive::steps::Shown;
+use rodcube::derive::{derive_all, on_cas_thread, spec};
+use std::path::Path;
+
+/// Every phase of every spec in `derivations/`.
+fn all_phases() -> Vec<Derivation> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("derivations");
+    let mut paths: Vec<_> = std::fs::read_dir(&dir)
+        .expect("derivations/")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| p.extension().is_some_and(|x| x == "yaml"))
+        .collect();
+    paths.sort();
+    let checked: Vec<_> = paths
+        .iter()
+        .map(|p| spec::load(p).unwrap_or_else(|e| panic!("{e}")))
+        .collect();
+    derive_all(&checked)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .into_iter()
+        .flat_map(|(phases, _)| phases)
+        .collect()
+}
+
+fn parse(text: &str) -> Expr {
+    let e = Expr::parse(text).unwrap_or_else(|e| panic!("test formula `{text}`: {}", e.message));
+    to_sc_expr(&e, "theta")
+}
+
+fn difference_vanishes(a: &Expr, b: &Expr) -> bool {
+    let diff = Expr::Add(vec![a.clone(), Expr::Mul(vec![Expr::int(-1), b.clone()])]);
+    on_cas_thread(move || mechanics::is_zero_trig(&cas::atom(&diff)))
+        .expect("Symbolica worker")
+        .expect("is_zero_trig")
+}
+
+/// Asserts a step is shown grouped, equal to `expected`, over sin(theta) alone (no `cos^2`
+/// left beside a `sin^2`), with one term per monomial in the velocities.
+fn assert_grouped(what: &str, shown: &Shown, expected: &str, terms: usize) {
+    assert_eq!(shown.as_derived, None, "{what} is shown as derived");
+    let expected = parse(expected);
+    assert!(
+        difference_vanishes(&shown.expr, &expected),
+        "{what}: {} is not {}",
+        shown.expr.to_infix(),
+        expected.to_infix()
+    );
+    let n = match &shown.expr {
+        Expr::Add(v) => v.len(),
+        _ => 1,
+    };
+    assert_eq!(n, terms, "{what}: {}", shown.expr.to_infix());
+    assert!(
+        operations(&shown.expr) <= operations(&shown.derived),
+        "{what}: {} is longer than as derived",
+        shown.expr.to_infix()
+    );
+}
+
+#[test]
+fn rod_cube_s_steps_are_the_hand_derivation_grouped_in_the_velocities() {
+    let phases = all_phases();
+    let d = phases
+        .iter()
+        .find(|d| d.name == "rod_cube")
+        .expect("rod_cube");
+    let steps = d.steps.as_ref().expect("steps");
+    // By hand: the rod's centre at (x1 + l cos/2, l sin/2), its own rotation m1 l^2/12; the
+    // cube at x2 = x1 + l cos(theta).
+    let t = "(m1 + m2)/2*dot_x1^2 - ell*(m1 + 2*m2)/2*sin(theta)*dot_x1*dot_theta \
+             + ell^2*(m1 + 3*m2*sin(theta)^2)/6*dot_theta^2";
+    assert_grouped("T", &steps.kinetic, t, 3);
+    assert!(
+        !steps.kinetic.expr.symbols().contains("rc_c"),
+        "sin^2 + cos^2 left in T: {}",
+        steps.kinetic.expr.to_infix()
+    );
+    assert_grouped("V", &steps.potential, "g*(m2*a + m1*ell*sin(theta))/2", 1);
+    // Newton–Euler for the pair along x, and about the rod's foot.
+    assert_grouped(
+        "Euler-Lagrange x1",
+        &steps.euler_lagrange[0],
+        "(m1 + m2)*ddot_x1 - ell*(m1 + 2*m2)/2*sin(theta)*ddot_theta \
+         - ell*(m1 + 2*m2)/2*cos(theta)*dot_theta^2",
+        3,
+    );
+    assert_grouped(
+        "Euler-Lagrange theta",
+        &steps.euler_lagrange[1],
+        "-ell*(m1 + 2*m2)/2*sin(theta)*ddot_x1 + ell^2*(m1 + 3*m2*sin(theta)^2)/3*ddot_theta \
+         + m2*ell^2*sin(theta)*cos(theta)*dot_theta^2 + m1*g*ell/2*cos(theta)",
+        4,
+    );
+    assert_grouped(
+        "p_x1",
+        &steps.momenta[0],
+        "(m1 + m2)*dot_x1 - ell*(m1 + 2*m2)/2*sin(theta)*dot_theta",
+        2,
+    );
+}
+
+#[test]
+fn every_shown_step_equals_the_derived_one_and_is_no_longer() {
+    for d in all_phases() {
+        let steps = d
+            .steps
+            .as_ref()
+            .unwrap_or_else(|| panic!("{} has no steps", d.name));
+        let mut shown: Vec<(String, &Shown)> = vec![
+            ("T".into(), &steps.kinetic),
+            ("V".into(), &steps.potential),
+            ("L".into(), &steps.lagrangian),
+        ];
+        shown.extend((steps.euler_lagrange.iter().enumerate()).map(|(i, s)| (format!("EL{i}"), s)));
+        shown.extend((steps.momenta.iter().enumerate()).map(|(i, s)| (format!("p{i}"), s)));
+        // A condition `= 0` is shown up to its constant factor (the presenter checks that).
+        shown.extend(
+            (steps.reduced.iter())
+                .filter(|(k, _)| k.as_str() != "separation_condition")
+                .map(|(k, s)| (k.clone(), s)),
+        );
+        for (what, s) in shown {
+            let what = format!("{} {what}", d.name);
+            assert!(
+                difference_vanishes(&s.expr, &s.derived),
+                "{what}: {} is not {}",
+                s.expr.to_infix(),
+                s.derived.to_infix()
+            );
+            assert!(
+                operations(&s.expr) <= operations(&s.derived),
+                "{what}: {} is longer than {}",
+                s.expr.to_infix(),
+                s.derived.to_infix()
+            );
+            if s.as_derived.is_some() {
+                assert_eq!(
+                    s.expr, s.derived,
+                    "{what}: shown as derived, yet another form"
+                );
+            }
+        }
+    }
+}
