@@ -286,7 +286,8 @@ fn rustfmt(model: &str, text: &str) -> Result<String, Error> {
 
 /// The Rust, LaTeX and JSON files of one derived phase.
 fn render_phase(root: &Path, c: &Checked, d: &Derivation) -> Result<Vec<Rendered>, Error> {
-    let ctx = emit::rust_context(c, d).map_err(|message| {
+    // A model the emitter cannot write is reported against its spec file.
+    let refused = |message: String| {
         Error::Spec(SpecError {
             file: c.file.clone(),
             line: 0,
@@ -296,19 +297,10 @@ fn render_phase(root: &Path, c: &Checked, d: &Derivation) -> Result<Vec<Rendered
             source_line: String::new(),
             width: 0,
         })
-    })?;
+    };
+    let ctx = emit::rust_context(c, d).map_err(refused)?;
     let rust = rustfmt(&d.name, &render(root, "model.rs.tera", &ctx)?)?;
-    let tex_ctx = emit::tex_context(c, d).map_err(|message| {
-        Error::Spec(SpecError {
-            file: c.file.clone(),
-            line: 0,
-            column: 0,
-            field: String::new(),
-            message: format!("model `{}`: {message}", d.name),
-            source_line: String::new(),
-            width: 0,
-        })
-    })?;
+    let tex_ctx = emit::tex_context(c, d).map_err(refused)?;
     let tex = render(root, "model.tex.tera", &tex_ctx)?;
     let json =
         serde_json::to_string_pretty(&emit::json_record(c, d)).map_err(|e| Error::Template {
