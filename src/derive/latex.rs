@@ -46,7 +46,16 @@ impl Expr {
                         for (i, f) in fs.iter().enumerate() {
                             if i > 0 {
                                 let digit_next = matches!(f, Expr::Rational(..) | Expr::Float(_));
-                                o.push_str(if digit_next { " \\cdot " } else { " " });
+                                // After `\sin \theta` a thin space, so that the next factor does
+                                // not read as part of the function's argument.
+                                let after_function = trig_factor(&fs[i - 1]);
+                                o.push_str(if digit_next {
+                                    " \\cdot "
+                                } else if after_function {
+                                    " \\, "
+                                } else {
+                                    " "
+                                });
                             }
                             // Alone above or below the line, a sum needs no brackets.
                             let alone = if den.is_empty() { 2 } else { 0 };
@@ -262,6 +271,20 @@ impl Expr {
             }
             _ => vec![self.to_latex(name)],
         }
+    }
+}
+
+/// Whether a factor prints as a function of a bare symbol (`\sin \theta`, `\cos^{2} \theta`),
+/// whose argument the next factor would seem to continue.
+fn trig_factor(f: &Expr) -> bool {
+    let bare_call = |e: &Expr| {
+        matches!(e, Expr::Fun(name, args)
+            if matches!(name.as_str(), "sin" | "cos" | "tan" | "exp" | "log")
+                && matches!(args.first(), Some(Expr::Sym(_))))
+    };
+    match f {
+        Expr::Pow(b, _) => bare_call(b),
+        f => bare_call(f),
     }
 }
 
