@@ -1,7 +1,7 @@
 //! The LaTeX printer of the derivation tool: an [`Expr`] as LaTeX, its printed width, and long
 //! displays broken into lines between the terms of a sum (the runtime crate prints no LaTeX).
 
-use super::expr::{Expr, write_signed_sum};
+use super::expr::{Expr, wrap_in, write_signed_sum};
 use std::fmt::Write as _;
 
 impl Expr {
@@ -366,13 +366,7 @@ fn visible_width(latex: &str) -> usize {
 }
 
 fn wrap_latex(out: &mut String, paren: bool, f: impl FnOnce(&mut String)) {
-    if paren {
-        out.push_str("\\left(");
-    }
-    f(out);
-    if paren {
-        out.push_str("\\right)");
-    }
+    wrap_in(out, paren.then_some(("\\left(", "\\right)")), f);
 }
 
 #[cfg(test)]

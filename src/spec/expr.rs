@@ -428,12 +428,18 @@ pub fn sum(mut v: Vec<Expr>) -> Expr {
 }
 
 fn wrap(out: &mut String, paren: bool, f: impl FnOnce(&mut String)) {
-    if paren {
-        out.push('(');
+    wrap_in(out, paren.then_some(("(", ")")), f);
+}
+
+/// What `f` writes, between `brackets` (opening, closing) when there are any: the printers'
+/// one way of bracketing a part.
+pub fn wrap_in(out: &mut String, brackets: Option<(&str, &str)>, f: impl FnOnce(&mut String)) {
+    if let Some((open, _)) = brackets {
+        out.push_str(open);
     }
     f(out);
-    if paren {
-        out.push(')');
+    if let Some((_, close)) = brackets {
+        out.push_str(close);
     }
 }
 
