@@ -13,6 +13,7 @@ use rodcube::solve::SolveError;
 use rodcube::solve::lean::LeanSolver;
 use rodcube::solve::prior::PRIOR_MAX_NODES;
 use rodcube::solve::quadrature::{RuleStep, SCHEDULE};
+use rodcube::system::SystemError;
 
 /// The paper's case: m1, m2, ell, a, g.
 const PAPER: [f64; 5] = [1.0, 3.0, 1.0, 0.25, 9.81];
@@ -260,4 +261,36 @@ fn the_angle_fallen_agrees_with_the_difference_of_the_angles() {
             );
         }
     }
+}
+
+#[test]
+fn a_constant_that_overflows_gets_the_full_preparations_error() {
+    // Lengths of 1e300 m under a gravity of 1e-10 m/s^2: a time scale ell/g overflows. The
+    // lean preparation forms only some constants and checks none of them; the overflow must
+    // still come back as the full preparation's typed error, never as a number.
+    let mut overflowed = 0;
+    for &model in rodcube::models::all() {
+        let Ok(mut solver) = LeanSolver::new(model) else {
+            continue;
+        };
+        let info = model.info();
+        let p: Vec<f64> = (info.parameters.iter())
+            .map(|q| match q.name {
+                "ell" => 1e300,
+                "a" => 0.25e300,
+                "g" => 1e-10,
+                _ => 1.0,
+            })
+            .collect();
+        let full = rodcube::system::Bound::from_values(model, &p).map(|_| ());
+        match (full, solver.solve(&p)) {
+            (Err(want @ SystemError::BadConstant { .. }), Err(SolveError::Parameters(got))) => {
+                assert_eq!(got, want, "{}", info.name);
+                overflowed += 1;
+            }
+            (Err(want), got) => panic!("{}: {want} but the lean solver gave {got:?}", info.name),
+            (Ok(()), _) => {}
+        }
+    }
+    assert!(overflowed >= 2, "only {overflowed} models overflowed");
 }

@@ -9,7 +9,12 @@
 //! wall_ladder), the solver prepares only the constants it reads
 //! ([`Reduction::prepare_lean`]) and takes the node
 //! counts a priori from the integrand's singularities ([`prior`](crate::solve::prior)): about
-//! 7 evaluations per point instead of 19, at `2^-53` relative.
+//! 7 evaluations per point instead of 19, at `2^-53` relative. Such a point is first solved on
+//! an unchecked route (`LeanSolver::quick`): the same root, integrand and plan with nothing but
+//! numbers between them (no error values built, no model call beyond the three polynomials'
+//! constants). Anything short of a clean solve there (a value not finite, no root, a phase that
+//! does not fall, too many panels) sends the point through the checked route, which solves it
+//! again and names what failed; so the unchecked route never decides an error.
 //!
 //! `rodcube accuracy` and the tests in `tests/hard_cases.rs` check the result against the
 //! high-precision reference (`rodcube::reference`, feature `cli`) across `n = m2/m1` from 1e-12 to 1e12 and
@@ -17,9 +22,11 @@
 
 use crate::model::{Model, ModelInfo, Reduction, ReductionInfo};
 use crate::solve::SolveError;
-use crate::solve::poly::MAX_DEGREE;
-use crate::solve::prior::{PRIOR_TOL, Prior, integrate_prior};
-use crate::solve::quadrature::{self, ACCEPT, Control, Fall, RuleStep, SCHEDULE};
+use crate::solve::poly::{self, MAX_DEGREE};
+use crate::solve::prior::{PRIOR_TOL, Prior, Singularities, integrate_prior, prior_panels};
+use crate::solve::quadrature::{
+    self, ACCEPT, Control, Fall, FallIntegrand, HalfRule, RuleStep, SCHEDULE, v_at_drop,
+};
 use crate::solve::separation::separation_root;
 use crate::system::{SystemError, check_parameters, ordered_values, prepare_constants};
 
@@ -188,10 +195,10 @@ impl<'m> LeanSolver<'m> {
         check_parameters(self.model, p, &mut self.margins).map_err(SolveError::Parameters)?;
         if self.prior.is_some() {
             self.red.prepare_lean(p, &mut self.k);
-            let k = &self.k;
-            let finite = (self.layout.lean_constants.iter())
-                .all(|&i| k.get(i).is_some_and(|v| v.abs() < f64::INFINITY));
-            if finite && let Ok(point) = self.solve_prepared() {
+            if let Some(point) = self.quick() {
+                return Ok(point);
+            }
+            if let Ok(point) = self.solve_prepared() {
                 return Ok(point);
             }
         }
@@ -213,6 +220,63 @@ impl<'m> LeanSolver<'m> {
             .and_then(|()| self.solve(&p));
         self.named = p;
         outcome
+    }
+
+    /// The a-priori route from the lean constants with nothing but numbers in between: the
+    /// separation polynomial's root ([`poly::largest_root`]), the fall's integrand
+    /// ([`FallIntegrand`]) and the a-priori plan ([`prior_panels`]), each the one copy the
+    /// checked route also uses. `None` on anything short of a phase that falls from rest to a
+    /// separation inside it with positive finite values at every node: the checked route
+    /// ([`LeanSolver::solve_prepared`]) then solves the point again and names what failed.
+    #[inline]
+    fn quick(&mut self) -> Option<LeanPoint> {
+        let (layout, k) = (self.layout, &self.k);
+        let prior = self.prior.as_ref()?;
+        if k[layout.k_theta_dot_initial] != 0.0 {
+            return None;
+        }
+        let (si, ci) = (k[layout.k_sin_initial], k[layout.k_cos_initial]);
+        // Fixed shapes (a cubic at most, else the checked route), zero past each degree, so
+        // that one unrolled test covers them all.
+        let (mut sep_all, mut fall_all) = ([0.0; 4], [0.0; 3]);
+        let (sep_len, fall_len) = (layout.separation_degree + 1, layout.fall_degree? + 1);
+        self.red
+            .separation_polynomial(k, sep_all.get_mut(..sep_len)?);
+        self.red.fall_polynomial(k, fall_all.get_mut(..fall_len)?);
+        let finite = |ok: bool, c: &f64| ok & c.is_finite();
+        if !(sep_all.iter().fold(true, finite) & fall_all.iter().fold(true, finite)) {
+            return None;
+        }
+        let (sep, fall) = (&sep_all[..sep_len], &fall_all[..fall_len]);
+        let s = poly::largest_root(sep, self.sin_end, si, &mut self.evals)??;
+        let drop = si - s;
+        // 1 - sin(theta_i) without cancellation near upright.
+        let e = ci * ci / (1.0 + si);
+        let below_vertical = e > 0.0 && e.is_finite() && si.abs() < 1.0 && ci > 0.0;
+        if !(below_vertical && drop > 0.0 && drop.is_finite()) {
+            return None;
+        }
+        let integrand = FallIntegrand::new(si, e, fall);
+        if !integrand.falls() {
+            return None;
+        }
+        let v_end = v_at_drop(e, drop);
+        let sing = Singularities::of(si, e, fall)?;
+        let panel = |rule: &HalfRule, a: f64, b: f64| {
+            let sum = integrand.panel(rule, a, b, a == 0.0);
+            if sum.ok() {
+                Ok((sum.value, sum.evals))
+            } else {
+                Err(())
+            }
+        };
+        let (t, evals) = prior_panels(&sing, v_end, prior, panel).ok()??;
+        self.evals += evals;
+        Some(LeanPoint {
+            separation_angle: s.asin(),
+            separation_time: t,
+            sines: [si, ci, s, drop],
+        })
     }
 
     /// The separation angle and time from prepared constants.

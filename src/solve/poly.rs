@@ -10,7 +10,8 @@
 //! the coefficients (e.g. `n = m2/m1` from 1e-12 to 1e12).
 //!
 //! The largest root of a quadratic or cubic (every separation polynomial of the per-point
-//! solver) is first sought without the split: Halley from the root of the linear part, kept
+//! solver) is first sought without the split: Halley from the root of the linear part
+//! corrected once by a fixed-point step, kept
 //! when deflation shows the other roots clear of it and of the interval above it
 //! (`certified_low`); else the split decides.
 
@@ -90,7 +91,8 @@ fn largest_low(c4: [f64; 4], lo: f64, hi: f64, evals: &mut u64) -> Option<f64> {
 /// decides that there is no root).
 ///
 /// Halley's method on plain Horner values from the root of the linear part `-c0 / c1` (most
-/// separation polynomials are dominated by it near their root), stopped once a step is below
+/// separation polynomials are dominated by it near their root) after one fixed-point
+/// correction, stopped once a step is below
 /// 1e-7 relative, then one Newton step on the compensated value, as in [`refine`]. The result
 /// is certified by deflation: `p(s) = (s - x) q(s)` up to the remainder, and the real roots of
 /// the quadratic (or linear) `q` must all lie clear of `(x - gap, hi + gap)`, so that `x` is a
@@ -101,8 +103,14 @@ fn largest_low(c4: [f64; 4], lo: f64, hi: f64, evals: &mut u64) -> Option<f64> {
 fn certified_low(c: [f64; 4], lo: f64, hi: f64, evals: &mut u64) -> Option<f64> {
     let [c0, c1, c2, c3] = c;
     let width = hi - lo;
+    // The root of the linear part, corrected once by the fixed point `x = -(c0 + c2 x^2 + c3
+    // x^3) / c1` (there `c0 + c1 x = 0`, so `p(x) = x^2 (c2 + c3 x)`): it squares the relative
+    // error `t ~ c3 x^2 / c1` of the linear root, which saves a Halley step wherever `t` is small.
     let linear = -c0 / c1;
-    let mut x = if linear > lo && linear < hi {
+    let fixed = linear - linear * linear * (c2 + c3 * linear) / c1;
+    let mut x = if fixed > lo && fixed < hi {
+        fixed
+    } else if linear > lo && linear < hi {
         linear
     } else {
         lo + 0.5 * width

@@ -147,9 +147,9 @@ impl Singularities {
         }
         let z = (si - below) / e;
         out.push((asinh_sqrt(z), 0.0));
-        (out.points[..out.len].iter())
-            .all(|&(x, y)| x.is_finite() && y.is_finite())
-            .then_some(out)
+        // Over the fixed array (points not pushed are zeros), so that the test unrolls.
+        let finite = |ok: bool, &(x, y): &(f64, f64)| ok & x.is_finite() & y.is_finite();
+        out.points.iter().fold(true, finite).then_some(out)
     }
 
     fn push(&mut self, p: (f64, f64)) {
@@ -279,9 +279,23 @@ pub fn integrate_prior(
     else {
         return Ok(None);
     };
+    prior_panels(&sing, v_end, prior, |rule, a, b| fall.panel(rule, a, b))
+}
+
+/// The a-priori plan on `[0, v_end]` (`v_end > 0`) for a phase from rest with singular points
+/// `sing`: one panel when a rule of at most [`PRIOR_MAX_NODES`] nodes suffices, else halves,
+/// depth first, each integrated by `panel(rule, a, b)` (the first one from rest symmetric).
+/// `Ok(None)` past [`PRIOR_MAX_PANELS`] panels; the integral and the evaluations otherwise.
+#[inline]
+pub fn prior_panels<E>(
+    sing: &Singularities,
+    v_end: f64,
+    prior: &Prior,
+    mut panel: impl FnMut(&'static HalfRule, f64, f64) -> Result<(f64, u64), E>,
+) -> Result<Option<(f64, u64)>, E> {
     // Most phases take one panel; the others are halved, depth first.
     if let Some(rule) = prior.rule_for(sing.rho(0.0, v_end)) {
-        return fall.panel(rule, 0.0, v_end).map(Some);
+        return panel(rule, 0.0, v_end).map(Some);
     }
     let mut stack = [(0.0, 0.0); PRIOR_STACK];
     stack[0] = (0.0, 0.5 * v_end);
@@ -300,7 +314,7 @@ pub fn integrate_prior(
         panels += 1;
         match prior.rule_for(sing.rho(c, h)) {
             Some(rule) => {
-                let (value, n) = fall.panel(rule, a, b)?;
+                let (value, n) = panel(rule, a, b)?;
                 total += value;
                 evals += n;
             }
