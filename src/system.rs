@@ -659,7 +659,7 @@ pub fn check_parameters(
 /// floats are exactly `1..=f64::MAX.to_bits()` (zero is 0, negatives have the sign bit set,
 /// infinity and NaN lie above `f64::MAX`).
 #[inline(always)]
-fn positive_finite(v: f64) -> bool {
+pub(crate) fn positive_finite(v: f64) -> bool {
     v.to_bits().wrapping_sub(1) < f64::MAX.to_bits()
 }
 

@@ -28,7 +28,9 @@ use crate::solve::quadrature::{
     self, ACCEPT, Control, Fall, FallIntegrand, HalfRule, RuleStep, SCHEDULE, v_at_drop,
 };
 use crate::solve::separation::separation_root;
-use crate::system::{SystemError, check_parameters, ordered_values, prepare_constants};
+use crate::system::{
+    SystemError, check_parameters, ordered_values, positive_finite, prepare_constants,
+};
 
 /// One point's separation.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -252,8 +254,8 @@ impl<'m> LeanSolver<'m> {
         let drop = si - s;
         // 1 - sin(theta_i) without cancellation near upright.
         let e = ci * ci / (1.0 + si);
-        let below_vertical = e > 0.0 && e.is_finite() && si.abs() < 1.0 && ci > 0.0;
-        if !(below_vertical && drop > 0.0 && drop.is_finite()) {
+        // Below the vertical, and a drop inside the phase (integer tests, without branches).
+        if !(positive_finite(e) & positive_finite(drop) & (si.abs() < 1.0) & (ci > 0.0)) {
             return None;
         }
         let integrand = FallIntegrand::new(si, e, fall);
