@@ -626,6 +626,31 @@ pub fn check_parameters(
     margins: &mut [f64],
 ) -> Result<(), SystemError> {
     let info = model.info();
+    // Finite and positive values pass every value check; the detailed checks and the messages
+    // are out of line, on the rare path.
+    if p.len() != info.parameters.len()
+        || margins.len() != info.requirements.len()
+        || !p.iter().all(|&v| positive_finite(v))
+    {
+        return parameters_refused(model, p, margins);
+    }
+    model.requirements(p, margins);
+    if margins.iter().all(|&m| m > 0.0) {
+        return Ok(());
+    }
+    parameters_refused(model, p, margins)
+}
+
+/// [`check_parameters`]' verdict on parameters that did not pass its quick tests: the first
+/// failure by name, or `Ok` (a value that is zero or negative where that is allowed).
+#[cold]
+#[inline(never)]
+fn parameters_refused(
+    model: &dyn Model,
+    p: &[f64],
+    margins: &mut [f64],
+) -> Result<(), SystemError> {
+    let info = model.info();
     if p.len() != info.parameters.len() || margins.len() != info.requirements.len() {
         return Err(SystemError::WrongCount {
             model: info.name,
@@ -633,15 +658,8 @@ pub fn check_parameters(
             got: p.len(),
         });
     }
-    // Finite and positive values pass every value check; others get the detailed one.
-    if !p.iter().all(|&v| positive_finite(v)) {
-        for (i, &value) in p.iter().enumerate() {
-            check_value(info, i, value)?;
-        }
-    }
-    model.requirements(p, margins);
-    if margins.iter().all(|&m| m > 0.0) {
-        return Ok(());
+    for (i, &value) in p.iter().enumerate() {
+        check_value(info, i, value)?;
     }
     if let Some((req, margin)) = failed_requirements(model, p, margins).next() {
         return Err(SystemError::Requirement {
