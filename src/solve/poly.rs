@@ -58,6 +58,14 @@ fn largest_low(c4: [f64; 4], lo: f64, hi: f64, evals: &mut u64) -> Option<f64> {
     if let Some(root) = certified_low(c4, lo, hi, evals) {
         return Some(root);
     }
+    largest_split(c4, lo, hi, evals)
+}
+
+/// [`largest_low`] by the monotone split, for a root the certified path left (out of line: the
+/// rare path).
+#[cold]
+#[inline(never)]
+fn largest_split(c4: [f64; 4], lo: f64, hi: f64, evals: &mut u64) -> Option<f64> {
     let c = &c4[..];
     // Knots ascending: lo, the critical points inside, hi.
     let mut crit = [0.0; MAX_DEGREE];

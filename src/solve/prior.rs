@@ -294,10 +294,22 @@ pub fn prior_panels<E>(
     prior: &Prior,
     mut panel: impl FnMut(&'static HalfRule, f64, f64) -> Result<(f64, u64), E>,
 ) -> Result<Option<(f64, u64)>, E> {
-    // Most phases take one panel; the others are halved, depth first.
+    // Most phases take one panel; the others are halved, depth first (out of line).
     if let Some(rule) = prior.rule_for(sing.rho(0.0, v_end)) {
         return panel(rule, 0.0, v_end).map(Some);
     }
+    halved_panels(sing, v_end, prior, panel)
+}
+
+/// [`prior_panels`] past its first panel: halves, depth first.
+#[cold]
+#[inline(never)]
+fn halved_panels<E>(
+    sing: &Singularities,
+    v_end: f64,
+    prior: &Prior,
+    mut panel: impl FnMut(&'static HalfRule, f64, f64) -> Result<(f64, u64), E>,
+) -> Result<Option<(f64, u64)>, E> {
     let mut stack = [(0.0, 0.0); PRIOR_STACK];
     stack[0] = (0.0, 0.5 * v_end);
     stack[1] = (0.5 * v_end, v_end);
