@@ -234,11 +234,68 @@ impl ModelInfo {
     }
 }
 
+/// What the per-point solver's unchecked route reads of one point, formed straight from the
+/// parameters by [`Model::lean_start`]: the start and the separation and fall polynomials'
+/// coefficients (lowest degree first, zero past each degree).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LeanStart {
+    /// `sin(theta_i)`.
+    pub sin_initial: f64,
+    /// `cos(theta_i)`.
+    pub cos_initial: f64,
+    /// `theta_dot_i`.
+    pub theta_dot_initial: f64,
+    /// The separation polynomial, degree at most 3.
+    pub separation: [f64; 4],
+    /// The fall polynomial, degree at most 2.
+    pub fall: [f64; 3],
+}
+
+/// Most constants `k` of a model that [`Model::lean_start`] serves (its scratch lives on the
+/// stack); a model with more takes the checked route.
+pub const LEAN_MAX_CONSTANTS: usize = 64;
+
+/// Most requirements of a model that [`Model::lean_start`] serves.
+pub const LEAN_MAX_REQUIREMENTS: usize = 8;
+
 /// Evaluation functions of one generated model over its full state. All are allocation-free
 /// and evaluate each shared subexpression once per call.
 pub trait Model: Send + Sync {
     /// Static description.
     fn info(&self) -> &'static ModelInfo;
+
+    /// The per-point solver's inputs for the parameters `p` in one call: `Some` only when the
+    /// parameters pass [`check_parameters`](crate::system::check_parameters)' quick test (so
+    /// that the full check would accept them too) and the model has a fast path with a
+    /// separation polynomial of degree at most 3 and a fall polynomial of degree at most 2;
+    /// `None` says nothing about why (the checked route then decides and names it). A default
+    /// method, so that each model's copy calls its own generated functions directly and the
+    /// compiler can fuse them (no constant vector in memory, no virtual call).
+    #[inline]
+    fn lean_start(&self, p: &[f64]) -> Option<LeanStart> {
+        let info = self.info();
+        let layout = info.reduction.as_ref()?;
+        let (sep_len, fall_len) = (layout.separation_degree + 1, layout.fall_degree? + 1);
+        let mut margins = [0.0; LEAN_MAX_REQUIREMENTS];
+        let margins = margins.get_mut(..info.requirements.len())?;
+        if !crate::system::parameters_pass(self, p, margins) {
+            return None;
+        }
+        let red = self.reduction()?;
+        let mut k = [0.0; LEAN_MAX_CONSTANTS];
+        let k = k.get_mut(..info.n_constants)?;
+        red.prepare_lean(p, k);
+        let (mut separation, mut fall) = ([0.0; 4], [0.0; 3]);
+        red.separation_polynomial(k, separation.get_mut(..sep_len)?);
+        red.fall_polynomial(k, fall.get_mut(..fall_len)?);
+        Some(LeanStart {
+            sin_initial: *k.get(layout.k_sin_initial)?,
+            cos_initial: *k.get(layout.k_cos_initial)?,
+            theta_dot_initial: *k.get(layout.k_theta_dot_initial)?,
+            separation,
+            fall,
+        })
+    }
 
     /// Requirement margins from the parameters alone (each must be `> 0`), in the order of
     /// [`ModelInfo::requirements`]. `out.len()` must equal that list's length.

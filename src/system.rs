@@ -625,20 +625,32 @@ pub fn check_parameters(
     p: &[f64],
     margins: &mut [f64],
 ) -> Result<(), SystemError> {
-    let info = model.info();
     // Finite and positive values pass every value check; the detailed checks and the messages
     // are out of line, on the rare path.
+    if parameters_pass(model, p, margins) {
+        return Ok(());
+    }
+    parameters_refused(model, p, margins)
+}
+
+/// [`check_parameters`]' quick test: the right counts, every value positive and finite and
+/// every requirement's margin (written to `margins`) positive. Passing it means the full check
+/// accepts; failing it leaves the verdict to the full check.
+#[inline(always)]
+pub(crate) fn parameters_pass<M: Model + ?Sized>(
+    model: &M,
+    p: &[f64],
+    margins: &mut [f64],
+) -> bool {
+    let info = model.info();
     if p.len() != info.parameters.len()
         || margins.len() != info.requirements.len()
         || !p.iter().all(|&v| positive_finite(v))
     {
-        return parameters_refused(model, p, margins);
+        return false;
     }
     model.requirements(p, margins);
-    if margins.iter().all(|&m| m > 0.0) {
-        return Ok(());
-    }
-    parameters_refused(model, p, margins)
+    margins.iter().all(|&m| m > 0.0)
 }
 
 /// [`check_parameters`]' verdict on parameters that did not pass its quick tests: the first

@@ -294,3 +294,68 @@ fn a_constant_that_overflows_gets_the_full_preparations_error() {
     }
     assert!(overflowed >= 2, "only {overflowed} models overflowed");
 }
+
+#[test]
+fn the_lean_start_is_the_prepared_start_or_nothing() {
+    // Model::lean_start forms the unchecked route's inputs in one call. Where it gives some,
+    // the full check must accept the point and every number must be the one the prepared
+    // constants and the model's polynomials give; a point the quick test cannot pass gets none.
+    let mut served = 0;
+    for &model in rodcube::models::all() {
+        let info = model.info();
+        let (Some(layout), Some(red)) = (info.reduction.as_ref(), model.reduction()) else {
+            continue;
+        };
+        for (ell, a) in [(1.0, 0.25), (2.0, 1.9), (1.0, 1e-9), (1.0, 1.0), (1.0, 1.5)] {
+            let p: Vec<f64> = (info.parameters.iter())
+                .map(|q| match q.name {
+                    "ell" => ell,
+                    "a" => a,
+                    "g" => 9.81,
+                    _ => 1.0,
+                })
+                .collect();
+            let mut margins = vec![0.0; info.requirements.len()];
+            let accepted = rodcube::system::check_parameters(model, &p, &mut margins).is_ok();
+            let Some(start) = model.lean_start(&p) else {
+                continue;
+            };
+            assert!(accepted, "{}: a start for refused {p:?}", info.name);
+            let mut k = vec![0.0; info.n_constants];
+            model.prepare(&p, &mut k);
+            let mut sep = vec![0.0; layout.separation_degree + 1];
+            red.separation_polynomial(&k, &mut sep);
+            let mut fall = vec![0.0; layout.fall_degree.unwrap() + 1];
+            red.fall_polynomial(&k, &mut fall);
+            assert_eq!(start.sin_initial, k[layout.k_sin_initial], "{}", info.name);
+            assert_eq!(start.cos_initial, k[layout.k_cos_initial], "{}", info.name);
+            let rate = k[layout.k_theta_dot_initial];
+            assert_eq!(start.theta_dot_initial, rate, "{}", info.name);
+            assert_eq!(start.separation[..sep.len()], sep[..], "{}", info.name);
+            assert!(start.separation[sep.len()..].iter().all(|&c| c == 0.0));
+            assert_eq!(start.fall[..fall.len()], fall[..], "{}", info.name);
+            assert!(start.fall[fall.len()..].iter().all(|&c| c == 0.0));
+            served += 1;
+            // What the quick test cannot pass: a value not positive and finite, a wrong count.
+            for bad in [f64::NAN, f64::INFINITY, 0.0, -1.0] {
+                let mut q = p.clone();
+                q[0] = bad;
+                assert_eq!(model.lean_start(&q), None, "{}: {q:?}", info.name);
+            }
+            assert_eq!(model.lean_start(&p[1..]), None, "{}", info.name);
+        }
+        // A requirement that fails (the rod shorter than the cube is tall, where the model has
+        // that requirement) gives none.
+        if info.parameters.iter().any(|q| q.name == "a") {
+            let p: Vec<f64> = (info.parameters.iter())
+                .map(|q| if q.name == "a" { 2.0 } else { 1.0 })
+                .collect();
+            let mut margins = vec![0.0; info.requirements.len()];
+            if rodcube::system::check_parameters(model, &p, &mut margins).is_err() {
+                assert_eq!(model.lean_start(&p), None, "{}", info.name);
+            }
+        }
+    }
+    // rod_cube, hinged_rod, loaded_rod and wall_ladder at least, at two points each.
+    assert!(served >= 8, "only {served} starts were formed");
+}

@@ -10,17 +10,19 @@
 //! ([`Reduction::prepare_lean`]) and takes the node
 //! counts a priori from the integrand's singularities ([`prior`](crate::solve::prior)): about
 //! 7 evaluations per point instead of 19, at `2^-53` relative. Such a point is first solved on
-//! an unchecked route (`LeanSolver::quick`): the same root, integrand and plan with nothing but
-//! numbers between them (no error values built, no model call beyond the three polynomials'
-//! constants). Anything short of a clean solve there (a value not finite, no root, a phase that
-//! does not fall, too many panels) sends the point through the checked route, which solves it
-//! again and names what failed; so the unchecked route never decides an error.
+//! an unchecked route (`LeanSolver::quick`): its inputs come from one call,
+//! [`Model::lean_start`] (the parameters' quick test and the start and polynomials, which each
+//! model's copy fuses), then the same root, integrand and plan with nothing but numbers between
+//! them (no error values built). Anything short of a clean solve there (a parameter the quick
+//! test does not pass, a value not finite, no root, a phase that does not fall, too many panels)
+//! sends the point through the checked route (`LeanSolver::checked`), which solves it again and
+//! names what failed; so the unchecked route never decides an error.
 //!
 //! `rodcube accuracy` and the tests in `tests/hard_cases.rs` check the result against the
 //! high-precision reference (`rodcube::reference`, feature `cli`) across `n = m2/m1` from 1e-12 to 1e12 and
 //! `a/ell` from 1e-10 to `1 - 1e-9`.
 
-use crate::model::{Model, ModelInfo, Reduction, ReductionInfo};
+use crate::model::{LeanStart, Model, ModelInfo, Reduction, ReductionInfo};
 use crate::solve::SolveError;
 use crate::solve::poly::{self, MAX_DEGREE};
 use crate::solve::prior::{PRIOR_TOL, Prior, Singularities, integrate_prior, prior_panels};
@@ -194,12 +196,21 @@ impl<'m> LeanSolver<'m> {
     /// that way is solved again from every constant, so that its error is the one the full
     /// preparation reports.
     pub fn solve(&mut self, p: &[f64]) -> Result<LeanPoint, SolveError> {
+        if self.prior.is_some()
+            && let Some(start) = self.model.lean_start(p)
+            && let Some(point) = self.quick(&start)
+        {
+            return Ok(point);
+        }
+        self.checked(p)
+    }
+
+    /// [`LeanSolver::solve`] by the checked route: every step's failure is a typed error.
+    #[inline(never)]
+    fn checked(&mut self, p: &[f64]) -> Result<LeanPoint, SolveError> {
         check_parameters(self.model, p, &mut self.margins).map_err(SolveError::Parameters)?;
         if self.prior.is_some() {
             self.red.prepare_lean(p, &mut self.k);
-            if let Some(point) = self.quick() {
-                return Ok(point);
-            }
             if let Ok(point) = self.solve_prepared() {
                 return Ok(point);
             }
@@ -224,32 +235,23 @@ impl<'m> LeanSolver<'m> {
         outcome
     }
 
-    /// The a-priori route from the lean constants with nothing but numbers in between: the
-    /// separation polynomial's root ([`poly::largest_root`]), the fall's integrand
-    /// ([`FallIntegrand`]) and the a-priori plan ([`prior_panels`]), each the one copy the
-    /// checked route also uses. `None` on anything short of a phase that falls from rest to a
-    /// separation inside it with positive finite values at every node: the checked route
-    /// ([`LeanSolver::solve_prepared`]) then solves the point again and names what failed.
+    /// The a-priori route from the point's start ([`Model::lean_start`]) with nothing but
+    /// numbers in between: the separation polynomial's root ([`poly::largest_root`]), the
+    /// fall's integrand ([`FallIntegrand`]) and the a-priori plan ([`prior_panels`]), each the
+    /// one copy the checked route also uses. `None` on anything short of a phase that falls
+    /// from rest to a separation inside it with positive finite values at every node: the
+    /// checked route ([`LeanSolver::checked`]) then solves the point again and names what
+    /// failed.
     #[inline]
-    fn quick(&mut self) -> Option<LeanPoint> {
-        let (layout, k) = (self.layout, &self.k);
+    fn quick(&mut self, start: &LeanStart) -> Option<LeanPoint> {
         let prior = self.prior.as_ref()?;
-        if k[layout.k_theta_dot_initial] != 0.0 {
-            return None;
-        }
-        let (si, ci) = (k[layout.k_sin_initial], k[layout.k_cos_initial]);
-        // Fixed shapes (a cubic at most, else the checked route), zero past each degree, so
-        // that one unrolled test covers them all.
-        let (mut sep_all, mut fall_all) = ([0.0; 4], [0.0; 3]);
-        let (sep_len, fall_len) = (layout.separation_degree + 1, layout.fall_degree? + 1);
-        self.red
-            .separation_polynomial(k, sep_all.get_mut(..sep_len)?);
-        self.red.fall_polynomial(k, fall_all.get_mut(..fall_len)?);
+        let (si, ci) = (start.sin_initial, start.cos_initial);
         let finite = |ok: bool, c: &f64| ok & c.is_finite();
-        if !(sep_all.iter().fold(true, finite) & fall_all.iter().fold(true, finite)) {
+        let coefficients = start.separation.iter().chain(&start.fall);
+        if !(coefficients.fold(true, finite) & (start.theta_dot_initial == 0.0)) {
             return None;
         }
-        let (sep, fall) = (&sep_all[..sep_len], &fall_all[..fall_len]);
+        let (sep, fall) = (&start.separation[..], &start.fall[..]);
         let s = poly::largest_root(sep, self.sin_end, si, &mut self.evals)??;
         let drop = si - s;
         // 1 - sin(theta_i) without cancellation near upright.

@@ -123,7 +123,8 @@ impl Singularities {
             }
         };
         match *coeffs {
-            [] | [_] => {}
+            // A constant, also padded to a quadratic with zeros: no zero.
+            [] | [_] | [_, 0.0, 0.0] => {}
             [p0, p1] => real(-p0 / p1, &mut out)?,
             [p0, p1, 0.0] => real(-p0 / p1, &mut out)?,
             [p0, p1, p2] => {
