@@ -1,7 +1,7 @@
 //! A lean per-point solve of the separation angle and time, for sweeps of millions of points:
 //! every buffer is allocated once per solver and reused, nothing is kept per point, and the
 //! numerics are the project's one copy of each: parameters checked by
-//! [`check_parameters`], the root by the isolator of [`poly`](crate::solve::poly), the time by the quadrature of
+//! [`check_parameters`], the root by the isolator of [`poly`], the time by the quadrature of
 //! [`quadrature`] (its module docs give the substitution that makes a few Gauss–Legendre nodes
 //! reach `f64` accuracy across the whole parameter range, and its error control).
 //!
