@@ -191,10 +191,10 @@ impl<'m> LeanSolver<'m> {
     /// Validates `p` (in the model's parameter order) exactly as
     /// [`System::from_values`](crate::system::System::from_values) does, then solves.
     ///
-    /// With the a-priori rule only the constants it reads are prepared
-    /// ([`Reduction::prepare_lean`]); a point that fails
-    /// that way is solved again from every constant, so that its error is the one the full
-    /// preparation reports.
+    /// With the a-priori rule the point is first solved from [`Model::lean_start`] (only the
+    /// constants it reads, nothing checked but numbers); a point that fails that way is
+    /// validated, and solved again from the lean constants and then from every constant, so
+    /// that its error is the one the full preparation reports.
     pub fn solve(&mut self, p: &[f64]) -> Result<LeanPoint, SolveError> {
         if self.prior.is_some()
             && let Some(start) = self.model.lean_start(p)
