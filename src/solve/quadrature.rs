@@ -400,43 +400,58 @@ impl<'a> FallIntegrand<'a> {
     /// NaN where `P(s) < 0`.
     #[inline(always)]
     fn value(&self, sh2: f64) -> f64 {
-        let s = self.si - self.e * sh2;
-        let p = if self.low {
+        if self.low {
             let [p0, p1, p2] = self.quadratic;
-            p0 + s * (p1 + s * p2)
+            self.value_with(sh2, |s| p0 + s * (p1 + s * p2))
         } else {
-            horner(self.coeffs, s)
-        };
-        2.0 * (p / (1.0 + s)).sqrt()
+            self.value_with(sh2, |s| horner(self.coeffs, s))
+        }
     }
 
-    /// [`FallIntegrand::value`] at two nodes in the same arithmetic (the compiler packs the
-    /// lanes).
+    /// [`FallIntegrand::value`] with the polynomial `p`.
     #[inline(always)]
-    fn value2(&self, sh2: [f64; 2]) -> [f64; 2] {
-        let [p0, p1, p2] = self.quadratic;
+    fn value_with(&self, sh2: f64, p: impl Fn(f64) -> f64) -> f64 {
+        let s = self.si - self.e * sh2;
+        2.0 * (p(s) / (1.0 + s)).sqrt()
+    }
+
+    /// [`FallIntegrand::value_with`] at two nodes in the same arithmetic, without a branch
+    /// between the lanes, so that the compiler packs them (`mulpd`, `divpd`, `sqrtpd`).
+    #[inline(always)]
+    fn value2_with(&self, sh2: [f64; 2], p: &impl Fn(f64) -> f64) -> [f64; 2] {
         let s = [self.si - self.e * sh2[0], self.si - self.e * sh2[1]];
-        if self.low {
-            let p = [p0 + s[0] * (p1 + s[0] * p2), p0 + s[1] * (p1 + s[1] * p2)];
-            [
-                2.0 * (p[0] / (1.0 + s[0])).sqrt(),
-                2.0 * (p[1] / (1.0 + s[1])).sqrt(),
-            ]
-        } else {
-            [self.value(sh2[0]), self.value(sh2[1])]
-        }
+        let q = [p(s[0]) / (1.0 + s[0]), p(s[1]) / (1.0 + s[1])];
+        [2.0 * q[0].sqrt(), 2.0 * q[1].sqrt()]
     }
 
     /// The rule on the panel `[a, b]` (`symmetric`: the first panel from rest, half of the rule
     /// on `[-b, b]`): each node takes its own `sinh^2`, and the values are checked once for the
-    /// whole panel by [`PanelSum::ok`].
+    /// whole panel by [`PanelSum::ok`]. The polynomial's shape is decided once per panel.
     #[inline]
     pub fn panel(&self, rule: &HalfRule, a: f64, b: f64, symmetric: bool) -> PanelSum {
+        if self.low {
+            let [p0, p1, p2] = self.quadratic;
+            self.panel_with(rule, a, b, symmetric, |s| p0 + s * (p1 + s * p2))
+        } else {
+            self.panel_with(rule, a, b, symmetric, |s| horner(self.coeffs, s))
+        }
+    }
+
+    /// [`FallIntegrand::panel`] with the polynomial `p`.
+    #[inline(always)]
+    fn panel_with(
+        &self,
+        rule: &HalfRule,
+        a: f64,
+        b: f64,
+        symmetric: bool,
+        p: impl Fn(f64) -> f64,
+    ) -> PanelSum {
         let (centre, half) = panel_frame(symmetric, a, b);
         let mut acc = 0.0;
         let mut least = f64::INFINITY;
         if rule.centre != 0.0 {
-            let f = self.value(sinh_sq(centre));
+            let f = self.value_with(sinh_sq(centre), &p);
             least = lesser(least, f);
             acc = rule.centre * f;
         }
@@ -445,20 +460,20 @@ impl<'a> FallIntegrand<'a> {
             let mut chunks = rule.pairs.chunks_exact(2);
             let (mut acc2, mut least2) = ([acc, 0.0], [least, f64::INFINITY]);
             for c in &mut chunks {
-                let f = self.value2(sinh_sq2([half * c[0].0, half * c[1].0]));
+                let f = self.value2_with(sinh_sq2([half * c[0].0, half * c[1].0]), &p);
                 least2 = [lesser(least2[0], f[0]), lesser(least2[1], f[1])];
                 acc2 = [acc2[0] + c[0].1 * f[0], acc2[1] + c[1].1 * f[1]];
             }
             (acc, least) = (acc2[0] + acc2[1], lesser(least2[0], least2[1]));
             for &(x, w) in chunks.remainder() {
-                let f = self.value(sinh_sq(half * x));
+                let f = self.value_with(sinh_sq(half * x), &p);
                 least = lesser(least, f);
                 acc += w * f;
             }
         } else {
             for &(x, w) in &rule.pairs {
                 let hx = half * x;
-                let [up, down] = self.value2(sinh_sq2([centre + hx, centre - hx]));
+                let [up, down] = self.value2_with(sinh_sq2([centre + hx, centre - hx]), &p);
                 least = lesser(least, lesser(up, down));
                 acc += w * (up + down);
             }
