@@ -271,7 +271,7 @@ pub trait Model: Send + Sync {
     /// `None` says nothing about why (the checked route then decides and names it). A default
     /// method, so that each model's copy calls its own generated functions directly and the
     /// compiler can fuse them (no constant vector in memory, no virtual call).
-    #[inline]
+    #[inline(always)]
     fn lean_start(&self, p: &[f64]) -> Option<LeanStart> {
         let info = self.info();
         let layout = info.reduction.as_ref()?;
@@ -295,6 +295,25 @@ pub trait Model: Send + Sync {
             separation,
             fall,
         })
+    }
+
+    /// The per-point solver's unchecked route for the parameters `p`: [`Model::lean_start`]
+    /// and the root, integrand and a-priori plan of [`LeanSolver`](crate::solve::lean::LeanSolver)
+    /// (to `prior`'s tolerance, with the root's bracket's low end at `sin_end`), with `evals`
+    /// counting the evaluations. `None` says nothing about why: the solver then takes its
+    /// checked route, which decides and names the error. A default method, so that each
+    /// model's copy is compiled with its generated functions inlined (its literal zeros and
+    /// constants folded into the whole route).
+    #[inline]
+    fn lean_point(
+        &self,
+        p: &[f64],
+        prior: &crate::solve::prior::Prior,
+        sin_end: f64,
+        evals: &mut u64,
+    ) -> Option<crate::solve::lean::LeanPoint> {
+        let start = self.lean_start(p)?;
+        crate::solve::lean::quick_route(&start, prior, sin_end, evals)
     }
 
     /// Requirement margins from the parameters alone (each must be `> 0`), in the order of

@@ -10,10 +10,11 @@
 //! ([`Reduction::prepare_lean`]) and takes the node
 //! counts a priori from the integrand's singularities ([`prior`](crate::solve::prior)): about
 //! 7 evaluations per point instead of 19, at `2^-53` relative. Such a point is first solved on
-//! an unchecked route (`LeanSolver::quick`): its inputs come from one call,
-//! [`Model::lean_start`] (the parameters' quick test and the start and polynomials, which each
-//! model's copy fuses), then the same root, integrand and plan with nothing but numbers between
-//! them (no error values built). Anything short of a clean solve there (a parameter the quick
+//! an unchecked route ([`Model::lean_point`], a default trait method, so each model's copy is
+//! compiled with its generated functions inlined and their literal zeros and constants folded
+//! into the route): its inputs come from [`Model::lean_start`] (the parameters' quick test and
+//! the start and polynomials), then the same root, integrand and plan with nothing but numbers
+//! between them (no error values built). Anything short of a clean solve there (a parameter the quick
 //! test does not pass, a value not finite, no root, a phase that does not fall, too many panels)
 //! sends the point through the checked route (`LeanSolver::checked`), which solves it again and
 //! names what failed; so the unchecked route never decides an error.
@@ -196,9 +197,10 @@ impl<'m> LeanSolver<'m> {
     /// validated, and solved again from the lean constants and then from every constant, so
     /// that its error is the one the full preparation reports.
     pub fn solve(&mut self, p: &[f64]) -> Result<LeanPoint, SolveError> {
-        if self.prior.is_some()
-            && let Some(start) = self.model.lean_start(p)
-            && let Some(point) = self.quick(&start)
+        if let Some(prior) = &self.prior
+            && let Some(point) = self
+                .model
+                .lean_point(p, prior, self.sin_end, &mut self.evals)
         {
             return Ok(point);
         }
@@ -233,54 +235,6 @@ impl<'m> LeanSolver<'m> {
             .and_then(|()| self.solve(&p));
         self.named = p;
         outcome
-    }
-
-    /// The a-priori route from the point's start ([`Model::lean_start`]) with nothing but
-    /// numbers in between: the separation polynomial's root ([`poly::largest_root`]), the
-    /// fall's integrand ([`FallIntegrand`]) and the a-priori plan ([`prior_panels`]), each the
-    /// one copy the checked route also uses. `None` on anything short of a phase that falls
-    /// from rest to a separation inside it with positive finite values at every node: the
-    /// checked route ([`LeanSolver::checked`]) then solves the point again and names what
-    /// failed.
-    #[inline]
-    fn quick(&mut self, start: &LeanStart) -> Option<LeanPoint> {
-        let prior = self.prior.as_ref()?;
-        let (si, ci) = (start.sin_initial, start.cos_initial);
-        let finite = |ok: bool, c: &f64| ok & c.is_finite();
-        let coefficients = start.separation.iter().chain(&start.fall);
-        if !(coefficients.fold(true, finite) & (start.theta_dot_initial == 0.0)) {
-            return None;
-        }
-        let (sep, fall) = (&start.separation[..], &start.fall[..]);
-        let s = poly::largest_root(sep, self.sin_end, si, &mut self.evals)??;
-        let drop = si - s;
-        // 1 - sin(theta_i) without cancellation near upright.
-        let e = ci * ci / (1.0 + si);
-        // Below the vertical, and a drop inside the phase (integer tests, without branches).
-        if !(positive_finite(e) & positive_finite(drop) & (si.abs() < 1.0) & (ci > 0.0)) {
-            return None;
-        }
-        let integrand = FallIntegrand::new(si, e, fall);
-        if !integrand.falls() {
-            return None;
-        }
-        let v_end = v_at_drop(e, drop);
-        let sing = Singularities::of(si, e, fall)?;
-        let panel = |rule: &HalfRule, a: f64, b: f64| {
-            let sum = integrand.panel(rule, a, b, a == 0.0);
-            if sum.ok() {
-                Ok((sum.value, sum.evals))
-            } else {
-                Err(())
-            }
-        };
-        let (t, evals) = prior_panels(&sing, v_end, prior, panel).ok()??;
-        self.evals += evals;
-        Some(LeanPoint {
-            separation_angle: s.asin(),
-            separation_time: t,
-            sines: [si, ci, s, drop],
-        })
     }
 
     /// The separation angle and time from prepared constants.
@@ -364,6 +318,60 @@ impl<'m> LeanSolver<'m> {
             }),
         }
     }
+}
+
+/// The unchecked route from a point's start ([`Model::lean_start`]) with nothing but numbers
+/// in between: the separation polynomial's root ([`poly::largest_root`]) in `(sin_end,
+/// sin(theta_i))`, the fall's integrand ([`FallIntegrand`]) and the a-priori plan
+/// ([`prior_panels`]), each the one copy the checked route also uses. `None` on anything short
+/// of a phase that falls from rest to a separation inside it with positive finite values at
+/// every node: the checked route ([`LeanSolver::solve`]) then solves the point again and names
+/// what failed. Called from [`Model::lean_point`], so that each model's copy is compiled with
+/// its generated start inlined (its literal zeros and constants folded into the root, the plan
+/// and the integrand).
+#[inline(always)]
+pub(crate) fn quick_route(
+    start: &LeanStart,
+    prior: &Prior,
+    sin_end: f64,
+    evals: &mut u64,
+) -> Option<LeanPoint> {
+    let (si, ci) = (start.sin_initial, start.cos_initial);
+    let finite = |ok: bool, c: &f64| ok & c.is_finite();
+    let coefficients = start.separation.iter().chain(&start.fall);
+    if !(coefficients.fold(true, finite) & (start.theta_dot_initial == 0.0)) {
+        return None;
+    }
+    let (sep, fall) = (&start.separation[..], &start.fall[..]);
+    let s = poly::largest_root(sep, sin_end, si, evals)??;
+    let drop = si - s;
+    // 1 - sin(theta_i) without cancellation near upright.
+    let e = ci * ci / (1.0 + si);
+    // Below the vertical, and a drop inside the phase (integer tests, without branches).
+    if !(positive_finite(e) & positive_finite(drop) & (si.abs() < 1.0) & (ci > 0.0)) {
+        return None;
+    }
+    let integrand = FallIntegrand::new(si, e, fall);
+    if !integrand.falls() {
+        return None;
+    }
+    let v_end = v_at_drop(e, drop);
+    let sing = Singularities::of(si, e, fall)?;
+    let panel = |rule: &HalfRule, a: f64, b: f64| {
+        let sum = integrand.panel(rule, a, b, a == 0.0);
+        if sum.ok() {
+            Ok((sum.value, sum.evals))
+        } else {
+            Err(())
+        }
+    };
+    let (t, n) = prior_panels(&sing, v_end, prior, panel).ok()??;
+    *evals += n;
+    Some(LeanPoint {
+        separation_angle: s.asin(),
+        separation_time: t,
+        sines: [si, ci, s, drop],
+    })
 }
 
 #[cfg(test)]

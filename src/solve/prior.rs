@@ -111,6 +111,7 @@ impl Singularities {
     /// The singular points of the integrand of a phase starting at `sin(theta_i) = si` with
     /// scale `e = 1 - si` and a fall polynomial `coeffs` (lowest degree first), or `None` when
     /// the polynomial has a degree above 2 or a zero at the start.
+    #[inline(always)]
     pub fn of(si: f64, e: f64, coeffs: &[f64]) -> Option<Singularities> {
         let mut out = Singularities {
             points: [(0.0, 0.0); 3],
