@@ -34,7 +34,7 @@ pub fn real_roots(coeffs: &[f64], lo: f64, hi: f64, evals: &mut u64) -> Option<V
 
 /// The largest sign-changing root of `coeffs` in `(lo, hi)`: `Some(None)` when there is none,
 /// `None` when the degree exceeds [`MAX_DEGREE`].
-#[inline]
+#[inline(always)]
 pub fn largest_root(coeffs: &[f64], lo: f64, hi: f64, evals: &mut u64) -> Option<Option<f64>> {
     let degree = coeffs.iter().rposition(|&c| c != 0.0).unwrap_or(0);
     // A quadratic or cubic, as a cubic (a quadratic's leading coefficient 0) of known length,

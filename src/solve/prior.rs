@@ -12,7 +12,8 @@
 //! `v` through `sinh^2 v = (sin theta_i - s) / e`; each gives one nearest point `v*` (the
 //! others are `-v*` and shifts by `i pi`, farther from a panel on `v >= 0`). A panel takes the
 //! fewest nodes `N` with `rho^(2N) >= PRIOR_MARGIN / tol` for the smallest `rho` over the points
-//! (a threshold table; the points' real parts are lower bounds from the logarithm's chord
+//! (a threshold table, scanned from a start that a small table looks up by `rho`'s float
+//! bits; the points' real parts are lower bounds from the logarithm's chord
 //! between powers of two, within `0.06`, which can only bring them nearer and ask for more
 //! nodes); a panel that would need more than
 //! [`PRIOR_MAX_NODES`] is halved. From rest the first panel `[0, b]` is half of the symmetric
@@ -56,11 +57,26 @@ pub const PRIOR_MARGIN: f64 = 1e2;
 /// The relative error the per-point solver asks of the a-priori rule (`2^-53`).
 pub const PRIOR_TOL: f64 = f64::EPSILON / 2.0;
 
+/// Mantissa bits of `rho` that index [`Prior`]'s table of scan starts (`2^6` cells per octave:
+/// a cell spans under two thresholds where they are densest, near the fewest panels' `rho`).
+const START_BITS: u32 = 6;
+
+/// Octaves of `rho` from 1 that the table covers (`rho` beyond `2^8` starts the scan at the
+/// fewest nodes; with the tolerance at least `2^-53` every threshold lies below `2^8`).
+const START_OCTAVES: usize = 8;
+
+// Every start (at most the count of thresholds) fits the table's bytes.
+const _: () = assert!(PRIOR_MAX_NODES - PRIOR_MIN_NODES < u8::MAX as usize);
+
 /// Rules and node-count thresholds for one tolerance, made once per solver.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Prior {
     /// `thresholds[j]`: the least `rho` for which `PRIOR_MIN_NODES + j` nodes suffice.
     thresholds: Vec<f64>,
+    /// For each cell of `rho` (its float's exponent from 0 and top [`START_BITS`] mantissa
+    /// bits), the first `j` whose threshold the cell's top reaches: no `rho` in the cell needs
+    /// fewer nodes, so the scan for `rho` starts there (about one step instead of ten).
+    starts: Vec<u8>,
     /// The Gauss–Legendre rules of `PRIOR_MIN_NODES + j` nodes.
     rules: Vec<&'static HalfRule>,
     /// Relative error asked.
@@ -77,26 +93,60 @@ impl Prior {
         };
         let log_ratio = (PRIOR_MARGIN / tol).ln();
         let counts = PRIOR_MIN_NODES..=PRIOR_MAX_NODES;
+        let thresholds: Vec<f64> = counts
+            .clone()
+            .map(|n| (log_ratio / (2.0 * n as f64)).exp())
+            .collect();
+        let starts = (0..START_OCTAVES << START_BITS)
+            .map(|cell| {
+                let top = cell_start(cell + 1);
+                // At most the count of thresholds, which fits (below).
+                first_reached(&thresholds, top, 0) as u8
+            })
+            .collect();
         Prior {
-            thresholds: counts
-                .clone()
-                .map(|n| (log_ratio / (2.0 * n as f64)).exp())
-                .collect(),
+            thresholds,
+            starts,
             rules: counts.map(half_rule).collect(),
             tol,
         }
     }
 
     /// The rule for a panel whose nearest singularity has Bernstein parameter `rho`, if one of
-    /// at most [`PRIOR_MAX_NODES`] nodes suffices.
+    /// at most [`PRIOR_MAX_NODES`] nodes suffices: the fewest nodes whose threshold `rho`
+    /// reaches, by a scan from the table's start for `rho`'s cell.
+    #[inline]
     fn rule_for(&self, rho: f64) -> Option<&'static HalfRule> {
-        // Thresholds fall with the node count: the first one `rho` reaches (a scan from the
-        // fewest nodes, as most panels need few).
-        let j = (self.thresholds.iter())
-            .position(|&t| rho >= t)
-            .unwrap_or(self.thresholds.len());
-        self.rules.get(j).copied()
+        // The cell from the float's bits above 1.0's; rho below 1, NaN, or beyond the table
+        // (its bits wrap or run past it) scans from the fewest nodes, which is exact too.
+        let cell = rho.to_bits().wrapping_sub(1f64.to_bits()) >> (52 - START_BITS);
+        let start = usize::try_from(cell)
+            .ok()
+            .and_then(|c| self.starts.get(c))
+            .map_or(0, |&j| usize::from(j));
+        self.rules
+            .get(first_reached(&self.thresholds, rho, start))
+            .copied()
     }
+}
+
+/// The least `rho` of table cell `cell` (the float whose bits are 1.0's plus the cell's).
+fn cell_start(cell: usize) -> f64 {
+    f64::from_bits(1f64.to_bits() + ((cell as u64) << (52 - START_BITS)))
+}
+
+/// The first `j >= from` with `rho >= thresholds[j]` (thresholds fall with `j`), or
+/// `thresholds.len()` when there is none.
+#[inline(always)]
+fn first_reached(thresholds: &[f64], rho: f64, from: usize) -> usize {
+    let mut j = from;
+    while let Some(&t) = thresholds.get(j) {
+        if rho >= t {
+            return j;
+        }
+        j += 1;
+    }
+    thresholds.len()
 }
 
 /// The points of the `v` plane where a fall's integrand is singular, one per singular value
@@ -120,17 +170,7 @@ impl Singularities {
         // Real singularities below the start lie on the real v axis, the nearest (largest s)
         // hiding the others: s = -1 and the real zeros of P below sin(theta_i).
         let mut below = -1.0f64;
-        let mut real = |s: f64, out: &mut Singularities| -> Option<()> {
-            if s < si {
-                below = below.max(s);
-                Some(())
-            } else if s > si {
-                out.push(above(si, e, s));
-                Some(())
-            } else {
-                None
-            }
-        };
+        let mut real = |s: f64, out: &mut Singularities| out.real(si, e, s, &mut below);
         match *coeffs {
             // A constant, also padded to a quadratic with zeros: no zero.
             [] | [_] | [_, 0.0, 0.0] => {}
@@ -163,6 +203,22 @@ impl Singularities {
         sum.is_finite().then_some(out)
     }
 
+    /// A real singular `s`: below the start it may be the nearest of those on the real axis
+    /// (kept in `below`), above it a point of its own; at the start, none (`None`).
+    #[inline(always)]
+    fn real(&mut self, si: f64, e: f64, s: f64, below: &mut f64) -> Option<()> {
+        if s < si {
+            *below = below.max(s);
+            Some(())
+        } else if s > si {
+            self.push(above(si, e, s));
+            Some(())
+        } else {
+            None
+        }
+    }
+
+    #[inline(always)]
     fn push(&mut self, p: (f64, f64)) {
         if self.len < self.points.len() {
             self.points[self.len] = p;
@@ -195,6 +251,7 @@ impl Singularities {
 /// [`ln_below`] of `u + sqrt(1 + u^2)` (within [`LN_BELOW_GAP`]). A singular point placed
 /// nearer than it is only asks for more nodes, so a bound serves where the logarithm would cost
 /// several times as much.
+#[inline(always)]
 fn asinh_sqrt(z: f64) -> f64 {
     let u = z.sqrt();
     if u < 0.5 {
@@ -209,6 +266,7 @@ fn asinh_sqrt(z: f64) -> f64 {
 /// `[1, 2)` (the exponent and mantissa of the float), and `ln m` bounded below by its chord
 /// `(m - 1) ln 2` (the logarithm is concave); the factor `1 - 1e-15` covers the rounding of
 /// `k + m - 1` and of `ln 2`. Infinity and NaN are returned as they are.
+#[inline(always)]
 fn ln_below(y: f64) -> f64 {
     if !y.is_finite() {
         return y;
@@ -221,6 +279,7 @@ fn ln_below(y: f64) -> f64 {
 
 /// The point for a real singular `s > sin(theta_i)`: `sinh v = i y`, `y = sqrt((s - si) / e)`,
 /// so `v = i asin(y)` for `y <= 1` and `v = acosh(y) + i pi/2` beyond.
+#[inline(always)]
 fn above(si: f64, e: f64, s: f64) -> (f64, f64) {
     let y = ((s - si) / e).sqrt();
     if y <= 1.0 {
@@ -426,6 +485,30 @@ mod tests {
                 low <= exact && exact - low <= LN_BELOW_GAP + 1.2e-4 * exact,
                 "asinh {z}"
             );
+        }
+    }
+
+    #[test]
+    fn the_tables_start_gives_the_plain_scans_rule() {
+        for tol in [PRIOR_TOL, 1e-12, 1e-6, 0.1] {
+            let prior = Prior::new(tol);
+            let plain = |rho: f64| {
+                let j = prior.thresholds.iter().position(|&t| rho >= t);
+                j.and_then(|j| prior.rules.get(j)).map(|r| r.nodes)
+            };
+            let mut rhos = vec![f64::NAN, -1.0, 0.0, 0.5, 1.0, 256.0, 1e300, f64::INFINITY];
+            // Each threshold, the floats beside it, and a dense geometric sweep.
+            for &t in &prior.thresholds {
+                rhos.extend([t, t.next_down(), t.next_up()]);
+            }
+            rhos.extend((0..20_000).map(|i| 1.0 + 400.0 * (i as f64 / 20_000.0).powi(3)));
+            for rho in rhos {
+                assert_eq!(
+                    prior.rule_for(rho).map(|r| r.nodes),
+                    plain(rho),
+                    "tol {tol:e}, rho {rho}"
+                );
+            }
         }
     }
 
