@@ -261,12 +261,18 @@ fn sinh_sq(y: f64) -> f64 {
 #[inline(always)]
 fn sinh_sq2(y: [f64; 2]) -> [f64; 2] {
     if y[0].abs() < SERIES_REACH && y[1].abs() < SERIES_REACH {
-        let z = [y[0] * y[0], y[1] * y[1]];
-        let r = [sinh_ratio_series(z[0]), sinh_ratio_series(z[1])];
-        [z[0] * r[0] * r[0], z[1] * r[1] * r[1]]
+        sinh_sq2_series(y)
     } else {
         [sinh_sq(y[0]), sinh_sq(y[1])]
     }
+}
+
+/// [`sinh_sq2`] for arguments known to lie within [`SERIES_REACH`]: the series alone.
+#[inline(always)]
+fn sinh_sq2_series(y: [f64; 2]) -> [f64; 2] {
+    let z = [y[0] * y[0], y[1] * y[1]];
+    let r = [sinh_ratio_series(z[0]), sinh_ratio_series(z[1])];
+    [z[0] * r[0] * r[0], z[1] * r[1] * r[1]]
 }
 
 /// `sinh(y) / y = sum y^(2k) / (2k + 1)!` for `z = y^2 < 2.25` by its Taylor series to `y^20`:
@@ -429,11 +435,30 @@ impl<'a> FallIntegrand<'a> {
     /// whole panel by [`PanelSum::ok`]. The polynomial's shape is decided once per panel.
     #[inline]
     pub fn panel(&self, rule: &HalfRule, a: f64, b: f64, symmetric: bool) -> PanelSum {
-        if self.low {
-            let [p0, p1, p2] = self.quadratic;
-            self.panel_with(rule, a, b, symmetric, |s| p0 + s * (p1 + s * p2))
-        } else {
-            self.panel_with(rule, a, b, symmetric, |s| horner(self.coeffs, s))
+        // Where every node lies within the series' reach (most panels), the pairs take it
+        // without a test per node.
+        let (centre, half) = panel_frame(symmetric, a, b);
+        let farthest = centre.abs() + half * rule.pairs.last().map_or(0.0, |&(x, _)| x);
+        let within = farthest < SERIES_REACH;
+        match (self.low, within) {
+            (true, true) => {
+                let [p0, p1, p2] = self.quadratic;
+                self.panel_with(
+                    rule,
+                    a,
+                    b,
+                    symmetric,
+                    |s| p0 + s * (p1 + s * p2),
+                    sinh_sq2_series,
+                )
+            }
+            (true, false) => {
+                let [p0, p1, p2] = self.quadratic;
+                self.panel_with(rule, a, b, symmetric, |s| p0 + s * (p1 + s * p2), sinh_sq2)
+            }
+            (false, _) => {
+                self.panel_with(rule, a, b, symmetric, |s| horner(self.coeffs, s), sinh_sq2)
+            }
         }
     }
 
@@ -446,6 +471,7 @@ impl<'a> FallIntegrand<'a> {
         b: f64,
         symmetric: bool,
         p: impl Fn(f64) -> f64,
+        sq2: impl Fn([f64; 2]) -> [f64; 2],
     ) -> PanelSum {
         let (centre, half) = panel_frame(symmetric, a, b);
         let mut acc = 0.0;
@@ -460,7 +486,7 @@ impl<'a> FallIntegrand<'a> {
             let mut chunks = rule.pairs.chunks_exact(2);
             let (mut acc2, mut least2) = ([acc, 0.0], [least, f64::INFINITY]);
             for c in &mut chunks {
-                let f = self.value2_with(sinh_sq2([half * c[0].0, half * c[1].0]), &p);
+                let f = self.value2_with(sq2([half * c[0].0, half * c[1].0]), &p);
                 least2 = [lesser(least2[0], f[0]), lesser(least2[1], f[1])];
                 acc2 = [acc2[0] + c[0].1 * f[0], acc2[1] + c[1].1 * f[1]];
             }
@@ -473,7 +499,7 @@ impl<'a> FallIntegrand<'a> {
         } else {
             for &(x, w) in &rule.pairs {
                 let hx = half * x;
-                let [up, down] = self.value2_with(sinh_sq2([centre + hx, centre - hx]), &p);
+                let [up, down] = self.value2_with(sq2([centre + hx, centre - hx]), &p);
                 least = lesser(least, lesser(up, down));
                 acc += w * (up + down);
             }
