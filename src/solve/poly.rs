@@ -11,7 +11,7 @@
 //!
 //! The largest root of a quadratic or cubic (every separation polynomial of the per-point
 //! solver) is first sought without the split: Halley from the root of the linear part
-//! corrected once by a fixed-point step, polished on the compensated value only where the
+//! corrected by three fixed-point steps, polished on the compensated value only where the
 //! running error bound of the last plain value (Higham's) does not already hold it within two
 //! ulps, and kept when deflation shows the other roots clear of it and of the interval above it
 //! (`certified_low`); else the split decides.
@@ -102,7 +102,7 @@ fn largest_split(c4: [f64; 4], lo: f64, hi: f64, evals: &mut u64) -> Option<f64>
 /// decides that there is no root).
 ///
 /// Halley's method on plain Horner values from the root of the linear part `-c0 / c1` (most
-/// separation polynomials are dominated by it near their root) after one fixed-point
+/// separation polynomials are dominated by it near their root) after three fixed-point
 /// correction, stopped once a step is below 1e-7 relative (Halley's own error is then far
 /// below an ulp). The last step came from a plain value within its running error bound `mu`
 /// (Higham, *Accuracy and Stability of Numerical Algorithms*, Algorithm 5.1), so the iterate
@@ -117,11 +117,16 @@ fn largest_split(c4: [f64; 4], lo: f64, hi: f64, evals: &mut u64) -> Option<f64>
 fn certified_low(c: [f64; 4], lo: f64, hi: f64, evals: &mut u64) -> Option<f64> {
     let [c0, c1, c2, c3] = c;
     let width = hi - lo;
-    // The root of the linear part, corrected once by the fixed point `x = -(c0 + c2 x^2 + c3
-    // x^3) / c1` (there `c0 + c1 x = 0`, so `p(x) = x^2 (c2 + c3 x)`): it squares the relative
-    // error `t ~ c3 x^2 / c1` of the linear root, which saves a Halley step wherever `t` is small.
+    // The root of the linear part, corrected three times by the fixed point `x = -(c0 + c2 x^2
+    // + c3 x^3) / c1` (at the linear root `c0 + c1 x = 0`, so `p(x) = x^2 (c2 + c3 x)`): each
+    // step multiplies the relative error by about `t ~ c3 x^2 / c1` (at most 1/9 for the rod
+    // on the cube), which saves Halley steps wherever `t` is small (three steps: 1.93 -> 1.45
+    // Halley steps per point on `examples/per_point.rs`' set).
     let linear = -c0 / c1;
-    let fixed = linear - linear * linear * (c2 + c3 * linear) / c1;
+    let mut fixed = linear;
+    for _ in 0..3 {
+        fixed = linear - fixed * fixed * (c2 + c3 * fixed) / c1;
+    }
     let mut x = if fixed > lo && fixed < hi {
         fixed
     } else if linear > lo && linear < hi {
