@@ -103,7 +103,7 @@ fn largest_split(c4: [f64; 4], lo: f64, hi: f64, evals: &mut u64) -> Option<f64>
 ///
 /// Halley's method on plain Horner values from the root of the linear part `-c0 / c1` (most
 /// separation polynomials are dominated by it near their root) after three fixed-point
-/// correction, stopped once a step is below 1e-7 relative (Halley's own error is then far
+/// corrections, stopped once a step is below 1e-7 relative (Halley's own error is then far
 /// below an ulp). The last step came from a plain value within its running error bound `mu`
 /// (Higham, *Accuracy and Stability of Numerical Algorithms*, Algorithm 5.1), so the iterate
 /// lies within `mu / |p'|` of the root, plus the step's rounding: where that is more than two
