@@ -482,17 +482,21 @@ mod tests {
         assert!(evals > 0);
     }
 
-    #[test]
-    fn the_certified_path_agrees_with_the_bracketed_isolator() {
-        // Random cubics and quadratics (many with several roots in the interval, double roots
-        // and roots at the ends): the largest root is the bracketed isolator's last one.
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
+    /// Deterministic uniform numbers in `[0, 1)` (xorshift64 from `state`).
+    fn uniform(mut state: u64) -> impl FnMut() -> f64 {
+        move || {
             state ^= state << 13;
             state ^= state >> 7;
             state ^= state << 17;
             (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        }
+    }
+
+    #[test]
+    fn the_certified_path_agrees_with_the_bracketed_isolator() {
+        // Random cubics and quadratics (many with several roots in the interval, double roots
+        // and roots at the ends): the largest root is the bracketed isolator's last one.
+        let mut next = uniform(0x2545_f491_4f6c_dd1d);
         let mut certified = 0;
         for case in 0..20_000 {
             // Roots r1 <= r2 <= r3 in [-0.5, 1.5]; some repeated, some on an end.
@@ -547,13 +551,7 @@ mod tests {
         // Halley's last iterate; elsewhere it polishes it on the compensated value. Either way
         // the root must lie within two ulps (and the final step's rounding) of the root
         // polished twice on the compensated value.
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = uniform(0x9e37_79b9_7f4a_7c15);
         let mut certified = 0;
         for case in 0..20_000 {
             // The separation cubics' shape (rod on cube, n over 24 decades, a/ell in (0, 1)),
