@@ -31,8 +31,10 @@
 //! at `v = 0` ([`FallIntegrand`], the one copy that [`Fall`] and the per-point solver's
 //! unchecked route share). Each node then takes `sinh^2 v` by itself (a series below 1.5, one
 //! `exp` above), which also spares the addition theorem's cancellation on long panels. Nodes
-//! are taken two at a time in the same arithmetic (`sinh_sq2`, `FallIntegrand::value2`), which
-//! the compiler packs into SSE2 pairs (`sqrtpd`, `divpd`) where the target allows. The
+//! are taken two at a time in the same arithmetic (`sinh_sq2`, `FallIntegrand::value2_with`,
+//! over `HalfRule::lanes`, where the node at 0 and a weightless pad make every step a pair),
+//! with the polynomial's shape decided once per panel, so that the compiler packs them into
+//! SSE2 pairs through the division and the root (`divpd`, `sqrtpd`). The
 //! per-point solver chooses its rules for such phases a priori
 //! ([`prior`](crate::solve::prior)); the verified pairs below serve everything else.
 //!
@@ -129,6 +131,13 @@ pub struct HalfRule {
     pub pairs: Vec<(f64, f64)>,
     /// Weight of the node at 0.
     pub centre: f64,
+    /// The nodes `x >= 0`: the node at 0 (odd orders) first with half its weight (it is then
+    /// counted at `+x` and `-x`, or, on a symmetric panel, once for the half of `[-b, b]`),
+    /// then `pairs`.
+    pub halved: Vec<(f64, f64)>,
+    /// `halved` two at a time, for a loop with nothing but pairs; where its count is odd, the
+    /// last node again with weight 0.
+    pub lanes: Vec<[(f64, f64); 2]>,
 }
 
 /// The rule of `order` nodes (clamped to `1..=MAX_NODES`), computed once per process and kept
@@ -152,10 +161,22 @@ pub fn half_rule(order: usize) -> &'static HalfRule {
             .filter(|(x, _)| x.abs() <= 1e-12)
             .map(|(_, w)| *w)
             .sum();
+        let mut halved: Vec<(f64, f64)> = Vec::with_capacity(pairs.len() + 1);
+        if centre != 0.0 {
+            halved.push((0.0, 0.5 * centre));
+        }
+        halved.extend_from_slice(&pairs);
+        let mut chunks = halved.chunks_exact(2);
+        let mut lanes: Vec<[(f64, f64); 2]> = (&mut chunks).map(|c| [c[0], c[1]]).collect();
+        if let &[(x, w)] = chunks.remainder() {
+            lanes.push([(x, w), (x, 0.0)]);
+        }
         Box::leak(Box::new(HalfRule {
             nodes: full.len(),
             pairs,
             centre,
+            halved,
+            lanes,
         }))
     })
 }
@@ -477,36 +498,25 @@ impl<'a> FallIntegrand<'a> {
         sq2: impl Fn([f64; 2]) -> [f64; 2],
     ) -> PanelSum {
         let (centre, half) = panel_frame(symmetric, a, b);
-        let mut acc = 0.0;
-        let mut least = f64::INFINITY;
-        if rule.centre != 0.0 {
-            let f = self.value_with(sinh_sq(centre), &p);
-            least = lesser(least, f);
-            acc = rule.centre * f;
-        }
-        if symmetric {
-            acc *= 0.5;
-            let mut chunks = rule.pairs.chunks_exact(2);
-            let (mut acc2, mut least2) = ([acc, 0.0], [least, f64::INFINITY]);
-            for c in &mut chunks {
-                let f = self.value2_with(sq2([half * c[0].0, half * c[1].0]), &p);
+        let (acc, least) = if symmetric {
+            // Half of the rule on [-b, b]: each node once (the integrand is even).
+            let (mut acc2, mut least2) = ([0.0; 2], [f64::INFINITY; 2]);
+            for l in &rule.lanes {
+                let f = self.value2_with(sq2([half * l[0].0, half * l[1].0]), &p);
                 least2 = [lesser(least2[0], f[0]), lesser(least2[1], f[1])];
-                acc2 = [acc2[0] + c[0].1 * f[0], acc2[1] + c[1].1 * f[1]];
+                acc2 = [acc2[0] + l[0].1 * f[0], acc2[1] + l[1].1 * f[1]];
             }
-            (acc, least) = (acc2[0] + acc2[1], lesser(least2[0], least2[1]));
-            for &(x, w) in chunks.remainder() {
-                let f = self.value_with(sinh_sq(half * x), &p);
-                least = lesser(least, f);
-                acc += w * f;
-            }
+            (acc2[0] + acc2[1], lesser(least2[0], least2[1]))
         } else {
-            for &(x, w) in &rule.pairs {
+            let (mut acc, mut least) = (0.0, f64::INFINITY);
+            for &(x, w) in &rule.halved {
                 let hx = half * x;
                 let [up, down] = self.value2_with(sq2([centre + hx, centre - hx]), &p);
                 least = lesser(least, lesser(up, down));
                 acc += w * (up + down);
             }
-        }
+            (acc, least)
+        };
         let evals = (usize::from(rule.centre != 0.0)
             + rule.pairs.len() * if symmetric { 1 } else { 2 }) as u64;
         PanelSum {
@@ -1140,7 +1150,16 @@ mod tests {
                         .map(|&(x, w)| 2.0 * w * x.powi(2 * j as i32))
                         .sum::<f64>();
                 assert!((sum - exact).abs() < 1e-14, "order {order}, x^{}", 2 * j);
+                // The same sum from the lanes (each node at +x and -x, the node at 0 halved,
+                // the padding weightless).
+                let lanes: f64 = (rule.lanes.iter().flatten())
+                    .map(|&(x, w)| 2.0 * w * x.powi(2 * j as i32))
+                    .sum();
+                assert!((lanes - exact).abs() < 1e-14, "lanes {order}, x^{}", 2 * j);
             }
+            assert_eq!(rule.halved.len(), rule.pairs.len() + odd);
+            assert_eq!(rule.lanes.len(), rule.halved.len().div_ceil(2));
+            assert!(rule.lanes.as_flattened().starts_with(&rule.halved));
         }
     }
 
