@@ -131,10 +131,12 @@ pub struct HalfRule {
     pub pairs: Vec<(f64, f64)>,
     /// Weight of the node at 0.
     pub centre: f64,
-    /// The nodes `x >= 0` two at a time, for a loop with nothing but pairs: the node at 0 (odd
-    /// orders) first with half its weight (it is then counted at `+x` and `-x`, or, on a
-    /// symmetric panel, once for the half of `[-b, b]`), then `pairs`, and where the count is
-    /// odd the last node again with weight 0.
+    /// The nodes `x >= 0`: the node at 0 (odd orders) first with half its weight (it is then
+    /// counted at `+x` and `-x`, or, on a symmetric panel, once for the half of `[-b, b]`),
+    /// then `pairs`.
+    pub halved: Vec<(f64, f64)>,
+    /// `halved` two at a time, for a loop with nothing but pairs; where its count is odd, the
+    /// last node again with weight 0.
     pub lanes: Vec<[(f64, f64); 2]>,
 }
 
@@ -173,6 +175,7 @@ pub fn half_rule(order: usize) -> &'static HalfRule {
             nodes: full.len(),
             pairs,
             centre,
+            halved,
             lanes,
         }))
     })
@@ -506,8 +509,7 @@ impl<'a> FallIntegrand<'a> {
             (acc2[0] + acc2[1], lesser(least2[0], least2[1]))
         } else {
             let (mut acc, mut least) = (0.0, f64::INFINITY);
-            // (A weightless pad costs one pair of evaluations, on these rare halved panels.)
-            for &(x, w) in rule.lanes.as_flattened() {
+            for &(x, w) in &rule.halved {
                 let hx = half * x;
                 let [up, down] = self.value2_with(sq2([centre + hx, centre - hx]), &p);
                 least = lesser(least, lesser(up, down));
@@ -1155,7 +1157,9 @@ mod tests {
                     .sum();
                 assert!((lanes - exact).abs() < 1e-14, "lanes {order}, x^{}", 2 * j);
             }
-            assert_eq!(rule.lanes.len(), (rule.pairs.len() + odd).div_ceil(2));
+            assert_eq!(rule.halved.len(), rule.pairs.len() + odd);
+            assert_eq!(rule.lanes.len(), rule.halved.len().div_ceil(2));
+            assert!(rule.lanes.as_flattened().starts_with(&rule.halved));
         }
     }
 
