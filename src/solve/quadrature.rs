@@ -136,7 +136,8 @@ pub struct HalfRule {
     /// then `pairs`.
     pub halved: Vec<(f64, f64)>,
     /// `halved` two at a time, for a loop with nothing but pairs; where its count is odd, the
-    /// last node again with weight 0.
+    /// last node again with weight 0. (Both lists are kept: a panel off `v = 0` evaluates each
+    /// node twice, at `c + hx` and `c - hx`, and takes `halved` so that it pays for no pad.)
     pub lanes: Vec<[(f64, f64); 2]>,
 }
 
