@@ -10,11 +10,16 @@
 //! the coefficients (e.g. `n = m2/m1` from 1e-12 to 1e12).
 //!
 //! The largest root of a quadratic or cubic (every separation polynomial of the per-point
-//! solver) is first sought without the split: Halley from the root of the linear part
-//! corrected by three fixed-point steps, polished on the compensated value only where the
-//! running error bound of the last plain value (Higham's) does not already hold it within two
-//! ulps, and kept when deflation shows the other roots clear of it and of the interval above it
-//! (`certified_low`); else the split decides.
+//! solver) is first sought without the split. A depressed cubic `c0 + c1 s + c3 s^3` (the
+//! separation cubic of every generated model that has one) whose root near `-c0 / c1` is a
+//! small correction of it takes one Halley step from a start interpolated once for all in
+//! the cubic's one shape parameter, and needs no deflation: where the root lies within the
+//! start's range, the next root is provably above the interval (`depressed_low`). Other
+//! quadratics and cubics take Halley from the root of the linear part corrected by three
+//! fixed-point steps, kept when deflation shows the other roots clear of it and of the
+//! interval above it (`certified_low`). Either way the last iterate is polished on the
+//! compensated value only where the running error bound of its plain value (Higham's) does
+//! not already hold it within two ulps; where neither applies, the split decides.
 
 /// Highest degree solved (on the stack; higher degrees are refused with `None`).
 pub const MAX_DEGREE: usize = 16;
@@ -58,6 +63,13 @@ pub fn largest_root(coeffs: &[f64], lo: f64, hi: f64, evals: &mut u64) -> Option
 /// quadratic formula, then only the highest piece with a sign change is refined.
 #[inline(always)]
 fn largest_low(c4: [f64; 4], lo: f64, hi: f64, evals: &mut u64) -> Option<f64> {
+    // A depressed cubic (no square term, as every separation cubic generated so far) in the
+    // range of its start; else the general start.
+    if c4[2] == 0.0
+        && let Some(root) = depressed_low(c4, lo, hi, evals)
+    {
+        return Some(root);
+    }
     if let Some(root) = certified_low(c4, lo, hi, evals) {
         return Some(root);
     }
@@ -119,9 +131,10 @@ fn certified_low(c: [f64; 4], lo: f64, hi: f64, evals: &mut u64) -> Option<f64> 
     let width = hi - lo;
     // The root of the linear part, corrected three times by the fixed point `x = -(c0 + c2 x^2
     // + c3 x^3) / c1` (at the linear root `c0 + c1 x = 0`, so `p(x) = x^2 (c2 + c3 x)`): each
-    // step multiplies the relative error by about `t ~ c3 x^2 / c1` (at most 1/9 for the rod
-    // on the cube), which saves Halley steps wherever `t` is small (three steps: 1.93 -> 1.45
-    // Halley steps per point on `examples/per_point.rs`' set).
+    // step multiplies the relative error by about `t ~ c3 x^2 / c1`, which saves Halley steps
+    // wherever `t` is small (on the rod on the cube's cubics, before they took
+    // [`depressed_low`], three steps took 1.93 to 1.45 Halley steps per point of
+    // `examples/per_point.rs`' set).
     let linear = -c0 / c1;
     let mut fixed = linear;
     for _ in 0..3 {
@@ -140,16 +153,8 @@ fn certified_low(c: [f64; 4], lo: f64, hi: f64, evals: &mut u64) -> Option<f64> 
     let mut slope = 0.0;
     for _ in 0..CERTIFIED_STEPS {
         *evals += 1;
-        let ax = x.abs();
-        let y2 = c3 * x + c2;
-        let y1 = y2 * x + c1;
-        let p = y1 * x + c0;
-        let mu = ((0.5 * c3.abs() * ax + y2.abs()) * ax + y1.abs()) * ax + p.abs();
-        bound = f64::EPSILON * mu - 0.5 * f64::EPSILON * p.abs();
-        let d1 = (3.0 * c3 * x + 2.0 * c2) * x + c1;
-        slope = d1;
-        let d2 = 6.0 * c3 * x + 2.0 * c2;
-        let step = 2.0 * p * d1 / (2.0 * d1 * d1 - p * d2);
+        let step;
+        (step, bound, slope) = halley_step(c, x);
         x -= step;
         // NaN fails both tests and leaves the loop unconverged.
         if step.abs() <= 1e-7 * x.abs() {
@@ -165,21 +170,7 @@ fn certified_low(c: [f64; 4], lo: f64, hi: f64, evals: &mut u64) -> Option<f64> 
     if !(converged && x > lo + gap && x < hi - gap) {
         return None;
     }
-    // The last step came from a value within `bound` of the exact one, so the root is within
-    // `bound / |p'|` (and the step's rounding) of `x`; where that exceeds two ulps, one Newton
-    // step on the compensated value.
-    // (A NaN bound is not held.)
-    let held = bound <= 2.0 * f64::EPSILON * x.abs() * slope.abs();
-    if !held {
-        *evals += 1;
-        let f = horner_compensated(&c, x);
-        let d1 = (3.0 * c3 * x + 2.0 * c2) * x + c1;
-        let newton = x - f / d1;
-        if !(newton > lo && newton < hi && polish(x, newton)) {
-            return None;
-        }
-        x = newton;
-    }
+    let x = held_or_polished(c, x, bound, slope, lo, hi, evals)?;
     // q(s) = c3 s^2 + q1 s + q0: the other roots.
     let (q1, q0) = (c2 + x * c3, c1 + x * (c2 + x * c3));
     let clear = |y: f64| !(y > x - gap && y < hi + gap);
@@ -200,6 +191,109 @@ fn certified_low(c: [f64; 4], lo: f64, hi: f64, evals: &mut u64) -> Option<f64> 
         }
     };
     certified.then_some(x)
+}
+
+/// One Halley step for the cubic `c` at `x` from its plain Horner value: `(step, bound,
+/// slope)`, the step to subtract, Higham's running bound on the value's rounding error (his
+/// Algorithm 5.1) and `p'(x)`.
+#[inline(always)]
+fn halley_step(c: [f64; 4], x: f64) -> (f64, f64, f64) {
+    let [c0, c1, c2, c3] = c;
+    let ax = x.abs();
+    let y2 = c3 * x + c2;
+    let y1 = y2 * x + c1;
+    let p = y1 * x + c0;
+    let mu = ((0.5 * c3.abs() * ax + y2.abs()) * ax + y1.abs()) * ax + p.abs();
+    let bound = f64::EPSILON * mu - 0.5 * f64::EPSILON * p.abs();
+    let d1 = (3.0 * c3 * x + 2.0 * c2) * x + c1;
+    let d2 = 6.0 * c3 * x + 2.0 * c2;
+    (2.0 * p * d1 / (2.0 * d1 * d1 - p * d2), bound, d1)
+}
+
+/// The root `x` of the cubic `c` in `(lo, hi)` reached by a Halley step from a plain value
+/// within `bound` of the exact one where the slope was `slope`: the root is then within
+/// `bound / |p'|` (and the step's rounding) of `x`, which is kept where that is at most two
+/// ulps; elsewhere one Newton step on the compensated value, as in [`refine`]. `None` when that
+/// step leaves the interval or moves `x` by more than a polish (a NaN bound is not held).
+#[inline(always)]
+fn held_or_polished(
+    c: [f64; 4],
+    x: f64,
+    bound: f64,
+    slope: f64,
+    lo: f64,
+    hi: f64,
+    evals: &mut u64,
+) -> Option<f64> {
+    let held = bound <= 2.0 * f64::EPSILON * x.abs() * slope.abs();
+    if held {
+        return Some(x);
+    }
+    *evals += 1;
+    let f = horner_compensated(&c, x);
+    let d1 = (3.0 * c[3] * x + 2.0 * c[2]) * x + c[1];
+    let newton = x - f / d1;
+    (newton > lo && newton < hi && polish(x, newton)).then_some(newton)
+}
+
+/// Largest `epsilon = -c3 L^2 / c1` (with `L = -c0 / c1`) of a depressed cubic that
+/// [`depressed_low`] solves: there the root `t1` of `epsilon t^3 - t + 1` near 1 lies in
+/// `[1, sqrt(5) - 1]` and the next root `t2` at or above 2 (`t^3 - 8 t + 8 = (t - 2)(t^2 + 2t
+/// - 4)` at `epsilon = 1/8`; `t2` falls as `epsilon` grows, to the double root 3/2 at 4/27).
+const DEPRESSED_MAX: f64 = 0.125;
+
+/// `t1` as a polynomial in `u = sqrt(1 - 27 epsilon / 4)` for `epsilon` in `[0, 1/8]` (`u` in
+/// `[0.395, 1]`), lowest degree first: the interpolant of degree 6 at the Chebyshev points of
+/// that interval, computed at 50 digits and rounded; within 2.7e-8 relative of `t1` (the
+/// double root at `u = 0` is no singularity of `t1(u)`: its nearest lies at `u = -1`, where
+/// `epsilon = 0` sends `t2` to infinity). Tested in `the_depressed_start_is_within_its_bound`.
+const DEPRESSED_START: [f64; 7] = [
+    1.499_307_168_710_495_5,
+    -0.857_678_971_849_920_3,
+    0.622_903_137_876_594_6,
+    -0.428_913_129_886_526_7,
+    0.233_290_052_930_634_15,
+    -0.082_608_742_007_146_68,
+    0.013_700_507_477_155_418,
+];
+
+/// Relative error of [`DEPRESSED_START`] that [`depressed_low`] allows its Halley step (a
+/// fortyfold margin over the interpolant's; the step then leaves an error of order
+/// `1e-18` relative, Halley's being cubic with a constant below 2 on the range).
+const DEPRESSED_STEP: f64 = 1e-6;
+
+/// The largest root in `(lo, hi)` of a depressed cubic `c0 + c1 s + c3 s^3` (`c[2] == 0`)
+/// with `epsilon` (see [`DEPRESSED_MAX`]) in `[0, 1/8]`, when the interval's top lies below
+/// the next root: `s = L t` with `t` from [`DEPRESSED_START`] and one Halley step, kept or
+/// polished by [`held_or_polished`]. The next root is at least `2 L` for `L > 0` (`L t2`) and
+/// at least `3 |L|` for `L < 0` (`L t3`, with `t3 = -(t1 + t2)`), so when `hi` lies below that
+/// bound the root is the largest in the interval without deflation. `None` outside that
+/// range, for a root within `1e-6` of the interval's width from an end, or for a Halley step
+/// larger than [`DEPRESSED_STEP`]: [`certified_low`] then decides.
+#[inline(always)]
+fn depressed_low(c: [f64; 4], lo: f64, hi: f64, evals: &mut u64) -> Option<f64> {
+    let [c0, c1, _, c3] = c;
+    let l = -c0 / c1;
+    let eps = c3 * l * l / -c1;
+    let next = if l > 0.0 { 2.0 * l } else { -3.0 * l };
+    // The margin covers the rounding of `l` and `eps` (NaN fails every test).
+    if !(eps >= 0.0 && eps <= DEPRESSED_MAX && hi < next * (1.0 - 1e-9)) {
+        return None;
+    }
+    let u = (1.0 - 6.75 * eps).sqrt();
+    let mut t = DEPRESSED_START[6];
+    for &a in DEPRESSED_START[..6].iter().rev() {
+        t = t * u + a;
+    }
+    let x0 = l * t;
+    *evals += 1;
+    let (step, bound, slope) = halley_step(c, x0);
+    let x = x0 - step;
+    let gap = 1e-6 * (hi - lo);
+    if !(step.abs() <= DEPRESSED_STEP * x.abs() && x > lo + gap && x < hi - gap) {
+        return None;
+    }
+    held_or_polished(c, x, bound, slope, lo, hi, evals)
 }
 
 /// Most Halley steps of [`certified_low`] before it leaves the root to the bracketed path.
@@ -611,6 +705,95 @@ mod tests {
         let c = [8.0, -24.0, 0.0, 3.0];
         let root = certified_low(c, 0.0, 0.5, &mut evals).expect("one clear root");
         assert!(horner(&c, root).abs() < 1e-14 && root > 0.33 && root < 0.34);
+    }
+
+    /// The root near 1 of `epsilon t^3 - t + 1` by bisection on `[1, 3/2]` (where the cubic
+    /// falls from 1 - 1 + epsilon > 0 through its root), to adjacent floats.
+    fn depressed_t1(eps: f64) -> f64 {
+        let (mut a, mut b) = (1.0f64, 1.5f64);
+        while b - a > f64::EPSILON {
+            let m = 0.5 * (a + b);
+            if horner_compensated(&[1.0, -1.0, 0.0, eps], m) > 0.0 {
+                a = m;
+            } else {
+                b = m;
+            }
+        }
+        0.5 * (a + b)
+    }
+
+    #[test]
+    fn the_depressed_start_is_within_its_bound() {
+        // The interpolant of `t1(u)` over the whole range of `epsilon` (ends included), within
+        // 3e-8 of the bisected root; and the bound the Halley step allows is forty times that.
+        let mut worst: f64 = 0.0;
+        for i in 0..=20_000 {
+            let eps = DEPRESSED_MAX * i as f64 / 20_000.0;
+            let u = (1.0 - 6.75 * eps).sqrt();
+            let start = horner(&DEPRESSED_START, u);
+            let t1 = depressed_t1(eps);
+            worst = worst.max((start - t1).abs() / t1);
+        }
+        assert!(worst < 3e-8 && worst > 1e-9, "{worst:e}");
+        assert!(DEPRESSED_STEP > 30.0 * worst);
+        // At the top of the range the roots are 2 and sqrt(5) - 1 (the bounds of the docs).
+        assert!((depressed_t1(DEPRESSED_MAX) - (5f64.sqrt() - 1.0)).abs() < 1e-15);
+        assert!(horner(&[1.0, -1.0, 0.0, DEPRESSED_MAX], 2.0) == 0.0);
+    }
+
+    #[test]
+    fn the_depressed_path_agrees_with_the_bracketed_isolator_to_two_ulps() {
+        // Depressed cubics of both signs of `L` over 24 decades of scale, with `epsilon` over
+        // and past its range and intervals reaching past the next root: where the depressed
+        // path answers, its root is the bracketed isolator's largest and within 2.5 ulps of
+        // the root polished twice on the compensated value; elsewhere it leaves the root.
+        let mut next = uniform(0x5851_f42d_4c95_7f2d);
+        let (mut taken, mut left) = (0, 0);
+        for case in 0..20_000 {
+            let l = (next() + 0.01) * if case % 3 == 0 { -1.0 } else { 1.0 };
+            let eps = next() * 0.15;
+            let scale = 10f64.powf(next() * 24.0 - 12.0) * if case % 5 == 0 { -1.0 } else { 1.0 };
+            // c1 = -scale, c0 = scale L, c3 = eps scale / L^2.
+            let c = [scale * l, -scale, 0.0, eps * scale / (l * l)];
+            let t1 = depressed_t1(eps.min(4.0 / 27.0));
+            let root = l * t1;
+            let (lo, hi) = if l > 0.0 {
+                (0.5 * root, root * (1.0 + 1.5 * next()))
+            } else {
+                (root * (1.0 + next()), -root * (2.0 + 2.0 * next()))
+            };
+            let mut out = [0.0; MAX_DEGREE];
+            let n = roots_in(&c, lo, hi, &mut out, &mut 0).expect("a cubic");
+            let want = (n > 0).then(|| out[n - 1]);
+            match depressed_low(c, lo, hi, &mut 0) {
+                Some(x) => {
+                    taken += 1;
+                    assert!(eps <= DEPRESSED_MAX, "{c:?}");
+                    let w = want.expect("the isolator finds the root");
+                    assert!(
+                        (x - w).abs() <= 4.0 * f64::EPSILON * w.abs(),
+                        "{c:?}: {x} vs {w}"
+                    );
+                    let slope = |x: f64| 3.0 * c[3] * x * x + c[1];
+                    let mut best = x;
+                    for _ in 0..2 {
+                        best -= horner_compensated(&c, best) / slope(best);
+                    }
+                    let e = (x - best).abs() / (f64::EPSILON * best.abs());
+                    assert!(e <= 2.5, "{c:?}: {x} vs {best} ({e} ulps)");
+                }
+                None => left += 1,
+            }
+            // Whichever path answers, the largest root is the isolator's.
+            let got = largest_root(&c, lo, hi, &mut 0).expect("a cubic");
+            match (got, want) {
+                (Some(g), Some(w)) => assert!((g - w).abs() <= 1e-12 * w.abs(), "{c:?}"),
+                (None, None) => {}
+                _ => panic!("{c:?}: {got:?} vs {want:?}"),
+            }
+        }
+        // Both branches are exercised: out-of-range epsilon and intervals past the next root.
+        assert!(taken > 8_000 && left > 4_000, "{taken} taken, {left} left");
     }
 
     #[test]
