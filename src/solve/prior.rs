@@ -150,11 +150,20 @@ fn first_reached(thresholds: &[f64], rho: f64, from: usize) -> usize {
 }
 
 /// The points of the `v` plane where a fall's integrand is singular, one per singular value
-/// of `s`, as `(x, y)` for `v* = x + i y` with `x >= 0` and `0 <= y <= pi/2`.
+/// of `s`, as `(x, y)` for `v* = x + i y` with `x >= 0` and `0 <= y <= pi/2`: the nearest on
+/// the real axis, the others off it. A real zero of the polynomial above the start whose point
+/// lies on the line `y = pi/2` keeps only its `cosh(x)`: its real part (a logarithm) is taken
+/// only for a panel where that line comes nearer than the points already seen.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Singularities {
-    points: [(f64, f64); 3],
+    /// `x` of the nearest point on the real axis (a lower bound).
+    real: f64,
+    /// Points off the real axis, `(x, y)` with `y > 0`.
+    points: [(f64, f64); 2],
     len: usize,
+    /// `cosh(x)` of points at `x + i pi/2`, `x` not yet bounded.
+    on_line: [f64; 2],
+    line_len: usize,
 }
 
 impl Singularities {
@@ -164,8 +173,11 @@ impl Singularities {
     #[inline(always)]
     pub fn of(si: f64, e: f64, coeffs: &[f64]) -> Option<Singularities> {
         let mut out = Singularities {
-            points: [(0.0, 0.0); 3],
+            real: 0.0,
+            points: [(0.0, 0.0); 2],
             len: 0,
+            on_line: [0.0; 2],
+            line_len: 0,
         };
         // Real singularities below the start lie on the real v axis, the nearest (largest s)
         // hiding the others: s = -1 and the real zeros of P below sin(theta_i).
@@ -185,21 +197,18 @@ impl Singularities {
                     real(p0 / q, &mut out)?;
                 } else {
                     // A conjugate pair: one representative (the ellipses are symmetric).
-                    out.push(complex(
-                        si,
-                        e,
-                        -0.5 * p1 / p2,
-                        0.5 * (-disc).sqrt() / p2.abs(),
-                    ));
+                    let p = complex(si, e, -0.5 * p1 / p2, 0.5 * (-disc).sqrt() / p2.abs());
+                    out.push(p);
                 }
             }
             _ => return None,
         }
-        let z = (si - below) / e;
-        out.push((asinh_sqrt(z), 0.0));
-        // Every coordinate is at least 0 (or NaN), and points not pushed are zeros: their sum
-        // is finite exactly when each is, by one test.
-        let sum: f64 = out.points.iter().map(|&(x, y)| x + y).sum();
+        out.real = asinh_sqrt((si - below) / e);
+        // Every coordinate is at least 0 (or NaN), and entries not set are zeros: their sum is
+        // finite exactly when each is, by one test.
+        let sum = out.real
+            + out.points.iter().map(|&(x, y)| x + y).sum::<f64>()
+            + out.on_line.iter().sum::<f64>();
         sum.is_finite().then_some(out)
     }
 
@@ -211,10 +220,23 @@ impl Singularities {
             *below = below.max(s);
             Some(())
         } else if s > si {
-            self.push(above(si, e, s));
+            self.above(si, e, s);
             Some(())
         } else {
             None
+        }
+    }
+
+    /// The point for a real singular `s > sin(theta_i)`: `sinh v = i y`, `y = sqrt((s - si) /
+    /// e)`, so `v = i asin(y)` for `y <= 1` and `v = acosh(y) + i pi/2` beyond (kept as `y`).
+    #[inline(always)]
+    fn above(&mut self, si: f64, e: f64, s: f64) {
+        let y = ((s - si) / e).sqrt();
+        if y <= 1.0 {
+            self.push((0.0, y.asin()));
+        } else if self.line_len < self.on_line.len() {
+            self.on_line[self.line_len] = y;
+            self.line_len += 1;
         }
     }
 
@@ -227,22 +249,38 @@ impl Singularities {
     }
 
     /// The Bernstein parameter of the nearest point for the panel of centre `c` and
-    /// half-length `h`: `rho = alpha + sqrt(alpha^2 - 1)`, `alpha` the mean distance to the
-    /// panel's ends over `h`.
+    /// half-length `h`: `rho = alpha + sqrt(alpha^2 - 1)`, `alpha` the least over the points
+    /// of the mean distance to the panel's ends over `h`. Points on the line `y = pi/2` are
+    /// passed over while `alpha <= sqrt(1 + (pi / 2h)^2)`, their least (the ellipse through a
+    /// point has a semi-minor axis of at least its `y`).
+    #[inline(always)]
     fn rho(&self, c: f64, h: f64) -> f64 {
-        let mut alpha = f64::INFINITY;
+        let mut alpha = mean_distance(self.real, 0.0, c, h);
         for &(x, y) in &self.points[..self.len] {
-            let u = (x - c) / h;
-            let a = if y == 0.0 {
-                // On the real axis the mean distance is max(|u|, 1).
-                u.abs().max(1.0)
-            } else {
-                let w2 = (y / h) * (y / h);
-                0.5 * (((u - 1.0) * (u - 1.0) + w2).sqrt() + ((u + 1.0) * (u + 1.0) + w2).sqrt())
-            };
-            alpha = alpha.min(a);
+            alpha = alpha.min(mean_distance(x, y, c, h));
+        }
+        if self.line_len > 0 {
+            let w = FRAC_PI_2 / h;
+            if 1.0 + w * w < alpha * alpha {
+                for &y in &self.on_line[..self.line_len] {
+                    alpha = alpha.min(mean_distance(acosh_below(y), FRAC_PI_2, c, h));
+                }
+            }
         }
         alpha + ((alpha - 1.0) * (alpha + 1.0)).max(0.0).sqrt()
+    }
+}
+
+/// The mean distance from `x + i y` to the ends of the panel of centre `c` and half-length `h`,
+/// over `h` (the ellipse's semi-major axis): `max(|u|, 1)` on the real axis.
+#[inline(always)]
+fn mean_distance(x: f64, y: f64, c: f64, h: f64) -> f64 {
+    let u = (x - c) / h;
+    if y == 0.0 {
+        u.abs().max(1.0)
+    } else {
+        let w2 = (y / h) * (y / h);
+        0.5 * (((u - 1.0) * (u - 1.0) + w2).sqrt() + ((u + 1.0) * (u + 1.0) + w2).sqrt())
     }
 }
 
@@ -277,20 +315,11 @@ fn ln_below(y: f64) -> f64 {
     (k + m - 1.0) * std::f64::consts::LN_2 * (1.0 - 1e-15)
 }
 
-/// The point for a real singular `s > sin(theta_i)`: `sinh v = i y`, `y = sqrt((s - si) / e)`,
-/// so `v = i asin(y)` for `y <= 1` and `v = acosh(y) + i pi/2` beyond.
+/// A lower bound of `acosh(y)` for `y > 1` (within [`LN_BELOW_GAP`]), as [`ln_below`] of
+/// `y + sqrt(y^2 - 1)`.
 #[inline(always)]
-fn above(si: f64, e: f64, s: f64) -> (f64, f64) {
-    let y = ((s - si) / e).sqrt();
-    if y <= 1.0 {
-        (0.0, y.asin())
-    } else {
-        // acosh(y), from below.
-        (
-            ln_below(y + ((y - 1.0) * (y + 1.0)).sqrt()).max(0.0),
-            FRAC_PI_2,
-        )
-    }
+fn acosh_below(y: f64) -> f64 {
+    ln_below(y + ((y - 1.0) * (y + 1.0)).sqrt()).max(0.0)
 }
 
 /// The point for a complex singular `s = re + i im`: `v* = asinh(sqrt(z))`, `z = (si - s) / e`,
@@ -424,10 +453,12 @@ mod tests {
         for s in [1.5, 0.9, -0.4] {
             // Real parts are lower bounds within LN_BELOW_GAP: sinh^2 comes back below, and
             // the exact point lies at most that far beyond.
-            let (x, y) = if s > si {
-                above(si, e, s)
-            } else {
-                (asinh_sqrt((si - s) / e), 0.0)
+            // The point as the rule sees it, from a polynomial with its one zero at s.
+            let sing = Singularities::of(si, e, &[-s, 1.0]).expect("a zero off the start");
+            let (x, y) = match (sing.len, sing.line_len) {
+                (1, 0) => sing.points[0],
+                (0, 1) => (acosh_below(sing.on_line[0]), FRAC_PI_2),
+                _ => (sing.real, 0.0),
             };
             let want = (si - s) / e;
             let (re, im) = sinh_sq(x, y);
@@ -449,6 +480,54 @@ mod tests {
                 "{re_s} {im_s}"
             );
         }
+    }
+
+    #[test]
+    fn points_on_the_line_are_bounded_only_where_they_can_be_nearest() {
+        // Quadratics with zeros above the start (on the line y = pi/2 or below it), below it
+        // and complex, on panels from rest and off it: the rule's rho equals the least over
+        // every point's real part bounded up front.
+        let mut state = 0x853c_49e6_748f_ea9b_u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut passed, mut bounded) = (0, 0);
+        for _ in 0..20_000 {
+            let si = next() * 1.98 - 0.99;
+            let e = 1.0 - si;
+            let coeffs = [next() * 4.0 - 1.0, next() * 4.0 - 2.0, next() * 4.0 - 2.0];
+            let Some(sing) = Singularities::of(si, e, &coeffs) else {
+                continue;
+            };
+            let h = 0.01 + 3.0 * next();
+            let c = if next() < 0.5 { 0.0 } else { h + 3.0 * next() };
+            let mut alpha = mean_distance(sing.real, 0.0, c, h);
+            for &(x, y) in &sing.points[..sing.len] {
+                alpha = alpha.min(mean_distance(x, y, c, h));
+            }
+            let seen = alpha;
+            for &y in &sing.on_line[..sing.line_len] {
+                alpha = alpha.min(mean_distance(acosh_below(y), FRAC_PI_2, c, h));
+            }
+            let eager = alpha + ((alpha - 1.0) * (alpha + 1.0)).max(0.0).sqrt();
+            assert_eq!(sing.rho(c, h), eager, "{si} {coeffs:?} {c} {h}");
+            if sing.line_len > 0 {
+                let w = FRAC_PI_2 / h;
+                if 1.0 + w * w < seen * seen {
+                    bounded += 1;
+                } else {
+                    passed += 1;
+                }
+            }
+        }
+        // Both branches ran many times.
+        assert!(
+            passed > 1_000 && bounded > 1_000,
+            "{passed} passed, {bounded} bounded"
+        );
     }
 
     #[test]
@@ -522,7 +601,7 @@ mod tests {
         assert_eq!(prior.rule_for(1.0), None);
         // A singular point on the panel gives rho = 1.
         let sing = Singularities::of(0.5, 0.5, &[]).expect("no polynomial: s = -1 alone");
-        assert_eq!(sing.points[0], (asinh_sqrt(3.0), 0.0));
+        assert_eq!(sing.real, asinh_sqrt(3.0));
         assert_eq!(sing.rho(0.0, asinh_sqrt(3.0)), 1.0);
         assert_eq!(Singularities::of(0.5, 0.5, &[1.0, 0.0, 0.0, 1.0]), None);
         assert_eq!(Singularities::of(0.5, 0.5, &[-0.5, 1.0]), None);
