@@ -138,7 +138,18 @@ pub struct HalfRule {
     /// `halved` two at a time, for a loop with nothing but pairs; where its count is odd, the
     /// last node again with weight 0. (Both lists are kept: a panel off `v = 0` evaluates each
     /// node twice, at `c + hx` and `c - hx`, and takes `halved` so that it pays for no pad.)
-    pub lanes: Vec<[(f64, f64); 2]>,
+    pub lanes: Vec<Lane>,
+}
+
+/// Two nodes of [`HalfRule::lanes`] and their weights, each pair aligned so that one packed
+/// load (or a packed operation's memory operand) reads it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(C, align(16))]
+pub struct Lane {
+    /// The nodes.
+    pub x: [f64; 2],
+    /// Their weights.
+    pub w: [f64; 2],
 }
 
 /// The rule of `order` nodes (clamped to `1..=MAX_NODES`), computed once per process and kept
@@ -168,9 +179,13 @@ pub fn half_rule(order: usize) -> &'static HalfRule {
         }
         halved.extend_from_slice(&pairs);
         let mut chunks = halved.chunks_exact(2);
-        let mut lanes: Vec<[(f64, f64); 2]> = (&mut chunks).map(|c| [c[0], c[1]]).collect();
+        let lane = |(x0, w0): (f64, f64), (x1, w1): (f64, f64)| Lane {
+            x: [x0, x1],
+            w: [w0, w1],
+        };
+        let mut lanes: Vec<Lane> = (&mut chunks).map(|c| lane(c[0], c[1])).collect();
         if let &[(x, w)] = chunks.remainder() {
-            lanes.push([(x, w), (x, 0.0)]);
+            lanes.push(lane((x, w), (x, 0.0)));
         }
         Box::leak(Box::new(HalfRule {
             nodes: full.len(),
@@ -446,13 +461,14 @@ impl<'a> FallIntegrand<'a> {
         2.0 * (p(s) / (1.0 + s)).sqrt()
     }
 
-    /// [`FallIntegrand::value_with`] at two nodes in the same arithmetic, without a branch
-    /// between the lanes, so that the compiler packs them (`mulpd`, `divpd`, `sqrtpd`).
+    /// Half of [`FallIntegrand::value_with`] (the factor 2 is taken once per panel) at two
+    /// nodes in the same arithmetic, without a branch between the lanes, so that the compiler
+    /// packs them (`mulpd`, `divpd`, `sqrtpd`).
     #[inline(always)]
-    fn value2_with(&self, sh2: [f64; 2], p: &impl Fn(f64) -> f64) -> [f64; 2] {
+    fn half_value2_with(&self, sh2: [f64; 2], p: &impl Fn(f64) -> f64) -> [f64; 2] {
         let s = [self.si - self.e * sh2[0], self.si - self.e * sh2[1]];
         let q = [p(s[0]) / (1.0 + s[0]), p(s[1]) / (1.0 + s[1])];
-        [2.0 * q[0].sqrt(), 2.0 * q[1].sqrt()]
+        [q[0].sqrt(), q[1].sqrt()]
     }
 
     /// The rule on the panel `[a, b]` (`symmetric`: the first panel from rest, half of the rule
@@ -499,20 +515,21 @@ impl<'a> FallIntegrand<'a> {
         sq2: impl Fn([f64; 2]) -> [f64; 2],
     ) -> PanelSum {
         let (centre, half) = panel_frame(symmetric, a, b);
+        // Sums of half values (the integrand over 2), and their least.
         let (acc, least) = if symmetric {
             // Half of the rule on [-b, b]: each node once (the integrand is even).
             let (mut acc2, mut least2) = ([0.0; 2], [f64::INFINITY; 2]);
             for l in &rule.lanes {
-                let f = self.value2_with(sq2([half * l[0].0, half * l[1].0]), &p);
+                let f = self.half_value2_with(sq2([half * l.x[0], half * l.x[1]]), &p);
                 least2 = [lesser(least2[0], f[0]), lesser(least2[1], f[1])];
-                acc2 = [acc2[0] + l[0].1 * f[0], acc2[1] + l[1].1 * f[1]];
+                acc2 = [acc2[0] + l.w[0] * f[0], acc2[1] + l.w[1] * f[1]];
             }
             (acc2[0] + acc2[1], lesser(least2[0], least2[1]))
         } else {
             let (mut acc, mut least) = (0.0, f64::INFINITY);
             for &(x, w) in &rule.halved {
                 let hx = half * x;
-                let [up, down] = self.value2_with(sq2([centre + hx, centre - hx]), &p);
+                let [up, down] = self.half_value2_with(sq2([centre + hx, centre - hx]), &p);
                 least = lesser(least, lesser(up, down));
                 acc += w * (up + down);
             }
@@ -521,8 +538,8 @@ impl<'a> FallIntegrand<'a> {
         let evals = (usize::from(rule.centre != 0.0)
             + rule.pairs.len() * if symmetric { 1 } else { 2 }) as u64;
         PanelSum {
-            value: half * acc,
-            least,
+            value: 2.0 * half * acc,
+            least: 2.0 * least,
             evals,
         }
     }
@@ -1153,14 +1170,18 @@ mod tests {
                 assert!((sum - exact).abs() < 1e-14, "order {order}, x^{}", 2 * j);
                 // The same sum from the lanes (each node at +x and -x, the node at 0 halved,
                 // the padding weightless).
-                let lanes: f64 = (rule.lanes.iter().flatten())
-                    .map(|&(x, w)| 2.0 * w * x.powi(2 * j as i32))
+                let lanes: f64 = (rule.lanes.iter())
+                    .flat_map(|l| [(l.x[0], l.w[0]), (l.x[1], l.w[1])])
+                    .map(|(x, w)| 2.0 * w * x.powi(2 * j as i32))
                     .sum();
                 assert!((lanes - exact).abs() < 1e-14, "lanes {order}, x^{}", 2 * j);
             }
             assert_eq!(rule.halved.len(), rule.pairs.len() + odd);
             assert_eq!(rule.lanes.len(), rule.halved.len().div_ceil(2));
-            assert!(rule.lanes.as_flattened().starts_with(&rule.halved));
+            let flat: Vec<(f64, f64)> = (rule.lanes.iter())
+                .flat_map(|l| [(l.x[0], l.w[0]), (l.x[1], l.w[1])])
+                .collect();
+            assert!(flat.starts_with(&rule.halved));
         }
     }
 
