@@ -351,12 +351,16 @@ pub(crate) fn quick_route(
     if !(positive_finite(e) & positive_finite(drop) & (si.abs() < 1.0) & (ci > 0.0)) {
         return None;
     }
+    // Whether the phase falls needs no test of its own here: the plan integrates no panel
+    // with a zero of the fall polynomial on it (the zero is then a singular point on the
+    // path, whose rho is 1) and takes every node's value positive, so the polynomial is
+    // positive over the whole path, its start included.
     let integrand = FallIntegrand::new(si, e, fall);
-    if !integrand.falls() {
+    let v_end = v_at_drop(e, drop);
+    let mut sing = Singularities::NONE;
+    if !sing.find(si, e, fall) {
         return None;
     }
-    let v_end = v_at_drop(e, drop);
-    let sing = Singularities::of(si, e, fall)?;
     let panel = |rule: &HalfRule, a: f64, b: f64| {
         let sum = integrand.panel(rule, a, b, a == 0.0);
         if sum.ok() {

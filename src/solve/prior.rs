@@ -172,13 +172,30 @@ impl Singularities {
     /// the polynomial has a degree above 2 or a zero at the start.
     #[inline(always)]
     pub fn of(si: f64, e: f64, coeffs: &[f64]) -> Option<Singularities> {
-        let mut out = Singularities {
-            real: 0.0,
-            points: [(0.0, 0.0); 2],
-            len: 0,
-            on_line: [0.0; 2],
-            line_len: 0,
-        };
+        let mut out = Singularities::NONE;
+        out.find(si, e, coeffs).then_some(out)
+    }
+
+    /// No points (the start of [`Singularities::find`]).
+    pub(crate) const NONE: Singularities = Singularities {
+        real: 0.0,
+        points: [(0.0, 0.0); 2],
+        len: 0,
+        on_line: [0.0; 2],
+        line_len: 0,
+    };
+
+    /// [`Singularities::of`] in place, into points that are [`Singularities::NONE`]: `false`
+    /// where `of` gives `None` (so that the route, which keeps the points where the plan reads
+    /// them, does not copy them out of an `Option`).
+    #[inline(always)]
+    pub(crate) fn find(&mut self, si: f64, e: f64, coeffs: &[f64]) -> bool {
+        self.find_points(si, e, coeffs).is_some()
+    }
+
+    #[inline(always)]
+    fn find_points(&mut self, si: f64, e: f64, coeffs: &[f64]) -> Option<()> {
+        let out = self;
         // Real singularities below the start lie on the real v axis, the nearest (largest s)
         // hiding the others: s = -1 and the real zeros of P below sin(theta_i).
         let mut below = -1.0f64;
@@ -186,15 +203,15 @@ impl Singularities {
         match *coeffs {
             // A constant, also padded to a quadratic with zeros: no zero.
             [] | [_] | [_, 0.0, 0.0] => {}
-            [p0, p1] => real(-p0 / p1, &mut out)?,
-            [p0, p1, 0.0] => real(-p0 / p1, &mut out)?,
+            [p0, p1] => real(-p0 / p1, out)?,
+            [p0, p1, 0.0] => real(-p0 / p1, out)?,
             [p0, p1, p2] => {
                 let disc = p1 * p1 - 4.0 * p0 * p2;
                 if disc >= 0.0 {
                     // Both real, without cancellation.
                     let q = -0.5 * (p1 + disc.sqrt().copysign(p1));
-                    real(q / p2, &mut out)?;
-                    real(p0 / q, &mut out)?;
+                    real(q / p2, out)?;
+                    real(p0 / q, out)?;
                 } else {
                     // A conjugate pair: one representative (the ellipses are symmetric).
                     let p = complex(si, e, -0.5 * p1 / p2, 0.5 * (-disc).sqrt() / p2.abs());
@@ -209,7 +226,7 @@ impl Singularities {
         let sum = out.real
             + out.points.iter().map(|&(x, y)| x + y).sum::<f64>()
             + out.on_line.iter().sum::<f64>();
-        sum.is_finite().then_some(out)
+        sum.is_finite().then_some(())
     }
 
     /// A real singular `s`: below the start it may be the nearest of those on the real axis
@@ -217,7 +234,10 @@ impl Singularities {
     #[inline(always)]
     fn real(&mut self, si: f64, e: f64, s: f64, below: &mut f64) -> Option<()> {
         if s < si {
-            *below = below.max(s);
+            // `s` is no NaN here (it compared below `si`): a plain comparison, not `max`.
+            if s > *below {
+                *below = s;
+            }
             Some(())
         } else if s > si {
             self.above(si, e, s);
