@@ -131,6 +131,8 @@ pub struct HalfRule {
     pub pairs: Vec<(f64, f64)>,
     /// Weight of the node at 0.
     pub centre: f64,
+    /// The largest node (0 for the one-node rule).
+    pub reach: f64,
     /// The nodes `x >= 0`: the node at 0 (odd orders) first with half its weight (it is then
     /// counted at `+x` and `-x`, or, on a symmetric panel, once for the half of `[-b, b]`),
     /// then `pairs`.
@@ -189,6 +191,7 @@ pub fn half_rule(order: usize) -> &'static HalfRule {
         }
         Box::leak(Box::new(HalfRule {
             nodes: full.len(),
+            reach: pairs.last().map_or(0.0, |&(x, _)| x),
             pairs,
             centre,
             halved,
@@ -479,7 +482,7 @@ impl<'a> FallIntegrand<'a> {
         // Where every node lies within the series' reach (most panels), the pairs take it
         // without a test per node.
         let (centre, half) = panel_frame(symmetric, a, b);
-        let farthest = centre.abs() + half * rule.pairs.last().map_or(0.0, |&(x, _)| x);
+        let farthest = centre.abs() + half * rule.reach;
         let within = farthest < SERIES_REACH;
         match (self.low, within) {
             (true, true) => {
@@ -535,8 +538,12 @@ impl<'a> FallIntegrand<'a> {
             }
             (acc, least)
         };
-        let evals = (usize::from(rule.centre != 0.0)
-            + rule.pairs.len() * if symmetric { 1 } else { 2 }) as u64;
+        // Each node once; on a symmetric panel the nodes x >= 0 once.
+        let evals = if symmetric {
+            rule.nodes.div_ceil(2)
+        } else {
+            rule.nodes
+        } as u64;
         PanelSum {
             value: 2.0 * half * acc,
             least: 2.0 * least,
@@ -1177,6 +1184,8 @@ mod tests {
                 assert!((lanes - exact).abs() < 1e-14, "lanes {order}, x^{}", 2 * j);
             }
             assert_eq!(rule.halved.len(), rule.pairs.len() + odd);
+            let largest = rule.pairs.iter().fold(0.0f64, |m, &(x, _)| m.max(x));
+            assert_eq!(rule.reach, largest);
             assert_eq!(rule.lanes.len(), rule.halved.len().div_ceil(2));
             let flat: Vec<(f64, f64)> = (rule.lanes.iter())
                 .flat_map(|l| [(l.x[0], l.w[0]), (l.x[1], l.w[1])])
