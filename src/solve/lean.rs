@@ -196,6 +196,7 @@ impl<'m> LeanSolver<'m> {
     /// constants it reads, nothing checked but numbers); a point that fails that way is
     /// validated, and solved again from the lean constants and then from every constant, so
     /// that its error is the one the full preparation reports.
+    #[inline]
     pub fn solve(&mut self, p: &[f64]) -> Result<LeanPoint, SolveError> {
         if let Some(prior) = &self.prior
             && let Some(point) = self

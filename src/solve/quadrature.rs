@@ -483,26 +483,31 @@ impl<'a> FallIntegrand<'a> {
         // without a test per node.
         let (centre, half) = panel_frame(symmetric, a, b);
         let farthest = centre.abs() + half * rule.reach;
-        let within = farthest < SERIES_REACH;
-        match (self.low, within) {
-            (true, true) => {
-                let [p0, p1, p2] = self.quadratic;
-                self.panel_with(
-                    rule,
-                    a,
-                    b,
-                    symmetric,
-                    |s| p0 + s * (p1 + s * p2),
-                    sinh_sq2_series,
-                )
-            }
-            (true, false) => {
-                let [p0, p1, p2] = self.quadratic;
-                self.panel_with(rule, a, b, symmetric, |s| p0 + s * (p1 + s * p2), sinh_sq2)
-            }
-            (false, _) => {
-                self.panel_with(rule, a, b, symmetric, |s| horner(self.coeffs, s), sinh_sq2)
-            }
+        if self.low && farthest < SERIES_REACH {
+            let [p0, p1, p2] = self.quadratic;
+            self.panel_with(
+                rule,
+                a,
+                b,
+                symmetric,
+                |s| p0 + s * (p1 + s * p2),
+                sinh_sq2_series,
+            )
+        } else {
+            self.panel_far(rule, a, b, symmetric)
+        }
+    }
+
+    /// [`FallIntegrand::panel`] where a node lies beyond the series' reach or the polynomial's
+    /// degree exceeds 2 (out of line, so that the common panel keeps its registers).
+    #[cold]
+    #[inline(never)]
+    fn panel_far(&self, rule: &HalfRule, a: f64, b: f64, symmetric: bool) -> PanelSum {
+        if self.low {
+            let [p0, p1, p2] = self.quadratic;
+            self.panel_with(rule, a, b, symmetric, |s| p0 + s * (p1 + s * p2), sinh_sq2)
+        } else {
+            self.panel_with(rule, a, b, symmetric, |s| horner(self.coeffs, s), sinh_sq2)
         }
     }
 
