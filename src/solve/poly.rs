@@ -277,7 +277,7 @@ fn depressed_low(c: [f64; 4], lo: f64, hi: f64, evals: &mut u64) -> Option<f64> 
     let eps = c3 * l * l / -c1;
     let next = if l > 0.0 { 2.0 * l } else { -3.0 * l };
     // The margin covers the rounding of `l` and `eps` (NaN fails every test).
-    if !(eps >= 0.0 && eps <= DEPRESSED_MAX && hi < next * (1.0 - 1e-9)) {
+    if !((0.0..=DEPRESSED_MAX).contains(&eps) && hi < next * (1.0 - 1e-9)) {
         return None;
     }
     let u = (1.0 - 6.75 * eps).sqrt();
