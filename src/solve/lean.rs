@@ -359,9 +359,7 @@ pub(crate) fn quick_route(
     let integrand = FallIntegrand::new(si, e, fall);
     let v_end = v_at_drop(e, drop);
     let mut sing = Singularities::NONE;
-    if !sing.find(si, e, fall) {
-        return None;
-    }
+    sing.find(si, e, fall)?;
     let panel = |rule: &HalfRule, a: f64, b: f64| {
         let sum = integrand.panel(rule, a, b, a == 0.0);
         if sum.ok() {

@@ -23,6 +23,17 @@ pub mod separation;
 pub mod series;
 pub mod unreduced;
 
+/// Deterministic uniform numbers in `[0, 1)` for the unit tests (xorshift64 from `state`).
+#[cfg(test)]
+pub(crate) fn uniform(mut state: u64) -> impl FnMut() -> f64 {
+    move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 use crate::system::SystemError;
 
 /// Everything that can go wrong while solving a validated [`System`](crate::system::System).

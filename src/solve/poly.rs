@@ -560,6 +560,7 @@ fn polish(x: f64, newton: f64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::solve::uniform;
 
     #[test]
     fn roots_of_a_product_are_found_in_order() {
@@ -574,16 +575,6 @@ mod tests {
         assert_eq!(largest_root(&c, 0.0, 0.7, &mut evals), Some(Some(roots[1])));
         assert_eq!(largest_root(&c, 0.95, 1.0, &mut evals), Some(None));
         assert!(evals > 0);
-    }
-
-    /// Deterministic uniform numbers in `[0, 1)` (xorshift64 from `state`).
-    fn uniform(mut state: u64) -> impl FnMut() -> f64 {
-        move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        }
     }
 
     #[test]

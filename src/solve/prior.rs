@@ -173,7 +173,7 @@ impl Singularities {
     #[inline(always)]
     pub fn of(si: f64, e: f64, coeffs: &[f64]) -> Option<Singularities> {
         let mut out = Singularities::NONE;
-        out.find(si, e, coeffs).then_some(out)
+        out.find(si, e, coeffs).map(|()| out)
     }
 
     /// No points (the start of [`Singularities::find`]).
@@ -185,16 +185,11 @@ impl Singularities {
         line_len: 0,
     };
 
-    /// [`Singularities::of`] in place, into points that are [`Singularities::NONE`]: `false`
-    /// where `of` gives `None` (so that the route, which keeps the points where the plan reads
-    /// them, does not copy them out of an `Option`).
+    /// [`Singularities::of`] in place, into points that are [`Singularities::NONE`] (so that
+    /// the route, which keeps the points where the plan reads them, does not copy them out of
+    /// an `Option`).
     #[inline(always)]
-    pub(crate) fn find(&mut self, si: f64, e: f64, coeffs: &[f64]) -> bool {
-        self.find_points(si, e, coeffs).is_some()
-    }
-
-    #[inline(always)]
-    fn find_points(&mut self, si: f64, e: f64, coeffs: &[f64]) -> Option<()> {
+    pub(crate) fn find(&mut self, si: f64, e: f64, coeffs: &[f64]) -> Option<()> {
         let out = self;
         // Real singularities below the start lie on the real v axis, the nearest (largest s)
         // hiding the others: s = -1 and the real zeros of P below sin(theta_i).
@@ -507,13 +502,7 @@ mod tests {
         // Quadratics with zeros above the start (on the line y = pi/2 or below it), below it
         // and complex, on panels from rest and off it: the rule's rho equals the least over
         // every point's real part bounded up front.
-        let mut state = 0x853c_49e6_748f_ea9b_u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = crate::solve::uniform(0x853c_49e6_748f_ea9b);
         let (mut passed, mut bounded) = (0, 0);
         for _ in 0..20_000 {
             let si = next() * 1.98 - 0.99;
