@@ -7,7 +7,8 @@
 //! (`ell = g = m1 = 1`, `m2 = n`), row-major by `i`; point `k` is grid index
 //! `(7919 k) mod 10000`.
 //!
-//! Usage: `cargo run --release --example per_point -- [N]`.
+//! Usage: `cargo run --release --example per_point -- [N] [--baseline]` (`--baseline`: the
+//! baseline instruction set even where the CPU has AVX2; the results are the same to the bit).
 
 use rodcube::models;
 use rodcube::solve::lean::LeanSolver;
@@ -23,16 +24,22 @@ fn point(n: &[f64], k: usize) -> [f64; 5] {
 }
 
 fn main() -> ExitCode {
-    let count = match std::env::args().nth(1) {
-        None => 1000,
-        Some(arg) => match arg.parse::<usize>() {
-            Ok(n) => n,
-            Err(_) => {
-                eprintln!("per_point: N must be a non-negative integer, got {arg:?}");
-                return ExitCode::from(2);
+    let (mut count, mut baseline) = (1000, false);
+    for arg in std::env::args().skip(1) {
+        if arg == "--baseline" {
+            baseline = true;
+        } else {
+            match arg.parse::<usize>() {
+                Ok(n) => count = n,
+                Err(_) => {
+                    eprintln!(
+                        "per_point: expected N (a non-negative integer) or --baseline, got {arg:?}"
+                    );
+                    return ExitCode::from(2);
+                }
             }
-        },
-    };
+        }
+    }
     let Some(model) = models::find("rod_cube") else {
         eprintln!("per_point: the model rod_cube is not generated");
         return ExitCode::FAILURE;
@@ -48,6 +55,9 @@ fn main() -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
+    if baseline {
+        solver.baseline_only();
+    }
     let mut sum = 0.0;
     for (k, p) in points.iter().enumerate() {
         match solver.solve(p) {

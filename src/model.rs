@@ -313,7 +313,31 @@ pub trait Model: Send + Sync {
         evals: &mut u64,
     ) -> Option<crate::solve::lean::LeanPoint> {
         let start = self.lean_start(p)?;
-        crate::solve::lean::quick_route(&start, prior, sin_end, evals)
+        crate::solve::lean::quick_route(&start, prior, sin_end, evals, |f, rule, a, b| {
+            f.panel(rule, a, b, a == 0.0)
+        })
+    }
+
+    /// [`Model::lean_point`] compiled for AVX2 (VEX encoding and four lanes), with the same
+    /// result to the bit: the same operations in the same order, correctly rounded in every
+    /// lane (no fused multiply-add). [`LeanSolver`](crate::solve::lean::LeanSolver) calls it
+    /// where the CPU has AVX2.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2 (`is_x86_feature_detected!("avx2")`).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn lean_point_avx2(
+        &self,
+        p: &[f64],
+        prior: &crate::solve::prior::Prior,
+        sin_end: f64,
+        evals: &mut u64,
+    ) -> Option<crate::solve::lean::LeanPoint> {
+        let start = self.lean_start(p)?;
+        crate::solve::lean::quick_route(&start, prior, sin_end, evals, |f, rule, a, b| {
+            f.panel_avx2(rule, a, b, a == 0.0)
+        })
     }
 
     /// Requirement margins from the parameters alone (each must be `> 0`), in the order of

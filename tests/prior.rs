@@ -192,6 +192,47 @@ fn the_a_priori_rule_agrees_with_the_verified_rules() {
 }
 
 #[test]
+fn the_avx2_route_gives_the_baseline_results_to_the_bit() {
+    // The same operations in the same order in every lane, correctly rounded, so the copy of
+    // the route compiled for AVX2 returns the baseline's numbers exactly, with as many
+    // evaluations; over every model with a fall polynomial, nearly upright and heavy cubes
+    // included (long panels, halved panels and the checked route all taken).
+    #[cfg(target_arch = "x86_64")]
+    let wide_cpu = std::arch::is_x86_feature_detected!("avx2");
+    #[cfg(not(target_arch = "x86_64"))]
+    let wide_cpu = false;
+    let mut u = Uniform(0x5eed);
+    for name in WITH_FALL {
+        let m = model(name);
+        let mut wide = LeanSolver::new(m).unwrap();
+        let mut base = LeanSolver::new(m).unwrap();
+        base.baseline_only();
+        assert_eq!(
+            wide.wide(),
+            wide_cpu,
+            "{name}: the AVX2 copy is used exactly where it runs"
+        );
+        assert!(!base.wide());
+        for _ in 0..3000 {
+            let p = random_point(name, &mut u);
+            let (a, b) = (wide.solve(&p), base.solve(&p));
+            match (a, b) {
+                (Ok(a), Ok(b)) => {
+                    assert_eq!(a.separation_angle.to_bits(), b.separation_angle.to_bits());
+                    assert_eq!(
+                        a.separation_time.to_bits(),
+                        b.separation_time.to_bits(),
+                        "{name} {p:?}: {a:?} vs {b:?}"
+                    );
+                }
+                (a, b) => assert_eq!(a.is_ok(), b.is_ok(), "{name} {p:?}"),
+            }
+            assert_eq!(wide.evals, base.evals, "{name} {p:?}");
+        }
+    }
+}
+
+#[test]
 fn the_per_point_solver_matches_the_reference_to_1e_15() {
     // The hard-case ranges: n from 1e-12 to 1e12, a/ell from 1e-10 to 1 - 1e-15.
     let ns = [1e-12, 1e-8, 1e-4, 1e-2, 1.0, 3.0, 1e2, 1e4, 1e8, 1e12];

@@ -17,7 +17,11 @@
 //! between them (no error values built). Anything short of a clean solve there (a parameter the quick
 //! test does not pass, a value not finite, no root, a phase that does not fall, too many panels)
 //! sends the point through the checked route (`LeanSolver::checked`), which solves it again and
-//! names what failed; so the unchecked route never decides an error.
+//! names what failed; so the unchecked route never decides an error. The unchecked route has a
+//! second compiled copy, [`Model::lean_point_avx2`], the same source built for AVX2 (4-wide
+//! division and root in the integrand) and taken when the CPU reports AVX2 at the solver's
+//! construction; it gives the same bits as the baseline copy ([`LeanSolver::baseline_only`]
+//! turns it off for comparison).
 //!
 //! `rodcube accuracy` and the tests in `tests/hard_cases.rs` check the result against the
 //! high-precision reference (`rodcube::reference`, feature `cli`) across `n = m2/m1` from 1e-12 to 1e12 and
@@ -28,7 +32,7 @@ use crate::solve::SolveError;
 use crate::solve::poly::{self, MAX_DEGREE};
 use crate::solve::prior::{PRIOR_TOL, Prior, Singularities, integrate_prior, prior_panels};
 use crate::solve::quadrature::{
-    self, ACCEPT, Control, Fall, FallIntegrand, HalfRule, RuleStep, SCHEDULE, v_at_drop,
+    self, ACCEPT, Control, Fall, FallIntegrand, HalfRule, PanelSum, RuleStep, SCHEDULE, v_at_drop,
 };
 use crate::solve::separation::separation_root;
 use crate::system::{
@@ -87,6 +91,8 @@ pub struct LeanSolver<'m> {
     /// Scratch for parameters given by name.
     named: Vec<f64>,
     stack: Vec<(f64, f64)>,
+    /// Whether the unchecked route runs its AVX2 copy (the CPU has it).
+    wide: bool,
     /// Evaluations of `theta_dot^2` and of the polynomial since the solver was made.
     pub evals: u64,
 }
@@ -180,6 +186,7 @@ impl<'m> LeanSolver<'m> {
             prior: None,
             named: Vec::new(),
             stack: Vec::with_capacity(64),
+            wide: has_avx2(),
             evals: 0,
         })
     }
@@ -198,14 +205,39 @@ impl<'m> LeanSolver<'m> {
     /// that its error is the one the full preparation reports.
     #[inline]
     pub fn solve(&mut self, p: &[f64]) -> Result<LeanPoint, SolveError> {
-        if let Some(prior) = &self.prior
-            && let Some(point) = self
+        if let Some(prior) = &self.prior {
+            #[cfg(target_arch = "x86_64")]
+            let quick = if self.wide {
+                // SAFETY: `wide` is set only where the CPU has AVX2 (`has_avx2`).
+                unsafe {
+                    self.model
+                        .lean_point_avx2(p, prior, self.sin_end, &mut self.evals)
+                }
+            } else {
+                self.model
+                    .lean_point(p, prior, self.sin_end, &mut self.evals)
+            };
+            #[cfg(not(target_arch = "x86_64"))]
+            let quick = self
                 .model
-                .lean_point(p, prior, self.sin_end, &mut self.evals)
-        {
-            return Ok(point);
+                .lean_point(p, prior, self.sin_end, &mut self.evals);
+            if let Some(point) = quick {
+                return Ok(point);
+            }
         }
         self.checked(p)
+    }
+
+    /// Solves by the baseline instruction set even where the CPU has AVX2 (the results are
+    /// the same to the bit, which `tests/prior.rs` checks; the two can be timed side by side,
+    /// as `examples/per_point.rs --baseline` does).
+    pub fn baseline_only(&mut self) {
+        self.wide = false;
+    }
+
+    /// Whether points are solved by the AVX2 copy of the route ([`Model::lean_point_avx2`]).
+    pub fn wide(&self) -> bool {
+        self.wide
     }
 
     /// [`LeanSolver::solve`] by the checked route: every step's failure is a typed error.
@@ -321,6 +353,14 @@ impl<'m> LeanSolver<'m> {
     }
 }
 
+/// Whether the CPU has AVX2 (where the unchecked route has a copy for it).
+fn has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    return std::arch::is_x86_feature_detected!("avx2");
+    #[cfg(not(target_arch = "x86_64"))]
+    false
+}
+
 /// The unchecked route from a point's start ([`Model::lean_start`]) with nothing but numbers
 /// in between: the separation polynomial's root ([`poly::largest_root`]) in `(sin_end,
 /// sin(theta_i))`, the fall's integrand ([`FallIntegrand`]) and the a-priori plan
@@ -336,11 +376,14 @@ pub(crate) fn quick_route(
     prior: &Prior,
     sin_end: f64,
     evals: &mut u64,
+    rule_on: impl Fn(&FallIntegrand, &HalfRule, f64, f64) -> PanelSum,
 ) -> Option<LeanPoint> {
     let (si, ci) = (start.sin_initial, start.cos_initial);
-    let finite = |ok: bool, c: &f64| ok & c.is_finite();
-    let coefficients = start.separation.iter().chain(&start.fall);
-    if !(coefficients.fold(true, finite) & (start.theta_dot_initial == 0.0)) {
+    // Every coefficient finite, by one test (`0 c` is 0 exactly when `c` is finite; no
+    // iterator adapter, which each copy of the route would call out of line).
+    let ([c0, c1, c2, c3], [p0, p1, p2]) = (start.separation, start.fall);
+    let zero = 0.0 * c0 + 0.0 * c1 + 0.0 * c2 + 0.0 * c3 + 0.0 * p0 + 0.0 * p1 + 0.0 * p2;
+    if !((zero == 0.0) & (start.theta_dot_initial == 0.0)) {
         return None;
     }
     let (sep, fall) = (&start.separation[..], &start.fall[..]);
@@ -361,7 +404,7 @@ pub(crate) fn quick_route(
     let mut sing = Singularities::NONE;
     sing.find(si, e, fall)?;
     let panel = |rule: &HalfRule, a: f64, b: f64| {
-        let sum = integrand.panel(rule, a, b, a == 0.0);
+        let sum = rule_on(&integrand, rule, a, b);
         if sum.ok() {
             Ok((sum.value, sum.evals))
         } else {

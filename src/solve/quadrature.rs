@@ -31,10 +31,14 @@
 //! at `v = 0` ([`FallIntegrand`], the one copy that [`Fall`] and the per-point solver's
 //! unchecked route share). Each node then takes `sinh^2 v` by itself (a series below 1.5, one
 //! `exp` above), which also spares the addition theorem's cancellation on long panels. Nodes
-//! are taken two at a time in the same arithmetic (`sinh_sq2`, `FallIntegrand::value2_with`,
-//! over `HalfRule::lanes`, where the node at 0 and a weightless pad make every step a pair),
-//! with the polynomial's shape decided once per panel, so that the compiler packs them into
-//! SSE2 pairs through the division and the root (`divpd`, `sqrtpd`). The
+//! are taken four at a time in the same arithmetic ([`LANES`] lanes of [`HalfRule`], the
+//! node at 0 and weightless pads filling the last group), with the polynomial's shape decided
+//! once per panel, so that the compiler packs them into vector registers through the division
+//! and the root: SSE2 pairs in the baseline build, and 4-wide AVX2 in a second copy of the same
+//! source (`FallIntegrand::panel_avx2`, compiled with `#[target_feature(enable = "avx2")]` and
+//! chosen at run time when the CPU has it). Each lane's sum and the final
+//! `((l0 + l1) + l2) + l3` are the same operations in both copies and no fused multiply-add is
+//! used, so both give the same bits (tested in `tests/prior.rs`). The
 //! per-point solver chooses its rules for such phases a priori
 //! ([`prior`](crate::solve::prior)); the verified pairs below serve everything else.
 //!
@@ -137,21 +141,26 @@ pub struct HalfRule {
     /// counted at `+x` and `-x`, or, on a symmetric panel, once for the half of `[-b, b]`),
     /// then `pairs`.
     pub halved: Vec<(f64, f64)>,
-    /// `halved` two at a time, for a loop with nothing but pairs; where its count is odd, the
-    /// last node again with weight 0. (Both lists are kept: a panel off `v = 0` evaluates each
-    /// node twice, at `c + hx` and `c - hx`, and takes `halved` so that it pays for no pad.)
+    /// `halved` [`LANES`] at a time, for a loop with nothing but full steps; the last step
+    /// padded with its last node again, with weight 0. (Both lists are kept: a panel off
+    /// `v = 0` evaluates each node twice, at `c + hx` and `c - hx`, and takes `halved` so that
+    /// it pays for no pad.)
     pub lanes: Vec<Lane>,
 }
 
-/// Two nodes of [`HalfRule::lanes`] and their weights, each pair aligned so that one packed
-/// load (or a packed operation's memory operand) reads it.
+/// Nodes per step of [`HalfRule::lanes`]: four, one AVX register of `f64` (two SSE2
+/// registers on the baseline, in the same order, so that both give the same sum to the bit).
+pub const LANES: usize = 4;
+
+/// [`LANES`] nodes of [`HalfRule::lanes`] and their weights, aligned so that one packed load
+/// (or a packed operation's memory operand) reads each array.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[repr(C, align(16))]
+#[repr(C, align(32))]
 pub struct Lane {
     /// The nodes.
-    pub x: [f64; 2],
+    pub x: [f64; LANES],
     /// Their weights.
-    pub w: [f64; 2],
+    pub w: [f64; LANES],
 }
 
 /// The rule of `order` nodes (clamped to `1..=MAX_NODES`), computed once per process and kept
@@ -180,15 +189,21 @@ pub fn half_rule(order: usize) -> &'static HalfRule {
             halved.push((0.0, 0.5 * centre));
         }
         halved.extend_from_slice(&pairs);
-        let mut chunks = halved.chunks_exact(2);
-        let lane = |(x0, w0): (f64, f64), (x1, w1): (f64, f64)| Lane {
-            x: [x0, x1],
-            w: [w0, w1],
-        };
-        let mut lanes: Vec<Lane> = (&mut chunks).map(|c| lane(c[0], c[1])).collect();
-        if let &[(x, w)] = chunks.remainder() {
-            lanes.push(lane((x, w), (x, 0.0)));
-        }
+        let lanes = halved
+            .chunks(LANES)
+            .map(|chunk| {
+                // The pad repeats the last node (a value like the others) with no weight.
+                let (last, _) = chunk[chunk.len() - 1];
+                let mut lane = Lane {
+                    x: [last; LANES],
+                    w: [0.0; LANES],
+                };
+                for (i, &(x, w)) in chunk.iter().enumerate() {
+                    (lane.x[i], lane.w[i]) = (x, w);
+                }
+                lane
+            })
+            .collect();
         Box::leak(Box::new(HalfRule {
             nodes: full.len(),
             reach: pairs.last().map_or(0.0, |&(x, _)| x),
@@ -297,22 +312,50 @@ fn sinh_sq(y: f64) -> f64 {
     }
 }
 
-/// [`sinh_sq`] of two arguments in the same arithmetic (the compiler packs the lanes).
-#[inline(always)]
-fn sinh_sq2(y: [f64; 2]) -> [f64; 2] {
-    if y[0].abs() < SERIES_REACH && y[1].abs() < SERIES_REACH {
-        sinh_sq2_series(y)
-    } else {
-        [sinh_sq(y[0]), sinh_sq(y[1])]
+/// `sinh^2` of several arguments in the same arithmetic, lane by lane (the compiler packs the
+/// lanes): by [`sinh_sq`], or by the series alone for arguments known to lie within
+/// [`SERIES_REACH`].
+trait SinhSq {
+    fn lanes<const N: usize>(y: [f64; N]) -> [f64; N];
+}
+
+/// [`SinhSq`] by [`sinh_sq`]: the series where every lane is within its reach, else each lane
+/// by itself.
+struct AnyReach;
+
+impl SinhSq for AnyReach {
+    #[inline(always)]
+    fn lanes<const N: usize>(y: [f64; N]) -> [f64; N] {
+        let mut near = true;
+        for v in y {
+            near &= v.abs() < SERIES_REACH;
+        }
+        if near {
+            Series::lanes(y)
+        } else {
+            let mut out = [0.0; N];
+            for i in 0..N {
+                out[i] = sinh_sq(y[i]);
+            }
+            out
+        }
     }
 }
 
-/// [`sinh_sq2`] for arguments known to lie within [`SERIES_REACH`]: the series alone.
-#[inline(always)]
-fn sinh_sq2_series(y: [f64; 2]) -> [f64; 2] {
-    let z = [y[0] * y[0], y[1] * y[1]];
-    let r = [sinh_ratio_series(z[0]), sinh_ratio_series(z[1])];
-    [z[0] * r[0] * r[0], z[1] * r[1] * r[1]]
+/// [`SinhSq`] by the series alone (every argument within [`SERIES_REACH`]).
+struct Series;
+
+impl SinhSq for Series {
+    #[inline(always)]
+    fn lanes<const N: usize>(y: [f64; N]) -> [f64; N] {
+        let mut out = [0.0; N];
+        for i in 0..N {
+            let z = y[i] * y[i];
+            let r = sinh_ratio_series(z);
+            out[i] = z * r * r;
+        }
+        out
+    }
 }
 
 /// `sinh(y) / y` for `z = y^2 <= 2.25` by a polynomial of degree 8 in `z`: the Taylor series
@@ -464,14 +507,17 @@ impl<'a> FallIntegrand<'a> {
         2.0 * (p(s) / (1.0 + s)).sqrt()
     }
 
-    /// Half of [`FallIntegrand::value_with`] (the factor 2 is taken once per panel) at two
+    /// Half of [`FallIntegrand::value_with`] (the factor 2 is taken once per panel) at `N`
     /// nodes in the same arithmetic, without a branch between the lanes, so that the compiler
     /// packs them (`mulpd`, `divpd`, `sqrtpd`).
     #[inline(always)]
-    fn half_value2_with(&self, sh2: [f64; 2], p: &impl Fn(f64) -> f64) -> [f64; 2] {
-        let s = [self.si - self.e * sh2[0], self.si - self.e * sh2[1]];
-        let q = [p(s[0]) / (1.0 + s[0]), p(s[1]) / (1.0 + s[1])];
-        [q[0].sqrt(), q[1].sqrt()]
+    fn half_values_with<const N: usize>(&self, sh2: [f64; N], p: &impl Fn(f64) -> f64) -> [f64; N] {
+        let mut out = [0.0; N];
+        for i in 0..N {
+            let s = self.si - self.e * sh2[i];
+            out[i] = (p(s) / (1.0 + s)).sqrt();
+        }
+        out
     }
 
     /// The rule on the panel `[a, b]` (`symmetric`: the first panel from rest, half of the rule
@@ -479,20 +525,31 @@ impl<'a> FallIntegrand<'a> {
     /// whole panel by [`PanelSum::ok`]. The polynomial's shape is decided once per panel.
     #[inline]
     pub fn panel(&self, rule: &HalfRule, a: f64, b: f64, symmetric: bool) -> PanelSum {
-        // Where every node lies within the series' reach (most panels), the pairs take it
+        self.panel_near(rule, a, b, symmetric)
+    }
+
+    /// [`FallIntegrand::panel`] compiled for AVX2 (four lanes in one register), with the same
+    /// result to the bit (the same operations in the same order in every lane).
+    ///
+    /// # Safety
+    /// Callable outside AVX2 code only in an `unsafe` block, and only where the CPU has AVX2
+    /// (`is_x86_feature_detected!("avx2")`).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    pub fn panel_avx2(&self, rule: &HalfRule, a: f64, b: f64, symmetric: bool) -> PanelSum {
+        self.panel_near(rule, a, b, symmetric)
+    }
+
+    /// The body of [`FallIntegrand::panel`], inlined into each instruction set's copy.
+    #[inline(always)]
+    fn panel_near(&self, rule: &HalfRule, a: f64, b: f64, symmetric: bool) -> PanelSum {
+        // Where every node lies within the series' reach (most panels), the lanes take it
         // without a test per node.
         let (centre, half) = panel_frame(symmetric, a, b);
         let farthest = centre.abs() + half * rule.reach;
         if self.low && farthest < SERIES_REACH {
             let [p0, p1, p2] = self.quadratic;
-            self.panel_with(
-                rule,
-                a,
-                b,
-                symmetric,
-                |s| p0 + s * (p1 + s * p2),
-                sinh_sq2_series,
-            )
+            self.panel_with::<Series>(rule, a, b, symmetric, |s| p0 + s * (p1 + s * p2))
         } else {
             self.panel_far(rule, a, b, symmetric)
         }
@@ -505,39 +562,44 @@ impl<'a> FallIntegrand<'a> {
     fn panel_far(&self, rule: &HalfRule, a: f64, b: f64, symmetric: bool) -> PanelSum {
         if self.low {
             let [p0, p1, p2] = self.quadratic;
-            self.panel_with(rule, a, b, symmetric, |s| p0 + s * (p1 + s * p2), sinh_sq2)
+            self.panel_with::<AnyReach>(rule, a, b, symmetric, |s| p0 + s * (p1 + s * p2))
         } else {
-            self.panel_with(rule, a, b, symmetric, |s| horner(self.coeffs, s), sinh_sq2)
+            self.panel_with::<AnyReach>(rule, a, b, symmetric, |s| horner(self.coeffs, s))
         }
     }
 
     /// [`FallIntegrand::panel`] with the polynomial `p`.
     #[inline(always)]
-    fn panel_with(
+    fn panel_with<Sq: SinhSq>(
         &self,
         rule: &HalfRule,
         a: f64,
         b: f64,
         symmetric: bool,
         p: impl Fn(f64) -> f64,
-        sq2: impl Fn([f64; 2]) -> [f64; 2],
     ) -> PanelSum {
         let (centre, half) = panel_frame(symmetric, a, b);
         // Sums of half values (the integrand over 2), and their least.
         let (acc, least) = if symmetric {
-            // Half of the rule on [-b, b]: each node once (the integrand is even).
-            let (mut acc2, mut least2) = ([0.0; 2], [f64::INFINITY; 2]);
-            for l in &rule.lanes {
-                let f = self.half_value2_with(sq2([half * l.x[0], half * l.x[1]]), &p);
-                least2 = [lesser(least2[0], f[0]), lesser(least2[1], f[1])];
-                acc2 = [acc2[0] + l.w[0] * f[0], acc2[1] + l.w[1] * f[1]];
+            // Half of the rule on [-b, b]: each node once (the integrand is even), a lane
+            // each, summed across the lanes in one fixed order at the end.
+            let (mut acc, mut least) = ([0.0; LANES], [f64::INFINITY; LANES]);
+            for &Lane { x, w } in &rule.lanes {
+                let f = self.half_values_with(Sq::lanes(x.map(|x| half * x)), &p);
+                for i in 0..LANES {
+                    least[i] = lesser(least[i], f[i]);
+                    acc[i] += w[i] * f[i];
+                }
             }
-            (acc2[0] + acc2[1], lesser(least2[0], least2[1]))
+            (
+                ((acc[0] + acc[1]) + acc[2]) + acc[3],
+                lesser(lesser(lesser(least[0], least[1]), least[2]), least[3]),
+            )
         } else {
             let (mut acc, mut least) = (0.0, f64::INFINITY);
             for &(x, w) in &rule.halved {
                 let hx = half * x;
-                let [up, down] = self.half_value2_with(sq2([centre + hx, centre - hx]), &p);
+                let [up, down] = self.half_values_with(Sq::lanes([centre + hx, centre - hx]), &p);
                 least = lesser(least, lesser(up, down));
                 acc += w * (up + down);
             }
@@ -1150,8 +1212,8 @@ mod tests {
             for got in [
                 sinh_sq(y),
                 sinh_sq(-y),
-                sinh_sq2([y, 0.1])[0],
-                sinh_sq2([2.0, y])[1],
+                AnyReach::lanes([y, 0.1])[0],
+                AnyReach::lanes([2.0, y, 0.3, 1.0])[1],
             ] {
                 worst = worst.max(((got - want) / want).abs());
             }
@@ -1183,7 +1245,7 @@ mod tests {
                 // The same sum from the lanes (each node at +x and -x, the node at 0 halved,
                 // the padding weightless).
                 let lanes: f64 = (rule.lanes.iter())
-                    .flat_map(|l| [(l.x[0], l.w[0]), (l.x[1], l.w[1])])
+                    .flat_map(|l| l.x.into_iter().zip(l.w))
                     .map(|(x, w)| 2.0 * w * x.powi(2 * j as i32))
                     .sum();
                 assert!((lanes - exact).abs() < 1e-14, "lanes {order}, x^{}", 2 * j);
@@ -1191,9 +1253,9 @@ mod tests {
             assert_eq!(rule.halved.len(), rule.pairs.len() + odd);
             let largest = rule.pairs.iter().fold(0.0f64, |m, &(x, _)| m.max(x));
             assert_eq!(rule.reach, largest);
-            assert_eq!(rule.lanes.len(), rule.halved.len().div_ceil(2));
+            assert_eq!(rule.lanes.len(), rule.halved.len().div_ceil(LANES));
             let flat: Vec<(f64, f64)> = (rule.lanes.iter())
-                .flat_map(|l| [(l.x[0], l.w[0]), (l.x[1], l.w[1])])
+                .flat_map(|l| l.x.into_iter().zip(l.w))
                 .collect();
             assert!(flat.starts_with(&rule.halved));
         }
