@@ -1,12 +1,13 @@
 //! Cost of solving: one parameter point's separation angle and time, through the planner and
 //! through the sweeps' lean per-point solver, on the integrated route (the two-coordinate
 //! `rod_cube_spring`, `rod_cube_friction` sliding and sticking, and `rod_cube` forced onto it),
-//! and the paper's whole scene
+//! the fixed set of 1,000 points of `examples/per_point.rs` on both compiled copies of the per-point route, and the
+//! paper's whole scene
 //! (`scenes/paper.yaml`, every quantity, 1000 samples per series) without writing files.
 //!
 //! Run: `cargo bench --bench solve -- --warm-up-time 1 --measurement-time 3`.
 
-use criterion::{Criterion, criterion_group, criterion_main};
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use rodcube::plan::{self, Request};
 use rodcube::quantity::Quantity;
 use rodcube::report;
@@ -15,6 +16,9 @@ use rodcube::solve::lean::LeanSolver;
 use rodcube::solve::phases::Route;
 use std::hint::black_box;
 use std::path::Path;
+
+#[path = "../examples/common/per_point_set.rs"]
+mod set;
 
 /// The paper's case by name.
 const PAPER: [(&str, f64); 5] = [
@@ -61,6 +65,37 @@ fn per_point(c: &mut Criterion) {
                 .expect("the paper's point solves")
         })
     });
+    g.finish();
+    per_point_set(c, model);
+}
+
+/// The fixed set of 1,000 points (`examples/per_point.rs`), one solver, one thread:
+/// the AVX2 copy of the per-point route where the CPU has it, against the baseline copy (the
+/// same results to the bit).
+fn per_point_set(c: &mut Criterion, model: &'static dyn rodcube::model::Model) {
+    let points = set::per_point_set(1000);
+    let mut g = c.benchmark_group("per_point_set");
+    g.throughput(Throughput::Elements(points.len() as u64));
+    let mut wide = LeanSolver::new(model).expect("rod_cube has a contact");
+    let mut baseline = LeanSolver::new(model).expect("rod_cube has a contact");
+    baseline.baseline_only();
+    let label = if wide.wide() {
+        "avx2_copy"
+    } else {
+        "baseline_copy_no_avx2_here"
+    };
+    for (label, solver) in [(label, &mut wide), ("baseline_copy", &mut baseline)] {
+        g.bench_function(label, |b| {
+            b.iter(|| {
+                let mut sum = 0.0;
+                for p in &points {
+                    let r = solver.solve(black_box(p)).expect("the set's points solve");
+                    sum += r.separation_angle + r.separation_time;
+                }
+                sum
+            })
+        });
+    }
     g.finish();
 }
 

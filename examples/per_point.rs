@@ -3,9 +3,9 @@
 //! angles plus times to 17 significant digits (run it under `valgrind --tool=callgrind` to count
 //! instructions per point; see `benches/README.md`).
 //!
-//! The set: the 100 x 100 grid `n_i = 10^(-3 + 6 i / 99)`, `a/ell_j = 0.01 + 0.98 j / 99`
-//! (`ell = g = m1 = 1`, `m2 = n`), row-major by `i`; point `k` is grid index
-//! `(7919 k) mod 10000`.
+//! The set (`examples/common/per_point_set.rs`): the 100 x 100 grid `n_i = 10^(-3 + 6 i / 99)`,
+//! `a/ell_j = 0.01 + 0.98 j / 99` (`ell = g = m1 = 1`, `m2 = n`), row-major by `i`; point `k` is
+//! grid index `(7919 k) mod 10000`.
 //!
 //! Usage: `cargo run --release --example per_point -- [N] [--baseline]` (`--baseline`: the
 //! baseline instruction set even where the CPU has AVX2; the results are the same to the bit).
@@ -14,14 +14,8 @@ use rodcube::models;
 use rodcube::solve::lean::LeanSolver;
 use std::process::ExitCode;
 
-/// Parameters `[m1, m2, ell, a, g]` of point `k` of the set (`n` holds the grid's 100 mass
-/// ratios, computed once).
-fn point(n: &[f64], k: usize) -> [f64; 5] {
-    let index = (7919 * k) % 10_000;
-    let (i, j) = (index / 100, index % 100);
-    let a = 0.01 + 0.98 * j as f64 / 99.0;
-    [1.0, n[i], 1.0, a, 1.0]
-}
+#[path = "common/per_point_set.rs"]
+mod set;
 
 fn main() -> ExitCode {
     let (mut count, mut baseline) = (1000, false);
@@ -44,10 +38,7 @@ fn main() -> ExitCode {
         eprintln!("per_point: the model rod_cube is not generated");
         return ExitCode::FAILURE;
     };
-    let n: Vec<f64> = (0..100)
-        .map(|i| 10f64.powf(-3.0 + 6.0 * i as f64 / 99.0))
-        .collect();
-    let points: Vec<[f64; 5]> = (0..count).map(|k| point(&n, k)).collect();
+    let points = set::per_point_set(count);
     let mut solver = match LeanSolver::new(model) {
         Ok(s) => s,
         Err(e) => {
