@@ -1,8 +1,8 @@
 //! Cost of solving: one parameter point's separation angle and time, through the planner and
 //! through the sweeps' lean per-point solver, on the integrated route (the two-coordinate
 //! `rod_cube_spring`, `rod_cube_friction` sliding and sticking, and `rod_cube` forced onto it),
-//! the fixed set of 1,000 points of `examples/per_point.rs` on both compiled copies of the per-point route, and the
-//! paper's whole scene
+//! the fixed set of 1,000 points of `examples/per_point.rs` on both compiled copies of the
+//! per-point route, and the paper's whole scene
 //! (`scenes/paper.yaml`, every quantity, 1000 samples per series) without writing files.
 //!
 //! Run: `cargo bench --bench solve -- --warm-up-time 1 --measurement-time 3`.
