@@ -19,7 +19,7 @@
 
 use super::cas::{self, A};
 use super::expr::{Expr, product, sum};
-use super::mechanics::{is_zero_trig, reduce_cos_sq};
+use super::algebra::{is_zero_trig, reduce_cos_sq};
 
 /// The rule that picks a presentation form among the candidates, as stated in the outputs.
 pub const RULE: &str = "fewest operations (each +, -, *, /, ^ and function call in the printed \

@@ -16,7 +16,8 @@
 
 use super::cas::{self, A};
 use super::expr::{Expr, product, sum};
-use super::mechanics::{Derivation, is_zero_trig, to_sc_expr};
+use super::algebra::{is_zero_trig, to_sc_expr};
+use super::types::Derivation;
 use super::present::{Presenter, Shape, operations};
 use std::collections::BTreeMap;
 
