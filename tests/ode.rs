@@ -1,15 +1,18 @@
 //! The unreduced ODE route (DOPRI5 with event location) against the quadrature route: the
-//! separation time, the state along the way, and conservation along the ODE path.
+//! separation time, the state along the way, and conservation along the ODE path; and both
+//! integrators (DOPRI5 and DOP853) on the rod and cube's unreduced equations.
 
 mod common;
 
 use common::paper::{FREE_ROD, ROD_CUBE, paper, ratios};
 use rodcube::results::{CheckKind, Work};
+use rodcube::solve::SolveError;
 use rodcube::solve::checks;
+use rodcube::solve::ode::{self, Method, OdeOptions, OdeProblem};
 use rodcube::solve::quadrature::TimeMesh;
 use rodcube::solve::separation::separation;
 use rodcube::solve::series::{delta_at_time, theta_dot_at};
-use rodcube::solve::unreduced::{EndEvent, integrate};
+use rodcube::solve::unreduced::{EndEvent, accelerations, integrate};
 use rodcube::system::{State, System};
 
 fn quadrature_separation(sys: &System) -> (f64, TimeMesh) {
@@ -119,4 +122,90 @@ fn free_rod_reaches_the_floor_event() {
     assert_eq!(run.end, EndEvent::Floor);
     assert!(((run.t_end - mesh.duration) / mesh.duration).abs() < 1e-9);
     assert!(run.state_end.q[1].abs() < 1e-12);
+}
+
+/// The unreduced equations as the integrator sees them, written here from the public API: the
+/// deviation `z = y - y0` from the release state, the contact force as the event.
+struct Unreduced<'a> {
+    sys: &'a System<'a>,
+    y0: Vec<f64>,
+    evals: u64,
+}
+
+impl Unreduced<'_> {
+    fn state(&self, z: &[f64]) -> State {
+        let n = self.y0.len() / 2;
+        let y: Vec<f64> = z.iter().zip(&self.y0).map(|(z, y0)| y0 + z).collect();
+        State {
+            q: y[..n].to_vec(),
+            qd: y[n..].to_vec(),
+        }
+    }
+}
+
+impl OdeProblem for Unreduced<'_> {
+    fn dim(&self) -> usize {
+        self.y0.len()
+    }
+    fn rhs(&mut self, t: f64, z: &[f64], dz: &mut [f64]) -> Result<(), SolveError> {
+        self.evals += 1;
+        let n = self.y0.len() / 2;
+        let state = self.state(z);
+        dz[..n].copy_from_slice(&state.qd);
+        dz[n..].copy_from_slice(&accelerations(self.sys, &state, t)?);
+        Ok(())
+    }
+    fn n_events(&self) -> usize {
+        1
+    }
+    fn events(&mut self, _t: f64, z: &[f64], dz: &[f64], g: &mut [f64]) -> Result<(), SolveError> {
+        let n = self.y0.len() / 2;
+        let contact = self.sys.info().contact.map_or(0, |c| c.force);
+        g[0] = self.sys.forces_full(&self.state(z), &dz[n..], &[])[contact];
+        Ok(())
+    }
+}
+
+/// Both integrators on the rod and cube to separation, against the quadrature's time; prints
+/// the counts behind [`Method::CROSSOVER_RTOL`]'s choice.
+#[test]
+fn both_integrators_find_the_separation() {
+    let sys = System::new(&ROD_CUBE, &paper(9.81)).unwrap();
+    let (t_quad, _) = quadrature_separation(&sys);
+    let start = sys.initial_state();
+    let y0 = [start.q.clone(), start.qd.clone()].concat();
+    for rtol in [
+        1e-6, 1e-8, 1e-9, 1e-10, 5e-11, 3e-11, 2e-11, 1e-11, 1e-12, 1e-13,
+    ] {
+        let opts = OdeOptions {
+            rtol,
+            atol: Vec::new(),
+            t_max: 1.0,
+            max_steps: 200_000,
+        };
+        let mut evals = [0; 2];
+        for (e, method) in evals.iter_mut().zip([Method::Dopri5, Method::Dop853]) {
+            let mut problem = Unreduced {
+                sys: &sys,
+                y0: y0.clone(),
+                evals: 0,
+            };
+            let zero = vec![0.0; y0.len()];
+            let sol = ode::integrate(method, &mut problem, 0.0, &zero, &opts).unwrap();
+            let t = sol.event.as_ref().unwrap().t;
+            let rel = ((t - t_quad) / t_quad).abs();
+            *e = problem.evals;
+            println!(
+                "rtol {rtol:.0e} {method}: {} accepted + {} rejected + {} event trials, {} evaluations, rel diff {rel:.2e}",
+                sol.accepted, sol.rejected, sol.event_trials, problem.evals
+            );
+            assert!(rel < rtol, "{method} at rtol {rtol:e}: {rel:e}");
+            if rtol <= 1e-10 {
+                assert!(rel < 1e-12, "{method} at rtol {rtol:e}: {rel:e}");
+            }
+        }
+        if rtol <= 1e-11 {
+            assert!(evals[1] < evals[0], "rtol {rtol:e}: {evals:?}");
+        }
+    }
 }
