@@ -6,6 +6,7 @@
 //! as `rodcube::derive::spec` (and [`expr`] as `rodcube::derive::expr`).
 
 pub mod expr;
+pub mod units;
 
 use crate::yaml::{At, Document, ReadError, Step, excerpt, line_text};
 use annotate_snippets::{Group, Level, Renderer};
