@@ -127,10 +127,14 @@ static INFO: ModelInfo = ModelInfo {
         PhaseInfo {
             closed: &[0, 1],
             model: "fixed_cylinder_closed",
+            release: true,
+            separation_degree: 0,
         },
         PhaseInfo {
             closed: &[1],
             model: "fixed_cylinder_free",
+            release: false,
+            separation_degree: 0,
         },
     ],
     reduction: Some(ReductionInfo {

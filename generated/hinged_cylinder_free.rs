@@ -167,10 +167,14 @@ static INFO: ModelInfo = ModelInfo {
         PhaseInfo {
             closed: &[0, 1, 2],
             model: "hinged_cylinder_closed",
+            release: true,
+            separation_degree: 0,
         },
         PhaseInfo {
             closed: &[1, 2],
             model: "hinged_cylinder_free",
+            release: false,
+            separation_degree: 0,
         },
     ],
     reduction: Some(ReductionInfo {

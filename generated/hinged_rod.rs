@@ -135,10 +135,14 @@ static INFO: ModelInfo = ModelInfo {
         PhaseInfo {
             closed: &[0, 1, 2],
             model: "hinged_rod_closed",
+            release: true,
+            separation_degree: 3,
         },
         PhaseInfo {
             closed: &[1, 2],
             model: "hinged_rod_free",
+            release: false,
+            separation_degree: 0,
         },
     ],
     reduction: None,

@@ -136,6 +136,8 @@ static INFO: ModelInfo = ModelInfo {
     phases: &[PhaseInfo {
         closed: &[0, 1, 2],
         model: "hinged_rod_spring_closed",
+        release: true,
+        separation_degree: 0,
     }],
     reduction: Some(ReductionInfo {
         k_theta_initial: 6,

@@ -135,10 +135,14 @@ static INFO: ModelInfo = ModelInfo {
         PhaseInfo {
             closed: &[0, 1],
             model: "loaded_rod_closed",
+            release: true,
+            separation_degree: 3,
         },
         PhaseInfo {
             closed: &[1],
             model: "loaded_rod_free",
+            release: false,
+            separation_degree: 0,
         },
     ],
     reduction: Some(ReductionInfo {
@@ -481,10 +485,10 @@ impl Reduction for LoadedRodClosed {
         let k = &k[..49]; // one bounds check for all constant loads
         match contact {
             0 => {
-                out[0] = k[38];
-                out[1] = -k[39];
+                out[0] = -k[38];
+                out[1] = k[39];
                 out[2] = 0.0;
-                out[3] = k[31];
+                out[3] = -k[31];
             }
             1 => {
                 out[0] = k[40];

@@ -171,10 +171,14 @@ static INFO: ModelInfo = ModelInfo {
         PhaseInfo {
             closed: &[0, 1],
             model: "loaded_rod_closed",
+            release: true,
+            separation_degree: 3,
         },
         PhaseInfo {
             closed: &[1],
             model: "loaded_rod_free",
+            release: false,
+            separation_degree: 0,
         },
     ],
     reduction: Some(ReductionInfo {

@@ -125,10 +125,14 @@ static INFO: ModelInfo = ModelInfo {
         PhaseInfo {
             closed: &[0, 1],
             model: "rod_cube_closed",
+            release: true,
+            separation_degree: 3,
         },
         PhaseInfo {
             closed: &[1],
             model: "rod_cube_free",
+            release: false,
+            separation_degree: 0,
         },
     ],
     reduction: None,

@@ -125,10 +125,14 @@ static INFO: ModelInfo = ModelInfo {
         PhaseInfo {
             closed: &[0, 1],
             model: "rod_cube_closed",
+            release: true,
+            separation_degree: 3,
         },
         PhaseInfo {
             closed: &[1],
             model: "rod_cube_free",
+            release: false,
+            separation_degree: 0,
         },
     ],
     reduction: Some(ReductionInfo {
@@ -376,10 +380,10 @@ impl Reduction for RodCubeClosed {
         let k = &k[..44]; // one bounds check for all constant loads
         match contact {
             0 => {
-                out[0] = k[35];
-                out[1] = -k[36];
+                out[0] = -k[35];
+                out[1] = k[36];
                 out[2] = 0.0;
-                out[3] = k[29];
+                out[3] = -k[29];
             }
             1 => {
                 out[0] = k[37];

@@ -136,6 +136,8 @@ static INFO: ModelInfo = ModelInfo {
     phases: &[PhaseInfo {
         closed: &[1],
         model: "rod_cylinder_free",
+        release: false,
+        separation_degree: 0,
     }],
     reduction: None,
     route_note: "coordinate `y1` is not cyclic (the Lagrangian depends on it), so it cannot be eliminated through a conserved momentum",

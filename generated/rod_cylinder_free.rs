@@ -172,6 +172,8 @@ static INFO: ModelInfo = ModelInfo {
     phases: &[PhaseInfo {
         closed: &[1],
         model: "rod_cylinder_free",
+        release: false,
+        separation_degree: 0,
     }],
     reduction: Some(ReductionInfo {
         k_theta_initial: 7,

@@ -115,10 +115,14 @@ static INFO: ModelInfo = ModelInfo {
         PhaseInfo {
             closed: &[0, 1],
             model: "wall_ladder_closed",
+            release: true,
+            separation_degree: 1,
         },
         PhaseInfo {
             closed: &[1],
             model: "wall_ladder_free",
+            release: false,
+            separation_degree: 0,
         },
     ],
     reduction: Some(ReductionInfo {

@@ -117,7 +117,7 @@ pub fn sweep(args: SweepArgs) -> Result<(), Failure> {
         ))
     })?;
     let info = model.info();
-    if info.contact.is_none() {
+    if !info.contacts.first().is_some_and(|c| !c.bilateral) {
         return Err(usage(sweep::SweepError::NoContact { model: info.name }));
     }
     let extra = sweep::parse_want(model, &args.want).map_err(usage)?;

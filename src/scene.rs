@@ -549,7 +549,7 @@ impl Ctx<'_> {
                     format!(
                         "model `{}` cannot provide `{name}`: {}; it offers: {}",
                         info.name,
-                        unavailable_reason(q, info),
+                        unavailable_reason(q),
                         Quantity::names(info).join(", ")
                     ),
                 )),
@@ -689,10 +689,16 @@ fn finish(mut out: Vec<Diagnostic>) -> SceneError {
 }
 
 /// Why a model cannot provide a quantity it knows by name.
-fn unavailable_reason(q: Quantity, info: &ModelInfo) -> &'static str {
+fn unavailable_reason(q: Quantity) -> &'static str {
     match q {
-        Quantity::FloorImpact if info.contact.is_some() => "it has no phase after separation",
-        _ => "it has no separating contact",
+        Quantity::LinearisedSeparationAngle => {
+            "it has no fast phase at release whose separation is a polynomial root"
+        }
+        Quantity::ContactTimeToFloor | Quantity::CrossCheck => {
+            "it has no fast phase that starts at release"
+        }
+        Quantity::ContactEnd => "it has no contact",
+        _ => "its first contact is not a unilateral contact",
     }
 }
 

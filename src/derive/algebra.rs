@@ -283,12 +283,19 @@ pub fn positive(e: &Expr, pos: &[String]) -> bool {
 /// Factorises and drops the factors free of `rc_s` that are strictly positive (or negative
 /// constants), so that what is left is the separation polynomial up to a positive factor.
 pub fn strip_positive_factors(poly: &A, pos: &[String]) -> Result<A, DeriveError> {
+    Ok(strip_signed(poly, pos)?.0)
+}
+
+/// [`strip_positive_factors`], and whether the factors dropped were negative overall (the
+/// polynomial left then has the opposite sign of `poly`).
+pub fn strip_signed(poly: &A, pos: &[String]) -> Result<(A, bool), DeriveError> {
     let f = to_expr(&cas::factor(poly), "factorised separation polynomial")?;
     let factors = match f {
         Expr::Mul(v) => v,
         e => vec![e],
     };
     let mut kept = Vec::new();
+    let mut negated = false;
     for x in factors {
         let has_s = x.symbols().contains("rc_s");
         if has_s {
@@ -297,11 +304,12 @@ pub fn strip_positive_factors(poly: &A, pos: &[String]) -> Result<A, DeriveError
         }
         let (neg, mag) = x.split_sign();
         if positive(&mag, pos) || (neg && mag.symbols().is_empty()) {
+            negated ^= neg;
             continue;
         }
         kept.push(x);
     }
-    Ok(cas::expand(&cas::atom(&product(kept))))
+    Ok((cas::expand(&cas::atom(&product(kept))), negated))
 }
 
 /// Solves `mat x = rhs` symbolically by Gauss–Jordan elimination (entries brought over one

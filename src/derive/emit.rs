@@ -90,6 +90,10 @@ pub struct PhaseEntry {
     pub closed: Vec<usize>,
     /// Its model's name.
     pub model: String,
+    /// Whether it starts from the spec's release state.
+    pub release: bool,
+    /// Its separation polynomial's degree (0 without one).
+    pub separation_degree: usize,
 }
 
 /// The static description of a model (`ModelInfo`'s fields), as literals.
@@ -404,7 +408,12 @@ fn static_info(
         })
         .collect();
     let phases_info = (phases.iter())
-        .map(|p| format!("PhaseInfo {{ closed: &{:?}, model: {:?} }}", p.closed, p.model))
+        .map(|p| {
+            format!(
+                "PhaseInfo {{ closed: &{:?}, model: {:?}, release: {}, separation_degree: {} }}",
+                p.closed, p.model, p.release, p.separation_degree
+            )
+        })
         .collect();
     let frictions_info = (d.frictions.iter())
         .map(|f| {

@@ -307,10 +307,14 @@ fn rustfmt(model: &str, text: &str) -> Result<String, Error> {
 /// the system lists them.
 fn fast_phases(phases: &[Derivation]) -> Vec<emit::PhaseEntry> {
     (phases.iter())
-        .filter(|d| d.reduction.is_ok())
-        .map(|d| emit::PhaseEntry {
-            closed: d.plan.closed.clone(),
-            model: d.name.clone(),
+        .filter_map(|d| {
+            let r = d.reduction.as_ref().ok()?;
+            Some(emit::PhaseEntry {
+                closed: d.plan.closed.clone(),
+                model: d.name.clone(),
+                release: !d.plan.start_params,
+                separation_degree: r.separation().map_or(0, |s| s.coefficients.len() - 1),
+            })
         })
         .collect()
 }

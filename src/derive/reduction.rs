@@ -15,8 +15,8 @@
 
 use super::algebra::{
     coefficients_in_s, collect_over, constant_value, d_theta, fall_polynomial, free_of,
-    from_sc, gap_vars, is_zero_trig, reduce_cos_sq, simplify_inverse_trig, solve_linear,
-    strip_positive_factors, to_expr, to_sc,
+    from_sc, gap_vars, is_zero_trig, positive, reduce_cos_sq, simplify_inverse_trig,
+    solve_linear, strip_signed, to_expr, to_sc,
 };
 use super::cas::{self, A};
 use super::constraints::ContactAtoms;
@@ -438,7 +438,18 @@ impl Reducer<'_> {
     ) -> Result<Result<Separation, Unreducible>, DeriveError> {
         let f = cas::together(&gap_vars(&self.on_motion(red, contact_force)));
         let fe = to_expr(&f, "contact force")?;
-        let (num, _) = fe.num_den();
+        let (num, den) = fe.num_den();
+        let mut positive_symbols = self.positive.clone();
+        positive_symbols.push("rc_si".into());
+        positive_symbols.push("rc_ci".into());
+        // The polynomial keeps the force's sign only where its denominator is evidently
+        // positive (a square, positive parameters); otherwise the zero is bracketed instead.
+        if !positive(&product(den), &positive_symbols) {
+            return Ok(Err(
+                "the sign of the force's denominator is not evident, so its zero is bracketed"
+                    .into(),
+            ));
+        }
         let numer = reduce_cos_sq(&cas::atom(&product(num)));
         let p0 = cas::expand(&cas::subs_var(&numer, "rc_c", &cas::num(0)));
         let p1 = cas::expand(&cas::subs_var(
@@ -453,6 +464,7 @@ impl Reducer<'_> {
                     .into(),
             ));
         }
+        // A factor cos(theta) is positive on the phase (0 < theta < pi/2).
         let poly = if cas::is_zero(&p1) {
             p0
         } else if cas::is_zero(&p0) {
@@ -463,10 +475,12 @@ impl Reducer<'_> {
                     .into(),
             ));
         };
-        let mut positive = self.positive.clone();
-        positive.push("rc_si".into());
-        positive.push("rc_ci".into());
-        let poly = strip_positive_factors(&poly, &positive)?;
+        let (poly, negated) = strip_signed(&poly, &positive_symbols)?;
+        let poly = if negated {
+            cas::expand(&(cas::num(0) - poly))
+        } else {
+            poly
+        };
         match coefficients_in_s(&poly, "coefficient")? {
             Some(coefficients) => Ok(Ok(Separation {
                 coefficients,

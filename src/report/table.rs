@@ -415,9 +415,10 @@ fn work(out: &mut String, results: &RunResults, layout: &Layout) {
 pub fn quantity_meaning(q: Quantity, info: &ModelInfo) -> String {
     match q {
         Quantity::ForceSeries(i) => {
+            let c = &info.contacts[i];
             format!(
-                "t and {} along the motion (N): {}",
-                info.forces[i].name, info.forces[i].meaning
+                "t and {} along the motion ({}): {}",
+                c.name, c.unit, c.meaning
             )
         }
         Quantity::Trajectory(i) => format!(
