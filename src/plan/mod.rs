@@ -626,7 +626,15 @@ impl<'m> Plan<'m> {
             };
             let bound = self.general().clone();
             let t_max = 2.0 * duration.max(f64::MIN_POSITIVE);
-            let run = unreduced::integrate(&bound, &from, self.walker.rtol, None, t_max, &mut self.work)?;
+            let scales = self.walker.scales(&from.state, &from.active)?;
+            let run = unreduced::integrate(
+                &bound,
+                &from,
+                self.walker.rtol,
+                Some(&scales),
+                t_max,
+                &mut self.work,
+            )?;
             self.ode = Some(run);
         }
         self.ode.as_ref().ok_or(SolveError::TooManyPhases { limit: 0 })

@@ -104,7 +104,7 @@ impl Plan<'_> {
             dy_max,
             "1",
             format!(
-                "largest relative difference between the integrated and the reduced states over {nodes} steps"
+                "largest difference between the integrated and the reduced states over {nodes} steps, relative to the largest coordinate (or velocity) on the path"
             ),
         );
         Ok(())
@@ -222,10 +222,19 @@ fn path_deviation(
     let sys = &first.system;
     let theta_i = sys.theta_initial();
     let nodes = ode.nodes();
-    let mut scale = vec![0.0f64; nodes.first().map_or(0, |(_, y)| y.len())];
+    // Each component against the largest of its kind on the path (coordinates, velocities):
+    // a coordinate a joint holds at zero carries only rounding, not a scale of its own.
+    let n = nodes.first().map_or(0, |(_, y)| y.len() / 2);
+    let mut scale = vec![0.0f64; 2 * n];
     for (_, y) in &nodes {
         for (s, v) in scale.iter_mut().zip(y.iter()) {
             *s = s.max(v.abs());
+        }
+    }
+    for kind in [0..n, n..2 * n] {
+        let top = scale[kind.clone()].iter().cloned().fold(0.0, f64::max);
+        for s in &mut scale[kind] {
+            *s = top;
         }
     }
     let (mut dt_max, mut dy_max) = (0.0f64, 0.0f64);

@@ -487,7 +487,7 @@ fn consistent(sys: &Bound, options: &Options, active: &Active, d: &Dynamics) -> 
             (FrictionOption::Keep(_), _) => true,
             (_, Mode::Stick) => d.fr[j].abs() <= mu[j] * normal.max(0.0) * (1.0 + 1e-12),
             (FrictionOption::Breaks(_), Mode::Slide(_)) => true,
-            (_, Mode::Slide(s)) => mu[j] == 0.0 || s * d.slip_acc[j] > 0.0,
+            (_, Mode::Slide(s)) => s * d.slip_acc[j] > 0.0,
         };
         if !ok {
             return false;

@@ -628,6 +628,14 @@ impl<'m> Walker<'m> {
         self.integrate(start, work)
     }
 
+    /// Typical sizes of the motion from `state` with `active` closed over the fall's time
+    /// scale, for the integrator's absolute tolerances ([`motion_scales`]).
+    pub fn scales(&self, state: &State, active: &Active) -> Result<Vec<f64>, SolveError> {
+        let time = fall_time_scale(&self.general, state);
+        let d = contacts::dynamics(&self.general, state, active, 0.0)?;
+        Ok(motion_scales(state, &d.qdd, time))
+    }
+
     /// Integrates the general model from `start` to its first event.
     pub fn integrate(
         &self,
@@ -636,8 +644,7 @@ impl<'m> Walker<'m> {
     ) -> Result<PhaseRun<'m>, SolveError> {
         let bound = self.general.clone();
         let time = fall_time_scale(&bound, &start.state);
-        let d = contacts::dynamics(&bound, &start.state, &start.active, start.t)?;
-        let scales = motion_scales(&start.state, &d.qdd, time);
+        let scales = self.scales(&start.state, &start.active)?;
         let from = Start {
             state: start.state.clone(),
             active: start.active.clone(),

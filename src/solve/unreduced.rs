@@ -51,6 +51,10 @@ pub const MAX_RTOL: f64 = 1e-2;
 /// Most steps before giving up.
 pub const MAX_STEPS: u64 = 200_000;
 
+/// A coordinate's (or velocity's) scale for the absolute tolerances is at least this fraction
+/// of the largest of its kind ([`motion_scales`]).
+pub const SCALE_FLOOR: f64 = 1e-3;
+
 /// Most stick/slip switches in one integration before giving up (a chattering contact).
 pub const MAX_SWITCHES: usize = 1000;
 
@@ -435,8 +439,11 @@ impl OdeProblem for Problem<'_, '_> {
 
 /// Typical sizes of the motion's deviation from its start over the time scale `time`, for the
 /// integrator's absolute tolerances: `|qd0| T + |qdd0| T^2 / 2` for the coordinates and
-/// `|qd0| + |qdd0| T` for the velocities, each at least `1e-8` of the largest of its kind, so
-/// that a tiny system (a rod of 1 cm nearly flat) is held to its own scale, not to one metre.
+/// `|qd0| + |qdd0| T` for the velocities, each at least [`SCALE_FLOOR`] of the largest of its
+/// kind. So a tiny system (a rod of 1 cm nearly flat) is held to its own scale, not to one
+/// metre, and a coordinate a closed contact holds still (the foot's height on the floor, whose
+/// acceleration is rounding noise of the constraint's) is held to the motion's scale, not to
+/// its own noise, which would shrink the steps to nothing.
 pub fn motion_scales(start: &State, qdd: &[f64], time: f64) -> Vec<f64> {
     let q: Vec<f64> = (start.qd.iter().zip(qdd))
         .map(|(v, a)| v.abs() * time + 0.5 * a.abs() * time * time)
@@ -447,7 +454,7 @@ pub fn motion_scales(start: &State, qdd: &[f64], time: f64) -> Vec<f64> {
     let floor = |x: Vec<f64>| {
         let top = x.iter().cloned().fold(0.0, f64::max);
         x.into_iter()
-            .map(|s| s.max(1e-8 * top).max(f64::MIN_POSITIVE))
+            .map(|s| s.max(SCALE_FLOOR * top).max(f64::MIN_POSITIVE))
             .collect::<Vec<f64>>()
     };
     let mut scales = floor(q);
