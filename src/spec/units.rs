@@ -1494,8 +1494,8 @@ mod tests {
         );
     }
 
-    /// The units of a spec's symbols: parameters and coordinates as declared, measured forces
-    /// and friction forces in N, the contact force conjugate to its gap.
+    /// The units of a spec's symbols: parameters and coordinates as declared, obstacle symbols
+    /// in m, friction forces in N, each contact's force conjugate to its gap.
     fn scope(spec: &crate::spec::Spec) -> BTreeMap<String, Unit> {
         let mut units = BTreeMap::new();
         for p in &spec.parameters {
@@ -1504,15 +1504,17 @@ mod tests {
         for c in &spec.coordinates {
             units.insert(c.name.clone(), u(&c.unit));
         }
-        for f in &spec.forces {
-            units.insert(f.name.clone(), Unit::NEWTON);
+        for o in &spec.obstacles {
+            for (symbol, _) in crate::spec::obstacle_symbols(o) {
+                units.insert(symbol, Unit::METRE);
+            }
         }
         for f in &spec.friction {
             units.insert(f.name.clone(), Unit::NEWTON);
         }
-        if let Some(c) = &spec.contact {
+        for c in &spec.contacts {
             let gap = unit_of(&parse(&c.gap), &|s| units.get(s).copied()).unwrap();
-            units.insert(c.force.clone(), conjugate_force_unit(gap).unwrap());
+            units.insert(c.name.clone(), conjugate_force_unit(gap).unwrap());
         }
         units
     }
@@ -1558,9 +1560,9 @@ mod tests {
             for p in &spec.potentials {
                 at("potential", &p.expr, Unit::JOULE);
             }
-            if let Some(c) = &spec.contact {
+            for c in &spec.contacts {
                 at("gap", &c.gap, m);
-                assert_eq!(units.get(&c.force), Some(&Unit::NEWTON));
+                assert_eq!(units.get(&c.name), Some(&Unit::NEWTON));
                 if let Some(edge) = &c.edge {
                     consistent("edge", edge);
                 }
@@ -1575,10 +1577,6 @@ mod tests {
             }
             for r in &spec.requirements {
                 consistent("requirement", &r.expr);
-            }
-            for f in &spec.forces {
-                consistent("direction", &f.direction[0]);
-                consistent("direction", &f.direction[1]);
             }
             for f in &spec.friction {
                 at("friction point", &f.point[0], m);
