@@ -5,6 +5,7 @@
 
 use crate::results::Work;
 use crate::solve::SolveError;
+use crate::solve::contacts::Active;
 use crate::solve::lean::LeanSolver;
 use crate::solve::ode::{OdeOptions, OdeProblem, dopri5};
 use crate::solve::poly::horner;
@@ -12,7 +13,6 @@ use crate::solve::prior::{Prior, integrate_prior};
 use crate::solve::quadrature::{Fall, TimeMesh, gauss_legendre_rule};
 use crate::solve::separation::{linearised_separation, separation};
 use crate::solve::series::sample_phase;
-use crate::solve::contacts::Active;
 use crate::solve::unreduced;
 use crate::system::System;
 use gauss_quad::{FiniteAboveNegOneF64, GaussJacobi};

@@ -10,12 +10,12 @@
 //! dimensionless, which is an error placed at the spec's `dimensionless` field. A free phase
 //! (after the contact) also has the group `omega_0 = theta_dot_0 T` for its start rate.
 
+use super::algebra::{positive, strip_positive_factors, to_sc_expr};
 use super::cas::{self, A};
 use super::expr::Expr;
-use super::algebra::{positive, strip_positive_factors, to_sc_expr};
-use super::types::{Derivation, DeriveError, FieldStep};
 use super::present::{Presenter, Shape};
 use super::spec::{Spec, Text, solved_parameters};
+use super::types::{Derivation, DeriveError, FieldStep};
 
 /// A dimensionless group.
 #[derive(Debug, Clone)]
@@ -206,7 +206,11 @@ pub fn derive(spec: &Spec, d: &Derivation) -> Result<Option<Dimensionless>, Deri
     ));
     // Forces in units of the force scale (a torque, conjugate to an angle, has another unit
     // and is not written here).
-    for c in d.contacts.iter().filter(|c| c.closed && c.force_unit == "N") {
+    for c in d
+        .contacts
+        .iter()
+        .filter(|c| c.closed && c.force_unit == "N")
+    {
         wanted.push((
             c.name.clone(),
             format!("force {}: {}", c.name, c.meaning),

@@ -1,15 +1,15 @@
 //! Turns a [`Derivation`] into template contexts (flat data, computed here) and renders the
 //! tera templates of `templates/` into Rust, LaTeX and JSON text.
 
+use super::algebra::{from_sc, to_sc_expr};
 use super::dimensionless::Dimensionless;
 use super::expr::Expr;
 use super::lower::{Body, Hoisted, Scope, lower};
-use super::algebra::{from_sc, to_sc_expr};
-use super::types::{self as mechanics, Derivation, Reduction};
 use super::method::{Preamble, method};
 use super::present;
 use super::spec::Checked;
 use super::steps::{Shown, Steps};
+use super::types::{self as mechanics, Derivation, Reduction};
 use serde::Serialize;
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -190,7 +190,6 @@ pub fn type_name(name: &str) -> String {
         .collect()
 }
 
-
 /// `out[i] = <output i>;` lines.
 fn out_lines(outputs: &[String]) -> Vec<String> {
     outputs
@@ -326,7 +325,14 @@ fn prepare_code(
             if !indices.contains(&slot) {
                 let c = &r.constants[j];
                 let prefix = format!("c{j}_");
-                bind_constant(&mut prepare, slot, Some(&c.symbol), &c.value, scope, &prefix);
+                bind_constant(
+                    &mut prepare,
+                    slot,
+                    Some(&c.symbol),
+                    &c.value,
+                    scope,
+                    &prefix,
+                );
             }
         }
         lean_indices = indices;
@@ -1001,7 +1007,14 @@ fn contact_code(
     let forces_full = per_contact(d, &|c| c.force.clone(), "0.0", "f", full_scope, hoisted);
     let open = |c: &mechanics::ContactRow| (!c.closed).then(|| c.gap.clone());
     let gaps = per_contact(d, &open, "0.0", "g", full_scope, hoisted);
-    let edges = per_contact(d, &|c| c.edge.clone(), "f64::INFINITY", "e", full_scope, hoisted);
+    let edges = per_contact(
+        d,
+        &|c| c.edge.clone(),
+        "f64::INFINITY",
+        "e",
+        full_scope,
+        hoisted,
+    );
 
     // The constraint rows: every contact's Jacobian row, then its bias.
     let mut exprs: Vec<Expr> = Vec::new();

@@ -40,7 +40,11 @@ pub fn equations(st: &Setup, lag: &Lagrangian, frictions: &[Vec<A>]) -> Equation
     }
     let cyclic: Vec<usize> = (0..st.coords.len())
         .filter(|&i| i != st.reduced && cas::is_zero(&cas::d(&lag.lag, &st.coords[i])))
-        .filter(|&i| frictions.iter().all(|row| row.get(i).is_none_or(cas::is_zero)))
+        .filter(|&i| {
+            frictions
+                .iter()
+                .all(|row| row.get(i).is_none_or(cas::is_zero))
+        })
         .collect();
     let momenta = cyclic
         .iter()
@@ -54,4 +58,3 @@ pub fn equations(st: &Setup, lag: &Lagrangian, frictions: &[Vec<A>]) -> Equation
         momenta,
     }
 }
-

@@ -91,4 +91,3 @@ impl Lagrangian {
         (expanded, cas::d(&self.springs, c))
     }
 }
-

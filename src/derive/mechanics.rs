@@ -22,9 +22,7 @@
 //! force; constants `rc_thi`, `rc_wi`, `rc_si`, `rc_ci`, `rc_ai` (reduced inertia at the
 //! start), `rc_x<j>i` (initial cyclic positions) and `rc_p<j>` (conserved momenta).
 
-pub use super::algebra::{
-    from_sc, is_zero_trig, reduce_cos_sq, simplify_inverse_trig, to_sc_expr,
-};
+pub use super::algebra::{from_sc, is_zero_trig, reduce_cos_sq, simplify_inverse_trig, to_sc_expr};
 pub use super::types::*;
 
 use super::algebra::to_expr;
@@ -71,8 +69,8 @@ pub fn phase_plans(spec: &Spec) -> Vec<PhasePlan> {
                 .collect::<Vec<usize>>()
         })
         .filter(|set| {
-            let keeps_joints = (spec.contacts.iter().enumerate())
-                .all(|(j, c)| !c.bilateral || set.contains(&j));
+            let keeps_joints =
+                (spec.contacts.iter().enumerate()).all(|(j, c)| !c.bilateral || set.contains(&j));
             keeps_joints && set.iter().all(|j| !with_friction.contains(j))
         })
         .collect();
@@ -220,14 +218,15 @@ fn phase_params(spec: &Spec, st: &Setup) -> Result<Vec<Param>, DeriveError> {
 /// phase with start parameters starts from them; otherwise from the spec's `initial`, where
 /// a coordinate a contact eliminates starts where the ties of every eliminable contact (all
 /// closed at release) put it.
-fn phase_initial(
-    spec: &Spec,
-    parsed: &Parsed,
-    st: &Setup,
-) -> Result<Vec<[Expr; 2]>, DeriveError> {
+fn phase_initial(spec: &Spec, parsed: &Parsed, st: &Setup) -> Result<Vec<[Expr; 2]>, DeriveError> {
     if st.plan.start_params {
         return Ok((st.coords.iter())
-            .map(|c| [Expr::sym(&format!("{c}_0")), Expr::sym(&format!("{c}_dot_0"))])
+            .map(|c| {
+                [
+                    Expr::sym(&format!("{c}_0")),
+                    Expr::sym(&format!("{c}_dot_0")),
+                ]
+            })
             .collect());
     }
     let eliminable: Vec<usize> = (0..spec.contacts.len())
@@ -325,10 +324,7 @@ fn point_kinematics(
 }
 
 /// The contacts of a phase as the runtime and the write-up see them.
-fn contact_rows(
-    checked: &Checked,
-    atoms: &[ContactAtoms],
-) -> Result<Vec<ContactRow>, DeriveError> {
+fn contact_rows(checked: &Checked, atoms: &[ContactAtoms]) -> Result<Vec<ContactRow>, DeriveError> {
     let spec = &checked.spec;
     let mut out = Vec::new();
     for (j, (c, a)) in spec.contacts.iter().zip(atoms).enumerate() {

@@ -15,24 +15,24 @@
 //! Every Symbolica call runs on one dedicated thread ([`on_cas_thread`]). In check mode
 //! nothing is written; stale files are reported.
 
-pub mod cas;
-pub mod types;
 pub mod algebra;
-pub mod read;
-pub mod setup;
-pub mod lagrangian;
-pub mod equations;
+pub mod cas;
 pub mod constraints;
-pub mod reduction;
-pub mod forces;
-pub mod mechanics;
-pub mod present;
-pub mod steps;
 pub mod dimensionless;
+pub mod emit;
+pub mod equations;
+pub mod forces;
+pub mod lagrangian;
 pub mod latex;
 pub mod lower;
+pub mod mechanics;
 pub mod method;
-pub mod emit;
+pub mod present;
+pub mod read;
+pub mod reduction;
+pub mod setup;
+pub mod steps;
+pub mod types;
 
 // Spec parsing and expressions need no Symbolica: they live in the runtime crate.
 pub use crate::spec::{self, expr};

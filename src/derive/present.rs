@@ -19,9 +19,9 @@
 //! a typed error, never printed. The others are not checked: they are never printed, and
 //! checking each cost most of the derivation's time.
 
+use super::algebra::{is_zero_trig, reduce_cos_sq};
 use super::cas::{self, A};
 use super::expr::{Expr, product, sum};
-use super::algebra::{is_zero_trig, reduce_cos_sq};
 
 /// The rule that picks a presentation form among the candidates, as stated in the outputs.
 pub const RULE: &str = "fewest operations (each +, -, *, /, ^ and function call in the printed \

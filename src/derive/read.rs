@@ -216,7 +216,10 @@ fn read_shape(
             ShapeKind::Rectangle,
             [centre.to_vec(), vec![parse(w)?, parse(h)?]].concat(),
         ),
-        (None, None, Some(r)) => (ShapeKind::Circle, [centre.to_vec(), vec![parse(r)?]].concat()),
+        (None, None, Some(r)) => (
+            ShapeKind::Circle,
+            [centre.to_vec(), vec![parse(r)?]].concat(),
+        ),
         _ => {
             return Err(at(
                 path,

@@ -14,9 +14,9 @@
 //! error: it is solved by integrating `M(q) qdd = F`, and the reason is recorded.
 
 use super::algebra::{
-    coefficients_in_s, collect_over, constant_value, d_theta, fall_polynomial, free_of,
-    from_sc, gap_vars, is_zero_trig, positive, reduce_cos_sq, simplify_inverse_trig,
-    solve_linear, strip_signed, to_expr, to_sc,
+    coefficients_in_s, collect_over, constant_value, d_theta, fall_polynomial, free_of, from_sc,
+    gap_vars, is_zero_trig, positive, reduce_cos_sq, simplify_inverse_trig, solve_linear,
+    strip_signed, to_expr, to_sc,
 };
 use super::cas::{self, A};
 use super::constraints::ContactAtoms;
@@ -336,8 +336,8 @@ impl Reducer<'_> {
         });
         let wi = self.start_rate(&constants);
         let two = cas::num(2);
-        let wsq = (cas::var("rc_ai") * wi.clone() * wi + two * potential_drop(&v_eff)?)
-            / inertia.clone();
+        let wsq =
+            (cas::var("rc_ai") * wi.clone() * wi + two * potential_drop(&v_eff)?) / inertia.clone();
         let wsq = cas::together(&wsq);
         let half = cas::atom(&Expr::Rational(1, 2));
         let acc = cas::together(&(half * d_theta(&wsq)));
@@ -544,7 +544,6 @@ impl Reducer<'_> {
         Ok(plain)
     }
 }
-
 
 /// `V(theta_i) - V(theta)` in the drops `rc_ds`, `rc_dc` for an effective potential over
 /// `rc_s`, `rc_c`: `2 beta rc_ds + 2 gamma rc_dc`'s halves for the usual

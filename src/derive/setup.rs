@@ -65,7 +65,11 @@ impl Setup {
 /// The ties of the contacts `closed` (indices into the spec's contacts): each gap, with the
 /// ties before it substituted, solved for its coordinate (it must be linear in it, with a
 /// coefficient that is not zero), and the new tie substituted into the earlier ones.
-pub fn ties(spec: &Spec, parsed: &Parsed, closed: &[usize]) -> Result<Vec<(String, A)>, DeriveError> {
+pub fn ties(
+    spec: &Spec,
+    parsed: &Parsed,
+    closed: &[usize],
+) -> Result<Vec<(String, A)>, DeriveError> {
     let mut ties: Vec<(String, A)> = Vec::new();
     for &j in closed {
         let c = spec
@@ -73,10 +77,12 @@ pub fn ties(spec: &Spec, parsed: &Parsed, closed: &[usize]) -> Result<Vec<(Strin
             .get(j)
             .ok_or_else(|| at(&[key("contacts")], format!("no contact {j}")))?;
         let path = entry("contacts", j, "eliminates");
-        let e = c
-            .eliminates
-            .clone()
-            .ok_or_else(|| at(&path, format!("contact `{}` eliminates no coordinate", c.name)))?;
+        let e = c.eliminates.clone().ok_or_else(|| {
+            at(
+                &path,
+                format!("contact `{}` eliminates no coordinate", c.name),
+            )
+        })?;
         let mut gap = cas::atom(&parsed.contacts[j].gap);
         for (name, value) in &ties {
             gap = cas::subs_var(&gap, name, value);

@@ -448,7 +448,9 @@ impl<'m> Plan<'m> {
         if self.release.is_none() {
             self.release = Some(self.walker.release()?);
         }
-        self.release.as_ref().ok_or(SolveError::TooManyPhases { limit: 0 })
+        self.release
+            .as_ref()
+            .ok_or(SolveError::TooManyPhases { limit: 0 })
     }
 
     /// The fast phase the motion starts on, where the release's closed contacts have one.
@@ -519,7 +521,13 @@ impl<'m> Plan<'m> {
                             }
                             .into_phase()
                         }
-                        _ => match ReducedRun::with_end(sys, 0.0, end, self.walker.tol, &mut self.work) {
+                        _ => match ReducedRun::with_end(
+                            sys,
+                            0.0,
+                            end,
+                            self.walker.tol,
+                            &mut self.work,
+                        ) {
                             Ok(run) => run.into_phase(),
                             Err(SolveError::TurningPoint { .. }) => {
                                 self.walker.integrate(&start, &mut self.work)?
@@ -594,8 +602,16 @@ impl<'m> Plan<'m> {
     /// ends at the floor.
     fn floor_mesh(&mut self) -> Result<&TimeMesh, SolveError> {
         if self.floor_mesh.is_none() {
-            let reuse = match (&self.end, self.motion.as_ref().and_then(|m| m.phases[0].reduced())) {
-                (Some(ReducedEnd { end: End::Floor, .. }), Some(r)) => Some(r.mesh.clone()),
+            let reuse = match (
+                &self.end,
+                self.motion.as_ref().and_then(|m| m.phases[0].reduced()),
+            ) {
+                (
+                    Some(ReducedEnd {
+                        end: End::Floor, ..
+                    }),
+                    Some(r),
+                ) => Some(r.mesh.clone()),
                 _ => None,
             };
             let mesh = match reuse {
@@ -637,7 +653,9 @@ impl<'m> Plan<'m> {
             )?;
             self.ode = Some(run);
         }
-        self.ode.as_ref().ok_or(SolveError::TooManyPhases { limit: 0 })
+        self.ode
+            .as_ref()
+            .ok_or(SolveError::TooManyPhases { limit: 0 })
     }
 
     fn quantity(

@@ -121,7 +121,10 @@ impl Plan<'_> {
             && end.end == End::Force(0)
             && let Some(at) = end.at
         {
-            let meaning = format!("{} where the first contact's force vanishes", angle_name(info));
+            let meaning = format!(
+                "{} where the first contact's force vanishes",
+                angle_name(info)
+            );
             scalar(out, &key, at.theta, "rad", meaning);
             return Ok(());
         }
@@ -132,8 +135,10 @@ impl Plan<'_> {
                 cause: "force",
             } => {
                 if q == Quantity::SeparationAngle {
-                    let meaning =
-                        format!("{} where the first contact's force vanishes", angle_name(info));
+                    let meaning = format!(
+                        "{} where the first contact's force vanishes",
+                        angle_name(info)
+                    );
                     scalar(out, &key, theta, "rad", meaning);
                 } else {
                     scalar(out, &key, t, "s", "time from release to separation".into());
@@ -149,7 +154,10 @@ impl Plan<'_> {
     /// Why the first contact does not separate, in words.
     fn why_no_separation(&self, fate: &Fate) -> String {
         let info = self.general().info();
-        let first = info.contacts.first().map_or("the first contact", |c| c.name);
+        let first = info
+            .contacts
+            .first()
+            .map_or("the first contact", |c| c.name);
         match fate {
             Fate::Ended { cause, .. } => format!(
                 "no separation: contact `{first}` ended before its force vanished ({}; \
@@ -201,7 +209,8 @@ impl Plan<'_> {
                 match &fate {
                     Fate::Ended { t, theta, cause } => {
                         let why = cause_words(cause);
-                        let meaning = format!("time from release until contact `{name}` ends: {why}");
+                        let meaning =
+                            format!("time from release until contact `{name}` ends: {why}");
                         scalar(out, &format!("{key}_time"), *t, "s", meaning);
                         let meaning =
                             format!("{} where contact `{name}` ends: {why}", angle_name(info));
@@ -219,10 +228,12 @@ impl Plan<'_> {
                         );
                     }
                     Fate::Held { until } => {
-                        out.notes.insert(key, format!("contact `{name}` holds {until}"));
+                        out.notes
+                            .insert(key, format!("contact `{name}` holds {until}"));
                     }
                     Fate::NeverClosed => {
-                        out.notes.insert(key, format!("contact `{name}` is open at release"));
+                        out.notes
+                            .insert(key, format!("contact `{name}` is open at release"));
                     }
                 }
             }
@@ -295,7 +306,13 @@ impl Plan<'_> {
             info.points[info.falling_point].name,
             format_number(h, 6)
         );
-        scalar(out, &Quantity::PointMassFallTime.name(info), t, "s", meaning);
+        scalar(
+            out,
+            &Quantity::PointMassFallTime.name(info),
+            t,
+            "s",
+            meaning,
+        );
     }
 
     /// Where the series end (s from release): the first contact's end, or the end of the
@@ -415,7 +432,10 @@ impl Plan<'_> {
                     ("t".into(), "s"),
                     ("theta".into(), "rad"),
                     (f.name.into(), "N"),
-                    (info.contacts[f.contact].name.into(), info.contacts[f.contact].unit),
+                    (
+                        info.contacts[f.contact].name.into(),
+                        info.contacts[f.contact].unit,
+                    ),
                     ("slip_velocity".into(), "m/s"),
                 ]
             }
@@ -488,7 +508,10 @@ impl Plan<'_> {
             "impact_angular_velocity",
             omega,
             "rad/s",
-            format!("rate of {} when it reaches its end ({path})", angle_name(info)),
+            format!(
+                "rate of {} when it reaches its end ({path})",
+                angle_name(info)
+            ),
         );
         Ok(())
     }

@@ -112,7 +112,11 @@ impl Plan<'_> {
 
     /// The checks of every phase to the end of the motion, and of the cross-check's path when
     /// it was solved.
-    pub(super) fn checks(&mut self, with_ode: bool, out: &mut RunResults) -> Result<(), SolveError> {
+    pub(super) fn checks(
+        &mut self,
+        with_ode: bool,
+        out: &mut RunResults,
+    ) -> Result<(), SolveError> {
         let n_phases = self.complete()?.phases.len();
         let tol = self.walker.tol;
         for i in 0..n_phases {
@@ -136,7 +140,14 @@ impl Plan<'_> {
             };
             let forces = sample_forces(run, samples)?;
             let mut found = checks::monitors(bound, samples, &forces, tol, &ctx);
-            found.extend(checks::contact_forces(bound, samples, &forces, &run.closed(), tol, &ctx));
+            found.extend(checks::contact_forces(
+                bound,
+                samples,
+                &forces,
+                &run.closed(),
+                tol,
+                &ctx,
+            ));
             found.extend(path_checks(run, samples, tol, &ctx));
             out.checks.extend(found);
         }
@@ -151,7 +162,8 @@ impl Plan<'_> {
                 order: 1,
                 t_start: 0.0,
             };
-            out.checks.extend(integrated_checks(general, ode, ode_tol, &ctx));
+            out.checks
+                .extend(integrated_checks(general, ode, ode_tol, &ctx));
         }
         Ok(())
     }
@@ -170,7 +182,14 @@ fn path_checks(
         PhaseRun::Reduced(r) => {
             let bound = r.system.bound();
             let conserved = Conserved::each_cyclic(bound);
-            checks::drift(bound, &samples.states, &conserved, tol, ctx, CheckKind::Identity)
+            checks::drift(
+                bound,
+                &samples.states,
+                &conserved,
+                tol,
+                ctx,
+                CheckKind::Identity,
+            )
         }
         PhaseRun::Integrated(r) => {
             integrated_checks(&r.bound, &r.run, tol.max(10.0 * r.run.rtol), ctx)

@@ -174,7 +174,14 @@ pub fn contact_forces(
 }
 
 /// A drift check: `drift <= tolerance`.
-fn drift_check(drift: f64, tolerance: f64, kind: CheckKind, ctx: &Context, samples: usize, meaning: String) -> Check {
+fn drift_check(
+    drift: f64,
+    tolerance: f64,
+    kind: CheckKind,
+    ctx: &Context,
+    samples: usize,
+    meaning: String,
+) -> Check {
     Check {
         passed: drift.is_finite() && drift <= tolerance,
         kind,
@@ -210,7 +217,11 @@ pub fn constraint_drift(
     for (state, closed) in states.iter().zip(rows) {
         let gaps = sys.gaps(state);
         for i in (0..m).filter(|&i| closed.get(i) == Some(&true) && !info.contacts[i].closed) {
-            let scale = if info.contacts[i].gap_unit == "m" { length } else { 1.0 };
+            let scale = if info.contacts[i].gap_unit == "m" {
+                length
+            } else {
+                1.0
+            };
             let d = (gaps[i] / scale).abs();
             worst[i] = Some(match worst[i] {
                 Some(w) if d.is_nan() || w.is_nan() => f64::NAN,
@@ -232,7 +243,14 @@ pub fn constraint_drift(
                 format_number(length, 4),
                 format_number(tolerance, 3)
             );
-            let check = drift_check(drift, tolerance, CheckKind::Drift, ctx, states.len(), meaning);
+            let check = drift_check(
+                drift,
+                tolerance,
+                CheckKind::Drift,
+                ctx,
+                states.len(),
+                meaning,
+            );
             Some((format!("{}.{}_gap", ctx.key, c.name), check))
         })
         .collect()
@@ -243,7 +261,11 @@ fn kinetic(sys: &Bound, s: &State) -> f64 {
     let n = sys.n_coordinates();
     let (mass, _) = sys.equations(s);
     0.5 * (0..n)
-        .map(|i| (0..n).map(|j| s.qd[i] * mass[i * n + j] * s.qd[j]).sum::<f64>())
+        .map(|i| {
+            (0..n)
+                .map(|j| s.qd[i] * mass[i * n + j] * s.qd[j])
+                .sum::<f64>()
+        })
         .sum::<f64>()
 }
 
@@ -355,7 +377,9 @@ fn null_space(rows: &[Vec<f64>], k: usize) -> Vec<Vec<f64>> {
         return unit_free;
     }
     // The columns some row touches: their null space by SVD.
-    let touched: Vec<usize> = (0..k).filter(|&c| rows.iter().any(|r| r[c] != 0.0)).collect();
+    let touched: Vec<usize> = (0..k)
+        .filter(|&c| rows.iter().any(|r| r[c] != 0.0))
+        .collect();
     let a = DMatrix::from_fn(rows.len().max(touched.len()), touched.len(), |r, c| {
         rows.get(r).map_or(0.0, |row| row[touched[c]])
     });
@@ -412,7 +436,11 @@ pub fn drift(
     let e0 = sys.energy(first) - work_at(0);
     let combine = |p: &[f64], w: &[f64]| -> f64 { p.iter().zip(w).map(|(a, b)| a * b).sum() };
     let p_first = sys.momenta(first);
-    let p0: Vec<f64> = conserved.momenta.iter().map(|(_, w)| combine(&p_first, w)).collect();
+    let p0: Vec<f64> = conserved
+        .momenta
+        .iter()
+        .map(|(_, w)| combine(&p_first, w))
+        .collect();
     let (mut e_dev, mut kin_max) = (0.0f64, 0.0f64);
     let (mut v_min, mut v_max) = (f64::INFINITY, f64::NEG_INFINITY);
     let mut p_dev = vec![0.0f64; p0.len()];

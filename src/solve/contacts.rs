@@ -205,7 +205,11 @@ pub fn dynamics(
     t: f64,
 ) -> Result<Dynamics, SolveError> {
     let info = sys.info();
-    let (n, m, nf) = (sys.n_coordinates(), info.contacts.len(), info.frictions.len());
+    let (n, m, nf) = (
+        sys.n_coordinates(),
+        info.contacts.len(),
+        info.frictions.len(),
+    );
     if active.closed.len() != m || active.modes.len() != nf {
         return Err(SolveError::ActiveSize {
             model: info.name,
@@ -515,7 +519,12 @@ fn combinations(sys: &Bound, options: &Options, t: f64) -> Result<Vec<Active>, S
         .ok_or_else(|| SolveError::Indeterminate {
             model: info.name,
             t,
-            contacts: info.contacts.iter().map(|c| c.name).collect::<Vec<_>>().join(", "),
+            contacts: info
+                .contacts
+                .iter()
+                .map(|c| c.name)
+                .collect::<Vec<_>>()
+                .join(", "),
             why: format!("more than {MAX_COMBINATIONS} combinations of contact states to try"),
         })?;
     let mut out: Vec<Active> = Vec::new();
@@ -532,7 +541,13 @@ fn combinations(sys: &Bound, options: &Options, t: f64) -> Result<Vec<Active>, S
         let canonical = |a: &Active| Active {
             closed: a.closed.clone(),
             modes: (a.modes.iter().enumerate())
-                .map(|(j, m)| if a.friction_acts(info, j) { *m } else { Mode::Stick })
+                .map(|(j, m)| {
+                    if a.friction_acts(info, j) {
+                        *m
+                    } else {
+                        Mode::Stick
+                    }
+                })
                 .collect(),
         };
         let c = canonical(&active);
@@ -547,12 +562,7 @@ fn combinations(sys: &Bound, options: &Options, t: f64) -> Result<Vec<Active>, S
 /// consistent sets, those that stick the most frictions are kept; if several remain and all
 /// give the same accelerations (a contact whose force and normal acceleration both vanish),
 /// the one with the most contacts closed; otherwise [`SolveError::Indeterminate`].
-pub fn decide(
-    sys: &Bound,
-    state: &State,
-    options: &Options,
-    t: f64,
-) -> Result<Active, SolveError> {
+pub fn decide(sys: &Bound, state: &State, options: &Options, t: f64) -> Result<Active, SolveError> {
     let info = sys.info();
     let mut found: Vec<(Active, Dynamics)> = Vec::new();
     let mut singular: Vec<String> = Vec::new();
@@ -618,10 +628,13 @@ fn pick(
             ),
         });
     };
-    let scale = d0.qdd.iter().fold(0.0f64, |m, a| m.max(a.abs())).max(1e-300);
-    let same = |d: &Dynamics| {
-        (d.qdd.iter().zip(&d0.qdd)).all(|(a, b)| (a - b).abs() <= 1e-9 * scale)
-    };
+    let scale = d0
+        .qdd
+        .iter()
+        .fold(0.0f64, |m, a| m.max(a.abs()))
+        .max(1e-300);
+    let same =
+        |d: &Dynamics| (d.qdd.iter().zip(&d0.qdd)).all(|(a, b)| (a - b).abs() <= 1e-9 * scale);
     if found.iter().all(|(_, d)| same(d)) {
         let closed = |a: &Active| a.closed.iter().filter(|c| **c).count();
         let best = found.iter().map(|(a, _)| closed(a)).max().unwrap_or(0);

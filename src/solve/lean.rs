@@ -27,17 +27,17 @@
 //! high-precision reference (`rodcube::reference`, feature `cli`) across `n = m2/m1` from 1e-12 to 1e12 and
 //! `a/ell` from 1e-10 to `1 - 1e-9`.
 
+use crate::model::PhaseInfo;
 use crate::model::{LeanStart, Model, ModelInfo, Reduction, ReductionInfo};
+use crate::results::Work;
 use crate::solve::SolveError;
+use crate::solve::phases::{End, phase_end};
+use crate::solve::poly::horner;
 use crate::solve::poly::{self, MAX_DEGREE};
 use crate::solve::prior::{PRIOR_TOL, Prior, Singularities, integrate_prior, prior_panels};
 use crate::solve::quadrature::{
     self, ACCEPT, Control, Fall, FallIntegrand, HalfRule, PanelSum, RuleStep, SCHEDULE, v_at_drop,
 };
-use crate::model::PhaseInfo;
-use crate::results::Work;
-use crate::solve::phases::{End, phase_end};
-use crate::solve::poly::horner;
 use crate::system::{
     System, SystemError, check_parameters, ordered_values, positive_finite, prepare_constants,
 };
@@ -46,8 +46,7 @@ use crate::system::{
 /// that is not a system's general model is taken as it is.
 fn release_phase(model: &dyn Model) -> Result<&dyn Model, SolveError> {
     let info = model.info();
-    if !info.is_general() || model.reduction().is_some() && info.contacts.iter().all(|c| c.closed)
-    {
+    if !info.is_general() || model.reduction().is_some() && info.contacts.iter().all(|c| c.closed) {
         return Ok(model);
     }
     let entry: Option<&PhaseInfo> = info.phases.iter().find(|p| p.release);
@@ -176,7 +175,11 @@ impl<'m> LeanSolver<'m> {
                 why: info.route_note,
             }));
         };
-        let why = if !info.contacts.first().is_some_and(|c| c.closed && !c.bilateral) {
+        let why = if !info
+            .contacts
+            .first()
+            .is_some_and(|c| c.closed && !c.bilateral)
+        {
             Some("its first contact is not a closed unilateral contact")
         } else if info.contacts.iter().any(|c| !c.closed) {
             Some("it leaves a contact open, whose gap only the planner watches")
@@ -401,7 +404,6 @@ impl<'m> LeanSolver<'m> {
         self.evals += evals;
         Ok(t)
     }
-
 }
 
 /// Whether the CPU has AVX2 (where the unchecked route has a copy for it).

@@ -47,7 +47,9 @@ pub enum SolveError {
     #[error("{0}")]
     Parameters(SystemError),
     /// Separation was asked of a model whose first contact is not closed in it.
-    #[error("model `{model}` does not hold a unilateral first contact closed, so it cannot separate")]
+    #[error(
+        "model `{model}` does not hold a unilateral first contact closed, so it cannot separate"
+    )]
     NoContact {
         /// Model name.
         model: &'static str,

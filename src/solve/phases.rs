@@ -651,8 +651,15 @@ impl<'m> Walker<'m> {
             frictions: start.frictions.clone(),
             friction_work: start.friction_work,
         };
-        let run = unreduced::integrate(&bound, &from, self.rtol, Some(&scales), time * MAX_FALL_TIMES, work)
-            .map_err(|e| at_time(e, start.t))?;
+        let run = unreduced::integrate(
+            &bound,
+            &from,
+            self.rtol,
+            Some(&scales),
+            time * MAX_FALL_TIMES,
+            work,
+        )
+        .map_err(|e| at_time(e, start.t))?;
         let phase = PhaseRun::Integrated(IntegratedRun {
             bound,
             t_start: start.t,

@@ -64,7 +64,11 @@ pub fn force_zero(
     work: &mut Work,
 ) -> Result<SeparationOutcome, SolveError> {
     let info = sys.info();
-    if !info.contacts.get(contact).is_some_and(|c| c.closed && !c.bilateral) {
+    if !info
+        .contacts
+        .get(contact)
+        .is_some_and(|c| c.closed && !c.bilateral)
+    {
         return Err(SolveError::NoContact { model: info.name });
     }
     let Some(coeffs) = sys.force_coefficients(contact) else {
@@ -104,7 +108,11 @@ pub fn separation_root(
 
 /// Where a closed contact runs off its edge: the first zero of its edge margin, which on the
 /// fast path depends on the angle alone (the derivation checks it).
-pub fn edge(sys: &System, contact: usize, work: &mut Work) -> Result<SeparationOutcome, SolveError> {
+pub fn edge(
+    sys: &System,
+    contact: usize,
+    work: &mut Work,
+) -> Result<SeparationOutcome, SolveError> {
     let margin = |sys: &System, delta: f64| {
         let edges = sys.edges(&sys.full_state(0.0, delta, 0.0));
         edges.get(contact).copied().unwrap_or(f64::NAN)

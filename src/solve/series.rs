@@ -94,7 +94,11 @@ pub fn sample_reduced_at(
         } else if target >= mesh.duration {
             mesh.delta_end
         } else {
-            let lo = if target >= t_prev { (v_prev, t_prev) } else { (0.0, 0.0) };
+            let lo = if target >= t_prev {
+                (v_prev, t_prev)
+            } else {
+                (0.0, 0.0)
+            };
             let v = invert(sys, mesh, target, lo.0, lo.1, work)?;
             v_prev = v;
             t_prev = target;
@@ -146,7 +150,11 @@ pub fn sample(run: &PhaseRun, samples: usize, work: &mut Work) -> Result<PhaseSa
 }
 
 /// Samples of a phase on either route at the phase times `times` (ascending, within it).
-pub fn sample_at(run: &PhaseRun, times: &[f64], work: &mut Work) -> Result<PhaseSamples, SolveError> {
+pub fn sample_at(
+    run: &PhaseRun,
+    times: &[f64],
+    work: &mut Work,
+) -> Result<PhaseSamples, SolveError> {
     match run {
         PhaseRun::Reduced(r) => sample_reduced_at(&r.system, &r.mesh, times, work),
         PhaseRun::Integrated(r) => sample_integrated_at(r, times),
@@ -161,7 +169,10 @@ pub fn sample_integrated(run: &IntegratedRun, samples: usize) -> Result<PhaseSam
 
 /// Samples of an integrated phase at the phase times `times`, from its dense output (a time
 /// at the end is the event state itself).
-pub fn sample_integrated_at(run: &IntegratedRun, times: &[f64]) -> Result<PhaseSamples, SolveError> {
+pub fn sample_integrated_at(
+    run: &IntegratedRun,
+    times: &[f64],
+) -> Result<PhaseSamples, SolveError> {
     let bound = &run.bound;
     let n = bound.n_coordinates();
     let r = bound.info().reduced;

@@ -560,13 +560,16 @@ pub fn integrate(
             q: y[..n].to_vec(),
             qd: y[n..2 * n].to_vec(),
         };
-        let watch = problem.watches.get(event.index).copied().ok_or_else(|| {
-            SolveError::OdeNonFinite {
-                what: "event index outside the watched events",
-                t: event.t,
-                y: y.clone(),
-            }
-        })?;
+        let watch =
+            problem
+                .watches
+                .get(event.index)
+                .copied()
+                .ok_or_else(|| SolveError::OdeNonFinite {
+                    what: "event index outside the watched events",
+                    t: event.t,
+                    y: y.clone(),
+                })?;
         let end = match watch {
             Watch::Force(i) => Some(EndEvent::Force(i)),
             Watch::Gap(i) => Some(EndEvent::Gap(i)),

@@ -11,11 +11,11 @@ pub mod units;
 use crate::yaml::{At, Document, ReadError, Step, excerpt, line_text};
 use annotate_snippets::{Group, Level, Renderer};
 use expr::{Expr, FUNCTIONS, gcd};
-use units::{Unit, conjugate_force_unit, expect_unit, unit_of};
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
 use std::path::{Path, PathBuf};
+use units::{Unit, conjugate_force_unit, expect_unit, unit_of};
 
 /// An expression field: YAML may write it as a string or a bare number.
 #[derive(Debug, Clone, Deserialize)]
@@ -770,7 +770,9 @@ impl Checker<'_> {
         }
         names.kinematic = names.params.clone();
         names.kinematic.extend(names.coords.iter().cloned());
-        names.kinematic.extend(names.obstacle_symbols.iter().cloned());
+        names
+            .kinematic
+            .extend(names.obstacle_symbols.iter().cloned());
         Ok(names)
     }
 
@@ -874,8 +876,12 @@ impl Checker<'_> {
         let units = self.symbol_units()?;
         let lookup = |n: &str| units.get(n).copied();
         let expect = |field: Field, text: &Text, unit: Unit, what: &str| {
-            let e = Expr::parse(&text.text())
-                .map_err(|e| self.err(&field, format!("cannot parse `{}`: {}", text.text(), e.message)))?;
+            let e = Expr::parse(&text.text()).map_err(|e| {
+                self.err(
+                    &field,
+                    format!("cannot parse `{}`: {}", text.text(), e.message),
+                )
+            })?;
             expect_unit(&e, &lookup, unit)
                 .map_err(|err| self.err(&field, format!("{what} must be in {unit}: {err}")))
         };
@@ -887,8 +893,18 @@ impl Checker<'_> {
             let f = Field::key("bodies").i(i);
             expect(f.k("mass"), &b.mass, Unit::KILOGRAM, "a mass")?;
             expect(f.k("inertia"), &b.inertia, kg_m2, "a moment of inertia")?;
-            expect(f.k("position").i(0), &b.position[0], Unit::METRE, "a position")?;
-            expect(f.k("position").i(1), &b.position[1], Unit::METRE, "a position")?;
+            expect(
+                f.k("position").i(0),
+                &b.position[0],
+                Unit::METRE,
+                "a position",
+            )?;
+            expect(
+                f.k("position").i(1),
+                &b.position[1],
+                Unit::METRE,
+                "a position",
+            )?;
             expect(f.k("angle"), &b.angle, Unit::DIMENSIONLESS, "an angle")?;
         }
         for (i, p) in s.potentials.iter().enumerate() {
@@ -899,24 +915,32 @@ impl Checker<'_> {
         for (i, c) in s.contacts.iter().enumerate() {
             let field = Field::key("contacts").i(i);
             let gap = Expr::parse(&c.gap.text()).map_err(|e| {
-                self.err(&field.k("gap"), format!("cannot parse `{}`: {}", c.gap.text(), e.message))
+                self.err(
+                    &field.k("gap"),
+                    format!("cannot parse `{}`: {}", c.gap.text(), e.message),
+                )
             })?;
             let gap_unit = unit_of(&gap, &lookup).map_err(|err| {
                 self.err(
                     &field.k("gap"),
-                    format!("the gap of contact `{}` has no consistent unit: {err}", c.name),
+                    format!(
+                        "the gap of contact `{}` has no consistent unit: {err}",
+                        c.name
+                    ),
                 )
             })?;
-            let force_unit = conjugate_force_unit(gap_unit).map_err(|err| {
-                self.err(&field.k("gap"), format!("contact `{}`: {err}", c.name))
-            })?;
+            let force_unit = conjugate_force_unit(gap_unit)
+                .map_err(|err| self.err(&field.k("gap"), format!("contact `{}`: {err}", c.name)))?;
             if let Some(edge) = &c.edge
                 && let Ok(e) = Expr::parse(&edge.text())
                 && let Err(err) = unit_of(&e, &lookup)
             {
                 return Err(self.err(
                     &field.k("edge"),
-                    format!("the edge of contact `{}` has no consistent unit: {err}", c.name),
+                    format!(
+                        "the edge of contact `{}` has no consistent unit: {err}",
+                        c.name
+                    ),
                 ));
             }
             // A torque and an energy are both kg m^2 s^-2: a multiplier is a torque.

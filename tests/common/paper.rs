@@ -678,7 +678,6 @@ impl Reduction for FreeRod {
     }
 }
 
-
 // ---------------------------------------------------------------------------------------------
 // rod_cube, the general model
 // ---------------------------------------------------------------------------------------------
@@ -772,7 +771,9 @@ impl Model for General {
         let (s, c) = q[2].sin_cos();
         let (v1, u1, w) = (qd[0], qd[1], qd[2]);
         let (vx, vy) = (v1 - 0.5 * ell * s * w, u1 + 0.5 * ell * c * w);
-        0.5 * m1 * (vx * vx + vy * vy) + m1 * ell * ell * w * w / 24.0 + 0.5 * m2 * qd[3] * qd[3]
+        0.5 * m1 * (vx * vx + vy * vy)
+            + m1 * ell * ell * w * w / 24.0
+            + 0.5 * m2 * qd[3] * qd[3]
             + m1 * g * (q[1] + 0.5 * ell * s)
             + m2 * g * a / 2.0
     }
@@ -789,10 +790,22 @@ impl Model for General {
         let w = qd[2];
         let (hs, hc) = (0.5 * m1 * ell * s, 0.5 * m1 * ell * c);
         mass.copy_from_slice(&[
-            m1, 0.0, -hs, 0.0, //
-            0.0, m1, hc, 0.0, //
-            -hs, hc, m1 * ell * ell / 3.0, 0.0, //
-            0.0, 0.0, 0.0, m2,
+            m1,
+            0.0,
+            -hs,
+            0.0, //
+            0.0,
+            m1,
+            hc,
+            0.0, //
+            -hs,
+            hc,
+            m1 * ell * ell / 3.0,
+            0.0, //
+            0.0,
+            0.0,
+            0.0,
+            m2,
         ]);
         rhs.copy_from_slice(&[hc * w * w, hs * w * w - m1 * g, -hc * g, 0.0]);
     }
