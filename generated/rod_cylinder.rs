@@ -74,7 +74,7 @@ static INFO: ModelInfo = ModelInfo {
     contacts: &[
         ContactInfo {
             name: "contact_force",
-            meaning: "horizontal push of the rod on the cylinder, positive while they touch",
+            meaning: "push of the rod on the cylinder, normal to the rod, positive while they touch",
             gap_unit: "m",
             unit: "N",
             bilateral: false,
@@ -299,34 +299,27 @@ impl Model for RodCylinder {
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
         let k = &k[..19]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        out[0] = -(k[3] / rc_s) - (k[3] * rc_c / rc_s) - q[0] + q[3] + (q[1] * rc_c / rc_s);
+        out[0] = -k[3] - (k[3] * rc_c) - (q[0] * rc_s) + (q[3] * rc_s) + (q[1] * rc_c);
         out[1] = q[1];
     }
 
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
         let k = &k[..19]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let jt0 = rc_c * rc_c;
-        let jt1 = qd[2] * qd[2];
-        let jt2 = rc_c.powi(3);
-        jac[0] = -1.0;
-        jac[1] = rc_c / rc_s;
-        jac[2] = k[3] + (k[3] * rc_c / (rc_s * rc_s)) + (k[3] * jt0 / (rc_s * rc_s))
-            - q[1]
-            - (q[1] * jt0 / (rc_s * rc_s));
-        jac[3] = 1.0;
+        let jt0 = qd[2] * qd[2];
+        jac[0] = -rc_s;
+        jac[1] = rc_c;
+        jac[2] = (k[3] * rc_s) - (q[0] * rc_c) + (q[3] * rc_c) - (q[1] * rc_s);
+        jac[3] = rc_s;
         jac[4] = 0.0;
         jac[5] = 1.0;
         jac[6] = 0.0;
         jac[7] = 0.0;
-        bias[0] = -(k[3] * jt1 / rc_s)
-            - (k[8] * jt1 * rc_c / rc_s)
-            - (k[8] * jt1 * jt0 / rc_s.powi(3))
-            - (k[8] * jt1 * jt2 / rc_s.powi(3))
-            - (2.0 * qd[2] * qd[1])
-            - (2.0 * qd[2] * qd[1] * jt0 / (rc_s * rc_s))
-            + (2.0 * jt1 * q[1] * rc_c / rc_s)
-            + (2.0 * jt1 * q[1] * jt2 / rc_s.powi(3));
+        bias[0] = (k[3] * jt0 * rc_c) - (2.0 * qd[2] * qd[0] * rc_c) + (2.0 * qd[2] * qd[3] * rc_c)
+            - (2.0 * qd[2] * qd[1] * rc_s)
+            + (jt0 * q[0] * rc_s)
+            - (jt0 * q[3] * rc_s)
+            - (jt0 * q[1] * rc_c);
         bias[1] = 0.0;
     }
 

@@ -110,7 +110,7 @@ static INFO: ModelInfo = ModelInfo {
     contacts: &[
         ContactInfo {
             name: "contact_force",
-            meaning: "horizontal push of the rod on the cylinder, positive while they touch",
+            meaning: "push of the rod on the cylinder, normal to the rod, positive while they touch",
             gap_unit: "m",
             unit: "N",
             bilateral: false,
@@ -342,25 +342,24 @@ impl Model for RodCylinderFree {
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
         let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        out[0] = -(k[3] / rc_s) - (k[3] * rc_c / rc_s) - q[0] + q[2];
+        out[0] = -k[3] - (k[3] * rc_c) - (q[0] * rc_s) + (q[2] * rc_s);
         out[1] = 0.0;
     }
 
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
         let k = &k[..40]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let jt0 = rc_c * rc_c;
-        let jt1 = qd[1] * qd[1];
-        jac[0] = -1.0;
-        jac[1] = k[3] + (k[3] * rc_c / (rc_s * rc_s)) + (k[3] * jt0 / (rc_s * rc_s));
-        jac[2] = 1.0;
+        let jt0 = qd[1] * qd[1];
+        jac[0] = -rc_s;
+        jac[1] = (k[3] * rc_s) - (q[0] * rc_c) + (q[2] * rc_c);
+        jac[2] = rc_s;
         jac[3] = 0.0;
         jac[4] = 0.0;
         jac[5] = 0.0;
-        bias[0] = -(k[3] * jt1 / rc_s)
-            - (k[18] * jt1 * rc_c / rc_s)
-            - (k[18] * jt1 * jt0 / rc_s.powi(3))
-            - (k[18] * jt1 * rc_c.powi(3) / rc_s.powi(3));
+        bias[0] = (k[3] * jt0 * rc_c) - (2.0 * qd[1] * qd[0] * rc_c)
+            + (2.0 * qd[1] * qd[2] * rc_c)
+            + (jt0 * q[0] * rc_s)
+            - (jt0 * q[2] * rc_s);
         bias[1] = 0.0;
     }
 

@@ -497,12 +497,18 @@ impl Ctx<'_> {
             }
         };
 
+        let systems = || -> Vec<&str> {
+            (registry.iter().map(|m| m.info()))
+                .filter(|i| i.is_general())
+                .map(|i| i.name)
+                .collect()
+        };
         let Some(model) = registry
             .iter()
             .copied()
             .find(|m| m.info().name == raw.model)
         else {
-            let names: Vec<&str> = registry.iter().map(|m| m.info().name).collect();
+            let names = systems();
             let available = if names.is_empty() {
                 "none (no model has been generated yet)".to_string()
             } else {
@@ -520,6 +526,22 @@ impl Ctx<'_> {
             return Err(finish(out));
         };
         let info = model.info();
+        if !info.is_general() {
+            out.push(self.diag(
+                Kind::UnknownModel,
+                "model",
+                At::Value,
+                format!(
+                    "model `{}` is a phase of the system `{}`, which decides its phases itself: \
+                     write `model: {}`; the systems are: {}",
+                    info.name,
+                    info.system,
+                    info.system,
+                    systems().join(", ")
+                ),
+            ));
+            return Err(finish(out));
+        }
 
         // want
         let mut want = Vec::new();

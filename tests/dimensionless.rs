@@ -162,8 +162,15 @@ fn the_hinged_rod_separates_where_3_n_s3_plus_3_s_equals_2_r() {
 
 /// Every spec in `derivations/` has groups and scales, every phase on the fast path writes its
 /// results in them alone (and the general models, integrated, none), and no printed form is
-/// longer than the raw result it came from (nor than 160 operations). Every violation is
+/// longer than the raw result it came from (nor than [`MOST_OPERATIONS`]). Every violation is
 /// listed.
+/// The longest printed form allowed, a guard against presentation regressions. The paper's
+/// family stays below 160; the closed phases with a curved contact and a second contact
+/// (`fixed_cylinder_closed`'s floor push, `hinged_cylinder_closed`'s hinge forces) are
+/// polynomials of degree 7 in sin and cos with three parameters, about 220 operations after
+/// factoring, and set this bound.
+const MOST_OPERATIONS: usize = 240;
+
 #[test]
 fn every_printed_form_is_bounded_and_free_of_units() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("derivations");
@@ -201,9 +208,12 @@ fn every_printed_form_is_bounded_and_free_of_units() {
                         r.form.to_infix()
                     ));
                 }
-                if r.operations > 160 {
+                if d.name.starts_with("rod_cube") && r.operations > 160 {
+                    bad.push(format!("{what}: {} operations > 160", r.operations));
+                }
+                if r.operations > MOST_OPERATIONS {
                     bad.push(format!(
-                        "{what}: {} operations > 160: {}",
+                        "{what}: {} operations > {MOST_OPERATIONS}: {}",
                         r.operations,
                         r.form.to_infix()
                     ));

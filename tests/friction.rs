@@ -15,7 +15,7 @@ use rodcube::quantity::Quantity;
 use rodcube::results::{RunResults, Work};
 use rodcube::solve::SolveError;
 use rodcube::solve::contacts::{
-    Active, Mode, Options, contact_options, decide, dynamics, friction_options,
+    Active, Mode, Moment, Options, contact_options, decide, dynamics, friction_options,
 };
 use rodcube::solve::phases::{PhaseRun, PhaseStart, Route, Walker};
 use rodcube::system::{Bound, State, SystemError};
@@ -304,7 +304,7 @@ fn free_rod_state(theta: f64, v1: f64, omega: f64) -> State {
 fn decide_free_rod(mu: f64, state: &State) -> Result<Active, SolveError> {
     let bound = Bound::new(model("rod_cube_friction"), &paper(mu)).unwrap();
     let options = Options {
-        contacts: contact_options(&bound, state)?,
+        contacts: contact_options(&bound, state, Moment::Release)?,
         frictions: friction_options(&bound, state),
     };
     decide(&bound, state, &options, 0.0)

@@ -187,8 +187,9 @@ fn the_cylinder_forces_balance_each_body_by_hand() {
         let (push, floor) = (f[0], f[1]);
         let (s, c) = (theta.sin(), theta.cos());
         let (x1dd, y1dd, thdd, xcdd) = (qdd[0], qdd[1], qdd[2], qdd[3]);
-        // The push is normal to the rod: on the cylinder N (sin, -cos), N = push / sin.
-        let n = push / s;
+        // The push is normal to the rod (its gap is the distance to the rod's line): on the
+        // cylinder N (sin, -cos).
+        let n = push;
         let d = r * (1.0 + c) / s; // contact point's distance from the foot
         // The rod's centre of mass and its acceleration.
         let ax = x1dd - 0.5 * ell * (s * thdd + c * omega * omega);
@@ -200,7 +201,7 @@ fn the_cylinder_forces_balance_each_body_by_hand() {
             (m1 * ax + n * s) / (m1 * g),
             (m1 * ay - (n * c + floor - m1 * g)) / (m1 * g),
             (inertia * thdd - ((d - 0.5 * ell) * n - 0.5 * ell * c * floor)) / (m1 * g * ell),
-            (m2 * xcdd - push) / (m1 * g),
+            (m2 * xcdd - n * s) / (m1 * g),
             (xcdd - axc) / g,
             y1dd / g,
         ];

@@ -203,10 +203,11 @@ fn a_polynomial_without_a_sign_change_is_named() {
     // Masses of 1e-300 kg: the polynomial's coefficients (products of masses) underflow, and so
     // does the push at release. The true separation is at sin(theta) = 2r/3 after
     // (2/3) sqrt(a/g) = 2.1e-151 s (PHYSICS.md's flat-rod limit), which the solver cannot form:
-    // a typed error, not a separation at release.
+    // a typed error (the push at release is 0/0), not a separation at release.
     let mut solver = LeanSolver::new(rod_cube()).unwrap();
     match solver.solve(&[1e-300, 1e-300, 1.0, 1e-300, 9.81]) {
         Err(SolveError::NoSeparation { lo, hi, .. }) => assert!(lo < hi),
+        Err(SolveError::NonFinite { value, delta, .. }) => assert!(value.is_nan() && delta == 0.0),
         other => panic!("{other:?}"),
     }
     // A tweaked polynomial that never vanishes (the contact holds to the floor).

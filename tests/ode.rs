@@ -52,7 +52,12 @@ fn integrate_general(
         friction_work: 0.0,
     };
     let d = contacts::dynamics(general, &start.state, &start.active, 0.0).unwrap();
-    let scales = motion_scales(&start.state, &d.qdd, fall_time_scale(general, &start.state));
+    let scales = motion_scales(
+        general,
+        &start.state,
+        &d.qdd,
+        fall_time_scale(general, &start.state),
+    );
     integrate(general, &start, rtol, Some(&scales), t_max, work).unwrap()
 }
 

@@ -8,10 +8,11 @@
 
 use proptest::prelude::*;
 use rodcube::model::Model;
-use rodcube::plan::{self, DEFAULT_TOLERANCE, Request};
+use rodcube::plan::{self, DEFAULT_TOLERANCE, PlanError, Request};
 use rodcube::quantity::Quantity;
 use rodcube::reference::{Inputs, Reference, RootRoute, TimeRoute, relative_error};
 use rodcube::results::{CheckKind, Work};
+use rodcube::solve::SolveError;
 use rodcube::solve::checks::{self, Conserved};
 use rodcube::solve::lean::LeanSolver;
 use rodcube::solve::phases::{End, PhaseRun, ReducedEnd, ReducedRun};
@@ -245,8 +246,24 @@ fn check_contact_end(model: &'static dyn Model, p: &[f64]) -> Result<(), TestCas
     let request = Request::new(model, p.to_vec())
         .with_want(&[Quantity::ContactEnd, Quantity::Checks])
         .with_samples(50);
-    let res = plan::run(&request)
-        .map_err(|e| TestCaseError::fail(format!("{}: {p:?}: {e}", model.info().name)))?;
+    let res = match plan::run(&request) {
+        Ok(res) => res,
+        // A rod whose foot lifts can pivot over its support and reach the end angle in the
+        // air (a rod lying across a cylinder's top): the spec's end angle is no landing
+        // there, and the planner says so. Only a foot free to lift can do that.
+        Err(PlanError::Solve(SolveError::AboveFloor { height, .. })) => {
+            let info = model.info();
+            let lifts = (info.contacts.iter()).any(|c| c.name == "floor_normal" && !c.bilateral);
+            prop_assert!(lifts && height > 0.0, "{}: {p:?}: above floor", info.name);
+            return Ok(());
+        }
+        Err(e) => {
+            return Err(TestCaseError::fail(format!(
+                "{}: {p:?}: {e}",
+                model.info().name
+            )));
+        }
+    };
     match res.results.get("contact_end_time") {
         Some(t) => {
             let theta = res.results["contact_end_angle"].value;

@@ -23,6 +23,10 @@ use super::algebra::{is_zero_trig, reduce_cos_sq};
 use super::cas::{self, A};
 use super::expr::{Expr, product, sum};
 
+/// A candidate form ranked: operations, characters, order made, the form, and the constant
+/// factor dropped from it.
+type Ranked = (usize, usize, usize, Expr, (i128, i128));
+
 /// The rule that picks a presentation form among the candidates, as stated in the outputs.
 pub const RULE: &str = "fewest operations (each +, -, *, /, ^ and function call in the printed \
                         form counts one), then fewest characters; each form checked equal to \
@@ -187,7 +191,7 @@ impl<'a> Presenter<'a> {
         let count = candidates.len();
         // Ranked by the rule (fewest operations, then fewest characters; the first made wins a
         // tie), each with the constant factor a condition `= 0` is written without.
-        let mut ranked: Vec<(usize, usize, usize, Expr, (i128, i128))> = (candidates.into_iter())
+        let mut ranked: Vec<Ranked> = (candidates.into_iter())
             .enumerate()
             .map(|(i, mut f)| {
                 let dropped = match shape {

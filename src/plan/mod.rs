@@ -378,6 +378,9 @@ struct Plan<'m> {
     floor_mesh: Option<TimeMesh>,
     /// Each solved phase's samples, uniform over it (checks and the animation).
     phase_samples: Vec<PhaseSamples>,
+    /// The series' samples over the first contact's span: per phase touched, its index, its
+    /// samples and their times from release.
+    span: Option<Vec<(usize, PhaseSamples, Vec<f64>)>>,
     /// The cross-check's integration.
     ode: Option<UnreducedRun>,
 }
@@ -434,6 +437,7 @@ impl<'m> Plan<'m> {
             motion: None,
             floor_mesh: None,
             phase_samples: Vec::new(),
+            span: None,
             ode: None,
         }
     }
@@ -521,19 +525,7 @@ impl<'m> Plan<'m> {
                             }
                             .into_phase()
                         }
-                        _ => match ReducedRun::with_end(
-                            sys,
-                            0.0,
-                            end,
-                            self.walker.tol,
-                            &mut self.work,
-                        ) {
-                            Ok(run) => run.into_phase(),
-                            Err(SolveError::TurningPoint { .. }) => {
-                                self.walker.integrate(&start, &mut self.work)?
-                            }
-                            Err(e) => return Err(e),
-                        },
+                        _ => self.walker.follow(sys, &start, end, &mut self.work)?,
                     }
                 }
                 None => self.walker.solve(&start, &mut self.work)?,
@@ -589,7 +581,17 @@ impl<'m> Plan<'m> {
                 let Some(run) = motion.phases.get(self.phase_samples.len()) else {
                     break;
                 };
-                let s = crate::solve::series::sample(run, self.samples, &mut self.work)?;
+                let k = self.phase_samples.len();
+                let times = crate::solve::series::uniform_times(run.duration(), self.samples)?;
+                // The series' samples where they are this phase's own (a span that is the
+                // whole of it, from the release): the same times, so not sampled twice.
+                let shared = (self.span.iter().flatten())
+                    .find(|(g, s, _)| *g == k && run.t_start() == 0.0 && s.t == times)
+                    .map(|(_, s, _)| s.clone());
+                let s = match shared {
+                    Some(s) => s,
+                    None => crate::solve::series::sample_at(run, &times, &mut self.work)?,
+                };
                 self.phase_samples.push(s);
             }
         }

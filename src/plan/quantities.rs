@@ -340,8 +340,11 @@ impl Plan<'_> {
 
     /// Samples at `samples` uniform times from release to [`Plan::span_end`], each in its
     /// phase: per phase touched, its index, its samples (times from the phase's start) and the
-    /// same times from release.
+    /// same times from release. Sampled once and shared by every series.
     fn span_samples(&mut self) -> Result<Vec<(usize, PhaseSamples, Vec<f64>)>, SolveError> {
+        if let Some(done) = &self.span {
+            return Ok(done.clone());
+        }
         let end = self.span_end()?;
         let times = crate::solve::series::uniform_times(end, self.samples)?;
         let Some(motion) = self.motion.as_ref() else {
@@ -366,6 +369,7 @@ impl Plan<'_> {
             let s = sample_at(phase, &local, &mut self.work)?;
             out.push((k, s, ts));
         }
+        self.span = Some(out.clone());
         Ok(out)
     }
 
@@ -389,8 +393,8 @@ impl Plan<'_> {
             let phase = &motion.phases[*k];
             match q {
                 Quantity::ThetaSeries => {
-                    for j in 0..s.len() {
-                        push(&[t[j], s.theta[j], s.theta_dot[j], s.theta_ddot[j]]);
+                    for (j, tj) in t.iter().enumerate().take(s.len()) {
+                        push(&[*tj, s.theta[j], s.theta_dot[j], s.theta_ddot[j]]);
                     }
                 }
                 Quantity::ForceSeries(i) => {

@@ -127,7 +127,7 @@ impl Plan<'_> {
             };
             let run = &motion.phases[i];
             let bound = run.bound();
-            let label = run.labels().join(", ");
+            let label = run.labels().join(" then ");
             let ctx = checks::Context {
                 phase: label.clone(),
                 key: if matches!(run, PhaseRun::Reduced(_)) {

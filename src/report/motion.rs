@@ -145,7 +145,7 @@ impl Animation {
         };
         let info = first.bound.info();
         let mut anim = Animation {
-            model: info.name.to_string(),
+            model: info.system.to_string(),
             bodies: info.bodies.iter().map(|b| b.to_string()).collect(),
             traced: traced.map(str::to_string),
             ..Animation::default()

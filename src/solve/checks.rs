@@ -81,7 +81,16 @@ impl Lowest {
     /// Whether it stayed `>= 0` up to `tolerance` times the largest magnitude (never when not
     /// finite).
     fn passed(&self, tolerance: f64) -> bool {
-        self.value.is_finite() && self.value >= -tolerance * self.scale
+        self.value.is_finite() && self.value >= self.limit(tolerance)
+    }
+
+    /// The bound it is held to: zero less `tolerance` times the largest magnitude (rounding).
+    fn limit(&self, tolerance: f64) -> f64 {
+        if self.scale > 0.0 {
+            -tolerance * self.scale
+        } else {
+            0.0
+        }
     }
 }
 
@@ -100,9 +109,9 @@ fn lowest_check(
         phase: ctx.phase.clone(),
         order: ctx.order,
         value: low.value,
-        limit: 0.0,
+        limit: low.limit(tolerance),
         unit: unit.to_string(),
-        margin: low.value,
+        margin: low.value - low.limit(tolerance),
         at_time: Some(ctx.t_start + low.at),
         samples,
         meaning,
@@ -441,7 +450,7 @@ pub fn drift(
         .iter()
         .map(|(_, w)| combine(&p_first, w))
         .collect();
-    let (mut e_dev, mut kin_max) = (0.0f64, 0.0f64);
+    let (mut e_dev, mut kin_max, mut size_max) = (0.0f64, 0.0f64, 0.0f64);
     let (mut v_min, mut v_max) = (f64::INFINITY, f64::NEG_INFINITY);
     let mut p_dev = vec![0.0f64; p0.len()];
     let mut p_scale = vec![0.0f64; p0.len()];
@@ -450,6 +459,7 @@ pub fn drift(
         let ke = kinetic(sys, s);
         e_dev = nan_max(e_dev, (total - work_at(i) - e0).abs());
         kin_max = kin_max.max(ke.abs());
+        size_max = size_max.max(ke.abs() + (total - ke).abs() + work_at(i).abs());
         v_min = v_min.min(total - ke);
         v_max = v_max.max(total - ke);
         let (mass, _) = sys.equations(s);
@@ -468,6 +478,14 @@ pub fn drift(
         }
     }
     let e_scale = kin_max + (v_max - v_min).max(0.0);
+    // What rounding alone leaves in `E` (a potential's large constant, such as `m2 g R`,
+    // cancels in its differences but not in its rounding): not counted as drift.
+    let rounding = ROUNDING_ULPS * f64::EPSILON * size_max;
+    let e_dev = if e_dev.is_nan() {
+        e_dev
+    } else {
+        (e_dev - rounding).max(0.0)
+    };
     let rel = |dev: f64, scale: f64| if scale > 0.0 { dev / scale } else { dev };
     let meaning = |what: String| match kind {
         CheckKind::Identity => format!(
@@ -489,7 +507,8 @@ pub fn drift(
         "the total energy"
     };
     let energy = format!(
-        "{energy}, relative to the largest kinetic energy plus the potential's range ({} J),",
+        "{energy}, beyond its rounding ({} J), relative to the largest kinetic energy plus the potential's range ({} J),",
+        format_number(rounding, 3),
         format_number(e_scale, 5)
     );
     let check = |drift: f64, what: String| {
@@ -514,6 +533,9 @@ pub fn drift(
     }
     out
 }
+
+/// How many units of rounding of the energy's largest terms the energy check allows.
+pub const ROUNDING_ULPS: f64 = 16.0;
 
 /// `max` that keeps a NaN (so a NaN drift fails its check).
 fn nan_max(a: f64, b: f64) -> f64 {

@@ -26,6 +26,7 @@
 
 use crate::model::ModelInfo;
 use crate::solve::SolveError;
+use crate::solve::rest;
 use crate::system::{Bound, State};
 use nalgebra::{DMatrix, DVector};
 
@@ -268,6 +269,7 @@ pub fn dynamics(
     let normal_acc = (0..m)
         .map(|i| Rows::dot(rows.row(&rows.jac, i), &qdd) + rows.bias[i])
         .collect();
+
     let slip = (0..nf)
         .map(|j| Rows::dot(rows.row(&rows.tjac, j), &state.qd))
         .collect();
@@ -405,12 +407,54 @@ pub fn friction_options(sys: &Bound, state: &State) -> Vec<FrictionOption> {
         .collect()
 }
 
+/// Where contact options are taken: at release, or after a phase that held some contacts
+/// closed by integration, whose gaps have drifted within the run's tolerance.
+#[derive(Debug, Clone, Copy)]
+pub enum Moment<'a> {
+    /// The spec's initial state.
+    Release,
+    /// The end of a phase.
+    After {
+        /// Absolute time (s from release).
+        t: f64,
+        /// The contacts the ending phase held closed.
+        held: &'a [bool],
+        /// The gap (relative to the system's length) a held contact may have drifted by and
+        /// still touch: the tolerance its constraint drift is checked against.
+        drift: f64,
+    },
+}
+
+impl Moment<'_> {
+    fn t(&self) -> f64 {
+        match self {
+            Moment::Release => 0.0,
+            Moment::After { t, .. } => *t,
+        }
+    }
+
+    /// How far (relative) contact `i`'s gap may be from zero and still touch.
+    fn touching(&self, i: usize) -> f64 {
+        match self {
+            Moment::After { held, drift, .. } if held.get(i) == Some(&true) => {
+                drift.max(DECIDE_TOLERANCE)
+            }
+            _ => DECIDE_TOLERANCE,
+        }
+    }
+}
+
 /// Each contact's state where the motion starts (or goes on after an event) at `state`: a
 /// contact the model eliminates is closed; a gap above [`DECIDE_TOLERANCE`] of the system's
-/// length scale is open; a touching contact moving apart is open; one at rest is a
+/// length scale is open (a contact the phase before held closed touches within its drift
+/// tolerance, see [`Moment`]); a touching contact moving apart is open; one at rest is a
 /// candidate. A gap below that is [`SolveError::Overlap`]; a touching contact moving together
 /// is [`SolveError::ImpactAtRelease`] (impacts are not modelled yet).
-pub fn contact_options(sys: &Bound, state: &State) -> Result<Vec<ContactOption>, SolveError> {
+pub fn contact_options(
+    sys: &Bound,
+    state: &State,
+    at: Moment,
+) -> Result<Vec<ContactOption>, SolveError> {
     let info = sys.info();
     let gaps = sys.gaps(state);
     let (jac, _) = sys.constraints(state);
@@ -424,13 +468,14 @@ pub fn contact_options(sys: &Bound, state: &State) -> Result<Vec<ContactOption>,
             continue;
         }
         let gap = gaps[i];
-        let tol = DECIDE_TOLERANCE * if c.gap_unit == "m" { length } else { 1.0 };
+        let tol = at.touching(i) * if c.gap_unit == "m" { length } else { 1.0 };
         if !gap.is_finite() || gap < -tol {
             return Err(SolveError::Overlap {
                 model: info.name,
                 contact: c.name,
                 gap,
                 unit: c.gap_unit,
+                t: at.t(),
             });
         }
         if gap > tol && !c.bilateral {
@@ -458,14 +503,20 @@ pub fn contact_options(sys: &Bound, state: &State) -> Result<Vec<ContactOption>,
 }
 
 /// Whether a candidate combination is consistent: closed candidates push (within
-/// [`DECIDE_TOLERANCE`]), open candidates accelerate apart, frictions obey Coulomb's law in
+/// [`DECIDE_TOLERANCE`] of the largest force), open candidates accelerate apart (within
+/// [`DECIDE_TOLERANCE`] of the size of their own normal acceleration's terms), frictions obey Coulomb's law in
 /// their modes, and sliding is clear of Painlevé's singularity.
-fn consistent(sys: &Bound, options: &Options, active: &Active, d: &Dynamics) -> bool {
+fn consistent(
+    sys: &Bound,
+    options: &Options,
+    active: &Active,
+    d: &Dynamics,
+    acc_scale: &[f64],
+) -> bool {
     let info = sys.info();
     let force_scale = (d.forces.iter())
         .chain(&d.fr)
         .fold(0.0f64, |m, f| m.max(f.abs()));
-    let acc_scale = (d.normal_acc.iter()).fold(sys.gravity(), |m, a| m.max(a.abs()));
     let mu = sys.friction_coefficients();
     for (i, opt) in options.contacts.iter().enumerate() {
         let ok = match (opt, active.closed[i]) {
@@ -473,7 +524,7 @@ fn consistent(sys: &Bound, options: &Options, active: &Active, d: &Dynamics) -> 
                 info.contacts[i].bilateral || d.forces[i] >= -DECIDE_TOLERANCE * force_scale
             }
             (ContactOption::Candidate | ContactOption::Opens, false) => {
-                d.normal_acc[i] >= -DECIDE_TOLERANCE * acc_scale
+                d.normal_acc[i] >= -DECIDE_TOLERANCE * acc_scale[i]
             }
             _ => true,
         };
@@ -569,19 +620,77 @@ pub fn decide(sys: &Bound, state: &State, options: &Options, t: f64) -> Result<A
     for active in combinations(sys, options, t)? {
         let d = match dynamics(sys, state, &active, t) {
             Ok(d) => d,
-            // A set whose equations are singular (redundant contacts, or Painlevé's
-            // singularity exactly) is not a motion; the error says so if no set is.
+            // Redundant supports that hold the system at rest (a ladder stuck at both ends):
+            // its motion is none, whatever share of the load each support takes.
+            Err(SolveError::SingularContacts { .. })
+                if rest::holds(sys, state, &active).is_some() =>
+            {
+                return Err(at_rest(info, &active, t, "redundantly, with"));
+            }
+            // Other singular sets (Painlevé's singularity exactly, or redundant contacts that
+            // cannot hold) are not a motion; the error says so if no set is.
             Err(SolveError::SingularContacts { .. }) => {
                 singular.push(active.describe(info));
                 continue;
             }
             Err(e) => return Err(e),
         };
-        if consistent(sys, options, &active, &d) {
+        let scales = acc_scales(sys, state, &active, &d);
+        if consistent(sys, options, &active, &d, &scales) {
             found.push((active, d));
         }
     }
-    pick(info, options, found, &singular, t)
+    let active = pick(info, options, found, &singular, t)?;
+    if rest::pins(sys, state, &active) {
+        return Err(at_rest(info, &active, t, "with"));
+    }
+    Ok(active)
+}
+
+/// The size of each contact's normal acceleration `J qdd + bias` in `d`, what its rounding is
+/// relative to: `sum_j |J_ij| s_j + |bias_i|`, where `s_j` sums the sizes of what each force
+/// (the applied ones, then each closed contact's and acting friction's) contributes to
+/// `qdd_j`. So a contact whose motion is slow next to gravity (a rod nearly flat on a thin
+/// block) is judged at its own scale, and one whose acceleration cancels to rounding noise
+/// (a foot just lifting) at the scale of the forces that cancel.
+fn acc_scales(sys: &Bound, state: &State, active: &Active, d: &Dynamics) -> Vec<f64> {
+    let info = sys.info();
+    let rows = Rows::at(sys, state);
+    let n = rows.n;
+    let mass = DMatrix::from_row_slice(n, n, &rows.mass);
+    let Some(inverse) = mass.try_inverse() else {
+        return vec![f64::INFINITY; info.contacts.len()];
+    };
+    let mut size = vec![0.0f64; n];
+    let mut add = |force: &[f64], times: f64| {
+        let f = DVector::from_iterator(n, force.iter().map(|v| v * times));
+        for (s, c) in size.iter_mut().zip((&inverse * f).iter()) {
+            *s += c.abs();
+        }
+    };
+    add(&rows.rhs, 1.0);
+    for i in (0..info.contacts.len()).filter(|&i| active.closed[i] && !info.contacts[i].closed) {
+        add(rows.row(&rows.jac, i), d.forces[i]);
+    }
+    for j in (0..info.frictions.len()).filter(|&j| active.friction_acts(info, j)) {
+        add(rows.row(&rows.tjac, j), d.fr[j]);
+    }
+    (0..info.contacts.len())
+        .map(|i| {
+            let row = rows.row(&rows.jac, i);
+            let terms: f64 = row.iter().zip(&size).map(|(j, s)| (j * s).abs()).sum();
+            terms + rows.bias[i].abs()
+        })
+        .collect()
+}
+
+/// The outcome of a system its supports hold at rest.
+fn at_rest(info: &ModelInfo, active: &Active, t: f64, how: &str) -> SolveError {
+    SolveError::AtRest {
+        model: info.name,
+        t,
+        how: format!("{how} {}", active.describe(info)),
+    }
 }
 
 /// [`decide`]'s choice among the consistent sets.

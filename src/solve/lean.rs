@@ -442,12 +442,14 @@ pub(crate) fn quick_route(
     let (sep, fall) = (&start.separation[..], &start.fall[..]);
     // Every closed contact pushes at release (each polynomial has its force's sign), and no
     // other one lets go before the separation.
-    if !(horner(sep, si) > 0.0) {
+    // (A NaN is no push: `partial_cmp` is `None`, not `Greater`.)
+    let pushes = |p: &[f64]| horner(p, si).partial_cmp(&0.0) == Some(std::cmp::Ordering::Greater);
+    if !pushes(sep) {
         return None;
     }
     let s = poly::largest_root(sep, sin_end, si, evals)??;
     for other in start.others.iter().take(start.n_others) {
-        if !(horner(other, si) > 0.0) || poly::largest_root(other, s, si, evals)?.is_some() {
+        if !pushes(other) || poly::largest_root(other, s, si, evals)?.is_some() {
             return None;
         }
     }

@@ -18,6 +18,7 @@ pub mod phases;
 pub mod poly;
 pub mod prior;
 pub mod quadrature;
+pub mod rest;
 pub mod roots;
 pub mod separation;
 pub mod series;
@@ -208,11 +209,54 @@ pub enum SolveError {
         /// What was found.
         why: String,
     },
-    /// Bodies that overlap at release (a gap below zero).
+    /// The reduced angle reaches its end angle with the body above the floor.
     #[error(
-        "model `{model}`: contact `{contact}` overlaps at release (gap {gap:e} {unit}): the initial state puts the bodies into each other"
+        "model `{model}` at t = {t:e} s: the angle reaches its end ({angle} rad) with `{point}` {height:e} m above the floor, so the body has not landed (a support lifted it); the spec's end angle does not describe the motion from here, and rodcube stops rather than report a landing"
+    )]
+    AboveFloor {
+        /// Model name.
+        model: &'static str,
+        /// Time from release (s).
+        t: f64,
+        /// The end angle (rad).
+        angle: f64,
+        /// The falling point.
+        point: &'static str,
+        /// Its height (m).
+        height: f64,
+    },
+    /// A phase that starts at rest and turns back before any contact ends: it swings for ever.
+    #[error(
+        "model `{model}`: the motion from rest at t = {t:e} s turns back after falling {delta:e} rad, before any contact ends; with one degree of freedom and no friction it swings between its two turning points for ever, so no contact ends and the motion never reaches the floor"
+    )]
+    Swings {
+        /// The phase's model.
+        model: &'static str,
+        /// Where the phase starts (s from release).
+        t: f64,
+        /// The angle fallen to the turning point (rad).
+        delta: f64,
+    },
+    /// The supports hold the system at rest: nothing moves, so no contact ends.
+    #[error(
+        "model `{model}` at t = {t:e} s: the system stays at rest, held {how} (each within its law: contacts push, stuck frictions within mu N); nothing moves from here, so no contact ends and there is no motion to report"
+    )]
+    AtRest {
+        /// Model name.
+        model: &'static str,
+        /// Time from release (s).
+        t: f64,
+        /// The supports that hold it, in words.
+        how: String,
+    },
+    /// Bodies that overlap where a phase starts (a gap below zero).
+    #[error(
+        "model `{model}`: contact `{contact}` overlaps at t = {t:e} s (gap {gap:e} {unit}): {}",
+        if *t == 0.0 { "the initial state puts the bodies into each other" } else { "the bodies have moved into each other beyond the tolerance" }
     )]
     Overlap {
+        /// Time from release (s).
+        t: f64,
         /// Model name.
         model: &'static str,
         /// The contact.

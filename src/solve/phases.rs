@@ -15,7 +15,7 @@ use crate::model::{Model, ModelInfo};
 use crate::results::Work;
 use crate::solve::SolveError;
 use crate::solve::contacts::{
-    self, Active, ContactOption, FrictionOption, Options, contact_options, friction_options,
+    self, Active, ContactOption, FrictionOption, Moment, Options, contact_options, friction_options,
 };
 use crate::solve::quadrature::TimeMesh;
 use crate::solve::roots::{self, changes_sign};
@@ -32,6 +32,10 @@ pub const MAX_PHASES: usize = 16;
 /// cube a million times heavier from nearly upright (a stuck foot makes it the hinged rod)
 /// takes some ten thousand.
 pub const MAX_FALL_TIMES: f64 = 1e5;
+
+/// How far (relative to the system's length) the falling point may be from the floor where
+/// the reduced angle reaches its end angle, and still count as landed.
+pub const LANDING_TOLERANCE: f64 = 1e-9;
 
 /// Cells of the grid, uniform in the fast path's time variable, on which an open contact's gap
 /// is watched for closing (the first cell whose ends differ in sign; a touch without a crossing
@@ -109,8 +113,9 @@ pub struct ReducedEnd {
 }
 
 /// Where a phase on the fast path ends, by its roots alone: the first of its closed contacts'
-/// force zeros and edges, else the floor. A closed contact whose force does not push at the
-/// start ends the phase there (`delta = 0`): it opens at once.
+/// force zeros and edges, else the floor. A closed contact whose force pulls at the start ends
+/// the phase there (`delta = 0`): it opens at once; a force that is not finite there is
+/// [`SolveError::NonFinite`].
 pub fn phase_end(sys: &System, work: &mut Work) -> Result<ReducedEnd, SolveError> {
     let info = sys.info();
     let at_start = sys.forces(0.0);
@@ -126,7 +131,15 @@ pub fn phase_end(sys: &System, work: &mut Work) -> Result<ReducedEnd, SolveError
         if !c.closed || c.bilateral {
             continue;
         }
-        if !(at_start[i] > 0.0) {
+        if !at_start[i].is_finite() {
+            return Err(SolveError::NonFinite {
+                model: info.name,
+                what: "a closed contact's force at the phase's start",
+                delta: 0.0,
+                value: at_start[i],
+            });
+        }
+        if at_start[i] < 0.0 {
             let theta = sys.theta_initial();
             return Ok(ReducedEnd {
                 end: End::Force(i),
@@ -405,6 +418,16 @@ impl<'m> PhaseRun<'m> {
         }
     }
 
+    /// The contacts closed at the end of the phase (in the general model's order).
+    pub fn closed_at_end(&self) -> Vec<bool> {
+        match self {
+            PhaseRun::Reduced(r) => r.system.info().contacts.iter().map(|c| c.closed).collect(),
+            PhaseRun::Integrated(r) => (r.run.segments.last())
+                .map(|s| s.active.closed.clone())
+                .unwrap_or_default(),
+        }
+    }
+
     /// The active sets over the phase: each stretch's start (s from release) and its closed
     /// contacts and friction modes in words.
     pub fn stretches(&self) -> Vec<(f64, String)> {
@@ -531,7 +554,7 @@ impl<'m> Walker<'m> {
     /// acceleration-level complementarity problem), with those that touched but opened.
     pub fn release(&self) -> Result<(PhaseStart, Vec<usize>), SolveError> {
         let state = self.general.initial_state();
-        let contacts = contact_options(&self.general, &state)?;
+        let contacts = contact_options(&self.general, &state, Moment::Release)?;
         let frictions = friction_options(&self.general, &state);
         let options = Options {
             contacts: contacts.clone(),
@@ -558,7 +581,13 @@ impl<'m> Walker<'m> {
     pub fn after(&self, run: &PhaseRun<'m>) -> Result<PhaseStart, SolveError> {
         let state = run.full_end_state();
         let t = run.t_end();
-        let mut contacts = contact_options(&self.general, &state)?;
+        let held = run.closed_at_end();
+        let at = Moment::After {
+            t,
+            held: &held,
+            drift: self.tol,
+        };
+        let mut contacts = contact_options(&self.general, &state, at)?;
         if let End::Force(i) = run.end()
             && let Some(c) = contacts.get_mut(i)
         {
@@ -616,16 +645,41 @@ impl<'m> Walker<'m> {
     /// Solves one phase from `start` to its end: on the fast path where [`Walker::fast_phase`]
     /// gives one (and its motion does not turn back before the end), else integrated.
     pub fn solve(&self, start: &PhaseStart, work: &mut Work) -> Result<PhaseRun<'m>, SolveError> {
-        if let Some(sys) = self.fast_phase(start)? {
-            let end = phase_end(&sys, work)?;
-            match ReducedRun::with_end(sys, start.t, end, self.tol, work) {
-                Ok(run) => return Ok(PhaseRun::Reduced(run)),
-                // The angle turns back before the phase's end: the fast path cannot follow it.
-                Err(SolveError::TurningPoint { .. }) => {}
-                Err(e) => return Err(e),
+        match self.fast_phase(start)? {
+            Some(sys) => {
+                let end = phase_end(&sys, work)?;
+                self.follow(sys, start, end, work)
             }
+            None => self.integrate(start, work),
         }
-        self.integrate(start, work)
+    }
+
+    /// Follows the fast phase `sys` from `start` to `end` (its roots' end). If the angle turns
+    /// back first: a phase that starts at rest swings for ever ([`SolveError::Swings`]: with
+    /// one degree of freedom, no friction and no momentum, its configuration is a function of
+    /// the angle and its forces of the angle and `theta_dot^2`, so it retraces its path to the
+    /// start and back); any other is integrated.
+    pub fn follow(
+        &self,
+        sys: System<'m>,
+        start: &PhaseStart,
+        end: ReducedEnd,
+        work: &mut Work,
+    ) -> Result<PhaseRun<'m>, SolveError> {
+        match ReducedRun::with_end(sys, start.t, end, self.tol, work) {
+            Ok(run) => Ok(PhaseRun::Reduced(run)),
+            Err(SolveError::TurningPoint { model, delta, .. })
+                if start.state.qd.iter().all(|v| *v == 0.0) =>
+            {
+                Err(SolveError::Swings {
+                    model,
+                    t: start.t,
+                    delta,
+                })
+            }
+            Err(SolveError::TurningPoint { .. }) => self.integrate(start, work),
+            Err(e) => Err(e),
+        }
     }
 
     /// Typical sizes of the motion from `state` with `active` closed over the fall's time
@@ -633,7 +687,7 @@ impl<'m> Walker<'m> {
     pub fn scales(&self, state: &State, active: &Active) -> Result<Vec<f64>, SolveError> {
         let time = fall_time_scale(&self.general, state);
         let d = contacts::dynamics(&self.general, state, active, 0.0)?;
-        Ok(motion_scales(state, &d.qdd, time))
+        Ok(motion_scales(&self.general, state, &d.qdd, time))
     }
 
     /// Integrates the general model from `start` to its first event.
@@ -660,6 +714,9 @@ impl<'m> Walker<'m> {
             work,
         )
         .map_err(|e| at_time(e, start.t))?;
+        if run.end == EndEvent::Floor {
+            self.landed(&run.state_end, start.t + run.t_end)?;
+        }
         let phase = PhaseRun::Integrated(IntegratedRun {
             bound,
             t_start: start.t,
@@ -667,6 +724,28 @@ impl<'m> Walker<'m> {
         });
         work.phases.extend(phase.labels());
         Ok(phase)
+    }
+
+    /// Whether the system has landed where its reduced angle reaches the end angle: the
+    /// falling point on the floor (within [`LANDING_TOLERANCE`] of the system's length, or
+    /// the walker's tolerance if looser). A support that lifted the body (a rod pivoting over
+    /// a cylinder, its foot in the air) brings it to the end angle above the floor: the motion
+    /// goes on past it, which the spec's end angle does not describe, so that is an error, not
+    /// a landing.
+    fn landed(&self, state: &State, t: f64) -> Result<(), SolveError> {
+        let info = self.general.info();
+        let height = self.general.points(state).pos[info.falling_point][1];
+        let length = self.general.length_scale(state);
+        if height.abs() <= LANDING_TOLERANCE.max(self.tol) * length {
+            return Ok(());
+        }
+        Err(SolveError::AboveFloor {
+            model: info.name,
+            t,
+            angle: info.end_angle,
+            point: info.points[info.falling_point].name,
+            height,
+        })
     }
 
     /// The whole motion from release: phase after phase until one ends for good.

@@ -440,25 +440,53 @@ impl OdeProblem for Problem<'_, '_> {
 /// Typical sizes of the motion's deviation from its start over the time scale `time`, for the
 /// integrator's absolute tolerances: `|qd0| T + |qdd0| T^2 / 2` for the coordinates and
 /// `|qd0| + |qdd0| T` for the velocities, each at least [`SCALE_FLOOR`] of the largest of its
-/// kind. So a tiny system (a rod of 1 cm nearly flat) is held to its own scale, not to one
-/// metre, and a coordinate a closed contact holds still (the foot's height on the floor, whose
-/// acceleration is rounding noise of the constraint's) is held to the motion's scale, not to
-/// its own noise, which would shrink the steps to nothing.
-pub fn motion_scales(start: &State, qdd: &[f64], time: f64) -> Vec<f64> {
+/// kind and at least [`SCALE_FLOOR`] of the change of that coordinate that moves a point of
+/// the system by its length (and that change over `T` for the velocities). So a tiny system (a
+/// rod of 1 cm nearly flat) is held to its own scale, not to one metre; a coordinate a closed
+/// contact holds still (the foot's height on the floor, whose acceleration is rounding noise
+/// of the constraint's) is held to the motion's scale, not to its own noise, which would
+/// shrink the steps to nothing; and a start that is slow at release (nearly upright) is held
+/// to the system's size, not to its first creeping.
+pub fn motion_scales(bound: &Bound, start: &State, qdd: &[f64], time: f64) -> Vec<f64> {
+    let n = start.q.len();
+    let length = bound.length_scale(start);
+    // Per coordinate: the change that moves some point by `length` (m per m, or rad).
+    let reach: Vec<f64> = (0..n)
+        .map(|j| {
+            let mut unit = State {
+                q: start.q.clone(),
+                qd: vec![0.0; n],
+            };
+            unit.qd[j] = 1.0;
+            let speed = (bound.points(&unit).vel.iter())
+                .map(|v| v[0].hypot(v[1]))
+                .fold(0.0f64, f64::max);
+            if speed > 0.0 && speed.is_finite() {
+                length / speed
+            } else {
+                0.0
+            }
+        })
+        .collect();
     let q: Vec<f64> = (start.qd.iter().zip(qdd))
         .map(|(v, a)| v.abs() * time + 0.5 * a.abs() * time * time)
         .collect();
     let v: Vec<f64> = (start.qd.iter().zip(qdd))
         .map(|(v, a)| v.abs() + a.abs() * time)
         .collect();
-    let floor = |x: Vec<f64>| {
+    let floor = |x: Vec<f64>, per: f64| {
         let top = x.iter().cloned().fold(0.0, f64::max);
-        x.into_iter()
-            .map(|s| s.max(SCALE_FLOOR * top).max(f64::MIN_POSITIVE))
+        (x.into_iter().zip(&reach))
+            .map(|(s, r)| {
+                let own = if time > 0.0 { r * per } else { 0.0 };
+                s.max(SCALE_FLOOR * top)
+                    .max(SCALE_FLOOR * own)
+                    .max(f64::MIN_POSITIVE)
+            })
             .collect::<Vec<f64>>()
     };
-    let mut scales = floor(q);
-    scales.extend(floor(v));
+    let mut scales = floor(q, 1.0);
+    scales.extend(floor(v, 1.0 / time));
     scales
 }
 
