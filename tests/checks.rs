@@ -36,7 +36,7 @@ fn release_phase(registry: &'static [&'static dyn Model]) -> PhaseRun<'static> {
 }
 
 #[test]
-fn a_monitor_below_zero_fails_with_its_minimum_as_margin() {
+fn a_monitor_below_zero_fails_with_its_minimum_as_value() {
     let phase = release_phase(registry(&LOW_MONITORS));
     assert_eq!(phase.end(), End::Force(0));
     let bound = phase.bound();
@@ -50,17 +50,18 @@ fn a_monitor_below_zero_fails_with_its_minimum_as_margin() {
         .unwrap()
         .1;
     assert!(!tip.passed && tip.margin < 0.0, "{tip:?}");
-    // A monitor's margin is its smallest value, in its own unit, with the time it was taken:
+    // A monitor's value is its smallest value, in its own unit, with the time it was taken:
     // the untweaked monitor's smallest value less the 4 N m the tweak takes off.
     assert_eq!(tip.kind, CheckKind::Monitor);
     assert_eq!(tip.unit, "N m");
-    assert_eq!(tip.value, tip.margin);
+    assert!(tip.limit <= 0.0 && tip.limit > -1e-9, "{tip:?}");
+    assert_eq!(tip.margin, tip.value - tip.limit);
     assert!(tip.at_time.is_some_and(|t| t >= 0.0), "{tip:?}");
     let plain = Bound::new(&ROD_CUBE, &paper(9.81)).unwrap();
     let untweaked = checks::monitors(&plain, &samples, &forces, 1e-12, &ctx);
-    let least = untweaked[0].1.margin;
+    let least = untweaked[0].1.value;
     assert!(untweaked[0].1.passed && least > 3.5, "{:?}", untweaked[0]);
-    assert!((tip.margin - (least - 4.0)).abs() < 1e-12, "{tip:?}");
+    assert!((tip.value - (least - 4.0)).abs() < 1e-12, "{tip:?}");
     // The contacts' own checks are not monitors: they pass, the floor's push at least m1 g / 4.
     let pushes = checks::contact_forces(bound, &samples, &forces, &phase.closed(), 1e-12, &ctx);
     let keys: Vec<&str> = pushes.iter().map(|(k, _)| k.as_str()).collect();
@@ -103,7 +104,8 @@ fn a_contact_that_would_pull_fails_its_check() {
     let pulled = checks::contact_forces(phase.bound(), &samples, &forces, &closed, 1e-12, &ctx);
     let floor = &pulled[1].1;
     assert_eq!(pulled[1].0, "rod_cube_closed.floor_normal_pushes");
-    assert!(!floor.passed && floor.margin == -1.0, "{floor:?}");
+    assert!(!floor.passed && floor.value == -1.0, "{floor:?}");
+    assert_eq!(floor.margin, floor.value - floor.limit);
     assert_eq!(floor.unit, "N");
     assert_eq!(floor.at_time, Some(samples.t[20]));
     assert!(pulled[0].1.passed);

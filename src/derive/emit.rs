@@ -1525,6 +1525,9 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> Result<TexContext, Stri
     })
 }
 
+/// A gradient entry's `\frac{\partial g}{\partial q} = ` counts this many characters of width.
+const GRADIENT_HEAD: usize = 6;
+
 /// The constraint rows of the contacts a phase does not hold closed: each gap, its gradient
 /// in the phase's coordinates and its bias, with what the runtime solves while a set of them is
 /// closed.
@@ -1553,19 +1556,39 @@ fn constraint_equations(d: &Derivation, name: &dyn Fn(&str) -> String, eqs: &mut
             None,
             name,
         );
-        let gradient: Vec<String> = (d.coords.iter().zip(&c.jacobian))
-            .filter(|(_, j)| !j.is_zero())
-            .map(|(q, j)| {
-                format!(
-                    "\\frac{{\\partial g_{{{}}}}}{{\\partial {}}} = {}",
-                    k + 1,
-                    name(q),
-                    sc(j).to_latex(name)
-                )
-            })
-            .collect();
+        // The gradient's entries, as many to a line as fit, a long one on lines of its own.
+        let mut lines: Vec<String> = Vec::new();
+        let mut used = TEX_LINE;
+        for (q, j) in (d.coords.iter().zip(&c.jacobian)).filter(|(_, j)| !j.is_zero()) {
+            let head = format!(
+                "\\frac{{\\partial g_{{{}}}}}{{\\partial {}}} = ",
+                k + 1,
+                name(q)
+            );
+            let j = sc(j);
+            let width = GRADIENT_HEAD + j.latex_width(name);
+            match lines.last_mut() {
+                Some(last) if used + 3 + width <= TEX_LINE => {
+                    last.push_str(",\\quad ");
+                    last.push_str(&head);
+                    last.push_str(&j.to_latex(name));
+                    used += 3 + width;
+                }
+                _ => {
+                    let own = j.to_latex_lines(name, TEX_LINE, GRADIENT_HEAD);
+                    used = if own.len() == 1 { width } else { TEX_LINE };
+                    for (i, line) in own.into_iter().enumerate() {
+                        lines.push(if i == 0 {
+                            format!("{head}{line}")
+                        } else {
+                            line
+                        });
+                    }
+                }
+            }
+        }
         gap.latex.push_str(" \\\\\n");
-        gap.latex.push_str(&gradient.join(",\\quad "));
+        gap.latex.push_str(&lines.join(" \\\\\n"));
         gap.env = "multline*";
         eqs.push(gap);
         if !c.bias.is_zero() {

@@ -449,7 +449,11 @@ pub(crate) fn quick_route(
     }
     let s = poly::largest_root(sep, sin_end, si, evals)??;
     for other in start.others.iter().take(start.n_others) {
-        if !pushes(other) || poly::largest_root(other, s, si, evals)?.is_some() {
+        // Positive on [s, si] by its Bernstein form (cheap), else by its roots.
+        if !pushes(other)
+            || (!poly::positive_on(other, s, si)
+                && poly::largest_root(other, s, si, evals)?.is_some())
+        {
             return None;
         }
     }
