@@ -1016,30 +1016,29 @@ fn contact_code(
         hoisted,
     );
 
-    // The constraint rows: every contact's Jacobian row, then its bias.
-    let mut exprs: Vec<Expr> = Vec::new();
-    for c in &d.contacts {
-        exprs.extend(c.jacobian.iter().map(sc));
-    }
-    exprs.extend(d.contacts.iter().map(|c| sc(&c.bias)));
-    let (mut constraints, out) = single("j", &exprs, hoisted);
-    let n_jac = nc * d.contacts.len();
-    constraints.outputs = (0..n_jac)
-        .map(|i| format!("jac[{i}] = {};", out[i]))
-        .chain((0..d.contacts.len()).map(|j| format!("bias[{j}] = {};", out[n_jac + j])))
-        .collect();
-
-    let mut exprs: Vec<Expr> = Vec::new();
-    for f in &d.frictions {
-        exprs.extend(f.jacobian.iter().map(sc));
-    }
-    exprs.extend(d.frictions.iter().map(|f| sc(&f.bias)));
-    let (mut friction, out) = single("s", &exprs, hoisted);
-    let n_jac = nc * d.frictions.len();
-    friction.outputs = (0..n_jac)
-        .map(|i| format!("jac[{i}] = {};", out[i]))
-        .chain((0..d.frictions.len()).map(|j| format!("bias[{j}] = {};", out[n_jac + j])))
-        .collect();
+    // The constraint rows (every contact's Jacobian row, then its bias) and the frictions'
+    // slip rows, in the same layout.
+    let mut rows = |prefix: &str, jacobians: Vec<&[Expr]>, biases: Vec<&Expr>| {
+        let mut exprs: Vec<Expr> = jacobians.iter().flat_map(|j| j.iter().map(sc)).collect();
+        exprs.extend(biases.iter().map(|b| sc(b)));
+        let (mut code, out) = single(prefix, &exprs, hoisted);
+        let n_jac = nc * biases.len();
+        code.outputs = (0..n_jac)
+            .map(|i| format!("jac[{i}] = {};", out[i]))
+            .chain((0..biases.len()).map(|j| format!("bias[{j}] = {};", out[n_jac + j])))
+            .collect();
+        code
+    };
+    let constraints = rows(
+        "j",
+        d.contacts.iter().map(|c| &c.jacobian[..]).collect(),
+        d.contacts.iter().map(|c| &c.bias).collect(),
+    );
+    let friction = rows(
+        "s",
+        d.frictions.iter().map(|f| &f.jacobian[..]).collect(),
+        d.frictions.iter().map(|f| &f.bias).collect(),
+    );
 
     let mut mon_scope = full_scope.clone();
     for i in 0..d.contacts.len() {

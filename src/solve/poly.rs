@@ -417,7 +417,7 @@ fn quadratic_roots(c: &[f64], lo: f64, hi: f64, out: &mut [f64; MAX_DEGREE]) -> 
 /// finite.
 #[inline]
 pub fn positive_on<const N: usize>(coeffs: &[f64; N], lo: f64, hi: f64) -> bool {
-    if N == 0 || N > MAX_DEGREE || !(lo <= hi) {
+    if N == 0 || N > MAX_DEGREE || lo.partial_cmp(&hi).is_none_or(|o| o.is_gt()) {
         return false;
     }
     let d = N - 1;
