@@ -11,7 +11,7 @@ use rodcube::models;
 use rodcube::plan::{Request, run};
 use rodcube::quantity::Quantity::{SeparationAngle, SeparationTime};
 use rodcube::results::Work;
-use rodcube::solve::phases::{End, PhaseRun, Route};
+use rodcube::solve::phases::{End, PhaseRun, Route, Walker};
 use rodcube::system::Bound;
 use std::error::Error;
 use std::path::PathBuf;
@@ -28,7 +28,7 @@ const MU_MAX: f64 = 2.0;
 /// The contact phase at one mu: how the foot moves, and where the rod leaves the cube.
 struct Point {
     mu: f64,
-    /// `slides -, sticks` (the foot's modes in order) and whether the rod leaves the cube.
+    /// `slides -, sticks` (the foot's modes in order) and how the contact phase ends.
     regime: String,
     /// Separation time (s) and angle (deg), if the rod leaves the cube.
     separation: Option<(f64, f64)>,
@@ -40,34 +40,39 @@ fn solve(mu: f64) -> Result<Point, Box<dyn Error>> {
     let model = models::find("rod_cube_friction").ok_or("rod_cube_friction was not generated")?;
     let mut params = PAPER.to_vec();
     params.push(("mu", mu));
-    let bound = Bound::new(model, &params)?;
-    let run = PhaseRun::solve(
-        bound,
-        0.0,
-        1e-12,
-        1e-13,
-        Route::Fastest,
-        &mut Work::default(),
-    )?;
-    let modes = run.contact_modes();
-    let steps: Vec<String> = modes
-        .iter()
-        .map(|(_, m)| m.trim_start_matches("foot_friction ").to_string())
+    let walker = Walker {
+        general: Bound::new(model, &params)?,
+        registry: models::all(),
+        tol: 1e-12,
+        rtol: 1e-13,
+        route: Route::Fastest,
+    };
+    // The contact phase: the first phase from release (the foot's friction acts, so the general
+    // model is integrated with both contacts closed), to its first event.
+    let (start, _) = walker.release()?;
+    let run = walker.solve(&start, &mut Work::default())?;
+    let PhaseRun::Integrated(phase) = &run else {
+        return Err("the contact phase with friction is integrated".into());
+    };
+    // The foot's friction is the model's only one: its mode in each stretch of the phase.
+    let modes: Vec<(f64, &str)> = (phase.run.segments.iter())
+        .map(|s| (phase.t_start + s.t_start, s.active.modes[0].describe()))
         .collect();
-    let separates = run.end() == End::Separation;
+    let steps: Vec<&str> = modes.iter().map(|(_, m)| *m).collect();
+    let end = run.end();
     let regime = format!(
         "foot {}; {}",
         steps.join(", then "),
-        if separates {
-            "leaves the cube"
-        } else {
-            "stays on the cube"
+        match end {
+            End::Force(0) => "leaves the cube",
+            End::Force(_) => "the foot lifts off the floor",
+            _ => "stays on the cube",
         }
     );
     Ok(Point {
         mu,
         regime,
-        separation: separates.then(|| (run.duration(), run.theta_end().to_degrees())),
+        separation: (end == End::Force(0)).then(|| (run.t_end(), run.theta_end().to_degrees())),
         first_switch: modes.get(1).map(|(t, _)| *t),
     })
 }

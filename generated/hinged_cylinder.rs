@@ -5,8 +5,8 @@
 // some of it unused.
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, NextPhase,
-    ParamInfo, Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
+    ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo,
+    Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
 };
 
 /// A uniform rod hinged at its foot, leaning on a cylinder that slides without spinning on a frictionless floor, released from rest.
@@ -16,6 +16,7 @@ static INFO: ModelInfo = ModelInfo {
     name: "hinged_cylinder",
     description: "A uniform rod hinged at its foot, leaning on a cylinder that slides without spinning on a frictionless floor, released from rest.",
     spec: "derivations/hinged_cylinder.yaml",
+    system: "hinged_cylinder",
     parameters: &[
         ParamInfo {
             name: "m1",
@@ -64,20 +65,44 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 32,
-    coordinates: &["theta"],
-    reduced: 0,
-    cyclic: &[],
+    n_constants: 19,
+    coordinates: &["x1", "y1", "theta", "xc"],
+    system_coordinates: &["x1", "y1", "theta", "xc"],
+    reduced: 2,
+    cyclic: &[0, 3],
     end_angle: 0.0,
-    forces: &[NamedInfo {
-        name: "contact_force",
-        meaning: "horizontal push of the rod on the cylinder, positive while they touch",
-    }],
-    contact: Some(ContactInfo {
-        force: 0,
-        eliminated: "xc",
-        edge: true,
-    }),
+    contacts: &[
+        ContactInfo {
+            name: "contact_force",
+            meaning: "horizontal push of the rod on the cylinder, positive while they touch",
+            gap_unit: "m",
+            unit: "N",
+            bilateral: false,
+            edge: true,
+            eliminates: Some("xc"),
+            closed: false,
+        },
+        ContactInfo {
+            name: "hinge_horizontal",
+            meaning: "horizontal force of the hinge on the rod (along +x)",
+            gap_unit: "m",
+            unit: "N",
+            bilateral: true,
+            edge: false,
+            eliminates: Some("x1"),
+            closed: false,
+        },
+        ContactInfo {
+            name: "hinge_vertical",
+            meaning: "vertical force of the hinge on the rod (along +y)",
+            gap_unit: "m",
+            unit: "N",
+            bilateral: true,
+            edge: false,
+            eliminates: Some("y1"),
+            closed: false,
+        },
+    ],
     frictions: &[],
     points: &[
         NamedInfo {
@@ -113,32 +138,23 @@ static INFO: ModelInfo = ModelInfo {
             first: 4,
         },
     ],
-    next_phase: Some(NextPhase {
-        model: "hinged_cylinder_free",
-        bindings: &[
-            Binding::Param(0),
-            Binding::Param(1),
-            Binding::Param(2),
-            Binding::Param(3),
-            Binding::Param(4),
-            Binding::Param(5),
-            Binding::Coordinate(0),
-            Binding::Eliminated,
-            Binding::Velocity(0),
-            Binding::EliminatedRate,
-        ],
-    }),
-    reduction: Some(ReductionInfo {
-        k_theta_initial: 4,
-        k_theta_dot_initial: 6,
-        k_sin_initial: 7,
-        k_cos_initial: 8,
-        separation_degree: 0,
-        polynomial_separation: false,
-        fall_degree: None,
-        lean_constants: &[6, 7, 8],
-    }),
-    route_note: "",
+    start_params: false,
+    phases: &[
+        PhaseInfo {
+            closed: &[0, 1, 2],
+            model: "hinged_cylinder_closed",
+            release: true,
+            separation_degree: 0,
+        },
+        PhaseInfo {
+            closed: &[1, 2],
+            model: "hinged_cylinder_free",
+            release: false,
+            separation_degree: 0,
+        },
+    ],
+    reduction: None,
+    route_note: "coordinate `y1` is not cyclic (the Lagrangian depends on it), so it cannot be eliminated through a conserved momentum",
 };
 
 impl Model for HingedCylinder {
@@ -155,145 +171,167 @@ impl Model for HingedCylinder {
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
         k[..6].copy_from_slice(p);
-        // k[4] also holds rc_thi = th0
-        Reduction::prepare_lean(self, p, k);
-        // k[9] = ell/2
-        k[9] = k[2] / 2.0;
-        // k[10] = R^2*m2/2 + ell^2*m1/24
-        k[10] = ((k[3] * k[3]) * k[1] / 2.0) + ((k[2] * k[2]) * k[0] / 24.0);
-        // k[11] = R^2*m2
-        k[11] = (k[3] * k[3]) * k[1];
-        // k[12] = R^2*m2/2
-        k[12] = (k[3] * k[3]) * k[1] / 2.0;
-        // k[13] = ell^2*m1/8
-        k[13] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[14] = R*g*m2
-        k[14] = k[3] * k[5] * k[1];
-        // k[15] = ell*g*m1/2
-        k[15] = k[2] * k[5] * k[0] / 2.0;
-        // k[16] = R^2*m2 + ell^2*m1/12
-        k[16] = ((k[3] * k[3]) * k[1]) + ((k[2] * k[2]) * k[0] / 12.0);
-        // k[17] = 2*R^2*m2
-        k[17] = 2.0 * (k[3] * k[3]) * k[1];
-        // k[18] = ell^2*m1/4
-        k[18] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[19] = 5*R^2*m2
-        k[19] = 5.0 * (k[3] * k[3]) * k[1];
-        // k[20] = 4*R^2*m2
-        k[20] = 4.0 * (k[3] * k[3]) * k[1];
-        // k[21] = 2*R
-        k[21] = 2.0 * k[3];
-        // k[22] = 3*ell*g*m1
-        k[22] = 3.0 * k[2] * k[5] * k[0];
-        // k[23] = 6*R^2*m2
-        k[23] = 6.0 * (k[3] * k[3]) * k[1];
-        // k[24] = 3*R^2*m2
-        k[24] = 3.0 * (k[3] * k[3]) * k[1];
-        // k[25] = ell^2*m1
-        k[25] = (k[2] * k[2]) * k[0];
-        // k[26] = 24*R^2*ell*g*m1*m2
-        k[26] = 24.0 * (k[3] * k[3]) * k[2] * k[5] * k[0] * k[1];
-        // k[27] = 6*R^2*ell*g*m1*m2
-        k[27] = 6.0 * (k[3] * k[3]) * k[2] * k[5] * k[0] * k[1];
-        // k[28] = 3*R^2*ell*g*m1*m2
-        k[28] = 3.0 * (k[3] * k[3]) * k[2] * k[5] * k[0] * k[1];
-        // k[29] = ell^3*g*m1^2
-        k[29] = k[2].powi(3) * k[5] * (k[0] * k[0]);
-        // k[30] = R*m2
-        k[30] = k[3] * k[1];
-        // k[31] = 2*R*m2
-        k[31] = 2.0 * k[3] * k[1];
+        // k[6] = R/sin(th0) + R*cos(th0)/sin(th0)
+        k[6] = (k[3] / k[4].sin()) + (k[3] * k[4].cos() / k[4].sin());
+        // k[7] = ell/2
+        k[7] = k[2] / 2.0;
+        // k[8] = ell*m1/2
+        k[8] = k[2] * k[0] / 2.0;
+        // k[9] = ell^2*m1/24
+        k[9] = (k[2] * k[2]) * k[0] / 24.0;
+        // k[10] = ell^2*m1/8
+        k[10] = (k[2] * k[2]) * k[0] / 8.0;
+        // k[11] = m1/2
+        k[11] = k[0] / 2.0;
+        // k[12] = m2/2
+        k[12] = k[1] / 2.0;
+        // k[13] = R*g*m2
+        k[13] = k[3] * k[5] * k[1];
+        // k[14] = ell*g*m1/2
+        k[14] = k[2] * k[5] * k[0] / 2.0;
+        // k[15] = g*m1
+        k[15] = k[5] * k[0];
+        // k[16] = ell^2*m1/12
+        k[16] = (k[2] * k[2]) * k[0] / 12.0;
+        // k[17] = ell^2*m1/4
+        k[17] = (k[2] * k[2]) * k[0] / 4.0;
+        // k[18] = 2*R
+        k[18] = 2.0 * k[3];
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..32]; // one bounds check for all constant loads
-        q[0] = k[4];
+        let k = &k[..19]; // one bounds check for all constant loads
+        q[0] = 0.0;
         qd[0] = 0.0;
+        q[1] = 0.0;
+        qd[1] = 0.0;
+        q[2] = k[4];
+        qd[2] = 0.0;
+        q[3] = k[6];
+        qd[3] = 0.0;
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..32]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        pos[0] = [0.0, 0.0];
-        vel[0] = [0.0, 0.0];
-        pos[1] = [k[2] * rc_c, k[2] * rc_s];
-        vel[1] = [-k[2] * qd[0] * rc_s, k[2] * qd[0] * rc_c];
-        pos[2] = [k[9] * rc_c, k[9] * rc_s];
-        vel[2] = [-k[9] * qd[0] * rc_s, k[9] * qd[0] * rc_c];
-        pos[3] = [(k[3] / rc_s) + (k[3] * rc_c / rc_s), k[3]];
-        vel[3] = [
-            -(k[3] * qd[0])
-                - (k[3] * qd[0] * rc_c / (rc_s * rc_s))
-                - (k[3] * qd[0] * (rc_c * rc_c) / (rc_s * rc_s)),
-            0.0,
+        let k = &k[..19]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        pos[0] = [q[0], q[1]];
+        vel[0] = [qd[0], qd[1]];
+        pos[1] = [(k[2] * rc_c) + q[0], (k[2] * rc_s) + q[1]];
+        vel[1] = [
+            -(k[2] * qd[2] * rc_s) + qd[0],
+            (k[2] * qd[2] * rc_c) + qd[1],
         ];
+        pos[2] = [(k[7] * rc_c) + q[0], (k[7] * rc_s) + q[1]];
+        vel[2] = [
+            -(k[7] * qd[2] * rc_s) + qd[0],
+            (k[7] * qd[2] * rc_c) + qd[1],
+        ];
+        pos[3] = [q[3], k[3]];
+        vel[3] = [qd[3], 0.0];
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..32]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        let et0 = qd[0] * qd[0];
-        let et1 = rc_c * rc_c;
-        ((k[10] * et0)
-            + (k[11] * et0 * rc_c / (rc_s * rc_s))
-            + (k[11] * et0 * et1 / (rc_s * rc_s))
-            + (k[12] * et0 * et1 / rc_s.powi(4))
-            + (k[11] * et0 * rc_c.powi(3) / rc_s.powi(4))
-            + (k[12] * et0 * rc_c.powi(4) / rc_s.powi(4))
-            + (k[13] * et0 * (rc_s * rc_s))
-            + (k[13] * et0 * et1))
-            + (k[14] + (k[15] * rc_s))
+        let k = &k[..19]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        let et0 = qd[2] * qd[2];
+        (-(k[8] * qd[2] * qd[0] * rc_s)
+            + (k[8] * qd[2] * qd[1] * rc_c)
+            + (k[9] * et0)
+            + (k[10] * et0 * (rc_s * rc_s))
+            + (k[10] * et0 * (rc_c * rc_c))
+            + (k[11] * (qd[0] * qd[0]))
+            + (k[12] * (qd[3] * qd[3]))
+            + (k[11] * (qd[1] * qd[1])))
+            + (k[13] + (k[14] * rc_s) + (k[15] * q[1]))
     }
 
-    fn momenta(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
+    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let k = &k[..19]; // one bounds check for all constant loads
+        let rc_s = q[2].sin();
+        out[0] = -(k[8] * qd[2] * rc_s) + (k[0] * qd[0]);
+        out[1] = k[1] * qd[3];
+    }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..32]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        let qt0 = rc_c * rc_c;
-        let qt1 = rc_c.powi(3);
-        let qt2 = rc_c.powi(4);
-        let qt3 = qd[0] * qd[0];
-        mass[0] = k[16]
-            + (k[17] * rc_c / (rc_s * rc_s))
-            + (k[17] * qt0 / (rc_s * rc_s))
-            + (k[11] * qt0 / rc_s.powi(4))
-            + (k[17] * qt1 / rc_s.powi(4))
-            + (k[11] * qt2 / rc_s.powi(4))
-            + (k[18] * (rc_s * rc_s))
-            + (k[18] * qt0);
-        rhs[0] = -(k[15] * rc_c)
-            + (k[11] * qt3 / rc_s)
-            + (k[17] * qt3 * rc_c / rc_s)
-            + (k[11] * qt3 * rc_c / rc_s.powi(3))
-            + (k[19] * qt3 * qt0 / rc_s.powi(3))
-            + (k[20] * qt3 * qt1 / rc_s.powi(3))
-            + (k[17] * qt3 * qt1 / rc_s.powi(5))
-            + (k[20] * qt3 * qt2 / rc_s.powi(5))
-            + (k[17] * qt3 * rc_c.powi(5) / rc_s.powi(5));
+        let k = &k[..19]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        let qt0 = -k[8] * rc_s;
+        let qt1 = k[8] * rc_c;
+        let qt2 = qd[2] * qd[2];
+        mass[0] = k[0];
+        mass[1] = 0.0;
+        mass[2] = qt0;
+        mass[3] = 0.0;
+        mass[4] = 0.0;
+        mass[5] = k[0];
+        mass[6] = qt1;
+        mass[7] = 0.0;
+        mass[8] = qt0;
+        mass[9] = qt1;
+        mass[10] = k[16] + (k[17] * (rc_s * rc_s)) + (k[17] * (rc_c * rc_c));
+        mass[11] = 0.0;
+        mass[12] = 0.0;
+        mass[13] = 0.0;
+        mass[14] = 0.0;
+        mass[15] = k[1];
+        rhs[0] = k[8] * qt2 * rc_c;
+        rhs[1] = -k[15] + (k[8] * qt2 * rc_s);
+        rhs[2] = -k[14] * rc_c;
+        rhs[3] = 0.0;
     }
 
-    fn forces_full(
-        &self,
-        k: &[f64],
-        q: &[f64],
-        qd: &[f64],
-        qdd: &[f64],
-        _fr: &[f64],
-        out: &mut [f64],
-    ) {
-        let k = &k[..32]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        let ft0 = rc_c * rc_c;
-        let ft1 = qd[0] * qd[0];
-        out[0] = k[1]
-            * (-(k[3] * qdd[0])
-                - (k[3] * qdd[0] * rc_c / (rc_s * rc_s))
-                - (k[3] * qdd[0] * ft0 / (rc_s * rc_s))
-                + (k[3] * ft1 / rc_s)
-                + (k[21] * ft1 * rc_c / rc_s)
-                + (k[21] * ft1 * ft0 / rc_s.powi(3))
-                + (k[21] * ft1 * rc_c.powi(3) / rc_s.powi(3)));
+    fn forces_full(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _qdd: &[f64], out: &mut [f64]) {
+        out[0] = 0.0;
+        out[1] = 0.0;
+        out[2] = 0.0;
+    }
+
+    fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
+        let k = &k[..19]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        out[0] = -(k[3] / rc_s) - (k[3] * rc_c / rc_s) - q[0] + q[3] + (q[1] * rc_c / rc_s);
+        out[1] = q[0];
+        out[2] = q[1];
+    }
+
+    fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        let k = &k[..19]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        let jt0 = rc_c * rc_c;
+        let jt1 = qd[2] * qd[2];
+        let jt2 = rc_c.powi(3);
+        jac[0] = -1.0;
+        jac[1] = rc_c / rc_s;
+        jac[2] = k[3] + (k[3] * rc_c / (rc_s * rc_s)) + (k[3] * jt0 / (rc_s * rc_s))
+            - q[1]
+            - (q[1] * jt0 / (rc_s * rc_s));
+        jac[3] = 1.0;
+        jac[4] = 1.0;
+        jac[5] = 0.0;
+        jac[6] = 0.0;
+        jac[7] = 0.0;
+        jac[8] = 0.0;
+        jac[9] = 1.0;
+        jac[10] = 0.0;
+        jac[11] = 0.0;
+        bias[0] = -(k[3] * jt1 / rc_s)
+            - (k[18] * jt1 * rc_c / rc_s)
+            - (k[18] * jt1 * jt0 / rc_s.powi(3))
+            - (k[18] * jt1 * jt2 / rc_s.powi(3))
+            - (2.0 * qd[2] * qd[1])
+            - (2.0 * qd[2] * qd[1] * jt0 / (rc_s * rc_s))
+            + (2.0 * jt1 * q[1] * rc_c / rc_s)
+            + (2.0 * jt1 * q[1] * jt2 / rc_s.powi(3));
+        bias[1] = 0.0;
+        bias[2] = 0.0;
+    }
+
+    fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
+        let k = &k[..19]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        out[0] = k[2] - (k[3] * rc_s) + (q[0] * rc_c) - (q[3] * rc_c) + (q[1] * rc_s);
+        out[1] = f64::INFINITY;
+        out[2] = f64::INFINITY;
     }
 
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
@@ -308,29 +346,25 @@ impl Model for HingedCylinder {
     ) {
     }
 
-    fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        let k = &k[..32]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        k[2] - (k[3] / rc_s) - (k[3] * rc_c / rc_s)
-    }
-
-    fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..32]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        out[0] = (k[3] / rc_s) + (k[3] * rc_c / rc_s);
-        out[1] = -(k[3] * qd[0])
-            - (k[3] * qd[0] * rc_c / (rc_s * rc_s))
-            - (k[3] * qd[0] * (rc_c * rc_c) / (rc_s * rc_s));
+    fn to_full(&self, _k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
+        q_full[0] = q[0];
+        qd_full[0] = qd[0];
+        q_full[1] = q[1];
+        qd_full[1] = qd[1];
+        q_full[2] = q[2];
+        qd_full[2] = qd[2];
+        q_full[3] = q[3];
+        qd_full[3] = qd[3];
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..32]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        poses[0] = [k[9] * rc_c, k[9] * rc_s, q[0]];
-        poses[1] = [(k[3] / rc_s) + (k[3] * rc_c / rc_s), k[3], 0.0];
-        sizes[0] = -k[9];
+        let k = &k[..19]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        poses[0] = [(k[7] * rc_c) + q[0], (k[7] * rc_s) + q[1], q[2]];
+        poses[1] = [q[3], k[3], 0.0];
+        sizes[0] = -k[7];
         sizes[1] = 0.0;
-        sizes[2] = k[9];
+        sizes[2] = k[7];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
@@ -338,94 +372,6 @@ impl Model for HingedCylinder {
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
-        Some(self)
-    }
-}
-
-impl Reduction for HingedCylinder {
-    fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..32]; // one bounds check for all constant loads
-        let (rc_s, rc_c, rc_ds, _) = start_offsets(k[4], k[7], k[8], delta);
-        let rt0 = rc_s.powi(4);
-        let rt1 = k[23] + (k[23] * rc_c) - (k[24] * (rc_s * rc_s)) + (k[25] * rt0);
-        let rt2 = rc_s.powi(3);
-        let rt3 = rc_c * rc_c;
-        let rt4 = rc_s.powi(5);
-        Reduced {
-            sin: rc_s,
-            cos: rc_c,
-            theta_dot_sq: k[22] * rt0 * rc_ds / rt1,
-            theta_ddot: -3.0
-                * (-(k[26] * rt2 * rc_c * rc_ds) - (k[26] * rt2 * rt3 * rc_ds)
-                    + (k[27] * rt0 * rc_c)
-                    + (k[27] * rt0 * rt3)
-                    + (k[27] * rt4 * rc_c * rc_ds)
-                    - (k[27] * rt4 * rc_ds)
-                    - (k[28] * rc_s.powi(6) * rc_c)
-                    + (k[29] * rc_s.powi(8) * rc_c))
-                / 2.0
-                / (rt1 * rt1),
-        }
-    }
-
-    fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..32]; // one bounds check for all constant loads
-        let rt0 = rc_s.powi(4);
-        k[22] * rt0 * rc_ds / (k[23] + (k[23] * rc_c) - (k[24] * (rc_s * rc_s)) + (k[25] * rt0))
-    }
-
-    fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..32]; // one bounds check for all constant loads
-        let (rc_s, rc_c, rc_ds, _) = start_offsets(k[4], k[7], k[8], delta);
-        let rt0 = rc_s.powi(4);
-        let rt1 = k[23] + (k[23] * rc_c) - (k[24] * (rc_s * rc_s)) + (k[25] * rt0);
-        let rt2 = rc_s.powi(3);
-        let rt3 = rc_c * rc_c;
-        let rt4 = rc_s.powi(5);
-        let rc_w2 = k[22] * rt0 * rc_ds / rt1;
-        let rc_acc = -3.0
-            * (-(k[26] * rt2 * rc_c * rc_ds) - (k[26] * rt2 * rt3 * rc_ds)
-                + (k[27] * rt0 * rc_c)
-                + (k[27] * rt0 * rt3)
-                + (k[27] * rt4 * rc_c * rc_ds)
-                - (k[27] * rt4 * rc_ds)
-                - (k[28] * rc_s.powi(6) * rc_c)
-                + (k[29] * rc_s.powi(8) * rc_c))
-            / 2.0
-            / (rt1 * rt1);
-        let ft0 = rc_c * rc_c;
-        out[0] = -(k[30] * rc_acc) + (k[31] * rc_c * rc_w2 / rc_s) + (k[30] * rc_w2 / rc_s)
-            - (k[30] * rc_c * rc_acc / (rc_s * rc_s))
-            - (k[30] * ft0 * rc_acc / (rc_s * rc_s))
-            + (k[31] * ft0 * rc_w2 / rc_s.powi(3))
-            + (k[31] * rc_c.powi(3) * rc_w2 / rc_s.powi(3));
-    }
-
-    fn separation_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
-
-    fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
-        k[..6].copy_from_slice(p);
-        // k[6] = rc_wi = 0.0
-        k[6] = 0.0;
-        // k[7] = rc_si = sin(rc_thi)
-        k[7] = k[4].sin();
-        // k[8] = rc_ci = cos(rc_thi)
-        k[8] = k[4].cos();
-    }
-
-    fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
-
-    fn full_state(
-        &self,
-        k: &[f64],
-        _t: f64,
-        delta: f64,
-        theta_dot: f64,
-        q: &mut [f64],
-        qd: &mut [f64],
-    ) {
-        let k = &k[..32]; // one bounds check for all constant loads
-        q[0] = k[4] - delta;
-        qd[0] = theta_dot;
+        None
     }
 }

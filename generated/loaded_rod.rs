@@ -5,8 +5,8 @@
 // some of it unused.
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, NextPhase,
-    ParamInfo, Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
+    ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo,
+    Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
 };
 
 /// A uniform rod with a point load at its upper end, leaning on a free cube on a frictionless floor, released from rest.
@@ -16,6 +16,7 @@ static INFO: ModelInfo = ModelInfo {
     name: "loaded_rod",
     description: "A uniform rod with a point load at its upper end, leaning on a free cube on a frictionless floor, released from rest.",
     spec: "derivations/loaded_rod.yaml",
+    system: "loaded_rod",
     parameters: &[
         ParamInfo {
             name: "m1",
@@ -58,31 +59,39 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 45,
-    coordinates: &["x1", "theta"],
-    reduced: 1,
-    cyclic: &[0],
+    n_constants: 24,
+    coordinates: &["x1", "y1", "theta", "x2"],
+    system_coordinates: &["x1", "y1", "theta", "x2"],
+    reduced: 2,
+    cyclic: &[0, 3],
     end_angle: 0.0,
-    forces: &[
-        NamedInfo {
+    contacts: &[
+        ContactInfo {
             name: "contact_force",
             meaning: "push of the rod's tip on the cube, positive while they touch",
+            gap_unit: "m",
+            unit: "N",
+            bilateral: false,
+            edge: false,
+            eliminates: Some("x2"),
+            closed: false,
         },
-        NamedInfo {
+        ContactInfo {
             name: "floor_normal",
-            meaning: "the floor's upward push on the rod's foot",
+            meaning: "the floor's upward push on the rod's foot, positive while they touch",
+            gap_unit: "m",
+            unit: "N",
+            bilateral: false,
+            edge: false,
+            eliminates: Some("y1"),
+            closed: false,
         },
     ],
-    contact: Some(ContactInfo {
-        force: 0,
-        eliminated: "x2",
-        edge: false,
-    }),
     frictions: &[],
     points: &[
         NamedInfo {
             name: "foot",
-            meaning: "the rod's foot on the floor",
+            meaning: "the rod's foot",
         },
         NamedInfo {
             name: "tip",
@@ -103,18 +112,11 @@ static INFO: ModelInfo = ModelInfo {
     ],
     falling_point: 3,
     gravity: 5,
-    monitors: &[
-        MonitorInfo {
-            name: "foot_on_floor",
-            meaning: "the rod's foot stays on the floor (N >= 0)",
-            unit: "N",
-        },
-        MonitorInfo {
-            name: "cube_does_not_tip",
-            meaning: "the push's torque about the cube's far edge stays below gravity's",
-            unit: "N m",
-        },
-    ],
+    monitors: &[MonitorInfo {
+        name: "cube_does_not_tip",
+        meaning: "the push's torque about the cube's far edge stays below gravity's",
+        unit: "N m",
+    }],
     bodies: &["loaded_rod", "cube"],
     shapes: &[
         ShapeInfo {
@@ -128,34 +130,23 @@ static INFO: ModelInfo = ModelInfo {
             first: 4,
         },
     ],
-    next_phase: Some(NextPhase {
-        model: "loaded_rod_free",
-        bindings: &[
-            Binding::Param(0),
-            Binding::Param(1),
-            Binding::Param(2),
-            Binding::Param(3),
-            Binding::Param(4),
-            Binding::Param(5),
-            Binding::Coordinate(0),
-            Binding::Coordinate(1),
-            Binding::Eliminated,
-            Binding::Velocity(0),
-            Binding::Velocity(1),
-            Binding::EliminatedRate,
-        ],
-    }),
-    reduction: Some(ReductionInfo {
-        k_theta_initial: 6,
-        k_theta_dot_initial: 7,
-        k_sin_initial: 8,
-        k_cos_initial: 9,
-        separation_degree: 3,
-        polynomial_separation: true,
-        fall_degree: Some(2),
-        lean_constants: &[7, 8, 9, 31, 38, 39, 40, 41],
-    }),
-    route_note: "",
+    start_params: false,
+    phases: &[
+        PhaseInfo {
+            closed: &[0, 1],
+            model: "loaded_rod_closed",
+            release: true,
+            separation_degree: 3,
+        },
+        PhaseInfo {
+            closed: &[1],
+            model: "loaded_rod_free",
+            release: false,
+            separation_degree: 0,
+        },
+    ],
+    reduction: None,
+    route_note: "coordinate `y1` is not cyclic (the Lagrangian depends on it), so it cannot be eliminated through a conserved momentum",
 };
 
 impl Model for LoadedRod {
@@ -170,260 +161,208 @@ impl Model for LoadedRod {
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
         k[..6].copy_from_slice(p);
-        Reduction::prepare_lean(self, p, k);
-        // k[6] = rc_thi = asin(a/ell)
+        // k[6] = asin(a/ell)
         k[6] = (k[4] / k[3]).asin();
-        // k[10] = rc_x0i = 0.0
-        k[10] = 0.0;
-        // k[11] = ell/2
-        k[11] = k[3] / 2.0;
-        // k[12] = ell*m1/(2*(m1 + m3)) + ell*m3/(m1 + m3)
-        k[12] = (k[3] * k[0] / 2.0 / (k[0] + k[2])) + (k[3] * k[2] / (k[0] + k[2]));
-        // k[13] = 3*ell*m1*m3/(2*(m1 + m3)) + ell*m2 + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3)
-        k[13] = (3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
-            + (k[3] * k[1])
+        // k[7] = ell*((1 - a/ell)*(1 + a/ell))^(1/2)
+        let h7_t0 = k[4] / k[3];
+        k[7] = k[3] * ((1.0 - h7_t0) * (1.0 + h7_t0)).sqrt();
+        // k[8] = ell/2
+        k[8] = k[3] / 2.0;
+        // k[9] = ell*m1/(2*(m1 + m3)) + ell*m3/(m1 + m3)
+        k[9] = (k[3] * k[0] / 2.0 / (k[0] + k[2])) + (k[3] * k[2] / (k[0] + k[2]));
+        // k[10] = 3*ell*m1*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3)
+        k[10] = (3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
             + (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
             + (k[3] * (k[2] * k[2]) / (k[0] + k[2]));
-        // k[14] = ell^2*m1/24 + ell^2*m1*m3/(8*(m1 + m3))
-        let h14_t0 = k[3] * k[3];
-        k[14] = (h14_t0 * k[0] / 24.0) + (h14_t0 * k[0] * k[2] / 8.0 / (k[0] + k[2]));
-        // k[15] = ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + ell^2*m2/2 + 5*ell^2*m1^2*m3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*(2*m1*m3 + m1^2 + m3^2))
-        let h15_t0 = k[3] * k[3];
-        let h15_t1 = k[2] * k[2];
-        let h15_t2 = k[0] * k[0];
-        k[15] = (h15_t0 * k[0] * h15_t1 / ((2.0 * k[0] * k[2]) + h15_t2 + h15_t1))
-            + (h15_t0 * k[1] / 2.0)
-            + (5.0 * h15_t0 * h15_t2 * k[2] / 8.0 / ((2.0 * k[0] * k[2]) + h15_t2 + h15_t1))
-            + (h15_t0 * k[0].powi(3) / 8.0 / ((2.0 * k[0] * k[2]) + h15_t2 + h15_t1))
-            + (h15_t0 * k[2].powi(3) / 2.0 / ((2.0 * k[0] * k[2]) + h15_t2 + h15_t1));
-        // k[16] = ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*(2*m1*m3 + m1^2 + m3^2))
-        let h16_t0 = k[3] * k[3];
-        let h16_t1 = k[2] * k[2];
-        let h16_t2 = k[0] * k[0];
-        k[16] = (h16_t0 * k[0] * h16_t1 / ((2.0 * k[0] * k[2]) + h16_t2 + h16_t1))
-            + (5.0 * h16_t0 * h16_t2 * k[2] / 8.0 / ((2.0 * k[0] * k[2]) + h16_t2 + h16_t1))
-            + (h16_t0 * k[0].powi(3) / 8.0 / ((2.0 * k[0] * k[2]) + h16_t2 + h16_t1))
-            + (h16_t0 * k[2].powi(3) / 2.0 / ((2.0 * k[0] * k[2]) + h16_t2 + h16_t1));
-        // k[17] = m1/2 + m2/2 + m3/2
-        k[17] = (k[0] / 2.0) + (k[1] / 2.0) + (k[2] / 2.0);
-        // k[18] = a*g*m2/2
-        k[18] = k[4] * k[5] * k[1] / 2.0;
-        // k[19] = ell*g*m1/2 + ell*g*m3
-        k[19] = (k[3] * k[5] * k[0] / 2.0) + (k[3] * k[5] * k[2]);
-        // k[20] = m1 + m2 + m3
-        k[20] = k[0] + k[1] + k[2];
-        // k[21] = ell^2*m1/12 + ell^2*m1*m3/(4*(m1 + m3))
-        let h21_t0 = k[3] * k[3];
-        k[21] = (h21_t0 * k[0] / 12.0) + (h21_t0 * k[0] * k[2] / 4.0 / (k[0] + k[2]));
-        // k[22] = 2*ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + ell^2*m2 + 5*ell^2*m1^2*m3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*m1*m3 + m1^2 + m3^2)
-        let h22_t0 = k[3] * k[3];
-        let h22_t1 = k[2] * k[2];
-        let h22_t2 = k[0] * k[0];
-        k[22] = (2.0 * h22_t0 * k[0] * h22_t1 / ((2.0 * k[0] * k[2]) + h22_t2 + h22_t1))
-            + (h22_t0 * k[1])
-            + (5.0 * h22_t0 * h22_t2 * k[2] / 4.0 / ((2.0 * k[0] * k[2]) + h22_t2 + h22_t1))
-            + (h22_t0 * k[0].powi(3) / 4.0 / ((2.0 * k[0] * k[2]) + h22_t2 + h22_t1))
-            + (h22_t0 * k[2].powi(3) / ((2.0 * k[0] * k[2]) + h22_t2 + h22_t1));
-        // k[23] = 2*ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*m1*m3 + m1^2 + m3^2)
-        let h23_t0 = k[3] * k[3];
-        let h23_t1 = k[2] * k[2];
-        let h23_t2 = k[0] * k[0];
-        k[23] = (2.0 * h23_t0 * k[0] * h23_t1 / ((2.0 * k[0] * k[2]) + h23_t2 + h23_t1))
-            + (5.0 * h23_t0 * h23_t2 * k[2] / 4.0 / ((2.0 * k[0] * k[2]) + h23_t2 + h23_t1))
-            + (h23_t0 * k[0].powi(3) / 4.0 / ((2.0 * k[0] * k[2]) + h23_t2 + h23_t1))
-            + (h23_t0 * k[2].powi(3) / ((2.0 * k[0] * k[2]) + h23_t2 + h23_t1));
-        // k[24] = ell^2*m2
-        k[24] = (k[3] * k[3]) * k[1];
-        // k[25] = g*m1 + g*m3
-        k[25] = (k[5] * k[0]) + (k[5] * k[2]);
-        // k[26] = 3*ell*m1*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3)
-        k[26] = (3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
-            + (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
-            + (k[3] * (k[2] * k[2]) / (k[0] + k[2]));
-        // k[27] = a/2
-        k[27] = k[4] / 2.0;
-        // k[28] = 12/ell
-        k[28] = 12.0 / k[3];
-        // k[29] = g*m1*m2 + 3*g*m1*m3 + 2*g*m2*m3 + g*m1^2 + 2*g*m3^2
-        k[29] = (k[5] * k[0] * k[1])
-            + (3.0 * k[5] * k[0] * k[2])
-            + (2.0 * k[5] * k[1] * k[2])
-            + (k[5] * (k[0] * k[0]))
-            + (2.0 * k[5] * (k[2] * k[2]));
-        // k[30] = 4*m1*m2 + 16*m1*m3 + 12*m2*m3 + 4*m1^2 + 12*m3^2
-        k[30] = (4.0 * k[0] * k[1])
-            + (16.0 * k[0] * k[2])
-            + (12.0 * k[1] * k[2])
-            + (4.0 * (k[0] * k[0]))
-            + (12.0 * (k[2] * k[2]));
-        // k[32] = 6/ell
-        k[32] = 6.0 / k[3];
-        // k[33] = 144*g*m1*m2*m3^2 + 24*g*m1*m2^2*m3 + 120*g*m1*m3^3 + 96*g*m2*m3^3 + 60*g*m1^2*m2*m3 + 108*g*m1^2*m3^2 + 6*g*m1^3*m2 + 42*g*m1^3*m3 + 6*g*m1^4 + 48*g*m2^2*m3^2 + 48*g*m3^4
-        let h33_t0 = k[2] * k[2];
-        let h33_t1 = k[1] * k[1];
-        let h33_t2 = k[2].powi(3);
-        let h33_t3 = k[0] * k[0];
-        let h33_t4 = k[0].powi(3);
-        k[33] = (144.0 * k[5] * k[0] * k[1] * h33_t0)
-            + (24.0 * k[5] * k[0] * h33_t1 * k[2])
-            + (120.0 * k[5] * k[0] * h33_t2)
-            + (96.0 * k[5] * k[1] * h33_t2)
-            + (60.0 * k[5] * h33_t3 * k[1] * k[2])
-            + (108.0 * k[5] * h33_t3 * h33_t0)
-            + (6.0 * k[5] * h33_t4 * k[1])
-            + (42.0 * k[5] * h33_t4 * k[2])
-            + (6.0 * k[5] * k[0].powi(4))
-            + (48.0 * k[5] * h33_t1 * h33_t0)
-            + (48.0 * k[5] * k[2].powi(4));
-        // k[34] = 88*g*m1*m2*m3^2 + 20*g*m1*m2^2*m3 + 68*g*m1*m3^3 + 48*g*m2*m3^3 + 48*g*m1^2*m2*m3 + 4*g*m1^2*m2^2 + 68*g*m1^2*m3^2 + 8*g*m1^3*m2 + 28*g*m1^3*m3 + 4*g*m1^4 + 24*g*m2^2*m3^2 + 24*g*m3^4
-        let h34_t0 = k[2] * k[2];
-        let h34_t1 = k[1] * k[1];
-        let h34_t2 = k[2].powi(3);
-        let h34_t3 = k[0] * k[0];
-        let h34_t4 = k[0].powi(3);
-        k[34] = (88.0 * k[5] * k[0] * k[1] * h34_t0)
-            + (20.0 * k[5] * k[0] * h34_t1 * k[2])
-            + (68.0 * k[5] * k[0] * h34_t2)
-            + (48.0 * k[5] * k[1] * h34_t2)
-            + (48.0 * k[5] * h34_t3 * k[1] * k[2])
-            + (4.0 * k[5] * h34_t3 * h34_t1)
-            + (68.0 * k[5] * h34_t3 * h34_t0)
-            + (8.0 * k[5] * h34_t4 * k[1])
-            + (28.0 * k[5] * h34_t4 * k[2])
-            + (4.0 * k[5] * k[0].powi(4))
-            + (24.0 * k[5] * h34_t1 * h34_t0)
-            + (24.0 * k[5] * k[2].powi(4));
-        // k[35] = 72*g*m1*m2*m3^2 + 12*g*m1*m2^2*m3 + 60*g*m1*m3^3 + 48*g*m2*m3^3 + 30*g*m1^2*m2*m3 + 54*g*m1^2*m3^2 + 3*g*m1^3*m2 + 21*g*m1^3*m3 + 3*g*m1^4 + 24*g*m2^2*m3^2 + 24*g*m3^4
-        let h35_t0 = k[2] * k[2];
-        let h35_t1 = k[1] * k[1];
-        let h35_t2 = k[2].powi(3);
-        let h35_t3 = k[0] * k[0];
-        let h35_t4 = k[0].powi(3);
-        k[35] = (72.0 * k[5] * k[0] * k[1] * h35_t0)
-            + (12.0 * k[5] * k[0] * h35_t1 * k[2])
-            + (60.0 * k[5] * k[0] * h35_t2)
-            + (48.0 * k[5] * k[1] * h35_t2)
-            + (30.0 * k[5] * h35_t3 * k[1] * k[2])
-            + (54.0 * k[5] * h35_t3 * h35_t0)
-            + (3.0 * k[5] * h35_t4 * k[1])
-            + (21.0 * k[5] * h35_t4 * k[2])
-            + (3.0 * k[5] * k[0].powi(4))
-            + (24.0 * k[5] * h35_t1 * h35_t0)
-            + (24.0 * k[5] * k[2].powi(4));
-        // k[36] = ell*m1*m2/(2*(m1 + m2 + m3))
-        k[36] = k[3] * k[0] * k[1] / 2.0 / (k[0] + k[1] + k[2]);
-        // k[37] = (ell*m1 + 2*ell*m3)/2
-        k[37] = ((k[3] * k[0]) + (2.0 * k[3] * k[2])) / 2.0;
-        // k[42] = ell*m1/(2*(m1 + m2 + m3)) + ell*m2/(m1 + m2 + m3) + ell*m3/(m1 + m2 + m3)
-        k[42] = (k[3] * k[0] / 2.0 / (k[0] + k[1] + k[2]))
-            + (k[3] * k[1] / (k[0] + k[1] + k[2]))
-            + (k[3] * k[2] / (k[0] + k[1] + k[2]));
-        // k[43] = ell*(m1/2 + m3)/(m1 + m3)
-        k[43] = k[3] * ((k[0] / 2.0) + k[2]) / (k[0] + k[2]);
-        // k[44] = ell*m1/(2*(m1 + m3))
-        k[44] = k[3] * k[0] / (2.0 * (k[0] + k[2]));
+        // k[11] = ell^2*m1/24 + ell^2*m1*m3/(8*(m1 + m3))
+        let h11_t0 = k[3] * k[3];
+        k[11] = (h11_t0 * k[0] / 24.0) + (h11_t0 * k[0] * k[2] / 8.0 / (k[0] + k[2]));
+        // k[12] = ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*(2*m1*m3 + m1^2 + m3^2))
+        let h12_t0 = k[3] * k[3];
+        let h12_t1 = k[2] * k[2];
+        let h12_t2 = k[0] * k[0];
+        k[12] = (h12_t0 * k[0] * h12_t1 / ((2.0 * k[0] * k[2]) + h12_t2 + h12_t1))
+            + (5.0 * h12_t0 * h12_t2 * k[2] / 8.0 / ((2.0 * k[0] * k[2]) + h12_t2 + h12_t1))
+            + (h12_t0 * k[0].powi(3) / 8.0 / ((2.0 * k[0] * k[2]) + h12_t2 + h12_t1))
+            + (h12_t0 * k[2].powi(3) / 2.0 / ((2.0 * k[0] * k[2]) + h12_t2 + h12_t1));
+        // k[13] = m1/2 + m3/2
+        k[13] = (k[0] / 2.0) + (k[2] / 2.0);
+        // k[14] = m2/2
+        k[14] = k[1] / 2.0;
+        // k[15] = a*g*m2/2
+        k[15] = k[4] * k[5] * k[1] / 2.0;
+        // k[16] = 3*ell*g*m1*m3/(2*(m1 + m3)) + ell*g*m1^2/(2*(m1 + m3)) + ell*g*m3^2/(m1 + m3)
+        k[16] = (3.0 * k[3] * k[5] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
+            + (k[3] * k[5] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
+            + (k[3] * k[5] * (k[2] * k[2]) / (k[0] + k[2]));
+        // k[17] = g*m1 + g*m3
+        k[17] = (k[5] * k[0]) + (k[5] * k[2]);
+        // k[18] = m1 + m3
+        k[18] = k[0] + k[2];
+        // k[19] = ell^2*m1/12 + ell^2*m1*m3/(4*(m1 + m3))
+        let h19_t0 = k[3] * k[3];
+        k[19] = (h19_t0 * k[0] / 12.0) + (h19_t0 * k[0] * k[2] / 4.0 / (k[0] + k[2]));
+        // k[20] = 2*ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*m1*m3 + m1^2 + m3^2)
+        let h20_t0 = k[3] * k[3];
+        let h20_t1 = k[2] * k[2];
+        let h20_t2 = k[0] * k[0];
+        k[20] = (2.0 * h20_t0 * k[0] * h20_t1 / ((2.0 * k[0] * k[2]) + h20_t2 + h20_t1))
+            + (5.0 * h20_t0 * h20_t2 * k[2] / 4.0 / ((2.0 * k[0] * k[2]) + h20_t2 + h20_t1))
+            + (h20_t0 * k[0].powi(3) / 4.0 / ((2.0 * k[0] * k[2]) + h20_t2 + h20_t1))
+            + (h20_t0 * k[2].powi(3) / ((2.0 * k[0] * k[2]) + h20_t2 + h20_t1));
+        // k[21] = a/2
+        k[21] = k[4] / 2.0;
+        // k[22] = ell*(m1/2 + m3)/(m1 + m3)
+        k[22] = k[3] * ((k[0] / 2.0) + k[2]) / (k[0] + k[2]);
+        // k[23] = ell*m1/(2*(m1 + m3))
+        k[23] = k[3] * k[0] / (2.0 * (k[0] + k[2]));
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..45]; // one bounds check for all constant loads
+        let k = &k[..24]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
-        q[1] = k[6];
+        q[1] = 0.0;
         qd[1] = 0.0;
+        q[2] = k[6];
+        qd[2] = 0.0;
+        q[3] = k[7];
+        qd[3] = 0.0;
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..45]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let pt0 = (k[3] * rc_c) + q[0];
-        let pt1 = -(k[3] * qd[1] * rc_s) + qd[0];
-        pos[0] = [q[0], 0.0];
-        vel[0] = [qd[0], 0.0];
-        pos[1] = [pt0, k[3] * rc_s];
-        vel[1] = [pt1, k[3] * qd[1] * rc_c];
-        pos[2] = [(k[11] * rc_c) + q[0], k[11] * rc_s];
-        vel[2] = [-(k[11] * qd[1] * rc_s) + qd[0], k[11] * qd[1] * rc_c];
-        pos[3] = [(k[12] * rc_c) + q[0], k[12] * rc_s];
-        vel[3] = [-(k[12] * qd[1] * rc_s) + qd[0], k[12] * qd[1] * rc_c];
-        pos[4] = [pt0, 0.0];
-        vel[4] = [pt1, 0.0];
+        let k = &k[..24]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        pos[0] = [q[0], q[1]];
+        vel[0] = [qd[0], qd[1]];
+        pos[1] = [(k[3] * rc_c) + q[0], (k[3] * rc_s) + q[1]];
+        vel[1] = [
+            -(k[3] * qd[2] * rc_s) + qd[0],
+            (k[3] * qd[2] * rc_c) + qd[1],
+        ];
+        pos[2] = [(k[8] * rc_c) + q[0], (k[8] * rc_s) + q[1]];
+        vel[2] = [
+            -(k[8] * qd[2] * rc_s) + qd[0],
+            (k[8] * qd[2] * rc_c) + qd[1],
+        ];
+        pos[3] = [(k[9] * rc_c) + q[0], (k[9] * rc_s) + q[1]];
+        vel[3] = [
+            -(k[9] * qd[2] * rc_s) + qd[0],
+            (k[9] * qd[2] * rc_c) + qd[1],
+        ];
+        pos[4] = [q[3], 0.0];
+        vel[4] = [qd[3], 0.0];
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..45]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let et0 = qd[1] * qd[1];
-        (-(k[13] * qd[1] * qd[0] * rc_s)
-            + (k[14] * et0)
-            + (k[15] * et0 * (rc_s * rc_s))
-            + (k[16] * et0 * (rc_c * rc_c))
-            + (k[17] * (qd[0] * qd[0])))
-            + (k[18] + (k[19] * rc_s))
+        let k = &k[..24]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        let et0 = qd[2] * qd[2];
+        (-(k[10] * qd[2] * qd[0] * rc_s)
+            + (k[10] * qd[2] * qd[1] * rc_c)
+            + (k[11] * et0)
+            + (k[12] * et0 * (rc_s * rc_s))
+            + (k[12] * et0 * (rc_c * rc_c))
+            + (k[13] * (qd[0] * qd[0]))
+            + (k[14] * (qd[3] * qd[3]))
+            + (k[13] * (qd[1] * qd[1])))
+            + (k[15] + (k[16] * rc_s) + (k[17] * q[1]))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..45]; // one bounds check for all constant loads
-        let rc_s = q[1].sin();
-        out[0] = -(k[13] * qd[1] * rc_s) + (k[20] * qd[0]);
+        let k = &k[..24]; // one bounds check for all constant loads
+        let rc_s = q[2].sin();
+        out[0] = -(k[10] * qd[2] * rc_s) + (k[18] * qd[0]);
+        out[1] = k[1] * qd[3];
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..45]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let qt0 = -k[13] * rc_s;
-        let qt1 = qd[1] * qd[1];
-        mass[0] = k[20];
-        mass[1] = qt0;
+        let k = &k[..24]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        let qt0 = -k[10] * rc_s;
+        let qt1 = k[10] * rc_c;
+        let qt2 = qd[2] * qd[2];
+        mass[0] = k[18];
+        mass[1] = 0.0;
         mass[2] = qt0;
-        mass[3] = k[21] + (k[22] * (rc_s * rc_s)) + (k[23] * (rc_c * rc_c));
-        rhs[0] = k[13] * qt1 * rc_c;
-        rhs[1] = -(k[19] * rc_c) - (k[24] * qt1 * rc_s * rc_c);
+        mass[3] = 0.0;
+        mass[4] = 0.0;
+        mass[5] = k[18];
+        mass[6] = qt1;
+        mass[7] = 0.0;
+        mass[8] = qt0;
+        mass[9] = qt1;
+        mass[10] = k[19] + (k[20] * (rc_s * rc_s)) + (k[20] * (rc_c * rc_c));
+        mass[11] = 0.0;
+        mass[12] = 0.0;
+        mass[13] = 0.0;
+        mass[14] = 0.0;
+        mass[15] = k[1];
+        rhs[0] = k[10] * qt2 * rc_c;
+        rhs[1] = -k[17] + (k[10] * qt2 * rc_s);
+        rhs[2] = -k[16] * rc_c;
+        rhs[3] = 0.0;
     }
 
-    fn forces_full(
-        &self,
-        k: &[f64],
-        q: &[f64],
-        qd: &[f64],
-        qdd: &[f64],
-        _fr: &[f64],
-        out: &mut [f64],
-    ) {
-        let k = &k[..45]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let ft0 = qd[1] * qd[1];
-        out[0] = k[1] * (-(k[3] * qdd[1] * rc_s) + qdd[0] - (k[3] * ft0 * rc_c));
-        out[1] = k[25] + (k[26] * qdd[1] * rc_c) - (k[26] * ft0 * rc_s);
+    fn forces_full(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _qdd: &[f64], out: &mut [f64]) {
+        out[0] = 0.0;
+        out[1] = 0.0;
+    }
+
+    fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
+        let k = &k[..24]; // one bounds check for all constant loads
+        let rc_c = q[2].cos();
+        out[0] = -(k[3] * rc_c) - q[0] + q[3];
+        out[1] = q[1];
+    }
+
+    fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        let k = &k[..24]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        jac[0] = -1.0;
+        jac[1] = 0.0;
+        jac[2] = k[3] * rc_s;
+        jac[3] = 1.0;
+        jac[4] = 0.0;
+        jac[5] = 1.0;
+        jac[6] = 0.0;
+        jac[7] = 0.0;
+        bias[0] = k[3] * (qd[2] * qd[2]) * rc_c;
+        bias[1] = 0.0;
+    }
+
+    fn edges(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
+        out[0] = f64::INFINITY;
+        out[1] = f64::INFINITY;
     }
 
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..45]; // one bounds check for all constant loads
-        let rc_s = q[1].sin();
-        out[0] = forces[1];
-        out[1] = k[18] - (forces[0] * (-k[27] + (k[3] * rc_s)));
+        let k = &k[..24]; // one bounds check for all constant loads
+        let rc_s = q[2].sin();
+        out[0] = k[15] - (forces[0] * (-k[21] + (k[3] * rc_s)));
     }
 
-    fn contact_edge(&self, _k: &[f64], _q: &[f64]) -> f64 {
-        f64::INFINITY
-    }
-
-    fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..45]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        out[0] = (k[3] * rc_c) + q[0];
-        out[1] = -(k[3] * qd[1] * rc_s) + qd[0];
+    fn to_full(&self, _k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
+        q_full[0] = q[0];
+        qd_full[0] = qd[0];
+        q_full[1] = q[1];
+        qd_full[1] = qd[1];
+        q_full[2] = q[2];
+        qd_full[2] = qd[2];
+        q_full[3] = q[3];
+        qd_full[3] = qd[3];
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..45]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        poses[0] = [(k[12] * rc_c) + q[0], k[12] * rc_s, q[1]];
-        poses[1] = [k[27] + (k[3] * rc_c) + q[0], k[27], 0.0];
-        sizes[0] = -k[43];
+        let k = &k[..24]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        poses[0] = [(k[9] * rc_c) + q[0], (k[9] * rc_s) + q[1], q[2]];
+        poses[1] = [k[21] + q[3], k[21], 0.0];
+        sizes[0] = -k[22];
         sizes[1] = 0.0;
-        sizes[2] = k[44];
+        sizes[2] = k[23];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
@@ -432,113 +371,6 @@ impl Model for LoadedRod {
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
-        Some(self)
-    }
-}
-
-impl Reduction for LoadedRod {
-    fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..45]; // one bounds check for all constant loads
-        let (rc_s, rc_c, rc_ds, _) = start_offsets(k[6], k[8], k[9], delta);
-        let rt0 = rc_s * rc_s;
-        let rt1 = -k[30] + (k[31] * rt0);
-        Reduced {
-            sin: rc_s,
-            cos: rc_c,
-            theta_dot_sq: -k[28] * (k[29] * rc_ds) / rt1,
-            theta_ddot: k[32]
-                * ((k[33] * rc_s * rc_c * rc_ds) - (k[34] * rc_c) + (k[35] * rt0 * rc_c))
-                / (rt1 * rt1),
-        }
-    }
-
-    fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..45]; // one bounds check for all constant loads
-        -k[28] * (k[29] * rc_ds) / (-k[30] + (k[31] * (rc_s * rc_s)))
-    }
-
-    fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..45]; // one bounds check for all constant loads
-        let (rc_s, rc_c, rc_ds, _) = start_offsets(k[6], k[8], k[9], delta);
-        let rt0 = rc_s * rc_s;
-        let rt1 = -k[30] + (k[31] * rt0);
-        let rc_w2 = -k[28] * (k[29] * rc_ds) / rt1;
-        let rc_acc = k[32]
-            * ((k[33] * rc_s * rc_c * rc_ds) - (k[34] * rc_c) + (k[35] * rt0 * rc_c))
-            / (rt1 * rt1);
-        out[0] = -(k[36] * rc_s * rc_acc) - (k[36] * rc_c * rc_w2);
-        out[1] = k[25] - (k[37] * rc_s * rc_w2) + (k[37] * rc_c * rc_acc);
-    }
-
-    fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..45]; // one bounds check for all constant loads
-        out[0] = k[38];
-        out[1] = -k[39];
-        out[2] = 0.0;
-        out[3] = k[31];
-    }
-
-    fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
-        k[..6].copy_from_slice(p);
-        // k[7] = rc_wi = 0.0
-        k[7] = 0.0;
-        // k[8] = rc_si = a/ell
-        k[8] = k[4] / k[3];
-        // k[9] = rc_ci = ((1 - a/ell)*(1 + a/ell))^(1/2)
-        let c3_t0 = k[4] / k[3];
-        k[9] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
-        // k[31] = 12*m1*m3 + 12*m2*m3 + 3*m1^2 + 12*m3^2
-        k[31] = (12.0 * k[0] * k[2])
-            + (12.0 * k[1] * k[2])
-            + (3.0 * (k[0] * k[0]))
-            + (12.0 * (k[2] * k[2]));
-        // k[38] = 8*m1*m2*rc_si + 32*m1*m3*rc_si + 24*m2*m3*rc_si + 8*m1^2*rc_si + 24*m3^2*rc_si
-        k[38] = (8.0 * k[0] * k[1] * k[8])
-            + (32.0 * k[0] * k[2] * k[8])
-            + (24.0 * k[1] * k[2] * k[8])
-            + (8.0 * (k[0] * k[0]) * k[8])
-            + (24.0 * (k[2] * k[2]) * k[8]);
-        // k[39] = 12*m1*m2 + 48*m1*m3 + 36*m2*m3 + 12*m1^2 + 36*m3^2
-        k[39] = (12.0 * k[0] * k[1])
-            + (48.0 * k[0] * k[2])
-            + (36.0 * k[1] * k[2])
-            + (12.0 * (k[0] * k[0]))
-            + (36.0 * (k[2] * k[2]));
-        // k[40] = (ell*m1 + 3*ell*m3)/(3*g*(m1 + 2*m3))
-        k[40] = ((k[3] * k[0]) + (3.0 * k[3] * k[2])) / 3.0 / k[5] / (k[0] + (2.0 * k[2]));
-        // k[41] = (4*ell*m1*m3 + 4*ell*m2*m3 + ell*m1^2 + 4*ell*m3^2)/(4*g*(m1 + 2*m3)*(m1 + m2 + m3))
-        k[41] = ((4.0 * k[3] * k[0] * k[2])
-            + (4.0 * k[3] * k[1] * k[2])
-            + (k[3] * (k[0] * k[0]))
-            + (4.0 * k[3] * (k[2] * k[2])))
-            / 4.0
-            / k[5]
-            / (k[0] + (2.0 * k[2]))
-            / (k[0] + k[1] + k[2]);
-    }
-
-    fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..45]; // one bounds check for all constant loads
-        out[0] = k[40];
-        out[1] = 0.0;
-        out[2] = -k[41];
-    }
-
-    fn full_state(
-        &self,
-        k: &[f64],
-        _t: f64,
-        delta: f64,
-        theta_dot: f64,
-        q: &mut [f64],
-        qd: &mut [f64],
-    ) {
-        let k = &k[..45]; // one bounds check for all constant loads
-        let (rc_s, _, _, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
-        let rc_w = theta_dot;
-        q[1] = k[6] - delta;
-        qd[1] = theta_dot;
-        q[0] = k[10] + (k[42] * rc_dc);
-        qd[0] = k[42] * rc_s * rc_w;
+        None
     }
 }

@@ -5,8 +5,8 @@
 // some of it unused.
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, NextPhase,
-    ParamInfo, Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
+    ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo,
+    Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
 };
 
 /// A uniform rod leaning on a free cube on a frictionless floor, released from rest.
@@ -16,6 +16,7 @@ static INFO: ModelInfo = ModelInfo {
     name: "rod_cube",
     description: "A uniform rod leaning on a free cube on a frictionless floor, released from rest.",
     spec: "derivations/rod_cube.yaml",
+    system: "rod_cube",
     parameters: &[
         ParamInfo {
             name: "m1",
@@ -52,31 +53,39 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 40,
-    coordinates: &["x1", "theta"],
-    reduced: 1,
-    cyclic: &[0],
+    n_constants: 19,
+    coordinates: &["x1", "y1", "theta", "x2"],
+    system_coordinates: &["x1", "y1", "theta", "x2"],
+    reduced: 2,
+    cyclic: &[0, 3],
     end_angle: 0.0,
-    forces: &[
-        NamedInfo {
+    contacts: &[
+        ContactInfo {
             name: "contact_force",
             meaning: "push of the rod's tip on the cube, positive while they touch",
+            gap_unit: "m",
+            unit: "N",
+            bilateral: false,
+            edge: false,
+            eliminates: Some("x2"),
+            closed: false,
         },
-        NamedInfo {
+        ContactInfo {
             name: "floor_normal",
-            meaning: "the floor's upward push on the rod's foot",
+            meaning: "the floor's upward push on the rod's foot, positive while they touch",
+            gap_unit: "m",
+            unit: "N",
+            bilateral: false,
+            edge: false,
+            eliminates: Some("y1"),
+            closed: false,
         },
     ],
-    contact: Some(ContactInfo {
-        force: 0,
-        eliminated: "x2",
-        edge: false,
-    }),
     frictions: &[],
     points: &[
         NamedInfo {
             name: "foot",
-            meaning: "the rod's foot on the floor",
+            meaning: "the rod's foot",
         },
         NamedInfo {
             name: "tip",
@@ -93,18 +102,11 @@ static INFO: ModelInfo = ModelInfo {
     ],
     falling_point: 2,
     gravity: 4,
-    monitors: &[
-        MonitorInfo {
-            name: "foot_on_floor",
-            meaning: "the rod's foot stays on the floor (N >= 0)",
-            unit: "N",
-        },
-        MonitorInfo {
-            name: "cube_does_not_tip",
-            meaning: "the push's torque about the cube's far edge stays below gravity's",
-            unit: "N m",
-        },
-    ],
+    monitors: &[MonitorInfo {
+        name: "cube_does_not_tip",
+        meaning: "the push's torque about the cube's far edge stays below gravity's",
+        unit: "N m",
+    }],
     bodies: &["rod", "cube"],
     shapes: &[
         ShapeInfo {
@@ -118,33 +120,23 @@ static INFO: ModelInfo = ModelInfo {
             first: 4,
         },
     ],
-    next_phase: Some(NextPhase {
-        model: "rod_cube_free",
-        bindings: &[
-            Binding::Param(0),
-            Binding::Param(1),
-            Binding::Param(2),
-            Binding::Param(3),
-            Binding::Param(4),
-            Binding::Coordinate(0),
-            Binding::Coordinate(1),
-            Binding::Eliminated,
-            Binding::Velocity(0),
-            Binding::Velocity(1),
-            Binding::EliminatedRate,
-        ],
-    }),
-    reduction: Some(ReductionInfo {
-        k_theta_initial: 5,
-        k_theta_dot_initial: 6,
-        k_sin_initial: 7,
-        k_cos_initial: 8,
-        separation_degree: 3,
-        polynomial_separation: true,
-        fall_degree: Some(2),
-        lean_constants: &[6, 7, 8, 29, 35, 36, 37, 38],
-    }),
-    route_note: "",
+    start_params: false,
+    phases: &[
+        PhaseInfo {
+            closed: &[0, 1],
+            model: "rod_cube_closed",
+            release: true,
+            separation_degree: 3,
+        },
+        PhaseInfo {
+            closed: &[1],
+            model: "rod_cube_free",
+            release: false,
+            separation_degree: 0,
+        },
+    ],
+    reduction: None,
+    route_note: "coordinate `y1` is not cyclic (the Lagrangian depends on it), so it cannot be eliminated through a conserved momentum",
 };
 
 impl Model for RodCube {
@@ -159,165 +151,177 @@ impl Model for RodCube {
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
         k[..5].copy_from_slice(p);
-        Reduction::prepare_lean(self, p, k);
-        // k[5] = rc_thi = asin(a/ell)
+        // k[5] = asin(a/ell)
         k[5] = (k[3] / k[2]).asin();
-        // k[9] = rc_x0i = 0.0
-        k[9] = 0.0;
-        // k[10] = ell/2
-        k[10] = k[2] / 2.0;
-        // k[11] = ell*m1/2 + ell*m2
-        k[11] = (k[2] * k[0] / 2.0) + (k[2] * k[1]);
-        // k[12] = ell^2*m1/24
-        k[12] = (k[2] * k[2]) * k[0] / 24.0;
-        // k[13] = ell^2*m1/8 + ell^2*m2/2
-        let h13_t0 = k[2] * k[2];
-        k[13] = (h13_t0 * k[0] / 8.0) + (h13_t0 * k[1] / 2.0);
-        // k[14] = ell^2*m1/8
-        k[14] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[15] = m1/2 + m2/2
-        k[15] = (k[0] / 2.0) + (k[1] / 2.0);
-        // k[16] = a*g*m2/2
-        k[16] = k[3] * k[4] * k[1] / 2.0;
-        // k[17] = ell*g*m1/2
-        k[17] = k[2] * k[4] * k[0] / 2.0;
-        // k[18] = m1 + m2
-        k[18] = k[0] + k[1];
-        // k[19] = ell^2*m1/12
-        k[19] = (k[2] * k[2]) * k[0] / 12.0;
-        // k[20] = ell^2*m1/4 + ell^2*m2
-        let h20_t0 = k[2] * k[2];
-        k[20] = (h20_t0 * k[0] / 4.0) + (h20_t0 * k[1]);
-        // k[21] = ell^2*m1/4
-        k[21] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[22] = ell^2*m2
-        k[22] = (k[2] * k[2]) * k[1];
-        // k[23] = g*m1
-        k[23] = k[4] * k[0];
-        // k[24] = ell*m1/2
-        k[24] = k[2] * k[0] / 2.0;
-        // k[25] = a/2
-        k[25] = k[3] / 2.0;
-        // k[26] = 12/ell
-        k[26] = 12.0 / k[2];
-        // k[27] = g*m1 + g*m2
-        k[27] = (k[4] * k[0]) + (k[4] * k[1]);
-        // k[28] = 4*m1 + 4*m2
-        k[28] = (4.0 * k[0]) + (4.0 * k[1]);
-        // k[30] = 6/ell
-        k[30] = 6.0 / k[2];
-        // k[31] = 6*g*m1*m2 + 6*g*m1^2
-        k[31] = (6.0 * k[4] * k[0] * k[1]) + (6.0 * k[4] * (k[0] * k[0]));
-        // k[32] = 8*g*m1*m2 + 4*g*m1^2 + 4*g*m2^2
-        k[32] = (8.0 * k[4] * k[0] * k[1])
-            + (4.0 * k[4] * (k[0] * k[0]))
-            + (4.0 * k[4] * (k[1] * k[1]));
-        // k[33] = 3*g*m1*m2 + 3*g*m1^2
-        k[33] = (3.0 * k[4] * k[0] * k[1]) + (3.0 * k[4] * (k[0] * k[0]));
-        // k[34] = ell*m1*m2/(2*(m1 + m2))
-        k[34] = k[2] * k[0] * k[1] / 2.0 / (k[0] + k[1]);
-        // k[39] = ell*m1/(2*(m1 + m2)) + ell*m2/(m1 + m2)
-        k[39] = (k[2] * k[0] / 2.0 / (k[0] + k[1])) + (k[2] * k[1] / (k[0] + k[1]));
+        // k[6] = ell*((1 - a/ell)*(1 + a/ell))^(1/2)
+        let h6_t0 = k[3] / k[2];
+        k[6] = k[2] * ((1.0 - h6_t0) * (1.0 + h6_t0)).sqrt();
+        // k[7] = ell/2
+        k[7] = k[2] / 2.0;
+        // k[8] = ell*m1/2
+        k[8] = k[2] * k[0] / 2.0;
+        // k[9] = ell^2*m1/24
+        k[9] = (k[2] * k[2]) * k[0] / 24.0;
+        // k[10] = ell^2*m1/8
+        k[10] = (k[2] * k[2]) * k[0] / 8.0;
+        // k[11] = m1/2
+        k[11] = k[0] / 2.0;
+        // k[12] = m2/2
+        k[12] = k[1] / 2.0;
+        // k[13] = a*g*m2/2
+        k[13] = k[3] * k[4] * k[1] / 2.0;
+        // k[14] = ell*g*m1/2
+        k[14] = k[2] * k[4] * k[0] / 2.0;
+        // k[15] = g*m1
+        k[15] = k[4] * k[0];
+        // k[16] = ell^2*m1/12
+        k[16] = (k[2] * k[2]) * k[0] / 12.0;
+        // k[17] = ell^2*m1/4
+        k[17] = (k[2] * k[2]) * k[0] / 4.0;
+        // k[18] = a/2
+        k[18] = k[3] / 2.0;
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..19]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
-        q[1] = k[5];
+        q[1] = 0.0;
         qd[1] = 0.0;
+        q[2] = k[5];
+        qd[2] = 0.0;
+        q[3] = k[6];
+        qd[3] = 0.0;
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..40]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let pt0 = (k[2] * rc_c) + q[0];
-        let pt1 = -(k[2] * qd[1] * rc_s) + qd[0];
-        pos[0] = [q[0], 0.0];
-        vel[0] = [qd[0], 0.0];
-        pos[1] = [pt0, k[2] * rc_s];
-        vel[1] = [pt1, k[2] * qd[1] * rc_c];
-        pos[2] = [(k[10] * rc_c) + q[0], k[10] * rc_s];
-        vel[2] = [-(k[10] * qd[1] * rc_s) + qd[0], k[10] * qd[1] * rc_c];
-        pos[3] = [pt0, 0.0];
-        vel[3] = [pt1, 0.0];
+        let k = &k[..19]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        pos[0] = [q[0], q[1]];
+        vel[0] = [qd[0], qd[1]];
+        pos[1] = [(k[2] * rc_c) + q[0], (k[2] * rc_s) + q[1]];
+        vel[1] = [
+            -(k[2] * qd[2] * rc_s) + qd[0],
+            (k[2] * qd[2] * rc_c) + qd[1],
+        ];
+        pos[2] = [(k[7] * rc_c) + q[0], (k[7] * rc_s) + q[1]];
+        vel[2] = [
+            -(k[7] * qd[2] * rc_s) + qd[0],
+            (k[7] * qd[2] * rc_c) + qd[1],
+        ];
+        pos[3] = [q[3], 0.0];
+        vel[3] = [qd[3], 0.0];
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..40]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let et0 = qd[1] * qd[1];
-        (-(k[11] * qd[1] * qd[0] * rc_s)
-            + (k[12] * et0)
-            + (k[13] * et0 * (rc_s * rc_s))
-            + (k[14] * et0 * (rc_c * rc_c))
-            + (k[15] * (qd[0] * qd[0])))
-            + (k[16] + (k[17] * rc_s))
+        let k = &k[..19]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        let et0 = qd[2] * qd[2];
+        (-(k[8] * qd[2] * qd[0] * rc_s)
+            + (k[8] * qd[2] * qd[1] * rc_c)
+            + (k[9] * et0)
+            + (k[10] * et0 * (rc_s * rc_s))
+            + (k[10] * et0 * (rc_c * rc_c))
+            + (k[11] * (qd[0] * qd[0]))
+            + (k[12] * (qd[3] * qd[3]))
+            + (k[11] * (qd[1] * qd[1])))
+            + (k[13] + (k[14] * rc_s) + (k[15] * q[1]))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
-        let rc_s = q[1].sin();
-        out[0] = -(k[11] * qd[1] * rc_s) + (k[18] * qd[0]);
+        let k = &k[..19]; // one bounds check for all constant loads
+        let rc_s = q[2].sin();
+        out[0] = -(k[8] * qd[2] * rc_s) + (k[0] * qd[0]);
+        out[1] = k[1] * qd[3];
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let qt0 = -k[11] * rc_s;
-        let qt1 = qd[1] * qd[1];
-        mass[0] = k[18];
-        mass[1] = qt0;
+        let k = &k[..19]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        let qt0 = -k[8] * rc_s;
+        let qt1 = k[8] * rc_c;
+        let qt2 = qd[2] * qd[2];
+        mass[0] = k[0];
+        mass[1] = 0.0;
         mass[2] = qt0;
-        mass[3] = k[19] + (k[20] * (rc_s * rc_s)) + (k[21] * (rc_c * rc_c));
-        rhs[0] = k[11] * qt1 * rc_c;
-        rhs[1] = -(k[17] * rc_c) - (k[22] * qt1 * rc_s * rc_c);
+        mass[3] = 0.0;
+        mass[4] = 0.0;
+        mass[5] = k[0];
+        mass[6] = qt1;
+        mass[7] = 0.0;
+        mass[8] = qt0;
+        mass[9] = qt1;
+        mass[10] = k[16] + (k[17] * (rc_s * rc_s)) + (k[17] * (rc_c * rc_c));
+        mass[11] = 0.0;
+        mass[12] = 0.0;
+        mass[13] = 0.0;
+        mass[14] = 0.0;
+        mass[15] = k[1];
+        rhs[0] = k[8] * qt2 * rc_c;
+        rhs[1] = -k[15] + (k[8] * qt2 * rc_s);
+        rhs[2] = -k[14] * rc_c;
+        rhs[3] = 0.0;
     }
 
-    fn forces_full(
-        &self,
-        k: &[f64],
-        q: &[f64],
-        qd: &[f64],
-        qdd: &[f64],
-        _fr: &[f64],
-        out: &mut [f64],
-    ) {
-        let k = &k[..40]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let ft0 = qd[1] * qd[1];
-        out[0] = k[1] * (-(k[2] * qdd[1] * rc_s) + qdd[0] - (k[2] * ft0 * rc_c));
-        out[1] = k[23] + (k[24] * qdd[1] * rc_c) - (k[24] * ft0 * rc_s);
+    fn forces_full(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _qdd: &[f64], out: &mut [f64]) {
+        out[0] = 0.0;
+        out[1] = 0.0;
+    }
+
+    fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
+        let k = &k[..19]; // one bounds check for all constant loads
+        let rc_c = q[2].cos();
+        out[0] = -(k[2] * rc_c) - q[0] + q[3];
+        out[1] = q[1];
+    }
+
+    fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        let k = &k[..19]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        jac[0] = -1.0;
+        jac[1] = 0.0;
+        jac[2] = k[2] * rc_s;
+        jac[3] = 1.0;
+        jac[4] = 0.0;
+        jac[5] = 1.0;
+        jac[6] = 0.0;
+        jac[7] = 0.0;
+        bias[0] = k[2] * (qd[2] * qd[2]) * rc_c;
+        bias[1] = 0.0;
+    }
+
+    fn edges(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
+        out[0] = f64::INFINITY;
+        out[1] = f64::INFINITY;
     }
 
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
-        let rc_s = q[1].sin();
-        out[0] = forces[1];
-        out[1] = k[16] - (forces[0] * (-k[25] + (k[2] * rc_s)));
+        let k = &k[..19]; // one bounds check for all constant loads
+        let rc_s = q[2].sin();
+        out[0] = k[13] - (forces[0] * (-k[18] + (k[2] * rc_s)));
     }
 
-    fn contact_edge(&self, _k: &[f64], _q: &[f64]) -> f64 {
-        f64::INFINITY
-    }
-
-    fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        out[0] = (k[2] * rc_c) + q[0];
-        out[1] = -(k[2] * qd[1] * rc_s) + qd[0];
+    fn to_full(&self, _k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
+        q_full[0] = q[0];
+        qd_full[0] = qd[0];
+        q_full[1] = q[1];
+        qd_full[1] = qd[1];
+        q_full[2] = q[2];
+        qd_full[2] = qd[2];
+        q_full[3] = q[3];
+        qd_full[3] = qd[3];
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        poses[0] = [(k[10] * rc_c) + q[0], k[10] * rc_s, q[1]];
-        poses[1] = [k[25] + (k[2] * rc_c) + q[0], k[25], 0.0];
-        sizes[0] = -k[10];
+        let k = &k[..19]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        poses[0] = [(k[7] * rc_c) + q[0], (k[7] * rc_s) + q[1], q[2]];
+        poses[1] = [k[18] + q[3], k[18], 0.0];
+        sizes[0] = -k[7];
         sizes[1] = 0.0;
-        sizes[2] = k[10];
+        sizes[2] = k[7];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
@@ -326,95 +330,6 @@ impl Model for RodCube {
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
-        Some(self)
-    }
-}
-
-impl Reduction for RodCube {
-    fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..40]; // one bounds check for all constant loads
-        let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[7], k[8], delta);
-        let rt0 = rc_s * rc_s;
-        let rt1 = -k[28] + (k[29] * rt0);
-        Reduced {
-            sin: rc_s,
-            cos: rc_c,
-            theta_dot_sq: -k[26] * (k[27] * rc_ds) / rt1,
-            theta_ddot: k[30]
-                * ((k[31] * rc_s * rc_c * rc_ds) - (k[32] * rc_c) + (k[33] * rt0 * rc_c))
-                / (rt1 * rt1),
-        }
-    }
-
-    fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..40]; // one bounds check for all constant loads
-        -k[26] * (k[27] * rc_ds) / (-k[28] + (k[29] * (rc_s * rc_s)))
-    }
-
-    fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
-        let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[7], k[8], delta);
-        let rt0 = rc_s * rc_s;
-        let rt1 = -k[28] + (k[29] * rt0);
-        let rc_w2 = -k[26] * (k[27] * rc_ds) / rt1;
-        let rc_acc = k[30]
-            * ((k[31] * rc_s * rc_c * rc_ds) - (k[32] * rc_c) + (k[33] * rt0 * rc_c))
-            / (rt1 * rt1);
-        out[0] = -(k[34] * rc_s * rc_acc) - (k[34] * rc_c * rc_w2);
-        out[1] = k[23] - (k[24] * rc_s * rc_w2) + (k[24] * rc_c * rc_acc);
-    }
-
-    fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
-        out[0] = k[35];
-        out[1] = -k[36];
-        out[2] = 0.0;
-        out[3] = k[29];
-    }
-
-    fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
-        k[..5].copy_from_slice(p);
-        // k[6] = rc_wi = 0.0
-        k[6] = 0.0;
-        // k[7] = rc_si = a/ell
-        k[7] = k[3] / k[2];
-        // k[8] = rc_ci = ((1 - a/ell)*(1 + a/ell))^(1/2)
-        let c3_t0 = k[3] / k[2];
-        k[8] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
-        // k[29] = 3*m1
-        k[29] = 3.0 * k[0];
-        // k[35] = 8*m1*rc_si + 8*m2*rc_si
-        k[35] = (8.0 * k[0] * k[7]) + (8.0 * k[1] * k[7]);
-        // k[36] = 12*m1 + 12*m2
-        k[36] = (12.0 * k[0]) + (12.0 * k[1]);
-        // k[37] = ell/(3*g)
-        k[37] = k[2] / 3.0 / k[4];
-        // k[38] = ell*m1/(4*g*(m1 + m2))
-        k[38] = k[2] * k[0] / 4.0 / k[4] / (k[0] + k[1]);
-    }
-
-    fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
-        out[0] = k[37];
-        out[1] = 0.0;
-        out[2] = -k[38];
-    }
-
-    fn full_state(
-        &self,
-        k: &[f64],
-        _t: f64,
-        delta: f64,
-        theta_dot: f64,
-        q: &mut [f64],
-        qd: &mut [f64],
-    ) {
-        let k = &k[..40]; // one bounds check for all constant loads
-        let (rc_s, _, _, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
-        let rc_w = theta_dot;
-        q[1] = k[5] - delta;
-        qd[1] = theta_dot;
-        q[0] = k[9] + (k[39] * rc_dc);
-        qd[0] = k[39] * rc_s * rc_w;
+        None
     }
 }

@@ -5,8 +5,8 @@
 // some of it unused.
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, NextPhase,
-    ParamInfo, Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
+    ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo,
+    Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
 };
 
 /// A uniform rod leaning on a cube that a horizontal spring ties to a fixed wall, all on a frictionless floor, released from rest.
@@ -16,6 +16,7 @@ static INFO: ModelInfo = ModelInfo {
     name: "rod_cube_spring",
     description: "A uniform rod leaning on a cube that a horizontal spring ties to a fixed wall, all on a frictionless floor, released from rest.",
     spec: "derivations/rod_cube_spring.yaml",
+    system: "rod_cube_spring",
     parameters: &[
         ParamInfo {
             name: "m1",
@@ -58,31 +59,39 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 26,
-    coordinates: &["x1", "theta"],
-    reduced: 1,
-    cyclic: &[],
+    n_constants: 22,
+    coordinates: &["x1", "y1", "theta", "x2"],
+    system_coordinates: &["x1", "y1", "theta", "x2"],
+    reduced: 2,
+    cyclic: &[0],
     end_angle: 0.0,
-    forces: &[
-        NamedInfo {
+    contacts: &[
+        ContactInfo {
             name: "contact_force",
             meaning: "push of the rod's tip on the cube, positive while they touch",
+            gap_unit: "m",
+            unit: "N",
+            bilateral: false,
+            edge: false,
+            eliminates: Some("x2"),
+            closed: false,
         },
-        NamedInfo {
+        ContactInfo {
             name: "floor_normal",
-            meaning: "the floor's upward push on the rod's foot",
+            meaning: "the floor's upward push on the rod's foot, positive while they touch",
+            gap_unit: "m",
+            unit: "N",
+            bilateral: false,
+            edge: false,
+            eliminates: Some("y1"),
+            closed: false,
         },
     ],
-    contact: Some(ContactInfo {
-        force: 0,
-        eliminated: "x2",
-        edge: false,
-    }),
     frictions: &[],
     points: &[
         NamedInfo {
             name: "foot",
-            meaning: "the rod's foot on the floor",
+            meaning: "the rod's foot",
         },
         NamedInfo {
             name: "tip",
@@ -99,11 +108,7 @@ static INFO: ModelInfo = ModelInfo {
     ],
     falling_point: 2,
     gravity: 4,
-    monitors: &[MonitorInfo {
-        name: "foot_on_floor",
-        meaning: "the rod's foot stays on the floor (N >= 0)",
-        unit: "N",
-    }],
+    monitors: &[],
     bodies: &["rod", "cube"],
     shapes: &[
         ShapeInfo {
@@ -117,25 +122,10 @@ static INFO: ModelInfo = ModelInfo {
             first: 4,
         },
     ],
-    next_phase: Some(NextPhase {
-        model: "rod_cube_spring_free",
-        bindings: &[
-            Binding::Param(0),
-            Binding::Param(1),
-            Binding::Param(2),
-            Binding::Param(3),
-            Binding::Param(4),
-            Binding::Param(5),
-            Binding::Coordinate(0),
-            Binding::Coordinate(1),
-            Binding::Eliminated,
-            Binding::Velocity(0),
-            Binding::Velocity(1),
-            Binding::EliminatedRate,
-        ],
-    }),
+    start_params: false,
+    phases: &[],
     reduction: None,
-    route_note: "coordinate `x1` is not cyclic (the Lagrangian depends on it), so it cannot be eliminated through a conserved momentum",
+    route_note: "coordinate `y1` is not cyclic (the Lagrangian depends on it), so it cannot be eliminated through a conserved momentum",
 };
 
 impl Model for RodCubeSpring {
@@ -152,143 +142,185 @@ impl Model for RodCubeSpring {
         k[..6].copy_from_slice(p);
         // k[6] = asin(a/ell)
         k[6] = (k[3] / k[2]).asin();
-        // k[7] = ell/2
-        k[7] = k[2] / 2.0;
-        // k[8] = ell*m1/2 + ell*m2
-        k[8] = (k[2] * k[0] / 2.0) + (k[2] * k[1]);
-        // k[9] = ell^2*m1/24
-        k[9] = (k[2] * k[2]) * k[0] / 24.0;
-        // k[10] = ell^2*m1/8 + ell^2*m2/2
-        let h10_t0 = k[2] * k[2];
-        k[10] = (h10_t0 * k[0] / 8.0) + (h10_t0 * k[1] / 2.0);
+        // k[7] = ell*((1 - a/ell)*(1 + a/ell))^(1/2)
+        let h7_t0 = k[3] / k[2];
+        k[7] = k[2] * ((1.0 - h7_t0) * (1.0 + h7_t0)).sqrt();
+        // k[8] = ell/2
+        k[8] = k[2] / 2.0;
+        // k[9] = ell*m1/2
+        k[9] = k[2] * k[0] / 2.0;
+        // k[10] = ell^2*m1/24
+        k[10] = (k[2] * k[2]) * k[0] / 24.0;
         // k[11] = ell^2*m1/8
         k[11] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[12] = m1/2 + m2/2
-        k[12] = (k[0] / 2.0) + (k[1] / 2.0);
-        // k[13] = a*g*m2/2
-        k[13] = k[3] * k[4] * k[1] / 2.0;
-        // k[14] = ell*g*m1/2
-        k[14] = k[2] * k[4] * k[0] / 2.0;
-        // k[15] = k/2
-        k[15] = k[5] / 2.0;
-        // k[16] = (-a^2 + ell^2)^(1/2)
-        k[16] = (-(k[3] * k[3]) + (k[2] * k[2])).sqrt();
-        // k[17] = m1 + m2
-        k[17] = k[0] + k[1];
-        // k[18] = ell^2*m1/12
-        k[18] = (k[2] * k[2]) * k[0] / 12.0;
-        // k[19] = ell^2*m1/4 + ell^2*m2
-        let h19_t0 = k[2] * k[2];
-        k[19] = (h19_t0 * k[0] / 4.0) + (h19_t0 * k[1]);
+        // k[12] = m1/2
+        k[12] = k[0] / 2.0;
+        // k[13] = m2/2
+        k[13] = k[1] / 2.0;
+        // k[14] = a*g*m2/2
+        k[14] = k[3] * k[4] * k[1] / 2.0;
+        // k[15] = ell*g*m1/2
+        k[15] = k[2] * k[4] * k[0] / 2.0;
+        // k[16] = g*m1
+        k[16] = k[4] * k[0];
+        // k[17] = k/2
+        k[17] = k[5] / 2.0;
+        // k[18] = (-a^2 + ell^2)^(1/2)
+        k[18] = (-(k[3] * k[3]) + (k[2] * k[2])).sqrt();
+        // k[19] = ell^2*m1/12
+        k[19] = (k[2] * k[2]) * k[0] / 12.0;
         // k[20] = ell^2*m1/4
         k[20] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[21] = ell*k
-        k[21] = k[2] * k[5];
-        // k[22] = ell^2*m2
-        k[22] = (k[2] * k[2]) * k[1];
-        // k[23] = g*m1
-        k[23] = k[4] * k[0];
-        // k[24] = ell*m1/2
-        k[24] = k[2] * k[0] / 2.0;
-        // k[25] = a/2
-        k[25] = k[3] / 2.0;
+        // k[21] = a/2
+        k[21] = k[3] / 2.0;
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..26]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
-        q[1] = k[6];
+        q[1] = 0.0;
         qd[1] = 0.0;
+        q[2] = k[6];
+        qd[2] = 0.0;
+        q[3] = k[7];
+        qd[3] = 0.0;
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..26]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let pt0 = (k[2] * rc_c) + q[0];
-        let pt1 = -(k[2] * qd[1] * rc_s) + qd[0];
-        pos[0] = [q[0], 0.0];
-        vel[0] = [qd[0], 0.0];
-        pos[1] = [pt0, k[2] * rc_s];
-        vel[1] = [pt1, k[2] * qd[1] * rc_c];
-        pos[2] = [(k[7] * rc_c) + q[0], k[7] * rc_s];
-        vel[2] = [-(k[7] * qd[1] * rc_s) + qd[0], k[7] * qd[1] * rc_c];
-        pos[3] = [pt0, 0.0];
-        vel[3] = [pt1, 0.0];
+        let k = &k[..22]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        pos[0] = [q[0], q[1]];
+        vel[0] = [qd[0], qd[1]];
+        pos[1] = [(k[2] * rc_c) + q[0], (k[2] * rc_s) + q[1]];
+        vel[1] = [
+            -(k[2] * qd[2] * rc_s) + qd[0],
+            (k[2] * qd[2] * rc_c) + qd[1],
+        ];
+        pos[2] = [(k[8] * rc_c) + q[0], (k[8] * rc_s) + q[1]];
+        vel[2] = [
+            -(k[8] * qd[2] * rc_s) + qd[0],
+            (k[8] * qd[2] * rc_c) + qd[1],
+        ];
+        pos[3] = [q[3], 0.0];
+        vel[3] = [qd[3], 0.0];
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..26]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let et0 = qd[1] * qd[1];
-        (-(k[8] * qd[1] * qd[0] * rc_s)
-            + (k[9] * et0)
-            + (k[10] * et0 * (rc_s * rc_s))
+        let k = &k[..22]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        let et0 = qd[2] * qd[2];
+        (-(k[9] * qd[2] * qd[0] * rc_s)
+            + (k[9] * qd[2] * qd[1] * rc_c)
+            + (k[10] * et0)
+            + (k[11] * et0 * (rc_s * rc_s))
             + (k[11] * et0 * (rc_c * rc_c))
-            + (k[12] * (qd[0] * qd[0])))
-            + (k[13]
-                + (k[14] * rc_s)
-                + (k[15] * ((-k[16] + (k[2] * rc_c) + q[0]) * (-k[16] + (k[2] * rc_c) + q[0]))))
+            + (k[12] * (qd[0] * qd[0]))
+            + (k[13] * (qd[3] * qd[3]))
+            + (k[12] * (qd[1] * qd[1])))
+            + (k[14]
+                + (k[15] * rc_s)
+                + (k[16] * q[1])
+                + (k[17] * ((-k[18] + q[3]) * (-k[18] + q[3]))))
     }
 
-    fn momenta(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
+    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let k = &k[..22]; // one bounds check for all constant loads
+        let rc_s = q[2].sin();
+        out[0] = -(k[9] * qd[2] * rc_s) + (k[0] * qd[0]);
+    }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..26]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let qt0 = -k[8] * rc_s;
-        let qt1 = -k[16] + (k[2] * rc_c) + q[0];
-        let qt2 = qd[1] * qd[1];
-        mass[0] = k[17];
-        mass[1] = qt0;
+        let k = &k[..22]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        let qt0 = -k[9] * rc_s;
+        let qt1 = k[9] * rc_c;
+        let qt2 = qd[2] * qd[2];
+        mass[0] = k[0];
+        mass[1] = 0.0;
         mass[2] = qt0;
-        mass[3] = k[18] + (k[19] * (rc_s * rc_s)) + (k[20] * (rc_c * rc_c));
-        rhs[0] = -(k[5] * qt1) + (k[8] * qt2 * rc_c);
-        rhs[1] = -(k[14] * rc_c) + (k[21] * qt1 * rc_s) - (k[22] * qt2 * rc_s * rc_c);
+        mass[3] = 0.0;
+        mass[4] = 0.0;
+        mass[5] = k[0];
+        mass[6] = qt1;
+        mass[7] = 0.0;
+        mass[8] = qt0;
+        mass[9] = qt1;
+        mass[10] = k[19] + (k[20] * (rc_s * rc_s)) + (k[20] * (rc_c * rc_c));
+        mass[11] = 0.0;
+        mass[12] = 0.0;
+        mass[13] = 0.0;
+        mass[14] = 0.0;
+        mass[15] = k[1];
+        rhs[0] = k[9] * qt2 * rc_c;
+        rhs[1] = -k[16] + (k[9] * qt2 * rc_s);
+        rhs[2] = -k[15] * rc_c;
+        rhs[3] = -k[5] * (-k[18] + q[3]);
     }
 
-    fn forces_full(
-        &self,
-        k: &[f64],
-        q: &[f64],
-        qd: &[f64],
-        qdd: &[f64],
-        _fr: &[f64],
-        out: &mut [f64],
-    ) {
-        let k = &k[..26]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let ft0 = qd[1] * qd[1];
-        out[0] = (k[5] * (-k[16] + (k[2] * rc_c) + q[0]))
-            + (k[1] * (-(k[2] * qdd[1] * rc_s) + qdd[0] - (k[2] * ft0 * rc_c)));
-        out[1] = k[23] + (k[24] * qdd[1] * rc_c) - (k[24] * ft0 * rc_s);
+    fn forces_full(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _qdd: &[f64], out: &mut [f64]) {
+        out[0] = 0.0;
+        out[1] = 0.0;
+    }
+
+    fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
+        let k = &k[..22]; // one bounds check for all constant loads
+        let rc_c = q[2].cos();
+        out[0] = -(k[2] * rc_c) - q[0] + q[3];
+        out[1] = q[1];
+    }
+
+    fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        let k = &k[..22]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        jac[0] = -1.0;
+        jac[1] = 0.0;
+        jac[2] = k[2] * rc_s;
+        jac[3] = 1.0;
+        jac[4] = 0.0;
+        jac[5] = 1.0;
+        jac[6] = 0.0;
+        jac[7] = 0.0;
+        bias[0] = k[2] * (qd[2] * qd[2]) * rc_c;
+        bias[1] = 0.0;
+    }
+
+    fn edges(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
+        out[0] = f64::INFINITY;
+        out[1] = f64::INFINITY;
     }
 
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
-    fn monitors_full(&self, _k: &[f64], _q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        out[0] = forces[1];
+    fn monitors_full(
+        &self,
+        _k: &[f64],
+        _q: &[f64],
+        _qd: &[f64],
+        _forces: &[f64],
+        _out: &mut [f64],
+    ) {
     }
 
-    fn contact_edge(&self, _k: &[f64], _q: &[f64]) -> f64 {
-        f64::INFINITY
-    }
-
-    fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..26]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        out[0] = (k[2] * rc_c) + q[0];
-        out[1] = -(k[2] * qd[1] * rc_s) + qd[0];
+    fn to_full(&self, _k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
+        q_full[0] = q[0];
+        qd_full[0] = qd[0];
+        q_full[1] = q[1];
+        qd_full[1] = qd[1];
+        q_full[2] = q[2];
+        qd_full[2] = qd[2];
+        q_full[3] = q[3];
+        qd_full[3] = qd[3];
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..26]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        poses[0] = [(k[7] * rc_c) + q[0], k[7] * rc_s, q[1]];
-        poses[1] = [k[25] + (k[2] * rc_c) + q[0], k[25], 0.0];
-        sizes[0] = -k[7];
+        let k = &k[..22]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        poses[0] = [(k[8] * rc_c) + q[0], (k[8] * rc_s) + q[1], q[2]];
+        poses[1] = [k[21] + q[3], k[21], 0.0];
+        sizes[0] = -k[8];
         sizes[1] = 0.0;
-        sizes[2] = k[7];
+        sizes[2] = k[8];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;

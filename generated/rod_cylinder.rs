@@ -5,8 +5,8 @@
 // some of it unused.
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, NextPhase,
-    ParamInfo, Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
+    ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo,
+    Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
 };
 
 /// A uniform rod leaning on a cylinder that slides without spinning on a frictionless floor, released from rest.
@@ -16,6 +16,7 @@ static INFO: ModelInfo = ModelInfo {
     name: "rod_cylinder",
     description: "A uniform rod leaning on a cylinder that slides without spinning on a frictionless floor, released from rest.",
     spec: "derivations/rod_cylinder.yaml",
+    system: "rod_cylinder",
     parameters: &[
         ParamInfo {
             name: "m1",
@@ -64,31 +65,39 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 25,
-    coordinates: &["x1", "theta"],
-    reduced: 1,
-    cyclic: &[0],
+    n_constants: 19,
+    coordinates: &["x1", "y1", "theta", "xc"],
+    system_coordinates: &["x1", "y1", "theta", "xc"],
+    reduced: 2,
+    cyclic: &[0, 3],
     end_angle: 0.0,
-    forces: &[
-        NamedInfo {
+    contacts: &[
+        ContactInfo {
             name: "contact_force",
-            meaning: "horizontal push of the rod on the cylinder, positive while they touch",
+            meaning: "push of the rod on the cylinder, normal to the rod, positive while they touch",
+            gap_unit: "m",
+            unit: "N",
+            bilateral: false,
+            edge: true,
+            eliminates: Some("xc"),
+            closed: false,
         },
-        NamedInfo {
+        ContactInfo {
             name: "floor_normal",
-            meaning: "the floor's upward push on the rod's foot",
+            meaning: "the floor's upward push on the rod's foot, positive while they touch",
+            gap_unit: "m",
+            unit: "N",
+            bilateral: false,
+            edge: false,
+            eliminates: Some("y1"),
+            closed: false,
         },
     ],
-    contact: Some(ContactInfo {
-        force: 0,
-        eliminated: "xc",
-        edge: true,
-    }),
     frictions: &[],
     points: &[
         NamedInfo {
             name: "foot",
-            meaning: "the rod's foot on the floor",
+            meaning: "the rod's foot",
         },
         NamedInfo {
             name: "tip",
@@ -104,16 +113,12 @@ static INFO: ModelInfo = ModelInfo {
         },
         NamedInfo {
             name: "touch",
-            meaning: "the point of the rod at the cylinder's tangent (the contact point while they touch)",
+            meaning: "the point of the rod nearest the cylinder's axis (the contact point while they touch)",
         },
     ],
     falling_point: 2,
     gravity: 5,
-    monitors: &[MonitorInfo {
-        name: "foot_on_floor",
-        meaning: "the rod's foot stays on the floor (N >= 0)",
-        unit: "N",
-    }],
+    monitors: &[],
     bodies: &["rod", "cylinder"],
     shapes: &[
         ShapeInfo {
@@ -127,25 +132,15 @@ static INFO: ModelInfo = ModelInfo {
             first: 4,
         },
     ],
-    next_phase: Some(NextPhase {
+    start_params: false,
+    phases: &[PhaseInfo {
+        closed: &[1],
         model: "rod_cylinder_free",
-        bindings: &[
-            Binding::Param(0),
-            Binding::Param(1),
-            Binding::Param(2),
-            Binding::Param(3),
-            Binding::Param(4),
-            Binding::Param(5),
-            Binding::Coordinate(0),
-            Binding::Coordinate(1),
-            Binding::Eliminated,
-            Binding::Velocity(0),
-            Binding::Velocity(1),
-            Binding::EliminatedRate,
-        ],
-    }),
+        release: false,
+        separation_degree: 0,
+    }],
     reduction: None,
-    route_note: "the velocity of `x1` is not affine in sin and cos of `theta`; its position has no closed form",
+    route_note: "coordinate `y1` is not cyclic (the Lagrangian depends on it), so it cannot be eliminated through a conserved momentum",
 };
 
 impl Model for RodCylinder {
@@ -162,207 +157,210 @@ impl Model for RodCylinder {
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
         k[..6].copy_from_slice(p);
-        // k[6] = ell/2
-        k[6] = k[2] / 2.0;
-        // k[7] = 2*R
-        k[7] = 2.0 * k[3];
-        // k[8] = R*m2
-        k[8] = k[3] * k[1];
+        // k[6] = R/sin(th0) + R*cos(th0)/sin(th0)
+        k[6] = (k[3] / k[4].sin()) + (k[3] * k[4].cos() / k[4].sin());
+        // k[7] = ell/2
+        k[7] = k[2] / 2.0;
+        // k[8] = 2*R
+        k[8] = 2.0 * k[3];
         // k[9] = ell*m1/2
         k[9] = k[2] * k[0] / 2.0;
-        // k[10] = R^2*m2/2 + ell^2*m1/24
-        k[10] = ((k[3] * k[3]) * k[1] / 2.0) + ((k[2] * k[2]) * k[0] / 24.0);
-        // k[11] = R^2*m2
-        k[11] = (k[3] * k[3]) * k[1];
-        // k[12] = R^2*m2/2
-        k[12] = (k[3] * k[3]) * k[1] / 2.0;
-        // k[13] = ell^2*m1/8
-        k[13] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[14] = m1/2 + m2/2
-        k[14] = (k[0] / 2.0) + (k[1] / 2.0);
-        // k[15] = R*g*m2
-        k[15] = k[3] * k[5] * k[1];
-        // k[16] = ell*g*m1/2
-        k[16] = k[2] * k[5] * k[0] / 2.0;
-        // k[17] = m1 + m2
-        k[17] = k[0] + k[1];
-        // k[18] = R^2*m2 + ell^2*m1/12
-        k[18] = ((k[3] * k[3]) * k[1]) + ((k[2] * k[2]) * k[0] / 12.0);
-        // k[19] = 2*R^2*m2
-        k[19] = 2.0 * (k[3] * k[3]) * k[1];
-        // k[20] = ell^2*m1/4
-        k[20] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[21] = 2*R*m2
-        k[21] = 2.0 * k[3] * k[1];
-        // k[22] = 5*R^2*m2
-        k[22] = 5.0 * (k[3] * k[3]) * k[1];
-        // k[23] = 4*R^2*m2
-        k[23] = 4.0 * (k[3] * k[3]) * k[1];
-        // k[24] = g*m1
-        k[24] = k[5] * k[0];
+        // k[10] = ell^2*m1/24
+        k[10] = (k[2] * k[2]) * k[0] / 24.0;
+        // k[11] = ell^2*m1/8
+        k[11] = (k[2] * k[2]) * k[0] / 8.0;
+        // k[12] = m1/2
+        k[12] = k[0] / 2.0;
+        // k[13] = m2/2
+        k[13] = k[1] / 2.0;
+        // k[14] = R*g*m2
+        k[14] = k[3] * k[5] * k[1];
+        // k[15] = ell*g*m1/2
+        k[15] = k[2] * k[5] * k[0] / 2.0;
+        // k[16] = g*m1
+        k[16] = k[5] * k[0];
+        // k[17] = ell^2*m1/12
+        k[17] = (k[2] * k[2]) * k[0] / 12.0;
+        // k[18] = ell^2*m1/4
+        k[18] = (k[2] * k[2]) * k[0] / 4.0;
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..25]; // one bounds check for all constant loads
+        let k = &k[..19]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
-        q[1] = k[4];
+        q[1] = 0.0;
         qd[1] = 0.0;
+        q[2] = k[4];
+        qd[2] = 0.0;
+        q[3] = k[6];
+        qd[3] = 0.0;
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..25]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let pt0 = k[3] * rc_c / rc_s;
-        let pt1 = rc_c * rc_c;
-        pos[0] = [q[0], 0.0];
-        vel[0] = [qd[0], 0.0];
-        pos[1] = [(k[2] * rc_c) + q[0], k[2] * rc_s];
-        vel[1] = [-(k[2] * qd[1] * rc_s) + qd[0], k[2] * qd[1] * rc_c];
-        pos[2] = [(k[6] * rc_c) + q[0], k[6] * rc_s];
-        vel[2] = [-(k[6] * qd[1] * rc_s) + qd[0], k[6] * qd[1] * rc_c];
-        pos[3] = [(k[3] / rc_s) + pt0 + q[0], k[3]];
-        vel[3] = [
-            -(k[3] * qd[1])
-                - (k[3] * qd[1] * rc_c / (rc_s * rc_s))
-                - (k[3] * qd[1] * pt1 / (rc_s * rc_s))
-                + qd[0],
-            0.0,
+        let k = &k[..19]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        let pt0 = rc_c * rc_c;
+        let pt1 = rc_s * rc_s;
+        pos[0] = [q[0], q[1]];
+        vel[0] = [qd[0], qd[1]];
+        pos[1] = [(k[2] * rc_c) + q[0], (k[2] * rc_s) + q[1]];
+        vel[1] = [
+            -(k[2] * qd[2] * rc_s) + qd[0],
+            (k[2] * qd[2] * rc_c) + qd[1],
         ];
-        pos[4] = [pt0 + (k[3] * pt1 / rc_s) + q[0], k[3] + (k[3] * rc_c)];
+        pos[2] = [(k[7] * rc_c) + q[0], (k[7] * rc_s) + q[1]];
+        vel[2] = [
+            -(k[7] * qd[2] * rc_s) + qd[0],
+            (k[7] * qd[2] * rc_c) + qd[1],
+        ];
+        pos[3] = [q[3], k[3]];
+        vel[3] = [qd[3], 0.0];
+        pos[4] = [
+            (k[3] * rc_s * rc_c) + q[0] - (q[0] * pt0) + (q[3] * pt0) - (q[1] * rc_s * rc_c),
+            (k[3] * pt1) - (q[0] * rc_s * rc_c) + (q[3] * rc_s * rc_c) + q[1] - (q[1] * pt1),
+        ];
         vel[4] = [
-            -(k[3] * qd[1])
-                - (k[7] * qd[1] * rc_c)
-                - (k[3] * qd[1] * pt1 / (rc_s * rc_s))
-                - (k[3] * qd[1] * rc_c.powi(3) / (rc_s * rc_s))
-                + qd[0],
-            -k[3] * qd[1] * rc_s,
+            -(k[3] * qd[2] * pt1) + (k[3] * qd[2] * pt0) + (2.0 * qd[2] * q[0] * rc_s * rc_c)
+                - (2.0 * qd[2] * q[3] * rc_s * rc_c)
+                + (qd[2] * q[1] * pt1)
+                - (qd[2] * q[1] * pt0)
+                + qd[0]
+                - (qd[0] * pt0)
+                + (qd[3] * pt0)
+                - (qd[1] * rc_s * rc_c),
+            (k[8] * qd[2] * rc_s * rc_c) + (qd[2] * q[0] * pt1)
+                - (qd[2] * q[0] * pt0)
+                - (qd[2] * q[3] * pt1)
+                + (qd[2] * q[3] * pt0)
+                - (2.0 * qd[2] * q[1] * rc_s * rc_c)
+                - (qd[0] * rc_s * rc_c)
+                + (qd[3] * rc_s * rc_c)
+                + qd[1]
+                - (qd[1] * pt1),
         ];
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..25]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let et0 = rc_c * rc_c;
-        let et1 = qd[1] * qd[1];
-        (-(k[8] * qd[1] * qd[0])
-            - (k[8] * qd[1] * qd[0] * rc_c / (rc_s * rc_s))
-            - (k[8] * qd[1] * qd[0] * et0 / (rc_s * rc_s))
-            - (k[9] * qd[1] * qd[0] * rc_s)
-            + (k[10] * et1)
-            + (k[11] * et1 * rc_c / (rc_s * rc_s))
-            + (k[11] * et1 * et0 / (rc_s * rc_s))
-            + (k[12] * et1 * et0 / rc_s.powi(4))
-            + (k[11] * et1 * rc_c.powi(3) / rc_s.powi(4))
-            + (k[12] * et1 * rc_c.powi(4) / rc_s.powi(4))
-            + (k[13] * et1 * (rc_s * rc_s))
-            + (k[13] * et1 * et0)
-            + (k[14] * (qd[0] * qd[0])))
-            + (k[15] + (k[16] * rc_s))
+        let k = &k[..19]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        let et0 = qd[2] * qd[2];
+        (-(k[9] * qd[2] * qd[0] * rc_s)
+            + (k[9] * qd[2] * qd[1] * rc_c)
+            + (k[10] * et0)
+            + (k[11] * et0 * (rc_s * rc_s))
+            + (k[11] * et0 * (rc_c * rc_c))
+            + (k[12] * (qd[0] * qd[0]))
+            + (k[13] * (qd[3] * qd[3]))
+            + (k[12] * (qd[1] * qd[1])))
+            + (k[14] + (k[15] * rc_s) + (k[16] * q[1]))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..25]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        out[0] = -(k[8] * qd[1])
-            - (k[8] * qd[1] * rc_c / (rc_s * rc_s))
-            - (k[8] * qd[1] * (rc_c * rc_c) / (rc_s * rc_s))
-            - (k[9] * qd[1] * rc_s)
-            + (k[17] * qd[0]);
+        let k = &k[..19]; // one bounds check for all constant loads
+        let rc_s = q[2].sin();
+        out[0] = -(k[9] * qd[2] * rc_s) + (k[0] * qd[0]);
+        out[1] = k[1] * qd[3];
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..25]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let qt0 = rc_c * rc_c;
-        let qt1 =
-            -k[8] - (k[8] * rc_c / (rc_s * rc_s)) - (k[8] * qt0 / (rc_s * rc_s)) - (k[9] * rc_s);
-        let qt2 = rc_c.powi(3);
-        let qt3 = rc_c.powi(4);
-        let qt4 = qd[1] * qd[1];
-        mass[0] = k[17];
-        mass[1] = qt1;
-        mass[2] = qt1;
-        mass[3] = k[18]
-            + (k[19] * rc_c / (rc_s * rc_s))
-            + (k[19] * qt0 / (rc_s * rc_s))
-            + (k[11] * qt0 / rc_s.powi(4))
-            + (k[19] * qt2 / rc_s.powi(4))
-            + (k[11] * qt3 / rc_s.powi(4))
-            + (k[20] * (rc_s * rc_s))
-            + (k[20] * qt0);
-        rhs[0] = -(k[8] * qt4 / rc_s)
-            - (k[21] * qt4 * rc_c / rc_s)
-            - (k[21] * qt4 * qt0 / rc_s.powi(3))
-            - (k[21] * qt4 * qt2 / rc_s.powi(3))
-            + (k[9] * qt4 * rc_c);
-        rhs[1] = -(k[16] * rc_c)
-            + (k[11] * qt4 / rc_s)
-            + (k[19] * qt4 * rc_c / rc_s)
-            + (k[11] * qt4 * rc_c / rc_s.powi(3))
-            + (k[22] * qt4 * qt0 / rc_s.powi(3))
-            + (k[23] * qt4 * qt2 / rc_s.powi(3))
-            + (k[19] * qt4 * qt2 / rc_s.powi(5))
-            + (k[23] * qt4 * qt3 / rc_s.powi(5))
-            + (k[19] * qt4 * rc_c.powi(5) / rc_s.powi(5));
+        let k = &k[..19]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        let qt0 = -k[9] * rc_s;
+        let qt1 = k[9] * rc_c;
+        let qt2 = qd[2] * qd[2];
+        mass[0] = k[0];
+        mass[1] = 0.0;
+        mass[2] = qt0;
+        mass[3] = 0.0;
+        mass[4] = 0.0;
+        mass[5] = k[0];
+        mass[6] = qt1;
+        mass[7] = 0.0;
+        mass[8] = qt0;
+        mass[9] = qt1;
+        mass[10] = k[17] + (k[18] * (rc_s * rc_s)) + (k[18] * (rc_c * rc_c));
+        mass[11] = 0.0;
+        mass[12] = 0.0;
+        mass[13] = 0.0;
+        mass[14] = 0.0;
+        mass[15] = k[1];
+        rhs[0] = k[9] * qt2 * rc_c;
+        rhs[1] = -k[16] + (k[9] * qt2 * rc_s);
+        rhs[2] = -k[15] * rc_c;
+        rhs[3] = 0.0;
     }
 
-    fn forces_full(
-        &self,
-        k: &[f64],
-        q: &[f64],
-        qd: &[f64],
-        qdd: &[f64],
-        _fr: &[f64],
-        out: &mut [f64],
-    ) {
-        let k = &k[..25]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let ft0 = rc_c * rc_c;
-        let ft1 = qd[1] * qd[1];
-        out[0] = k[1]
-            * (-(k[3] * qdd[1])
-                - (k[3] * qdd[1] * rc_c / (rc_s * rc_s))
-                - (k[3] * qdd[1] * ft0 / (rc_s * rc_s))
-                + (k[3] * ft1 / rc_s)
-                + (k[7] * ft1 * rc_c / rc_s)
-                + (k[7] * ft1 * ft0 / rc_s.powi(3))
-                + (k[7] * ft1 * rc_c.powi(3) / rc_s.powi(3))
-                + qdd[0]);
-        out[1] =
-            k[24] + (k[0] * qdd[0] * rc_c / rc_s) - (k[9] * ft1 * rc_s) - (k[9] * ft1 * ft0 / rc_s);
+    fn forces_full(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _qdd: &[f64], out: &mut [f64]) {
+        out[0] = 0.0;
+        out[1] = 0.0;
+    }
+
+    fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
+        let k = &k[..19]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        out[0] = -k[3] - (k[3] * rc_c) - (q[0] * rc_s) + (q[3] * rc_s) + (q[1] * rc_c);
+        out[1] = q[1];
+    }
+
+    fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        let k = &k[..19]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        let jt0 = qd[2] * qd[2];
+        jac[0] = -rc_s;
+        jac[1] = rc_c;
+        jac[2] = (k[3] * rc_s) - (q[0] * rc_c) + (q[3] * rc_c) - (q[1] * rc_s);
+        jac[3] = rc_s;
+        jac[4] = 0.0;
+        jac[5] = 1.0;
+        jac[6] = 0.0;
+        jac[7] = 0.0;
+        bias[0] = (k[3] * jt0 * rc_c) - (2.0 * qd[2] * qd[0] * rc_c) + (2.0 * qd[2] * qd[3] * rc_c)
+            - (2.0 * qd[2] * qd[1] * rc_s)
+            + (jt0 * q[0] * rc_s)
+            - (jt0 * q[3] * rc_s)
+            - (jt0 * q[1] * rc_c);
+        bias[1] = 0.0;
+    }
+
+    fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
+        let k = &k[..19]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        out[0] = k[2] - (k[3] * rc_s) + (q[0] * rc_c) - (q[3] * rc_c) + (q[1] * rc_s);
+        out[1] = f64::INFINITY;
     }
 
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
-    fn monitors_full(&self, _k: &[f64], _q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        out[0] = forces[1];
+    fn monitors_full(
+        &self,
+        _k: &[f64],
+        _q: &[f64],
+        _qd: &[f64],
+        _forces: &[f64],
+        _out: &mut [f64],
+    ) {
     }
 
-    fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        let k = &k[..25]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        k[2] - (k[3] / rc_s) - (k[3] * rc_c / rc_s)
-    }
-
-    fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..25]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        out[0] = (k[3] / rc_s) + (k[3] * rc_c / rc_s) + q[0];
-        out[1] = -(k[3] * qd[1])
-            - (k[3] * qd[1] * rc_c / (rc_s * rc_s))
-            - (k[3] * qd[1] * (rc_c * rc_c) / (rc_s * rc_s))
-            + qd[0];
+    fn to_full(&self, _k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
+        q_full[0] = q[0];
+        qd_full[0] = qd[0];
+        q_full[1] = q[1];
+        qd_full[1] = qd[1];
+        q_full[2] = q[2];
+        qd_full[2] = qd[2];
+        q_full[3] = q[3];
+        qd_full[3] = qd[3];
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..25]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        poses[0] = [(k[6] * rc_c) + q[0], k[6] * rc_s, q[1]];
-        poses[1] = [(k[3] / rc_s) + (k[3] * rc_c / rc_s) + q[0], k[3], 0.0];
-        sizes[0] = -k[6];
+        let k = &k[..19]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        poses[0] = [(k[7] * rc_c) + q[0], (k[7] * rc_s) + q[1], q[2]];
+        poses[1] = [q[3], k[3], 0.0];
+        sizes[0] = -k[7];
         sizes[1] = 0.0;
-        sizes[2] = k[6];
+        sizes[2] = k[7];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;

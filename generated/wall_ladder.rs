@@ -5,8 +5,8 @@
 // some of it unused.
 #[allow(unused_imports)]
 use crate::model::{
-    Binding, ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, NextPhase,
-    ParamInfo, Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
+    ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo,
+    Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
 };
 
 /// A uniform ladder sliding down a fixed frictionless wall on a frictionless floor.
@@ -16,6 +16,7 @@ static INFO: ModelInfo = ModelInfo {
     name: "wall_ladder",
     description: "A uniform ladder sliding down a fixed frictionless wall on a frictionless floor.",
     spec: "derivations/wall_ladder.yaml",
+    system: "wall_ladder",
     parameters: &[
         ParamInfo {
             name: "m1",
@@ -46,31 +47,39 @@ static INFO: ModelInfo = ModelInfo {
         name: "ladder_leans",
         meaning: "the top must start below the ladder's length (a < ell)",
     }],
-    n_constants: 20,
-    coordinates: &["theta"],
-    reduced: 0,
-    cyclic: &[],
+    n_constants: 16,
+    coordinates: &["x1", "y1", "theta"],
+    system_coordinates: &["x1", "y1", "theta"],
+    reduced: 2,
+    cyclic: &[0],
     end_angle: 0.0,
-    forces: &[
-        NamedInfo {
+    contacts: &[
+        ContactInfo {
             name: "contact_force",
             meaning: "push of the wall on the ladder, positive while they touch",
+            gap_unit: "m",
+            unit: "N",
+            bilateral: false,
+            edge: false,
+            eliminates: Some("x1"),
+            closed: false,
         },
-        NamedInfo {
+        ContactInfo {
             name: "floor_normal",
-            meaning: "the floor's upward push on the ladder's foot",
+            meaning: "the floor's upward push on the ladder's foot, positive while they touch",
+            gap_unit: "m",
+            unit: "N",
+            bilateral: false,
+            edge: false,
+            eliminates: Some("y1"),
+            closed: false,
         },
     ],
-    contact: Some(ContactInfo {
-        force: 0,
-        eliminated: "x1",
-        edge: false,
-    }),
     frictions: &[],
     points: &[
         NamedInfo {
             name: "foot",
-            meaning: "the ladder's foot on the floor",
+            meaning: "the ladder's foot",
         },
         NamedInfo {
             name: "tip",
@@ -87,11 +96,7 @@ static INFO: ModelInfo = ModelInfo {
     ],
     falling_point: 2,
     gravity: 3,
-    monitors: &[MonitorInfo {
-        name: "foot_on_floor",
-        meaning: "the ladder's foot stays on the floor (N >= 0)",
-        unit: "N",
-    }],
+    monitors: &[],
     bodies: &["rod"],
     shapes: &[
         ShapeInfo {
@@ -105,30 +110,23 @@ static INFO: ModelInfo = ModelInfo {
             first: 4,
         },
     ],
-    next_phase: Some(NextPhase {
-        model: "wall_ladder_free",
-        bindings: &[
-            Binding::Param(0),
-            Binding::Param(1),
-            Binding::Param(2),
-            Binding::Param(3),
-            Binding::Eliminated,
-            Binding::Coordinate(0),
-            Binding::EliminatedRate,
-            Binding::Velocity(0),
-        ],
-    }),
-    reduction: Some(ReductionInfo {
-        k_theta_initial: 4,
-        k_theta_dot_initial: 5,
-        k_sin_initial: 6,
-        k_cos_initial: 7,
-        separation_degree: 1,
-        polynomial_separation: true,
-        fall_degree: Some(0),
-        lean_constants: &[5, 6, 7, 18, 19],
-    }),
-    route_note: "",
+    start_params: false,
+    phases: &[
+        PhaseInfo {
+            closed: &[0, 1],
+            model: "wall_ladder_closed",
+            release: true,
+            separation_degree: 1,
+        },
+        PhaseInfo {
+            closed: &[1],
+            model: "wall_ladder_free",
+            release: false,
+            separation_degree: 0,
+        },
+    ],
+    reduction: None,
+    route_note: "coordinate `y1` is not cyclic (the Lagrangian depends on it), so it cannot be eliminated through a conserved momentum",
 };
 
 impl Model for WallLadder {
@@ -143,184 +141,169 @@ impl Model for WallLadder {
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
         k[..4].copy_from_slice(p);
-        Reduction::prepare_lean(self, p, k);
-        // k[4] = rc_thi = asin(a/ell)
-        k[4] = (k[2] / k[1]).asin();
-        // k[8] = ell/2
-        k[8] = k[1] / 2.0;
-        // k[9] = ell^2*m1/24
-        k[9] = (k[1] * k[1]) * k[0] / 24.0;
-        // k[10] = ell^2*m1/8
-        k[10] = (k[1] * k[1]) * k[0] / 8.0;
+        // k[4] = ell*((1 - a/ell)*(1 + a/ell))^(1/2)
+        let h4_t0 = k[2] / k[1];
+        k[4] = k[1] * ((1.0 - h4_t0) * (1.0 + h4_t0)).sqrt();
+        // k[5] = asin(a/ell)
+        k[5] = (k[2] / k[1]).asin();
+        // k[6] = ell/2
+        k[6] = k[1] / 2.0;
+        // k[7] = ell*m1/2
+        k[7] = k[1] * k[0] / 2.0;
+        // k[8] = ell^2*m1/24
+        k[8] = (k[1] * k[1]) * k[0] / 24.0;
+        // k[9] = ell^2*m1/8
+        k[9] = (k[1] * k[1]) * k[0] / 8.0;
+        // k[10] = m1/2
+        k[10] = k[0] / 2.0;
         // k[11] = ell*g*m1/2
         k[11] = k[1] * k[3] * k[0] / 2.0;
-        // k[12] = ell^2*m1/12
-        k[12] = (k[1] * k[1]) * k[0] / 12.0;
-        // k[13] = ell^2*m1/4
-        k[13] = (k[1] * k[1]) * k[0] / 4.0;
-        // k[14] = ell*m1/2
-        k[14] = k[1] * k[0] / 2.0;
-        // k[15] = g*m1
-        k[15] = k[3] * k[0];
-        // k[16] = 3*g/ell
-        k[16] = 3.0 * k[3] / k[1];
-        // k[17] = 3*g/(2*ell)
-        k[17] = 3.0 * k[3] / 2.0 / k[1];
+        // k[12] = g*m1
+        k[12] = k[3] * k[0];
+        // k[13] = ell^2*m1/12
+        k[13] = (k[1] * k[1]) * k[0] / 12.0;
+        // k[14] = ell^2*m1/4
+        k[14] = (k[1] * k[1]) * k[0] / 4.0;
+        // k[15] = 0.0 + ell
+        k[15] = 0.0 + k[1];
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..20]; // one bounds check for all constant loads
-        q[0] = k[4];
+        let k = &k[..16]; // one bounds check for all constant loads
+        q[0] = -k[4];
         qd[0] = 0.0;
+        q[1] = 0.0;
+        qd[1] = 0.0;
+        q[2] = k[5];
+        qd[2] = 0.0;
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..20]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        pos[0] = [-k[1] * rc_c, 0.0];
-        vel[0] = [k[1] * qd[0] * rc_s, 0.0];
-        pos[1] = [0.0, k[1] * rc_s];
-        vel[1] = [0.0, k[1] * qd[0] * rc_c];
-        pos[2] = [-k[8] * rc_c, k[8] * rc_s];
-        vel[2] = [k[8] * qd[0] * rc_s, k[8] * qd[0] * rc_c];
+        let k = &k[..16]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        pos[0] = [q[0], q[1]];
+        vel[0] = [qd[0], qd[1]];
+        pos[1] = [(k[1] * rc_c) + q[0], (k[1] * rc_s) + q[1]];
+        vel[1] = [
+            -(k[1] * qd[2] * rc_s) + qd[0],
+            (k[1] * qd[2] * rc_c) + qd[1],
+        ];
+        pos[2] = [(k[6] * rc_c) + q[0], (k[6] * rc_s) + q[1]];
+        vel[2] = [
+            -(k[6] * qd[2] * rc_s) + qd[0],
+            (k[6] * qd[2] * rc_c) + qd[1],
+        ];
         pos[3] = [0.0, 0.0];
         vel[3] = [0.0, 0.0];
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..20]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        let et0 = qd[0] * qd[0];
-        ((k[9] * et0) + (k[10] * et0 * (rc_s * rc_s)) + (k[10] * et0 * (rc_c * rc_c)))
-            + (k[11] * rc_s)
+        let k = &k[..16]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        let et0 = qd[2] * qd[2];
+        (-(k[7] * qd[2] * qd[0] * rc_s)
+            + (k[7] * qd[2] * qd[1] * rc_c)
+            + (k[8] * et0)
+            + (k[9] * et0 * (rc_s * rc_s))
+            + (k[9] * et0 * (rc_c * rc_c))
+            + (k[10] * (qd[0] * qd[0]))
+            + (k[10] * (qd[1] * qd[1])))
+            + ((k[11] * rc_s) + (k[12] * q[1]))
     }
 
-    fn momenta(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
-
-    fn equations(&self, k: &[f64], q: &[f64], _qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..20]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        mass[0] = k[12] + (k[13] * (rc_s * rc_s)) + (k[13] * (rc_c * rc_c));
-        rhs[0] = -k[11] * rc_c;
+    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let k = &k[..16]; // one bounds check for all constant loads
+        let rc_s = q[2].sin();
+        out[0] = -(k[7] * qd[2] * rc_s) + (k[0] * qd[0]);
     }
 
-    fn forces_full(
-        &self,
-        k: &[f64],
-        q: &[f64],
-        qd: &[f64],
-        qdd: &[f64],
-        _fr: &[f64],
-        out: &mut [f64],
-    ) {
-        let k = &k[..20]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        let ft0 = qd[0] * qd[0];
-        out[0] = -(-(k[14] * qdd[0] * rc_s)
-            + (k[0] * ((k[1] * qdd[0] * rc_s) + (k[1] * ft0 * rc_c)))
-            - (k[14] * ft0 * rc_c));
-        out[1] = k[15] + (k[14] * qdd[0] * rc_c) - (k[14] * ft0 * rc_s);
+    fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
+        let k = &k[..16]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        let qt0 = -k[7] * rc_s;
+        let qt1 = k[7] * rc_c;
+        let qt2 = qd[2] * qd[2];
+        mass[0] = k[0];
+        mass[1] = 0.0;
+        mass[2] = qt0;
+        mass[3] = 0.0;
+        mass[4] = k[0];
+        mass[5] = qt1;
+        mass[6] = qt0;
+        mass[7] = qt1;
+        mass[8] = k[13] + (k[14] * (rc_s * rc_s)) + (k[14] * (rc_c * rc_c));
+        rhs[0] = k[7] * qt2 * rc_c;
+        rhs[1] = -k[12] + (k[7] * qt2 * rc_s);
+        rhs[2] = -k[11] * rc_c;
+    }
+
+    fn forces_full(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _qdd: &[f64], out: &mut [f64]) {
+        out[0] = 0.0;
+        out[1] = 0.0;
+    }
+
+    fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
+        let k = &k[..16]; // one bounds check for all constant loads
+        let rc_c = q[2].cos();
+        out[0] = -(k[1] * rc_c) - q[0];
+        out[1] = q[1];
+    }
+
+    fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        let k = &k[..16]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        jac[0] = -1.0;
+        jac[1] = 0.0;
+        jac[2] = k[1] * rc_s;
+        jac[3] = 0.0;
+        jac[4] = 1.0;
+        jac[5] = 0.0;
+        bias[0] = k[1] * (qd[2] * qd[2]) * rc_c;
+        bias[1] = 0.0;
+    }
+
+    fn edges(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
+        out[0] = f64::INFINITY;
+        out[1] = f64::INFINITY;
     }
 
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
-    fn monitors_full(&self, _k: &[f64], _q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        out[0] = forces[1];
+    fn monitors_full(
+        &self,
+        _k: &[f64],
+        _q: &[f64],
+        _qd: &[f64],
+        _forces: &[f64],
+        _out: &mut [f64],
+    ) {
     }
 
-    fn contact_edge(&self, _k: &[f64], _q: &[f64]) -> f64 {
-        f64::INFINITY
-    }
-
-    fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..20]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        out[0] = -k[1] * rc_c;
-        out[1] = k[1] * qd[0] * rc_s;
+    fn to_full(&self, _k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
+        q_full[0] = q[0];
+        qd_full[0] = qd[0];
+        q_full[1] = q[1];
+        qd_full[1] = qd[1];
+        q_full[2] = q[2];
+        qd_full[2] = qd[2];
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..20]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        poses[0] = [-k[8] * rc_c, k[8] * rc_s, q[0]];
-        sizes[0] = -k[8];
+        let k = &k[..16]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        let dt0 = 0.0 + 0.0;
+        poses[0] = [(k[6] * rc_c) + q[0], (k[6] * rc_s) + q[1], q[2]];
+        sizes[0] = -k[6];
         sizes[1] = 0.0;
-        sizes[2] = k[8];
+        sizes[2] = k[6];
         sizes[3] = 0.0;
-        sizes[4] = 0.0;
-        sizes[5] = 0.0;
-        sizes[6] = 0.0;
-        sizes[7] = k[1];
+        sizes[4] = dt0;
+        sizes[5] = dt0;
+        sizes[6] = dt0;
+        sizes[7] = k[15];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
-        Some(self)
-    }
-}
-
-impl Reduction for WallLadder {
-    fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..20]; // one bounds check for all constant loads
-        let (rc_s, rc_c, rc_ds, _) = start_offsets(k[4], k[6], k[7], delta);
-        Reduced {
-            sin: rc_s,
-            cos: rc_c,
-            theta_dot_sq: k[16] * rc_ds,
-            theta_ddot: -k[17] * rc_c,
-        }
-    }
-
-    fn theta_dot_sq_sc(&self, k: &[f64], _rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..20]; // one bounds check for all constant loads
-        k[16] * rc_ds
-    }
-
-    fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..20]; // one bounds check for all constant loads
-        let (rc_s, rc_c, rc_ds, _) = start_offsets(k[4], k[6], k[7], delta);
-        let rc_w2 = k[16] * rc_ds;
-        let rc_acc = -k[17] * rc_c;
-        out[0] = -(k[14] * rc_s * rc_acc) - (k[14] * rc_c * rc_w2);
-        out[1] = k[15] - (k[14] * rc_s * rc_w2) + (k[14] * rc_c * rc_acc);
-    }
-
-    fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..20]; // one bounds check for all constant loads
-        out[0] = -k[18];
-        out[1] = 3.0;
-    }
-
-    fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
-        k[..4].copy_from_slice(p);
-        // k[5] = rc_wi = 0.0
-        k[5] = 0.0;
-        // k[6] = rc_si = a/ell
-        k[6] = k[2] / k[1];
-        // k[7] = rc_ci = ((1 - a/ell)*(1 + a/ell))^(1/2)
-        let c3_t0 = k[2] / k[1];
-        k[7] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
-        // k[18] = 2*rc_si
-        k[18] = 2.0 * k[6];
-        // k[19] = ell/(3*g)
-        k[19] = k[1] / 3.0 / k[3];
-    }
-
-    fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..20]; // one bounds check for all constant loads
-        out[0] = k[19];
-    }
-
-    fn full_state(
-        &self,
-        k: &[f64],
-        _t: f64,
-        delta: f64,
-        theta_dot: f64,
-        q: &mut [f64],
-        qd: &mut [f64],
-    ) {
-        let k = &k[..20]; // one bounds check for all constant loads
-        q[0] = k[4] - delta;
-        qd[0] = theta_dot;
+        None
     }
 }

@@ -350,7 +350,10 @@ fn planner_failure(scene: &Scene, error: PlanError) -> Failure {
 
 /// `rodcube models`.
 fn models(args: LayoutArgs) -> Result<(), Failure> {
-    let infos: Vec<_> = rodcube::models::all().iter().map(|m| m.info()).collect();
+    // The systems a scene may name; their fast phases are listed under them.
+    let infos: Vec<_> = (rodcube::models::all().iter().map(|m| m.info()))
+        .filter(|i| i.is_general())
+        .collect();
     print_stdout(&report::table::models(&infos, &args.layout()))
 }
 

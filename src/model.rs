@@ -1,11 +1,15 @@
 //! The contract between generated model code (`generated/*.rs`) and the runtime solvers.
 //!
-//! A model is one phase of a planar mechanical system: its Euler–Lagrange equations
-//! `M(q) qdd = F(q, qd)`, reaction forces, monitors and contact ([`Model`]), and, when every
-//! coordinate but the reduced one (`theta`, the rod's angle to the floor) is cyclic, a fast path
-//! on which the motion is a function of the angle ([`Reduction`]). Every function here is
+//! A spec describes a *system* of bodies and contacts; each model is one *phase* of it
+//! ([`Model`]): its Euler–Lagrange equations `M(q) qdd = F(q, qd)`, its contacts, monitors and
+//! drawing. The system's **general model** (named as the spec) has every coordinate and treats
+//! every contact as a constraint row (gap, Jacobian, bias) whose force the runtime solves along
+//! with the motion, for whichever contacts are closed. A **fast phase** holds some contacts
+//! closed by eliminating the coordinates they tie (their forces in closed form) and, when every
+//! coordinate but the reduced one (`theta`, the rod's angle to the floor) is cyclic, has a fast
+//! path on which the motion is a function of the angle ([`Reduction`]). Every function here is
 //! emitted by `rodcube derive` from a spec in `derivations/*.yaml`; the runtime never knows
-//! which model it is driving.
+//! which model it is driving: it walks the contacts and phases the [`ModelInfo`] lists.
 //!
 //! # Conventions
 //! - `p`: parameter values in the order of [`ModelInfo::parameters`] (SI units).
@@ -18,8 +22,11 @@
 //!   without cancellation near the start, where the energy integral vanishes.
 //! - `q`, `qd`, `qdd`: the full (unreduced) coordinates, velocities and accelerations in the order
 //!   of [`ModelInfo::coordinates`].
-//! - `fr`: the friction forces in the order of [`ModelInfo::frictions`].
-//! - Forces are in newtons, positive in the sense documented by each force's [`NamedInfo`] in [`ModelInfo::forces`].
+//! - `q_full`, `qd_full`: the system's coordinates and velocities, in the order of
+//!   [`ModelInfo::system_coordinates`] (the general model's).
+//! - Contact forces are one value per contact of [`ModelInfo::contacts`], in the unit of each
+//!   ([`ContactInfo::unit`]), positive in the sense its meaning documents (a unilateral
+//!   contact's pushes).
 
 /// A model parameter as declared in its spec.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -88,28 +95,39 @@ pub struct ShapeInfo {
     pub first: usize,
 }
 
-/// The contact of a model: a unilateral constraint `gap(q) >= 0` that ties one coordinate
-/// while it holds. Its force (the Lagrange multiplier) is positive while the bodies push apart;
-/// the contact ends where the force reaches zero or, for a contact with an edge, where the
-/// edge margin [`Model::contact_edge`] reaches zero.
+/// A contact of the system: a unilateral constraint `gap(q) >= 0` (or a bilateral one,
+/// `gap(q) = 0` for good) whose force is its Lagrange multiplier. Every model of a system lists
+/// the same contacts, in the spec's order; [`ContactInfo::closed`] says whether this model
+/// holds it closed by elimination.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ContactInfo {
-    /// Index into [`ModelInfo::forces`] of the contact force (positive while touching).
-    pub force: usize,
-    /// The coordinate the contact ties while it holds (free again in the next phase); its value
-    /// and rate come from [`Model::released`].
-    pub eliminated: &'static str,
-    /// Whether the contact can also end at an edge (a contact point running off a body).
+    /// Name of the contact and of its force (a result key).
+    pub name: &'static str,
+    /// What its force is, with its sign convention.
+    pub meaning: &'static str,
+    /// Unit of its gap (`m`).
+    pub gap_unit: &'static str,
+    /// Unit of its force, conjugate to the gap (`N`; `N m` for a gap in radians).
+    pub unit: &'static str,
+    /// A joint: always closed, its force of either sign.
+    pub bilateral: bool,
+    /// Whether it can also end where its point runs off an edge ([`Model::edges`]).
     pub edge: bool,
+    /// The coordinate the spec lets it eliminate while closed.
+    pub eliminates: Option<&'static str>,
+    /// Whether this model holds it closed by elimination (its force is in
+    /// [`Model::forces_full`]); otherwise it is a constraint row ([`Model::gaps`],
+    /// [`Model::constraints`]).
+    pub closed: bool,
 }
 
-/// Coulomb friction at a contact point ([`Model::friction`] gives its slip velocity).
+/// Coulomb friction at a contact ([`Model::friction`] gives its slip velocity).
 ///
 /// While the contact slides with slip velocity `v`, the friction force is
 /// `f = -mu N sign(v)`; while it sticks (`v = 0`), `f` is the force that keeps it stuck, which
-/// must stay within `|f| <= mu N`. `N` is the normal force [`FrictionInfo::normal`] and
+/// must stay within `|f| <= mu N`. `N` is the force of contact [`FrictionInfo::contact`] and
 /// `mu` the parameter [`FrictionInfo::coefficient`]. Its generalized force is `f J`, with `J`
-/// the row of [`Model::friction`]'s Jacobian (`v = J qd`).
+/// the row of [`Model::friction`]'s Jacobian (`v = J qd`). An open contact has no friction.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct FrictionInfo {
     /// Identifier of the friction force (a result key, in newtons).
@@ -118,37 +136,27 @@ pub struct FrictionInfo {
     pub meaning: &'static str,
     /// Index in [`ModelInfo::parameters`] of the friction coefficient `mu` (`>= 0`).
     pub coefficient: usize,
-    /// Index in [`ModelInfo::forces`] of the normal force `N`.
-    pub normal: usize,
+    /// Index in [`ModelInfo::contacts`] of the contact whose force is the normal force.
+    pub contact: usize,
 }
 
-/// Where a value passed to the next phase comes from.
+/// A fast phase of a system: the model that holds these contacts closed (and the others
+/// open) on the fast path.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Binding {
-    /// A parameter of this model, by index.
-    Param(usize),
-    /// A coordinate of this model at the end of the phase, by index.
-    Coordinate(usize),
-    /// A velocity of this model at the end of the phase, by index.
-    Velocity(usize),
-    /// The value of the coordinate the contact tied ([`ContactInfo::eliminated`]).
-    Eliminated,
-    /// The rate of that coordinate.
-    EliminatedRate,
-}
-
-/// The model that continues the motion after the contact ends (derived from the same spec
-/// with the tied coordinate free).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct NextPhase {
-    /// Name of the next model in the registry.
+pub struct PhaseInfo {
+    /// Indices in [`ModelInfo::contacts`] of the contacts it holds closed, ascending.
+    pub closed: &'static [usize],
+    /// Its model's name in the registry.
     pub model: &'static str,
-    /// One binding per parameter of the next model, in its parameter order.
-    pub bindings: &'static [Binding],
+    /// Whether it starts from the spec's release state (otherwise from a state given as its
+    /// start parameters).
+    pub release: bool,
+    /// The degree of its separation polynomial (the first contact's force polynomial; 0 when
+    /// it has none).
+    pub separation_degree: usize,
 }
 
-/// Where the fast path of a model keeps its start in `k`, and its separation polynomial's
-/// degree.
+/// Where the fast path of a model keeps its start in `k`, and its polynomials' degrees.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ReductionInfo {
     /// Index in `k` of the initial reduced angle `theta_i`.
@@ -160,17 +168,29 @@ pub struct ReductionInfo {
     pub k_sin_initial: usize,
     /// Index in `k` of `cos(theta_i)`, formed from the parameters without cancellation.
     pub k_cos_initial: usize,
-    /// Degree of the separation polynomial in `sin(theta)` (0 without one).
-    pub separation_degree: usize,
-    /// Whether the contact force's zero is a root of that polynomial; a model with a contact
-    /// and without one has it found as a bracketed root of its reduced contact force.
-    pub polynomial_separation: bool,
+    /// Per contact, the degree of the polynomial in `sin(theta)` whose root is its force's zero
+    /// ([`Reduction::force_polynomial`]); 0 where there is none (an open or bilateral contact,
+    /// or a force whose zero is found as a bracketed root of [`Reduction::forces`]).
+    pub force_degrees: &'static [usize],
     /// Degree of the fall polynomial [`Reduction::fall_polynomial`], where the phase has one.
     pub fall_degree: Option<usize>,
     /// Indices in `k` (beyond the parameters) that [`Reduction::prepare_lean`] fills: the start's
     /// sine, cosine and rate (not the angle `theta_i`, which only [`Model::prepare`] forms) and
-    /// the two polynomials' coefficients with what they are computed from.
+    /// the polynomials' coefficients with what they are computed from.
     pub lean_constants: &'static [usize],
+}
+
+impl ReductionInfo {
+    /// The degree of the separation polynomial: the first contact's force polynomial (0 when
+    /// it has none).
+    pub fn separation_degree(&self) -> usize {
+        self.force_degrees.first().copied().unwrap_or(0)
+    }
+
+    /// Whether the first contact's force has its zero as a polynomial root.
+    pub fn polynomial_separation(&self) -> bool {
+        self.separation_degree() > 0
+    }
 }
 
 /// Static description of a generated model.
@@ -182,25 +202,28 @@ pub struct ModelInfo {
     pub description: &'static str,
     /// Spec file the model was derived from, relative to the project root.
     pub spec: &'static str,
+    /// The system it is a phase of: the spec's name, which is its general model's name.
+    pub system: &'static str,
     /// Parameters in the order every function expects them.
     pub parameters: &'static [ParamInfo],
     /// Requirements on the parameters, each a margin that must be strictly positive.
     pub requirements: &'static [NamedInfo],
     /// Length of the prepared-constant vector `k`.
     pub n_constants: usize,
-    /// Generalized coordinates of the unreduced system.
+    /// Generalized coordinates of this model (the system's, without those it eliminates).
     pub coordinates: &'static [&'static str],
+    /// The system's coordinates (the general model's), which [`Model::to_full`] fills.
+    pub system_coordinates: &'static [&'static str],
     /// Index in `coordinates` of the reduced coordinate (`theta`).
     pub reduced: usize,
-    /// Indices in `coordinates` of the cyclic coordinates eliminated by conserved momenta.
+    /// Indices in `coordinates` of the cyclic coordinates (the Lagrangian does not depend on
+    /// them); on the fast path their conserved momenta eliminate them.
     pub cyclic: &'static [usize],
     /// The angle at which the motion ends (the rod lies on the floor), in radians.
     pub end_angle: f64,
-    /// Reaction forces evaluated along the motion (the contact force among them).
-    pub forces: &'static [NamedInfo],
-    /// The contact, if the model has one.
-    pub contact: Option<ContactInfo>,
-    /// Coulomb frictions (the reaction forces in [`Model::forces_full`] depend on their values).
+    /// Every contact of the system, in the spec's order.
+    pub contacts: &'static [ContactInfo],
+    /// Coulomb frictions (at contacts; only the general model has them).
     pub frictions: &'static [FrictionInfo],
     /// Named points whose trajectories can be asked for.
     pub points: &'static [NamedInfo],
@@ -212,10 +235,13 @@ pub struct ModelInfo {
     pub monitors: &'static [MonitorInfo],
     /// The bodies, in the order of the poses [`Model::drawing`] writes.
     pub bodies: &'static [&'static str],
-    /// The shapes that draw the bodies and the scenery (the floor `y = 0` is not among them).
+    /// The shapes that draw the bodies and the obstacles (the floor `y = 0` is not among them).
     pub shapes: &'static [ShapeInfo],
-    /// The phase that follows the end of the contact, if any.
-    pub next_phase: Option<NextPhase>,
+    /// Whether the parameters after the spec's are this phase's start state: `<q>_0` for each
+    /// of its coordinates, then `<q>_dot_0` (otherwise it starts from the spec's `initial`).
+    pub start_params: bool,
+    /// The system's fast phases (the same list in every model of the system).
+    pub phases: &'static [PhaseInfo],
     /// The fast path's layout, when the model has one ([`Model::reduction`] is `Some`).
     pub reduction: Option<ReductionInfo>,
     /// Why the model has no fast path (empty when it has one): it is then solved by
@@ -224,6 +250,16 @@ pub struct ModelInfo {
 }
 
 impl ModelInfo {
+    /// Whether this is its system's general model (nothing eliminated).
+    pub fn is_general(&self) -> bool {
+        self.name == self.system
+    }
+
+    /// Indices of the contacts this model holds closed by elimination.
+    pub fn closed(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..self.contacts.len()).filter(|&i| self.contacts[i].closed)
+    }
+
     /// How many numbers [`Model::drawing`] writes into `sizes`.
     pub fn drawing_sizes(&self) -> usize {
         self.shapes
@@ -235,8 +271,8 @@ impl ModelInfo {
 }
 
 /// What the per-point solver's unchecked route reads of one point, formed straight from the
-/// parameters by [`Model::lean_start`]: the start and the separation and fall polynomials'
-/// coefficients (lowest degree first, zero past each degree).
+/// parameters by [`Model::lean_start`]: the start and the closed contacts' force polynomials
+/// and the fall polynomial's coefficients (lowest degree first, zero past each degree).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LeanStart {
     /// `sin(theta_i)`.
@@ -245,10 +281,15 @@ pub struct LeanStart {
     pub cos_initial: f64,
     /// `theta_dot_i`.
     pub theta_dot_initial: f64,
-    /// The separation polynomial, degree at most 3.
+    /// The separation polynomial (the first contact's force), degree at most 3.
     pub separation: [f64; 4],
     /// The fall polynomial, degree at most 2.
     pub fall: [f64; 3],
+    /// The other closed unilateral contacts' force polynomials: none may reach zero between
+    /// the start and the separation (the phase would end there first).
+    pub others: [[f64; LEAN_OTHER_COEFFICIENTS]; LEAN_MAX_OTHERS],
+    /// How many rows of `others` hold a polynomial.
+    pub n_others: usize,
 }
 
 /// Most constants `k` of a model that [`Model::lean_start`] serves (its scratch lives on the
@@ -258,6 +299,12 @@ pub const LEAN_MAX_CONSTANTS: usize = 64;
 /// Most requirements of a model that [`Model::lean_start`] serves.
 pub const LEAN_MAX_REQUIREMENTS: usize = 8;
 
+/// Most closed unilateral contacts besides the first that [`Model::lean_start`] serves.
+pub const LEAN_MAX_OTHERS: usize = 2;
+
+/// Most coefficients of such a contact's force polynomial that [`Model::lean_start`] serves.
+pub const LEAN_OTHER_COEFFICIENTS: usize = 8;
+
 /// Evaluation functions of one generated model over its full state. All are allocation-free
 /// and evaluate each shared subexpression once per call.
 pub trait Model: Send + Sync {
@@ -266,16 +313,19 @@ pub trait Model: Send + Sync {
 
     /// The per-point solver's inputs for the parameters `p` in one call: `Some` only when the
     /// parameters pass [`check_parameters`](crate::system::check_parameters)' quick test (so
-    /// that the full check would accept them too) and the model has a fast path with a
-    /// separation polynomial of degree at most 3 and a fall polynomial of degree at most 2;
-    /// `None` says nothing about why (the checked route then decides and names it). A default
-    /// method, so that each model's copy calls its own generated functions directly and the
-    /// compiler can fuse them (no constant vector in memory, no virtual call).
+    /// that the full check would accept them too), the model holds every contact of its system
+    /// closed, has a fast path whose first contact's force is a polynomial of degree at most 3
+    /// and whose other closed unilateral contacts' forces are polynomials too, and a fall
+    /// polynomial of degree at most 2; `None` says nothing about why (the checked route then
+    /// decides and names it). A default method, so that each model's copy calls its own
+    /// generated functions directly and the compiler can fuse them (no constant vector in
+    /// memory, no virtual call).
     #[inline(always)]
     fn lean_start(&self, p: &[f64]) -> Option<LeanStart> {
         let info = self.info();
         let layout = info.reduction.as_ref()?;
-        let (sep_len, fall_len) = (layout.separation_degree + 1, layout.fall_degree? + 1);
+        let sep_len = layout.separation_degree() + 1;
+        let fall_len = layout.fall_degree? + 1;
         let mut margins = [0.0; LEAN_MAX_REQUIREMENTS];
         let margins = margins.get_mut(..info.requirements.len())?;
         if !crate::system::parameters_pass(self, p, margins) {
@@ -286,14 +336,30 @@ pub trait Model: Send + Sync {
         let k = k.get_mut(..info.n_constants)?;
         red.prepare_lean(p, k);
         let (mut separation, mut fall) = ([0.0; 4], [0.0; 3]);
-        red.separation_polynomial(k, separation.get_mut(..sep_len)?);
+        red.force_polynomial(k, 0, separation.get_mut(..sep_len)?);
         red.fall_polynomial(k, fall.get_mut(..fall_len)?);
+        let mut others = [[0.0; LEAN_OTHER_COEFFICIENTS]; LEAN_MAX_OTHERS];
+        let mut n_others = 0;
+        for (i, c) in info.contacts.iter().enumerate().skip(1) {
+            if !c.closed {
+                return None;
+            }
+            if c.bilateral {
+                continue;
+            }
+            let degree = *layout.force_degrees.get(i)?;
+            let row = others.get_mut(n_others)?;
+            red.force_polynomial(k, i, row.get_mut(..degree.checked_add(1)?)?);
+            n_others += 1;
+        }
         Some(LeanStart {
             sin_initial: *k.get(layout.k_sin_initial)?,
             cos_initial: *k.get(layout.k_cos_initial)?,
             theta_dot_initial: *k.get(layout.k_theta_dot_initial)?,
             separation,
             fall,
+            others,
+            n_others,
         })
     }
 
@@ -352,7 +418,8 @@ pub trait Model: Send + Sync {
     /// Call only after [`Model::requirements`] passed.
     fn prepare(&self, p: &[f64], k: &mut [f64]);
 
-    /// The state at release (from the spec's `initial`, or a free phase's start parameters).
+    /// The state at release (from the spec's `initial`, where a coordinate a contact
+    /// eliminates starts where `gap = 0` puts it; or a phase's start parameters).
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]);
 
     /// Positions and velocities of the named points for a full state.
@@ -364,21 +431,29 @@ pub trait Model: Send + Sync {
     /// Momenta conjugate to the cyclic coordinates, in the order of [`ModelInfo::cyclic`].
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]);
 
-    /// The unreduced Euler–Lagrange equations `M(q) qdd = F(q, qd)`: `mass` is row-major
-    /// `n x n`, `rhs` has length `n`, with `n` the number of coordinates.
+    /// The unreduced Euler–Lagrange equations `M(q) qdd = F(q, qd)` (before the forces of the
+    /// contacts this model does not eliminate, and of friction): `mass` is row-major `n x n`,
+    /// `rhs` has length `n`, with `n` the number of coordinates.
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]);
 
-    /// The reaction forces of [`ModelInfo::forces`] from a full state, its acceleration and the
-    /// friction forces `fr` (in the order of [`ModelInfo::frictions`]; empty without friction).
-    fn forces_full(
-        &self,
-        k: &[f64],
-        q: &[f64],
-        qd: &[f64],
-        qdd: &[f64],
-        fr: &[f64],
-        out: &mut [f64],
-    );
+    /// The forces of the contacts this model holds closed, from a full state and its
+    /// acceleration, one per contact of [`ModelInfo::contacts`] (zero for the others, whose
+    /// forces the runtime solves).
+    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]);
+
+    /// Every contact's gap (`>= 0` while apart), one per contact (zero for those this model
+    /// holds closed).
+    fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]);
+
+    /// Every contact's constraint row: `jac` (row-major `m x n`, `m` contacts by `n`
+    /// coordinates) is `d gap / dq` and `bias` is `dJ/dt qd`, so that a contact's normal
+    /// acceleration is `J qdd + bias` and its force `lambda` acts as `lambda J^T` (rows of
+    /// closed contacts are zero).
+    fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]);
+
+    /// Every contact's edge margin (`>= 0` while its contact point is on the body), one per
+    /// contact; `f64::INFINITY` for a contact without an edge.
+    fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]);
 
     /// The slip velocities of the frictions, `v = J(q) qd`, as the Jacobian `jac` (row-major
     /// `m x n`, `m` frictions by `n` coordinates) and `bias = dJ/dt qd`, the part of the slip
@@ -386,16 +461,13 @@ pub trait Model: Send + Sync {
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]);
 
     /// Monitor values (each must stay `>= 0`), in the order of [`ModelInfo::monitors`], from a
-    /// full state and the forces at it (in the order of [`ModelInfo::forces`]).
+    /// full state and the contacts' forces at it (one per contact).
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], forces: &[f64], out: &mut [f64]);
 
-    /// The margin to the contact's edge (`>= 0` while the contact can exist);
-    /// `f64::INFINITY` when the model has no contact or its contact has no edge.
-    fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64;
-
-    /// The value and rate of the coordinate the contact ties
-    /// ([`ContactInfo::eliminated`]); `out.len()` is 2 with a contact, 0 without.
-    fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]);
+    /// The system's state (the general model's coordinates and velocities, in the order of
+    /// [`ModelInfo::system_coordinates`]) that this model's state stands for: its own
+    /// coordinates, and those it eliminates where their contacts' ties put them.
+    fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]);
 
     /// The drawing of a full state: each body's pose `[x, y, angle]` (its centre of mass and
     /// orientation, in the order of [`ModelInfo::bodies`]) and the numbers of every shape of
@@ -421,12 +493,16 @@ pub trait Reduction: Send + Sync {
     /// `reduced(k, delta).theta_dot_sq` at the same angle.
     fn theta_dot_sq_sc(&self, k: &[f64], s: f64, c: f64, ds: f64, dc: f64) -> f64;
 
-    /// Reaction forces at `delta` along the reduced motion, in the order of [`ModelInfo::forces`].
+    /// Every contact's force at `delta` along the reduced motion (zero for a contact open in
+    /// the phase), in the order of [`ModelInfo::contacts`].
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]);
 
-    /// Coefficients of the separation polynomial in `s = sin(theta)`, lowest degree first
-    /// (`out.len() == separation_degree + 1`). Its root in `(0, sin theta_i)` is the separation.
-    fn separation_polynomial(&self, k: &[f64], out: &mut [f64]);
+    /// Coefficients of contact `contact`'s force polynomial in `s = sin(theta)`, lowest degree
+    /// first (`out.len() == force_degrees[contact] + 1`): its roots are the force's zeros, and
+    /// it has the force's sign on the phase. Writes nothing for a contact without one. The
+    /// first contact's is the separation polynomial: its root in `(0, sin theta_i)` is the
+    /// separation.
+    fn force_polynomial(&self, k: &[f64], contact: usize, out: &mut [f64]);
 
     /// Coefficients of the fall polynomial `P(s) = (sin theta_i - s) / theta_dot^2` in
     /// `s = sin(theta)`, lowest degree first (`out.len() == fall_degree + 1`), for a phase
@@ -439,7 +515,7 @@ pub trait Reduction: Send + Sync {
 
     /// [`Model::prepare`] for the per-point solver: copies the parameters into `k` and computes
     /// only the constants of [`ReductionInfo::lean_constants`] (the start's sine, cosine and rate,
-    /// and the separation and fall polynomials), leaving the others as they were.
+    /// and the force and fall polynomials), leaving the others as they were.
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]);
 
     /// The full state on the reduced motion at time `t`, angle fallen `delta` and rate

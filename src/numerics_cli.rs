@@ -106,9 +106,9 @@ fn output(e: impl Into<anyhow::Error>) -> Failure {
 /// `rodcube sweep`.
 pub fn sweep(args: SweepArgs) -> Result<(), Failure> {
     let model = rodcube::models::find(&args.model).ok_or_else(|| {
-        let names: Vec<&str> = rodcube::models::all()
-            .iter()
-            .map(|m| m.info().name)
+        let names: Vec<&str> = (rodcube::models::all().iter().map(|m| m.info()))
+            .filter(|i| i.is_general())
+            .map(|i| i.name)
             .collect();
         usage(format!(
             "no model `{}`; the models are: {}",
@@ -117,7 +117,13 @@ pub fn sweep(args: SweepArgs) -> Result<(), Failure> {
         ))
     })?;
     let info = model.info();
-    if info.contact.is_none() {
+    if !info.is_general() {
+        return Err(usage(format!(
+            "`{}` is a phase of the system `{}`, which decides its phases itself: sweep `--model {}`",
+            info.name, info.system, info.system
+        )));
+    }
+    if info.contacts.first().is_none_or(|c| c.bilateral) {
         return Err(usage(sweep::SweepError::NoContact { model: info.name }));
     }
     let extra = sweep::parse_want(model, &args.want).map_err(usage)?;

@@ -2,17 +2,17 @@
 
 use crate::model::ModelInfo;
 
-/// One quantity a scene can want. Force series and trajectories are named after the model's
-/// forces and points, so every model gets the quantities its spec declares.
+/// One quantity a scene can want. Force series and trajectories are named after the system's
+/// contacts, frictions and points, so every model gets the quantities its spec declares.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Quantity {
-    /// Angle at which the contact force vanishes (rad).
+    /// Angle at which the first contact's force vanishes (rad).
     SeparationAngle,
     /// The paper's approximation: the separation polynomial with its terms above degree 1 dropped.
     LinearisedSeparationAngle,
     /// Time from release to separation (s), eq. (15).
     SeparationTime,
-    /// When, at which angle and why (`force` or `edge`) the contact ends.
+    /// When, at which angle and why (`force`, `edge` or `contact`) each contact ends.
     ContactEnd,
     /// Time to the floor if the rod stayed in contact all the way (s), eq. (10).
     ContactTimeToFloor,
@@ -20,18 +20,20 @@ pub enum Quantity {
     PointMassFallTime,
     /// `t, theta, theta_dot, theta_ddot` from release to separation (or to the floor).
     ThetaSeries,
-    /// A reaction force (index into `ModelInfo::forces`) along the motion: `<force>_series`.
+    /// A contact's force (index into `ModelInfo::contacts`) along the motion:
+    /// `<contact>_series`.
     ForceSeries(usize),
     /// A friction (index into `ModelInfo::frictions`) along the motion, with its normal force
     /// and slip velocity: `<friction>_series`.
     FrictionSeries(usize),
     /// A point's path (index into `ModelInfo::points`): `<point>_trajectory`.
     Trajectory(usize),
-    /// The free-sliding phase after separation, up to the rod lying on the floor.
+    /// The motion after separation, phase after phase, up to the rod lying on the floor.
     FloorImpact,
     /// The physical assumptions and conservation laws, each pass/fail with its margin.
     Checks,
-    /// Integration of the unreduced equations `M(q) qdd = F(q, qd)` to the separation event.
+    /// Integration of the general model's equations, the contacts as constraints, to the
+    /// fast path's first event.
     CrossCheck,
 }
 
@@ -55,7 +57,7 @@ pub const FIXED: &[(&str, Quantity, &str)] = &[
     (
         "contact_end",
         Quantity::ContactEnd,
-        "when, at which angle and why the contact ends (force or edge)",
+        "when, at which angle and why each contact ends (force, edge or contact)",
     ),
     (
         "contact_time_to_floor",
@@ -75,7 +77,7 @@ pub const FIXED: &[(&str, Quantity, &str)] = &[
     (
         "floor_impact",
         Quantity::FloorImpact,
-        "free-sliding phase after separation, to the floor",
+        "the motion after separation, to the floor",
     ),
     (
         "checks",
@@ -85,7 +87,7 @@ pub const FIXED: &[(&str, Quantity, &str)] = &[
     (
         "cross_check",
         Quantity::CrossCheck,
-        "unreduced equations integrated to the separation event",
+        "the general model's equations integrated to the fast path's first event",
     ),
 ];
 
@@ -96,7 +98,7 @@ impl Quantity {
             return Ok(*q);
         }
         if let Some(force) = name.strip_suffix("_series")
-            && let Some(i) = info.forces.iter().position(|f| f.name == force)
+            && let Some(i) = info.contacts.iter().position(|c| c.name == force)
         {
             return Ok(Quantity::ForceSeries(i));
         }
@@ -125,7 +127,7 @@ impl Quantity {
         };
         match self {
             Quantity::ForceSeries(i) => {
-                let force = named(info.forces.get(*i).map(|f| f.name), "force", *i);
+                let force = named(info.contacts.get(*i).map(|c| c.name), "contact", *i);
                 format!("{force}_series")
             }
             Quantity::FrictionSeries(i) => {
@@ -157,30 +159,34 @@ impl Quantity {
             .map(|(_, q, _)| *q)
             .filter(|q| q.available(info))
             .collect();
-        out.extend((0..info.forces.len()).map(Quantity::ForceSeries));
+        out.extend((0..info.contacts.len()).map(Quantity::ForceSeries));
         out.extend((0..info.frictions.len()).map(Quantity::FrictionSeries));
         out.extend((0..info.points.len()).map(Quantity::Trajectory));
         out
     }
 
-    /// Whether a model can provide this quantity: separation needs a contact, the floor
-    /// impact a phase after it, the quantities of the energy integral (the time to the floor in
-    /// contact, the cross-check against the quadrature) the fast path, the linearised angle
-    /// a separation polynomial, and an indexed quantity an index the model has.
+    /// Whether a model can provide this quantity: the separation needs a unilateral first
+    /// contact, the contacts' ends a contact, the quantities of the energy integral (the time
+    /// to the floor in contact, the cross-check against the quadrature) a fast phase that
+    /// starts at release, the linearised angle one with a separation polynomial, and an indexed
+    /// quantity an index the model has.
     pub fn available(&self, info: &ModelInfo) -> bool {
-        let contact = info.contact.is_some();
-        let fast = info.reduction.is_some();
+        let separates = info.contacts.first().is_some_and(|c| !c.bilateral);
+        let release = info.phases.iter().find(|p| p.release);
         match self {
-            Quantity::SeparationAngle | Quantity::SeparationTime | Quantity::ContactEnd => contact,
+            Quantity::SeparationAngle | Quantity::SeparationTime => separates,
+            Quantity::ContactEnd => !info.contacts.is_empty(),
             Quantity::LinearisedSeparationAngle => {
-                contact && info.reduction.is_some_and(|r| r.polynomial_separation)
+                separates && release.is_some_and(|p| p.separation_degree > 0)
             }
-            Quantity::ContactTimeToFloor | Quantity::CrossCheck => fast,
-            Quantity::FloorImpact => contact && info.next_phase.is_some(),
-            Quantity::ForceSeries(i) => *i < info.forces.len(),
+            Quantity::ContactTimeToFloor | Quantity::CrossCheck => release.is_some(),
+            Quantity::ForceSeries(i) => *i < info.contacts.len(),
             Quantity::FrictionSeries(i) => *i < info.frictions.len(),
             Quantity::Trajectory(i) => *i < info.points.len(),
-            Quantity::ThetaSeries | Quantity::Checks | Quantity::PointMassFallTime => true,
+            Quantity::FloorImpact
+            | Quantity::ThetaSeries
+            | Quantity::Checks
+            | Quantity::PointMassFallTime => true,
         }
     }
 }

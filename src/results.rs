@@ -75,11 +75,12 @@ pub struct Check {
     pub order: usize,
     /// What was measured: a monitor's smallest value (in `unit`), or a relative drift.
     pub value: f64,
-    /// The bound: `value >= 0` for a monitor (up to rounding), `value <= limit` otherwise.
+    /// The bound: `value >= limit` for a monitor (its limit is minus the rounding allowance,
+    /// `-tolerance` times the monitor's scale along the motion), `value <= limit` otherwise.
     pub limit: f64,
     /// Unit of `value` and `margin` (`1` for relative drifts; empty when the spec gives none).
     pub unit: String,
-    /// How much room was left, in `unit`: a monitor's smallest value, `limit - value` for a
+    /// How much room was left, in `unit`: `value - limit` for a monitor, `limit - value` for a
     /// drift; negative when it failed.
     pub margin: f64,
     /// Time from release (s) where a monitor took its smallest value.

@@ -455,9 +455,40 @@ impl Ctx<'_> {
         self.at(kind, e.mark, &field, message)
     }
 
+    /// The scene in stages: settings, the model, what is wanted, the parameters and, once
+    /// those are valid, the model's requirements; every problem found is reported together.
     fn validate(&self, raw: Raw, registry: &[&'static dyn Model]) -> Result<Scene, SceneError> {
         let mut out: Vec<Diagnostic> = Vec::new();
+        let (tolerance, samples) = self.settings(&raw, &mut out);
+        let Some(model) = self.model(&raw, registry, &mut out) else {
+            return Err(finish(out));
+        };
+        let want = self.wanted(&raw, model.info(), &mut out);
+        let values = self.parameter_values(&raw, model.info(), &mut out);
+        if let Some(values) = &values {
+            self.requirements(model, values, &mut out);
+        }
+        if !out.is_empty() {
+            return Err(finish(out));
+        }
+        let Some(parameters) = values else {
+            // Every parameter that is missing or invalid has its diagnostic.
+            return Err(finish(out));
+        };
+        Ok(Scene {
+            file: self.file.to_path_buf(),
+            model,
+            parameters,
+            want,
+            tolerance,
+            samples,
+            source: self.doc.text().to_string(),
+        })
+    }
 
+    /// `tolerance` and `samples`, which do not depend on the model (their defaults where
+    /// absent; a value out of range is reported and its default kept for the other checks).
+    fn settings(&self, raw: &Raw, out: &mut Vec<Diagnostic>) -> (f64, usize) {
         // tolerance and samples do not depend on the model.
         let tolerance = raw.tolerance.unwrap_or(DEFAULT_TOLERANCE);
         if !tolerance.is_finite() {
@@ -497,12 +528,29 @@ impl Ctx<'_> {
             }
         };
 
+        (tolerance, samples)
+    }
+
+    /// The scene's model: a system in the registry (a phase model is refused, naming its
+    /// system).
+    fn model(
+        &self,
+        raw: &Raw,
+        registry: &[&'static dyn Model],
+        out: &mut Vec<Diagnostic>,
+    ) -> Option<&'static dyn Model> {
+        let systems = || -> Vec<&str> {
+            (registry.iter().map(|m| m.info()))
+                .filter(|i| i.is_general())
+                .map(|i| i.name)
+                .collect()
+        };
         let Some(model) = registry
             .iter()
             .copied()
             .find(|m| m.info().name == raw.model)
         else {
-            let names: Vec<&str> = registry.iter().map(|m| m.info().name).collect();
+            let names = systems();
             let available = if names.is_empty() {
                 "none (no model has been generated yet)".to_string()
             } else {
@@ -517,11 +565,31 @@ impl Ctx<'_> {
                     raw.model
                 ),
             ));
-            return Err(finish(out));
+            return None;
         };
         let info = model.info();
+        if !info.is_general() {
+            out.push(self.diag(
+                Kind::UnknownModel,
+                "model",
+                At::Value,
+                format!(
+                    "model `{}` is a phase of the system `{}`, which decides its phases itself: \
+                     write `model: {}`; the systems are: {}",
+                    info.name,
+                    info.system,
+                    info.system,
+                    systems().join(", ")
+                ),
+            ));
+            return None;
+        }
 
-        // want
+        Some(model)
+    }
+
+    /// The quantities of `want`, each known, available from the model and named once.
+    fn wanted(&self, raw: &Raw, info: &ModelInfo, out: &mut Vec<Diagnostic>) -> Vec<Quantity> {
         let mut want = Vec::new();
         if raw.want.is_empty() {
             out.push(self.diag(
@@ -549,7 +617,7 @@ impl Ctx<'_> {
                     format!(
                         "model `{}` cannot provide `{name}`: {}; it offers: {}",
                         info.name,
-                        unavailable_reason(q, info),
+                        unavailable_reason(q),
                         Quantity::names(info).join(", ")
                     ),
                 )),
@@ -563,7 +631,17 @@ impl Ctx<'_> {
             }
         }
 
-        // parameters
+        want
+    }
+
+    /// The parameter values in the model's order, each checked by [`check_value`]; `None`
+    /// when one is missing or invalid (each reported).
+    fn parameter_values(
+        &self,
+        raw: &Raw,
+        info: &'static ModelInfo,
+        out: &mut Vec<Diagnostic>,
+    ) -> Option<Vec<f64>> {
         let expected: Vec<&str> = info.parameters.iter().map(|p| p.name).collect();
         for name in raw.parameters.keys() {
             if !expected.contains(&name.as_str()) {
@@ -634,10 +712,16 @@ impl Ctx<'_> {
             values.push(v);
         }
 
-        // requirements, once every parameter is there and valid
-        if all_good && !info.requirements.is_empty() {
+        all_good.then_some(values)
+    }
+
+    /// The model's requirements on valid parameters, each failure placed at the first of its
+    /// parameters in the file.
+    fn requirements(&self, model: &dyn Model, values: &[f64], out: &mut Vec<Diagnostic>) {
+        let info = model.info();
+        if !info.requirements.is_empty() {
             let mut margins = vec![0.0; info.requirements.len()];
-            for (r, margin) in failed_requirements(model, &values, &mut margins) {
+            for (r, margin) in failed_requirements(model, values, &mut margins) {
                 {
                     let involved = involved_parameters(r.name, r.meaning, info);
                     let field =
@@ -666,19 +750,6 @@ impl Ctx<'_> {
                 }
             }
         }
-
-        if !out.is_empty() {
-            return Err(finish(out));
-        }
-        Ok(Scene {
-            file: self.file.to_path_buf(),
-            model,
-            parameters: values,
-            want,
-            tolerance,
-            samples,
-            source: self.doc.text().to_string(),
-        })
     }
 }
 
@@ -689,10 +760,16 @@ fn finish(mut out: Vec<Diagnostic>) -> SceneError {
 }
 
 /// Why a model cannot provide a quantity it knows by name.
-fn unavailable_reason(q: Quantity, info: &ModelInfo) -> &'static str {
+fn unavailable_reason(q: Quantity) -> &'static str {
     match q {
-        Quantity::FloorImpact if info.contact.is_some() => "it has no phase after separation",
-        _ => "it has no separating contact",
+        Quantity::LinearisedSeparationAngle => {
+            "it has no fast phase at release whose separation is a polynomial root"
+        }
+        Quantity::ContactTimeToFloor | Quantity::CrossCheck => {
+            "it has no fast phase that starts at release"
+        }
+        Quantity::ContactEnd => "it has no contact",
+        _ => "its first contact is not a unilateral contact",
     }
 }
 

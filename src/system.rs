@@ -318,14 +318,55 @@ impl<'m> Bound<'m> {
         (mass, rhs)
     }
 
-    /// Reaction forces from a full state, its accelerations and the friction forces `fr` (in
-    /// the order of [`ModelInfo::frictions`](crate::model::ModelInfo::frictions); empty without
-    /// friction).
-    pub fn forces_full(&self, state: &State, qdd: &[f64], fr: &[f64]) -> Vec<f64> {
-        let mut out = vec![0.0; self.info().forces.len()];
+    /// Number of contacts of the system.
+    pub fn n_contacts(&self) -> usize {
+        self.info().contacts.len()
+    }
+
+    /// The forces of the contacts this model holds closed by elimination (one per contact;
+    /// zero for the others) from a full state and its accelerations.
+    pub fn forces_full(&self, state: &State, qdd: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; self.n_contacts()];
         self.model
-            .forces_full(&self.k, &state.q, &state.qd, qdd, fr, &mut out);
+            .forces_full(&self.k, &state.q, &state.qd, qdd, &mut out);
         out
+    }
+
+    /// Every contact's gap (zero for those this model holds closed).
+    pub fn gaps(&self, state: &State) -> Vec<f64> {
+        let mut out = vec![0.0; self.n_contacts()];
+        self.model.gaps(&self.k, &state.q, &mut out);
+        out
+    }
+
+    /// Every contact's constraint row `J = d gap / dq` (row-major, one row per contact) and
+    /// bias `dJ/dt qd`: a contact's normal acceleration is `J qdd + bias`.
+    pub fn constraints(&self, state: &State) -> (Vec<f64>, Vec<f64>) {
+        let m = self.n_contacts();
+        let mut jac = vec![0.0; m * self.n_coordinates()];
+        let mut bias = vec![0.0; m];
+        self.model
+            .constraints(&self.k, &state.q, &state.qd, &mut jac, &mut bias);
+        (jac, bias)
+    }
+
+    /// Every contact's edge margin (`+inf` for a contact without an edge).
+    pub fn edges(&self, state: &State) -> Vec<f64> {
+        let mut out = vec![0.0; self.n_contacts()];
+        self.model.edges(&self.k, &state.q, &mut out);
+        out
+    }
+
+    /// The system's state (the general model's coordinates) this model's state stands for.
+    pub fn to_full(&self, state: &State) -> State {
+        let n = self.info().system_coordinates.len();
+        let mut full = State {
+            q: vec![0.0; n],
+            qd: vec![0.0; n],
+        };
+        self.model
+            .to_full(&self.k, &state.q, &state.qd, &mut full.q, &mut full.qd);
+        full
     }
 
     /// The frictions' slip-velocity Jacobian `J` (row-major, one row per friction) and the
@@ -346,7 +387,7 @@ impl<'m> Bound<'m> {
             .collect()
     }
 
-    /// Monitor values (each must stay `>= 0`) at a state with the forces there.
+    /// Monitor values (each must stay `>= 0`) at a state with the contacts' forces there.
     pub fn monitors_full(&self, state: &State, forces: &[f64]) -> Vec<f64> {
         let mut out = vec![0.0; self.info().monitors.len()];
         self.model
@@ -354,17 +395,18 @@ impl<'m> Bound<'m> {
         out
     }
 
-    /// The margin to the contact's edge (`+inf` without an edge).
-    pub fn contact_edge(&self, state: &State) -> f64 {
-        self.model.contact_edge(&self.k, &state.q)
-    }
-
-    /// The value and rate of the coordinate the contact ties (`None` without a contact).
-    pub fn released(&self, state: &State) -> Option<[f64; 2]> {
-        self.info().contact?;
-        let mut out = [0.0; 2];
-        self.model.released(&self.k, &state.q, &state.qd, &mut out);
-        Some(out)
+    /// A typical length of the system at a state: the largest distance of a named point from
+    /// the origin (1 m for a model without points), against which gaps in metres are measured.
+    pub fn length_scale(&self, state: &State) -> f64 {
+        let pts = self.points(state);
+        let reach = (pts.pos.iter())
+            .map(|p| p[0].hypot(p[1]))
+            .fold(0.0f64, f64::max);
+        if reach > 0.0 && reach.is_finite() {
+            reach
+        } else {
+            1.0
+        }
     }
 }
 
@@ -482,18 +524,30 @@ impl<'m> System<'m> {
         self.reduced(self.theta_initial() - theta)
     }
 
-    /// Reaction forces at `delta` in the order of [`ModelInfo::forces`].
+    /// Every contact's force at `delta`, in the order of [`ModelInfo::contacts`] (zero for a
+    /// contact open in the phase).
     pub fn forces(&self, delta: f64) -> Vec<f64> {
-        let mut out = vec![0.0; self.info().forces.len()];
+        let mut out = vec![0.0; self.info().contacts.len()];
         self.reduction.forces(self.k(), delta, &mut out);
         out
     }
 
-    /// Coefficients of the separation polynomial in `sin(theta)`, lowest degree first.
+    /// Coefficients of contact `contact`'s force polynomial in `sin(theta)`, lowest degree
+    /// first; `None` when its zero is no polynomial root.
+    pub fn force_coefficients(&self, contact: usize) -> Option<Vec<f64>> {
+        let degree = *self.layout.force_degrees.get(contact)?;
+        if degree == 0 {
+            return None;
+        }
+        let mut out = vec![0.0; degree + 1];
+        self.reduction.force_polynomial(self.k(), contact, &mut out);
+        Some(out)
+    }
+
+    /// Coefficients of the separation polynomial (the first contact's force polynomial), lowest
+    /// degree first; empty when it has none.
     pub fn separation_coefficients(&self) -> Vec<f64> {
-        let mut out = vec![0.0; self.layout.separation_degree + 1];
-        self.reduction.separation_polynomial(self.k(), &mut out);
-        out
+        self.force_coefficients(0).unwrap_or_default()
     }
 
     /// Coefficients of the fall polynomial in `sin(theta)`, lowest degree first (empty when the

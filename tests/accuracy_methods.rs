@@ -14,7 +14,7 @@ fn case(
     accuracy::CaseReference,
     rodcube::reference::Reference,
 ) {
-    let model = rodcube::models::find("rod_cube").unwrap();
+    let model = rodcube::models::find("rod_cube_closed").unwrap();
     let sys = System::from_values(model, &[1.0, 3.0, 1.0, a_over_ell, 1.0]).unwrap();
     let c = accuracy::Case {
         name: "test",

@@ -1,6 +1,10 @@
 //! Invalid model specs are refused with the file, the line (and column where it is precise) and
 //! the field of the mistake: one test per error class, on specs written to a temporary project
 //! (its own `derivations/` and a copy of `templates/`) so that nothing in the tree is touched.
+//! Specs in the retired schema (`contact:`, `forces:`, `scenery:`, a friction's `normal:`, a
+//! potential's `acts_on:`) are refused saying what replaced them; the contacts' own mistakes
+//! (a gap of no coordinate or of no consistent unit, two contacts of one name, a friction at a
+//! contact that does not exist or a bilateral one, an obstacle that moves) each name their field.
 #![cfg(feature = "derive")]
 
 use rodcube::derive::spec::{self, SpecError};
@@ -35,7 +39,8 @@ points:
   - {name: centre, position: [x1 + ell/2*cos(theta), ell/2*sin(theta)], meaning: centre}
   - {name: wall, position: [0, 0], meaning: wall}
 falling_point: centre
-contact: {force: push, meaning: wall push, gap: -x1 - ell*cos(theta), eliminates: x1}
+contacts:
+  - {name: push, meaning: wall push, gap: -x1 - ell*cos(theta), eliminates: x1}
 initial:
   theta: {position: asin(a/ell), velocity: 0}
 ";
@@ -140,11 +145,15 @@ fn the_base_spec_is_valid() {
     // The control for every test below: only the edit makes a spec invalid.
     let (root, _) = write("base", BASE);
     let (files, _) = render_all(&root, &[]).unwrap_or_else(|e| panic!("{e}"));
-    assert!(
-        files
-            .iter()
-            .any(|f| f.path == Path::new("generated/ladder.rs"))
-    );
+    // The general model and the contact phase (the wall's push closed, x1 eliminated).
+    for model in ["ladder", "ladder_closed"] {
+        let path = Path::new("generated").join(format!("{model}.rs"));
+        assert!(
+            files.iter().any(|f| f.path == path),
+            "no {}",
+            path.display()
+        );
+    }
     let _ = std::fs::remove_dir_all(&root);
 }
 
@@ -220,64 +229,179 @@ fn unknown_function() {
 
 #[test]
 fn a_gap_that_cannot_be_solved_for_its_coordinate() {
-    let text = edit("gap: -x1 - ell*cos(theta)", "gap: -x1^2 - ell*cos(theta)");
+    // In metres, but quadratic in x1.
+    let text = edit(
+        "gap: -x1 - ell*cos(theta)",
+        "gap: -x1^2/ell - ell*cos(theta)",
+    );
     refused(
         "gap_not_linear",
         &text,
-        ("gap: -x1^2", "contact"),
-        "contact.gap",
+        ("gap: -x1^2", "gap"),
+        "contacts[0].gap",
         &["linear in `x1`", "d(gap)/dx1"],
     );
-    let (line, _) = place(&text, "gap: -x1^2", "contact");
+    let (line, _) = place(&text, "gap: -x1^2", "gap");
     // The same through `derive_all` directly.
     let (root, path) = write("gap_not_linear_direct", &text);
     let checked = spec::load(&path).unwrap_or_else(|e| panic!("{e}"));
     match derive_all(&[checked]) {
-        Err(Error::Spec(e)) => check(&path, &e, (line, None), "contact.gap", &["x1"]),
+        Err(Error::Spec(e)) => check(&path, &e, (line, None), "contacts[0].gap", &["x1"]),
         other => panic!("expected a spec error, got {other:?}"),
     }
     let _ = std::fs::remove_dir_all(&root);
 }
 
 #[test]
+fn a_gap_that_depends_on_no_coordinate_is_refused() {
+    let text = edit(
+        "gap: -x1 - ell*cos(theta), eliminates: x1}",
+        "gap: ell - a}",
+    );
+    refused(
+        "gap_no_coordinate",
+        &text,
+        ("gap: ell - a", "gap"),
+        "contacts[0].gap",
+        &["`ell - a`", "contact `push` depends on no coordinate"],
+    );
+}
+
+#[test]
+fn a_gap_without_a_consistent_unit_is_refused() {
+    // Metres and radians added: no unit for the gap, so none for its force.
+    let text = edit("gap: -x1 - ell*cos(theta)", "gap: -x1 - theta");
+    refused(
+        "gap_units",
+        &text,
+        ("gap: -x1 - theta", "gap"),
+        "contacts[0].gap",
+        &["the gap of contact `push` has no consistent unit"],
+    );
+}
+
+#[test]
+fn two_contacts_of_one_name_are_refused() {
+    let text = edit(
+        "initial:\n",
+        "  - {name: push, meaning: the floor, gap: ell*sin(theta)}\ninitial:\n",
+    );
+    let (path, err) = error_of("duplicate_contact", &text);
+    let (line, col) = place(&text, "meaning: the floor", "name: push");
+    check(
+        &path,
+        &err,
+        (line, Some(col)),
+        "contacts[1].name",
+        &["`push` is declared twice"],
+    );
+}
+
+#[test]
 fn a_coordinate_that_is_not_cyclic_is_integrated_not_refused() {
-    // A spring on the foot: the Lagrangian depends on x1 after the contact is dropped, so the
-    // free phase has no fast path; it is derived for the integrated route, with the reason.
+    // A spring on the foot: the Lagrangian depends on x1, so the general model (every
+    // coordinate, the wall a constraint row) has no fast path; it is derived for the integrated
+    // route, with the reason. The contact phase ties x1 to theta and still reduces.
     let text = edit(
         "falling_point: centre\n",
-        "falling_point: centre\npotentials:\n  - {name: spring, expr: m1*g/ell*x1^2, acts_on: [rod], meaning: a spring on the foot}\n",
+        "falling_point: centre\npotentials:\n  - {name: spring, expr: m1*g/ell*x1^2, meaning: a spring on the foot}\n",
     );
     let (root, _) = write("spring_on_foot", &text);
     let (files, _) = render_all(&root, &[]).unwrap_or_else(|e| panic!("{e}"));
-    let record = files
-        .iter()
-        .find(|f| f.path == Path::new("generated/ladder_free.json"))
-        .expect("the free phase's record");
-    let v: serde_json::Value = serde_json::from_str(&record.text).unwrap();
-    assert_eq!(v["route"], "integrated");
+    let record = |model: &str| -> serde_json::Value {
+        let path = Path::new("generated").join(format!("{model}.json"));
+        let f = (files.iter())
+            .find(|f| f.path == path)
+            .unwrap_or_else(|| panic!("no {}", path.display()));
+        serde_json::from_str(&f.text).unwrap()
+    };
+    let general = record("ladder");
+    assert_eq!(general["route"], "integrated");
     assert!(
-        v["route_note"]
+        general["route_note"]
             .as_str()
             .unwrap()
             .contains("`x1` is not cyclic"),
         "{}",
-        v["route_note"]
+        general["route_note"]
     );
+    assert_eq!(record("ladder_closed")["route"], "reduced");
     let _ = std::fs::remove_dir_all(&root);
 }
 
+/// A spec in the retired schema is refused at the retired field, saying what replaced it.
 #[test]
-fn a_potential_on_the_body_of_a_measured_force_is_refused() {
+fn the_retired_fields_are_refused_with_what_replaced_them() {
+    // The one `contact:` of the old schema (BASE as it was written before `contacts:`).
+    let text = edit(
+        "contacts:\n  - {name: push, meaning: wall push, gap: -x1 - ell*cos(theta), eliminates: x1}\n",
+        "contact: {force: push, meaning: wall push, gap: -x1 - ell*cos(theta), eliminates: x1}\n",
+    );
+    let (path, err) = error_of("retired_contact", &text);
+    let (line, col) = place(&text, "contact: {force", "contact");
+    check(
+        &path,
+        &err,
+        (line, Some(col)),
+        "contact",
+        &["`contact:` is now `contacts:`, a list", "`name:`"],
+    );
+    // Reaction forces projected by hand.
     let text = edit(
         "falling_point: centre\n",
-        "falling_point: centre\nforces:\n  - {name: floor_normal, body: rod, direction: [0, 1], meaning: floor push}\npotentials:\n  - {name: spring, expr: x1^2, acts_on: [rod], meaning: a spring on the foot}\n",
+        "falling_point: centre\nforces:\n  - {name: floor_normal, body: rod, direction: [0, 1], meaning: floor push}\n",
     );
-    refused(
-        "potential_on_measured_body",
-        &text,
-        ("name: floor_normal", "floor_normal"),
-        "forces[0].body",
-        &["potential `spring` also acts on that body"],
+    let (path, err) = error_of("retired_forces", &text);
+    let (line, col) = place(&text, "forces:", "forces");
+    check(
+        &path,
+        &err,
+        (line, Some(col)),
+        "forces",
+        &[
+            "reaction forces projected by hand are retired",
+            "`contacts:`",
+        ],
+    );
+    // Fixed shapes.
+    let text = edit(
+        "initial:\n",
+        "scenery:\n  - {rectangle: [a, ell], at: [a/2, ell/2]}\ninitial:\n",
+    );
+    let (path, err) = error_of("retired_scenery", &text);
+    let (line, col) = place(&text, "scenery:", "scenery");
+    check(
+        &path,
+        &err,
+        (line, Some(col)),
+        "scenery",
+        &["`scenery:` is now `obstacles:`"],
+    );
+    // A friction's `normal:` (now the `contact:` it acts at) and a potential's `acts_on:`.
+    let text = with_friction(
+        "  - {name: wall_friction, meaning: wall friction, coefficient: mu, normal: push, body: rod, point: [x1 + ell*cos(theta), ell*sin(theta)], direction: [0, 1]}\n",
+    );
+    let (path, err) = error_of("retired_normal", &text);
+    let (line, col) = place(&text, "name: wall_friction", "normal");
+    check(
+        &path,
+        &err,
+        (line, Some(col)),
+        "friction[0]",
+        &["unknown field `normal`", "contact"],
+    );
+    let text = edit(
+        "falling_point: centre\n",
+        "falling_point: centre\npotentials:\n  - {name: spring, expr: m1*g/ell*x1^2, acts_on: [rod], meaning: a spring}\n",
+    );
+    let (path, err) = error_of("retired_acts_on", &text);
+    let (line, col) = place(&text, "acts_on", "acts_on");
+    check(
+        &path,
+        &err,
+        (line, Some(col)),
+        "potentials[0]",
+        &["unknown field `acts_on`"],
     );
 }
 
@@ -355,13 +479,11 @@ fn a_hand_written_next_phase_is_an_unknown_field() {
     );
 }
 
-/// BASE with a measured floor force and Coulomb friction at the foot, `friction` as given.
+/// BASE with Coulomb friction (`friction` as given) and its coefficient `mu`.
 fn with_friction(friction: &str) -> String {
     edit(
         "falling_point: centre\n",
-        &format!(
-            "falling_point: centre\nforces:\n  - {{name: floor_normal, body: rod, direction: [0, 1], meaning: floor push}}\nfriction:\n{friction}"
-        ),
+        &format!("falling_point: centre\nfriction:\n{friction}"),
     )
     .replace(
         "  - {name: g, meaning: gravity, unit: m/s^2}\n",
@@ -372,7 +494,7 @@ fn with_friction(friction: &str) -> String {
 #[test]
 fn a_friction_with_a_well_formed_spec_is_accepted() {
     let text = with_friction(
-        "  - {name: foot_friction, meaning: floor friction, coefficient: mu, normal: floor_normal, body: rod, point: [x1, 0], direction: [1, 0]}\n",
+        "  - {name: wall_friction, meaning: wall friction, coefficient: mu, contact: push, body: rod, point: [x1 + ell*cos(theta), ell*sin(theta)], direction: [0, 1]}\n",
     );
     let (root, _) = write("friction_ok", &text);
     let (rendered, _) = render_all(&root, &[]).unwrap_or_else(|e| panic!("refused: {e}"));
@@ -381,35 +503,53 @@ fn a_friction_with_a_well_formed_spec_is_accepted() {
             .iter()
             .any(|r| r.path.extension().is_some_and(|e| e == "rs")
                 && r.text.contains("FrictionInfo")
-                && r.text.contains("\"foot_friction\"")),
+                && r.text.contains("\"wall_friction\"")),
         "no generated model carries the friction"
     );
     let _ = std::fs::remove_dir_all(&root);
 }
 
 #[test]
-fn a_friction_that_names_no_normal_force_is_refused() {
+fn a_friction_at_a_contact_that_does_not_exist_is_refused() {
     let text = with_friction(
-        "  - {name: foot_friction, meaning: floor friction, coefficient: mu, normal: floor_push, body: rod, point: [x1, 0], direction: [1, 0]}\n",
+        "  - {name: wall_friction, meaning: wall friction, coefficient: mu, contact: wall_push, body: rod, point: [x1 + ell*cos(theta), ell*sin(theta)], direction: [0, 1]}\n",
     );
     refused(
-        "friction_no_normal",
+        "friction_no_contact",
         &text,
-        ("name: foot_friction", "foot_friction"),
-        "friction[0].normal",
-        &["`floor_push` is not a normal force", "floor_normal"],
+        ("name: wall_friction", "wall_friction"),
+        "friction[0].contact",
+        &[
+            "there is no contact `wall_push`",
+            "one of the contacts (push)",
+        ],
+    );
+}
+
+#[test]
+fn a_friction_at_a_bilateral_contact_is_refused() {
+    let text = with_friction(
+        "  - {name: wall_friction, meaning: wall friction, coefficient: mu, contact: push, body: rod, point: [x1 + ell*cos(theta), ell*sin(theta)], direction: [0, 1]}\n",
+    )
+    .replace("eliminates: x1}", "eliminates: x1, bilateral: true}");
+    refused(
+        "friction_bilateral",
+        &text,
+        ("name: wall_friction", "wall_friction"),
+        "friction[0].contact",
+        &["contact `push` is bilateral", "normal force"],
     );
 }
 
 #[test]
 fn a_friction_coefficient_that_is_not_a_parameter_is_refused() {
     let text = with_friction(
-        "  - {name: foot_friction, meaning: floor friction, coefficient: 0.3, normal: floor_normal, body: rod, point: [x1, 0], direction: [1, 0]}\n",
+        "  - {name: wall_friction, meaning: wall friction, coefficient: 0.3, contact: push, body: rod, point: [x1 + ell*cos(theta), ell*sin(theta)], direction: [0, 1]}\n",
     );
     refused(
         "friction_number",
         &text,
-        ("name: foot_friction", "foot_friction"),
+        ("name: wall_friction", "wall_friction"),
         "friction[0].coefficient",
         &["is not a parameter"],
     );
@@ -418,12 +558,12 @@ fn a_friction_coefficient_that_is_not_a_parameter_is_refused() {
 #[test]
 fn a_friction_direction_that_is_not_a_unit_vector_is_refused() {
     let text = with_friction(
-        "  - {name: foot_friction, meaning: floor friction, coefficient: mu, normal: floor_normal, body: rod, point: [x1, 0], direction: [2, 0]}\n",
+        "  - {name: wall_friction, meaning: wall friction, coefficient: mu, contact: push, body: rod, point: [x1 + ell*cos(theta), ell*sin(theta)], direction: [0, 2]}\n",
     );
     refused(
         "friction_direction",
         &text,
-        ("name: foot_friction", "foot_friction"),
+        ("name: wall_friction", "wall_friction"),
         "friction[0].direction",
         &["not a unit vector"],
     );
@@ -432,12 +572,12 @@ fn a_friction_direction_that_is_not_a_unit_vector_is_refused() {
 #[test]
 fn a_body_rubbing_against_itself_is_refused() {
     let text = with_friction(
-        "  - {name: foot_friction, meaning: floor friction, coefficient: mu, normal: floor_normal, body: rod, against: rod, point: [x1, 0], direction: [1, 0]}\n",
+        "  - {name: wall_friction, meaning: wall friction, coefficient: mu, contact: push, body: rod, against: rod, point: [x1 + ell*cos(theta), ell*sin(theta)], direction: [0, 1]}\n",
     );
     refused(
         "friction_itself",
         &text,
-        ("name: foot_friction", "foot_friction"),
+        ("name: wall_friction", "wall_friction"),
         "friction[0].against",
         &["cannot rub against itself"],
     );
@@ -485,25 +625,38 @@ fn a_shape_of_two_kinds_or_an_unknown_kind_is_refused() {
 }
 
 #[test]
-fn scenery_over_the_coordinates_is_refused() {
+fn an_obstacle_given_a_coordinate_is_refused() {
+    // Its place...
     let text = edit(
         "initial:\n",
-        "scenery:\n  - {segment: [[0, 0], [x1, ell]]}\ninitial:\n",
+        "obstacles:\n  - {name: step, meaning: a step, at: [x1, 0], shape: {rectangle: [a, a]}}\ninitial:\n",
     );
     refused(
-        "scenery_coordinates",
+        "obstacle_place",
         &text,
-        ("[x1, ell]", "segment"),
-        "scenery[0].segment[1][0]",
-        &["undefined symbol `x1`"],
+        ("name: step", "step"),
+        "obstacles[0].at[0]",
+        &["obstacle `step` is fixed", "not on the coordinate `x1`"],
+    );
+    // ...or its shape.
+    let text = edit(
+        "initial:\n",
+        "obstacles:\n  - {name: step, meaning: a step, at: [0, 0], shape: {segment: [[0, 0], [x1, ell]]}}\ninitial:\n",
+    );
+    refused(
+        "obstacle_shape",
+        &text,
+        ("name: step", "step"),
+        "obstacles[0].shape.segment[1][0]",
+        &["obstacle `step` is fixed", "not on the coordinate `x1`"],
     );
 }
 
 #[test]
-fn shapes_scenery_and_monitor_units_reach_the_generated_code() {
+fn shapes_obstacles_and_monitor_units_reach_the_generated_code() {
     let text = edit(
         "initial:\n",
-        "scenery:\n  - {rectangle: [a, ell], at: [a/2, ell/2]}\nmonitors:\n  - {name: leaning, expr: theta, meaning: the ladder leans, unit: rad}\ninitial:\n",
+        "obstacles:\n  - {name: block, meaning: a block by the wall, at: [0, 0], shape: {rectangle: [a, ell], at: [a/2, ell/2]}}\nmonitors:\n  - {name: leaning, expr: theta, meaning: the ladder leans, unit: rad}\ninitial:\n",
     )
     .replace(
         "    angle: theta\n",
@@ -512,7 +665,7 @@ fn shapes_scenery_and_monitor_units_reach_the_generated_code() {
     let (root, _) = write("shapes", &text);
     let (files, _) = render_all(&root, &[]).unwrap_or_else(|e| panic!("{e}"));
     let _ = std::fs::remove_dir_all(&root);
-    for model in ["ladder", "ladder_free"] {
+    for model in ["ladder", "ladder_closed"] {
         let rust = files
             .iter()
             .find(|f| f.path == Path::new("generated").join(format!("{model}.rs")))

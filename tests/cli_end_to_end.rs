@@ -1,5 +1,5 @@
 //! The `rodcube` binary end to end on the generated models (`rod_cube`, `hinged_rod`,
-//! `wall_ladder`, `rod_cube_free`): every shipped scene runs, the paper's scene prints and writes the
+//! `wall_ladder`, ...): every shipped scene runs, the paper's scene prints and writes the
 //! paper's figures, `--json` is valid JSON, `models` lists them, and scene errors that need a
 //! model's parameters name file:line:column and the field.
 //!
@@ -161,7 +161,6 @@ fn models_lists_every_model_with_parameters_and_quantities() {
         "rod_cube",
         "hinged_rod",
         "wall_ladder",
-        "rod_cube_free",
         "rod_cube_spring",
         "rod_cylinder",
         "m1",
@@ -173,6 +172,12 @@ fn models_lists_every_model_with_parameters_and_quantities() {
     ] {
         assert!(stdout.contains(want), "missing {want:?} in\n{stdout}");
     }
+    // Phases are listed under their system, not as models a scene may name.
+    assert!(
+        stdout.contains("fast phases: rod_cube_closed (contact_force, floor_normal closed)")
+            && !stdout.contains("\nrod_cube_free:"),
+        "{stdout}"
+    );
 }
 
 /// Runs a scene text and asserts a scene error with every needle on stderr.
@@ -249,11 +254,11 @@ fn unknown_quantity() {
 fn unavailable_quantity() {
     scene_error(
         "unavailable",
-        "model: rod_cube_free\nparameters: {m1: 1, m2: 3, ell: 1, a: 0.25, g: 9.81, x1_0: 0, theta_0: 0.2, x2_0: 1, x1_dot_0: 0, theta_dot_0: -1, x2_dot_0: 0}\nwant: [separation_time]\n",
+        "model: rod_cube_friction\nparameters: {m1: 1, m2: 3, ell: 1, a: 0.25, g: 9.81, mu: 0.1}\nwant: [contact_time_to_floor]\n",
         &[
             "error[unavailable-quantity]: want[0]:",
             "--> s.yaml:3:8",
-            "no separating contact",
+            "no fast phase that starts at release",
         ],
     );
 }

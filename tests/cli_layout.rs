@@ -122,7 +122,7 @@ fn checks_come_phase_by_phase_with_their_own_units_and_bounds() {
             .unwrap_or_else(|| panic!("no {needle:?} in\n{text}"))
     };
     // The contact phase, its ODE cross-check, then the free phase.
-    assert!(at("\nrod_cube:\n") < at("\nrod_cube (ODE cross-check):\n"));
+    assert!(at("\nrod_cube_closed:\n") < at("\nrod_cube (ODE cross-check):\n"));
     assert!(at("\nrod_cube (ODE cross-check):\n") < at("\nrod_cube_free:\n"));
     // A monitor reports its smallest value with its unit and when; a conservation law on the
     // reduced path says it holds by construction; the integrated one, its drift and bound.

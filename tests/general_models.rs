@@ -1,17 +1,20 @@
-//! Models outside the fast path, each one YAML file: `rod_cube_spring` (two coordinates move
-//! while in contact, a spring potential) and `rod_cylinder` (a curved contact whose point moves
-//! along the rod and can run off its end). Checked against independent references: the spring
-//! going slack reproduces the paper, a hand Newton–Euler balance of each body at random states
-//! agrees with the generated forces, the edge is where `R cot(theta/2) = ell`, and the
-//! integrated route agrees with the fast path where both apply.
+//! Systems whose contact phase is outside the fast path, each one YAML file: `rod_cube_spring`
+//! (two coordinates move while in contact, a spring potential) and `rod_cylinder` (a curved
+//! contact whose point moves along the rod and can run off its end); their contact phases run on
+//! the general model with both contacts as constraint rows. Checked against independent
+//! references: the spring going slack reproduces the paper, a hand Newton–Euler balance of each
+//! body at random states agrees with the solved contact forces, the edge is where
+//! `R cot(theta/2) = ell`, and the integrated route agrees with the fast path where both apply.
+
+mod common;
 
 use rodcube::model::Model;
 use rodcube::models::find;
 use rodcube::plan::{Request, run};
 use rodcube::quantity::Quantity;
 use rodcube::results::RunResults;
+use rodcube::solve::contacts::{Active, dynamics};
 use rodcube::solve::phases::Route;
-use rodcube::solve::unreduced::accelerations;
 use rodcube::system::{Bound, State};
 
 /// The paper's separation time (g = 9.81), exact to f64 (tests/hard_cases.rs).
@@ -57,24 +60,30 @@ const CYLINDER: [(&str, f64); 6] = [
 
 #[test]
 fn the_new_models_take_the_integrated_route_and_say_why() {
-    for name in ["rod_cube_spring", "rod_cube_spring_free", "rod_cylinder"] {
+    for name in ["rod_cube_spring", "rod_cylinder"] {
         let info = model(name).info();
+        assert!(info.is_general(), "{name}");
         assert!(info.reduction.is_none(), "{name}");
-        assert!(!info.route_note.is_empty(), "{name}");
+        assert!(info.route_note.contains("`y1` is not cyclic"), "{name}");
+        // The contact phase (both contacts closed) has no fast phase: it is integrated.
+        assert!(
+            !info.phases.iter().any(|p| p.closed == [0, 1]),
+            "{name}: {:?}",
+            info.phases
+        );
     }
-    assert!(
-        model("rod_cube_spring")
-            .info()
-            .route_note
-            .contains("`x1` is not cyclic")
-    );
-    assert!(
-        model("rod_cylinder")
-            .info()
-            .route_note
-            .contains("not affine")
-    );
+    // With the spring the cube's position is in the potential: no phase reduces to the angle,
+    // not even the rod alone on the floor with the cube on its spring.
+    assert!(model("rod_cube_spring").info().phases.is_empty());
+    assert!(find("rod_cube_spring_free").is_none());
+    assert!(find("rod_cube_spring_closed").is_none());
     // After the cylinder the rod and cylinder move freely: both cyclic, the fast path again.
+    let phases = model("rod_cylinder").info().phases;
+    assert_eq!(phases.len(), 1);
+    assert_eq!(
+        (phases[0].model, phases[0].closed),
+        ("rod_cylinder_free", &[1][..])
+    );
     assert!(model("rod_cylinder_free").info().reduction.is_some());
 }
 
@@ -122,9 +131,13 @@ fn a_stiff_spring_holds_the_cube_and_delays_the_separation() {
         Route::Fastest,
     );
     assert!(value(&stiff, "separation_time") > value(&soft, "separation_time"));
+    // The contact phase, then the rod alone on the floor (both integrated).
     assert_eq!(
         stiff.work.phases,
-        vec!["rod_cube_spring", "rod_cube_spring_free"]
+        vec![
+            "rod_cube_spring (contact_force, floor_normal closed)",
+            "rod_cube_spring (floor_normal closed)"
+        ]
     );
     for (name, c) in &stiff.checks {
         assert!(c.passed, "{name}: {c:?}");
@@ -132,14 +145,33 @@ fn a_stiff_spring_holds_the_cube_and_delays_the_separation() {
     assert!(value(&stiff, "floor_impact_time") > value(&stiff, "separation_time"));
 }
 
-/// A state of the contact phase (x1, theta and their rates) and its accelerations.
-fn state_and_accelerations(bound: &Bound, theta: f64, omega: f64, v1: f64) -> (State, Vec<f64>) {
+/// A state of the contact phase: the foot on the floor at `x1 = 0.1` with speed `v1`, the angle
+/// and its rate, the other body at `x2 = x1 + tie(theta)` (gap zero) moving with the tie; its
+/// accelerations and contact forces with both contacts closed.
+fn state_and_dynamics(
+    bound: &Bound,
+    theta: f64,
+    omega: f64,
+    v1: f64,
+    tie: impl Fn(f64) -> (f64, f64),
+) -> (State, Vec<f64>, Vec<f64>) {
+    let (x2, dx2) = tie(theta);
     let state = State {
-        q: vec![0.1, theta],
-        qd: vec![v1, omega],
+        q: vec![0.1, 0.0, theta, 0.1 + x2],
+        qd: vec![v1, 0.0, omega, v1 + dx2 * omega],
     };
-    let qdd = accelerations(bound, &state, 0.0).unwrap();
-    (state, qdd)
+    let active = Active {
+        closed: vec![true, true],
+        modes: Vec::new(),
+    };
+    let d = dynamics(bound, &state, &active, 0.0).unwrap();
+    for (i, a) in d.normal_acc.iter().enumerate() {
+        assert!(
+            a.abs() < 1e-12,
+            "theta {theta}: contact {i} accelerates apart: {a:e}"
+        );
+    }
+    (state, d.qdd, d.forces)
 }
 
 #[test]
@@ -148,18 +180,20 @@ fn the_cylinder_forces_balance_each_body_by_hand() {
     let (m1, m2, ell, r, g) = (1.0, 3.0, 1.0, 0.2, 9.81);
     let inertia = m1 * ell * ell / 12.0;
     let mut worst = 0.0f64;
-    for (theta, omega, v1) in [(0.9, 0.0, 0.0), (0.7, -1.3, 0.4), (0.5, -2.5, -0.3)] {
-        let (state, qdd) = state_and_accelerations(&bound, theta, omega, v1);
-        let f = bound.forces_full(&state, &qdd, &[]);
+    for (theta, omega, v1) in [(0.9f64, 0.0, 0.0), (0.7, -1.3, 0.4), (0.5, -2.5, -0.3)] {
+        // The axis at xc = x1 + R (1 + cos)/sin, with d/dtheta = -R/(1 - cos).
+        let tie = |t: f64| (r * (1.0 + t.cos()) / t.sin(), -r / (1.0 - t.cos()));
+        let (_, qdd, f) = state_and_dynamics(&bound, theta, omega, v1, tie);
         let (push, floor) = (f[0], f[1]);
         let (s, c) = (theta.sin(), theta.cos());
-        let (x1dd, thdd) = (qdd[0], qdd[1]);
-        // The push is normal to the rod: on the cylinder N (sin, -cos), N = push / sin.
-        let n = push / s;
+        let (x1dd, y1dd, thdd, xcdd) = (qdd[0], qdd[1], qdd[2], qdd[3]);
+        // The push is normal to the rod (its gap is the distance to the rod's line): on the
+        // cylinder N (sin, -cos).
+        let n = push;
         let d = r * (1.0 + c) / s; // contact point's distance from the foot
         // The rod's centre of mass and its acceleration.
         let ax = x1dd - 0.5 * ell * (s * thdd + c * omega * omega);
-        let ay = 0.5 * ell * (c * thdd - s * omega * omega);
+        let ay = y1dd + 0.5 * ell * (c * thdd - s * omega * omega);
         // The cylinder's axis xc = x1 + R (1 + cos)/sin: d/dtheta = -R/(1 - cos),
         // d2/dtheta2 = R sin/(1 - cos)^2.
         let axc = x1dd - r / (1.0 - c) * thdd + r * s / (1.0 - c).powi(2) * omega * omega;
@@ -167,7 +201,9 @@ fn the_cylinder_forces_balance_each_body_by_hand() {
             (m1 * ax + n * s) / (m1 * g),
             (m1 * ay - (n * c + floor - m1 * g)) / (m1 * g),
             (inertia * thdd - ((d - 0.5 * ell) * n - 0.5 * ell * c * floor)) / (m1 * g * ell),
-            (m2 * axc - push) / (m1 * g),
+            (m2 * xcdd - n * s) / (m1 * g),
+            (xcdd - axc) / g,
+            y1dd / g,
         ];
         for (i, res) in residuals.iter().enumerate() {
             assert!(
@@ -186,14 +222,14 @@ fn the_spring_forces_balance_each_body_by_hand() {
     let (m1, m2, ell, a, g, k): (f64, f64, f64, f64, f64, f64) = (1.0, 3.0, 1.0, 0.25, 9.81, 50.0);
     let inertia = m1 * ell * ell / 12.0;
     let x2_rest = (ell * ell - a * a).sqrt();
-    for (theta, omega, v1) in [(0.25, 0.0, 0.0), (0.2, -1.1, -0.2), (0.15, -1.6, -0.45)] {
-        let (state, qdd) = state_and_accelerations(&bound, theta, omega, v1);
-        let f = bound.forces_full(&state, &qdd, &[]);
+    for (theta, omega, v1) in [(0.25f64, 0.0, 0.0), (0.2, -1.1, -0.2), (0.15, -1.6, -0.45)] {
+        let tie = |t: f64| (ell * t.cos(), -ell * t.sin());
+        let (state, qdd, f) = state_and_dynamics(&bound, theta, omega, v1, tie);
         let (push, floor) = (f[0], f[1]);
         let (s, c) = (theta.sin(), theta.cos());
-        let (x1, x1dd, thdd) = (state.q[0], qdd[0], qdd[1]);
+        let (x1, x1dd, y1dd, thdd, x2dd) = (state.q[0], qdd[0], qdd[1], qdd[2], qdd[3]);
         let ax = x1dd - 0.5 * ell * (s * thdd + c * omega * omega);
-        let ay = 0.5 * ell * (c * thdd - s * omega * omega);
+        let ay = y1dd + 0.5 * ell * (c * thdd - s * omega * omega);
         // The cube's face x2 = x1 + ell cos(theta), pushed by the tip and pulled by the spring.
         let x2 = x1 + ell * c;
         let ax2 = x1dd - ell * (s * thdd + c * omega * omega);
@@ -202,7 +238,9 @@ fn the_spring_forces_balance_each_body_by_hand() {
             (m1 * ax + push) / (m1 * g),
             (m1 * ay - (floor - m1 * g)) / (m1 * g),
             (inertia * thdd - (0.5 * ell * s * push - 0.5 * ell * c * floor)) / (m1 * g * ell),
-            (m2 * ax2 - (push - k * (x2 - x2_rest))) / (m1 * g),
+            (m2 * x2dd - (push - k * (x2 - x2_rest))) / (m1 * g),
+            (x2dd - ax2) / g,
+            y1dd / g,
         ];
         for (i, res) in residuals.iter().enumerate() {
             assert!(
@@ -236,34 +274,73 @@ fn the_cylinder_runs_off_the_rods_end_where_r_cot_half_theta_is_ell() {
     }
 }
 
+/// A rod released steeply on a small cylinder leaves it at once, and meets it again lower down.
+///
+/// By hand: released from rest without the cylinder, the rod's centre falls straight down
+/// (`x1'' = (ell/2) sin(th0) theta''`), so the point of the rod at the tangent distance
+/// `d = R (1 + cos)/sin` from the foot accelerates along the rod's normal towards the cylinder
+/// by `theta'' ((ell/2) sin^2 - d)`, away from it (`theta'' < 0`) when `(ell/2) sin^2 > d`: the
+/// push would have to pull, so the contact opens at release. The rod then falls alone (energy:
+/// `theta'^2 (1 + 3 cos^2) = 12 (g/ell) (sin th0 - sin)`, its centre's abscissa fixed) past the
+/// cylinder at rest, until the gap `xc - x1 - R (1 + cos)/sin` closes again: the bodies meet
+/// there, which ends the motion (impacts are not modelled).
 #[test]
-fn a_short_rod_on_a_small_cylinder_separates_by_force_first() {
-    // A heavy cylinder and a rod released steeply: the push vanishes before the tangent point
-    // reaches the end (the classic separation), and the cause says so.
+fn a_steep_rod_on_a_small_cylinder_leaves_it_at_release_and_meets_it_again() {
+    let (ell, r, th0, g) = (1.0f64, 0.05f64, 1.4f64, 9.81);
     let params = [
         ("m1", 1.0),
         ("m2", 1.0),
-        ("ell", 1.0),
-        ("R", 0.05),
-        ("th0", 1.4),
-        ("g", 9.81),
+        ("ell", ell),
+        ("R", r),
+        ("th0", th0),
+        ("g", g),
     ];
-    let r = ask(
+    let (s0, c0) = th0.sin_cos();
+    assert!(0.5 * ell * s0 * s0 > r * (1.0 + c0) / s0);
+    let got = ask(
         "rod_cylinder",
         &params,
         &[Quantity::ContactEnd, Quantity::FloorImpact],
         Route::Fastest,
     );
-    let cause = &r.labels["contact_end_cause"].value;
-    let theta = value(&r, "contact_end_angle");
-    println!("rod_cylinder R = 0.05, th0 = 1.4: the contact ends by {cause} at {theta}");
-    if cause == "force" {
-        assert!(theta > 2.0 * 0.05f64.atan());
-        assert!(value(&r, "floor_impact_time") > value(&r, "contact_end_time"));
-        assert_eq!(r.work.phases, vec!["rod_cylinder", "rod_cylinder_free"]);
-    } else {
-        assert!((theta - 2.0 * 0.05f64.atan()).abs() < 1e-12);
+    assert_eq!(got.labels["contact_end_cause"].value, "force");
+    assert_eq!(value(&got, "contact_end_time"), 0.0);
+    assert_eq!(value(&got, "contact_end_angle"), th0);
+    // Only the rod alone on the floor runs (on the fast path), until it meets the cylinder.
+    assert_eq!(got.work.phases, vec!["rod_cylinder_free"]);
+    assert_eq!(got.labels["floor_normal_end_cause"].value, "contact");
+    assert!(
+        got.notes["floor_impact"].contains("the bodies meet"),
+        "{:?}",
+        got.notes
+    );
+    // Where the gap closes again, by bisection (it is positive just below th0, negative near
+    // the floor).
+    let gap =
+        |t: f64| r * (1.0 + c0) / s0 - 0.5 * ell * (c0 - t.cos()) - r * (1.0 + t.cos()) / t.sin();
+    let (mut lo, mut hi) = (0.05, 1.3);
+    assert!(gap(lo) < 0.0 && gap(hi) > 0.0);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if gap(mid) < 0.0 { lo = mid } else { hi = mid }
     }
+    let meet = 0.5 * (lo + hi);
+    // The time to fall there, with theta = th0 - u^2 (the integrand is smooth in u).
+    let rate = |u: f64| {
+        let t = th0 - u * u;
+        (12.0 * g / ell * common::hand::sin_drop(th0, t) / (1.0 + 3.0 * t.cos().powi(2))).sqrt()
+    };
+    let time =
+        common::hand::Gauss::new(20).integrate(|u| 2.0 * u / rate(u), 0.0, (th0 - meet).sqrt(), 16);
+    let (angle, t) = (
+        value(&got, "floor_normal_end_angle"),
+        value(&got, "floor_normal_end_time"),
+    );
+    println!(
+        "rod_cylinder R = {r}, th0 = {th0}: meets the cylinder at {t:.15} s, {angle:.15} rad (by hand {time:.15}, {meet:.15})"
+    );
+    assert!(((angle - meet) / meet).abs() < 1e-10, "{angle} vs {meet}");
+    assert!(((t - time) / time).abs() < 1e-10, "{t} vs {time}");
 }
 
 #[test]
@@ -295,9 +372,18 @@ fn a_hinged_rod_on_a_cylinder_takes_the_fast_path_to_its_edge() {
     // One coordinate left after the tie: the fast path applies although the push's zero is no
     // polynomial root (it is looked for numerically) and the contact has an edge (a root in
     // the angle). The integrated route, sharing no code with it, agrees.
-    let info = model("hinged_cylinder").info();
-    let layout = info.reduction.expect("hinged_cylinder has a fast path");
-    assert!(!layout.polynomial_separation && info.contact.is_some_and(|c| c.edge));
+    let system = model("hinged_cylinder").info();
+    let release = system
+        .phases
+        .iter()
+        .find(|p| p.release)
+        .expect("a release phase");
+    assert_eq!(release.model, "hinged_cylinder_closed");
+    let info = model("hinged_cylinder_closed").info();
+    let layout = info
+        .reduction
+        .expect("hinged_cylinder_closed has a fast path");
+    assert!(!layout.polynomial_separation() && info.contacts[0].edge && info.contacts[0].closed);
     let want = [Quantity::ContactEnd, Quantity::SeparationAngle];
     for (r, th0) in [(0.2, 0.9), (0.05, 1.4)] {
         let params = [

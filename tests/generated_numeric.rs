@@ -1,9 +1,11 @@
 //! The generated model code (`generated/*.rs`, no Symbolica) against the paper's formulas typed
-//! in by hand, at 1,000 random parameter points each: rod_cube's eq (5), (9), corrected (12),
-//! (14), (16), (18) and (22), its tip on the ellipse of eq (21); the hinged rod and the ladder on
-//! a wall against their closed forms (PHYSICS.md). Errors are relative to the size of the terms
-//! of each formula, so a formula that crosses zero (the contact force at separation) is judged
-//! by the digits it carries, not by the digits it cancels.
+//! in by hand, at 1,000 random parameter points each: the contact phase of rod_cube
+//! (`rod_cube_closed`) against eq (5), (9), corrected (12), (14), (16), (18) and (22), its tip on
+//! the ellipse of eq (21) and the floor's push with its quartic; the contact phases of the hinged
+//! rod and of the ladder on a wall against their closed forms (PHYSICS.md), the hinge's two
+//! forces and the ladder's floor with theirs. Errors are relative to the size of the terms of
+//! each formula, so a formula that crosses zero (the contact force at separation) is judged by
+//! the digits it carries, not by the digits it cancels.
 
 use rodcube::model::Model;
 use std::collections::BTreeMap;
@@ -111,6 +113,28 @@ fn index(list: &[rodcube::model::NamedInfo], name: &str) -> usize {
         .unwrap_or_else(|| panic!("no {name}"))
 }
 
+fn contact_index(info: &rodcube::model::ModelInfo, name: &str) -> usize {
+    (info.contacts.iter())
+        .position(|c| c.name == name)
+        .unwrap_or_else(|| panic!("no contact {name}"))
+}
+
+/// Contact `contact`'s force polynomial of `model` (its degree from the layout).
+fn force_polynomial(model: &dyn Model, k: &[f64], contact: usize) -> Vec<f64> {
+    let degree = model.info().reduction.unwrap().force_degrees[contact];
+    let mut coef = vec![f64::NAN; degree + 1];
+    model
+        .reduction()
+        .unwrap()
+        .force_polynomial(k, contact, &mut coef);
+    coef
+}
+
+/// `sum c_k s^k`.
+fn horner(c: &[f64], s: f64) -> f64 {
+    c.iter().rev().fold(0.0, |acc, ck| acc * s + ck)
+}
+
 /// The root in (0, hi) of `sum c_k s^k` by bisection to the last bit (one sign change assumed).
 fn root(c: &[f64], hi: f64) -> f64 {
     let p = |s: f64| c.iter().rev().fold(0.0, |acc, ck| acc * s + ck);
@@ -170,13 +194,14 @@ fn state(model: &dyn Model, k: &[f64], t: f64, delta: f64, theta_dot: f64) -> St
 
 #[test]
 fn rod_cube_agrees_with_the_papers_formulas_at_1000_random_points() {
-    let model = find("rod_cube");
+    let model = find("rod_cube_closed");
     let info = model.info();
     assert_eq!(info.coordinates, ["x1", "theta"]);
-    assert_eq!(info.reduction.unwrap().separation_degree, 3);
+    assert_eq!(info.reduction.unwrap().separation_degree(), 3);
+    assert_eq!(info.reduction.unwrap().force_degrees, [3, 4]);
     let (contact, floor) = (
-        index(info.forces, "contact_force"),
-        index(info.forces, "floor_normal"),
+        contact_index(info, "contact_force"),
+        contact_index(info, "floor_normal"),
     );
     let (foot, tip, centre, cube) = (
         index(info.points, "foot"),
@@ -238,7 +263,7 @@ fn rod_cube_agrees_with_the_papers_formulas_at_1000_random_points() {
         worst.check("eq12 theta_ddot", red.theta_ddot, acc, acc_scale, &at);
 
         // Eq (16) and the floor's push N = m1 (g + y_cm'').
-        let mut f = vec![f64::NAN; info.forces.len()];
+        let mut f = vec![f64::NAN; info.contacts.len()];
         model.reduction().unwrap().forces(&k, delta, &mut f);
         let bracket = 8.0 * r * (1.0 + n) - 12.0 * (1.0 + n) * s + 3.0 * s.powi(3);
         let bracket_scale = 8.0 * r * (1.0 + n) + 12.0 * (1.0 + n) * s + 3.0 * s.powi(3);
@@ -249,13 +274,35 @@ fn rod_cube_agrees_with_the_papers_formulas_at_1000_random_points() {
         let normal = m1 * (g + 0.5 * ell * (c * acc - s * w2));
         let normal_scale = m1 * (g + 0.5 * ell * (c * acc_scale + s * w2));
         worst.check("floor_normal", f[floor], normal, normal_scale, &at);
+        // The floor's push as a quartic: N D^2 / (m1 g) with D = 4/3 - mu s^2, mu = 1/(1+n),
+        // from N above and eqs (9), (12) (tests/common/paper.rs), up to a positive factor.
+        let mu = 1.0 / (1.0 + n);
+        let quartic = [
+            4.0 / 9.0,
+            2.0 * mu * r - 8.0 * r / 3.0,
+            4.0 - 11.0 * mu / 3.0,
+            0.0,
+            mu * mu - mu,
+        ];
+        let floor_coef = force_polynomial(model, &k, floor);
+        let factor = floor_coef[0] / quartic[0];
+        assert!(factor > 0.0, "{at}: {floor_coef:?}");
+        for (j, (got, want)) in floor_coef.iter().zip(quartic).enumerate() {
+            let name = ["floor c0", "floor c1", "floor c2", "floor c3", "floor c4"][j];
+            worst.check(name, got / factor, want, 4.0, &at);
+        }
+        let quartic_scale: f64 = quartic.iter().map(|q| q.abs()).sum();
+        worst.check(
+            "floor quartic",
+            horner(&quartic, s),
+            normal * dd * dd / (m1 * g),
+            quartic_scale,
+            &at,
+        );
 
         // Eq (14): compare the polynomial up to scale (divided by 1+n) and its root in (0, r).
-        let mut coef = vec![f64::NAN; 4];
-        model
-            .reduction()
-            .unwrap()
-            .separation_polynomial(&k, &mut coef);
+        let coef = force_polynomial(model, &k, contact);
+        assert_eq!(coef.len(), 4);
         let eq14 = [8.0 * r, -12.0, 0.0, 3.0 / (1.0 + n)];
         let scale = coef[1] / eq14[1];
         for (j, (got, want)) in coef.iter().zip(eq14).enumerate() {
@@ -316,6 +363,22 @@ fn rod_cube_agrees_with_the_papers_formulas_at_1000_random_points() {
         );
         worst.check("centre y", st.pos[centre][1], 0.5 * ell * s, ell, &at);
         worst.check("cube x", st.pos[cube][0], x2, x2, &at);
+        // The system's state this phase stands for: the foot on the floor, the cube's face at
+        // the tip (eq 22), moving with it.
+        let (mut q_full, mut qd_full) = (vec![f64::NAN; 4], vec![f64::NAN; 4]);
+        model.to_full(&k, &st.q, &st.qd, &mut q_full, &mut qd_full);
+        assert_eq!(
+            (q_full[0], q_full[1], q_full[2]),
+            (st.q[0], 0.0, st.q[1]),
+            "{at}"
+        );
+        assert_eq!(
+            (qd_full[0], qd_full[1], qd_full[2]),
+            (st.qd[0], 0.0, st.qd[1]),
+            "{at}"
+        );
+        worst.check("to_full x2", q_full[3], x2, x2, &at);
+        worst.check("to_full x2_dot", qd_full[3], x2_dot, x2_dot_scale, &at);
 
         // Energy is that of the start (eq 8) and the horizontal momentum stays zero (eq 4).
         let e0 = m1 * g * a / 2.0 + m2 * g * a / 2.0;
@@ -325,16 +388,16 @@ fn rod_cube_agrees_with_the_papers_formulas_at_1000_random_points() {
         let mom_scale = (m1 + m2) * ell * theta_dot.abs();
         worst.check("eq4 momentum", mom[0], 0.0, mom_scale, &at);
     }
-    worst.assert_within("rod_cube", TOL);
+    worst.assert_within("rod_cube_closed", TOL);
 }
 
 #[test]
 fn rod_cube_keeps_its_digits_at_extreme_mass_ratios() {
     // PHYSICS.md: n from 1e-12 to 1e12 must not lose digits. The contact force once did (its
     // expanded coefficients nearly cancelled, ~n eps relative error: 1.6e-3 at n = 1e12).
-    let model = find("rod_cube");
+    let model = find("rod_cube_closed");
     let info = model.info();
-    let contact = index(info.forces, "contact_force");
+    let contact = contact_index(info, "contact_force");
     let mut worst = Worst::default();
     for e in -12..=12 {
         let n = 10f64.powi(e);
@@ -357,38 +420,37 @@ fn rod_cube_keeps_its_digits_at_extreme_mass_ratios() {
             let (t1, t2) = (-c / dd, r_minus_s * 2.0 * s * c / ((1.0 + n) * dd * dd));
             let acc = 2.0 * g / ell * (t1 + t2);
             worst.check("theta_ddot", red.theta_ddot, acc, acc, &at);
-            let mut f = vec![f64::NAN; info.forces.len()];
+            let mut f = vec![f64::NAN; info.contacts.len()];
             model.reduction().unwrap().forces(&k, delta, &mut f);
             // Eq (16) divided through by (1+n)^2, so that it is exact for any n.
             let cubic = 8.0 * r - 12.0 * s + 3.0 * s.powi(3) / (1.0 + n);
             let den = (4.0 - 3.0 * s * s / (1.0 + n)).powi(2);
             let f16 = -3.0 * g * c * cubic / den * (n * m1 / (1.0 + n));
             worst.check("contact_force", f[contact], f16, f16, &at);
-            let mut coef = [f64::NAN; 4];
-            model
-                .reduction()
-                .unwrap()
-                .separation_polynomial(&k, &mut coef);
+            let coef = force_polynomial(model, &k, contact);
             let eq14 = [8.0 * r, -12.0, 0.0, 3.0 / (1.0 + n)];
             let s_sep = root(&coef, r);
             worst.check("separation root", s_sep, root(&eq14, r), s_sep, &at);
         }
     }
-    worst.assert_within("rod_cube extreme n", TOL);
+    worst.assert_within("rod_cube_closed extreme n", TOL);
 }
 
 #[test]
 fn hinged_rod_agrees_with_its_closed_forms() {
     // theta'^2 = 3 (g/ell) (r - s)/(1 + 3 n s^2); separation 3 n s^3 + 3 s - 2 r = 0;
-    // F = (3/2) m2 g c (3 n s^3 + 3 s - 2 r)/(1 + 3 n s^2)^2.
-    let model = find("hinged_rod");
+    // F = (3/2) m2 g c (3 n s^3 + 3 s - 2 r)/(1 + 3 n s^2)^2. The hinge holds the rod's foot:
+    // Newton for the rod's centre (ell/2)(c, s) gives its two forces.
+    let model = find("hinged_rod_closed");
     let info = model.info();
     assert_eq!(info.coordinates, ["theta"]);
-    assert_eq!(info.reduction.unwrap().separation_degree, 3);
-    let (contact, hinge) = (
-        index(info.forces, "contact_force"),
-        index(info.forces, "hinge_vertical"),
+    assert_eq!(info.reduction.unwrap().separation_degree(), 3);
+    let (contact, horizontal, vertical) = (
+        contact_index(info, "contact_force"),
+        contact_index(info, "hinge_horizontal"),
+        contact_index(info, "hinge_vertical"),
     );
+    assert!(info.contacts[horizontal].bilateral && info.contacts[vertical].bilateral);
     let tip = index(info.points, "tip");
     let mut rng = Rng(0x41_4E_47_45);
     let mut worst = Worst::default();
@@ -416,7 +478,7 @@ fn hinged_rod_agrees_with_its_closed_forms() {
         worst.check("theta_dot_sq", red.theta_dot_sq, w2, w2, &at);
         let acc = 1.5 * g * c / ell * (-den - 6.0 * n * s * r_minus_s) / (den * den);
         worst.check("theta_ddot", red.theta_ddot, acc, acc, &at);
-        let mut f = vec![f64::NAN; info.forces.len()];
+        let mut f = vec![f64::NAN; info.contacts.len()];
         model.reduction().unwrap().forces(&k, delta, &mut f);
         let cubic = 3.0 * n * s.powi(3) + 3.0 * s - 2.0 * r;
         let cubic_scale = 3.0 * n * s.powi(3) + 3.0 * s + 2.0 * r;
@@ -430,12 +492,19 @@ fn hinged_rod_agrees_with_its_closed_forms() {
         );
         let normal = m1 * (g + 0.5 * ell * (c * acc - s * w2));
         let normal_scale = m1 * (g + 0.5 * ell * (c * acc.abs() + s * w2));
-        worst.check("hinge_vertical", f[hinge], normal, normal_scale, &at);
-        let mut coef = vec![f64::NAN; 4];
-        model
-            .reduction()
-            .unwrap()
-            .separation_polynomial(&k, &mut coef);
+        worst.check("hinge_vertical", f[vertical], normal, normal_scale, &at);
+        // m1 x_cm'' = H - F, x_cm'' = -(ell/2)(s theta'' + c theta'^2): the cube pushes back.
+        let along = -0.5 * m1 * ell * (s * acc + c * w2);
+        let along_scale = 0.5 * m1 * ell * (s * acc.abs() + c * w2) + lead * cubic_scale;
+        worst.check(
+            "hinge_horizontal",
+            f[horizontal],
+            along + lead * cubic,
+            along_scale,
+            &at,
+        );
+        let coef = force_polynomial(model, &k, contact);
+        assert_eq!(coef.len(), 4);
         let want = [-2.0 * r, 3.0, 0.0, 3.0 * n];
         let scale = coef[1] / want[1];
         for (j, (got, w)) in coef.iter().zip(want).enumerate() {
@@ -456,19 +525,21 @@ fn hinged_rod_agrees_with_its_closed_forms() {
         let e0 = (m1 + m2) * g * a / 2.0;
         worst.check("energy", model.energy(&k, &st.q, &st.qd), e0, e0, &at);
     }
-    worst.assert_within("hinged_rod", TOL);
+    worst.assert_within("hinged_rod_closed", TOL);
 }
 
 #[test]
 fn wall_ladder_agrees_with_its_closed_forms() {
     // theta'^2 = 3 (g/ell) (r - s), theta'' = -3 g c/(2 ell), F = (3/4) m1 g c (3 s - 2 r):
-    // the ladder leaves the wall at s = 2r/3.
-    let model = find("wall_ladder");
+    // the ladder leaves the wall at s = 2r/3. The floor: N = m1 (g + y_cm''), that is
+    // N / (m1 g) = 1/4 - (3/2) r s + (9/4) s^2.
+    let model = find("wall_ladder_closed");
     let info = model.info();
-    assert_eq!(info.reduction.unwrap().separation_degree, 1);
+    assert_eq!(info.reduction.unwrap().separation_degree(), 1);
+    assert_eq!(info.reduction.unwrap().force_degrees, [1, 2]);
     let (contact, floor) = (
-        index(info.forces, "contact_force"),
-        index(info.forces, "floor_normal"),
+        contact_index(info, "contact_force"),
+        contact_index(info, "floor_normal"),
     );
     let (foot, tip, centre) = (
         index(info.points, "foot"),
@@ -495,7 +566,7 @@ fn wall_ladder_agrees_with_its_closed_forms() {
         worst.check("theta_dot_sq", red.theta_dot_sq, w2, w2, &at);
         let acc = -1.5 * g * c / ell;
         worst.check("theta_ddot", red.theta_ddot, acc, acc, &at);
-        let mut f = vec![f64::NAN; info.forces.len()];
+        let mut f = vec![f64::NAN; info.contacts.len()];
         model.reduction().unwrap().forces(&k, delta, &mut f);
         let push = 0.75 * m1 * g * c * (3.0 * s - 2.0 * r);
         let push_scale = 0.75 * m1 * g * c * (3.0 * s + 2.0 * r);
@@ -503,11 +574,24 @@ fn wall_ladder_agrees_with_its_closed_forms() {
         let normal = m1 * (g + 0.5 * ell * (c * acc - s * w2));
         let normal_scale = m1 * (g + 0.5 * ell * (c * acc.abs() + s * w2));
         worst.check("floor_normal", f[floor], normal, normal_scale, &at);
-        let mut coef = vec![f64::NAN; 2];
-        model
-            .reduction()
-            .unwrap()
-            .separation_polynomial(&k, &mut coef);
+        let quadratic = [0.25, -1.5 * r, 2.25];
+        let quadratic_scale = 0.25 + 1.5 * r * s + 2.25 * s * s;
+        worst.check(
+            "floor quadratic",
+            horner(&quadratic, s),
+            normal / (m1 * g),
+            quadratic_scale,
+            &at,
+        );
+        let floor_coef = force_polynomial(model, &k, floor);
+        let factor = floor_coef[0] / quadratic[0];
+        assert!(factor > 0.0, "{at}: {floor_coef:?}");
+        for (j, (got, want)) in floor_coef.iter().zip(quadratic).enumerate() {
+            let name = ["floor c0", "floor c1", "floor c2"][j];
+            worst.check(name, got / factor, want, 2.25, &at);
+        }
+        let coef = force_polynomial(model, &k, contact);
+        assert_eq!(coef.len(), 2);
         worst.check("separation root", -coef[0] / coef[1], 2.0 * r / 3.0, r, &at);
         let st = state(model, &k, 0.0, delta, -red.theta_dot_sq.sqrt());
         worst.check("foot x", st.pos[foot][0], -ell * c, ell, &at);
@@ -519,13 +603,13 @@ fn wall_ladder_agrees_with_its_closed_forms() {
         let e0 = m1 * g * a / 2.0;
         worst.check("energy", model.energy(&k, &st.q, &st.qd), e0, e0, &at);
     }
-    worst.assert_within("wall_ladder", TOL);
+    worst.assert_within("wall_ladder_closed", TOL);
 }
 
 #[test]
 fn the_comparison_can_fail() {
     // A control: the same check with eq (9)'s 4/3 replaced by 1.3 is far outside the tolerance.
-    let model = find("rod_cube");
+    let model = find("rod_cube_closed");
     let p = params(
         model,
         &[

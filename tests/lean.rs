@@ -1,25 +1,34 @@
 //! The sweep's per-point solver (`rodcube::solve::lean`): it agrees with the hand-typed paper
 //! model (which uses the trait's default `theta_dot_sq_sc` through `reduced`), with fixed rule
 //! pairs and with a much finer setting; its schedule spends fewer
-//! evaluations where short panels allow; and a model that does not fall, turns back or breaks
-//! inside the phase gets a typed error, never a number.
+//! evaluations where short panels allow; it solves a system by its release fast phase and
+//! refuses what is not one phase from release to the separation; and a model that does not
+//! fall, turns back, breaks or lets another contact go inside the phase gets a typed error,
+//! never a number.
 
 mod common;
 
 use common::paper::ROD_CUBE;
 use common::tweaked::{Fault, Tweaked};
-use rodcube::model::Model;
+use rodcube::model::{Model, ModelInfo, Reduced, Reduction, ReductionInfo};
 use rodcube::solve::SolveError;
 use rodcube::solve::lean::LeanSolver;
 use rodcube::solve::prior::PRIOR_MAX_NODES;
 use rodcube::solve::quadrature::{RuleStep, SCHEDULE};
 use rodcube::system::SystemError;
+use std::sync::LazyLock;
 
 /// The paper's case: m1, m2, ell, a, g.
 const PAPER: [f64; 5] = [1.0, 3.0, 1.0, 0.25, 9.81];
 
+/// The paper's system (its general model): the solver takes its release fast phase.
 fn rod_cube() -> &'static dyn Model {
     rodcube::models::find("rod_cube").expect("rod_cube is generated")
+}
+
+/// The system's release fast phase, both contacts closed.
+fn rod_cube_closed() -> &'static dyn Model {
+    rodcube::models::find("rod_cube_closed").expect("rod_cube_closed is generated")
 }
 
 fn rel(a: f64, b: f64) -> f64 {
@@ -29,6 +38,7 @@ fn rel(a: f64, b: f64) -> f64 {
 #[test]
 fn the_papers_point_and_the_hand_typed_model() {
     let mut generated = LeanSolver::new(rod_cube()).unwrap();
+    assert_eq!(generated.model().info().name, "rod_cube_closed");
     let out = generated.solve(&PAPER).unwrap();
     // Section 3 of the paper: 9.61 degrees and 0.108 s (0.108493254 s to the digits shown by
     // `rodcube run`).
@@ -129,7 +139,7 @@ fn a_custom_schedule_is_sorted_and_an_empty_one_is_the_default() {
 }
 
 fn solve_broken(fault: Fault) -> SolveError {
-    let model = Tweaked::with_fault(rod_cube(), fault);
+    let model = Tweaked::with_fault(rod_cube_closed(), fault);
     let mut solver = LeanSolver::new(&model).unwrap();
     match solver.solve(&PAPER) {
         Ok(out) => panic!("{fault:?} solved: {out:?}"),
@@ -162,7 +172,7 @@ fn broken_models_get_typed_errors() {
         e => panic!("{e}"),
     }
     // A control: the same wrapper without a fault in reach solves.
-    let model = Tweaked::with_fault(rod_cube(), Fault::TurnsBack { below: 0.1 });
+    let model = Tweaked::with_fault(rod_cube_closed(), Fault::TurnsBack { below: 0.1 });
     assert!(LeanSolver::new(&model).unwrap().solve(&PAPER).is_ok());
 }
 
@@ -190,10 +200,14 @@ fn bad_parameters_are_refused_by_name_not_as_a_next_phase() {
 
 #[test]
 fn a_polynomial_without_a_sign_change_is_named() {
-    // Masses of 1e-300 kg: the polynomial's coefficients (products of masses) underflow.
+    // Masses of 1e-300 kg: the polynomial's coefficients (products of masses) underflow, and so
+    // does the push at release. The true separation is at sin(theta) = 2r/3 after
+    // (2/3) sqrt(a/g) = 2.1e-151 s (PHYSICS.md's flat-rod limit), which the solver cannot form:
+    // a typed error (the push at release is 0/0), not a separation at release.
     let mut solver = LeanSolver::new(rod_cube()).unwrap();
     match solver.solve(&[1e-300, 1e-300, 1.0, 1e-300, 9.81]) {
         Err(SolveError::NoSeparation { lo, hi, .. }) => assert!(lo < hi),
+        Err(SolveError::NonFinite { value, delta, .. }) => assert!(value.is_nan() && delta == 0.0),
         other => panic!("{other:?}"),
     }
     // A tweaked polynomial that never vanishes (the contact holds to the floor).
@@ -282,7 +296,8 @@ fn a_constant_that_overflows_gets_the_full_preparations_error() {
                 _ => 1.0,
             })
             .collect();
-        let full = rodcube::system::Bound::from_values(model, &p).map(|_| ());
+        // The model the solver solves: a system's release fast phase.
+        let full = rodcube::system::Bound::from_values(solver.model(), &p).map(|_| ());
         match (full, solver.solve(&p)) {
             (Err(want @ SystemError::BadConstant { .. }), Err(SolveError::Parameters(got))) => {
                 assert_eq!(got, want, "{}", info.name);
@@ -323,8 +338,8 @@ fn the_lean_start_is_the_prepared_start_or_nothing() {
             assert!(accepted, "{}: a start for refused {p:?}", info.name);
             let mut k = vec![0.0; info.n_constants];
             model.prepare(&p, &mut k);
-            let mut sep = vec![0.0; layout.separation_degree + 1];
-            red.separation_polynomial(&k, &mut sep);
+            let mut sep = vec![0.0; layout.separation_degree() + 1];
+            red.force_polynomial(&k, 0, &mut sep);
             let mut fall = vec![0.0; layout.fall_degree.unwrap() + 1];
             red.fall_polynomial(&k, &mut fall);
             assert_eq!(start.sin_initial, k[layout.k_sin_initial], "{}", info.name);
@@ -335,6 +350,17 @@ fn the_lean_start_is_the_prepared_start_or_nothing() {
             assert!(start.separation[sep.len()..].iter().all(|&c| c == 0.0));
             assert_eq!(start.fall[..fall.len()], fall[..], "{}", info.name);
             assert!(start.fall[fall.len()..].iter().all(|&c| c == 0.0));
+            // Every other closed unilateral contact's force polynomial, in order.
+            let others: Vec<usize> = (1..info.contacts.len())
+                .filter(|&i| !info.contacts[i].bilateral)
+                .collect();
+            assert_eq!(start.n_others, others.len(), "{}", info.name);
+            for (row, &i) in start.others.iter().zip(&others) {
+                let mut poly = vec![0.0; layout.force_degrees[i] + 1];
+                red.force_polynomial(&k, i, &mut poly);
+                assert_eq!(row[..poly.len()], poly[..], "{} contact {i}", info.name);
+                assert!(row[poly.len()..].iter().all(|&c| c == 0.0));
+            }
             served += 1;
             // What the quick test cannot pass: a value not positive and finite, a wrong count.
             for bad in [f64::NAN, f64::INFINITY, 0.0, -1.0] {
@@ -356,6 +382,202 @@ fn the_lean_start_is_the_prepared_start_or_nothing() {
             }
         }
     }
-    // rod_cube, hinged_rod, loaded_rod and wall_ladder at least, at two points each.
+    // rod_cube_closed, hinged_rod_closed, loaded_rod_closed and wall_ladder_closed at least, at
+    // two points each.
     assert!(served >= 8, "only {served} starts were formed");
+}
+
+#[test]
+fn a_system_is_solved_by_its_release_phase_and_other_phases_are_refused() {
+    // The system and its release phase give the same numbers to the bit.
+    let mut system = LeanSolver::new(rod_cube()).unwrap();
+    let mut phase = LeanSolver::new(rod_cube_closed()).unwrap();
+    assert_eq!(phase.model().info().name, "rod_cube_closed");
+    for p in [
+        PAPER,
+        [1.0, 1e-3, 1.0, 0.9, 9.81],
+        [1.0, 1e3, 2.0, 0.1, 1.0],
+    ] {
+        assert_eq!(system.solve(&p).unwrap(), phase.solve(&p).unwrap(), "{p:?}");
+    }
+    // A phase that leaves the tip open has no separation of its own to find.
+    let free = rodcube::models::find("rod_cube_free").expect("rod_cube_free is generated");
+    match LeanSolver::new(free) {
+        Err(SolveError::NotPerPoint { model, why }) => {
+            assert_eq!(model, "rod_cube_free");
+            assert!(why.contains("contact"), "{why}");
+        }
+        other => panic!("{other:?}"),
+    }
+    // A system without a fast phase from release (the ladder with friction, integrated).
+    let ladder = rodcube::models::find("ladder_friction").expect("generated model");
+    match LeanSolver::new(ladder) {
+        Err(SolveError::NotPerPoint { model, why }) => {
+            assert_eq!(model, "ladder_friction");
+            assert!(why.contains("release"), "{why}");
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+/// `rod_cube_closed` (hand-typed) whose floor normal force is replaced by `m1 g P(sin theta)`
+/// with the linear polynomial `P`: a floor that lets the foot go where `P` vanishes.
+struct FloorLetsGo {
+    /// `P`'s coefficients, lowest degree first.
+    floor: [f64; 2],
+    info: &'static ModelInfo,
+}
+
+/// `rod_cube_closed`'s description with the floor's force polynomial of degree 1.
+static FLOOR_INFO: LazyLock<ModelInfo> = LazyLock::new(|| {
+    let base = ROD_CUBE.info();
+    ModelInfo {
+        reduction: base.reduction.map(|r| ReductionInfo {
+            force_degrees: &[3, 1],
+            ..r
+        }),
+        ..*base
+    }
+});
+
+impl FloorLetsGo {
+    fn new(floor: [f64; 2]) -> FloorLetsGo {
+        FloorLetsGo {
+            floor,
+            info: &FLOOR_INFO,
+        }
+    }
+
+    fn floor_force(&self, k: &[f64], s: f64) -> f64 {
+        k[0] * k[4] * (self.floor[0] + self.floor[1] * s)
+    }
+}
+
+impl Model for FloorLetsGo {
+    fn info(&self) -> &'static ModelInfo {
+        self.info
+    }
+    fn requirements(&self, p: &[f64], out: &mut [f64]) {
+        ROD_CUBE.requirements(p, out)
+    }
+    fn prepare(&self, p: &[f64], k: &mut [f64]) {
+        ROD_CUBE.prepare(p, k)
+    }
+    fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
+        ROD_CUBE.initial_state(k, q, qd)
+    }
+    fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
+        ROD_CUBE.points(k, q, qd, pos, vel)
+    }
+    fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
+        ROD_CUBE.energy(k, q, qd)
+    }
+    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        ROD_CUBE.momenta(k, q, qd, out)
+    }
+    fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
+        ROD_CUBE.equations(k, q, qd, mass, rhs)
+    }
+    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+        ROD_CUBE.forces_full(k, q, qd, qdd, out);
+        out[1] = self.floor_force(k, q[1].sin());
+    }
+    fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
+        ROD_CUBE.gaps(k, q, out)
+    }
+    fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        ROD_CUBE.constraints(k, q, qd, jac, bias)
+    }
+    fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
+        ROD_CUBE.edges(k, q, out)
+    }
+    fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        ROD_CUBE.friction(k, q, qd, jac, bias)
+    }
+    fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], f: &[f64], out: &mut [f64]) {
+        ROD_CUBE.monitors_full(k, q, qd, f, out)
+    }
+    fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
+        ROD_CUBE.to_full(k, q, qd, q_full, qd_full)
+    }
+    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
+        ROD_CUBE.drawing(k, q, poses, sizes)
+    }
+    fn reduction(&self) -> Option<&dyn Reduction> {
+        Some(self)
+    }
+}
+
+impl Reduction for FloorLetsGo {
+    fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
+        ROD_CUBE.reduced(k, delta)
+    }
+    fn theta_dot_sq_sc(&self, k: &[f64], s: f64, c: f64, ds: f64, dc: f64) -> f64 {
+        ROD_CUBE.theta_dot_sq_sc(k, s, c, ds, dc)
+    }
+    fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
+        ROD_CUBE.forces(k, delta, out);
+        out[1] = self.floor_force(k, ROD_CUBE.reduced(k, delta).sin);
+    }
+    fn force_polynomial(&self, k: &[f64], contact: usize, out: &mut [f64]) {
+        match contact {
+            1 => out.copy_from_slice(&self.floor),
+            _ => ROD_CUBE.force_polynomial(k, contact, out),
+        }
+    }
+    fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
+        ROD_CUBE.fall_polynomial(k, out)
+    }
+    fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        ROD_CUBE.prepare_lean(p, k)
+    }
+    fn full_state(
+        &self,
+        k: &[f64],
+        t: f64,
+        delta: f64,
+        theta_dot: f64,
+        q: &mut [f64],
+        qd: &mut [f64],
+    ) {
+        ROD_CUBE.full_state(k, t, delta, theta_dot, q, qd)
+    }
+}
+
+#[test]
+fn another_contact_that_lets_go_first_is_not_this_phase() {
+    // The paper's phase runs from sin(theta) = 0.25 down to the separation at 0.167.
+    let mut solver = LeanSolver::new(&ROD_CUBE).unwrap();
+    let paper = solver.solve(&PAPER).unwrap();
+    assert!((paper.separation_angle.sin() - 0.167).abs() < 1e-3);
+    // A floor that lets go at sin(theta) = 0.1, after the separation: the same answer.
+    let after = FloorLetsGo::new([-0.1, 1.0]);
+    let out = LeanSolver::new(&after).unwrap().solve(&PAPER).unwrap();
+    assert_eq!(out, paper);
+    // At sin(theta) = 0.2, before it: the phase the solver solves ends with the foot lifting.
+    let before = FloorLetsGo::new([-0.2, 1.0]);
+    match LeanSolver::new(&before).unwrap().solve(&PAPER) {
+        Err(SolveError::NotThisPhase {
+            model,
+            contact,
+            why,
+        }) => {
+            assert_eq!((model, contact), ("rod_cube_closed", "floor_normal"));
+            assert!(why.contains("before the separation"), "{why}");
+        }
+        other => panic!("{other:?}"),
+    }
+    // A floor that would have to pull from the start (P < 0 on the whole phase).
+    let pulls = FloorLetsGo::new([-1.0, 1.0]);
+    match LeanSolver::new(&pulls).unwrap().solve(&PAPER) {
+        Err(SolveError::NotThisPhase {
+            model,
+            contact,
+            why,
+        }) => {
+            assert_eq!((model, contact), ("rod_cube_closed", "floor_normal"));
+            assert!(why.contains("pull"), "{why}");
+        }
+        other => panic!("{other:?}"),
+    }
 }

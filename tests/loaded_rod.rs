@@ -1,8 +1,10 @@
-//! The sixth model, added as one spec (`derivations/loaded_rod.yaml`, whose free phase
-//! `loaded_rod_free` is derived from it) and one `rodcube derive`, with no Rust edited: the paper's rod with a
-//! point load `m3` at its upper end. Its generated code agrees with a hand computation at 1,000
-//! random points, becomes `rod_cube` as m3 -> 0, conserves energy and momentum along its reduced
-//! motion, separates inside (0, theta_i), and runs end to end through the `rodcube` binary.
+//! The sixth system, added as one spec (`derivations/loaded_rod.yaml`, whose general model
+//! `loaded_rod` and fast phases `loaded_rod_closed` and `loaded_rod_free` are derived from it)
+//! and one `rodcube derive`, with no Rust edited: the paper's rod with a point load `m3` at its
+//! upper end. Its contact phase's generated code agrees with a hand computation at 1,000 random
+//! points, becomes the paper's (`rod_cube_closed`) as m3 -> 0, conserves energy and momentum
+//! along its reduced motion, separates inside (0, theta_i), and the system runs end to end
+//! through the `rodcube` binary.
 //!
 //! By hand, with M = m1+m2+m3, h = m1/2+m3, P = m1/3+m3, K = ((m1/2+m3)^2 + m2 m3)/M: zero
 //! horizontal momentum leaves the reduced inertia ell^2 (P - K s^2), so
@@ -45,6 +47,12 @@ fn index(list: &[rodcube::model::NamedInfo], name: &str) -> usize {
         .unwrap_or_else(|| panic!("no {name}"))
 }
 
+fn contact_index(info: &rodcube::model::ModelInfo, name: &str) -> usize {
+    (info.contacts.iter())
+        .position(|c| c.name == name)
+        .unwrap_or_else(|| panic!("no contact {name}"))
+}
+
 #[derive(Clone, Copy, Debug)]
 struct Params {
     m1: f64,
@@ -68,7 +76,7 @@ impl Params {
             g: rng.uniform(1.0, 30.0),
         }
     }
-    /// The parameter vector of `model`, by name (`rod_cube` ignores m3).
+    /// The parameter vector of `model`, by name (`rod_cube_closed` ignores m3).
     fn vector(&self, model: &dyn Model) -> Vec<f64> {
         model
             .info()
@@ -146,34 +154,74 @@ fn points(model: &dyn Model, k: &[f64], q: &[f64], qd: &[f64]) -> Vec<[f64; 2]> 
 }
 
 #[test]
-fn it_is_registered_with_its_free_phase() {
-    let model = find("loaded_rod");
-    let info = model.info();
-    assert_eq!(info.spec, "derivations/loaded_rod.yaml");
-    let names: Vec<&str> = info.parameters.iter().map(|p| p.name).collect();
+fn it_is_registered_with_its_phases() {
+    let system = find("loaded_rod").info();
+    assert!(system.is_general());
+    assert_eq!(system.spec, "derivations/loaded_rod.yaml");
+    assert_eq!(system.coordinates, ["x1", "y1", "theta", "x2"]);
+    assert!(system.reduction.is_none());
+    let names: Vec<&str> = system.parameters.iter().map(|p| p.name).collect();
     assert_eq!(names, ["m1", "m2", "m3", "ell", "a", "g"]);
+    let contacts: Vec<(&str, Option<&str>)> = (system.contacts.iter())
+        .map(|c| (c.name, c.eliminates))
+        .collect();
+    assert_eq!(
+        contacts,
+        [("contact_force", Some("x2")), ("floor_normal", Some("y1"))]
+    );
+    // The contact phase: both contacts closed, from the release state.
+    let info = find("loaded_rod_closed").info();
+    assert_eq!((info.system, info.spec), ("loaded_rod", system.spec));
+    assert_eq!(info.parameters, system.parameters);
     assert_eq!(info.coordinates, ["x1", "theta"]);
     assert_eq!(info.cyclic, [0]);
-    assert_eq!(info.reduction.unwrap().separation_degree, 3);
+    assert_eq!(info.reduction.unwrap().separation_degree(), 3);
     assert_eq!(info.points[info.falling_point].name, "mass_centre");
-    let contact = info.contact.expect("a contact");
-    assert_eq!(info.forces[contact.force].name, "contact_force");
-    assert_eq!(contact.eliminated, "x2");
-    let next = info.next_phase.expect("a free phase");
-    assert_eq!(next.model, "loaded_rod_free");
+    assert!(info.contacts.iter().all(|c| c.closed));
+    // The free phase: the tip open, starting from the state it is handed.
+    let free = find("loaded_rod_free").info();
+    assert_eq!(free.coordinates, ["x1", "theta", "x2"]);
+    assert!(free.start_params && !free.contacts[0].closed && free.contacts[1].closed);
+    let free_names: Vec<&str> = free.parameters.iter().map(|p| p.name).collect();
     assert_eq!(
-        next.bindings.len(),
-        find("loaded_rod_free").info().parameters.len()
+        free_names,
+        [
+            "m1",
+            "m2",
+            "m3",
+            "ell",
+            "a",
+            "g",
+            "x1_0",
+            "theta_0",
+            "x2_0",
+            "x1_dot_0",
+            "theta_dot_0",
+            "x2_dot_0"
+        ]
     );
+    // Every model of the system lists the same phases.
+    let phases: Vec<(&[usize], &str, bool)> = (system.phases.iter())
+        .map(|p| (p.closed, p.model, p.release))
+        .collect();
+    assert_eq!(
+        phases,
+        [
+            (&[0, 1][..], "loaded_rod_closed", true),
+            (&[1][..], "loaded_rod_free", false)
+        ]
+    );
+    assert_eq!(info.phases, system.phases);
+    assert_eq!(free.phases, system.phases);
 }
 
 #[test]
 fn it_agrees_with_the_hand_computation_at_1000_random_points() {
-    let model = find("loaded_rod");
+    let model = find("loaded_rod_closed");
     let info = model.info();
     let (contact, floor) = (
-        index(info.forces, "contact_force"),
-        index(info.forces, "floor_normal"),
+        contact_index(info, "contact_force"),
+        contact_index(info, "floor_normal"),
     );
     let (tip, centre) = (index(info.points, "tip"), index(info.points, "mass_centre"));
     let mut rng = Rng(0x10AD);
@@ -205,7 +253,7 @@ fn it_agrees_with_the_hand_computation_at_1000_random_points() {
         let lead = g * h * c / (ell * inertia * inertia);
         let acc = lead * (t1 + t2);
         worst[1] = worst[1].max(rel(red.theta_ddot, acc, lead * (t1.abs() + t2.abs())));
-        let mut f = vec![f64::NAN; info.forces.len()];
+        let mut f = vec![f64::NAN; info.contacts.len()];
         model.reduction().unwrap().forces(&k, delta, &mut f);
         let cubic = kk * s.powi(3) - 3.0 * pp * s + 2.0 * pp * r;
         let cubic_scale = kk * s.powi(3) + 3.0 * pp * s + 2.0 * pp * r;
@@ -220,7 +268,7 @@ fn it_agrees_with_the_hand_computation_at_1000_random_points() {
         model
             .reduction()
             .unwrap()
-            .separation_polynomial(&k, &mut coef);
+            .force_polynomial(&k, contact, &mut coef);
         let want = [2.0 * r, -3.0, 0.0, kk / pp];
         let scale = coef[1] / want[1];
         for (got, w) in coef.iter().zip(want) {
@@ -264,10 +312,11 @@ fn it_agrees_with_the_hand_computation_at_1000_random_points() {
 
 #[test]
 fn a_vanishing_load_gives_the_papers_rod() {
-    let (loaded, paper) = (find("loaded_rod"), find("rod_cube"));
+    let (loaded, paper) = (find("loaded_rod_closed"), find("rod_cube_closed"));
     let info = loaded.info();
-    let forces = info.forces.len();
-    assert_eq!(forces, paper.info().forces.len());
+    let forces = info.contacts.len();
+    let names = |m: &dyn Model| m.info().contacts.iter().map(|c| c.name).collect::<Vec<_>>();
+    assert_eq!(names(loaded), names(paper));
     let mut rng = Rng(0xF1A7);
     let mut worst = 0.0f64;
     for _ in 0..200 {
@@ -294,11 +343,8 @@ fn a_vanishing_load_gives_the_papers_rod() {
         loaded
             .reduction()
             .unwrap()
-            .separation_polynomial(&kl, &mut cl);
-        paper
-            .reduction()
-            .unwrap()
-            .separation_polynomial(&kp, &mut cp);
+            .force_polynomial(&kl, 0, &mut cl);
+        paper.reduction().unwrap().force_polynomial(&kp, 0, &mut cp);
         let r = p.a / p.ell;
         let s_sep = root(&cp, r);
         worst = worst.max(rel(root(&cl, r), s_sep, s_sep));
@@ -319,13 +365,13 @@ fn a_vanishing_load_gives_the_papers_rod() {
             }
         }
     }
-    println!("loaded_rod with m3 = 1e-14 m1 vs rod_cube: max error {worst:.3e}");
+    println!("loaded_rod_closed with m3 = 1e-14 m1 vs rod_cube_closed: max error {worst:.3e}");
     assert!(worst <= TOL, "{worst:e}");
 }
 
 #[test]
 fn energy_and_momentum_are_conserved_along_the_reduced_motion() {
-    let model = find("loaded_rod");
+    let model = find("loaded_rod_closed");
     let mut rng = Rng(0xE4E7);
     let mut worst = 0.0f64;
     for _ in 0..50 {
@@ -352,9 +398,9 @@ fn energy_and_momentum_are_conserved_along_the_reduced_motion() {
 
 #[test]
 fn it_separates_between_the_start_and_the_floor() {
-    let model = find("loaded_rod");
+    let model = find("loaded_rod_closed");
     let info = model.info();
-    let contact = index(info.forces, "contact_force");
+    let contact = contact_index(info, "contact_force");
     let mut rng = Rng(0x5E9A);
     for _ in 0..200 {
         let p = Params::random(&mut rng, (1e-3, 1e3));
@@ -364,12 +410,12 @@ fn it_separates_between_the_start_and_the_floor() {
         model
             .reduction()
             .unwrap()
-            .separation_polynomial(&k, &mut coef);
+            .force_polynomial(&k, contact, &mut coef);
         let theta_sep = root(&coef, p.a / p.ell).asin();
         assert!(theta_sep > 0.0 && theta_sep < theta_i, "{p:?}: {theta_sep}");
         // The contact force pushes before separation and would pull after it.
         let force = |theta: f64| {
-            let mut f = vec![0.0; info.forces.len()];
+            let mut f = vec![0.0; info.contacts.len()];
             model
                 .reduction()
                 .unwrap()
@@ -394,13 +440,13 @@ fn it_separates_between_the_start_and_the_floor() {
     model
         .reduction()
         .unwrap()
-        .separation_polynomial(&k, &mut coef);
+        .force_polynomial(&k, contact, &mut coef);
     let loaded = root(&coef, 0.25).asin();
-    let bare = find("rod_cube");
+    let bare = find("rod_cube_closed");
     let kb = prepare(bare, &p);
     bare.reduction()
         .unwrap()
-        .separation_polynomial(&kb, &mut coef);
+        .force_polynomial(&kb, 0, &mut coef);
     let paper = root(&coef, 0.25).asin();
     assert!(
         (paper.to_degrees() - 9.61).abs() < 0.005,
@@ -444,6 +490,7 @@ fn the_binary_runs_a_loaded_rod_scene_end_to_end() {
     for (name, c) in checks {
         assert_eq!(c["passed"], true, "check {name} failed: {c}");
     }
+    assert_eq!(v["work"]["phases"][0], "loaded_rod_closed");
     assert_eq!(v["work"]["phases"][1], "loaded_rod_free");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -312,7 +312,7 @@ fn the_bodies_are_where_results_json_says() {
             .parse()
             .unwrap_or_else(|_| panic!("time label {time:?}"));
         assert!((value - t).abs() <= 0.002, "{time} at {t} s");
-        assert_eq!(label(&shown, "phase"), "phase 1 of 2: rod_cube");
+        assert_eq!(label(&shown, "phase"), "phase 1 of 2: rod_cube_closed");
         assert!(shown["contact_end"].as_array().unwrap().is_empty());
         seen.push((x, y, th));
     }

@@ -73,7 +73,8 @@ fn a_non_finite_derivative_is_reported_with_the_state() {
 }
 
 fn paper_system() -> System<'static> {
-    let model = rodcube::models::find("rod_cube").expect("rod_cube is generated");
+    // The paper's contact phase: the fast phase of `rod_cube` with both contacts closed.
+    let model = rodcube::models::find("rod_cube_closed").expect("rod_cube_closed is generated");
     let params = [
         ("m1", 1.0),
         ("m2", 3.0),

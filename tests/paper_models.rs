@@ -1,11 +1,13 @@
 //! The hand-typed test models are self-consistent: their reduced functions, unreduced
-//! equations, reaction forces and energy agree, so the solver tests built on them mean something.
+//! equations, reaction forces and energy agree, and the general model `rod_cube` with its
+//! contacts as constraints moves as each fast phase does, so the solver tests built on them
+//! mean something.
 
 mod common;
 
-use common::paper::{FREE_ROD, ROD_CUBE, paper, ratios};
-use rodcube::solve::unreduced::accelerations;
-use rodcube::system::System;
+use common::paper::{FREE_ROD, GENERAL, ROD_CUBE, paper, ratios};
+use rodcube::solve::contacts::{self, Active};
+use rodcube::system::{Bound, State, System};
 
 fn close(a: f64, b: f64, rel: f64) -> bool {
     (a - b).abs() <= rel * a.abs().max(b.abs()).max(1e-300)
@@ -21,14 +23,18 @@ fn check_consistency(sys: &System, delta_end: f64) {
         let red = sys.reduced(delta);
         let theta_dot = -red.theta_dot_sq.sqrt();
         let state = sys.full_state(0.1, delta, theta_dot);
-        let qdd = accelerations(sys, &state, 0.0).unwrap();
+        let active = Active::of_model(sys.info());
+        let qdd = contacts::dynamics(sys.bound(), &state, &active, 0.0)
+            .unwrap()
+            .qdd;
+        let theta = sys.info().reduced;
         assert!(
-            close(qdd[1], red.theta_ddot, 1e-12),
+            close(qdd[theta], red.theta_ddot, 1e-12),
             "theta'' {} vs {}",
-            qdd[1],
+            qdd[theta],
             red.theta_ddot
         );
-        let f_full = sys.forces_full(&state, &qdd, &[]);
+        let f_full = sys.forces_full(&state, &qdd);
         let f_red = sys.forces(delta);
         let f_scale = f_red.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         for (a, b) in f_full.iter().zip(&f_red) {
@@ -57,11 +63,112 @@ fn check_consistency(sys: &System, delta_end: f64) {
     }
 }
 
+/// The general model along a fast phase's motion, with that phase's contacts `closed` as
+/// constraint rows: the same state (points, energy, total horizontal momentum), its closed gaps
+/// and their rates zero, its Jacobian and bias the derivatives of its gaps (central
+/// differences), and the same `theta''` and contact forces from the constrained equations.
+fn check_general(sys: &System, closed: [bool; 2], delta_end: f64) {
+    let general = Bound::from_values(&GENERAL, &sys.bound().p()[..5]).unwrap();
+    let n = 4;
+    let active = Active {
+        closed: closed.to_vec(),
+        modes: vec![],
+    };
+    for i in 0..=20 {
+        let delta = delta_end * i as f64 / 20.0;
+        let red = sys.reduced(delta);
+        let theta_dot = -red.theta_dot_sq.max(0.0).sqrt();
+        let state = sys.full_state(0.1, delta, theta_dot);
+        let full = sys.to_full(&state);
+        // The same bodies at the same places.
+        let (a, b) = (sys.points(&state), general.points(&full));
+        for (p, q) in a.pos.iter().chain(&a.vel).zip(b.pos.iter().chain(&b.vel)) {
+            assert!(
+                (p[0] - q[0]).abs() < 1e-15 && (p[1] - q[1]).abs() < 1e-15,
+                "{p:?} vs {q:?}"
+            );
+        }
+        let (e, e_general) = (sys.energy(&state), general.energy(&full));
+        assert!(close(e, e_general, 1e-14), "energy {e} vs {e_general}");
+        let total = |p: Vec<f64>| p.iter().sum::<f64>();
+        let (p, p_general) = (total(sys.momenta(&state)), total(general.momenta(&full)));
+        assert!((p - p_general).abs() < 1e-14, "momentum {p} vs {p_general}");
+        // Gaps, their Jacobian and bias.
+        let gaps = general.gaps(&full);
+        let (jac, bias) = general.constraints(&full);
+        for c in 0..2 {
+            let row = &jac[c * n..(c + 1) * n];
+            let rate: f64 = row.iter().zip(&full.qd).map(|(j, v)| j * v).sum();
+            if closed[c] {
+                assert!(gaps[c].abs() < 1e-15, "gap {c}: {}", gaps[c]);
+                assert!(rate.abs() < 1e-14, "gap {c}'s rate {rate}");
+            }
+            let h = 1e-6;
+            for j in 0..n {
+                let shifted = |d: f64| {
+                    let mut q = full.q.clone();
+                    q[j] += d;
+                    general.gaps(&State {
+                        q,
+                        qd: full.qd.clone(),
+                    })[c]
+                };
+                let fd = (shifted(h) - shifted(-h)) / (2.0 * h);
+                assert!(
+                    (fd - row[j]).abs() < 1e-8,
+                    "dgap{c}/dq{j}: {fd} vs {}",
+                    row[j]
+                );
+            }
+            let moved = |d: f64| {
+                let q = (full.q.iter().zip(&full.qd))
+                    .map(|(q, v)| q + d * v)
+                    .collect();
+                let (jac, _) = general.constraints(&State {
+                    q,
+                    qd: full.qd.clone(),
+                });
+                (0..n).map(|j| jac[c * n + j] * full.qd[j]).sum::<f64>()
+            };
+            let fd = (moved(h) - moved(-h)) / (2.0 * h);
+            let size = full.qd.iter().map(|v| v * v).sum::<f64>().max(1.0);
+            assert!(
+                (fd - bias[c]).abs() < 1e-7 * size,
+                "bias {c}: {fd} vs {}",
+                bias[c]
+            );
+        }
+        // The constrained equations give the reduced motion and its forces.
+        let d = contacts::dynamics(&general, &full, &active, 0.0).unwrap();
+        let theta = general.info().reduced;
+        assert!(
+            close(d.qdd[theta], red.theta_ddot, 1e-11),
+            "theta'' {} vs {}",
+            d.qdd[theta],
+            red.theta_ddot
+        );
+        let f_red = sys.forces(delta);
+        let f_scale = f_red.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for c in 0..2 {
+            let want = if closed[c] { f_red[c] } else { 0.0 };
+            assert!(
+                (d.forces[c] - want).abs() <= 1e-11 * f_scale,
+                "force {c}: {} vs {want} at delta {delta}",
+                d.forces[c]
+            );
+            if closed[c] {
+                assert!(d.normal_acc[c].abs() < 1e-10, "{:?}", d.normal_acc);
+            }
+        }
+    }
+}
+
 #[test]
 fn rod_cube_reduced_and_unreduced_forms_agree() {
     for (n, r) in [(3.0, 0.25), (0.01, 0.9), (100.0, 0.05), (1.0, 0.5)] {
         let sys = System::new(&ROD_CUBE, &ratios(n, r)).unwrap();
         check_consistency(&sys, 0.99 * sys.theta_initial());
+        check_general(&sys, [true, true], 0.99 * sys.theta_initial());
     }
 }
 
@@ -99,6 +206,7 @@ fn free_rod_reduced_and_unreduced_forms_agree() {
     let params = common::paper::free_after(0.17, -1.3, -0.01, -0.2);
     let sys = System::new(&FREE_ROD, &params).unwrap();
     check_consistency(&sys, 0.17);
+    check_general(&sys, [false, true], 0.17);
     // The centre of mass keeps its horizontal velocity.
     let v0 = sys.points(&sys.initial_state()).vel[2][0];
     let delta = 0.1;

@@ -1,41 +1,73 @@
 //! Chaining phases: the free phase after separation gets the right state, energy and momentum
 //! carry across the boundary, the floor impact follows from them, and the ODE agrees on the free
-//! phase.
+//! phase. The system is the hand-typed `rod_cube`, walked from phase to phase by [`Walker`].
 
 mod common;
 
-use common::paper::{MODELS, ROD_CUBE, paper};
+use common::paper::{FREE_ROD, GENERAL, MODELS, ROD_CUBE, paper};
 use rodcube::model::Model;
 use rodcube::results::Work;
 use rodcube::solve::SolveError;
-use rodcube::solve::phases::{End, Motion, PhaseRun, Route, extend_to_floor, next_bound};
-use rodcube::solve::unreduced::{EndEvent, integrate};
+use rodcube::solve::contacts::Active;
+use rodcube::solve::phases::{End, Motion, Route, Walker, phase_parameters};
+use rodcube::solve::unreduced::{EndEvent, Start, integrate};
 use rodcube::system::Bound;
 
-fn paper_motion<'m>(registry: &[&'m dyn Model], bound: Bound<'m>, work: &mut Work) -> Motion<'m> {
-    let first = PhaseRun::solve(bound, 0.0, 1e-13, 1e-13, Route::Fastest, work).unwrap();
-    let mut motion = Motion::new(first);
-    extend_to_floor(&mut motion, registry, 1e-13, 1e-13, Route::Fastest, work).unwrap();
-    motion
+fn walker(registry: &'static [&'static dyn Model]) -> Walker<'static> {
+    Walker {
+        general: Bound::new(&GENERAL, &paper(9.81)).unwrap(),
+        registry,
+        tol: 1e-13,
+        rtol: 1e-13,
+        route: Route::Fastest,
+    }
+}
+
+fn paper_motion(work: &mut Work) -> Motion<'static> {
+    walker(MODELS).motion(work).unwrap()
 }
 
 #[test]
 fn the_free_phase_starts_from_the_separation_state() {
-    let bound = Bound::new(&ROD_CUBE, &paper(9.81)).unwrap();
-    let first = PhaseRun::solve(
-        bound,
-        0.0,
-        1e-13,
-        1e-13,
-        Route::Fastest,
-        &mut Work::default(),
-    )
-    .unwrap();
-    assert_eq!(first.end(), End::Separation);
-    let next = next_bound(&first, MODELS).unwrap().unwrap();
-    assert_eq!(next.name(), "rod_cube_free");
+    let w = walker(MODELS);
+    let mut work = Work::default();
+    // At release both contacts push: both stay closed, none opens.
+    let (release, opened) = w.release().unwrap();
+    assert!(opened.is_empty(), "{opened:?}");
+    assert_eq!(release.active.closed, vec![true, true]);
+    assert_eq!(release.t, 0.0);
+    let first = w.solve(&release, &mut work).unwrap();
+    assert_eq!(first.bound().name(), "rod_cube_closed");
+    assert_eq!(first.end(), End::Force(0));
+    // After the tip's force vanishes, the foot stays on the floor and the tip opens.
+    let next = w.after(&first).unwrap();
+    assert_eq!(next.active.closed, vec![false, true]);
+    assert_eq!(next.t, first.t_end());
+    assert_eq!(next.state, first.full_end_state());
     let end = first.end_state();
-    let start = next.initial_state();
+    // The system's state at the separation: x1, y1 = 0 (the foot on the floor), theta, and x2
+    // where the tip was.
+    let tip = first.bound().points(&end).pos[1][0];
+    assert_eq!(next.state.q[0], end.q[0]);
+    assert_eq!(next.state.q[1], 0.0);
+    assert_eq!(next.state.q[2], end.q[1]);
+    assert!((next.state.q[3] - tip).abs() <= 1e-15);
+    // The free phase takes that state as its parameters, by coordinate name.
+    let p = phase_parameters(&w.general, FREE_ROD.info(), &next.state).unwrap();
+    let s = &next.state;
+    let mut want = vec![1.0, 3.0, 1.0, 0.25, 9.81];
+    want.extend([s.q[0], s.q[2], s.q[3], s.qd[0], s.qd[2], s.qd[3]]);
+    assert_eq!(p, want);
+    // The release phase takes only the spec's parameters.
+    let p0 = phase_parameters(&w.general, ROD_CUBE.info(), &release.state).unwrap();
+    assert_eq!(p0, vec![1.0, 3.0, 1.0, 0.25, 9.81]);
+    let sys = w
+        .fast_phase(&next)
+        .unwrap()
+        .expect("a fast phase for the tip open");
+    assert_eq!(sys.name(), "rod_cube_free");
+    assert_eq!(sys.bound().p(), &p[..]);
+    let start = sys.bound().initial_state();
     // x1 and theta carry over; x2 is where the tip was.
     for (a, b) in [
         (end.q[0], start.q[0]),
@@ -45,18 +77,24 @@ fn the_free_phase_starts_from_the_separation_state() {
     ] {
         assert!((a - b).abs() <= 1e-15 * a.abs().max(1.0), "{a} vs {b}");
     }
-    let tip = first.bound().points(&end).pos[1][0];
     assert!((start.q[2] - tip).abs() <= 1e-15);
-    assert_eq!(next.param("theta_0"), Some(first.theta_end()));
+    assert_eq!(sys.param("theta_0"), Some(first.theta_end()));
+    // The release fast phase serves only at release.
+    assert!(w.fast_phase(&release).unwrap().is_some());
+    let mut later = release.clone();
+    later.t = 0.05;
+    assert!(w.fast_phase(&later).unwrap().is_none());
 }
 
 #[test]
 fn floor_impact_conserves_energy_and_momentum_across_the_boundary() {
     let mut work = Work::default();
-    let bound = Bound::new(&ROD_CUBE, &paper(9.81)).unwrap();
     let (m1, m2, g, ell) = (1.0, 3.0, 9.81, 1.0);
-    let motion = paper_motion(MODELS, bound, &mut work);
-    assert_eq!(work.phases, vec!["rod_cube", "rod_cube_free"]);
+    let motion = paper_motion(&mut work);
+    assert_eq!(work.phases, vec!["rod_cube_closed", "rod_cube_free"]);
+    assert!(motion.opened_at_release.is_empty());
+    assert!(motion.complete());
+    assert_eq!(motion.last_end(), Some(End::Floor));
     let (rc, fr) = (&motion.phases[0], &motion.phases[1]);
     // Energy: the rod + cube system at separation = the free phase's (rod and gliding cube).
     let e_rc = rc.bound().energy(&rc.end_state());
@@ -72,14 +110,14 @@ fn floor_impact_conserves_energy_and_momentum_across_the_boundary() {
     let omega_sep = rc.theta_dot_end();
     assert!((v_cube + ell * sep.sin_theta * omega_sep / 8.0).abs() < 1e-15);
     // At the floor all potential energy of the rod is kinetic: m1 v_cm^2 / 2 + m1 ell^2 w^2 / 6.
-    let w = motion.impact_angular_velocity();
+    let w = motion.end_angular_velocity();
     let e_cube = 0.5 * m2 * v_cube * v_cube + m2 * g * 0.25 / 2.0;
     let want = -(6.0 * (e_fr - e_cube - 0.5 * m1 * v_cm * v_cm) / (m1 * ell * ell)).sqrt();
     assert!(((w - want) / want).abs() < 1e-13, "{w} vs {want}");
     let e_end = fr.bound().energy(&fr.end_state());
     assert!(((e_end - e_fr) / e_fr).abs() < 1e-14);
     // Times: after separation, and different from the paper's contact-all-the-way 0.18693 s.
-    let t = motion.floor_time();
+    let t = motion.end_time();
     assert!(t > rc.t_end() && (t - 0.18693).abs() > 1e-4);
     assert_eq!(fr.t_start(), rc.t_end());
 }
@@ -87,10 +125,20 @@ fn floor_impact_conserves_energy_and_momentum_across_the_boundary() {
 #[test]
 fn ode_agrees_on_the_free_phase() {
     let mut work = Work::default();
-    let bound = Bound::new(&ROD_CUBE, &paper(9.81)).unwrap();
-    let motion = paper_motion(MODELS, bound, &mut work);
+    let w = walker(MODELS);
+    let motion = w.motion(&mut work).unwrap();
     let fr = &motion.phases[1];
-    let run = integrate(fr.bound(), 1e-12, None, 1.0, &mut Work::default()).unwrap();
+    // The general model integrated from the separation with only the foot's contact closed.
+    let start = Start {
+        state: motion.phases[0].full_end_state(),
+        active: Active {
+            closed: vec![false, true],
+            modes: vec![],
+        },
+        frictions: vec![],
+        friction_work: 0.0,
+    };
+    let run = integrate(&w.general, &start, 1e-12, None, 1.0, &mut Work::default()).unwrap();
     assert_eq!(run.end, EndEvent::Floor);
     assert!(
         ((run.t_end - fr.duration()) / fr.duration()).abs() < 1e-9,
@@ -98,14 +146,24 @@ fn ode_agrees_on_the_free_phase() {
         run.t_end,
         fr.duration()
     );
-    assert!(((run.state_end.qd[1] - fr.theta_dot_end()) / fr.theta_dot_end()).abs() < 1e-9);
+    let theta_dot = run.state_end.qd[GENERAL.info().reduced];
+    assert!(((theta_dot - fr.theta_dot_end()) / fr.theta_dot_end()).abs() < 1e-9);
+    // The walker's own integrated route gives the same phase.
+    let integrated = Walker {
+        route: Route::Integrated,
+        ..w.clone()
+    };
+    let next = integrated.after(&motion.phases[0]).unwrap();
+    let phase = integrated.solve(&next, &mut Work::default()).unwrap();
+    assert!(phase.reduced().is_none());
+    assert_eq!(phase.end(), End::Floor);
+    assert!(((phase.duration() - fr.duration()) / fr.duration()).abs() < 1e-9);
 }
 
 #[test]
 fn the_tip_leaves_the_cube_behind() {
     let mut work = Work::default();
-    let bound = Bound::new(&ROD_CUBE, &paper(9.81)).unwrap();
-    let motion = paper_motion(MODELS, bound, &mut work);
+    let motion = paper_motion(&mut work);
     let fr = &motion.phases[1];
     let s = rodcube::solve::series::sample(fr, 11, &mut work).unwrap();
     let gap = |i: usize| {
@@ -117,36 +175,31 @@ fn the_tip_leaves_the_cube_behind() {
     for i in 1..11 {
         assert!(gap(i) > last, "gap {} after {last}", gap(i));
         last = gap(i);
+        // The system's gap of the open contact is the same.
+        let g = fr.bound().gaps(&s.states[i])[0];
+        assert!((g - gap(i)).abs() <= 1e-15, "{g} vs {}", gap(i));
     }
 }
 
 #[test]
-fn a_missing_next_model_is_a_typed_error() {
-    let bound = Bound::new(&ROD_CUBE, &paper(9.81)).unwrap();
-    let first = PhaseRun::solve(
-        bound,
-        0.0,
-        1e-13,
-        1e-13,
-        Route::Fastest,
-        &mut Work::default(),
-    )
-    .unwrap();
-    let mut motion = Motion::new(first);
-    let err = extend_to_floor(
-        &mut motion,
-        &[],
-        1e-13,
-        1e-13,
-        Route::Fastest,
-        &mut Work::default(),
-    )
-    .unwrap_err();
+fn a_missing_phase_model_is_a_typed_error() {
+    static WITHOUT_FREE: [&dyn Model; 2] = [&GENERAL, &ROD_CUBE];
+    let err = walker(&WITHOUT_FREE)
+        .motion(&mut Work::default())
+        .unwrap_err();
     assert_eq!(
         err,
-        SolveError::UnknownNextModel {
-            from: "rod_cube",
+        SolveError::UnknownPhaseModel {
+            system: "rod_cube",
             name: "rod_cube_free"
+        }
+    );
+    let err = walker(&[]).motion(&mut Work::default()).unwrap_err();
+    assert_eq!(
+        err,
+        SolveError::UnknownPhaseModel {
+            system: "rod_cube",
+            name: "rod_cube_closed"
         }
     );
 }

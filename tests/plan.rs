@@ -1,9 +1,12 @@
 //! The planner: the paper's figures end to end, each quantity computed with its prerequisites
-//! and nothing else (proved by the work counters), checks only when asked, typed errors.
+//! and nothing else (proved by the work counters), checks only when asked, typed errors. The
+//! system run is the hand-typed `rod_cube` (its general model), whose phases are the hand-typed
+//! `rod_cube_closed` and `rod_cube_free`.
 
 mod common;
 
-use common::paper::{FREE_ROD, MODELS, ROD_CUBE, paper};
+use common::paper::{FREE_ROD, GENERAL, MODELS, ROD_CUBE, paper};
+use common::tweaked::{Tweaked, registry};
 use rodcube::model::Model;
 use rodcube::plan::{PlanError, Request, run};
 use rodcube::quantity::Quantity;
@@ -12,16 +15,22 @@ use rodcube::solve::SolveError;
 use rodcube::system::SystemError;
 
 fn ask(want: &[Quantity]) -> RunResults {
-    ask_model(&ROD_CUBE, want)
+    ask_in(MODELS, want)
 }
 
-fn ask_model(model: &'static dyn Model, want: &[Quantity]) -> RunResults {
-    let request = Request::new(model, paper(9.81))
+/// The hand-typed system with its phases looked up in `models`.
+fn ask_in(models: &'static [&'static dyn Model], want: &[Quantity]) -> RunResults {
+    let request = Request::new(&GENERAL, paper(9.81))
         .with_want(want)
         .with_tolerance(1e-12)
         .with_samples(101)
-        .with_registry(MODELS);
+        .with_registry(models);
     run(&request).unwrap()
+}
+
+/// The hand-typed system with `phase` as its release phase.
+fn ask_tweaked(phase: &'static Tweaked, want: &[Quantity]) -> RunResults {
+    ask_in(registry(phase), want)
 }
 
 fn value(r: &RunResults, key: &str) -> f64 {
@@ -85,7 +94,7 @@ fn cheap_quantities_cost_nothing_they_do_not_need() {
     assert_eq!(r.work.ode_steps, 0);
     assert_eq!(
         r.work.phases,
-        vec!["rod_cube"],
+        vec!["rod_cube_closed"],
         "no free phase for the separation time"
     );
 }
@@ -104,7 +113,7 @@ fn series_share_one_set_of_samples() {
         theta.work, all.work,
         "forces and trajectories reuse the theta samples"
     );
-    assert_eq!(all.work.phases, vec!["rod_cube"]);
+    assert_eq!(all.work.phases, vec!["rod_cube_closed"]);
     let s = &all.series["theta_series"];
     let names: Vec<&str> = s.columns.iter().map(|c| c.name.as_str()).collect();
     assert_eq!(names, ["t", "theta", "theta_dot", "theta_ddot"]);
@@ -130,7 +139,7 @@ fn series_share_one_set_of_samples() {
 #[test]
 fn floor_impact_simulates_the_free_phase_only_when_asked() {
     let r = ask(&[Quantity::FloorImpact]);
-    assert_eq!(r.work.phases, vec!["rod_cube", "rod_cube_free"]);
+    assert_eq!(r.work.phases, vec!["rod_cube_closed", "rod_cube_free"]);
     assert_eq!(r.work.ode_steps, 0);
     let t = value(&r, "floor_impact_time");
     assert!(t > 0.10849 && t < 0.2, "{t}");
@@ -142,7 +151,7 @@ fn floor_impact_simulates_the_free_phase_only_when_asked() {
 fn cross_check_agrees_to_1e_9_and_runs_no_free_phase() {
     let r = ask(&[Quantity::CrossCheck]);
     assert!(r.work.ode_steps > 0);
-    assert_eq!(r.work.phases, vec!["rod_cube"]);
+    assert_eq!(r.work.phases, vec!["rod_cube_closed"]);
     let rel = value(&r, "cross_check_relative_difference");
     println!(
         "ODE {:.15} s, rel diff {rel:.2e}, time dev {:.2e} s, state dev {:.2e}, {} ODE steps",
@@ -159,20 +168,31 @@ fn cross_check_agrees_to_1e_9_and_runs_no_free_phase() {
 
 #[test]
 fn checks_cover_every_phase_and_pass_for_the_paper() {
-    let r = ask(&[Quantity::Checks, Quantity::CrossCheck]);
+    let r = ask(&[
+        Quantity::Checks,
+        Quantity::CrossCheck,
+        Quantity::FloorImpact,
+    ]);
     let names: Vec<&str> = r.checks.keys().map(String::as_str).collect();
+    // Each fast phase: its monitor, each closed contact's push, energy and each cyclic momentum.
+    // The cross-check integrates the general model (x1, y1, theta, x2) with both contacts as
+    // constraints: its energy, the gaps it holds closed, and the one combination of the cyclic
+    // momenta (x1 and x2) that the tip's push (row -1 on x1, +1 on x2) does not change.
     assert_eq!(
         names,
         [
-            "rod_cube.cube_does_not_tip",
-            "rod_cube.energy",
-            "rod_cube.foot_on_floor",
-            "rod_cube.momentum_x1",
+            "rod_cube.ode.contact_force_gap",
             "rod_cube.ode.energy",
-            "rod_cube.ode.momentum_x1",
-            "rod_cube_free.contact_open",
+            "rod_cube.ode.floor_normal_gap",
+            "rod_cube.ode.momentum_x1_x2",
+            "rod_cube_closed.contact_force_pushes",
+            "rod_cube_closed.cube_does_not_tip",
+            "rod_cube_closed.energy",
+            "rod_cube_closed.floor_normal_pushes",
+            "rod_cube_closed.momentum_x1",
+            "rod_cube_free.cube_does_not_tip",
             "rod_cube_free.energy",
-            "rod_cube_free.foot_on_floor",
+            "rod_cube_free.floor_normal_pushes",
             "rod_cube_free.momentum_x1",
             "rod_cube_free.momentum_x2",
         ]
@@ -182,16 +202,23 @@ fn checks_cover_every_phase_and_pass_for_the_paper() {
         assert!(c.passed, "{name}: {c:?}");
     }
     // PHYSICS.md: N >= 0.25 m1 g (to two digits) and the tipping ratio stays below 0.05.
-    let n_min = r.checks["rod_cube.foot_on_floor"].margin / 9.81;
+    let n_min = r.checks["rod_cube_closed.floor_normal_pushes"].margin / 9.81;
     assert!((n_min - 0.25).abs() < 5e-3, "{n_min}");
     let restoring = 3.0 * 9.81 * 0.25 / 2.0;
-    assert!(1.0 - r.checks["rod_cube.cube_does_not_tip"].margin / restoring < 0.05);
-    assert!(r.checks["rod_cube_free.contact_open"].passed);
-    assert_eq!(r.work.phases, vec!["rod_cube", "rod_cube_free"]);
+    assert!(1.0 - r.checks["rod_cube_closed.cube_does_not_tip"].margin / restoring < 0.05);
+    // The push is positive until it vanishes at separation, the phase's last sample.
+    let push = &r.checks["rod_cube_closed.contact_force_pushes"];
+    assert!(push.margin.abs() < 1e-9, "{push:?}");
+    // The cube does not run into the tip again: the free phase reaches the floor (an open
+    // contact's gap that closed would have ended the motion there, with a note).
+    assert!(!r.notes.contains_key("floor_impact"), "{:?}", r.notes);
+    assert!(value(&r, "floor_impact_time") > 0.10849);
+    assert_eq!(r.work.phases, vec!["rod_cube_closed", "rod_cube_free"]);
 }
 
 #[test]
 fn unavailable_quantities_and_bad_requests_are_typed_errors() {
+    // The planner runs systems: a fast phase decides nothing about its contacts.
     let free = [
         ("m1", 1.0),
         ("m2", 3.0),
@@ -209,39 +236,85 @@ fn unavailable_quantities_and_bad_requests_are_typed_errors() {
         .with_want(&[Quantity::SeparationAngle])
         .with_registry(MODELS);
     let err = run(&request).unwrap_err();
-    assert!(
-        matches!(&err, PlanError::Unavailable { quantity, model: "rod_cube_free", .. } if quantity == "separation_angle")
+    assert_eq!(
+        err,
+        PlanError::NotASystem {
+            name: "rod_cube_free",
+            system: "rod_cube"
+        }
     );
-    let request = Request::new(&FREE_ROD, free).with_want(&[Quantity::FloorImpact]);
-    assert!(matches!(run(&request), Err(PlanError::Unavailable { .. })));
-    // The free phase can still give its own time to the floor.
-    let request = Request::new(&FREE_ROD, free).with_want(&[Quantity::ContactTimeToFloor]);
-    assert!(run(&request).unwrap().results["contact_time_to_floor"].value > 0.0);
+    assert!(err.to_string().contains("run `rod_cube`"), "{err}");
+    let err = run(&Request::new(&ROD_CUBE, paper(9.81)).with_want(&[Quantity::SeparationAngle]))
+        .unwrap_err();
+    assert_eq!(
+        err,
+        PlanError::NotASystem {
+            name: "rod_cube_closed",
+            system: "rod_cube"
+        }
+    );
+    // A quantity the system does not have.
+    let request = Request::new(&GENERAL, paper(9.81))
+        .with_want(&[Quantity::FrictionSeries(0)])
+        .with_registry(MODELS);
+    let err = run(&request).unwrap_err();
+    assert!(
+        matches!(&err, PlanError::Unavailable { quantity, model: "rod_cube", offers } if quantity == "friction #0_series" && offers.contains("floor_normal_series")),
+        "{err}"
+    );
+    // The time to the floor in contact is the release fast phase's: a system without one
+    // (the ladder with friction, integrated throughout) does not offer it.
+    let ladder = rodcube::models::find("ladder_friction").expect("generated model");
+    let err = run(
+        &Request::new(ladder, vec![1.0; ladder.info().parameters.len()])
+            .with_want(&[Quantity::ContactTimeToFloor]),
+    )
+    .unwrap_err();
+    assert!(
+        matches!(&err, PlanError::Unavailable { quantity, model: "ladder_friction", .. } if quantity == "contact_time_to_floor"),
+        "{err}"
+    );
 
     let mut p = paper(9.81);
     p[3].1 = 2.0;
-    let err = run(&Request::new(&ROD_CUBE, p).with_want(&[Quantity::SeparationAngle])).unwrap_err();
+    let err = run(&Request::new(&GENERAL, p)
+        .with_want(&[Quantity::SeparationAngle])
+        .with_registry(MODELS))
+    .unwrap_err();
     assert!(
         matches!(err, PlanError::System(SystemError::Requirement { .. })),
         "{err}"
     );
-    let err = run(&Request::new(&ROD_CUBE, paper(9.81)).with_tolerance(0.5)).unwrap_err();
+    let err = run(&Request::new(&GENERAL, paper(9.81)).with_tolerance(0.5)).unwrap_err();
     assert_eq!(err, PlanError::BadTolerance { tolerance: 0.5 });
-    let err = run(&Request::new(&ROD_CUBE, paper(9.81))
+    let err = run(&Request::new(&GENERAL, paper(9.81))
         .with_want(&[Quantity::ThetaSeries])
         .with_samples(1))
     .unwrap_err();
     assert_eq!(err, PlanError::TooFewSamples { samples: 1 });
-    // Without `rod_cube_free` in the registry the floor impact cannot be followed.
-    let err = run(&Request::new(&ROD_CUBE, paper(9.81))
+    // Without `rod_cube_free` in the registry the floor impact cannot be followed past the
+    // separation; without `rod_cube_closed` the motion cannot even start on the fast path.
+    static WITHOUT_FREE: [&dyn Model; 2] = [&GENERAL, &ROD_CUBE];
+    let err = run(&Request::new(&GENERAL, paper(9.81))
+        .with_want(&[Quantity::FloorImpact])
+        .with_registry(&WITHOUT_FREE))
+    .unwrap_err();
+    assert_eq!(
+        err,
+        PlanError::Solve(SolveError::UnknownPhaseModel {
+            system: "rod_cube",
+            name: "rod_cube_free"
+        })
+    );
+    let err = run(&Request::new(&GENERAL, paper(9.81))
         .with_want(&[Quantity::FloorImpact])
         .with_registry(&[]))
     .unwrap_err();
     assert_eq!(
         err,
-        PlanError::Solve(SolveError::UnknownNextModel {
-            from: "rod_cube",
-            name: "rod_cube_free"
+        PlanError::Solve(SolveError::UnknownPhaseModel {
+            system: "rod_cube",
+            name: "rod_cube_closed"
         })
     );
     assert!(matches!(
@@ -254,9 +327,14 @@ fn unavailable_quantities_and_bad_requests_are_typed_errors() {
 #[test]
 fn parameters_by_value_or_by_name_give_the_same_run() {
     let want = [Quantity::SeparationTime];
-    let by_name = run(&Request::new(&ROD_CUBE, paper(9.81)).with_want(&want)).unwrap();
-    let by_value =
-        run(&Request::new(&ROD_CUBE, vec![1.0, 3.0, 1.0, 0.25, 9.81]).with_want(&want)).unwrap();
+    let by_name = run(&Request::new(&GENERAL, paper(9.81))
+        .with_want(&want)
+        .with_registry(MODELS))
+    .unwrap();
+    let by_value = run(&Request::new(&GENERAL, vec![1.0, 3.0, 1.0, 0.25, 9.81])
+        .with_want(&want)
+        .with_registry(MODELS))
+    .unwrap();
     assert_eq!(by_name, by_value);
 }
 
@@ -269,35 +347,41 @@ fn no_separation_is_a_note_and_the_floor_is_reached_in_contact() {
         Quantity::FloorImpact,
         Quantity::ContactTimeToFloor,
     ];
-    let r = ask_model(&NEVER_SEPARATES, &want);
+    let r = ask_tweaked(&NEVER_SEPARATES, &want);
     assert!(
         !r.results.contains_key("separation_angle") && !r.results.contains_key("separation_time")
     );
     assert!(r.notes["separation_angle"].contains("no separation"));
     assert!(r.notes["separation_time"].contains("no separation"));
-    assert!(r.notes.contains_key("floor_impact"));
-    assert_eq!(r.work.phases, vec!["rod_cube"]);
+    // The contact holds to the floor, which the motion reaches: a landing, not a note.
+    assert!(
+        r.notes["separation_angle"].contains("holds until"),
+        "{}",
+        r.notes["separation_angle"]
+    );
+    assert!(!r.notes.contains_key("floor_impact"), "{:?}", r.notes);
+    assert_eq!(r.work.phases, vec!["rod_cube_closed"]);
     // The contact phase to the floor is integrated once and serves both quantities.
     assert_eq!(
         value(&r, "floor_impact_time"),
         value(&r, "contact_time_to_floor")
     );
-    let alone = ask_model(&NEVER_SEPARATES, &[Quantity::ContactTimeToFloor]);
+    let alone = ask_tweaked(&NEVER_SEPARATES, &[Quantity::ContactTimeToFloor]);
     assert_eq!(r.work.integrand_evals, alone.work.integrand_evals);
 }
 
 #[test]
 fn without_separation_the_contact_integral_is_shared_in_either_order() {
     use common::tweaked::NEVER_SEPARATES;
-    let a = ask_model(
+    let a = ask_tweaked(
         &NEVER_SEPARATES,
         &[Quantity::ContactTimeToFloor, Quantity::FloorImpact],
     );
-    let b = ask_model(
+    let b = ask_tweaked(
         &NEVER_SEPARATES,
         &[Quantity::FloorImpact, Quantity::ContactTimeToFloor],
     );
-    let alone = ask_model(&NEVER_SEPARATES, &[Quantity::ContactTimeToFloor]);
+    let alone = ask_tweaked(&NEVER_SEPARATES, &[Quantity::ContactTimeToFloor]);
     assert_eq!(a.work.integrand_evals, alone.work.integrand_evals);
     assert_eq!(b.work.integrand_evals, alone.work.integrand_evals);
     assert_eq!(a.results, b.results);
@@ -310,7 +394,7 @@ fn every_quantity_runs_across_extreme_ratios_and_tolerances() {
     for n in [1e-12, 3.0, 1e12] {
         for r in [1e-10, 0.25, 1.0 - 1e-9] {
             for tol in [1e-14, 1e-8, 1e-2] {
-                let model: &'static dyn Model = &ROD_CUBE;
+                let model: &'static dyn Model = &GENERAL;
                 let request = Request::new(model, ratios(n, r))
                     .with_want(&Quantity::all(model.info()))
                     .with_tolerance(tol)
@@ -357,14 +441,23 @@ fn every_quantity_runs_across_extreme_ratios_and_tolerances() {
 
 #[test]
 fn a_nan_from_the_model_is_an_error_naming_the_series() {
+    // The release phase's floor normal force is NaN everywhere: a broken model function, which
+    // must be reported as such (not read as a force that stopped pushing, and never returned).
     use common::tweaked::NAN_FORCE;
-    let request = Request::new(&NAN_FORCE, paper(9.81))
+    let request = Request::new(&GENERAL, paper(9.81))
         .with_want(&[Quantity::ForceSeries(1)])
         .with_samples(5)
-        .with_registry(MODELS);
+        .with_registry(registry(&NAN_FORCE));
     let err = run(&request).unwrap_err();
-    assert!(
-        matches!(&err, PlanError::NonFinite { key, index: 0, .. } if key == "floor_normal_series.floor_normal"),
-        "{err}"
-    );
+    let named = match &err {
+        PlanError::NonFinite { key, index, value } => {
+            key == "floor_normal_series.floor_normal" && *index == 0 && value.is_nan()
+        }
+        // Or refused where the phase's end is sought, before any series.
+        PlanError::Solve(SolveError::NonFinite { model, value, .. }) => {
+            *model == "rod_cube_closed" && value.is_nan()
+        }
+        _ => false,
+    };
+    assert!(named, "{err:?}: {err}");
 }

@@ -1,8 +1,10 @@
-//! The derivation's steps as the LaTeX shows them (`derive::steps`): rod_cube's kinetic energy,
-//! Euler–Lagrange equations and conserved momentum equal a hand Newton–Euler/Koenig
-//! derivation and are grouped in the velocities with `sin^2 + cos^2 = 1` applied; in every
-//! model every shown step equals the derived one and has no more operations. Formulas are
-//! compared by equivalence (difference zero modulo sin^2 + cos^2 = 1), never as strings.
+//! The derivation's steps as the LaTeX shows them (`derive::steps`): the kinetic energy,
+//! Euler–Lagrange equations and conserved momenta of rod_cube's contact phase
+//! (`rod_cube_closed`) and of its general model (`rod_cube`, every coordinate) equal a hand
+//! Newton–Euler/Koenig derivation and are grouped in the velocities with `sin^2 + cos^2 = 1`
+//! applied; in every model every shown step equals the derived one and has no more operations.
+//! Formulas are compared by equivalence (difference zero modulo sin^2 + cos^2 = 1), never as
+//! strings.
 #![cfg(feature = "derive")]
 
 use rodcube::derive::cas;
@@ -69,12 +71,12 @@ fn assert_grouped(what: &str, shown: &Shown, expected: &str, terms: usize) {
 }
 
 #[test]
-fn rod_cube_s_steps_are_the_hand_derivation_grouped_in_the_velocities() {
+fn rod_cube_s_contact_phase_steps_are_the_hand_derivation_grouped_in_the_velocities() {
     let phases = all_phases();
     let d = phases
         .iter()
-        .find(|d| d.name == "rod_cube")
-        .expect("rod_cube");
+        .find(|d| d.name == "rod_cube_closed")
+        .expect("rod_cube_closed");
     let steps = d.steps.as_ref().expect("steps");
     // By hand: the rod's centre at (x1 + l cos/2, l sin/2), its own rotation m1 l^2/12; the
     // cube at x2 = x1 + l cos(theta).
@@ -108,6 +110,62 @@ fn rod_cube_s_steps_are_the_hand_derivation_grouped_in_the_velocities() {
         "(m1 + m2)*dot_x1 - ell*(m1 + 2*m2)/2*sin(theta)*dot_theta",
         2,
     );
+}
+
+/// The general model keeps every coordinate (`x1, y1, theta, x2`): by hand, the rod's centre at
+/// `(x1 + l cos/2, y1 + l sin/2)` with its own rotation `m1 l^2/12`, the cube at `x2` alone.
+#[test]
+fn rod_cube_s_general_steps_are_the_hand_derivation_grouped_in_the_velocities() {
+    let phases = all_phases();
+    let d = phases
+        .iter()
+        .find(|d| d.name == "rod_cube")
+        .expect("rod_cube");
+    let steps = d.steps.as_ref().expect("steps");
+    let t = "m1/2*dot_x1^2 + m1/2*dot_y1^2 - m1*ell/2*sin(theta)*dot_x1*dot_theta \
+             + m1*ell/2*cos(theta)*dot_y1*dot_theta + m1*ell^2/6*dot_theta^2 + m2/2*dot_x2^2";
+    assert_grouped("T", &steps.kinetic, t, 6);
+    assert_grouped(
+        "V",
+        &steps.potential,
+        "m1*g*y1 + g*(m2*a + m1*ell*sin(theta))/2",
+        1,
+    );
+    assert_eq!(steps.euler_lagrange.len(), 4);
+    // Newton for the rod's centre along x and y, Euler about the foot, Newton for the cube.
+    assert_grouped(
+        "Euler-Lagrange x1",
+        &steps.euler_lagrange[0],
+        "m1*ddot_x1 - m1*ell/2*sin(theta)*ddot_theta - m1*ell/2*cos(theta)*dot_theta^2",
+        3,
+    );
+    assert_grouped(
+        "Euler-Lagrange y1",
+        &steps.euler_lagrange[1],
+        "m1*ddot_y1 + m1*ell/2*cos(theta)*ddot_theta - m1*ell/2*sin(theta)*dot_theta^2 + m1*g",
+        4,
+    );
+    assert_grouped(
+        "Euler-Lagrange theta",
+        &steps.euler_lagrange[2],
+        "-m1*ell/2*sin(theta)*ddot_x1 + m1*ell/2*cos(theta)*ddot_y1 + m1*ell^2/3*ddot_theta \
+         + m1*g*ell/2*cos(theta)",
+        4,
+    );
+    assert_grouped(
+        "Euler-Lagrange x2",
+        &steps.euler_lagrange[3],
+        "m2*ddot_x2",
+        1,
+    );
+    assert_eq!(steps.momenta.len(), 2);
+    assert_grouped(
+        "p_x1",
+        &steps.momenta[0],
+        "m1*dot_x1 - m1*ell/2*sin(theta)*dot_theta",
+        2,
+    );
+    assert_grouped("p_x2", &steps.momenta[1], "m2*dot_x2", 1);
 }
 
 #[test]

@@ -310,7 +310,7 @@ fn bad_sweeps_fail_with_a_clear_message() {
                 "--out",
                 d,
             ],
-            "no contact",
+            "phase of the system `rod_cube`",
         ),
         (
             vec![

@@ -1,8 +1,10 @@
 //! The symbolic derivation, run in-process on the specs in `derivations/`, reproduces the paper's
-//! equations (5), (9), (14), (16), (18) and the corrected (12) *by equivalence*: each difference
-//! is zero as a rational function of sin(theta), cos(theta) modulo sin^2 + cos^2 = 1 (never by
-//! comparing strings). Also the hinged rod, the ladder on a wall, and the loaded rod against
-//! hand computations, and negative controls showing a wrong formula is caught.
+//! equations (5), (9), (14), (16), (18) and the corrected (12) in rod_cube's contact phase
+//! (`rod_cube_closed`, both contacts closed) *by equivalence*: each difference is zero as a
+//! rational function of sin(theta), cos(theta) modulo sin^2 + cos^2 = 1 (never by comparing
+//! strings); and the floor's push under the foot. Also the contact phases of the hinged rod (with
+//! its hinge's two forces), the ladder on a wall, and the loaded rod against hand computations,
+//! and negative controls showing a wrong formula is caught.
 #![cfg(feature = "derive")]
 
 use rodcube::derive::cas;
@@ -11,14 +13,23 @@ use rodcube::derive::mechanics::{self, Derivation, Reduction};
 use rodcube::derive::{derive_all, on_cas_thread, spec};
 use std::path::Path;
 
-/// Derives one model from its spec in `derivations/`.
-fn derive(name: &str) -> Derivation {
+/// Derives the spec `derivations/<spec>.yaml` and returns its contact phase `<spec>_closed`
+/// (every contact closed, the coordinates they tie eliminated).
+fn derive(spec: &str) -> Derivation {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("derivations")
-        .join(format!("{name}.yaml"));
+        .join(format!("{spec}.yaml"));
     let checked = spec::load(&path).unwrap_or_else(|e| panic!("{e}"));
     let mut out = derive_all(&[checked]).unwrap_or_else(|e| panic!("{e}"));
-    out.remove(0).0.remove(0)
+    let phases = out.remove(0).0;
+    let name = format!("{spec}_closed");
+    let names: Vec<String> = phases.iter().map(|d| d.name.clone()).collect();
+    let d = (phases.into_iter())
+        .find(|d| d.name == name)
+        .unwrap_or_else(|| panic!("no phase {name} among {names:?}"));
+    assert_eq!(d.system, spec);
+    assert!(d.contacts.iter().all(|c| c.closed), "{name}");
+    d
 }
 
 /// The fast path of a derived phase.
@@ -157,6 +168,10 @@ const MASSES: &[&str] = &["m1", "m2", "m3", "ell", "a", "g"];
 const EQ9: &str = "4*(g/ell)*(r - S)/(4/3 - S^2/(1 + n))";
 /// Eq (14), the separation cubic.
 const EQ14: &str = "3*S^3 - 12*(1 + n)*S + 8*r*(1 + n)";
+/// Eq (14) with the push's sign: eq (16) is `-3 g m2 cos(theta) / (4(1+n) - 3 S^2)^2` times eq
+/// (14), and a separation condition has its force's sign on the phase (`Reduction::
+/// force_polynomial`).
+const EQ14_PUSH: &str = "-(3*S^3 - 12*(1 + n)*S + 8*r*(1 + n))";
 /// Eq (16), the contact force.
 const EQ16: &str = "m2*(-3*g*C*(8*r*(1 + n) - 12*(1 + n)*S + 3*S^3)/(4*(1 + n) - 3*S^2)^2)";
 /// PHYSICS.md erratum 2: the corrected eq (12), with D = 4/3 - sin^2/(1+n), sin 2theta = 2 S C.
@@ -173,22 +188,22 @@ fn rod_cube_theta_dot_squared_is_eq_9() {
 }
 
 #[test]
-fn rod_cube_separation_condition_is_eq_14_up_to_a_positive_factor() {
+fn rod_cube_separation_condition_is_eq_14_with_the_push_s_sign() {
     let d = derive("rod_cube");
     let ratio = assert_positive_multiple(
         "separation_condition",
         &plain(&d, "separation_condition"),
-        &paper(EQ14),
+        &paper(EQ14_PUSH),
         MASSES,
     );
-    // The factor is the rod's mass (the cubic is m1 times eq 14).
+    // The factor is the rod's mass (the cubic is -m1 times eq 14).
     assert_equivalent("the factor", &ratio, &Expr::sym("m1"));
     // The generated coefficients are the same cubic: rc_si = sin(theta_i) = a/ell.
-    let sep = red(&d).separation.as_ref().expect("rod_cube has a contact");
+    let sep = red(&d).separation().expect("rod_cube_closed has a contact");
     assert_eq!(sep.coefficients.len(), 4);
     let poly = polynomial(&sep.coefficients);
     let poly = subs(&poly, "rc_si", &parse("a/ell"));
-    assert_positive_multiple("coefficients", &poly, &paper(EQ14), MASSES);
+    assert_positive_multiple("coefficients", &poly, &paper(EQ14_PUSH), MASSES);
 }
 
 /// The polynomial `sum c_k rc_s^k` from its coefficients.
@@ -227,6 +242,62 @@ fn subs(e: &Expr, name: &str, value: &Expr) -> Expr {
 fn rod_cube_contact_force_is_eq_16() {
     let d = derive("rod_cube");
     assert_equivalent("contact_force", &plain(&d, "contact_force"), &paper(EQ16));
+}
+
+/// The floor's push under the foot, N = m1 (g + y_cm'') with eqs (9) and (12): a quartic in
+/// sin(theta) over D^2, D = 4/3 - mu S^2, mu = 1/(1+n) (tests/common/paper.rs).
+#[test]
+fn rod_cube_floor_push_is_the_hand_quartic() {
+    let d = derive("rod_cube");
+    let quartic = expand_shorthands(
+        "m1*g*(4/9 + (2*mu*r - 8*r/3)*S + (4 - 11*mu/3)*S^2 + (mu^2 - mu)*S^4)/(4/3 - mu*S^2)^2",
+        &[
+            ("mu", "1/(1 + n)"),
+            ("n", "m2/m1"),
+            ("r", "a/ell"),
+            ("S", "rc_s"),
+        ],
+    );
+    assert_equivalent("floor_normal", &plain(&d, "floor_normal"), &quartic);
+    // And the same from Newton for the rod's centre, with the derived theta'^2 and theta''.
+    let newton = Expr::Mul(vec![
+        Expr::sym("m1"),
+        Expr::Add(vec![
+            Expr::sym("g"),
+            Expr::Mul(vec![
+                parse("ell/2"),
+                Expr::Add(vec![
+                    Expr::Mul(vec![Expr::sym("rc_c"), plain(&d, "theta_ddot")]),
+                    Expr::Mul(vec![
+                        Expr::int(-1),
+                        Expr::sym("rc_s"),
+                        plain(&d, "theta_dot_sq"),
+                    ]),
+                ]),
+            ]),
+        ]),
+    ]);
+    assert_equivalent(
+        "floor_normal by Newton",
+        &plain(&d, "floor_normal"),
+        &newton,
+    );
+    // Its zero is the floor force polynomial's (up to a positive factor).
+    let floor = red(&d).force_polynomials[1]
+        .as_ref()
+        .expect("the floor's push has a polynomial");
+    assert_eq!(floor.coefficients.len(), 5);
+    let poly = subs(&polynomial(&floor.coefficients), "rc_si", &parse("a/ell"));
+    let numerator = expand_shorthands(
+        "4/9 + (2*mu*r - 8*r/3)*S + (4 - 11*mu/3)*S^2 + (mu^2 - mu)*S^4",
+        &[
+            ("mu", "1/(1 + n)"),
+            ("n", "m2/m1"),
+            ("r", "a/ell"),
+            ("S", "rc_s"),
+        ],
+    );
+    assert_positive_multiple("floor coefficients", &poly, &numerator, MASSES);
 }
 
 #[test]
@@ -320,10 +391,10 @@ fn a_theta_dependent_or_negative_factor_is_refused() {
     let d = derive("rod_cube");
     let derived = plain(&d, "separation_condition");
     let ok = |expected: &str| positive_multiple(&derived, &paper(expected), MASSES).is_ok();
-    assert!(ok(EQ14));
-    assert!(!ok("-(3*S^3 - 12*(1 + n)*S + 8*r*(1 + n))"));
-    assert!(!ok("S*(3*S^3 - 12*(1 + n)*S + 8*r*(1 + n))"));
-    assert!(!ok("3*S^3 - 12*(1 + n)*S + 7*r*(1 + n)"));
+    assert!(ok(EQ14_PUSH));
+    assert!(!ok(EQ14));
+    assert!(!ok("-S*(3*S^3 - 12*(1 + n)*S + 8*r*(1 + n))"));
+    assert!(!ok("-(3*S^3 - 12*(1 + n)*S + 7*r*(1 + n))"));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -333,6 +404,7 @@ fn a_theta_dependent_or_negative_factor_is_refused() {
 #[test]
 fn hinged_rod_separates_where_3_n_s3_plus_3_s_equals_2_r() {
     let d = derive("hinged_rod");
+    assert_eq!(d.coords, ["theta"]);
     assert_positive_multiple(
         "hinged_rod separation_condition",
         &plain(&d, "separation_condition"),
@@ -351,6 +423,37 @@ fn hinged_rod_separates_where_3_n_s3_plus_3_s_equals_2_r() {
         &plain(&d, "contact_force"),
         &paper("3/2*m2*g*C*(3*n*S^3 + 3*S - 2*r)/(1 + 3*n*S^2)^2"),
     );
+    // The hinge holds the foot: Newton for the rod's centre (ell/2)(C, S), the cube pushing
+    // back at the tip, with theta'^2 above and theta'' = (1/2) d(theta'^2)/d(theta).
+    let hinged = |text: &str| {
+        expand_shorthands(
+            text,
+            &[
+                ("F", "3/2*m2*g*C*(3*n*S^3 + 3*S - 2*r)/DD^2"),
+                ("W", "3*(g/ell)*(r - S)/DD"),
+                ("A", "3/2*(g/ell)*C*(-DD - 6*n*S*(r - S))/DD^2"),
+                ("DD", "1 + 3*n*S^2"),
+                ("n", "m2/m1"),
+                ("r", "a/ell"),
+                ("S", "rc_s"),
+                ("C", "rc_c"),
+            ],
+        )
+    };
+    assert_equivalent(
+        "hinged_rod hinge_vertical",
+        &plain(&d, "hinge_vertical"),
+        &hinged("m1*(g + ell/2*(C*A - S*W))"),
+    );
+    assert_equivalent(
+        "hinged_rod hinge_horizontal",
+        &plain(&d, "hinge_horizontal"),
+        &hinged("F - m1*ell/2*(S*A + C*W)"),
+    );
+    assert!(!equivalent(
+        &plain(&d, "hinge_horizontal"),
+        &hinged("-m1*ell/2*(S*A + C*W)")
+    ));
 }
 
 #[test]
@@ -371,6 +474,12 @@ fn wall_ladder_separates_at_two_thirds_of_a_over_ell() {
         "wall_ladder contact_force",
         &plain(&d, "contact_force"),
         &paper("3/4*m1*g*C*(3*S - 2*r)"),
+    );
+    // The floor: N = m1 (g + y_cm'') with theta'' = -3 g C / (2 ell).
+    assert_equivalent(
+        "wall_ladder floor_normal",
+        &plain(&d, "floor_normal"),
+        &paper("m1*g*(1/4 - 3/2*r*S + 9/4*S^2)"),
     );
 }
 
@@ -402,10 +511,11 @@ fn loaded_rod_matches_the_hand_computation() {
         &plain(&d, "theta_dot_sq"),
         &loaded("2*g*H*(r - S)/(ell*(P - K*S^2))"),
     );
+    // With the push's sign, as the contact force below.
     assert_positive_multiple(
         "loaded_rod separation_condition",
         &plain(&d, "separation_condition"),
-        &loaded("K*S^3 - 3*P*S + 2*P*r"),
+        &loaded("-(K*S^3 - 3*P*S + 2*P*r)"),
         MASSES,
     );
     // F = -m2 m1 g h c (K s^3 - 3 P s + 2 P r) / (2 M (P - K s^2)^2).

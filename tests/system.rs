@@ -3,14 +3,14 @@
 
 mod common;
 
-use common::paper::{FREE_ROD, ROD_CUBE, paper};
-use rodcube::system::{System, SystemError};
+use common::paper::{FREE_ROD, GENERAL, ROD_CUBE, paper};
+use rodcube::system::{Bound, System, SystemError};
 use std::collections::BTreeMap;
 
 #[test]
 fn paper_parameters_bind() {
     let sys = System::new(&ROD_CUBE, &paper(9.81)).unwrap();
-    assert_eq!(sys.name(), "rod_cube");
+    assert_eq!(sys.name(), "rod_cube_closed");
     assert_eq!(sys.param("a"), Some(0.25));
     assert_eq!(sys.param("nope"), None);
     assert_eq!(sys.gravity(), 9.81);
@@ -32,6 +32,22 @@ fn paper_parameters_bind() {
     assert_eq!(sys.k(), ordered.k());
     assert_eq!(sys.k(), mapped.k());
     assert_eq!(sys.parameter_map(), map);
+    // The system's general model binds the same parameters, but has no fast path of its own:
+    // it is integrated (its fast phases are other models).
+    let general = Bound::new(&GENERAL, &paper(9.81)).unwrap();
+    assert_eq!(general.name(), "rod_cube");
+    assert_eq!(general.p(), sys.bound().p());
+    let err = System::new(&GENERAL, &paper(9.81)).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            SystemError::NoReduction {
+                model: "rod_cube",
+                ..
+            }
+        ),
+        "{err}"
+    );
 }
 
 #[test]
@@ -44,7 +60,7 @@ fn missing_unknown_and_duplicate_parameters() {
     assert_eq!(
         err,
         SystemError::MissingParameter {
-            model: "rod_cube",
+            model: "rod_cube_closed",
             name: "a"
         }
     );
@@ -70,7 +86,7 @@ fn missing_unknown_and_duplicate_parameters() {
     assert_eq!(
         err,
         SystemError::WrongCount {
-            model: "rod_cube",
+            model: "rod_cube_closed",
             expected: 5,
             got: 2
         }
@@ -95,7 +111,7 @@ fn non_finite_and_non_positive_values() {
         assert_eq!(
             err,
             SystemError::NotPositive {
-                model: "rod_cube",
+                model: "rod_cube_closed",
                 name: "g",
                 value: bad
             }

@@ -5,6 +5,7 @@
 
 use crate::results::Work;
 use crate::solve::SolveError;
+use crate::solve::contacts::Active;
 use crate::solve::lean::LeanSolver;
 use crate::solve::ode::{OdeOptions, OdeProblem, dopri5};
 use crate::solve::poly::horner;
@@ -454,9 +455,15 @@ pub fn time_reduced_ode(sys: &System, delta: f64, rtol: f64, t_max: f64) -> Outc
 /// The separation time from the unreduced equations with the contact-force event.
 pub fn time_unreduced(sys: &System, rtol: f64, t_max: f64) -> Outcome<f64> {
     let mut work = Work::default();
-    let run = unreduced::integrate(sys, rtol, None, t_max, &mut work).map_err(err)?;
-    if run.end != unreduced::EndEvent::Separation {
-        return Err("reached the floor before the contact force vanished".into());
+    let start = unreduced::Start {
+        state: sys.initial_state(),
+        active: Active::of_model(sys.info()),
+        frictions: Vec::new(),
+        friction_work: 0.0,
+    };
+    let run = unreduced::integrate(sys, &start, rtol, None, t_max, &mut work).map_err(err)?;
+    if run.end != unreduced::EndEvent::Force(0) {
+        return Err("the phase ended before the first contact's force vanished".into());
     }
     // Six right-hand sides per step (FSAL saves the seventh).
     Ok((run.t_end, 6 * work.ode_steps))

@@ -122,14 +122,42 @@ pub fn expand(a: &A) -> A {
     a.expand()
 }
 
+/// Most results a memo of [`together`] or [`factor`] keeps before it starts afresh.
+const MEMO_CAPACITY: usize = 20_000;
+
+thread_local! {
+    /// Results of [`together`] and [`factor`] by their input: the presentation asks for the
+    /// same rational normalisations and factorisations many times over (every candidate form
+    /// of a result, every phase of a spec). The derivation runs on one thread, so the memo is
+    /// that thread's.
+    static MEMO: std::cell::RefCell<[std::collections::HashMap<A, A>; 2]> =
+        std::cell::RefCell::new(Default::default());
+}
+
+/// `op(a)`, remembered in memo `slot`.
+fn memo(slot: usize, a: &A, op: impl FnOnce(&A) -> A) -> A {
+    if let Some(hit) = MEMO.with(|m| m.borrow()[slot].get(a).cloned()) {
+        return hit;
+    }
+    let out = op(a);
+    MEMO.with(|m| {
+        let mut m = m.borrow_mut();
+        if m[slot].len() >= MEMO_CAPACITY {
+            m[slot].clear();
+        }
+        m[slot].insert(a.clone(), out.clone());
+    });
+    out
+}
+
 /// One rational function `numerator / denominator` with common factors cancelled.
 pub fn together(a: &A) -> A {
-    a.together()
+    memo(0, a, |a| a.together())
 }
 
 /// Factorised form.
 pub fn factor(a: &A) -> A {
-    a.factor()
+    memo(1, a, |a| a.factor())
 }
 
 /// Replaces every occurrence of a pattern (a symbol or a function call) by `value`.

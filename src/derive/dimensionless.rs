@@ -10,13 +10,12 @@
 //! dimensionless, which is an error placed at the spec's `dimensionless` field. A free phase
 //! (after the contact) also has the group `omega_0 = theta_dot_0 T` for its start rate.
 
+use super::algebra::{positive, strip_positive_factors, to_sc_expr};
 use super::cas::{self, A};
 use super::expr::Expr;
-use super::mechanics::{
-    Derivation, DeriveError, FieldStep, Phase, positive, strip_positive_factors, to_sc_expr,
-};
 use super::present::{Presenter, Shape};
 use super::spec::{Spec, Text, solved_parameters};
+use super::types::{Derivation, DeriveError, FieldStep};
 
 /// A dimensionless group.
 #[derive(Debug, Clone)]
@@ -104,7 +103,7 @@ fn groups(
         });
     }
     let rate = format!("{}_dot_0", d.theta());
-    if d.phase == Phase::Free && d.params.iter().any(|p| p.name == rate) {
+    if d.plan.start_params && d.params.iter().any(|p| p.name == rate) {
         let taken = out.iter().any(|g| g.name == START_RATE_GROUP)
             || d.params.iter().any(|p| p.name == START_RATE_GROUP);
         if taken {
@@ -205,15 +204,16 @@ pub fn derive(spec: &Spec, d: &Derivation) -> Result<Option<Dimensionless>, Deri
         Some(rate_unit),
         Shape::Fraction,
     ));
-    for (i, f) in d.forces.iter().enumerate() {
-        let key = if i == 0 && d.contact.is_some() {
-            "contact_force".to_string()
-        } else {
-            f.name.clone()
-        };
+    // Forces in units of the force scale (a torque, conjugate to an angle, has another unit
+    // and is not written here).
+    for c in d
+        .contacts
+        .iter()
+        .filter(|c| c.closed && c.force_unit == "N")
+    {
         wanted.push((
-            key,
-            format!("force {}: {}", f.name, f.meaning),
+            c.name.clone(),
+            format!("force {}: {}", c.name, c.meaning),
             cas::num(1) / cas::atom(&force),
             Some(force.clone()),
             Shape::Fraction,

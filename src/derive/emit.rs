@@ -1,14 +1,15 @@
 //! Turns a [`Derivation`] into template contexts (flat data, computed here) and renders the
 //! tera templates of `templates/` into Rust, LaTeX and JSON text.
 
+use super::algebra::{from_sc, to_sc_expr};
 use super::dimensionless::Dimensionless;
 use super::expr::Expr;
 use super::lower::{Body, Hoisted, Scope, lower};
-use super::mechanics::{self, Binding, Derivation, Reduction, from_sc, to_sc_expr};
 use super::method::{Preamble, method};
 use super::present;
 use super::spec::Checked;
 use super::steps::{Shown, Steps};
+use super::types::{self as mechanics, Derivation, Reduction};
 use serde::Serialize;
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -82,9 +83,22 @@ struct Param {
     positive: bool,
 }
 
-/// Everything the Rust template needs, all computed.
+/// A fast phase of a system, as every model of the system lists it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PhaseEntry {
+    /// The contacts it holds closed.
+    pub closed: Vec<usize>,
+    /// Its model's name.
+    pub model: String,
+    /// Whether it starts from the spec's release state.
+    pub release: bool,
+    /// Its separation polynomial's degree (0 without one).
+    pub separation_degree: usize,
+}
+
+/// The static description of a model (`ModelInfo`'s fields), as literals.
 #[derive(Debug, Clone, Serialize)]
-pub struct RustContext {
+struct StaticInfo {
     command: String,
     name: String,
     type_name: String,
@@ -94,14 +108,20 @@ pub struct RustContext {
     params: Vec<Param>,
     requirements_info: Vec<Named>,
     n_params: usize,
-    n_constants: usize,
     coordinates: Vec<String>,
     n_coordinates: usize,
     reduced: usize,
     cyclic: Vec<usize>,
     end_angle: String,
-    forces_info: Vec<Named>,
-    contact: Option<String>,
+    /// The system: the spec's name (its general model) and coordinates.
+    system: String,
+    system_coordinates: Vec<String>,
+    /// `ContactInfo { .. }` literals, one per contact of the spec.
+    contacts_info: Vec<String>,
+    /// `PhaseInfo { .. }` literals: the system's fast phases.
+    phases_info: Vec<String>,
+    /// Whether the parameters after the spec's are the phase's start state.
+    start_params: bool,
     /// `FrictionInfo { .. }` literals.
     frictions_info: Vec<String>,
     points_info: Vec<Named>,
@@ -110,15 +130,22 @@ pub struct RustContext {
     monitors_info: Vec<Monitor>,
     /// The bodies' names, as Rust string literals.
     bodies: Vec<String>,
+    /// Why the phase has no fast path (empty when it has one).
+    route_note: String,
+}
+
+/// Everything the Rust template needs, all computed.
+#[derive(Debug, Clone, Serialize)]
+pub struct RustContext {
+    #[serde(flatten)]
+    info: StaticInfo,
+    n_constants: usize,
     /// `ShapeInfo { .. }` literals.
     shapes_info: Vec<String>,
     /// `Model::drawing`: the bodies' poses and the shapes' numbers.
     drawing: Code,
-    next_phase: Option<String>,
     /// `ReductionInfo { .. }` when the phase has the fast path.
     reduction_info: Option<String>,
-    /// Why the phase has no fast path (empty when it has one).
-    route_note: String,
     requirements: Code,
     prepare: Code,
     #[serde(flatten)]
@@ -138,7 +165,11 @@ pub struct ReducedCode {
     reduced_code: Code,
     theta_dot_sq_code: Code,
     forces: Code,
-    separation: Code,
+    /// `Reduction::force_polynomial`: per contact, its polynomial's coefficients.
+    force_polynomial: Code,
+    /// The lines of each contact's polynomial (for the constants the per-point solver reads).
+    #[serde(skip)]
+    polynomial_lines: Vec<Vec<String>>,
     fall: Code,
     full_state: Code,
     /// The constants the per-point solver reads, and the code computing only them.
@@ -159,21 +190,6 @@ pub fn type_name(name: &str) -> String {
         .collect()
 }
 
-fn lit(x: f64) -> String {
-    super::expr::float_literal(x)
-}
-
-/// The Rust spelling of a binding to the next phase.
-fn binding(b: &Binding) -> String {
-    match b {
-        Binding::Param(i) => format!("Binding::Param({i})"),
-        Binding::Coordinate(i) => format!("Binding::Coordinate({i})"),
-        Binding::Velocity(i) => format!("Binding::Velocity({i})"),
-        Binding::Eliminated => "Binding::Eliminated".into(),
-        Binding::EliminatedRate => "Binding::EliminatedRate".into(),
-    }
-}
-
 /// `out[i] = <output i>;` lines.
 fn out_lines(outputs: &[String]) -> Vec<String> {
     outputs
@@ -183,17 +199,21 @@ fn out_lines(outputs: &[String]) -> Vec<String> {
         .collect()
 }
 
-/// Builds the Rust context of one derived phase.
+/// Builds the Rust context of one derived phase; `phases` are its system's fast phases.
 ///
 /// A named constant of the reduction that no generated line reads and the runtime does not
 /// read either (`ReductionInfo`'s start slots) gets no slot: the context is built once to find
 /// such constants, and again without them.
-pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, String> {
-    let first = context_without(checked, d, &BTreeSet::new())?;
+pub fn rust_context(
+    checked: &Checked,
+    d: &Derivation,
+    phases: &[PhaseEntry],
+) -> Result<RustContext, String> {
+    let first = context_without(checked, d, phases, &BTreeSet::new())?;
     if first.unread.is_empty() {
         return Ok(first);
     }
-    let second = context_without(checked, d, &first.unread)?;
+    let second = context_without(checked, d, phases, &first.unread)?;
     match second.unread.is_empty() {
         true => Ok(second),
         false => Err(format!(
@@ -207,25 +227,67 @@ pub fn rust_context(checked: &Checked, d: &Derivation) -> Result<RustContext, St
 fn context_without(
     checked: &Checked,
     d: &Derivation,
+    phases: &[PhaseEntry],
     skip: &BTreeSet<String>,
 ) -> Result<RustContext, String> {
-    let spec = &checked.spec;
     let np = d.params.len();
-    let (scope, mut prepare, own) = constant_layout(d, skip);
+    let (scope, start, own) = constant_layout(d, skip);
     let mut hoisted = Hoisted::new(np + own.len());
     if let Ok(r) = &d.reduction {
         for &(j, slot) in &own {
             hoisted.known(&r.constants[j].value, slot);
         }
     }
-    let general = full_state_code(d, &scope, &mut hoisted)?;
-    let reduction = match &d.reduction {
+    let mut general = full_state_code(d, &scope, &mut hoisted)?;
+    let mut reduction = match &d.reduction {
         Ok(r) => Some(reduced_code(d, r, &scope, &mut hoisted)?),
         Err(_) => None,
     };
-    let (drawing, shapes_info) = drawing_code(d, &scope, &mut hoisted);
+    let (mut drawing, shapes_info) = drawing_code(d, &scope, &mut hoisted);
+    let mut requirements = requirements_code(d);
+    let n_constants = hoisted.len();
+    let mut prepare = prepare_code(d, start, &own, &scope, &hoisted, reduction.as_mut())?;
+    let reduction_info = match (&d.reduction, &reduction) {
+        (Ok(r), Some(code)) => Some(reduction_info(d, r, code, &scope)?),
+        _ => None,
+    };
+    // Every method's arguments and lines, now that the code is complete.
+    prepare
+        .stmts
+        .insert(0, format!("k[..{np}].copy_from_slice(p);"));
+    prepare.finish(&[("p", "&[f64]"), ("k", "&mut [f64]")], &[]);
+    requirements.finish(&[("p", "&[f64]"), OUT], &[Preamble::Let("k", "p")]);
+    general.finish(n_constants, d.reduced);
+    if let Some(code) = reduction.as_mut() {
+        code.finish(n_constants, np, d.reduced);
+    }
+    let poses = ("poses", "&mut [[f64; 3]]");
+    let sizes = ("sizes", "&mut [f64]");
+    drawing.finish(
+        &[K, Q, poses, sizes],
+        &[Preamble::Slice(n_constants), Preamble::Angle(d.reduced)],
+    );
+    let mut codes: Vec<&Code> = vec![&requirements, &prepare, &drawing];
+    codes.extend(general.codes());
+    codes.extend(reduction.iter().flat_map(ReducedCode::codes));
+    let unread = unread_constants(d, &own, &codes);
+    Ok(RustContext {
+        info: static_info(checked, d, phases)?,
+        n_constants,
+        shapes_info,
+        drawing,
+        reduction_info,
+        requirements,
+        prepare,
+        general,
+        reduction,
+        unread,
+    })
+}
 
-    // Requirements over the parameters (no hoisting: they run before prepare).
+/// `Model::requirements`: the margins over the parameters (no hoisting: they run before
+/// `prepare`).
+fn requirements_code(d: &Derivation) -> Code {
     let mut requirements = Code::default();
     let mut req_scope = Scope::default();
     for (i, p) in d.params.iter().enumerate() {
@@ -233,31 +295,43 @@ fn context_without(
     }
     let out = requirements.push_body(lower(&d.requirements, &req_scope, None, "q"));
     requirements.outputs = out_lines(&out);
+    requirements
+}
 
-    // With a fast path, prepare starts with the per-point solver's constants
-    // (`prepare_lean`) and computes the others after them, each once; hoisted constants go to
-    // the end.
-    let n_constants = hoisted.len();
-    let mut reduction = reduction;
+/// `Model::prepare` after the parameters: with a fast path, the per-point solver's constants
+/// first (`prepare_lean`, filled into `code`), then the others, each once; hoisted constants
+/// go last. A named constant that is another one lives in its slot: `prepare` starts by
+/// saying so.
+fn prepare_code(
+    d: &Derivation,
+    start: Code,
+    own: &[(usize, usize)],
+    scope: &Scope,
+    hoisted: &Hoisted,
+    code: Option<&mut ReducedCode>,
+) -> Result<Code, String> {
+    let np = d.params.len();
+    let mut prepare = start;
     let mut lean_indices = Vec::new();
-    if let (Ok(r), Some(code)) = (&d.reduction, reduction.as_mut()) {
-        let (lean, indices) = lean_prepare(np, r, &own, &scope, &hoisted, code)?;
+    if let (Ok(r), Some(code)) = (&d.reduction, code) {
+        let (lean, indices) = lean_prepare(np, r, own, scope, hoisted, code)?;
         code.prepare_lean = lean;
         code.lean_constants = indices.clone();
         prepare = Code::default();
         prepare
             .stmts
             .push("Reduction::prepare_lean(self, p, k);".into());
-        for &(j, slot) in &own {
+        for &(j, slot) in own {
             if !indices.contains(&slot) {
                 let c = &r.constants[j];
+                let prefix = format!("c{j}_");
                 bind_constant(
                     &mut prepare,
                     slot,
                     Some(&c.symbol),
                     &c.value,
-                    &scope,
-                    &format!("c{j}_"),
+                    scope,
+                    &prefix,
                 );
             }
         }
@@ -265,15 +339,11 @@ fn context_without(
     }
     for (i, e) in &hoisted.entries {
         if !lean_indices.contains(i) {
-            bind_constant(&mut prepare, *i, None, e, &scope, &format!("h{i}_"));
+            bind_constant(&mut prepare, *i, None, e, scope, &format!("h{i}_"));
         }
     }
-    // A named constant that is another one lives in its slot: `prepare` starts by saying so.
     if let Ok(r) = &d.reduction {
-        let notes = r
-            .constants
-            .iter()
-            .enumerate()
+        let notes = (r.constants.iter().enumerate())
             .filter(|(j, _)| !own.iter().any(|&(o, _)| o == *j))
             .filter_map(|(_, c)| {
                 let i = scope.constants.get(&c.symbol)?;
@@ -286,170 +356,134 @@ fn context_without(
             .collect::<Vec<_>>();
         prepare.stmts.splice(0..0, notes);
     }
+    Ok(prepare)
+}
 
-    // Static info.
+/// The `ReductionInfo { .. }` literal of a fast path.
+fn reduction_info(
+    d: &Derivation,
+    r: &Reduction,
+    code: &ReducedCode,
+    scope: &Scope,
+) -> Result<String, String> {
+    let wi = scope
+        .constants
+        .get("rc_wi")
+        .copied()
+        .ok_or("the reduction has no constant `rc_wi`")?;
+    let degrees: Vec<usize> = (r.force_polynomials.iter())
+        .map(|p| p.as_ref().map_or(0, |s| s.coefficients.len() - 1))
+        .collect();
+    debug_assert_eq!(degrees.len(), d.contacts.len());
+    Ok(format!(
+        "ReductionInfo {{ k_theta_initial: {}, k_theta_dot_initial: {wi}, k_sin_initial: {}, k_cos_initial: {}, force_degrees: &{degrees:?}, fall_degree: {:?}, lean_constants: &{:?} }}",
+        code.k_theta_initial,
+        code.k_sin_initial,
+        code.k_cos_initial,
+        r.fall.as_ref().map(|f| f.len() - 1),
+        code.lean_constants
+    ))
+}
+
+/// `ModelInfo`'s fields as literals.
+fn static_info(
+    checked: &Checked,
+    d: &Derivation,
+    phases: &[PhaseEntry],
+) -> Result<StaticInfo, String> {
+    let spec = &checked.spec;
+    let np = d.params.len();
     let point_index = |name: &str| {
-        spec.points
-            .iter()
-            .position(|p| p.name == name)
+        (spec.points.iter().position(|p| p.name == name))
             .ok_or_else(|| format!("`{name}` is not one of the points"))
     };
-    let contact = d.contact.as_ref().map(|c| {
-        format!(
-            "ContactInfo {{ force: {}, eliminated: {:?}, edge: {} }}",
-            c.force,
-            c.eliminated,
-            c.edge.is_some()
-        )
-    });
-    let next_phase = d.next.as_ref().map(|n| {
-        format!(
-            "NextPhase {{ model: {:?}, bindings: &[{}] }}",
-            n.model,
-            n.bindings
-                .iter()
-                .map(binding)
-                .collect::<Vec<_>>()
-                .join(", ")
-        )
-    });
-    let reduction_info = match (&d.reduction, &reduction) {
-        (Ok(r), Some(code)) => {
-            let k = |s: &str| {
-                scope
-                    .constants
-                    .get(s)
-                    .copied()
-                    .ok_or_else(|| format!("the reduction has no constant `{s}`"))
-            };
-            Some(format!(
-                "ReductionInfo {{ k_theta_initial: {}, k_theta_dot_initial: {}, k_sin_initial: {}, k_cos_initial: {}, separation_degree: {}, polynomial_separation: {}, fall_degree: {:?}, lean_constants: &{:?} }}",
-                code.k_theta_initial,
-                k("rc_wi")?,
-                code.k_sin_initial,
-                code.k_cos_initial,
-                r.separation
-                    .as_ref()
-                    .map_or(0, |s| s.coefficients.len() - 1),
-                r.separation.is_some(),
-                r.fall.as_ref().map(|f| f.len() - 1),
-                code.lean_constants
-            ))
-        }
-        _ => None,
-    };
-    // Every method's arguments and lines, now that the code is complete.
-    prepare
-        .stmts
-        .insert(0, format!("k[..{np}].copy_from_slice(p);"));
-    prepare.finish(&[("p", "&[f64]"), ("k", "&mut [f64]")], &[]);
-    requirements.finish(&[("p", "&[f64]"), OUT], &[Preamble::Let("k", "p")]);
-    let mut general = general;
-    general.finish(n_constants, d.reduced);
-    if let Some(code) = reduction.as_mut() {
-        code.finish(n_constants, np, d.reduced);
-    }
-    let mut drawing = drawing;
-    let poses = ("poses", "&mut [[f64; 3]]");
-    let sizes = ("sizes", "&mut [f64]");
-    drawing.finish(
-        &[K, Q, poses, sizes],
-        &[Preamble::Slice(n_constants), Preamble::Angle(d.reduced)],
-    );
-    let named = |v: &[mechanics::Named]| {
-        v.iter()
-            .map(|n| Named {
-                name: n.name.clone(),
-                meaning: format!("{:?}", n.meaning),
-            })
-            .collect()
-    };
-    let mut codes: Vec<&Code> = vec![&requirements, &prepare, &drawing];
-    codes.extend(general.codes());
-    codes.extend(reduction.iter().flat_map(ReducedCode::codes));
-    let unread = unread_constants(d, &own, &codes);
-    Ok(RustContext {
+    let lit = |s: &str| format!("{s:?}");
+    let contacts_info = (d.contacts.iter())
+        .map(|c| {
+            format!(
+                "ContactInfo {{ name: {:?}, meaning: {:?}, gap_unit: {:?}, unit: {:?}, bilateral: {}, edge: {}, eliminates: {:?}, closed: {} }}",
+                c.name,
+                c.meaning,
+                c.gap_unit,
+                c.force_unit,
+                c.bilateral,
+                c.edge.is_some(),
+                c.eliminates.as_deref(),
+                c.closed
+            )
+        })
+        .collect();
+    let phases_info = (phases.iter())
+        .map(|p| {
+            format!(
+                "PhaseInfo {{ closed: &{:?}, model: {:?}, release: {}, separation_degree: {} }}",
+                p.closed, p.model, p.release, p.separation_degree
+            )
+        })
+        .collect();
+    let frictions_info = (d.frictions.iter())
+        .map(|f| {
+            format!(
+                "FrictionInfo {{ name: {:?}, meaning: {:?}, coefficient: {}, contact: {} }}",
+                f.named.name, f.named.meaning, f.coefficient, f.contact
+            )
+        })
+        .collect();
+    Ok(StaticInfo {
         command: COMMAND.into(),
         name: d.name.clone(),
         type_name: type_name(&d.name),
         // Comments in the generated code: one line, so no spec text can end them.
         description: one_line(&d.description),
-        description_literal: format!("{:?}", d.description),
+        description_literal: lit(&d.description),
         spec: one_line(&spec_path(checked)),
-        params: d
-            .params
-            .iter()
+        params: (d.params.iter())
             .map(|p| Param {
                 name: p.name.clone(),
-                meaning: format!("{:?}", p.meaning),
-                unit: format!("{:?}", p.unit),
+                meaning: lit(&p.meaning),
+                unit: lit(&p.unit),
                 positive: p.positive,
             })
             .collect(),
-        requirements_info: spec
-            .requirements
-            .iter()
+        requirements_info: (spec.requirements.iter())
             .map(|r| Named {
                 name: r.name.clone(),
-                meaning: format!("{:?}", r.meaning),
+                meaning: lit(&r.meaning),
             })
             .collect(),
         n_params: np,
-        n_constants,
         coordinates: d.coords.clone(),
         n_coordinates: d.coords.len(),
         reduced: d.reduced,
         cyclic: d.cyclic.clone(),
-        end_angle: lit(spec.end_angle),
-        forces_info: named(&d.forces),
-        contact,
-        frictions_info: d
-            .frictions
-            .iter()
-            .map(|f| {
-                format!(
-                    "FrictionInfo {{ name: {:?}, meaning: {:?}, coefficient: {}, normal: {} }}",
-                    f.named.name, f.named.meaning, f.coefficient, f.normal
-                )
-            })
-            .collect(),
-        points_info: spec
-            .points
-            .iter()
+        end_angle: super::expr::float_literal(spec.end_angle),
+        system: d.system.clone(),
+        system_coordinates: d.full_coords.clone(),
+        contacts_info,
+        phases_info,
+        start_params: d.plan.start_params,
+        frictions_info,
+        points_info: (spec.points.iter())
             .map(|p| Named {
                 name: p.name.clone(),
-                meaning: format!("{:?}", p.meaning),
+                meaning: lit(&p.meaning),
             })
             .collect(),
         falling_point: point_index(&spec.falling_point)?,
-        gravity: d
-            .params
-            .iter()
-            .position(|p| p.name == spec.gravity)
+        gravity: (d.params.iter().position(|p| p.name == spec.gravity))
             .ok_or_else(|| format!("`{}` is not a parameter", spec.gravity))?,
-        monitors_info: d
-            .monitors
-            .iter()
+        monitors_info: (d.monitors.iter())
             .map(|m| Monitor {
-                name: format!("{:?}", m.name),
-                meaning: format!("{:?}", m.meaning),
-                unit: format!("{:?}", m.unit),
+                name: lit(&m.name),
+                meaning: lit(&m.meaning),
+                unit: lit(&m.unit),
             })
             .collect(),
-        bodies: d.bodies.iter().map(|b| format!("{b:?}")).collect(),
-        shapes_info,
-        drawing,
-        next_phase,
-        reduction_info,
+        bodies: d.bodies.iter().map(|b| lit(b)).collect(),
         route_note: match &d.reduction {
-            Ok(_) => format!("{:?}", ""),
-            Err(why) => format!("{:?}", one_line(why)),
+            Ok(_) => lit(""),
+            Err(why) => lit(&one_line(why)),
         },
-        requirements,
-        prepare,
-        general,
-        reduction,
-        unread,
     })
 }
 
@@ -560,10 +594,8 @@ fn lean_prepare(
     // The start enters the lean path through its sine, cosine and rate only: the angle itself
     // (an `asin`) is left to the full `prepare`.
     let mut stack = vec![code.k_sin_initial, code.k_cos_initial, wi];
-    for line in [&code.separation, &code.fall]
-        .into_iter()
-        .flat_map(|c| c.stmts.iter().chain(&c.outputs))
-    {
+    let fall = code.fall.stmts.iter().chain(&code.fall.outputs);
+    for line in code.polynomial_lines.iter().flatten().chain(fall) {
         stack.extend(k_indices(line));
     }
     let mut needed = std::collections::BTreeSet::new();
@@ -617,10 +649,12 @@ struct FullStateCode {
     momenta: Code,
     equations: Code,
     forces_full: Code,
+    gaps: Code,
+    constraints: Code,
+    edges: Code,
     friction: Code,
     monitors_full: Code,
-    contact_edge: Code,
-    released: Code,
+    to_full: Code,
 }
 
 /// The reduction's constants with a slot of their own (`own`) that no line of `codes` reads
@@ -646,7 +680,7 @@ fn unread_constants(d: &Derivation, own: &[(usize, usize)], codes: &[&Code]) -> 
 
 impl FullStateCode {
     /// Every method's code.
-    fn codes(&self) -> [&Code; 10] {
+    fn codes(&self) -> [&Code; 12] {
         [
             &self.initial_state,
             &self.points,
@@ -654,10 +688,12 @@ impl FullStateCode {
             &self.momenta,
             &self.equations,
             &self.forces_full,
+            &self.gaps,
+            &self.constraints,
+            &self.edges,
             &self.friction,
             &self.monitors_full,
-            &self.contact_edge,
-            &self.released,
+            &self.to_full,
         ]
     }
 
@@ -678,15 +714,18 @@ impl FullStateCode {
         let rhs = ("rhs", "&mut [f64]");
         self.equations.finish(&[K, Q, QD, mass, rhs], &state);
         let qdd = ("qdd", "&[f64]");
-        let fr = ("fr", "&[f64]");
-        self.forces_full.finish(&[K, Q, QD, qdd, fr, OUT], &state);
+        self.forces_full.finish(&[K, Q, QD, qdd, OUT], &state);
+        self.gaps.finish(&[K, Q, OUT], &state);
         let jac = ("jac", "&mut [f64]");
         let bias = ("bias", "&mut [f64]");
+        self.constraints.finish(&[K, Q, QD, jac, bias], &state);
+        self.edges.finish(&[K, Q, OUT], &state);
         self.friction.finish(&[K, Q, QD, jac, bias], &state);
         let forces = ("forces", "&[f64]");
         self.monitors_full.finish(&[K, Q, QD, forces, OUT], &state);
-        self.contact_edge.finish(&[K, Q], &state);
-        self.released.finish(&[K, Q, QD, OUT], &state);
+        let qf = ("q_full", "&mut [f64]");
+        let qdf = ("qd_full", "&mut [f64]");
+        self.to_full.finish(&[K, Q, QD, qf, qdf], &state);
     }
 }
 
@@ -697,7 +736,7 @@ impl ReducedCode {
             &self.reduced_code,
             &self.theta_dot_sq_code,
             &self.forces,
-            &self.separation,
+            &self.force_polynomial,
             &self.fall,
             &self.full_state,
             &self.prepare_lean,
@@ -723,8 +762,8 @@ impl ReducedCode {
             .finish(&[K, sc[0], sc[1], sc[2], sc[3]], &[slice]);
         self.forces.outputs = out_lines(&self.forces.outputs);
         self.forces.finish(&[K, DELTA, OUT], &[slice, start, delta]);
-        self.separation.outputs = out_lines(&self.separation.outputs);
-        self.separation.finish(&[K, OUT], &[slice]);
+        self.force_polynomial
+            .finish(&[K, ("contact", "usize"), OUT], &[slice]);
         self.fall.outputs = out_lines(&self.fall.outputs);
         self.fall.finish(&[K, OUT], &[slice]);
         self.prepare_lean
@@ -821,7 +860,7 @@ fn full_state_code(
     hoisted: &mut Hoisted,
 ) -> Result<FullStateCode, String> {
     let theta = d.theta().to_string();
-    let mut full_scope = state_scope(d, scope);
+    let full_scope = state_scope(d, scope);
     let sc = |e: &Expr| to_sc_expr(e, &theta);
     let single = |prefix: &str, exprs: &[Expr], scope: &Scope, hoisted: &mut Hoisted| {
         let mut code = Code::default();
@@ -886,77 +925,152 @@ fn full_state_code(
         .chain((0..nc).map(|i| format!("rhs[{i}] = {};", out[nc * nc + i])))
         .collect();
 
-    for j in 0..d.frictions.len() {
-        full_scope
-            .locals
-            .insert(format!("rc_fr{j}"), format!("fr[{j}]"));
-    }
-    let ff: Vec<Expr> = d.forces_full.iter().map(sc).collect();
-    let (mut forces_full, out) = single("f", &ff, &full_scope, hoisted);
-    forces_full.outputs = out_lines(&out);
-
-    let mut exprs: Vec<Expr> = Vec::new();
-    for f in &d.frictions {
-        exprs.extend(f.jacobian.iter().map(sc));
-    }
-    exprs.extend(d.frictions.iter().map(|f| sc(&f.bias)));
-    let (mut friction, out) = single("s", &exprs, &full_scope, hoisted);
-    let n_jac = nc * d.frictions.len();
-    friction.outputs = (0..n_jac)
-        .map(|i| format!("jac[{i}] = {};", out[i]))
-        .chain((0..d.frictions.len()).map(|j| format!("bias[{j}] = {};", out[n_jac + j])))
-        .collect();
-
-    let mut mon_scope = full_scope.clone();
-    for i in 0..d.forces.len() {
-        mon_scope
-            .locals
-            .insert(format!("rc_f{i}"), format!("forces[{i}]"));
-    }
-    let mo: Vec<Expr> = d.monitors_full.iter().map(sc).collect();
-    let (mut monitors_full, out) = single("m", &mo, &mon_scope, hoisted);
-    monitors_full.outputs = out_lines(&out);
-
-    let mut contact_edge = Code::default();
-    let mut released = Code::default();
-    match &d.contact {
-        Some(c) => {
-            if let Some(edge) = &c.edge {
-                let (code, out) = single("g", &[sc(edge)], &full_scope, hoisted);
-                contact_edge = code;
-                contact_edge.outputs = out;
-            } else {
-                contact_edge.outputs = vec!["f64::INFINITY".into()];
-            }
-            let (code, out) = single(
-                "r",
-                &[sc(&c.released[0]), sc(&c.released[1])],
-                &full_scope,
-                hoisted,
-            );
-            released = code;
-            released.outputs = out_lines(&out);
-        }
-        None => contact_edge.outputs = vec!["f64::INFINITY".into()],
-    }
-    let stray = super::lower::unbound(&d.forces_full, &full_scope);
-    if !stray.is_empty() {
-        return Err(format!(
-            "the forces depend on {} besides the state and the parameters",
-            stray.into_iter().collect::<Vec<_>>().join(", ")
-        ));
-    }
+    let contacts = contact_code(d, &full_scope, hoisted)?;
     Ok(FullStateCode {
         initial_state,
         points,
         energy,
         momenta,
         equations,
+        forces_full: contacts.forces_full,
+        gaps: contacts.gaps,
+        constraints: contacts.constraints,
+        edges: contacts.edges,
+        friction: contacts.friction,
+        monitors_full: contacts.monitors_full,
+        to_full: contacts.to_full,
+    })
+}
+
+/// The functions of the contacts, frictions and monitors over the full state.
+struct ContactCode {
+    forces_full: Code,
+    gaps: Code,
+    constraints: Code,
+    edges: Code,
+    friction: Code,
+    monitors_full: Code,
+    to_full: Code,
+}
+
+/// One expression per contact, each lowered where `pick` gives one and `default` elsewhere,
+/// as `out[i] = ...;` lines.
+fn per_contact(
+    d: &Derivation,
+    pick: &dyn Fn(&mechanics::ContactRow) -> Option<Expr>,
+    default: &str,
+    prefix: &str,
+    scope: &Scope,
+    hoisted: &mut Hoisted,
+) -> Code {
+    let theta = d.theta().to_string();
+    let picked: Vec<Option<Expr>> = d.contacts.iter().map(pick).collect();
+    let exprs: Vec<Expr> = (picked.iter().flatten())
+        .map(|e| to_sc_expr(e, &theta))
+        .collect();
+    let mut code = Code::default();
+    let out = code.push_body(lower(&exprs, scope, Some(hoisted), prefix));
+    let mut values = out.into_iter();
+    code.outputs = (picked.iter().enumerate())
+        .map(|(i, p)| {
+            let v = match p {
+                Some(_) => values.next().unwrap_or_else(|| default.to_string()),
+                None => default.to_string(),
+            };
+            format!("out[{i}] = {v};")
+        })
+        .collect();
+    code
+}
+
+fn contact_code(
+    d: &Derivation,
+    full_scope: &Scope,
+    hoisted: &mut Hoisted,
+) -> Result<ContactCode, String> {
+    let theta = d.theta().to_string();
+    let sc = |e: &Expr| to_sc_expr(e, &theta);
+    let nc = d.coords.len();
+    let single = |prefix: &str, exprs: &[Expr], hoisted: &mut Hoisted| {
+        let mut code = Code::default();
+        let out = code.push_body(lower(exprs, full_scope, Some(hoisted), prefix));
+        (code, out)
+    };
+    let forces: Vec<Expr> = d.contacts.iter().filter_map(|c| c.force.clone()).collect();
+    let stray = super::lower::unbound(&forces, full_scope);
+    if !stray.is_empty() {
+        return Err(format!(
+            "the forces depend on {} besides the state and the parameters",
+            stray.into_iter().collect::<Vec<_>>().join(", ")
+        ));
+    }
+    let forces_full = per_contact(d, &|c| c.force.clone(), "0.0", "f", full_scope, hoisted);
+    let open = |c: &mechanics::ContactRow| (!c.closed).then(|| c.gap.clone());
+    let gaps = per_contact(d, &open, "0.0", "g", full_scope, hoisted);
+    let edges = per_contact(
+        d,
+        &|c| c.edge.clone(),
+        "f64::INFINITY",
+        "e",
+        full_scope,
+        hoisted,
+    );
+
+    // The constraint rows (every contact's Jacobian row, then its bias) and the frictions'
+    // slip rows, in the same layout.
+    let mut rows = |prefix: &str, jacobians: Vec<&[Expr]>, biases: Vec<&Expr>| {
+        let mut exprs: Vec<Expr> = jacobians.iter().flat_map(|j| j.iter().map(sc)).collect();
+        exprs.extend(biases.iter().map(|b| sc(b)));
+        let (mut code, out) = single(prefix, &exprs, hoisted);
+        let n_jac = nc * biases.len();
+        code.outputs = (0..n_jac)
+            .map(|i| format!("jac[{i}] = {};", out[i]))
+            .chain((0..biases.len()).map(|j| format!("bias[{j}] = {};", out[n_jac + j])))
+            .collect();
+        code
+    };
+    let constraints = rows(
+        "j",
+        d.contacts.iter().map(|c| &c.jacobian[..]).collect(),
+        d.contacts.iter().map(|c| &c.bias).collect(),
+    );
+    let friction = rows(
+        "s",
+        d.frictions.iter().map(|f| &f.jacobian[..]).collect(),
+        d.frictions.iter().map(|f| &f.bias).collect(),
+    );
+
+    let mut mon_scope = full_scope.clone();
+    for i in 0..d.contacts.len() {
+        mon_scope
+            .locals
+            .insert(format!("rc_f{i}"), format!("forces[{i}]"));
+    }
+    let mo: Vec<Expr> = d.monitors_full.iter().map(sc).collect();
+    let mut monitors_full = Code::default();
+    let out = monitors_full.push_body(lower(&mo, &mon_scope, Some(hoisted), "m"));
+    monitors_full.outputs = out_lines(&out);
+
+    let exprs: Vec<Expr> = (d.to_full.iter())
+        .flat_map(|[x, v]| [sc(x), sc(v)])
+        .collect();
+    let (mut to_full, out) = single("t", &exprs, hoisted);
+    to_full.outputs = (0..d.to_full.len())
+        .flat_map(|i| {
+            [
+                format!("q_full[{i}] = {};", out[2 * i]),
+                format!("qd_full[{i}] = {};", out[2 * i + 1]),
+            ]
+        })
+        .collect();
+    Ok(ContactCode {
         forces_full,
+        gaps,
+        constraints,
+        edges,
         friction,
         monitors_full,
-        contact_edge,
-        released,
+        to_full,
     })
 }
 
@@ -1027,11 +1141,28 @@ fn reduced_code(
     let fo = forces.push_body(lower(&r.forces_reduced, &force_scope, Some(hoisted), "f"));
     forces.outputs = fo;
 
-    // Separation polynomial: coefficients are constants, hoisted into k.
-    let mut separation = Code::default();
-    if let Some(sep) = &r.separation {
-        separation.outputs =
-            separation.push_body(lower(&sep.coefficients, scope, Some(hoisted), "p"));
+    // Each contact's force polynomial: coefficients are constants, hoisted into k; one arm of
+    // `match contact` per contact that has one.
+    let mut force_polynomial = Code::default();
+    let mut polynomial_lines = Vec::new();
+    let mut arms = Vec::new();
+    for (i, p) in r.force_polynomials.iter().enumerate() {
+        let mut lines = Vec::new();
+        if let Some(sep) = p {
+            let mut arm = Code::default();
+            let out = arm.push_body(lower(&sep.coefficients, scope, Some(hoisted), "p"));
+            lines = arm.stmts.iter().cloned().chain(out_lines(&out)).collect();
+            arms.push(format!("{i} => {{"));
+            arms.extend(lines.iter().cloned());
+            arms.push("}".into());
+        }
+        polynomial_lines.push(lines);
+    }
+    if !arms.is_empty() {
+        force_polynomial.stmts.push("match contact {".into());
+        force_polynomial.stmts.extend(arms);
+        force_polynomial.stmts.push("_ => {}".into());
+        force_polynomial.stmts.push("}".into());
     }
     // Fall polynomial: coefficients are constants too.
     let mut fall = Code::default();
@@ -1061,7 +1192,8 @@ fn reduced_code(
         reduced_code: reduced,
         theta_dot_sq_code: theta_dot_sq,
         forces,
-        separation,
+        force_polynomial,
+        polynomial_lines,
         fall,
         full_state,
         prepare_lean: Code::default(),
@@ -1264,15 +1396,21 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> Result<TexContext, Stri
     };
     let sc = |e: &Expr| from_sc(e, &theta);
     let mut eqs = Vec::new();
-    if let Some(c) = &d.contact {
+    for (c, row) in d.contacts.iter().filter(|c| c.closed).filter_map(|c| {
+        let e = c.eliminates.as_ref()?;
+        let i = d.full_coords.iter().position(|q| q == e)?;
+        Some((c, d.to_full.get(i)?))
+    }) {
+        let e = c.eliminates.as_deref().unwrap_or_default();
         eqs.push(display(
             &format!(
-                "Contact: the gap is zero while the bodies touch, which ties ${}$",
-                name(&c.eliminated)
+                "Contact \\texttt{{{}}} is closed: its gap is zero, which ties ${}$",
+                tex_text(&c.name),
+                name(e)
             ),
-            format!("{} = ", name(&c.eliminated)),
+            format!("{} = ", name(e)),
             3,
-            &c.released[0],
+            &sc(&row[0]),
             None,
             &name,
         ));
@@ -1322,35 +1460,44 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> Result<TexContext, Stri
             &name,
         ));
     }
+    constraint_equations(d, &name, &mut eqs);
     match &d.reduction {
         Ok(r) => reduced_equations(d, r, steps, &name, &mut eqs)?,
-        Err(why) => {
-            for (f, e) in d.forces.iter().zip(&d.forces_full) {
-                eqs.push(display(
-                    &format!(
-                        "Force \\texttt{{{}}}: {} (integrated route: {})",
-                        tex_text(&f.name),
-                        tex_text(&f.meaning),
-                        tex_text(why)
-                    ),
-                    "F = ".into(),
-                    2,
-                    &sc(e),
-                    None,
-                    &name,
-                ));
+        Err(why) if d.contacts.iter().any(|c| c.closed) => {
+            for c in d.contacts.iter().filter(|c| c.closed) {
+                if let Some(f) = &c.force {
+                    eqs.push(display(
+                        &format!(
+                            "Force \\texttt{{{}}}: {} (integrated route: {})",
+                            tex_text(&c.name),
+                            tex_text(&c.meaning),
+                            tex_text(why)
+                        ),
+                        "F = ".into(),
+                        2,
+                        &sc(f),
+                        None,
+                        &name,
+                    ));
+                }
             }
         }
+        Err(_) => {}
     }
-    if let Some(edge) = d.contact.as_ref().and_then(|c| c.edge.as_ref()) {
-        eqs.push(display(
-            "Edge: the contact can exist while this margin is not negative",
-            String::new(),
-            0,
-            &sc(edge),
-            None,
-            &name,
-        ));
+    for c in &d.contacts {
+        if let Some(edge) = &c.edge {
+            eqs.push(display(
+                &format!(
+                    "Edge of contact \\texttt{{{}}}: it can exist while this margin is not negative",
+                    tex_text(&c.name)
+                ),
+                String::new(),
+                0,
+                &sc(edge),
+                None,
+                &name,
+            ));
+        }
     }
     let (dim_groups, dim_scales, dim_results) = match &d.dimensionless {
         Some(dim) => tex_dimensionless(dim, &theta, &name),
@@ -1375,6 +1522,99 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> Result<TexContext, Stri
         scales: dim_scales,
         results: dim_results,
     })
+}
+
+/// A gradient entry's `\frac{\partial g}{\partial q} = ` counts this many characters of width.
+const GRADIENT_HEAD: usize = 6;
+
+/// The constraint rows of the contacts a phase does not hold closed: each gap, its gradient
+/// in the phase's coordinates and its bias, with what the runtime solves while a set of them is
+/// closed.
+fn constraint_equations(d: &Derivation, name: &dyn Fn(&str) -> String, eqs: &mut Vec<Equation>) {
+    let theta = d.theta().to_string();
+    let sc = |e: &Expr| from_sc(e, &theta);
+    let open: Vec<&mechanics::ContactRow> = d.contacts.iter().filter(|c| !c.closed).collect();
+    for (k, c) in open.iter().enumerate() {
+        let kind = if c.bilateral {
+            "a joint: its gap stays zero and its force $\\lambda$ may have either sign"
+        } else {
+            "a contact: its gap stays $\\ge 0$; while it is zero its force $\\lambda \\ge 0$ pushes"
+        };
+        let mut gap = display(
+            &format!(
+                "Contact \\texttt{{{}}} ({}, {}): gap in {}, force in {}",
+                tex_text(&c.name),
+                tex_text(&c.meaning),
+                kind,
+                tex_text(&c.gap_unit),
+                tex_text(&c.force_unit)
+            ),
+            format!("g_{{{}}} = ", k + 1),
+            4,
+            &sc(&c.gap),
+            None,
+            name,
+        );
+        // The gradient's entries, as many to a line as fit, a long one on lines of its own.
+        let mut lines: Vec<String> = Vec::new();
+        let mut used = TEX_LINE;
+        for (q, j) in (d.coords.iter().zip(&c.jacobian)).filter(|(_, j)| !j.is_zero()) {
+            let head = format!(
+                "\\frac{{\\partial g_{{{}}}}}{{\\partial {}}} = ",
+                k + 1,
+                name(q)
+            );
+            let j = sc(j);
+            let width = GRADIENT_HEAD + j.latex_width(name);
+            match lines.last_mut() {
+                Some(last) if used + 3 + width <= TEX_LINE => {
+                    last.push_str(",\\quad ");
+                    last.push_str(&head);
+                    last.push_str(&j.to_latex(name));
+                    used += 3 + width;
+                }
+                _ => {
+                    let own = j.to_latex_lines(name, TEX_LINE, GRADIENT_HEAD);
+                    used = if own.len() == 1 { width } else { TEX_LINE };
+                    for (i, line) in own.into_iter().enumerate() {
+                        lines.push(if i == 0 {
+                            format!("{head}{line}")
+                        } else {
+                            line
+                        });
+                    }
+                }
+            }
+        }
+        gap.latex.push_str(" \\\\\n");
+        gap.latex.push_str(&lines.join(" \\\\\n"));
+        gap.env = "multline*";
+        eqs.push(gap);
+        if !c.bias.is_zero() {
+            eqs.push(display(
+                &format!(
+                    "Its normal acceleration is $\\sum_j \\partial g_{{{}}}/\\partial q_j\\,\\ddot q_j$ plus",
+                    k + 1
+                ),
+                String::new(),
+                0,
+                &sc(&c.bias),
+                None,
+                name,
+            ));
+        }
+    }
+    if !open.is_empty() {
+        eqs.push(Equation {
+            title: "While a set $A$ of these contacts is closed, the runtime solves for the \
+                    accelerations and the closed contacts' forces together"
+                .into(),
+            env: "equation*",
+            latex: "M(q)\\,\\ddot q = F(q, \\dot q) + \\sum_{j \\in A} \\lambda_j \\frac{\\partial g_j}{\\partial q}, \\qquad \\frac{\\partial g_j}{\\partial q}\\,\\ddot q + \\dot{\\Big(\\frac{\\partial g_j}{\\partial q}\\Big)}\\,\\dot q = 0 \\quad (j \\in A)".into(),
+            tag: None,
+            small: false,
+        });
+    }
 }
 
 /// A step's title and the form to print (over `rc_s`, `rc_c`): its presented form, unless
@@ -1550,17 +1790,12 @@ fn reduced_equations(
             eqs.push(display(&title, lhs, width, &sc(&e), None, name));
         }
     }
-    for (i, f) in d.forces.iter().enumerate() {
-        let key = if i == 0 && d.contact.is_some() {
-            "contact_force"
-        } else {
-            f.name.as_str()
-        };
-        if let Some(s) = shown(key)? {
+    for c in d.contacts.iter().filter(|c| c.closed) {
+        if let Some(s) = shown(&c.name)? {
             let title = format!(
                 "Force \\texttt{{{}}}: {}",
-                tex_text(&f.name),
-                tex_text(&f.meaning)
+                tex_text(&c.name),
+                tex_text(&c.meaning)
             );
             let (title, e) = step(&title, s, name);
             eqs.push(display(&title, "F = ".into(), 2, &sc(&e), None, name));
@@ -1587,6 +1822,7 @@ fn reduced_equations(
 /// The machine-readable record (`generated/<model>.json`).
 pub fn json_record(checked: &Checked, d: &Derivation) -> serde_json::Value {
     let theta = d.theta().to_string();
+    let infix = |e: &Expr| from_sc(e, &theta).to_infix();
     let mut expressions = BTreeMap::new();
     let (route, reason) = match &d.reduction {
         Ok(r) => {
@@ -1596,28 +1832,58 @@ pub fn json_record(checked: &Checked, d: &Derivation) -> serde_json::Value {
                 }
                 expressions.insert(k.to_string(), from_sc(v, &theta).to_infix());
             }
-            let how = match (&d.contact, &r.separation) {
-                (Some(_), Some(_)) => "separation: the root of a polynomial in sin(theta)",
-                (Some(_), None) => "separation: a bracketed root of the reduced contact force",
+            let how = match (d.contacts.first(), r.separation()) {
+                (Some(c), Some(_)) if c.closed => {
+                    "separation: the root of a polynomial in sin(theta)"
+                }
+                (Some(c), None) if c.closed => {
+                    "separation: a bracketed root of the reduced contact force"
+                }
                 _ => "",
             };
             ("reduced", how.to_string())
         }
-        Err(why) => {
-            for (f, e) in d.forces.iter().zip(&d.forces_full) {
-                expressions.insert(f.name.clone(), from_sc(e, &theta).to_infix());
-            }
-            ("integrated", why.clone())
-        }
+        Err(why) => ("integrated", why.clone()),
     };
-    expressions.insert(
-        "lagrangian".into(),
-        from_sc(&d.lagrangian, &theta).to_infix(),
-    );
+    expressions.insert("lagrangian".into(), infix(&d.lagrangian));
+    let contacts: Vec<serde_json::Value> = (d.contacts.iter())
+        .map(|c| {
+            let mut v = serde_json::json!({
+                "name": c.name,
+                "meaning": c.meaning,
+                "gap_unit": c.gap_unit,
+                "force_unit": c.force_unit,
+                "bilateral": c.bilateral,
+                "eliminates": c.eliminates,
+                "closed": c.closed,
+            });
+            match &c.force {
+                Some(f) => v["force"] = infix(f).into(),
+                None => {
+                    v["gap"] = infix(&c.gap).into();
+                    v["jacobian"] = (d.coords.iter().zip(&c.jacobian))
+                        .map(|(q, j)| (q.clone(), serde_json::Value::from(infix(j))))
+                        .collect::<serde_json::Map<_, _>>()
+                        .into();
+                    v["bias"] = infix(&c.bias).into();
+                }
+            }
+            if let Some(e) = &c.edge {
+                v["edge"] = infix(e).into();
+            }
+            v
+        })
+        .collect();
+    let closed: Vec<&str> = (d.plan.closed.iter())
+        .filter_map(|&j| d.contacts.get(j).map(|c| c.name.as_str()))
+        .collect();
     let mut record = serde_json::json!({
         "generated_by": COMMAND,
         "note": "Generated file; do not edit by hand.",
         "model": d.name,
+        "system": d.system,
+        "closed": closed,
+        "start_params": d.plan.start_params,
         "spec": spec_path(checked),
         "description": d.description,
         "parameters": d.params.iter().map(|p| serde_json::json!({"name": p.name, "meaning": p.meaning, "unit": p.unit})).collect::<Vec<_>>(),
@@ -1626,7 +1892,10 @@ pub fn json_record(checked: &Checked, d: &Derivation) -> serde_json::Value {
         "cyclic": d.cyclic.iter().map(|&i| d.coords[i].clone()).collect::<Vec<_>>(),
         "route": route,
         "route_note": reason,
-        "velocity_symbols": "theta_dot, theta_ddot in the reduced expressions are eliminated; dot_q / ddot_q denote velocities and accelerations in `lagrangian` and in integrated forces",
+        "velocity_symbols": "theta_dot, theta_ddot in the reduced expressions are eliminated; dot_q / ddot_q denote velocities and accelerations in `lagrangian`, the contacts' rows and forces",
+        "mass_matrix": d.mass.iter().map(|row| row.iter().map(infix).collect::<Vec<_>>()).collect::<Vec<_>>(),
+        "rhs": d.rhs.iter().map(infix).collect::<Vec<_>>(),
+        "contacts": contacts,
         "expressions": expressions,
     });
     if let Some(dim) = &d.dimensionless {
@@ -1642,8 +1911,8 @@ pub fn json_record(checked: &Checked, d: &Derivation) -> serde_json::Value {
                     "name": f.named.name,
                     "meaning": f.named.meaning,
                     "coefficient": d.params[f.coefficient].name,
-                    "normal": d.forces[f.normal].name,
-                    "slip_velocity": from_sc(&f.slip, &theta).to_infix(),
+                    "contact": d.contacts[f.contact].name,
+                    "slip_velocity": infix(&f.slip),
                     "force_symbol": format!("rc_fr{j}"),
                 })
             })

@@ -259,7 +259,16 @@ fn hoist_constants(e: &Expr, scope: &Scope, h: &mut Hoisted) -> Expr {
                 .into_iter()
                 .map(|(_, rest, coefs)| Expr::Mul(vec![super::expr::sum(coefs), rest]).tidy())
                 .collect();
-            return hoist_constants(&super::expr::sum(terms), scope, h);
+            let grouped = super::expr::sum(terms);
+            // Only a sum the grouping shortened is taken apart again (tidying a grouped term
+            // may spread it back into as many terms, which would recurse for ever).
+            let shorter = match &grouped {
+                Expr::Add(w) => w.len() < v.len(),
+                _ => true,
+            };
+            if shorter {
+                return hoist_constants(&grouped, scope, h);
+            }
         }
     }
     // Products and sums: hoist the constant part as one factor / term.

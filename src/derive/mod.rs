@@ -1,19 +1,38 @@
 //! The derivation tool (cargo feature `derive`): model specs in `derivations/*.yaml` are
 //! derived by Symbolica and rendered through `templates/` into `generated/`.
 //!
-//! Data flows one way: [`spec`] (YAML, checked) → [`mechanics`] (Symbolica, on one dedicated
-//! thread) → [`emit`] (flat template contexts, [`lower`]ed to straight-line Rust) → tera →
-//! rustfmt → `generated/`. In check mode nothing is written; stale files are reported.
+//! Data flows one way, through modules that import only those before them:
+//!
+//! - below every stage: [`cas`] (the only module that calls Symbolica), [`types`] (what the
+//!   stages hand each other), [`algebra`] (trigonometric rewriting and polynomial helpers);
+//! - the stages of the derivation proper, each a file: [`read`] → [`setup`] → [`lagrangian`] →
+//!   [`equations`] → [`constraints`] → [`reduction`] → [`forces`], run in that order for each
+//!   phase by [`mechanics`];
+//! - presentation: [`present`] (forms checked equal), [`steps`], [`dimensionless`], [`latex`];
+//! - emission: [`lower`] (straight-line Rust), [`method`], [`emit`] (flat template contexts)
+//!   → tera → rustfmt → `generated/`.
+//!
+//! Every Symbolica call runs on one dedicated thread ([`on_cas_thread`]). In check mode
+//! nothing is written; stale files are reported.
 
+pub mod algebra;
 pub mod cas;
+pub mod constraints;
 pub mod dimensionless;
 pub mod emit;
+pub mod equations;
+pub mod forces;
+pub mod lagrangian;
 pub mod latex;
 pub mod lower;
 pub mod mechanics;
 pub mod method;
 pub mod present;
+pub mod read;
+pub mod reduction;
+pub mod setup;
 pub mod steps;
+pub mod types;
 
 // Spec parsing and expressions need no Symbolica: they live in the runtime crate.
 pub use crate::spec::{self, expr};
@@ -284,8 +303,29 @@ fn rustfmt(model: &str, text: &str) -> Result<String, Error> {
     String::from_utf8(out.stdout).map_err(|e| err(e.to_string()))
 }
 
+/// The fast phases of a system (its derived phases that have a fast path), as every model of
+/// the system lists them.
+fn fast_phases(phases: &[Derivation]) -> Vec<emit::PhaseEntry> {
+    (phases.iter())
+        .filter_map(|d| {
+            let r = d.reduction.as_ref().ok()?;
+            Some(emit::PhaseEntry {
+                closed: d.plan.closed.clone(),
+                model: d.name.clone(),
+                release: !d.plan.start_params,
+                separation_degree: r.separation().map_or(0, |s| s.coefficients.len() - 1),
+            })
+        })
+        .collect()
+}
+
 /// The Rust, LaTeX and JSON files of one derived phase.
-fn render_phase(root: &Path, c: &Checked, d: &Derivation) -> Result<Vec<Rendered>, Error> {
+fn render_phase(
+    root: &Path,
+    c: &Checked,
+    d: &Derivation,
+    phases: &[emit::PhaseEntry],
+) -> Result<Vec<Rendered>, Error> {
     // A model the emitter cannot write is reported against its spec file.
     let refused = |message: String| {
         Error::Spec(SpecError {
@@ -298,7 +338,7 @@ fn render_phase(root: &Path, c: &Checked, d: &Derivation) -> Result<Vec<Rendered
             width: 0,
         })
     };
-    let ctx = emit::rust_context(c, d).map_err(refused)?;
+    let ctx = emit::rust_context(c, d, phases).map_err(refused)?;
     let rust = rustfmt(&d.name, &render(root, "model.rs.tera", &ctx)?)?;
     let tex_ctx = emit::tex_context(c, d).map_err(refused)?;
     let tex = render(root, "model.tex.tera", &tex_ctx)?;
@@ -348,8 +388,9 @@ pub fn render_all(root: &Path, specs: &[PathBuf]) -> Result<(Vec<Rendered>, Timi
     let mut timings = Vec::new();
     for (c, (phases, took)) in selected.iter().zip(derived) {
         timings.push((c.spec.name.clone(), took));
+        let fast = fast_phases(&phases);
         for d in &phases {
-            out.extend(render_phase(root, c, d)?);
+            out.extend(render_phase(root, c, d, &fast)?);
         }
     }
     // The registry lists only models whose Rust file exists once this run has written: those

@@ -14,12 +14,18 @@
 //! theta-free sums, then `sin`, `cos`, then sums with theta. In a fraction a sum runs from its
 //! theta-free term up, that term positive (`r - sin(theta)`, `4 (1 + n) - 3 sin(theta)^2`); a
 //! polynomial condition (`... = 0`) runs from its highest power down, that term positive.
-//! Every candidate is checked equal to the result (their difference is zero as a rational
-//! function modulo `sin^2 + cos^2 = 1`); one that is not is a typed error, never printed.
+//! The candidate the rule picks is checked equal to the result before it is printed (their
+//! difference is zero as a rational function modulo `sin^2 + cos^2 = 1`); one that is not is
+//! a typed error, never printed. The others are not checked: they are never printed, and
+//! checking each cost most of the derivation's time.
 
+use super::algebra::{is_zero_trig, reduce_cos_sq};
 use super::cas::{self, A};
 use super::expr::{Expr, product, sum};
-use super::mechanics::{is_zero_trig, reduce_cos_sq};
+
+/// A candidate form ranked: operations, characters, order made, the form, and the constant
+/// factor dropped from it.
+type Ranked = (usize, usize, usize, Expr, (i128, i128));
 
 /// The rule that picks a presentation form among the candidates, as stated in the outputs.
 pub const RULE: &str = "fewest operations (each +, -, *, /, ^ and function call in the printed \
@@ -182,30 +188,33 @@ impl<'a> Presenter<'a> {
                 .collect::<Result<Vec<_>, _>>()?;
             candidates.extend(moved.into_iter().flatten());
         }
-        let mut best: Option<(usize, usize, Expr)> = None;
         let count = candidates.len();
-        for mut f in candidates {
-            // A condition `= 0` is written without its constant factor, which is checked too.
-            let dropped = match shape {
-                Shape::Polynomial => std::mem::replace(&mut f.coefficient, (1, 1)),
-                Shape::Fraction => (1, 1),
-            };
-            let e = self.assemble(&f);
-            let factor = cas::atom(&Expr::Rational(dropped.0, dropped.1));
-            let diff = cas::atom(&e) * factor - a.clone();
-            if !is_zero_trig(&diff)? {
-                return Err(format!(
-                    "the presentation form `{}` is not equal to the result `{}`",
-                    e.to_infix(),
-                    cas::expr(a)?.to_infix()
-                ));
-            }
-            let key = (operations(&e), e.to_infix().len());
-            if best.as_ref().is_none_or(|b| key < (b.0, b.1)) {
-                best = Some((key.0, key.1, e));
-            }
+        // Ranked by the rule (fewest operations, then fewest characters; the first made wins a
+        // tie), each with the constant factor a condition `= 0` is written without.
+        let mut ranked: Vec<Ranked> = (candidates.into_iter())
+            .enumerate()
+            .map(|(i, mut f)| {
+                let dropped = match shape {
+                    Shape::Polynomial => std::mem::replace(&mut f.coefficient, (1, 1)),
+                    Shape::Fraction => (1, 1),
+                };
+                let e = self.assemble(&f);
+                (operations(&e), e.to_infix().len(), i, e, dropped)
+            })
+            .collect();
+        ranked.sort_by_key(|r| (r.0, r.1, r.2));
+        // The best form is printed only once Symbolica finds it equal to the result; a form
+        // that is not is a bug in its maker, reported rather than skipped.
+        let (ops, _, _, expr, dropped) = ranked.into_iter().next().ok_or("no presentation form")?;
+        let factor = cas::atom(&Expr::Rational(dropped.0, dropped.1));
+        let diff = cas::atom(&expr) * factor - a.clone();
+        if !is_zero_trig(&diff)? {
+            return Err(format!(
+                "the presentation form `{}` is not equal to the result `{}`",
+                expr.to_infix(),
+                cas::expr(a)?.to_infix()
+            ));
         }
-        let (ops, _, expr) = best.ok_or("no presentation form")?;
         Ok(Form {
             expr,
             operations: ops,

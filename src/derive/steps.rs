@@ -14,10 +14,11 @@
 //! `sin^2 + cos^2 = 1`; a condition `= 0` up to its constant factor) before it can be shown; one
 //! that is not is not shown, and the step is shown as derived with the reason.
 
+use super::algebra::{is_zero_trig, to_sc_expr};
 use super::cas::{self, A};
 use super::expr::{Expr, product, sum};
-use super::mechanics::{Derivation, is_zero_trig, to_sc_expr};
 use super::present::{Presenter, Shape, operations};
+use super::types::Derivation;
 use std::collections::BTreeMap;
 
 /// One step as shown, over `rc_s`, `rc_c` like the derivation.

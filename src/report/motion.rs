@@ -145,13 +145,13 @@ impl Animation {
         };
         let info = first.bound.info();
         let mut anim = Animation {
-            model: info.name.to_string(),
+            model: info.system.to_string(),
             bodies: info.bodies.iter().map(|b| b.to_string()).collect(),
             traced: traced.map(str::to_string),
             ..Animation::default()
         };
         anim.shapes = first_shapes(first, &mut anim.notes);
-        for (i, phase) in phases.iter().enumerate() {
+        for phase in phases {
             let pinfo = phase.bound.info();
             if pinfo.bodies != info.bodies {
                 anim.notes.push(format!(
@@ -166,16 +166,18 @@ impl Animation {
                 t_start: phase.t_start,
             });
             add_frames(&mut anim, phase, index, traced);
-            if i == 0
-                && let Some(cause) = match phase.end {
-                    End::Separation => Some("the push vanishes"),
-                    End::Edge => Some("the contact point runs off an edge"),
-                    End::Floor => None,
-                }
+            let name = |c: usize| pinfo.contacts.get(c).map_or("a contact", |c| c.name);
+            let cause = match phase.end {
+                End::Force(c) => Some(format!("{} lets go", name(c))),
+                End::Edge(c) => Some(format!("{} runs off an edge", name(c))),
+                End::Contact(_) | End::Floor => None,
+            };
+            if anim.contact_end.is_none()
+                && let Some(cause) = cause
                 && let Some(last) = anim.frames.last()
             {
                 anim.contact_end = Some(ContactEnd {
-                    cause: cause.into(),
+                    cause,
                     frame: last.clone(),
                 });
             }

@@ -333,14 +333,27 @@ fn checks(out: &mut String, results: &RunResults, layout: &Layout) {
             t.add_row(row.to_vec());
             legend.push((row[0].clone(), c.meaning.clone()));
         }
-        for (i, w) in widths.iter().enumerate() {
+        // The same widths in every group, where they fit the line; else each group wraps.
+        let total: usize = widths.iter().map(|w| w + 3).sum::<usize>() + 1;
+        let fixed = if layout.width.is_some_and(|w| total > w) {
+            &[][..]
+        } else {
+            &widths[..]
+        };
+        for (i, w) in fixed.iter().enumerate() {
             if let Some(col) = t.column_mut(i) {
                 let w = u16::try_from(*w + 2).unwrap_or(u16::MAX);
                 col.set_constraint(ColumnConstraint::LowerBoundary(Width::Fixed(w)));
             }
         }
         align_right(&mut t, &[4]);
-        section(out, &format!("{phase}:"), &t, &legend, layout);
+        section(
+            out,
+            &wrap(&format!("{phase}:"), layout.width, 2),
+            &t,
+            &legend,
+            layout,
+        );
         legend.clear();
         group = end;
     }
@@ -353,7 +366,7 @@ fn check_cells(key: &str, c: &Check) -> [String; 5] {
     let (measured, held_to) = match c.kind {
         CheckKind::Monitor => (
             format!("min {}", with_unit(c.value, 5, &c.unit)),
-            ">= 0".to_string(),
+            format!(">= {}", with_unit(c.limit, 3, &c.unit)),
         ),
         CheckKind::Drift => (
             format!("drift {}", format_number(c.value, 3)),
@@ -415,9 +428,10 @@ fn work(out: &mut String, results: &RunResults, layout: &Layout) {
 pub fn quantity_meaning(q: Quantity, info: &ModelInfo) -> String {
     match q {
         Quantity::ForceSeries(i) => {
+            let c = &info.contacts[i];
             format!(
-                "t and {} along the motion (N): {}",
-                info.forces[i].name, info.forces[i].meaning
+                "t and {} along the motion ({}): {}",
+                c.name, c.unit, c.meaning
             )
         }
         Quantity::Trajectory(i) => format!(
@@ -448,6 +462,38 @@ pub fn models(infos: &[&ModelInfo], layout: &Layout) -> String {
             2,
         ));
         out.push_str(&format!("\n  spec: {}\n", info.spec));
+        let contacts: Vec<&str> = info.contacts.iter().map(|c| c.name).collect();
+        if !contacts.is_empty() {
+            out.push_str("  ");
+            out.push_str(&wrap(
+                &format!("contacts: {}", contacts.join(", ")),
+                layout.width.map(|w| w.saturating_sub(2)),
+                2,
+            ));
+            out.push('\n');
+        }
+        let phases: Vec<String> = (info.phases.iter())
+            .map(|p| {
+                let closed: Vec<&str> = (p.closed.iter())
+                    .filter_map(|&i| info.contacts.get(i).map(|c| c.name))
+                    .collect();
+                let closed = if closed.is_empty() {
+                    "nothing".to_string()
+                } else {
+                    closed.join(", ")
+                };
+                format!("{} ({closed} closed)", p.model)
+            })
+            .collect();
+        if !phases.is_empty() {
+            out.push_str("  ");
+            out.push_str(&wrap(
+                &format!("fast phases: {}", phases.join("; ")),
+                layout.width.map(|w| w.saturating_sub(2)),
+                2,
+            ));
+            out.push('\n');
+        }
         let mut t = new_table(&["parameter", "unit", "meaning"], layout);
         for p in info.parameters {
             let meaning = if p.positive {

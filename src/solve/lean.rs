@@ -27,17 +27,40 @@
 //! high-precision reference (`rodcube::reference`, feature `cli`) across `n = m2/m1` from 1e-12 to 1e12 and
 //! `a/ell` from 1e-10 to `1 - 1e-9`.
 
+use crate::model::PhaseInfo;
 use crate::model::{LeanStart, Model, ModelInfo, Reduction, ReductionInfo};
+use crate::results::Work;
 use crate::solve::SolveError;
+use crate::solve::phases::{End, phase_end};
+use crate::solve::poly::horner;
 use crate::solve::poly::{self, MAX_DEGREE};
 use crate::solve::prior::{PRIOR_TOL, Prior, Singularities, integrate_prior, prior_panels};
 use crate::solve::quadrature::{
     self, ACCEPT, Control, Fall, FallIntegrand, HalfRule, PanelSum, RuleStep, SCHEDULE, v_at_drop,
 };
-use crate::solve::separation::separation_root;
 use crate::system::{
-    SystemError, check_parameters, ordered_values, positive_finite, prepare_constants,
+    System, SystemError, check_parameters, ordered_values, positive_finite, prepare_constants,
 };
+
+/// The fast phase a system starts in (its release phase), looked up in the registry; a model
+/// that is not a system's general model is taken as it is.
+fn release_phase(model: &dyn Model) -> Result<&dyn Model, SolveError> {
+    let info = model.info();
+    if !info.is_general() || model.reduction().is_some() && info.contacts.iter().all(|c| c.closed) {
+        return Ok(model);
+    }
+    let entry: Option<&PhaseInfo> = info.phases.iter().find(|p| p.release);
+    let Some(entry) = entry else {
+        return Err(SolveError::NotPerPoint {
+            model: info.name,
+            why: "it has no fast phase that starts at release",
+        });
+    };
+    crate::models::find(entry.model).ok_or(SolveError::UnknownPhaseModel {
+        system: info.name,
+        name: entry.model,
+    })
+}
 
 /// One point's separation.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -82,7 +105,6 @@ pub struct LeanSolver<'m> {
     sin_end: f64,
     k: Vec<f64>,
     margins: Vec<f64>,
-    coeffs: Vec<f64>,
     /// The fall polynomial's coefficients (empty without one).
     fall: Vec<f64>,
     control: Control,
@@ -145,28 +167,41 @@ impl<'m> LeanSolver<'m> {
         schedule: &[RuleStep],
         accept: f64,
     ) -> Result<Self, SolveError> {
+        let model = release_phase(model)?;
         let info = model.info();
-        if info.contact.is_none() {
-            return Err(SolveError::NoContact { model: info.name });
-        }
         let (Some(red), Some(layout)) = (model.reduction(), info.reduction.as_ref()) else {
             return Err(SolveError::Parameters(SystemError::NoReduction {
                 model: info.name,
                 why: info.route_note,
             }));
         };
-        let contact = info.contact.is_some_and(|c| c.edge);
-        if !layout.polynomial_separation || contact {
+        let why = if !info
+            .contacts
+            .first()
+            .is_some_and(|c| c.closed && !c.bilateral)
+        {
+            Some("its first contact is not a closed unilateral contact")
+        } else if info.contacts.iter().any(|c| !c.closed) {
+            Some("it leaves a contact open, whose gap only the planner watches")
+        } else if info.contacts.iter().any(|c| c.edge) {
+            Some("a contact can end at an edge")
+        } else if !layout.polynomial_separation() {
+            Some("its separation is no polynomial root")
+        } else if (info.contacts.iter().zip(layout.force_degrees))
+            .skip(1)
+            .any(|(c, &d)| !c.bilateral && d == 0)
+        {
+            Some("another contact's force has no polynomial whose roots the solver could check")
+        } else {
+            None
+        };
+        if let Some(why) = why {
             return Err(SolveError::NotPerPoint {
                 model: info.name,
-                why: if contact {
-                    "its contact can end at an edge"
-                } else {
-                    "its separation is no polynomial root"
-                },
+                why,
             });
         }
-        if layout.separation_degree > MAX_DEGREE {
+        if layout.separation_degree() > MAX_DEGREE {
             return Err(SolveError::BadPolynomial {
                 model: info.name,
                 coefficients: Vec::new(),
@@ -180,7 +215,6 @@ impl<'m> LeanSolver<'m> {
             sin_end: info.end_angle.sin(),
             k: vec![0.0; info.n_constants],
             margins: vec![0.0; info.requirements.len()],
-            coeffs: vec![0.0; layout.separation_degree + 1],
             fall: vec![0.0; layout.fall_degree.map_or(0, |d| d + 1)],
             control: Control::new(schedule, accept),
             prior: None,
@@ -240,18 +274,55 @@ impl<'m> LeanSolver<'m> {
         self.wide
     }
 
-    /// [`LeanSolver::solve`] by the checked route: every step's failure is a typed error.
+    /// [`LeanSolver::solve`] by the checked route: every step's failure is a typed error. The
+    /// phase's end comes from the planner's one route ([`phase_end`]): a closed contact that
+    /// does not push at release, or whose force reaches zero before the separation, leaves the
+    /// phase the solver solves, which is [`SolveError::NotThisPhase`].
     #[inline(never)]
     fn checked(&mut self, p: &[f64]) -> Result<LeanPoint, SolveError> {
         check_parameters(self.model, p, &mut self.margins).map_err(SolveError::Parameters)?;
-        if self.prior.is_some() {
-            self.red.prepare_lean(p, &mut self.k);
-            if let Ok(point) = self.solve_prepared() {
-                return Ok(point);
+        prepare_constants(self.model, p, &mut self.k).map_err(SolveError::Parameters)?;
+        let sys = System::from_values(self.model, p).map_err(SolveError::Parameters)?;
+        let mut work = Work::default();
+        let end = phase_end(&sys, &mut work)?;
+        self.evals += work.polynomial_evals;
+        let name = |i: usize| self.info.contacts.get(i).map_or("a contact", |c| c.name);
+        match end.end {
+            End::Force(0) => {}
+            End::Force(i) if end.delta == 0.0 => {
+                return Err(SolveError::NotThisPhase {
+                    model: self.info.name,
+                    contact: name(i),
+                    why: "would have to pull",
+                });
+            }
+            End::Force(i) => {
+                return Err(SolveError::NotThisPhase {
+                    model: self.info.name,
+                    contact: name(i),
+                    why: "lets go before the separation",
+                });
+            }
+            _ => {
+                return Err(SolveError::NoSeparation {
+                    model: self.info.name,
+                    coefficients: sys.separation_coefficients(),
+                    lo: self.sin_end,
+                    hi: self.k[self.layout.k_sin_initial],
+                });
             }
         }
-        prepare_constants(self.model, p, &mut self.k).map_err(SolveError::Parameters)?;
-        self.solve_prepared()
+        let si = self.k[self.layout.k_sin_initial];
+        if end.delta == 0.0 {
+            // The first contact lets go at once: separation at release.
+            return Ok(LeanPoint {
+                separation_angle: si.asin(),
+                separation_time: 0.0,
+                sines: [si, self.k[self.layout.k_cos_initial], si, 0.0],
+            });
+        }
+        let s = end.at.map_or(f64::NAN, |a| a.sin_theta);
+        self.solve_prepared(s, si - s)
     }
 
     /// [`LeanSolver::solve`] with the parameters by name (any order, each exactly once), put
@@ -270,9 +341,9 @@ impl<'m> LeanSolver<'m> {
         outcome
     }
 
-    /// The separation angle and time from prepared constants.
-    fn solve_prepared(&mut self) -> Result<LeanPoint, SolveError> {
-        let (s, drop) = self.separation()?;
+    /// The separation angle and time from prepared constants, the separation at `sin(theta)
+    /// = s`, `drop = sin(theta_i) - s` below the start.
+    fn solve_prepared(&mut self, s: f64, drop: f64) -> Result<LeanPoint, SolveError> {
         let (si, ci) = (
             self.k[self.layout.k_sin_initial],
             self.k[self.layout.k_cos_initial],
@@ -333,24 +404,6 @@ impl<'m> LeanSolver<'m> {
         self.evals += evals;
         Ok(t)
     }
-
-    /// `(sin(theta_sep), sin(theta_i) - sin(theta_sep))` from the largest sign-changing root of
-    /// the separation polynomial in `(sin(end_angle), sin(theta_i))`.
-    fn separation(&mut self) -> Result<(f64, f64), SolveError> {
-        let info = self.info;
-        self.red.separation_polynomial(&self.k, &mut self.coeffs);
-        let hi = self.k[self.layout.k_sin_initial];
-        let root = separation_root(info.name, &self.coeffs, self.sin_end, hi, &mut self.evals)?;
-        match root {
-            Some(s) => Ok((s, hi - s)),
-            None => Err(SolveError::NoSeparation {
-                model: info.name,
-                coefficients: self.coeffs.clone(),
-                lo: self.sin_end,
-                hi,
-            }),
-        }
-    }
 }
 
 /// Whether the CPU has AVX2 (where the unchecked route has a copy for it).
@@ -387,7 +440,23 @@ pub(crate) fn quick_route(
         return None;
     }
     let (sep, fall) = (&start.separation[..], &start.fall[..]);
+    // Every closed contact pushes at release (each polynomial has its force's sign), and no
+    // other one lets go before the separation.
+    // (A NaN is no push: `partial_cmp` is `None`, not `Greater`.)
+    let pushes = |p: &[f64]| horner(p, si).partial_cmp(&0.0) == Some(std::cmp::Ordering::Greater);
+    if !pushes(sep) {
+        return None;
+    }
     let s = poly::largest_root(sep, sin_end, si, evals)??;
+    for other in start.others.iter().take(start.n_others) {
+        // Positive on [s, si] by its Bernstein form (cheap), else by its roots.
+        if !pushes(other)
+            || (!poly::positive_on(other, s, si)
+                && poly::largest_root(other, s, si, evals)?.is_some())
+        {
+            return None;
+        }
+    }
     let drop = si - s;
     // 1 - sin(theta_i) without cancellation near upright.
     let e = ci * ci / (1.0 + si);

@@ -11,13 +11,14 @@
 //! [`Work`](crate::results::Work) passed down by the caller.
 
 pub mod checks;
-pub mod friction;
+pub mod contacts;
 pub mod lean;
 pub mod ode;
 pub mod phases;
 pub mod poly;
 pub mod prior;
 pub mod quadrature;
+pub mod rest;
 pub mod roots;
 pub mod separation;
 pub mod series;
@@ -46,8 +47,10 @@ pub enum SolveError {
     /// [`System::from_values`](crate::system::System::from_values)).
     #[error("{0}")]
     Parameters(SystemError),
-    /// Separation was asked of a model without a contact.
-    #[error("model `{model}` has no contact, so it cannot separate")]
+    /// Separation was asked of a model whose first contact is not closed in it.
+    #[error(
+        "model `{model}` does not hold a unilateral first contact closed, so it cannot separate"
+    )]
     NoContact {
         /// Model name.
         model: &'static str,
@@ -177,25 +180,130 @@ pub enum SolveError {
         /// Why.
         reason: &'static str,
     },
-    /// A friction model was solved with the wrong number of contact modes.
-    #[error("model `{model}` has {expected} friction contact(s), given {got} mode(s)")]
-    FrictionModes {
+    /// An active set whose size does not match the model's contacts or frictions.
+    #[error(
+        "model `{model}` has {contacts} contact(s) and {frictions} friction(s); the active set given has {closed} and {modes}"
+    )]
+    ActiveSize {
         /// Model name.
         model: &'static str,
+        /// Contacts of the model.
+        contacts: usize,
         /// Frictions of the model.
-        expected: usize,
-        /// Modes given.
-        got: usize,
+        frictions: usize,
+        /// Contact states given.
+        closed: usize,
+        /// Friction modes given.
+        modes: usize,
     },
-    /// No single consistent way for the friction contacts to move (stick or slide).
-    #[error("model `{model}` at t = {t:e} s: {why}")]
-    FrictionIndeterminate {
+    /// No single consistent set of closed contacts and friction modes (a contact that would
+    /// have to pull, Painlevé's paradox of friction, or several sets with different motions).
+    #[error("model `{model}` at t = {t:e} s ({contacts}): {why}")]
+    Indeterminate {
         /// Model name.
         model: &'static str,
-        /// Time in the phase.
+        /// Time from release.
         t: f64,
+        /// The contacts concerned, comma-separated.
+        contacts: String,
         /// What was found.
         why: String,
+    },
+    /// The reduced angle reaches its end angle with the body above the floor.
+    #[error(
+        "model `{model}` at t = {t:e} s: the angle reaches its end ({angle} rad) with `{point}` {height:e} m above the floor, so the body has not landed (a support lifted it); the spec's end angle does not describe the motion from here, and rodcube stops rather than report a landing"
+    )]
+    AboveFloor {
+        /// Model name.
+        model: &'static str,
+        /// Time from release (s).
+        t: f64,
+        /// The end angle (rad).
+        angle: f64,
+        /// The falling point.
+        point: &'static str,
+        /// Its height (m).
+        height: f64,
+    },
+    /// A phase that starts at rest and turns back before any contact ends: it swings for ever.
+    #[error(
+        "model `{model}`: the motion from rest at t = {t:e} s turns back after falling {delta:e} rad, before any contact ends; with one degree of freedom and no friction it swings between its two turning points for ever, so no contact ends and the motion never reaches the floor"
+    )]
+    Swings {
+        /// The phase's model.
+        model: &'static str,
+        /// Where the phase starts (s from release).
+        t: f64,
+        /// The angle fallen to the turning point (rad).
+        delta: f64,
+    },
+    /// The supports hold the system at rest: nothing moves, so no contact ends.
+    #[error(
+        "model `{model}` at t = {t:e} s: the system stays at rest, held {how} (each within its law: contacts push, stuck frictions within mu N); nothing moves from here, so no contact ends and there is no motion to report"
+    )]
+    AtRest {
+        /// Model name.
+        model: &'static str,
+        /// Time from release (s).
+        t: f64,
+        /// The supports that hold it, in words.
+        how: String,
+    },
+    /// Bodies that overlap where a phase starts (a gap below zero).
+    #[error(
+        "model `{model}`: contact `{contact}` overlaps at t = {t:e} s (gap {gap:e} {unit}): {}",
+        if *t == 0.0 { "the initial state puts the bodies into each other" } else { "the bodies have moved into each other beyond the tolerance" }
+    )]
+    Overlap {
+        /// Time from release (s).
+        t: f64,
+        /// Model name.
+        model: &'static str,
+        /// The contact.
+        contact: &'static str,
+        /// Its gap.
+        gap: f64,
+        /// The gap's unit.
+        unit: &'static str,
+    },
+    /// A contact that closes with a velocity at release (an impact, not modelled yet).
+    #[error(
+        "model `{model}`: contact `{contact}` is closing at release with normal velocity {velocity:e}: an impact, which rodcube does not model yet"
+    )]
+    ImpactAtRelease {
+        /// Model name.
+        model: &'static str,
+        /// The contact.
+        contact: &'static str,
+        /// Its normal velocity (negative: closing).
+        velocity: f64,
+    },
+    /// The phase the per-point solver solves is not the one the system starts in.
+    #[error(
+        "model `{model}`: at release contact `{contact}` {why}, so the motion does not start in this phase; solve the system with the planner (`rodcube run`)"
+    )]
+    NotThisPhase {
+        /// Model name.
+        model: &'static str,
+        /// The contact.
+        contact: &'static str,
+        /// What it does.
+        why: &'static str,
+    },
+    /// The closed contacts' constraints and the mass matrix form a singular system
+    /// (contacts that are redundant, or a mass matrix that is not invertible).
+    #[error(
+        "model `{model}` at t = {t:e} s: the equations with {closed} closed are singular at q = {q:?} (redundant contacts, or a singular mass matrix)"
+    )]
+    SingularContacts {
+        /// Model name.
+        model: &'static str,
+        /// Time.
+        t: f64,
+        /// The closed contacts, comma-separated.
+        closed: String,
+        /// Coordinates.
+        q: Vec<f64>,
     },
     /// The friction contacts switched between sticking and sliding too often (chatter).
     #[error(
@@ -263,27 +371,32 @@ pub enum SolveError {
         /// The time limit.
         t_max: f64,
     },
-    /// The next phase's model is not in the registry.
-    #[error("model `{from}` continues with `{name}`, which is not in the registry")]
-    UnknownNextModel {
-        /// This model.
-        from: &'static str,
+    /// A quantity of the energy integral was asked where the motion does not start on a fast
+    /// phase.
+    #[error("model `{model}` does not start on the fast path: {why}")]
+    NotOnFastPath {
+        /// Model name.
+        model: &'static str,
+        /// Why.
+        why: String,
+    },
+    /// A phase's model is not in the registry.
+    #[error("system `{system}` continues with `{name}`, which is not in the registry")]
+    UnknownPhaseModel {
+        /// The system.
+        system: &'static str,
         /// The missing model.
         name: &'static str,
     },
-    /// A next-phase binding does not fit either model.
-    #[error(
-        "model `{from}` binds {got} values to `{name}`, which takes {expected} parameters (or a binding index is out of range)"
-    )]
-    BadBindings {
-        /// This model.
-        from: &'static str,
-        /// The next model.
+    /// A phase model whose parameters or coordinates do not fit its system's.
+    #[error("phase `{name}` of system `{system}` does not fit it: {why}")]
+    PhaseMismatch {
+        /// The system.
+        system: &'static str,
+        /// The phase model.
         name: &'static str,
-        /// Parameters of the next model.
-        expected: usize,
-        /// Bindings given.
-        got: usize,
+        /// What does not fit.
+        why: String,
     },
     /// The per-point solver handles separations that are polynomial roots, without edges.
     #[error(

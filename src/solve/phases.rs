@@ -1,29 +1,31 @@
-//! Phases of the motion: one model from its start until its contact ends (the force reaching
-//! zero, or the contact running off an edge) or the rod reaches the floor, and the chain to the
-//! next model (the same spec with the contact's coordinate free) down to the floor.
+//! Phases of the motion of a system: at release, and after every event, the contacts that stay
+//! closed are decided ([`contacts::decide`]); each stretch with one set of closed contacts is
+//! a phase, solved on the fast path where the system has a fast phase for that set, otherwise
+//! by integrating the general model with the closed contacts as constraints; the motion goes on
+//! from phase to phase until the rod reaches the floor, a contact runs off an edge, or an open
+//! contact closes (the bodies meet: impacts are not modelled yet, so the run ends there with
+//! cause `contact`).
 //!
-//! A phase is solved on one of two routes. A model with a fast path ([`System`]) is solved by
-//! the separation root and the time quadrature of its energy integral; any other model
-//! ([`Bound`]) by integrating `M(q) qdd = F(q, qd)` with event location on the contact force,
-//! the contact's edge and the floor ([`unreduced::integrate`]).
-//!
-//! A next phase gets its parameters from [`NextPhase::bindings`](crate::model::NextPhase): a
-//! parameter of this model, a coordinate or velocity at the end of the phase, or the value and
-//! rate of the coordinate the contact tied ([`Model::released`]).
-//! Its clock restarts at zero; the absolute time of its start is kept in [`PhaseRun::t_start`].
+//! A fast phase that starts from a given state takes it as parameters (`<q>_0`,
+//! `<q>_dot_0`, bound from the system's state by coordinate name); the one that starts from
+//! the spec's release state serves only at release. A phase's clock restarts at zero; the
+//! absolute time of its start is kept in [`PhaseRun::t_start`].
 
-use crate::model::{Binding, Model};
+use crate::model::{Model, ModelInfo};
 use crate::results::Work;
 use crate::solve::SolveError;
-use crate::solve::friction::{self, Mode};
+use crate::solve::contacts::{
+    self, Active, ContactOption, FrictionOption, Moment, Options, contact_options, friction_options,
+};
 use crate::solve::quadrature::TimeMesh;
-use crate::solve::separation::{Separation, SeparationOutcome, edge, separation};
+use crate::solve::roots::{self, changes_sign};
+use crate::solve::separation::{Separation, SeparationOutcome, edge, force_zero};
 use crate::solve::series::theta_dot_at;
-use crate::solve::unreduced::{self, EndEvent, UnreducedRun};
+use crate::solve::unreduced::{self, EndEvent, Start, UnreducedRun, motion_scales};
 use crate::system::{Bound, State, System};
 
 /// Most phases chained before giving up.
-pub const MAX_PHASES: usize = 8;
+pub const MAX_PHASES: usize = 16;
 
 /// An integrated phase that has not reached an event after this many free-fall times of its
 /// falling point is reported as [`SolveError::NoEvent`]. Generous: a light rod that pushes a
@@ -31,34 +33,70 @@ pub const MAX_PHASES: usize = 8;
 /// takes some ten thousand.
 pub const MAX_FALL_TIMES: f64 = 1e5;
 
+/// How far (relative to the system's length) the falling point may be from the floor where
+/// the reduced angle reaches its end angle, and still count as landed.
+pub const LANDING_TOLERANCE: f64 = 1e-9;
+
+/// Cells of the grid, uniform in the fast path's time variable, on which an open contact's gap
+/// is watched for closing (the first cell whose ends differ in sign; a touch without a crossing
+/// inside one cell is not seen).
+pub const GAP_CELLS: usize = 64;
+
 /// Which route solves a phase.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Route {
-    /// The fast path where the model has one, integration otherwise.
+    /// The fast path where the system has one for the phase, integration otherwise.
     #[default]
     Fastest,
-    /// Integration of `M(q) qdd = F` for every phase, fast path or not (to compare the routes).
+    /// Integration of the general model for every phase (to compare the routes).
     Integrated,
 }
 
 /// Why a phase ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum End {
-    /// The contact force reached zero: the bodies separate.
-    Separation,
-    /// The contact ran off an edge of a body.
-    Edge,
+    /// A closed contact's force reached zero: it opens (the first contact's is the separation).
+    Force(usize),
+    /// A closed contact's point ran off the edge of a body.
+    Edge(usize),
+    /// An open contact's gap closed: the bodies meet.
+    Contact(usize),
     /// The reduced angle reached the model's end angle (the rod lies on the floor).
     Floor,
 }
 
 impl End {
-    /// `"force"`, `"edge"` or `"floor"`.
-    pub fn name(self) -> &'static str {
+    /// `"force"`, `"edge"`, `"contact"` or `"floor"`.
+    pub fn cause(self) -> &'static str {
         match self {
-            End::Separation => "force",
-            End::Edge => "edge",
+            End::Force(_) => "force",
+            End::Edge(_) => "edge",
+            End::Contact(_) => "contact",
             End::Floor => "floor",
+        }
+    }
+
+    /// The contact the event is about (none at the floor).
+    pub fn contact(self) -> Option<usize> {
+        match self {
+            End::Force(i) | End::Edge(i) | End::Contact(i) => Some(i),
+            End::Floor => None,
+        }
+    }
+
+    /// Whether the motion goes on after it (only a contact that opens lets it).
+    pub fn continues(self) -> bool {
+        matches!(self, End::Force(_))
+    }
+}
+
+impl From<EndEvent> for End {
+    fn from(e: EndEvent) -> End {
+        match e {
+            EndEvent::Force(i) => End::Force(i),
+            EndEvent::Edge(i) => End::Edge(i),
+            EndEvent::Gap(i) => End::Contact(i),
+            EndEvent::Floor => End::Floor,
         }
     }
 }
@@ -66,33 +104,59 @@ impl End {
 /// Where a phase on the fast path ends.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ReducedEnd {
-    /// Why: the contact force's zero, the contact's edge, or the floor.
+    /// Why.
     pub end: End,
-    /// The angle where the contact ends (`None` at the floor).
+    /// The angle where a contact ends (`None` at the floor).
     pub at: Option<Separation>,
     /// The angle fallen at the end.
     pub delta: f64,
 }
 
-/// Where a phase on the fast path ends: the first of its separation and its contact's edge,
-/// else the floor.
+/// Where a phase on the fast path ends, by its roots alone: the first of its closed contacts'
+/// force zeros and edges, else the floor. A closed contact whose force pulls at the start ends
+/// the phase there (`delta = 0`): it opens at once; a force that is not finite there is
+/// [`SolveError::NonFinite`].
 pub fn phase_end(sys: &System, work: &mut Work) -> Result<ReducedEnd, SolveError> {
-    let Some(contact) = sys.info().contact else {
-        return Ok(ReducedEnd {
-            end: End::Floor,
-            at: None,
-            delta: sys.delta_to_floor(),
-        });
-    };
+    let info = sys.info();
+    let at_start = sys.forces(0.0);
     let mut found: Option<(End, Separation)> = None;
-    if let SeparationOutcome::Separates(s) = separation(sys, work)? {
-        found = Some((End::Separation, s));
+    let mut consider = |end: End, outcome: SeparationOutcome| {
+        if let SeparationOutcome::Separates(s) = outcome
+            && found.is_none_or(|(_, f)| s.delta < f.delta)
+        {
+            found = Some((end, s));
+        }
+    };
+    for (i, c) in info.contacts.iter().enumerate() {
+        if !c.closed || c.bilateral {
+            continue;
+        }
+        if !at_start[i].is_finite() {
+            return Err(SolveError::NonFinite {
+                model: info.name,
+                what: "a closed contact's force at the phase's start",
+                delta: 0.0,
+                value: at_start[i],
+            });
+        }
+        if at_start[i] < 0.0 {
+            let theta = sys.theta_initial();
+            return Ok(ReducedEnd {
+                end: End::Force(i),
+                at: Some(Separation {
+                    sin_theta: theta.sin(),
+                    theta,
+                    delta: 0.0,
+                }),
+                delta: 0.0,
+            });
+        }
+        consider(End::Force(i), force_zero(sys, i, work)?);
     }
-    if contact.edge
-        && let SeparationOutcome::Separates(e) = edge(sys, work)?
-        && found.is_none_or(|(_, s)| e.delta < s.delta)
-    {
-        found = Some((End::Edge, e));
+    for (i, c) in info.contacts.iter().enumerate() {
+        if c.closed && c.edge {
+            consider(End::Edge(i), edge(sys, i, work)?);
+        }
     }
     Ok(match found {
         Some((end, at)) => ReducedEnd {
@@ -122,7 +186,8 @@ pub struct ReducedRun<'m> {
 }
 
 impl<'m> ReducedRun<'m> {
-    /// Solves the phase when its end is already known.
+    /// Solves the phase when the end of its closed contacts is already known, then watches its
+    /// open contacts' gaps along it: one that closes first ends the phase there.
     pub fn with_end(
         sys: System<'m>,
         t_start: f64,
@@ -130,7 +195,31 @@ impl<'m> ReducedRun<'m> {
         tol: f64,
         work: &mut Work,
     ) -> Result<Self, SolveError> {
-        let mesh = TimeMesh::build(&sys, end.delta, tol, work)?;
+        if end.delta == 0.0 {
+            // A contact that opens at once: a phase of no length.
+            work.phases.push(sys.name().to_string());
+            return Ok(ReducedRun {
+                mesh: TimeMesh::empty(),
+                system: sys,
+                t_start,
+                end,
+            });
+        }
+        let mut mesh = TimeMesh::build(&sys, end.delta, tol, work)?;
+        let mut end = end;
+        if let Some((i, delta)) = first_gap_closing(&sys, &mesh, work)? {
+            mesh = TimeMesh::build(&sys, delta, tol, work)?;
+            let theta = sys.theta_initial() - delta;
+            end = ReducedEnd {
+                end: End::Contact(i),
+                at: Some(Separation {
+                    sin_theta: theta.sin(),
+                    theta,
+                    delta,
+                }),
+                delta,
+            };
+        }
         work.phases.push(sys.name().to_string());
         Ok(ReducedRun {
             system: sys,
@@ -140,10 +229,10 @@ impl<'m> ReducedRun<'m> {
         })
     }
 
-    /// The separation that ends it, if its contact force reached zero.
+    /// The separation that ends it, if its first contact's force reached zero.
     pub fn separation(&self) -> Option<Separation> {
         match self.end.end {
-            End::Separation => self.end.at,
+            End::Force(0) => self.end.at,
             _ => None,
         }
     }
@@ -168,10 +257,67 @@ impl<'m> ReducedRun<'m> {
     }
 }
 
-/// A phase solved by integrating its equations of motion.
+/// The first open contact whose gap closes along a fast phase, and the angle fallen where it
+/// does: each open contact's gap on [`GAP_CELLS`] cells uniform in the time variable `v`,
+/// bracketed and refined by [`roots::illinois`] in the angle fallen. A gap that starts at zero
+/// (a contact that has just opened) counts only once it has grown past rounding.
+fn first_gap_closing(
+    sys: &System,
+    mesh: &TimeMesh,
+    work: &mut Work,
+) -> Result<Option<(usize, f64)>, SolveError> {
+    let info = sys.info();
+    let open: Vec<usize> = (0..info.contacts.len())
+        .filter(|&i| !info.contacts[i].closed)
+        .collect();
+    if open.is_empty() {
+        return Ok(None);
+    }
+    let state_at = |delta: f64, work: &mut Work| -> Result<State, SolveError> {
+        let t = mesh.time_at_delta(sys, delta, work)?;
+        Ok(sys.full_state(t, delta, theta_dot_at(sys, delta)))
+    };
+    let tol = contacts::DECIDE_TOLERANCE * sys.length_scale(&state_at(0.0, work)?);
+    let mut best: Option<(usize, f64)> = None;
+    for &i in &open {
+        let mut gap = |delta: f64| -> Result<f64, SolveError> {
+            let mut w = Work::default();
+            let g = sys.gaps(&state_at(delta, &mut w)?)[i];
+            work.integrand_evals += w.integrand_evals;
+            Ok(g)
+        };
+        let mut armed = gap(0.0)? > tol;
+        let mut a = (0.0, 1.0);
+        for j in 1..=GAP_CELLS {
+            let v = mesh.v_end * j as f64 / GAP_CELLS as f64;
+            let delta = if j == GAP_CELLS {
+                mesh.delta_end
+            } else {
+                mesh.delta_at_v(sys, v)?
+            };
+            let g = gap(delta)?;
+            if !armed {
+                armed = g > tol;
+                a = (delta, 1.0);
+                continue;
+            }
+            if changes_sign(a.1, g) {
+                let root = roots::illinois(&mut gap, a, (delta, g))?;
+                if best.is_none_or(|(_, d)| root < d) {
+                    best = Some((i, root));
+                }
+                break;
+            }
+            a = (delta, g);
+        }
+    }
+    Ok(best)
+}
+
+/// A phase solved by integrating the general model's equations.
 #[derive(Debug, Clone)]
 pub struct IntegratedRun<'m> {
-    /// The model and its parameters for this phase.
+    /// The general model and its parameters.
     pub bound: Bound<'m>,
     /// Absolute time of the phase start (s from release).
     pub t_start: f64,
@@ -189,41 +335,6 @@ pub enum PhaseRun<'m> {
 }
 
 impl<'m> PhaseRun<'m> {
-    /// Solves a phase starting at absolute time `t_start` to its end, on the fast path when the
-    /// model has one (and `route` allows it). `rtol` is the integrator's tolerance on the other
-    /// route.
-    pub fn solve(
-        bound: Bound<'m>,
-        t_start: f64,
-        tol: f64,
-        rtol: f64,
-        route: Route,
-        work: &mut Work,
-    ) -> Result<Self, SolveError> {
-        if route == Route::Fastest && bound.model().reduction().is_some() {
-            let sys = System::reduce(bound)?;
-            let end = phase_end(&sys, work)?;
-            let run = ReducedRun::with_end(sys, t_start, end, tol, work)?;
-            return Ok(PhaseRun::Reduced(run));
-        }
-        let time = fall_time_scale(&bound);
-        let scales = motion_scales(&bound, time)?;
-        let run = unreduced::integrate(&bound, rtol, Some(&scales), time * MAX_FALL_TIMES, work)?;
-        if bound.info().frictions.is_empty() {
-            work.phases.push(bound.name().to_string());
-        } else {
-            // One entry per stretch of constant contact modes: `rod_cube_friction (foot_friction sticks)`.
-            for (_, modes) in run.switches(&bound) {
-                work.phases.push(format!("{} ({modes})", bound.name()));
-            }
-        }
-        Ok(PhaseRun::Integrated(IntegratedRun {
-            bound,
-            t_start,
-            run,
-        }))
-    }
-
     /// The model and its parameters.
     pub fn bound(&self) -> &Bound<'m> {
         match self {
@@ -257,20 +368,21 @@ impl<'m> PhaseRun<'m> {
     pub fn end(&self) -> End {
         match self {
             PhaseRun::Reduced(r) => r.end.end,
-            PhaseRun::Integrated(r) => match r.run.end {
-                EndEvent::Separation => End::Separation,
-                EndEvent::Edge => End::Edge,
-                EndEvent::Floor => End::Floor,
-            },
+            PhaseRun::Integrated(r) => r.run.end.into(),
         }
     }
 
-    /// The full state at the end of the phase.
+    /// The state at the end of the phase, in its model's coordinates.
     pub fn end_state(&self) -> State {
         match self {
             PhaseRun::Reduced(r) => r.end_state(),
             PhaseRun::Integrated(r) => r.run.state_end.clone(),
         }
+    }
+
+    /// The system's state at the end of the phase (the general model's coordinates).
+    pub fn full_end_state(&self) -> State {
+        self.bound().to_full(&self.end_state())
     }
 
     /// The reduced angle at the end of the phase (rad).
@@ -286,7 +398,8 @@ impl<'m> PhaseRun<'m> {
         }
     }
 
-    /// Work done by friction over the phase (J, `<= 0`; zero without friction).
+    /// Work done by friction from release to the end of the phase (J, `<= 0`; zero without
+    /// friction).
     pub fn friction_work(&self) -> f64 {
         match self {
             PhaseRun::Reduced(_) => 0.0,
@@ -294,15 +407,51 @@ impl<'m> PhaseRun<'m> {
         }
     }
 
-    /// The friction contacts' modes over the phase: each stretch's start (s from release) and
-    /// its modes (`foot_friction sticks`); empty without friction.
-    pub fn contact_modes(&self) -> Vec<(f64, String)> {
+    /// The contacts closed during the phase (at its start; a friction switch changes only the
+    /// modes).
+    pub fn closed(&self) -> Vec<bool> {
         match self {
-            PhaseRun::Integrated(r) if !r.bound.info().frictions.is_empty() => (r.run)
+            PhaseRun::Reduced(r) => r.system.info().contacts.iter().map(|c| c.closed).collect(),
+            PhaseRun::Integrated(r) => (r.run.segments.first())
+                .map(|s| s.active.closed.clone())
+                .unwrap_or_default(),
+        }
+    }
+
+    /// The contacts closed at the end of the phase (in the general model's order).
+    pub fn closed_at_end(&self) -> Vec<bool> {
+        match self {
+            PhaseRun::Reduced(r) => r.system.info().contacts.iter().map(|c| c.closed).collect(),
+            PhaseRun::Integrated(r) => (r.run.segments.last())
+                .map(|s| s.active.closed.clone())
+                .unwrap_or_default(),
+        }
+    }
+
+    /// The active sets over the phase: each stretch's start (s from release) and its closed
+    /// contacts and friction modes in words.
+    pub fn stretches(&self) -> Vec<(f64, String)> {
+        match self {
+            PhaseRun::Reduced(r) => {
+                let info = r.system.info();
+                vec![(r.t_start, Active::of_model(info).describe(info))]
+            }
+            PhaseRun::Integrated(r) => (r.run)
                 .switches(&r.bound)
                 .map(|(t, modes)| (r.t_start + t, modes))
                 .collect(),
-            _ => Vec::new(),
+        }
+    }
+
+    /// The phase as `work.phases` names it: its model, and for an integrated phase the closed
+    /// contacts (and friction modes) of each stretch.
+    pub fn labels(&self) -> Vec<String> {
+        match self {
+            PhaseRun::Reduced(r) => vec![r.system.name().to_string()],
+            PhaseRun::Integrated(r) => (r.run)
+                .switches(&r.bound)
+                .map(|(_, modes)| format!("{} ({modes})", r.bound.name()))
+                .collect(),
         }
     }
 
@@ -315,124 +464,33 @@ impl<'m> PhaseRun<'m> {
     }
 }
 
-/// `sqrt(2 h / g)` for the initial height `h` of the falling point (`sqrt(2 m / g)` when it
-/// starts on the floor): the time scale of the motion.
-fn fall_time_scale(bound: &Bound) -> f64 {
+/// `sqrt(2 h / g)` for the height `h` of the falling point at `state` (`sqrt(2 m / g)` when it
+/// is on the floor): the time scale of the motion.
+pub fn fall_time_scale(bound: &Bound, state: &State) -> f64 {
     let info = bound.info();
-    let h = bound.points(&bound.initial_state()).pos[info.falling_point][1];
+    let h = bound.points(state).pos[info.falling_point][1];
     let h = if h > 0.0 { h } else { 1.0 };
     (2.0 * h / bound.gravity()).sqrt()
 }
 
-/// Typical sizes of the motion's deviation from the release state over the time scale `time`,
-/// for the integrator's absolute tolerances: `|qd0| T + |qdd0| T^2 / 2` for the coordinates and
-/// `|qd0| + |qdd0| T` for the velocities, each at least `1e-8` of the largest of its kind, so
-/// that a tiny system (a rod of 1 cm nearly flat) is held to its own scale, not to one metre.
-fn motion_scales(bound: &Bound, time: f64) -> Result<Vec<f64>, SolveError> {
-    let start = bound.initial_state();
-    let mut qdd = unreduced::start_dynamics(bound)?.qdd;
-    // A stuck contact's coordinate has no acceleration at the start but may slide later: its
-    // scale is the one it would have sliding (else rounding noise in the stuck phase sets the
-    // step size).
-    let m = bound.info().frictions.len();
-    if m > 0
-        && let Ok(sliding) = friction::dynamics(bound, &start, &vec![Mode::Slide(1.0); m], 0.0)
-    {
-        for (a, s) in qdd.iter_mut().zip(&sliding.qdd) {
-            *a = a.abs().max(s.abs());
-        }
-    }
-    let q: Vec<f64> = (start.qd.iter().zip(&qdd))
-        .map(|(v, a)| v.abs() * time + 0.5 * a.abs() * time * time)
-        .collect();
-    let v: Vec<f64> = (start.qd.iter().zip(&qdd))
-        .map(|(v, a)| v.abs() + a.abs() * time)
-        .collect();
-    let floor = |x: Vec<f64>| {
-        let top = x.iter().cloned().fold(0.0, f64::max);
-        x.into_iter()
-            .map(|s| s.max(1e-8 * top).max(f64::MIN_POSITIVE))
-            .collect::<Vec<f64>>()
-    };
-    let mut scales = floor(q);
-    scales.extend(floor(v));
-    Ok(scales)
-}
-
-/// The bound model of the phase after `run`, from the registry: only after a separation (the
-/// motion after a contact runs off an edge is not modelled).
-pub fn next_bound<'m>(
-    run: &PhaseRun<'m>,
-    registry: &[&'m dyn Model],
-) -> Result<Option<Bound<'m>>, SolveError> {
-    let bound = run.bound();
-    let info = bound.info();
-    let Some(next) = info.next_phase else {
-        return Ok(None);
-    };
-    if run.end() != End::Separation {
-        return Ok(None);
-    }
-    let Some(model) = registry
-        .iter()
-        .copied()
-        .find(|m| m.info().name == next.model)
-    else {
-        return Err(SolveError::UnknownNextModel {
-            from: info.name,
-            name: next.model,
-        });
-    };
-    let expected = model.info().parameters.len();
-    let bad = || SolveError::BadBindings {
-        from: info.name,
-        name: next.model,
-        expected,
-        got: next.bindings.len(),
-    };
-    if next.bindings.len() != expected {
-        return Err(bad());
-    }
-    let end = run.end_state();
-    let released = bound.released(&end);
-    let p = bound.p();
-    let values = next
-        .bindings
-        .iter()
-        .map(|b| match *b {
-            Binding::Param(i) => p.get(i).copied(),
-            Binding::Coordinate(i) => end.q.get(i).copied(),
-            Binding::Velocity(i) => end.qd.get(i).copied(),
-            Binding::Eliminated => released.map(|r| r[0]),
-            Binding::EliminatedRate => released.map(|r| r[1]),
-        })
-        .collect::<Option<Vec<f64>>>()
-        .ok_or_else(bad)?;
-    Ok(Some(Bound::from_values(model, &values)?))
-}
-
-/// The whole motion from release to the floor, phase after phase.
+/// The whole motion, phase after phase.
 #[derive(Debug, Clone)]
 pub struct Motion<'m> {
-    /// The phases in order; the last one reaches the floor (or ends at an edge).
+    /// The phases in order; the last one reaches the floor, an edge or a closing contact.
     pub phases: Vec<PhaseRun<'m>>,
+    /// The contacts that touched at release but opened at once (their force would have had to
+    /// pull).
+    pub opened_at_release: Vec<usize>,
 }
 
 impl<'m> Motion<'m> {
-    /// A motion made of its first phase.
-    pub fn new(first: PhaseRun<'m>) -> Self {
-        Motion {
-            phases: vec![first],
-        }
-    }
-
-    /// Absolute time the last phase ends (s): the rod on the floor, unless it ended at an edge.
-    pub fn floor_time(&self) -> f64 {
+    /// Absolute time the last phase ends (s).
+    pub fn end_time(&self) -> f64 {
         self.phases.last().map_or(0.0, PhaseRun::t_end)
     }
 
     /// `theta_dot` at the end of the last phase (rad/s).
-    pub fn impact_angular_velocity(&self) -> f64 {
+    pub fn end_angular_velocity(&self) -> f64 {
         self.phases.last().map_or(0.0, PhaseRun::theta_dot_end)
     }
 
@@ -440,27 +498,350 @@ impl<'m> Motion<'m> {
     pub fn last_end(&self) -> Option<End> {
         self.phases.last().map(PhaseRun::end)
     }
+
+    /// Whether the motion is complete: its last phase ends for good (the floor, an edge or a
+    /// contact that closes).
+    pub fn complete(&self) -> bool {
+        self.last_end().is_some_and(|e| !e.continues())
+    }
 }
 
-/// Continues the motion from its last phase through every next phase to the floor.
-pub fn extend_to_floor<'m>(
-    motion: &mut Motion<'m>,
-    registry: &[&'m dyn Model],
-    tol: f64,
-    rtol: f64,
-    route: Route,
-    work: &mut Work,
-) -> Result<(), SolveError> {
-    loop {
-        let last = &motion.phases[motion.phases.len() - 1];
-        let Some(next) = next_bound(last, registry)? else {
-            return Ok(());
-        };
-        if motion.phases.len() >= MAX_PHASES {
-            return Err(SolveError::TooManyPhases { limit: MAX_PHASES });
-        }
-        let t_start = last.t_end();
-        let run = PhaseRun::solve(next, t_start, tol, rtol, route, work)?;
-        motion.phases.push(run);
+/// How a system's motion is solved: its general model with parameters, where to find its
+/// fast phases, the tolerances and the route.
+#[derive(Clone)]
+pub struct Walker<'m> {
+    /// The general model with its parameters.
+    pub general: Bound<'m>,
+    /// Where the fast phases are looked up by name.
+    pub registry: &'m [&'m dyn Model],
+    /// Relative tolerance of the fast path's quadrature.
+    pub tol: f64,
+    /// Relative tolerance of the integrator.
+    pub rtol: f64,
+    /// Which route solves the phases.
+    pub route: Route,
+}
+
+impl std::fmt::Debug for Walker<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Walker")
+            .field("general", &self.general)
+            .field("tol", &self.tol)
+            .field("rtol", &self.rtol)
+            .field("route", &self.route)
+            .finish()
     }
+}
+
+/// Where a phase starts: the system's state, its active set and the friction options it was
+/// decided from, and the absolute time.
+#[derive(Debug, Clone)]
+pub struct PhaseStart {
+    /// The system's state.
+    pub state: State,
+    /// The closed contacts and friction modes.
+    pub active: Active,
+    /// The friction options the modes were decided from.
+    pub frictions: Vec<FrictionOption>,
+    /// Absolute time (s from release).
+    pub t: f64,
+    /// Work done by friction before (J).
+    pub friction_work: f64,
+}
+
+impl<'m> Walker<'m> {
+    /// The release: the system's initial state and the contacts that stay closed there (the
+    /// acceleration-level complementarity problem), with those that touched but opened.
+    pub fn release(&self) -> Result<(PhaseStart, Vec<usize>), SolveError> {
+        let state = self.general.initial_state();
+        let contacts = contact_options(&self.general, &state, Moment::Release)?;
+        let frictions = friction_options(&self.general, &state);
+        let options = Options {
+            contacts: contacts.clone(),
+            frictions: frictions.clone(),
+        };
+        let active = contacts::decide(&self.general, &state, &options, 0.0)?;
+        let opened = (0..contacts.len())
+            .filter(|&i| contacts[i] == ContactOption::Candidate && !active.closed[i])
+            .collect();
+        Ok((
+            PhaseStart {
+                state,
+                active,
+                frictions,
+                t: 0.0,
+                friction_work: 0.0,
+            },
+            opened,
+        ))
+    }
+
+    /// What follows a phase that ended with contact `opened`'s force at zero: the contacts
+    /// that stay closed there, that one open.
+    pub fn after(&self, run: &PhaseRun<'m>) -> Result<PhaseStart, SolveError> {
+        let state = run.full_end_state();
+        let t = run.t_end();
+        let held = run.closed_at_end();
+        let at = Moment::After {
+            t,
+            held: &held,
+            drift: self.tol,
+        };
+        let mut contacts = contact_options(&self.general, &state, at)?;
+        if let End::Force(i) = run.end()
+            && let Some(c) = contacts.get_mut(i)
+        {
+            *c = ContactOption::Opens;
+        }
+        let frictions = friction_options(&self.general, &state);
+        let options = Options {
+            contacts,
+            frictions: frictions.clone(),
+        };
+        let active = contacts::decide(&self.general, &state, &options, t)?;
+        Ok(PhaseStart {
+            state,
+            active,
+            frictions,
+            t,
+            friction_work: run.friction_work(),
+        })
+    }
+
+    /// The fast phase for `start`'s closed contacts, bound to start there, if the route allows
+    /// it and the system has one that applies (no friction acting; a phase that starts from
+    /// the spec's release state only at release; a phase that falls).
+    pub fn fast_phase(&self, start: &PhaseStart) -> Result<Option<System<'m>>, SolveError> {
+        let info = self.general.info();
+        if self.route != Route::Fastest
+            || (0..info.frictions.len()).any(|j| start.active.friction_acts(info, j))
+        {
+            return Ok(None);
+        }
+        let closed: Vec<usize> = (0..start.active.closed.len())
+            .filter(|&i| start.active.closed[i])
+            .collect();
+        let Some(entry) = info.phases.iter().find(|p| p.closed == closed.as_slice()) else {
+            return Ok(None);
+        };
+        let Some(model) = (self.registry.iter().copied()).find(|m| m.info().name == entry.model)
+        else {
+            return Err(SolveError::UnknownPhaseModel {
+                system: info.name,
+                name: entry.model,
+            });
+        };
+        let phase = model.info();
+        if !phase.start_params && start.t != 0.0 {
+            return Ok(None);
+        }
+        let p = phase_parameters(&self.general, phase, &start.state)?;
+        let sys = System::from_values(model, &p)?;
+        // The fast path follows a falling angle from below the vertical.
+        let falls = sys.theta_dot_initial() <= 0.0 && sys.theta_initial().cos() > 0.0;
+        Ok(falls.then_some(sys))
+    }
+
+    /// Solves one phase from `start` to its end: on the fast path where [`Walker::fast_phase`]
+    /// gives one (and its motion does not turn back before the end), else integrated.
+    pub fn solve(&self, start: &PhaseStart, work: &mut Work) -> Result<PhaseRun<'m>, SolveError> {
+        match self.fast_phase(start)? {
+            Some(sys) => {
+                let end = phase_end(&sys, work)?;
+                self.follow(sys, start, end, work)
+            }
+            None => self.integrate(start, work),
+        }
+    }
+
+    /// Follows the fast phase `sys` from `start` to `end` (its roots' end). If the angle turns
+    /// back first: a phase that starts at rest swings for ever ([`SolveError::Swings`]: with
+    /// one degree of freedom, no friction and no momentum, its configuration is a function of
+    /// the angle and its forces of the angle and `theta_dot^2`, so it retraces its path to the
+    /// start and back); any other is integrated.
+    pub fn follow(
+        &self,
+        sys: System<'m>,
+        start: &PhaseStart,
+        end: ReducedEnd,
+        work: &mut Work,
+    ) -> Result<PhaseRun<'m>, SolveError> {
+        match ReducedRun::with_end(sys, start.t, end, self.tol, work) {
+            Ok(run) => Ok(PhaseRun::Reduced(run)),
+            Err(SolveError::TurningPoint { model, delta, .. })
+                if start.state.qd.iter().all(|v| *v == 0.0) =>
+            {
+                Err(SolveError::Swings {
+                    model,
+                    t: start.t,
+                    delta,
+                })
+            }
+            Err(SolveError::TurningPoint { .. }) => self.integrate(start, work),
+            Err(e) => Err(e),
+        }
+    }
+
+    /// Typical sizes of the motion from `state` with `active` closed over the fall's time
+    /// scale, for the integrator's absolute tolerances ([`motion_scales`]).
+    pub fn scales(&self, state: &State, active: &Active) -> Result<Vec<f64>, SolveError> {
+        let time = fall_time_scale(&self.general, state);
+        let d = contacts::dynamics(&self.general, state, active, 0.0)?;
+        Ok(motion_scales(&self.general, state, &d.qdd, time))
+    }
+
+    /// Integrates the general model from `start` to its first event.
+    pub fn integrate(
+        &self,
+        start: &PhaseStart,
+        work: &mut Work,
+    ) -> Result<PhaseRun<'m>, SolveError> {
+        let bound = self.general.clone();
+        let time = fall_time_scale(&bound, &start.state);
+        let scales = self.scales(&start.state, &start.active)?;
+        let from = Start {
+            state: start.state.clone(),
+            active: start.active.clone(),
+            frictions: start.frictions.clone(),
+            friction_work: start.friction_work,
+        };
+        let run = unreduced::integrate(
+            &bound,
+            &from,
+            self.rtol,
+            Some(&scales),
+            time * MAX_FALL_TIMES,
+            work,
+        )
+        .map_err(|e| at_time(e, start.t))?;
+        if run.end == EndEvent::Floor {
+            self.landed(&run.state_end, start.t + run.t_end)?;
+        }
+        let phase = PhaseRun::Integrated(IntegratedRun {
+            bound,
+            t_start: start.t,
+            run,
+        });
+        work.phases.extend(phase.labels());
+        Ok(phase)
+    }
+
+    /// Whether the system has landed where its reduced angle reaches the end angle: the
+    /// falling point on the floor (within [`LANDING_TOLERANCE`] of the system's length, or
+    /// the walker's tolerance if looser). A support that lifted the body (a rod pivoting over
+    /// a cylinder, its foot in the air) brings it to the end angle above the floor: the motion
+    /// goes on past it, which the spec's end angle does not describe, so that is an error, not
+    /// a landing.
+    fn landed(&self, state: &State, t: f64) -> Result<(), SolveError> {
+        let info = self.general.info();
+        let height = self.general.points(state).pos[info.falling_point][1];
+        let length = self.general.length_scale(state);
+        if height.abs() <= LANDING_TOLERANCE.max(self.tol) * length {
+            return Ok(());
+        }
+        Err(SolveError::AboveFloor {
+            model: info.name,
+            t,
+            angle: info.end_angle,
+            point: info.points[info.falling_point].name,
+            height,
+        })
+    }
+
+    /// The whole motion from release: phase after phase until one ends for good.
+    pub fn motion(&self, work: &mut Work) -> Result<Motion<'m>, SolveError> {
+        let (start, opened) = self.release()?;
+        let first = self.solve(&start, work)?;
+        let mut motion = Motion {
+            phases: vec![first],
+            opened_at_release: opened,
+        };
+        self.extend(&mut motion, work)?;
+        Ok(motion)
+    }
+
+    /// Continues a motion from its last phase until one ends for good.
+    pub fn extend(&self, motion: &mut Motion<'m>, work: &mut Work) -> Result<(), SolveError> {
+        while let Some(last) = motion.phases.last() {
+            if !last.end().continues() {
+                return Ok(());
+            }
+            if motion.phases.len() >= MAX_PHASES {
+                return Err(SolveError::TooManyPhases { limit: MAX_PHASES });
+            }
+            let start = self.after(last)?;
+            let next = self.solve(&start, work)?;
+            motion.phases.push(next);
+        }
+        Ok(())
+    }
+}
+
+/// A phase's error with the phase's start time added to the time it names (the integrator
+/// counts from the phase's start).
+fn at_time(e: SolveError, t0: f64) -> SolveError {
+    match e {
+        SolveError::Indeterminate {
+            model,
+            t,
+            contacts,
+            why,
+        } => SolveError::Indeterminate {
+            model,
+            t: t + t0,
+            contacts,
+            why,
+        },
+        other => other,
+    }
+}
+
+/// The parameters of fast phase `phase` starting at the system's `state`: the spec's (the
+/// general model's), then for a phase that takes its start state each of its coordinates'
+/// values and rates, found by name among the system's coordinates.
+pub fn phase_parameters(
+    general: &Bound,
+    phase: &'static ModelInfo,
+    state: &State,
+) -> Result<Vec<f64>, SolveError> {
+    let info = general.info();
+    let mut p = general.p().to_vec();
+    if !phase.start_params {
+        if phase.parameters.len() != p.len() {
+            return Err(SolveError::PhaseMismatch {
+                system: info.name,
+                name: phase.name,
+                why: format!(
+                    "it takes {} parameters, the system {}",
+                    phase.parameters.len(),
+                    p.len()
+                ),
+            });
+        }
+        return Ok(p);
+    }
+    let index = |c: &str| {
+        (info.coordinates.iter().position(|q| *q == c)).ok_or_else(|| SolveError::PhaseMismatch {
+            system: info.name,
+            name: phase.name,
+            why: format!("its coordinate `{c}` is not one of the system's"),
+        })
+    };
+    let indices: Vec<usize> = (phase.coordinates.iter())
+        .map(|c| index(c))
+        .collect::<Result<_, _>>()?;
+    p.extend(indices.iter().map(|&i| state.q[i]));
+    p.extend(indices.iter().map(|&i| state.qd[i]));
+    if p.len() != phase.parameters.len() {
+        return Err(SolveError::PhaseMismatch {
+            system: info.name,
+            name: phase.name,
+            why: format!(
+                "it takes {} parameters, the system's state gives {}",
+                phase.parameters.len(),
+                p.len()
+            ),
+        });
+    }
+    Ok(p)
 }

@@ -406,6 +406,63 @@ fn quadratic_roots(c: &[f64], lo: f64, hi: f64, out: &mut [f64; MAX_DEGREE]) -> 
     n
 }
 
+/// Whether `coeffs` (lowest degree first, degree below `N`) is certainly positive on
+/// `[lo, hi]`, by the shifted polynomial `p(lo + h u) = sum a_j u^j` (`h = hi - lo`, `u` in
+/// `[0, 1]`): first the cheap bound `a_0 + sum_j min(a_j, 0) > margin`, else every coefficient
+/// of its Bernstein form of degree `N - 1` above the margin (the Bernstein form's convex hull
+/// holds the graph). The margin is [`BERNSTEIN_MARGIN`] times the same shift done on
+/// `|coeffs|` and `|lo|`, which bounds the shift's rounding. A sufficient test, cheap next to
+/// isolating roots (`O(N^2)` flops, no branch on the data): `false` says nothing, and the
+/// caller then looks for roots. `false` too past [`MAX_DEGREE`] or for a value that is not
+/// finite.
+#[inline]
+pub fn positive_on<const N: usize>(coeffs: &[f64; N], lo: f64, hi: f64) -> bool {
+    if N == 0 || N > MAX_DEGREE || lo.partial_cmp(&hi).is_none_or(|o| o.is_gt()) {
+        return false;
+    }
+    let d = N - 1;
+    // The Taylor shift to `lo` (repeated synthetic division), and its bound on `|coeffs|`.
+    let (mut a, mut m) = (*coeffs, coeffs.map(f64::abs));
+    for i in 0..d {
+        for j in (i..d).rev() {
+            a[j] += lo * a[j + 1];
+            m[j] += lo.abs() * m[j + 1];
+        }
+    }
+    let h = hi - lo;
+    let (mut power, mut size) = (1.0, 0.0);
+    for (aj, mj) in a.iter_mut().zip(m) {
+        *aj *= power;
+        size += mj * power;
+        power *= h;
+    }
+    if !size.is_finite() || size == 0.0 {
+        return false;
+    }
+    let floor = BERNSTEIN_MARGIN * size;
+    let falling: f64 = a[1..].iter().map(|&aj| aj.min(0.0)).sum();
+    if a[0] + falling > floor {
+        return true;
+    }
+    // b_k = sum_{j <= k} C(k, j) / C(d, j) a_j.
+    (0..=d).all(|k| {
+        let (mut b, mut ratio) = (0.0, 1.0);
+        for (j, aj) in a.iter().enumerate().take(k + 1) {
+            b += ratio * aj;
+            // C(k, j+1)/C(d, j+1) = C(k, j)/C(d, j) * (k - j)/(d - j).
+            if j < k {
+                ratio *= (k - j) as f64 / (d - j) as f64;
+            }
+        }
+        b > floor
+    })
+}
+
+/// How far above zero, relative to the shift of the coefficients' magnitudes, the bound of
+/// [`positive_on`] must be: far above the shift's rounding (at most `2 N` units in the last
+/// place of that size).
+pub const BERNSTEIN_MARGIN: f64 = 1e-12;
+
 /// `p(x)` by Horner's rule (coefficients lowest degree first), with separate multiplies and
 /// adds (without a hardware FMA target feature `f64::mul_add` is a library call several times
 /// slower than the arithmetic).
@@ -575,6 +632,57 @@ mod tests {
         assert_eq!(largest_root(&c, 0.0, 0.7, &mut evals), Some(Some(roots[1])));
         assert_eq!(largest_root(&c, 0.95, 1.0, &mut evals), Some(None));
         assert!(evals > 0);
+    }
+
+    #[test]
+    fn a_bernstein_certificate_never_contradicts_the_roots() {
+        // Random polynomials of degree 0..=6, with roots placed near and inside the interval:
+        // whenever `positive_on` says yes, the polynomial has no root there and is positive at
+        // its ends; and away from roots it says yes often enough to save the root search.
+        let mut next = uniform(0x0bad_5eed_1234_5678);
+        let mut said_yes = 0;
+        for case in 0..20_000 {
+            let degree = case % 7;
+            let lead = if next() < 0.5 { -1.0 } else { 1.0 } * 10f64.powf(next() * 8.0 - 4.0);
+            let mut c = vec![lead];
+            for _ in 0..degree {
+                // Multiply by (x - r), r in [-1, 2]; interval below is inside [-0.2, 1.2].
+                let r = next() * 3.0 - 1.0;
+                let mut m = vec![0.0; c.len() + 1];
+                for (i, ci) in c.iter().enumerate() {
+                    m[i + 1] += ci;
+                    m[i] -= r * ci;
+                }
+                c = m;
+            }
+            let lo = next() * 1.4 - 0.2;
+            let hi = lo + next() * (1.2 - lo);
+            let mut fixed = [0.0; 7];
+            fixed[..c.len()].copy_from_slice(&c);
+            if !positive_on(&fixed, lo, hi) {
+                continue;
+            }
+            said_yes += 1;
+            let mut evals = 0;
+            let roots = real_roots(&c, lo, hi, &mut evals).expect("degree <= 6");
+            assert!(roots.is_empty(), "{c:?} on [{lo}, {hi}]: roots {roots:?}");
+            assert!(
+                horner(&c, lo) > 0.0 && horner(&c, hi) > 0.0,
+                "{c:?} on [{lo}, {hi}]"
+            );
+        }
+        assert!(said_yes > 2_000, "{said_yes}");
+        // Exact cases: a positive constant, a line through zero inside, nothing at all.
+        assert!(positive_on(&[2.0], -1.0, 1.0));
+        assert!(!positive_on(&[0.0, 1.0], -1.0, 1.0));
+        assert!(positive_on(&[0.0, 1.0], 0.5, 1.0));
+        assert!(!positive_on(&[0.0; 3], 0.0, 1.0));
+        // A double root far from zero, where the shift cancels: (x - 10)^2.
+        assert!(!positive_on(&[100.0, -20.0, 1.0], 9.0, 11.0));
+        assert!(positive_on(&[100.0, -20.0, 1.0], 10.5, 11.0));
+        assert!(!positive_on::<0>(&[], 0.0, 1.0));
+        assert!(!positive_on(&[1.0, f64::NAN], 0.0, 1.0));
+        assert!(!positive_on(&[1.0], 1.0, 0.0));
     }
 
     #[test]

@@ -1098,6 +1098,18 @@ pub struct TimeMesh {
 }
 
 impl TimeMesh {
+    /// The mesh of a phase of no length (a contact that opens at its start).
+    pub fn empty() -> TimeMesh {
+        TimeMesh {
+            delta_end: 0.0,
+            v_end: 0.0,
+            panels: Vec::new(),
+            starts: Vec::new(),
+            duration: 0.0,
+            control: Control::with_tolerance(ACCEPT),
+        }
+    }
+
     /// Integrates the phase of `sys` from its start to `delta_end` to relative tolerance `tol`
     /// (the two rules of every panel agree to `tol * TOL_SAFETY`, raised to [`MIN_TOL`]).
     pub fn build(

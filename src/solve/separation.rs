@@ -1,8 +1,9 @@
-//! Separation: the root of a model's separation polynomial in `s = sin(theta)` where the rod
-//! first loses contact coming down from `theta_i`, found to full `f64` precision; and, for a
-//! model whose contact force's zero is no polynomial root or whose contact has an edge, the
-//! first sign change of the reduced contact force (or of the edge margin) as a function of the
-//! angle fallen, bracketed on a grid and refined by [`roots::illinois`].
+//! Where a fast phase's closed contacts end: the root of a contact's force polynomial in
+//! `s = sin(theta)` where its force first reaches zero coming down from `theta_i`, found to full
+//! `f64` precision (the first contact's is the separation); and, for a force whose zero is no
+//! polynomial root or a contact with an edge, the first sign change of the reduced force (or of
+//! the edge margin) as a function of the angle fallen, bracketed on a grid and refined by
+//! [`roots::illinois`].
 //!
 //! The polynomial's roots come from the one isolator, [`poly`].
 
@@ -47,19 +48,34 @@ impl SeparationOutcome {
     }
 }
 
-/// The separation of a system: the largest sign-changing root of its separation polynomial in
-/// `(sin(end_angle), sin(theta_i))`, i.e. the first met coming down from `theta_i`; or, without
-/// a polynomial, the first zero of the reduced contact force.
+/// The separation of a system: where its first contact's force reaches zero
+/// ([`force_zero`] of contact 0).
 pub fn separation(sys: &System, work: &mut Work) -> Result<SeparationOutcome, SolveError> {
+    force_zero(sys, 0, work)
+}
+
+/// Where a closed contact's force reaches zero coming down from `theta_i`: the largest
+/// sign-changing root of its force polynomial in `(sin(end_angle), sin(theta_i))`, or without
+/// one the first sign change of its reduced force. A contact that is not closed in the phase is
+/// [`SolveError::NoContact`].
+pub fn force_zero(
+    sys: &System,
+    contact: usize,
+    work: &mut Work,
+) -> Result<SeparationOutcome, SolveError> {
     let info = sys.info();
-    let Some(contact) = info.contact else {
+    if !info
+        .contacts
+        .get(contact)
+        .is_some_and(|c| c.closed && !c.bilateral)
+    {
         return Err(SolveError::NoContact { model: info.name });
-    };
-    if !sys.layout().polynomial_separation {
-        let force = |sys: &System, delta: f64| sys.forces(delta)[contact.force];
-        return first_zero(sys, force, work);
     }
-    let (coeffs, lo, hi) = setup(sys)?;
+    let Some(coeffs) = sys.force_coefficients(contact) else {
+        let force = |sys: &System, delta: f64| sys.forces(delta)[contact];
+        return first_zero(sys, force, work);
+    };
+    let (lo, hi) = bracket(sys)?;
     Ok(
         match separation_root(info.name, &coeffs, lo, hi, &mut work.polynomial_evals)? {
             Some(s) => SeparationOutcome::Separates(at_sine(sys, s)),
@@ -90,17 +106,24 @@ pub fn separation_root(
     poly::largest_root(coeffs, lo, hi, evals).ok_or_else(bad)
 }
 
-/// Where the contact runs off its edge: the first zero of the edge margin, which on the fast
-/// path depends on the angle alone (the derivation checks it).
-pub fn edge(sys: &System, work: &mut Work) -> Result<SeparationOutcome, SolveError> {
-    let margin = |sys: &System, delta: f64| sys.contact_edge(&sys.full_state(0.0, delta, 0.0));
+/// Where a closed contact runs off its edge: the first zero of its edge margin, which on the
+/// fast path depends on the angle alone (the derivation checks it).
+pub fn edge(
+    sys: &System,
+    contact: usize,
+    work: &mut Work,
+) -> Result<SeparationOutcome, SolveError> {
+    let margin = |sys: &System, delta: f64| {
+        let edges = sys.edges(&sys.full_state(0.0, delta, 0.0));
+        edges.get(contact).copied().unwrap_or(f64::NAN)
+    };
     first_zero(sys, margin, work)
 }
 
 /// The first sign change of `f(delta)` coming down from the start: bracketed on
 /// [`BRACKET_CELLS`] cells uniform in `sqrt(delta)` (fine near the start, where the fall is
 /// slow), then refined to adjacent floats. Each evaluation counts as a polynomial evaluation.
-fn first_zero(
+pub fn first_zero(
     sys: &System,
     f: impl Fn(&System, f64) -> f64,
     work: &mut Work,
@@ -152,7 +175,13 @@ fn first_zero(
 
 /// The paper's approximation: the root of the polynomial with its terms above degree 1 dropped.
 pub fn linearised_separation(sys: &System) -> Result<SeparationOutcome, SolveError> {
-    let (coeffs, lo, hi) = setup(sys)?;
+    let coeffs = sys.separation_coefficients();
+    if coeffs.is_empty() {
+        return Err(SolveError::NoContact {
+            model: sys.info().name,
+        });
+    }
+    let (lo, hi) = bracket(sys)?;
     let (c0, c1) = (coeffs[0], coeffs.get(1).copied().unwrap_or(0.0));
     if c1 == 0.0 {
         return Ok(SeparationOutcome::NoSeparationBeforeFloor);
@@ -165,24 +194,19 @@ pub fn linearised_separation(sys: &System) -> Result<SeparationOutcome, SolveErr
     })
 }
 
-/// Coefficients (checked) and the open interval `(sin(end_angle), sin(theta_i))`.
-fn setup(sys: &System) -> Result<(Vec<f64>, f64, f64), SolveError> {
-    let info = sys.info();
-    if info.contact.is_none() {
-        return Err(SolveError::NoContact { model: info.name });
-    }
-    let coeffs = sys.separation_coefficients();
+/// The open interval `(sin(end_angle), sin(theta_i))` the phase's roots lie in.
+fn bracket(sys: &System) -> Result<(f64, f64), SolveError> {
     let hi = sys.reduced(0.0).sin;
     let lo = sys.end_angle().sin();
     if !hi.is_finite() {
         return Err(SolveError::NonFinite {
-            model: info.name,
+            model: sys.info().name,
             what: "sin(theta_i)",
             delta: 0.0,
             value: hi,
         });
     }
-    Ok((coeffs, lo, hi))
+    Ok((lo, hi))
 }
 
 /// The angle of a root in `s`: `theta = asin(s)`, `delta = theta_i - theta`.

@@ -12,7 +12,7 @@ use crate::results::Work;
 use crate::solve::SolveError;
 use crate::solve::phases::{IntegratedRun, PhaseRun};
 use crate::solve::quadrature::TimeMesh;
-use crate::system::{State, System};
+use crate::system::{Bound, State, System};
 
 /// Samples of one phase, uniform in time from its start to its end (both included).
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -59,24 +59,52 @@ pub fn sample_phase(
     samples: usize,
     work: &mut Work,
 ) -> Result<PhaseSamples, SolveError> {
+    sample_reduced_at(sys, mesh, &uniform_times(mesh.duration, samples)?, work)
+}
+
+/// `samples` times uniform over `[0, duration]`, both ends included (the last exactly
+/// `duration`).
+pub fn uniform_times(duration: f64, samples: usize) -> Result<Vec<f64>, SolveError> {
     if samples < 2 {
         return Err(SolveError::TooFewSamples { samples });
     }
+    Ok((0..samples)
+        .map(|j| {
+            if j == samples - 1 {
+                duration
+            } else {
+                duration * j as f64 / (samples - 1) as f64
+            }
+        })
+        .collect())
+}
+
+/// Samples of a fast phase at the phase times `times` (ascending, within the phase).
+pub fn sample_reduced_at(
+    sys: &System,
+    mesh: &TimeMesh,
+    times: &[f64],
+    work: &mut Work,
+) -> Result<PhaseSamples, SolveError> {
     let mut out = PhaseSamples::default();
     let (mut v_prev, mut t_prev) = (0.0, 0.0);
-    for j in 0..samples {
-        let (t, delta) = if j == 0 {
-            (0.0, 0.0)
-        } else if j == samples - 1 {
-            (mesh.duration, mesh.delta_end)
+    for &target in times {
+        let delta = if target <= 0.0 {
+            0.0
+        } else if target >= mesh.duration {
+            mesh.delta_end
         } else {
-            let target = mesh.duration * j as f64 / (samples - 1) as f64;
-            let v = invert(sys, mesh, target, v_prev, t_prev, work)?;
+            let lo = if target >= t_prev {
+                (v_prev, t_prev)
+            } else {
+                (0.0, 0.0)
+            };
+            let v = invert(sys, mesh, target, lo.0, lo.1, work)?;
             v_prev = v;
             t_prev = target;
-            (target, mesh.delta_at_v(sys, v)?)
+            mesh.delta_at_v(sys, v)?
         };
-        push(sys, &mut out, t, delta);
+        push(sys, &mut out, target.clamp(0.0, mesh.duration), delta);
     }
     Ok(out)
 }
@@ -118,26 +146,40 @@ fn push(sys: &System, out: &mut PhaseSamples, t: f64, delta: f64) {
 
 /// `samples` points uniform in time over a phase on either route.
 pub fn sample(run: &PhaseRun, samples: usize, work: &mut Work) -> Result<PhaseSamples, SolveError> {
+    sample_at(run, &uniform_times(run.duration(), samples)?, work)
+}
+
+/// Samples of a phase on either route at the phase times `times` (ascending, within it).
+pub fn sample_at(
+    run: &PhaseRun,
+    times: &[f64],
+    work: &mut Work,
+) -> Result<PhaseSamples, SolveError> {
     match run {
-        PhaseRun::Reduced(r) => sample_phase(&r.system, &r.mesh, samples, work),
-        PhaseRun::Integrated(r) => sample_integrated(r, samples),
+        PhaseRun::Reduced(r) => sample_reduced_at(&r.system, &r.mesh, times, work),
+        PhaseRun::Integrated(r) => sample_integrated_at(r, times),
     }
 }
 
 /// `samples` points uniform in time over an integrated phase, from its dense output (the last
 /// one is the event state itself).
 pub fn sample_integrated(run: &IntegratedRun, samples: usize) -> Result<PhaseSamples, SolveError> {
-    if samples < 2 {
-        return Err(SolveError::TooFewSamples { samples });
-    }
+    sample_integrated_at(run, &uniform_times(run.run.t_end, samples)?)
+}
+
+/// Samples of an integrated phase at the phase times `times`, from its dense output (a time
+/// at the end is the event state itself).
+pub fn sample_integrated_at(
+    run: &IntegratedRun,
+    times: &[f64],
+) -> Result<PhaseSamples, SolveError> {
     let bound = &run.bound;
     let n = bound.n_coordinates();
     let r = bound.info().reduced;
     let duration = run.run.t_end;
     let mut out = PhaseSamples::default();
-    for j in 0..samples {
-        let t = duration * j as f64 / (samples - 1) as f64;
-        let state = if j == samples - 1 {
+    for &t in times {
+        let state = if t >= duration {
             run.run.state_end.clone()
         } else {
             let y = run.run.state_at(t).ok_or(SolveError::Inversion {
@@ -150,6 +192,7 @@ pub fn sample_integrated(run: &IntegratedRun, samples: usize) -> Result<PhaseSam
                 qd: y[n..2 * n].to_vec(),
             }
         };
+        let t = t.min(duration);
         let qdd = run.run.dynamics_at(bound, &state, t)?.qdd;
         out.t.push(t);
         out.theta.push(state.q[r]);
@@ -160,8 +203,8 @@ pub fn sample_integrated(run: &IntegratedRun, samples: usize) -> Result<PhaseSam
     Ok(out)
 }
 
-/// The reaction forces at every sample of a phase: from the energy integral on the fast path
-/// (its cancellation-free forms), from the accelerations of the equations of motion otherwise.
+/// Every contact's force at every sample of a phase: from the energy integral on the fast path
+/// (its cancellation-free forms), solved with the accelerations otherwise.
 pub fn sample_forces(run: &PhaseRun, s: &PhaseSamples) -> Result<Vec<Vec<f64>>, SolveError> {
     match run {
         PhaseRun::Reduced(r) => Ok(s.delta.iter().map(|&d| r.system.forces(d)).collect()),
@@ -175,23 +218,40 @@ pub fn sample_forces(run: &PhaseRun, s: &PhaseSamples) -> Result<Vec<Vec<f64>>, 
 }
 
 /// The friction forces, their normal forces and slip velocities at every sample of a phase
-/// (`[f, N, v]`, each one value per friction), in the contact modes of the sample's time.
-pub fn sample_friction(run: &PhaseRun, s: &PhaseSamples) -> Result<Vec<[Vec<f64>; 3]>, SolveError> {
-    let info = run.bound().info();
+/// (`[f, N, v]`, each one value per friction of the system's general model `general`), in the
+/// active set of the sample's time. No friction acts in a fast phase (a contact with friction
+/// is never held closed by elimination): its forces are zero there and its slip is read off the
+/// general model at the system's state.
+pub fn sample_friction(
+    run: &PhaseRun,
+    general: &Bound,
+    s: &PhaseSamples,
+) -> Result<Vec<[Vec<f64>; 3]>, SolveError> {
+    let info = general.info();
+    let nf = info.frictions.len();
     match run {
-        PhaseRun::Reduced(_) if info.frictions.is_empty() => Ok(vec![Default::default(); s.len()]),
-        PhaseRun::Reduced(_) => Err(SolveError::FrictionModes {
-            model: info.name,
-            expected: info.frictions.len(),
-            got: 0,
-        }),
+        PhaseRun::Reduced(r) => (s.states.iter().zip(&s.delta))
+            .map(|(state, &delta)| {
+                let full = r.system.to_full(state);
+                let n = general.n_coordinates();
+                let (jac, _) = general.friction(&full);
+                let slip = (0..nf)
+                    .map(|j| (0..n).map(|c| jac[j * n + c] * full.qd[c]).sum())
+                    .collect();
+                let forces = r.system.forces(delta);
+                let normals = (info.frictions.iter())
+                    .map(|f| forces.get(f.contact).copied().unwrap_or(0.0))
+                    .collect();
+                Ok([vec![0.0; nf], normals, slip])
+            })
+            .collect(),
         PhaseRun::Integrated(r) => s
             .states
             .iter()
             .zip(&s.t)
             .map(|(state, &t)| {
                 let d = r.run.dynamics_at(&r.bound, state, t)?;
-                let normals = info.frictions.iter().map(|f| d.forces[f.normal]).collect();
+                let normals = info.frictions.iter().map(|f| d.forces[f.contact]).collect();
                 Ok([d.fr, normals, d.slip])
             })
             .collect(),

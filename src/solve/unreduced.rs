@@ -1,43 +1,59 @@
-//! The unreduced equations `M(q) qdd = F(q, qd)` of a model as an ODE, integrated with
-//! [`ode::dopri5`](crate::solve::ode::dopri5) from the release state until the contact force
-//! crosses zero (separation), the contact runs off its edge, or the reduced angle reaches the
-//! floor: the route of every model without a fast path, and for the others an independent
-//! route to the separation time that shares no code with the quadrature.
+//! The integrated route: a model's equations `M(q) qdd = F(q, qd) + J^T lambda + T^T f`
+//! integrated with the generic [`ode`](crate::solve::ode) integrator from a state, with a set of
+//! closed contacts, until an event ends the phase: a closed contact's force reaching zero (it
+//! would have to pull, so it opens), an open contact's gap closing (the bodies meet), a closed
+//! contact running off its edge, or the reduced angle reaching the floor. It is the route of
+//! every phase without a fast path, and for the others an independent route to the same events
+//! that shares no code with the quadrature.
 //!
-//! A model with Coulomb friction is integrated in segments, one per combination of contact
-//! modes ([`friction::Mode`]): a segment ends where a sliding contact's slip velocity reaches
-//! zero or a stuck contact's friction reaches `mu N`, both located as events; the next
-//! segment's modes are the one consistent choice there ([`friction::decide`]). The work done by
-//! friction is integrated with the motion (the last component of the ODE state), so that the
-//! energy check can hold `E(t) - E(0)` to it.
+//! The contacts' forces and the frictions' are solved with the accelerations at every
+//! evaluation ([`contacts::dynamics`]). With Coulomb friction the integration goes in segments,
+//! one per combination of friction modes: a segment ends where a sliding contact's slip
+//! velocity reaches zero or a stuck contact's friction reaches `mu N`, both located as events;
+//! the next segment's modes are the one consistent choice there ([`contacts::decide`]). The work
+//! done by friction is integrated with the motion (the last component of the ODE state), so
+//! that the energy check can hold `E(t) - E(0)` to it.
 //!
-//! The integrator's state is the deviation `z = y - y0` from the release state `y0 = [q, qd]`,
-//! so its error control is relative to the motion itself rather than to the absolute angle: a
+//! A gap that starts at zero (a contact that just opened) or an edge margin that does (a
+//! contact point starting at a corner) arms its event only once it has grown past
+//! [`DECIDE_TOLERANCE`](contacts::DECIDE_TOLERANCE) of the system's length: its rounding at the
+//! start is no crossing.
+//!
+//! The integrator's state is the deviation `z = y - y0` from the start `y0 = [q, qd]`, so its
+//! error control is relative to the motion itself rather than to the absolute angle: a
 //! near-upright start lingers by an unstable equilibrium, which amplifies any absolute angle
 //! error. The model's equations still take the absolute angle, whose rounding (~1e-16 rad)
-//! limits this route to ~1e-11 relative there.
+//! limits this route to ~1e-11 relative there. The method is chosen by the tolerance
+//! ([`Method::for_rtol`]): the 8th-order Dormand–Prince method (DOP853) for tight tolerances,
+//! the 5th-order one (DOPRI5) otherwise.
 //!
 //! The mass matrix is ill-conditioned when the bodies' masses are far apart (for the rod and
 //! cube its condition number grows like `m2/m1`): the accelerations then carry a relative
-//! rounding error of about `eps * cond(M)`, and so does the contact force built from them. The
+//! rounding error of about `eps * cond(M)`, and so do the contact forces built from them. The
 //! integrator's tolerance is therefore never set below [`CONDITION_SAFETY`]` * eps * cond(M)`
-//! at release, and the tolerance actually used is reported in [`UnreducedRun::rtol`].
+//! at the start, and the tolerance actually used is reported in [`UnreducedRun::rtol`].
 
 use crate::results::Work;
 use crate::solve::SolveError;
-use crate::solve::friction::{self, Dynamics, Mode, Options};
-use crate::solve::ode::{OdeOptions, OdeProblem, OdeSolution, dopri5};
+use crate::solve::contacts::{
+    self, Active, ContactOption, DECIDE_TOLERANCE, Dynamics, FrictionOption, Mode, Options,
+};
+use crate::solve::ode::{Method, OdeOptions, OdeProblem, OdeSolution, integrate as ode_integrate};
 use crate::system::{Bound, State};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 
-/// The tolerance floor is this many times `eps * cond(M)` at release.
+/// The tolerance floor is this many times `eps * cond(M)` at the start.
 pub const CONDITION_SAFETY: f64 = 10.0;
 
-/// Loosest tolerance worth integrating with: beyond it the cross-check says nothing.
+/// Loosest tolerance worth integrating with.
 pub const MAX_RTOL: f64 = 1e-2;
 
 /// Most steps before giving up.
 pub const MAX_STEPS: u64 = 200_000;
+
+/// A coordinate's (or velocity's) scale for the absolute tolerances is at least this fraction
+/// of the largest of its kind ([`motion_scales`]).
+pub const SCALE_FLOOR: f64 = 1e-3;
 
 /// Most stick/slip switches in one integration before giving up (a chattering contact).
 pub const MAX_SWITCHES: usize = 1000;
@@ -56,71 +72,45 @@ pub fn mass_condition(sys: &Bound, state: &State) -> f64 {
     }
 }
 
-/// Accelerations `qdd` solving `M(q) qdd = F(q, qd)` at a state (`t` labels errors), for a
-/// model without friction (whose accelerations depend on the contacts' modes: see
-/// [`friction::dynamics`]).
-pub fn accelerations(sys: &Bound, state: &State, t: f64) -> Result<Vec<f64>, SolveError> {
-    let n = sys.n_coordinates();
-    let m = sys.info().frictions.len();
-    if m > 0 {
-        return Err(SolveError::FrictionModes {
-            model: sys.name(),
-            expected: m,
-            got: 0,
-        });
-    }
-    let (mass, rhs) = sys.equations(state);
-    let m = DMatrix::from_row_slice(n, n, &mass);
-    let b = DVector::from_column_slice(&rhs);
-    match m.lu().solve(&b) {
-        Some(x) if x.iter().all(|v| v.is_finite()) => Ok(x.iter().copied().collect()),
-        _ => Err(SolveError::SingularMassMatrix {
-            t,
-            q: state.q.clone(),
-        }),
-    }
-}
-
-/// The accelerations, friction and reaction forces at release, with the friction contacts in
-/// their one consistent mode.
-pub fn start_dynamics(sys: &Bound) -> Result<Dynamics, SolveError> {
-    let start = sys.initial_state();
-    let modes = friction::decide(sys, &start, &friction::start_options(sys, &start), 0.0)?;
-    friction::dynamics(sys, &start, &modes, 0.0)
-}
-
-/// The slip velocity each friction's event measures from at a segment's start: its own slip
-/// for a contact that may have switched there, zero for one that keeps its mode.
-fn slip_offsets(sys: &Bound, state: &State, options: &[Options]) -> Vec<f64> {
-    let n = sys.n_coordinates();
-    let (jac, _) = sys.friction(state);
-    (options.iter().enumerate())
-        .map(|(k, o)| match o {
-            Options::Keep(_) => 0.0,
-            _ => (0..n).map(|j| jac[k * n + j] * state.qd[j]).sum(),
-        })
-        .collect()
-}
-
-/// How the unreduced integration ended.
+/// How an integrated phase ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum EndEvent {
-    /// The contact force crossed zero.
-    Separation,
-    /// The contact's edge margin crossed zero.
-    Edge,
+    /// A closed contact's force reached zero: it opens.
+    Force(usize),
+    /// A closed contact's point ran off its edge.
+    Edge(usize),
+    /// An open contact's gap closed: the bodies meet.
+    Gap(usize),
     /// The reduced angle reached the model's end angle.
     Floor,
 }
 
-/// One stretch of the integration with the friction contacts in one mode (the whole
-/// integration for a model without friction).
+/// What an event function measures.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Watch {
+    /// A closed unilateral contact's force.
+    Force(usize),
+    /// An open contact's gap.
+    Gap(usize),
+    /// A closed contact's edge margin.
+    Edge(usize),
+    /// The reduced angle above the end angle.
+    Floor,
+    /// A sliding friction's slip velocity (from its offset at the segment's start).
+    Slip(usize),
+    /// A stuck friction's margin `mu N - |f|`.
+    Stuck(usize),
+    /// The sliding system's distance from Painlevé's singularity.
+    Painleve,
+}
+
+/// One stretch of the integration in one active set.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Segment {
     /// Time of the segment's start (s from the phase's start).
     pub t_start: f64,
-    /// The contacts' modes (empty without friction).
-    pub modes: Vec<Mode>,
+    /// The closed contacts and the frictions' modes.
+    pub active: Active,
     /// The state `y0 = [q, qd, W]` at the segment's start (`W`, the work of friction so far, only
     /// with friction).
     pub y0: Vec<f64>,
@@ -134,18 +124,20 @@ impl Segment {
     }
 }
 
-/// A finished unreduced integration.
+/// A finished integration.
 #[derive(Debug, Clone, PartialEq)]
 pub struct UnreducedRun {
     /// The segments in order (one without friction).
     pub segments: Vec<Segment>,
     /// The relative tolerance used: the one asked, raised to the conditioning floor.
     pub rtol: f64,
-    /// Condition number of the mass matrix at release.
+    /// The integration method.
+    pub method: Method,
+    /// Condition number of the mass matrix at the start.
     pub condition: f64,
     /// Which event ended it.
     pub end: EndEvent,
-    /// Time of that event (s from release).
+    /// Time of that event (s from the phase's start).
     pub t_end: f64,
     /// The state there.
     pub state_end: State,
@@ -172,18 +164,18 @@ impl UnreducedRun {
         Some(seg.add_y0(&z))
     }
 
-    /// Accelerations, friction and reaction forces at a state at time `t` of the run, in the
-    /// contact modes of its segment.
+    /// Accelerations, contact and friction forces at a state at time `t` of the run, in the
+    /// active set of its segment.
     pub fn dynamics_at(&self, sys: &Bound, state: &State, t: f64) -> Result<Dynamics, SolveError> {
         let seg = self.segment_at(t).ok_or(SolveError::Inversion {
             target: t,
             duration: self.t_end,
             reason: "time outside the integrated phase",
         })?;
-        friction::dynamics(sys, state, &seg.modes, t)
+        contacts::dynamics(sys, state, &seg.active, t)
     }
 
-    /// Time and `y` at the release and at the end of every accepted step, over every segment.
+    /// Time and `y` at the start and at the end of every accepted step, over every segment.
     pub fn nodes(&self) -> Vec<(f64, Vec<f64>)> {
         let mut out = Vec::new();
         for (i, seg) in self.segments.iter().enumerate() {
@@ -196,7 +188,7 @@ impl UnreducedRun {
         out
     }
 
-    /// The full state at the release and at the end of every accepted step.
+    /// The full state at the start and at the end of every accepted step.
     pub fn states(&self) -> Vec<State> {
         let n = self.state_end.q.len();
         self.nodes()
@@ -206,6 +198,17 @@ impl UnreducedRun {
                 qd: y[n..2 * n].to_vec(),
             })
             .collect()
+    }
+
+    /// The segment of each node of [`Self::nodes`] (by index).
+    pub fn node_segments(&self) -> Vec<usize> {
+        let mut out = Vec::new();
+        for (i, seg) in self.segments.iter().enumerate() {
+            let skip = usize::from(i > 0);
+            let count = seg.solution.nodes().len().saturating_sub(skip);
+            out.extend(std::iter::repeat_n(i, count));
+        }
+        out
     }
 
     /// The work done by friction at every node of [`Self::nodes`] (zeros without friction,
@@ -218,9 +221,9 @@ impl UnreducedRun {
             .collect()
     }
 
-    /// When each segment started, with its contact modes described.
+    /// When each segment started, with its active set described.
     pub fn switches<'a>(&'a self, sys: &'a Bound) -> impl Iterator<Item = (f64, String)> + 'a {
-        (self.segments.iter()).map(move |s| (s.t_start, friction::describe(sys.info(), &s.modes)))
+        (self.segments.iter()).map(move |s| (s.t_start, s.active.describe(sys.info())))
     }
 
     /// Every step taken (accepted, rejected and event trials).
@@ -232,21 +235,25 @@ impl UnreducedRun {
 struct Problem<'a, 'm> {
     sys: &'a Bound<'m>,
     n: usize,
-    modes: Vec<Mode>,
+    active: Active,
+    watches: Vec<Watch>,
+    /// Per watch, whether it is armed (a gap or edge margin that starts at zero arms once it
+    /// has grown past `arm_at`).
+    armed: Vec<bool>,
+    arm_at: f64,
     /// Per friction, the slip velocity its event measures from: the rounding-level slip at the
     /// start of a contact that just switched (so that it does not count as a crossing), zero
     /// for one that keeps sliding.
     slip_offset: Vec<f64>,
-    contact: Option<usize>,
-    edge: bool,
     reduced: usize,
     end_angle: f64,
     y0: Vec<f64>,
     y: Vec<f64>,
     state: State,
-    /// With friction, the dynamics of the last right-hand side and the `z` it was at: the
-    /// integrator asks for the events at the state it has just evaluated.
+    /// The dynamics of the last right-hand side and the `z` it was at: the integrator asks for
+    /// the events at the state it has just evaluated.
     last: Option<(Vec<f64>, Dynamics)>,
+    with_work: bool,
 }
 
 impl Problem<'_, '_> {
@@ -259,108 +266,250 @@ impl Problem<'_, '_> {
         self.state.qd.copy_from_slice(&self.y[self.n..2 * self.n]);
     }
 
-    /// At friction event `k` (a contact's slip stopped or its stuck friction reached `mu N`;
-    /// `k == m` is Painlevé's singularity), the next modes: the one consistent choice.
-    fn switch(&mut self, k: usize, state: &State, t: f64) -> Result<(), SolveError> {
-        if k == self.frictions() {
-            return Err(friction::painleve_error(self.sys, state, &self.modes, t));
+    /// The events of the active set: each closed unilateral contact's force (a row's, or in
+    /// closed form where the model eliminates it), each open contact's gap, each closed
+    /// contact's edge, the floor, then the acting frictions' and Painlevé's; armed where they
+    /// start clear of zero.
+    fn watch(&mut self, d: &Dynamics) {
+        let info = self.sys.info();
+        let mut watches = Vec::new();
+        for (i, c) in info.contacts.iter().enumerate() {
+            match (self.active.closed[i], c.bilateral) {
+                (true, false) => watches.push(Watch::Force(i)),
+                (false, _) => watches.push(Watch::Gap(i)),
+                _ => {}
+            }
+            if self.active.closed[i] && c.edge {
+                watches.push(Watch::Edge(i));
+            }
         }
-        // A stuck contact breaks loose against the friction that held it.
-        let held = friction::dynamics(self.sys, state, &self.modes, t)?;
-        let options: Vec<Options> = (self.modes.iter().enumerate())
-            .map(|(i, &mode)| match (i == k, mode) {
-                (false, mode) => Options::Keep(mode),
-                (true, Mode::Slide(s)) => Options::Stopped(s),
-                (true, Mode::Stick) => Options::Breaks(-held.fr[i].signum()),
+        watches.push(Watch::Floor);
+        let mut sliding = false;
+        for j in 0..info.frictions.len() {
+            if self.active.friction_acts(info, j) {
+                watches.push(match self.active.modes[j] {
+                    Mode::Slide(_) => {
+                        sliding = true;
+                        Watch::Slip(j)
+                    }
+                    Mode::Stick => Watch::Stuck(j),
+                });
+            }
+        }
+        if sliding {
+            watches.push(Watch::Painleve);
+        }
+        self.watches = watches;
+        let mut g = vec![0.0; self.watches.len()];
+        self.values(d, &mut g);
+        self.armed = (self.watches.iter().zip(&g))
+            .map(|(w, v)| match w {
+                Watch::Gap(_) | Watch::Edge(_) | Watch::Force(_) => *v > self.arm_at_for(*w),
+                _ => true,
             })
             .collect();
-        self.modes = friction::decide(self.sys, state, &options, t)?;
-        self.slip_offset = slip_offsets(self.sys, state, &options);
+    }
+
+    /// The value past which a watch of this kind arms.
+    fn arm_at_for(&self, w: Watch) -> f64 {
+        match w {
+            Watch::Force(_) => 0.0,
+            _ => self.arm_at,
+        }
+    }
+
+    /// Every watch's value at the loaded state with its dynamics `d`.
+    fn values(&self, d: &Dynamics, g: &mut [f64]) {
+        let info = self.sys.info();
+        let needs_gaps = self.watches.iter().any(|w| matches!(w, Watch::Gap(_)));
+        let needs_edges = self.watches.iter().any(|w| matches!(w, Watch::Edge(_)));
+        let gaps = if needs_gaps {
+            self.sys.gaps(&self.state)
+        } else {
+            Vec::new()
+        };
+        let edges = if needs_edges {
+            self.sys.edges(&self.state)
+        } else {
+            Vec::new()
+        };
+        let mu = self.sys.friction_coefficients();
+        for (v, w) in g.iter_mut().zip(&self.watches) {
+            *v = match *w {
+                Watch::Force(i) => d.forces[i],
+                Watch::Gap(i) => gaps[i],
+                Watch::Edge(i) => edges[i],
+                Watch::Floor => self.state.q[self.reduced] - self.end_angle,
+                Watch::Slip(j) => d.slip[j] - self.slip_offset[j],
+                Watch::Stuck(j) => mu[j] * d.forces[info.frictions[j].contact] - d.fr[j].abs(),
+                Watch::Painleve => d.painleve - contacts::PAINLEVE_FLOOR,
+            };
+        }
+    }
+
+    /// At friction watch `w` (a contact's slip stopped or its stuck friction reached `mu N`),
+    /// the next modes: the one consistent choice, the contacts kept as they are.
+    fn switch(&mut self, w: Watch, state: &State, t: f64) -> Result<(), SolveError> {
+        let info = self.sys.info();
+        if w == Watch::Painleve {
+            return Err(contacts::painleve_error(self.sys, state, &self.active, t));
+        }
+        // A stuck contact breaks loose against the friction that held it.
+        let held = contacts::dynamics(self.sys, state, &self.active, t)?;
+        let frictions: Vec<FrictionOption> = (0..info.frictions.len())
+            .map(|j| match (w, self.active.modes[j]) {
+                (Watch::Slip(k), Mode::Slide(s)) if k == j => FrictionOption::Stopped(s),
+                (Watch::Stuck(k), Mode::Stick) if k == j => {
+                    FrictionOption::Breaks(-held.fr[j].signum())
+                }
+                (_, mode) => FrictionOption::Keep(mode),
+            })
+            .collect();
+        let options = Options {
+            contacts: self
+                .active
+                .closed
+                .iter()
+                .map(|&c| ContactOption::Keep(c))
+                .collect(),
+            frictions: frictions.clone(),
+        };
+        self.active = contacts::decide(self.sys, state, &options, t)?;
+        self.slip_offset = slip_offsets(self.sys, state, &frictions);
         self.last = None;
         Ok(())
     }
+}
 
-    fn frictions(&self) -> usize {
-        self.modes.len()
-    }
-
-    /// Events that end the phase (contact, edge, floor); the frictions' come after them.
-    fn n_end_events(&self) -> usize {
-        1 + usize::from(self.contact.is_some()) + usize::from(self.edge)
-    }
+/// The slip velocity each friction's event measures from at a segment's start: its own slip
+/// for a contact that may have switched there, zero for one that keeps its mode.
+fn slip_offsets(sys: &Bound, state: &State, options: &[FrictionOption]) -> Vec<f64> {
+    let n = sys.n_coordinates();
+    let (jac, _) = sys.friction(state);
+    (options.iter().enumerate())
+        .map(|(k, o)| match o {
+            FrictionOption::Keep(_) => 0.0,
+            _ => (0..n).map(|j| jac[k * n + j] * state.qd[j]).sum(),
+        })
+        .collect()
 }
 
 impl OdeProblem for Problem<'_, '_> {
     fn dim(&self) -> usize {
-        2 * self.n + usize::from(self.frictions() > 0)
+        2 * self.n + usize::from(self.with_work)
     }
 
     fn rhs(&mut self, t: f64, z: &[f64], dz: &mut [f64]) -> Result<(), SolveError> {
         self.load(z);
+        let d = contacts::dynamics(self.sys, &self.state, &self.active, t)?;
         dz[..self.n].copy_from_slice(&self.state.qd);
-        if self.frictions() == 0 {
-            let qdd = accelerations(self.sys, &self.state, t)?;
-            dz[self.n..].copy_from_slice(&qdd);
-        } else {
-            let d = friction::dynamics(self.sys, &self.state, &self.modes, t)?;
-            dz[self.n..2 * self.n].copy_from_slice(&d.qdd);
+        dz[self.n..2 * self.n].copy_from_slice(&d.qdd);
+        if self.with_work {
             dz[2 * self.n] = d.friction_power();
-            self.last = Some((z.to_vec(), d));
         }
+        self.last = Some((z.to_vec(), d));
         Ok(())
     }
 
     fn n_events(&self) -> usize {
-        let m = self.frictions();
-        self.n_end_events() + m + usize::from(m > 0)
+        self.watches.len()
     }
 
-    /// Events in order: the contact force, the edge margin, the floor, then per friction its
-    /// slip velocity (sliding) or its margin `mu N - |f|` (stuck), and last the sliding
-    /// system's distance from Painlevé's singularity.
-    fn events(&mut self, t: f64, z: &[f64], dz: &[f64], g: &mut [f64]) -> Result<(), SolveError> {
+    fn events(&mut self, t: f64, z: &[f64], _dz: &[f64], g: &mut [f64]) -> Result<(), SolveError> {
         self.load(z);
         let d = match self.last.take() {
-            _ if self.frictions() == 0 => None,
-            Some((at, d)) if at == z => Some(d),
-            _ => Some(friction::dynamics(self.sys, &self.state, &self.modes, t)?),
+            Some((at, d)) if at == z => d,
+            _ => contacts::dynamics(self.sys, &self.state, &self.active, t)?,
         };
-        let mut i = 0;
-        if let Some(c) = self.contact {
-            g[i] = match &d {
-                Some(d) => d.forces[c],
-                None => self.sys.forces_full(&self.state, &dz[self.n..], &[])[c],
-            };
-            i += 1;
-        }
-        if self.edge {
-            g[i] = self.sys.contact_edge(&self.state);
-            i += 1;
-        }
-        g[i] = self.state.q[self.reduced] - self.end_angle;
-        if let Some(d) = d {
-            let info = self.sys.info();
-            let mu = self.sys.friction_coefficients();
-            for (k, (mode, f)) in self.modes.iter().zip(info.frictions).enumerate() {
-                g[i + 1 + k] = match mode {
-                    Mode::Slide(_) => d.slip[k] - self.slip_offset[k],
-                    Mode::Stick => mu[k] * d.forces[f.normal] - d.fr[k].abs(),
-                };
+        self.values(&d, g);
+        for (k, v) in g.iter_mut().enumerate() {
+            if !self.armed[k] {
+                if *v > self.arm_at_for(self.watches[k]) {
+                    self.armed[k] = true;
+                } else {
+                    // Unarmed: no crossing until it has grown clear of zero.
+                    *v = 1.0;
+                }
             }
-            g[i + 1 + self.modes.len()] = d.painleve - friction::PAINLEVE_FLOOR;
         }
+        self.last = Some((z.to_vec(), d));
         Ok(())
     }
 }
 
-/// Integrates the unreduced equations of `sys` from its release state to separation (or the
-/// floor) with relative tolerance `rtol`. `scales` (length `2 n`), when given, are typical
-/// magnitudes of the motion `y - y0` (e.g. its size at the end of the reduced phase) used for
-/// the absolute tolerances; without them the control is relative to the largest deviation
-/// seen. `t_max` bounds the search. `rtol` is raised to [`CONDITION_SAFETY`]` * eps * cond(M)`.
-/// With friction, the contacts' modes at release are the one consistent choice.
+/// Typical sizes of the motion's deviation from its start over the time scale `time`, for the
+/// integrator's absolute tolerances: `|qd0| T + |qdd0| T^2 / 2` for the coordinates and
+/// `|qd0| + |qdd0| T` for the velocities, each at least [`SCALE_FLOOR`] of the largest of its
+/// kind and at least [`SCALE_FLOOR`] of the change of that coordinate that moves a point of
+/// the system by its length (and that change over `T` for the velocities). So a tiny system (a
+/// rod of 1 cm nearly flat) is held to its own scale, not to one metre; a coordinate a closed
+/// contact holds still (the foot's height on the floor, whose acceleration is rounding noise
+/// of the constraint's) is held to the motion's scale, not to its own noise, which would
+/// shrink the steps to nothing; and a start that is slow at release (nearly upright) is held
+/// to the system's size, not to its first creeping.
+pub fn motion_scales(bound: &Bound, start: &State, qdd: &[f64], time: f64) -> Vec<f64> {
+    let n = start.q.len();
+    let length = bound.length_scale(start);
+    // Per coordinate: the change that moves some point by `length` (m per m, or rad).
+    let reach: Vec<f64> = (0..n)
+        .map(|j| {
+            let mut unit = State {
+                q: start.q.clone(),
+                qd: vec![0.0; n],
+            };
+            unit.qd[j] = 1.0;
+            let speed = (bound.points(&unit).vel.iter())
+                .map(|v| v[0].hypot(v[1]))
+                .fold(0.0f64, f64::max);
+            if speed > 0.0 && speed.is_finite() {
+                length / speed
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let q: Vec<f64> = (start.qd.iter().zip(qdd))
+        .map(|(v, a)| v.abs() * time + 0.5 * a.abs() * time * time)
+        .collect();
+    let v: Vec<f64> = (start.qd.iter().zip(qdd))
+        .map(|(v, a)| v.abs() + a.abs() * time)
+        .collect();
+    let floor = |x: Vec<f64>, per: f64| {
+        let top = x.iter().cloned().fold(0.0, f64::max);
+        (x.into_iter().zip(&reach))
+            .map(|(s, r)| {
+                let own = if time > 0.0 { r * per } else { 0.0 };
+                s.max(SCALE_FLOOR * top)
+                    .max(SCALE_FLOOR * own)
+                    .max(f64::MIN_POSITIVE)
+            })
+            .collect::<Vec<f64>>()
+    };
+    let mut scales = floor(q, 1.0);
+    scales.extend(floor(v, 1.0 / time));
+    scales
+}
+
+/// What an integration starts from and how long it may run.
+#[derive(Debug, Clone)]
+pub struct Start {
+    /// The state.
+    pub state: State,
+    /// The closed contacts and friction modes there (see [`contacts::decide`]).
+    pub active: Active,
+    /// The friction options it was decided from (their slips' offsets start the slip events).
+    pub frictions: Vec<FrictionOption>,
+    /// Work done by friction before the start (J).
+    pub friction_work: f64,
+}
+
+/// Integrates `sys` from `start` until an event ends the phase, with relative tolerance
+/// `rtol` (raised to [`CONDITION_SAFETY`]` * eps * cond(M)`). `scales` (length `2 n`), when
+/// given, are typical magnitudes of the motion `y - y0` for the absolute tolerances; without
+/// them the control is relative to the largest deviation seen. `t_max` bounds the search.
 pub fn integrate(
     sys: &Bound,
+    start: &Start,
     rtol: f64,
     scales: Option<&[f64]>,
     t_max: f64,
@@ -368,9 +517,8 @@ pub fn integrate(
 ) -> Result<UnreducedRun, SolveError> {
     let info = sys.info();
     let n = sys.n_coordinates();
-    let m = info.frictions.len();
-    let start = sys.initial_state();
-    let condition = mass_condition(sys, &start);
+    let with_work = !info.frictions.is_empty();
+    let condition = mass_condition(sys, &start.state);
     let rtol = rtol.max(CONDITION_SAFETY * f64::EPSILON * condition);
     if rtol.is_nan() || rtol > MAX_RTOL {
         return Err(SolveError::IllConditioned {
@@ -379,28 +527,30 @@ pub fn integrate(
             rtol,
         });
     }
-    let mut y0 = start.q.clone();
-    y0.extend_from_slice(&start.qd);
-    if m > 0 {
-        y0.push(0.0);
+    let method = Method::for_rtol(rtol);
+    let mut y0 = start.state.q.clone();
+    y0.extend_from_slice(&start.state.qd);
+    if with_work {
+        y0.push(start.friction_work);
     }
-    let options = friction::start_options(sys, &start);
-    let modes = friction::decide(sys, &start, &options, 0.0)?;
-    let slip_offset = slip_offsets(sys, &start, &options);
     let mut problem = Problem {
         sys,
         n,
-        modes,
-        slip_offset,
-        contact: info.contact.map(|c| c.force),
-        edge: info.contact.is_some_and(|c| c.edge),
+        active: start.active.clone(),
+        watches: Vec::new(),
+        armed: Vec::new(),
+        arm_at: DECIDE_TOLERANCE * sys.length_scale(&start.state),
+        slip_offset: slip_offsets(sys, &start.state, &start.frictions),
         reduced: info.reduced,
         end_angle: info.end_angle,
         y0: y0.clone(),
         y: y0.clone(),
-        state: start,
+        state: start.state.clone(),
         last: None,
+        with_work,
     };
+    let d = contacts::dynamics(sys, &start.state, &problem.active, 0.0)?;
+    problem.watch(&d);
     let mut atol: Vec<f64> = match scales {
         Some(s) if s.len() == 2 * n => s
             .iter()
@@ -408,9 +558,9 @@ pub fn integrate(
             .collect(),
         _ => Vec::new(),
     };
-    if m > 0 && !atol.is_empty() {
+    if with_work && !atol.is_empty() {
         // The work of friction is held to the energy's own scale.
-        let e = sys.energy(&problem.state).abs();
+        let e = sys.energy(&start.state).abs();
         atol.push(rtol * if e > 0.0 { e } else { 1.0 });
     }
     let opts = OdeOptions {
@@ -422,17 +572,15 @@ pub fn integrate(
     let mut segments = Vec::new();
     let mut t0 = 0.0;
     loop {
-        let solution = dopri5(&mut problem, t0, &vec![0.0; y0.len()], &opts)?;
+        let solution = ode_integrate(method, &mut problem, t0, &vec![0.0; y0.len()], &opts)?;
         work.ode_steps += solution.total_steps();
         let Some(event) = solution.event.clone() else {
             return Err(SolveError::NoEvent { t_max });
         };
-        let y = (event.y.iter().zip(&y0))
-            .map(|(z, y0)| y0 + z)
-            .collect::<Vec<f64>>();
+        let y: Vec<f64> = (event.y.iter().zip(&y0)).map(|(z, y0)| y0 + z).collect();
         segments.push(Segment {
             t_start: t0,
-            modes: problem.modes.clone(),
+            active: problem.active.clone(),
             y0: y0.clone(),
             solution,
         });
@@ -440,23 +588,32 @@ pub fn integrate(
             q: y[..n].to_vec(),
             qd: y[n..2 * n].to_vec(),
         };
-        let n_end = problem.n_end_events();
-        if event.index < n_end {
-            let n_contact = usize::from(problem.contact.is_some());
-            let end = if event.index < n_contact {
-                EndEvent::Separation
-            } else if problem.edge && event.index == n_contact {
-                EndEvent::Edge
-            } else {
-                EndEvent::Floor
-            };
+        let watch =
+            problem
+                .watches
+                .get(event.index)
+                .copied()
+                .ok_or_else(|| SolveError::OdeNonFinite {
+                    what: "event index outside the watched events",
+                    t: event.t,
+                    y: y.clone(),
+                })?;
+        let end = match watch {
+            Watch::Force(i) => Some(EndEvent::Force(i)),
+            Watch::Gap(i) => Some(EndEvent::Gap(i)),
+            Watch::Edge(i) => Some(EndEvent::Edge(i)),
+            Watch::Floor => Some(EndEvent::Floor),
+            _ => None,
+        };
+        if let Some(end) = end {
             return Ok(UnreducedRun {
                 segments,
                 rtol,
+                method,
                 condition,
                 end,
                 t_end: event.t,
-                friction_work: if m > 0 { y[2 * n] } else { 0.0 },
+                friction_work: if with_work { y[2 * n] } else { 0.0 },
                 state_end: state,
             });
         }
@@ -467,10 +624,12 @@ pub fn integrate(
                 t: event.t,
             });
         }
-        problem.switch(event.index - n_end, &state, event.t)?;
+        problem.switch(watch, &state, event.t)?;
         problem.state = state;
         y0 = y;
         problem.y0 = y0.clone();
+        let d = contacts::dynamics(sys, &problem.state, &problem.active, event.t)?;
+        problem.watch(&d);
         t0 = event.t;
     }
 }

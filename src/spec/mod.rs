@@ -6,6 +6,7 @@
 //! as `rodcube::derive::spec` (and [`expr`] as `rodcube::derive::expr`).
 
 pub mod expr;
+pub mod units;
 
 use crate::yaml::{At, Document, ReadError, Step, excerpt, line_text};
 use annotate_snippets::{Group, Level, Renderer};
@@ -14,6 +15,7 @@ use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
 use std::path::{Path, PathBuf};
+use units::{Unit, conjugate_force_unit, expect_unit, unit_of};
 
 /// An expression field: YAML may write it as a string or a bare number.
 #[derive(Debug, Clone, Deserialize)]
@@ -100,7 +102,8 @@ pub struct BodySpec {
 
 /// A shape to draw, with its sizes as expressions of the parameters: exactly one of `segment`,
 /// `rectangle` and `circle`. On a body it is in the body's own frame (its centre of mass at the
-/// origin, x along its `angle`); in `scenery`, in world coordinates (y up, the floor at y = 0).
+/// origin, x along its `angle`); on an obstacle, in the obstacle's frame (origin at its `at`,
+/// axes along the world's: y up, the floor at y = 0).
 ///
 /// `{segment: [[-ell/2, 0], [ell/2, 0]]}` (a rod), `{rectangle: [a, a]}` (a cube),
 /// `{circle: R}` (a cylinder); a rectangle or circle is centred at the origin of its frame
@@ -134,24 +137,22 @@ pub struct PointSpec {
     pub meaning: String,
 }
 
-/// A reaction force measured on one body along one direction.
+/// A fixed body (a wall, a cylinder, a step): no coordinates, placed by parameters, drawn in
+/// `motion.svg`. Gaps, edges, points, frictions and monitors may use its symbols
+/// (see [`obstacle_symbols`]): `<name>_x` and `<name>_y` (where `at` puts it), and its shape's
+/// sizes, `<name>_r` for a circle, `<name>_w` and `<name>_h` for a rectangle.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct ForceSpec {
-    /// Identifier.
+pub struct ObstacleSpec {
+    /// Identifier (the prefix of its symbols).
     pub name: String,
-    /// Body whose equation of motion gives the force.
-    pub body: String,
-    /// Direction `d`, numbers (a unit vector) or expressions of the coordinates: the force is
-    /// the body's Newton balance projected on `d`, `m (d . a) + m g d_y`, that is the sum of
-    /// the non-gravity forces on `body` dotted with `d`. It measures one force when every other
-    /// force on the body is perpendicular to `d`; a force along a direction that another force
-    /// also has a component on can be isolated with a `d` perpendicular to that other force,
-    /// scaled so that the wanted force comes out whole (the floor's push on a rod that also
-    /// leans on a cylinder: `d = [cos(theta)/sin(theta), 1]`, perpendicular to the push).
-    pub direction: [Text; 2],
-    /// What it is, with its sign convention.
+    /// What it is.
     pub meaning: String,
+    /// Its reference point `[x, y]` in world coordinates, over the parameters: the origin of
+    /// its shape's frame.
+    pub at: [Text; 2],
+    /// Its shape in its own frame (origin at `at`, axes along the world's).
+    pub shape: ShapeSpec,
 }
 
 /// An extra potential-energy term besides gravity (a spring, say).
@@ -162,46 +163,54 @@ pub struct PotentialSpec {
     pub name: String,
     /// Energy as an expression of parameters and coordinates (J).
     pub expr: Text,
-    /// The bodies its force acts on. A reaction force in `forces` is measured by a Newton
-    /// balance on one body, which is only right when no potential acts on that body besides
-    /// gravity: the spec check refuses such a pair.
-    pub acts_on: Vec<String>,
     /// What it is.
     pub meaning: String,
 }
 
-/// A unilateral contact: `gap(q) >= 0`, touching while `gap = 0` and its force is positive.
+/// A support: a unilateral constraint `gap(q) >= 0` (or, `bilateral`, `gap(q) = 0` always).
 ///
-/// While touching, `gap = 0` is solved for the coordinate `eliminates` (the gap must be linear
-/// in it with a constant coefficient `c`), which is substituted everywhere; the contact force
-/// is the Lagrange multiplier `lambda = E_e / c`, where `E_e` is the Euler–Lagrange expression
-/// of that coordinate with every other force accounted for. The phase after the contact ends is
-/// derived from the same spec with the coordinate free again (the model `<name>_free`).
+/// Its force is the constraint's Lagrange multiplier `lambda`, conjugate to the gap: the
+/// generalized force on the coordinates is `lambda d(gap)/dq`, so a gap in metres gives a force
+/// in newtons and a gap in radians a torque in newton metres. A unilateral contact pushes
+/// (`lambda >= 0`) while it is closed (`gap = 0`) and opens where its force would have to pull;
+/// an open contact closes where its gap reaches zero. A bilateral one (a hinge, a pin) holds
+/// with a force of either sign and never opens.
+///
+/// With `eliminates`, a closed contact may be solved for that coordinate: `gap = 0` must be
+/// linear in it, with a coefficient that does not vanish (it may depend on the other
+/// coordinates), and the phases in which it is closed are derived with the coordinate
+/// eliminated (the fast path, where they reduce to one coordinate). Without it, the coordinate
+/// stays and the force is solved along with the motion.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ContactSpec {
-    /// Name of the contact force (a result key; not one of `forces`).
-    pub force: String,
+    /// Name of its force (a result key: `<name>_series`, `<name>_end_time`, ...).
+    pub name: String,
     /// What the force is, with its sign convention (positive while the bodies push apart).
     pub meaning: String,
-    /// Gap: positive when apart, zero when touching (expression of parameters and coordinates).
+    /// Gap: positive when apart, zero when touching (expression of parameters, coordinates and
+    /// obstacle symbols). Its unit sets the unit of the force.
     pub gap: Text,
-    /// The coordinate solved from `gap = 0` while touching.
-    pub eliminates: String,
+    /// The coordinate `gap = 0` is solved for while the contact is closed (optional).
+    #[serde(default)]
+    pub eliminates: Option<String>,
     /// Optional geometric end: an expression that stays `>= 0` while the contact can exist
-    /// (a contact point still on the body); its zero ends the contact at an edge.
+    /// (a contact point still on the body); its zero ends the motion at an edge.
     #[serde(default)]
     pub edge: Option<Text>,
+    /// A joint rather than a contact: closed for good, its force of either sign.
+    #[serde(default)]
+    pub bilateral: bool,
 }
 
-/// Coulomb friction at a point where a body touches another body or the floor.
+/// Coulomb friction at a contact: its normal force is that contact's force.
 ///
 /// The friction force `f` acts on `body` at `point` along the unit tangent `direction` (and
 /// `-f` on `against`, when it is a body). Its slip velocity is
 /// `v = direction . (v_body(point) - v_against(point))`, the velocity of the body's material point
 /// there relative to the other surface's, and its generalized force is `f dv/dqd`. While the
 /// contact slides, `f = -mu N sign(v)`; while it sticks, `v` stays zero and `f` is whatever keeps
-/// it so, as long as `|f| <= mu N`.
+/// it so, as long as `|f| <= mu N`. While the contact is open there is no friction.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FrictionSpec {
@@ -212,11 +221,12 @@ pub struct FrictionSpec {
     /// The friction coefficient: a parameter (declared `positive: false` if it may be zero; a
     /// negative value is refused when the model is bound).
     pub coefficient: String,
-    /// The normal force the friction is proportional to: one of `forces`, or the contact force.
-    pub normal: String,
+    /// The contact it acts at (one of `contacts`, unilateral): its force is the normal force.
+    pub contact: String,
     /// The body the friction acts on.
     pub body: String,
-    /// The other body at the contact (it feels `-f`); absent for the fixed floor or a wall.
+    /// The other body at the contact (it feels `-f`); absent for the fixed floor or an
+    /// obstacle.
     #[serde(default)]
     pub against: Option<String>,
     /// The contact point `[x, y]` (expressions of the coordinates).
@@ -389,23 +399,31 @@ pub struct Spec {
     /// Potential energy besides gravity.
     #[serde(default)]
     pub potentials: Vec<PotentialSpec>,
-    /// Reaction forces to evaluate.
+    /// Fixed bodies (walls, cylinders, steps): drawn, and usable in gaps through their
+    /// symbols.
     #[serde(default)]
-    pub forces: Vec<ForceSpec>,
-    /// The separating contact, if any.
+    pub obstacles: Vec<ObstacleSpec>,
+    /// Every support: unilateral contacts and bilateral joints, in the order results list
+    /// them (the first is the one whose end is the "separation").
     #[serde(default)]
-    pub contact: Option<ContactSpec>,
+    pub contacts: Vec<ContactSpec>,
     /// Coulomb friction at contacts.
     #[serde(default)]
     pub friction: Vec<FrictionSpec>,
     /// Monitored assumptions.
     #[serde(default)]
     pub monitors: Vec<MonitorSpec>,
-    /// Fixed shapes drawn in world coordinates besides the floor (a wall, say); sizes are
-    /// expressions of the parameters.
+    /// Retired (reaction forces projected by hand): read only to say what replaced it.
     #[serde(default)]
-    pub scenery: Vec<ShapeSpec>,
-    /// Initial state, one entry per coordinate (except the one the contact eliminates).
+    pub forces: Option<serde::de::IgnoredAny>,
+    /// Retired (the one contact): read only to say what replaced it.
+    #[serde(default)]
+    pub contact: Option<serde::de::IgnoredAny>,
+    /// Retired (fixed shapes): read only to say what replaced it.
+    #[serde(default)]
+    pub scenery: Option<serde::de::IgnoredAny>,
+    /// Initial state, one entry per coordinate except those a contact eliminates (they start
+    /// where `gap = 0` puts them).
     pub initial: BTreeMap<String, InitialSpec>,
     /// Dimensionless groups and scales in which the results are also written (none: the
     /// results are written in the parameters only).
@@ -480,6 +498,17 @@ pub struct Checked {
     pub spec: Spec,
     /// Where it came from.
     pub file: PathBuf,
+    /// Each contact's gap unit and its force's unit (conjugate to the gap), in the spec's
+    /// order.
+    pub units: Vec<(String, String)>,
+}
+
+impl Checked {
+    /// The gap unit and force unit of contact `j` (`("m", "N")`); empty strings for an index
+    /// out of range.
+    pub fn contact_units(&self, j: usize) -> (String, String) {
+        self.units.get(j).cloned().unwrap_or_default()
+    }
 }
 
 /// Names the derivation uses internally; specs may not use them.
@@ -513,10 +542,70 @@ pub fn parse(path: &Path, text: &str) -> Result<Checked, SpecError> {
         spec: &spec,
     };
     checker.check()?;
+    let units = checker.contact_units()?;
     Ok(Checked {
         spec,
         file: path.to_path_buf(),
+        units,
     })
+}
+
+/// The names a spec declares, by kind, and the scopes they make.
+#[derive(Default)]
+struct Names {
+    /// Parameters, coordinates, obstacle symbols and contacts: one namespace of symbols.
+    symbols: BTreeSet<String>,
+    params: BTreeSet<String>,
+    coords: BTreeSet<String>,
+    obstacles: BTreeSet<String>,
+    obstacle_symbols: BTreeSet<String>,
+    contacts: BTreeSet<String>,
+    bodies: BTreeSet<String>,
+    points: BTreeSet<String>,
+    /// Parameters, coordinates and obstacle symbols: what a position may depend on.
+    kinematic: BTreeSet<String>,
+}
+
+/// The symbols an obstacle defines, with their values over the parameters: `<name>_x` and
+/// `<name>_y` (its `at`), and its shape's sizes (`<name>_r` for a circle, `<name>_w` and
+/// `<name>_h` for a rectangle; a segment's ends are its own business).
+pub fn obstacle_symbols(o: &ObstacleSpec) -> Vec<(String, Text)> {
+    let mut out = vec![
+        (format!("{}_x", o.name), o.at[0].clone()),
+        (format!("{}_y", o.name), o.at[1].clone()),
+    ];
+    if let Some(r) = &o.shape.circle {
+        out.push((format!("{}_r", o.name), r.clone()));
+    }
+    if let Some([w, h]) = &o.shape.rectangle {
+        out.push((format!("{}_w", o.name), w.clone()));
+        out.push((format!("{}_h", o.name), h.clone()));
+    }
+    out
+}
+
+/// Every expression of a shape with its field.
+fn shape_texts<'s>(field: &Field, shape: &'s ShapeSpec) -> Vec<(Field, &'s Text)> {
+    let mut out = Vec::new();
+    if let Some(ends) = &shape.segment {
+        for (j, end) in ends.iter().enumerate() {
+            let f = field.k("segment").i(j);
+            out.push((f.i(0), &end[0]));
+            out.push((f.i(1), &end[1]));
+        }
+    }
+    if let Some([w, h]) = &shape.rectangle {
+        out.push((field.k("rectangle").i(0), w));
+        out.push((field.k("rectangle").i(1), h));
+    }
+    if let Some(r) = &shape.circle {
+        out.push((field.k("circle"), r));
+    }
+    if let Some([x, y]) = &shape.at {
+        out.push((field.k("at").i(0), x));
+        out.push((field.k("at").i(1), y));
+    }
+    out
 }
 
 struct Checker<'a> {
@@ -585,6 +674,22 @@ impl Checker<'_> {
     }
 
     fn check(&self) -> Result<(), SpecError> {
+        let names = self.check_names()?;
+        self.check_references(&names)?;
+        self.check_kinematics(&names)?;
+        self.check_obstacles(&names)?;
+        self.check_contacts(&names)?;
+        self.check_friction(&names)?;
+        self.check_drawing(&names.params)?;
+        self.check_monitors(&names)?;
+        self.check_initial(&names)?;
+        let mut seen = names.symbols.clone();
+        self.check_dimensionless(&names.params, &names.contacts, &mut seen)
+    }
+
+    /// Every name a plain identifier, declared once; the retired fields named with what
+    /// replaced them.
+    fn check_names(&self) -> Result<Names, SpecError> {
         let s = self.spec;
         if !is_identifier(&s.name) {
             return Err(self.err(
@@ -596,57 +701,64 @@ impl Checker<'_> {
                 ),
             ));
         }
-        let mut seen = BTreeSet::new();
-        let params: BTreeSet<String> = s.parameters.iter().map(|p| p.name.clone()).collect();
-        let coords: BTreeSet<String> = s.coordinates.iter().map(|c| c.name.clone()).collect();
+        let retired = [
+            (
+                s.forces.is_some(),
+                "forces",
+                "reaction forces projected by hand are retired: make each support a contact \
+                 (`contacts:`, a gap that is zero while touching), whose force is its Lagrange \
+                 multiplier",
+            ),
+            (
+                s.contact.is_some(),
+                "contact",
+                "`contact:` is now `contacts:`, a list; its `force:` is the contact's `name:`",
+            ),
+            (
+                s.scenery.is_some(),
+                "scenery",
+                "`scenery:` is now `obstacles:`, each with a `name`, a `meaning`, its place `at` \
+                 and a `shape`",
+            ),
+        ];
+        if let Some((_, key, why)) = retired.iter().find(|r| r.0) {
+            return Err(self.err(&Field::key(key), (*why).to_string()));
+        }
+        let mut names = Names::default();
         let named = |list: &str, i: usize| Field::key(list).i(i).k("name");
         for (i, p) in s.parameters.iter().enumerate() {
-            self.identifier(&named("parameters", i), &p.name, &mut seen)?;
+            self.identifier(&named("parameters", i), &p.name, &mut names.symbols)?;
+            names.params.insert(p.name.clone());
         }
         for (i, c) in s.coordinates.iter().enumerate() {
-            self.identifier(&named("coordinates", i), &c.name, &mut seen)?;
+            self.identifier(&named("coordinates", i), &c.name, &mut names.symbols)?;
+            names.coords.insert(c.name.clone());
         }
-        let mut names = BTreeSet::new();
+        for (i, o) in s.obstacles.iter().enumerate() {
+            self.identifier(&named("obstacles", i), &o.name, &mut names.obstacles)?;
+            for (symbol, _) in obstacle_symbols(o) {
+                self.identifier(&named("obstacles", i), &symbol, &mut names.symbols)?;
+                names.obstacle_symbols.insert(symbol);
+            }
+        }
+        for (i, c) in s.contacts.iter().enumerate() {
+            self.identifier(&named("contacts", i), &c.name, &mut names.symbols)?;
+            names.contacts.insert(c.name.clone());
+        }
+        let mut others = BTreeSet::new();
         for (i, b) in s.bodies.iter().enumerate() {
-            self.identifier(&named("bodies", i), &b.name, &mut names)?;
+            self.identifier(&named("bodies", i), &b.name, &mut names.bodies)?;
         }
-        let mut point_names = BTreeSet::new();
         for (i, p) in s.points.iter().enumerate() {
-            self.identifier(&named("points", i), &p.name, &mut point_names)?;
+            self.identifier(&named("points", i), &p.name, &mut names.points)?;
         }
-        let mut force_names = BTreeSet::new();
-        for (i, f) in s.forces.iter().enumerate() {
-            self.identifier(&named("forces", i), &f.name, &mut force_names)?;
-            if seen.contains(&f.name) {
-                return Err(self.err(
-                    &named("forces", i),
-                    format!("`{}` is already a parameter or coordinate", f.name),
-                ));
-            }
-        }
-        if let Some(c) = &s.contact {
-            let field = Field::key("contact").k("force");
-            self.identifier(&field, &c.force, &mut force_names)?;
-            if seen.contains(&c.force) {
-                return Err(self.err(
-                    &field,
-                    format!("`{}` is already a parameter or coordinate", c.force),
-                ));
-            }
-        }
-        let mut potential_names = BTreeSet::new();
         for (i, p) in s.potentials.iter().enumerate() {
-            self.identifier(&named("potentials", i), &p.name, &mut potential_names)?;
+            self.identifier(&named("potentials", i), &p.name, &mut others)?;
         }
-        let mut friction_names = force_names.clone();
+        // Friction forces are result keys beside the contacts' forces: one namespace.
+        let mut results = names.symbols.clone();
         for (i, f) in s.friction.iter().enumerate() {
-            self.identifier(&named("friction", i), &f.name, &mut friction_names)?;
-            if seen.contains(&f.name) {
-                return Err(self.err(
-                    &named("friction", i),
-                    format!("`{}` is already a parameter or coordinate", f.name),
-                ));
-            }
+            self.identifier(&named("friction", i), &f.name, &mut results)?;
         }
         let mut monitor_names = BTreeSet::new();
         for (i, m) in s.monitors.iter().enumerate() {
@@ -656,141 +768,308 @@ impl Checker<'_> {
         for (i, r) in s.requirements.iter().enumerate() {
             self.identifier(&named("requirements", i), &r.name, &mut req_names)?;
         }
+        names.kinematic = names.params.clone();
+        names.kinematic.extend(names.coords.iter().cloned());
+        names
+            .kinematic
+            .extend(names.obstacle_symbols.iter().cloned());
+        Ok(names)
+    }
+
+    /// `gravity`, `reduced` and `falling_point` name what they should; there is a body.
+    fn check_references(&self, names: &Names) -> Result<(), SpecError> {
+        let s = self.spec;
         if s.bodies.is_empty() {
             return Err(self.err(
                 &Field::key("bodies"),
                 "a model needs at least one body".into(),
             ));
         }
-        if !params.contains(&s.gravity) {
+        if !names.params.contains(&s.gravity) {
             return Err(self.err(
                 &Field::key("gravity"),
                 format!("`{}` is not a parameter", s.gravity),
             ));
         }
-        if !coords.contains(&s.reduced) {
+        if !names.coords.contains(&s.reduced) {
             return Err(self.err(
                 &Field::key("reduced"),
                 format!("`{}` is not a coordinate", s.reduced),
             ));
         }
-        if !point_names.contains(&s.falling_point) {
+        if !names.points.contains(&s.falling_point) {
             return Err(self.err(
                 &Field::key("falling_point"),
                 format!("`{}` is not one of the points", s.falling_point),
             ));
         }
-        let only_params: BTreeSet<String> = params.clone();
-        let mut kinematic = params.clone();
-        kinematic.extend(coords.iter().cloned());
+        Ok(())
+    }
+
+    /// Requirements over the parameters; bodies, points and potentials over the state.
+    fn check_kinematics(&self, names: &Names) -> Result<(), SpecError> {
+        let s = self.spec;
         for (i, r) in s.requirements.iter().enumerate() {
-            self.expr(
-                &Field::key("requirements").i(i).k("expr"),
-                &r.expr,
-                &only_params,
-            )?;
+            let f = Field::key("requirements").i(i).k("expr");
+            self.expr(&f, &r.expr, &names.params)?;
         }
         for (i, b) in s.bodies.iter().enumerate() {
             let f = Field::key("bodies").i(i);
-            self.expr(&f.k("mass"), &b.mass, &only_params)?;
-            self.expr(&f.k("inertia"), &b.inertia, &only_params)?;
-            self.expr(&f.k("position").i(0), &b.position[0], &kinematic)?;
-            self.expr(&f.k("position").i(1), &b.position[1], &kinematic)?;
-            self.expr(&f.k("angle"), &b.angle, &kinematic)?;
+            self.expr(&f.k("mass"), &b.mass, &names.params)?;
+            self.expr(&f.k("inertia"), &b.inertia, &names.params)?;
+            self.expr(&f.k("position").i(0), &b.position[0], &names.kinematic)?;
+            self.expr(&f.k("position").i(1), &b.position[1], &names.kinematic)?;
+            self.expr(&f.k("angle"), &b.angle, &names.kinematic)?;
         }
         for (i, p) in s.points.iter().enumerate() {
             let f = Field::key("points").i(i).k("position");
-            self.expr(&f.i(0), &p.position[0], &kinematic)?;
-            self.expr(&f.i(1), &p.position[1], &kinematic)?;
+            self.expr(&f.i(0), &p.position[0], &names.kinematic)?;
+            self.expr(&f.i(1), &p.position[1], &names.kinematic)?;
         }
-        let bodies: BTreeSet<String> = s.bodies.iter().map(|b| b.name.clone()).collect();
         for (i, p) in s.potentials.iter().enumerate() {
-            let field = Field::key("potentials").i(i);
-            self.expr(&field.k("expr"), &p.expr, &kinematic)?;
-            for (j, b) in p.acts_on.iter().enumerate() {
-                if !bodies.contains(b) {
+            let f = Field::key("potentials").i(i).k("expr");
+            self.expr(&f, &p.expr, &names.kinematic)?;
+        }
+        Ok(())
+    }
+
+    /// The unit of every parameter, coordinate and obstacle symbol; a unit string that does
+    /// not parse is an error at its field.
+    fn symbol_units(&self) -> Result<BTreeMap<String, Unit>, SpecError> {
+        let s = self.spec;
+        let mut out = BTreeMap::new();
+        let parameters = s.parameters.iter().map(|p| (&p.name, &p.unit));
+        let coordinates = s.coordinates.iter().map(|c| (&c.name, &c.unit));
+        let declared = (parameters.enumerate().map(|(i, e)| ("parameters", i, e)))
+            .chain(coordinates.enumerate().map(|(i, e)| ("coordinates", i, e)));
+        for (list, i, (name, unit)) in declared {
+            let u = Unit::parse(unit).map_err(|e| {
+                self.err(
+                    &Field::key(list).i(i).k("unit"),
+                    format!("the unit `{unit}` of `{name}`: {e}"),
+                )
+            })?;
+            out.insert(name.clone(), u);
+        }
+        let params: BTreeSet<String> = s.parameters.iter().map(|p| p.name.clone()).collect();
+        for (i, o) in s.obstacles.iter().enumerate() {
+            for (symbol, text) in obstacle_symbols(o) {
+                let field = Field::key("obstacles").i(i);
+                let e = self.expr(&field, &text, &params)?;
+                // Every obstacle symbol is a length: a place or a size.
+                let lookup = |n: &str| out.get(n).copied();
+                expect_unit(&e, &lookup, Unit::METRE).map_err(|err| {
+                    self.err(&field, format!("`{symbol}` = `{}`: {err}", text.text()))
+                })?;
+                out.insert(symbol, Unit::METRE);
+            }
+        }
+        Ok(out)
+    }
+
+    /// The units the mechanics needs: bodies' masses in kg, inertias in kg m^2, positions in
+    /// m, potentials in J, and every contact's gap in one unit, whose force is conjugate to it
+    /// (N for a gap in metres, N m for one in radians). Returns each contact's gap and force
+    /// unit, as printed.
+    fn contact_units(&self) -> Result<Vec<(String, String)>, SpecError> {
+        let s = self.spec;
+        let units = self.symbol_units()?;
+        let lookup = |n: &str| units.get(n).copied();
+        let expect = |field: Field, text: &Text, unit: Unit, what: &str| {
+            let e = Expr::parse(&text.text()).map_err(|e| {
+                self.err(
+                    &field,
+                    format!("cannot parse `{}`: {}", text.text(), e.message),
+                )
+            })?;
+            expect_unit(&e, &lookup, unit)
+                .map_err(|err| self.err(&field, format!("{what} must be in {unit}: {err}")))
+        };
+        let kg_m2 = Unit::KILOGRAM
+            .checked_mul(Unit::METRE)
+            .and_then(|u| u.checked_mul(Unit::METRE))
+            .map_err(|e| self.err(&Field::key("bodies"), e.to_string()))?;
+        for (i, b) in s.bodies.iter().enumerate() {
+            let f = Field::key("bodies").i(i);
+            expect(f.k("mass"), &b.mass, Unit::KILOGRAM, "a mass")?;
+            expect(f.k("inertia"), &b.inertia, kg_m2, "a moment of inertia")?;
+            expect(
+                f.k("position").i(0),
+                &b.position[0],
+                Unit::METRE,
+                "a position",
+            )?;
+            expect(
+                f.k("position").i(1),
+                &b.position[1],
+                Unit::METRE,
+                "a position",
+            )?;
+            expect(f.k("angle"), &b.angle, Unit::DIMENSIONLESS, "an angle")?;
+        }
+        for (i, p) in s.potentials.iter().enumerate() {
+            let f = Field::key("potentials").i(i).k("expr");
+            expect(f, &p.expr, Unit::JOULE, "a potential energy")?;
+        }
+        let mut out = Vec::new();
+        for (i, c) in s.contacts.iter().enumerate() {
+            let field = Field::key("contacts").i(i);
+            let gap = Expr::parse(&c.gap.text()).map_err(|e| {
+                self.err(
+                    &field.k("gap"),
+                    format!("cannot parse `{}`: {}", c.gap.text(), e.message),
+                )
+            })?;
+            let gap_unit = unit_of(&gap, &lookup).map_err(|err| {
+                self.err(
+                    &field.k("gap"),
+                    format!(
+                        "the gap of contact `{}` has no consistent unit: {err}",
+                        c.name
+                    ),
+                )
+            })?;
+            let force_unit = conjugate_force_unit(gap_unit)
+                .map_err(|err| self.err(&field.k("gap"), format!("contact `{}`: {err}", c.name)))?;
+            if let Some(edge) = &c.edge
+                && let Ok(e) = Expr::parse(&edge.text())
+                && let Err(err) = unit_of(&e, &lookup)
+            {
+                return Err(self.err(
+                    &field.k("edge"),
+                    format!(
+                        "the edge of contact `{}` has no consistent unit: {err}",
+                        c.name
+                    ),
+                ));
+            }
+            // A torque and an energy are both kg m^2 s^-2: a multiplier is a torque.
+            let force = if force_unit == Unit::JOULE {
+                "N m".to_string()
+            } else {
+                force_unit.to_string()
+            };
+            out.push((gap_unit.to_string(), force));
+        }
+        Ok(out)
+    }
+
+    /// An obstacle is fixed: its place and shape depend on the parameters only.
+    fn check_obstacles(&self, names: &Names) -> Result<(), SpecError> {
+        for (i, o) in self.spec.obstacles.iter().enumerate() {
+            let f = Field::key("obstacles").i(i);
+            let mut texts: Vec<(Field, &Text)> =
+                vec![(f.k("at").i(0), &o.at[0]), (f.k("at").i(1), &o.at[1])];
+            texts.extend(shape_texts(&f.k("shape"), &o.shape));
+            for (field, text) in texts {
+                if let Ok(e) = Expr::parse(&text.text())
+                    && let Some(c) = e.symbols().iter().find(|s| names.coords.contains(*s))
+                {
                     return Err(self.err(
-                        &field.k("acts_on").i(j),
-                        format!("`{b}` is not one of the bodies"),
+                        &field,
+                        format!(
+                            "obstacle `{}` is fixed: its place and shape may depend on the \
+                             parameters only, not on the coordinate `{c}` (a body that moves \
+                             is one of `bodies`)",
+                            o.name
+                        ),
+                    ));
+                }
+                self.expr(&field, text, &names.params)?;
+            }
+            self.shape(&f.k("shape"), &o.shape, &names.params)?;
+        }
+        Ok(())
+    }
+
+    /// Each contact: a gap of the state that depends on a coordinate, the coordinate it may
+    /// eliminate (each at most once, never the reduced one), an edge only on a unilateral one.
+    fn check_contacts(&self, names: &Names) -> Result<(), SpecError> {
+        let s = self.spec;
+        let mut eliminated: BTreeMap<&str, usize> = BTreeMap::new();
+        for (i, c) in s.contacts.iter().enumerate() {
+            let field = Field::key("contacts").i(i);
+            let gap = self.expr(&field.k("gap"), &c.gap, &names.kinematic)?;
+            let symbols = gap.symbols();
+            if !symbols.iter().any(|x| names.coords.contains(x)) {
+                return Err(self.err(
+                    &field.k("gap"),
+                    format!(
+                        "the gap `{}` of contact `{}` depends on no coordinate, so nothing can \
+                         open or close it",
+                        c.gap.text(),
+                        c.name
+                    ),
+                ));
+            }
+            if let Some(e) = &c.eliminates {
+                let f = field.k("eliminates");
+                if !names.coords.contains(e) {
+                    return Err(self.err(&f, format!("`{e}` is not a coordinate")));
+                }
+                if *e == s.reduced {
+                    return Err(self.err(
+                        &f,
+                        format!(
+                            "`{e}` is the reduced coordinate, which the motion is reported in; \
+                             eliminate another one"
+                        ),
+                    ));
+                }
+                if !symbols.contains(e) {
+                    return Err(self.err(
+                        &f,
+                        format!("the gap `{}` does not depend on `{e}`", c.gap.text()),
+                    ));
+                }
+                if let Some(j) = eliminated.insert(e, i) {
+                    return Err(self.err(
+                        &f,
+                        format!(
+                            "`{e}` is already eliminated by contact `{}`",
+                            s.contacts[j].name
+                        ),
                     ));
                 }
             }
-        }
-        for (i, f) in s.forces.iter().enumerate() {
-            let field = Field::key("forces").i(i);
-            if !bodies.contains(&f.body) {
-                return Err(self.err(
-                    &field.k("body"),
-                    format!("`{}` is not one of the bodies", f.body),
-                ));
-            }
-            if let Some(p) = s.potentials.iter().find(|p| p.acts_on.contains(&f.body)) {
-                return Err(self.err(
-                    &field.k("body"),
-                    format!(
-                        "force `{}` is measured by a Newton balance on `{}`, but potential `{}` \
-                         also acts on that body, so the balance would not isolate the force; \
-                         measure it on another body or make it a contact",
-                        f.name, f.body, p.name
-                    ),
-                ));
-            }
-            let d = field.k("direction");
-            self.expr(&d.i(0), &f.direction[0], &kinematic)?;
-            self.expr(&d.i(1), &f.direction[1], &kinematic)?;
-            if let (Text::Num(x), Text::Num(y)) = (&f.direction[0], &f.direction[1]) {
-                self.unit(&d, [*x, *y])?;
-            }
-        }
-        if let Some(c) = &s.contact {
-            let field = Field::key("contact");
-            self.expr(&field.k("gap"), &c.gap, &kinematic)?;
-            if !coords.contains(&c.eliminates) {
-                return Err(self.err(
-                    &field.k("eliminates"),
-                    format!("`{}` is not a coordinate", c.eliminates),
-                ));
-            }
-            if c.eliminates == s.reduced {
-                return Err(self.err(
-                    &field.k("eliminates"),
-                    format!(
-                        "`{}` is the reduced coordinate, which the motion is reported in; \
-                         eliminate another one",
-                        c.eliminates
-                    ),
-                ));
-            }
-            if s.coordinates.len() < 2 {
-                return Err(self.err(
-                    &field.k("eliminates"),
-                    "a contact needs a coordinate besides the reduced one to eliminate".into(),
-                ));
-            }
             if let Some(edge) = &c.edge {
-                self.expr(&field.k("edge"), edge, &kinematic)?;
+                if c.bilateral {
+                    return Err(self.err(
+                        &field.k("edge"),
+                        "a bilateral contact never ends, so it has no edge".into(),
+                    ));
+                }
+                self.expr(&field.k("edge"), edge, &names.kinematic)?;
             }
         }
-        self.check_friction(&params, &bodies, &force_names, &kinematic)?;
-        self.check_drawing(&only_params)?;
-        let mut monitor_scope = kinematic.clone();
-        monitor_scope.extend(force_names.iter().cloned());
-        for (i, m) in s.monitors.iter().enumerate() {
-            self.expr(
-                &Field::key("monitors").i(i).k("expr"),
-                &m.expr,
-                &monitor_scope,
-            )?;
+        Ok(())
+    }
+
+    /// Monitors over the state, the parameters and the contacts' forces.
+    fn check_monitors(&self, names: &Names) -> Result<(), SpecError> {
+        let mut scope = names.kinematic.clone();
+        scope.extend(names.contacts.iter().cloned());
+        for (i, m) in self.spec.monitors.iter().enumerate() {
+            self.expr(&Field::key("monitors").i(i).k("expr"), &m.expr, &scope)?;
         }
-        let eliminated = s.contact.as_ref().map(|c| c.eliminates.as_str());
+        Ok(())
+    }
+
+    /// An initial position and velocity for every coordinate but those a contact eliminates
+    /// (they start where `gap = 0` puts them), over the parameters.
+    fn check_initial(&self, names: &Names) -> Result<(), SpecError> {
+        let s = self.spec;
+        let eliminated: BTreeMap<&str, &str> = (s.contacts.iter())
+            .filter_map(|c| c.eliminates.as_deref().map(|e| (e, c.name.as_str())))
+            .collect();
         for c in &s.coordinates {
-            if Some(c.name.as_str()) == eliminated {
+            if let Some(contact) = eliminated.get(c.name.as_str()) {
                 if s.initial.contains_key(&c.name) {
                     return Err(self.err(
                         &Field::key("initial").k(&c.name),
                         format!(
-                            "`{}` starts where `gap = 0` puts it (the contact eliminates it); \
-                             remove its initial value",
+                            "`{}` starts where `gap = 0` puts it (contact `{contact}` \
+                             eliminates it); remove its initial value",
                             c.name
                         ),
                     ));
@@ -807,16 +1086,16 @@ impl Checker<'_> {
                 ));
             };
             let f = Field::key("initial").k(&c.name);
-            self.expr(&f.k("position"), &init.position, &only_params)?;
-            self.expr(&f.k("velocity"), &init.velocity, &only_params)?;
+            self.expr(&f.k("position"), &init.position, &names.params)?;
+            self.expr(&f.k("velocity"), &init.velocity, &names.params)?;
         }
-        if let Some(extra) = s.initial.keys().find(|k| !coords.contains(*k)) {
+        if let Some(extra) = s.initial.keys().find(|k| !names.coords.contains(*k)) {
             return Err(self.err(
                 &Field::key("initial").k(extra),
                 format!("`{extra}` is not a coordinate"),
             ));
         }
-        self.check_dimensionless(&only_params, &force_names, &mut seen)
+        Ok(())
     }
 
     /// Each group a new identifier and a monomial of the parameters that can be solved for
@@ -884,18 +1163,13 @@ impl Checker<'_> {
         Ok(())
     }
 
-    /// Each friction names a parameter as its coefficient, a force or the contact force as its
-    /// normal force, bodies that exist (two different ones), a point and a unit tangent.
-    fn check_friction(
-        &self,
-        params: &BTreeSet<String>,
-        bodies: &BTreeSet<String>,
-        force_names: &BTreeSet<String>,
-        kinematic: &BTreeSet<String>,
-    ) -> Result<(), SpecError> {
-        for (i, f) in self.spec.friction.iter().enumerate() {
+    /// Each friction names a parameter as its coefficient, a unilateral contact whose force
+    /// is its normal force, bodies that exist (two different ones), a point and a unit tangent.
+    fn check_friction(&self, names: &Names) -> Result<(), SpecError> {
+        let s = self.spec;
+        for (i, f) in s.friction.iter().enumerate() {
             let field = Field::key("friction").i(i);
-            if !params.contains(&f.coefficient) {
+            if !names.params.contains(&f.coefficient) {
                 return Err(self.err(
                     &field.k("coefficient"),
                     format!(
@@ -905,30 +1179,42 @@ impl Checker<'_> {
                     ),
                 ));
             }
-            if !force_names.contains(&f.normal) {
-                let known: Vec<&str> = force_names.iter().map(String::as_str).collect();
-                return Err(self.err(
-                    &field.k("normal"),
-                    format!(
-                        "`{}` is not a normal force of the model; friction is proportional to \
-                         one of its forces or its contact force ({})",
-                        f.normal,
-                        if known.is_empty() {
-                            "it has none".to_string()
-                        } else {
-                            known.join(", ")
-                        }
-                    ),
-                ));
+            match s.contacts.iter().find(|c| c.name == f.contact) {
+                None => {
+                    let known: Vec<&str> = s.contacts.iter().map(|c| c.name.as_str()).collect();
+                    return Err(self.err(
+                        &field.k("contact"),
+                        format!(
+                            "there is no contact `{}`: friction acts at one of the contacts ({})",
+                            f.contact,
+                            if known.is_empty() {
+                                "the model has none".to_string()
+                            } else {
+                                known.join(", ")
+                            }
+                        ),
+                    ));
+                }
+                Some(c) if c.bilateral => {
+                    return Err(self.err(
+                        &field.k("contact"),
+                        format!(
+                            "contact `{}` is bilateral: Coulomb friction needs a normal force \
+                             that pushes",
+                            c.name
+                        ),
+                    ));
+                }
+                Some(_) => {}
             }
-            if !bodies.contains(&f.body) {
+            if !names.bodies.contains(&f.body) {
                 return Err(self.err(
                     &field.k("body"),
                     format!("`{}` is not one of the bodies", f.body),
                 ));
             }
             if let Some(other) = &f.against {
-                if !bodies.contains(other) {
+                if !names.bodies.contains(other) {
                     return Err(self.err(
                         &field.k("against"),
                         format!("`{other}` is not one of the bodies"),
@@ -942,11 +1228,11 @@ impl Checker<'_> {
                 }
             }
             let p = field.k("point");
-            self.expr(&p.i(0), &f.point[0], kinematic)?;
-            self.expr(&p.i(1), &f.point[1], kinematic)?;
+            self.expr(&p.i(0), &f.point[0], &names.kinematic)?;
+            self.expr(&p.i(1), &f.point[1], &names.kinematic)?;
             let d = field.k("direction");
-            self.expr(&d.i(0), &f.direction[0], kinematic)?;
-            self.expr(&d.i(1), &f.direction[1], kinematic)?;
+            self.expr(&d.i(0), &f.direction[0], &names.kinematic)?;
+            self.expr(&d.i(1), &f.direction[1], &names.kinematic)?;
             if let (Text::Num(x), Text::Num(y)) = (&f.direction[0], &f.direction[1]) {
                 self.unit(&d, [*x, *y])?;
             }
@@ -954,15 +1240,12 @@ impl Checker<'_> {
         Ok(())
     }
 
-    /// The bodies' shapes and the scenery, drawn in `motion.svg`.
+    /// The bodies' shapes, drawn in `motion.svg` (the obstacles' are checked with them).
     fn check_drawing(&self, params: &BTreeSet<String>) -> Result<(), SpecError> {
         for (i, b) in self.spec.bodies.iter().enumerate() {
             if let Some(shape) = &b.shape {
                 self.shape(&Field::key("bodies").i(i).k("shape"), shape, params)?;
             }
-        }
-        for (i, shape) in self.spec.scenery.iter().enumerate() {
-            self.shape(&Field::key("scenery").i(i), shape, params)?;
         }
         Ok(())
     }

@@ -1,7 +1,9 @@
 //! Hand-typed models of the seed paper, for testing the solvers before (and independently of)
-//! the generated ones: `rod_cube` from eqs. (5), (9), (12 as corrected in PHYSICS.md erratum 2),
-//! (14), (16), (18), (22), and `rod_cube_free`, the rod sliding alone and the cube gliding on
-//! after they part.
+//! the generated ones: the system `rod_cube` as a general model (the foot's height a coordinate,
+//! the tip on the cube and the floor under the foot two contacts, typed from the Lagrangian by
+//! hand), its fast phase `rod_cube_closed` from eqs. (5), (9), (12 as corrected in PHYSICS.md
+//! erratum 2), (14), (16), (18), (22), and `rod_cube_free`, the rod sliding alone and the cube
+//! gliding on after they part.
 //!
 //! Both follow the `k`/`delta` conventions of `rodcube::model`; every `sin(theta_i) - sin(theta)`
 //! and `cos(theta) - cos(theta_i)` is formed from `delta` without cancellation. Their
@@ -9,7 +11,7 @@
 //! that the tests compare with the generated one.
 
 use rodcube::model::{
-    Binding, ContactInfo, Model, ModelInfo, MonitorInfo, NamedInfo, NextPhase, ParamInfo, Reduced,
+    ContactInfo, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo, Reduced,
     Reduction, ReductionInfo, ShapeInfo, ShapeKind,
 };
 
@@ -38,6 +40,63 @@ const fn monitor(name: &'static str, meaning: &'static str, unit: &'static str) 
         unit,
     }
 }
+
+/// The system's contacts as a phase holding `closed` (by elimination) sees them: the tip on the
+/// cube (eliminating `x2`) and the floor under the foot (eliminating `y1`).
+const fn contacts(tip: bool, floor: bool) -> [ContactInfo; 2] {
+    [
+        ContactInfo {
+            name: "contact_force",
+            meaning: "push of the rod on the cube (N), positive while touching, eq. (16)",
+            gap_unit: "m",
+            unit: "N",
+            bilateral: false,
+            edge: false,
+            eliminates: Some("x2"),
+            closed: tip,
+        },
+        ContactInfo {
+            name: "floor_normal",
+            meaning: "floor reaction on the rod's foot (N), m1 (g + y_cm'')",
+            gap_unit: "m",
+            unit: "N",
+            bilateral: false,
+            edge: false,
+            eliminates: Some("y1"),
+            closed: floor,
+        },
+    ]
+}
+
+static GENERAL_CONTACTS: [ContactInfo; 2] = contacts(false, false);
+static CLOSED_CONTACTS: [ContactInfo; 2] = contacts(true, true);
+static FREE_CONTACTS: [ContactInfo; 2] = contacts(false, true);
+
+/// The system's fast phases (the same list in every model of the hand-typed system).
+static PHASES: &[PhaseInfo] = &[
+    PhaseInfo {
+        closed: &[0, 1],
+        model: "rod_cube_closed",
+        release: true,
+        separation_degree: 3,
+    },
+    PhaseInfo {
+        closed: &[1],
+        model: "rod_cube_free",
+        release: false,
+        separation_degree: 0,
+    },
+];
+
+/// The system's coordinates.
+const SYSTEM_COORDINATES: &[&str] = &["x1", "y1", "theta", "x2"];
+
+/// The system's monitor, in every phase (the push, zero where the tip is off the cube).
+const MONITORS: &[MonitorInfo] = &[monitor(
+    "cube_does_not_tip",
+    "m2 g a/2 - F (y_tip - a/2) >= 0",
+    "N m",
+)];
 
 /// The rod (a segment from end to end through its centre) and the cube (a square of side `a`).
 const SHAPES: &[ShapeInfo] = &[
@@ -95,10 +154,11 @@ fn delta_from_drops(si: f64, ci: f64, s: f64, c: f64, ds: f64, dc: f64) -> f64 {
 // rod_cube
 // ---------------------------------------------------------------------------------------------
 
-/// The rod leaning on a cube that slides on a frictionless floor (the paper's system).
+/// The rod leaning on a cube that slides on a frictionless floor (the paper's system), both
+/// contacts closed: the fast phase `rod_cube_closed`.
 pub struct RodCube;
 
-/// The `rod_cube` model.
+/// The `rod_cube_closed` model.
 pub static ROD_CUBE: RodCube = RodCube;
 
 // k layout
@@ -111,9 +171,10 @@ const RC_G_ELL: usize = 10; // g / ell
 const RC_KX: usize = 11; // (1 + 2n) / (2 (1 + n))
 
 static RC_INFO: ModelInfo = ModelInfo {
-    name: "rod_cube",
+    name: "rod_cube_closed",
     description: "uniform rod leaning on a sliding cube, frictionless floor (hand-typed from the paper)",
     spec: "tests/common/paper.rs",
+    system: "rod_cube",
     parameters: &[
         param("m1", "rod mass", "kg", true),
         param("m2", "cube mass", "kg", true),
@@ -127,24 +188,11 @@ static RC_INFO: ModelInfo = ModelInfo {
     )],
     n_constants: 12,
     coordinates: &["x1", "theta"],
+    system_coordinates: SYSTEM_COORDINATES,
     reduced: 1,
     cyclic: &[0],
     end_angle: 0.0,
-    forces: &[
-        named(
-            "contact_force",
-            "push of the rod on the cube (N), positive while touching, eq. (16)",
-        ),
-        named(
-            "floor_normal",
-            "floor reaction on the rod's foot (N), m1 (g + y_cm'')",
-        ),
-    ],
-    contact: Some(ContactInfo {
-        force: 0,
-        eliminated: "x2",
-        edge: false,
-    }),
+    contacts: &CLOSED_CONTACTS,
     frictions: &[],
     points: &[
         named("foot", "rod end on the floor"),
@@ -154,39 +202,17 @@ static RC_INFO: ModelInfo = ModelInfo {
     ],
     falling_point: 2,
     gravity: 4,
-    monitors: &[
-        monitor("foot_on_floor", "floor normal force on the foot >= 0", "N"),
-        monitor(
-            "cube_does_not_tip",
-            "m2 g a/2 - F (ell s - a/2) >= 0",
-            "N m",
-        ),
-    ],
+    monitors: MONITORS,
     bodies: &["rod", "cube"],
     shapes: SHAPES,
-    next_phase: Some(NextPhase {
-        model: "rod_cube_free",
-        bindings: &[
-            Binding::Param(0),
-            Binding::Param(1),
-            Binding::Param(2),
-            Binding::Param(3),
-            Binding::Param(4),
-            Binding::Coordinate(0),
-            Binding::Coordinate(1),
-            Binding::Eliminated,
-            Binding::Velocity(0),
-            Binding::Velocity(1),
-            Binding::EliminatedRate,
-        ],
-    }),
+    start_params: false,
+    phases: PHASES,
     reduction: Some(ReductionInfo {
         k_theta_initial: RC_THETA_I,
         k_theta_dot_initial: RC_THETA_DOT_I,
         k_sin_initial: RC_R,
         k_cos_initial: RC_C0,
-        separation_degree: 3,
-        polynomial_separation: true,
+        force_degrees: &[3, 4],
         fall_degree: Some(2),
         lean_constants: &[5, 6, 7, 8, 9, 10, 11],
     }),
@@ -270,21 +296,26 @@ impl Model for RodCube {
         rhs[1] = -m2 * ell * ell * s * c * w * w - m1 * g * ell * c / 2.0;
     }
 
-    fn forces_full(
-        &self,
-        k: &[f64],
-        q: &[f64],
-        qd: &[f64],
-        qdd: &[f64],
-        _fr: &[f64],
-        out: &mut [f64],
-    ) {
+    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
         let (m1, m2, ell, g) = (k[0], k[1], k[2], k[4]);
         let (s, c) = (q[1].sin(), q[1].cos());
         let (w, x1dd, wd) = (qd[1], qdd[0], qdd[1]);
         // F = m2 x2'', x2 = x1 + ell cos(theta)
         out[0] = m2 * (x1dd - ell * s * wd - ell * c * w * w);
         out[1] = m1 * (g + 0.5 * ell * (c * wd - s * w * w));
+    }
+
+    fn gaps(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
+        out.fill(0.0);
+    }
+
+    fn constraints(&self, _k: &[f64], _q: &[f64], _qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        jac.fill(0.0);
+        bias.fill(0.0);
+    }
+
+    fn edges(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
+        out.fill(f64::INFINITY);
     }
 
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
@@ -294,19 +325,14 @@ impl Model for RodCube {
 
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], f: &[f64], out: &mut [f64]) {
         let (m2, ell, a, g) = (k[1], k[2], k[3], k[4]);
-        out[0] = f[1];
-        out[1] = m2 * g * a / 2.0 - f[0] * (ell * q[1].sin() - a / 2.0);
+        out[0] = m2 * g * a / 2.0 - f[0] * (ell * q[1].sin() - a / 2.0);
     }
 
-    fn contact_edge(&self, _k: &[f64], _q: &[f64]) -> f64 {
-        f64::INFINITY
-    }
-
-    fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+    fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
         let ell = k[2];
         let (s, c) = q[1].sin_cos();
-        out[0] = q[0] + ell * c;
-        out[1] = qd[0] - ell * s * qd[1];
+        q_full.copy_from_slice(&[q[0], 0.0, q[1], q[0] + ell * c]);
+        qd_full.copy_from_slice(&[qd[0], 0.0, qd[1], qd[0] - ell * s * qd[1]]);
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
@@ -353,9 +379,23 @@ impl Reduction for RodCube {
         out[1] = m1 * (g + 0.5 * ell * (c * red.theta_ddot - s * red.theta_dot_sq));
     }
 
-    fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        // eq. (14) divided by (1 + n)
-        out.copy_from_slice(&[8.0 * k[RC_R], -12.0, 0.0, 3.0 * k[RC_MU]]);
+    fn force_polynomial(&self, k: &[f64], contact: usize, out: &mut [f64]) {
+        let (r, mu) = (k[RC_R], k[RC_MU]);
+        match contact {
+            // eq. (14) divided by (1 + n), with the push's sign: F is -(8r - 12s + 3 mu s^3)
+            // times a positive factor (eq. 16).
+            0 => out.copy_from_slice(&[-8.0 * r, 12.0, 0.0, -3.0 * mu]),
+            // N D^2 / (m1 g) with D = 4/3 - mu s^2, from N = m1 (g + ell/2 (c theta'' - s
+            // theta'^2)) and eqs. (9), (12): a quartic with no cubic term.
+            1 => out.copy_from_slice(&[
+                4.0 / 9.0,
+                2.0 * mu * r - 8.0 * r / 3.0,
+                4.0 - 11.0 * mu / 3.0,
+                0.0,
+                mu * mu - mu,
+            ]),
+            _ => {}
+        }
     }
 
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
@@ -411,6 +451,7 @@ static FR_INFO: ModelInfo = ModelInfo {
     name: "rod_cube_free",
     description: "uniform rod sliding on a frictionless floor after leaving the cube (hand-typed)",
     spec: "tests/common/paper.rs",
+    system: "rod_cube",
     parameters: &[
         param("m1", "rod mass", "kg", true),
         param("m2", "cube mass", "kg", true),
@@ -432,14 +473,11 @@ static FR_INFO: ModelInfo = ModelInfo {
     requirements: &[named("a_below_ell", "(ell - a) / ell > 0")],
     n_constants: 18,
     coordinates: &["x1", "theta", "x2"],
+    system_coordinates: SYSTEM_COORDINATES,
     reduced: 1,
     cyclic: &[0, 2],
     end_angle: 0.0,
-    forces: &[named(
-        "floor_normal",
-        "floor reaction on the rod's foot (N)",
-    )],
-    contact: None,
+    contacts: &FREE_CONTACTS,
     frictions: &[],
     points: &[
         named("foot", "rod end on the floor"),
@@ -449,24 +487,17 @@ static FR_INFO: ModelInfo = ModelInfo {
     ],
     falling_point: 2,
     gravity: 4,
-    monitors: &[
-        monitor("foot_on_floor", "floor normal force on the foot >= 0", "N"),
-        monitor(
-            "contact_open",
-            "the tip stays clear of the cube: x2 - x1 - ell cos >= 0",
-            "m",
-        ),
-    ],
+    monitors: MONITORS,
     bodies: &["rod", "cube"],
     shapes: SHAPES,
-    next_phase: None,
+    start_params: true,
+    phases: PHASES,
     reduction: Some(ReductionInfo {
         k_theta_initial: FR_THETA_I,
         k_theta_dot_initial: FR_THETA_DOT_I,
         k_sin_initial: FR_S0,
         k_cos_initial: FR_C0,
-        separation_degree: 0,
-        polynomial_separation: false,
+        force_degrees: &[0, 0],
         fall_degree: None,
         lean_constants: &[],
     }),
@@ -541,18 +572,27 @@ impl Model for FreeRod {
         rhs[2] = 0.0;
     }
 
-    fn forces_full(
-        &self,
-        k: &[f64],
-        q: &[f64],
-        qd: &[f64],
-        qdd: &[f64],
-        _fr: &[f64],
-        out: &mut [f64],
-    ) {
+    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
         let (m1, ell, g) = (k[0], k[2], k[4]);
         let (s, c) = (q[1].sin(), q[1].cos());
-        out[0] = m1 * (g + 0.5 * ell * (c * qdd[1] - s * qd[1] * qd[1]));
+        out[0] = 0.0;
+        out[1] = m1 * (g + 0.5 * ell * (c * qdd[1] - s * qd[1] * qd[1]));
+    }
+
+    fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
+        out[0] = q[2] - q[0] - k[2] * q[1].cos();
+        out[1] = 0.0;
+    }
+
+    fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        let ell = k[2];
+        let (s, c) = q[1].sin_cos();
+        jac.copy_from_slice(&[-1.0, ell * s, 1.0, 0.0, 0.0, 0.0]);
+        bias.copy_from_slice(&[ell * c * qd[1] * qd[1], 0.0]);
+    }
+
+    fn edges(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
+        out.fill(f64::INFINITY);
     }
 
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
@@ -561,15 +601,14 @@ impl Model for FreeRod {
     }
 
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], f: &[f64], out: &mut [f64]) {
-        out[0] = f[0];
-        out[1] = q[2] - q[0] - k[2] * q[1].cos();
+        let (m2, ell, a, g) = (k[1], k[2], k[3], k[4]);
+        out[0] = m2 * g * a / 2.0 - f[0] * (ell * q[1].sin() - a / 2.0);
     }
 
-    fn contact_edge(&self, _k: &[f64], _q: &[f64]) -> f64 {
-        f64::INFINITY
+    fn to_full(&self, _k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
+        q_full.copy_from_slice(&[q[0], 0.0, q[1], q[2]]);
+        qd_full.copy_from_slice(&[qd[0], 0.0, qd[1], qd[2]]);
     }
-
-    fn released(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
         let (x1, th, ell) = (q[0], q[1], k[2]);
@@ -607,12 +646,11 @@ impl Reduction for FreeRod {
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
         let (m1, ell, g) = (k[0], k[2], k[4]);
         let r = self.reduced(k, delta);
-        out[0] = m1 * (g + 0.5 * ell * (r.cos * r.theta_ddot - r.sin * r.theta_dot_sq));
+        out[0] = 0.0;
+        out[1] = m1 * (g + 0.5 * ell * (r.cos * r.theta_ddot - r.sin * r.theta_dot_sq));
     }
 
-    fn separation_polynomial(&self, _k: &[f64], out: &mut [f64]) {
-        out[0] = 1.0;
-    }
+    fn force_polynomial(&self, _k: &[f64], _contact: usize, _out: &mut [f64]) {}
 
     fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
 
@@ -640,8 +678,187 @@ impl Reduction for FreeRod {
     }
 }
 
-/// The local registry: what `rodcube::models::all()` will hold once the generated models exist.
-pub static MODELS: &[&dyn Model] = &[&ROD_CUBE, &FREE_ROD];
+// ---------------------------------------------------------------------------------------------
+// rod_cube, the general model
+// ---------------------------------------------------------------------------------------------
+
+/// The system itself: rod and cube with every coordinate (`x1`, `y1`, `theta`, `x2`) and the
+/// two contacts as constraint rows, from `T = m1 (v_cm^2)/2 + m1 ell^2 theta'^2 / 24 +
+/// m2 x2'^2 / 2`, `V = m1 g (y1 + ell s / 2) + m2 g a / 2` by hand.
+pub struct General;
+
+/// The general `rod_cube` model.
+pub static GENERAL: General = General;
+
+static GEN_INFO: ModelInfo = ModelInfo {
+    name: "rod_cube",
+    description: "uniform rod leaning on a sliding cube, its foot free to lift (hand-typed)",
+    spec: "tests/common/paper.rs",
+    system: "rod_cube",
+    parameters: &[
+        param("m1", "rod mass", "kg", true),
+        param("m2", "cube mass", "kg", true),
+        param("ell", "rod length", "m", true),
+        param("a", "cube side", "m", true),
+        param("g", "gravitational acceleration", "m/s^2", true),
+    ],
+    requirements: &[named(
+        "a_below_ell",
+        "the cube is lower than the rod is long: (ell - a) / ell > 0",
+    )],
+    n_constants: 6,
+    coordinates: SYSTEM_COORDINATES,
+    system_coordinates: SYSTEM_COORDINATES,
+    reduced: 2,
+    cyclic: &[0, 3],
+    end_angle: 0.0,
+    contacts: &GENERAL_CONTACTS,
+    frictions: &[],
+    points: &[
+        named("foot", "rod end on the floor"),
+        named("tip", "rod end on the cube"),
+        named("rod_centre", "rod centre of mass"),
+        named("cube", "cube's bottom-left corner"),
+    ],
+    falling_point: 2,
+    gravity: 4,
+    monitors: MONITORS,
+    bodies: &["rod", "cube"],
+    shapes: SHAPES,
+    start_params: false,
+    phases: PHASES,
+    reduction: None,
+    route_note: "coordinate `y1` is not cyclic",
+};
+
+impl Model for General {
+    fn info(&self) -> &'static ModelInfo {
+        &GEN_INFO
+    }
+
+    fn requirements(&self, p: &[f64], out: &mut [f64]) {
+        out[0] = (p[2] - p[3]) / p[2];
+    }
+
+    fn prepare(&self, p: &[f64], k: &mut [f64]) {
+        let (ell, a) = (p[2], p[3]);
+        k[..5].copy_from_slice(p);
+        k[5] = a.atan2(((ell - a) * (ell + a)).sqrt());
+    }
+
+    fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
+        let (ell, a) = (k[2], k[3]);
+        q.copy_from_slice(&[0.0, 0.0, k[5], ((ell - a) * (ell + a)).sqrt()]);
+        qd.fill(0.0);
+    }
+
+    fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
+        let ell = k[2];
+        let (x1, y1, th, v1, u1, w) = (q[0], q[1], q[2], qd[0], qd[1], qd[2]);
+        let (s, c) = th.sin_cos();
+        pos[0] = [x1, y1];
+        vel[0] = [v1, u1];
+        pos[1] = [x1 + ell * c, y1 + ell * s];
+        vel[1] = [v1 - ell * s * w, u1 + ell * c * w];
+        pos[2] = [x1 + 0.5 * ell * c, y1 + 0.5 * ell * s];
+        vel[2] = [v1 - 0.5 * ell * s * w, u1 + 0.5 * ell * c * w];
+        pos[3] = [q[3], 0.0];
+        vel[3] = [qd[3], 0.0];
+    }
+
+    fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
+        let (m1, m2, ell, a, g) = (k[0], k[1], k[2], k[3], k[4]);
+        let (s, c) = q[2].sin_cos();
+        let (v1, u1, w) = (qd[0], qd[1], qd[2]);
+        let (vx, vy) = (v1 - 0.5 * ell * s * w, u1 + 0.5 * ell * c * w);
+        0.5 * m1 * (vx * vx + vy * vy)
+            + m1 * ell * ell * w * w / 24.0
+            + 0.5 * m2 * qd[3] * qd[3]
+            + m1 * g * (q[1] + 0.5 * ell * s)
+            + m2 * g * a / 2.0
+    }
+
+    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let (m1, m2, ell) = (k[0], k[1], k[2]);
+        out[0] = m1 * (qd[0] - 0.5 * ell * q[2].sin() * qd[2]);
+        out[1] = m2 * qd[3];
+    }
+
+    fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
+        let (m1, m2, ell, g) = (k[0], k[1], k[2], k[4]);
+        let (s, c) = q[2].sin_cos();
+        let w = qd[2];
+        let (hs, hc) = (0.5 * m1 * ell * s, 0.5 * m1 * ell * c);
+        mass.copy_from_slice(&[
+            m1,
+            0.0,
+            -hs,
+            0.0, //
+            0.0,
+            m1,
+            hc,
+            0.0, //
+            -hs,
+            hc,
+            m1 * ell * ell / 3.0,
+            0.0, //
+            0.0,
+            0.0,
+            0.0,
+            m2,
+        ]);
+        rhs.copy_from_slice(&[hc * w * w, hs * w * w - m1 * g, -hc * g, 0.0]);
+    }
+
+    fn forces_full(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _qdd: &[f64], out: &mut [f64]) {
+        out.fill(0.0);
+    }
+
+    fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
+        out[0] = q[3] - q[0] - k[2] * q[2].cos();
+        out[1] = q[1];
+    }
+
+    fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        let ell = k[2];
+        let (s, c) = q[2].sin_cos();
+        jac.copy_from_slice(&[-1.0, 0.0, ell * s, 1.0, 0.0, 1.0, 0.0, 0.0]);
+        bias.copy_from_slice(&[ell * c * qd[2] * qd[2], 0.0]);
+    }
+
+    fn edges(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
+        out.fill(f64::INFINITY);
+    }
+
+    fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        // Frictionless: no rows.
+        let _ = (k, q, qd, jac, bias);
+    }
+
+    fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], f: &[f64], out: &mut [f64]) {
+        let (m2, ell, a, g) = (k[1], k[2], k[3], k[4]);
+        out[0] = m2 * g * a / 2.0 - f[0] * (q[1] + ell * q[2].sin() - a / 2.0);
+    }
+
+    fn to_full(&self, _k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
+        q_full.copy_from_slice(q);
+        qd_full.copy_from_slice(qd);
+    }
+
+    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
+        let (x1, y1, th, ell) = (q[0], q[1], q[2], k[2]);
+        let rod = [x1 + 0.5 * ell * th.cos(), y1 + 0.5 * ell * th.sin(), th];
+        draw(k, rod, q[3], poses, sizes);
+    }
+
+    fn reduction(&self) -> Option<&dyn Reduction> {
+        None
+    }
+}
+
+/// The local registry: the hand-typed system and its two fast phases, as
+/// `rodcube::models::all()` holds the generated ones.
+pub static MODELS: &[&dyn Model] = &[&GENERAL, &ROD_CUBE, &FREE_ROD];
 
 /// The paper's parameters (n = 3, r = 1/4, ell = 1 m) with a chosen `g`.
 pub fn paper(g: f64) -> [(&'static str, f64); 5] {

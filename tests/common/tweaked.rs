@@ -1,6 +1,7 @@
 //! A model wrapper that changes one thing about a base model (its separation polynomial, its
 //! monitors, a force or its `theta_dot^2`), to drive the solvers into outcomes the paper's
-//! models never reach.
+//! models never reach. A tweaked fast phase runs in its system through a registry that holds
+//! it in place of the original ([`registry`]).
 
 use rodcube::model::{Model, ModelInfo, Reduced, Reduction, ReductionInfo};
 use std::collections::HashMap;
@@ -97,21 +98,22 @@ impl Model for Tweaked {
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
         self.base.equations(k, q, qd, mass, rhs)
     }
-    fn forces_full(
-        &self,
-        k: &[f64],
-        q: &[f64],
-        qd: &[f64],
-        qdd: &[f64],
-        fr: &[f64],
-        out: &mut [f64],
-    ) {
-        self.base.forces_full(k, q, qd, qdd, fr, out);
+    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+        self.base.forces_full(k, q, qd, qdd, out);
         if self.nan_force
             && let Some(last) = out.last_mut()
         {
             *last = f64::NAN;
         }
+    }
+    fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
+        self.base.gaps(k, q, out)
+    }
+    fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
+        self.base.constraints(k, q, qd, jac, bias)
+    }
+    fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
+        self.base.edges(k, q, out)
     }
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
         self.base.friction(k, q, qd, jac, bias);
@@ -123,11 +125,8 @@ impl Model for Tweaked {
             *v += self.monitor_shift;
         }
     }
-    fn contact_edge(&self, k: &[f64], q: &[f64]) -> f64 {
-        self.base.contact_edge(k, q)
-    }
-    fn released(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        self.base.released(k, q, qd, out)
+    fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
+        self.base.to_full(k, q, qd, q_full, qd_full)
     }
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
         self.base.drawing(k, q, poses, sizes)
@@ -163,10 +162,10 @@ impl Reduction for Tweaked {
             *last = f64::NAN;
         }
     }
-    fn separation_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        match self.polynomial {
-            Some(c) => out.copy_from_slice(c),
-            None => self.reduction.separation_polynomial(k, out),
+    fn force_polynomial(&self, k: &[f64], contact: usize, out: &mut [f64]) {
+        match (contact, self.polynomial) {
+            (0, Some(c)) => out.copy_from_slice(c),
+            _ => self.reduction.force_polynomial(k, contact, out),
         }
     }
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
@@ -188,7 +187,7 @@ impl Reduction for Tweaked {
     }
 }
 
-/// `rod_cube` whose separation polynomial `1 + s^2` never vanishes: contact to the floor.
+/// `rod_cube_closed` whose separation polynomial `1 + s^2` never vanishes: contact to the floor.
 pub static NEVER_SEPARATES: Tweaked = Tweaked {
     base: &super::paper::ROD_CUBE,
     reduction: &super::paper::ROD_CUBE,
@@ -198,18 +197,18 @@ pub static NEVER_SEPARATES: Tweaked = Tweaked {
     theta_dot_sq: Fault::None,
 };
 
-/// `rod_cube` whose monitors are lowered by 3 (N or N m): the floor normal then dips below zero
-/// near separation, while the tipping margin (>= 3.5) stays positive.
+/// `rod_cube_closed` whose monitor is lowered by 4 N m: the tipping margin (3.51 N m at its
+/// least) then dips below zero.
 pub static LOW_MONITORS: Tweaked = Tweaked {
     base: &super::paper::ROD_CUBE,
     reduction: &super::paper::ROD_CUBE,
     polynomial: None,
-    monitor_shift: -3.0,
+    monitor_shift: -4.0,
     nan_force: false,
     theta_dot_sq: Fault::None,
 };
 
-/// `rod_cube` whose floor normal force is NaN.
+/// `rod_cube_closed` whose floor normal force is NaN.
 pub static NAN_FORCE: Tweaked = Tweaked {
     base: &super::paper::ROD_CUBE,
     reduction: &super::paper::ROD_CUBE,
@@ -218,3 +217,20 @@ pub static NAN_FORCE: Tweaked = Tweaked {
     nan_force: true,
     theta_dot_sq: Fault::None,
 };
+
+/// A registry of the hand-typed `rod_cube` system with `phase` in place of its release phase
+/// (the tweaked models keep the original's name, so the system finds them).
+pub fn registry(phase: &'static Tweaked) -> &'static [&'static dyn Model] {
+    static REGISTRIES: OnceLock<Mutex<HashMap<usize, &'static [&'static dyn Model]>>> =
+        OnceLock::new();
+    let mut all = REGISTRIES
+        .get_or_init(Default::default)
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
+    let key = phase as *const Tweaked as usize;
+    all.entry(key).or_insert_with(|| {
+        let models: Vec<&'static dyn Model> =
+            vec![&super::paper::GENERAL, phase, &super::paper::FREE_ROD];
+        Box::leak(models.into_boxed_slice())
+    })
+}

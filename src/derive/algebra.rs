@@ -1,0 +1,341 @@
+//! Algebra the derivation's stages share, on Symbolica atoms through [`cas`]: the
+//! trigonometric rewriting that makes results unique modulo `sin^2 + cos^2 = 1`, the switch
+//! between `sin(theta)`, `cos(theta)` and the internal symbols `rc_s`, `rc_c`, polynomial
+//! coefficients in `sin(theta)`, and sign tests. Below every stage; imports only [`cas`],
+//! [`expr`] and [`types`](super::types).
+
+use super::cas::{self, A};
+use super::expr::{Expr, product};
+use super::types::{Constant, DeriveError, at};
+
+/// A Symbolica atom as an expression, or the error of the step `what`.
+pub fn to_expr(a: &A, what: &str) -> Result<Expr, DeriveError> {
+    cas::expr(a).map_err(|m| at(&[], format!("{what}: {m}")))
+}
+
+/// `sin(asin(x)) = x`, `cos(asin(x)) = sqrt(1 - x^2)` and the like, applied bottom-up.
+pub fn simplify_inverse_trig(e: &Expr) -> Expr {
+    let rec = |v: &Vec<Expr>| v.iter().map(simplify_inverse_trig).collect::<Vec<_>>();
+    match e {
+        Expr::Add(v) => Expr::Add(rec(v)),
+        Expr::Mul(v) => Expr::Mul(rec(v)),
+        Expr::Pow(b, x) => Expr::Pow(
+            Box::new(simplify_inverse_trig(b)),
+            Box::new(simplify_inverse_trig(x)),
+        ),
+        Expr::Fun(f, args) => {
+            let args = rec(args);
+            if let Some(Expr::Fun(g, inner)) = args.first() {
+                let x = inner[0].clone();
+                // sqrt((1 - x)(1 + x)): no cancellation in 1 - x^2 as x -> 1.
+                let one_minus_sq = || {
+                    let minus_x = Expr::Mul(vec![Expr::int(-1), x.clone()]);
+                    Expr::Pow(
+                        Box::new(Expr::Mul(vec![
+                            Expr::Add(vec![Expr::int(1), minus_x]),
+                            Expr::Add(vec![Expr::int(1), x.clone()]),
+                        ])),
+                        Box::new(Expr::Rational(1, 2)),
+                    )
+                };
+                match (f.as_str(), g.as_str()) {
+                    ("sin", "asin") | ("cos", "acos") => return x,
+                    ("cos", "asin") | ("sin", "acos") => return one_minus_sq(),
+                    _ => {}
+                }
+            }
+            Expr::Fun(f.clone(), args)
+        }
+        _ => e.clone(),
+    }
+}
+
+/// Replaces `cos^k` by `cos^(k mod 2) (1 - sin^2)^(k div 2)` in an expanded polynomial of
+/// `rc_s`, `rc_c`, so that results are unique modulo `sin^2 + cos^2 = 1`.
+pub fn reduce_cos_sq(a: &A) -> A {
+    let mut cur = cas::expand(a);
+    for _ in 0..16 {
+        let mut next = cur.clone();
+        let pow =
+            |base: &str, n: i128| Expr::Pow(Box::new(Expr::sym(base)), Box::new(Expr::int(n)));
+        for k in (2..=12).rev() {
+            let pat = cas::atom(&pow("rc_c", k));
+            let one_minus_s2 = Expr::Add(vec![
+                Expr::int(1),
+                Expr::Mul(vec![Expr::int(-1), pow("rc_s", 2)]),
+            ]);
+            let rep = cas::atom(&Expr::Mul(vec![
+                pow("rc_c", k % 2),
+                Expr::Pow(Box::new(one_minus_s2), Box::new(Expr::int(k / 2))),
+            ]));
+            next = cas::subs(&next, &pat, &rep);
+        }
+        next = cas::expand(&next);
+        if next == cur {
+            break;
+        }
+        cur = next;
+    }
+    cur
+}
+
+/// Whether a rational expression of `rc_s`, `rc_c` (and anything else) is zero modulo
+/// `sin^2 + cos^2 = 1`.
+pub fn is_zero_trig(a: &A) -> Result<bool, String> {
+    let t = cas::together(a);
+    let e = cas::expr(&t)?;
+    let (num, _) = e.num_den();
+    let n = cas::atom(&product(num));
+    Ok(cas::is_zero(&reduce_cos_sq(&n)))
+}
+
+/// Replaces `sin(theta)`, `cos(theta)` by `rc_s`, `rc_c`.
+pub fn to_sc(a: &A, theta: &str) -> A {
+    let s = cas::subs(
+        a,
+        &cas::atom(&Expr::Fun("sin".into(), vec![Expr::sym(theta)])),
+        &cas::var("rc_s"),
+    );
+    cas::subs(
+        &s,
+        &cas::atom(&Expr::Fun("cos".into(), vec![Expr::sym(theta)])),
+        &cas::var("rc_c"),
+    )
+}
+
+/// Replaces `rc_s`, `rc_c` by `sin(theta)`, `cos(theta)` in a plain expression.
+pub fn from_sc(e: &Expr, theta: &str) -> Expr {
+    match e {
+        Expr::Sym(s) if s == "rc_s" => Expr::Fun("sin".into(), vec![Expr::sym(theta)]),
+        Expr::Sym(s) if s == "rc_c" => Expr::Fun("cos".into(), vec![Expr::sym(theta)]),
+        Expr::Add(v) => Expr::Add(v.iter().map(|x| from_sc(x, theta)).collect()),
+        Expr::Mul(v) => Expr::Mul(v.iter().map(|x| from_sc(x, theta)).collect()),
+        Expr::Pow(b, x) => Expr::Pow(Box::new(from_sc(b, theta)), Box::new(from_sc(x, theta))),
+        Expr::Fun(f, v) => Expr::Fun(f.clone(), v.iter().map(|x| from_sc(x, theta)).collect()),
+        _ => e.clone(),
+    }
+}
+
+/// Replaces `sin(theta)`, `cos(theta)` by `rc_s`, `rc_c` in a plain expression (the inverse
+/// of [`from_sc`]).
+pub fn to_sc_expr(e: &Expr, theta: &str) -> Expr {
+    let rec = |v: &Vec<Expr>| v.iter().map(|x| to_sc_expr(x, theta)).collect();
+    match e {
+        Expr::Fun(f, args) if args.len() == 1 && args[0] == Expr::sym(theta) && f == "sin" => {
+            Expr::sym("rc_s")
+        }
+        Expr::Fun(f, args) if args.len() == 1 && args[0] == Expr::sym(theta) && f == "cos" => {
+            Expr::sym("rc_c")
+        }
+        Expr::Add(v) => Expr::Add(rec(v)),
+        Expr::Mul(v) => Expr::Mul(rec(v)),
+        Expr::Pow(b, x) => Expr::Pow(
+            Box::new(to_sc_expr(b, theta)),
+            Box::new(to_sc_expr(x, theta)),
+        ),
+        Expr::Fun(f, v) => Expr::Fun(f.clone(), rec(v)),
+        _ => e.clone(),
+    }
+}
+
+/// Groups the terms of an expanded expression by their factors in `motion` symbols and brings
+/// each group's coefficient over one denominator: `sum_m together(sum c_i) * m`.
+///
+/// Expanded, the reduced forces of a model with a cyclic coordinate hold parameter-only terms
+/// that nearly cancel (`m1 ell m2/(2(m1+m2)) - ell m2 + ell m2^2/(m1+m2)` in rod_cube's contact
+/// force is `-m1 m2 ell/(2(m1+m2))`): emitted as they are, the force loses `log10(m2/m1)`
+/// digits for a heavy cube. Together, each coefficient is one term and keeps them.
+pub fn collect_over(a: &A, motion: &[&str]) -> Result<A, DeriveError> {
+    let e = to_expr(a, "expression to collect")?;
+    let terms = match e {
+        Expr::Add(v) => v,
+        e => vec![e],
+    };
+    // (key, motion factors, coefficient terms), in order of first appearance.
+    let mut groups: Vec<(String, Vec<Expr>, Vec<Expr>)> = Vec::new();
+    for t in terms {
+        let factors = match t {
+            Expr::Mul(v) => v,
+            t => vec![t],
+        };
+        let (mut moving, coefficient): (Vec<Expr>, Vec<Expr>) = factors
+            .into_iter()
+            .partition(|f| f.symbols().iter().any(|s| motion.contains(&s.as_str())));
+        moving.sort_by_key(|f| f.to_infix());
+        let key = moving
+            .iter()
+            .map(|f| f.to_infix())
+            .collect::<Vec<_>>()
+            .join("*");
+        match groups.iter_mut().find(|g| g.0 == key) {
+            Some(g) => g.2.push(product(coefficient)),
+            None => groups.push((key, moving, vec![product(coefficient)])),
+        }
+    }
+    let mut out = cas::num(0);
+    for (_, moving, coefficients) in groups {
+        let c = cas::together(&cas::atom(&Expr::Add(coefficients)));
+        out += c * cas::atom(&product(moving));
+    }
+    Ok(out)
+}
+
+pub fn free_of(a: &A, names: &[&str]) -> bool {
+    names.iter().all(|n| cas::is_zero(&cas::d(a, n)))
+}
+
+/// A constant's value where it is a plain number, its symbol otherwise.
+pub fn constant_value(constants: &[Constant], symbol: &str) -> A {
+    constants
+        .iter()
+        .find(|c| c.symbol == symbol)
+        .and_then(|c| {
+            let t = c.value.tidy();
+            t.symbols().is_empty().then(|| cas::atom(&t))
+        })
+        .unwrap_or_else(|| cas::var(symbol))
+}
+
+/// `d/dtheta` of an expression over `rc_s`, `rc_c`, `rc_ds`, `rc_dc`.
+pub fn d_theta(f: &A) -> A {
+    cas::d(f, "rc_s") * cas::var("rc_c")
+        - cas::d(f, "rc_c") * cas::var("rc_s")
+        - cas::d(f, "rc_ds") * cas::var("rc_c")
+        + cas::d(f, "rc_dc") * cas::var("rc_s")
+}
+
+/// Most coefficients of a polynomial in `sin(theta)` the derivation writes (separation and fall
+/// polynomials).
+pub const MAX_POLY_COEFFICIENTS: usize = 17;
+
+/// The coefficients in `rc_s` of `a`, lowest degree first, if `a` is a polynomial in `rc_s` of
+/// degree below [`MAX_POLY_COEFFICIENTS`] over symbols free of `rc_s` (checked by comparing
+/// `a` with the sum of its Taylor terms).
+pub fn coefficients_in_s(a: &A, what: &str) -> Result<Option<Vec<Expr>>, DeriveError> {
+    let mut coefficients = Vec::new();
+    let mut terms = Vec::new();
+    let mut deriv = a.clone();
+    let mut factorial: i64 = 1;
+    for deg in 0..MAX_POLY_COEFFICIENTS as i64 {
+        if deg > 0 {
+            factorial *= deg;
+        }
+        let c0 = cas::expand(&(cas::subs_var(&deriv, "rc_s", &cas::num(0)) / cas::num(factorial)));
+        let power = (0..deg).fold(cas::num(1), |acc, _| acc * cas::var("rc_s"));
+        terms.push(c0.clone() * power);
+        coefficients.push(to_expr(&c0, what)?);
+        deriv = cas::expand(&cas::d(&deriv, "rc_s"));
+        if cas::is_zero(&deriv) {
+            let sum = terms.iter().fold(cas::num(0), |acc, t| acc + t.clone());
+            return Ok(cas::is_zero(&cas::expand(&(a.clone() - sum))).then_some(coefficients));
+        }
+    }
+    Ok(None)
+}
+
+/// The fall polynomial `(sin theta_i - s) / theta_dot^2` in `s = rc_s`, where it is one (see
+/// [`Reduction::fall`]); `None` for a phase that does not start from rest, whose potential
+/// has a `cos(theta)` term, or whose inertia is no polynomial in `sin(theta)`.
+pub fn fall_polynomial(
+    wsq: &A,
+    coords: &[String],
+    theta: &str,
+) -> Result<Option<Vec<Expr>>, DeriveError> {
+    if cas::is_zero(wsq) {
+        return Ok(None);
+    }
+    let ratio = reduce_cos_sq(&cas::together(&(cas::var("rc_ds") / wsq.clone())));
+    let ratio = cas::expand(&ratio);
+    let mut motion = vec!["rc_ds", "rc_dc", "rc_c", theta];
+    motion.extend(coords.iter().map(String::as_str));
+    if !free_of(&ratio, &motion) {
+        return Ok(None);
+    }
+    // Each coefficient over one denominator, common factors cancelled (`l (m1 + m2) / (3 g
+    // (m1 + m2))` is `l / (3 g)`).
+    let Some(coefficients) = coefficients_in_s(&ratio, "fall polynomial coefficient")? else {
+        return Ok(None);
+    };
+    let tidy = |c: &Expr| to_expr(&cas::together(&cas::atom(c)), "fall polynomial coefficient");
+    Ok(Some(
+        coefficients.iter().map(tidy).collect::<Result<_, _>>()?,
+    ))
+}
+
+/// `rc_ds`, `rc_dc` written as differences from the start.
+pub fn gap_vars(a: &A) -> A {
+    let out = cas::subs_var(a, "rc_ds", &(cas::var("rc_si") - cas::var("rc_s")));
+    cas::subs_var(&out, "rc_dc", &(cas::var("rc_ci") - cas::var("rc_c")))
+}
+
+/// Whether an expression is structurally positive when the symbols `pos` are.
+pub fn positive(e: &Expr, pos: &[String]) -> bool {
+    match e {
+        Expr::Rational(n, _) => *n > 0,
+        Expr::Float(x) => *x > 0.0,
+        Expr::Sym(s) => pos.contains(s),
+        Expr::Add(v) | Expr::Mul(v) => v.iter().all(|x| positive(x, pos)),
+        Expr::Pow(b, x) => positive(b, pos) || x.as_integer().is_some_and(|n| n % 2 == 0),
+        Expr::Fun(..) => false,
+    }
+}
+
+/// Factorises and drops the factors free of `rc_s` that are strictly positive (or negative
+/// constants), so that what is left is the separation polynomial up to a positive factor.
+pub fn strip_positive_factors(poly: &A, pos: &[String]) -> Result<A, DeriveError> {
+    Ok(strip_signed(poly, pos)?.0)
+}
+
+/// [`strip_positive_factors`], and whether the factors dropped were negative overall (the
+/// polynomial left then has the opposite sign of `poly`).
+pub fn strip_signed(poly: &A, pos: &[String]) -> Result<(A, bool), DeriveError> {
+    let f = to_expr(&cas::factor(poly), "factorised separation polynomial")?;
+    let factors = match f {
+        Expr::Mul(v) => v,
+        e => vec![e],
+    };
+    let mut kept = Vec::new();
+    let mut negated = false;
+    for x in factors {
+        let has_s = x.symbols().contains("rc_s");
+        if has_s {
+            kept.push(x);
+            continue;
+        }
+        let (neg, mag) = x.split_sign();
+        if positive(&mag, pos) || (neg && mag.symbols().is_empty()) {
+            negated ^= neg;
+            continue;
+        }
+        kept.push(x);
+    }
+    Ok((cas::expand(&cas::atom(&product(kept))), negated))
+}
+
+/// Solves `mat x = rhs` symbolically by Gauss–Jordan elimination (entries brought over one
+/// denominator as they are formed); `None` when a column has no nonzero pivot. Each solution is
+/// `b_r / m_rr` as formed, left for the caller to simplify.
+pub fn solve_linear(mut mat: Vec<Vec<A>>, mut rhs: Vec<A>) -> Option<Vec<A>> {
+    let k = rhs.len();
+    if mat.len() != k || mat.iter().any(|row| row.len() != k) {
+        return None;
+    }
+    for col in 0..k {
+        let pivot = (col..k).find(|&r| !cas::is_zero(&mat[r][col]))?;
+        mat.swap(col, pivot);
+        rhs.swap(col, pivot);
+        let p = mat[col][col].clone();
+        let pivot_row = mat[col].clone();
+        for r in 0..k {
+            if r == col || cas::is_zero(&mat[r][col]) {
+                continue;
+            }
+            let f = cas::together(&(mat[r][col].clone() / p.clone()));
+            for (m, pc) in mat[r].iter_mut().zip(&pivot_row) {
+                *m = cas::together(&(m.clone() - f.clone() * pc.clone()));
+            }
+            rhs[r] = cas::together(&(rhs[r].clone() - f.clone() * rhs[col].clone()));
+        }
+    }
+    Some((0..k).map(|r| rhs[r].clone() / mat[r][r].clone()).collect())
+}

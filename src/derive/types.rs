@@ -1,0 +1,299 @@
+//! What the derivation produces, stage by stage: the typed values that every stage of
+//! `derive/` hands to the next (and the errors placed at a spec field), below all of them.
+//!
+//! A spec describes a *system*: its coordinates, bodies, potentials, obstacles and contacts.
+//! Each derived model is one *phase* of it, named by the contacts it holds closed by
+//! elimination: the general model (nothing eliminated, every contact a constraint row whose
+//! force the runtime solves along with the motion) and the fast phases (some contacts closed by
+//! elimination, the rest open, reduced to one coordinate).
+
+use super::expr::Expr;
+pub use crate::model::ShapeKind;
+use std::collections::BTreeMap;
+
+/// Where a derivation error belongs in the spec: a dotted field path and a message.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DeriveError {
+    /// Field path (`coordinates[0]`), used to find the line.
+    pub field: Vec<FieldStep>,
+    /// What failed.
+    pub message: String,
+}
+
+/// One step of a field path.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum FieldStep {
+    /// Mapping key.
+    Key(String),
+    /// Sequence index.
+    Index(usize),
+}
+
+/// A derivation error at `path`.
+pub fn at(path: &[FieldStep], message: String) -> DeriveError {
+    DeriveError {
+        field: path.to_vec(),
+        message,
+    }
+}
+
+/// A mapping key as a field step.
+pub fn key(k: &str) -> FieldStep {
+    FieldStep::Key(k.to_string())
+}
+
+/// The field of the `i`-th entry of list `list`, key `sub` (`contacts[1].gap`).
+pub fn entry(list: &str, i: usize, sub: &str) -> [FieldStep; 3] {
+    [key(list), FieldStep::Index(i), key(sub)]
+}
+
+/// Which contacts a phase holds closed by elimination (indices into the spec's `contacts`,
+/// ascending), and what it is called.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PhasePlan {
+    /// Model name.
+    pub name: String,
+    /// The contacts eliminated (closed for the whole phase).
+    pub closed: Vec<usize>,
+    /// Whether the phase starts from a state given as parameters (`<q>_0`, `<q>_dot_0`) rather
+    /// than from the spec's initial state.
+    pub start_params: bool,
+}
+
+impl PhasePlan {
+    /// Whether this is the general model (nothing eliminated).
+    pub fn is_general(&self) -> bool {
+        self.closed.is_empty()
+    }
+}
+
+/// A constant computed once per parameter set (in `prepare`).
+#[derive(Debug, Clone)]
+pub struct Constant {
+    /// Internal symbol.
+    pub symbol: String,
+    /// Definition over parameters and earlier constants.
+    pub value: Expr,
+}
+
+/// A contact force's zero on the reduced motion as a polynomial in `sin(theta)`.
+#[derive(Debug, Clone)]
+pub struct Separation {
+    /// Coefficients of the polynomial in `sin(theta)`, lowest degree first, over constants.
+    pub coefficients: Vec<Expr>,
+    /// The polynomial itself, in `rc_s`.
+    pub polynomial: Expr,
+}
+
+/// A parameter of a derived model.
+#[derive(Debug, Clone)]
+pub struct Param {
+    /// Symbol.
+    pub name: String,
+    /// What it is.
+    pub meaning: String,
+    /// SI unit.
+    pub unit: String,
+    /// Whether it must be strictly positive.
+    pub positive: bool,
+}
+
+/// A named output with its meaning.
+#[derive(Debug, Clone)]
+pub struct Named {
+    /// Identifier.
+    pub name: String,
+    /// What it means.
+    pub meaning: String,
+}
+
+/// A monitored assumption of a phase.
+#[derive(Debug, Clone)]
+pub struct Monitor {
+    /// Identifier.
+    pub name: String,
+    /// What it checks.
+    pub meaning: String,
+    /// The unit of its value (empty when the spec gives none).
+    pub unit: String,
+}
+
+/// A shape of the drawing, from a body's `shape` or an obstacle.
+#[derive(Debug, Clone)]
+pub struct Shape {
+    /// What it is.
+    pub kind: ShapeKind,
+    /// Index in [`Derivation::bodies`] of the body it moves with (`None`: an obstacle).
+    pub body: Option<usize>,
+    /// Its numbers over the parameters, in the order [`ShapeKind`] documents.
+    pub numbers: Vec<Expr>,
+}
+
+/// One contact of the spec as a phase sees it.
+#[derive(Debug, Clone)]
+pub struct ContactRow {
+    /// Its name (the name of its force).
+    pub name: String,
+    /// What its force is.
+    pub meaning: String,
+    /// The unit of its gap (`m`) and of its force (`N`).
+    pub gap_unit: String,
+    /// The unit of its force, conjugate to the gap.
+    pub force_unit: String,
+    /// A joint: always closed, its force of either sign.
+    pub bilateral: bool,
+    /// The coordinate the spec lets it eliminate.
+    pub eliminates: Option<String>,
+    /// Whether this phase holds it closed by elimination.
+    pub closed: bool,
+    /// Its gap over the phase's coordinates (zero where closed).
+    pub gap: Expr,
+    /// `d gap / d q_j` for each coordinate of the phase (zeros where closed).
+    pub jacobian: Vec<Expr>,
+    /// `d/dt (J qd)` with the accelerations zero: the normal acceleration is `J qdd + bias`.
+    pub bias: Expr,
+    /// Its edge margin over the phase's coordinates, if it can end at an edge.
+    pub edge: Option<Expr>,
+    /// Where closed: its force (the Lagrange multiplier) over the phase's `q`, `qd`, `qdd`.
+    pub force: Option<Expr>,
+}
+
+/// A Coulomb friction in one phase.
+#[derive(Debug, Clone)]
+pub struct Friction {
+    /// Identifier and meaning.
+    pub named: Named,
+    /// Index of the coefficient in [`Derivation::params`].
+    pub coefficient: usize,
+    /// Index of its contact in [`Derivation::contacts`].
+    pub contact: usize,
+    /// Slip velocity `v = J qd` over the phase's state.
+    pub slip: Expr,
+    /// `J`: `dv/dqd_j`, one per coordinate (the generalized force per unit friction force).
+    pub jacobian: Vec<Expr>,
+    /// `dv/dt` with the accelerations set to zero.
+    pub bias: Expr,
+}
+
+/// The fast path of a phase: the cyclic coordinates eliminated through their conserved momenta.
+#[derive(Debug, Clone)]
+pub struct Reduction {
+    /// Constants computed in `prepare`, in order.
+    pub constants: Vec<Constant>,
+    /// Reduced inertia `A(theta)` in `T = A theta_dot^2 / 2 + ...`.
+    pub reduced_inertia: Expr,
+    /// Reduced kinetic-plus-potential energy with the cyclic velocities eliminated.
+    pub reduced_energy: Expr,
+    /// `theta_dot^2` over `rc_s, rc_c, rc_ds, rc_dc` and constants.
+    pub theta_dot_sq: Expr,
+    /// `theta_ddot` over the same symbols.
+    pub theta_ddot: Expr,
+    /// Cyclic velocities on the reduced motion (over `rc_s, rc_c, rc_w`).
+    pub cyclic_velocity: Vec<Expr>,
+    /// Cyclic positions on the reduced motion (over `rc_t, rc_ds, rc_dc, rc_delta`).
+    pub cyclic_position: Vec<Expr>,
+    /// Every contact's force on the reduced motion (over `rc_s, rc_c, rc_w2, rc_acc`; zero
+    /// for a contact that is open in the phase).
+    pub forces_reduced: Vec<Expr>,
+    /// Per contact: its force's zero as a polynomial in `sin(theta)`, where it is one (else the
+    /// runtime finds that zero numerically, from the reduced force).
+    pub force_polynomials: Vec<Option<Separation>>,
+    /// Coefficients in `sin(theta)` (lowest degree first, over constants) of the fall
+    /// polynomial `P(s) = (sin theta_i - s) / theta_dot^2`, where that ratio is a polynomial in
+    /// `s` alone: the phase starts from rest, its potential is linear in `sin(theta)` and its
+    /// reduced inertia a polynomial in `sin(theta)`. Its zeros and `s = -1` are then the only
+    /// singularities of the time integrand, which lets the runtime choose its quadrature rule
+    /// a priori.
+    pub fall: Option<Vec<Expr>>,
+    /// Fully substituted forms over parameters and `theta` for people and other tools.
+    pub plain: BTreeMap<String, Expr>,
+}
+
+impl Reduction {
+    /// The separation polynomial: that of the spec's first contact, where it is closed in the
+    /// phase and its zero is a polynomial root.
+    pub fn separation(&self) -> Option<&Separation> {
+        self.force_polynomials.first().and_then(Option::as_ref)
+    }
+}
+
+/// Everything derived for one phase (one generated model), as plain expressions.
+#[derive(Debug, Clone)]
+pub struct Derivation {
+    /// Model name (`rod_cube`, `rod_cube_closed`, `rod_cube_free`).
+    pub name: String,
+    /// The spec's name: the system this phase belongs to (its general model's name).
+    pub system: String,
+    /// Which contacts it holds closed, and how it starts.
+    pub plan: PhasePlan,
+    /// One line for people.
+    pub description: String,
+    /// Parameters in order (a phase with `start_params` adds its start state).
+    pub params: Vec<Param>,
+    /// Coordinate names in order.
+    pub coords: Vec<String>,
+    /// The spec's coordinates (the general model's), in order.
+    pub full_coords: Vec<String>,
+    /// Index of the reduced coordinate.
+    pub reduced: usize,
+    /// Indices of the cyclic coordinates (whose momenta are conserved).
+    pub cyclic: Vec<usize>,
+    /// Kinetic energy (full state).
+    pub kinetic: Expr,
+    /// Potential energy (full state), gravity and the spec's potentials.
+    pub potential: Expr,
+    /// The Lagrangian `T - V`.
+    pub lagrangian: Expr,
+    /// Euler–Lagrange expressions `d/dt dL/dqd - dL/dq` (each `= 0`, with the contacts'
+    /// generalized forces on the right).
+    pub euler_lagrange: Vec<Expr>,
+    /// Mass matrix `M(q)`, row-major.
+    pub mass: Vec<Vec<Expr>>,
+    /// Right-hand side `F(q, qd)` of `M qdd = F` (before the contacts' and frictions' forces).
+    pub rhs: Vec<Expr>,
+    /// Conjugate momenta of the cyclic coordinates (full state).
+    pub momenta: Vec<Expr>,
+    /// Initial position and velocity of every coordinate, over the parameters.
+    pub initial: Vec<[Expr; 2]>,
+    /// Point positions (full state).
+    pub point_pos: Vec<[Expr; 2]>,
+    /// Point velocities (full state).
+    pub point_vel: Vec<[Expr; 2]>,
+    /// Every contact of the spec, in its order.
+    pub contacts: Vec<ContactRow>,
+    /// Monitors (each `>= 0` while the assumption holds).
+    pub monitors: Vec<Monitor>,
+    /// Monitors over the full state, parameters and the contacts' forces `rc_f<i>`.
+    pub monitors_full: Vec<Expr>,
+    /// Parameter requirements (over parameters).
+    pub requirements: Vec<Expr>,
+    /// The bodies' names, in the spec's order.
+    pub bodies: Vec<String>,
+    /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the full state.
+    pub body_pose: Vec<[Expr; 3]>,
+    /// The shapes of the drawing: the bodies' (in their order), then the obstacles'.
+    pub shapes: Vec<Shape>,
+    /// The frictions (all of the spec's; a phase with friction is never a fast phase).
+    pub frictions: Vec<Friction>,
+    /// Each of the spec's coordinates, value and rate, over this phase's state: the state of
+    /// the general model this phase's state stands for.
+    pub to_full: Vec<[Expr; 2]>,
+    /// The fast path, or why the phase is integrated instead.
+    pub reduction: Result<Reduction, String>,
+    /// The results without units, if the spec gives groups and scales.
+    pub dimensionless: Option<super::dimensionless::Dimensionless>,
+    /// The steps as the LaTeX derivation shows them ([`super::steps`]), once presented.
+    pub steps: Option<super::steps::Steps>,
+}
+
+impl Derivation {
+    /// The reduced coordinate's name.
+    pub fn theta(&self) -> &str {
+        &self.coords[self.reduced]
+    }
+
+    /// Whether this is the general model of its system.
+    pub fn is_general(&self) -> bool {
+        self.plan.is_general()
+    }
+}

@@ -1,0 +1,561 @@
+//! The planner's quantities of the motion: the separation, every contact's end, the time to
+//! the floor in contact, the point mass's fall, the series over the first contact's span and
+//! the landing, each computing only what it needs of the motion.
+
+use super::{Plan, angle_name, column, motion_end, path, scalar};
+use crate::model::ModelInfo;
+use crate::quantity::Quantity;
+use crate::report::motion::{Animation, PhaseInput};
+use crate::results::{Label, RunResults, Series, format_number};
+use crate::solve::SolveError;
+use crate::solve::phases::{End, Motion, PhaseRun};
+use crate::solve::separation::{SeparationOutcome, linearised_separation};
+use crate::solve::series::{PhaseSamples, sample_at, sample_forces, sample_friction};
+
+/// How a contact fared along the motion.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) enum Fate {
+    /// It ended at this time from release and angle, for this cause (`force`, `edge` or
+    /// `contact`: the motion stopped where another contact closed).
+    Ended {
+        /// Time from release (s).
+        t: f64,
+        /// The reduced angle then (rad).
+        theta: f64,
+        /// `force`, `edge` or `contact`.
+        cause: &'static str,
+    },
+    /// It held to the end of the motion, which ended as `until` says.
+    Held {
+        /// How the motion ended.
+        until: String,
+    },
+    /// It was open from release on.
+    NeverClosed,
+}
+
+/// Contact `i`'s fate on `motion` as far as it is solved; `None` when the phases solved so
+/// far do not tell yet.
+pub(super) fn fate(motion: &Motion, info: &ModelInfo, i: usize) -> Option<Fate> {
+    let first = motion.phases.first()?;
+    if motion.opened_at_release.contains(&i) {
+        let theta = first.bound().to_full(&first.bound().initial_state()).q[info.reduced];
+        return Some(Fate::Ended {
+            t: 0.0,
+            theta,
+            cause: "force",
+        });
+    }
+    if !first.closed().get(i).copied().unwrap_or(false) {
+        return Some(Fate::NeverClosed);
+    }
+    let name = |j: usize| info.contacts.get(j).map_or("a contact", |c| c.name);
+    for (k, phase) in motion.phases.iter().enumerate() {
+        let ended = |cause| Fate::Ended {
+            t: phase.t_end(),
+            theta: phase.theta_end(),
+            cause,
+        };
+        match phase.end() {
+            End::Force(j) if j == i => return Some(ended("force")),
+            End::Edge(j) if j == i => return Some(ended("edge")),
+            End::Contact(_) => return Some(ended("contact")),
+            End::Floor => {
+                return Some(Fate::Held {
+                    until: format!("until {}", motion_end(info)),
+                });
+            }
+            End::Edge(j) => {
+                return Some(Fate::Held {
+                    until: format!(
+                        "until contact `{}` ran off an edge at t = {} s, where the motion stops",
+                        name(j),
+                        format_number(phase.t_end(), 6)
+                    ),
+                });
+            }
+            End::Force(_) => {
+                // Another contact opened; the decision there may have opened this one too.
+                let next = motion.phases.get(k + 1)?;
+                if !next.closed().get(i).copied().unwrap_or(false) {
+                    return Some(ended("force"));
+                }
+            }
+        }
+    }
+    None
+}
+
+/// What a cause means, for the results' meanings.
+fn cause_words(cause: &str) -> &'static str {
+    match cause {
+        "force" => "its force reached zero (it would have had to pull)",
+        "edge" => "its contact point ran off a body",
+        _ => "another contact closed there: the bodies meet, and impacts are not modelled yet",
+    }
+}
+
+impl Plan<'_> {
+    /// Contact `i`'s fate, solving the motion as far as needed.
+    pub(super) fn fate(&mut self, i: usize) -> Result<Fate, SolveError> {
+        let info = self.general().info();
+        let motion = self.extend_until(|m| fate(m, info, i).is_some())?;
+        fate(motion, info, i).ok_or(SolveError::TooManyPhases {
+            limit: crate::solve::phases::MAX_PHASES,
+        })
+    }
+
+    /// The separation angle or time, or a note saying why there is none. Where the motion
+    /// starts on a fast phase that ends by the first contact's force, its roots alone give the
+    /// angle.
+    pub(super) fn separation_quantity(
+        &mut self,
+        q: Quantity,
+        out: &mut RunResults,
+    ) -> Result<(), SolveError> {
+        let info = self.general().info();
+        let key = q.name(info);
+        if q == Quantity::SeparationAngle
+            && self.fast()?.is_some()
+            && let Ok(end) = self.end()
+            && end.end == End::Force(0)
+            && let Some(at) = end.at
+        {
+            let meaning = format!(
+                "{} where the first contact's force vanishes",
+                angle_name(info)
+            );
+            scalar(out, &key, at.theta, "rad", meaning);
+            return Ok(());
+        }
+        match self.fate(0)? {
+            Fate::Ended {
+                t,
+                theta,
+                cause: "force",
+            } => {
+                if q == Quantity::SeparationAngle {
+                    let meaning = format!(
+                        "{} where the first contact's force vanishes",
+                        angle_name(info)
+                    );
+                    scalar(out, &key, theta, "rad", meaning);
+                } else {
+                    scalar(out, &key, t, "s", "time from release to separation".into());
+                }
+            }
+            other => {
+                out.notes.insert(key, self.why_no_separation(&other));
+            }
+        }
+        Ok(())
+    }
+
+    /// Why the first contact does not separate, in words.
+    fn why_no_separation(&self, fate: &Fate) -> String {
+        let info = self.general().info();
+        let first = info
+            .contacts
+            .first()
+            .map_or("the first contact", |c| c.name);
+        match fate {
+            Fate::Ended { cause, .. } => format!(
+                "no separation: contact `{first}` ended before its force vanished ({}; \
+                 `contact_end` says when)",
+                cause_words(cause)
+            ),
+            Fate::Held { until } => {
+                format!("no separation: contact `{first}` holds {until}")
+            }
+            Fate::NeverClosed => format!("no separation: contact `{first}` is open at release"),
+        }
+    }
+
+    /// The release phase's separation polynomial with its terms above degree 1 dropped.
+    pub(super) fn linearised(&mut self, out: &mut RunResults) -> Result<(), SolveError> {
+        let key = Quantity::LinearisedSeparationAngle.name(self.general().info());
+        let sys = self.fast_required()?;
+        match linearised_separation(&sys)? {
+            SeparationOutcome::Separates(s) => scalar(
+                out,
+                &key,
+                s.theta,
+                "rad",
+                "separation angle with the polynomial's terms above degree 1 dropped".into(),
+            ),
+            SeparationOutcome::NoSeparationBeforeFloor => {
+                out.notes.insert(
+                    key,
+                    "the linearised polynomial has no root between the floor and the start".into(),
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// Every contact's end: time, angle and cause, the first contact's under
+    /// `contact_end_*` as well as its own name; notes for those that hold or never close.
+    pub(super) fn contact_ends(&mut self, out: &mut RunResults) -> Result<(), SolveError> {
+        let info = self.general().info();
+        for i in 0..info.contacts.len() {
+            let fate = self.fate(i)?;
+            let name = info.contacts[i].name;
+            let keys: Vec<String> = if i == 0 {
+                vec!["contact_end".into(), format!("{name}_end")]
+            } else {
+                vec![format!("{name}_end")]
+            };
+            for key in keys {
+                match &fate {
+                    Fate::Ended { t, theta, cause } => {
+                        let why = cause_words(cause);
+                        let meaning =
+                            format!("time from release until contact `{name}` ends: {why}");
+                        scalar(out, &format!("{key}_time"), *t, "s", meaning);
+                        let meaning =
+                            format!("{} where contact `{name}` ends: {why}", angle_name(info));
+                        scalar(out, &format!("{key}_angle"), *theta, "rad", meaning);
+                        out.labels.insert(
+                            format!("{key}_cause"),
+                            Label {
+                                value: cause.to_string(),
+                                meaning: format!(
+                                    "why contact `{name}` ended: `force` (its force reached zero), \
+                                     `edge` (its point ran off a body) or `contact` (another \
+                                     contact closed, where the motion stops)"
+                                ),
+                            },
+                        );
+                    }
+                    Fate::Held { until } => {
+                        out.notes
+                            .insert(key, format!("contact `{name}` holds {until}"));
+                    }
+                    Fate::NeverClosed => {
+                        out.notes
+                            .insert(key, format!("contact `{name}` is open at release"));
+                    }
+                }
+            }
+        }
+        self.friction_report(out)
+    }
+
+    /// With friction, over the first contact's span: the work friction did
+    /// (`contact_end_friction_work`, J) and the sequence of active sets
+    /// (`contact_end_contact_modes`).
+    fn friction_report(&mut self, out: &mut RunResults) -> Result<(), SolveError> {
+        let info = self.general().info();
+        if info.frictions.is_empty() {
+            return Ok(());
+        }
+        let end = self.span_end()?;
+        let Some(motion) = self.motion.as_ref() else {
+            return Ok(());
+        };
+        let phases: Vec<&PhaseRun> = (motion.phases.iter())
+            .filter(|p| p.t_start() < end || (end == 0.0 && p.t_start() == 0.0))
+            .collect();
+        let work = phases.last().map_or(0.0, |p| p.friction_work());
+        scalar(
+            out,
+            "contact_end_friction_work",
+            work,
+            "J",
+            "work done by friction over the first contact's phase (energy lost)".into(),
+        );
+        let sequence = (phases.iter().flat_map(|p| p.stretches()))
+            .map(|(t, m)| format!("{m} from t = {} s", format_number(t, 6)))
+            .collect::<Vec<_>>()
+            .join("; ");
+        out.labels.insert(
+            "contact_end_contact_modes".into(),
+            Label {
+                value: sequence,
+                meaning: "the closed contacts and how each friction contact moves over the first \
+                          contact's phase: sticks, or slides + / - along its direction, each from \
+                          the time the set began (switches located as events)"
+                    .into(),
+            },
+        );
+        Ok(())
+    }
+
+    /// The time to the end angle keeping the release contacts closed.
+    pub(super) fn contact_time_to_floor(&mut self, out: &mut RunResults) -> Result<(), SolveError> {
+        let info = self.general().info();
+        let t = self.floor_mesh()?.duration;
+        let key = Quantity::ContactTimeToFloor.name(info);
+        let meaning = format!(
+            "time to {} if the release contacts held all the way",
+            motion_end(info)
+        );
+        scalar(out, &key, t, "s", meaning);
+        Ok(())
+    }
+
+    /// `sqrt(2 h / g)` from the falling point's height at release.
+    pub(super) fn point_mass_fall_time(&mut self, out: &mut RunResults) {
+        let general = self.general();
+        let info = general.info();
+        let pts = general.points(&general.initial_state());
+        let h = pts.pos[info.falling_point][1];
+        let t = (2.0 * h.max(0.0) / general.gravity()).sqrt();
+        let meaning = format!(
+            "free fall of a point mass from the release height of `{}` ({} m)",
+            info.points[info.falling_point].name,
+            format_number(h, 6)
+        );
+        scalar(
+            out,
+            &Quantity::PointMassFallTime.name(info),
+            t,
+            "s",
+            meaning,
+        );
+    }
+
+    /// Where the series end (s from release): the first contact's end, or the end of the
+    /// motion; where that is the release itself (a contact open at once), the end of the first
+    /// phase that lasts.
+    pub(super) fn span_end(&mut self) -> Result<f64, SolveError> {
+        let info = self.general().info();
+        let fate = if info.contacts.is_empty() {
+            Fate::NeverClosed
+        } else {
+            self.fate(0)?
+        };
+        let end = match fate {
+            Fate::Ended { t, .. } if t > 0.0 => t,
+            Fate::Held { .. } => self.complete()?.end_time(),
+            _ => {
+                let motion = self.extend_until(|m| m.phases.iter().any(|p| p.duration() > 0.0))?;
+                (motion.phases.iter())
+                    .find(|p| p.duration() > 0.0)
+                    .map_or(0.0, PhaseRun::t_end)
+            }
+        };
+        Ok(end)
+    }
+
+    /// Samples at `samples` uniform times from release to [`Plan::span_end`], each in its
+    /// phase: per phase touched, its index, its samples (times from the phase's start) and the
+    /// same times from release. Sampled once and shared by every series.
+    fn span_samples(&mut self) -> Result<Vec<(usize, PhaseSamples, Vec<f64>)>, SolveError> {
+        if let Some(done) = &self.span {
+            return Ok(done.clone());
+        }
+        let end = self.span_end()?;
+        let times = crate::solve::series::uniform_times(end, self.samples)?;
+        let Some(motion) = self.motion.as_ref() else {
+            return Ok(Vec::new());
+        };
+        let mut groups: Vec<(usize, Vec<f64>)> = Vec::new();
+        for &t in &times {
+            // The phase that runs at `t`: the last one starting at or before it that lasts, or
+            // the one ending there.
+            let k = (motion.phases.iter())
+                .rposition(|p| p.t_start() <= t && (t < p.t_end() || p.t_end() >= end))
+                .unwrap_or(0);
+            match groups.last_mut() {
+                Some((g, ts)) if *g == k => ts.push(t),
+                _ => groups.push((k, vec![t])),
+            }
+        }
+        let mut out = Vec::new();
+        for (k, ts) in groups {
+            let phase = &motion.phases[k];
+            let local: Vec<f64> = ts.iter().map(|t| (t - phase.t_start()).max(0.0)).collect();
+            let s = sample_at(phase, &local, &mut self.work)?;
+            out.push((k, s, ts));
+        }
+        self.span = Some(out.clone());
+        Ok(out)
+    }
+
+    /// A series over the first contact's span: the angle, a contact's force, a friction, or a
+    /// point's path.
+    pub(super) fn series(&mut self, q: Quantity, out: &mut RunResults) -> Result<(), SolveError> {
+        let info = self.general().info();
+        let groups = self.span_samples()?;
+        let general = self.general().clone();
+        let Some(motion) = self.motion.as_ref() else {
+            return Ok(());
+        };
+        let mut cols: Vec<Vec<f64>> = Vec::new();
+        let mut push = |row: &[f64]| {
+            cols.resize(row.len(), Vec::new());
+            for (c, v) in cols.iter_mut().zip(row) {
+                c.push(*v);
+            }
+        };
+        for (k, s, t) in &groups {
+            let phase = &motion.phases[*k];
+            match q {
+                Quantity::ThetaSeries => {
+                    for (j, tj) in t.iter().enumerate().take(s.len()) {
+                        push(&[*tj, s.theta[j], s.theta_dot[j], s.theta_ddot[j]]);
+                    }
+                }
+                Quantity::ForceSeries(i) => {
+                    for (j, f) in sample_forces(phase, s)?.iter().enumerate() {
+                        push(&[t[j], s.theta[j], f.get(i).copied().unwrap_or(f64::NAN)]);
+                    }
+                }
+                Quantity::FrictionSeries(i) => {
+                    for (j, [f, n, v]) in sample_friction(phase, &general, s)?.iter().enumerate() {
+                        let at = |x: &[f64]| x.get(i).copied().unwrap_or(f64::NAN);
+                        push(&[t[j], s.theta[j], at(f), at(n), at(v)]);
+                    }
+                }
+                Quantity::Trajectory(i) => {
+                    for (j, state) in s.states.iter().enumerate() {
+                        let pts = phase.bound().points(state);
+                        let (p, v) = (pts.pos[i], pts.vel[i]);
+                        push(&[t[j], p[0], p[1], v[0], v[1]]);
+                    }
+                }
+                _ => {}
+            }
+        }
+        let names: Vec<(String, &'static str)> = match q {
+            Quantity::ThetaSeries => vec![
+                ("t".into(), "s"),
+                ("theta".into(), "rad"),
+                ("theta_dot".into(), "rad/s"),
+                ("theta_ddot".into(), "rad/s^2"),
+            ],
+            Quantity::ForceSeries(i) => vec![
+                ("t".into(), "s"),
+                ("theta".into(), "rad"),
+                (info.contacts[i].name.into(), info.contacts[i].unit),
+            ],
+            Quantity::FrictionSeries(i) => {
+                let f = &info.frictions[i];
+                vec![
+                    ("t".into(), "s"),
+                    ("theta".into(), "rad"),
+                    (f.name.into(), "N"),
+                    (
+                        info.contacts[f.contact].name.into(),
+                        info.contacts[f.contact].unit,
+                    ),
+                    ("slip_velocity".into(), "m/s"),
+                ]
+            }
+            _ => vec![
+                ("t".into(), "s"),
+                ("x".into(), "m"),
+                ("y".into(), "m"),
+                ("vx".into(), "m/s"),
+                ("vy".into(), "m/s"),
+            ],
+        };
+        cols.resize(names.len(), Vec::new());
+        let series = Series {
+            columns: (names.into_iter().zip(cols))
+                .map(|((name, unit), values)| column(&name, unit, values))
+                .collect(),
+        };
+        out.series.insert(q.name(info), series);
+        Ok(())
+    }
+
+    /// The motion to its end: the landing time and rate where it reaches the floor, a note
+    /// otherwise; with friction, the work it did.
+    pub(super) fn floor_impact(&mut self, out: &mut RunResults) -> Result<(), SolveError> {
+        let info = self.general().info();
+        let motion = self.complete()?;
+        if !info.frictions.is_empty() {
+            let work = motion.phases.last().map_or(0.0, PhaseRun::friction_work);
+            scalar(
+                out,
+                "floor_impact_friction_work",
+                work,
+                "J",
+                format!(
+                    "work done by friction from release until {} (energy lost)",
+                    motion_end(info)
+                ),
+            );
+        }
+        let path = path(motion);
+        let name = |j: usize| info.contacts.get(j).map_or("a contact", |c| c.name);
+        let note = match motion.last_end() {
+            Some(End::Floor) => None,
+            Some(End::Edge(j)) => Some(format!(
+                "contact `{}` ran off an edge at t = {} s ({path}); the motion after that is not modelled",
+                name(j),
+                format_number(motion.end_time(), 6)
+            )),
+            Some(End::Contact(j)) => Some(format!(
+                "contact `{}` closed at t = {} s ({path}): the bodies meet, and impacts are not modelled yet",
+                name(j),
+                format_number(motion.end_time(), 6)
+            )),
+            _ => Some(format!("the motion ended before the floor ({path})")),
+        };
+        if let Some(note) = note {
+            out.notes.insert("floor_impact".into(), note);
+            return Ok(());
+        }
+        let (time, omega) = (motion.end_time(), motion.end_angular_velocity());
+        scalar(
+            out,
+            "floor_impact_time",
+            time,
+            "s",
+            format!("time from release until {} ({path})", motion_end(info)),
+        );
+        scalar(
+            out,
+            "impact_angular_velocity",
+            omega,
+            "rad/s",
+            format!(
+                "rate of {} when it reaches its end ({path})",
+                angle_name(info)
+            ),
+        );
+        Ok(())
+    }
+
+    /// The bodies' motion for `motion.svg`: every phase this run solved (the first always, the
+    /// next ones when other quantities asked for them), each sampled once, with the path of the
+    /// first point whose trajectory is wanted. A later phase that cannot be sampled ends the
+    /// animation there, with a note in it.
+    pub(super) fn animation(
+        &mut self,
+        want: &[Quantity],
+        out: &mut RunResults,
+    ) -> Result<(), SolveError> {
+        let n = self.motion()?.phases.len();
+        let mut notes = Vec::new();
+        for i in 0..n {
+            if let Err(e) = self.samples_of(i) {
+                notes.push(format!("the animation stops before phase {}: {e}", i + 1));
+                break;
+            }
+        }
+        let Some(motion) = self.motion.as_ref() else {
+            return Ok(());
+        };
+        let info = self.walker.general.info();
+        let traced = want.iter().find_map(|q| match q {
+            Quantity::Trajectory(i) => info.points.get(*i).map(|p| p.name),
+            _ => None,
+        });
+        let phases: Vec<PhaseInput> = (motion.phases.iter().zip(&self.phase_samples))
+            .map(|(run, samples)| PhaseInput {
+                bound: run.bound(),
+                samples,
+                t_start: run.t_start(),
+                end: run.end(),
+            })
+            .collect();
+        let mut animation = Animation::build(&phases, traced);
+        animation.notes.extend(notes);
+        out.motion = Some(animation);
+        Ok(())
+    }
+}

@@ -1,0 +1,274 @@
+//! The planner's evidence: the cross-check of the fast path against the general model
+//! integrated with the same contacts closed, and the physical checks of every phase.
+
+use super::{Plan, scalar};
+use crate::results::{CheckKind, RunResults, Work};
+use crate::solve::SolveError;
+use crate::solve::checks::{self, Conserved, free_momenta};
+use crate::solve::phases::{End, PhaseRun};
+use crate::solve::series::{sample_forces, theta_dot_at};
+use crate::solve::unreduced::{EndEvent, UnreducedRun};
+
+/// The event of an integrated run in words.
+fn event_words(run: &UnreducedRun, info: &crate::model::ModelInfo) -> String {
+    let name = |i: usize| info.contacts.get(i).map_or("a contact", |c| c.name);
+    match run.end {
+        EndEvent::Force(i) => format!("contact `{}`'s force crossing zero", name(i)),
+        EndEvent::Edge(i) => format!("contact `{}`'s edge", name(i)),
+        EndEvent::Gap(i) => format!("contact `{}` closing", name(i)),
+        EndEvent::Floor => "the floor".into(),
+    }
+}
+
+impl Plan<'_> {
+    /// The fast path's first phase against the general model integrated from release with the
+    /// same contacts closed: the event time, and along the path the quadrature's time and the
+    /// reduced state at each step's angle.
+    pub(super) fn cross_check(&mut self, out: &mut RunResults) -> Result<(), SolveError> {
+        self.fast_required()?;
+        self.motion()?;
+        match self.ode() {
+            Ok(_) => {}
+            // Not an error of the run: the integrated route has nothing to say here.
+            Err(e @ SolveError::IllConditioned { .. }) => {
+                out.notes.insert("cross_check".into(), e.to_string());
+                return Ok(());
+            }
+            Err(e) => return Err(e),
+        }
+        let (Some(motion), Some(ode)) = (self.motion.as_ref(), self.ode.as_ref()) else {
+            return Ok(());
+        };
+        let Some(first) = motion.phases[0].reduced() else {
+            return Ok(());
+        };
+        let info = self.walker.general.info();
+        let t_quad = first.mesh.duration;
+        let event = event_words(ode, info);
+        let same = End::from(ode.end) == first.end.end;
+        if !same {
+            out.notes.insert(
+                "cross_check".into(),
+                format!(
+                    "the integrated route ended at {event}, the fast path at {:?}: they disagree \
+                     on the first event",
+                    first.end.end
+                ),
+            );
+        }
+        let rel = if t_quad > 0.0 {
+            (ode.t_end - t_quad).abs() / t_quad
+        } else {
+            (ode.t_end - t_quad).abs()
+        };
+        let (dt_max, dy_max, nodes) = path_deviation(first, ode, info.reduced, &mut self.work)?;
+        let steps = ode.steps();
+        scalar(
+            out,
+            "cross_check_time",
+            ode.t_end,
+            "s",
+            format!(
+                "the general model ({}, {steps} steps) integrated to {event}",
+                ode.method.name()
+            ),
+        );
+        scalar(
+            out,
+            "cross_check_relative_difference",
+            rel,
+            "1",
+            format!(
+                "|t_ode - t_quadrature| / t_quadrature at {event} (quadrature: {t_quad:.15e} s; \
+                 ODE rtol {:.1e}, mass-matrix condition {:.1e})",
+                ode.rtol, ode.condition
+            ),
+        );
+        scalar(
+            out,
+            "cross_check_rtol",
+            ode.rtol,
+            "1",
+            "relative tolerance the integrator ran with: the one asked, raised to 10 eps cond(M) when the mass matrix is ill-conditioned".into(),
+        );
+        scalar(
+            out,
+            "cross_check_time_deviation",
+            dt_max,
+            "s",
+            format!("largest |t_ode - t(theta_ode)| over {nodes} integrator steps"),
+        );
+        scalar(
+            out,
+            "cross_check_state_deviation",
+            dy_max,
+            "1",
+            format!(
+                "largest difference between the integrated and the reduced states over {nodes} steps, relative to the largest coordinate (or velocity) on the path"
+            ),
+        );
+        Ok(())
+    }
+
+    /// The checks of every phase to the end of the motion, and of the cross-check's path when
+    /// it was solved.
+    pub(super) fn checks(
+        &mut self,
+        with_ode: bool,
+        out: &mut RunResults,
+    ) -> Result<(), SolveError> {
+        let n_phases = self.complete()?.phases.len();
+        let tol = self.walker.tol;
+        for i in 0..n_phases {
+            self.samples_of(i)?;
+            let (Some(motion), Some(samples)) = (self.motion.as_ref(), self.phase_samples.get(i))
+            else {
+                continue;
+            };
+            let run = &motion.phases[i];
+            let bound = run.bound();
+            let label = run.labels().join(" then ");
+            let ctx = checks::Context {
+                phase: label.clone(),
+                key: if matches!(run, PhaseRun::Reduced(_)) {
+                    bound.name().to_string()
+                } else {
+                    format!("{}.{}", bound.name(), i + 1)
+                },
+                order: 2 * i,
+                t_start: run.t_start(),
+            };
+            let forces = sample_forces(run, samples)?;
+            let mut found = checks::monitors(bound, samples, &forces, tol, &ctx);
+            found.extend(checks::contact_forces(
+                bound,
+                samples,
+                &forces,
+                &run.closed(),
+                tol,
+                &ctx,
+            ));
+            found.extend(path_checks(run, samples, tol, &ctx));
+            out.checks.extend(found);
+        }
+        if with_ode && let Some(ode) = self.ode.as_ref() {
+            // The cross-check's path is held to its own accuracy: ten times its rtol at the
+            // least. It integrates the first phase, so its checks come right after that phase's.
+            let general = &self.walker.general;
+            let ode_tol = tol.max(10.0 * ode.rtol);
+            let ctx = checks::Context {
+                phase: format!("{} (ODE cross-check)", general.name()),
+                key: format!("{}.ode", general.name()),
+                order: 1,
+                t_start: 0.0,
+            };
+            out.checks
+                .extend(integrated_checks(general, ode, ode_tol, &ctx));
+        }
+        Ok(())
+    }
+}
+
+/// The conservation checks of a phase's own path: by construction on the fast path (the
+/// generated functions agree with it at the samples), along the integrator's steps otherwise,
+/// held to the integrator's accuracy (ten times its rtol at the least).
+fn path_checks(
+    run: &PhaseRun,
+    samples: &crate::solve::series::PhaseSamples,
+    tol: f64,
+    ctx: &checks::Context,
+) -> Vec<(String, crate::results::Check)> {
+    match run {
+        PhaseRun::Reduced(r) => {
+            let bound = r.system.bound();
+            let conserved = Conserved::each_cyclic(bound);
+            checks::drift(
+                bound,
+                &samples.states,
+                &conserved,
+                tol,
+                ctx,
+                CheckKind::Identity,
+            )
+        }
+        PhaseRun::Integrated(r) => {
+            integrated_checks(&r.bound, &r.run, tol.max(10.0 * r.run.rtol), ctx)
+        }
+    }
+}
+
+/// Energy (with the work of friction), the momenta no closed contact or acting friction pushes
+/// on, and the closed contacts' gaps, along an integration's steps.
+fn integrated_checks(
+    bound: &crate::system::Bound,
+    run: &UnreducedRun,
+    tol: f64,
+    ctx: &checks::Context,
+) -> Vec<(String, crate::results::Check)> {
+    let info = bound.info();
+    let states = run.states();
+    let segments = run.node_segments();
+    let rows: Vec<(Vec<bool>, Vec<bool>)> = segments
+        .iter()
+        .map(|&k| {
+            let active = &run.segments[k].active;
+            let acting = (0..info.frictions.len())
+                .map(|j| active.friction_acts(info, j))
+                .collect();
+            (active.closed.clone(), acting)
+        })
+        .collect();
+    let work = run.node_friction_work();
+    let conserved = Conserved {
+        friction_work: (!info.frictions.is_empty()).then_some(&work[..]),
+        momenta: free_momenta(bound, &states, &rows),
+    };
+    let mut out = checks::drift(bound, &states, &conserved, tol, ctx, CheckKind::Drift);
+    let closed: Vec<Vec<bool>> = rows.into_iter().map(|(c, _)| c).collect();
+    out.extend(checks::constraint_drift(bound, &states, &closed, tol, ctx));
+    out
+}
+
+/// Along the integrated cross-check's steps: the largest `|t_ode - t(theta_ode)|` and the
+/// largest relative difference between its state and the reduced one at the same angle (in the
+/// system's coordinates), and the number of steps.
+fn path_deviation(
+    first: &crate::solve::phases::ReducedRun,
+    ode: &UnreducedRun,
+    reduced: usize,
+    work: &mut Work,
+) -> Result<(f64, f64, usize), SolveError> {
+    let sys = &first.system;
+    let theta_i = sys.theta_initial();
+    let nodes = ode.nodes();
+    // Each component against the largest of its kind on the path (coordinates, velocities):
+    // a coordinate a joint holds at zero carries only rounding, not a scale of its own.
+    let n = nodes.first().map_or(0, |(_, y)| y.len() / 2);
+    let mut scale = vec![0.0f64; 2 * n];
+    for (_, y) in &nodes {
+        for (s, v) in scale.iter_mut().zip(y.iter()) {
+            *s = s.max(v.abs());
+        }
+    }
+    for kind in [0..n, n..2 * n] {
+        let top = scale[kind.clone()].iter().cloned().fold(0.0, f64::max);
+        for s in &mut scale[kind] {
+            *s = top;
+        }
+    }
+    let (mut dt_max, mut dy_max) = (0.0f64, 0.0f64);
+    let mut w = Work::default();
+    for (t, y) in &nodes {
+        let delta = (theta_i - y[reduced]).clamp(0.0, first.mesh.delta_end);
+        let tq = first.mesh.time_at_delta(sys, delta, &mut w)?;
+        dt_max = dt_max.max((t - tq).abs());
+        let full = sys.to_full(&sys.full_state(*t, delta, theta_dot_at(sys, delta)));
+        for (i, (a, b)) in full.q.iter().chain(&full.qd).zip(y.iter()).enumerate() {
+            if scale[i] > 0.0 {
+                dy_max = dy_max.max((a - b).abs() / scale[i]);
+            }
+        }
+    }
+    work.integrand_evals += w.integrand_evals;
+    Ok((dt_max, dy_max, nodes.len()))
+}

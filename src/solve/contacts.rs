@@ -1,0 +1,789 @@
+//! Contacts and friction at one state: which contacts are closed and how each friction
+//! contact moves ([`Active`]), the accelerations and forces that follow ([`dynamics`]), and the
+//! one consistent choice where they may change ([`decide`]).
+//!
+//! With `n` coordinates, the closed contacts that the model does not eliminate (constraint
+//! rows `J_r`, bias `b_r`) and the frictions of closed contacts (slip rows `T_j`, bias `c_j`),
+//! the unknowns are `qdd`, the rows' forces `lambda_r` and the friction forces `f_j`:
+//!
+//! - `M qdd - J^T lambda - T^T f = F` (a contact's force acts through its gap's gradient, a
+//!   friction's through its slip velocity's);
+//! - `J_r qdd + b_r = 0` for every closed row (its gap stays zero);
+//! - sliding with slip sign `s`: `f_j + s mu_j lambda_j = 0`, `lambda_j` the force of its
+//!   contact; sticking: `T_j qdd + c_j = 0` (the slip velocity stays zero).
+//!
+//! A contact the model eliminates has its force in closed form ([`Bound::forces_full`]).
+//!
+//! Which contacts are closed is a linear complementarity problem at the acceleration level:
+//! among the contacts that touch without moving apart (gap and normal velocity zero), find the
+//! set whose forces push (`lambda >= 0`) while every other accelerates apart (normal
+//! acceleration `J qdd + b >= 0`). For a handful of contacts every subset is tried
+//! ([`MAX_COMBINATIONS`] with the frictions' modes). Frictionless rigid bodies give one
+//! acceleration; with friction a contact at rest that can stick does stick (the rule of the
+//! rigid-body literature), and no consistent choice, or several with as many stuck contacts and
+//! different motions (Painlevé), is [`SolveError::Indeterminate`], naming the time and the
+//! contacts, never a guess.
+
+use crate::model::ModelInfo;
+use crate::solve::SolveError;
+use crate::solve::rest;
+use crate::system::{Bound, State};
+use nalgebra::{DMatrix, DVector};
+
+/// Most combinations of contact states and friction modes tried at one decision.
+pub const MAX_COMBINATIONS: usize = 4096;
+
+/// A contact or friction at rest is one whose speed is below this fraction of the speeds it
+/// is made of.
+pub const REST: f64 = 1e-9;
+
+/// Where sliding is given up as Painlevé's singularity: the system's determinant with the
+/// sliding frictions over the one without them ([`Dynamics::painleve`]) has fallen to this.
+pub const PAINLEVE_FLOOR: f64 = 1e-3;
+
+/// How small, relative to the largest of its kind, a force or normal acceleration may be and
+/// still count as zero when a contact's state is decided.
+pub const DECIDE_TOLERANCE: f64 = 1e-9;
+
+/// How a friction contact moves.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Mode {
+    /// Sliding with the slip velocity's sign `+1` or `-1`; the friction force is
+    /// `-sign mu N`.
+    Slide(f64),
+    /// Stuck: the slip velocity stays zero, the friction force is what keeps it so.
+    Stick,
+}
+
+impl Mode {
+    /// `slides +`, `slides -` or `sticks`.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Mode::Slide(s) if s > 0.0 => "slides +",
+            Mode::Slide(_) => "slides -",
+            Mode::Stick => "sticks",
+        }
+    }
+}
+
+/// Which contacts are closed, and how each friction moves.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Active {
+    /// Per contact of the system: closed (a contact the model eliminates always is).
+    pub closed: Vec<bool>,
+    /// Per friction: its mode (meaningful only while its contact is closed).
+    pub modes: Vec<Mode>,
+}
+
+impl Active {
+    /// The contacts a model holds closed by elimination, every friction sliding `+` (a
+    /// placeholder for models without friction).
+    pub fn of_model(info: &ModelInfo) -> Active {
+        Active {
+            closed: info.contacts.iter().map(|c| c.closed).collect(),
+            modes: vec![Mode::Slide(1.0); info.frictions.len()],
+        }
+    }
+
+    /// Whether friction `j` acts (its contact is closed).
+    pub fn friction_acts(&self, info: &ModelInfo, j: usize) -> bool {
+        (info.frictions.get(j)).is_some_and(|f| self.closed.get(f.contact) == Some(&true))
+    }
+
+    /// The names of the closed contacts.
+    pub fn closed_names(&self, info: &ModelInfo) -> Vec<&'static str> {
+        (info.contacts.iter().zip(&self.closed))
+            .filter(|(_, c)| **c)
+            .map(|(c, _)| c.name)
+            .collect()
+    }
+
+    /// `contact_force, floor_normal closed; floor_friction sticks` (`nothing closed` when no
+    /// contact is).
+    pub fn describe(&self, info: &ModelInfo) -> String {
+        let closed = self.closed_names(info);
+        let mut out = if closed.is_empty() {
+            "nothing closed".to_string()
+        } else {
+            format!("{} closed", closed.join(", "))
+        };
+        let modes: Vec<String> = (info.frictions.iter().zip(&self.modes).enumerate())
+            .filter(|(j, _)| self.friction_acts(info, *j))
+            .map(|(_, (f, m))| format!("{} {}", f.name, m.describe()))
+            .collect();
+        if !modes.is_empty() {
+            out.push_str("; ");
+            out.push_str(&modes.join(", "));
+        }
+        out
+    }
+}
+
+/// The accelerations, contact and friction forces at one state in one active set.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Dynamics {
+    /// `qdd`.
+    pub qdd: Vec<f64>,
+    /// Every contact's force (zero where open), in the order of the model's contacts.
+    pub forces: Vec<f64>,
+    /// Friction forces, in the order of the model's frictions (zero where its contact is
+    /// open).
+    pub fr: Vec<f64>,
+    /// Every contact's normal acceleration `J qdd + bias` (zero for one the model eliminates).
+    pub normal_acc: Vec<f64>,
+    /// Slip velocities `T qd`.
+    pub slip: Vec<f64>,
+    /// Slip accelerations `T qdd + c`.
+    pub slip_acc: Vec<f64>,
+    /// `det(A) / det(A0)` of the system solved over the same system without the sliding
+    /// frictions' coupling: 1 without sliding friction, zero at Painlevé's singularity, where
+    /// sliding has no solution.
+    pub painleve: f64,
+}
+
+impl Dynamics {
+    /// The power of the frictions, `sum f v` (W).
+    pub fn friction_power(&self) -> f64 {
+        self.fr.iter().zip(&self.slip).map(|(f, v)| f * v).sum()
+    }
+}
+
+/// The rows of one solve: the model's matrices at a state.
+struct Rows {
+    n: usize,
+    mass: Vec<f64>,
+    rhs: Vec<f64>,
+    jac: Vec<f64>,
+    bias: Vec<f64>,
+    tjac: Vec<f64>,
+    tbias: Vec<f64>,
+}
+
+impl Rows {
+    fn at(sys: &Bound, state: &State) -> Rows {
+        let (mass, rhs) = sys.equations(state);
+        let (jac, bias) = sys.constraints(state);
+        let (tjac, tbias) = sys.friction(state);
+        Rows {
+            n: sys.n_coordinates(),
+            mass,
+            rhs,
+            jac,
+            bias,
+            tjac,
+            tbias,
+        }
+    }
+
+    fn row<'a>(&self, m: &'a [f64], i: usize) -> &'a [f64] {
+        &m[i * self.n..(i + 1) * self.n]
+    }
+
+    fn dot(a: &[f64], b: &[f64]) -> f64 {
+        a.iter().zip(b).map(|(x, y)| x * y).sum()
+    }
+}
+
+/// The names of the closed contacts, for messages.
+fn closed_list(info: &ModelInfo, closed: &[bool]) -> String {
+    let names: Vec<&str> = (info.contacts.iter().zip(closed))
+        .filter(|(_, c)| **c)
+        .map(|(c, _)| c.name)
+        .collect();
+    if names.is_empty() {
+        "no contact".into()
+    } else {
+        names.join(", ")
+    }
+}
+
+/// Solves for the accelerations, the contacts' forces and the friction forces at `state` in
+/// the active set `active`. `t` (from release) labels errors.
+pub fn dynamics(
+    sys: &Bound,
+    state: &State,
+    active: &Active,
+    t: f64,
+) -> Result<Dynamics, SolveError> {
+    let info = sys.info();
+    let (n, m, nf) = (
+        sys.n_coordinates(),
+        info.contacts.len(),
+        info.frictions.len(),
+    );
+    if active.closed.len() != m || active.modes.len() != nf {
+        return Err(SolveError::ActiveSize {
+            model: info.name,
+            contacts: m,
+            frictions: nf,
+            closed: active.closed.len(),
+            modes: active.modes.len(),
+        });
+    }
+    let rows = Rows::at(sys, state);
+    // Closed constraint rows (closed and not eliminated), then acting frictions.
+    let kkt: Vec<usize> = (0..m)
+        .filter(|&i| active.closed[i] && !info.contacts[i].closed)
+        .collect();
+    let acting: Vec<usize> = (0..nf).filter(|&j| active.friction_acts(info, j)).collect();
+    let dim = n + kkt.len() + acting.len();
+    let mu = sys.friction_coefficients();
+    let (a, b) = assemble(&rows, &mu, info, active, &kkt, &acting, dim);
+    let singular = || SolveError::SingularContacts {
+        model: info.name,
+        t,
+        closed: closed_list(info, &active.closed),
+        q: state.q.clone(),
+    };
+    let lu = a.clone().lu();
+    let x = lu.solve(&b).ok_or_else(singular)?;
+    if !x.iter().all(|v| v.is_finite()) {
+        return Err(singular());
+    }
+    let sliding = acting
+        .iter()
+        .any(|&j| matches!(active.modes[j], Mode::Slide(_)));
+    let painleve = if sliding {
+        // The same system without the sliding frictions' coupling to their normal forces.
+        let mut a0 = a;
+        for (r, &j) in acting.iter().enumerate() {
+            if matches!(active.modes[j], Mode::Slide(_)) {
+                for c in 0..dim {
+                    a0[(n + kkt.len() + r, c)] = if c == n + kkt.len() + r { 1.0 } else { 0.0 };
+                }
+            }
+        }
+        lu.determinant() / a0.lu().determinant()
+    } else {
+        1.0
+    };
+    let qdd: Vec<f64> = x.iter().take(n).copied().collect();
+    let mut forces = sys.forces_full(state, &qdd);
+    for (r, &i) in kkt.iter().enumerate() {
+        forces[i] = x[n + r];
+    }
+    let mut fr = vec![0.0; nf];
+    for (r, &j) in acting.iter().enumerate() {
+        fr[j] = x[n + kkt.len() + r];
+    }
+    let normal_acc = (0..m)
+        .map(|i| Rows::dot(rows.row(&rows.jac, i), &qdd) + rows.bias[i])
+        .collect();
+
+    let slip = (0..nf)
+        .map(|j| Rows::dot(rows.row(&rows.tjac, j), &state.qd))
+        .collect();
+    let slip_acc = (0..nf)
+        .map(|j| Rows::dot(rows.row(&rows.tjac, j), &qdd) + rows.tbias[j])
+        .collect();
+    Ok(Dynamics {
+        qdd,
+        forces,
+        fr,
+        normal_acc,
+        slip,
+        slip_acc,
+        painleve,
+    })
+}
+
+/// The linear system of [`dynamics`]: the equations of motion, the closed rows and the
+/// frictions' laws.
+fn assemble(
+    rows: &Rows,
+    mu: &[f64],
+    info: &ModelInfo,
+    active: &Active,
+    kkt: &[usize],
+    acting: &[usize],
+    dim: usize,
+) -> (DMatrix<f64>, DVector<f64>) {
+    let n = rows.n;
+    let mut a = DMatrix::<f64>::zeros(dim, dim);
+    let mut b = DVector::<f64>::zeros(dim);
+    for r in 0..n {
+        for c in 0..n {
+            a[(r, c)] = rows.mass[r * n + c];
+        }
+        b[r] = rows.rhs[r];
+        for (k, &i) in kkt.iter().enumerate() {
+            a[(r, n + k)] = -rows.jac[i * n + r];
+        }
+        for (k, &j) in acting.iter().enumerate() {
+            a[(r, n + kkt.len() + k)] = -rows.tjac[j * n + r];
+        }
+    }
+    for (k, &i) in kkt.iter().enumerate() {
+        for c in 0..n {
+            a[(n + k, c)] = rows.jac[i * n + c];
+        }
+        b[n + k] = -rows.bias[i];
+    }
+    for (k, &j) in acting.iter().enumerate() {
+        let r = n + kkt.len() + k;
+        match active.modes[j] {
+            Mode::Slide(sign) => {
+                // f + sign mu lambda = 0, lambda the force of the friction's contact (a row).
+                let contact = info.frictions[j].contact;
+                a[(r, r)] = 1.0;
+                if let Some(col) = kkt.iter().position(|&i| i == contact) {
+                    a[(r, n + col)] = sign * mu[j];
+                }
+            }
+            Mode::Stick => {
+                for c in 0..n {
+                    a[(r, c)] = rows.tjac[j * n + c];
+                }
+                b[r] = -rows.tbias[j];
+            }
+        }
+    }
+    (a, b)
+}
+
+/// What may happen to one contact at a decision.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ContactOption {
+    /// It keeps its state (closed or open).
+    Keep(bool),
+    /// It touches without moving apart: it may stay closed or open.
+    Candidate,
+    /// Its force reached zero: it opens.
+    Opens,
+}
+
+/// What may happen to one friction at a decision.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FrictionOption {
+    /// It keeps its mode (it is sliding and not at rest, or did not switch).
+    Keep(Mode),
+    /// It is at rest: it may stick or slide either way.
+    AtRest,
+    /// Its slip stopped while sliding with this sign: it sticks or slides back.
+    Stopped(f64),
+    /// Its stuck friction reached `mu N`: it slides with this sign, against the friction that
+    /// held it.
+    Breaks(f64),
+}
+
+impl FrictionOption {
+    fn modes(&self) -> Vec<Mode> {
+        match *self {
+            FrictionOption::Keep(m) => vec![m],
+            FrictionOption::AtRest => vec![Mode::Stick, Mode::Slide(1.0), Mode::Slide(-1.0)],
+            FrictionOption::Stopped(s) => vec![Mode::Stick, Mode::Slide(-s)],
+            FrictionOption::Breaks(s) => vec![Mode::Slide(s)],
+        }
+    }
+}
+
+/// The options of every contact and friction at a decision.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Options {
+    /// Per contact.
+    pub contacts: Vec<ContactOption>,
+    /// Per friction.
+    pub frictions: Vec<FrictionOption>,
+}
+
+/// The options of every friction at a state: at rest where its slip speed is below [`REST`]
+/// of the state's speed scale (`sum_j |T_j|` times the largest `|qd_j|`), otherwise sliding the
+/// way it slips.
+pub fn friction_options(sys: &Bound, state: &State) -> Vec<FrictionOption> {
+    let n = sys.n_coordinates();
+    let (jac, _) = sys.friction(state);
+    let fastest = state.qd.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    (0..sys.info().frictions.len())
+        .map(|k| {
+            let row = &jac[k * n..(k + 1) * n];
+            let v: f64 = row.iter().zip(&state.qd).map(|(j, q)| j * q).sum();
+            let size: f64 = fastest * row.iter().map(|j| j.abs()).sum::<f64>();
+            if v == 0.0 || v.abs() <= REST * size {
+                FrictionOption::AtRest
+            } else {
+                FrictionOption::Keep(Mode::Slide(v.signum()))
+            }
+        })
+        .collect()
+}
+
+/// Where contact options are taken: at release, or after a phase that held some contacts
+/// closed by integration, whose gaps have drifted within the run's tolerance.
+#[derive(Debug, Clone, Copy)]
+pub enum Moment<'a> {
+    /// The spec's initial state.
+    Release,
+    /// The end of a phase.
+    After {
+        /// Absolute time (s from release).
+        t: f64,
+        /// The contacts the ending phase held closed.
+        held: &'a [bool],
+        /// The gap (relative to the system's length) a held contact may have drifted by and
+        /// still touch: the tolerance its constraint drift is checked against.
+        drift: f64,
+    },
+}
+
+impl Moment<'_> {
+    fn t(&self) -> f64 {
+        match self {
+            Moment::Release => 0.0,
+            Moment::After { t, .. } => *t,
+        }
+    }
+
+    /// How far (relative) contact `i`'s gap may be from zero and still touch.
+    fn touching(&self, i: usize) -> f64 {
+        match self {
+            Moment::After { held, drift, .. } if held.get(i) == Some(&true) => {
+                drift.max(DECIDE_TOLERANCE)
+            }
+            _ => DECIDE_TOLERANCE,
+        }
+    }
+}
+
+/// Each contact's state where the motion starts (or goes on after an event) at `state`: a
+/// contact the model eliminates is closed; a gap above [`DECIDE_TOLERANCE`] of the system's
+/// length scale is open (a contact the phase before held closed touches within its drift
+/// tolerance, see [`Moment`]); a touching contact moving apart is open; one at rest is a
+/// candidate. A gap below that is [`SolveError::Overlap`]; a touching contact moving together
+/// is [`SolveError::ImpactAtRelease`] (impacts are not modelled yet).
+pub fn contact_options(
+    sys: &Bound,
+    state: &State,
+    at: Moment,
+) -> Result<Vec<ContactOption>, SolveError> {
+    let info = sys.info();
+    let gaps = sys.gaps(state);
+    let (jac, _) = sys.constraints(state);
+    let n = sys.n_coordinates();
+    let length = sys.length_scale(state);
+    let fastest = state.qd.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let mut out = Vec::new();
+    for (i, c) in info.contacts.iter().enumerate() {
+        if c.closed {
+            out.push(ContactOption::Keep(true));
+            continue;
+        }
+        let gap = gaps[i];
+        let tol = at.touching(i) * if c.gap_unit == "m" { length } else { 1.0 };
+        if !gap.is_finite() || gap < -tol {
+            return Err(SolveError::Overlap {
+                model: info.name,
+                contact: c.name,
+                gap,
+                unit: c.gap_unit,
+                t: at.t(),
+            });
+        }
+        if gap > tol && !c.bilateral {
+            out.push(ContactOption::Keep(false));
+            continue;
+        }
+        let row = &jac[i * n..(i + 1) * n];
+        let v: f64 = row.iter().zip(&state.qd).map(|(j, q)| j * q).sum();
+        let size: f64 = fastest * row.iter().map(|j| j.abs()).sum::<f64>();
+        let at_rest = v == 0.0 || v.abs() <= REST * size;
+        out.push(match (c.bilateral, at_rest) {
+            (true, _) => ContactOption::Keep(true),
+            (false, true) => ContactOption::Candidate,
+            (false, false) if v > 0.0 => ContactOption::Keep(false),
+            (false, false) => {
+                return Err(SolveError::ImpactAtRelease {
+                    model: info.name,
+                    contact: c.name,
+                    velocity: v,
+                });
+            }
+        });
+    }
+    Ok(out)
+}
+
+/// Whether a candidate combination is consistent: closed candidates push (within
+/// [`DECIDE_TOLERANCE`] of the largest force), open candidates accelerate apart (within
+/// [`DECIDE_TOLERANCE`] of the size of their own normal acceleration's terms), frictions obey Coulomb's law in
+/// their modes, and sliding is clear of Painlevé's singularity.
+fn consistent(
+    sys: &Bound,
+    options: &Options,
+    active: &Active,
+    d: &Dynamics,
+    acc_scale: &[f64],
+) -> bool {
+    let info = sys.info();
+    let force_scale = (d.forces.iter())
+        .chain(&d.fr)
+        .fold(0.0f64, |m, f| m.max(f.abs()));
+    let mu = sys.friction_coefficients();
+    for (i, opt) in options.contacts.iter().enumerate() {
+        let ok = match (opt, active.closed[i]) {
+            (ContactOption::Candidate, true) => {
+                info.contacts[i].bilateral || d.forces[i] >= -DECIDE_TOLERANCE * force_scale
+            }
+            (ContactOption::Candidate | ContactOption::Opens, false) => {
+                d.normal_acc[i] >= -DECIDE_TOLERANCE * acc_scale[i]
+            }
+            _ => true,
+        };
+        if !ok {
+            return false;
+        }
+    }
+    for (j, opt) in options.frictions.iter().enumerate() {
+        if !active.friction_acts(info, j) {
+            continue;
+        }
+        let normal = d.forces[info.frictions[j].contact];
+        let mode = active.modes[j];
+        let ok = match (opt, mode) {
+            (FrictionOption::Keep(_), _) => true,
+            (_, Mode::Stick) => d.fr[j].abs() <= mu[j] * normal.max(0.0) * (1.0 + 1e-12),
+            (FrictionOption::Breaks(_), Mode::Slide(_)) => true,
+            (_, Mode::Slide(s)) => s * d.slip_acc[j] > 0.0,
+        };
+        if !ok {
+            return false;
+        }
+    }
+    d.painleve > PAINLEVE_FLOOR
+}
+
+/// Every combination the options allow (contacts first, then the modes of the frictions whose
+/// contacts are closed in it); an error past [`MAX_COMBINATIONS`].
+fn combinations(sys: &Bound, options: &Options, t: f64) -> Result<Vec<Active>, SolveError> {
+    let info = sys.info();
+    let contact_lists: Vec<Vec<bool>> = (options.contacts.iter())
+        .map(|o| match o {
+            ContactOption::Keep(c) => vec![*c],
+            ContactOption::Candidate => vec![true, false],
+            ContactOption::Opens => vec![false],
+        })
+        .collect();
+    let mode_lists: Vec<Vec<Mode>> = options.frictions.iter().map(|o| o.modes()).collect();
+    let total = (contact_lists.iter().map(Vec::len))
+        .chain(mode_lists.iter().map(Vec::len))
+        .try_fold(1usize, |acc, l| acc.checked_mul(l))
+        .filter(|&n| n <= MAX_COMBINATIONS)
+        .ok_or_else(|| SolveError::Indeterminate {
+            model: info.name,
+            t,
+            contacts: info
+                .contacts
+                .iter()
+                .map(|c| c.name)
+                .collect::<Vec<_>>()
+                .join(", "),
+            why: format!("more than {MAX_COMBINATIONS} combinations of contact states to try"),
+        })?;
+    let mut out: Vec<Active> = Vec::new();
+    for mut index in 0..total {
+        let mut pick = |l: usize| {
+            let k = index % l;
+            index /= l;
+            k
+        };
+        let closed: Vec<bool> = contact_lists.iter().map(|l| l[pick(l.len())]).collect();
+        let modes: Vec<Mode> = mode_lists.iter().map(|l| l[pick(l.len())]).collect();
+        let active = Active { closed, modes };
+        // Modes of frictions whose contact is open do not matter: keep one of each.
+        let canonical = |a: &Active| Active {
+            closed: a.closed.clone(),
+            modes: (a.modes.iter().enumerate())
+                .map(|(j, m)| {
+                    if a.friction_acts(info, j) {
+                        *m
+                    } else {
+                        Mode::Stick
+                    }
+                })
+                .collect(),
+        };
+        let c = canonical(&active);
+        if !out.iter().any(|o| canonical(o) == c) {
+            out.push(active);
+        }
+    }
+    Ok(out)
+}
+
+/// The one consistent active set among `options` at `state` (`t` from release). Among the
+/// consistent sets, those that stick the most frictions are kept; if several remain and all
+/// give the same accelerations (a contact whose force and normal acceleration both vanish),
+/// the one with the most contacts closed; otherwise [`SolveError::Indeterminate`].
+pub fn decide(sys: &Bound, state: &State, options: &Options, t: f64) -> Result<Active, SolveError> {
+    let info = sys.info();
+    let mut found: Vec<(Active, Dynamics)> = Vec::new();
+    let mut singular: Vec<String> = Vec::new();
+    for active in combinations(sys, options, t)? {
+        let d = match dynamics(sys, state, &active, t) {
+            Ok(d) => d,
+            // Redundant supports that hold the system at rest (a ladder stuck at both ends):
+            // its motion is none, whatever share of the load each support takes.
+            Err(SolveError::SingularContacts { .. })
+                if rest::holds(sys, state, &active).is_some() =>
+            {
+                return Err(at_rest(info, &active, t, "redundantly, with"));
+            }
+            // Other singular sets (Painlevé's singularity exactly, or redundant contacts that
+            // cannot hold) are not a motion; the error says so if no set is.
+            Err(SolveError::SingularContacts { .. }) => {
+                singular.push(active.describe(info));
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
+        let scales = acc_scales(sys, state, &active, &d);
+        if consistent(sys, options, &active, &d, &scales) {
+            found.push((active, d));
+        }
+    }
+    let active = pick(info, options, found, &singular, t)?;
+    if rest::pins(sys, state, &active) {
+        return Err(at_rest(info, &active, t, "with"));
+    }
+    Ok(active)
+}
+
+/// The size of each contact's normal acceleration `J qdd + bias` in `d`, what its rounding is
+/// relative to: `sum_j |J_ij| s_j + |bias_i|`, where `s_j` sums the sizes of what each force
+/// (the applied ones, then each closed contact's and acting friction's) contributes to
+/// `qdd_j`. So a contact whose motion is slow next to gravity (a rod nearly flat on a thin
+/// block) is judged at its own scale, and one whose acceleration cancels to rounding noise
+/// (a foot just lifting) at the scale of the forces that cancel.
+fn acc_scales(sys: &Bound, state: &State, active: &Active, d: &Dynamics) -> Vec<f64> {
+    let info = sys.info();
+    let rows = Rows::at(sys, state);
+    let n = rows.n;
+    let mass = DMatrix::from_row_slice(n, n, &rows.mass);
+    let Some(inverse) = mass.try_inverse() else {
+        return vec![f64::INFINITY; info.contacts.len()];
+    };
+    let mut size = vec![0.0f64; n];
+    let mut add = |force: &[f64], times: f64| {
+        let f = DVector::from_iterator(n, force.iter().map(|v| v * times));
+        for (s, c) in size.iter_mut().zip((&inverse * f).iter()) {
+            *s += c.abs();
+        }
+    };
+    add(&rows.rhs, 1.0);
+    for i in (0..info.contacts.len()).filter(|&i| active.closed[i] && !info.contacts[i].closed) {
+        add(rows.row(&rows.jac, i), d.forces[i]);
+    }
+    for j in (0..info.frictions.len()).filter(|&j| active.friction_acts(info, j)) {
+        add(rows.row(&rows.tjac, j), d.fr[j]);
+    }
+    (0..info.contacts.len())
+        .map(|i| {
+            let row = rows.row(&rows.jac, i);
+            let terms: f64 = row.iter().zip(&size).map(|(j, s)| (j * s).abs()).sum();
+            terms + rows.bias[i].abs()
+        })
+        .collect()
+}
+
+/// The outcome of a system its supports hold at rest.
+fn at_rest(info: &ModelInfo, active: &Active, t: f64, how: &str) -> SolveError {
+    SolveError::AtRest {
+        model: info.name,
+        t,
+        how: format!("{how} {}", active.describe(info)),
+    }
+}
+
+/// [`decide`]'s choice among the consistent sets.
+fn pick(
+    info: &ModelInfo,
+    options: &Options,
+    mut found: Vec<(Active, Dynamics)>,
+    singular: &[String],
+    t: f64,
+) -> Result<Active, SolveError> {
+    let concerned = || {
+        let names: Vec<&str> = (info.contacts.iter().zip(&options.contacts))
+            .filter(|(_, o)| !matches!(o, ContactOption::Keep(false)))
+            .map(|(c, _)| c.name)
+            .chain(info.frictions.iter().map(|f| f.name))
+            .collect();
+        names.join(", ")
+    };
+    let stuck = |a: &Active| {
+        (0..a.modes.len())
+            .filter(|&j| a.friction_acts(info, j) && a.modes[j] == Mode::Stick)
+            .count()
+    };
+    let most = found.iter().map(|(a, _)| stuck(a)).max().unwrap_or(0);
+    let all = found.len();
+    found.retain(|(a, _)| stuck(a) == most);
+    let Some((first, d0)) = found.first() else {
+        return Err(SolveError::Indeterminate {
+            model: info.name,
+            t,
+            contacts: concerned(),
+            why: format!(
+                "no set of closed contacts and friction modes is consistent: a contact would \
+                 have to pull, or sticking needs more than mu N while no sliding direction \
+                 accelerates the slip (Painlevé's inconsistency){}",
+                if singular.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        "; the equations are singular with {}",
+                        singular.join("; with ")
+                    )
+                }
+            ),
+        });
+    };
+    let scale = d0
+        .qdd
+        .iter()
+        .fold(0.0f64, |m, a| m.max(a.abs()))
+        .max(1e-300);
+    let same =
+        |d: &Dynamics| (d.qdd.iter().zip(&d0.qdd)).all(|(a, b)| (a - b).abs() <= 1e-9 * scale);
+    if found.iter().all(|(_, d)| same(d)) {
+        let closed = |a: &Active| a.closed.iter().filter(|c| **c).count();
+        let best = found.iter().map(|(a, _)| closed(a)).max().unwrap_or(0);
+        if let Some((a, _)) = found.iter().find(|(a, _)| closed(a) == best) {
+            return Ok(a.clone());
+        }
+        return Ok(first.clone());
+    }
+    Err(SolveError::Indeterminate {
+        model: info.name,
+        t,
+        contacts: concerned(),
+        why: format!(
+            "{} of {all} consistent sets of closed contacts and friction modes give different \
+             motions ({}): rigid bodies with Coulomb friction do not determine the motion here \
+             (Painlevé's indeterminacy)",
+            found.len(),
+            found
+                .iter()
+                .map(|(a, _)| a.describe(info))
+                .collect::<Vec<_>>()
+                .join("; ")
+        ),
+    })
+}
+
+/// The error for sliding that has reached Painlevé's singularity ([`PAINLEVE_FLOOR`]).
+pub fn painleve_error(sys: &Bound, state: &State, active: &Active, t: f64) -> SolveError {
+    let info = sys.info();
+    SolveError::Indeterminate {
+        model: info.name,
+        t,
+        contacts: closed_list(info, &active.closed),
+        why: format!(
+            "with {} the sliding equations approach a singularity at q = {:?} (their \
+             determinant fell to {PAINLEVE_FLOOR:e} of the frictionless one): the normal force \
+             stops resisting the sliding (Painlevé's paradox), and rigid bodies with Coulomb \
+             friction have no answer from here",
+            active.describe(info),
+            state.q
+        ),
+    }
+}
