@@ -6,7 +6,7 @@
 mod common;
 
 use common::paper::{FREE_ROD, GENERAL, MODELS, ROD_CUBE, free_after, paper};
-use common::tweaked::{LOW_MONITORS, registry};
+use common::tweaked::{INFINITE_MONITORS, LOW_MONITORS, registry};
 use rodcube::model::Model;
 use rodcube::plan::{Request, run};
 use rodcube::quantity::Quantity;
@@ -88,6 +88,76 @@ fn a_monitor_below_zero_fails_with_its_minimum_as_value() {
         .map(|(k, _)| k)
         .collect();
     assert_eq!(failed, ["rod_cube_closed.cube_does_not_tip"]);
+}
+
+#[test]
+fn a_monitor_at_minus_infinity_fails() {
+    // An allowance scaled by the monitor's own largest magnitude would be infinite here, and
+    // `-inf >= -inf` would pass: the check must not depend on the value it judges.
+    let phase = release_phase(registry(&INFINITE_MONITORS));
+    let samples = sample(&phase, 50, &mut Work::default()).unwrap();
+    let forces = sample_forces(&phase, &samples).unwrap();
+    let ctx = checks::Context::new("rod_cube_closed");
+    let found = checks::monitors(phase.bound(), &samples, &forces, 1e-12, &ctx);
+    let tip = &found[0].1;
+    assert_eq!(found[0].0, "rod_cube_closed.cube_does_not_tip");
+    assert!(!tip.passed && tip.value == f64::NEG_INFINITY, "{tip:?}");
+    assert!(tip.limit.is_finite(), "{tip:?}");
+    // Through the planner: the run goes on, and its checks say the monitor failed.
+    let request = Request::new(&GENERAL, paper(9.81))
+        .with_want(&[Quantity::Checks])
+        .with_registry(registry(&INFINITE_MONITORS));
+    let r = run(&request).unwrap();
+    assert!(!r.checks["rod_cube_closed.cube_does_not_tip"].passed);
+}
+
+#[test]
+fn energy_drift_is_judged_against_the_motion_not_a_constant_potential() {
+    // m2 = 1e6 m1: the cube's potential m2 g a / 2 is about 1.2e6 J and constant (the cube
+    // slides on the floor), while the motion's energies are of order m1 g ell = 10 J. A drift
+    // of 1e-6 of the motion's energy (a million times the tolerance) must fail at 1e-12;
+    // measured against |E| it would look like 1e-12 and pass. (Rounding in E itself, 16 ulps
+    // of 1.2e6 J or about 4e-9 J, is allowed: a drift below that is not measurable in f64.)
+    let p = [1.0, 1e6, 1.0, 0.25, 9.81];
+    let sys = Bound::new(&ROD_CUBE, &p).unwrap();
+    let w = Walker {
+        general: Bound::new(&GENERAL, &p).unwrap(),
+        registry: MODELS,
+        tol: 1e-12,
+        rtol: 1e-12,
+        route: Route::Fastest,
+    };
+    let (start, _) = w.release().unwrap();
+    let phase = w.solve(&start, &mut Work::default()).unwrap();
+    assert_eq!(phase.bound().info().name, sys.info().name);
+    let mut samples = sample(&phase, 50, &mut Work::default()).unwrap();
+    let ctx = checks::Context::new("rod_cube_closed");
+    let conserved = Conserved::each_cyclic(phase.bound());
+    let ok = checks::drift(
+        phase.bound(),
+        &samples.states,
+        &conserved,
+        1e-12,
+        &ctx,
+        CheckKind::Identity,
+    );
+    assert!(ok.iter().all(|(_, c)| c.passed), "{ok:?}");
+    // The rod's angular velocity 5e-7 too fast at the last sample: its kinetic energy (most
+    // of the motion's there) 1e-6 of itself too large.
+    let last = samples.states.len() - 1;
+    samples.states[last].qd[1] *= 1.0 + 5e-7;
+    let bad = checks::drift(
+        phase.bound(),
+        &samples.states,
+        &conserved,
+        1e-12,
+        &ctx,
+        CheckKind::Drift,
+    );
+    let energy = &bad[0].1;
+    assert_eq!(bad[0].0, "rod_cube_closed.energy");
+    assert!(!energy.passed, "{energy:?}");
+    assert!(energy.value > 1e-8 && energy.value < 1e-5, "{energy:?}");
 }
 
 #[test]

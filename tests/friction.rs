@@ -20,7 +20,8 @@ use rodcube::solve::contacts::{
 use rodcube::solve::phases::{PhaseRun, PhaseStart, Route, Walker};
 use rodcube::system::{Bound, State, SystemError};
 
-/// The paper's separation time (g = 9.81), exact to f64 (tests/hard_cases.rs).
+/// The paper's separation time (g = 9.81) to 15 digits, held to the 256-bit reference by
+/// `tests/hard_cases.rs` (`the_quoted_paper_separation_time_is_the_references`).
 const PAPER_T_SEP: f64 = 0.108493254170856;
 
 /// The active set of the contact phase: both contacts closed, the foot's friction in `mode`.

@@ -322,7 +322,7 @@ fn check_theta_dot_sq_sc(model: &'static dyn Model, u: &[f64], spread: u8, frac:
         return;
     }
     let p = parameters(model, u, spread);
-    let sys = rodcube::system::System::from_values(model, &p).expect("valid parameters");
+    let sys = System::from_values(model, &p).expect("valid parameters");
     let k = sys.k();
     let (theta_i, sin_i, cos_i) = (
         k[info.reduction.unwrap().k_theta_initial],

@@ -16,7 +16,7 @@
 //!
 //! A gap that starts at zero (a contact that just opened) or an edge margin that does (a
 //! contact point starting at a corner) arms its event only once it has grown past
-//! [`DECIDE_TOLERANCE`](contacts::DECIDE_TOLERANCE) of the system's length: its rounding at the
+//! [`DECIDE_TOLERANCE`] of the system's length: its rounding at the
 //! start is no crossing.
 //!
 //! The integrator's state is the deviation `z = y - y0` from the start `y0 = [q, qd]`, so its
