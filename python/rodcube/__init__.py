@@ -12,7 +12,8 @@
   listed in ``errors`` with the reason.
 - ``models()`` and ``parameters(model)``: the registry, with each parameter's unit and meaning.
 
-Errors are ``RodcubeError`` (a ``ValueError``) with rodcube's own messages.
+Errors are ``RodcubeError`` (a ``ValueError``) with rodcube's own messages. Type stubs
+(``__init__.pyi``) describe every function for editors and type checkers.
 """
 
 from __future__ import annotations

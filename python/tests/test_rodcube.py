@@ -1,12 +1,15 @@
 """rodcube's Python package: the paper's numbers, series as NumPy arrays, the sweep against
 independent oracles (the paper's cubic, a quadrature in NumPy) and against single solves, its
 required parameters, failure reasons and broadcasting, the registry, errors as exceptions with
-rodcube's messages. Also runs the README's Python example.
+rodcube's messages, and the type stubs shipped in the package. Also runs the README's Python
+example.
 
 Every expected number says where it comes from: the paper's printed figures, a closed form
 solved here in NumPy, a quadrature written here in NumPy, or dimensional analysis; none is
 copied from rodcube's own output."""
 
+import ast
+import inspect
 import math
 import pathlib
 import re
@@ -311,6 +314,43 @@ def test_errors_are_exceptions_with_rodcubes_messages():
     with pytest.raises(rodcube.RodcubeError, match="as many"):
         rodcube._rodcube.sweep_flat("rod_cube", ["n", "a_over_ell"], [np.ones(3), np.ones(2)], [], [])
     assert issubclass(rodcube.RodcubeError, ValueError)
+
+
+def test_the_package_ships_its_type_stubs():
+    # The installed package (a wheel built by maturin), not the source tree.
+    package = pathlib.Path(rodcube.__file__).parent
+    assert (package / "py.typed").is_file()
+    stub = ast.parse((package / "__init__.pyi").read_text())
+    functions = {f.name: f for f in stub.body if isinstance(f, ast.FunctionDef)}
+    classes = {c.name for c in stub.body if isinstance(c, ast.ClassDef)}
+    assert "RodcubeError" in classes
+    # Every public function is in the stub, with the runtime's parameters, kinds and
+    # defaults, and a return type.
+    for name in rodcube.__all__:
+        if name == "RodcubeError":
+            continue
+        assert name in functions, name
+        f = functions[name]
+        assert f.returns is not None, name
+        a = f.args
+        empty = inspect.Parameter.empty
+        defaults = [empty] * (len(a.posonlyargs + a.args) - len(a.defaults)) + a.defaults
+        stubbed = [(p.arg, "POSITIONAL_ONLY") for p in a.posonlyargs]
+        stubbed += [(p.arg, "POSITIONAL_OR_KEYWORD") for p in a.args]
+        stubbed += [(p.arg, "KEYWORD_ONLY") for p in a.kwonlyargs]
+        defaults += a.kw_defaults
+        if a.vararg:
+            stubbed.append((a.vararg.arg, "VAR_POSITIONAL"))
+            defaults.append(empty)
+        if a.kwarg:
+            stubbed.append((a.kwarg.arg, "VAR_KEYWORD"))
+            defaults.append(empty)
+        params = a.posonlyargs + a.args + a.kwonlyargs + [p for p in (a.vararg, a.kwarg) if p]
+        assert all(p.annotation is not None for p in params), name
+        runtime = inspect.signature(getattr(rodcube, name)).parameters.values()
+        assert stubbed == [(p.name, p.kind.name) for p in runtime], name
+        stub_defaults = [d if d is empty else ast.literal_eval(d) for d in defaults]
+        assert stub_defaults == [p.default for p in runtime], name
 
 
 def test_the_readme_example_runs():
