@@ -118,7 +118,8 @@ fn energy_drift_is_judged_against_the_motion_not_a_constant_potential() {
     // of 1e-6 of the motion's energy (a million times the tolerance) must fail at 1e-12;
     // measured against |E| it would look like 1e-12 and pass. (Rounding in E itself, 16 ulps
     // of 1.2e6 J or about 4e-9 J, is allowed: a drift below that is not measurable in f64.)
-    let p = [1.0, 1e6, 1.0, 0.25, 9.81];
+    let mut p = paper(9.81);
+    p[1].1 = 1e6;
     let sys = Bound::new(&ROD_CUBE, &p).unwrap();
     let w = Walker {
         general: Bound::new(&GENERAL, &p).unwrap(),
