@@ -425,7 +425,7 @@ fn every_quantity_runs_across_extreme_ratios_and_tolerances() {
                 // factor of order ten), and the integrator cannot do better than some ulps of
                 // that.
                 let wanted = if tol <= 1e-8 { 1e-9 } else { 10.0 * tol };
-                let conditioning = 1e4 * f64::EPSILON * n.max(1.0 / n);
+                let conditioning = 100.0 * f64::EPSILON * n.max(1.0 / n);
                 let bound = wanted.max(conditioning);
                 let rtol = value(&r_, "cross_check_rtol");
                 assert!(
