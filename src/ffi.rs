@@ -1,7 +1,10 @@
 //! The C ABI (cargo feature `capi`): the per-point solver of any registered model, by handle,
 //! with parameters in the model's order or by name, and a whole scene run to a JSON string.
-//! `include/rodcube.h` declares these functions; `examples/c/` builds a C program against
-//! them.
+//! `include/rodcube.h` is generated from this file by cbindgen (`cbindgen.toml`;
+//! `cargo run --example c_header` writes it, `tests/capi_header.rs` fails when it is stale), so
+//! the doc comments of the public items here are the header's documentation: they are written
+//! for a C reader and name C functions and types plainly. `examples/c/` builds a C program
+//! against them.
 //!
 //! Conventions, for every function:
 //! - a status code is returned (`RODCUBE_OK` = 0, else one of the `RODCUBE_ERR_*` codes);
@@ -40,7 +43,7 @@ pub const RODCUBE_ERR_BUFFER: c_int = 6;
 /// An internal error (a panic, caught at the boundary).
 pub const RODCUBE_ERR_PANIC: c_int = 7;
 
-/// One point's separation, as [`LeanSolver::solve`] returns it.
+/// One point's separation, as the per-point solver returns it.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct RodcubePoint {
@@ -52,7 +55,8 @@ pub struct RodcubePoint {
     pub delta: f64,
 }
 
-/// A per-point solver of one model, owned by the caller through a pointer.
+/// A per-point solver of one model (opaque), owned by the caller through a pointer: made by
+/// `rodcube_solver_new`, released by `rodcube_solver_free`.
 pub struct RodcubeSolver {
     solver: LeanSolver<'static>,
     /// Scratch for parameters given by name.
@@ -159,7 +163,7 @@ unsafe fn slice<'a, T>(p: *const T, n: usize, what: &str) -> Result<&'a [T], Fai
 /// The solver behind a handle.
 ///
 /// # Safety
-/// `solver` is NULL or a live pointer from [`rodcube_solver_new`].
+/// `solver` is NULL or a live pointer from `rodcube_solver_new`.
 unsafe fn solver_mut<'a>(solver: *mut RodcubeSolver) -> Result<&'a mut RodcubeSolver, Failure> {
     // SAFETY: as the caller promises.
     unsafe { solver.as_mut() }.ok_or_else(|| failure(RODCUBE_ERR_ARGUMENT, "the solver is NULL"))
@@ -168,7 +172,7 @@ unsafe fn solver_mut<'a>(solver: *mut RodcubeSolver) -> Result<&'a mut RodcubeSo
 /// The caller's output.
 ///
 /// # Safety
-/// `out` is NULL or points to one writable [`RodcubePoint`].
+/// `out` is NULL or points to one writable `rodcube_point`.
 unsafe fn output<'a>(out: *mut RodcubePoint) -> Result<&'a mut RodcubePoint, Failure> {
     // SAFETY: as the caller promises.
     unsafe { out.as_mut() }.ok_or_else(|| failure(RODCUBE_ERR_ARGUMENT, "the output is NULL"))
@@ -218,30 +222,31 @@ pub extern "C" fn rodcube_model_count() -> usize {
     catch_unwind(|| names().len()).unwrap_or(0)
 }
 
-/// The name of model `index` (static storage), or NULL past the end.
+/// The name of model `model` (an index below `rodcube_model_count()`; static storage), or
+/// NULL past the end.
 #[unsafe(no_mangle)]
-pub extern "C" fn rodcube_model_name(index: usize) -> *const c_char {
+pub extern "C" fn rodcube_model_name(model: usize) -> *const c_char {
     catch_unwind(|| {
         names()
-            .get(index)
+            .get(model)
             .map_or(std::ptr::null(), |(n, _)| n.as_ptr())
     })
     .unwrap_or(std::ptr::null())
 }
 
-/// How many parameters model `index` takes.
+/// How many parameters model `model` (an index) takes; 0 past the end.
 #[unsafe(no_mangle)]
-pub extern "C" fn rodcube_parameter_count(index: usize) -> usize {
-    catch_unwind(|| names().get(index).map_or(0, |(_, p)| p.len())).unwrap_or(0)
+pub extern "C" fn rodcube_parameter_count(model: usize) -> usize {
+    catch_unwind(|| names().get(model).map_or(0, |(_, p)| p.len())).unwrap_or(0)
 }
 
-/// The name of parameter `parameter` of model `index` (static storage, in the order
-/// [`rodcube_solve`] takes the values), or NULL past the end.
+/// The name of parameter `parameter` of model `model` (indices; static storage, in the order
+/// `rodcube_solve` takes the values), or NULL past the end.
 #[unsafe(no_mangle)]
-pub extern "C" fn rodcube_parameter_name(index: usize, parameter: usize) -> *const c_char {
+pub extern "C" fn rodcube_parameter_name(model: usize, parameter: usize) -> *const c_char {
     catch_unwind(|| {
         names()
-            .get(index)
+            .get(model)
             .and_then(|(_, p)| p.get(parameter))
             .map_or(std::ptr::null(), |n| n.as_ptr())
     })
@@ -249,7 +254,7 @@ pub extern "C" fn rodcube_parameter_name(index: usize, parameter: usize) -> *con
 }
 
 /// A per-point solver for the model named `model`, or NULL with the reason in `err`. Release
-/// it with [`rodcube_solver_free`].
+/// it with `rodcube_solver_free`.
 ///
 /// # Safety
 /// `model` is a NUL-terminated string; `err` is NULL or points to `err_len` writable bytes.
@@ -278,7 +283,7 @@ pub unsafe extern "C" fn rodcube_solver_new(
 /// Releases a solver (NULL is ignored).
 ///
 /// # Safety
-/// `solver` is NULL or a pointer from [`rodcube_solver_new`] not yet released.
+/// `solver` is NULL or a pointer from `rodcube_solver_new` not yet released.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn rodcube_solver_free(solver: *mut RodcubeSolver) {
     if !solver.is_null() {
@@ -288,11 +293,11 @@ pub unsafe extern "C" fn rodcube_solver_free(solver: *mut RodcubeSolver) {
 }
 
 /// Solves one point: `n_params` values in the model's parameter order
-/// ([`rodcube_parameter_name`]). Writes `*out` on success.
+/// (`rodcube_parameter_name`). Writes `*out` on success.
 ///
 /// # Safety
-/// `solver` comes from [`rodcube_solver_new`]; `params` points to `n_params` values; `out` to
-/// one writable [`RodcubePoint`]; `err` is NULL or points to `err_len` writable bytes.
+/// `solver` comes from `rodcube_solver_new`; `params` points to `n_params` values; `out` to
+/// one writable `rodcube_point`; `err` is NULL or points to `err_len` writable bytes.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn rodcube_solve(
     solver: *mut RodcubeSolver,
@@ -318,7 +323,7 @@ pub unsafe extern "C" fn rodcube_solve(
 /// the model's parameters exactly once, in any order.
 ///
 /// # Safety
-/// As [`rodcube_solve`]; `names` points to `n` NUL-terminated strings and `values` to `n`
+/// As `rodcube_solve`; `names` points to `n` NUL-terminated strings and `values` to `n`
 /// values.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn rodcube_solve_named(
@@ -349,15 +354,15 @@ pub unsafe extern "C" fn rodcube_solve_named(
     }
 }
 
-/// Runs a scene given as YAML text (the format of `scenes/*.yaml`) and writes its results as
-/// JSON (the `results.json` of `rodcube run`) into `json`, NUL-terminated. When `json_len` is
-/// too small, returns `RODCUBE_ERR_BUFFER` and sets `*needed` (also on success) to the bytes
-/// required, NUL included: call again with a buffer that large.
+/// Runs a scene given as YAML text (the format of the files in `scenes/`) and writes its
+/// results as JSON (the `results.json` of `rodcube run`) into `json`, NUL-terminated. When
+/// `json_len` is too small, returns `RODCUBE_ERR_BUFFER` and sets `*needed` (also on success)
+/// to the bytes required, NUL included: call again with a buffer that large.
 ///
 /// # Safety
 /// `scene_yaml` is a NUL-terminated string; `json` is NULL (with `json_len` 0) or points to
 /// `json_len` writable bytes; `needed` is NULL or points to a writable `size_t`; `err` as
-/// [`rodcube_solve`].
+/// `rodcube_solve`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn rodcube_run_scene(
     scene_yaml: *const c_char,

@@ -13,14 +13,22 @@ const PAPER: [f64; 5] = [1.0, 3.0, 1.0, 0.25, 9.81];
 fn the_c_example_prints_the_rust_solvers_numbers() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let target = Path::new(env!("CARGO_TARGET_TMPDIR")).join("capi");
+    // cargo test puts its own target directories on LD_LIBRARY_PATH, which the dynamic loader
+    // searches before the programs' run path: a `librodcube.so` left there by another build
+    // (`examples/c/run.sh` run by hand) would be loaded instead of the one built here.
     let out = Command::new(root.join("examples/c/run.sh"))
         .env("CARGO_TARGET_DIR", &target)
         .env("CARGO", env!("CARGO"))
+        .env_remove("LD_LIBRARY_PATH")
         .output()
         .expect("run.sh runs");
     let stdout = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "run.sh failed:\n{stdout}\n{stderr}");
+    assert!(
+        out.status.success(),
+        "run.sh failed ({:?}):\n{stdout}\n{stderr}",
+        out.status
+    );
     let line = stdout.lines().next().unwrap_or("");
     let value = |key: &str| -> f64 {
         line.split_whitespace()
@@ -72,7 +80,10 @@ fn the_c_example_prints_the_rust_solvers_numbers() {
         "the README's C example does not compile:\n{}",
         String::from_utf8_lossy(&built.stderr)
     );
-    let ran = Command::new(dir.join("readme")).output().expect("it runs");
+    let ran = Command::new(dir.join("readme"))
+        .env_remove("LD_LIBRARY_PATH")
+        .output()
+        .expect("it runs");
     assert!(ran.status.success());
     assert_eq!(
         String::from_utf8_lossy(&ran.stdout).lines().next(),
