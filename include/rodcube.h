@@ -7,10 +7,18 @@
  *   cargo rustc --release --lib --no-default-features --features capi --crate-type cdylib
  * (or --crate-type staticlib) and link with -lrodcube; examples/c/run.sh does both.
  *
- * Every function that can fail returns a status code (RODCUBE_OK or a RODCUBE_ERR_*) and
- * copies the reason into the caller's buffer `err` of `err_len` bytes (NUL-terminated; `err`
- * may be NULL). Strings returned are static; the only object to release is a solver, with
- * rodcube_solver_free. No call panics or aborts: an internal error is RODCUBE_ERR_PANIC.
+ * Every function that can fail returns a status code (RODCUBE_OK or a RODCUBE_ERR_*: each
+ * kind of failure has its own, rodcube_error_name names it, rodcube_error_group gives its
+ * group), hands back what it made through an out pointer, and copies the reason into the
+ * caller's buffer `err` of `err_len` bytes (NUL-terminated; `err` may be NULL). Strings
+ * returned are static or owned by a handle; the objects to release are a solver
+ * (rodcube_solver_free) and a scene's results (rodcube_results_free). No call panics or
+ * aborts: an internal error is RODCUBE_ERR_PANIC.
+ *
+ * Status codes below 100 concern the call itself (3, 4 and 5 are no longer used: they were
+ * catch-all codes); 101-199 are refused parameters, 201-299 a refused request, 301-399 a
+ * solver's failure and 401-499 a refused scene, each group's own code (RODCUBE_ERR_PARAMETERS
+ * = 100, ...) being what rodcube_error_group returns for its members.
  */
 
 #ifndef RODCUBE_H
@@ -24,29 +32,15 @@
 #define RODCUBE_OK 0
 
 /**
- * A null pointer, text that is not UTF-8, or an inconsistent length.
+ * A NULL pointer where the call needs one: a handle, an output, a text, an out pointer, or
+ * an array whose count is not zero.
  */
 #define RODCUBE_ERR_ARGUMENT 1
 
 /**
- * No model of that name, or one the per-point solver cannot solve.
+ * No model of that name in the registry (`rodcube_solver_new`).
  */
 #define RODCUBE_ERR_MODEL 2
-
-/**
- * The parameters were refused (count, value, or a requirement of the model).
- */
-#define RODCUBE_ERR_PARAMETERS 3
-
-/**
- * A solver failed (no separation before the floor, say).
- */
-#define RODCUBE_ERR_SOLVE 4
-
-/**
- * The scene was refused.
- */
-#define RODCUBE_ERR_SCENE 5
 
 /**
  * The output buffer is too small; `*needed` says how large it must be.
@@ -54,13 +48,382 @@
 #define RODCUBE_ERR_BUFFER 6
 
 /**
- * An internal error (a panic, caught at the boundary).
+ * An internal error: a panic, caught at the boundary (please report it).
  */
 #define RODCUBE_ERR_PANIC 7
 
 /**
- * A per-point solver of one model (opaque), owned by the caller through a pointer: made by
- * `rodcube_solver_new`, released by `rodcube_solver_free`.
+ * A text argument (a model, parameter name or scene) is not UTF-8.
+ */
+#define RODCUBE_ERR_UTF8 8
+
+/**
+ * The results could not be written as JSON.
+ */
+#define RODCUBE_ERR_JSON 9
+
+/**
+ * Group: the parameters were refused (codes 101 to 199).
+ */
+#define RODCUBE_ERR_PARAMETERS 100
+
+/**
+ * A parameter the model declares was not given (by name).
+ */
+#define RODCUBE_ERR_PARAM_MISSING 101
+
+/**
+ * A name that is not one of the model's parameters.
+ */
+#define RODCUBE_ERR_PARAM_UNKNOWN 102
+
+/**
+ * The same parameter given twice (by name).
+ */
+#define RODCUBE_ERR_PARAM_DUPLICATE 103
+
+/**
+ * A count of values that is not the model's number of parameters.
+ */
+#define RODCUBE_ERR_PARAM_COUNT 104
+
+/**
+ * A parameter that is NaN or infinite.
+ */
+#define RODCUBE_ERR_PARAM_NOT_FINITE 105
+
+/**
+ * A parameter the model declares positive is zero or negative.
+ */
+#define RODCUBE_ERR_PARAM_NOT_POSITIVE 106
+
+/**
+ * A friction coefficient below zero.
+ */
+#define RODCUBE_ERR_PARAM_NEGATIVE_FRICTION 107
+
+/**
+ * A requirement of the model on its parameters fails (e.g. `a < ell` for `rod_cube`).
+ */
+#define RODCUBE_ERR_PARAM_REQUIREMENT 108
+
+/**
+ * The model has no reduced fast path to bind the parameters to.
+ */
+#define RODCUBE_ERR_PARAM_NO_REDUCTION 109
+
+/**
+ * The parameters give the model a non-finite constant (an extreme input).
+ */
+#define RODCUBE_ERR_PARAM_BAD_CONSTANT 110
+
+/**
+ * Group: the request was refused (codes 201 to 299).
+ */
+#define RODCUBE_ERR_REQUEST 200
+
+/**
+ * A fast phase was named where a system is run: run its system.
+ */
+#define RODCUBE_ERR_NOT_A_SYSTEM 201
+
+/**
+ * The model cannot provide a wanted quantity.
+ */
+#define RODCUBE_ERR_UNAVAILABLE 202
+
+/**
+ * The tolerance is outside the accepted range.
+ */
+#define RODCUBE_ERR_TOLERANCE 203
+
+/**
+ * Fewer than 2 samples where a series or a check is wanted.
+ */
+#define RODCUBE_ERR_TOO_FEW_SAMPLES 204
+
+/**
+ * More samples per series than accepted.
+ */
+#define RODCUBE_ERR_TOO_MANY_SAMPLES 205
+
+/**
+ * Group: a solver failed (codes 301 to 399).
+ */
+#define RODCUBE_ERR_SOLVE 300
+
+/**
+ * The model does not hold a unilateral first contact closed, so it cannot separate.
+ */
+#define RODCUBE_ERR_NO_CONTACT 301
+
+/**
+ * The separation polynomial is identically zero or has a non-finite coefficient.
+ */
+#define RODCUBE_ERR_BAD_POLYNOMIAL 302
+
+/**
+ * No separation in the phase: the contact holds to the floor, or the polynomial's
+ * coefficients under- or overflowed.
+ */
+#define RODCUBE_ERR_NO_SEPARATION 303
+
+/**
+ * Released from rest where the acceleration does not make it fall.
+ */
+#define RODCUBE_ERR_NO_MOTION 304
+
+/**
+ * The phase starts at or beyond the vertical.
+ */
+#define RODCUBE_ERR_BEYOND_VERTICAL 305
+
+/**
+ * The initial rate makes the angle grow; phases must fall.
+ */
+#define RODCUBE_ERR_RISING 306
+
+/**
+ * The angular rate reaches zero (a turning point) before the end of the phase.
+ */
+#define RODCUBE_ERR_TURNING_POINT 307
+
+/**
+ * A model function returned NaN or an infinity.
+ */
+#define RODCUBE_ERR_NON_FINITE 308
+
+/**
+ * The phase would end at an angle fallen that is not positive and finite.
+ */
+#define RODCUBE_ERR_BAD_PHASE_END 309
+
+/**
+ * An angle outside the phase was asked of its time integral.
+ */
+#define RODCUBE_ERR_OUTSIDE_PHASE 310
+
+/**
+ * The adaptive quadrature did not reach its tolerance.
+ */
+#define RODCUBE_ERR_QUADRATURE 311
+
+/**
+ * The time integral could not be inverted at a time.
+ */
+#define RODCUBE_ERR_INVERSION 312
+
+/**
+ * An active set whose size does not match the model's contacts or frictions.
+ */
+#define RODCUBE_ERR_ACTIVE_SIZE 313
+
+/**
+ * No single consistent set of closed contacts and friction modes (a contact that would
+ * have to pull, Painleve's paradox, or several sets with different motions).
+ */
+#define RODCUBE_ERR_INDETERMINATE 314
+
+/**
+ * The angle reaches its end with the body above the floor (a support lifted it).
+ */
+#define RODCUBE_ERR_ABOVE_FLOOR 315
+
+/**
+ * The motion from rest turns back before any contact ends: it swings for ever.
+ */
+#define RODCUBE_ERR_SWINGS 316
+
+/**
+ * The supports hold the system at rest: nothing moves, so no contact ends.
+ */
+#define RODCUBE_ERR_AT_REST 317
+
+/**
+ * Bodies overlap where a phase starts (a gap below zero).
+ */
+#define RODCUBE_ERR_OVERLAP 318
+
+/**
+ * A contact closes with a velocity at release: an impact, not modelled.
+ */
+#define RODCUBE_ERR_IMPACT_AT_RELEASE 319
+
+/**
+ * The motion does not start in the phase the per-point solver solves (another contact lets
+ * go first, or would have to pull): solve the system with `rodcube_run_scene`.
+ */
+#define RODCUBE_ERR_NOT_THIS_PHASE 320
+
+/**
+ * The closed contacts' constraints and the mass matrix form a singular system.
+ */
+#define RODCUBE_ERR_SINGULAR_CONTACTS 321
+
+/**
+ * The friction contacts switched between sticking and sliding too often (chatter).
+ */
+#define RODCUBE_ERR_TOO_MANY_SWITCHES 322
+
+/**
+ * The mass matrix could not be solved.
+ */
+#define RODCUBE_ERR_SINGULAR_MASS_MATRIX 323
+
+/**
+ * The ODE's right-hand side or an event function was not finite.
+ */
+#define RODCUBE_ERR_ODE_NON_FINITE 324
+
+/**
+ * The ODE's step size fell below what a double can resolve.
+ */
+#define RODCUBE_ERR_STEP_SIZE_TOO_SMALL 325
+
+/**
+ * The mass matrix is too ill-conditioned for the unreduced equations to mean anything.
+ */
+#define RODCUBE_ERR_ILL_CONDITIONED 326
+
+/**
+ * The ODE took too many steps.
+ */
+#define RODCUBE_ERR_TOO_MANY_STEPS 327
+
+/**
+ * The ODE reached its time limit without the separation or the floor.
+ */
+#define RODCUBE_ERR_NO_EVENT 328
+
+/**
+ * A quantity of the energy integral was asked where the motion does not start on a fast
+ * phase.
+ */
+#define RODCUBE_ERR_NOT_ON_FAST_PATH 329
+
+/**
+ * A system continues with a phase model that is not in the registry.
+ */
+#define RODCUBE_ERR_UNKNOWN_PHASE_MODEL 330
+
+/**
+ * A phase model whose parameters or coordinates do not fit its system's.
+ */
+#define RODCUBE_ERR_PHASE_MISMATCH 331
+
+/**
+ * The model is not for the per-point solver (its separation is not a polynomial root, or
+ * its motion does not start on a fast phase): run it as a scene.
+ */
+#define RODCUBE_ERR_NOT_PER_POINT 332
+
+/**
+ * Phases kept separating without reaching the floor.
+ */
+#define RODCUBE_ERR_TOO_MANY_PHASES 333
+
+/**
+ * The parameters a phase hands to the next were refused.
+ */
+#define RODCUBE_ERR_NEXT_PHASE 334
+
+/**
+ * A result came out NaN or infinite (a model function misbehaving).
+ */
+#define RODCUBE_ERR_RESULT_NOT_FINITE 335
+
+/**
+ * Group: the scene was refused (codes 401 to 499). A scene's message lists every problem
+ * found; the code is the kind of the first, in file order. Returned alone only for a scene
+ * error without a problem, which scene parsing never makes.
+ */
+#define RODCUBE_ERR_SCENE 400
+
+/**
+ * Scene: the scene could not be read.
+ */
+#define RODCUBE_ERR_SCENE_READ 401
+
+/**
+ * Scene: not valid YAML, a duplicate key, or an empty text.
+ */
+#define RODCUBE_ERR_SCENE_SYNTAX 402
+
+/**
+ * Scene: a key that scenes do not have.
+ */
+#define RODCUBE_ERR_SCENE_UNKNOWN_KEY 403
+
+/**
+ * Scene: a value of the wrong type, or a required key missing.
+ */
+#define RODCUBE_ERR_SCENE_STRUCTURE 404
+
+/**
+ * Scene: a model that is not in the registry.
+ */
+#define RODCUBE_ERR_SCENE_UNKNOWN_MODEL 405
+
+/**
+ * Scene: a `want` entry that no quantity of the model matches.
+ */
+#define RODCUBE_ERR_SCENE_UNKNOWN_QUANTITY 406
+
+/**
+ * Scene: a quantity this model cannot provide.
+ */
+#define RODCUBE_ERR_SCENE_UNAVAILABLE_QUANTITY 407
+
+/**
+ * Scene: a `want` entry listed twice.
+ */
+#define RODCUBE_ERR_SCENE_DUPLICATE_QUANTITY 408
+
+/**
+ * Scene: a parameter of the model that the scene does not give.
+ */
+#define RODCUBE_ERR_SCENE_MISSING_PARAMETER 409
+
+/**
+ * Scene: a parameter the model does not have.
+ */
+#define RODCUBE_ERR_SCENE_UNKNOWN_PARAMETER 410
+
+/**
+ * Scene: a parameter that must be strictly positive is not.
+ */
+#define RODCUBE_ERR_SCENE_NOT_POSITIVE 411
+
+/**
+ * Scene: a friction coefficient below zero.
+ */
+#define RODCUBE_ERR_SCENE_NEGATIVE_FRICTION 412
+
+/**
+ * Scene: NaN or an infinity (`.nan`, `.inf`).
+ */
+#define RODCUBE_ERR_SCENE_NOT_FINITE 413
+
+/**
+ * Scene: `tolerance` or `samples` outside its range, or an empty `want`.
+ */
+#define RODCUBE_ERR_SCENE_OUT_OF_RANGE 414
+
+/**
+ * Scene: a requirement of the model on its parameters (e.g. `a < ell`) fails.
+ */
+#define RODCUBE_ERR_SCENE_REQUIREMENT 415
+
+/**
+ * A scene's results (opaque): the text of its `results.json`, made once by
+ * `rodcube_run_scene`, read by `rodcube_results_json`, `rodcube_results_len` and
+ * `rodcube_results_copy` (which never solve again), released by `rodcube_results_free`.
+ */
+typedef struct rodcube_results rodcube_results;
+
+/**
+ * A per-point solver of one model (opaque): made by `rodcube_solver_new`, released by
+ * `rodcube_solver_free`.
  */
 typedef struct rodcube_solver rodcube_solver;
 
@@ -87,6 +450,20 @@ extern "C" {
 #endif // __cplusplus
 
 /**
+ * The name of status code `code` as the header spells it (`"RODCUBE_ERR_AT_REST"`, static
+ * storage), or NULL for a number that is no code.
+ */
+const char *rodcube_error_name(int code);
+
+/**
+ * The group of status code `code`: `RODCUBE_ERR_PARAMETERS`, `RODCUBE_ERR_REQUEST`,
+ * `RODCUBE_ERR_SOLVE` or `RODCUBE_ERR_SCENE` for the codes of a group (the group's own code
+ * included), the code itself for the others below 100 (`RODCUBE_OK` included), -1 for a
+ * number that is no code.
+ */
+int rodcube_error_group(int code);
+
+/**
  * How many models are registered.
  */
 size_t rodcube_model_count(void);
@@ -103,19 +480,25 @@ const char *rodcube_model_name(size_t model);
 size_t rodcube_parameter_count(size_t model);
 
 /**
- * The name of parameter `parameter` of model `model` (indices; static storage, in the order
- * `rodcube_solve` takes the values), or NULL past the end.
+ * The name of parameter `parameter` of model `model` (indices; static storage), in the
+ * order `rodcube_solve` takes the values, or NULL past the end.
  */
 const char *rodcube_parameter_name(size_t model, size_t parameter);
 
 /**
- * A per-point solver for the model named `model`, or NULL with the reason in `err`. Release
- * it with `rodcube_solver_free`.
+ * Makes a per-point solver for the model named `model` into `*solver` (NULL on failure).
+ * Release it with `rodcube_solver_free`. Fails with `RODCUBE_ERR_MODEL` for a name not in the
+ * registry, and with `RODCUBE_ERR_NOT_PER_POINT` or `RODCUBE_ERR_NO_CONTACT` for a model the
+ * per-point solver cannot solve (run it as a scene).
  *
  * # Safety
- * `model` is a NUL-terminated string; `err` is NULL or points to `err_len` writable bytes.
+ * `model` is a NUL-terminated string; `solver` points to a writable pointer; `err` is NULL
+ * or points to `err_len` writable bytes.
  */
-struct rodcube_solver *rodcube_solver_new(const char *model, char *err, size_t err_len);
+int rodcube_solver_new(const char *model,
+                       struct rodcube_solver **solver,
+                       char *err,
+                       size_t err_len);
 
 /**
  * Releases a solver (NULL is ignored).
@@ -127,7 +510,8 @@ void rodcube_solver_free(struct rodcube_solver *solver);
 
 /**
  * Solves one point: `n_params` values in the model's parameter order
- * (`rodcube_parameter_name`). Writes `*out` on success.
+ * (`rodcube_parameter_name`). Writes `*out` on success. Refused parameters fail with their
+ * `RODCUBE_ERR_PARAM_*` code, a failed solve with its code from the solver group.
  *
  * # Safety
  * `solver` comes from `rodcube_solver_new`; `params` points to `n_params` values; `out` to
@@ -157,22 +541,64 @@ int rodcube_solve_named(struct rodcube_solver *solver,
                         size_t err_len);
 
 /**
- * Runs a scene given as YAML text (the format of the files in `scenes/`) and writes its
- * results as JSON (the `results.json` of `rodcube run`) into `json`, NUL-terminated. When
- * `json_len` is too small, returns `RODCUBE_ERR_BUFFER` and sets `*needed` (also on success)
- * to the bytes required, NUL included: call again with a buffer that large.
+ * Runs a scene given as YAML text (the format of the files in `scenes/`) once, and makes its
+ * results (the `results.json` of `rodcube run`) into `*results` (NULL on failure): read them
+ * with `rodcube_results_json`, `rodcube_results_len` or `rodcube_results_copy`, as often as
+ * wanted without solving again, and release them with `rodcube_results_free`. A refused
+ * scene fails with a `RODCUBE_ERR_SCENE_*` code (the kind of its first problem; the message
+ * lists every problem with its line and column), a failed solve with its code from the
+ * solver group.
  *
  * # Safety
- * `scene_yaml` is a NUL-terminated string; `json` is NULL (with `json_len` 0) or points to
- * `json_len` writable bytes; `needed` is NULL or points to a writable `size_t`; `err` as
- * `rodcube_solve`.
+ * `scene_yaml` is a NUL-terminated string; `results` points to a writable pointer; `err` is
+ * NULL or points to `err_len` writable bytes.
  */
 int rodcube_run_scene(const char *scene_yaml,
-                      char *json,
-                      size_t json_len,
-                      size_t *needed,
+                      struct rodcube_results **results,
                       char *err,
                       size_t err_len);
+
+/**
+ * The results' JSON text, NUL-terminated, owned by `results` and valid until
+ * `rodcube_results_free`; NULL for NULL.
+ *
+ * # Safety
+ * `results` is NULL or a live pointer from `rodcube_run_scene`.
+ */
+const char *rodcube_results_json(const struct rodcube_results *results);
+
+/**
+ * The length of the results' JSON text in bytes, without its NUL (as `strlen`); 0 for NULL.
+ *
+ * # Safety
+ * `results` is NULL or a live pointer from `rodcube_run_scene`.
+ */
+size_t rodcube_results_len(const struct rodcube_results *results);
+
+/**
+ * Copies the results' JSON text, NUL-terminated, into `json` of `json_len` bytes. Sets
+ * `*needed` (when not NULL) to the bytes required, NUL included, and returns
+ * `RODCUBE_ERR_BUFFER` when `json_len` is smaller (`json` may then be NULL).
+ *
+ * # Safety
+ * `results` is NULL or a live pointer from `rodcube_run_scene`; `json` is NULL or points to
+ * `json_len` writable bytes; `needed` is NULL or points to a writable `size_t`; `err` is
+ * NULL or points to `err_len` writable bytes.
+ */
+int rodcube_results_copy(const struct rodcube_results *results,
+                         char *json,
+                         size_t json_len,
+                         size_t *needed,
+                         char *err,
+                         size_t err_len);
+
+/**
+ * Releases a scene's results (NULL is ignored).
+ *
+ * # Safety
+ * `results` is NULL or a pointer from `rodcube_run_scene` not yet released.
+ */
+void rodcube_results_free(struct rodcube_results *results);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -1,13 +1,50 @@
 //! `include/rodcube.h` is what cbindgen makes of `src/ffi.rs` and `cbindgen.toml` today (the
 //! test compares, it never writes: `cargo run --example c_header` regenerates it), and it
-//! keeps what the header promises: a do-not-edit line and the names C programs use.
+//! keeps what the header promises: a do-not-edit line, the names C programs use, and one
+//! documented `#define` per status code, with distinct values in their groups.
 
 #[path = "../examples/common/c_header.rs"]
 mod c_header;
 
+use std::collections::BTreeMap;
+
 fn committed() -> String {
     let path = c_header::root().join(c_header::HEADER);
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// The status codes the header defines, by name, each with the doc comment above it.
+fn codes(header: &str) -> BTreeMap<String, (i64, String)> {
+    let lines: Vec<&str> = header.lines().collect();
+    let mut out = BTreeMap::new();
+    for (i, line) in lines.iter().enumerate() {
+        let Some(rest) = line.strip_prefix("#define RODCUBE_") else {
+            continue;
+        };
+        if rest == "H" {
+            continue;
+        }
+        let mut words = rest.split_whitespace();
+        let name = format!("RODCUBE_{}", words.next().unwrap_or(""));
+        let value: i64 = words
+            .next()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or_else(|| panic!("no integer value in {line:?}"));
+        // The doc comment: the lines from `/**` down to ` */` just above.
+        let mut doc = Vec::new();
+        if i > 0 && lines[i - 1] == " */" {
+            for l in lines[..i - 1].iter().rev() {
+                if *l == "/**" {
+                    break;
+                }
+                doc.push(l.trim_start_matches(" *").trim());
+            }
+        }
+        doc.reverse();
+        let previous = out.insert(name.clone(), (value, doc.join(" ")));
+        assert!(previous.is_none(), "{name} defined twice");
+    }
+    out
 }
 
 #[test]
@@ -52,6 +89,7 @@ fn the_header_says_it_is_generated_and_keeps_its_names() {
         "#include <stddef.h>",
         "extern \"C\" {",
         "typedef struct rodcube_solver rodcube_solver;",
+        "typedef struct rodcube_results rodcube_results;",
         "typedef struct rodcube_point {",
         "    double separation_angle;",
         "    double separation_time;",
@@ -89,4 +127,66 @@ fn the_header_says_it_is_generated_and_keeps_its_names() {
         rest = &at[step..];
     }
     assert!(!in_comment, "a comment left open");
+}
+
+#[test]
+fn every_status_code_is_distinct_documented_and_in_its_group() {
+    let codes = codes(&committed());
+    assert!(codes.len() > 60, "{} codes", codes.len());
+    let mut by_value: BTreeMap<i64, &str> = BTreeMap::new();
+    for (name, (value, doc)) in &codes {
+        if let Some(other) = by_value.insert(*value, name) {
+            panic!("{name} and {other} share the value {value}");
+        }
+        assert!(!doc.is_empty(), "{name} has no documentation");
+        assert!((0..500).contains(value), "{name} = {value}");
+        // Names say their group; the groups' own codes are the hundreds.
+        let group = if *value < 100 { 0 } else { value - value % 100 };
+        let expected = if name.starts_with("RODCUBE_ERR_PARAM_") || name == "RODCUBE_ERR_PARAMETERS"
+        {
+            100
+        } else if name.starts_with("RODCUBE_ERR_SCENE") {
+            400
+        } else if name == "RODCUBE_ERR_REQUEST" {
+            200
+        } else if name == "RODCUBE_ERR_SOLVE" {
+            300
+        } else {
+            group
+        };
+        assert_eq!(group, expected, "{name} = {value}");
+    }
+    for (name, value) in [
+        ("RODCUBE_OK", 0),
+        ("RODCUBE_ERR_ARGUMENT", 1),
+        ("RODCUBE_ERR_MODEL", 2),
+        ("RODCUBE_ERR_BUFFER", 6),
+        ("RODCUBE_ERR_PANIC", 7),
+        ("RODCUBE_ERR_PARAMETERS", 100),
+        ("RODCUBE_ERR_REQUEST", 200),
+        ("RODCUBE_ERR_SOLVE", 300),
+        ("RODCUBE_ERR_SCENE", 400),
+    ] {
+        assert_eq!(codes.get(name).map(|c| c.0), Some(value), "{name}");
+    }
+    // Each failure kind the issue names has its own code.
+    for kind in [
+        "NO_SEPARATION",
+        "TURNING_POINT",
+        "AT_REST",
+        "SWINGS",
+        "ABOVE_FLOOR",
+        "OVERLAP",
+        "SINGULAR_CONTACTS",
+        "INDETERMINATE",
+        "NON_FINITE",
+        "STEP_SIZE_TOO_SMALL",
+        "TOO_MANY_STEPS",
+        "PARAM_NOT_FINITE",
+        "PARAM_COUNT",
+        "SCENE_SYNTAX",
+    ] {
+        let name = format!("RODCUBE_ERR_{kind}");
+        assert!(codes.contains_key(&name), "no {name}");
+    }
 }
