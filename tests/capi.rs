@@ -276,8 +276,8 @@ mod calls {
                 panic!("{line}")
             });
             let expected = match name {
-                "size" => std::mem::size_of::<RodcubePoint>(),
-                "align" => std::mem::align_of::<RodcubePoint>(),
+                "size" => size_of::<RodcubePoint>(),
+                "align" => align_of::<RodcubePoint>(),
                 "separation_angle" => std::mem::offset_of!(RodcubePoint, separation_angle),
                 "separation_time" => std::mem::offset_of!(RodcubePoint, separation_time),
                 "delta" => std::mem::offset_of!(RodcubePoint, delta),
@@ -340,8 +340,8 @@ mod calls {
         let s = solver("rod_cube").unwrap();
         let mut err = [0 as c_char; 256];
         let mut out = RodcubePoint::default();
-        let mut handle: *mut RodcubeSolver = std::ptr::null_mut();
-        let mut results: *mut RodcubeResults = std::ptr::null_mut();
+        let mut handle: *mut RodcubeSolver = null_mut();
+        let mut results: *mut RodcubeResults = null_mut();
         // SAFETY: every pointer is valid or deliberately NULL.
         unsafe {
             let e = err.as_mut_ptr();
@@ -400,7 +400,7 @@ mod calls {
         // SAFETY: valid pointers and sizes.
         unsafe {
             // A NULL error buffer is allowed; success clears the message.
-            let code = rodcube_solve(s, PAPER.as_ptr(), 5, &mut out, std::ptr::null_mut(), 0);
+            let code = rodcube_solve(s, PAPER.as_ptr(), 5, &mut out, null_mut(), 0);
             assert_eq!(code, RODCUBE_OK);
             assert!((out.separation_angle.to_degrees() - 9.611).abs() < 1e-3);
             let code = rodcube_solve(s, PAPER.as_ptr(), 5, &mut out, err.as_mut_ptr(), 256);
@@ -654,14 +654,8 @@ mod calls {
             assert_eq!(CStr::from_ptr(text).to_str(), Ok(once.as_str()));
             assert_eq!(rodcube_results_len(results), once.len());
             let mut needed = 0usize;
-            let code = rodcube_results_copy(
-                results,
-                std::ptr::null_mut(),
-                0,
-                &mut needed,
-                err.as_mut_ptr(),
-                256,
-            );
+            let code =
+                rodcube_results_copy(results, null_mut(), 0, &mut needed, err.as_mut_ptr(), 256);
             assert_eq!(code, RODCUBE_ERR_BUFFER, "{}", message(&err));
             assert_eq!(needed, once.len() + 1);
             let mut small = vec![7 as c_char; needed - 1];
@@ -681,7 +675,7 @@ mod calls {
                     results,
                     json.as_mut_ptr(),
                     json.len(),
-                    std::ptr::null_mut(),
+                    null_mut(),
                     err.as_mut_ptr(),
                     256,
                 );
