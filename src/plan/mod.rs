@@ -673,10 +673,7 @@ impl<'m> Plan<'m> {
             Quantity::LinearisedSeparationAngle => self.linearised(out),
             Quantity::ContactEnd => self.contact_ends(out),
             Quantity::ContactTimeToFloor => self.contact_time_to_floor(out),
-            Quantity::PointMassFallTime => {
-                self.point_mass_fall_time(out);
-                Ok(())
-            }
+            Quantity::PointMassFallTime => self.point_mass_fall_time(out),
             Quantity::ThetaSeries
             | Quantity::ForceSeries(_)
             | Quantity::FrictionSeries(_)

@@ -36,16 +36,29 @@ pub(super) enum Fate {
 
 /// Contact `i`'s fate on `motion` as far as it is solved; `None` when the phases solved so
 /// far do not tell yet.
-pub(super) fn fate(motion: &Motion, info: &ModelInfo, i: usize) -> Option<Fate> {
-    let first = motion.phases.first()?;
+pub(super) fn fate(
+    motion: &Motion,
+    info: &ModelInfo,
+    i: usize,
+) -> Result<Option<Fate>, SolveError> {
+    let Some(first) = motion.phases.first() else {
+        return Ok(None);
+    };
     if motion.opened_at_release.contains(&i) {
-        let theta = first.bound().to_full(&first.bound().initial_state()).q[info.reduced];
-        return Some(Fate::Ended {
+        let bound = first.bound();
+        let theta = bound.to_full(&bound.initial_state())?.q[info.reduced];
+        return Ok(Some(Fate::Ended {
             t: 0.0,
             theta,
             cause: "force",
-        });
+        }));
     }
+    Ok(fate_along(motion, info, i))
+}
+
+/// [`fate`] for a contact that did not open at release.
+fn fate_along(motion: &Motion, info: &ModelInfo, i: usize) -> Option<Fate> {
+    let first = motion.phases.first()?;
     if !first.closed().get(i).copied().unwrap_or(false) {
         return Some(Fate::NeverClosed);
     }
@@ -99,8 +112,9 @@ impl Plan<'_> {
     /// Contact `i`'s fate, solving the motion as far as needed.
     pub(super) fn fate(&mut self, i: usize) -> Result<Fate, SolveError> {
         let info = self.general().info();
-        let motion = self.extend_until(|m| fate(m, info, i).is_some())?;
-        fate(motion, info, i).ok_or(SolveError::TooManyPhases {
+        // An error stops the extension; the call after it returns that error.
+        let motion = self.extend_until(|m| !matches!(fate(m, info, i), Ok(None)))?;
+        fate(motion, info, i)?.ok_or(SolveError::TooManyPhases {
             limit: crate::solve::phases::MAX_PHASES,
         })
     }
@@ -295,10 +309,10 @@ impl Plan<'_> {
     }
 
     /// `sqrt(2 h / g)` from the falling point's height at release.
-    pub(super) fn point_mass_fall_time(&mut self, out: &mut RunResults) {
+    pub(super) fn point_mass_fall_time(&mut self, out: &mut RunResults) -> Result<(), SolveError> {
         let general = self.general();
         let info = general.info();
-        let pts = general.points(&general.initial_state());
+        let pts = general.points(&general.initial_state())?;
         let h = pts.pos[info.falling_point][1];
         let t = (2.0 * h.max(0.0) / general.gravity()).sqrt();
         let meaning = format!(
@@ -313,6 +327,7 @@ impl Plan<'_> {
             "s",
             meaning,
         );
+        Ok(())
     }
 
     /// Where the series end (s from release): the first contact's end, or the end of the
@@ -410,7 +425,7 @@ impl Plan<'_> {
                 }
                 Quantity::Trajectory(i) => {
                     for (j, state) in s.states.iter().enumerate() {
-                        let pts = phase.bound().points(state);
+                        let pts = phase.bound().points(state)?;
                         let (p, v) = (pts.pos[i], pts.vel[i]);
                         push(&[t[j], p[0], p[1], v[0], v[1]]);
                     }

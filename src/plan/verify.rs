@@ -139,7 +139,7 @@ impl Plan<'_> {
                 t_start: run.t_start(),
             };
             let forces = sample_forces(run, samples)?;
-            let mut found = checks::monitors(bound, samples, &forces, tol, &ctx);
+            let mut found = checks::monitors(bound, samples, &forces, tol, &ctx)?;
             found.extend(checks::contact_forces(
                 bound,
                 samples,
@@ -148,7 +148,7 @@ impl Plan<'_> {
                 tol,
                 &ctx,
             ));
-            found.extend(path_checks(run, samples, tol, &ctx));
+            found.extend(path_checks(run, samples, tol, &ctx)?);
             out.checks.extend(found);
         }
         if with_ode && let Some(ode) = self.ode.as_ref() {
@@ -163,7 +163,7 @@ impl Plan<'_> {
                 t_start: 0.0,
             };
             out.checks
-                .extend(integrated_checks(general, ode, ode_tol, &ctx));
+                .extend(integrated_checks(general, ode, ode_tol, &ctx)?);
         }
         Ok(())
     }
@@ -177,7 +177,7 @@ fn path_checks(
     samples: &crate::solve::series::PhaseSamples,
     tol: f64,
     ctx: &checks::Context,
-) -> Vec<(String, crate::results::Check)> {
+) -> Result<Vec<(String, crate::results::Check)>, SolveError> {
     match run {
         PhaseRun::Reduced(r) => {
             let bound = r.system.bound();
@@ -204,7 +204,7 @@ fn integrated_checks(
     run: &UnreducedRun,
     tol: f64,
     ctx: &checks::Context,
-) -> Vec<(String, crate::results::Check)> {
+) -> Result<Vec<(String, crate::results::Check)>, SolveError> {
     let info = bound.info();
     let states = run.states();
     let segments = run.node_segments();
@@ -221,12 +221,12 @@ fn integrated_checks(
     let work = run.node_friction_work();
     let conserved = Conserved {
         friction_work: (!info.frictions.is_empty()).then_some(&work[..]),
-        momenta: free_momenta(bound, &states, &rows),
+        momenta: free_momenta(bound, &states, &rows)?,
     };
-    let mut out = checks::drift(bound, &states, &conserved, tol, ctx, CheckKind::Drift);
+    let mut out = checks::drift(bound, &states, &conserved, tol, ctx, CheckKind::Drift)?;
     let closed: Vec<Vec<bool>> = rows.into_iter().map(|(c, _)| c).collect();
-    out.extend(checks::constraint_drift(bound, &states, &closed, tol, ctx));
-    out
+    out.extend(checks::constraint_drift(bound, &states, &closed, tol, ctx)?);
+    Ok(out)
 }
 
 /// Along the integrated cross-check's steps: the largest `|t_ode - t(theta_ode)|` and the
@@ -262,7 +262,7 @@ fn path_deviation(
         let delta = (theta_i - y[reduced]).clamp(0.0, first.mesh.delta_end);
         let tq = first.mesh.time_at_delta(sys, delta, &mut w)?;
         dt_max = dt_max.max((t - tq).abs());
-        let full = sys.to_full(&sys.full_state(*t, delta, theta_dot_at(sys, delta)));
+        let full = sys.to_full(&sys.full_state(*t, delta, theta_dot_at(sys, delta))?)?;
         for (i, (a, b)) in full.q.iter().chain(&full.qd).zip(y.iter()).enumerate() {
             if scale[i] > 0.0 {
                 dy_max = dy_max.max((a - b).abs() / scale[i]);

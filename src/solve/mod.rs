@@ -42,7 +42,11 @@ use crate::system::SystemError;
 pub enum SolveError {
     /// The parameters handed to a next phase were refused.
     #[error("next phase: {0}")]
-    System(#[from] SystemError),
+    System(SystemError),
+    /// A state, slice or value given to a model's function was refused (a length that is not
+    /// the model's, a value that is not finite): see [`Bound`](crate::system::Bound).
+    #[error("{0}")]
+    Input(#[from] SystemError),
     /// The parameters handed to a per-point solver were refused (the same checks as
     /// [`System::from_values`](crate::system::System::from_values)).
     #[error("{0}")]

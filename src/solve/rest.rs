@@ -9,6 +9,7 @@
 //! vertices.
 
 use crate::model::ModelInfo;
+use crate::solve::SolveError;
 use crate::solve::contacts::{Active, DECIDE_TOLERANCE, Mode};
 use crate::system::{Bound, State};
 use nalgebra::{DMatrix, DVector};
@@ -37,60 +38,78 @@ fn support_rows(info: &ModelInfo, active: &Active) -> Option<(Vec<usize>, Vec<us
 }
 
 /// The stacked support rows `G` (one per closed contact, then one per stuck friction).
-fn stacked(sys: &Bound, state: &State, kkt: &[usize], acting: &[usize]) -> DMatrix<f64> {
+fn stacked(
+    sys: &Bound,
+    state: &State,
+    kkt: &[usize],
+    acting: &[usize],
+) -> Result<DMatrix<f64>, SolveError> {
     let n = sys.n_coordinates();
-    let (jac, _) = sys.constraints(state);
-    let (tjac, _) = sys.friction(state);
+    let (jac, _) = sys.constraints(state)?;
+    let (tjac, _) = sys.friction(state)?;
     let rows = kkt.len() + acting.len();
-    DMatrix::from_fn(rows, n, |r, c| {
+    Ok(DMatrix::from_fn(rows, n, |r, c| {
         if r < kkt.len() {
             jac[kkt[r] * n + c]
         } else {
             tjac[acting[r - kkt.len()] * n + c]
         }
-    })
+    }))
 }
 
 /// Whether `active`'s closed contacts and stuck frictions pin every coordinate (their rows
-/// have full column rank): then the only motion they allow from rest is none.
-pub fn pins(sys: &Bound, state: &State, active: &Active) -> bool {
+/// have full column rank): then the only motion they allow from rest is none. A state or
+/// active set that does not fit the model is an error.
+pub fn pins(sys: &Bound, state: &State, active: &Active) -> Result<bool, SolveError> {
     let info = sys.info();
+    sys.check_state(state)?;
+    crate::solve::contacts::check_active(info, active)?;
     let Some((kkt, acting)) = support_rows(info, active) else {
-        return false;
+        return Ok(false);
     };
     let n = sys.n_coordinates();
     if kkt.len() + acting.len() < n {
-        return false;
+        return Ok(false);
     }
-    let g = stacked(sys, state, &kkt, &acting);
+    let g = stacked(sys, state, &kkt, &acting)?;
     let sv = g.singular_values();
     let top = sv.iter().fold(0.0f64, |m, s| m.max(*s));
-    top > 0.0 && sv.iter().filter(|s| **s > RANK_TOLERANCE * top).count() == n
+    Ok(top > 0.0 && sv.iter().filter(|s| **s > RANK_TOLERANCE * top).count() == n)
 }
+
+/// Support forces that hold a system at rest: every contact's (in the model's order), then
+/// every friction's.
+pub type Supports = (Vec<f64>, Vec<f64>);
 
 /// Whether the system at rest at `state` stays there with `active` closed and stuck although
 /// its supports are redundant: some member of the family of support forces that balances the
 /// applied forces (`G^T y = -Q`) pushes at every closed unilateral contact and keeps every
 /// stuck friction within `mu N`. Returns that member (contact forces in the model's order,
 /// then friction forces), or `None` where none exists, the set does not pin the system, or the
-/// search is too large.
-pub fn holds(sys: &Bound, state: &State, active: &Active) -> Option<(Vec<f64>, Vec<f64>)> {
+/// search is too large; a state or active set that does not fit the model is an error.
+pub fn holds(sys: &Bound, state: &State, active: &Active) -> Result<Option<Supports>, SolveError> {
     let info = sys.info();
-    let (kkt, acting) = support_rows(info, active)?;
-    if !pins(sys, state, active) {
-        return None;
+    if !pins(sys, state, active)? {
+        return Ok(None);
     }
-    let g = stacked(sys, state, &kkt, &acting);
-    let (_, rhs) = sys.equations(state);
+    let Some((kkt, acting)) = support_rows(info, active) else {
+        return Ok(None);
+    };
+    let g = stacked(sys, state, &kkt, &acting)?;
+    let (_, rhs) = sys.equations(state)?;
     let q = DVector::from_vec(rhs);
     // Least-norm particular solution y = G (G^T G)^-1 (-Q) and the null space of G^T.
     let gtg = g.transpose() * &g;
-    let w = gtg.lu().solve(&(-&q))?;
+    let Some(w) = gtg.lu().solve(&(-&q)) else {
+        return Ok(None);
+    };
     let particular = &g * w;
     let null = null_space(&g.transpose());
     let inequalities = admissible(info, sys, &kkt, &acting);
     let scale = particular.amax().max(f64::MIN_POSITIVE);
-    let found = feasible(&particular, &null, &inequalities, DECIDE_TOLERANCE * scale)?;
+    let Some(found) = feasible(&particular, &null, &inequalities, DECIDE_TOLERANCE * scale) else {
+        return Ok(None);
+    };
     let mut forces = vec![0.0; info.contacts.len()];
     for (r, &i) in kkt.iter().enumerate() {
         forces[i] = found[r];
@@ -99,7 +118,7 @@ pub fn holds(sys: &Bound, state: &State, active: &Active) -> Option<(Vec<f64>, V
     for (r, &j) in acting.iter().enumerate() {
         fr[j] = found[kkt.len() + r];
     }
-    Some((forces, fr))
+    Ok(Some((forces, fr)))
 }
 
 /// An orthonormal basis (columns) of the null space of `gt` (`n x k`, `k >= n`): the right

@@ -72,7 +72,8 @@ pub fn force_zero(
         return Err(SolveError::NoContact { model: info.name });
     }
     let Some(coeffs) = sys.force_coefficients(contact) else {
-        let force = |sys: &System, delta: f64| sys.forces(delta)[contact];
+        // `contact` is one of the model's (checked above).
+        let force = |sys: &System, delta: f64| Ok(sys.forces(delta)?[contact]);
         return first_zero(sys, force, work);
     };
     let (lo, hi) = bracket(sys)?;
@@ -114,25 +115,26 @@ pub fn edge(
     work: &mut Work,
 ) -> Result<SeparationOutcome, SolveError> {
     let margin = |sys: &System, delta: f64| {
-        let edges = sys.edges(&sys.full_state(0.0, delta, 0.0));
-        edges.get(contact).copied().unwrap_or(f64::NAN)
+        let edges = sys.edges(&sys.full_state(0.0, delta, 0.0)?)?;
+        Ok(edges.get(contact).copied().unwrap_or(f64::NAN))
     };
     first_zero(sys, margin, work)
 }
 
 /// The first sign change of `f(delta)` coming down from the start: bracketed on
 /// [`BRACKET_CELLS`] cells uniform in `sqrt(delta)` (fine near the start, where the fall is
-/// slow), then refined to adjacent floats. Each evaluation counts as a polynomial evaluation.
+/// slow), then refined to adjacent floats. Each evaluation counts as a polynomial evaluation;
+/// one that fails is the error.
 pub fn first_zero(
     sys: &System,
-    f: impl Fn(&System, f64) -> f64,
+    f: impl Fn(&System, f64) -> Result<f64, SolveError>,
     work: &mut Work,
 ) -> Result<SeparationOutcome, SolveError> {
     let end = sys.delta_to_floor();
     let model = sys.info().name;
     let mut value = |delta: f64| -> Result<f64, SolveError> {
         work.polynomial_evals += 1;
-        let v = f(sys, delta);
+        let v = f(sys, delta)?;
         if v.is_nan() {
             return Err(SolveError::NonFinite {
                 model,
@@ -155,7 +157,7 @@ pub fn first_zero(
         let delta = if i == BRACKET_CELLS { end } else { u * u };
         // A model may be singular at the floor itself (a cylinder's tangent point runs off to
         // infinity as theta -> 0): no value there means no zero met before it.
-        if i == BRACKET_CELLS && f(sys, delta).is_nan() {
+        if i == BRACKET_CELLS && f(sys, delta)?.is_nan() {
             break;
         }
         let b = (delta, value(delta)?);
@@ -196,7 +198,7 @@ pub fn linearised_separation(sys: &System) -> Result<SeparationOutcome, SolveErr
 
 /// The open interval `(sin(end_angle), sin(theta_i))` the phase's roots lie in.
 fn bracket(sys: &System) -> Result<(f64, f64), SolveError> {
-    let hi = sys.reduced(0.0).sin;
+    let hi = sys.reduced(0.0)?.sin;
     let lo = sys.end_angle().sin();
     if !hi.is_finite() {
         return Err(SolveError::NonFinite {
