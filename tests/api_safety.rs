@@ -719,7 +719,9 @@ fn the_solvers_refuse_a_state_of_another_length() {
             "pins",
         );
         input(
-            &unpanicked("holds", || rest::holds(&bound, &bad, &active).map(drop)),
+            &unpanicked("holds", || {
+                rest::holds(&bound, &bad, &active, 0.0).map(drop)
+            }),
             "holds",
         );
         input(

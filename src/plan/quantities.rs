@@ -129,9 +129,14 @@ impl Plan<'_> {
     ) -> Result<(), SolveError> {
         let info = self.general().info();
         let key = q.name(info);
-        if q == Quantity::SeparationAngle
-            && self.fast()?.is_some()
-            && let Ok(end) = self.end()
+        // Where the motion starts on a fast phase its end by the roots is the motion's own
+        // first step: an error there is the quantity's error.
+        let end = if q == Quantity::SeparationAngle && self.fast()?.is_some() {
+            Some(self.end()?)
+        } else {
+            None
+        };
+        if let Some(end) = end
             && end.end == End::Force(0)
             && let Some(at) = end.at
         {
@@ -264,9 +269,7 @@ impl Plan<'_> {
             return Ok(());
         }
         let end = self.span_end()?;
-        let Some(motion) = self.motion.as_ref() else {
-            return Ok(());
-        };
+        let motion = &*self.motion()?;
         let phases: Vec<&PhaseRun> = (motion.phases.iter())
             .filter(|p| p.t_start() < end || (end == 0.0 && p.t_start() == 0.0))
             .collect();
@@ -362,16 +365,22 @@ impl Plan<'_> {
         }
         let end = self.span_end()?;
         let times = crate::solve::series::uniform_times(end, self.samples)?;
-        let Some(motion) = self.motion.as_ref() else {
-            return Ok(Vec::new());
-        };
+        let motion = self.take_motion()?;
+        let Plan {
+            motion: slot, work, ..
+        } = self;
+        let motion = &*slot.insert(motion);
         let mut groups: Vec<(usize, Vec<f64>)> = Vec::new();
         for &t in &times {
             // The phase that runs at `t`: the last one starting at or before it that lasts, or
-            // the one ending there.
+            // the one ending there (the phases cover the span, so there is one).
             let k = (motion.phases.iter())
                 .rposition(|p| p.t_start() <= t && (t < p.t_end() || p.t_end() >= end))
-                .unwrap_or(0);
+                .ok_or(SolveError::Inversion {
+                    target: t,
+                    duration: end,
+                    reason: "no solved phase runs at this time",
+                })?;
             match groups.last_mut() {
                 Some((g, ts)) if *g == k => ts.push(t),
                 _ => groups.push((k, vec![t])),
@@ -381,7 +390,7 @@ impl Plan<'_> {
         for (k, ts) in groups {
             let phase = &motion.phases[k];
             let local: Vec<f64> = ts.iter().map(|t| (t - phase.t_start()).max(0.0)).collect();
-            let s = sample_at(phase, &local, &mut self.work)?;
+            let s = sample_at(phase, &local, work)?;
             out.push((k, s, ts));
         }
         self.span = Some(out.clone());
@@ -394,9 +403,7 @@ impl Plan<'_> {
         let info = self.general().info();
         let groups = self.span_samples()?;
         let general = self.general().clone();
-        let Some(motion) = self.motion.as_ref() else {
-            return Ok(());
-        };
+        let motion = &*self.motion()?;
         let mut cols: Vec<Vec<f64>> = Vec::new();
         let mut push = |row: &[f64]| {
             cols.resize(row.len(), Vec::new());
@@ -552,15 +559,21 @@ impl Plan<'_> {
                 break;
             }
         }
-        let Some(motion) = self.motion.as_ref() else {
-            return Ok(());
-        };
-        let info = self.walker.general.info();
+        let motion = self.take_motion()?;
+        let Plan {
+            motion: slot,
+            walker,
+            phase_samples,
+            ..
+        } = self;
+        let motion = &*slot.insert(motion);
+        let info = walker.general.info();
         let traced = want.iter().find_map(|q| match q {
             Quantity::Trajectory(i) => info.points.get(*i).map(|p| p.name),
             _ => None,
         });
-        let phases: Vec<PhaseInput> = (motion.phases.iter().zip(&self.phase_samples))
+        // The phases sampled (all of them, or those before the one that could not be).
+        let phases: Vec<PhaseInput> = (motion.phases.iter().zip(phase_samples.iter()))
             .map(|(run, samples)| PhaseInput {
                 bound: run.bound(),
                 samples,

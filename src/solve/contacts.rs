@@ -643,19 +643,21 @@ pub fn decide(sys: &Bound, state: &State, options: &Options, t: f64) -> Result<A
             // Redundant supports that hold the system at rest (a ladder stuck at both ends):
             // its motion is none, whatever share of the load each support takes.
             Err(SolveError::SingularContacts { .. })
-                if rest::holds(sys, state, &active)?.is_some() =>
+                if rest::holds(sys, state, &active, t)?.is_some() =>
             {
                 return Err(at_rest(info, &active, t, "redundantly, with"));
             }
             // Other singular sets (Painlevé's singularity exactly, or redundant contacts that
-            // cannot hold) are not a motion; the error says so if no set is.
+            // cannot hold) are not a motion; the error says so if no set is. Nothing is lost
+            // where another set is consistent: a set whose rows are redundant describes the
+            // motion of a smaller set (one redundant row left open), which is tried on its own.
             Err(SolveError::SingularContacts { .. }) => {
                 singular.push(active.describe(info));
                 continue;
             }
             Err(e) => return Err(e),
         };
-        let scales = acc_scales(sys, state, &active, &d)?;
+        let scales = acc_scales(sys, state, &active, &d, t)?;
         if consistent(sys, options, &active, &d, &scales) {
             found.push((active, d));
         }
@@ -673,18 +675,25 @@ pub fn decide(sys: &Bound, state: &State, options: &Options, t: f64) -> Result<A
 /// `qdd_j`. So a contact whose motion is slow next to gravity (a rod nearly flat on a thin
 /// block) is judged at its own scale, and one whose acceleration cancels to rounding noise
 /// (a foot just lifting) at the scale of the forces that cancel.
+///
+/// A mass matrix that cannot be inverted (while the constrained system could be solved) gives
+/// no scale to judge a contact by: [`SolveError::SingularMassMatrix`], not a guess.
 fn acc_scales(
     sys: &Bound,
     state: &State,
     active: &Active,
     d: &Dynamics,
+    t: f64,
 ) -> Result<Vec<f64>, SolveError> {
     let info = sys.info();
     let rows = Rows::at(sys, state)?;
     let n = rows.n;
     let mass = DMatrix::from_row_slice(n, n, &rows.mass);
     let Some(inverse) = mass.try_inverse() else {
-        return Ok(vec![f64::INFINITY; info.contacts.len()]);
+        return Err(SolveError::SingularMassMatrix {
+            t,
+            q: state.q.clone(),
+        });
     };
     let mut size = vec![0.0f64; n];
     let mut add = |force: &[f64], times: f64| {

@@ -69,7 +69,11 @@ pub fn force_zero(
         .get(contact)
         .is_some_and(|c| c.closed && !c.bilateral)
     {
-        return Err(SolveError::NoContact { model: info.name });
+        return Err(SolveError::NoContact {
+            model: info.name,
+            contact,
+            edge: false,
+        });
     }
     let Some(coeffs) = sys.force_coefficients(contact) else {
         // `contact` is one of the model's (checked above).
@@ -108,16 +112,28 @@ pub fn separation_root(
 }
 
 /// Where a closed contact runs off its edge: the first zero of its edge margin, which on the
-/// fast path depends on the angle alone (the derivation checks it).
+/// fast path depends on the angle alone (the derivation checks it). A contact that is not
+/// closed with an edge in the phase is [`SolveError::NoContact`].
 pub fn edge(
     sys: &System,
     contact: usize,
     work: &mut Work,
 ) -> Result<SeparationOutcome, SolveError> {
-    let margin = |sys: &System, delta: f64| {
-        let edges = sys.edges(&sys.full_state(0.0, delta, 0.0)?)?;
-        Ok(edges.get(contact).copied().unwrap_or(f64::NAN))
-    };
+    let info = sys.info();
+    if !info
+        .contacts
+        .get(contact)
+        .is_some_and(|c| c.closed && c.edge)
+    {
+        return Err(SolveError::NoContact {
+            model: info.name,
+            contact,
+            edge: true,
+        });
+    }
+    // `contact` is one of the model's (checked above).
+    let margin =
+        |sys: &System, delta: f64| Ok(sys.edges(&sys.full_state(0.0, delta, 0.0)?)?[contact]);
     first_zero(sys, margin, work)
 }
 
@@ -181,6 +197,8 @@ pub fn linearised_separation(sys: &System) -> Result<SeparationOutcome, SolveErr
     if coeffs.is_empty() {
         return Err(SolveError::NoContact {
             model: sys.info().name,
+            contact: 0,
+            edge: false,
         });
     }
     let (lo, hi) = bracket(sys)?;

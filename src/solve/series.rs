@@ -44,15 +44,15 @@ impl PhaseSamples {
 }
 
 /// `theta_dot` at `delta` on a falling phase: `-sqrt(theta_dot^2)`, and exactly the initial rate
-/// at the start (zero from rest).
+/// at the start (zero from rest); NaN for a `delta` that is not finite (or where the model's
+/// `theta_dot^2` is NaN).
 pub fn theta_dot_at(sys: &System, delta: f64) -> f64 {
     if delta == 0.0 {
         return sys.theta_dot_initial();
     }
-    -(sys.reduction().reduced(sys.k(), delta))
-        .theta_dot_sq
-        .max(0.0)
-        .sqrt()
+    // The model's function itself: a NaN argument gives NaN, which `f64::max` would hide.
+    let w2 = sys.reduction().reduced(sys.k(), delta).theta_dot_sq;
+    if w2.is_nan() { w2 } else { -w2.max(0.0).sqrt() }
 }
 
 /// `samples` points uniform in time over the phase described by `mesh`.
@@ -245,8 +245,21 @@ pub fn sample_friction(
                     .collect();
                 let forces = r.system.forces(delta)?;
                 let normals = (info.frictions.iter())
-                    .map(|f| forces.get(f.contact).copied().unwrap_or(0.0))
-                    .collect();
+                    .map(|f| {
+                        forces
+                            .get(f.contact)
+                            .copied()
+                            .ok_or_else(|| SolveError::PhaseMismatch {
+                                system: info.name,
+                                name: r.system.name(),
+                                why: format!(
+                                    "it has {} contacts, the system {}",
+                                    forces.len(),
+                                    info.contacts.len()
+                                ),
+                            })
+                    })
+                    .collect::<Result<_, _>>()?;
                 Ok([vec![0.0; nf], normals, slip])
             })
             .collect(),
