@@ -229,7 +229,8 @@ fn check_fast_phase(model: &'static dyn Model, u: &[f64], spread: u8) -> Result<
         tol,
         &checks::Context::new(info.name),
         CheckKind::Identity,
-    );
+    )
+    .expect("the samples are the model's states");
     prop_assert!(found.iter().any(|(k, _)| k.ends_with(".energy")));
     for (key, check) in found {
         prop_assert!(check.passed, "{key}: {} at {p:?}", check.meaning);
