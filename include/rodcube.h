@@ -118,6 +118,21 @@
 #define RODCUBE_ERR_PARAM_BAD_CONSTANT 110
 
 /**
+ * A state's positions and velocities differ in length (a library caller's state).
+ */
+#define RODCUBE_ERR_PARAM_STATE_SHAPE 111
+
+/**
+ * A state or vector has the wrong length for the model.
+ */
+#define RODCUBE_ERR_PARAM_LENGTH 112
+
+/**
+ * A state or vector holds a NaN or an infinity.
+ */
+#define RODCUBE_ERR_PARAM_NOT_FINITE_INPUT 113
+
+/**
  * Group: the request was refused (codes 201 to 299).
  */
 #define RODCUBE_ERR_REQUEST 200
@@ -331,6 +346,11 @@
  * A result came out NaN or infinite (a model function misbehaving).
  */
 #define RODCUBE_ERR_RESULT_NOT_FINITE 335
+
+/**
+ * A phase index past the phases of the run (a planner inconsistency).
+ */
+#define RODCUBE_ERR_NO_SUCH_PHASE 336
 
 /**
  * Group: the scene was refused (codes 401 to 499). A scene's message lists every problem

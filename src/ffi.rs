@@ -72,6 +72,12 @@ pub const RODCUBE_ERR_PARAM_REQUIREMENT: c_int = 108;
 pub const RODCUBE_ERR_PARAM_NO_REDUCTION: c_int = 109;
 /// The parameters give the model a non-finite constant (an extreme input).
 pub const RODCUBE_ERR_PARAM_BAD_CONSTANT: c_int = 110;
+/// A state's positions and velocities differ in length (a library caller's state).
+pub const RODCUBE_ERR_PARAM_STATE_SHAPE: c_int = 111;
+/// A state or vector has the wrong length for the model.
+pub const RODCUBE_ERR_PARAM_LENGTH: c_int = 112;
+/// A state or vector holds a NaN or an infinity.
+pub const RODCUBE_ERR_PARAM_NOT_FINITE_INPUT: c_int = 113;
 
 /// Group: the request was refused (codes 201 to 299).
 pub const RODCUBE_ERR_REQUEST: c_int = 200;
@@ -163,6 +169,8 @@ pub const RODCUBE_ERR_TOO_MANY_PHASES: c_int = 333;
 pub const RODCUBE_ERR_NEXT_PHASE: c_int = 334;
 /// A result came out NaN or infinite (a model function misbehaving).
 pub const RODCUBE_ERR_RESULT_NOT_FINITE: c_int = 335;
+/// A phase index past the phases of the run (a planner inconsistency).
+pub const RODCUBE_ERR_NO_SUCH_PHASE: c_int = 336;
 
 /// Group: the scene was refused (codes 401 to 499). A scene's message lists every problem
 /// found; the code is the kind of the first, in file order. Returned alone only for a scene
@@ -229,6 +237,9 @@ static CODES: &[(c_int, &CStr)] = named![
     RODCUBE_ERR_PARAM_REQUIREMENT,
     RODCUBE_ERR_PARAM_NO_REDUCTION,
     RODCUBE_ERR_PARAM_BAD_CONSTANT,
+    RODCUBE_ERR_PARAM_STATE_SHAPE,
+    RODCUBE_ERR_PARAM_LENGTH,
+    RODCUBE_ERR_PARAM_NOT_FINITE_INPUT,
     RODCUBE_ERR_REQUEST,
     RODCUBE_ERR_NOT_A_SYSTEM,
     RODCUBE_ERR_UNAVAILABLE,
@@ -271,6 +282,7 @@ static CODES: &[(c_int, &CStr)] = named![
     RODCUBE_ERR_TOO_MANY_PHASES,
     RODCUBE_ERR_NEXT_PHASE,
     RODCUBE_ERR_RESULT_NOT_FINITE,
+    RODCUBE_ERR_NO_SUCH_PHASE,
     RODCUBE_ERR_SCENE,
     RODCUBE_ERR_SCENE_READ,
     RODCUBE_ERR_SCENE_SYNTAX,
@@ -302,6 +314,9 @@ fn system_code(e: &SystemError) -> c_int {
         SystemError::Requirement { .. } => RODCUBE_ERR_PARAM_REQUIREMENT,
         SystemError::NoReduction { .. } => RODCUBE_ERR_PARAM_NO_REDUCTION,
         SystemError::BadConstant { .. } => RODCUBE_ERR_PARAM_BAD_CONSTANT,
+        SystemError::StateShape { .. } => RODCUBE_ERR_PARAM_STATE_SHAPE,
+        SystemError::Length { .. } => RODCUBE_ERR_PARAM_LENGTH,
+        SystemError::NotFiniteInput { .. } => RODCUBE_ERR_PARAM_NOT_FINITE_INPUT,
     }
 }
 
@@ -309,7 +324,8 @@ fn system_code(e: &SystemError) -> c_int {
 fn solve_code(e: &SolveError) -> c_int {
     match e {
         SolveError::System(_) => RODCUBE_ERR_NEXT_PHASE,
-        SolveError::Parameters(e) => system_code(e),
+        SolveError::Parameters(e) | SolveError::Input(e) => system_code(e),
+        SolveError::NoSuchPhase { .. } => RODCUBE_ERR_NO_SUCH_PHASE,
         SolveError::NoContact { .. } => RODCUBE_ERR_NO_CONTACT,
         SolveError::BadPolynomial { .. } => RODCUBE_ERR_BAD_POLYNOMIAL,
         SolveError::NoSeparation { .. } => RODCUBE_ERR_NO_SEPARATION,
