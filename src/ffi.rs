@@ -1,46 +1,405 @@
 //! The C ABI (cargo feature `capi`): the per-point solver of any registered model, by handle,
-//! with parameters in the model's order or by name, and a whole scene run to a JSON string.
-//! `include/rodcube.h` declares these functions; `examples/c/` builds a C program against
-//! them.
+//! with parameters in the model's order or by name, and a whole scene run once to a handle on
+//! its JSON results. `include/rodcube.h` is generated from this file by cbindgen
+//! (`cbindgen.toml`; `cargo run --example c_header` writes it, `tests/capi_header.rs` fails when
+//! it is stale), so the doc comments here are the header's documentation: they are written for
+//! a C reader and name C functions and constants plainly.
 //!
 //! Conventions, for every function:
-//! - a status code is returned (`RODCUBE_OK` = 0, else one of the `RODCUBE_ERR_*` codes);
+//! - a function that can fail returns a status code (`RODCUBE_OK` = 0, else one of the
+//!   `RODCUBE_ERR_*` codes: each kind of failure has its own, `rodcube_error_name` names it and
+//!   `rodcube_error_group` gives its group), and hands back what it made through an out
+//!   pointer;
 //! - the message of a failure is copied into the caller's buffer `err` of `err_len` bytes
 //!   (NUL-terminated, cut at a character boundary; `err` may be NULL);
 //! - nothing the caller must free with its own allocator is returned: a solver handle is
-//!   released by [`rodcube_solver_free`], strings are either static or copied into the
-//!   caller's buffers;
+//!   released by `rodcube_solver_free`, a scene's results by `rodcube_results_free`; other
+//!   strings are static or copied into the caller's buffers;
 //! - no panic crosses the boundary: one would be caught and reported as `RODCUBE_ERR_PANIC`.
+//!
+//! Architecture invariant: every error of the layers below (`SystemError`, `SolveError`,
+//! `PlanError`, the scene's `Kind`) maps to its code by an exhaustive `match`, so a new
+//! variant does not compile until it has a code here (and thereby in the header).
 
 use crate::model::Model;
-use crate::plan::{self, Request};
-use crate::scene::Scene;
+use crate::plan::{self, PlanError, Request};
+use crate::scene::{Kind, Scene, SceneError};
 use crate::solve::SolveError;
 use crate::solve::lean::{LeanPoint, LeanSolver};
-use crate::system::ordered_values;
+use crate::system::{SystemError, ordered_values};
 use std::ffi::{CStr, CString, c_char, c_int};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
 use std::sync::OnceLock;
 
+// Status codes: their numbering is described in the header's opening comment (`cbindgen.toml`).
+
 /// Success.
 pub const RODCUBE_OK: c_int = 0;
-/// A null pointer, text that is not UTF-8, or an inconsistent length.
+/// A NULL pointer where the call needs one: a handle, an output, a text, an out pointer, or
+/// an array whose count is not zero.
 pub const RODCUBE_ERR_ARGUMENT: c_int = 1;
-/// No model of that name, or one the per-point solver cannot solve.
+/// No model of that name in the registry (`rodcube_solver_new`).
 pub const RODCUBE_ERR_MODEL: c_int = 2;
-/// The parameters were refused (count, value, or a requirement of the model).
-pub const RODCUBE_ERR_PARAMETERS: c_int = 3;
-/// A solver failed (no separation before the floor, say).
-pub const RODCUBE_ERR_SOLVE: c_int = 4;
-/// The scene was refused.
-pub const RODCUBE_ERR_SCENE: c_int = 5;
 /// The output buffer is too small; `*needed` says how large it must be.
 pub const RODCUBE_ERR_BUFFER: c_int = 6;
-/// An internal error (a panic, caught at the boundary).
+/// An internal error: a panic, caught at the boundary (please report it).
 pub const RODCUBE_ERR_PANIC: c_int = 7;
+/// A text argument (a model, parameter name or scene) is not UTF-8.
+pub const RODCUBE_ERR_UTF8: c_int = 8;
+/// The results could not be written as JSON.
+pub const RODCUBE_ERR_JSON: c_int = 9;
 
-/// One point's separation, as [`LeanSolver::solve`] returns it.
+/// Group: the parameters were refused (codes 101 to 199).
+pub const RODCUBE_ERR_PARAMETERS: c_int = 100;
+/// A parameter the model declares was not given (by name).
+pub const RODCUBE_ERR_PARAM_MISSING: c_int = 101;
+/// A name that is not one of the model's parameters.
+pub const RODCUBE_ERR_PARAM_UNKNOWN: c_int = 102;
+/// The same parameter given twice (by name).
+pub const RODCUBE_ERR_PARAM_DUPLICATE: c_int = 103;
+/// A count of values that is not the model's number of parameters.
+pub const RODCUBE_ERR_PARAM_COUNT: c_int = 104;
+/// A parameter that is NaN or infinite.
+pub const RODCUBE_ERR_PARAM_NOT_FINITE: c_int = 105;
+/// A parameter the model declares positive is zero or negative.
+pub const RODCUBE_ERR_PARAM_NOT_POSITIVE: c_int = 106;
+/// A friction coefficient below zero.
+pub const RODCUBE_ERR_PARAM_NEGATIVE_FRICTION: c_int = 107;
+/// A requirement of the model on its parameters fails (e.g. `a < ell` for `rod_cube`).
+pub const RODCUBE_ERR_PARAM_REQUIREMENT: c_int = 108;
+/// The model has no reduced fast path to bind the parameters to.
+pub const RODCUBE_ERR_PARAM_NO_REDUCTION: c_int = 109;
+/// The parameters give the model a non-finite constant (an extreme input).
+pub const RODCUBE_ERR_PARAM_BAD_CONSTANT: c_int = 110;
+/// A state's positions and velocities differ in length (a library caller's state).
+pub const RODCUBE_ERR_PARAM_STATE_SHAPE: c_int = 111;
+/// A state or vector has the wrong length for the model.
+pub const RODCUBE_ERR_PARAM_LENGTH: c_int = 112;
+/// A state or vector holds a NaN or an infinity.
+pub const RODCUBE_ERR_PARAM_NOT_FINITE_INPUT: c_int = 113;
+
+/// Group: the request was refused (codes 201 to 299).
+pub const RODCUBE_ERR_REQUEST: c_int = 200;
+/// A fast phase was named where a system is run: run its system.
+pub const RODCUBE_ERR_NOT_A_SYSTEM: c_int = 201;
+/// The model cannot provide a wanted quantity.
+pub const RODCUBE_ERR_UNAVAILABLE: c_int = 202;
+/// The tolerance is outside the accepted range.
+pub const RODCUBE_ERR_TOLERANCE: c_int = 203;
+/// Fewer than 2 samples where a series or a check is wanted.
+pub const RODCUBE_ERR_TOO_FEW_SAMPLES: c_int = 204;
+/// More samples per series than accepted.
+pub const RODCUBE_ERR_TOO_MANY_SAMPLES: c_int = 205;
+
+/// Group: a solver failed (codes 301 to 399).
+pub const RODCUBE_ERR_SOLVE: c_int = 300;
+/// The model does not hold a unilateral first contact closed, so it cannot separate.
+pub const RODCUBE_ERR_NO_CONTACT: c_int = 301;
+/// The separation polynomial is identically zero or has a non-finite coefficient.
+pub const RODCUBE_ERR_BAD_POLYNOMIAL: c_int = 302;
+/// No separation in the phase: the contact holds to the floor, or the polynomial's
+/// coefficients under- or overflowed.
+pub const RODCUBE_ERR_NO_SEPARATION: c_int = 303;
+/// Released from rest where the acceleration does not make it fall.
+pub const RODCUBE_ERR_NO_MOTION: c_int = 304;
+/// The phase starts at or beyond the vertical.
+pub const RODCUBE_ERR_BEYOND_VERTICAL: c_int = 305;
+/// The initial rate makes the angle grow; phases must fall.
+pub const RODCUBE_ERR_RISING: c_int = 306;
+/// The angular rate reaches zero (a turning point) before the end of the phase.
+pub const RODCUBE_ERR_TURNING_POINT: c_int = 307;
+/// A model function returned NaN or an infinity.
+pub const RODCUBE_ERR_NON_FINITE: c_int = 308;
+/// The phase would end at an angle fallen that is not positive and finite.
+pub const RODCUBE_ERR_BAD_PHASE_END: c_int = 309;
+/// An angle outside the phase was asked of its time integral.
+pub const RODCUBE_ERR_OUTSIDE_PHASE: c_int = 310;
+/// The adaptive quadrature did not reach its tolerance.
+pub const RODCUBE_ERR_QUADRATURE: c_int = 311;
+/// The time integral could not be inverted at a time.
+pub const RODCUBE_ERR_INVERSION: c_int = 312;
+/// An active set whose size does not match the model's contacts or frictions.
+pub const RODCUBE_ERR_ACTIVE_SIZE: c_int = 313;
+/// No single consistent set of closed contacts and friction modes (a contact that would
+/// have to pull, Painleve's paradox, or several sets with different motions).
+pub const RODCUBE_ERR_INDETERMINATE: c_int = 314;
+/// The angle reaches its end with the body above the floor (a support lifted it).
+pub const RODCUBE_ERR_ABOVE_FLOOR: c_int = 315;
+/// The motion from rest turns back before any contact ends: it swings for ever.
+pub const RODCUBE_ERR_SWINGS: c_int = 316;
+/// The supports hold the system at rest: nothing moves, so no contact ends.
+pub const RODCUBE_ERR_AT_REST: c_int = 317;
+/// Bodies overlap where a phase starts (a gap below zero).
+pub const RODCUBE_ERR_OVERLAP: c_int = 318;
+/// A contact closes with a velocity at release: an impact, not modelled.
+pub const RODCUBE_ERR_IMPACT_AT_RELEASE: c_int = 319;
+/// The motion does not start in the phase the per-point solver solves (another contact lets
+/// go first, or would have to pull): solve the system with `rodcube_run_scene`.
+pub const RODCUBE_ERR_NOT_THIS_PHASE: c_int = 320;
+/// The closed contacts' constraints and the mass matrix form a singular system.
+pub const RODCUBE_ERR_SINGULAR_CONTACTS: c_int = 321;
+/// The friction contacts switched between sticking and sliding too often (chatter).
+pub const RODCUBE_ERR_TOO_MANY_SWITCHES: c_int = 322;
+/// The mass matrix could not be solved.
+pub const RODCUBE_ERR_SINGULAR_MASS_MATRIX: c_int = 323;
+/// The ODE's right-hand side or an event function was not finite.
+pub const RODCUBE_ERR_ODE_NON_FINITE: c_int = 324;
+/// The ODE's step size fell below what a double can resolve.
+pub const RODCUBE_ERR_STEP_SIZE_TOO_SMALL: c_int = 325;
+/// The mass matrix is too ill-conditioned for the unreduced equations to mean anything.
+pub const RODCUBE_ERR_ILL_CONDITIONED: c_int = 326;
+/// The ODE took too many steps.
+pub const RODCUBE_ERR_TOO_MANY_STEPS: c_int = 327;
+/// The ODE reached its time limit without the separation or the floor.
+pub const RODCUBE_ERR_NO_EVENT: c_int = 328;
+/// A quantity of the energy integral was asked where the motion does not start on a fast
+/// phase.
+pub const RODCUBE_ERR_NOT_ON_FAST_PATH: c_int = 329;
+/// A system continues with a phase model that is not in the registry.
+pub const RODCUBE_ERR_UNKNOWN_PHASE_MODEL: c_int = 330;
+/// A phase model whose parameters or coordinates do not fit its system's.
+pub const RODCUBE_ERR_PHASE_MISMATCH: c_int = 331;
+/// The model is not for the per-point solver (its separation is not a polynomial root, or
+/// its motion does not start on a fast phase): run it as a scene.
+pub const RODCUBE_ERR_NOT_PER_POINT: c_int = 332;
+/// Phases kept separating without reaching the floor.
+pub const RODCUBE_ERR_TOO_MANY_PHASES: c_int = 333;
+/// The parameters a phase hands to the next were refused.
+pub const RODCUBE_ERR_NEXT_PHASE: c_int = 334;
+/// A result came out NaN or infinite (a model function misbehaving).
+pub const RODCUBE_ERR_RESULT_NOT_FINITE: c_int = 335;
+/// A phase index past the phases of the run (a planner inconsistency).
+pub const RODCUBE_ERR_NO_SUCH_PHASE: c_int = 336;
+
+/// Group: the scene was refused (codes 401 to 499). A scene's message lists every problem
+/// found; the code is the kind of the first, in file order. Returned alone only for a scene
+/// error without a problem, which scene parsing never makes.
+pub const RODCUBE_ERR_SCENE: c_int = 400;
+/// Scene: the scene could not be read.
+pub const RODCUBE_ERR_SCENE_READ: c_int = 401;
+/// Scene: not valid YAML, a duplicate key, or an empty text.
+pub const RODCUBE_ERR_SCENE_SYNTAX: c_int = 402;
+/// Scene: a key that scenes do not have.
+pub const RODCUBE_ERR_SCENE_UNKNOWN_KEY: c_int = 403;
+/// Scene: a value of the wrong type, or a required key missing.
+pub const RODCUBE_ERR_SCENE_STRUCTURE: c_int = 404;
+/// Scene: a model that is not in the registry.
+pub const RODCUBE_ERR_SCENE_UNKNOWN_MODEL: c_int = 405;
+/// Scene: a `want` entry that no quantity of the model matches.
+pub const RODCUBE_ERR_SCENE_UNKNOWN_QUANTITY: c_int = 406;
+/// Scene: a quantity this model cannot provide.
+pub const RODCUBE_ERR_SCENE_UNAVAILABLE_QUANTITY: c_int = 407;
+/// Scene: a `want` entry listed twice.
+pub const RODCUBE_ERR_SCENE_DUPLICATE_QUANTITY: c_int = 408;
+/// Scene: a parameter of the model that the scene does not give.
+pub const RODCUBE_ERR_SCENE_MISSING_PARAMETER: c_int = 409;
+/// Scene: a parameter the model does not have.
+pub const RODCUBE_ERR_SCENE_UNKNOWN_PARAMETER: c_int = 410;
+/// Scene: a parameter that must be strictly positive is not.
+pub const RODCUBE_ERR_SCENE_NOT_POSITIVE: c_int = 411;
+/// Scene: a friction coefficient below zero.
+pub const RODCUBE_ERR_SCENE_NEGATIVE_FRICTION: c_int = 412;
+/// Scene: NaN or an infinity (`.nan`, `.inf`).
+pub const RODCUBE_ERR_SCENE_NOT_FINITE: c_int = 413;
+/// Scene: `tolerance` or `samples` outside its range, or an empty `want`.
+pub const RODCUBE_ERR_SCENE_OUT_OF_RANGE: c_int = 414;
+/// Scene: a requirement of the model on its parameters (e.g. `a < ell`) fails.
+pub const RODCUBE_ERR_SCENE_REQUIREMENT: c_int = 415;
+
+/// Every status code with its name, for `rodcube_error_name` and `rodcube_error_group`.
+macro_rules! named {
+    ($($code:ident),* $(,)?) => {
+        &[$(($code, match CStr::from_bytes_with_nul(concat!(stringify!($code), "\0").as_bytes()) {
+            Ok(name) => name,
+            Err(_) => c"",
+        })),*]
+    };
+}
+
+/// The status codes and their names, in the order of the header.
+static CODES: &[(c_int, &CStr)] = named![
+    RODCUBE_OK,
+    RODCUBE_ERR_ARGUMENT,
+    RODCUBE_ERR_MODEL,
+    RODCUBE_ERR_BUFFER,
+    RODCUBE_ERR_PANIC,
+    RODCUBE_ERR_UTF8,
+    RODCUBE_ERR_JSON,
+    RODCUBE_ERR_PARAMETERS,
+    RODCUBE_ERR_PARAM_MISSING,
+    RODCUBE_ERR_PARAM_UNKNOWN,
+    RODCUBE_ERR_PARAM_DUPLICATE,
+    RODCUBE_ERR_PARAM_COUNT,
+    RODCUBE_ERR_PARAM_NOT_FINITE,
+    RODCUBE_ERR_PARAM_NOT_POSITIVE,
+    RODCUBE_ERR_PARAM_NEGATIVE_FRICTION,
+    RODCUBE_ERR_PARAM_REQUIREMENT,
+    RODCUBE_ERR_PARAM_NO_REDUCTION,
+    RODCUBE_ERR_PARAM_BAD_CONSTANT,
+    RODCUBE_ERR_PARAM_STATE_SHAPE,
+    RODCUBE_ERR_PARAM_LENGTH,
+    RODCUBE_ERR_PARAM_NOT_FINITE_INPUT,
+    RODCUBE_ERR_REQUEST,
+    RODCUBE_ERR_NOT_A_SYSTEM,
+    RODCUBE_ERR_UNAVAILABLE,
+    RODCUBE_ERR_TOLERANCE,
+    RODCUBE_ERR_TOO_FEW_SAMPLES,
+    RODCUBE_ERR_TOO_MANY_SAMPLES,
+    RODCUBE_ERR_SOLVE,
+    RODCUBE_ERR_NO_CONTACT,
+    RODCUBE_ERR_BAD_POLYNOMIAL,
+    RODCUBE_ERR_NO_SEPARATION,
+    RODCUBE_ERR_NO_MOTION,
+    RODCUBE_ERR_BEYOND_VERTICAL,
+    RODCUBE_ERR_RISING,
+    RODCUBE_ERR_TURNING_POINT,
+    RODCUBE_ERR_NON_FINITE,
+    RODCUBE_ERR_BAD_PHASE_END,
+    RODCUBE_ERR_OUTSIDE_PHASE,
+    RODCUBE_ERR_QUADRATURE,
+    RODCUBE_ERR_INVERSION,
+    RODCUBE_ERR_ACTIVE_SIZE,
+    RODCUBE_ERR_INDETERMINATE,
+    RODCUBE_ERR_ABOVE_FLOOR,
+    RODCUBE_ERR_SWINGS,
+    RODCUBE_ERR_AT_REST,
+    RODCUBE_ERR_OVERLAP,
+    RODCUBE_ERR_IMPACT_AT_RELEASE,
+    RODCUBE_ERR_NOT_THIS_PHASE,
+    RODCUBE_ERR_SINGULAR_CONTACTS,
+    RODCUBE_ERR_TOO_MANY_SWITCHES,
+    RODCUBE_ERR_SINGULAR_MASS_MATRIX,
+    RODCUBE_ERR_ODE_NON_FINITE,
+    RODCUBE_ERR_STEP_SIZE_TOO_SMALL,
+    RODCUBE_ERR_ILL_CONDITIONED,
+    RODCUBE_ERR_TOO_MANY_STEPS,
+    RODCUBE_ERR_NO_EVENT,
+    RODCUBE_ERR_NOT_ON_FAST_PATH,
+    RODCUBE_ERR_UNKNOWN_PHASE_MODEL,
+    RODCUBE_ERR_PHASE_MISMATCH,
+    RODCUBE_ERR_NOT_PER_POINT,
+    RODCUBE_ERR_TOO_MANY_PHASES,
+    RODCUBE_ERR_NEXT_PHASE,
+    RODCUBE_ERR_RESULT_NOT_FINITE,
+    RODCUBE_ERR_NO_SUCH_PHASE,
+    RODCUBE_ERR_SCENE,
+    RODCUBE_ERR_SCENE_READ,
+    RODCUBE_ERR_SCENE_SYNTAX,
+    RODCUBE_ERR_SCENE_UNKNOWN_KEY,
+    RODCUBE_ERR_SCENE_STRUCTURE,
+    RODCUBE_ERR_SCENE_UNKNOWN_MODEL,
+    RODCUBE_ERR_SCENE_UNKNOWN_QUANTITY,
+    RODCUBE_ERR_SCENE_UNAVAILABLE_QUANTITY,
+    RODCUBE_ERR_SCENE_DUPLICATE_QUANTITY,
+    RODCUBE_ERR_SCENE_MISSING_PARAMETER,
+    RODCUBE_ERR_SCENE_UNKNOWN_PARAMETER,
+    RODCUBE_ERR_SCENE_NOT_POSITIVE,
+    RODCUBE_ERR_SCENE_NEGATIVE_FRICTION,
+    RODCUBE_ERR_SCENE_NOT_FINITE,
+    RODCUBE_ERR_SCENE_OUT_OF_RANGE,
+    RODCUBE_ERR_SCENE_REQUIREMENT,
+];
+
+/// The code of a refused parameter set.
+fn system_code(e: &SystemError) -> c_int {
+    match e {
+        SystemError::MissingParameter { .. } => RODCUBE_ERR_PARAM_MISSING,
+        SystemError::UnknownParameter { .. } => RODCUBE_ERR_PARAM_UNKNOWN,
+        SystemError::DuplicateParameter { .. } => RODCUBE_ERR_PARAM_DUPLICATE,
+        SystemError::WrongCount { .. } => RODCUBE_ERR_PARAM_COUNT,
+        SystemError::NotFinite { .. } => RODCUBE_ERR_PARAM_NOT_FINITE,
+        SystemError::NotPositive { .. } => RODCUBE_ERR_PARAM_NOT_POSITIVE,
+        SystemError::NegativeFriction { .. } => RODCUBE_ERR_PARAM_NEGATIVE_FRICTION,
+        SystemError::Requirement { .. } => RODCUBE_ERR_PARAM_REQUIREMENT,
+        SystemError::NoReduction { .. } => RODCUBE_ERR_PARAM_NO_REDUCTION,
+        SystemError::BadConstant { .. } => RODCUBE_ERR_PARAM_BAD_CONSTANT,
+        SystemError::StateShape { .. } => RODCUBE_ERR_PARAM_STATE_SHAPE,
+        SystemError::Length { .. } => RODCUBE_ERR_PARAM_LENGTH,
+        SystemError::NotFiniteInput { .. } => RODCUBE_ERR_PARAM_NOT_FINITE_INPUT,
+    }
+}
+
+/// The code of a solver's failure: the parameters' own code for refused parameters.
+fn solve_code(e: &SolveError) -> c_int {
+    match e {
+        SolveError::System(_) => RODCUBE_ERR_NEXT_PHASE,
+        SolveError::Parameters(e) | SolveError::Input(e) => system_code(e),
+        SolveError::NoSuchPhase { .. } => RODCUBE_ERR_NO_SUCH_PHASE,
+        SolveError::NoContact { .. } => RODCUBE_ERR_NO_CONTACT,
+        SolveError::BadPolynomial { .. } => RODCUBE_ERR_BAD_POLYNOMIAL,
+        SolveError::NoSeparation { .. } => RODCUBE_ERR_NO_SEPARATION,
+        SolveError::NoMotion { .. } => RODCUBE_ERR_NO_MOTION,
+        SolveError::BeyondVertical { .. } => RODCUBE_ERR_BEYOND_VERTICAL,
+        SolveError::Rising { .. } => RODCUBE_ERR_RISING,
+        SolveError::TurningPoint { .. } => RODCUBE_ERR_TURNING_POINT,
+        SolveError::NonFinite { .. } => RODCUBE_ERR_NON_FINITE,
+        SolveError::BadPhaseEnd { .. } => RODCUBE_ERR_BAD_PHASE_END,
+        SolveError::OutsidePhase { .. } => RODCUBE_ERR_OUTSIDE_PHASE,
+        SolveError::QuadratureNotConverged { .. } => RODCUBE_ERR_QUADRATURE,
+        SolveError::Inversion { .. } => RODCUBE_ERR_INVERSION,
+        SolveError::ActiveSize { .. } => RODCUBE_ERR_ACTIVE_SIZE,
+        SolveError::Indeterminate { .. } => RODCUBE_ERR_INDETERMINATE,
+        SolveError::AboveFloor { .. } => RODCUBE_ERR_ABOVE_FLOOR,
+        SolveError::Swings { .. } => RODCUBE_ERR_SWINGS,
+        SolveError::AtRest { .. } => RODCUBE_ERR_AT_REST,
+        SolveError::Overlap { .. } => RODCUBE_ERR_OVERLAP,
+        SolveError::ImpactAtRelease { .. } => RODCUBE_ERR_IMPACT_AT_RELEASE,
+        SolveError::NotThisPhase { .. } => RODCUBE_ERR_NOT_THIS_PHASE,
+        SolveError::SingularContacts { .. } => RODCUBE_ERR_SINGULAR_CONTACTS,
+        SolveError::TooManySwitches { .. } => RODCUBE_ERR_TOO_MANY_SWITCHES,
+        SolveError::SingularMassMatrix { .. } => RODCUBE_ERR_SINGULAR_MASS_MATRIX,
+        SolveError::OdeNonFinite { .. } => RODCUBE_ERR_ODE_NON_FINITE,
+        SolveError::StepSizeTooSmall { .. } => RODCUBE_ERR_STEP_SIZE_TOO_SMALL,
+        SolveError::IllConditioned { .. } => RODCUBE_ERR_ILL_CONDITIONED,
+        SolveError::TooManySteps { .. } => RODCUBE_ERR_TOO_MANY_STEPS,
+        SolveError::NoEvent { .. } => RODCUBE_ERR_NO_EVENT,
+        SolveError::NotOnFastPath { .. } => RODCUBE_ERR_NOT_ON_FAST_PATH,
+        SolveError::UnknownPhaseModel { .. } => RODCUBE_ERR_UNKNOWN_PHASE_MODEL,
+        SolveError::PhaseMismatch { .. } => RODCUBE_ERR_PHASE_MISMATCH,
+        SolveError::NotPerPoint { .. } => RODCUBE_ERR_NOT_PER_POINT,
+        SolveError::TooManyPhases { .. } => RODCUBE_ERR_TOO_MANY_PHASES,
+        SolveError::TooFewSamples { .. } => RODCUBE_ERR_TOO_FEW_SAMPLES,
+    }
+}
+
+/// The code of a planner's refusal or failure.
+fn plan_code(e: &PlanError) -> c_int {
+    match e {
+        PlanError::UnknownModel { .. } => RODCUBE_ERR_MODEL,
+        PlanError::NotASystem { .. } => RODCUBE_ERR_NOT_A_SYSTEM,
+        PlanError::Unavailable { .. } => RODCUBE_ERR_UNAVAILABLE,
+        PlanError::BadTolerance { .. } => RODCUBE_ERR_TOLERANCE,
+        PlanError::TooFewSamples { .. } => RODCUBE_ERR_TOO_FEW_SAMPLES,
+        PlanError::TooManySamples { .. } => RODCUBE_ERR_TOO_MANY_SAMPLES,
+        PlanError::System(e) => system_code(e),
+        PlanError::Solve(e) => solve_code(e),
+        PlanError::NonFinite { .. } => RODCUBE_ERR_RESULT_NOT_FINITE,
+    }
+}
+
+/// The code of one kind of scene problem.
+fn scene_kind_code(kind: Kind) -> c_int {
+    match kind {
+        Kind::Read => RODCUBE_ERR_SCENE_READ,
+        Kind::Syntax => RODCUBE_ERR_SCENE_SYNTAX,
+        Kind::UnknownKey => RODCUBE_ERR_SCENE_UNKNOWN_KEY,
+        Kind::Structure => RODCUBE_ERR_SCENE_STRUCTURE,
+        Kind::UnknownModel => RODCUBE_ERR_SCENE_UNKNOWN_MODEL,
+        Kind::UnknownQuantity => RODCUBE_ERR_SCENE_UNKNOWN_QUANTITY,
+        Kind::UnavailableQuantity => RODCUBE_ERR_SCENE_UNAVAILABLE_QUANTITY,
+        Kind::DuplicateQuantity => RODCUBE_ERR_SCENE_DUPLICATE_QUANTITY,
+        Kind::MissingParameter => RODCUBE_ERR_SCENE_MISSING_PARAMETER,
+        Kind::UnknownParameter => RODCUBE_ERR_SCENE_UNKNOWN_PARAMETER,
+        Kind::NotPositive => RODCUBE_ERR_SCENE_NOT_POSITIVE,
+        Kind::NegativeFriction => RODCUBE_ERR_SCENE_NEGATIVE_FRICTION,
+        Kind::NotFinite => RODCUBE_ERR_SCENE_NOT_FINITE,
+        Kind::OutOfRange => RODCUBE_ERR_SCENE_OUT_OF_RANGE,
+        Kind::Requirement => RODCUBE_ERR_SCENE_REQUIREMENT,
+    }
+}
+
+/// One point's separation, as the per-point solver returns it.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct RodcubePoint {
@@ -52,11 +411,19 @@ pub struct RodcubePoint {
     pub delta: f64,
 }
 
-/// A per-point solver of one model, owned by the caller through a pointer.
+/// A per-point solver of one model (opaque): made by `rodcube_solver_new`, released by
+/// `rodcube_solver_free`.
 pub struct RodcubeSolver {
     solver: LeanSolver<'static>,
     /// Scratch for parameters given by name.
     values: Vec<f64>,
+}
+
+/// A scene's results (opaque): the text of its `results.json`, made once by
+/// `rodcube_run_scene`, read by `rodcube_results_json`, `rodcube_results_len` and
+/// `rodcube_results_copy` (which never solve again), released by `rodcube_results_free`.
+pub struct RodcubeResults {
+    json: CString,
 }
 
 /// A failure: its code and message.
@@ -66,14 +433,32 @@ fn failure(code: c_int, message: impl Into<String>) -> Failure {
     Failure(code, message.into())
 }
 
-/// The code of a solver error.
-fn solve_failure(e: SolveError) -> Failure {
-    let code = match e {
-        SolveError::Parameters(_) => RODCUBE_ERR_PARAMETERS,
-        SolveError::NoContact { .. } | SolveError::NotPerPoint { .. } => RODCUBE_ERR_MODEL,
-        _ => RODCUBE_ERR_SOLVE,
-    };
-    failure(code, e.to_string())
+impl From<SystemError> for Failure {
+    fn from(e: SystemError) -> Self {
+        Failure(system_code(&e), e.to_string())
+    }
+}
+
+impl From<SolveError> for Failure {
+    fn from(e: SolveError) -> Self {
+        Failure(solve_code(&e), e.to_string())
+    }
+}
+
+impl From<PlanError> for Failure {
+    fn from(e: PlanError) -> Self {
+        Failure(plan_code(&e), e.to_string())
+    }
+}
+
+impl From<SceneError> for Failure {
+    fn from(e: SceneError) -> Self {
+        let code = e
+            .diagnostics
+            .first()
+            .map_or(RODCUBE_ERR_SCENE, |d| scene_kind_code(d.kind));
+        Failure(code, e.to_string())
+    }
 }
 
 /// Copies `message` into `err` (NUL-terminated, cut at a character boundary).
@@ -135,7 +520,7 @@ unsafe fn text<'a>(s: *const c_char, what: &str) -> Result<&'a str, Failure> {
     // SAFETY: the caller gives a NUL-terminated string.
     unsafe { CStr::from_ptr(s) }
         .to_str()
-        .map_err(|e| failure(RODCUBE_ERR_ARGUMENT, format!("{what} is not UTF-8: {e}")))
+        .map_err(|e| failure(RODCUBE_ERR_UTF8, format!("{what} is not UTF-8: {e}")))
 }
 
 /// `n` values at `p` as a slice (empty for `n == 0`, whatever `p`).
@@ -154,6 +539,18 @@ unsafe fn slice<'a, T>(p: *const T, n: usize, what: &str) -> Result<&'a [T], Fai
     }
     // SAFETY: the caller gives `n` readable values.
     Ok(unsafe { std::slice::from_raw_parts(p, n) })
+}
+
+/// The place behind an out pointer, set to NULL (what a failure leaves there).
+///
+/// # Safety
+/// `out` is NULL or points to one writable pointer.
+unsafe fn out_handle<'a, T>(out: *mut *mut T, what: &str) -> Result<&'a mut *mut T, Failure> {
+    // SAFETY: as the caller promises.
+    let slot = unsafe { out.as_mut() }
+        .ok_or_else(|| failure(RODCUBE_ERR_ARGUMENT, format!("{what} is NULL")))?;
+    *slot = std::ptr::null_mut();
+    Ok(slot)
 }
 
 /// The solver behind a handle.
@@ -212,73 +609,102 @@ fn names() -> &'static [(CString, Vec<CString>)] {
     })
 }
 
+/// The name of status code `code` as the header spells it (`"RODCUBE_ERR_AT_REST"`, static
+/// storage), or NULL for a number that is no code.
+#[unsafe(no_mangle)]
+pub extern "C" fn rodcube_error_name(code: c_int) -> *const c_char {
+    CODES
+        .iter()
+        .find(|(c, _)| *c == code)
+        .map_or(std::ptr::null(), |(_, name)| name.as_ptr())
+}
+
+/// The group of status code `code`: `RODCUBE_ERR_PARAMETERS`, `RODCUBE_ERR_REQUEST`,
+/// `RODCUBE_ERR_SOLVE` or `RODCUBE_ERR_SCENE` for the codes of a group (the group's own code
+/// included), the code itself for the others below 100 (`RODCUBE_OK` included), -1 for a
+/// number that is no code.
+#[unsafe(no_mangle)]
+pub extern "C" fn rodcube_error_group(code: c_int) -> c_int {
+    if rodcube_error_name(code).is_null() {
+        -1
+    } else if code < 100 {
+        code
+    } else {
+        code - code % 100
+    }
+}
+
 /// How many models are registered.
 #[unsafe(no_mangle)]
 pub extern "C" fn rodcube_model_count() -> usize {
     catch_unwind(|| names().len()).unwrap_or(0)
 }
 
-/// The name of model `index` (static storage), or NULL past the end.
+/// The name of model `model` (an index below `rodcube_model_count()`; static storage), or
+/// NULL past the end.
 #[unsafe(no_mangle)]
-pub extern "C" fn rodcube_model_name(index: usize) -> *const c_char {
+pub extern "C" fn rodcube_model_name(model: usize) -> *const c_char {
     catch_unwind(|| {
         names()
-            .get(index)
+            .get(model)
             .map_or(std::ptr::null(), |(n, _)| n.as_ptr())
     })
     .unwrap_or(std::ptr::null())
 }
 
-/// How many parameters model `index` takes.
+/// How many parameters model `model` (an index) takes; 0 past the end.
 #[unsafe(no_mangle)]
-pub extern "C" fn rodcube_parameter_count(index: usize) -> usize {
-    catch_unwind(|| names().get(index).map_or(0, |(_, p)| p.len())).unwrap_or(0)
+pub extern "C" fn rodcube_parameter_count(model: usize) -> usize {
+    catch_unwind(|| names().get(model).map_or(0, |(_, p)| p.len())).unwrap_or(0)
 }
 
-/// The name of parameter `parameter` of model `index` (static storage, in the order
-/// [`rodcube_solve`] takes the values), or NULL past the end.
+/// The name of parameter `parameter` of model `model` (indices; static storage), in the
+/// order `rodcube_solve` takes the values, or NULL past the end.
 #[unsafe(no_mangle)]
-pub extern "C" fn rodcube_parameter_name(index: usize, parameter: usize) -> *const c_char {
+pub extern "C" fn rodcube_parameter_name(model: usize, parameter: usize) -> *const c_char {
     catch_unwind(|| {
         names()
-            .get(index)
+            .get(model)
             .and_then(|(_, p)| p.get(parameter))
             .map_or(std::ptr::null(), |n| n.as_ptr())
     })
     .unwrap_or(std::ptr::null())
 }
 
-/// A per-point solver for the model named `model`, or NULL with the reason in `err`. Release
-/// it with [`rodcube_solver_free`].
+/// Makes a per-point solver for the model named `model` into `*solver` (NULL on failure).
+/// Release it with `rodcube_solver_free`. Fails with `RODCUBE_ERR_MODEL` for a name not in the
+/// registry, and with `RODCUBE_ERR_NOT_PER_POINT` or `RODCUBE_ERR_NO_CONTACT` for a model the
+/// per-point solver cannot solve (run it as a scene).
 ///
 /// # Safety
-/// `model` is a NUL-terminated string; `err` is NULL or points to `err_len` writable bytes.
+/// `model` is a NUL-terminated string; `solver` points to a writable pointer; `err` is NULL
+/// or points to `err_len` writable bytes.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn rodcube_solver_new(
     model: *const c_char,
+    solver: *mut *mut RodcubeSolver,
     err: *mut c_char,
     err_len: usize,
-) -> *mut RodcubeSolver {
-    let mut made = std::ptr::null_mut();
+) -> c_int {
     // SAFETY: forwarded from the caller.
     unsafe {
         guarded(err, err_len, || {
+            let slot = out_handle(solver, "the solver's out pointer")?;
             let m = find_model(text(model, "the model name")?)?;
-            let solver = LeanSolver::new(m).map_err(solve_failure)?;
-            made = Box::into_raw(Box::new(RodcubeSolver {
-                solver,
+            let lean = LeanSolver::new(m)?;
+            *slot = Box::into_raw(Box::new(RodcubeSolver {
+                solver: lean,
                 values: vec![0.0; m.info().parameters.len()],
             }));
             Ok(())
         })
-    };
-    made
+    }
 }
 
 /// Releases a solver (NULL is ignored).
 ///
 /// # Safety
-/// `solver` is NULL or a pointer from [`rodcube_solver_new`] not yet released.
+/// `solver` is NULL or a pointer from `rodcube_solver_new` not yet released.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn rodcube_solver_free(solver: *mut RodcubeSolver) {
     if !solver.is_null() {
@@ -288,11 +714,12 @@ pub unsafe extern "C" fn rodcube_solver_free(solver: *mut RodcubeSolver) {
 }
 
 /// Solves one point: `n_params` values in the model's parameter order
-/// ([`rodcube_parameter_name`]). Writes `*out` on success.
+/// (`rodcube_parameter_name`). Writes `*out` on success. Refused parameters fail with their
+/// `RODCUBE_ERR_PARAM_*` code, a failed solve with its code from the solver group.
 ///
 /// # Safety
-/// `solver` comes from [`rodcube_solver_new`]; `params` points to `n_params` values; `out` to
-/// one writable [`RodcubePoint`]; `err` is NULL or points to `err_len` writable bytes.
+/// `solver` comes from `rodcube_solver_new`; `params` points to `n_params` values; `out` to
+/// one writable `rodcube_point`; `err` is NULL or points to `err_len` writable bytes.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn rodcube_solve(
     solver: *mut RodcubeSolver,
@@ -308,7 +735,7 @@ pub unsafe extern "C" fn rodcube_solve(
             let s = solver_mut(solver)?;
             let out = output(out)?;
             let p = slice(params, n_params, "the parameters")?;
-            *out = s.solver.solve(p).map_err(solve_failure)?.into();
+            *out = s.solver.solve(p)?.into();
             Ok(())
         })
     }
@@ -318,7 +745,7 @@ pub unsafe extern "C" fn rodcube_solve(
 /// the model's parameters exactly once, in any order.
 ///
 /// # Safety
-/// As [`rodcube_solve`]; `names` points to `n` NUL-terminated strings and `values` to `n`
+/// As `rodcube_solve`; `names` points to `n` NUL-terminated strings and `values` to `n`
 /// values.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn rodcube_solve_named(
@@ -340,27 +767,84 @@ pub unsafe extern "C" fn rodcube_solve_named(
             for (i, (&name, &value)) in given.iter().zip(vals).enumerate() {
                 pairs.push((text(name, &format!("name {i}"))?, value));
             }
-            ordered_values(s.solver.model().info(), &pairs, &mut s.values)
-                .map_err(|e| failure(RODCUBE_ERR_PARAMETERS, e.to_string()))?;
+            ordered_values(s.solver.model().info(), &pairs, &mut s.values)?;
             let out = output(out)?;
-            *out = s.solver.solve(&s.values).map_err(solve_failure)?.into();
+            *out = s.solver.solve(&s.values)?.into();
             Ok(())
         })
     }
 }
 
-/// Runs a scene given as YAML text (the format of `scenes/*.yaml`) and writes its results as
-/// JSON (the `results.json` of `rodcube run`) into `json`, NUL-terminated. When `json_len` is
-/// too small, returns `RODCUBE_ERR_BUFFER` and sets `*needed` (also on success) to the bytes
-/// required, NUL included: call again with a buffer that large.
+/// Runs a scene given as YAML text (the format of the files in `scenes/`) once, and makes its
+/// results (the `results.json` of `rodcube run`) into `*results` (NULL on failure): read them
+/// with `rodcube_results_json`, `rodcube_results_len` or `rodcube_results_copy`, as often as
+/// wanted without solving again, and release them with `rodcube_results_free`. A refused
+/// scene fails with a `RODCUBE_ERR_SCENE_*` code (the kind of its first problem; the message
+/// lists every problem with its line and column), a failed solve with its code from the
+/// solver group.
 ///
 /// # Safety
-/// `scene_yaml` is a NUL-terminated string; `json` is NULL (with `json_len` 0) or points to
-/// `json_len` writable bytes; `needed` is NULL or points to a writable `size_t`; `err` as
-/// [`rodcube_solve`].
+/// `scene_yaml` is a NUL-terminated string; `results` points to a writable pointer; `err` is
+/// NULL or points to `err_len` writable bytes.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn rodcube_run_scene(
     scene_yaml: *const c_char,
+    results: *mut *mut RodcubeResults,
+    err: *mut c_char,
+    err_len: usize,
+) -> c_int {
+    // SAFETY: forwarded from the caller.
+    unsafe {
+        guarded(err, err_len, || {
+            let slot = out_handle(results, "the results' out pointer")?;
+            let yaml = text(scene_yaml, "the scene")?;
+            let scene = Scene::parse(yaml, Path::new("<scene>"), crate::models::all())?;
+            let request = Request::new(scene.model, scene.parameters.clone())
+                .with_want(&scene.want)
+                .with_tolerance(scene.tolerance)
+                .with_samples(scene.samples);
+            let run = plan::run(&request)?;
+            let json = crate::report::json::to_string(&run)
+                .map_err(|e| failure(RODCUBE_ERR_JSON, e.to_string()))?;
+            let json = CString::new(json).map_err(|e| failure(RODCUBE_ERR_JSON, e.to_string()))?;
+            *slot = Box::into_raw(Box::new(RodcubeResults { json }));
+            Ok(())
+        })
+    }
+}
+
+/// The results' JSON text, NUL-terminated, owned by `results` and valid until
+/// `rodcube_results_free`; NULL for NULL.
+///
+/// # Safety
+/// `results` is NULL or a live pointer from `rodcube_run_scene`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn rodcube_results_json(results: *const RodcubeResults) -> *const c_char {
+    // SAFETY: as the caller promises.
+    unsafe { results.as_ref() }.map_or(std::ptr::null(), |r| r.json.as_ptr())
+}
+
+/// The length of the results' JSON text in bytes, without its NUL (as `strlen`); 0 for NULL.
+///
+/// # Safety
+/// `results` is NULL or a live pointer from `rodcube_run_scene`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn rodcube_results_len(results: *const RodcubeResults) -> usize {
+    // SAFETY: as the caller promises.
+    unsafe { results.as_ref() }.map_or(0, |r| r.json.as_bytes().len())
+}
+
+/// Copies the results' JSON text, NUL-terminated, into `json` of `json_len` bytes. Sets
+/// `*needed` (when not NULL) to the bytes required, NUL included, and returns
+/// `RODCUBE_ERR_BUFFER` when `json_len` is smaller (`json` may then be NULL).
+///
+/// # Safety
+/// `results` is NULL or a live pointer from `rodcube_run_scene`; `json` is NULL or points to
+/// `json_len` writable bytes; `needed` is NULL or points to a writable `size_t`; `err` is
+/// NULL or points to `err_len` writable bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn rodcube_results_copy(
+    results: *const RodcubeResults,
     json: *mut c_char,
     json_len: usize,
     needed: *mut usize,
@@ -370,37 +854,36 @@ pub unsafe extern "C" fn rodcube_run_scene(
     // SAFETY: forwarded from the caller.
     unsafe {
         guarded(err, err_len, || {
-            let yaml = text(scene_yaml, "the scene")?;
-            let scene = Scene::parse(yaml, Path::new("<scene>"), crate::models::all())
-                .map_err(|e| failure(RODCUBE_ERR_SCENE, e.to_string()))?;
-            let request = Request::new(scene.model, scene.parameters.clone())
-                .with_want(&scene.want)
-                .with_tolerance(scene.tolerance)
-                .with_samples(scene.samples);
-            let results = plan::run(&request).map_err(|e| {
-                let code = match e {
-                    plan::PlanError::Solve(_) | plan::PlanError::NonFinite { .. } => {
-                        RODCUBE_ERR_SOLVE
-                    }
-                    _ => RODCUBE_ERR_SCENE,
-                };
-                failure(code, e.to_string())
-            })?;
-            let text = crate::report::json::to_string(&results)
-                .map_err(|e| failure(RODCUBE_ERR_SOLVE, e.to_string()))?;
-            let size = text.len() + 1;
+            let r = results
+                .as_ref()
+                .ok_or_else(|| failure(RODCUBE_ERR_ARGUMENT, "the results are NULL"))?;
+            let text = r.json.as_bytes_with_nul();
             if let Some(n) = needed.as_mut() {
-                *n = size;
+                *n = text.len();
             }
-            if json.is_null() || json_len < size {
+            if json.is_null() || json_len < text.len() {
                 return Err(failure(
                     RODCUBE_ERR_BUFFER,
-                    format!("the results need {size} bytes; the buffer has {json_len}"),
+                    format!(
+                        "the results need {} bytes; the buffer has {json_len}",
+                        text.len()
+                    ),
                 ));
             }
             std::ptr::copy_nonoverlapping(text.as_ptr(), json.cast::<u8>(), text.len());
-            *json.add(text.len()) = 0;
             Ok(())
         })
+    }
+}
+
+/// Releases a scene's results (NULL is ignored).
+///
+/// # Safety
+/// `results` is NULL or a pointer from `rodcube_run_scene` not yet released.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn rodcube_results_free(results: *mut RodcubeResults) {
+    if !results.is_null() {
+        // SAFETY: made by `Box::into_raw` in `rodcube_run_scene`, released once.
+        let _ = catch_unwind(AssertUnwindSafe(|| drop(unsafe { Box::from_raw(results) })));
     }
 }

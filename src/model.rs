@@ -307,6 +307,20 @@ pub const LEAN_OTHER_COEFFICIENTS: usize = 8;
 
 /// Evaluation functions of one generated model over its full state. All are allocation-free
 /// and evaluate each shared subexpression once per call.
+///
+/// # Contract
+/// These are the low-level, unchecked functions the solvers' inner loops call. The caller
+/// passes every slice at the length [`ModelInfo`] gives it: `p` one value per parameter, `k`
+/// [`ModelInfo::n_constants`] values (from [`Model::prepare`] of parameters that passed
+/// [`check_parameters`](crate::system::check_parameters)), `q`, `qd` and `qdd` one per
+/// coordinate, `q_full` and `qd_full` one per system coordinate, `forces` one per contact, and
+/// each output as its method says. A slice of another length makes the generated code index out
+/// of bounds and panic. Non-finite numbers never panic here; they give non-finite results.
+///
+/// [`Bound`](crate::system::Bound) and [`System`](crate::system::System) are the checked way to
+/// call them: they hold checked parameters and prepared constants, size every output, and
+/// refuse a [`State`](crate::system::State) or slice of the wrong length (or a value that is
+/// not finite) with a typed [`SystemError`](crate::system::SystemError) instead of panicking.
 pub trait Model: Send + Sync {
     /// Static description.
     fn info(&self) -> &'static ModelInfo;
@@ -481,6 +495,10 @@ pub trait Model: Send + Sync {
 
 /// The fast path of a model whose coordinates other than `theta` are cyclic: the motion as a
 /// function of the angle fallen `delta`, from the energy integral.
+///
+/// The same contract as [`Model`]'s: the caller passes `k` and every output at the lengths
+/// [`ModelInfo`] and [`ReductionInfo`] give; [`System`](crate::system::System) is the checked
+/// way to call these.
 pub trait Reduction: Send + Sync {
     /// Reduced state at `delta`: returns `(sin theta, cos theta, theta_dot^2, theta_ddot)`.
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced;

@@ -721,7 +721,22 @@ impl Ctx<'_> {
         let info = model.info();
         if !info.requirements.is_empty() {
             let mut margins = vec![0.0; info.requirements.len()];
-            for (r, margin) in failed_requirements(model, values, &mut margins) {
+            // `values` holds one value per parameter (`parameter_values`) and `margins` one
+            // entry per requirement, so a refusal here would be a bug: it is reported, not
+            // dropped.
+            let failed = match failed_requirements(model, values, &mut margins) {
+                Ok(failed) => failed,
+                Err(e) => {
+                    out.push(self.diag(
+                        Kind::Requirement,
+                        "parameters",
+                        At::Key,
+                        format!("the requirements could not be checked: {e}"),
+                    ));
+                    return;
+                }
+            };
+            for (r, margin) in failed {
                 {
                     let involved = involved_parameters(r.name, r.meaning, info);
                     let field =

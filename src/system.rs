@@ -6,6 +6,15 @@
 //! Architecture invariant: a [`Bound`] (and so a [`System`]) only exists for parameters that passed every check
 //! (all present, finite, positive where declared, every requirement margin `> 0`, every
 //! prepared constant finite), so the solvers never see a NaN that came from the input.
+//!
+//! Architecture invariant: no method here panics on any argument. The raw [`Model`] functions
+//! index their slices unchecked (their contract is the lengths [`ModelInfo`] gives); every
+//! method here that passes a [`State`] or a slice to one checks its length against the model
+//! first ([`SystemError::Length`]), and refuses a value that is not finite where the model's
+//! formulas would carry it into the result ([`SystemError::NotFiniteInput`]). A [`State`]'s
+//! coordinates and velocities always have one length ([`State::new`] also refuses non-finite
+//! values), so one comparison checks it. The checks cost a comparison per call; the per-point
+//! solver's route never comes through here.
 
 use crate::model::{Model, ModelInfo, Reduced, Reduction, ReductionInfo};
 use std::collections::BTreeMap;
@@ -114,6 +123,36 @@ pub enum SystemError {
         /// Why, from the derivation.
         why: &'static str,
     },
+    /// A state's coordinates and velocities of different lengths ([`State::new`]).
+    #[error("a state needs as many velocities as coordinates: q has {q} values, qd {qd}")]
+    StateShape {
+        /// Values in `q`.
+        q: usize,
+        /// Values in `qd`.
+        qd: usize,
+    },
+    /// A state, or a slice passed with one, whose length is not the model's.
+    #[error("model `{model}` takes {expected} values in `{what}`, got {got}")]
+    Length {
+        /// Model name.
+        model: &'static str,
+        /// Which argument (`state`, `qdd`, `forces`).
+        what: &'static str,
+        /// Values the model takes.
+        expected: usize,
+        /// Values given.
+        got: usize,
+    },
+    /// A value given to a model's function that is NaN or infinite.
+    #[error("`{what}[{index}]` is {value}, not a finite number")]
+    NotFiniteInput {
+        /// Which argument (`q`, `qd`, `qdd`, `forces`, `delta`, ...).
+        what: &'static str,
+        /// Its index (0 for a scalar).
+        index: usize,
+        /// The value.
+        value: f64,
+    },
     /// `Model::prepare` produced a non-finite constant (a bug in the model or an extreme input).
     #[error(
         "model `{model}` prepared a non-finite constant k[{index}] = {value} from {parameters}"
@@ -132,12 +171,82 @@ pub enum SystemError {
 
 /// A full (unreduced) state: coordinates and velocities in the order of
 /// [`ModelInfo::coordinates`].
+///
+/// Its coordinates and velocities always have the same length, and one built by
+/// [`State::new`] (or [`Bound::state`], which also checks the length against a model) holds
+/// finite values only. Which model a state belongs to is not part of it: every [`Bound`]
+/// method that takes one checks its length against the model and returns
+/// [`SystemError::Length`] otherwise.
 #[derive(Debug, Clone, PartialEq)]
 pub struct State {
-    /// Coordinates.
-    pub q: Vec<f64>,
-    /// Velocities.
-    pub qd: Vec<f64>,
+    pub(crate) q: Vec<f64>,
+    pub(crate) qd: Vec<f64>,
+}
+
+impl State {
+    /// A state from its coordinates and velocities: as many of each, every value finite
+    /// ([`SystemError::StateShape`], [`SystemError::NotFiniteInput`] otherwise).
+    pub fn new(q: Vec<f64>, qd: Vec<f64>) -> Result<State, SystemError> {
+        if q.len() != qd.len() {
+            return Err(SystemError::StateShape {
+                q: q.len(),
+                qd: qd.len(),
+            });
+        }
+        finite("q", &q)?;
+        finite("qd", &qd)?;
+        Ok(State { q, qd })
+    }
+
+    /// A state of `n` coordinates, all zero and at rest (filled by the model's functions).
+    pub(crate) fn zeros(n: usize) -> State {
+        State {
+            q: vec![0.0; n],
+            qd: vec![0.0; n],
+        }
+    }
+
+    /// The coordinates.
+    pub fn q(&self) -> &[f64] {
+        &self.q
+    }
+
+    /// The velocities.
+    pub fn qd(&self) -> &[f64] {
+        &self.qd
+    }
+
+    /// The number of coordinates.
+    pub fn len(&self) -> usize {
+        self.q.len()
+    }
+
+    /// Whether the state has no coordinates.
+    pub fn is_empty(&self) -> bool {
+        self.q.is_empty()
+    }
+
+    /// The coordinates and velocities.
+    pub fn into_parts(self) -> (Vec<f64>, Vec<f64>) {
+        (self.q, self.qd)
+    }
+}
+
+/// `Ok` when every value of `values` is finite, else the first that is not, named `what`.
+fn finite(what: &'static str, values: &[f64]) -> Result<(), SystemError> {
+    match values.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(index) => Err(SystemError::NotFiniteInput {
+            what,
+            index,
+            value: values[index],
+        }),
+    }
+}
+
+/// `Ok` when `value` is finite, else [`SystemError::NotFiniteInput`] naming it.
+fn finite_scalar(what: &'static str, value: f64) -> Result<(), SystemError> {
+    finite(what, &[value])
 }
 
 /// Positions and velocities of every named point of a model, in the order of
@@ -269,18 +378,50 @@ impl<'m> Bound<'m> {
 
     /// The state at release.
     pub fn initial_state(&self) -> State {
-        let n = self.n_coordinates();
-        let mut state = State {
-            q: vec![0.0; n],
-            qd: vec![0.0; n],
-        };
+        let mut state = State::zeros(self.n_coordinates());
         self.model
             .initial_state(&self.k, &mut state.q, &mut state.qd);
         state
     }
 
+    /// A state of this model: [`State::new`] with the length checked against the model's
+    /// coordinates ([`SystemError::Length`]).
+    pub fn state(&self, q: Vec<f64>, qd: Vec<f64>) -> Result<State, SystemError> {
+        let state = State::new(q, qd)?;
+        self.check_state(&state)?;
+        Ok(state)
+    }
+
+    /// `Ok` when `state` has this model's number of coordinates, else
+    /// [`SystemError::Length`]: the check every method here that takes a state makes first.
+    #[inline]
+    pub fn check_state(&self, state: &State) -> Result<(), SystemError> {
+        self.check_length("state", self.n_coordinates(), state.len())
+    }
+
+    /// `Ok` when `got == expected`, else [`SystemError::Length`] naming `what`.
+    #[inline]
+    fn check_length(
+        &self,
+        what: &'static str,
+        expected: usize,
+        got: usize,
+    ) -> Result<(), SystemError> {
+        if got == expected {
+            Ok(())
+        } else {
+            Err(SystemError::Length {
+                model: self.name(),
+                what,
+                expected,
+                got,
+            })
+        }
+    }
+
     /// Positions and velocities of the named points.
-    pub fn points(&self, state: &State) -> Points {
+    pub fn points(&self, state: &State) -> Result<Points, SystemError> {
+        self.check_state(state)?;
         let m = self.info().points.len();
         let mut pts = Points {
             pos: vec![[0.0; 2]; m],
@@ -288,7 +429,7 @@ impl<'m> Bound<'m> {
         };
         self.model
             .points(&self.k, &state.q, &state.qd, &mut pts.pos, &mut pts.vel);
-        pts
+        Ok(pts)
     }
 
     /// Index of a named point.
@@ -297,25 +438,28 @@ impl<'m> Bound<'m> {
     }
 
     /// Total energy of a full state.
-    pub fn energy(&self, state: &State) -> f64 {
-        self.model.energy(&self.k, &state.q, &state.qd)
+    pub fn energy(&self, state: &State) -> Result<f64, SystemError> {
+        self.check_state(state)?;
+        Ok(self.model.energy(&self.k, &state.q, &state.qd))
     }
 
     /// Momenta conjugate to the cyclic coordinates.
-    pub fn momenta(&self, state: &State) -> Vec<f64> {
+    pub fn momenta(&self, state: &State) -> Result<Vec<f64>, SystemError> {
+        self.check_state(state)?;
         let mut out = vec![0.0; self.info().cyclic.len()];
         self.model.momenta(&self.k, &state.q, &state.qd, &mut out);
-        out
+        Ok(out)
     }
 
     /// The mass matrix (row-major) and right-hand side of `M(q) qdd = F(q, qd)`.
-    pub fn equations(&self, state: &State) -> (Vec<f64>, Vec<f64>) {
+    pub fn equations(&self, state: &State) -> Result<(Vec<f64>, Vec<f64>), SystemError> {
+        self.check_state(state)?;
         let n = self.n_coordinates();
         let mut mass = vec![0.0; n * n];
         let mut rhs = vec![0.0; n];
         self.model
             .equations(&self.k, &state.q, &state.qd, &mut mass, &mut rhs);
-        (mass, rhs)
+        Ok((mass, rhs))
     }
 
     /// Number of contacts of the system.
@@ -324,60 +468,65 @@ impl<'m> Bound<'m> {
     }
 
     /// The forces of the contacts this model holds closed by elimination (one per contact;
-    /// zero for the others) from a full state and its accelerations.
-    pub fn forces_full(&self, state: &State, qdd: &[f64]) -> Vec<f64> {
+    /// zero for the others) from a full state and its accelerations (one per coordinate, each
+    /// finite).
+    pub fn forces_full(&self, state: &State, qdd: &[f64]) -> Result<Vec<f64>, SystemError> {
+        self.check_state(state)?;
+        self.check_length("qdd", self.n_coordinates(), qdd.len())?;
+        finite("qdd", qdd)?;
         let mut out = vec![0.0; self.n_contacts()];
         self.model
             .forces_full(&self.k, &state.q, &state.qd, qdd, &mut out);
-        out
+        Ok(out)
     }
 
     /// Every contact's gap (zero for those this model holds closed).
-    pub fn gaps(&self, state: &State) -> Vec<f64> {
+    pub fn gaps(&self, state: &State) -> Result<Vec<f64>, SystemError> {
+        self.check_state(state)?;
         let mut out = vec![0.0; self.n_contacts()];
         self.model.gaps(&self.k, &state.q, &mut out);
-        out
+        Ok(out)
     }
 
     /// Every contact's constraint row `J = d gap / dq` (row-major, one row per contact) and
     /// bias `dJ/dt qd`: a contact's normal acceleration is `J qdd + bias`.
-    pub fn constraints(&self, state: &State) -> (Vec<f64>, Vec<f64>) {
+    pub fn constraints(&self, state: &State) -> Result<(Vec<f64>, Vec<f64>), SystemError> {
+        self.check_state(state)?;
         let m = self.n_contacts();
         let mut jac = vec![0.0; m * self.n_coordinates()];
         let mut bias = vec![0.0; m];
         self.model
             .constraints(&self.k, &state.q, &state.qd, &mut jac, &mut bias);
-        (jac, bias)
+        Ok((jac, bias))
     }
 
     /// Every contact's edge margin (`+inf` for a contact without an edge).
-    pub fn edges(&self, state: &State) -> Vec<f64> {
+    pub fn edges(&self, state: &State) -> Result<Vec<f64>, SystemError> {
+        self.check_state(state)?;
         let mut out = vec![0.0; self.n_contacts()];
         self.model.edges(&self.k, &state.q, &mut out);
-        out
+        Ok(out)
     }
 
     /// The system's state (the general model's coordinates) this model's state stands for.
-    pub fn to_full(&self, state: &State) -> State {
-        let n = self.info().system_coordinates.len();
-        let mut full = State {
-            q: vec![0.0; n],
-            qd: vec![0.0; n],
-        };
+    pub fn to_full(&self, state: &State) -> Result<State, SystemError> {
+        self.check_state(state)?;
+        let mut full = State::zeros(self.info().system_coordinates.len());
         self.model
             .to_full(&self.k, &state.q, &state.qd, &mut full.q, &mut full.qd);
-        full
+        Ok(full)
     }
 
     /// The frictions' slip-velocity Jacobian `J` (row-major, one row per friction) and the
     /// part of the slip acceleration free of `qdd`: `v = J qd`, `dv/dt = J qdd + bias`.
-    pub fn friction(&self, state: &State) -> (Vec<f64>, Vec<f64>) {
+    pub fn friction(&self, state: &State) -> Result<(Vec<f64>, Vec<f64>), SystemError> {
+        self.check_state(state)?;
         let m = self.info().frictions.len();
         let mut jac = vec![0.0; m * self.n_coordinates()];
         let mut bias = vec![0.0; m];
         self.model
             .friction(&self.k, &state.q, &state.qd, &mut jac, &mut bias);
-        (jac, bias)
+        Ok((jac, bias))
     }
 
     /// The friction coefficient of each friction.
@@ -387,26 +536,43 @@ impl<'m> Bound<'m> {
             .collect()
     }
 
-    /// Monitor values (each must stay `>= 0`) at a state with the contacts' forces there.
-    pub fn monitors_full(&self, state: &State, forces: &[f64]) -> Vec<f64> {
+    /// Monitor values (each must stay `>= 0`) at a state with the contacts' forces there (one
+    /// per contact, each finite).
+    pub fn monitors_full(&self, state: &State, forces: &[f64]) -> Result<Vec<f64>, SystemError> {
+        self.check_state(state)?;
+        self.check_length("forces", self.n_contacts(), forces.len())?;
+        finite("forces", forces)?;
         let mut out = vec![0.0; self.info().monitors.len()];
         self.model
             .monitors_full(&self.k, &state.q, &state.qd, forces, &mut out);
-        out
+        Ok(out)
+    }
+
+    /// The drawing of a state: each body's pose `[x, y, angle]` (in the order of
+    /// [`ModelInfo::bodies`]) and the numbers of every shape ([`ModelInfo::shapes`]).
+    pub fn drawing(&self, state: &State) -> Result<(Vec<[f64; 3]>, Vec<f64>), SystemError> {
+        self.check_state(state)?;
+        let info = self.info();
+        let mut poses = vec![[0.0; 3]; info.bodies.len()];
+        let mut sizes = vec![0.0; info.drawing_sizes()];
+        self.model
+            .drawing(&self.k, &state.q, &mut poses, &mut sizes);
+        Ok((poses, sizes))
     }
 
     /// A typical length of the system at a state: the largest distance of a named point from
-    /// the origin (1 m for a model without points), against which gaps in metres are measured.
-    pub fn length_scale(&self, state: &State) -> f64 {
-        let pts = self.points(state);
+    /// the origin (1 m for a model without points, or where that distance is not finite),
+    /// against which gaps in metres are measured.
+    pub fn length_scale(&self, state: &State) -> Result<f64, SystemError> {
+        let pts = self.points(state)?;
         let reach = (pts.pos.iter())
             .map(|p| p[0].hypot(p[1]))
             .fold(0.0f64, f64::max);
-        if reach > 0.0 && reach.is_finite() {
+        Ok(if reach > 0.0 && reach.is_finite() {
             reach
         } else {
             1.0
-        }
+        })
     }
 }
 
@@ -513,23 +679,29 @@ impl<'m> System<'m> {
         self.theta_initial() - self.end_angle()
     }
 
-    /// Reduced state at `delta = theta_i - theta`.
-    pub fn reduced(&self, delta: f64) -> Reduced {
-        self.reduction.reduced(self.k(), delta)
+    /// Reduced state at `delta = theta_i - theta`. Any finite `delta` gives the model's
+    /// formulas' values (outside the phase, `[0, delta_to_floor]`, `theta_dot_sq` may be
+    /// negative: no motion reaches there); a `delta` that is not finite is
+    /// [`SystemError::NotFiniteInput`].
+    pub fn reduced(&self, delta: f64) -> Result<Reduced, SystemError> {
+        finite_scalar("delta", delta)?;
+        Ok(self.reduction.reduced(self.k(), delta))
     }
 
     /// Reduced state at an angle `theta` (loses the cancellation-free form near the start:
     /// prefer [`System::reduced`] with `delta`).
-    pub fn reduced_at_theta(&self, theta: f64) -> Reduced {
+    pub fn reduced_at_theta(&self, theta: f64) -> Result<Reduced, SystemError> {
+        finite_scalar("theta", theta)?;
         self.reduced(self.theta_initial() - theta)
     }
 
     /// Every contact's force at `delta`, in the order of [`ModelInfo::contacts`] (zero for a
-    /// contact open in the phase).
-    pub fn forces(&self, delta: f64) -> Vec<f64> {
+    /// contact open in the phase); as [`System::reduced`] for `delta` outside the phase.
+    pub fn forces(&self, delta: f64) -> Result<Vec<f64>, SystemError> {
+        finite_scalar("delta", delta)?;
         let mut out = vec![0.0; self.info().contacts.len()];
         self.reduction.forces(self.k(), delta, &mut out);
-        out
+        Ok(out)
     }
 
     /// Coefficients of contact `contact`'s force polynomial in `sin(theta)`, lowest degree
@@ -557,16 +729,15 @@ impl<'m> System<'m> {
     }
 
     /// The full state on the reduced motion at phase time `t`, angle fallen `delta` and rate
-    /// `theta_dot`.
-    pub fn full_state(&self, t: f64, delta: f64, theta_dot: f64) -> State {
-        let n = self.n_coordinates();
-        let mut state = State {
-            q: vec![0.0; n],
-            qd: vec![0.0; n],
-        };
+    /// `theta_dot`; an argument that is not finite is [`SystemError::NotFiniteInput`].
+    pub fn full_state(&self, t: f64, delta: f64, theta_dot: f64) -> Result<State, SystemError> {
+        finite_scalar("t", t)?;
+        finite_scalar("delta", delta)?;
+        finite_scalar("theta_dot", theta_dot)?;
+        let mut state = State::zeros(self.n_coordinates());
         self.reduction
             .full_state(self.k(), t, delta, theta_dot, &mut state.q, &mut state.qd);
-        state
+        Ok(state)
     }
 }
 
@@ -655,19 +826,36 @@ pub fn check_value(info: &'static ModelInfo, i: usize, value: f64) -> Result<(),
 }
 
 /// The requirements of [`ModelInfo::requirements`] that `p` fails, with their margins
-/// (`margins` is scratch of one entry per requirement; `p` must hold valid values).
+/// (`margins` is scratch of one entry per requirement; `p` must hold finite values, one per
+/// parameter). Counts that are not the model's are an error, not a verdict.
 pub fn failed_requirements<'a>(
     model: &dyn Model,
     p: &[f64],
     margins: &'a mut [f64],
-) -> impl Iterator<Item = (&'static crate::model::NamedInfo, f64)> + 'a {
+) -> Result<impl Iterator<Item = (&'static crate::model::NamedInfo, f64)> + 'a, SystemError> {
     let info = model.info();
+    if p.len() != info.parameters.len() {
+        return Err(SystemError::WrongCount {
+            model: info.name,
+            expected: info.parameters.len(),
+            got: p.len(),
+        });
+    }
+    if margins.len() != info.requirements.len() {
+        return Err(SystemError::Length {
+            model: info.name,
+            what: "margins",
+            expected: info.requirements.len(),
+            got: margins.len(),
+        });
+    }
     model.requirements(p, margins);
-    info.requirements
+    Ok(info
+        .requirements
         .iter()
         .zip(margins.iter())
         .filter(|(_, m)| m.is_nan() || **m <= 0.0)
-        .map(|(r, m)| (r, *m))
+        .map(|(r, m)| (r, *m)))
 }
 
 /// The one validation of a model's parameter values, in the order of
@@ -727,7 +915,7 @@ fn parameters_refused(
     for (i, &value) in p.iter().enumerate() {
         check_value(info, i, value)?;
     }
-    if let Some((req, margin)) = failed_requirements(model, p, margins).next() {
+    if let Some((req, margin)) = failed_requirements(model, p, margins)?.next() {
         return Err(SystemError::Requirement {
             model: info.name,
             name: req.name,
@@ -751,9 +939,17 @@ pub(crate) fn positive_finite(v: f64) -> bool {
 /// parameters and refuses any that is not finite.
 pub fn prepare_constants(model: &dyn Model, p: &[f64], k: &mut [f64]) -> Result<(), SystemError> {
     let info = model.info();
-    if k.len() != info.n_constants {
+    if p.len() != info.parameters.len() {
         return Err(SystemError::WrongCount {
             model: info.name,
+            expected: info.parameters.len(),
+            got: p.len(),
+        });
+    }
+    if k.len() != info.n_constants {
+        return Err(SystemError::Length {
+            model: info.name,
+            what: "k",
             expected: info.n_constants,
             got: k.len(),
         });

@@ -6,7 +6,7 @@
 mod common;
 
 use common::paper::{FREE_ROD, GENERAL, MODELS, ROD_CUBE, free_after, paper};
-use common::tweaked::{LOW_MONITORS, registry};
+use common::tweaked::{INFINITE_MONITORS, LOW_MONITORS, registry};
 use rodcube::model::Model;
 use rodcube::plan::{Request, run};
 use rodcube::quantity::Quantity;
@@ -16,7 +16,7 @@ use rodcube::solve::contacts::Active;
 use rodcube::solve::phases::{End, PhaseRun, ReducedRun, Route, Walker, phase_end};
 use rodcube::solve::series::{sample, sample_forces};
 use rodcube::solve::unreduced::{self, EndEvent, Start};
-use rodcube::system::{Bound, System};
+use rodcube::system::{Bound, State, System};
 
 fn walker(registry: &'static [&'static dyn Model], route: Route) -> Walker<'static> {
     Walker {
@@ -43,7 +43,7 @@ fn a_monitor_below_zero_fails_with_its_minimum_as_value() {
     let samples = sample(&phase, 50, &mut Work::default()).unwrap();
     let forces = sample_forces(&phase, &samples).unwrap();
     let ctx = checks::Context::new("rod_cube_closed");
-    let found = checks::monitors(bound, &samples, &forces, 1e-12, &ctx);
+    let found = checks::monitors(bound, &samples, &forces, 1e-12, &ctx).unwrap();
     let tip = &found
         .iter()
         .find(|(k, _)| k == "rod_cube_closed.cube_does_not_tip")
@@ -58,7 +58,7 @@ fn a_monitor_below_zero_fails_with_its_minimum_as_value() {
     assert_eq!(tip.margin, tip.value - tip.limit);
     assert!(tip.at_time.is_some_and(|t| t >= 0.0), "{tip:?}");
     let plain = Bound::new(&ROD_CUBE, &paper(9.81)).unwrap();
-    let untweaked = checks::monitors(&plain, &samples, &forces, 1e-12, &ctx);
+    let untweaked = checks::monitors(&plain, &samples, &forces, 1e-12, &ctx).unwrap();
     let least = untweaked[0].1.value;
     assert!(untweaked[0].1.passed && least > 3.5, "{:?}", untweaked[0]);
     assert!((tip.value - (least - 4.0)).abs() < 1e-12, "{tip:?}");
@@ -88,6 +88,81 @@ fn a_monitor_below_zero_fails_with_its_minimum_as_value() {
         .map(|(k, _)| k)
         .collect();
     assert_eq!(failed, ["rod_cube_closed.cube_does_not_tip"]);
+}
+
+#[test]
+fn a_monitor_at_minus_infinity_fails() {
+    // An allowance scaled by the monitor's own largest magnitude would be infinite here, and
+    // `-inf >= -inf` would pass: the check must not depend on the value it judges.
+    let phase = release_phase(registry(&INFINITE_MONITORS));
+    let samples = sample(&phase, 50, &mut Work::default()).unwrap();
+    let forces = sample_forces(&phase, &samples).unwrap();
+    let ctx = checks::Context::new("rod_cube_closed");
+    let found = checks::monitors(phase.bound(), &samples, &forces, 1e-12, &ctx).unwrap();
+    let tip = &found[0].1;
+    assert_eq!(found[0].0, "rod_cube_closed.cube_does_not_tip");
+    assert!(!tip.passed && tip.value == f64::NEG_INFINITY, "{tip:?}");
+    assert!(tip.limit.is_finite(), "{tip:?}");
+    // Through the planner: the run goes on, and its checks say the monitor failed.
+    let request = Request::new(&GENERAL, paper(9.81))
+        .with_want(&[Quantity::Checks])
+        .with_registry(registry(&INFINITE_MONITORS));
+    let r = run(&request).unwrap();
+    assert!(!r.checks["rod_cube_closed.cube_does_not_tip"].passed);
+}
+
+#[test]
+fn energy_drift_is_judged_against_the_motion_not_a_constant_potential() {
+    // m2 = 1e6 m1: the cube's potential m2 g a / 2 is about 1.2e6 J and constant (the cube
+    // slides on the floor), while the motion's energies are of order m1 g ell = 10 J. A drift
+    // of 1e-6 of the motion's energy (a million times the tolerance) must fail at 1e-12;
+    // measured against |E| it would look like 1e-12 and pass. (Rounding in E itself, 16 ulps
+    // of 1.2e6 J or about 4e-9 J, is allowed: a drift below that is not measurable in f64.)
+    let mut p = paper(9.81);
+    p[1].1 = 1e6;
+    let sys = Bound::new(&ROD_CUBE, &p).unwrap();
+    let w = Walker {
+        general: Bound::new(&GENERAL, &p).unwrap(),
+        registry: MODELS,
+        tol: 1e-12,
+        rtol: 1e-12,
+        route: Route::Fastest,
+    };
+    let (start, _) = w.release().unwrap();
+    let phase = w.solve(&start, &mut Work::default()).unwrap();
+    assert_eq!(phase.bound().info().name, sys.info().name);
+    let mut samples = sample(&phase, 50, &mut Work::default()).unwrap();
+    let ctx = checks::Context::new("rod_cube_closed");
+    let conserved = Conserved::each_cyclic(phase.bound());
+    let ok = checks::drift(
+        phase.bound(),
+        &samples.states,
+        &conserved,
+        1e-12,
+        &ctx,
+        CheckKind::Identity,
+    )
+    .unwrap();
+    assert!(ok.iter().all(|(_, c)| c.passed), "{ok:?}");
+    // The rod's angular velocity 5e-7 too fast at the last sample: its kinetic energy (most
+    // of the motion's there) 1e-6 of itself too large.
+    let last = samples.states.len() - 1;
+    let (q, mut qd) = samples.states[last].clone().into_parts();
+    qd[1] *= 1.0 + 5e-7;
+    samples.states[last] = State::new(q, qd).unwrap();
+    let bad = checks::drift(
+        phase.bound(),
+        &samples.states,
+        &conserved,
+        1e-12,
+        &ctx,
+        CheckKind::Drift,
+    )
+    .unwrap();
+    let energy = &bad[0].1;
+    assert_eq!(bad[0].0, "rod_cube_closed.energy");
+    assert!(!energy.passed, "{energy:?}");
+    assert!(energy.value > 1e-8 && energy.value < 1e-5, "{energy:?}");
 }
 
 #[test]
@@ -139,7 +214,8 @@ fn drift_beyond_the_tolerance_fails() {
         1e-12,
         &ctx,
         CheckKind::Identity,
-    );
+    )
+    .unwrap();
     let keys: Vec<&str> = ok.iter().map(|(k, _)| k.as_str()).collect();
     assert_eq!(
         keys,
@@ -150,10 +226,12 @@ fn drift_beyond_the_tolerance_fails() {
     // and the foot 1e-6 m/s faster still (the horizontal momentum, zero throughout, off by
     // (m1 + m2) 1e-6 kg m/s).
     let last = samples.states.len() - 1;
-    for v in &mut samples.states[last].qd {
+    let (q, mut qd) = samples.states[last].clone().into_parts();
+    for v in &mut qd {
         *v *= 1.0 + 1e-6;
     }
-    samples.states[last].qd[0] += 1e-6;
+    qd[0] += 1e-6;
+    samples.states[last] = State::new(q, qd).unwrap();
     let bad = checks::drift(
         bound,
         &samples.states,
@@ -161,7 +239,8 @@ fn drift_beyond_the_tolerance_fails() {
         1e-12,
         &ctx,
         CheckKind::Drift,
-    );
+    )
+    .unwrap();
     for (key, c) in &bad {
         assert!(
             !c.passed && c.value > 1e-8 && c.margin < 0.0,
@@ -177,7 +256,8 @@ fn drift_beyond_the_tolerance_fails() {
         1e-4,
         &ctx,
         CheckKind::Drift,
-    );
+    )
+    .unwrap();
     assert!(loose.iter().all(|(_, c)| c.passed), "{loose:?}");
 }
 
@@ -194,7 +274,7 @@ fn a_closed_gap_that_opens_fails_its_check() {
     let mut states = run.run.states();
     let closed = vec![vec![true, true]; states.len()];
     let ctx = checks::Context::new("rod_cube.1");
-    let ok = checks::constraint_drift(&w.general, &states, &closed, 1e-10, &ctx);
+    let ok = checks::constraint_drift(&w.general, &states, &closed, 1e-10, &ctx).unwrap();
     let keys: Vec<&str> = ok.iter().map(|(k, _)| k.as_str()).collect();
     assert_eq!(
         keys,
@@ -207,8 +287,10 @@ fn a_closed_gap_that_opens_fails_its_check() {
     // The foot 1 um above the floor at one state: 1e-6 of the system's length (the tip's
     // reach, 1 m), far beyond 1e-10.
     let k = states.len() / 2;
-    states[k].q[1] = 1e-6;
-    let lifted = checks::constraint_drift(&w.general, &states, &closed, 1e-10, &ctx);
+    let (mut q, qd) = states[k].clone().into_parts();
+    q[1] = 1e-6;
+    states[k] = State::new(q, qd).unwrap();
+    let lifted = checks::constraint_drift(&w.general, &states, &closed, 1e-10, &ctx).unwrap();
     let floor = &lifted[1].1;
     assert!(!floor.passed, "{floor:?}");
     assert!((floor.value - 1e-6).abs() < 1e-9, "{floor:?}");
@@ -216,7 +298,7 @@ fn a_closed_gap_that_opens_fails_its_check() {
     // A contact open at that state is not held to its gap.
     let mut open = closed.clone();
     open[k][1] = false;
-    let excused = checks::constraint_drift(&w.general, &states, &open, 1e-10, &ctx);
+    let excused = checks::constraint_drift(&w.general, &states, &open, 1e-10, &ctx).unwrap();
     assert!(excused.iter().all(|(_, c)| c.passed), "{excused:?}");
 }
 
@@ -231,7 +313,7 @@ fn a_cube_running_into_the_tip_ends_the_motion() {
     // 1 - cos(0.2) = 0.0199 m closes at about 1.1 m/s, long before the rod lies flat.
     let p = free_after(0.2, -1.0, 0.0, 1.0);
     let sys = System::new(&FREE_ROD, &p).unwrap();
-    let gap0 = sys.bound().gaps(&sys.bound().initial_state())[0];
+    let gap0 = sys.bound().gaps(&sys.bound().initial_state()).unwrap()[0];
     assert!((gap0 - (1.0 - 0.2f64.cos())).abs() < 1e-15, "{gap0}");
     let mut work = Work::default();
     let end = phase_end(&sys, &mut work).unwrap();
@@ -244,13 +326,13 @@ fn a_cube_running_into_the_tip_ends_the_motion() {
     assert_eq!(run.end.end, End::Contact(0));
     let t_meet = run.mesh.duration;
     assert!(t_meet > 0.0 && t_meet < 0.03, "{t_meet}");
-    let at = run.end_state();
-    let gap = sys.bound().gaps(&at)[0];
+    let at = run.end_state().unwrap();
+    let gap = sys.bound().gaps(&at).unwrap()[0];
     assert!(gap.abs() < 1e-12, "{gap}");
     // The integrated route from the same state (the general model, only the foot's contact
     // closed) meets the cube at the same time.
     let start = Start {
-        state: sys.to_full(&sys.bound().initial_state()),
+        state: sys.to_full(&sys.bound().initial_state()).unwrap(),
         active: Active {
             closed: vec![false, true],
             modes: vec![],

@@ -23,7 +23,7 @@ use rodcube::solve::phases::{Route, Walker};
 use rodcube::system::Bound;
 
 /// The paper's separation time (scenes/paper.yaml: m1 = 1, m2 = 3, ell = 1, a = 0.25,
-/// g = 9.81), exact to f64 (tests/hard_cases.rs, tests/general_models.rs).
+/// g = 9.81) to 15 digits, held to the 256-bit reference by `tests/hard_cases.rs`.
 const PAPER_T_SEP: f64 = 0.108493254170856;
 
 /// The paper's parameters (scenes/paper.yaml, scenes/liftoff.yaml).

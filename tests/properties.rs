@@ -229,7 +229,8 @@ fn check_fast_phase(model: &'static dyn Model, u: &[f64], spread: u8) -> Result<
         tol,
         &checks::Context::new(info.name),
         CheckKind::Identity,
-    );
+    )
+    .expect("the samples are the model's states");
     prop_assert!(found.iter().any(|(k, _)| k.ends_with(".energy")));
     for (key, check) in found {
         prop_assert!(check.passed, "{key}: {} at {p:?}", check.meaning);
@@ -322,7 +323,7 @@ fn check_theta_dot_sq_sc(model: &'static dyn Model, u: &[f64], spread: u8, frac:
         return;
     }
     let p = parameters(model, u, spread);
-    let sys = rodcube::system::System::from_values(model, &p).expect("valid parameters");
+    let sys = System::from_values(model, &p).expect("valid parameters");
     let k = sys.k();
     let (theta_i, sin_i, cos_i) = (
         k[info.reduction.unwrap().k_theta_initial],

@@ -1,7 +1,8 @@
 //! The Python package (`python/`): built by `pip install ./python` (maturin) in a fresh virtual
 //! environment under the test's temporary directory, then its pytest suite (`python/tests`,
 //! the README's Python example included) runs against it. Needs `python3` with `venv` and
-//! the Python package registry (for maturin, NumPy and pytest); `.ci/run` installs them.
+//! the Python package registry (for maturin, NumPy and pytest, at the versions pinned in
+//! `python/requirements-test.txt`); `.ci/run` installs them.
 
 use std::path::Path;
 use std::process::Command;
@@ -43,8 +44,11 @@ fn the_python_package_installs_and_passes_its_tests() {
         "--quiet",
         "--disable-pip-version-check",
     ];
+    // The exact versions `.ci/run` installs too.
+    let requirements = root.join("python/requirements-test.txt");
+    let requirements = requirements.to_str().expect("UTF-8 path");
     let mut deps = quiet.to_vec();
-    deps.extend(["maturin>=1.5,<2", "numpy", "pytest"]);
+    deps.extend(["-r", requirements]);
     run(&python, &deps, &tmp, &[]);
     // Built in place from python/, with its own target directory (not the test run's).
     let target = tmp.join("target");

@@ -44,7 +44,7 @@ fn paper_series_is_uniform_in_time_and_ends_at_separation() {
     assert!((s.theta[200].to_degrees() - 9.61).abs() < 0.005);
     for j in 1..201 {
         assert!(s.theta[j] < s.theta[j - 1] && s.theta_dot[j] < 0.0);
-        assert_eq!(s.theta_ddot[j], sys.reduced(s.delta[j]).theta_ddot);
+        assert_eq!(s.theta_ddot[j], sys.reduced(s.delta[j]).unwrap().theta_ddot);
         // Each sample's angle gives back its time.
         let t = mesh
             .time_at_delta(&sys, s.delta[j], &mut Work::default())

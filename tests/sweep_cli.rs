@@ -398,8 +398,8 @@ fn any_model_sweeps_over_its_own_parameters_and_ratios() {
 
 #[test]
 fn the_tolerance_shown_in_help_is_the_planners_default() {
-    let shown: f64 = rodcube::plan::DEFAULT_TOLERANCE_TEXT.parse().unwrap();
-    assert_eq!(shown, rodcube::plan::DEFAULT_TOLERANCE);
+    let shown: f64 = plan::DEFAULT_TOLERANCE_TEXT.parse().unwrap();
+    assert_eq!(shown, plan::DEFAULT_TOLERANCE);
     let help = String::from_utf8_lossy(&rodcube(&["sweep", "--help"]).stdout).into_owned();
     assert!(help.contains("[default: 1e-10]"), "{help}");
 }

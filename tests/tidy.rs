@@ -43,18 +43,87 @@ fn every_rust_file_starts_with_a_doc_line() {
     );
 }
 
+/// Whether Rust source `text` ignores a test in any spelling: the `ignore` attribute alone or
+/// with a reason, with spaces or line breaks anywhere in it, or through `cfg_attr`. (This
+/// file spells none: the attribute is built from pieces.)
+fn ignores_a_test(text: &str) -> bool {
+    let squeezed: String = text.chars().filter(|c| !c.is_whitespace()).collect();
+    let word = ["ig", "nore"].concat();
+    let head = format!("#[{word}");
+    let direct = squeezed.match_indices(&head).any(|(i, _)| {
+        matches!(
+            squeezed[i + head.len()..].chars().next(),
+            Some(']' | '=' | '(')
+        )
+    });
+    if direct {
+        return true;
+    }
+    // Through `cfg_attr(cond, <the attribute>)`, with or without a reason.
+    squeezed.match_indices("#[cfg_attr(").any(|(i, m)| {
+        let rest = &squeezed[i + m.len()..];
+        let attr = rest.split("]").next().unwrap_or(rest);
+        attr.split([',', '(', ')'])
+            .any(|t| t == word || t.starts_with(&format!("{word}=")))
+    })
+}
+
 #[test]
 fn no_test_is_ignored() {
-    let needle = format!("#[{}]", "ignore");
-    let found: Vec<_> = all()
+    let mut files = all();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for dir in ["python/src", "fuzz/fuzz_targets"] {
+        rust_files(&root.join(dir), &mut files);
+    }
+    let found: Vec<_> = files
         .into_iter()
-        .filter(|p| {
-            std::fs::read_to_string(p)
-                .unwrap_or_default()
-                .contains(&needle)
-        })
+        .filter(|p| ignores_a_test(&std::fs::read_to_string(p).unwrap_or_default()))
         .collect();
     assert!(found.is_empty(), "ignored tests in {found:?}");
+    // The detector itself, on every spelling (built so that this file holds none).
+    let word = ["ig", "nore"].concat();
+    for spelling in [
+        format!("#[{word}]"),
+        format!("#[{word} = \"slow\"]"),
+        format!("# [ {word} ]"),
+        format!("#[\n    {word}\n]"),
+        format!("#[cfg_attr(miri, {word})]"),
+        format!("#[cfg_attr(not(target_os = \"linux\"), {word} = \"why\")]"),
+    ] {
+        assert!(ignores_a_test(&spelling), "{spelling:?} not caught");
+    }
+    for fine in [
+        "#[test]".to_string(),
+        format!("let {word}d = 1;"),
+        format!("#[cfg_attr(miri, allow({word}d_lint))]"),
+    ] {
+        assert!(!ignores_a_test(&fine), "{fine:?} caught");
+    }
+}
+
+/// Python tests skipped or expected to fail: `pytest.mark.skip`, `skipif`, `xfail`, or
+/// `pytest.skip(...)` in a test body.
+#[test]
+fn no_python_test_is_skipped() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("python/tests");
+    let entries = std::fs::read_dir(&root).expect("python/tests");
+    let markers = [
+        ["mark.", "skip"].concat(),
+        ["x", "fail"].concat(),
+        ["pytest.", "skip("].concat(),
+    ];
+    let mut read = 0;
+    for e in entries.flatten() {
+        let p = e.path();
+        if p.extension().is_some_and(|x| x == "py") {
+            read += 1;
+            let text = std::fs::read_to_string(&p).unwrap_or_default();
+            for m in &markers {
+                assert!(!text.contains(m.as_str()), "{} contains {m}", p.display());
+            }
+        }
+    }
+    assert!(read > 0, "no Python test files in {}", root.display());
 }
 
 #[test]

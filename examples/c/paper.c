@@ -2,8 +2,8 @@
  *
  * Prints `separation_angle=<rad> separation_time=<s>` to full double precision. It also
  * solves the point with its parameters in the model's order (the two must agree), shows a
- * refused point's message, and runs a scene to JSON, so every function of rodcube.h is
- * called. Build and run: examples/c/run.sh
+ * refused point's code and message, and runs a scene once to its JSON results, read in place
+ * and copied, so every function of rodcube.h is called. Build and run: examples/c/run.sh
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -12,7 +12,9 @@
 #include "rodcube.h"
 
 static int fail(const char *what, int code, const char *err) {
-    fprintf(stderr, "paper: %s failed (code %d): %s\n", what, code, err);
+    const char *name = rodcube_error_name(code);
+    fprintf(stderr, "paper: %s failed (code %d, %s): %s\n", what, code,
+            name != NULL ? name : "not a rodcube code", err);
     return 1;
 }
 
@@ -28,16 +30,17 @@ static long find_model(const char *name) {
 
 int main(void) {
     char err[1024];
-    rodcube_solver *solver = rodcube_solver_new("rod_cube", err, sizeof err);
-    if (solver == NULL) {
-        return fail("rodcube_solver_new", -1, err);
+    rodcube_solver *solver = NULL;
+    int code = rodcube_solver_new("rod_cube", &solver, err, sizeof err);
+    if (code != RODCUBE_OK) {
+        return fail("rodcube_solver_new", code, err);
     }
 
     /* By name, in any order. */
     const char *names[] = {"g", "a", "ell", "m2", "m1"};
     const double values[] = {9.81, 0.25, 1.0, 3.0, 1.0};
     rodcube_point named;
-    int code = rodcube_solve_named(solver, names, values, 5, &named, err, sizeof err);
+    code = rodcube_solve_named(solver, names, values, 5, &named, err, sizeof err);
     if (code != RODCUBE_OK) {
         return fail("rodcube_solve_named", code, err);
     }
@@ -65,33 +68,42 @@ int main(void) {
         return fail("comparing", -1, "by name and in order differ");
     }
 
-    /* A refused point: the cube as high as the rod is long. */
+    /* A refused point: the cube as high as the rod is long, a requirement of the model, in
+     * the group of refused parameters. */
     const double upright[] = {1.0, 3.0, 1.0, 1.0, 9.81};
     rodcube_point unused;
     code = rodcube_solve(solver, upright, 5, &unused, err, sizeof err);
-    if (code != RODCUBE_ERR_PARAMETERS || strstr(err, "a < ell") == NULL) {
+    if (code != RODCUBE_ERR_PARAM_REQUIREMENT ||
+        rodcube_error_group(code) != RODCUBE_ERR_PARAMETERS ||
+        strcmp(rodcube_error_name(code), "RODCUBE_ERR_PARAM_REQUIREMENT") != 0 ||
+        strstr(err, "a < ell") == NULL) {
         return fail("refusing a = ell", code, err);
     }
     rodcube_solver_free(solver);
 
-    /* A scene to JSON: ask the size, then fill. */
+    /* A scene, solved once; its JSON is read in place, then copied into a buffer of ours. */
     const char *scene =
         "model: rod_cube\n"
         "parameters: {m1: 1.0, m2: 3.0, ell: 1.0, a: 0.25, g: 9.81}\n"
         "want: [separation_time]\n";
-    size_t needed = 0;
-    code = rodcube_run_scene(scene, NULL, 0, &needed, err, sizeof err);
-    if (code != RODCUBE_ERR_BUFFER || needed == 0) {
-        return fail("sizing the scene's JSON", code, err);
+    rodcube_results *results = NULL;
+    code = rodcube_run_scene(scene, &results, err, sizeof err);
+    if (code != RODCUBE_OK) {
+        return fail("rodcube_run_scene", code, err);
     }
+    const char *text = rodcube_results_json(results);
+    size_t needed = rodcube_results_len(results) + 1;
     char *json = malloc(needed);
     if (json == NULL) {
+        rodcube_results_free(results);
         return fail("malloc", -1, "out of memory");
     }
-    code = rodcube_run_scene(scene, json, needed, &needed, err, sizeof err);
-    if (code != RODCUBE_OK || strstr(json, "\"separation_time\"") == NULL) {
+    code = rodcube_results_copy(results, json, needed, &needed, err, sizeof err);
+    int same = code == RODCUBE_OK && strcmp(json, text) == 0;
+    rodcube_results_free(results);
+    if (!same || strstr(json, "\"separation_time\"") == NULL) {
         free(json);
-        return fail("rodcube_run_scene", code, err);
+        return fail("reading the scene's results", code, err);
     }
     free(json);
 

@@ -36,8 +36,8 @@ int main(int argc, char **argv) {
         p[4] = 1.0;
     }
     char err[512];
-    rodcube_solver *solver = rodcube_solver_new("rod_cube", err, sizeof err);
-    if (solver == NULL) {
+    rodcube_solver *solver = NULL;
+    if (rodcube_solver_new("rod_cube", &solver, err, sizeof err) != RODCUBE_OK) {
         fprintf(stderr, "per_point: %s\n", err);
         return 1;
     }

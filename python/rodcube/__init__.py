@@ -3,15 +3,120 @@
 - ``solve(model, want=[...], **parameters)``: one parameter point through rodcube's planner;
   returns a dict of floats (scalars), strings (words such as ``contact_end_cause``) and dicts
   of NumPy arrays (series, by column).
-- ``sweep(n, a_over_ell, model="rod_cube", axes={...}, **fixed)``: separation angle and time
-  over NumPy arrays, in parallel with the GIL released; NaN where a point has no solution.
-  Axes are ``n = m2/m1``, ``a_over_ell``, or in ``axes`` any parameter or ratio ``p_over_q``
-  of two parameters; parameters on no axis are 1 unless given as keywords.
-- ``models()`` and ``parameters(model)``: the registry.
+- ``sweep(n, a_over_ell, *, model="rod_cube", axes={...}, defaults={...}, **parameters)``:
+  separation angle and time over arrays, in parallel with the GIL released. Axes are
+  ``n = m2/m1``, ``a_over_ell``, the entries of ``axes`` (any parameter or ratio ``p_over_q``
+  of two parameters) and every keyword parameter given as an array; scalars and array-likes
+  broadcast against each other as NumPy broadcasts. Every parameter needs a value: rodcube
+  assumes none (not even g). A point that fails is NaN, ``False`` in the ``ok`` mask, and
+  listed in ``errors`` with the reason.
+- ``models()`` and ``parameters(model)``: the registry, with each parameter's unit and meaning.
 
-Errors are ``RodcubeError`` (a ``ValueError``) with rodcube's own messages.
+Errors are ``RodcubeError`` (a ``ValueError``) with rodcube's own messages. Type stubs
+(``__init__.pyi``) describe every function for editors and type checkers.
 """
 
-from ._rodcube import RodcubeError, models, parameters, solve, sweep
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from ._rodcube import RodcubeError, models, parameters, solve
+from ._rodcube import sweep_flat as _sweep_flat
 
 __all__ = ["RodcubeError", "models", "parameters", "solve", "sweep"]
+
+
+def _numbers(what, value):
+    """``value`` as a float64 array, or a RodcubeError saying that ``what`` must be numbers."""
+    try:
+        return np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise RodcubeError(
+            f"{what} must be a number or an array-like of numbers, not {value!r}"
+        ) from None
+
+
+def sweep(n=None, a_over_ell=None, *, model="rod_cube", axes=None, defaults=None, **parameters):
+    """Separation angle and time of ``model`` over arrays of parameter values.
+
+    The axes are ``n`` (= m2/m1), ``a_over_ell``, the entries of ``axes`` (a dict from a
+    parameter name, or a ratio ``p_over_q`` of two parameters of one unit, to values) and
+    every keyword parameter given as an array-like; keyword parameters given as scalars are
+    fixed. All axes broadcast against each other as NumPy broadcasts (scalars, lists, 0-d
+    and n-d arrays); the results have the broadcast shape.
+
+    Every parameter of the model needs a value: an axis sets it, a keyword gives it, or else
+    ``defaults`` (a dict from parameter name to number) does. rodcube assumes none, g
+    included. A ratio axis sets only its numerator: ``n`` sets m2 = n * m1, so m1 still needs
+    a value, and ``a_over_ell`` sets a = a_over_ell * ell, so ell does. The paper's point is
+    ``sweep(n=3.0, a_over_ell=0.25, m1=1.0, ell=1.0, g=9.81)``.
+
+    Returns a dict:
+
+    - ``separation_angle`` (rad) and ``separation_time`` (s): float arrays, NaN where a point
+      failed;
+    - ``ok``: a bool array, ``True`` where the point was solved;
+    - ``errors``: ``(index, message)`` for every failed point in C order (the order of
+      ``np.argwhere(~ok)``); ``index`` is a tuple indexing the result arrays, ``message`` is
+      rodcube's reason.
+
+    Raises ``RodcubeError`` for an unknown model, axis or parameter, a parameter without a
+    value (the message lists each with its unit and meaning), a parameter set twice, a value
+    that is not a number, or axes whose shapes do not broadcast together.
+    """
+    named = []
+    if n is not None:
+        named.append(("n", n))
+    if a_over_ell is not None:
+        named.append(("a_over_ell", a_over_ell))
+    if axes is not None:
+        if not isinstance(axes, Mapping):
+            raise RodcubeError(f"axes must be a dict from names to values, not {axes!r}")
+        named.extend((str(name), values) for name, values in axes.items())
+    fixed = []
+    for name, value in parameters.items():
+        values = _numbers(f"parameter `{name}`", value)
+        if values.ndim == 0:
+            fixed.append((name, float(values)))
+        else:
+            named.append((name, values))
+    given = []
+    if defaults is not None:
+        if not isinstance(defaults, Mapping):
+            raise RodcubeError(f"defaults must be a dict from parameter names to numbers, not {defaults!r}")
+        for name, value in defaults.items():
+            number = _numbers(f"defaults[{name!r}]", value)
+            if number.ndim != 0:
+                raise RodcubeError(f"defaults[{name!r}] must be one number, not an array of shape {number.shape}")
+            given.append((str(name), float(number)))
+    if not named:
+        raise RodcubeError(
+            "give an axis: n, a_over_ell, axes={name: values} (a parameter or a ratio p_over_q), "
+            "or a keyword parameter with an array of values"
+        )
+    arrays = [_numbers(f"axis `{name}`", values) for name, values in named]
+    try:
+        broadcast = np.broadcast_arrays(*arrays)
+    except ValueError:
+        shapes = ", ".join(f"`{name}` {a.shape}" for (name, _), a in zip(named, arrays))
+        raise RodcubeError(f"the axes' shapes do not broadcast together: {shapes}") from None
+    shape = broadcast[0].shape
+    columns = [np.ascontiguousarray(b).reshape(-1) for b in broadcast]
+    angle, time, ok, failures = _sweep_flat(
+        model, [name for name, _ in named], columns, fixed, given
+    )
+    if failures and shape:
+        flat = np.fromiter((i for i, _ in failures), dtype=np.intp, count=len(failures))
+        where = zip(*(k.tolist() for k in np.unravel_index(flat, shape)))
+        errors = [(index, message) for index, (_, message) in zip(where, failures)]
+    else:
+        # A 0-d result: its one point's index is ().
+        errors = [((), message) for _, message in failures]
+    return {
+        "separation_angle": angle.reshape(shape),
+        "separation_time": time.reshape(shape),
+        "ok": ok.reshape(shape),
+        "errors": errors,
+    }

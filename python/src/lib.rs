@@ -1,22 +1,24 @@
-//! Python bindings of rodcube (PyO3, abi3, NumPy): `solve` runs the planner for one parameter
-//! point, `sweep` the per-point solver over NumPy arrays in parallel with the GIL released,
-//! `models` and `parameters` list the registry. Errors are `rodcube.RodcubeError` (a
-//! `ValueError`) with the library's own messages.
+//! Python bindings of rodcube (PyO3, abi3, NumPy), the compiled module `rodcube._rodcube`:
+//! `solve` runs the planner for one parameter point, `sweep_flat` the per-point solver over
+//! flat NumPy arrays in parallel with the GIL released (the package's `sweep`, in
+//! `rodcube/__init__.py`, broadcasts its arguments into them), `models` and `parameters` list
+//! the registry. Errors are `rodcube.RodcubeError` (a `ValueError`) with the library's own
+//! messages; a point that fails in a sweep keeps its error's message.
 
-use numpy::{IntoPyArray, PyReadonlyArray1};
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
-use rodcube::axes::Mapping;
-use rodcube::model::Model;
+use rodcube::axes::{Mapping, Target, resolve};
+use rodcube::model::{Model, ModelInfo, ParamInfo};
 use rodcube::plan::{self, Parameters, Request};
 use rodcube::quantity::Quantity;
 use rodcube::solve::lean::LeanSolver;
 
 create_exception!(
-    _rodcube,
+    rodcube,
     RodcubeError,
     PyValueError,
     "A request rodcube refused or could not solve; the message says why."
@@ -131,107 +133,206 @@ fn solve<'py>(
 /// Points per parallel task.
 const CHUNK: usize = 4096;
 
-/// The sweep's axes in order: `n`, `a_over_ell`, then the `axes` dict's entries; all of one
-/// length.
-fn sweep_axes(
-    n: Option<PyReadonlyArray1<'_, f64>>,
-    a_over_ell: Option<PyReadonlyArray1<'_, f64>>,
-    axes: Option<&Bound<'_, PyDict>>,
-) -> PyResult<(Vec<String>, Vec<Vec<f64>>)> {
-    let mut names = Vec::new();
-    let mut columns: Vec<Vec<f64>> = Vec::new();
-    for (name, values) in [("n", n), ("a_over_ell", a_over_ell)] {
-        if let Some(v) = values {
-            names.push(name.to_string());
-            columns.push(v.as_array().to_vec());
-        }
+/// A parameter that neither an axis nor a keyword sets, with its entry in `defaults` if any.
+type Unset<'a> = (&'static ParamInfo, Option<&'a (String, f64)>);
+
+/// The parameters set by neither an axis (`targets`, resolved) nor a keyword value, each with
+/// what `defaults` gives it (`None`: nothing, so the sweep cannot run). Keyword values that
+/// are no parameter are left to [`Mapping::new`], which refuses them by name.
+fn unset<'a>(
+    info: &'static ModelInfo,
+    targets: &[Target],
+    fixed: &[(&str, f64)],
+    defaults: &'a [(String, f64)],
+) -> PyResult<Vec<Unset<'a>>> {
+    if let Some((name, _)) = defaults
+        .iter()
+        .find(|(name, _)| !info.parameters.iter().any(|p| p.name == *name))
+    {
+        let names: Vec<&str> = info.parameters.iter().map(|p| p.name).collect();
+        return Err(error(format!(
+            "defaults: model `{}` has no parameter `{name}`; its parameters are {}",
+            info.name,
+            names.join(", ")
+        )));
     }
-    if let Some(dict) = axes {
-        for (key, value) in dict.iter() {
-            names.push(key.extract()?);
-            columns.push(value.extract().map_err(|_| {
-                error(format!("axis `{key}` must be a 1-D array or a sequence of numbers"))
-            })?);
-        }
+    Ok(info
+        .parameters
+        .iter()
+        .enumerate()
+        .filter(|&(i, p)| {
+            let on_axis = targets.iter().any(|t| match *t {
+                Target::Parameter(j) | Target::Ratio { numerator: j, .. } => j == i,
+            });
+            !on_axis && !fixed.iter().any(|(name, _)| *name == p.name)
+        })
+        .map(|(_, p)| (p, defaults.iter().find(|(d, _)| d == p.name)))
+        .collect())
+}
+
+/// The message for parameters that nothing sets: each with its unit and meaning, and the
+/// ratio axes measured against it.
+fn missing_message(
+    info: &'static ModelInfo,
+    axes: &[&str],
+    targets: &[Target],
+    missing: &[&ParamInfo],
+) -> String {
+    let lines: Vec<String> = missing
+        .iter()
+        .map(|p| {
+            let against: Vec<String> = axes
+                .iter()
+                .zip(targets)
+                .filter(|(_, t)| match **t {
+                    Target::Ratio { denominator, .. } => {
+                        info.parameters.get(denominator).map(|d| d.name) == Some(p.name)
+                    }
+                    Target::Parameter(_) => false,
+                })
+                .map(|(name, _)| format!("`{name}`"))
+                .collect();
+            let ratio = if against.is_empty() {
+                String::new()
+            } else {
+                format!("; the axis {} is measured against it", against.join(", "))
+            };
+            format!("  {} [{}]: {}{ratio}", p.name, p.unit, p.meaning)
+        })
+        .collect();
+    let first = missing.first().map_or("g", |p| p.name);
+    format!(
+        "model `{}`: no value for {} parameter{} (rodcube assumes none):\n{}\n\
+         give each as a keyword ({first}=...), on an axis, or in defaults={{\"{first}\": ...}}",
+        info.name,
+        missing.len(),
+        if missing.len() == 1 { "" } else { "s" },
+        lines.join("\n")
+    )
+}
+
+/// What [`sweep_flat`] returns: separation angle and time (NaN where a point failed), whether
+/// each point succeeded, and every failure as `(flat index, message)` in index order.
+type Flat<'py> = (
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<bool>>,
+    Vec<(usize, String)>,
+);
+
+/// The sweep over flat arrays, one per axis and all of one length (the Python `sweep`
+/// broadcasts and reshapes): separation angle and time by the per-point solver, in parallel
+/// with the GIL released. `fixed` are keyword values; `defaults` give parameters that neither
+/// an axis nor `fixed` sets. A parameter that nothing sets is an error naming it: no value is
+/// ever assumed. A point that fails is NaN, `False` in the mask, and its error's message.
+#[pyfunction]
+#[pyo3(signature = (model, axes, columns, fixed, defaults))]
+fn sweep_flat<'py>(
+    py: Python<'py>,
+    model: &str,
+    axes: Vec<String>,
+    columns: Vec<PyReadonlyArray1<'py, f64>>,
+    fixed: Vec<(String, f64)>,
+    defaults: Vec<(String, f64)>,
+) -> PyResult<Flat<'py>> {
+    let m = find(model)?;
+    let info = m.info();
+    LeanSolver::new(m).map_err(error)?;
+    if axes.is_empty() || axes.len() != columns.len() {
+        return Err(error(format!(
+            "give one column per axis and at least one axis: {} axes, {} columns",
+            axes.len(),
+            columns.len()
+        )));
     }
-    let Some(first) = columns.first() else {
-        return Err(error(
-            "give the axes: n, a_over_ell, or axes={name: values} (a parameter or a ratio p_over_q)",
-        ));
-    };
-    let len = first.len();
-    if let Some((name, c)) = names.iter().zip(&columns).find(|(_, c)| c.len() != len) {
+    let columns: Vec<Vec<f64>> = columns.iter().map(|c| c.as_array().to_vec()).collect();
+    let len = columns[0].len();
+    if let Some((name, c)) = axes.iter().zip(&columns).find(|(_, c)| c.len() != len) {
         return Err(error(format!(
             "axis `{}` has {len} values and `{name}` {}; they must have as many",
-            names[0],
+            axes[0],
             c.len()
         )));
     }
-    Ok((names, columns))
-}
-
-/// Separation angle and time over arrays of axis values (all of one length), in parallel with
-/// the GIL released. Axes are `n = m2/m1`, `a_over_ell`, or any parameter or ratio `p_over_q`
-/// of two parameters in `axes`; other parameters are 1 unless given as keywords. A point that
-/// has no solution (no separation, refused values) is NaN in both arrays.
-#[pyfunction]
-#[pyo3(signature = (n=None, a_over_ell=None, model="rod_cube", axes=None, **fixed))]
-fn sweep<'py>(
-    py: Python<'py>,
-    n: Option<PyReadonlyArray1<'py, f64>>,
-    a_over_ell: Option<PyReadonlyArray1<'py, f64>>,
-    model: &str,
-    axes: Option<&Bound<'py, PyDict>>,
-    fixed: Option<&Bound<'py, PyDict>>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let m = find(model)?;
-    LeanSolver::new(m).map_err(error)?;
-    let (names, columns) = sweep_axes(n, a_over_ell, axes)?;
-    let mut values: Vec<(String, f64)> = Vec::new();
-    if let Some(dict) = fixed {
-        for (key, value) in dict.iter() {
-            let name: String = key.extract()?;
-            let v = value
-                .extract()
-                .map_err(|_| error(format!("parameter `{name}` must be a number")))?;
-            values.push((name, v));
-        }
+    let axis_names: Vec<&str> = axes.iter().map(String::as_str).collect();
+    let mut values: Vec<(&str, f64)> = fixed.iter().map(|(n, v)| (n.as_str(), *v)).collect();
+    // Refused axes or keyword values first, by name, before anything is said to be missing.
+    Mapping::new(info, &axis_names, &values).map_err(error)?;
+    let targets = axis_names
+        .iter()
+        .map(|name| resolve(name, info).map_err(error))
+        .collect::<PyResult<Vec<_>>>()?;
+    let unset = unset(info, &targets, &values, &defaults)?;
+    let missing: Vec<&ParamInfo> = unset
+        .iter()
+        .filter(|(_, d)| d.is_none())
+        .map(|(p, _)| *p)
+        .collect();
+    if !missing.is_empty() {
+        return Err(error(missing_message(
+            info,
+            &axis_names,
+            &targets,
+            &missing,
+        )));
     }
-    let axis_names: Vec<&str> = names.iter().map(String::as_str).collect();
-    let fixed_ref: Vec<(&str, f64)> = values.iter().map(|(n, v)| (n.as_str(), *v)).collect();
-    let mapping = Mapping::new(m.info(), &axis_names, &fixed_ref).map_err(error)?;
-    let len = columns[0].len();
+    values.extend(
+        unset
+            .iter()
+            .flat_map(|(_, d)| d.map(|(n, v)| (n.as_str(), *v))),
+    );
+    // Every parameter is now an axis or a value given: `Mapping`'s 1 for the others never
+    // applies.
+    let mapping = Mapping::new(info, &axis_names, &values).map_err(error)?;
     let dims = columns.len();
     let points: Vec<f64> = (0..len)
         .flat_map(|k| columns.iter().map(move |c| c[k]))
         .collect();
     let mut angle = vec![f64::NAN; len];
     let mut time = vec![f64::NAN; len];
-    py.detach(|| {
+    let mut ok = vec![false; len];
+    let errors: Vec<(usize, String)> = py.detach(|| {
         (
             points.par_chunks(CHUNK * dims),
             angle.par_chunks_mut(CHUNK),
             time.par_chunks_mut(CHUNK),
+            ok.par_chunks_mut(CHUNK),
         )
             .into_par_iter()
-            .for_each(|(chunk, angles, times)| {
-                let Ok(mut solver) = LeanSolver::new(m) else {
-                    return;
+            .enumerate()
+            .flat_map_iter(|(c, (chunk, angles, times, oks))| {
+                let first = c * CHUNK;
+                let mut errors = Vec::new();
+                let mut solver = match LeanSolver::new(m) {
+                    Ok(solver) => solver,
+                    Err(e) => {
+                        let message = e.to_string();
+                        errors.extend((0..oks.len()).map(|k| (first + k, message.clone())));
+                        return errors.into_iter();
+                    }
                 };
-                let mut p = vec![0.0; m.info().parameters.len()];
+                let mut p = vec![0.0; info.parameters.len()];
                 for (k, point) in chunk.chunks(dims).enumerate() {
                     mapping.fill(point, &mut p);
-                    if let Ok(out) = solver.solve(&p) {
-                        angles[k] = out.separation_angle;
-                        times[k] = out.separation_time;
+                    match solver.solve(&p) {
+                        Ok(out) => {
+                            angles[k] = out.separation_angle;
+                            times[k] = out.separation_time;
+                            oks[k] = true;
+                        }
+                        Err(e) => errors.push((first + k, e.to_string())),
                     }
                 }
-            });
+                errors.into_iter()
+            })
+            .collect()
     });
-    let out = PyDict::new(py);
-    out.set_item("separation_angle", angle.into_pyarray(py))?;
-    out.set_item("separation_time", time.into_pyarray(py))?;
-    Ok(out)
+    Ok((
+        angle.into_pyarray(py),
+        time.into_pyarray(py),
+        ok.into_pyarray(py),
+        errors,
+    ))
 }
 
 /// The compiled half of the `rodcube` package.
@@ -240,7 +341,7 @@ fn _rodcube(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(models, m)?)?;
     m.add_function(wrap_pyfunction!(parameters, m)?)?;
     m.add_function(wrap_pyfunction!(solve, m)?)?;
-    m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep_flat, m)?)?;
     m.add("RodcubeError", m.py().get_type::<RodcubeError>())?;
     Ok(())
 }

@@ -32,7 +32,7 @@ fn polynomial(sys: &System) -> (Vec<f64>, f64, f64) {
     (
         sys.separation_coefficients(),
         sys.end_angle().sin(),
-        sys.reduced(0.0).sin,
+        sys.reduction().reduced(sys.k(), 0.0).sin,
     )
 }
 
@@ -193,7 +193,7 @@ pub fn time_gl_u2(sys: &System, delta: f64, nodes: usize) -> Outcome<f64> {
 /// `u = 0` released from rest.
 fn u_integrand(sys: &System, u: f64) -> Result<f64, String> {
     if u == 0.0 {
-        let theta_ddot = sys.reduced(0.0).theta_ddot;
+        let theta_ddot = sys.reduction().reduced(sys.k(), 0.0).theta_ddot;
         return if sys.starts_at_rest() && theta_ddot < 0.0 {
             Ok(2.0 / (-2.0 * theta_ddot).sqrt())
         } else {
@@ -205,7 +205,7 @@ fn u_integrand(sys: &System, u: f64) -> Result<f64, String> {
 
 /// `1 / |theta_dot|` at `delta` (the raw integrand, singular at 0).
 fn raw(sys: &System, delta: f64) -> Result<f64, String> {
-    let w2 = sys.reduced(delta).theta_dot_sq;
+    let w2 = sys.reduced(delta).map_err(|e| e.to_string())?.theta_dot_sq;
     if w2 > 0.0 && w2.is_finite() {
         Ok(1.0 / w2.sqrt())
     } else {
@@ -401,7 +401,7 @@ impl OdeProblem for Reduced<'_, '_> {
     }
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SolveError> {
         self.calls += 1;
-        let acc = -self.sys.reduced(y[0]).theta_ddot;
+        let acc = -self.sys.reduced(y[0])?.theta_ddot;
         if !acc.is_finite() {
             return Err(SolveError::OdeNonFinite {
                 what: "theta_ddot",

@@ -2,7 +2,7 @@
 //! trigonometric rewriting that makes results unique modulo `sin^2 + cos^2 = 1`, the switch
 //! between `sin(theta)`, `cos(theta)` and the internal symbols `rc_s`, `rc_c`, polynomial
 //! coefficients in `sin(theta)`, and sign tests. Below every stage; imports only [`cas`],
-//! [`expr`] and [`types`](super::types).
+//! [`expr`](super::expr) and [`types`](super::types).
 
 use super::cas::{self, A};
 use super::expr::{Expr, product};
@@ -180,6 +180,7 @@ pub fn collect_over(a: &A, motion: &[&str]) -> Result<A, DeriveError> {
     Ok(out)
 }
 
+/// Whether `a` does not depend on any of `names` (each partial derivative is zero).
 pub fn free_of(a: &A, names: &[&str]) -> bool {
     names.iter().all(|n| cas::is_zero(&cas::d(a, n)))
 }
@@ -234,7 +235,7 @@ pub fn coefficients_in_s(a: &A, what: &str) -> Result<Option<Vec<Expr>>, DeriveE
 }
 
 /// The fall polynomial `(sin theta_i - s) / theta_dot^2` in `s = rc_s`, where it is one (see
-/// [`Reduction::fall`]); `None` for a phase that does not start from rest, whose potential
+/// [`Reduction::fall`](super::types::Reduction::fall)); `None` for a phase that does not start from rest, whose potential
 /// has a `cos(theta)` term, or whose inertia is no polynomial in `sin(theta)`.
 pub fn fall_polynomial(
     wsq: &A,

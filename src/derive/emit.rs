@@ -16,7 +16,7 @@ use std::collections::{BTreeMap, BTreeSet};
 /// The command that regenerates `generated/`, named in every file header.
 pub const COMMAND: &str = "cargo run --release --features derive -- derive";
 
-/// A straight-line function body: statements, then outputs; [`Code::finish`] makes it a
+/// A straight-line function body: statements, then outputs; `Code::finish` makes it a
 /// method's argument list and lines.
 #[derive(Debug, Clone, Serialize, Default)]
 pub struct Code {
@@ -598,7 +598,7 @@ fn lean_prepare(
     for line in code.polynomial_lines.iter().flatten().chain(fall) {
         stack.extend(k_indices(line));
     }
-    let mut needed = std::collections::BTreeSet::new();
+    let mut needed = BTreeSet::new();
     while let Some(i) = stack.pop() {
         if needed.insert(i)
             && let Some(e) = definition(i)

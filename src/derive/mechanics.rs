@@ -1,10 +1,10 @@
 //! The derivation of a spec's phases, stage by stage: [`read`](super::read) (every expression
 //! parsed once) → [`setup`](super::setup) (a phase's coordinates and the ties of the contacts
 //! it holds closed) → [`lagrangian`](super::lagrangian) → [`equations`](super::equations)
-//! (`M(q) qdd = F(q, qd)`, cyclic coordinates, momenta) → [`constraints`](super::constraints)
+//! (`M(q) qdd = F(q, qd)`, cyclic coordinates, momenta) → [`constraints`]
 //! (each contact's gap, Jacobian and bias, or its force in closed form where the phase holds it
 //! closed; the frictions' slips) → [`reduction`](super::reduction) (the fast path) →
-//! [`forces`](super::forces) (monitors). This module only runs them, in that order, for every
+//! [`forces`] (monitors). This module only runs them, in that order, for every
 //! phase of a spec; it is the top of the derivation proper.
 //!
 //! A spec gives its **general model** (named as the spec): every coordinate, every contact a

@@ -449,12 +449,11 @@ impl<'m> Plan<'m> {
 
     /// The release: its state and closed contacts, and the contacts that opened at once.
     fn release(&mut self) -> Result<&(PhaseStart, Vec<usize>), SolveError> {
-        if self.release.is_none() {
-            self.release = Some(self.walker.release()?);
-        }
-        self.release
-            .as_ref()
-            .ok_or(SolveError::TooManyPhases { limit: 0 })
+        let release = match self.release.take() {
+            Some(release) => release,
+            None => self.walker.release()?,
+        };
+        Ok(self.release.insert(release))
     }
 
     /// The fast phase the motion starts on, where the release's closed contacts have one.
@@ -509,35 +508,40 @@ impl<'m> Plan<'m> {
     /// (a first phase that ends at the floor reuses the contact-to-floor integral if it
     /// exists), otherwise integrated to its first event.
     fn motion(&mut self) -> Result<&mut Motion<'m>, SolveError> {
-        if self.motion.is_none() {
-            let (start, opened) = self.release()?.clone();
-            let first = match self.fast()? {
-                Some(sys) => {
-                    let end = self.end()?;
-                    match (end.end, &self.floor_mesh) {
-                        (End::Floor, Some(mesh)) => {
-                            self.work.phases.push(sys.name().to_string());
-                            ReducedRun {
-                                system: sys,
-                                t_start: 0.0,
-                                end,
-                                mesh: mesh.clone(),
-                            }
-                            .into_phase()
-                        }
-                        _ => self.walker.follow(sys, &start, end, &mut self.work)?,
-                    }
-                }
-                None => self.walker.solve(&start, &mut self.work)?,
-            };
-            self.motion = Some(Motion {
-                phases: vec![first],
-                opened_at_release: opened,
-            });
+        let motion = self.take_motion()?;
+        Ok(self.motion.insert(motion))
+    }
+
+    /// The motion as [`Plan::motion`] has it, taken out of the cache (the caller puts it back:
+    /// `self.motion.insert(motion)` gives it to the caller next to the plan's other fields).
+    fn take_motion(&mut self) -> Result<Motion<'m>, SolveError> {
+        if let Some(motion) = self.motion.take() {
+            return Ok(motion);
         }
-        self.motion
-            .as_mut()
-            .ok_or(SolveError::TooManyPhases { limit: 0 })
+        let (start, opened) = self.release()?.clone();
+        let first = match self.fast()? {
+            Some(sys) => {
+                let end = self.end()?;
+                match (end.end, &self.floor_mesh) {
+                    (End::Floor, Some(mesh)) => {
+                        self.work.phases.push(sys.name().to_string());
+                        ReducedRun {
+                            system: sys,
+                            t_start: 0.0,
+                            end,
+                            mesh: mesh.clone(),
+                        }
+                        .into_phase()
+                    }
+                    _ => self.walker.follow(sys, &start, end, &mut self.work)?,
+                }
+            }
+            None => self.walker.solve(&start, &mut self.work)?,
+        };
+        Ok(Motion {
+            phases: vec![first],
+            opened_at_release: opened,
+        })
     }
 
     /// Extends the motion phase by phase until `done` says so or it ends for good.
@@ -545,16 +549,21 @@ impl<'m> Plan<'m> {
         &mut self,
         done: impl Fn(&Motion<'m>) -> bool,
     ) -> Result<&Motion<'m>, SolveError> {
-        self.motion()?;
-        loop {
-            let (Some(motion), walker) = (self.motion.as_mut(), &self.walker) else {
-                return Err(SolveError::TooManyPhases { limit: 0 });
-            };
-            if done(motion) || motion.complete() {
-                break;
-            }
+        let motion = self.take_motion()?;
+        let Plan {
+            motion: slot,
+            walker,
+            work,
+            ..
+        } = self;
+        let motion = slot.insert(motion);
+        while !(done(motion) || motion.complete()) {
             let Some(last) = motion.phases.last() else {
-                break;
+                // A motion always has its first phase (`take_motion`).
+                return Err(SolveError::NoSuchPhase {
+                    index: 0,
+                    solved: 0,
+                });
             };
             if motion.phases.len() >= crate::solve::phases::MAX_PHASES {
                 return Err(SolveError::TooManyPhases {
@@ -562,10 +571,10 @@ impl<'m> Plan<'m> {
                 });
             }
             let start = walker.after(last)?;
-            let next = walker.solve(&start, &mut self.work)?;
+            let next = walker.solve(&start, work)?;
             motion.phases.push(next);
         }
-        Ok(self.motion()?)
+        Ok(motion)
     }
 
     /// Every phase to the end of the motion.
@@ -573,91 +582,103 @@ impl<'m> Plan<'m> {
         self.extend_until(|_| false)
     }
 
-    /// Samples of the solved phases up to `i` (each sampled once, uniform over it).
+    /// Samples of the solved phases up to `i` (each sampled once, uniform over it); a phase
+    /// the motion does not have is [`SolveError::NoSuchPhase`].
     fn samples_of(&mut self, i: usize) -> Result<&PhaseSamples, SolveError> {
-        self.motion()?;
-        if let Some(motion) = self.motion.as_ref() {
-            while self.phase_samples.len() <= i {
-                let Some(run) = motion.phases.get(self.phase_samples.len()) else {
-                    break;
-                };
-                let k = self.phase_samples.len();
-                let times = crate::solve::series::uniform_times(run.duration(), self.samples)?;
-                // The series' samples where they are this phase's own (a span that is the
-                // whole of it, from the release): the same times, so not sampled twice.
-                let shared = (self.span.iter().flatten())
-                    .find(|(g, s, _)| *g == k && run.t_start() == 0.0 && s.t == times)
-                    .map(|(_, s, _)| s.clone());
-                let s = match shared {
-                    Some(s) => s,
-                    None => crate::solve::series::sample_at(run, &times, &mut self.work)?,
-                };
-                self.phase_samples.push(s);
-            }
+        let motion = self.take_motion()?;
+        let Plan {
+            motion: slot,
+            phase_samples,
+            span,
+            samples,
+            work,
+            ..
+        } = self;
+        let motion = slot.insert(motion);
+        while phase_samples.len() <= i {
+            let k = phase_samples.len();
+            let Some(run) = motion.phases.get(k) else {
+                break;
+            };
+            let times = crate::solve::series::uniform_times(run.duration(), *samples)?;
+            // The series' samples where they are this phase's own (a span that is the
+            // whole of it, from the release): the same times, so not sampled twice.
+            let shared = (span.iter().flatten())
+                .find(|(g, s, _)| *g == k && run.t_start() == 0.0 && s.t == times)
+                .map(|(_, s, _)| s.clone());
+            let s = match shared {
+                Some(s) => s,
+                None => crate::solve::series::sample_at(run, &times, work)?,
+            };
+            phase_samples.push(s);
         }
-        self.phase_samples
+        let solved = phase_samples.len();
+        phase_samples
             .get(i)
-            .ok_or(SolveError::TooManyPhases { limit: i })
+            .ok_or(SolveError::NoSuchPhase { index: i, solved })
     }
 
     /// `t` to the floor keeping the release contacts closed: the first phase itself when it
     /// ends at the floor.
     fn floor_mesh(&mut self) -> Result<&TimeMesh, SolveError> {
-        if self.floor_mesh.is_none() {
-            let reuse = match (
-                &self.end,
-                self.motion.as_ref().and_then(|m| m.phases[0].reduced()),
-            ) {
-                (
-                    Some(ReducedEnd {
-                        end: End::Floor, ..
-                    }),
-                    Some(r),
-                ) => Some(r.mesh.clone()),
-                _ => None,
-            };
-            let mesh = match reuse {
-                Some(mesh) => mesh,
-                None => {
-                    let sys = self.fast_required()?;
-                    TimeMesh::build(&sys, sys.delta_to_floor(), self.walker.tol, &mut self.work)?
-                }
-            };
-            self.floor_mesh = Some(mesh);
-        }
-        self.floor_mesh
-            .as_ref()
-            .ok_or(SolveError::TooManyPhases { limit: 0 })
+        let mesh = match self.floor_mesh.take() {
+            Some(mesh) => mesh,
+            None => self.build_floor_mesh()?,
+        };
+        Ok(self.floor_mesh.insert(mesh))
+    }
+
+    /// [`Plan::floor_mesh`] computed.
+    fn build_floor_mesh(&mut self) -> Result<TimeMesh, SolveError> {
+        let reuse = match (
+            &self.end,
+            self.motion.as_ref().and_then(|m| m.phases[0].reduced()),
+        ) {
+            (
+                Some(ReducedEnd {
+                    end: End::Floor, ..
+                }),
+                Some(r),
+            ) => Some(r.mesh.clone()),
+            _ => None,
+        };
+        let mesh = match reuse {
+            Some(mesh) => mesh,
+            None => {
+                let sys = self.fast_required()?;
+                TimeMesh::build(&sys, sys.delta_to_floor(), self.walker.tol, &mut self.work)?
+            }
+        };
+        Ok(mesh)
     }
 
     /// The general model integrated from release with the release's contacts closed, to its
-    /// first event (the cross-check of the fast path).
-    fn ode(&mut self) -> Result<&UnreducedRun, SolveError> {
-        if self.ode.is_none() {
-            let duration = self.motion()?.phases[0].duration();
-            let start = self.release()?.0.clone();
-            let from = unreduced::Start {
-                state: start.state,
-                active: start.active,
-                frictions: start.frictions,
-                friction_work: 0.0,
-            };
-            let bound = self.general().clone();
-            let t_max = 2.0 * duration.max(f64::MIN_POSITIVE);
-            let scales = self.walker.scales(&from.state, &from.active)?;
-            let run = unreduced::integrate(
-                &bound,
-                &from,
-                self.walker.rtol,
-                Some(&scales),
-                t_max,
-                &mut self.work,
-            )?;
-            self.ode = Some(run);
+    /// first event (the cross-check of the fast path), taken out of the cache (the caller puts
+    /// it back).
+    fn take_ode(&mut self) -> Result<UnreducedRun, SolveError> {
+        if let Some(run) = self.ode.take() {
+            return Ok(run);
         }
-        self.ode
-            .as_ref()
-            .ok_or(SolveError::TooManyPhases { limit: 0 })
+        let duration = self.motion()?.phases[0].duration();
+        let start = self.release()?.0.clone();
+        let from = unreduced::Start {
+            state: start.state,
+            active: start.active,
+            frictions: start.frictions,
+            friction_work: 0.0,
+        };
+        let bound = self.general().clone();
+        let t_max = 2.0 * duration.max(f64::MIN_POSITIVE);
+        let scales = self.walker.scales(&from.state, &from.active)?;
+        let run = unreduced::integrate(
+            &bound,
+            &from,
+            self.walker.rtol,
+            Some(&scales),
+            t_max,
+            &mut self.work,
+        )?;
+        Ok(run)
     }
 
     fn quantity(
@@ -673,10 +694,7 @@ impl<'m> Plan<'m> {
             Quantity::LinearisedSeparationAngle => self.linearised(out),
             Quantity::ContactEnd => self.contact_ends(out),
             Quantity::ContactTimeToFloor => self.contact_time_to_floor(out),
-            Quantity::PointMassFallTime => {
-                self.point_mass_fall_time(out);
-                Ok(())
-            }
+            Quantity::PointMassFallTime => self.point_mass_fall_time(out),
             Quantity::ThetaSeries
             | Quantity::ForceSeries(_)
             | Quantity::FrictionSeries(_)

@@ -36,16 +36,29 @@ pub(super) enum Fate {
 
 /// Contact `i`'s fate on `motion` as far as it is solved; `None` when the phases solved so
 /// far do not tell yet.
-pub(super) fn fate(motion: &Motion, info: &ModelInfo, i: usize) -> Option<Fate> {
-    let first = motion.phases.first()?;
+pub(super) fn fate(
+    motion: &Motion,
+    info: &ModelInfo,
+    i: usize,
+) -> Result<Option<Fate>, SolveError> {
+    let Some(first) = motion.phases.first() else {
+        return Ok(None);
+    };
     if motion.opened_at_release.contains(&i) {
-        let theta = first.bound().to_full(&first.bound().initial_state()).q[info.reduced];
-        return Some(Fate::Ended {
+        let bound = first.bound();
+        let theta = bound.to_full(&bound.initial_state())?.q[info.reduced];
+        return Ok(Some(Fate::Ended {
             t: 0.0,
             theta,
             cause: "force",
-        });
+        }));
     }
+    Ok(fate_along(motion, info, i))
+}
+
+/// [`fate`] for a contact that did not open at release.
+fn fate_along(motion: &Motion, info: &ModelInfo, i: usize) -> Option<Fate> {
+    let first = motion.phases.first()?;
     if !first.closed().get(i).copied().unwrap_or(false) {
         return Some(Fate::NeverClosed);
     }
@@ -99,8 +112,9 @@ impl Plan<'_> {
     /// Contact `i`'s fate, solving the motion as far as needed.
     pub(super) fn fate(&mut self, i: usize) -> Result<Fate, SolveError> {
         let info = self.general().info();
-        let motion = self.extend_until(|m| fate(m, info, i).is_some())?;
-        fate(motion, info, i).ok_or(SolveError::TooManyPhases {
+        // An error stops the extension; the call after it returns that error.
+        let motion = self.extend_until(|m| !matches!(fate(m, info, i), Ok(None)))?;
+        fate(motion, info, i)?.ok_or(SolveError::TooManyPhases {
             limit: crate::solve::phases::MAX_PHASES,
         })
     }
@@ -115,9 +129,14 @@ impl Plan<'_> {
     ) -> Result<(), SolveError> {
         let info = self.general().info();
         let key = q.name(info);
-        if q == Quantity::SeparationAngle
-            && self.fast()?.is_some()
-            && let Ok(end) = self.end()
+        // Where the motion starts on a fast phase its end by the roots is the motion's own
+        // first step: an error there is the quantity's error.
+        let end = if q == Quantity::SeparationAngle && self.fast()?.is_some() {
+            Some(self.end()?)
+        } else {
+            None
+        };
+        if let Some(end) = end
             && end.end == End::Force(0)
             && let Some(at) = end.at
         {
@@ -250,9 +269,7 @@ impl Plan<'_> {
             return Ok(());
         }
         let end = self.span_end()?;
-        let Some(motion) = self.motion.as_ref() else {
-            return Ok(());
-        };
+        let motion = &*self.motion()?;
         let phases: Vec<&PhaseRun> = (motion.phases.iter())
             .filter(|p| p.t_start() < end || (end == 0.0 && p.t_start() == 0.0))
             .collect();
@@ -295,10 +312,10 @@ impl Plan<'_> {
     }
 
     /// `sqrt(2 h / g)` from the falling point's height at release.
-    pub(super) fn point_mass_fall_time(&mut self, out: &mut RunResults) {
+    pub(super) fn point_mass_fall_time(&mut self, out: &mut RunResults) -> Result<(), SolveError> {
         let general = self.general();
         let info = general.info();
-        let pts = general.points(&general.initial_state());
+        let pts = general.points(&general.initial_state())?;
         let h = pts.pos[info.falling_point][1];
         let t = (2.0 * h.max(0.0) / general.gravity()).sqrt();
         let meaning = format!(
@@ -313,6 +330,7 @@ impl Plan<'_> {
             "s",
             meaning,
         );
+        Ok(())
     }
 
     /// Where the series end (s from release): the first contact's end, or the end of the
@@ -347,16 +365,22 @@ impl Plan<'_> {
         }
         let end = self.span_end()?;
         let times = crate::solve::series::uniform_times(end, self.samples)?;
-        let Some(motion) = self.motion.as_ref() else {
-            return Ok(Vec::new());
-        };
+        let motion = self.take_motion()?;
+        let Plan {
+            motion: slot, work, ..
+        } = self;
+        let motion = &*slot.insert(motion);
         let mut groups: Vec<(usize, Vec<f64>)> = Vec::new();
         for &t in &times {
             // The phase that runs at `t`: the last one starting at or before it that lasts, or
-            // the one ending there.
+            // the one ending there (the phases cover the span, so there is one).
             let k = (motion.phases.iter())
                 .rposition(|p| p.t_start() <= t && (t < p.t_end() || p.t_end() >= end))
-                .unwrap_or(0);
+                .ok_or(SolveError::Inversion {
+                    target: t,
+                    duration: end,
+                    reason: "no solved phase runs at this time",
+                })?;
             match groups.last_mut() {
                 Some((g, ts)) if *g == k => ts.push(t),
                 _ => groups.push((k, vec![t])),
@@ -366,7 +390,7 @@ impl Plan<'_> {
         for (k, ts) in groups {
             let phase = &motion.phases[k];
             let local: Vec<f64> = ts.iter().map(|t| (t - phase.t_start()).max(0.0)).collect();
-            let s = sample_at(phase, &local, &mut self.work)?;
+            let s = sample_at(phase, &local, work)?;
             out.push((k, s, ts));
         }
         self.span = Some(out.clone());
@@ -379,9 +403,7 @@ impl Plan<'_> {
         let info = self.general().info();
         let groups = self.span_samples()?;
         let general = self.general().clone();
-        let Some(motion) = self.motion.as_ref() else {
-            return Ok(());
-        };
+        let motion = &*self.motion()?;
         let mut cols: Vec<Vec<f64>> = Vec::new();
         let mut push = |row: &[f64]| {
             cols.resize(row.len(), Vec::new());
@@ -410,7 +432,7 @@ impl Plan<'_> {
                 }
                 Quantity::Trajectory(i) => {
                     for (j, state) in s.states.iter().enumerate() {
-                        let pts = phase.bound().points(state);
+                        let pts = phase.bound().points(state)?;
                         let (p, v) = (pts.pos[i], pts.vel[i]);
                         push(&[t[j], p[0], p[1], v[0], v[1]]);
                     }
@@ -537,15 +559,21 @@ impl Plan<'_> {
                 break;
             }
         }
-        let Some(motion) = self.motion.as_ref() else {
-            return Ok(());
-        };
-        let info = self.walker.general.info();
+        let motion = self.take_motion()?;
+        let Plan {
+            motion: slot,
+            walker,
+            phase_samples,
+            ..
+        } = self;
+        let motion = &*slot.insert(motion);
+        let info = walker.general.info();
         let traced = want.iter().find_map(|q| match q {
             Quantity::Trajectory(i) => info.points.get(*i).map(|p| p.name),
             _ => None,
         });
-        let phases: Vec<PhaseInput> = (motion.phases.iter().zip(&self.phase_samples))
+        // The phases sampled (all of them, or those before the one that could not be).
+        let phases: Vec<PhaseInput> = (motion.phases.iter().zip(phase_samples.iter()))
             .map(|(run, samples)| PhaseInput {
                 bound: run.bound(),
                 samples,

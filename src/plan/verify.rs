@@ -26,23 +26,34 @@ impl Plan<'_> {
     /// reduced state at each step's angle.
     pub(super) fn cross_check(&mut self, out: &mut RunResults) -> Result<(), SolveError> {
         self.fast_required()?;
-        self.motion()?;
-        match self.ode() {
-            Ok(_) => {}
+        let ode = match self.take_ode() {
+            Ok(ode) => ode,
             // Not an error of the run: the integrated route has nothing to say here.
             Err(e @ SolveError::IllConditioned { .. }) => {
                 out.notes.insert("cross_check".into(), e.to_string());
                 return Ok(());
             }
             Err(e) => return Err(e),
-        }
-        let (Some(motion), Some(ode)) = (self.motion.as_ref(), self.ode.as_ref()) else {
-            return Ok(());
         };
+        let motion = self.take_motion()?;
+        let Plan {
+            motion: motion_slot,
+            ode: ode_slot,
+            walker,
+            work,
+            ..
+        } = self;
+        let (motion, ode) = (&*motion_slot.insert(motion), &*ode_slot.insert(ode));
+        let info = walker.general.info();
+        // The motion starts on the fast phase (`fast_required`), whose first phase from rest
+        // is never integrated instead (one that turns back is `SolveError::Swings`).
         let Some(first) = motion.phases[0].reduced() else {
-            return Ok(());
+            return Err(SolveError::NotOnFastPath {
+                model: info.name,
+                why: "its first phase was integrated, so there is no fast path to cross-check"
+                    .into(),
+            });
         };
-        let info = self.walker.general.info();
         let t_quad = first.mesh.duration;
         let event = event_words(ode, info);
         let same = End::from(ode.end) == first.end.end;
@@ -61,7 +72,7 @@ impl Plan<'_> {
         } else {
             (ode.t_end - t_quad).abs()
         };
-        let (dt_max, dy_max, nodes) = path_deviation(first, ode, info.reduced, &mut self.work)?;
+        let (dt_max, dy_max, nodes) = path_deviation(first, ode, info.reduced, work)?;
         let steps = ode.steps();
         scalar(
             out,
@@ -121,11 +132,21 @@ impl Plan<'_> {
         let tol = self.walker.tol;
         for i in 0..n_phases {
             self.samples_of(i)?;
-            let (Some(motion), Some(samples)) = (self.motion.as_ref(), self.phase_samples.get(i))
-            else {
-                continue;
-            };
-            let run = &motion.phases[i];
+        }
+        let motion = self.take_motion()?;
+        let Plan {
+            motion: slot,
+            phase_samples,
+            ode,
+            walker,
+            ..
+        } = self;
+        let motion = &*slot.insert(motion);
+        for (i, run) in motion.phases.iter().enumerate() {
+            let solved = phase_samples.len();
+            let samples = phase_samples
+                .get(i)
+                .ok_or(SolveError::NoSuchPhase { index: i, solved })?;
             let bound = run.bound();
             let label = run.labels().join(" then ");
             let ctx = checks::Context {
@@ -139,7 +160,7 @@ impl Plan<'_> {
                 t_start: run.t_start(),
             };
             let forces = sample_forces(run, samples)?;
-            let mut found = checks::monitors(bound, samples, &forces, tol, &ctx);
+            let mut found = checks::monitors(bound, samples, &forces, tol, &ctx)?;
             found.extend(checks::contact_forces(
                 bound,
                 samples,
@@ -148,13 +169,13 @@ impl Plan<'_> {
                 tol,
                 &ctx,
             ));
-            found.extend(path_checks(run, samples, tol, &ctx));
+            found.extend(path_checks(run, samples, tol, &ctx)?);
             out.checks.extend(found);
         }
-        if with_ode && let Some(ode) = self.ode.as_ref() {
+        if with_ode && let Some(ode) = ode.as_ref() {
             // The cross-check's path is held to its own accuracy: ten times its rtol at the
             // least. It integrates the first phase, so its checks come right after that phase's.
-            let general = &self.walker.general;
+            let general = &walker.general;
             let ode_tol = tol.max(10.0 * ode.rtol);
             let ctx = checks::Context {
                 phase: format!("{} (ODE cross-check)", general.name()),
@@ -163,7 +184,7 @@ impl Plan<'_> {
                 t_start: 0.0,
             };
             out.checks
-                .extend(integrated_checks(general, ode, ode_tol, &ctx));
+                .extend(integrated_checks(general, ode, ode_tol, &ctx)?);
         }
         Ok(())
     }
@@ -177,7 +198,7 @@ fn path_checks(
     samples: &crate::solve::series::PhaseSamples,
     tol: f64,
     ctx: &checks::Context,
-) -> Vec<(String, crate::results::Check)> {
+) -> Result<Vec<(String, crate::results::Check)>, SolveError> {
     match run {
         PhaseRun::Reduced(r) => {
             let bound = r.system.bound();
@@ -204,7 +225,7 @@ fn integrated_checks(
     run: &UnreducedRun,
     tol: f64,
     ctx: &checks::Context,
-) -> Vec<(String, crate::results::Check)> {
+) -> Result<Vec<(String, crate::results::Check)>, SolveError> {
     let info = bound.info();
     let states = run.states();
     let segments = run.node_segments();
@@ -221,12 +242,12 @@ fn integrated_checks(
     let work = run.node_friction_work();
     let conserved = Conserved {
         friction_work: (!info.frictions.is_empty()).then_some(&work[..]),
-        momenta: free_momenta(bound, &states, &rows),
+        momenta: free_momenta(bound, &states, &rows)?,
     };
-    let mut out = checks::drift(bound, &states, &conserved, tol, ctx, CheckKind::Drift);
+    let mut out = checks::drift(bound, &states, &conserved, tol, ctx, CheckKind::Drift)?;
     let closed: Vec<Vec<bool>> = rows.into_iter().map(|(c, _)| c).collect();
-    out.extend(checks::constraint_drift(bound, &states, &closed, tol, ctx));
-    out
+    out.extend(checks::constraint_drift(bound, &states, &closed, tol, ctx)?);
+    Ok(out)
 }
 
 /// Along the integrated cross-check's steps: the largest `|t_ode - t(theta_ode)|` and the
@@ -262,7 +283,7 @@ fn path_deviation(
         let delta = (theta_i - y[reduced]).clamp(0.0, first.mesh.delta_end);
         let tq = first.mesh.time_at_delta(sys, delta, &mut w)?;
         dt_max = dt_max.max((t - tq).abs());
-        let full = sys.to_full(&sys.full_state(*t, delta, theta_dot_at(sys, delta)));
+        let full = sys.to_full(&sys.full_state(*t, delta, theta_dot_at(sys, delta))?)?;
         for (i, (a, b)) in full.q.iter().chain(&full.qd).zip(y.iter()).enumerate() {
             if scale[i] > 0.0 {
                 dy_max = dy_max.max((a - b).abs() / scale[i]);

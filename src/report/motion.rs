@@ -12,8 +12,9 @@
 //! [`TARGET_SECONDS`]; it is printed in the picture. The last frame holds for
 //! [`PAUSE_SECONDS`], then the animation repeats.
 //!
-//! Nothing here panics on bad numbers: a frame with a NaN or infinite number is left out (and
-//! counted in [`Animation::dropped`]), a shape with one is not drawn; with a single frame, or a
+//! Nothing here panics on bad numbers: a frame with a NaN or infinite number, or whose state the
+//! model refuses (a length not its own), is left out (and counted in [`Animation::dropped`],
+//! the refusal in a note), a shape with one is not drawn; with a single frame, or a
 //! motion of zero duration, the picture is static (that frame, with a note saying so); with
 //! none, it shows the floor and the note.
 //!
@@ -113,7 +114,7 @@ pub struct Animation {
     pub contact_end: Option<ContactEnd>,
     /// The name of the point whose path is traced, if any.
     pub traced: Option<String>,
-    /// Frames left out for a NaN or infinite number.
+    /// Frames left out for a NaN or infinite number, or for a state the model refuses.
     pub dropped: usize,
     /// What could not be drawn, and why.
     pub notes: Vec<String>,
@@ -190,16 +191,17 @@ impl Animation {
 /// body that does not exist, are left out with a note).
 fn first_shapes(first: &PhaseInput, notes: &mut Vec<String>) -> Vec<Shape> {
     let info = first.bound.info();
-    let mut poses = vec![[0.0; 3]; info.bodies.len()];
-    let mut sizes = vec![0.0; info.drawing_sizes()];
     let start = match first.samples.states.first() {
         Some(s) => s.clone(),
         None => first.bound.initial_state(),
     };
-    first
-        .bound
-        .model()
-        .drawing(first.bound.k(), &start.q, &mut poses, &mut sizes);
+    let (poses, sizes) = match first.bound.drawing(&start) {
+        Ok(drawn) => drawn,
+        Err(e) => {
+            notes.push(format!("the shapes of `{}` are not drawn: {e}", info.name));
+            return Vec::new();
+        }
+    };
     let mut shapes = Vec::new();
     for (i, s) in info.shapes.iter().enumerate() {
         let numbers = sizes.get(s.first..s.first + s.kind.numbers());
@@ -226,19 +228,28 @@ fn first_shapes(first: &PhaseInput, notes: &mut Vec<String>) -> Vec<Shape> {
 /// previous one's last, is skipped; one with a NaN or infinite number is dropped).
 fn add_frames(anim: &mut Animation, phase: &PhaseInput, index: usize, traced: Option<&str>) {
     let bound = phase.bound;
-    let info = bound.info();
     let point = traced.and_then(|name| bound.point_index(name));
-    let mut poses = vec![[0.0; 3]; info.bodies.len()];
-    let mut sizes = vec![0.0; info.drawing_sizes()];
+    let mut refused = None;
     for (t, state) in phase.samples.t.iter().zip(&phase.samples.states) {
         let t = phase.t_start + t;
         if anim.frames.last().is_some_and(|f| t <= f.t) {
             continue;
         }
-        bound
-            .model()
-            .drawing(bound.k(), &state.q, &mut poses, &mut sizes);
-        let traced = point.and_then(|i| bound.points(state).pos.get(i).copied());
+        let drawn = bound.drawing(state).and_then(|(poses, _)| {
+            let traced = match point {
+                Some(i) => bound.points(state)?.pos.get(i).copied(),
+                None => None,
+            };
+            Ok((poses, traced))
+        });
+        let (poses, traced) = match drawn {
+            Ok(drawn) => drawn,
+            Err(e) => {
+                anim.dropped += 1;
+                refused.get_or_insert(e);
+                continue;
+            }
+        };
         let finite = t.is_finite()
             && poses.iter().flatten().all(|v| v.is_finite())
             && traced.is_none_or(|p| p.iter().all(|v| v.is_finite()));
@@ -246,12 +257,18 @@ fn add_frames(anim: &mut Animation, phase: &PhaseInput, index: usize, traced: Op
             anim.frames.push(Frame {
                 t,
                 phase: index,
-                poses: poses.clone(),
+                poses,
                 traced,
             });
         } else {
             anim.dropped += 1;
         }
+    }
+    if let Some(e) = refused {
+        anim.notes.push(format!(
+            "frames of phase `{}` not drawn: {e}",
+            bound.info().name
+        ));
     }
 }
 

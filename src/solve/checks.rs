@@ -20,6 +20,7 @@
 //!   `E - E(0) = W_friction`.
 
 use crate::results::{Check, CheckKind, format_number};
+use crate::solve::SolveError;
 use crate::solve::series::PhaseSamples;
 use crate::system::{Bound, State};
 use nalgebra::DMatrix;
@@ -120,22 +121,23 @@ fn lowest_check(
 
 /// One check per monitor of a phase: its smallest value over the samples (the margin, in the
 /// monitor's unit) must be `>= 0` up to rounding. `forces` are the contacts' forces at each
-/// sample (`series::sample_forces`). Keys are `<key>.<monitor>`.
+/// sample (`series::sample_forces`). Keys are `<key>.<monitor>`. A state or forces the model
+/// refuses ([`Bound::monitors_full`]) is an error, not a failed check.
 pub fn monitors(
     sys: &Bound,
     samples: &PhaseSamples,
     forces: &[Vec<f64>],
     tolerance: f64,
     ctx: &Context,
-) -> Vec<(String, Check)> {
+) -> Result<Vec<(String, Check)>, SolveError> {
     let info = sys.info();
     let mut low: Vec<Lowest> = info.monitors.iter().map(|_| Lowest::new()).collect();
     for ((&t, state), f) in samples.t.iter().zip(&samples.states).zip(forces) {
-        for (l, v) in low.iter_mut().zip(sys.monitors_full(state, f)) {
+        for (l, v) in low.iter_mut().zip(sys.monitors_full(state, f)?) {
             l.add(v, t);
         }
     }
-    (info.monitors.iter().zip(low))
+    Ok((info.monitors.iter().zip(low))
         .map(|(mon, low)| {
             let meaning = format!(
                 "{}: the smallest value over {} samples of `{}` must be >= 0",
@@ -146,7 +148,7 @@ pub fn monitors(
             let check = lowest_check(&low, tolerance, mon.unit, samples.len(), ctx, meaning);
             (format!("{}.{}", ctx.key, mon.name), check)
         })
-        .collect()
+        .collect())
 }
 
 /// One check per unilateral contact closed in the phase (`closed`, per contact): its smallest
@@ -215,16 +217,16 @@ pub fn constraint_drift(
     rows: &[Vec<bool>],
     tolerance: f64,
     ctx: &Context,
-) -> Vec<(String, Check)> {
+) -> Result<Vec<(String, Check)>, SolveError> {
     let info = sys.info();
     let Some(first) = states.first() else {
-        return Vec::new();
+        return Ok(Vec::new());
     };
-    let length = sys.length_scale(first);
+    let length = sys.length_scale(first)?;
     let m = info.contacts.len();
     let mut worst = vec![None::<f64>; m];
     for (state, closed) in states.iter().zip(rows) {
-        let gaps = sys.gaps(state);
+        let gaps = sys.gaps(state)?;
         for i in (0..m).filter(|&i| closed.get(i) == Some(&true) && !info.contacts[i].closed) {
             let scale = if info.contacts[i].gap_unit == "m" {
                 length
@@ -239,7 +241,7 @@ pub fn constraint_drift(
             });
         }
     }
-    (0..m)
+    Ok((0..m)
         .filter_map(|i| {
             let drift = worst[i]?;
             let c = &info.contacts[i];
@@ -262,20 +264,21 @@ pub fn constraint_drift(
             );
             Some((format!("{}.{}_gap", ctx.key, c.name), check))
         })
-        .collect()
+        .collect())
 }
 
 /// The kinetic energy `qd^T M qd / 2` of a state.
-fn kinetic(sys: &Bound, s: &State) -> f64 {
+fn kinetic(sys: &Bound, s: &State) -> Result<f64, SolveError> {
     let n = sys.n_coordinates();
-    let (mass, _) = sys.equations(s);
-    0.5 * (0..n)
-        .map(|i| {
-            (0..n)
-                .map(|j| s.qd[i] * mass[i * n + j] * s.qd[j])
-                .sum::<f64>()
-        })
-        .sum::<f64>()
+    let (mass, _) = sys.equations(s)?;
+    Ok(0.5
+        * (0..n)
+            .map(|i| {
+                (0..n)
+                    .map(|j| s.qd[i] * mass[i * n + j] * s.qd[j])
+                    .sum::<f64>()
+            })
+            .sum::<f64>())
 }
 
 /// What conserves along a path: the energy (less the work of friction, when given: the
@@ -314,13 +317,15 @@ pub fn free_momenta(
     sys: &Bound,
     states: &[State],
     rows: &[(Vec<bool>, Vec<bool>)],
-) -> Vec<(String, Vec<f64>)> {
+) -> Result<Vec<(String, Vec<f64>)>, SolveError> {
     let info = sys.info();
     let cyclic = info.cyclic;
     let n = sys.n_coordinates();
-    let pushing = |s: &State, (closed, acting): &(Vec<bool>, Vec<bool>)| -> Vec<Vec<f64>> {
-        let (jac, _) = sys.constraints(s);
-        let (tjac, _) = sys.friction(s);
+    let pushing = |s: &State,
+                   (closed, acting): &(Vec<bool>, Vec<bool>)|
+     -> Result<Vec<Vec<f64>>, SolveError> {
+        let (jac, _) = sys.constraints(s)?;
+        let (tjac, _) = sys.friction(s)?;
         let mut out: Vec<Vec<f64>> = (0..info.contacts.len())
             .filter(|&i| closed.get(i) == Some(&true) && !info.contacts[i].closed)
             .map(|i| cyclic.iter().map(|&c| jac[i * n + c]).collect())
@@ -330,17 +335,16 @@ pub fn free_momenta(
                 .filter(|&j| acting.get(j) == Some(&true))
                 .map(|j| cyclic.iter().map(|&c| tjac[j * n + c]).collect()),
         );
-        out
+        Ok(out)
     };
     let (Some(first), Some(first_rows)) = (states.first(), rows.first()) else {
-        return Vec::new();
+        return Ok(Vec::new());
     };
-    let all: Vec<Vec<f64>> = states
-        .iter()
-        .zip(rows)
-        .flat_map(|(s, r)| pushing(s, r))
-        .collect();
-    let candidates = null_space(&pushing(first, first_rows), cyclic.len());
+    let mut all: Vec<Vec<f64>> = Vec::new();
+    for (s, r) in states.iter().zip(rows) {
+        all.extend(pushing(s, r)?);
+    }
+    let candidates = null_space(&pushing(first, first_rows)?, cyclic.len());
     let single = |w: &[f64]| {
         let nonzero: Vec<usize> = (0..w.len()).filter(|&c| w[c].abs() > 1e-12).collect();
         match nonzero.as_slice() {
@@ -355,7 +359,7 @@ pub fn free_momenta(
             ),
         }
     };
-    candidates
+    Ok(candidates
         .into_iter()
         .filter(|w| {
             all.iter().all(|row| {
@@ -365,7 +369,7 @@ pub fn free_momenta(
             })
         })
         .map(|w| (single(&w), w))
-        .collect()
+        .collect())
 }
 
 /// An orthonormal basis of the null space of `rows` (each of length `k`), with the unit
@@ -431,10 +435,10 @@ pub fn drift(
     tolerance: f64,
     ctx: &Context,
     kind: CheckKind,
-) -> Vec<(String, Check)> {
+) -> Result<Vec<(String, Check)>, SolveError> {
     let info = sys.info();
     let Some(first) = states.first() else {
-        return Vec::new();
+        return Ok(Vec::new());
     };
     let n = sys.n_coordinates();
     // A state without its work of friction counts as NaN, which fails the check.
@@ -442,9 +446,9 @@ pub fn drift(
         Some(w) => w.get(i).copied().unwrap_or(f64::NAN),
         None => 0.0,
     };
-    let e0 = sys.energy(first) - work_at(0);
+    let e0 = sys.energy(first)? - work_at(0);
     let combine = |p: &[f64], w: &[f64]| -> f64 { p.iter().zip(w).map(|(a, b)| a * b).sum() };
-    let p_first = sys.momenta(first);
+    let p_first = sys.momenta(first)?;
     let p0: Vec<f64> = conserved
         .momenta
         .iter()
@@ -455,15 +459,15 @@ pub fn drift(
     let mut p_dev = vec![0.0f64; p0.len()];
     let mut p_scale = vec![0.0f64; p0.len()];
     for (i, s) in states.iter().enumerate() {
-        let total = sys.energy(s);
-        let ke = kinetic(sys, s);
+        let total = sys.energy(s)?;
+        let ke = kinetic(sys, s)?;
         e_dev = nan_max(e_dev, (total - work_at(i) - e0).abs());
         kin_max = kin_max.max(ke.abs());
         size_max = size_max.max(ke.abs() + (total - ke).abs() + work_at(i).abs());
         v_min = v_min.min(total - ke);
         v_max = v_max.max(total - ke);
-        let (mass, _) = sys.equations(s);
-        let p = sys.momenta(s);
+        let (mass, _) = sys.equations(s)?;
+        let p = sys.momenta(s)?;
         for (c, (_, w)) in conserved.momenta.iter().enumerate() {
             p_dev[c] = nan_max(p_dev[c], (combine(&p, w) - p0[c]).abs());
             let terms: f64 = (0..n)
@@ -531,7 +535,7 @@ pub fn drift(
             ),
         ));
     }
-    out
+    Ok(out)
 }
 
 /// How many units of rounding of the energy's largest terms the energy check allows.

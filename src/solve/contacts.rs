@@ -160,11 +160,11 @@ struct Rows {
 }
 
 impl Rows {
-    fn at(sys: &Bound, state: &State) -> Rows {
-        let (mass, rhs) = sys.equations(state);
-        let (jac, bias) = sys.constraints(state);
-        let (tjac, tbias) = sys.friction(state);
-        Rows {
+    fn at(sys: &Bound, state: &State) -> Result<Rows, SolveError> {
+        let (mass, rhs) = sys.equations(state)?;
+        let (jac, bias) = sys.constraints(state)?;
+        let (tjac, tbias) = sys.friction(state)?;
+        Ok(Rows {
             n: sys.n_coordinates(),
             mass,
             rhs,
@@ -172,7 +172,7 @@ impl Rows {
             bias,
             tjac,
             tbias,
-        }
+        })
     }
 
     fn row<'a>(&self, m: &'a [f64], i: usize) -> &'a [f64] {
@@ -197,6 +197,22 @@ fn closed_list(info: &ModelInfo, closed: &[bool]) -> String {
     }
 }
 
+/// `Ok` when `active` has one state per contact and one mode per friction of the model, else
+/// [`SolveError::ActiveSize`].
+pub fn check_active(info: &ModelInfo, active: &Active) -> Result<(), SolveError> {
+    let (m, nf) = (info.contacts.len(), info.frictions.len());
+    if active.closed.len() != m || active.modes.len() != nf {
+        return Err(SolveError::ActiveSize {
+            model: info.name,
+            contacts: m,
+            frictions: nf,
+            closed: active.closed.len(),
+            modes: active.modes.len(),
+        });
+    }
+    Ok(())
+}
+
 /// Solves for the accelerations, the contacts' forces and the friction forces at `state` in
 /// the active set `active`. `t` (from release) labels errors.
 pub fn dynamics(
@@ -211,16 +227,8 @@ pub fn dynamics(
         info.contacts.len(),
         info.frictions.len(),
     );
-    if active.closed.len() != m || active.modes.len() != nf {
-        return Err(SolveError::ActiveSize {
-            model: info.name,
-            contacts: m,
-            frictions: nf,
-            closed: active.closed.len(),
-            modes: active.modes.len(),
-        });
-    }
-    let rows = Rows::at(sys, state);
+    check_active(info, active)?;
+    let rows = Rows::at(sys, state)?;
     // Closed constraint rows (closed and not eliminated), then acting frictions.
     let kkt: Vec<usize> = (0..m)
         .filter(|&i| active.closed[i] && !info.contacts[i].closed)
@@ -258,7 +266,7 @@ pub fn dynamics(
         1.0
     };
     let qdd: Vec<f64> = x.iter().take(n).copied().collect();
-    let mut forces = sys.forces_full(state, &qdd);
+    let mut forces = sys.forces_full(state, &qdd)?;
     for (r, &i) in kkt.iter().enumerate() {
         forces[i] = x[n + r];
     }
@@ -389,11 +397,11 @@ pub struct Options {
 /// The options of every friction at a state: at rest where its slip speed is below [`REST`]
 /// of the state's speed scale (`sum_j |T_j|` times the largest `|qd_j|`), otherwise sliding the
 /// way it slips.
-pub fn friction_options(sys: &Bound, state: &State) -> Vec<FrictionOption> {
+pub fn friction_options(sys: &Bound, state: &State) -> Result<Vec<FrictionOption>, SolveError> {
     let n = sys.n_coordinates();
-    let (jac, _) = sys.friction(state);
+    let (jac, _) = sys.friction(state)?;
     let fastest = state.qd.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    (0..sys.info().frictions.len())
+    Ok((0..sys.info().frictions.len())
         .map(|k| {
             let row = &jac[k * n..(k + 1) * n];
             let v: f64 = row.iter().zip(&state.qd).map(|(j, q)| j * q).sum();
@@ -404,7 +412,7 @@ pub fn friction_options(sys: &Bound, state: &State) -> Vec<FrictionOption> {
                 FrictionOption::Keep(Mode::Slide(v.signum()))
             }
         })
-        .collect()
+        .collect())
 }
 
 /// Where contact options are taken: at release, or after a phase that held some contacts
@@ -456,10 +464,10 @@ pub fn contact_options(
     at: Moment,
 ) -> Result<Vec<ContactOption>, SolveError> {
     let info = sys.info();
-    let gaps = sys.gaps(state);
-    let (jac, _) = sys.constraints(state);
+    let gaps = sys.gaps(state)?;
+    let (jac, _) = sys.constraints(state)?;
     let n = sys.n_coordinates();
-    let length = sys.length_scale(state);
+    let length = sys.length_scale(state)?;
     let fastest = state.qd.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let mut out = Vec::new();
     for (i, c) in info.contacts.iter().enumerate() {
@@ -615,6 +623,18 @@ fn combinations(sys: &Bound, options: &Options, t: f64) -> Result<Vec<Active>, S
 /// the one with the most contacts closed; otherwise [`SolveError::Indeterminate`].
 pub fn decide(sys: &Bound, state: &State, options: &Options, t: f64) -> Result<Active, SolveError> {
     let info = sys.info();
+    sys.check_state(state)?;
+    if options.contacts.len() != info.contacts.len()
+        || options.frictions.len() != info.frictions.len()
+    {
+        return Err(SolveError::ActiveSize {
+            model: info.name,
+            contacts: info.contacts.len(),
+            frictions: info.frictions.len(),
+            closed: options.contacts.len(),
+            modes: options.frictions.len(),
+        });
+    }
     let mut found: Vec<(Active, Dynamics)> = Vec::new();
     let mut singular: Vec<String> = Vec::new();
     for active in combinations(sys, options, t)? {
@@ -623,25 +643,27 @@ pub fn decide(sys: &Bound, state: &State, options: &Options, t: f64) -> Result<A
             // Redundant supports that hold the system at rest (a ladder stuck at both ends):
             // its motion is none, whatever share of the load each support takes.
             Err(SolveError::SingularContacts { .. })
-                if rest::holds(sys, state, &active).is_some() =>
+                if rest::holds(sys, state, &active, t)?.is_some() =>
             {
                 return Err(at_rest(info, &active, t, "redundantly, with"));
             }
             // Other singular sets (Painlevé's singularity exactly, or redundant contacts that
-            // cannot hold) are not a motion; the error says so if no set is.
+            // cannot hold) are not a motion; the error says so if no set is. Nothing is lost
+            // where another set is consistent: a set whose rows are redundant describes the
+            // motion of a smaller set (one redundant row left open), which is tried on its own.
             Err(SolveError::SingularContacts { .. }) => {
                 singular.push(active.describe(info));
                 continue;
             }
             Err(e) => return Err(e),
         };
-        let scales = acc_scales(sys, state, &active, &d);
+        let scales = acc_scales(sys, state, &active, &d, t)?;
         if consistent(sys, options, &active, &d, &scales) {
             found.push((active, d));
         }
     }
     let active = pick(info, options, found, &singular, t)?;
-    if rest::pins(sys, state, &active) {
+    if rest::pins(sys, state, &active)? {
         return Err(at_rest(info, &active, t, "with"));
     }
     Ok(active)
@@ -653,13 +675,25 @@ pub fn decide(sys: &Bound, state: &State, options: &Options, t: f64) -> Result<A
 /// `qdd_j`. So a contact whose motion is slow next to gravity (a rod nearly flat on a thin
 /// block) is judged at its own scale, and one whose acceleration cancels to rounding noise
 /// (a foot just lifting) at the scale of the forces that cancel.
-fn acc_scales(sys: &Bound, state: &State, active: &Active, d: &Dynamics) -> Vec<f64> {
+///
+/// A mass matrix that cannot be inverted (while the constrained system could be solved) gives
+/// no scale to judge a contact by: [`SolveError::SingularMassMatrix`], not a guess.
+fn acc_scales(
+    sys: &Bound,
+    state: &State,
+    active: &Active,
+    d: &Dynamics,
+    t: f64,
+) -> Result<Vec<f64>, SolveError> {
     let info = sys.info();
-    let rows = Rows::at(sys, state);
+    let rows = Rows::at(sys, state)?;
     let n = rows.n;
     let mass = DMatrix::from_row_slice(n, n, &rows.mass);
     let Some(inverse) = mass.try_inverse() else {
-        return vec![f64::INFINITY; info.contacts.len()];
+        return Err(SolveError::SingularMassMatrix {
+            t,
+            q: state.q.clone(),
+        });
     };
     let mut size = vec![0.0f64; n];
     let mut add = |force: &[f64], times: f64| {
@@ -675,13 +709,13 @@ fn acc_scales(sys: &Bound, state: &State, active: &Active, d: &Dynamics) -> Vec<
     for j in (0..info.frictions.len()).filter(|&j| active.friction_acts(info, j)) {
         add(rows.row(&rows.tjac, j), d.fr[j]);
     }
-    (0..info.contacts.len())
+    Ok((0..info.contacts.len())
         .map(|i| {
             let row = rows.row(&rows.jac, i);
             let terms: f64 = row.iter().zip(&size).map(|(j, s)| (j * s).abs()).sum();
             terms + rows.bias[i].abs()
         })
-        .collect()
+        .collect())
 }
 
 /// The outcome of a system its supports hold at rest.

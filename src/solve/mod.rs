@@ -42,18 +42,28 @@ use crate::system::SystemError;
 pub enum SolveError {
     /// The parameters handed to a next phase were refused.
     #[error("next phase: {0}")]
-    System(#[from] SystemError),
+    System(SystemError),
+    /// A state, slice or value given to a model's function was refused (a length that is not
+    /// the model's, a value that is not finite): see [`Bound`](crate::system::Bound).
+    #[error("{0}")]
+    Input(#[from] SystemError),
     /// The parameters handed to a per-point solver were refused (the same checks as
     /// [`System::from_values`](crate::system::System::from_values)).
     #[error("{0}")]
     Parameters(SystemError),
-    /// Separation was asked of a model whose first contact is not closed in it.
+    /// A contact's end was asked of a model that does not hold it closed as a unilateral
+    /// contact (with an edge, where its edge was asked), or that has no such contact.
     #[error(
-        "model `{model}` does not hold a unilateral first contact closed, so it cannot separate"
+        "model `{model}` does not hold contact {contact} closed as a unilateral contact{}, so it cannot end there",
+        if *edge { " with an edge" } else { "" }
     )]
     NoContact {
         /// Model name.
         model: &'static str,
+        /// The contact's index in the model's contacts (0: the separation's).
+        contact: usize,
+        /// Whether its edge was asked.
+        edge: bool,
     },
     /// The separation polynomial is identically zero or has a non-finite coefficient.
     #[error("separation polynomial of model `{model}` is unusable: {coefficients:?}")]
@@ -407,6 +417,14 @@ pub enum SolveError {
         model: &'static str,
         /// What it lacks.
         why: &'static str,
+    },
+    /// A phase the motion does not have was asked for (an index past its solved phases).
+    #[error("phase {index} was asked of a motion with {solved} solved phase(s)")]
+    NoSuchPhase {
+        /// The index asked (from 0).
+        index: usize,
+        /// How many phases are solved.
+        solved: usize,
     },
     /// Phases kept separating without reaching the floor.
     #[error("more than {limit} phases without reaching the floor")]

@@ -118,7 +118,7 @@ pub struct ReducedEnd {
 /// [`SolveError::NonFinite`].
 pub fn phase_end(sys: &System, work: &mut Work) -> Result<ReducedEnd, SolveError> {
     let info = sys.info();
-    let at_start = sys.forces(0.0);
+    let at_start = sys.forces(0.0)?;
     let mut found: Option<(End, Separation)> = None;
     let mut consider = |end: End, outcome: SeparationOutcome| {
         if let SeparationOutcome::Separates(s) = outcome
@@ -248,12 +248,12 @@ impl<'m> ReducedRun<'m> {
     }
 
     /// The full state at the end of the phase.
-    pub fn end_state(&self) -> State {
-        self.system.full_state(
+    pub fn end_state(&self) -> Result<State, SolveError> {
+        Ok(self.system.full_state(
             self.mesh.duration,
             self.mesh.delta_end,
             self.theta_dot_end(),
-        )
+        )?)
     }
 }
 
@@ -275,14 +275,14 @@ fn first_gap_closing(
     }
     let state_at = |delta: f64, work: &mut Work| -> Result<State, SolveError> {
         let t = mesh.time_at_delta(sys, delta, work)?;
-        Ok(sys.full_state(t, delta, theta_dot_at(sys, delta)))
+        Ok(sys.full_state(t, delta, theta_dot_at(sys, delta))?)
     };
-    let tol = contacts::DECIDE_TOLERANCE * sys.length_scale(&state_at(0.0, work)?);
+    let tol = contacts::DECIDE_TOLERANCE * sys.length_scale(&state_at(0.0, work)?)?;
     let mut best: Option<(usize, f64)> = None;
     for &i in &open {
         let mut gap = |delta: f64| -> Result<f64, SolveError> {
             let mut w = Work::default();
-            let g = sys.gaps(&state_at(delta, &mut w)?)[i];
+            let g = sys.gaps(&state_at(delta, &mut w)?)?[i];
             work.integrand_evals += w.integrand_evals;
             Ok(g)
         };
@@ -373,21 +373,25 @@ impl<'m> PhaseRun<'m> {
     }
 
     /// The state at the end of the phase, in its model's coordinates.
-    pub fn end_state(&self) -> State {
+    pub fn end_state(&self) -> Result<State, SolveError> {
         match self {
             PhaseRun::Reduced(r) => r.end_state(),
-            PhaseRun::Integrated(r) => r.run.state_end.clone(),
+            PhaseRun::Integrated(r) => Ok(r.run.state_end.clone()),
         }
     }
 
     /// The system's state at the end of the phase (the general model's coordinates).
-    pub fn full_end_state(&self) -> State {
-        self.bound().to_full(&self.end_state())
+    pub fn full_end_state(&self) -> Result<State, SolveError> {
+        Ok(self.bound().to_full(&self.end_state()?)?)
     }
 
-    /// The reduced angle at the end of the phase (rad).
+    /// The reduced angle at the end of the phase (rad): `theta_i - delta_end` on the fast path
+    /// (the reduced coordinate of [`ReducedRun::end_state`]), the end state's otherwise.
     pub fn theta_end(&self) -> f64 {
-        self.end_state().q[self.bound().info().reduced]
+        match self {
+            PhaseRun::Reduced(r) => r.system.theta_initial() - r.mesh.delta_end,
+            PhaseRun::Integrated(r) => r.run.state_end.q[r.bound.info().reduced],
+        }
     }
 
     /// `theta_dot` at the end of the phase (rad/s).
@@ -466,11 +470,11 @@ impl<'m> PhaseRun<'m> {
 
 /// `sqrt(2 h / g)` for the height `h` of the falling point at `state` (`sqrt(2 m / g)` when it
 /// is on the floor): the time scale of the motion.
-pub fn fall_time_scale(bound: &Bound, state: &State) -> f64 {
+pub fn fall_time_scale(bound: &Bound, state: &State) -> Result<f64, SolveError> {
     let info = bound.info();
-    let h = bound.points(state).pos[info.falling_point][1];
+    let h = bound.points(state)?.pos[info.falling_point][1];
     let h = if h > 0.0 { h } else { 1.0 };
-    (2.0 * h / bound.gravity()).sqrt()
+    Ok((2.0 * h / bound.gravity()).sqrt())
 }
 
 /// The whole motion, phase after phase.
@@ -555,7 +559,7 @@ impl<'m> Walker<'m> {
     pub fn release(&self) -> Result<(PhaseStart, Vec<usize>), SolveError> {
         let state = self.general.initial_state();
         let contacts = contact_options(&self.general, &state, Moment::Release)?;
-        let frictions = friction_options(&self.general, &state);
+        let frictions = friction_options(&self.general, &state)?;
         let options = Options {
             contacts: contacts.clone(),
             frictions: frictions.clone(),
@@ -579,7 +583,7 @@ impl<'m> Walker<'m> {
     /// What follows a phase that ended with contact `opened`'s force at zero: the contacts
     /// that stay closed there, that one open.
     pub fn after(&self, run: &PhaseRun<'m>) -> Result<PhaseStart, SolveError> {
-        let state = run.full_end_state();
+        let state = run.full_end_state()?;
         let t = run.t_end();
         let held = run.closed_at_end();
         let at = Moment::After {
@@ -593,7 +597,7 @@ impl<'m> Walker<'m> {
         {
             *c = ContactOption::Opens;
         }
-        let frictions = friction_options(&self.general, &state);
+        let frictions = friction_options(&self.general, &state)?;
         let options = Options {
             contacts,
             frictions: frictions.clone(),
@@ -636,7 +640,7 @@ impl<'m> Walker<'m> {
             return Ok(None);
         }
         let p = phase_parameters(&self.general, phase, &start.state)?;
-        let sys = System::from_values(model, &p)?;
+        let sys = System::from_values(model, &p).map_err(SolveError::System)?;
         // The fast path follows a falling angle from below the vertical.
         let falls = sys.theta_dot_initial() <= 0.0 && sys.theta_initial().cos() > 0.0;
         Ok(falls.then_some(sys))
@@ -685,9 +689,9 @@ impl<'m> Walker<'m> {
     /// Typical sizes of the motion from `state` with `active` closed over the fall's time
     /// scale, for the integrator's absolute tolerances ([`motion_scales`]).
     pub fn scales(&self, state: &State, active: &Active) -> Result<Vec<f64>, SolveError> {
-        let time = fall_time_scale(&self.general, state);
+        let time = fall_time_scale(&self.general, state)?;
         let d = contacts::dynamics(&self.general, state, active, 0.0)?;
-        Ok(motion_scales(&self.general, state, &d.qdd, time))
+        motion_scales(&self.general, state, &d.qdd, time)
     }
 
     /// Integrates the general model from `start` to its first event.
@@ -697,7 +701,7 @@ impl<'m> Walker<'m> {
         work: &mut Work,
     ) -> Result<PhaseRun<'m>, SolveError> {
         let bound = self.general.clone();
-        let time = fall_time_scale(&bound, &start.state);
+        let time = fall_time_scale(&bound, &start.state)?;
         let scales = self.scales(&start.state, &start.active)?;
         let from = Start {
             state: start.state.clone(),
@@ -734,8 +738,8 @@ impl<'m> Walker<'m> {
     /// a landing.
     fn landed(&self, state: &State, t: f64) -> Result<(), SolveError> {
         let info = self.general.info();
-        let height = self.general.points(state).pos[info.falling_point][1];
-        let length = self.general.length_scale(state);
+        let height = self.general.points(state)?.pos[info.falling_point][1];
+        let length = self.general.length_scale(state)?;
         if height.abs() <= LANDING_TOLERANCE.max(self.tol) * length {
             return Ok(());
         }
@@ -805,6 +809,7 @@ pub fn phase_parameters(
     state: &State,
 ) -> Result<Vec<f64>, SolveError> {
     let info = general.info();
+    general.check_state(state)?;
     let mut p = general.p().to_vec();
     if !phase.start_params {
         if phase.parameters.len() != p.len() {

@@ -9,6 +9,7 @@
 //! vertices.
 
 use crate::model::ModelInfo;
+use crate::solve::SolveError;
 use crate::solve::contacts::{Active, DECIDE_TOLERANCE, Mode};
 use crate::system::{Bound, State};
 use nalgebra::{DMatrix, DVector};
@@ -37,60 +38,109 @@ fn support_rows(info: &ModelInfo, active: &Active) -> Option<(Vec<usize>, Vec<us
 }
 
 /// The stacked support rows `G` (one per closed contact, then one per stuck friction).
-fn stacked(sys: &Bound, state: &State, kkt: &[usize], acting: &[usize]) -> DMatrix<f64> {
+fn stacked(
+    sys: &Bound,
+    state: &State,
+    kkt: &[usize],
+    acting: &[usize],
+) -> Result<DMatrix<f64>, SolveError> {
     let n = sys.n_coordinates();
-    let (jac, _) = sys.constraints(state);
-    let (tjac, _) = sys.friction(state);
+    let (jac, _) = sys.constraints(state)?;
+    let (tjac, _) = sys.friction(state)?;
     let rows = kkt.len() + acting.len();
-    DMatrix::from_fn(rows, n, |r, c| {
+    Ok(DMatrix::from_fn(rows, n, |r, c| {
         if r < kkt.len() {
             jac[kkt[r] * n + c]
         } else {
             tjac[acting[r - kkt.len()] * n + c]
         }
-    })
+    }))
 }
 
 /// Whether `active`'s closed contacts and stuck frictions pin every coordinate (their rows
-/// have full column rank): then the only motion they allow from rest is none.
-pub fn pins(sys: &Bound, state: &State, active: &Active) -> bool {
+/// have full column rank): then the only motion they allow from rest is none. A state or
+/// active set that does not fit the model is an error.
+pub fn pins(sys: &Bound, state: &State, active: &Active) -> Result<bool, SolveError> {
     let info = sys.info();
+    sys.check_state(state)?;
+    crate::solve::contacts::check_active(info, active)?;
     let Some((kkt, acting)) = support_rows(info, active) else {
-        return false;
+        return Ok(false);
     };
     let n = sys.n_coordinates();
     if kkt.len() + acting.len() < n {
-        return false;
+        return Ok(false);
     }
-    let g = stacked(sys, state, &kkt, &acting);
+    let g = stacked(sys, state, &kkt, &acting)?;
     let sv = g.singular_values();
     let top = sv.iter().fold(0.0f64, |m, s| m.max(*s));
-    top > 0.0 && sv.iter().filter(|s| **s > RANK_TOLERANCE * top).count() == n
+    Ok(top > 0.0 && sv.iter().filter(|s| **s > RANK_TOLERANCE * top).count() == n)
 }
+
+/// Support forces that hold a system at rest: every contact's (in the model's order), then
+/// every friction's.
+pub type Supports = (Vec<f64>, Vec<f64>);
 
 /// Whether the system at rest at `state` stays there with `active` closed and stuck although
 /// its supports are redundant: some member of the family of support forces that balances the
 /// applied forces (`G^T y = -Q`) pushes at every closed unilateral contact and keeps every
 /// stuck friction within `mu N`. Returns that member (contact forces in the model's order,
-/// then friction forces), or `None` where none exists, the set does not pin the system, or the
-/// search is too large.
-pub fn holds(sys: &Bound, state: &State, active: &Active) -> Option<(Vec<f64>, Vec<f64>)> {
+/// then friction forces), or `None` where none exists or the set does not pin the system. A
+/// search that passes [`MAX_VERTICES`] decides nothing and is [`SolveError::Indeterminate`];
+/// a state or active set that does not fit the model is an error.
+pub fn holds(
+    sys: &Bound,
+    state: &State,
+    active: &Active,
+    t: f64,
+) -> Result<Option<Supports>, SolveError> {
     let info = sys.info();
-    let (kkt, acting) = support_rows(info, active)?;
-    if !pins(sys, state, active) {
-        return None;
+    if !pins(sys, state, active)? {
+        return Ok(None);
     }
-    let g = stacked(sys, state, &kkt, &acting);
-    let (_, rhs) = sys.equations(state);
+    let Some((kkt, acting)) = support_rows(info, active) else {
+        return Ok(None);
+    };
+    let g = stacked(sys, state, &kkt, &acting)?;
+    let (_, rhs) = sys.equations(state)?;
     let q = DVector::from_vec(rhs);
-    // Least-norm particular solution y = G (G^T G)^-1 (-Q) and the null space of G^T.
+    let undecided = |why: String| SolveError::Indeterminate {
+        model: info.name,
+        t,
+        contacts: active.describe(info),
+        why,
+    };
+    // Least-norm particular solution y = G (G^T G)^-1 (-Q) and the null space of G^T. `pins`
+    // found G of full column rank, so G^T G is regular unless rounding made it exactly
+    // singular.
     let gtg = g.transpose() * &g;
-    let w = gtg.lu().solve(&(-&q))?;
+    let Some(w) = gtg.lu().solve(&(-&q)) else {
+        return Err(undecided(
+            "the support rows pin every coordinate, yet their normal equations are singular: \
+             whether the supports hold the system at rest is not decided"
+                .into(),
+        ));
+    };
     let particular = &g * w;
     let null = null_space(&g.transpose());
     let inequalities = admissible(info, sys, &kkt, &acting);
     let scale = particular.amax().max(f64::MIN_POSITIVE);
-    let found = feasible(&particular, &null, &inequalities, DECIDE_TOLERANCE * scale)?;
+    let found = match feasible(
+        &particular,
+        &null,
+        &inequalities,
+        DECIDE_TOLERANCE * scale,
+        MAX_VERTICES,
+    ) {
+        Search::Found(y) => y,
+        Search::Infeasible => return Ok(None),
+        Search::TooLarge => {
+            return Err(undecided(format!(
+                "the redundant supports' forces form a family too large to search (more than \
+                 {MAX_VERTICES} vertices): whether they hold the system at rest is not decided"
+            )));
+        }
+    };
     let mut forces = vec![0.0; info.contacts.len()];
     for (r, &i) in kkt.iter().enumerate() {
         forces[i] = found[r];
@@ -99,7 +149,7 @@ pub fn holds(sys: &Bound, state: &State, active: &Active) -> Option<(Vec<f64>, V
     for (r, &j) in acting.iter().enumerate() {
         fr[j] = found[kkt.len() + r];
     }
-    Some((forces, fr))
+    Ok(Some((forces, fr)))
 }
 
 /// An orthonormal basis (columns) of the null space of `gt` (`n x k`, `k >= n`): the right
@@ -151,15 +201,27 @@ fn admissible(info: &ModelInfo, sys: &Bound, kkt: &[usize], acting: &[usize]) ->
     rows
 }
 
+/// What the search of [`feasible`] found.
+#[derive(Debug, Clone, PartialEq)]
+enum Search {
+    /// A point that obeys every row.
+    Found(Vec<f64>),
+    /// No vertex obeys every row: the polyhedron is empty.
+    Infeasible,
+    /// More vertices than the limit: nothing decided.
+    TooLarge,
+}
+
 /// A point `y = p + N z` with every `a . y >= -tol`, searched among the vertices of that
 /// polyhedron in `z` (it has one wherever it is not empty: its rows bound every force, so it
-/// holds no line). `None` if there is none or the search passes [`MAX_VERTICES`].
+/// holds no line), examining at most `limit` of them.
 fn feasible(
     p: &DVector<f64>,
     null: &DMatrix<f64>,
     rows: &[Vec<f64>],
     tol: f64,
-) -> Option<Vec<f64>> {
+    limit: usize,
+) -> Search {
     let d = null.ncols();
     let at = |z: &DVector<f64>| -> DVector<f64> { p + null * z };
     let ok = |y: &DVector<f64>| {
@@ -168,7 +230,11 @@ fn feasible(
     };
     if d == 0 {
         let y = at(&DVector::zeros(0));
-        return ok(&y).then(|| y.iter().copied().collect());
+        return if ok(&y) {
+            Search::Found(y.iter().copied().collect())
+        } else {
+            Search::Infeasible
+        };
     }
     // Each row in z: (a^T N) z >= -a^T p.
     let reduced: Vec<(DVector<f64>, f64)> = rows
@@ -180,18 +246,19 @@ fn feasible(
         .collect();
     let mut examined = 0usize;
     let mut pick = Vec::with_capacity(d);
-    vertices(&reduced, d, 0, &mut pick, &mut |chosen: &[usize]| {
+    let found = vertices(&reduced, d, 0, &mut pick, &mut |chosen: &[usize]| {
         examined += 1;
-        if examined > MAX_VERTICES {
-            return Some(None);
+        if examined > limit {
+            return Some(Search::TooLarge);
         }
         let m = DMatrix::from_fn(d, d, |r, c| reduced[chosen[r]].0[c]);
         let b = DVector::from_fn(d, |r, _| reduced[chosen[r]].1);
+        // Rows that meet in no single point are no vertex: the next subset.
         let z = m.lu().solve(&b)?;
         let y = at(&z);
-        ok(&y).then(|| Some(y.iter().copied().collect()))
-    })
-    .flatten()
+        ok(&y).then(|| Search::Found(y.iter().copied().collect()))
+    });
+    found.unwrap_or(Search::Infeasible)
 }
 
 /// Calls `visit` on every `d`-subset of the rows (in order) until it returns `Some`.
@@ -214,4 +281,27 @@ fn vertices<T>(
         }
     }
     None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Search, feasible};
+    use nalgebra::{DMatrix, DVector};
+
+    /// `y = (-3, 3) + z (1, 1)` with `y_0 >= -1` and `y_1 <= 1`: `z >= 2` and `z <= -2`, an
+    /// empty family. Its two candidate vertices are both examined before it is called
+    /// infeasible; a search cut short says so instead.
+    #[test]
+    fn a_search_past_its_limit_is_no_verdict() {
+        let p = DVector::from_vec(vec![-3.0, 3.0]);
+        let null = DMatrix::from_column_slice(2, 1, &[1.0, 1.0]);
+        let rows = vec![vec![1.0, 0.0], vec![0.0, -1.0]];
+        // One row alone: z = 3 gives y = (0, 6), which obeys it.
+        assert_eq!(
+            feasible(&p, &null, &rows[..1], 1.0, 10),
+            Search::Found(vec![0.0, 6.0])
+        );
+        assert_eq!(feasible(&p, &null, &rows, 1.0, 10), Search::Infeasible);
+        assert_eq!(feasible(&p, &null, &rows, 1.0, 1), Search::TooLarge);
+    }
 }

@@ -69,10 +69,15 @@ pub fn force_zero(
         .get(contact)
         .is_some_and(|c| c.closed && !c.bilateral)
     {
-        return Err(SolveError::NoContact { model: info.name });
+        return Err(SolveError::NoContact {
+            model: info.name,
+            contact,
+            edge: false,
+        });
     }
     let Some(coeffs) = sys.force_coefficients(contact) else {
-        let force = |sys: &System, delta: f64| sys.forces(delta)[contact];
+        // `contact` is one of the model's (checked above).
+        let force = |sys: &System, delta: f64| Ok(sys.forces(delta)?[contact]);
         return first_zero(sys, force, work);
     };
     let (lo, hi) = bracket(sys)?;
@@ -107,32 +112,45 @@ pub fn separation_root(
 }
 
 /// Where a closed contact runs off its edge: the first zero of its edge margin, which on the
-/// fast path depends on the angle alone (the derivation checks it).
+/// fast path depends on the angle alone (the derivation checks it). A contact that is not
+/// closed with an edge in the phase is [`SolveError::NoContact`].
 pub fn edge(
     sys: &System,
     contact: usize,
     work: &mut Work,
 ) -> Result<SeparationOutcome, SolveError> {
-    let margin = |sys: &System, delta: f64| {
-        let edges = sys.edges(&sys.full_state(0.0, delta, 0.0));
-        edges.get(contact).copied().unwrap_or(f64::NAN)
-    };
+    let info = sys.info();
+    if !info
+        .contacts
+        .get(contact)
+        .is_some_and(|c| c.closed && c.edge)
+    {
+        return Err(SolveError::NoContact {
+            model: info.name,
+            contact,
+            edge: true,
+        });
+    }
+    // `contact` is one of the model's (checked above).
+    let margin =
+        |sys: &System, delta: f64| Ok(sys.edges(&sys.full_state(0.0, delta, 0.0)?)?[contact]);
     first_zero(sys, margin, work)
 }
 
 /// The first sign change of `f(delta)` coming down from the start: bracketed on
 /// [`BRACKET_CELLS`] cells uniform in `sqrt(delta)` (fine near the start, where the fall is
-/// slow), then refined to adjacent floats. Each evaluation counts as a polynomial evaluation.
+/// slow), then refined to adjacent floats. Each evaluation counts as a polynomial evaluation;
+/// one that fails is the error.
 pub fn first_zero(
     sys: &System,
-    f: impl Fn(&System, f64) -> f64,
+    f: impl Fn(&System, f64) -> Result<f64, SolveError>,
     work: &mut Work,
 ) -> Result<SeparationOutcome, SolveError> {
     let end = sys.delta_to_floor();
     let model = sys.info().name;
     let mut value = |delta: f64| -> Result<f64, SolveError> {
         work.polynomial_evals += 1;
-        let v = f(sys, delta);
+        let v = f(sys, delta)?;
         if v.is_nan() {
             return Err(SolveError::NonFinite {
                 model,
@@ -155,7 +173,7 @@ pub fn first_zero(
         let delta = if i == BRACKET_CELLS { end } else { u * u };
         // A model may be singular at the floor itself (a cylinder's tangent point runs off to
         // infinity as theta -> 0): no value there means no zero met before it.
-        if i == BRACKET_CELLS && f(sys, delta).is_nan() {
+        if i == BRACKET_CELLS && f(sys, delta)?.is_nan() {
             break;
         }
         let b = (delta, value(delta)?);
@@ -179,6 +197,8 @@ pub fn linearised_separation(sys: &System) -> Result<SeparationOutcome, SolveErr
     if coeffs.is_empty() {
         return Err(SolveError::NoContact {
             model: sys.info().name,
+            contact: 0,
+            edge: false,
         });
     }
     let (lo, hi) = bracket(sys)?;
@@ -196,7 +216,7 @@ pub fn linearised_separation(sys: &System) -> Result<SeparationOutcome, SolveErr
 
 /// The open interval `(sin(end_angle), sin(theta_i))` the phase's roots lie in.
 fn bracket(sys: &System) -> Result<(f64, f64), SolveError> {
-    let hi = sys.reduced(0.0).sin;
+    let hi = sys.reduced(0.0)?.sin;
     let lo = sys.end_angle().sin();
     if !hi.is_finite() {
         return Err(SolveError::NonFinite {

@@ -44,12 +44,15 @@ impl PhaseSamples {
 }
 
 /// `theta_dot` at `delta` on a falling phase: `-sqrt(theta_dot^2)`, and exactly the initial rate
-/// at the start (zero from rest).
+/// at the start (zero from rest); NaN for a `delta` that is not finite (or where the model's
+/// `theta_dot^2` is NaN).
 pub fn theta_dot_at(sys: &System, delta: f64) -> f64 {
     if delta == 0.0 {
         return sys.theta_dot_initial();
     }
-    -sys.reduced(delta).theta_dot_sq.max(0.0).sqrt()
+    // The model's function itself: a NaN argument gives NaN, which `f64::max` would hide.
+    let w2 = sys.reduction().reduced(sys.k(), delta).theta_dot_sq;
+    if w2.is_nan() { w2 } else { -w2.max(0.0).sqrt() }
 }
 
 /// `samples` points uniform in time over the phase described by `mesh`.
@@ -104,7 +107,7 @@ pub fn sample_reduced_at(
             t_prev = target;
             mesh.delta_at_v(sys, v)?
         };
-        push(sys, &mut out, target.clamp(0.0, mesh.duration), delta);
+        push(sys, &mut out, target.clamp(0.0, mesh.duration), delta)?;
     }
     Ok(out)
 }
@@ -133,15 +136,17 @@ pub fn delta_at_time(
     mesh.delta_at_v(sys, v)
 }
 
-fn push(sys: &System, out: &mut PhaseSamples, t: f64, delta: f64) {
-    let reduced = sys.reduced(delta);
+fn push(sys: &System, out: &mut PhaseSamples, t: f64, delta: f64) -> Result<(), SolveError> {
+    let reduced = sys.reduced(delta)?;
     let theta_dot = theta_dot_at(sys, delta);
+    let state = sys.full_state(t, delta, theta_dot)?;
     out.t.push(t);
     out.delta.push(delta);
     out.theta.push(sys.theta_initial() - delta);
     out.theta_dot.push(theta_dot);
     out.theta_ddot.push(reduced.theta_ddot);
-    out.states.push(sys.full_state(t, delta, theta_dot));
+    out.states.push(state);
+    Ok(())
 }
 
 /// `samples` points uniform in time over a phase on either route.
@@ -207,7 +212,7 @@ pub fn sample_integrated_at(
 /// (its cancellation-free forms), solved with the accelerations otherwise.
 pub fn sample_forces(run: &PhaseRun, s: &PhaseSamples) -> Result<Vec<Vec<f64>>, SolveError> {
     match run {
-        PhaseRun::Reduced(r) => Ok(s.delta.iter().map(|&d| r.system.forces(d)).collect()),
+        PhaseRun::Reduced(r) => (s.delta.iter()).map(|&d| Ok(r.system.forces(d)?)).collect(),
         PhaseRun::Integrated(r) => s
             .states
             .iter()
@@ -232,16 +237,29 @@ pub fn sample_friction(
     match run {
         PhaseRun::Reduced(r) => (s.states.iter().zip(&s.delta))
             .map(|(state, &delta)| {
-                let full = r.system.to_full(state);
+                let full = r.system.to_full(state)?;
                 let n = general.n_coordinates();
-                let (jac, _) = general.friction(&full);
+                let (jac, _) = general.friction(&full)?;
                 let slip = (0..nf)
                     .map(|j| (0..n).map(|c| jac[j * n + c] * full.qd[c]).sum())
                     .collect();
-                let forces = r.system.forces(delta);
+                let forces = r.system.forces(delta)?;
                 let normals = (info.frictions.iter())
-                    .map(|f| forces.get(f.contact).copied().unwrap_or(0.0))
-                    .collect();
+                    .map(|f| {
+                        forces
+                            .get(f.contact)
+                            .copied()
+                            .ok_or_else(|| SolveError::PhaseMismatch {
+                                system: info.name,
+                                name: r.system.name(),
+                                why: format!(
+                                    "it has {} contacts, the system {}",
+                                    forces.len(),
+                                    info.contacts.len()
+                                ),
+                            })
+                    })
+                    .collect::<Result<_, _>>()?;
                 Ok([vec![0.0; nf], normals, slip])
             })
             .collect(),

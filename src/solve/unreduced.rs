@@ -16,7 +16,7 @@
 //!
 //! A gap that starts at zero (a contact that just opened) or an edge margin that does (a
 //! contact point starting at a corner) arms its event only once it has grown past
-//! [`DECIDE_TOLERANCE`](contacts::DECIDE_TOLERANCE) of the system's length: its rounding at the
+//! [`DECIDE_TOLERANCE`] of the system's length: its rounding at the
 //! start is no crossing.
 //!
 //! The integrator's state is the deviation `z = y - y0` from the start `y0 = [q, qd]`, so its
@@ -58,18 +58,22 @@ pub const SCALE_FLOOR: f64 = 1e-3;
 /// Most stick/slip switches in one integration before giving up (a chattering contact).
 pub const MAX_SWITCHES: usize = 1000;
 
-/// The 2-norm condition number of the mass matrix at a state (infinite if singular).
-pub fn mass_condition(sys: &Bound, state: &State) -> f64 {
+/// The 2-norm condition number of the mass matrix at a state (infinite if singular or not
+/// finite).
+pub fn mass_condition(sys: &Bound, state: &State) -> Result<f64, SolveError> {
     let n = sys.n_coordinates();
-    let (mass, _) = sys.equations(state);
+    let (mass, _) = sys.equations(state)?;
+    if !mass.iter().all(|m| m.is_finite()) {
+        return Ok(f64::INFINITY);
+    }
     let sv = DMatrix::from_row_slice(n, n, &mass).singular_values();
     let max = sv.iter().cloned().fold(0.0, f64::max);
     let min = sv.iter().cloned().fold(f64::INFINITY, f64::min);
-    if min > 0.0 && max.is_finite() {
+    Ok(if min > 0.0 && max.is_finite() {
         max / min
     } else {
         f64::INFINITY
-    }
+    })
 }
 
 /// How an integrated phase ended.
@@ -270,7 +274,7 @@ impl Problem<'_, '_> {
     /// closed form where the model eliminates it), each open contact's gap, each closed
     /// contact's edge, the floor, then the acting frictions' and Painlevé's; armed where they
     /// start clear of zero.
-    fn watch(&mut self, d: &Dynamics) {
+    fn watch(&mut self, d: &Dynamics) -> Result<(), SolveError> {
         let info = self.sys.info();
         let mut watches = Vec::new();
         for (i, c) in info.contacts.iter().enumerate() {
@@ -301,13 +305,14 @@ impl Problem<'_, '_> {
         }
         self.watches = watches;
         let mut g = vec![0.0; self.watches.len()];
-        self.values(d, &mut g);
+        self.values(d, &mut g)?;
         self.armed = (self.watches.iter().zip(&g))
             .map(|(w, v)| match w {
                 Watch::Gap(_) | Watch::Edge(_) | Watch::Force(_) => *v > self.arm_at_for(*w),
                 _ => true,
             })
             .collect();
+        Ok(())
     }
 
     /// The value past which a watch of this kind arms.
@@ -319,17 +324,17 @@ impl Problem<'_, '_> {
     }
 
     /// Every watch's value at the loaded state with its dynamics `d`.
-    fn values(&self, d: &Dynamics, g: &mut [f64]) {
+    fn values(&self, d: &Dynamics, g: &mut [f64]) -> Result<(), SolveError> {
         let info = self.sys.info();
         let needs_gaps = self.watches.iter().any(|w| matches!(w, Watch::Gap(_)));
         let needs_edges = self.watches.iter().any(|w| matches!(w, Watch::Edge(_)));
         let gaps = if needs_gaps {
-            self.sys.gaps(&self.state)
+            self.sys.gaps(&self.state)?
         } else {
             Vec::new()
         };
         let edges = if needs_edges {
-            self.sys.edges(&self.state)
+            self.sys.edges(&self.state)?
         } else {
             Vec::new()
         };
@@ -345,6 +350,7 @@ impl Problem<'_, '_> {
                 Watch::Painleve => d.painleve - contacts::PAINLEVE_FLOOR,
             };
         }
+        Ok(())
     }
 
     /// At friction watch `w` (a contact's slip stopped or its stuck friction reached `mu N`),
@@ -375,7 +381,7 @@ impl Problem<'_, '_> {
             frictions: frictions.clone(),
         };
         self.active = contacts::decide(self.sys, state, &options, t)?;
-        self.slip_offset = slip_offsets(self.sys, state, &frictions);
+        self.slip_offset = slip_offsets(self.sys, state, &frictions)?;
         self.last = None;
         Ok(())
     }
@@ -383,15 +389,20 @@ impl Problem<'_, '_> {
 
 /// The slip velocity each friction's event measures from at a segment's start: its own slip
 /// for a contact that may have switched there, zero for one that keeps its mode.
-fn slip_offsets(sys: &Bound, state: &State, options: &[FrictionOption]) -> Vec<f64> {
+fn slip_offsets(
+    sys: &Bound,
+    state: &State,
+    options: &[FrictionOption],
+) -> Result<Vec<f64>, SolveError> {
     let n = sys.n_coordinates();
-    let (jac, _) = sys.friction(state);
-    (options.iter().enumerate())
+    let (jac, _) = sys.friction(state)?;
+    // One option per friction (checked by `integrate`): `jac` has a row for each.
+    Ok((options.iter().enumerate())
         .map(|(k, o)| match o {
             FrictionOption::Keep(_) => 0.0,
             _ => (0..n).map(|j| jac[k * n + j] * state.qd[j]).sum(),
         })
-        .collect()
+        .collect())
 }
 
 impl OdeProblem for Problem<'_, '_> {
@@ -421,7 +432,7 @@ impl OdeProblem for Problem<'_, '_> {
             Some((at, d)) if at == z => d,
             _ => contacts::dynamics(self.sys, &self.state, &self.active, t)?,
         };
-        self.values(&d, g);
+        self.values(&d, g)?;
         for (k, v) in g.iter_mut().enumerate() {
             if !self.armed[k] {
                 if *v > self.arm_at_for(self.watches[k]) {
@@ -447,27 +458,42 @@ impl OdeProblem for Problem<'_, '_> {
 /// of the constraint's) is held to the motion's scale, not to its own noise, which would
 /// shrink the steps to nothing; and a start that is slow at release (nearly upright) is held
 /// to the system's size, not to its first creeping.
-pub fn motion_scales(bound: &Bound, start: &State, qdd: &[f64], time: f64) -> Vec<f64> {
+///
+/// A state or accelerations that do not fit the model are an error.
+pub fn motion_scales(
+    bound: &Bound,
+    start: &State,
+    qdd: &[f64],
+    time: f64,
+) -> Result<Vec<f64>, SolveError> {
     let n = start.q.len();
-    let length = bound.length_scale(start);
+    let length = bound.length_scale(start)?;
+    if qdd.len() != n {
+        return Err(crate::system::SystemError::Length {
+            model: bound.name(),
+            what: "qdd",
+            expected: n,
+            got: qdd.len(),
+        }
+        .into());
+    }
     // Per coordinate: the change that moves some point by `length` (m per m, or rad).
-    let reach: Vec<f64> = (0..n)
-        .map(|j| {
-            let mut unit = State {
-                q: start.q.clone(),
-                qd: vec![0.0; n],
-            };
-            unit.qd[j] = 1.0;
-            let speed = (bound.points(&unit).vel.iter())
-                .map(|v| v[0].hypot(v[1]))
-                .fold(0.0f64, f64::max);
-            if speed > 0.0 && speed.is_finite() {
-                length / speed
-            } else {
-                0.0
-            }
-        })
-        .collect();
+    let mut reach = Vec::with_capacity(n);
+    for j in 0..n {
+        let mut unit = State {
+            q: start.q.clone(),
+            qd: vec![0.0; n],
+        };
+        unit.qd[j] = 1.0;
+        let speed = (bound.points(&unit)?.vel.iter())
+            .map(|v| v[0].hypot(v[1]))
+            .fold(0.0f64, f64::max);
+        reach.push(if speed > 0.0 && speed.is_finite() {
+            length / speed
+        } else {
+            0.0
+        });
+    }
     let q: Vec<f64> = (start.qd.iter().zip(qdd))
         .map(|(v, a)| v.abs() * time + 0.5 * a.abs() * time * time)
         .collect();
@@ -487,7 +513,7 @@ pub fn motion_scales(bound: &Bound, start: &State, qdd: &[f64], time: f64) -> Ve
     };
     let mut scales = floor(q, 1.0);
     scales.extend(floor(v, 1.0 / time));
-    scales
+    Ok(scales)
 }
 
 /// What an integration starts from and how long it may run.
@@ -518,7 +544,17 @@ pub fn integrate(
     let info = sys.info();
     let n = sys.n_coordinates();
     let with_work = !info.frictions.is_empty();
-    let condition = mass_condition(sys, &start.state);
+    contacts::check_active(info, &start.active)?;
+    if start.frictions.len() != info.frictions.len() {
+        return Err(SolveError::ActiveSize {
+            model: info.name,
+            contacts: info.contacts.len(),
+            frictions: info.frictions.len(),
+            closed: start.active.closed.len(),
+            modes: start.frictions.len(),
+        });
+    }
+    let condition = mass_condition(sys, &start.state)?;
     let rtol = rtol.max(CONDITION_SAFETY * f64::EPSILON * condition);
     if rtol.is_nan() || rtol > MAX_RTOL {
         return Err(SolveError::IllConditioned {
@@ -539,8 +575,8 @@ pub fn integrate(
         active: start.active.clone(),
         watches: Vec::new(),
         armed: Vec::new(),
-        arm_at: DECIDE_TOLERANCE * sys.length_scale(&start.state),
-        slip_offset: slip_offsets(sys, &start.state, &start.frictions),
+        arm_at: DECIDE_TOLERANCE * sys.length_scale(&start.state)?,
+        slip_offset: slip_offsets(sys, &start.state, &start.frictions)?,
         reduced: info.reduced,
         end_angle: info.end_angle,
         y0: y0.clone(),
@@ -550,7 +586,7 @@ pub fn integrate(
         with_work,
     };
     let d = contacts::dynamics(sys, &start.state, &problem.active, 0.0)?;
-    problem.watch(&d);
+    problem.watch(&d)?;
     let mut atol: Vec<f64> = match scales {
         Some(s) if s.len() == 2 * n => s
             .iter()
@@ -560,7 +596,7 @@ pub fn integrate(
     };
     if with_work && !atol.is_empty() {
         // The work of friction is held to the energy's own scale.
-        let e = sys.energy(&start.state).abs();
+        let e = sys.energy(&start.state)?.abs();
         atol.push(rtol * if e > 0.0 { e } else { 1.0 });
     }
     let opts = OdeOptions {
@@ -629,7 +665,7 @@ pub fn integrate(
         y0 = y;
         problem.y0 = y0.clone();
         let d = contacts::dynamics(sys, &problem.state, &problem.active, event.t)?;
-        problem.watch(&d);
+        problem.watch(&d)?;
         t0 = event.t;
     }
 }

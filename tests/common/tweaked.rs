@@ -208,6 +208,17 @@ pub static LOW_MONITORS: Tweaked = Tweaked {
     theta_dot_sq: Fault::None,
 };
 
+/// `rod_cube_closed` whose monitor is minus infinity everywhere (a gap or a margin that
+/// overflowed): its check must fail, whatever allowance a finite value would get.
+pub static INFINITE_MONITORS: Tweaked = Tweaked {
+    base: &super::paper::ROD_CUBE,
+    reduction: &super::paper::ROD_CUBE,
+    polynomial: None,
+    monitor_shift: f64::NEG_INFINITY,
+    nan_force: false,
+    theta_dot_sq: Fault::None,
+};
+
 /// `rod_cube_closed` whose floor normal force is NaN.
 pub static NAN_FORCE: Tweaked = Tweaked {
     base: &super::paper::ROD_CUBE,

@@ -1,0 +1,63 @@
+"""Type stubs of the rodcube package, for editors and type checkers: every public function with
+its parameters and return types (`python/tests` checks them against the installed package)."""
+
+from collections.abc import Mapping, Sequence
+from typing import Any, Optional, TypedDict, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = ["RodcubeError", "models", "parameters", "solve", "sweep"]
+
+class RodcubeError(ValueError):
+    """A request rodcube refused or could not solve; the message says why."""
+
+class Check(TypedDict):
+    """One check of a solve: whether it passed, by what margin, and what it checks."""
+
+    passed: bool
+    margin: float
+    meaning: str
+
+class SweepResult(TypedDict):
+    """What `sweep` returns; the arrays have the broadcast shape of its axes."""
+
+    separation_angle: npt.NDArray[np.float64]
+    """rad, NaN where the point failed."""
+    separation_time: npt.NDArray[np.float64]
+    """s, NaN where the point failed."""
+    ok: npt.NDArray[np.bool_]
+    """True where the point was solved."""
+    errors: list[tuple[tuple[int, ...], str]]
+    """(index into the arrays, rodcube's message) for every failed point, in C order."""
+
+def models() -> list[str]:
+    """The names of the registered models."""
+
+def parameters(model: str) -> list[tuple[str, str, str]]:
+    """The parameters of a model, in order: `(name, unit, meaning)`."""
+
+def solve(
+    model: str,
+    want: Optional[Sequence[str]] = None,
+    tolerance: Optional[float] = None,
+    samples: Optional[int] = None,
+    **parameters: float,
+) -> dict[str, Any]:
+    """Solves one parameter point (every parameter given) and returns what `want` names:
+    scalars as `float`, words as `str`, series as `dict[str, NDArray[float64]]` by column,
+    `checks` as `dict[str, Check]`, and `notes: list[str]` when a wanted quantity has no value.
+    """
+
+def sweep(
+    n: Optional[npt.ArrayLike] = None,
+    a_over_ell: Optional[npt.ArrayLike] = None,
+    *,
+    model: str = "rod_cube",
+    axes: Optional[Mapping[str, npt.ArrayLike]] = None,
+    defaults: Optional[Mapping[str, float]] = None,
+    **parameters: Union[float, npt.ArrayLike],
+) -> SweepResult:
+    """Separation angle and time over broadcast axes (`n` = m2/m1, `a_over_ell`, `axes`, and
+    keyword parameters given as arrays); every parameter needs a value from an axis, a keyword
+    or `defaults`, g included."""
