@@ -54,6 +54,30 @@ pub fn separation(sys: &System, work: &mut Work) -> Result<SeparationOutcome, So
     force_zero(sys, 0, work)
 }
 
+/// `Ok` when `contact` is closed in the phase and `also` holds for it, else
+/// [`SolveError::NoContact`] (`edge` says whether an edge was asked for).
+fn closed_contact(
+    sys: &System,
+    contact: usize,
+    edge: bool,
+    also: impl Fn(&crate::model::ContactInfo) -> bool,
+) -> Result<(), SolveError> {
+    let info = sys.info();
+    if info
+        .contacts
+        .get(contact)
+        .is_some_and(|c| c.closed && also(c))
+    {
+        Ok(())
+    } else {
+        Err(SolveError::NoContact {
+            model: info.name,
+            contact,
+            edge,
+        })
+    }
+}
+
 /// Where a closed contact's force reaches zero coming down from `theta_i`: the largest
 /// sign-changing root of its force polynomial in `(sin(end_angle), sin(theta_i))`, or without
 /// one the first sign change of its reduced force. A contact that is not closed in the phase is
@@ -63,18 +87,7 @@ pub fn force_zero(
     contact: usize,
     work: &mut Work,
 ) -> Result<SeparationOutcome, SolveError> {
-    let info = sys.info();
-    if !info
-        .contacts
-        .get(contact)
-        .is_some_and(|c| c.closed && !c.bilateral)
-    {
-        return Err(SolveError::NoContact {
-            model: info.name,
-            contact,
-            edge: false,
-        });
-    }
+    closed_contact(sys, contact, false, |c| !c.bilateral)?;
     let Some(coeffs) = sys.force_coefficients(contact) else {
         // `contact` is one of the model's (checked above).
         let force = |sys: &System, delta: f64| Ok(sys.forces(delta)?[contact]);
@@ -82,7 +95,7 @@ pub fn force_zero(
     };
     let (lo, hi) = bracket(sys)?;
     Ok(
-        match separation_root(info.name, &coeffs, lo, hi, &mut work.polynomial_evals)? {
+        match separation_root(sys.info().name, &coeffs, lo, hi, &mut work.polynomial_evals)? {
             Some(s) => SeparationOutcome::Separates(at_sine(sys, s)),
             None => SeparationOutcome::NoSeparationBeforeFloor,
         },
@@ -119,18 +132,7 @@ pub fn edge(
     contact: usize,
     work: &mut Work,
 ) -> Result<SeparationOutcome, SolveError> {
-    let info = sys.info();
-    if !info
-        .contacts
-        .get(contact)
-        .is_some_and(|c| c.closed && c.edge)
-    {
-        return Err(SolveError::NoContact {
-            model: info.name,
-            contact,
-            edge: true,
-        });
-    }
+    closed_contact(sys, contact, true, |c| c.edge)?;
     // `contact` is one of the model's (checked above).
     let margin =
         |sys: &System, delta: f64| Ok(sys.edges(&sys.full_state(0.0, delta, 0.0)?)?[contact]);
