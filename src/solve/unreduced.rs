@@ -258,6 +258,8 @@ struct Problem<'a, 'm> {
     /// the events at the state it has just evaluated.
     last: Option<(Vec<f64>, Dynamics)>,
     with_work: bool,
+    /// Right-hand sides evaluated.
+    evaluations: u64,
 }
 
 impl Problem<'_, '_> {
@@ -411,6 +413,7 @@ impl OdeProblem for Problem<'_, '_> {
     }
 
     fn rhs(&mut self, t: f64, z: &[f64], dz: &mut [f64]) -> Result<(), SolveError> {
+        self.evaluations += 1;
         self.load(z);
         let d = contacts::dynamics(self.sys, &self.state, &self.active, t)?;
         dz[..self.n].copy_from_slice(&self.state.qd);
@@ -530,13 +533,28 @@ pub struct Start {
 }
 
 /// Integrates `sys` from `start` until an event ends the phase, with relative tolerance
-/// `rtol` (raised to [`CONDITION_SAFETY`]` * eps * cond(M)`). `scales` (length `2 n`), when
-/// given, are typical magnitudes of the motion `y - y0` for the absolute tolerances; without
-/// them the control is relative to the largest deviation seen. `t_max` bounds the search.
+/// `rtol` (raised to [`CONDITION_SAFETY`]` * eps * cond(M)`) by the method
+/// [`Method::for_rtol`] picks for it. `scales` (length `2 n`), when given, are typical
+/// magnitudes of the motion `y - y0` for the absolute tolerances; without them the control is
+/// relative to the largest deviation seen. `t_max` bounds the search.
 pub fn integrate(
     sys: &Bound,
     start: &Start,
     rtol: f64,
+    scales: Option<&[f64]>,
+    t_max: f64,
+    work: &mut Work,
+) -> Result<UnreducedRun, SolveError> {
+    integrate_with(sys, start, rtol, None, scales, t_max, work)
+}
+
+/// [`integrate`] by `method` when one is given (`rodcube accuracy` compares the two at every
+/// tolerance), else by the method [`Method::for_rtol`] picks for the raised tolerance.
+pub fn integrate_with(
+    sys: &Bound,
+    start: &Start,
+    rtol: f64,
+    method: Option<Method>,
     scales: Option<&[f64]>,
     t_max: f64,
     work: &mut Work,
@@ -563,7 +581,7 @@ pub fn integrate(
             rtol,
         });
     }
-    let method = Method::for_rtol(rtol);
+    let method = method.unwrap_or_else(|| Method::for_rtol(rtol));
     let mut y0 = start.state.q.clone();
     y0.extend_from_slice(&start.state.qd);
     if with_work {
@@ -584,6 +602,7 @@ pub fn integrate(
         state: start.state.clone(),
         last: None,
         with_work,
+        evaluations: 0,
     };
     let d = contacts::dynamics(sys, &start.state, &problem.active, 0.0)?;
     problem.watch(&d)?;
@@ -608,7 +627,9 @@ pub fn integrate(
     let mut segments = Vec::new();
     let mut t0 = 0.0;
     loop {
-        let solution = ode_integrate(method, &mut problem, t0, &vec![0.0; y0.len()], &opts)?;
+        let solution = ode_integrate(method, &mut problem, t0, &vec![0.0; y0.len()], &opts);
+        work.ode_evaluations += std::mem::take(&mut problem.evaluations);
+        let solution = solution?;
         work.ode_steps += solution.total_steps();
         let Some(event) = solution.event.clone() else {
             return Err(SolveError::NoEvent { t_max });
