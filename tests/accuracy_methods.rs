@@ -183,7 +183,11 @@ fn the_integrators_converge_on_the_integrated_models_against_their_references() 
             let loose = integrated::measure_one(m, &reference, method, 6, &TINY);
             let tight = integrated::measure_one(m, &reference, method, 12, &TINY);
             let (el, et) = (loose.error.abs(), tight.error.abs());
-            assert!(el < 1e-4 && et < 1e-10 && et < el, "{} {method}: {el} {et}", m.model);
+            assert!(
+                el < 1e-4 && et < 1e-10 && et < el,
+                "{} {method}: {el} {et}",
+                m.model
+            );
             assert!(tight.evals > 0 && tight.steps.unwrap() > 0 && tight.setup_seconds.is_some());
         }
     }
@@ -212,7 +216,9 @@ fn options_that_name_nothing_are_refused_before_anything_runs() {
     assert_eq!(all.closed.len(), 1);
     assert_eq!(all.closed[0].2.len(), 5);
     assert_eq!(all.integrated.len(), 3);
-    let one = opts(&["rod_cube"], &["paper"], &["halley"]).choose().unwrap();
+    let one = opts(&["rod_cube"], &["paper"], &["halley"])
+        .choose()
+        .unwrap();
     assert_eq!(one.settings(), 1);
 }
 

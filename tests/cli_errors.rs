@@ -278,7 +278,10 @@ fn accuracy_options_that_name_nothing_are_usage_errors_that_write_nothing() {
             &["--model", "rod_cube_spring,nope"][..],
             &["no model `nope`", "rod_cube_friction"][..],
         ),
-        (&["--case", "upright"], &["no case `upright`", "near_upright"]),
+        (
+            &["--case", "upright"],
+            &["no case `upright`", "near_upright"],
+        ),
         (
             &["--model", "rod_cube_spring", "--case", "paper"],
             &["no case `paper`", "scene"],

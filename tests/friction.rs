@@ -17,7 +17,8 @@ use rodcube::solve::SolveError;
 use rodcube::solve::contacts::{
     Active, Mode, Moment, Options, contact_options, decide, dynamics, friction_options,
 };
-use rodcube::solve::phases::{PhaseRun, PhaseStart, Route, Walker};
+use rodcube::solve::ode::Method;
+use rodcube::solve::phases::{End, PhaseRun, PhaseStart, Route, Walker};
 use rodcube::system::{Bound, State, SystemError};
 
 /// The paper's separation time (g = 9.81) to 15 digits, held to the 256-bit reference by
@@ -278,6 +279,39 @@ fn switches_are_located_where_their_event_functions_vanish() {
         println!("switch at {b:.15e} s moves by {rel:.1e} relative");
         assert!(rel < 1e-12, "{a} vs {b}");
     }
+}
+
+/// A stop the integrator steps over. At mu = 1.45 the foot slides back from rest and stops at
+/// 0.0965 s; DOP853 forced to rtol 1e-4 takes its first step to 0.109 s, so the slip goes out
+/// from zero and back through it within one step. The slip watch starts with its mode's sign
+/// (it leaves zero that way), so that step is a crossing: the stop is found, the foot sticks, and
+/// the contact ends where a tight integration by the other method puts it (before, the stop
+/// was never seen and the phase ran on to the floor at 0.218 s, friction pushing the foot).
+#[test]
+fn a_stop_inside_one_long_step_is_found() {
+    let w = walker(1.45, 1e-12, 1e-4);
+    let start = w.release().unwrap().0;
+    let run = w
+        .integrate_with(&start, Some(Method::Dop853), &mut Work::default())
+        .unwrap();
+    let PhaseRun::Integrated(r) = &run else {
+        panic!("forced onto the integrator")
+    };
+    let modes: Vec<String> = r.run.switches(&r.bound).map(|(_, m)| m).collect();
+    assert_eq!(modes, [both_closed("slides -"), both_closed("sticks")]);
+    assert_eq!(run.end(), End::Force(0));
+    let tight = walker(1.45, 1e-12, 1e-13);
+    let reference = tight
+        .integrate_with(&start, Some(Method::Dopri5), &mut Work::default())
+        .unwrap();
+    let rel = (run.t_end() - reference.t_end()).abs() / reference.t_end();
+    // DOP853 at 1e-4 against DOPRI5 at 1e-13: the loose run's own tolerance, with margin.
+    assert!(
+        rel < 1e-5,
+        "{} vs {}: {rel:e}",
+        run.t_end(),
+        reference.t_end()
+    );
 }
 
 #[test]

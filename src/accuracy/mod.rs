@@ -361,7 +361,9 @@ impl Progress {
 
     fn case(&self, model: &str, case: &str, settings: usize) {
         if let Some(line) = &self.line {
-            line(&format!("accuracy: {model}, case {case}: {settings} settings"));
+            line(&format!(
+                "accuracy: {model}, case {case}: {settings} settings"
+            ));
         }
     }
 
@@ -453,10 +455,9 @@ impl Options {
         let mut closed = Vec::new();
         let mut integrated_models = Vec::new();
         for name in models {
-            if let (Some(family), Some(&model)) = (
-                Family::of(name),
-                CLOSED_MODELS.iter().find(|m| **m == name),
-            ) {
+            if let (Some(family), Some(&model)) =
+                (Family::of(name), CLOSED_MODELS.iter().find(|m| **m == name))
+            {
                 closed.push((model, family, cases(family)));
             } else if let Some(m) = integrated::find(name) {
                 integrated_models.push(m);
@@ -571,7 +572,8 @@ fn run_case(
     let m = crate::models::find(model).ok_or_else(|| failed(format!("no model `{model}`")))?;
     // The phase the reference describes: the contact closed from release.
     let m = crate::solve::lean::release_phase(m).map_err(|e| failed(e.to_string()))?;
-    let sys = System::from_values(m, &parameters(family, case)).map_err(|e| failed(e.to_string()))?;
+    let sys =
+        System::from_values(m, &parameters(family, case)).map_err(|e| failed(e.to_string()))?;
     let delta = methods::delta_sep(&sys).map_err(failed)?;
     let point = Point {
         sys: &sys,
@@ -605,16 +607,22 @@ fn run_case(
         r
     };
     for s in &angle {
-        let outcome = s
-            .measure(&point, budget)
-            .map(|m| (reference::relative_error(m.value, &cref.angle), m.without_value()));
+        let outcome = s.measure(&point, budget).map(|m| {
+            (
+                reference::relative_error(m.value, &cref.angle),
+                m.without_value(),
+            )
+        });
         rows.push(row(Measured::Angle, s, outcome));
         progress.step(format!("{model} {}: {} {}", case.key, s.label, s.setting));
     }
     for s in &time {
-        let outcome = s
-            .measure(&point, budget)
-            .map(|m| (reference::relative_error(m.value, &cref.time), m.without_value()));
+        let outcome = s.measure(&point, budget).map(|m| {
+            (
+                reference::relative_error(m.value, &cref.time),
+                m.without_value(),
+            )
+        });
         rows.push(row(Measured::Time, s, outcome));
         progress.step(format!("{model} {}: {} {}", case.key, s.label, s.setting));
     }

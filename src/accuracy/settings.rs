@@ -84,10 +84,7 @@ pub const LABELS: &[(&str, &str)] = &[
         "halley",
         "default root: derivative isolation + bracketed Halley on filtered Horner",
     ),
-    (
-        "viete",
-        "closed form of the cubic (Viete / Cardano) in f64",
-    ),
+    ("viete", "closed form of the cubic (Viete / Cardano) in f64"),
     ("newton", "plain Newton from sin(theta_i), plain Horner"),
     ("bisect", "bisection to adjacent floats"),
     ("linear", "the paper's linearised root (cubic term dropped)"),

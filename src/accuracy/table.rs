@@ -24,7 +24,11 @@ pub fn render(report: &Report, layout: &Layout) -> String {
         out.push('\n');
     }
     for r in &report.integrated {
-        out.push_str(&wrap(&format!("reference {}", r.describe()), layout.width, 2));
+        out.push_str(&wrap(
+            &format!("reference {}", r.describe()),
+            layout.width,
+            2,
+        ));
         out.push('\n');
     }
     let mut blocks: Vec<(&str, Measured)> = Vec::new();
@@ -37,7 +41,11 @@ pub fn render(report: &Report, layout: &Layout) -> String {
         let rows: Vec<&Row> = (report.rows.iter())
             .filter(|r| r.model == model && r.measured == measured)
             .collect();
-        out.push_str(&format!("\n{model}: {}\n{}\n", measured.name(), block(&rows, layout)));
+        out.push_str(&format!(
+            "\n{model}: {}\n{}\n",
+            measured.name(),
+            block(&rows, layout)
+        ));
     }
     out.push_str(&wrap(
         "set-up: made once per setting and reused by every solve (a solver, a rule's nodes, a \
@@ -74,7 +82,11 @@ fn block(rows: &[&Row], layout: &Layout) -> String {
             r.label.to_string(),
             r.setting.clone(),
             error,
-            if failed { "-".into() } else { r.evals.to_string() },
+            if failed {
+                "-".into()
+            } else {
+                r.evals.to_string()
+            },
         ];
         if integrated {
             cells.push(r.steps.map_or("-".into(), |s| s.to_string()));

@@ -347,7 +347,16 @@ impl Problem<'_, '_> {
                 Watch::Gap(i) => gaps[i],
                 Watch::Edge(i) => edges[i],
                 Watch::Floor => self.state.q[self.reduced] - self.end_angle,
-                Watch::Slip(j) => d.slip[j] - self.slip_offset[j],
+                Watch::Slip(j) => {
+                    let v = d.slip[j] - self.slip_offset[j];
+                    // A slide that starts from zero slip (from rest, or just switched) has its
+                    // mode's sign from its first instant: a step that carries the slip out and
+                    // back across zero is then a crossing, not a start at zero and an end past it.
+                    match self.active.modes[j] {
+                        Mode::Slide(sign) if v == 0.0 => sign * f64::MIN_POSITIVE,
+                        _ => v,
+                    }
+                }
                 Watch::Stuck(j) => mu[j] * d.forces[info.frictions[j].contact] - d.fr[j].abs(),
                 Watch::Painleve => d.painleve - contacts::PAINLEVE_FLOOR,
             };
@@ -438,10 +447,16 @@ impl OdeProblem for Problem<'_, '_> {
         self.values(&d, g)?;
         for (k, v) in g.iter_mut().enumerate() {
             if !self.armed[k] {
-                if *v > self.arm_at_for(self.watches[k]) {
+                let watch = self.watches[k];
+                let arm_at = self.arm_at_for(watch);
+                // A gap or edge margin clear of zero on the wrong side (one that opened and
+                // closed again within one step: the bodies now overlap) goes through, and the
+                // integrator locates where it crossed.
+                let through = matches!(watch, Watch::Gap(_) | Watch::Edge(_)) && *v < -arm_at;
+                if *v > arm_at {
                     self.armed[k] = true;
-                } else {
-                    // Unarmed: no crossing until it has grown clear of zero.
+                } else if !through {
+                    // Unarmed: no crossing while it has not grown clear of zero.
                     *v = 1.0;
                 }
             }
