@@ -303,7 +303,7 @@ pub fn accuracy(args: AccuracyArgs) -> Result<(), Failure> {
         bar.set_style(style);
     }
     // A progress bar on a terminal; a line per model and case otherwise.
-    let lines: Option<Box<dyn Fn(&str)>> = if std::io::stderr().is_terminal() {
+    let lines: Option<accuracy::LineSink> = if std::io::stderr().is_terminal() {
         None
     } else {
         Some(Box::new(note))

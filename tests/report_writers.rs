@@ -159,6 +159,7 @@ fn paper_results(m2: f64) -> RunResults {
             polynomial_evals: 7,
             integrand_evals: 40,
             ode_steps: 0,
+            ode_evaluations: 0,
             phases: vec!["rod_cube".into(), "rod_cube_free".into()],
         },
         notes: BTreeMap::new(),

@@ -336,16 +336,19 @@ pub struct Report {
     pub integrated: Vec<integrated::IntegratedReference>,
 }
 
+/// Receives a sentence per model and case.
+pub type LineSink = Box<dyn Fn(&str)>;
+
 /// How [`run`] says what it is doing: a bar advanced once per setting, and a line per model
 /// and case (for output that is not a terminal).
 pub struct Progress {
     bar: ProgressBar,
-    line: Option<Box<dyn Fn(&str)>>,
+    line: Option<LineSink>,
 }
 
 impl Progress {
     /// Advances `bar`; `line`, if given, receives a sentence per model and case.
-    pub fn new(bar: ProgressBar, line: Option<Box<dyn Fn(&str)>>) -> Progress {
+    pub fn new(bar: ProgressBar, line: Option<LineSink>) -> Progress {
         Progress { bar, line }
     }
 

@@ -149,7 +149,7 @@ impl<'m> LeanSolver<'m> {
     /// loosen.
     pub fn with_tolerance(model: &'m dyn Model, tol: f64) -> Result<Self, SolveError> {
         let mut solver = Self::with_schedule(model, &SCHEDULE, ACCEPT)?;
-        if !solver.layout.fall_degree.is_some_and(|d| d <= 2) {
+        if solver.layout.fall_degree.is_none_or(|d| d > 2) {
             return Err(SolveError::NotPerPoint {
                 model: solver.info.name,
                 why: "its fall polynomial has no a-priori rule (degree above 2)",
