@@ -101,6 +101,8 @@ pub struct Work {
     pub integrand_evals: u64,
     /// Accepted and rejected steps of any ODE integration.
     pub ode_steps: u64,
+    /// Right-hand sides evaluated by any ODE integration.
+    pub ode_evaluations: u64,
     /// Names of the phases simulated (`rod_cube`, `free_rod`, ...).
     pub phases: Vec<String>,
 }

@@ -402,6 +402,8 @@ mod calls {
             // A NULL error buffer is allowed; success clears the message.
             let code = rodcube_solve(s, PAPER.as_ptr(), 5, &mut out, null_mut(), 0);
             assert_eq!(code, RODCUBE_OK);
+            // The paper's case: eq. (14)'s root, 9.61097 deg (PHYSICS.md; to 1e-12 in
+            // tests/hard_cases.rs against the 256-bit reference).
             assert!((out.separation_angle.to_degrees() - 9.611).abs() < 1e-3);
             let code = rodcube_solve(s, PAPER.as_ptr(), 5, &mut out, err.as_mut_ptr(), 256);
             assert_eq!((code, message(&err)), (RODCUBE_OK, String::new()));
@@ -688,6 +690,7 @@ mod calls {
             let t = value["results"]["separation_time"]["value"]
                 .as_f64()
                 .unwrap();
+            // The paper's 0.108 s (t_sep = 0.10849 s, PHYSICS.md).
             assert!((t - 0.1085).abs() < 5e-4);
             rodcube_results_free(results);
         }

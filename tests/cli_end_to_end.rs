@@ -89,6 +89,10 @@ fn the_paper_scene_by_default_prints_the_papers_figures_and_writes_out_paper() {
     .unwrap();
     let o = rodcube(&dir, &["run"]);
     let stdout = ok(&o);
+    // The paper's figures as printed (section 3), then the leading digits of ours: eq. (14)'s
+    // root 9.6109706 deg (the degree column's six digits) and t_sep 0.10849325 s (the 256-bit
+    // reference, tests/hard_cases.rs), eq. (10)'s time to the floor in contact 0.18692909 s
+    // (mpmath quadrature) and sqrt(a/g) = 0.15963771 s, each a prefix of what is printed.
     for want in [
         "9.61°",
         "9.59°",
@@ -131,6 +135,7 @@ fn json_mode_prints_results_json_on_stdout() {
         assert!(v.get(k).is_some(), "missing {k}");
     }
     let t = v["results"]["separation_time"]["value"].as_f64().unwrap();
+    // PHYSICS.md: t_sep = 0.10849 s at g = 9.81.
     assert!((t - 0.10849).abs() < 1e-5, "{t}");
     let on_disk: serde_json::Value =
         serde_json::from_str(&fs::read_to_string(dir.join("o/results.json")).unwrap()).unwrap();
@@ -280,6 +285,7 @@ fn a_bare_rodcube_runs_the_papers_scene_from_any_directory() {
     let out = rodcube(&dir, &[]);
     let table = ok(&out);
     assert!(table.contains("model rod_cube"), "{table}");
+    // eq. (14)'s root, 9.6109706 deg, as the table prints it.
     assert!(table.contains("9.61097°"), "{table}");
     assert!(dir.join("out/paper/results.json").is_file());
     // A file still overrides it.

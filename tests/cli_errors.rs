@@ -271,6 +271,41 @@ fn unknown_subcommand_is_a_usage_error() {
 }
 
 #[test]
+fn accuracy_options_that_name_nothing_are_usage_errors_that_write_nothing() {
+    let dir = fresh("accuracy_options");
+    for (args, needles) in [
+        (
+            &["--model", "rod_cube_spring,nope"][..],
+            &["no model `nope`", "rod_cube_friction"][..],
+        ),
+        (
+            &["--case", "upright"],
+            &["no case `upright`", "near_upright"],
+        ),
+        (
+            &["--model", "rod_cube_spring", "--case", "paper"],
+            &["no case `paper`", "scene"],
+        ),
+        (&["--method", "rk4"], &["no method `rk4`", "dop853"]),
+        (
+            &["--model", "rod_cube_spring", "--method", "halley"],
+            &["nothing to measure"],
+        ),
+    ] {
+        let mut all = vec!["accuracy", "--out", "acc"];
+        all.extend_from_slice(args);
+        let o = rodcube_in(&dir, &all);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(EXIT_USAGE), "{args:?}: {err}");
+        assert!(o.stdout.is_empty(), "{args:?}");
+        for n in needles {
+            assert!(err.contains(n), "{args:?}: missing {n:?} in {err}");
+        }
+        assert!(!dir.join("acc").exists(), "{args:?}: nothing is written");
+    }
+}
+
+#[test]
 fn out_naming_a_file_is_an_output_error_naming_it() {
     let dir = fresh("out_is_a_file");
     fs::write(dir.join("scene.yaml"), VALID).unwrap();

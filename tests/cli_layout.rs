@@ -126,6 +126,8 @@ fn checks_come_phase_by_phase_with_their_own_units_and_bounds() {
     assert!(at("\nrod_cube (ODE cross-check):\n") < at("\nrod_cube_free:\n"));
     // A monitor reports its smallest value with its unit and when; a conservation law on the
     // reduced path says it holds by construction; the integrated one, its drift and bound.
+    // The floor's push is smallest at the separation, m1 g / 4 = 9.81/4 N
+    // (docs/hand_derivations.md, section D).
     assert!(text.contains("min 2.4525 N"), "{text}");
     assert!(text.contains("(built in)"), "{text}");
     assert!(text.contains("<= 1e-12"), "{text}");

@@ -19,7 +19,8 @@ use rodcube::plan::{PlanError, Request, run};
 use rodcube::quantity::Quantity;
 use rodcube::results::{RunResults, Work};
 use rodcube::solve::SolveError;
-use rodcube::solve::phases::{Route, Walker};
+use rodcube::solve::ode::Method;
+use rodcube::solve::phases::{End, Route, Walker};
 use rodcube::system::Bound;
 
 /// The paper's separation time (scenes/paper.yaml: m1 = 1, m2 = 3, ell = 1, a = 0.25,
@@ -287,6 +288,61 @@ fn fixed_cylinder_foot_lifts_at_the_hand_time() {
             Some(end) => assert!(end.value > hand.t, "{route:?}: {}", end.value),
             None => assert!(r.notes.contains_key("cylinder_push_end"), "{:?}", r.notes),
         }
+    }
+}
+
+/// At R = 0.2, th0 = 1.2 the cylinder would have to pull at release: the rod leaves it, falls
+/// with its foot on the frictionless floor (its centre straight down) and strikes the cylinder
+/// again. By hand: with the cylinder's centre at (0, R) and the foot at (-L, 0), the rod's line
+/// lies R from the centre where L sin(theta) - R cos(theta) = R (at release L0 = R cot(th0/2));
+/// the centre keeps its x, so L = L0 + (ell/2)(cos(theta) - cos(th0)); energy gives
+/// theta'^2 = g (sin th0 - sin theta) / (ell (cos^2(theta)/4 + 1/12)), and the time is its
+/// integral after theta = th0 - u^2 (smooth in u). The integrator must find the strike whatever
+/// its steps: DOP853 at rtol 1e-2 steps over the whole flight in its first step (before the
+/// gaps were watched through a step, it fell through the cylinder to the floor, at 0.427 s).
+#[test]
+fn a_rod_that_leaves_the_cylinder_strikes_it_again_in_any_step() {
+    let (r, th0, ell) = (0.2f64, 1.2f64, 1.0f64);
+    let l0 = r / (0.5 * th0).tan();
+    let gap = |th: f64| (l0 + 0.5 * ell * (th.cos() - th0.cos())) * th.sin() - r * th.cos() - r;
+    // The gap opens below th0, then closes: scan down for the sign change, then bisect.
+    let mut hi = th0 - 1e-3;
+    assert!(gap(hi) > 0.0, "the rod leaves the cylinder");
+    let mut lo = hi;
+    while gap(lo) > 0.0 {
+        lo -= 1e-3;
+    }
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if gap(mid) > 0.0 { hi = mid } else { lo = mid }
+    }
+    let th_hit = 0.5 * (lo + hi);
+    let omega = |th: f64| {
+        (G * (th0.sin() - th.sin()) / (ell * (0.25 * th.cos().powi(2) + 1.0 / 12.0))).sqrt()
+    };
+    let t_hit = Gauss::new(30).integrate(
+        |u| 2.0 * u / omega(th0 - u * u),
+        0.0,
+        (th0 - th_hit).sqrt(),
+        4,
+    );
+    println!("hand: strike at theta = {th_hit} rad, t = {t_hit} s");
+    let params = cylinder_params(r, th0);
+    for (rtol, method, tol) in [
+        (1e-13, None, 1e-10),
+        (1e-2, Some(Method::Dop853), 1e-3),
+        (1e-2, Some(Method::Dopri5), 1e-3),
+    ] {
+        let mut w = walker("fixed_cylinder", &params, Route::Integrated);
+        w.rtol = rtol;
+        let (start, opened) = w.release().unwrap();
+        assert_eq!(opened, [0], "the cylinder opens at release");
+        let run = w
+            .integrate_with(&start, method, &mut Work::default())
+            .unwrap();
+        let what = format!("rtol {rtol:e}, {method:?}");
+        assert_eq!(run.end(), End::Contact(0), "{what}");
+        close(run.t_end(), t_hit, tol, &what);
     }
 }
 

@@ -1,7 +1,7 @@
 //! Coulomb friction between the rod's foot and the floor (`rod_cube_friction`, a general model:
 //! the foot's height a coordinate and the floor a contact like the cube's face), checked against
 //! independent references: mu = 0 is the paper's frictionless case, a foot that never slips is
-//! the hinged rod (a different system, on the fast path), a hand Newton–Euler balance of each
+//! the hinged rod (both held to the 256-bit reference), a hand Newton–Euler balance of each
 //! body agrees with the solved contact forces and friction, energy lost equals the work of
 //! friction, stick/slip switches sit where their event functions vanish and do not move when the
 //! integrator is tightened, a sliding foot past Painlevé's bound (derived by hand) has no
@@ -12,12 +12,14 @@ use rodcube::model::Model;
 use rodcube::models::{all, find};
 use rodcube::plan::{Request, run};
 use rodcube::quantity::Quantity;
+use rodcube::reference::{Family, Inputs, Reference, RootRoute, TimeRoute, relative_error};
 use rodcube::results::{RunResults, Work};
 use rodcube::solve::SolveError;
 use rodcube::solve::contacts::{
     Active, Mode, Moment, Options, contact_options, decide, dynamics, friction_options,
 };
-use rodcube::solve::phases::{PhaseRun, PhaseStart, Route, Walker};
+use rodcube::solve::ode::Method;
+use rodcube::solve::phases::{End, PhaseRun, PhaseStart, Route, Walker};
 use rodcube::system::{Bound, State, SystemError};
 
 /// The paper's separation time (g = 9.81) to 15 digits, held to the 256-bit reference by
@@ -49,6 +51,24 @@ fn ask(name: &str, params: &[(&str, f64)], want: &[Quantity], tolerance: f64) ->
         .with_want(want)
         .with_tolerance(tolerance);
     run(&request).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+/// The 256-bit reference's separation angle and time of `family` at the paper's parameters
+/// (`src/reference.rs`: closed forms and arbitrary-precision quadrature, no code shared with
+/// the generated models or the planner).
+fn reference(family: Family) -> (Reference, rodcube::reference::SeparationReference) {
+    let (m1, m2, ell, a, g) = (1.0, 3.0, 1.0, 0.25, 9.81);
+    let inputs = Inputs {
+        family,
+        m1,
+        m2,
+        ell,
+        a,
+        g,
+    };
+    let mut reference = Reference::new(inputs).unwrap();
+    let sep = reference.separation(RootRoute::ClosedForm).unwrap();
+    (reference, sep)
 }
 
 fn value(r: &RunResults, key: &str) -> f64 {
@@ -91,10 +111,11 @@ fn without_friction_the_foot_slides_as_in_the_paper() {
     let rel = (t - PAPER_T_SEP).abs() / PAPER_T_SEP;
     println!("mu = 0: t_sep = {t:.15e} s, {rel:.1e} from the paper");
     assert!(rel < 1e-12, "{t} vs {PAPER_T_SEP}");
-    let frictionless = ask("rod_cube", &paper(0.0)[..5], SEPARATION, 1e-12);
+    // The angle: eq. (14)'s root, from the 256-bit reference.
+    let (_, sep) = reference(Family::RodCube);
     let angle = value(&r, "separation_angle");
-    let want = value(&frictionless, "separation_angle");
-    assert!((angle - want).abs() < 1e-12 * want, "{angle} vs {want}");
+    let e = relative_error(angle, &sep.theta).abs();
+    assert!(e < 1e-12, "{angle} vs {} ({e:e})", sep.theta_f64);
     // The contact phase slides back all the way to the separation, in one stretch; after it the
     // rod runs on its foot alone.
     assert_eq!(
@@ -112,21 +133,20 @@ fn without_friction_the_foot_slides_as_in_the_paper() {
 
 #[test]
 fn a_foot_that_never_slips_is_the_hinged_rod() {
-    let hinged = ask("hinged_rod", &paper(0.0)[..5], SEPARATION, 1e-12);
-    let (t_h, angle_h) = (
-        value(&hinged, "separation_time"),
-        value(&hinged, "separation_angle"),
-    );
+    // The hinged rod's separation (`3 n s^3 + 3 s - 2 r = 0`, PHYSICS.md erratum 5) and its
+    // time from the 256-bit reference, which shares no code with either model.
+    let (mut hinged, sep) = reference(Family::HingedRod);
+    let t_h = hinged.separation_time(TimeRoute::SinhGauss).unwrap();
     for mu in [2.0, 10.0, 1e6] {
         let r = ask("rod_cube_friction", &paper(mu), SEPARATION, 1e-12);
         let (t, angle) = (value(&r, "separation_time"), value(&r, "separation_angle"));
-        println!(
-            "mu = {mu:e}: t_sep {t:.15e} (hinged {t_h:.15e}, {:.1e}), angle {:.1e} off",
-            (t - t_h).abs() / t_h,
-            (angle - angle_h).abs() / angle_h
+        let (et, ea) = (
+            relative_error(t, &t_h).abs(),
+            relative_error(angle, &sep.theta).abs(),
         );
-        assert!((t - t_h).abs() < 1e-12 * t_h, "mu {mu}: {t} vs {t_h}");
-        assert!((angle - angle_h).abs() < 1e-12 * angle_h, "mu {mu}");
+        println!("mu = {mu:e}: t_sep {t:.15e}, {et:.1e} off the hinged rod's, angle {ea:.1e} off");
+        assert!(et < 1e-12, "mu {mu}: {t} is {et:e} off the reference");
+        assert!(ea < 1e-12, "mu {mu}: {angle} is {ea:e} off the reference");
         assert_eq!(
             r.work.phases[0],
             format!("rod_cube_friction ({})", both_closed("sticks"))
@@ -278,6 +298,39 @@ fn switches_are_located_where_their_event_functions_vanish() {
         println!("switch at {b:.15e} s moves by {rel:.1e} relative");
         assert!(rel < 1e-12, "{a} vs {b}");
     }
+}
+
+/// A stop the integrator steps over. At mu = 1.45 the foot slides back from rest and stops at
+/// 0.0965 s; DOP853 forced to rtol 1e-4 takes its first step to 0.109 s, so the slip goes out
+/// from zero and back through it within one step. The slip watch starts with its mode's sign
+/// (it leaves zero that way), so that step is a crossing: the stop is found, the foot sticks, and
+/// the contact ends where a tight integration by the other method puts it (before, the stop
+/// was never seen and the phase ran on to the floor at 0.218 s, friction pushing the foot).
+#[test]
+fn a_stop_inside_one_long_step_is_found() {
+    let w = walker(1.45, 1e-12, 1e-4);
+    let start = w.release().unwrap().0;
+    let run = w
+        .integrate_with(&start, Some(Method::Dop853), &mut Work::default())
+        .unwrap();
+    let PhaseRun::Integrated(r) = &run else {
+        panic!("forced onto the integrator")
+    };
+    let modes: Vec<String> = r.run.switches(&r.bound).map(|(_, m)| m).collect();
+    assert_eq!(modes, [both_closed("slides -"), both_closed("sticks")]);
+    assert_eq!(run.end(), End::Force(0));
+    let tight = walker(1.45, 1e-12, 1e-13);
+    let reference = tight
+        .integrate_with(&start, Some(Method::Dopri5), &mut Work::default())
+        .unwrap();
+    let rel = (run.t_end() - reference.t_end()).abs() / reference.t_end();
+    // DOP853 at 1e-4 against DOPRI5 at 1e-13: the loose run's own tolerance, with margin.
+    assert!(
+        rel < 1e-5,
+        "{} vs {}: {rel:e}",
+        run.t_end(),
+        reference.t_end()
+    );
 }
 
 #[test]

@@ -620,9 +620,13 @@ fn tall_light_block_tips_at_release() {
     let blk = block(0.1, 0.05, 0.5);
     let th0 = blk.theta0();
     let p0 = blk.push(th0);
+    // At release eq. (16) gives P/(m2 g) = 3 c r/(4 (1+n) - 3 r^2) (the bracket is
+    // -r (4 (1+n) - 3 r^2) at s = r) and y_tip - h/2 = h/2, so the ratio is h/w times that:
+    // 3.559008508703 (docs/hand_derivations.md, section C).
+    let (r, c) = (0.5f64, 0.5f64.asin().cos());
     close(
         blk.tipping_ratio(th0, p0),
-        3.559_008_508_703_173,
+        (0.5 / 0.05) * 3.0 * c * r / (4.0 * 1.1 - 3.0 * r * r),
         1e-12,
         "ratio at release",
     );

@@ -96,6 +96,34 @@ impl Params {
     fn theta_i(&self) -> f64 {
         (self.a / self.ell).asin()
     }
+    /// The hand constants of the header: `(h, P, K)`.
+    fn hand(&self) -> (f64, f64, f64) {
+        let mm = self.m1 + self.m2 + self.m3;
+        let h = self.m1 / 2.0 + self.m3;
+        (h, self.m1 / 3.0 + self.m3, (h * h + self.m2 * self.m3) / mm)
+    }
+    /// `sin(theta_sep)` by hand: the root in `(0, r)` of `K s^3 - 3 P s + 2 P r`.
+    fn hand_separation_sine(&self) -> f64 {
+        let (_, pp, kk) = self.hand();
+        let r = self.a / self.ell;
+        root(&[2.0 * pp * r, -3.0 * pp, 0.0, kk], r)
+    }
+    /// `t_sep` by hand: `integral dtheta / |theta'|` with the header's
+    /// `theta'^2 = 2 g h (r - s) / (ell (P - K s^2))`, substituting `theta = theta_i - v^2`
+    /// (which removes the `1/sqrt` at the start), by 60-point Gauss–Legendre.
+    fn hand_separation_time(&self) -> f64 {
+        let (h, pp, kk) = self.hand();
+        let theta_i = self.theta_i();
+        let v_end = (theta_i - self.hand_separation_sine().asin()).sqrt();
+        let rule = gauss_quad::GaussLegendre::new(60.try_into().unwrap());
+        rule.integrate(0.0, v_end, |v| {
+            let (theta, d) = (theta_i - v * v, v * v);
+            let r_minus_s = 2.0 * (theta_i - 0.5 * d).cos() * (0.5 * d).sin();
+            let s = theta.sin();
+            let w2 = 2.0 * self.g * h * r_minus_s / (self.ell * (pp - kk * s * s));
+            2.0 * v / w2.sqrt()
+        })
+    }
 }
 
 fn prepare(model: &dyn Model, p: &Params) -> Vec<f64> {
@@ -442,12 +470,16 @@ fn it_separates_between_the_start_and_the_floor() {
         .unwrap()
         .force_polynomial(&k, contact, &mut coef);
     let loaded = root(&coef, 0.25).asin();
+    // The header's hand cubic K s^3 - 3 P s + 2 P r (here P = 4/3, K = 21/20).
+    let hand = p.hand_separation_sine();
+    assert!(rel(loaded.sin(), hand, hand) < 1e-14, "{loaded} vs {hand}");
     let bare = find("rod_cube_closed");
     let kb = prepare(bare, &p);
     bare.reduction()
         .unwrap()
         .force_polynomial(&kb, 0, &mut coef);
     let paper = root(&coef, 0.25).asin();
+    // The paper's section 3: 9.61 degrees.
     assert!(
         (paper.to_degrees() - 9.61).abs() < 0.005,
         "{}",
@@ -481,10 +513,22 @@ fn the_binary_runs_a_loaded_rod_scene_end_to_end() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(0), "stderr:\n{stderr}");
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // The header's hand derivation: the cubic's root and the energy integral's time.
+    let p = Params {
+        m1: 1.0,
+        m2: 3.0,
+        m3: 0.5,
+        ell: 1.0,
+        a: 0.25,
+        g: 9.81,
+    };
     let theta_sep = v["results"]["separation_angle"]["value"].as_f64().unwrap();
-    assert!(theta_sep > 0.0 && theta_sep < 0.25f64.asin(), "{theta_sep}");
+    let want = p.hand_separation_sine().asin();
+    assert!(rel(theta_sep, want, want) < 1e-12, "{theta_sep} vs {want}");
     let t_sep = v["results"]["separation_time"]["value"].as_f64().unwrap();
-    assert!(t_sep > 0.0);
+    let want = p.hand_separation_time();
+    // The scene asks the default tolerance, 1e-10 relative.
+    assert!(rel(t_sep, want, want) < 1e-10, "{t_sep} vs {want}");
     let checks = v["checks"].as_object().unwrap();
     assert!(!checks.is_empty());
     for (name, c) in checks {

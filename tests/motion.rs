@@ -259,6 +259,9 @@ fn label(shown: &Value, kind: &str) -> String {
 
 #[test]
 fn the_bodies_are_where_results_json_says() {
+    // The expectations are results.json's own numbers: this checks the drawing against them,
+    // not the physics (held to hand derivations and the 256-bit reference in
+    // tests/generated_numeric.rs, hard_cases.rs and phases.rs).
     let r = results();
     let svg = read(&paper().join("motion.svg"));
     let factor = root_attribute(&svg, "data-slow-motion");

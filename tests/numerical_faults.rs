@@ -52,6 +52,7 @@ fn step_size_collapse_is_reported_where_it_happens() {
     let SolveError::StepSizeTooSmall { t, h } = err else {
         panic!("expected a step-size collapse, got {err:?}");
     };
+    // y' = y^2, y(0) = 1 is y = 1/(1 - t): it blows up at t = 1.
     assert!(t > 0.999 && t <= 1.0, "t = {t}");
     assert!(h > 0.0 && h < 1e-12, "h = {h}");
     let message = err.to_string();

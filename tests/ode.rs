@@ -183,7 +183,8 @@ fn ode_path_conserves_energy_and_momentum() {
     let states = run.states();
     assert_eq!(states.len(), run.nodes().len());
     let rows = vec![(vec![true, true], vec![]); states.len()];
-    // The tip pushes x1 back and x2 forward alike: only their sum's momentum is conserved.
+    // The tip pushes x1 back and x2 forward alike: only their sum's momentum is conserved, its
+    // unit weights (1, 1)/sqrt(2) (by hand: the tip's row has -1 and +1 in x1 and x2).
     let conserved = Conserved {
         friction_work: None,
         momenta: free_momenta(&general, &states, &rows).unwrap(),

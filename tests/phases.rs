@@ -5,7 +5,9 @@
 mod common;
 
 use common::paper::{FREE_ROD, GENERAL, MODELS, ROD_CUBE, paper};
+use gauss_quad::GaussLegendre;
 use rodcube::model::Model;
+use rodcube::reference::{Family, Inputs, Reference, RootRoute, TimeRoute, to_f64};
 use rodcube::results::Work;
 use rodcube::solve::SolveError;
 use rodcube::solve::contacts::Active;
@@ -126,6 +128,44 @@ fn floor_impact_conserves_energy_and_momentum_across_the_boundary() {
     // Times: after separation, and different from the paper's contact-all-the-way 0.18693 s.
     let t = motion.end_time();
     assert!(t > rc.t_end() && (t - 0.18693).abs() > 1e-4);
+    // The landing by hand (0.187051069750276 s, -2.70536110443833 rad/s; mpmath agrees):
+    // t_sep and sin(theta_sep) from the 256-bit reference, theta'^2 there from eq. (9), the
+    // rod's centre then moving at v = x1' - (ell/2) s theta' = (3/8) ell s theta' (eq. 5,
+    // n = 3) for good; the free rod's energy per m1, e = v^2/2 + (c^2/4 + 1/12) ell^2 w^2/2
+    // + g ell s/2, gives w^2(theta), integrated from theta_sep to 0 by Gauss–Legendre (w != 0
+    // on the way: a smooth integrand).
+    let mut reference = Reference::new(Inputs {
+        family: Family::RodCube,
+        m1,
+        m2,
+        ell,
+        a: 0.25,
+        g,
+    })
+    .unwrap();
+    let s_sep = to_f64(
+        &reference
+            .separation(RootRoute::ClosedForm)
+            .unwrap()
+            .sin_theta,
+    );
+    let t_sep = to_f64(&reference.separation_time(TimeRoute::SinhGauss).unwrap());
+    let (n, r) = (m2 / m1, 0.25 / ell);
+    let c_sep = (1.0 - s_sep * s_sep).sqrt();
+    let w_sep = -(4.0 * g / ell * (r - s_sep) / (4.0 / 3.0 - s_sep * s_sep / (1.0 + n))).sqrt();
+    let v = ((1.0 + 2.0 * n) / (2.0 * (1.0 + n)) - 0.5) * ell * s_sep * w_sep;
+    let e = 0.5 * v * v
+        + 0.5 * (0.25 * c_sep * c_sep + 1.0 / 12.0) * ell * ell * w_sep * w_sep
+        + 0.5 * g * ell * s_sep;
+    let w_sq = |theta: f64| {
+        (2.0 * e - v * v - g * ell * theta.sin())
+            / (ell * ell * (0.25 * theta.cos().powi(2) + 1.0 / 12.0))
+    };
+    let rule = GaussLegendre::new(40.try_into().unwrap());
+    let landing = t_sep + rule.integrate(0.0, s_sep.asin(), |theta| 1.0 / w_sq(theta).sqrt());
+    assert!(((t - landing) / landing).abs() < 1e-12, "{t} vs {landing}");
+    let w_end = -w_sq(0.0).sqrt();
+    assert!(((w - w_end) / w_end).abs() < 1e-12, "{w} vs {w_end}");
     assert_eq!(fr.t_start(), rc.t_end());
 }
 

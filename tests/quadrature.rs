@@ -60,6 +60,8 @@ fn rel(a: f64, b: f64) -> f64 {
 
 #[test]
 fn paper_times() {
+    // PHYSICS.md's figures of the paper's case to five digits (eq. 15 to the separation,
+    // eq. 10 to the floor in contact, sqrt(a/g)), for both values of g the paper may have used.
     for (g, t_sep, t_floor, t_point) in [
         (9.81, 0.10849, 0.18693, 0.15964),
         (9.8, 0.10855, 0.18702, 0.15972),

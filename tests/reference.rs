@@ -1,7 +1,7 @@
 //! The high-precision reference (`rodcube::reference`) checked against itself and against
 //! what is known independently: its two routes to each quantity agree to far more than 25
 //! significant digits on the paper's case and near upright, and its values match the paper's
-//! figures, the wall-ladder closed form and the near-upright asymptote.
+//! figures, the wall-ladder closed form, the flat-rod limit and the near-upright asymptote.
 
 use rodcube::reference::{
     Family, Inputs, Reference, ReferenceError, RootRoute, TimeRoute, relative_difference, to_f64,
@@ -97,6 +97,29 @@ fn the_wall_ladder_separates_at_two_thirds_of_its_height() {
             Reference::new(Inputs::dimensionless(Family::WallLadder, 1.0, r)).unwrap();
         let s = to_f64(&reference.separation_sine(RootRoute::ClosedForm).unwrap());
         assert!(((s - 2.0 * r / 3.0) / s).abs() < 2e-16, "r = {r}: {s}");
+    }
+}
+
+#[test]
+fn a_nearly_flat_rod_separates_after_two_thirds_of_sqrt_a_over_g() {
+    // PHYSICS.md's r -> 0 limit, for every family: near the floor theta'^2 -> 3 (g/ell)
+    // (theta_0 - theta), so theta = theta_0 - (3 g / 4 ell) t^2 reaches the separation at
+    // theta_0/3 below the start (sin(theta_sep) -> 2r/3) after t = (2/3) sqrt(a/g). The
+    // corrections (asin r - r, mu s^2) are relative O(r^2); allowed here: 2r.
+    for family in [Family::RodCube, Family::HingedRod, Family::WallLadder] {
+        let mut last = f64::INFINITY;
+        for r in [1e-2, 1e-4, 1e-6, 1e-8] {
+            let mut reference = Reference::new(Inputs::dimensionless(family, 3.0, r)).unwrap();
+            let t = to_f64(&reference.separation_time(TimeRoute::TanhSinh).unwrap());
+            let limit = 2.0 / 3.0 * r.sqrt(); // g = 1, a = r
+            let dev = ((t - limit) / limit).abs();
+            assert!(
+                dev < 2.0 * r,
+                "{family:?} r = {r}: {t} vs {limit} ({dev:e})"
+            );
+            assert!(dev < last, "{family:?} r = {r}: {dev:e} after {last:e}");
+            last = dev;
+        }
     }
 }
 

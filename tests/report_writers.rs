@@ -28,8 +28,11 @@ fn scalar(value: f64, unit: &'static str, meaning: &str) -> Scalar {
     }
 }
 
-/// Results shaped like the planner's for the paper's scene (values from PHYSICS.md, series
-/// from simple closed forms with the right ranges).
+/// Results shaped like the planner's for the paper's scene: inputs to the writers, not physics
+/// under test. The times 0.10849, 0.18693 and 0.15964 s are PHYSICS.md's figures; the angle
+/// 9.6114 deg and the landing at 0.1989 s are made up, unlike the true 9.61097 deg and
+/// 0.18705 s (`tests/phases.rs` checks the landing), so that the table test finds each row by
+/// its own digits. The series are simple closed forms with the right ranges.
 fn paper_results(m2: f64) -> RunResults {
     let theta0 = 0.25f64.asin();
     let theta_sep = 9.6114f64.to_radians();
@@ -159,6 +162,7 @@ fn paper_results(m2: f64) -> RunResults {
             polynomial_evals: 7,
             integrand_evals: 40,
             ode_steps: 0,
+            ode_evaluations: 0,
             phases: vec!["rod_cube".into(), "rod_cube_free".into()],
         },
         notes: BTreeMap::new(),
@@ -403,6 +407,7 @@ fn radians_are_plotted_in_degrees() {
         vec![std::f64::consts::PI, 0.25f64.asin()],
     ));
     assert_eq!(unit, "deg");
+    // pi rad = 180 deg, asin(1/4) = 14.4775 deg.
     assert!((v[0] - 180.0).abs() < 1e-12 && (v[1] - 14.4775).abs() < 1e-4);
     let (v, unit) = plot::display_column(&col("contact_force", "N", vec![2.0]));
     assert_eq!((v, unit), (vec![2.0], "N"));
@@ -553,6 +558,8 @@ fn table_explains_quantities_without_a_value() {
 
 #[test]
 fn numbers_are_plain_or_in_engineering_notation() {
+    // Format, not physics: each is the number rounded by hand to the significant digits asked,
+    // plain between 1e-3 and 1e6 and otherwise with an exponent that is a multiple of 3.
     assert_eq!(table::format_number(0.108487, 3), "0.108");
     assert_eq!(table::format_number(9.611361, 6), "9.61136");
     assert_eq!(table::format_number(1.0, 12), "1");

@@ -41,6 +41,7 @@ fn paper_series_is_uniform_in_time_and_ends_at_separation() {
     assert_eq!(s.theta[0], sys.theta_initial());
     assert_eq!(s.theta_dot[0], 0.0);
     assert!((s.theta[200] - (sys.theta_initial() - mesh.delta_end)).abs() < 1e-16);
+    // The paper's 9.61 deg (section 3, PHYSICS.md).
     assert!((s.theta[200].to_degrees() - 9.61).abs() < 0.005);
     for j in 1..201 {
         assert!(s.theta[j] < s.theta[j - 1] && s.theta_dot[j] < 0.0);

@@ -5,6 +5,7 @@
 
 use rodcube::plan::{self, Request};
 use rodcube::quantity::Quantity;
+use rodcube::reference::{Family, Inputs, Reference, RootRoute, TimeRoute, relative_error};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -35,6 +36,19 @@ fn read_csv(path: &Path) -> (String, Vec<String>, Vec<Vec<f64>>) {
         })
         .collect();
     (comment, header, rows)
+}
+
+/// The 256-bit reference's separation angle and time of `family` at `m1 = ell = g = 1`,
+/// `m2 = n`, `a = r` (`src/reference.rs`: no code shared with the sweep or the planner); the
+/// returned errors are relative to it.
+fn reference_errors(family: Family, n: f64, r: f64, theta: f64, t: f64) -> (f64, f64) {
+    let mut reference = Reference::new(Inputs::dimensionless(family, n, r)).unwrap();
+    let sep = reference.separation(RootRoute::ClosedForm).unwrap();
+    let t_ref = reference.separation_time(TimeRoute::SinhGauss).unwrap();
+    (
+        relative_error(theta, &sep.theta).abs(),
+        relative_error(t, &t_ref).abs(),
+    )
 }
 
 fn planner(model: &str, p: Vec<f64>) -> (f64, f64) {
@@ -91,6 +105,9 @@ fn a_grid_sweep_matches_the_planner_and_says_it_is_dimensionless() {
             "{row:?} vs {theta}"
         );
         assert!(((row[3] - t) / t).abs() < 1e-11, "{row:?} vs {t}");
+        // And both are the 256-bit reference's (at the sweep's default tolerance, 1e-10).
+        let (ea, et) = reference_errors(Family::RodCube, row[0], row[1], row[2], row[3]);
+        assert!(ea < 1e-12 && et < 1e-10, "{row:?}: {ea:e} {et:e}");
     }
     for svg in ["separation_angle.svg", "separation_time.svg"] {
         let text = std::fs::read_to_string(dir.join(svg)).unwrap();
@@ -134,7 +151,8 @@ fn set_fixes_parameters_and_extra_quantities_come_from_the_planner() {
     );
     assert!(header.contains(&"linearised_separation_angle".to_string()));
     let row = &rows[0];
-    // The paper's case: theta_sep = 9.61 deg, t_sep = 0.10849 s, point mass 0.15964 s.
+    // The paper's case (PHYSICS.md, g = 9.81): theta_sep = 9.61 deg, t_sep = 0.10849 s, point
+    // mass sqrt(a/g) = 0.15964 s.
     assert!((row[2].to_degrees() - 9.61).abs() < 0.005);
     assert!((row[3] - 0.10849).abs() < 5e-6, "{}", row[3]);
     let k = header
@@ -176,6 +194,10 @@ fn a_points_file_is_swept_in_its_order() {
         let (theta, t) = planner("hinged_rod", vec![1.0, n, 1.0, r, 1.0]);
         assert!(((row[2] - theta) / theta).abs() < 1e-13);
         assert!(((row[3] - t) / t).abs() < 1e-10, "{row:?} vs {t}");
+        // The reference, with the hinged rod's rounding limit near a heavy cube
+        // (`tests/hard_cases.rs`: 16 eps sin(theta_i) / sin(theta_sep), here below 1e-10).
+        let (ea, et) = reference_errors(Family::HingedRod, n, r, row[2], row[3]);
+        assert!(ea < 1e-12 && et < 1e-10, "{row:?}: {ea:e} {et:e}");
     }
     let _ = std::fs::remove_dir_all(&dir);
 }

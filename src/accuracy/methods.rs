@@ -1,24 +1,24 @@
 //! The methods compared by `rodcube accuracy`, each a function from a validated
 //! [`System`] to a value and the model evaluations it took: the project's own solvers, and the
 //! alternatives a user would try (closed forms, plain Newton and bisection, Gauss–Jacobi,
-//! tanh–sinh and Gauss–Kronrod on the raw integrand, Runge–Kutta with event location).
+//! tanh–sinh and Gauss–Kronrod on the raw integrand, Runge–Kutta with event location). A method
+//! with a set-up (a solver, a rule's nodes) has it in its own function, so that the report
+//! times the set-up once and the solve alone, as a user who solves many points pays for them.
 
 use crate::results::Work;
 use crate::solve::SolveError;
 use crate::solve::contacts::Active;
 use crate::solve::lean::LeanSolver;
-use crate::solve::ode::{OdeOptions, OdeProblem, dopri5};
+use crate::solve::ode::{Method, OdeOptions, OdeProblem, dopri5};
 use crate::solve::poly::horner;
-use crate::solve::prior::{Prior, integrate_prior};
-use crate::solve::quadrature::{Fall, TimeMesh, gauss_legendre_rule};
+use crate::solve::quadrature::{TimeMesh, gauss_legendre_rule};
 use crate::solve::separation::{linearised_separation, separation};
 use crate::solve::series::sample_phase;
 use crate::solve::unreduced;
 use crate::system::System;
 use gauss_quad::{FiniteAboveNegOneF64, GaussJacobi};
-use std::collections::{BinaryHeap, HashMap};
+use std::collections::BinaryHeap;
 use std::num::NonZeroUsize;
-use std::sync::{Mutex, OnceLock};
 
 /// A method's answer and its cost in model evaluations.
 pub type Outcome<T> = Result<(T, u64), String>;
@@ -166,15 +166,30 @@ pub fn time_default(sys: &System, delta: f64, tol: f64) -> Outcome<f64> {
     Ok((mesh.duration, work.integrand_evals))
 }
 
-/// The per-point solver's a-priori rule ([`prior`](crate::solve::prior)): nodes chosen from
-/// where the integrand is singular, for a relative error `tol`, without an error estimate.
-pub fn time_prior(sys: &System, delta: f64, tol: f64) -> Outcome<f64> {
-    let fall = Fall::of(sys, delta).map_err(err)?;
-    let v_end = fall.v_at_delta(delta);
-    match integrate_prior(&fall, v_end, &Prior::new(tol)).map_err(err)? {
-        Some(done) => Ok(done),
-        None => Err("the model has no fall polynomial of degree 2 or less".into()),
-    }
+/// The set-up of the per-point route for a relative error `tol`: the sweeps' solver with its
+/// a-priori rule ([`prior`](crate::solve::prior): nodes chosen from where the integrand is
+/// singular, without an error estimate) made for `tol`.
+pub fn per_point_solver(sys: &System<'static>, tol: f64) -> Result<LeanSolver<'static>, String> {
+    LeanSolver::with_tolerance(sys.model(), tol).map_err(err)
+}
+
+/// The set-up of the per-point solver comparing fixed rules of `low` and `high` nodes on every
+/// panel, keeping the `high` one when they agree to `accept`.
+pub fn fixed_rules_solver(
+    sys: &System<'static>,
+    low: usize,
+    high: usize,
+    accept: f64,
+) -> Result<LeanSolver<'static>, String> {
+    LeanSolver::with_rules(sys.model(), low, high, accept).map_err(err)
+}
+
+/// One point solved by a per-point solver from its parameters (root and time, as a sweep
+/// solves each point): the separation time and the evaluations it took.
+pub fn time_per_point(solver: &mut LeanSolver, sys: &System) -> Outcome<f64> {
+    let before = solver.evals;
+    let out = solver.solve(sys.p()).map_err(err)?;
+    Ok((out.separation_time, solver.evals - before))
 }
 
 /// One Gauss–Legendre panel of `nodes` after `delta = u^2`.
@@ -213,19 +228,9 @@ fn raw(sys: &System, delta: f64) -> Result<f64, String> {
     }
 }
 
-/// Gauss–Jacobi nodes and weights for the weight `(1 + x)^(-1/2)`, computed once per node
-/// count (Golub–Welsch costs far more than the integral itself).
-fn jacobi_rule(nodes: usize) -> Result<Vec<(f64, f64)>, String> {
-    type Rules = Mutex<HashMap<usize, Vec<(f64, f64)>>>;
-    static RULES: OnceLock<Rules> = OnceLock::new();
-    let cache = RULES.get_or_init(|| Mutex::new(HashMap::new()));
-    let mut map = match cache.lock() {
-        Ok(map) => map,
-        Err(poisoned) => poisoned.into_inner(),
-    };
-    if let Some(rule) = map.get(&nodes) {
-        return Ok(rule.clone());
-    }
+/// The set-up of Gauss–Jacobi: the nodes and weights of `nodes` points for the weight
+/// `(1 + x)^(-1/2)` (by Golub–Welsch, which costs far more than the integral itself).
+pub fn jacobi_rule(nodes: usize) -> Result<Vec<(f64, f64)>, String> {
     let (Some(n), Some(alpha), Some(beta)) = (
         NonZeroUsize::new(nodes),
         FiniteAboveNegOneF64::new(0.0),
@@ -233,23 +238,21 @@ fn jacobi_rule(nodes: usize) -> Result<Vec<(f64, f64)>, String> {
     ) else {
         return Err("bad Gauss-Jacobi parameters".into());
     };
-    let rule = GaussJacobi::new(n, alpha, beta)
+    Ok(GaussJacobi::new(n, alpha, beta)
         .as_node_weight_pairs()
-        .to_vec();
-    map.insert(nodes, rule.clone());
-    Ok(rule)
+        .to_vec())
 }
 
 /// Gauss–Jacobi with the endpoint weight `(1 + x)^(-1/2)` absorbing the `1/sqrt(delta)`.
-pub fn time_gauss_jacobi(sys: &System, delta: f64, nodes: usize) -> Outcome<f64> {
-    let rule = jacobi_rule(nodes)?;
+/// `rule` is [`jacobi_rule`]'s.
+pub fn time_gauss_jacobi(sys: &System, delta: f64, rule: &[(f64, f64)]) -> Outcome<f64> {
     let mut sum = 0.0;
-    for &(x, w) in &rule {
+    for &(x, w) in rule {
         // delta = delta_sep (1 + x)/2; the smooth factor is sqrt(delta) / |theta_dot|.
         let d = 0.5 * delta * (1.0 + x);
         sum += w * d.sqrt() * raw(sys, d)?;
     }
-    Ok(((0.5 * delta).sqrt() * sum, nodes as u64))
+    Ok(((0.5 * delta).sqrt() * sum, rule.len() as u64))
 }
 
 /// Tanh–sinh on the raw integrand over `[0, delta]` with step `h`; the distance to the
@@ -461,20 +464,20 @@ pub fn time_unreduced(sys: &System, rtol: f64, t_max: f64) -> Outcome<f64> {
         frictions: Vec::new(),
         friction_work: 0.0,
     };
-    let run = unreduced::integrate(sys, &start, rtol, None, t_max, &mut work).map_err(err)?;
+    let run = unreduced::integrate_with(
+        sys,
+        &start,
+        rtol,
+        Some(Method::Dopri5),
+        None,
+        t_max,
+        &mut work,
+    )
+    .map_err(err)?;
     if run.end != unreduced::EndEvent::Force(0) {
         return Err("the phase ended before the first contact's force vanished".into());
     }
-    // Six right-hand sides per step (FSAL saves the seventh).
-    Ok((run.t_end, 6 * work.ode_steps))
-}
-
-/// The per-point solver (root and time) comparing fixed rules of `low` and `high` nodes on
-/// every panel.
-pub fn time_lean_fixed(sys: &System, low: usize, high: usize, accept: f64) -> Outcome<f64> {
-    let mut s = LeanSolver::with_rules(sys.model(), low, high, accept).map_err(err)?;
-    let out = s.solve(sys.p()).map_err(err)?;
-    Ok((out.separation_time, s.evals))
+    Ok((run.t_end, work.ode_evaluations))
 }
 
 // ----------------------------------------------------------------------------------------

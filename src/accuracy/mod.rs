@@ -1,27 +1,54 @@
 //! `rodcube accuracy`: what accuracy costs in time. Every method the project ships, and the
 //! ones a user would reach for, is run on the paper's case and on the hard cases (near upright,
 //! nearly flat, extreme mass ratios) and compared with the independent high-precision
-//! [`reference`](mod@crate::reference): relative error, model evaluations and time per solve, as a
-//! table, a CSV and log–log SVG plots of error against time with the Pareto front marked.
+//! [`reference`](mod@crate::reference); the integrators are run on the models that need them
+//! (springs, friction, curved contacts) against a reference that does not share their route.
+//! Each setting's set-up (a solver, a rule, a bound model) is timed apart from its solve, which
+//! is timed alone, as a user who solves many points pays for them: relative error, model
+//! evaluations, set-up and time per solve, as a table, a CSV and log–log SVG plots of error
+//! against time with the Pareto front marked.
 
+pub mod integrated;
 pub mod methods;
 pub mod plot;
+pub mod settings;
+pub mod table;
 
 use crate::reference::{self, Family, Inputs, Reference, RootRoute, TimeRoute};
-use crate::solve::prior::PRIOR_TOL;
+use crate::solve::ode::Method;
 use crate::system::System;
 use astro_float::BigFloat;
 use indicatif::ProgressBar;
+use settings::{Point, Setting};
 use std::time::{Duration, Instant};
 
 /// Samples in each `theta(t)` series.
 pub const SERIES_SAMPLES: usize = 101;
 
-/// Each setting is repeated until this much time has passed (at least [`MIN_REPEATS`] times).
-pub const TIMING_BUDGET: Duration = Duration::from_millis(25);
+/// Samples in each `theta(t)` series with `--quick`.
+pub const QUICK_SERIES_SAMPLES: usize = 21;
 
-/// Fewest timed repetitions of a setting.
-pub const MIN_REPEATS: u32 = 3;
+/// How long each setting's set-up and solve are timed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Budget {
+    /// Each is repeated until this much time has passed ...
+    pub time: Duration,
+    /// ... and at least this many times.
+    pub min_repeats: u32,
+}
+
+impl Budget {
+    /// The full report's: 25 ms and 3 repetitions.
+    pub const FULL: Budget = Budget {
+        time: Duration::from_millis(25),
+        min_repeats: 3,
+    };
+    /// `--quick`: 2 ms and 2 repetitions.
+    pub const QUICK: Budget = Budget {
+        time: Duration::from_millis(2),
+        min_repeats: 2,
+    };
+}
 
 /// Errors below this are drawn at it (the plots are logarithmic).
 pub const ERROR_FLOOR: f64 = 1e-17;
@@ -35,6 +62,8 @@ pub enum Measured {
     Time,
     /// The `theta(t)` series from release to separation.
     Series,
+    /// The time the first contact ends, on the integrated route.
+    ContactEnd,
 }
 
 impl Measured {
@@ -44,6 +73,7 @@ impl Measured {
             Measured::Angle => "separation_angle",
             Measured::Time => "separation_time",
             Measured::Series => "theta_series",
+            Measured::ContactEnd => "contact_end_time",
         }
     }
 }
@@ -51,7 +81,9 @@ impl Measured {
 /// One test case.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Case {
-    /// Short name.
+    /// Short name (the table's and `--case`'s).
+    pub key: &'static str,
+    /// What it is.
     pub name: &'static str,
     /// `m2/m1`.
     pub n: f64,
@@ -64,16 +96,19 @@ pub struct Case {
 pub fn cases(family: Family) -> Vec<Case> {
     let mut out = vec![
         Case {
+            key: "paper",
             name: "paper (n=3, a/ell=1/4)",
             n: 3.0,
             a_over_ell: 0.25,
         },
         Case {
+            key: "near_upright",
             name: "near upright (a/ell=1-1e-9)",
             n: 3.0,
             a_over_ell: 1.0 - 1e-9,
         },
         Case {
+            key: "nearly_flat",
             name: "nearly flat (a/ell=1e-10)",
             n: 3.0,
             a_over_ell: 1e-10,
@@ -81,11 +116,13 @@ pub fn cases(family: Family) -> Vec<Case> {
     ];
     if family != Family::WallLadder {
         out.push(Case {
+            key: "heavy_cube",
             name: "heavy cube (n=1e12)",
             n: 1e12,
             a_over_ell: 0.25,
         });
         out.push(Case {
+            key: "light_cube",
             name: "light cube (n=1e-12)",
             n: 1e-12,
             a_over_ell: 0.25,
@@ -97,12 +134,14 @@ pub fn cases(family: Family) -> Vec<Case> {
 /// One measured setting of one method on one case.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Row {
+    /// The model.
+    pub model: &'static str,
     /// What was measured.
     pub measured: Measured,
-    /// The case's name.
+    /// The case's key.
     pub case: &'static str,
-    /// The method.
-    pub method: &'static str,
+    /// The method's short label ([`settings::LABELS`] describes it).
+    pub label: &'static str,
     /// Its setting (nodes, tolerance, step).
     pub setting: String,
     /// Relative error against the reference (for a series, the largest over its samples);
@@ -110,7 +149,12 @@ pub struct Row {
     pub error: f64,
     /// Model evaluations (integrand, polynomial or right-hand side).
     pub evals: u64,
-    /// Seconds per solve.
+    /// Integrator steps (accepted, rejected and event trials), for the integrated routes.
+    pub steps: Option<u64>,
+    /// Seconds of the set-up, made once and reused by every solve; `None` for a method
+    /// without one.
+    pub setup_seconds: Option<f64>,
+    /// Seconds per solve, the set-up excluded.
     pub seconds: f64,
     /// Why it failed, or a remark.
     pub note: String,
@@ -131,150 +175,53 @@ pub struct CaseReference {
     pub time_routes: f64,
 }
 
-/// A method setting: its name, setting label and the function computing its answer.
-type AngleFn = Box<dyn Fn(&System) -> methods::Outcome<f64>>;
-type TimeFn = Box<dyn Fn(&System, f64, f64) -> methods::Outcome<f64>>;
-type SeriesFn = Box<dyn Fn(&System, f64, f64) -> methods::Outcome<methods::Samples>>;
-
-fn angle_methods() -> Vec<(&'static str, String, AngleFn)> {
-    vec![
-        (
-            "default: isolation + bracketed Halley",
-            "filtered Horner".into(),
-            Box::new(methods::angle_default),
-        ),
-        (
-            "closed form (Viete)",
-            "f64".into(),
-            Box::new(methods::angle_closed_form),
-        ),
-        (
-            "Newton from sin(theta_i)",
-            "plain Horner".into(),
-            Box::new(methods::angle_newton),
-        ),
-        (
-            "bisection",
-            "to adjacent floats".into(),
-            Box::new(methods::angle_bisection),
-        ),
-        (
-            "linearised (paper)",
-            "cubic term dropped".into(),
-            Box::new(methods::angle_linearised),
-        ),
-    ]
+/// A setting's answer, its cost in evaluations, and its times.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Measurement<T> {
+    /// The answer of the first solve.
+    pub value: T,
+    /// Model evaluations of one solve.
+    pub evals: u64,
+    /// Seconds per set-up, if the method has one.
+    pub setup_seconds: Option<f64>,
+    /// Seconds per solve, the set-up made once before the timing.
+    pub seconds: f64,
 }
 
-/// Time methods; the function gets the system, `delta_sep` and a time bound for the ODEs.
-fn time_methods() -> Vec<(&'static str, String, TimeFn)> {
-    let mut out: Vec<(&'static str, String, TimeFn)> = Vec::new();
-    for tol in [1e-4, 1e-6, 1e-8, 1e-10, 1e-12, 1e-14] {
-        out.push((
-            "default: sin/sinh subst., GL pairs by panel length",
-            format!("tol {tol:.0e}"),
-            Box::new(move |s, d, _| methods::time_default(s, d, tol)),
-        ));
-    }
-    for tol in [1e-6, 1e-10, 1e-14, PRIOR_TOL] {
-        out.push((
-            "per point: sin/sinh subst., GL nodes a priori from singularities",
-            format!("tol {tol:.0e}"),
-            Box::new(move |s, d, _| methods::time_prior(s, d, tol)),
-        ));
-    }
-    for (low, high) in [(6, 9), (8, 12)] {
-        out.push((
-            "per point: sin/sinh subst., fixed GL pair per panel",
-            format!("GL {low} vs {high}"),
-            Box::new(move |s, _, _| methods::time_lean_fixed(s, low, high, 1e-12)),
-        ));
-    }
-    for nodes in [5, 10, 20, 40, 80] {
-        out.push((
-            "GL after delta=u^2, one panel",
-            format!("{nodes} nodes"),
-            Box::new(move |s, d, _| methods::time_gl_u2(s, d, nodes)),
-        ));
-    }
-    for nodes in [5, 10, 20, 40, 80] {
-        out.push((
-            "Gauss-Jacobi, weight (1+x)^-1/2",
-            format!("{nodes} nodes"),
-            Box::new(move |s, d, _| methods::time_gauss_jacobi(s, d, nodes)),
-        ));
-    }
-    for level in 1..=7 {
-        let h = 0.5f64.powi(level);
-        out.push((
-            "tanh-sinh, raw integrand",
-            format!("h = 2^-{level}"),
-            Box::new(move |s, d, _| methods::time_tanh_sinh(s, d, h)),
-        ));
-    }
-    for tol in [1e-4, 1e-6, 1e-8, 1e-10, 1e-12] {
-        out.push((
-            "adaptive Gauss-Kronrod 7/15, raw integrand",
-            format!("tol {tol:.0e}"),
-            Box::new(move |s, d, _| methods::time_gauss_kronrod(s, d, tol)),
-        ));
-    }
-    for k in [3, 4, 6, 8, 10, 12] {
-        let rtol = 10f64.powi(-k);
-        out.push((
-            "DOPRI5 on theta'' with event",
-            format!("rtol 1e-{k}"),
-            Box::new(move |s, d, t| methods::time_reduced_ode(s, d, rtol, t)),
-        ));
-    }
-    for k in [3, 4, 6, 8, 10, 12] {
-        let rtol = 10f64.powi(-k);
-        out.push((
-            "unreduced equations, DOPRI5 + contact event",
-            format!("rtol 1e-{k}"),
-            Box::new(move |s, _, t| methods::time_unreduced(s, rtol, t)),
-        ));
-    }
-    out
+/// Measures a method with set-up `prepare` and solve `solve`: one set-up and one solve for the
+/// answer, then (if `has_setup`) the set-up alone timed, then the solve alone timed on the
+/// first set-up's state. No set-up runs once the solve's timing has begun.
+pub fn measure<S, T>(
+    mut prepare: impl FnMut() -> Result<S, String>,
+    mut solve: impl FnMut(&mut S) -> methods::Outcome<T>,
+    has_setup: bool,
+    budget: &Budget,
+) -> Result<Measurement<T>, String> {
+    let mut state = prepare()?;
+    let (value, evals) = solve(&mut state)?;
+    let setup_seconds = has_setup.then(|| time_per_call(budget, &mut prepare));
+    let seconds = time_per_call(budget, || solve(&mut state));
+    Ok(Measurement {
+        value,
+        evals,
+        setup_seconds,
+        seconds,
+    })
 }
 
-fn series_methods() -> Vec<(&'static str, String, SeriesFn)> {
-    let mut out: Vec<(&'static str, String, SeriesFn)> = Vec::new();
-    for tol in [1e-4, 1e-6, 1e-8, 1e-10, 1e-12] {
-        out.push((
-            "default: quadrature t(v) inverted by Newton",
-            format!("tol {tol:.0e}"),
-            Box::new(move |s, d, _| methods::series_quadrature(s, d, tol, SERIES_SAMPLES)),
-        ));
-    }
-    for k in [3, 4, 6, 8, 10, 12] {
-        let rtol = 10f64.powi(-k);
-        out.push((
-            "DOPRI5 on theta'', dense output",
-            format!("rtol 1e-{k}"),
-            Box::new(move |s, d, t| methods::series_ode(s, d, rtol, t, SERIES_SAMPLES)),
-        ));
-    }
-    out
-}
-
-/// How many settings [`run`] measures per case (for a progress bar).
-pub fn settings_per_case() -> usize {
-    angle_methods().len() + time_methods().len() + series_methods().len()
-}
-
-/// Seconds per call of `f`, repeated until [`TIMING_BUDGET`] has passed.
-fn time_per_call<T>(mut f: impl FnMut() -> T) -> f64 {
+/// Seconds per call of `f`, repeated until the budget has passed: in batches that double, so
+/// that reading the clock costs nothing next to a call of a fraction of a microsecond.
+fn time_per_call<T>(budget: &Budget, mut f: impl FnMut() -> T) -> f64 {
     let start = Instant::now();
-    let mut n = 0u32;
-    while n < MIN_REPEATS || start.elapsed() < TIMING_BUDGET {
-        std::hint::black_box(f());
-        n += 1;
-        if n >= 100_000 {
-            break;
+    let (mut n, mut batch) = (0u64, 1u64);
+    while n < u64::from(budget.min_repeats) || start.elapsed() < budget.time {
+        for _ in 0..batch {
+            std::hint::black_box(f());
         }
+        n += batch;
+        batch = (2 * batch).min(1 << 16);
     }
-    start.elapsed().as_secs_f64() / f64::from(n)
+    start.elapsed().as_secs_f64() / n.max(1) as f64
 }
 
 /// The reference of one case.
@@ -309,118 +256,416 @@ fn parameters(family: Family, case: Case) -> Vec<f64> {
     }
 }
 
-/// Runs every method on every case of `model` (one of `rod_cube`, `hinged_rod`,
-/// `wall_ladder`), advancing `progress` once per setting.
-pub fn run(model: &str, progress: &ProgressBar) -> Result<(Vec<Row>, Vec<CaseReference>), String> {
-    let family = Family::of(model).ok_or_else(|| {
-        format!(
-            "`rodcube accuracy` needs a model with a closed-form reference (rod_cube, hinged_rod, wall_ladder), not `{model}`"
-        )
-    })?;
-    let m = crate::models::find(model).ok_or_else(|| format!("no model `{model}`"))?;
-    let mut rows = Vec::new();
-    let mut refs = Vec::new();
-    for case in cases(family) {
-        let (mut reference, cref) = case_reference(family, case)?;
-        let sys = System::from_values(m, &parameters(family, case)).map_err(|e| e.to_string())?;
-        let delta = methods::delta_sep(&sys)?;
-        let t_ref = reference::to_f64(&cref.time);
-        let t_max = 100.0 * t_ref;
-        let row =
-            |measured, method, setting: String, error: f64, evals, seconds, note: String| Row {
-                measured,
-                case: case.name,
-                method,
-                setting,
-                error,
-                evals,
-                seconds,
-                note,
-            };
-        for (method, setting, f) in angle_methods() {
-            progress.set_message(format!("{}: {method}", case.name));
-            match f(&sys) {
-                Ok((theta, evals)) => {
-                    let seconds = time_per_call(|| f(&sys));
-                    let e = reference::relative_error(theta, &cref.angle);
-                    rows.push(row(
-                        Measured::Angle,
-                        method,
-                        setting,
-                        e,
-                        evals,
-                        seconds,
-                        String::new(),
-                    ));
-                }
-                Err(note) => rows.push(row(
-                    Measured::Angle,
-                    method,
-                    setting,
-                    f64::NAN,
-                    0,
-                    0.0,
-                    note,
-                )),
-            }
-            progress.inc(1);
-        }
-        for (method, setting, f) in time_methods() {
-            progress.set_message(format!("{}: {method} {setting}", case.name));
-            match f(&sys, delta, t_max) {
-                Ok((t, evals)) => {
-                    let seconds = time_per_call(|| f(&sys, delta, t_max));
-                    let e = reference::relative_error(t, &cref.time);
-                    rows.push(row(
-                        Measured::Time,
-                        method,
-                        setting,
-                        e,
-                        evals,
-                        seconds,
-                        String::new(),
-                    ));
-                }
-                Err(note) => {
-                    rows.push(row(Measured::Time, method, setting, f64::NAN, 0, 0.0, note))
-                }
-            }
-            progress.inc(1);
-        }
-        for (method, setting, f) in series_methods() {
-            progress.set_message(format!("{}: {method} {setting}", case.name));
-            match f(&sys, delta, t_max) {
-                Ok(((t, d), evals)) => {
-                    let seconds = time_per_call(|| f(&sys, delta, t_max));
-                    let (e, note) = match series_error(&mut reference, &sys, &t, &d) {
-                        Ok(e) => (e, String::new()),
-                        Err(note) => (f64::NAN, note),
-                    };
-                    rows.push(row(
-                        Measured::Series,
-                        method,
-                        setting,
-                        e,
-                        evals,
-                        seconds,
-                        note,
-                    ));
-                }
-                Err(note) => rows.push(row(
-                    Measured::Series,
-                    method,
-                    setting,
-                    f64::NAN,
-                    0,
-                    0.0,
-                    note,
-                )),
-            }
-            progress.inc(1);
-        }
-        refs.push(cref);
+/// What `rodcube accuracy` measures.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Options {
+    /// Models by name: closed-form ones ([`CLOSED_MODELS`]) and integrated ones
+    /// ([`integrated::MODELS`]); empty means `rod_cube` and every integrated model.
+    pub models: Vec<String>,
+    /// Case keys (`paper`, `near_upright`, ..., `scene`); empty means every case.
+    pub cases: Vec<String>,
+    /// Method labels ([`settings::LABELS`]); empty means every method.
+    pub methods: Vec<String>,
+    /// Fewer settings per method and a smaller timing budget ([`Budget::QUICK`]).
+    pub quick: bool,
+}
+
+/// The models with a closed-form reference.
+pub const CLOSED_MODELS: [&str; 3] = ["rod_cube", "hinged_rod", "wall_ladder"];
+
+/// Why the report cannot be made.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum AccuracyError {
+    /// A model the report has no reference for.
+    #[error("no model `{name}` in the report; its models are: {known}")]
+    UnknownModel {
+        /// The name given.
+        name: String,
+        /// The models it has.
+        known: String,
+    },
+    /// A case none of the chosen models has.
+    #[error("no case `{name}` for the chosen models; their cases are: {known}")]
+    UnknownCase {
+        /// The key given.
+        name: String,
+        /// The keys the chosen models have.
+        known: String,
+    },
+    /// A method label the report does not have.
+    #[error("no method `{name}` in the report; its methods are: {known}")]
+    UnknownMethod {
+        /// The label given.
+        name: String,
+        /// The labels.
+        known: String,
+    },
+    /// The choices leave nothing to measure.
+    #[error("nothing to measure: {why}")]
+    Nothing {
+        /// Which choices exclude each other.
+        why: String,
+    },
+    /// A reference could not be computed.
+    #[error("{model}, case {case}: no reference: {message}")]
+    Reference {
+        /// The model.
+        model: String,
+        /// The case.
+        case: String,
+        /// Why.
+        message: String,
+    },
+}
+
+impl AccuracyError {
+    /// Whether the error is in the options (a usage error).
+    pub fn is_usage(&self) -> bool {
+        !matches!(self, AccuracyError::Reference { .. })
     }
-    Ok((rows, refs))
+}
+
+/// A report's rows and the references they were measured against.
+#[derive(Debug, Clone, Default)]
+pub struct Report {
+    /// Every measured setting.
+    pub rows: Vec<Row>,
+    /// The closed-form models' references, by model.
+    pub references: Vec<(&'static str, CaseReference)>,
+    /// The integrated models' references.
+    pub integrated: Vec<integrated::IntegratedReference>,
+}
+
+/// Receives a sentence per model and case.
+pub type LineSink = Box<dyn Fn(&str)>;
+
+/// How [`run`] says what it is doing: a bar advanced once per setting, and a line per model
+/// and case (for output that is not a terminal).
+pub struct Progress {
+    bar: ProgressBar,
+    line: Option<LineSink>,
+}
+
+impl Progress {
+    /// Advances `bar`; `line`, if given, receives a sentence per model and case.
+    pub fn new(bar: ProgressBar, line: Option<LineSink>) -> Progress {
+        Progress { bar, line }
+    }
+
+    /// Says nothing.
+    pub fn hidden() -> Progress {
+        Progress::new(ProgressBar::hidden(), None)
+    }
+
+    /// The bar.
+    pub fn bar(&self) -> &ProgressBar {
+        &self.bar
+    }
+
+    fn case(&self, model: &str, case: &str, settings: usize) {
+        if let Some(line) = &self.line {
+            line(&format!(
+                "accuracy: {model}, case {case}: {settings} settings"
+            ));
+        }
+    }
+
+    fn step(&self, message: String) {
+        self.bar.set_message(message);
+        self.bar.inc(1);
+    }
+}
+
+/// The options checked against what the report has.
+#[derive(Debug, Clone)]
+pub struct Chosen {
+    /// Closed-form models with their cases.
+    pub closed: Vec<(&'static str, Family, Vec<Case>)>,
+    /// Integrated models.
+    pub integrated: Vec<&'static integrated::IntegratedModel>,
+    methods: Vec<String>,
+    quick: bool,
+}
+
+impl Chosen {
+    fn wants(&self, label: &str) -> bool {
+        self.methods.is_empty() || self.methods.iter().any(|m| m == label)
+    }
+
+    fn angle(&self) -> Vec<Setting<f64>> {
+        let mut s = settings::angle();
+        s.retain(|x| self.wants(x.label));
+        s
+    }
+
+    fn time(&self) -> Vec<Setting<f64>> {
+        let mut s = settings::time(self.quick);
+        s.retain(|x| self.wants(x.label));
+        s
+    }
+
+    fn series(&self) -> Vec<Setting<methods::Samples>> {
+        let mut s = settings::series(self.quick);
+        s.retain(|x| self.wants(x.label));
+        s
+    }
+
+    fn integrators(&self) -> Vec<Method> {
+        [Method::Dopri5, Method::Dop853]
+            .into_iter()
+            .filter(|m| self.wants(integrated::label(*m)))
+            .collect()
+    }
+
+    /// How many settings [`run`] measures (for a progress bar).
+    pub fn settings(&self) -> usize {
+        let per_case = self.angle().len() + self.time().len() + self.series().len();
+        let closed: usize = self.closed.iter().map(|(_, _, c)| c.len() * per_case).sum();
+        let integrated = self.integrated.len()
+            * self.integrators().len()
+            * integrated::tolerances(self.quick).len();
+        closed + integrated
+    }
+
+    /// The timing budget.
+    pub fn budget(&self) -> Budget {
+        if self.quick {
+            Budget::QUICK
+        } else {
+            Budget::FULL
+        }
+    }
+}
+
+fn known(names: impl IntoIterator<Item = impl AsRef<str>>) -> String {
+    names
+        .into_iter()
+        .map(|n| n.as_ref().to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+impl Options {
+    /// Checks every model, case and method named, and what they leave to measure.
+    pub fn choose(&self) -> Result<Chosen, AccuracyError> {
+        let models: Vec<&str> = if self.models.is_empty() {
+            let mut m = vec!["rod_cube"];
+            m.extend(integrated::MODELS.iter().map(|i| i.model));
+            m
+        } else {
+            self.models.iter().map(String::as_str).collect()
+        };
+        let mut closed = Vec::new();
+        let mut integrated_models = Vec::new();
+        for name in models {
+            if let (Some(family), Some(&model)) =
+                (Family::of(name), CLOSED_MODELS.iter().find(|m| **m == name))
+            {
+                closed.push((model, family, cases(family)));
+            } else if let Some(m) = integrated::find(name) {
+                integrated_models.push(m);
+            } else {
+                return Err(AccuracyError::UnknownModel {
+                    name: name.to_string(),
+                    known: known(
+                        CLOSED_MODELS
+                            .iter()
+                            .copied()
+                            .chain(integrated::MODELS.iter().map(|m| m.model)),
+                    ),
+                });
+            }
+        }
+        let mut keys: Vec<&str> = Vec::new();
+        for key in (closed.iter().flat_map(|(_, _, c)| c.iter().map(|c| c.key)))
+            .chain(integrated_models.iter().map(|m| m.case))
+        {
+            if !keys.contains(&key) {
+                keys.push(key);
+            }
+        }
+        if let Some(bad) = self.cases.iter().find(|c| !keys.contains(&c.as_str())) {
+            return Err(AccuracyError::UnknownCase {
+                name: bad.clone(),
+                known: known(&keys),
+            });
+        }
+        let labels = settings::LABELS.iter().map(|(l, _)| *l);
+        if let Some(bad) = (self.methods.iter()).find(|m| !labels.clone().any(|l| l == m.as_str()))
+        {
+            return Err(AccuracyError::UnknownMethod {
+                name: bad.clone(),
+                known: known(labels),
+            });
+        }
+        let wants_case = |key: &str| self.cases.is_empty() || self.cases.iter().any(|c| c == key);
+        for (_, _, c) in &mut closed {
+            c.retain(|c| wants_case(c.key));
+        }
+        closed.retain(|(_, _, c)| !c.is_empty());
+        integrated_models.retain(|m| wants_case(m.case));
+        let chosen = Chosen {
+            closed,
+            integrated: integrated_models,
+            methods: self.methods.clone(),
+            quick: self.quick,
+        };
+        if chosen.settings() == 0 {
+            return Err(AccuracyError::Nothing {
+                why: "no chosen method applies to a chosen model and case (the closed-form models \
+                      rod_cube, hinged_rod and wall_ladder have the root, quadrature and series \
+                      methods; the integrated models have dopri5 and dop853)"
+                    .into(),
+            });
+        }
+        Ok(chosen)
+    }
+}
+
+/// Runs what `chosen` names, advancing `progress` once per setting.
+pub fn run(chosen: &Chosen, progress: &Progress) -> Result<Report, AccuracyError> {
+    let mut report = Report::default();
+    let budget = chosen.budget();
+    for (model, family, cases) in &chosen.closed {
+        for case in cases {
+            let (rows, cref) = run_case(chosen, model, *family, *case, &budget, progress)?;
+            report.rows.extend(rows);
+            report.references.push((model, cref));
+        }
+    }
+    let integrators = chosen.integrators();
+    let tolerances = integrated::tolerances(chosen.quick);
+    for m in &chosen.integrated {
+        progress.case(m.model, m.case, integrators.len() * tolerances.len());
+        let reference = integrated::reference(m).map_err(|message| AccuracyError::Reference {
+            model: m.model.into(),
+            case: m.case.into(),
+            message,
+        })?;
+        for &method in &integrators {
+            for &k in &tolerances {
+                report
+                    .rows
+                    .push(integrated::measure_one(m, &reference, method, k, &budget));
+                progress.step(format!("{}: {} rtol 1e-{k}", m.model, method.name()));
+            }
+        }
+        report.integrated.push(reference);
+    }
+    Ok(report)
+}
+
+/// Every chosen method on one case of a closed-form model.
+fn run_case(
+    chosen: &Chosen,
+    model: &'static str,
+    family: Family,
+    case: Case,
+    budget: &Budget,
+    progress: &Progress,
+) -> Result<(Vec<Row>, CaseReference), AccuracyError> {
+    let failed = |message: String| AccuracyError::Reference {
+        model: model.into(),
+        case: case.key.into(),
+        message,
+    };
+    let (angle, time, series) = (chosen.angle(), chosen.time(), chosen.series());
+    progress.case(model, case.key, angle.len() + time.len() + series.len());
+    let (mut reference, cref) = case_reference(family, case).map_err(failed)?;
+    let m = crate::models::find(model).ok_or_else(|| failed(format!("no model `{model}`")))?;
+    // The phase the reference describes: the contact closed from release.
+    let m = crate::solve::lean::release_phase(m).map_err(|e| failed(e.to_string()))?;
+    let sys =
+        System::from_values(m, &parameters(family, case)).map_err(|e| failed(e.to_string()))?;
+    let delta = methods::delta_sep(&sys).map_err(failed)?;
+    let point = Point {
+        sys: &sys,
+        delta,
+        t_max: 100.0 * reference::to_f64(&cref.time),
+    };
+    let mut rows = Vec::new();
+    let row = |measured, s: &dyn Labelled, outcome: Result<(f64, Measurement<()>), String>| {
+        let mut r = Row {
+            model,
+            measured,
+            case: case.key,
+            label: s.label(),
+            setting: s.setting(),
+            error: f64::NAN,
+            evals: 0,
+            steps: None,
+            setup_seconds: None,
+            seconds: 0.0,
+            note: String::new(),
+        };
+        match outcome {
+            Ok((error, m)) => {
+                r.error = error;
+                r.evals = m.evals;
+                r.setup_seconds = m.setup_seconds;
+                r.seconds = m.seconds;
+            }
+            Err(note) => r.note = note,
+        }
+        r
+    };
+    for s in &angle {
+        let outcome = s.measure(&point, budget).map(|m| {
+            (
+                reference::relative_error(m.value, &cref.angle),
+                m.without_value(),
+            )
+        });
+        rows.push(row(Measured::Angle, s, outcome));
+        progress.step(format!("{model} {}: {} {}", case.key, s.label, s.setting));
+    }
+    for s in &time {
+        let outcome = s.measure(&point, budget).map(|m| {
+            (
+                reference::relative_error(m.value, &cref.time),
+                m.without_value(),
+            )
+        });
+        rows.push(row(Measured::Time, s, outcome));
+        progress.step(format!("{model} {}: {} {}", case.key, s.label, s.setting));
+    }
+    for s in &series {
+        let outcome = s.measure(&point, budget).and_then(|m| {
+            let (t, d) = &m.value;
+            let e = series_error(&mut reference, &sys, t, d)?;
+            Ok((e, m.without_value()))
+        });
+        rows.push(row(Measured::Series, s, outcome));
+        progress.step(format!("{model} {}: {} {}", case.key, s.label, s.setting));
+    }
+    Ok((rows, cref))
+}
+
+/// A setting's label and setting, whatever it computes.
+trait Labelled {
+    fn label(&self) -> &'static str;
+    fn setting(&self) -> String;
+}
+
+impl<T> Labelled for Setting<T> {
+    fn label(&self) -> &'static str {
+        self.label
+    }
+    fn setting(&self) -> String {
+        self.setting.clone()
+    }
+}
+
+impl<T> Measurement<T> {
+    /// The evaluations and times without the answer.
+    fn without_value(&self) -> Measurement<()> {
+        Measurement {
+            value: (),
+            evals: self.evals,
+            setup_seconds: self.setup_seconds,
+            seconds: self.seconds,
+        }
+    }
 }
 
 /// The largest relative error of `theta` over a series `(t_j, delta_j)`: the reference time
@@ -449,105 +694,43 @@ fn series_error(
     Ok(worst)
 }
 
-/// The rows as CSV (`quantity,case,method,setting,relative_error,evaluations,seconds_per_solve,note`).
-pub fn to_csv(rows: &[Row]) -> String {
+/// The rows as CSV (`model,quantity,case,method,setting,relative_error,evaluations,steps,
+/// setup_seconds,seconds_per_solve,note`; an empty cell is a value the row has not).
+pub fn to_csv(rows: &[Row]) -> Result<String, String> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    let _ = w.write_record([
+    let fail = |e: csv::Error| e.to_string();
+    w.write_record([
+        "model",
         "quantity",
         "case",
         "method",
         "setting",
         "relative_error",
         "evaluations",
+        "steps",
+        "setup_seconds",
         "seconds_per_solve",
         "note",
-    ]);
+    ])
+    .map_err(fail)?;
+    let or_empty = |v: Option<String>| v.unwrap_or_default();
     for r in rows {
-        let _ = w.write_record([
+        let failed = r.error.is_nan();
+        w.write_record([
+            r.model.to_string(),
             r.measured.name().to_string(),
             r.case.to_string(),
-            r.method.to_string(),
+            r.label.to_string(),
             r.setting.clone(),
-            if r.error.is_nan() {
-                String::new()
-            } else {
-                format!("{:e}", r.error)
-            },
-            r.evals.to_string(),
-            format!("{:e}", r.seconds),
+            or_empty((!failed).then(|| format!("{:e}", r.error))),
+            or_empty((!failed).then(|| r.evals.to_string())),
+            or_empty(r.steps.map(|s| s.to_string())),
+            or_empty(r.setup_seconds.map(|s| format!("{s:e}"))),
+            or_empty((!failed).then(|| format!("{:e}", r.seconds))),
             r.note.clone(),
-        ]);
+        ])
+        .map_err(fail)?;
     }
-    String::from_utf8(w.into_inner().unwrap_or_default()).unwrap_or_default()
-}
-
-/// The human table: one block per quantity and case.
-pub fn table(rows: &[Row], refs: &[CaseReference]) -> String {
-    use comfy_table::{Table, presets::UTF8_FULL_CONDENSED};
-    let mut out = String::new();
-    for r in refs {
-        out.push_str(&format!(
-            "reference {}: theta_sep = {:.17e} rad (root routes agree to {:.1e}), t_sep = {:.17e} sqrt(ell/g) (quadrature routes agree to {:.1e})\n",
-            r.case.name,
-            reference::to_f64(&r.angle),
-            r.angle_routes,
-            reference::to_f64(&r.time),
-            r.time_routes
-        ));
-    }
-    for measured in [Measured::Angle, Measured::Time, Measured::Series] {
-        let mut table = Table::new();
-        table.load_style(UTF8_FULL_CONDENSED);
-        table.set_header([
-            "case",
-            "method",
-            "setting",
-            "rel. error",
-            "evals",
-            "time/solve",
-        ]);
-        for r in rows.iter().filter(|r| r.measured == measured) {
-            let error = if r.error.is_nan() {
-                format!("failed: {}", shorten(&r.note, 60))
-            } else {
-                format!("{:.1e}", r.error.abs())
-            };
-            table.add_row([
-                r.case.to_string(),
-                r.method.to_string(),
-                r.setting.clone(),
-                error,
-                r.evals.to_string(),
-                if r.seconds > 0.0 {
-                    format_seconds(r.seconds)
-                } else {
-                    "-".into()
-                },
-            ]);
-        }
-        out.push_str(&format!("\n{}\n{table}\n", measured.name()));
-    }
-    out
-}
-
-fn shorten(s: &str, n: usize) -> String {
-    if s.chars().count() <= n {
-        s.to_string()
-    } else {
-        let cut: String = s.chars().take(n).collect();
-        format!("{cut}...")
-    }
-}
-
-/// `1.2 us`, `3.4 ms`, `0.56 s`.
-pub fn format_seconds(s: f64) -> String {
-    if s < 1e-6 {
-        format!("{:.0} ns", s * 1e9)
-    } else if s < 1e-3 {
-        format!("{:.2} us", s * 1e6)
-    } else if s < 1.0 {
-        format!("{:.2} ms", s * 1e3)
-    } else {
-        format!("{s:.2} s")
-    }
+    let bytes = w.into_inner().map_err(|e| e.to_string())?;
+    String::from_utf8(bytes).map_err(|e| e.to_string())
 }

@@ -51,15 +51,17 @@ fn draw(
     model: &str,
     rows: &[Row],
 ) -> Result<Option<String>, Box<dyn std::error::Error>> {
-    let rows: Vec<&Row> = rows.iter().filter(|r| r.measured == measured).collect();
+    let rows: Vec<&Row> = (rows.iter())
+        .filter(|r| r.measured == measured && r.model == model)
+        .collect();
     let mut cases: Vec<&str> = Vec::new();
     let mut methods: Vec<&str> = Vec::new();
     for r in &rows {
         if !cases.contains(&r.case) {
             cases.push(r.case);
         }
-        if !methods.contains(&r.method) {
-            methods.push(r.method);
+        if !methods.contains(&r.label) {
+            methods.push(r.label);
         }
     }
     let ok = |r: &&&Row| r.error.is_finite() && r.seconds > 0.0;
@@ -120,7 +122,7 @@ fn draw(
                 let color = COLORS[k % COLORS.len()];
                 let mut pts: Vec<(f64, f64)> = here
                     .iter()
-                    .filter(|r| r.method == *method)
+                    .filter(|r| r.label == *method)
                     .map(|r| point(r))
                     .collect();
                 pts.sort_by(|a, b| a.0.total_cmp(&b.0));

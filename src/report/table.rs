@@ -89,7 +89,7 @@ fn with_unit(v: f64, sig: usize, unit: &str) -> String {
     }
 }
 
-fn new_table(header: &[&str], layout: &Layout) -> Table {
+pub(crate) fn new_table(header: &[&str], layout: &Layout) -> Table {
     let mut t = Table::new();
     t.load_style(presets::UTF8_FULL_CONDENSED)
         .set_header(header.to_vec());
@@ -107,7 +107,7 @@ fn new_table(header: &[&str], layout: &Layout) -> Table {
 }
 
 /// Keeps these columns at their content's width (identifiers and numbers must not wrap).
-fn no_wrap(t: &mut Table, columns: &[usize]) {
+pub(crate) fn no_wrap(t: &mut Table, columns: &[usize]) {
     for &c in columns {
         if let Some(col) = t.column_mut(c) {
             col.set_constraint(ColumnConstraint::ContentWidth);
@@ -127,7 +127,7 @@ fn result_order(key: &str) -> (usize, &str) {
     )
 }
 
-fn align_right(t: &mut Table, columns: &[usize]) {
+pub(crate) fn align_right(t: &mut Table, columns: &[usize]) {
     for &c in columns {
         if let Some(col) = t.column_mut(c) {
             col.set_cell_alignment(CellAlignment::Right);
@@ -137,7 +137,7 @@ fn align_right(t: &mut Table, columns: &[usize]) {
 
 /// `text` broken at spaces into lines of at most `width` characters (a longer word stays
 /// whole), each line after the first indented by `indent` spaces.
-fn wrap(text: &str, width: Option<usize>, indent: usize) -> String {
+pub(crate) fn wrap(text: &str, width: Option<usize>, indent: usize) -> String {
     let Some(width) = width else {
         return text.to_string();
     };
@@ -412,6 +412,10 @@ fn work(out: &mut String, results: &RunResults, layout: &Layout) {
         w.integrand_evals.to_string(),
     ]);
     t.add_row(vec!["ODE steps".to_string(), w.ode_steps.to_string()]);
+    t.add_row(vec![
+        "ODE right-hand sides".to_string(),
+        w.ode_evaluations.to_string(),
+    ]);
     t.add_row(vec![
         "phases".to_string(),
         if w.phases.is_empty() {

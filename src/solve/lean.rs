@@ -44,7 +44,7 @@ use crate::system::{
 
 /// The fast phase a system starts in (its release phase), looked up in the registry; a model
 /// that is not a system's general model is taken as it is.
-fn release_phase(model: &dyn Model) -> Result<&dyn Model, SolveError> {
+pub(crate) fn release_phase(model: &dyn Model) -> Result<&dyn Model, SolveError> {
     let info = model.info();
     if !info.is_general() || model.reduction().is_some() && info.contacts.iter().all(|c| c.closed) {
         return Ok(model);
@@ -140,6 +140,22 @@ impl<'m> LeanSolver<'m> {
         if solver.layout.fall_degree.is_some_and(|d| d <= 2) {
             solver.prior = Some(Prior::new(PRIOR_TOL));
         }
+        Ok(solver)
+    }
+
+    /// [`LeanSolver::new`] with the a-priori rule made for a relative error `tol` instead of
+    /// `2^-53` (raised to `2^-53`; not finite means `2^-53`). A model whose fall polynomial
+    /// does not allow the a-priori rule is [`SolveError::NotPerPoint`]: it has no such rule to
+    /// loosen.
+    pub fn with_tolerance(model: &'m dyn Model, tol: f64) -> Result<Self, SolveError> {
+        let mut solver = Self::with_schedule(model, &SCHEDULE, ACCEPT)?;
+        if solver.layout.fall_degree.is_none_or(|d| d > 2) {
+            return Err(SolveError::NotPerPoint {
+                model: solver.info.name,
+                why: "its fall polynomial has no a-priori rule (degree above 2)",
+            });
+        }
+        solver.prior = Some(Prior::new(tol));
         Ok(solver)
     }
 

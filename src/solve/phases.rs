@@ -17,6 +17,7 @@ use crate::solve::SolveError;
 use crate::solve::contacts::{
     self, Active, ContactOption, FrictionOption, Moment, Options, contact_options, friction_options,
 };
+use crate::solve::ode::Method;
 use crate::solve::quadrature::TimeMesh;
 use crate::solve::roots::{self, changes_sign};
 use crate::solve::separation::{Separation, SeparationOutcome, edge, force_zero};
@@ -700,6 +701,17 @@ impl<'m> Walker<'m> {
         start: &PhaseStart,
         work: &mut Work,
     ) -> Result<PhaseRun<'m>, SolveError> {
+        self.integrate_with(start, None, work)
+    }
+
+    /// [`Walker::integrate`] by `method` when one is given, else by the method the integrator
+    /// picks for the walker's tolerance ([`unreduced::integrate_with`]).
+    pub fn integrate_with(
+        &self,
+        start: &PhaseStart,
+        method: Option<Method>,
+        work: &mut Work,
+    ) -> Result<PhaseRun<'m>, SolveError> {
         let bound = self.general.clone();
         let time = fall_time_scale(&bound, &start.state)?;
         let scales = self.scales(&start.state, &start.active)?;
@@ -709,10 +721,11 @@ impl<'m> Walker<'m> {
             frictions: start.frictions.clone(),
             friction_work: start.friction_work,
         };
-        let run = unreduced::integrate(
+        let run = unreduced::integrate_with(
             &bound,
             &from,
             self.rtol,
+            method,
             Some(&scales),
             time * MAX_FALL_TIMES,
             work,

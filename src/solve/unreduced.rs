@@ -258,6 +258,8 @@ struct Problem<'a, 'm> {
     /// the events at the state it has just evaluated.
     last: Option<(Vec<f64>, Dynamics)>,
     with_work: bool,
+    /// Right-hand sides evaluated.
+    evaluations: u64,
 }
 
 impl Problem<'_, '_> {
@@ -345,7 +347,16 @@ impl Problem<'_, '_> {
                 Watch::Gap(i) => gaps[i],
                 Watch::Edge(i) => edges[i],
                 Watch::Floor => self.state.q[self.reduced] - self.end_angle,
-                Watch::Slip(j) => d.slip[j] - self.slip_offset[j],
+                Watch::Slip(j) => {
+                    let v = d.slip[j] - self.slip_offset[j];
+                    // A slide that starts from zero slip (from rest, or just switched) has its
+                    // mode's sign from its first instant: a step that carries the slip out and
+                    // back across zero is then a crossing, not a start at zero and an end past it.
+                    match self.active.modes[j] {
+                        Mode::Slide(sign) if v == 0.0 => sign * f64::MIN_POSITIVE,
+                        _ => v,
+                    }
+                }
                 Watch::Stuck(j) => mu[j] * d.forces[info.frictions[j].contact] - d.fr[j].abs(),
                 Watch::Painleve => d.painleve - contacts::PAINLEVE_FLOOR,
             };
@@ -411,6 +422,7 @@ impl OdeProblem for Problem<'_, '_> {
     }
 
     fn rhs(&mut self, t: f64, z: &[f64], dz: &mut [f64]) -> Result<(), SolveError> {
+        self.evaluations += 1;
         self.load(z);
         let d = contacts::dynamics(self.sys, &self.state, &self.active, t)?;
         dz[..self.n].copy_from_slice(&self.state.qd);
@@ -435,10 +447,16 @@ impl OdeProblem for Problem<'_, '_> {
         self.values(&d, g)?;
         for (k, v) in g.iter_mut().enumerate() {
             if !self.armed[k] {
-                if *v > self.arm_at_for(self.watches[k]) {
+                let watch = self.watches[k];
+                let arm_at = self.arm_at_for(watch);
+                // A gap or edge margin clear of zero on the wrong side (one that opened and
+                // closed again within one step: the bodies now overlap) goes through, and the
+                // integrator locates where it crossed.
+                let through = matches!(watch, Watch::Gap(_) | Watch::Edge(_)) && *v < -arm_at;
+                if *v > arm_at {
                     self.armed[k] = true;
-                } else {
-                    // Unarmed: no crossing until it has grown clear of zero.
+                } else if !through {
+                    // Unarmed: no crossing while it has not grown clear of zero.
                     *v = 1.0;
                 }
             }
@@ -530,13 +548,28 @@ pub struct Start {
 }
 
 /// Integrates `sys` from `start` until an event ends the phase, with relative tolerance
-/// `rtol` (raised to [`CONDITION_SAFETY`]` * eps * cond(M)`). `scales` (length `2 n`), when
-/// given, are typical magnitudes of the motion `y - y0` for the absolute tolerances; without
-/// them the control is relative to the largest deviation seen. `t_max` bounds the search.
+/// `rtol` (raised to [`CONDITION_SAFETY`]` * eps * cond(M)`) by the method
+/// [`Method::for_rtol`] picks for it. `scales` (length `2 n`), when given, are typical
+/// magnitudes of the motion `y - y0` for the absolute tolerances; without them the control is
+/// relative to the largest deviation seen. `t_max` bounds the search.
 pub fn integrate(
     sys: &Bound,
     start: &Start,
     rtol: f64,
+    scales: Option<&[f64]>,
+    t_max: f64,
+    work: &mut Work,
+) -> Result<UnreducedRun, SolveError> {
+    integrate_with(sys, start, rtol, None, scales, t_max, work)
+}
+
+/// [`integrate`] by `method` when one is given (`rodcube accuracy` compares the two at every
+/// tolerance), else by the method [`Method::for_rtol`] picks for the raised tolerance.
+pub fn integrate_with(
+    sys: &Bound,
+    start: &Start,
+    rtol: f64,
+    method: Option<Method>,
     scales: Option<&[f64]>,
     t_max: f64,
     work: &mut Work,
@@ -563,7 +596,7 @@ pub fn integrate(
             rtol,
         });
     }
-    let method = Method::for_rtol(rtol);
+    let method = method.unwrap_or_else(|| Method::for_rtol(rtol));
     let mut y0 = start.state.q.clone();
     y0.extend_from_slice(&start.state.qd);
     if with_work {
@@ -584,6 +617,7 @@ pub fn integrate(
         state: start.state.clone(),
         last: None,
         with_work,
+        evaluations: 0,
     };
     let d = contacts::dynamics(sys, &start.state, &problem.active, 0.0)?;
     problem.watch(&d)?;
@@ -608,7 +642,9 @@ pub fn integrate(
     let mut segments = Vec::new();
     let mut t0 = 0.0;
     loop {
-        let solution = ode_integrate(method, &mut problem, t0, &vec![0.0; y0.len()], &opts)?;
+        let solution = ode_integrate(method, &mut problem, t0, &vec![0.0; y0.len()], &opts);
+        work.ode_evaluations += std::mem::take(&mut problem.evaluations);
+        let solution = solution?;
         work.ode_steps += solution.total_steps();
         let Some(event) = solution.event.clone() else {
             return Err(SolveError::NoEvent { t_max });

@@ -198,7 +198,8 @@ pub static NEVER_SEPARATES: Tweaked = Tweaked {
 };
 
 /// `rod_cube_closed` whose monitor is lowered by 4 N m: the tipping margin (3.51 N m at its
-/// least) then dips below zero.
+/// least, at release: `m2 g a/2 = 3.679 N m` times `1 - 0.0459`, the cube's tipping ratio
+/// `3 c r/(4(1+n) - 3 r^2)` there, docs/hand_derivations.md section C) then dips below zero.
 pub static LOW_MONITORS: Tweaked = Tweaked {
     base: &super::paper::ROD_CUBE,
     reduction: &super::paper::ROD_CUBE,
