@@ -353,6 +353,11 @@
 #define RODCUBE_ERR_NO_SUCH_PHASE 336
 
 /**
+ * A coefficient of restitution outside [0, 1].
+ */
+#define RODCUBE_ERR_RESTITUTION 337
+
+/**
  * Group: the scene was refused (codes 401 to 499). A scene's message lists every problem
  * found; the code is the kind of the first, in file order. Returned alone only for a scene
  * error without a problem, which scene parsing never makes.

@@ -12,6 +12,7 @@
 
 pub mod checks;
 pub mod contacts;
+pub mod impact;
 pub mod lean;
 pub mod ode;
 pub mod phases;
@@ -275,6 +276,18 @@ pub enum SolveError {
         gap: f64,
         /// The gap's unit.
         unit: &'static str,
+    },
+    /// A coefficient of restitution outside `[0, 1]` (or not a number).
+    #[error(
+        "model `{model}`: contact `{contact}` has restitution {value}, outside [0, 1] (0: the bodies stay together, 1: no energy is lost)"
+    )]
+    Restitution {
+        /// Model name.
+        model: &'static str,
+        /// The contact.
+        contact: &'static str,
+        /// The coefficient given.
+        value: f64,
     },
     /// A contact that closes with a velocity at release (an impact, not modelled yet).
     #[error(
