@@ -133,6 +133,11 @@
 #define RODCUBE_ERR_PARAM_NOT_FINITE_INPUT 113
 
 /**
+ * A contact's coefficient of restitution (from the parameters) outside [0, 1].
+ */
+#define RODCUBE_ERR_PARAM_RESTITUTION 114
+
+/**
  * Group: the request was refused (codes 201 to 299).
  */
 #define RODCUBE_ERR_REQUEST 200
@@ -351,11 +356,6 @@
  * A phase index past the phases of the run (a planner inconsistency).
  */
 #define RODCUBE_ERR_NO_SUCH_PHASE 336
-
-/**
- * A coefficient of restitution outside [0, 1].
- */
-#define RODCUBE_ERR_RESTITUTION 337
 
 /**
  * Group: the scene was refused (codes 401 to 499). A scene's message lists every problem

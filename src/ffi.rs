@@ -78,6 +78,8 @@ pub const RODCUBE_ERR_PARAM_STATE_SHAPE: c_int = 111;
 pub const RODCUBE_ERR_PARAM_LENGTH: c_int = 112;
 /// A state or vector holds a NaN or an infinity.
 pub const RODCUBE_ERR_PARAM_NOT_FINITE_INPUT: c_int = 113;
+/// A contact's coefficient of restitution (from the parameters) outside [0, 1].
+pub const RODCUBE_ERR_PARAM_RESTITUTION: c_int = 114;
 
 /// Group: the request was refused (codes 201 to 299).
 pub const RODCUBE_ERR_REQUEST: c_int = 200;
@@ -171,8 +173,6 @@ pub const RODCUBE_ERR_NEXT_PHASE: c_int = 334;
 pub const RODCUBE_ERR_RESULT_NOT_FINITE: c_int = 335;
 /// A phase index past the phases of the run (a planner inconsistency).
 pub const RODCUBE_ERR_NO_SUCH_PHASE: c_int = 336;
-/// A coefficient of restitution outside [0, 1].
-pub const RODCUBE_ERR_RESTITUTION: c_int = 337;
 
 /// Group: the scene was refused (codes 401 to 499). A scene's message lists every problem
 /// found; the code is the kind of the first, in file order. Returned alone only for a scene
@@ -242,6 +242,7 @@ static CODES: &[(c_int, &CStr)] = named![
     RODCUBE_ERR_PARAM_STATE_SHAPE,
     RODCUBE_ERR_PARAM_LENGTH,
     RODCUBE_ERR_PARAM_NOT_FINITE_INPUT,
+    RODCUBE_ERR_PARAM_RESTITUTION,
     RODCUBE_ERR_REQUEST,
     RODCUBE_ERR_NOT_A_SYSTEM,
     RODCUBE_ERR_UNAVAILABLE,
@@ -285,7 +286,6 @@ static CODES: &[(c_int, &CStr)] = named![
     RODCUBE_ERR_NEXT_PHASE,
     RODCUBE_ERR_RESULT_NOT_FINITE,
     RODCUBE_ERR_NO_SUCH_PHASE,
-    RODCUBE_ERR_RESTITUTION,
     RODCUBE_ERR_SCENE,
     RODCUBE_ERR_SCENE_READ,
     RODCUBE_ERR_SCENE_SYNTAX,
@@ -320,6 +320,7 @@ fn system_code(e: &SystemError) -> c_int {
         SystemError::StateShape { .. } => RODCUBE_ERR_PARAM_STATE_SHAPE,
         SystemError::Length { .. } => RODCUBE_ERR_PARAM_LENGTH,
         SystemError::NotFiniteInput { .. } => RODCUBE_ERR_PARAM_NOT_FINITE_INPUT,
+        SystemError::Restitution { .. } => RODCUBE_ERR_PARAM_RESTITUTION,
     }
 }
 
@@ -348,7 +349,6 @@ fn solve_code(e: &SolveError) -> c_int {
         SolveError::AtRest { .. } => RODCUBE_ERR_AT_REST,
         SolveError::Overlap { .. } => RODCUBE_ERR_OVERLAP,
         SolveError::ImpactAtRelease { .. } => RODCUBE_ERR_IMPACT_AT_RELEASE,
-        SolveError::Restitution { .. } => RODCUBE_ERR_RESTITUTION,
         SolveError::NotThisPhase { .. } => RODCUBE_ERR_NOT_THIS_PHASE,
         SolveError::SingularContacts { .. } => RODCUBE_ERR_SINGULAR_CONTACTS,
         SolveError::TooManySwitches { .. } => RODCUBE_ERR_TOO_MANY_SWITCHES,

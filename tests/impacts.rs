@@ -1,20 +1,23 @@
-//! Impacts (`solve::impact`) against a hand impulse–momentum balance: the rod of
-//! `fixed_cylinder` (R = 0.2, th0 = 1.2) leaves the cylinder at release, falls on its foot and
-//! strikes the cylinder again; the impulses of the cylinder and of the floor at the strike, and
-//! the rod's velocities after, are solved here by Newton–Euler in world coordinates (the rod's
-//! centre and angle, its inertia `m ell^2 / 12`), sharing no code with the model. Then Newton's
-//! law at `e = 0`, `e = 1/2` and `e = 1`, the energy lost against the impulses, and the typed
-//! refusals.
+//! Impacts (`solve::impact`) against hand impulse–momentum balances solved here by
+//! Newton–Euler in world coordinates (each body's centre and angle, the rod's inertia
+//! `m ell^2 / 12`), sharing no code with the models:
+//! - the rod of `fixed_cylinder` (R = 0.2, th0 = 1.2) leaves the cylinder at release, falls on
+//!   its foot and strikes the cylinder again (plastic: the spec gives no restitution);
+//! - `rod_cube_liftoff` (restitution `e` at the tip on the cube and at the foot on the floor)
+//!   with its rod driven into the cube and the floor at once, at `e = 0`, `1/2` and `1`: Newton's
+//!   law at both contacts, horizontal momentum kept (the floor's impulse is vertical), energy
+//!   kept at `e = 1`, and the energy lost equal to what the impulses say;
+//! - the typed refusals: a restitution outside `[0, 1]` from the parameters, and a part list
+//!   of the wrong length.
 
 mod common;
 
 use common::hand::solve_linear;
 use rodcube::models::{all, find};
 use rodcube::results::Work;
-use rodcube::solve::SolveError;
 use rodcube::solve::impact::{Part, resolve};
 use rodcube::solve::phases::{End, Route, Walker};
-use rodcube::system::{Bound, State};
+use rodcube::system::{Bound, State, SystemError};
 
 const G: f64 = 9.81;
 const M: f64 = 1.0;
@@ -46,9 +49,10 @@ fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
     a[0] * b[1] - a[1] * b[0]
 }
 
-/// The hand balance at the strike with the floor's and the cylinder's restitution: the rod's
-/// foot velocity `(x1', y1')` and `theta'` after, and the impulses `(P_cylinder, P_floor)`.
-fn hand(state: &State, e_cyl: f64, e_floor: f64) -> ([f64; 3], [f64; 2]) {
+/// The hand balance at the strike, plastic at both contacts: the rod's foot velocity
+/// `(x1', y1')` and `theta'` after, and the impulses `(P_cylinder, P_floor)`.
+fn hand(state: &State) -> ([f64; 3], [f64; 2]) {
+    let (e_cyl, e_floor) = (0.0, 0.0);
     let (q, qd) = (state.q(), state.qd());
     let (x1, y1, th) = (q[0], q[1], q[2]);
     let (s, c) = th.sin_cos();
@@ -119,15 +123,112 @@ fn close(a: f64, b: f64, tol: f64, what: &str) {
 }
 
 #[test]
-fn a_strike_on_the_cylinder_matches_the_hand_impulse_balance() {
+fn a_plastic_strike_on_the_cylinder_matches_the_hand_impulse_balance() {
     let (bound, state, t) = strike();
-    let energy = bound.energy(&state).unwrap();
+    assert_eq!(
+        bound.restitutions(),
+        [0.0, 0.0],
+        "the spec gives no restitution"
+    );
+    let impact = resolve(&bound, &state, &[Part::Unilateral; 2], t).unwrap();
+    let (velocities, impulses) = hand(&state);
+    for (k, name) in ["x1'", "y1'", "theta'"].iter().enumerate() {
+        close(impact.after.qd()[k], velocities[k], 1e-12, name);
+    }
+    close(impact.impulse[0], impulses[0], 1e-12, "P_cylinder");
+    close(impact.impulse[1], impulses[1], 1e-12, "P_floor");
+    // The strike lifts the foot: the floor takes no impulse and the foot rises.
+    assert_eq!(impulses[1], 0.0);
+    assert!(impact.normal_velocity_after[1] > 0.0);
+    // Plastic: the rod stays on the cylinder, and the energy lost is what the impact took.
+    assert!(impact.normal_velocity_after[0].abs() < 1e-12);
+    let lost = bound.energy(&state).unwrap() - bound.energy(&impact.after).unwrap();
+    assert!(lost > 0.0);
+    close(impact.energy_lost, lost, 1e-12, "energy lost");
+    assert_eq!(
+        impact.after.q(),
+        state.q(),
+        "the configuration does not move"
+    );
+}
+
+/// `rod_cube_liftoff` at its release configuration (paper's rod and cube), the rod driven into
+/// the cube and into the floor: its foot at `(x1', y1') = (0.3, -0.2)` m/s, `theta' = -0.5`
+/// rad/s (the tip moving towards the cube at 0.425 m/s), the cube at rest.
+fn liftoff(e: f64) -> (Bound<'static>, State) {
+    let (m2, a) = (3.0, 0.25);
+    let params = [
+        ("m1", M),
+        ("m2", m2),
+        ("ell", ELL),
+        ("a", a),
+        ("g", G),
+        ("e", e),
+    ];
+    let bound = Bound::new(find("rod_cube_liftoff").unwrap(), &params).unwrap();
+    let theta = (a / ELL).asin();
+    let q = vec![0.0, 0.0, theta, (ELL * ELL - a * a).sqrt()];
+    let state = bound.state(q, vec![0.3, -0.2, -0.5, 0.0]).unwrap();
+    (bound, state)
+}
+
+/// The hand balance of the rod and the cube at restitution `e`: `[x1', y1', theta', x2']` after
+/// and the impulses `(P_tip, P_floor)`. The tip pushes the cube along +x (and the cube the rod
+/// along -x); the floor pushes the foot along +y; the cube only slides.
+fn hand_liftoff(state: &State, e: f64) -> ([f64; 4], [f64; 2]) {
+    let m2 = 3.0;
+    let (q, qd) = (state.q(), state.qd());
+    let (s, c) = q[2].sin_cos();
+    let w = qd[2];
+    let r_tip = [0.5 * ELL * c, 0.5 * ELL * s];
+    let r_foot = [-0.5 * ELL * c, -0.5 * ELL * s];
+    let v_centre = [qd[0] - 0.5 * ELL * s * w, qd[1] + 0.5 * ELL * c * w];
+    let tip_x = v_centre[0] - w * r_tip[1];
+    let foot_y = v_centre[1] + w * r_foot[0];
+    let (gap_rate, foot_rate) = (qd[3] - tip_x, foot_y);
+    assert!(gap_rate < 0.0 && foot_rate < 0.0, "both approach");
+    let inertia = M * ELL * ELL / 12.0;
+    // Unknowns [dvx, dvy, dw, dx2', P_tip, P_floor].
+    let a6 = [
+        [M, 0.0, 0.0, 0.0, 1.0, 0.0],
+        [0.0, M, 0.0, 0.0, 0.0, -1.0],
+        [
+            0.0,
+            0.0,
+            inertia,
+            0.0,
+            -cross(r_tip, [-1.0, 0.0]),
+            -cross(r_foot, [0.0, 1.0]),
+        ],
+        [0.0, 0.0, 0.0, m2, -1.0, 0.0],
+        [-1.0, 0.0, r_tip[1], 1.0, 0.0, 0.0],
+        [0.0, 1.0, r_foot[0], 0.0, 0.0, 0.0],
+    ];
+    let b = [
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        -(1.0 + e) * gap_rate,
+        -(1.0 + e) * foot_rate,
+    ];
+    let x = solve_linear(a6, b);
+    assert!(x[4] > 0.0 && x[5] > 0.0, "both push: {x:?}");
+    let v = [v_centre[0] + x[0], v_centre[1] + x[1]];
+    let w_after = w + x[2];
+    let foot = [v[0] - w_after * r_foot[1], v[1] + w_after * r_foot[0]];
+    ([foot[0], foot[1], w_after, qd[3] + x[3]], [x[4], x[5]])
+}
+
+#[test]
+fn the_rod_driven_into_cube_and_floor_obeys_newton_at_both_contacts() {
     for e in [0.0, 0.5, 1.0] {
-        let parts = [Part::Unilateral(e), Part::Unilateral(0.0)];
-        let impact = resolve(&bound, &state, &parts, t).unwrap();
-        let (velocities, impulses) = hand(&state, e, 0.0);
+        let (bound, state) = liftoff(e);
+        assert_eq!(bound.restitutions(), [e, e]);
+        let impact = resolve(&bound, &state, &[Part::Unilateral; 2], 0.0).unwrap();
+        let (velocities, impulses) = hand_liftoff(&state, e);
         let what = format!("e = {e}");
-        for (k, name) in ["x1'", "y1'", "theta'"].iter().enumerate() {
+        for (k, name) in ["x1'", "y1'", "theta'", "x2'"].iter().enumerate() {
             close(
                 impact.after.qd()[k],
                 velocities[k],
@@ -139,7 +240,7 @@ fn a_strike_on_the_cylinder_matches_the_hand_impulse_balance() {
             impact.impulse[0],
             impulses[0],
             1e-12,
-            &format!("{what}: P_cyl"),
+            &format!("{what}: P_tip"),
         );
         close(
             impact.impulse[1],
@@ -147,65 +248,70 @@ fn a_strike_on_the_cylinder_matches_the_hand_impulse_balance() {
             1e-12,
             &format!("{what}: P_floor"),
         );
-        // Newton's law at the cylinder, and the foot staying on the floor.
-        let (before, after) = (
-            impact.normal_velocity_before[0],
-            impact.normal_velocity_after[0],
-        );
-        close(after, -e * before, 1e-12, &format!("{what}: v+ = -e v-"));
-        // The foot: held on the floor where the floor pushes, else leaving it.
-        if impulses[1] > 0.0 {
-            assert!(impact.normal_velocity_after[1].abs() < 1e-12, "{what}");
-        } else {
-            assert!(impact.normal_velocity_after[1] > 0.0, "{what}");
+        // Newton's law at both contacts.
+        for i in 0..2 {
+            let (before, after) = (
+                impact.normal_velocity_before[i],
+                impact.normal_velocity_after[i],
+            );
+            close(after, -e * before, 1e-12, &format!("{what}: contact {i}"));
         }
-        println!(
-            "{what}: impulses {:?}, foot {:?}",
-            impact.impulse,
-            &impact.after.qd()
+        // Horizontal momentum: the tip's impulse is internal, the floor's vertical.
+        let momentum = |qd: &[f64]| {
+            let v_centre_x = qd[0] - 0.5 * ELL * state.q()[2].sin() * qd[2];
+            M * v_centre_x + 3.0 * qd[3]
+        };
+        close(
+            momentum(impact.after.qd()),
+            momentum(state.qd()),
+            1e-14,
+            &format!("{what}: horizontal momentum"),
         );
-        // The energy lost from the impulses is the kinetic energy the impact took.
-        let lost = energy - bound.energy(&impact.after).unwrap();
+        let lost = bound.energy(&state).unwrap() - bound.energy(&impact.after).unwrap();
         close(
             impact.energy_lost,
             lost,
             1e-12,
             &format!("{what}: energy lost"),
         );
-        // Restitution conserves energy at e = 1, and loses it otherwise.
         if e == 1.0 {
-            assert!(lost.abs() < 1e-12 * energy.abs(), "{lost:e}");
+            assert!(lost.abs() < 1e-14, "{what}: {lost:e}");
         } else {
             assert!(lost > 0.0, "{what}: {lost:e}");
         }
-        // The configuration does not move in an impact.
-        assert_eq!(impact.after.q(), state.q());
     }
 }
 
 #[test]
 fn restitution_outside_zero_to_one_and_wrong_lengths_are_refused() {
-    let (bound, state, t) = strike();
-    for e in [-0.1, 1.5, f64::NAN, f64::INFINITY] {
-        let parts = [Part::Unilateral(e), Part::Unilateral(0.0)];
-        match resolve(&bound, &state, &parts, t) {
-            Err(SolveError::Restitution { contact, value, .. }) => {
-                assert_eq!(contact, "cylinder_push");
-                assert!(value.is_nan() || value == e);
+    let model = find("rod_cube_liftoff").unwrap();
+    for e in [-0.1, 1.5] {
+        let params = [
+            ("m1", 1.0),
+            ("m2", 3.0),
+            ("ell", 1.0),
+            ("a", 0.25),
+            ("g", G),
+            ("e", e),
+        ];
+        match Bound::new(model, &params) {
+            Err(SystemError::Restitution { contact, value, .. }) => {
+                assert_eq!(contact, "contact_force");
+                assert_eq!(value, e);
             }
             other => panic!("e = {e}: {other:?}"),
         }
     }
-    let err = resolve(&bound, &state, &[Part::Unilateral(0.0)], t).unwrap_err();
+    let (bound, state, t) = strike();
+    let err = resolve(&bound, &state, &[Part::Unilateral], t).unwrap_err();
     assert!(err.to_string().contains("impact parts"), "{err}");
 }
 
 #[test]
 fn a_contact_that_takes_no_part_is_left_alone() {
     let (bound, state, t) = strike();
-    // Only the cylinder takes part: the foot is free to leave the floor, and no impulse acts
-    // there; the rod then leaves the floor if the strike lifts its foot.
-    let impact = resolve(&bound, &state, &[Part::Unilateral(0.0), Part::None], t).unwrap();
+    // Only the cylinder takes part: no impulse acts at the floor.
+    let impact = resolve(&bound, &state, &[Part::Unilateral, Part::None], t).unwrap();
     assert_eq!(impact.impulse[1], 0.0);
     assert!(impact.impulse[0] > 0.0);
     assert!(impact.normal_velocity_after[0].abs() < 1e-12);

@@ -25,12 +25,13 @@ pub const IMPACT_TOLERANCE: f64 = 1e-9;
 pub const MAX_IMPACT_CONTACTS: usize = 12;
 
 /// A contact's part in an impact.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Part {
     /// Not taking part (open, and not closing).
     None,
-    /// A unilateral contact closed or closing, with its coefficient of restitution in `[0, 1]`.
-    Unilateral(f64),
+    /// A unilateral contact closed or closing, with its coefficient of restitution
+    /// ([`Bound::restitutions`]).
+    Unilateral,
     /// A closed bilateral contact.
     Bilateral,
 }
@@ -51,8 +52,8 @@ pub struct Impact {
 }
 
 /// The impact at `state` (time `t`, for messages) with each contact's `parts`: the impulses,
-/// the velocities after and the energy lost. A coefficient outside `[0, 1]`, a part list of the
-/// wrong length, impulses that are not unique or do not exist, are typed errors.
+/// the velocities after and the energy lost. A part list of the wrong length, impulses that are
+/// not unique or do not exist, are typed errors.
 pub fn resolve(sys: &Bound, state: &State, parts: &[Part], t: f64) -> Result<Impact, SolveError> {
     let info = sys.info();
     sys.check_state(state)?;
@@ -73,26 +74,13 @@ pub fn resolve(sys: &Bound, state: &State, parts: &[Part], t: f64) -> Result<Imp
         }
         .into());
     }
-    for (i, p) in parts.iter().enumerate() {
-        if let Part::Unilateral(e) = *p
-            && !(0.0..=1.0).contains(&e)
-        {
-            return Err(SolveError::Restitution {
-                model: info.name,
-                contact: info.contacts[i].name,
-                value: e,
-            });
-        }
-    }
     let (mass, _) = sys.equations(state)?;
     let (jac, _) = sys.constraints(state)?;
     let mass = DMatrix::from_row_slice(n, n, &mass);
     let row = |i: usize| DVector::from_row_slice(&jac[i * n..(i + 1) * n]);
     let qd = DVector::from_row_slice(state.qd());
     let before: Vec<f64> = (0..m).map(|i| row(i).dot(&qd)).collect();
-    let unilateral: Vec<usize> = (0..m)
-        .filter(|&i| matches!(parts[i], Part::Unilateral(_)))
-        .collect();
+    let unilateral: Vec<usize> = (0..m).filter(|&i| parts[i] == Part::Unilateral).collect();
     let bilateral: Vec<usize> = (0..m).filter(|&i| parts[i] == Part::Bilateral).collect();
     let indeterminate = |why: String| SolveError::Indeterminate {
         model: info.name,
@@ -105,13 +93,10 @@ pub fn resolve(sys: &Bound, state: &State, parts: &[Part], t: f64) -> Result<Imp
             "more than {MAX_IMPACT_CONTACTS} contacts take part in one impact"
         )));
     }
-    let restitution = |i: usize| match parts[i] {
-        Part::Unilateral(e) => e,
-        _ => 0.0,
-    };
+    let restitution = sys.restitutions();
     // The target of a contact whose law holds with equality: v+ = -e v- (approaching), 0
     // (resting or separating; a separating contact that takes part can only stay so).
-    let target = |i: usize| -restitution(i) * before[i].min(0.0);
+    let target = |i: usize| -restitution[i] * before[i].min(0.0);
     let speed = (unilateral.iter().map(|&i| before[i].abs())).fold(f64::EPSILON, f64::max);
     let mut found: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();
     for set in 0..(1usize << unilateral.len()) {

@@ -277,18 +277,6 @@ pub enum SolveError {
         /// The gap's unit.
         unit: &'static str,
     },
-    /// A coefficient of restitution outside `[0, 1]` (or not a number).
-    #[error(
-        "model `{model}`: contact `{contact}` has restitution {value}, outside [0, 1] (0: the bodies stay together, 1: no energy is lost)"
-    )]
-    Restitution {
-        /// Model name.
-        model: &'static str,
-        /// The contact.
-        contact: &'static str,
-        /// The coefficient given.
-        value: f64,
-    },
     /// A contact that closes with a velocity at release (an impact, not modelled yet).
     #[error(
         "model `{model}`: contact `{contact}` is closing at release with normal velocity {velocity:e}: an impact, which rodcube does not model yet"
