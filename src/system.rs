@@ -857,13 +857,7 @@ pub fn failed_requirements<'a>(
     margins: &'a mut [f64],
 ) -> Result<impl Iterator<Item = (&'static crate::model::NamedInfo, f64)> + 'a, SystemError> {
     let info = model.info();
-    if p.len() != info.parameters.len() {
-        return Err(SystemError::WrongCount {
-            model: info.name,
-            expected: info.parameters.len(),
-            got: p.len(),
-        });
-    }
+    check_count(info, p)?;
     if margins.len() != info.requirements.len() {
         return Err(SystemError::Length {
             model: info.name,
@@ -881,17 +875,24 @@ pub fn failed_requirements<'a>(
         .map(|(r, m)| (r, *m)))
 }
 
+/// `p` holds one value per parameter of the model, or [`SystemError::WrongCount`].
+fn check_count(info: &'static ModelInfo, p: &[f64]) -> Result<(), SystemError> {
+    if p.len() == info.parameters.len() {
+        Ok(())
+    } else {
+        Err(SystemError::WrongCount {
+            model: info.name,
+            expected: info.parameters.len(),
+            got: p.len(),
+        })
+    }
+}
+
 /// Each contact's coefficient of restitution for parameters `p` that passed
 /// [`check_parameters`] ([`Model::restitutions`]), every one checked to lie in `[0, 1]`.
 pub fn restitutions(model: &dyn Model, p: &[f64]) -> Result<Vec<f64>, SystemError> {
     let info = model.info();
-    if p.len() != info.parameters.len() {
-        return Err(SystemError::WrongCount {
-            model: info.name,
-            expected: info.parameters.len(),
-            got: p.len(),
-        });
-    }
+    check_count(info, p)?;
     let mut out = vec![0.0; info.contacts.len()];
     model.restitutions(p, &mut out);
     match (info.contacts.iter().zip(&out)).find(|(_, e)| !(0.0..=1.0).contains(*e)) {
@@ -986,13 +987,7 @@ pub(crate) fn positive_finite(v: f64) -> bool {
 /// parameters and refuses any that is not finite.
 pub fn prepare_constants(model: &dyn Model, p: &[f64], k: &mut [f64]) -> Result<(), SystemError> {
     let info = model.info();
-    if p.len() != info.parameters.len() {
-        return Err(SystemError::WrongCount {
-            model: info.name,
-            expected: info.parameters.len(),
-            got: p.len(),
-        });
-    }
+    check_count(info, p)?;
     if k.len() != info.n_constants {
         return Err(SystemError::Length {
             model: info.name,

@@ -245,8 +245,9 @@ impl Model for OneContact {
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
         self.base.requirements(p, out)
     }
-    fn restitutions(&self, p: &[f64], out: &mut [f64]) {
-        self.base.restitutions(p, out)
+    fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
+        // The one contact kept is the base's first, which is plastic (the spec gives it none).
+        out.fill(0.0);
     }
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
         self.base.prepare(p, k)
