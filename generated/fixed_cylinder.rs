@@ -75,6 +75,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: true,
             eliminates: Some("x1"),
             closed: false,
+            restitution: "0",
         },
         ContactInfo {
             name: "floor_normal",
@@ -85,6 +86,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: false,
             eliminates: Some("y1"),
             closed: false,
+            restitution: "0",
         },
     ],
     frictions: &[],
@@ -151,6 +153,11 @@ impl Model for FixedCylinder {
         let qt0 = k[3].cos();
         out[0] = qt0;
         out[1] = k[1] - (k[2] * (1.0 + qt0) / k[3].sin());
+    }
+
+    fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
+        out[0] = 0.0;
+        out[1] = 0.0;
     }
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {

@@ -99,6 +99,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: true,
             eliminates: Some("x1"),
             closed: false,
+            restitution: "0",
         },
         ContactInfo {
             name: "floor_normal",
@@ -109,6 +110,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: false,
             eliminates: Some("y1"),
             closed: true,
+            restitution: "0",
         },
     ],
     frictions: &[],
@@ -183,6 +185,11 @@ impl Model for FixedCylinderFree {
         let qt0 = k[3].cos();
         out[0] = qt0;
         out[1] = k[1] - (k[2] * (1.0 + qt0) / k[3].sin());
+    }
+
+    fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
+        out[0] = 0.0;
+        out[1] = 0.0;
     }
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {

@@ -105,6 +105,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: true,
             eliminates: Some("xc"),
             closed: false,
+            restitution: "0",
         },
         ContactInfo {
             name: "hinge_horizontal",
@@ -115,6 +116,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: false,
             eliminates: Some("x1"),
             closed: true,
+            restitution: "0",
         },
         ContactInfo {
             name: "hinge_vertical",
@@ -125,6 +127,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: false,
             eliminates: Some("y1"),
             closed: true,
+            restitution: "0",
         },
     ],
     frictions: &[],
@@ -199,6 +202,12 @@ impl Model for HingedCylinderFree {
         let qt0 = k[4].cos();
         out[0] = qt0;
         out[1] = k[2] - (k[3] * (1.0 + qt0) / k[4].sin());
+    }
+
+    fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
+        out[0] = 0.0;
+        out[1] = 0.0;
+        out[2] = 0.0;
     }
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {

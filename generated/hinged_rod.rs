@@ -69,6 +69,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: false,
             eliminates: Some("x2"),
             closed: false,
+            restitution: "0",
         },
         ContactInfo {
             name: "hinge_horizontal",
@@ -79,6 +80,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: false,
             eliminates: Some("x1"),
             closed: false,
+            restitution: "0",
         },
         ContactInfo {
             name: "hinge_vertical",
@@ -89,6 +91,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: false,
             eliminates: Some("y1"),
             closed: false,
+            restitution: "0",
         },
     ],
     frictions: &[],
@@ -157,6 +160,12 @@ impl Model for HingedRod {
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
         let k = p;
         out[0] = k[2] - k[3];
+    }
+
+    fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
+        out[0] = 0.0;
+        out[1] = 0.0;
+        out[2] = 0.0;
     }
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {

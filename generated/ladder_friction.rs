@@ -75,6 +75,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: false,
             eliminates: None,
             closed: false,
+            restitution: "0",
         },
         ContactInfo {
             name: "floor_normal",
@@ -85,6 +86,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: false,
             eliminates: None,
             closed: false,
+            restitution: "0",
         },
     ],
     frictions: &[
@@ -145,6 +147,11 @@ impl Model for LadderFriction {
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
         let k = p;
         out[0] = k[1] - k[2];
+    }
+
+    fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
+        out[0] = 0.0;
+        out[1] = 0.0;
     }
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {

@@ -111,6 +111,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: false,
             eliminates: Some("x2"),
             closed: false,
+            restitution: "0",
         },
         ContactInfo {
             name: "floor_normal",
@@ -121,6 +122,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: false,
             eliminates: Some("y1"),
             closed: true,
+            restitution: "0",
         },
     ],
     frictions: &[],
@@ -201,6 +203,11 @@ impl Model for LoadedRodFree {
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
         let k = p;
         out[0] = k[3] - k[4];
+    }
+
+    fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
+        out[0] = 0.0;
+        out[1] = 0.0;
     }
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {

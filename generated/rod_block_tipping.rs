@@ -75,6 +75,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: true,
             eliminates: None,
             closed: false,
+            restitution: "0",
         },
         ContactInfo {
             name: "block_near_edge",
@@ -85,6 +86,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: false,
             eliminates: None,
             closed: false,
+            restitution: "0",
         },
         ContactInfo {
             name: "block_far_edge",
@@ -95,6 +97,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: false,
             eliminates: None,
             closed: false,
+            restitution: "0",
         },
         ContactInfo {
             name: "floor_normal",
@@ -105,6 +108,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: false,
             eliminates: None,
             closed: false,
+            restitution: "0",
         },
     ],
     frictions: &[],
@@ -164,6 +168,13 @@ impl Model for RodBlockTipping {
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
         let k = p;
         out[0] = k[2] - k[4];
+    }
+
+    fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
+        out[0] = 0.0;
+        out[1] = 0.0;
+        out[2] = 0.0;
+        out[3] = 0.0;
     }
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {

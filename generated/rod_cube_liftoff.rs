@@ -48,12 +48,18 @@ static INFO: ModelInfo = ModelInfo {
             unit: "m/s^2",
             positive: true,
         },
+        ParamInfo {
+            name: "e",
+            meaning: "coefficient of restitution of the rod's tip on the cube and of its foot on the floor (0 plastic; 1 elastic)",
+            unit: "1",
+            positive: false,
+        },
     ],
     requirements: &[NamedInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 19,
+    n_constants: 20,
     coordinates: &["x1", "y1", "theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced: 2,
@@ -69,6 +75,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: false,
             eliminates: None,
             closed: false,
+            restitution: "e",
         },
         ContactInfo {
             name: "floor_normal",
@@ -79,6 +86,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: false,
             eliminates: None,
             closed: false,
+            restitution: "e",
         },
     ],
     frictions: &[],
@@ -136,52 +144,58 @@ impl Model for RodCubeLiftoff {
         out[0] = k[2] - k[3];
     }
 
+    fn restitutions(&self, p: &[f64], out: &mut [f64]) {
+        let k = p;
+        out[0] = k[5];
+        out[1] = k[5];
+    }
+
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
-        k[..5].copy_from_slice(p);
-        // k[5] = asin(a/ell)
-        k[5] = (k[3] / k[2]).asin();
-        // k[6] = sqrt((ell - a)*(ell + a))
-        k[6] = ((k[2] - k[3]) * (k[2] + k[3])).sqrt();
-        // k[7] = ell/2
-        k[7] = k[2] / 2.0;
-        // k[8] = ell*m1/2
-        k[8] = k[2] * k[0] / 2.0;
-        // k[9] = ell^2*m1/24
-        k[9] = (k[2] * k[2]) * k[0] / 24.0;
-        // k[10] = ell^2*m1/8
-        k[10] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[11] = m1/2
-        k[11] = k[0] / 2.0;
-        // k[12] = m2/2
-        k[12] = k[1] / 2.0;
-        // k[13] = a*g*m2/2
-        k[13] = k[3] * k[4] * k[1] / 2.0;
-        // k[14] = ell*g*m1/2
-        k[14] = k[2] * k[4] * k[0] / 2.0;
-        // k[15] = g*m1
-        k[15] = k[4] * k[0];
-        // k[16] = ell^2*m1/12
-        k[16] = (k[2] * k[2]) * k[0] / 12.0;
-        // k[17] = ell^2*m1/4
-        k[17] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[18] = a/2
-        k[18] = k[3] / 2.0;
+        k[..6].copy_from_slice(p);
+        // k[6] = asin(a/ell)
+        k[6] = (k[3] / k[2]).asin();
+        // k[7] = sqrt((ell - a)*(ell + a))
+        k[7] = ((k[2] - k[3]) * (k[2] + k[3])).sqrt();
+        // k[8] = ell/2
+        k[8] = k[2] / 2.0;
+        // k[9] = ell*m1/2
+        k[9] = k[2] * k[0] / 2.0;
+        // k[10] = ell^2*m1/24
+        k[10] = (k[2] * k[2]) * k[0] / 24.0;
+        // k[11] = ell^2*m1/8
+        k[11] = (k[2] * k[2]) * k[0] / 8.0;
+        // k[12] = m1/2
+        k[12] = k[0] / 2.0;
+        // k[13] = m2/2
+        k[13] = k[1] / 2.0;
+        // k[14] = a*g*m2/2
+        k[14] = k[3] * k[4] * k[1] / 2.0;
+        // k[15] = ell*g*m1/2
+        k[15] = k[2] * k[4] * k[0] / 2.0;
+        // k[16] = g*m1
+        k[16] = k[4] * k[0];
+        // k[17] = ell^2*m1/12
+        k[17] = (k[2] * k[2]) * k[0] / 12.0;
+        // k[18] = ell^2*m1/4
+        k[18] = (k[2] * k[2]) * k[0] / 4.0;
+        // k[19] = a/2
+        k[19] = k[3] / 2.0;
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = 0.0;
         qd[1] = 0.0;
-        q[2] = k[5];
+        q[2] = k[6];
         qd[2] = 0.0;
-        q[3] = k[6];
+        q[3] = k[7];
         qd[3] = 0.0;
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         pos[0] = [q[0], q[1]];
         vel[0] = [qd[0], qd[1]];
@@ -190,42 +204,42 @@ impl Model for RodCubeLiftoff {
             -(k[2] * qd[2] * rc_s) + qd[0],
             (k[2] * qd[2] * rc_c) + qd[1],
         ];
-        pos[2] = [(k[7] * rc_c) + q[0], (k[7] * rc_s) + q[1]];
+        pos[2] = [(k[8] * rc_c) + q[0], (k[8] * rc_s) + q[1]];
         vel[2] = [
-            -(k[7] * qd[2] * rc_s) + qd[0],
-            (k[7] * qd[2] * rc_c) + qd[1],
+            -(k[8] * qd[2] * rc_s) + qd[0],
+            (k[8] * qd[2] * rc_c) + qd[1],
         ];
         pos[3] = [q[3], 0.0];
         vel[3] = [qd[3], 0.0];
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let et0 = qd[2] * qd[2];
-        (-(k[8] * qd[2] * qd[0] * rc_s)
-            + (k[8] * qd[2] * qd[1] * rc_c)
-            + (k[9] * et0)
-            + (k[10] * et0 * (rc_s * rc_s))
-            + (k[10] * et0 * (rc_c * rc_c))
-            + (k[11] * (qd[0] * qd[0]))
-            + (k[12] * (qd[3] * qd[3]))
-            + (k[11] * (qd[1] * qd[1])))
-            + (k[13] + (k[14] * rc_s) + (k[15] * q[1]))
+        (-(k[9] * qd[2] * qd[0] * rc_s)
+            + (k[9] * qd[2] * qd[1] * rc_c)
+            + (k[10] * et0)
+            + (k[11] * et0 * (rc_s * rc_s))
+            + (k[11] * et0 * (rc_c * rc_c))
+            + (k[12] * (qd[0] * qd[0]))
+            + (k[13] * (qd[3] * qd[3]))
+            + (k[12] * (qd[1] * qd[1])))
+            + (k[14] + (k[15] * rc_s) + (k[16] * q[1]))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
-        out[0] = -(k[8] * qd[2] * rc_s) + (k[0] * qd[0]);
+        out[0] = -(k[9] * qd[2] * rc_s) + (k[0] * qd[0]);
         out[1] = k[1] * qd[3];
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let qt0 = -k[8] * rc_s;
-        let qt1 = k[8] * rc_c;
+        let qt0 = -k[9] * rc_s;
+        let qt1 = k[9] * rc_c;
         let qt2 = qd[2] * qd[2];
         mass[0] = k[0];
         mass[1] = 0.0;
@@ -237,15 +251,15 @@ impl Model for RodCubeLiftoff {
         mass[7] = 0.0;
         mass[8] = qt0;
         mass[9] = qt1;
-        mass[10] = k[16] + (k[17] * (rc_s * rc_s)) + (k[17] * (rc_c * rc_c));
+        mass[10] = k[17] + (k[18] * (rc_s * rc_s)) + (k[18] * (rc_c * rc_c));
         mass[11] = 0.0;
         mass[12] = 0.0;
         mass[13] = 0.0;
         mass[14] = 0.0;
         mass[15] = k[1];
-        rhs[0] = k[8] * qt2 * rc_c;
-        rhs[1] = -k[15] + (k[8] * qt2 * rc_s);
-        rhs[2] = -k[14] * rc_c;
+        rhs[0] = k[9] * qt2 * rc_c;
+        rhs[1] = -k[16] + (k[9] * qt2 * rc_s);
+        rhs[2] = -k[15] * rc_c;
         rhs[3] = 0.0;
     }
 
@@ -255,14 +269,14 @@ impl Model for RodCubeLiftoff {
     }
 
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let rc_c = q[2].cos();
         out[0] = -(k[2] * rc_c) - q[0] + q[3];
         out[1] = q[1];
     }
 
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         jac[0] = -1.0;
         jac[1] = 0.0;
@@ -284,9 +298,9 @@ impl Model for RodCubeLiftoff {
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
-        out[0] = k[13] - (forces[0] * (-k[18] + (k[2] * rc_s) + q[1]));
+        out[0] = k[14] - (forces[0] * (-k[19] + (k[2] * rc_s) + q[1]));
     }
 
     fn to_full(&self, _k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
@@ -301,13 +315,13 @@ impl Model for RodCubeLiftoff {
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        poses[0] = [(k[7] * rc_c) + q[0], (k[7] * rc_s) + q[1], q[2]];
-        poses[1] = [k[18] + q[3], k[18], 0.0];
-        sizes[0] = -k[7];
+        poses[0] = [(k[8] * rc_c) + q[0], (k[8] * rc_s) + q[1], q[2]];
+        poses[1] = [k[19] + q[3], k[19], 0.0];
+        sizes[0] = -k[8];
         sizes[1] = 0.0;
-        sizes[2] = k[7];
+        sizes[2] = k[8];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;

@@ -117,6 +117,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: true,
             eliminates: Some("xc"),
             closed: false,
+            restitution: "0",
         },
         ContactInfo {
             name: "floor_normal",
@@ -127,6 +128,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: false,
             eliminates: Some("y1"),
             closed: true,
+            restitution: "0",
         },
     ],
     frictions: &[],
@@ -197,6 +199,11 @@ impl Model for RodCylinderFree {
         let qt0 = k[4].cos();
         out[0] = qt0;
         out[1] = k[2] - (k[3] * (1.0 + qt0) / k[4].sin());
+    }
+
+    fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
+        out[0] = 0.0;
+        out[1] = 0.0;
     }
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {

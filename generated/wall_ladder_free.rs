@@ -87,6 +87,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: false,
             eliminates: Some("x1"),
             closed: false,
+            restitution: "0",
         },
         ContactInfo {
             name: "floor_normal",
@@ -97,6 +98,7 @@ static INFO: ModelInfo = ModelInfo {
             edge: false,
             eliminates: Some("y1"),
             closed: true,
+            restitution: "0",
         },
     ],
     frictions: &[],
@@ -169,6 +171,11 @@ impl Model for WallLadderFree {
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
         let k = p;
         out[0] = k[1] - k[2];
+    }
+
+    fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
+        out[0] = 0.0;
+        out[1] = 0.0;
     }
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {

@@ -133,6 +133,11 @@
 #define RODCUBE_ERR_PARAM_NOT_FINITE_INPUT 113
 
 /**
+ * A contact's coefficient of restitution (from the parameters) outside [0, 1].
+ */
+#define RODCUBE_ERR_PARAM_RESTITUTION 114
+
+/**
  * Group: the request was refused (codes 201 to 299).
  */
 #define RODCUBE_ERR_REQUEST 200

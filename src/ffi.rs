@@ -78,6 +78,8 @@ pub const RODCUBE_ERR_PARAM_STATE_SHAPE: c_int = 111;
 pub const RODCUBE_ERR_PARAM_LENGTH: c_int = 112;
 /// A state or vector holds a NaN or an infinity.
 pub const RODCUBE_ERR_PARAM_NOT_FINITE_INPUT: c_int = 113;
+/// A contact's coefficient of restitution (from the parameters) outside [0, 1].
+pub const RODCUBE_ERR_PARAM_RESTITUTION: c_int = 114;
 
 /// Group: the request was refused (codes 201 to 299).
 pub const RODCUBE_ERR_REQUEST: c_int = 200;
@@ -240,6 +242,7 @@ static CODES: &[(c_int, &CStr)] = named![
     RODCUBE_ERR_PARAM_STATE_SHAPE,
     RODCUBE_ERR_PARAM_LENGTH,
     RODCUBE_ERR_PARAM_NOT_FINITE_INPUT,
+    RODCUBE_ERR_PARAM_RESTITUTION,
     RODCUBE_ERR_REQUEST,
     RODCUBE_ERR_NOT_A_SYSTEM,
     RODCUBE_ERR_UNAVAILABLE,
@@ -317,6 +320,7 @@ fn system_code(e: &SystemError) -> c_int {
         SystemError::StateShape { .. } => RODCUBE_ERR_PARAM_STATE_SHAPE,
         SystemError::Length { .. } => RODCUBE_ERR_PARAM_LENGTH,
         SystemError::NotFiniteInput { .. } => RODCUBE_ERR_PARAM_NOT_FINITE_INPUT,
+        SystemError::Restitution { .. } => RODCUBE_ERR_PARAM_RESTITUTION,
     }
 }
 

@@ -119,6 +119,9 @@ pub struct ContactInfo {
     /// [`Model::forces_full`]); otherwise it is a constraint row ([`Model::gaps`],
     /// [`Model::constraints`]).
     pub closed: bool,
+    /// Its coefficient of restitution as the spec writes it (`0` where it gives none);
+    /// [`Model::restitutions`] evaluates it.
+    pub restitution: &'static str,
 }
 
 /// Coulomb friction at a contact ([`Model::friction`] gives its slip velocity).
@@ -427,6 +430,12 @@ pub trait Model: Send + Sync {
     /// Requirement margins from the parameters alone (each must be `> 0`), in the order of
     /// [`ModelInfo::requirements`]. `out.len()` must equal that list's length.
     fn requirements(&self, p: &[f64], out: &mut [f64]);
+
+    /// Each contact's coefficient of restitution from the parameters alone (the spec's
+    /// `restitution`, `0` where it gives none), in the order of [`ModelInfo::contacts`].
+    /// `out.len()` must equal that list's length; [`Bound`](crate::system::Bound) checks that
+    /// each lies in `[0, 1]`.
+    fn restitutions(&self, p: &[f64], out: &mut [f64]);
 
     /// Prepared constants for a parameter set: `k.len()` must be [`ModelInfo::n_constants`].
     /// Call only after [`Model::requirements`] passed.

@@ -467,6 +467,7 @@ impl Ctx<'_> {
         let values = self.parameter_values(&raw, model.info(), &mut out);
         if let Some(values) = &values {
             self.requirements(model, values, &mut out);
+            self.restitutions(model, values, &mut out);
         }
         if !out.is_empty() {
             return Err(finish(out));
@@ -713,6 +714,29 @@ impl Ctx<'_> {
         }
 
         all_good.then_some(values)
+    }
+
+    /// Each contact's coefficient of restitution from valid parameters, in `[0, 1]`; a failure
+    /// is placed at the first of the parameters in the file.
+    fn restitutions(&self, model: &dyn Model, values: &[f64], out: &mut Vec<Diagnostic>) {
+        let info = model.info();
+        if let Err(e) = crate::system::restitutions(model, values) {
+            // At the first in the file of the parameters its contact's restitution reads.
+            let involved = match &e {
+                SystemError::Restitution { contact, .. } => (info.contacts.iter())
+                    .find(|c| c.name == *contact)
+                    .map(|c| involved_parameters("", c.restitution, info))
+                    .unwrap_or_default(),
+                _ => Vec::new(),
+            };
+            let field = self.first_in_file(involved.iter().map(|n| format!("parameters.{n}")));
+            let field = if field.is_empty() {
+                "parameters".to_string()
+            } else {
+                field
+            };
+            out.push(self.diag(Kind::OutOfRange, &field, At::Key, e.to_string()));
+        }
     }
 
     /// The model's requirements on valid parameters, each failure placed at the first of its

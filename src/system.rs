@@ -115,6 +115,20 @@ pub enum SystemError {
         /// The parameters, `name = value` comma-separated.
         parameters: String,
     },
+    /// A contact's coefficient of restitution (from the parameters) outside `[0, 1]`.
+    #[error(
+        "model `{model}`: contact `{contact}` has restitution {value} with {parameters}, outside [0, 1] (0: the bodies stay together, 1: no energy is lost)"
+    )]
+    Restitution {
+        /// Model name.
+        model: &'static str,
+        /// The contact.
+        contact: &'static str,
+        /// Its coefficient.
+        value: f64,
+        /// The parameters, `name = value` comma-separated.
+        parameters: String,
+    },
     /// The model has no fast path (a [`System`] needs one; use a [`Bound`]).
     #[error("model `{model}` has no reduced fast path ({why}); it is solved by integration")]
     NoReduction {
@@ -265,6 +279,7 @@ pub struct Bound<'m> {
     model: &'m dyn Model,
     p: Vec<f64>,
     k: Vec<f64>,
+    restitutions: Vec<f64>,
 }
 
 impl std::fmt::Debug for Bound<'_> {
@@ -303,13 +318,21 @@ impl<'m> Bound<'m> {
         let info = model.info();
         let mut margins = vec![0.0; info.requirements.len()];
         check_parameters(model, p, &mut margins)?;
+        let restitutions = restitutions(model, p)?;
         let mut k = vec![0.0; info.n_constants];
         prepare_constants(model, p, &mut k)?;
         Ok(Bound {
             model,
             p: p.to_vec(),
             k,
+            restitutions,
         })
+    }
+
+    /// Each contact's coefficient of restitution, in `[0, 1]` (checked when bound), in the
+    /// order of [`ModelInfo::contacts`].
+    pub fn restitutions(&self) -> &[f64] {
+        &self.restitutions
     }
 
     /// The model.
@@ -834,13 +857,7 @@ pub fn failed_requirements<'a>(
     margins: &'a mut [f64],
 ) -> Result<impl Iterator<Item = (&'static crate::model::NamedInfo, f64)> + 'a, SystemError> {
     let info = model.info();
-    if p.len() != info.parameters.len() {
-        return Err(SystemError::WrongCount {
-            model: info.name,
-            expected: info.parameters.len(),
-            got: p.len(),
-        });
-    }
+    check_count(info, p)?;
     if margins.len() != info.requirements.len() {
         return Err(SystemError::Length {
             model: info.name,
@@ -856,6 +873,37 @@ pub fn failed_requirements<'a>(
         .zip(margins.iter())
         .filter(|(_, m)| m.is_nan() || **m <= 0.0)
         .map(|(r, m)| (r, *m)))
+}
+
+/// `p` holds one value per parameter of the model, or [`SystemError::WrongCount`].
+fn check_count(info: &'static ModelInfo, p: &[f64]) -> Result<(), SystemError> {
+    if p.len() == info.parameters.len() {
+        Ok(())
+    } else {
+        Err(SystemError::WrongCount {
+            model: info.name,
+            expected: info.parameters.len(),
+            got: p.len(),
+        })
+    }
+}
+
+/// Each contact's coefficient of restitution for parameters `p` that passed
+/// [`check_parameters`] ([`Model::restitutions`]), every one checked to lie in `[0, 1]`.
+pub fn restitutions(model: &dyn Model, p: &[f64]) -> Result<Vec<f64>, SystemError> {
+    let info = model.info();
+    check_count(info, p)?;
+    let mut out = vec![0.0; info.contacts.len()];
+    model.restitutions(p, &mut out);
+    match (info.contacts.iter().zip(&out)).find(|(_, e)| !(0.0..=1.0).contains(*e)) {
+        Some((c, &value)) => Err(SystemError::Restitution {
+            model: info.name,
+            contact: c.name,
+            value,
+            parameters: describe(info, p),
+        }),
+        None => Ok(out),
+    }
 }
 
 /// The one validation of a model's parameter values, in the order of
@@ -939,13 +987,7 @@ pub(crate) fn positive_finite(v: f64) -> bool {
 /// parameters and refuses any that is not finite.
 pub fn prepare_constants(model: &dyn Model, p: &[f64], k: &mut [f64]) -> Result<(), SystemError> {
     let info = model.info();
-    if p.len() != info.parameters.len() {
-        return Err(SystemError::WrongCount {
-            model: info.name,
-            expected: info.parameters.len(),
-            got: p.len(),
-        });
-    }
+    check_count(info, p)?;
     if k.len() != info.n_constants {
         return Err(SystemError::Length {
             model: info.name,

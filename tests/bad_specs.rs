@@ -771,3 +771,48 @@ fn a_paper_number_for_an_unknown_result_is_refused() {
         &["`energy` is not a result of this model"],
     );
 }
+
+#[test]
+fn a_restitution_outside_zero_to_one_of_a_coordinate_or_with_a_unit_is_refused() {
+    let with = |e: &str| {
+        edit(
+            "eliminates: x1}",
+            &format!("eliminates: x1, restitution: {e}}}"),
+        )
+    };
+    // A number outside [0, 1].
+    refused(
+        "restitution_range",
+        &with("1.5"),
+        ("name: push", "push"),
+        "contacts[0].restitution",
+        &["restitution of contact `push` is 1.5", "outside [0, 1]"],
+    );
+    // An expression of a coordinate (the coefficient is a property of the contact).
+    refused(
+        "restitution_coordinate",
+        &with("x1"),
+        ("name: push", "push"),
+        "contacts[0].restitution",
+        &["x1"],
+    );
+    // A length is not a coefficient.
+    refused(
+        "restitution_unit",
+        &with("ell"),
+        ("name: push", "push"),
+        "contacts[0].restitution",
+        &["coefficient of restitution"],
+    );
+    // A bilateral contact never closes on an approach.
+    refused(
+        "restitution_bilateral",
+        &edit(
+            "eliminates: x1}",
+            "eliminates: x1, bilateral: true, restitution: 0.5}",
+        ),
+        ("name: push", "push"),
+        "contacts[0].restitution",
+        &["bilateral contact", "no restitution"],
+    );
+}

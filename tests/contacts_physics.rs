@@ -140,7 +140,9 @@ fn rod_cube_liftoff_separates_as_rod_cube_with_the_floor_pushing() {
         Quantity::ContactEnd,
         Quantity::ForceSeries(floor),
     ];
-    let lift = ask("rod_cube_liftoff", &PAPER, &want, 1e-12, Route::Fastest);
+    let mut liftoff = PAPER.to_vec();
+    liftoff.push(("e", 0.0));
+    let lift = ask("rod_cube_liftoff", &liftoff, &want, 1e-12, Route::Fastest);
     let paper = ask(
         "rod_cube",
         &PAPER,

@@ -474,6 +474,9 @@ impl Model for FloorLetsGo {
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
         ROD_CUBE.requirements(p, out)
     }
+    fn restitutions(&self, p: &[f64], out: &mut [f64]) {
+        ROD_CUBE.restitutions(p, out)
+    }
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
         ROD_CUBE.prepare(p, k)
     }

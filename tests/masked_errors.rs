@@ -31,6 +31,9 @@ impl Model for MasslessCube {
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
         GENERAL.requirements(p, out)
     }
+    fn restitutions(&self, p: &[f64], out: &mut [f64]) {
+        GENERAL.restitutions(p, out)
+    }
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
         GENERAL.prepare(p, k)
     }
@@ -241,6 +244,10 @@ impl Model for OneContact {
     }
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
         self.base.requirements(p, out)
+    }
+    fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
+        // The one contact kept is the base's first, which is plastic (the spec gives it none).
+        out.fill(0.0);
     }
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
         self.base.prepare(p, k)

@@ -39,6 +39,8 @@ fn parameters(model: &dyn Model, u: &[f64], spread: u8) -> Vec<f64> {
             // Friction from none to below Painlevé's 4/3 for a free rod sliding on its foot
             // (above it the sliding equations can turn singular: tests/friction.rs).
             "mu" | "mu_f" | "mu_w" => lin(u[i], 0.0, 1.3),
+            // A coefficient of restitution, over its whole range [0, 1].
+            "e" => u[i],
             _ if q.positive => log(u[i], -1.0, 1.0),
             _ => lin(u[i], -1.0, 1.0),
         };

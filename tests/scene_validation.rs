@@ -322,6 +322,25 @@ fn a_failed_requirement_points_at_the_first_involved_parameter() {
 }
 
 #[test]
+fn a_restitution_outside_zero_to_one_points_at_its_parameter() {
+    // rod_cube_liftoff's contacts take the restitution `e`.
+    let text = "model: rod_cube_liftoff\nparameters:\n  m1: 1.0\n  m2: 3.0\n  ell: 1.0\n  a: 0.25\n  e: 1.5\n  g: 9.81\nwant: [separation_angle]\n";
+    let parse_all = |t: &str| Scene::parse(t, Path::new(FILE), rodcube::models::all());
+    let e = parse_all(text).unwrap_err();
+    assert_eq!(e.diagnostics.len(), 1, "{e}");
+    let d = &e.diagnostics[0];
+    at(d, Kind::OutOfRange, 7, 3, "parameters.e");
+    assert!(
+        d.message
+            .contains("contact `contact_force` has restitution 1.5"),
+        "{d}"
+    );
+    assert!(d.message.contains("outside [0, 1]"), "{d}");
+    // In range, it is a valid scene.
+    assert!(parse_all(&text.replace("e: 1.5", "e: 1")).is_ok());
+}
+
+#[test]
 fn every_problem_is_reported_in_file_order() {
     let text = "model: rod_cube\nparameters:\n  m1: -1\n  m2: 3\n  ell: 1\n  a: 0.25\n  g: .inf\n  h: 2\nwant: [separation_angle, nothing]\nsamples: 1\n";
     let e = parse(text).unwrap_err();

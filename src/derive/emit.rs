@@ -147,6 +147,7 @@ pub struct RustContext {
     /// `ReductionInfo { .. }` when the phase has the fast path.
     reduction_info: Option<String>,
     requirements: Code,
+    restitutions: Code,
     prepare: Code,
     #[serde(flatten)]
     general: FullStateCode,
@@ -244,7 +245,8 @@ fn context_without(
         Err(_) => None,
     };
     let (mut drawing, shapes_info) = drawing_code(d, &scope, &mut hoisted);
-    let mut requirements = requirements_code(d);
+    let mut requirements = parameters_code(&d.requirements, d);
+    let mut restitutions = parameters_code(&d.restitutions, d);
     let n_constants = hoisted.len();
     let mut prepare = prepare_code(d, start, &own, &scope, &hoisted, reduction.as_mut())?;
     let reduction_info = match (&d.reduction, &reduction) {
@@ -257,6 +259,7 @@ fn context_without(
         .insert(0, format!("k[..{np}].copy_from_slice(p);"));
     prepare.finish(&[("p", "&[f64]"), ("k", "&mut [f64]")], &[]);
     requirements.finish(&[("p", "&[f64]"), OUT], &[Preamble::Let("k", "p")]);
+    restitutions.finish(&[("p", "&[f64]"), OUT], &[Preamble::Let("k", "p")]);
     general.finish(n_constants, d.reduced);
     if let Some(code) = reduction.as_mut() {
         code.finish(n_constants, np, d.reduced);
@@ -267,7 +270,7 @@ fn context_without(
         &[K, Q, poses, sizes],
         &[Preamble::Slice(n_constants), Preamble::Angle(d.reduced)],
     );
-    let mut codes: Vec<&Code> = vec![&requirements, &prepare, &drawing];
+    let mut codes: Vec<&Code> = vec![&requirements, &restitutions, &prepare, &drawing];
     codes.extend(general.codes());
     codes.extend(reduction.iter().flat_map(ReducedCode::codes));
     let unread = unread_constants(d, &own, &codes);
@@ -278,6 +281,7 @@ fn context_without(
         drawing,
         reduction_info,
         requirements,
+        restitutions,
         prepare,
         general,
         reduction,
@@ -285,17 +289,17 @@ fn context_without(
     })
 }
 
-/// `Model::requirements`: the margins over the parameters (no hoisting: they run before
-/// `prepare`).
-fn requirements_code(d: &Derivation) -> Code {
-    let mut requirements = Code::default();
-    let mut req_scope = Scope::default();
+/// A method over the parameters alone, `Model::requirements` (the margins) or
+/// `Model::restitutions` (no hoisting: they run before `prepare`, or without it).
+fn parameters_code(exprs: &[Expr], d: &Derivation) -> Code {
+    let mut code = Code::default();
+    let mut scope = Scope::default();
     for (i, p) in d.params.iter().enumerate() {
-        req_scope.constants.insert(p.name.clone(), i);
+        scope.constants.insert(p.name.clone(), i);
     }
-    let out = requirements.push_body(lower(&d.requirements, &req_scope, None, "q"));
-    requirements.outputs = out_lines(&out);
-    requirements
+    let out = code.push_body(lower(exprs, &scope, None, "q"));
+    code.outputs = out_lines(&out);
+    code
 }
 
 /// `Model::prepare` after the parameters: with a fast path, the per-point solver's constants
@@ -400,8 +404,12 @@ fn static_info(
     let lit = |s: &str| format!("{s:?}");
     let contacts_info = (d.contacts.iter())
         .map(|c| {
+            let restitution = (spec.contacts.iter())
+                .find(|s| s.name == c.name)
+                .and_then(|s| s.restitution.as_ref())
+                .map_or_else(|| "0".to_string(), |e| e.text());
             format!(
-                "ContactInfo {{ name: {:?}, meaning: {:?}, gap_unit: {:?}, unit: {:?}, bilateral: {}, edge: {}, eliminates: {:?}, closed: {} }}",
+                "ContactInfo {{ name: {:?}, meaning: {:?}, gap_unit: {:?}, unit: {:?}, bilateral: {}, edge: {}, eliminates: {:?}, closed: {}, restitution: {:?} }}",
                 c.name,
                 c.meaning,
                 c.gap_unit,
@@ -409,7 +417,8 @@ fn static_info(
                 c.bilateral,
                 c.edge.is_some(),
                 c.eliminates.as_deref(),
-                c.closed
+                c.closed,
+                restitution
             )
         })
         .collect();
@@ -1533,12 +1542,19 @@ const GRADIENT_HEAD: usize = 6;
 fn constraint_equations(d: &Derivation, name: &dyn Fn(&str) -> String, eqs: &mut Vec<Equation>) {
     let theta = d.theta().to_string();
     let sc = |e: &Expr| from_sc(e, &theta);
-    let open: Vec<&mechanics::ContactRow> = d.contacts.iter().filter(|c| !c.closed).collect();
-    for (k, c) in open.iter().enumerate() {
+    let open: Vec<(&mechanics::ContactRow, &Expr)> = (d.contacts.iter().zip(&d.restitutions))
+        .filter(|(c, _)| !c.closed)
+        .collect();
+    for (k, (c, e)) in open.iter().enumerate() {
         let kind = if c.bilateral {
-            "a joint: its gap stays zero and its force $\\lambda$ may have either sign"
+            "a joint: its gap stays zero and its force $\\lambda$ may have either sign".to_string()
         } else {
-            "a contact: its gap stays $\\ge 0$; while it is zero its force $\\lambda \\ge 0$ pushes"
+            format!(
+                "a contact: its gap stays $\\ge 0$; while it is zero its force $\\lambda \\ge 0$ \
+                 pushes; where it closes with an approach velocity $v^-$ it leaves with \
+                 $v^+ = -e\\,v^-$, $e = {}$",
+                sc(e).to_latex(name)
+            )
         };
         let mut gap = display(
             &format!(
@@ -1846,8 +1862,8 @@ pub fn json_record(checked: &Checked, d: &Derivation) -> serde_json::Value {
         Err(why) => ("integrated", why.clone()),
     };
     expressions.insert("lagrangian".into(), infix(&d.lagrangian));
-    let contacts: Vec<serde_json::Value> = (d.contacts.iter())
-        .map(|c| {
+    let contacts: Vec<serde_json::Value> = (d.contacts.iter().zip(&d.restitutions))
+        .map(|(c, e)| {
             let mut v = serde_json::json!({
                 "name": c.name,
                 "meaning": c.meaning,
@@ -1856,6 +1872,7 @@ pub fn json_record(checked: &Checked, d: &Derivation) -> serde_json::Value {
                 "bilateral": c.bilateral,
                 "eliminates": c.eliminates,
                 "closed": c.closed,
+                "restitution": infix(e),
             });
             match &c.force {
                 Some(f) => v["force"] = infix(f).into(),

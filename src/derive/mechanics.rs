@@ -471,6 +471,7 @@ fn derive_phase(
         monitors: monitor_names,
         monitors_full: list(&monitors_full, "monitor")?,
         requirements: parsed.requirements.clone(),
+        restitutions: parsed.restitutions.clone(),
         bodies: parsed.bodies.iter().map(|b| b.name.clone()).collect(),
         body_pose: body_poses(parsed, &lag)?,
         shapes: parsed.shapes.clone(),

@@ -48,6 +48,9 @@ pub struct Parsed {
     pub monitors: Vec<Expr>,
     /// The requirements on the parameters.
     pub requirements: Vec<Expr>,
+    /// Each contact's coefficient of restitution over the parameters (`0` where the spec
+    /// gives none).
+    pub restitutions: Vec<Expr>,
     /// Initial position and velocity per coordinate the spec gives.
     pub initial: BTreeMap<String, [Expr; 2]>,
     /// The drawing: the bodies' shapes, then the obstacles'.
@@ -138,6 +141,12 @@ pub fn read(spec: &Spec) -> Result<Parsed, DeriveError> {
     let requirements = (spec.requirements.iter().enumerate())
         .map(|(i, r)| parse_text(&r.expr, &entry("requirements", i, "expr")))
         .collect::<Result<_, _>>()?;
+    let restitutions = (spec.contacts.iter().enumerate())
+        .map(|(i, c)| match &c.restitution {
+            Some(e) => parse_text(e, &entry("contacts", i, "restitution")),
+            None => Ok(Expr::Rational(0, 1)),
+        })
+        .collect::<Result<_, _>>()?;
     let mut initial = BTreeMap::new();
     for (c, s) in &spec.initial {
         let path = [key("initial"), key(c)];
@@ -156,6 +165,7 @@ pub fn read(spec: &Spec) -> Result<Parsed, DeriveError> {
         friction,
         monitors,
         requirements,
+        restitutions,
         initial,
     })
 }

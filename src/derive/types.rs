@@ -267,6 +267,8 @@ pub struct Derivation {
     pub monitors_full: Vec<Expr>,
     /// Parameter requirements (over parameters).
     pub requirements: Vec<Expr>,
+    /// Each contact's coefficient of restitution (over parameters).
+    pub restitutions: Vec<Expr>,
     /// The bodies' names, in the spec's order.
     pub bodies: Vec<String>,
     /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the full state.

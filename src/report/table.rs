@@ -466,7 +466,13 @@ pub fn models(infos: &[&ModelInfo], layout: &Layout) -> String {
             2,
         ));
         out.push_str(&format!("\n  spec: {}\n", info.spec));
-        let contacts: Vec<&str> = info.contacts.iter().map(|c| c.name).collect();
+        // A contact with a restitution other than the plastic default says which.
+        let contacts: Vec<String> = (info.contacts.iter())
+            .map(|c| match c.restitution {
+                "0" => c.name.to_string(),
+                e => format!("{} (restitution {e})", c.name),
+            })
+            .collect();
         if !contacts.is_empty() {
             out.push_str("  ");
             out.push_str(&wrap(

@@ -12,6 +12,7 @@
 
 pub mod checks;
 pub mod contacts;
+pub mod impact;
 pub mod lean;
 pub mod ode;
 pub mod phases;

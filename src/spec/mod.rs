@@ -201,6 +201,11 @@ pub struct ContactSpec {
     /// A joint rather than a contact: closed for good, its force of either sign.
     #[serde(default)]
     pub bilateral: bool,
+    /// Newton's coefficient of restitution where the contact closes with an approach velocity:
+    /// an expression of the parameters in `[0, 1]` (0, the default: the bodies stay together;
+    /// 1: no energy is lost). A bilateral contact never closes, so it has none.
+    #[serde(default)]
+    pub restitution: Option<Text>,
 }
 
 /// Coulomb friction at a contact: its normal force is that contact's force.
@@ -943,6 +948,14 @@ impl Checker<'_> {
                     ),
                 ));
             }
+            if let Some(e) = &c.restitution {
+                expect(
+                    field.k("restitution"),
+                    e,
+                    Unit::DIMENSIONLESS,
+                    "a coefficient of restitution",
+                )?;
+            }
             // A torque and an energy are both kg m^2 s^-2: a multiplier is a torque.
             let force = if force_unit == Unit::JOULE {
                 "N m".to_string()
@@ -1040,6 +1053,42 @@ impl Checker<'_> {
                     ));
                 }
                 self.expr(&field.k("edge"), edge, &names.kinematic)?;
+            }
+            if let Some(e) = &c.restitution {
+                self.restitution(&field.k("restitution"), c, e, names)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// A contact's restitution: not on a bilateral contact, an expression of the parameters,
+    /// and a number in `[0, 1]` where it is one (an expression is checked when the parameters
+    /// are bound).
+    fn restitution(
+        &self,
+        field: &Field,
+        c: &ContactSpec,
+        e: &Text,
+        names: &Names,
+    ) -> Result<(), SpecError> {
+        if c.bilateral {
+            return Err(self.err(
+                field,
+                "a bilateral contact never closes on an approach, so it has no restitution".into(),
+            ));
+        }
+        let expr = self.expr(field, e, &names.params)?;
+        if expr.symbols().is_empty() {
+            let value = expr.eval(&|_| None);
+            if !(0.0..=1.0).contains(&value) {
+                return Err(self.err(
+                    field,
+                    format!(
+                        "the restitution of contact `{}` is {value}, outside [0, 1] (0: the \
+                         bodies stay together, 1: no energy is lost)",
+                        c.name
+                    ),
+                ));
             }
         }
         Ok(())

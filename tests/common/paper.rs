@@ -54,6 +54,7 @@ const fn contacts(tip: bool, floor: bool) -> [ContactInfo; 2] {
             edge: false,
             eliminates: Some("x2"),
             closed: tip,
+            restitution: "0",
         },
         ContactInfo {
             name: "floor_normal",
@@ -64,6 +65,7 @@ const fn contacts(tip: bool, floor: bool) -> [ContactInfo; 2] {
             edge: false,
             eliminates: Some("y1"),
             closed: floor,
+            restitution: "0",
         },
     ]
 }
@@ -243,6 +245,11 @@ impl Model for RodCube {
 
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
         out[0] = (p[2] - p[3]) / p[2];
+    }
+
+    fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
+        // The paper's contacts are plastic (the spec gives no restitution).
+        out.fill(0.0);
     }
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
@@ -520,6 +527,11 @@ impl Model for FreeRod {
         out[0] = (p[2] - p[3]) / p[2];
     }
 
+    fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
+        // The paper's contacts are plastic (the spec gives no restitution).
+        out.fill(0.0);
+    }
+
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
         let (ell, g, th, v1, om) = (p[2], p[4], p[6], p[8], p[9]);
         k[..11].copy_from_slice(p);
@@ -738,6 +750,11 @@ impl Model for General {
 
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
         out[0] = (p[2] - p[3]) / p[2];
+    }
+
+    fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
+        // The paper's contacts are plastic (the spec gives no restitution).
+        out.fill(0.0);
     }
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {

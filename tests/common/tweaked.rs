@@ -80,6 +80,9 @@ impl Model for Tweaked {
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
         self.base.requirements(p, out)
     }
+    fn restitutions(&self, p: &[f64], out: &mut [f64]) {
+        self.base.restitutions(p, out)
+    }
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
         self.base.prepare(p, k)
     }
