@@ -210,19 +210,13 @@ pub fn measure_one(
     budget: &Budget,
 ) -> Row {
     let rtol = 10f64.powi(-k);
-    let mut row = Row {
-        model: m.model,
-        measured: Measured::ContactEnd,
-        case: m.case,
-        label: label(method),
-        setting: format!("rtol 1e-{k}"),
-        error: f64::NAN,
-        evals: 0,
-        steps: None,
-        setup_seconds: None,
-        seconds: 0.0,
-        note: String::new(),
-    };
+    let mut row = Row::unmeasured(
+        m.model,
+        Measured::ContactEnd,
+        m.case,
+        label(method),
+        format!("rtol 1e-{k}"),
+    );
     let Some(model) = crate::models::find(m.model) else {
         row.note = format!("no model `{}`", m.model);
         return row;

@@ -160,6 +160,31 @@ pub struct Row {
     pub note: String,
 }
 
+impl Row {
+    /// A setting not measured yet: no error (NaN), no evaluations, no time, no note.
+    pub fn unmeasured(
+        model: &'static str,
+        measured: Measured,
+        case: &'static str,
+        label: &'static str,
+        setting: String,
+    ) -> Row {
+        Row {
+            model,
+            measured,
+            case,
+            label,
+            setting,
+            error: f64::NAN,
+            evals: 0,
+            steps: None,
+            setup_seconds: None,
+            seconds: 0.0,
+            note: String::new(),
+        }
+    }
+}
+
 /// The reference values of one case, with the agreement of the two routes.
 #[derive(Debug, Clone)]
 pub struct CaseReference {
@@ -585,19 +610,7 @@ fn run_case(
     };
     let mut rows = Vec::new();
     let row = |measured, s: &dyn Labelled, outcome: Result<(f64, Measurement<()>), String>| {
-        let mut r = Row {
-            model,
-            measured,
-            case: case.key,
-            label: s.label(),
-            setting: s.setting(),
-            error: f64::NAN,
-            evals: 0,
-            steps: None,
-            setup_seconds: None,
-            seconds: 0.0,
-            note: String::new(),
-        };
+        let mut r = Row::unmeasured(model, measured, case.key, s.label(), s.setting());
         match outcome {
             Ok((error, m)) => {
                 r.error = error;
