@@ -6,6 +6,7 @@
 //! fall, turns back, breaks or lets another contact go inside the phase gets a typed error,
 //! never a number.
 
+#[macro_use]
 mod common;
 
 use common::paper::ROD_CUBE;
@@ -468,57 +469,14 @@ impl FloorLetsGo {
 }
 
 impl Model for FloorLetsGo {
+    forward_model!(|_: &Self| &ROD_CUBE; requirements, restitutions, prepare, initial_state, points, energy, momenta, equations, gaps, constraints, edges, friction, monitors_full, to_full, drawing);
+
     fn info(&self) -> &'static ModelInfo {
         self.info
-    }
-    fn requirements(&self, p: &[f64], out: &mut [f64]) {
-        ROD_CUBE.requirements(p, out)
-    }
-    fn restitutions(&self, p: &[f64], out: &mut [f64]) {
-        ROD_CUBE.restitutions(p, out)
-    }
-    fn prepare(&self, p: &[f64], k: &mut [f64]) {
-        ROD_CUBE.prepare(p, k)
-    }
-    fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        ROD_CUBE.initial_state(k, q, qd)
-    }
-    fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        ROD_CUBE.points(k, q, qd, pos, vel)
-    }
-    fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        ROD_CUBE.energy(k, q, qd)
-    }
-    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        ROD_CUBE.momenta(k, q, qd, out)
-    }
-    fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        ROD_CUBE.equations(k, q, qd, mass, rhs)
     }
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
         ROD_CUBE.forces_full(k, q, qd, qdd, out);
         out[1] = self.floor_force(k, q[1].sin());
-    }
-    fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        ROD_CUBE.gaps(k, q, out)
-    }
-    fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        ROD_CUBE.constraints(k, q, qd, jac, bias)
-    }
-    fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        ROD_CUBE.edges(k, q, out)
-    }
-    fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        ROD_CUBE.friction(k, q, qd, jac, bias)
-    }
-    fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], f: &[f64], out: &mut [f64]) {
-        ROD_CUBE.monitors_full(k, q, qd, f, out)
-    }
-    fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        ROD_CUBE.to_full(k, q, qd, q_full, qd_full)
-    }
-    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        ROD_CUBE.drawing(k, q, poses, sizes)
     }
     fn reduction(&self) -> Option<&dyn Reduction> {
         Some(self)

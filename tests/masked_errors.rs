@@ -3,6 +3,7 @@
 //! returns a typed error or records why, and each is driven here by a tweaked model or a crafted
 //! input.
 
+#[macro_use]
 mod common;
 
 use common::paper::{GENERAL, MODELS, paper};
@@ -25,58 +26,12 @@ use std::sync::OnceLock;
 struct MasslessCube;
 
 impl Model for MasslessCube {
-    fn info(&self) -> &'static ModelInfo {
-        GENERAL.info()
-    }
-    fn requirements(&self, p: &[f64], out: &mut [f64]) {
-        GENERAL.requirements(p, out)
-    }
-    fn restitutions(&self, p: &[f64], out: &mut [f64]) {
-        GENERAL.restitutions(p, out)
-    }
-    fn prepare(&self, p: &[f64], k: &mut [f64]) {
-        GENERAL.prepare(p, k)
-    }
-    fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        GENERAL.initial_state(k, q, qd)
-    }
-    fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        GENERAL.points(k, q, qd, pos, vel)
-    }
-    fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        GENERAL.energy(k, q, qd)
-    }
-    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        GENERAL.momenta(k, q, qd, out)
-    }
+    forward_model!(|_: &Self| &GENERAL; info, requirements, restitutions, prepare, initial_state, points, energy, momenta, forces_full, gaps, constraints, edges, friction, monitors_full, to_full, drawing);
+
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
         GENERAL.equations(k, q, qd, mass, rhs);
         // The cube's row and column of the mass matrix (x2 is the last of four coordinates).
         mass[15] = 0.0;
-    }
-    fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        GENERAL.forces_full(k, q, qd, qdd, out)
-    }
-    fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        GENERAL.gaps(k, q, out)
-    }
-    fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        GENERAL.constraints(k, q, qd, jac, bias)
-    }
-    fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        GENERAL.edges(k, q, out)
-    }
-    fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        GENERAL.friction(k, q, qd, jac, bias)
-    }
-    fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], f: &[f64], out: &mut [f64]) {
-        GENERAL.monitors_full(k, q, qd, f, out)
-    }
-    fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        GENERAL.to_full(k, q, qd, q_full, qd_full)
-    }
-    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        GENERAL.drawing(k, q, poses, sizes)
     }
     fn reduction(&self) -> Option<&dyn Reduction> {
         None
@@ -239,33 +194,14 @@ impl OneContact {
 }
 
 impl Model for OneContact {
+    forward_model!(|m: &Self| m.base; requirements, prepare, initial_state, points, energy, momenta, equations, friction, to_full, drawing);
+
     fn info(&self) -> &'static ModelInfo {
         one_contact_info(self.base.info())
-    }
-    fn requirements(&self, p: &[f64], out: &mut [f64]) {
-        self.base.requirements(p, out)
     }
     fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
         // The one contact kept is the base's first, which is plastic (the spec gives it none).
         out.fill(0.0);
-    }
-    fn prepare(&self, p: &[f64], k: &mut [f64]) {
-        self.base.prepare(p, k)
-    }
-    fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        self.base.initial_state(k, q, qd)
-    }
-    fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        self.base.points(k, q, qd, pos, vel)
-    }
-    fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        self.base.energy(k, q, qd)
-    }
-    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        self.base.momenta(k, q, qd, out)
-    }
-    fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        self.base.equations(k, q, qd, mass, rhs)
     }
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
         Self::first(out, |both| self.base.forces_full(k, q, qd, qdd, both))
@@ -283,16 +219,7 @@ impl Model for OneContact {
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
         Self::first(out, |both| self.base.edges(k, q, both))
     }
-    fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        self.base.friction(k, q, qd, jac, bias)
-    }
     fn monitors_full(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _f: &[f64], _out: &mut [f64]) {}
-    fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        self.base.to_full(k, q, qd, q_full, qd_full)
-    }
-    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        self.base.drawing(k, q, poses, sizes)
-    }
     fn reduction(&self) -> Option<&dyn Reduction> {
         Some(self)
     }

@@ -71,35 +71,13 @@ fn without_fall(info: &'static ModelInfo) -> &'static ModelInfo {
 }
 
 impl Model for Tweaked {
+    forward_model!(|m: &Self| m.base; requirements, restitutions, prepare, initial_state, points, energy, momenta, equations, gaps, constraints, edges, friction, to_full, drawing);
+
     fn info(&self) -> &'static ModelInfo {
         match self.theta_dot_sq {
             Fault::None => self.base.info(),
             _ => without_fall(self.base.info()),
         }
-    }
-    fn requirements(&self, p: &[f64], out: &mut [f64]) {
-        self.base.requirements(p, out)
-    }
-    fn restitutions(&self, p: &[f64], out: &mut [f64]) {
-        self.base.restitutions(p, out)
-    }
-    fn prepare(&self, p: &[f64], k: &mut [f64]) {
-        self.base.prepare(p, k)
-    }
-    fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        self.base.initial_state(k, q, qd)
-    }
-    fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        self.base.points(k, q, qd, pos, vel)
-    }
-    fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        self.base.energy(k, q, qd)
-    }
-    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        self.base.momenta(k, q, qd, out)
-    }
-    fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        self.base.equations(k, q, qd, mass, rhs)
     }
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
         self.base.forces_full(k, q, qd, qdd, out);
@@ -109,30 +87,11 @@ impl Model for Tweaked {
             *last = f64::NAN;
         }
     }
-    fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        self.base.gaps(k, q, out)
-    }
-    fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        self.base.constraints(k, q, qd, jac, bias)
-    }
-    fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        self.base.edges(k, q, out)
-    }
-    fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        self.base.friction(k, q, qd, jac, bias);
-    }
-
     fn monitors_full(&self, k: &[f64], q: &[f64], qd: &[f64], f: &[f64], out: &mut [f64]) {
         self.base.monitors_full(k, q, qd, f, out);
         for v in out.iter_mut() {
             *v += self.monitor_shift;
         }
-    }
-    fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        self.base.to_full(k, q, qd, q_full, qd_full)
-    }
-    fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        self.base.drawing(k, q, poses, sizes)
     }
     fn reduction(&self) -> Option<&dyn Reduction> {
         Some(self)
