@@ -4,7 +4,7 @@
 
 use clap::{Args, Parser, Subcommand};
 use rodcube::io::{OutDir, check_name};
-use rodcube::plan::{self, PlanError, Request};
+use rodcube::plan::{self, PlanError};
 use rodcube::report;
 use rodcube::results::RunResults;
 use rodcube::scene::{Kind, Scene, SceneError};
@@ -309,10 +309,7 @@ fn default_out_dir(scene: &Scene) -> Result<PathBuf, Failure> {
 
 /// The one call into the planner ([`rodcube::plan::run`]).
 fn solve(scene: &Scene) -> Result<RunResults, Failure> {
-    let request = Request::new(scene.model, scene.parameters.clone())
-        .with_want(&scene.want)
-        .with_tolerance(scene.tolerance)
-        .with_samples(scene.samples);
+    let request = scene.request();
     plan::run(&request).map_err(|e| planner_failure(scene, e))
 }
 
@@ -339,6 +336,7 @@ fn planner_failure(scene: &Scene, error: PlanError) -> Failure {
         }
         PlanError::Unavailable { .. } => at("want".into(), Kind::UnavailableQuantity),
         PlanError::BadTolerance { .. } => at("tolerance".into(), Kind::OutOfRange),
+        PlanError::BadUntil { .. } => at("until".into(), Kind::OutOfRange),
         PlanError::TooFewSamples { .. } | PlanError::TooManySamples { .. } => {
             at("samples".into(), Kind::OutOfRange)
         }

@@ -35,6 +35,7 @@ fn strike() -> (Bound<'static>, State, f64) {
         tol: 1e-12,
         rtol: 1e-13,
         route: Route::Integrated,
+        until: None,
     };
     let (start, opened) = w.release().unwrap();
     assert_eq!(opened, [0], "the cylinder opens at release");

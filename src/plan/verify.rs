@@ -7,16 +7,17 @@ use crate::solve::SolveError;
 use crate::solve::checks::{self, Conserved, free_momenta};
 use crate::solve::phases::{End, PhaseRun};
 use crate::solve::series::{sample_forces, theta_dot_at};
-use crate::solve::unreduced::{EndEvent, UnreducedRun};
+use crate::solve::unreduced::UnreducedRun;
 
 /// The event of an integrated run in words.
 fn event_words(run: &UnreducedRun, info: &crate::model::ModelInfo) -> String {
     let name = |i: usize| info.contacts.get(i).map_or("a contact", |c| c.name);
     match run.end {
-        EndEvent::Force(i) => format!("contact `{}`'s force crossing zero", name(i)),
-        EndEvent::Edge(i) => format!("contact `{}`'s edge", name(i)),
-        EndEvent::Gap(i) => format!("contact `{}` closing", name(i)),
-        EndEvent::Floor => "the floor".into(),
+        End::Force(i) => format!("contact `{}`'s force crossing zero", name(i)),
+        End::Edge(i) => format!("contact `{}`'s edge", name(i)),
+        End::Contact(i) => format!("contact `{}` closing", name(i)),
+        End::Floor => "the floor".into(),
+        End::Until => "the run's end".into(),
     }
 }
 

@@ -171,7 +171,7 @@ impl Animation {
             let cause = match phase.end {
                 End::Force(c) => Some(format!("{} lets go", name(c))),
                 End::Edge(c) => Some(format!("{} runs off an edge", name(c))),
-                End::Contact(_) | End::Floor => None,
+                End::Contact(_) | End::Floor | End::Until => None,
             };
             if anim.contact_end.is_none()
                 && let Some(cause) = cause

@@ -193,9 +193,10 @@ pub fn render(results: &RunResults, info: Option<&ModelInfo>, layout: &Layout) -
     if !results.results.is_empty() || !results.labels.is_empty() {
         scalars(&mut out, results, layout);
     }
-    // Wanted quantities without a value, and why.
+    // Wanted quantities without a value and why, and what the motion's end and its impacts
+    // need said.
     if !results.notes.is_empty() {
-        let mut t = new_table(&["quantity", "why it has no value"], layout);
+        let mut t = new_table(&["about", "note"], layout);
         for (key, why) in &results.notes {
             t.add_row(vec![key.clone(), why.clone()]);
         }

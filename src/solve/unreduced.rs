@@ -38,7 +38,9 @@ use crate::solve::SolveError;
 use crate::solve::contacts::{
     self, Active, ContactOption, DECIDE_TOLERANCE, Dynamics, FrictionOption, Mode, Options,
 };
-use crate::solve::ode::{Method, OdeOptions, OdeProblem, OdeSolution, integrate as ode_integrate};
+use crate::solve::ode::{
+    Event, Method, OdeOptions, OdeProblem, OdeSolution, integrate as ode_integrate,
+};
 use crate::system::{Bound, State};
 use nalgebra::DMatrix;
 
@@ -76,17 +78,40 @@ pub fn mass_condition(sys: &Bound, state: &State) -> Result<f64, SolveError> {
     })
 }
 
-/// How an integrated phase ended.
+/// Why a phase ended (integrated or on the fast path).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum EndEvent {
-    /// A closed contact's force reached zero: it opens.
+pub enum End {
+    /// A closed contact's force reached zero: it opens (the first contact's is the separation).
     Force(usize),
-    /// A closed contact's point ran off its edge.
+    /// A closed contact's point ran off the edge of a body.
     Edge(usize),
     /// An open contact's gap closed: the bodies meet.
-    Gap(usize),
-    /// The reduced angle reached the model's end angle.
+    Contact(usize),
+    /// The reduced angle reached the model's end angle (the rod lies on the floor).
     Floor,
+    /// The run reached the time it was asked to go on to (a scene's `until`).
+    Until,
+}
+
+impl End {
+    /// `"force"`, `"edge"`, `"contact"`, `"floor"` or `"until"`.
+    pub fn cause(self) -> &'static str {
+        match self {
+            End::Force(_) => "force",
+            End::Edge(_) => "edge",
+            End::Contact(_) => "contact",
+            End::Floor => "floor",
+            End::Until => "until",
+        }
+    }
+
+    /// The contact the event is about (none at the floor or the run's end).
+    pub fn contact(self) -> Option<usize> {
+        match self {
+            End::Force(i) | End::Edge(i) | End::Contact(i) => Some(i),
+            End::Floor | End::Until => None,
+        }
+    }
 }
 
 /// What an event function measures.
@@ -140,7 +165,7 @@ pub struct UnreducedRun {
     /// Condition number of the mass matrix at the start.
     pub condition: f64,
     /// Which event ended it.
-    pub end: EndEvent,
+    pub end: End,
     /// Time of that event (s from the phase's start).
     pub t_end: f64,
     /// The state there.
@@ -545,13 +570,31 @@ pub struct Start {
     pub frictions: Vec<FrictionOption>,
     /// Work done by friction before the start (J).
     pub friction_work: f64,
+    /// Where the run is asked to stop (s from this start) if no event comes first: it then
+    /// ends there with [`End::Until`]. `None`: only an event ends it.
+    pub stop_at: Option<f64>,
+}
+
+/// The end of a solution that reached the start's `stop_at` without an event, as an event at
+/// that time (its index is never read).
+fn until_event(solution: &OdeSolution, stop_at: Option<f64>) -> Option<Event> {
+    let stop = stop_at?;
+    let last = solution.steps.last()?;
+    let reached = (solution.t_final() - stop).abs() <= 4.0 * f64::EPSILON * stop.abs();
+    reached.then(|| Event {
+        index: usize::MAX,
+        t: stop,
+        y: last.y1.clone(),
+    })
 }
 
 /// Integrates `sys` from `start` until an event ends the phase, with relative tolerance
 /// `rtol` (raised to [`CONDITION_SAFETY`]` * eps * cond(M)`) by the method
 /// [`Method::for_rtol`] picks for it. `scales` (length `2 n`), when given, are typical
 /// magnitudes of the motion `y - y0` for the absolute tolerances; without them the control is
-/// relative to the largest deviation seen. `t_max` bounds the search.
+/// relative to the largest deviation seen. `t_max` bounds the search: reaching it is
+/// [`SolveError::NoEvent`], unless the start's `stop_at` comes first (the run then ends there,
+/// [`End::Until`]).
 pub fn integrate(
     sys: &Bound,
     start: &Start,
@@ -633,10 +676,11 @@ pub fn integrate_with(
         let e = sys.energy(&start.state)?.abs();
         atol.push(rtol * if e > 0.0 { e } else { 1.0 });
     }
+    let stop_at = start.stop_at.filter(|s| *s <= t_max);
     let opts = OdeOptions {
         rtol,
         atol,
-        t_max,
+        t_max: stop_at.unwrap_or(t_max),
         max_steps: MAX_STEPS,
     };
     let mut segments = Vec::new();
@@ -646,7 +690,11 @@ pub fn integrate_with(
         work.ode_evaluations += std::mem::take(&mut problem.evaluations);
         let solution = solution?;
         work.ode_steps += solution.total_steps();
-        let Some(event) = solution.event.clone() else {
+        let Some(event) = solution
+            .event
+            .clone()
+            .or_else(|| until_event(&solution, stop_at))
+        else {
             return Err(SolveError::NoEvent { t_max });
         };
         let y: Vec<f64> = (event.y.iter().zip(&y0)).map(|(z, y0)| y0 + z).collect();
@@ -660,6 +708,18 @@ pub fn integrate_with(
             q: y[..n].to_vec(),
             qd: y[n..2 * n].to_vec(),
         };
+        if segments.last().is_some_and(|g| g.solution.event.is_none()) {
+            return Ok(UnreducedRun {
+                segments,
+                rtol,
+                method,
+                condition,
+                end: End::Until,
+                t_end: event.t,
+                friction_work: if with_work { y[2 * n] } else { 0.0 },
+                state_end: state,
+            });
+        }
         let watch =
             problem
                 .watches
@@ -671,10 +731,10 @@ pub fn integrate_with(
                     y: y.clone(),
                 })?;
         let end = match watch {
-            Watch::Force(i) => Some(EndEvent::Force(i)),
-            Watch::Gap(i) => Some(EndEvent::Gap(i)),
-            Watch::Edge(i) => Some(EndEvent::Edge(i)),
-            Watch::Floor => Some(EndEvent::Floor),
+            Watch::Force(i) => Some(End::Force(i)),
+            Watch::Gap(i) => Some(End::Contact(i)),
+            Watch::Edge(i) => Some(End::Edge(i)),
+            Watch::Floor => Some(End::Floor),
             _ => None,
         };
         if let Some(end) = end {
