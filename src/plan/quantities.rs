@@ -39,11 +39,8 @@ pub(super) enum Fate {
 
 /// Contact `i`'s fate on `motion` as far as it is solved; `None` when the phases solved so
 /// far do not tell yet.
-pub(super) fn fate(
-    motion: &Motion,
-    info: &ModelInfo,
-    i: usize,
-) -> Result<Option<Fate>, SolveError> {
+pub(super) fn fate(motion: &Motion, general: &Bound, i: usize) -> Result<Option<Fate>, SolveError> {
+    let info = general.info();
     let Some(first) = motion.phases.first() else {
         return Ok(None);
     };
@@ -56,11 +53,18 @@ pub(super) fn fate(
             cause: "force",
         }));
     }
-    Ok(fate_along(motion, info, i))
+    // A run that ends where a contact closes with the body on the floor (the floor under the
+    // rod's end a contact) ends at its landing: the contacts still closed held to it.
+    let landed = match (motion.through_impacts, motion.phases.last()) {
+        (false, Some(last)) if matches!(last.end(), End::Contact(_)) => is_landing(general, last)?,
+        _ => false,
+    };
+    Ok(fate_along(motion, info, i, landed))
 }
 
-/// [`fate`] for a contact that did not open at release.
-fn fate_along(motion: &Motion, info: &ModelInfo, i: usize) -> Option<Fate> {
+/// [`fate`] for a contact that did not open at release; `landed`: the motion ends at a landing
+/// where a contact closes.
+fn fate_along(motion: &Motion, info: &ModelInfo, i: usize, landed: bool) -> Option<Fate> {
     let first = motion.phases.first()?;
     if !first.closed().get(i).copied().unwrap_or(false) {
         return Some(Fate::NeverClosed);
@@ -75,6 +79,15 @@ fn fate_along(motion: &Motion, info: &ModelInfo, i: usize) -> Option<Fate> {
         match phase.end() {
             End::Force(j) if j == i => return Some(ended("force")),
             End::Edge(j) if j == i => return Some(ended("edge")),
+            End::Contact(j) if !motion.through_impacts && landed => {
+                return Some(Fate::Held {
+                    until: format!(
+                        "until the body lands, where contact `{}` closes at t = {} s",
+                        name(j),
+                        format_number(phase.t_end(), 6)
+                    ),
+                });
+            }
             End::Contact(_) if !motion.through_impacts => return Some(ended("contact")),
             End::Contact(_) => {
                 // An impact: it may have separated this contact.
@@ -188,10 +201,10 @@ fn cause_words(cause: &str) -> &'static str {
 impl Plan<'_> {
     /// Contact `i`'s fate, solving the motion as far as needed.
     pub(super) fn fate(&mut self, i: usize) -> Result<Fate, SolveError> {
-        let info = self.general().info();
+        let general = self.general().clone();
         // An error stops the extension; the call after it returns that error.
-        let motion = self.extend_until(|m| !matches!(fate(m, info, i), Ok(None)))?;
-        fate(motion, info, i)?.ok_or(SolveError::TooManyPhases {
+        let motion = self.extend_until(|m| !matches!(fate(m, &general, i), Ok(None)))?;
+        fate(motion, &general, i)?.ok_or(SolveError::TooManyPhases {
             limit: crate::solve::phases::MAX_PHASES,
         })
     }

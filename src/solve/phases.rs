@@ -14,10 +14,11 @@
 //! absolute time of its start is kept in [`PhaseRun::t_start`].
 
 use crate::model::{Model, ModelInfo};
-use crate::results::Work;
+use crate::results::{Work, format_number};
 use crate::solve::SolveError;
 use crate::solve::contacts::{
-    self, Active, ContactOption, FrictionOption, Moment, Options, contact_options, friction_options,
+    self, Active, ContactOption, DECIDE_TOLERANCE, FrictionOption, Moment, Options,
+    contact_options, friction_options,
 };
 use crate::solve::impact::{self, Impact, Part};
 use crate::solve::ode::Method;
@@ -248,7 +249,7 @@ fn first_gap_closing(
         let t = mesh.time_at_delta(sys, delta, work)?;
         Ok(sys.full_state(t, delta, theta_dot_at(sys, delta))?)
     };
-    let tol = contacts::DECIDE_TOLERANCE * sys.length_scale(&state_at(0.0, work)?)?;
+    let tol = DECIDE_TOLERANCE * sys.length_scale(&state_at(0.0, work)?)?;
     let mut best: Option<(usize, f64)> = None;
     for &i in &open {
         let mut gap = |delta: f64| -> Result<f64, SolveError> {
@@ -339,7 +340,7 @@ impl<'m> PhaseRun<'m> {
     pub fn end(&self) -> End {
         match self {
             PhaseRun::Reduced(r) => r.end.end,
-            PhaseRun::Integrated(r) => r.run.end.into(),
+            PhaseRun::Integrated(r) => r.run.end,
         }
     }
 
@@ -439,12 +440,18 @@ impl<'m> PhaseRun<'m> {
     }
 }
 
-/// `sqrt(2 h / g)` for the height `h` of the falling point at `state` (`sqrt(2 m / g)` when it
-/// is on the floor): the time scale of the motion.
+/// `sqrt(2 h / g)` for the height `h` of the falling point at `state` (the system's length
+/// scale in place of a height within [`LANDING_TOLERANCE`] of it: a body lying on the floor):
+/// the time scale of the motion.
 pub fn fall_time_scale(bound: &Bound, state: &State) -> Result<f64, SolveError> {
     let info = bound.info();
     let h = bound.points(state)?.pos[info.falling_point][1];
-    let h = if h > 0.0 { h } else { 1.0 };
+    let length = bound.length_scale(state)?;
+    let h = if h > LANDING_TOLERANCE * length {
+        h
+    } else {
+        length
+    };
     Ok((2.0 * h / bound.gravity()).sqrt())
 }
 
@@ -724,7 +731,7 @@ impl<'m> Walker<'m> {
             return Ok(run);
         };
         let local = until - run.t_start;
-        if run.t_start + run.mesh.duration <= until || !(local > 0.0) {
+        if run.t_start + run.mesh.duration <= until || local.is_nan() || local <= 0.0 {
             return Ok(run);
         }
         let delta = delta_at_time(&run.system, &run.mesh, local, work)?;
@@ -775,16 +782,11 @@ impl<'m> Walker<'m> {
             friction_work: start.friction_work,
             stop_at: self.until.map(|u| u - start.t),
         };
-        let run = unreduced::integrate_with(
-            &bound,
-            &from,
-            self.rtol,
-            method,
-            Some(&scales),
-            time * MAX_FALL_TIMES,
-            work,
-        )
-        .map_err(|e| at_time(e, start.t))?;
+        // A run with an end time may go on to it however long its phases last.
+        let t_max = (time * MAX_FALL_TIMES).max(from.stop_at.unwrap_or(0.0));
+        let run =
+            unreduced::integrate_with(&bound, &from, self.rtol, method, Some(&scales), t_max, work)
+                .map_err(|e| at_time(e, start.t))?;
         if run.end == End::Floor {
             self.landed(&run.state_end, start.t + run.t_end)?;
         }
@@ -860,9 +862,21 @@ impl<'m> Walker<'m> {
             }
             End::Contact(i) => {
                 let at = self.impact(motion, i)?;
-                let start = self.after_impact(&at, friction_work)?;
+                let start = self.after_impact(&at, friction_work);
                 motion.impacts.push(at);
-                start
+                match start {
+                    Ok(start) => start,
+                    // An impact that leaves the system at rest ends its motion.
+                    Err(SolveError::AtRest { t, how, .. }) => {
+                        motion.halted = Some(format!(
+                            "the system comes to rest at the impact at t = {} s, held {how}, and \
+                             stays so",
+                            format_number(t, 9)
+                        ));
+                        return Ok(());
+                    }
+                    Err(e) => return Err(e),
+                }
             }
             _ => self.after(last_phase(motion)?)?,
         };
@@ -874,7 +888,7 @@ impl<'m> Walker<'m> {
     /// The impact that ends the motion's last phase, where contact `closing` closed: every
     /// contact closed then, `closing` and any other open one that touches while approaching take
     /// part; a contact with friction taking part is [`SolveError::FrictionalImpact`]. Bounces
-    /// converging as Zeno's ([`zeno_limit`]) are closed by a plastic impact, with a note.
+    /// converging as Zeno's (`zeno_limit`) are closed by a plastic impact, with a note.
     pub fn impact(&self, motion: &mut Motion<'m>, closing: usize) -> Result<ImpactAt, SolveError> {
         let general = &self.general;
         let info = general.info();
@@ -903,18 +917,29 @@ impl<'m> Walker<'m> {
                 contact: info.contacts[f.contact].name,
             });
         }
-        let limit = zeno_limit(&motion.impacts, closing, t, self.tol);
+        let name = info.contacts[closing].name;
         let mut restitution = general.restitutions().to_vec();
+        let limit = zeno_limit(&motion.impacts, closing, t, self.tol);
         if limit.is_some() {
-            restitution.iter_mut().for_each(|e| *e = 0.0);
+            restitution[closing] = 0.0;
         }
-        let impact = impact::resolve_with(general, &state, &parts, &restitution, t)?;
+        let mut impact = impact::resolve_with(general, &state, &parts, &restitution, t)?;
+        let mut plastic = limit.is_some();
         if let Some((ratio, t_limit, bounces)) = limit {
             motion.notes.push(format!(
-                "contact `{}` bounced {bounces} times with intervals shrinking by a steady ratio \
-                 {ratio:.4} (Zeno): their limit is t = {t_limit:.12} s, within the run's \
-                 tolerance of the bounce at t = {t:.12} s, which was made plastic for the rest",
-                info.contacts[closing].name
+                "contact `{name}` bounced {bounces} times with intervals shrinking by a steady \
+                 ratio {ratio:.4} (Zeno): their limit is t = {t_limit:.12} s, within the run's \
+                 tolerance of the bounce at t = {t:.12} s, which was made plastic for the rest"
+            ));
+        } else if let Some(rise) = self.unresolved_bounce(&impact, &parts, closing, t)? {
+            restitution[closing] = 0.0;
+            impact = impact::resolve_with(general, &state, &parts, &restitution, t)?;
+            plastic = true;
+            motion.notes.push(format!(
+                "contact `{name}` would bounce at t = {t:.12} s by {rise:.3e} of the length \
+                 scale, below the {DECIDE_TOLERANCE:e} at which a gap counts as open: the bounces \
+                 from there (a converging Zeno sequence) are taken as one plastic impact, so the \
+                 motion after it runs early by about their duration"
             ));
         }
         Ok(ImpactAt {
@@ -923,8 +948,50 @@ impl<'m> Walker<'m> {
             closing,
             parts,
             impact,
-            zeno: limit.is_some(),
+            zeno: plastic,
         })
+    }
+
+    /// How high (relative to the system's length scale) contact `closing` would rise after
+    /// `impact`, where that is below [`DECIDE_TOLERANCE`] (the gap at which a contact counts as
+    /// open): its normal velocity after squared over twice its normal acceleration pulling it
+    /// back, with it open and the other contacts decided at the state after. `None` for a
+    /// contact that stays closed, is not pulled back, or rises clear.
+    fn unresolved_bounce(
+        &self,
+        impact: &Impact,
+        parts: &[Part],
+        closing: usize,
+        t: f64,
+    ) -> Result<Option<f64>, SolveError> {
+        let u = impact.normal_velocity_after[closing];
+        if u <= 0.0 {
+            return Ok(None);
+        }
+        let state = &impact.after;
+        let held: Vec<bool> = parts.iter().map(|p| *p != Part::None).collect();
+        let moment = Moment::After {
+            t,
+            held: &held,
+            drift: self.tol,
+        };
+        let options = Options {
+            contacts: contact_options(&self.general, state, moment)?,
+            frictions: friction_options(&self.general, state)?,
+        };
+        let active = contacts::decide(&self.general, state, &options, t)?;
+        let pull = -contacts::dynamics(&self.general, state, &active, t)?.normal_acc[closing];
+        if pull <= 0.0 {
+            return Ok(None);
+        }
+        let info = self.general.info();
+        let scale = if info.contacts[closing].gap_unit == "m" {
+            self.general.length_scale(state)?
+        } else {
+            1.0
+        };
+        let rise = u * u / (2.0 * pull) / scale;
+        Ok((rise < DECIDE_TOLERANCE).then_some(rise))
     }
 
     /// What follows an impact at the end of `run`: the contacts decided again at the state
@@ -979,7 +1046,7 @@ fn approaching_touches(sys: &Bound, state: &State) -> Result<Vec<bool>, SolveErr
             let v: f64 = (jac[i * n..(i + 1) * n].iter().zip(&state.qd))
                 .map(|(j, q)| j * q)
                 .sum();
-            !c.closed && !c.bilateral && gaps[i] <= contacts::DECIDE_TOLERANCE * scale && v < 0.0
+            !c.closed && !c.bilateral && gaps[i] <= DECIDE_TOLERANCE * scale && v < 0.0
         })
         .collect())
 }

@@ -475,12 +475,13 @@ impl OdeProblem for Problem<'_, '_> {
                 let watch = self.watches[k];
                 let arm_at = self.arm_at_for(watch);
                 // A gap or edge margin clear of zero on the wrong side (one that opened and
-                // closed again within one step: the bodies now overlap) goes through, and the
-                // integrator locates where it crossed.
+                // closed again without growing past `arm_at`, or within one step: the bodies
+                // now overlap) goes through and arms, so that the integrator locates where it
+                // crossed zero itself (its values inside the step are the true ones).
                 let through = matches!(watch, Watch::Gap(_) | Watch::Edge(_)) && *v < -arm_at;
-                if *v > arm_at {
+                if *v > arm_at || through {
                     self.armed[k] = true;
-                } else if !through {
+                } else {
                     // Unarmed: no crossing while it has not grown clear of zero.
                     *v = 1.0;
                 }
