@@ -1,8 +1,11 @@
 //! Impacts in the reports, from impacts built here: `impacts.csv` has its documented header and
 //! reads back exactly, the printed table has a row per contact with the closing one and the
-//! Zeno limit marked, and `write_all` writes `impacts.csv` only when the run has impacts.
+//! Zeno limit marked, `write_all` writes `impacts.csv` only when the run has impacts, and
+//! `motion.svg` has a star per impact with a place; and for `fixed_cylinder` run through its
+//! impact, the animation marks that impact where the rod meets the cylinder.
 
 use rodcube::io::OutDir;
+use rodcube::report::motion::{self, Animation, Frame, ImpactMark, PhaseSpan};
 use rodcube::report::{self, csv, table};
 use rodcube::results::{ContactImpulse, ImpactRecord, RunResults};
 use std::fs;
@@ -254,5 +257,110 @@ fn write_all_writes_impacts_csv_only_when_the_run_has_impacts() {
         on_disk,
         ["impacts.csv", "results.json"],
         "no temporary files"
+    );
+}
+
+/// A rod falling by its centre over 21 frames of two phases, with an impact at the phase
+/// boundary and one at the end.
+fn animation(impacts: Vec<ImpactMark>) -> Animation {
+    let frames = (0..=20)
+        .map(|i| {
+            let t = 0.01 * i as f64;
+            Frame {
+                t,
+                phase: usize::from(i > 10),
+                poses: vec![[0.0, 1.0 - t, 0.3]],
+                traced: None,
+            }
+        })
+        .collect();
+    Animation {
+        model: "falling".into(),
+        bodies: vec!["rod".into()],
+        shapes: vec![motion::Shape {
+            kind: rodcube::model::ShapeKind::Segment,
+            body: Some(0),
+            numbers: vec![-0.5, 0.0, 0.5, 0.0],
+        }],
+        phases: vec![
+            PhaseSpan {
+                name: "first".into(),
+                t_start: 0.0,
+            },
+            PhaseSpan {
+                name: "second".into(),
+                t_start: 0.1,
+            },
+        ],
+        frames,
+        impacts,
+        ..Animation::default()
+    }
+}
+
+#[test]
+fn motion_svg_has_a_star_per_impact() {
+    let marks = vec![
+        ImpactMark {
+            t: 0.1,
+            contact: "floor_normal".into(),
+            at: Some([-0.4, 0.8]),
+        },
+        ImpactMark {
+            t: 0.2,
+            contact: "floor_normal".into(),
+            at: Some([0.4, 0.9]),
+        },
+    ];
+    let svg = motion::svg(&animation(marks.clone()));
+    assert_eq!(svg.matches(r#"class="impact-mark""#).count(), 2);
+    assert!(svg.contains(r#"id="impact-1""#) && svg.contains(r#"id="impact-2""#));
+    assert!(svg.contains(">impact 1 of 2 at t = 0.1 s (floor_normal)<"));
+    assert!(svg.contains(">impact 2 of 2 at t = 0.2 s (floor_normal)<"));
+    assert_eq!(
+        svg.matches("<polygon").count(),
+        svg.matches("</polygon>").count()
+    );
+    // Without impacts: neither stars nor captions.
+    let none = motion::svg(&animation(Vec::new()));
+    assert!(!none.contains("impact"), "{none}");
+    // An impact without a place: its caption only.
+    let mut unplaced = marks;
+    unplaced[1].at = None;
+    let svg = motion::svg(&animation(unplaced));
+    assert_eq!(svg.matches(r#"class="impact-mark""#).count(), 1);
+    assert_eq!(svg.matches(r#"class="impact-label""#).count(), 2);
+}
+
+const FIXED_CYLINDER: &str = "model: fixed_cylinder
+parameters: {m1: 1.0, ell: 1.0, R: 0.2, th0: 1.2, g: 9.81}
+want: [impacts, tip_trajectory]
+tolerance: 1.0e-10
+until: 1.0
+";
+
+#[test]
+fn the_rod_striking_the_cylinder_is_marked_where_they_meet() {
+    let scene =
+        rodcube::scene::Scene::parse(FIXED_CYLINDER, Path::new("<scene>"), rodcube::models::all())
+            .unwrap();
+    let results = rodcube::plan::run(&scene.request()).unwrap();
+    let impacts = results.impacts.as_ref().unwrap();
+    let anim = results.motion.as_ref().unwrap();
+    assert!(!impacts.is_empty());
+    assert_eq!(anim.impacts.len(), impacts.len());
+    for (mark, record) in anim.impacts.iter().zip(impacts) {
+        assert_eq!(mark.t.to_bits(), record.time.to_bits());
+        assert_eq!(mark.contact, record.closing);
+    }
+    // The rod strikes the cylinder (axis (0, R), radius R = 0.2): the star is on its surface.
+    let strike = &anim.impacts[0];
+    assert_eq!(strike.contact, "cylinder_push");
+    let [x, y] = strike.at.unwrap();
+    assert!((x.hypot(y - 0.2) - 0.2).abs() < 1e-6, "{x} {y}");
+    let svg = motion::svg(anim);
+    assert_eq!(
+        svg.matches(r#"class="impact-mark""#).count(),
+        anim.impacts.len()
     );
 }

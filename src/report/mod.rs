@@ -21,6 +21,7 @@ pub mod motion;
 pub mod plot;
 #[cfg(feature = "cli")]
 pub mod table;
+mod touch;
 
 #[cfg(feature = "cli")]
 use crate::io::OutDir;
