@@ -64,7 +64,7 @@ static INFO: ModelInfo = ModelInfo {
     system_coordinates: &["x1", "y1", "theta", "xb", "yb", "phi"],
     reduced: 2,
     cyclic: &[0, 3, 5],
-    end_angle: -1.5707963267948966,
+    end_angle: -std::f64::consts::FRAC_PI_2,
     contacts: &[
         ContactInfo {
             name: "contact_force",

@@ -391,7 +391,7 @@ fn the_generator_covers_every_model() {
         for spread in 0..3 {
             let p = parameters(model, &u, spread);
             assert!(
-                rodcube::system::Bound::from_values(model, &p).is_ok(),
+                Bound::from_values(model, &p).is_ok(),
                 "{}: {p:?}",
                 model.info().name
             );
