@@ -576,6 +576,30 @@ pub struct Start {
     pub stop_at: Option<f64>,
 }
 
+/// The integrator's absolute tolerances: `rtol` times each of `scales` (length `2 n`; none
+/// without them), and with friction the work's, held to the energy's own scale.
+fn absolute_tolerances(
+    sys: &Bound,
+    start: &Start,
+    scales: Option<&[f64]>,
+    rtol: f64,
+    with_work: bool,
+) -> Result<Vec<f64>, SolveError> {
+    let n = sys.n_coordinates();
+    let mut atol: Vec<f64> = match scales {
+        Some(s) if s.len() == 2 * n => s
+            .iter()
+            .map(|v| rtol * v.abs().max(f64::MIN_POSITIVE))
+            .collect(),
+        _ => Vec::new(),
+    };
+    if with_work && !atol.is_empty() {
+        let e = sys.energy(&start.state)?.abs();
+        atol.push(rtol * if e > 0.0 { e } else { 1.0 });
+    }
+    Ok(atol)
+}
+
 /// The end of a solution that reached the start's `stop_at` without an event, as an event at
 /// that time (its index is never read).
 fn until_event(solution: &OdeSolution, stop_at: Option<f64>) -> Option<Event> {
@@ -665,18 +689,7 @@ pub fn integrate_with(
     };
     let d = contacts::dynamics(sys, &start.state, &problem.active, 0.0)?;
     problem.watch(&d)?;
-    let mut atol: Vec<f64> = match scales {
-        Some(s) if s.len() == 2 * n => s
-            .iter()
-            .map(|v| rtol * v.abs().max(f64::MIN_POSITIVE))
-            .collect(),
-        _ => Vec::new(),
-    };
-    if with_work && !atol.is_empty() {
-        // The work of friction is held to the energy's own scale.
-        let e = sys.energy(&start.state)?.abs();
-        atol.push(rtol * if e > 0.0 { e } else { 1.0 });
-    }
+    let atol = absolute_tolerances(sys, start, scales, rtol, with_work)?;
     let stop_at = start.stop_at.filter(|s| *s <= t_max);
     let opts = OdeOptions {
         rtol,
@@ -709,47 +722,41 @@ pub fn integrate_with(
             q: y[..n].to_vec(),
             qd: y[n..2 * n].to_vec(),
         };
-        if segments.last().is_some_and(|g| g.solution.event.is_none()) {
-            return Ok(UnreducedRun {
-                segments,
-                rtol,
-                method,
-                condition,
-                end: End::Until,
-                t_end: event.t,
-                friction_work: if with_work { y[2 * n] } else { 0.0 },
-                state_end: state,
-            });
-        }
-        let watch =
-            problem
-                .watches
-                .get(event.index)
-                .copied()
-                .ok_or_else(|| SolveError::OdeNonFinite {
-                    what: "event index outside the watched events",
-                    t: event.t,
-                    y: y.clone(),
-                })?;
-        let end = match watch {
-            Watch::Force(i) => Some(End::Force(i)),
-            Watch::Gap(i) => Some(End::Contact(i)),
-            Watch::Edge(i) => Some(End::Edge(i)),
-            Watch::Floor => Some(End::Floor),
-            _ => None,
+        // The run's end, or the watch whose switch goes on with it.
+        let next: Result<End, Watch> =
+            if segments.last().is_some_and(|g| g.solution.event.is_none()) {
+                Ok(End::Until)
+            } else {
+                match problem.watches.get(event.index).copied() {
+                    Some(Watch::Force(i)) => Ok(End::Force(i)),
+                    Some(Watch::Gap(i)) => Ok(End::Contact(i)),
+                    Some(Watch::Edge(i)) => Ok(End::Edge(i)),
+                    Some(Watch::Floor) => Ok(End::Floor),
+                    Some(watch) => Err(watch),
+                    None => {
+                        return Err(SolveError::OdeNonFinite {
+                            what: "event index outside the watched events",
+                            t: event.t,
+                            y,
+                        });
+                    }
+                }
+            };
+        let watch = match next {
+            Ok(end) => {
+                return Ok(UnreducedRun {
+                    segments,
+                    rtol,
+                    method,
+                    condition,
+                    end,
+                    t_end: event.t,
+                    friction_work: if with_work { y[2 * n] } else { 0.0 },
+                    state_end: state,
+                });
+            }
+            Err(watch) => watch,
         };
-        if let Some(end) = end {
-            return Ok(UnreducedRun {
-                segments,
-                rtol,
-                method,
-                condition,
-                end,
-                t_end: event.t,
-                friction_work: if with_work { y[2 * n] } else { 0.0 },
-                state_end: state,
-            });
-        }
         if segments.len() > MAX_SWITCHES {
             return Err(SolveError::TooManySwitches {
                 model: info.name,
