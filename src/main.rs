@@ -44,6 +44,7 @@ A scene is a YAML file:
   want: [separation_angle, separation_time, theta_series, contact_force_series, tip_trajectory]
   tolerance: 1.0e-12        # relative, optional
   samples: 1000             # points in each series, optional
+  until: 0.6                # s from release: go on through impacts to this time, optional
 `rodcube models` lists each model's parameters and the quantities `want` may name.
 
 Examples:

@@ -124,7 +124,11 @@ fn fate_along(motion: &Motion, info: &ModelInfo, i: usize, landed: bool) -> Opti
             }
             End::Force(_) => {
                 // Another contact opened; the decision there may have opened this one too.
-                let next = motion.phases.get(k + 1)?;
+                let Some(next) = motion.phases.get(k + 1) else {
+                    return (motion.halted.as_ref()).map(|why| Fate::Held {
+                        until: format!("until {why}"),
+                    });
+                };
                 if !next.closed().get(i).copied().unwrap_or(false) {
                     return Some(ended("force"));
                 }
@@ -619,7 +623,10 @@ impl Plan<'_> {
                 Some(End::Until) => {
                     format!("the run reached its end at t = {at} s before the body landed ({path})")
                 }
-                _ => format!("the motion ended before the floor ({path})"),
+                _ => match &motion.halted {
+                    Some(why) => format!("the motion ended before the floor: {why} ({path})"),
+                    None => format!("the motion ended before the floor ({path})"),
+                },
             };
             out.notes.insert("floor_impact".into(), note);
             return Ok(());

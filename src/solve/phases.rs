@@ -851,38 +851,72 @@ impl<'m> Walker<'m> {
             return Err(SolveError::TooManyPhases { limit: MAX_PHASES });
         }
         let start = match end {
-            End::Contact(_) if motion.impacts.len() >= MAX_IMPACTS => {
-                motion.halted = Some(format!(
-                    "the run stopped at its impact number {} at t = {} s: the bounces neither \
-                     came to rest nor converged",
-                    MAX_IMPACTS + 1,
-                    motion.end_time()
-                ));
-                return Ok(());
-            }
-            End::Contact(i) => {
-                let at = self.impact(motion, i)?;
-                let start = self.after_impact(&at, friction_work);
-                motion.impacts.push(at);
-                match start {
-                    Ok(start) => start,
-                    // An impact that leaves the system at rest ends its motion.
-                    Err(SolveError::AtRest { t, how, .. }) => {
+            End::Contact(i) => self.through_impact(motion, i, friction_work)?,
+            _ => match self.after(last_phase(motion)?) {
+                Ok(start) => Some(start),
+                // Another contact closes at the very moment this one opened (within the
+                // contacts' tolerance): an impact there.
+                Err(e @ SolveError::ImpactAtRelease { contact, .. }) => {
+                    let info = self.general.info();
+                    let Some(j) = info.contacts.iter().position(|c| c.name == contact) else {
+                        return Err(e);
+                    };
+                    if motion.through_impacts {
+                        self.through_impact(motion, j, friction_work)?
+                    } else {
                         motion.halted = Some(format!(
-                            "the system comes to rest at the impact at t = {} s, held {how}, and \
-                             stays so",
-                            format_number(t, 9)
+                            "contact `{contact}` closes at t = {} s, as the contact before it \
+                             opens: the bodies meet, and the run ends at its first impact unless \
+                             it is given a time to go on to (`until`)",
+                            format_number(motion.end_time(), 9)
                         ));
-                        return Ok(());
+                        None
                     }
-                    Err(e) => return Err(e),
                 }
-            }
-            _ => self.after(last_phase(motion)?)?,
+                Err(e) => return Err(e),
+            },
+        };
+        let Some(start) = start else {
+            return Ok(());
         };
         let next = self.solve(&start, work)?;
         motion.phases.push(next);
         Ok(())
+    }
+
+    /// The impact at the end of the motion's last phase where contact `closing` closes, and
+    /// where the motion starts again after it; `None` (with the motion halted and why) past
+    /// [`MAX_IMPACTS`], or where the impact leaves the system at rest.
+    fn through_impact(
+        &self,
+        motion: &mut Motion<'m>,
+        closing: usize,
+        friction_work: f64,
+    ) -> Result<Option<PhaseStart>, SolveError> {
+        if motion.impacts.len() >= MAX_IMPACTS {
+            motion.halted = Some(format!(
+                "the run stopped at its impact number {} at t = {} s: the bounces neither came \
+                 to rest nor converged",
+                MAX_IMPACTS + 1,
+                motion.end_time()
+            ));
+            return Ok(None);
+        }
+        let at = self.impact(motion, closing)?;
+        let start = self.after_impact(&at, friction_work);
+        motion.impacts.push(at);
+        match start {
+            Ok(start) => Ok(Some(start)),
+            // An impact that leaves the system at rest ends its motion.
+            Err(SolveError::AtRest { t, how, .. }) => {
+                motion.halted = Some(format!(
+                    "the system comes to rest at the impact at t = {} s, held {how}, and stays so",
+                    format_number(t, 9)
+                ));
+                Ok(None)
+            }
+            Err(e) => Err(e),
+        }
     }
 
     /// The impact that ends the motion's last phase, where contact `closing` closed: every
@@ -931,15 +965,18 @@ impl<'m> Walker<'m> {
                  ratio {ratio:.4} (Zeno): their limit is t = {t_limit:.12} s, within the run's \
                  tolerance of the bounce at t = {t:.12} s, which was made plastic for the rest"
             ));
-        } else if let Some(rise) = self.unresolved_bounce(&impact, &parts, closing, t)? {
+        } else if let Some((rise, flight)) = self.unresolved_bounce(&impact, &parts, closing, t)? {
+            // The bounces left, each `e` times the one before: their flights sum to about
+            // `flight / (1 - e)`.
+            let left = flight / (1.0 - restitution[closing]).max(f64::EPSILON);
             restitution[closing] = 0.0;
             impact = impact::resolve_with(general, &state, &parts, &restitution, t)?;
             plastic = true;
             motion.notes.push(format!(
                 "contact `{name}` would bounce at t = {t:.12} s by {rise:.3e} of the length \
                  scale, below the {DECIDE_TOLERANCE:e} at which a gap counts as open: the bounces \
-                 from there (a converging Zeno sequence) are taken as one plastic impact, so the \
-                 motion after it runs early by about their duration"
+                 from there (a converging Zeno sequence, about {left:.3e} s in all) are taken as \
+                 one plastic impact, so the motion after it runs early by about that much"
             ));
         }
         Ok(ImpactAt {
@@ -954,16 +991,17 @@ impl<'m> Walker<'m> {
 
     /// How high (relative to the system's length scale) contact `closing` would rise after
     /// `impact`, where that is below [`DECIDE_TOLERANCE`] (the gap at which a contact counts as
-    /// open): its normal velocity after squared over twice its normal acceleration pulling it
-    /// back, with it open and the other contacts decided at the state after. `None` for a
-    /// contact that stays closed, is not pulled back, or rises clear.
+    /// open), and for how long (s): its normal velocity after squared over twice its normal
+    /// acceleration pulling it back, and twice the velocity over that acceleration, with it
+    /// open and the other contacts decided at the state after. `None` for a contact that stays
+    /// closed, is not pulled back, or rises clear.
     fn unresolved_bounce(
         &self,
         impact: &Impact,
         parts: &[Part],
         closing: usize,
         t: f64,
-    ) -> Result<Option<f64>, SolveError> {
+    ) -> Result<Option<(f64, f64)>, SolveError> {
         let u = impact.normal_velocity_after[closing];
         if u <= 0.0 {
             return Ok(None);
@@ -991,7 +1029,7 @@ impl<'m> Walker<'m> {
             1.0
         };
         let rise = u * u / (2.0 * pull) / scale;
-        Ok((rise < DECIDE_TOLERANCE).then_some(rise))
+        Ok((rise < DECIDE_TOLERANCE).then_some((rise, 2.0 * u / pull)))
     }
 
     /// What follows an impact at the end of `run`: the contacts decided again at the state
