@@ -16,7 +16,7 @@ use rodcube::models::{all, find};
 use rodcube::plan::{self, PlanError, Request};
 use rodcube::quantity::Quantity;
 use rodcube::results::Work;
-use rodcube::solve::phases::{End, Motion, Route, Walker};
+use rodcube::solve::phases::{End, MAX_IMPACTS, Motion, Route, Walker};
 use rodcube::system::Bound;
 
 const G: f64 = 9.81;
@@ -353,4 +353,30 @@ fn a_block_that_tipped_comes_down_on_its_near_edge_by_the_hand_impulse() {
     // The motion goes on, the block rocking on its near edge.
     let next = &motion.phases[at.phase + 1];
     assert!(next.closed()[near] && !next.closed()[far]);
+}
+
+#[test]
+fn elastic_bounces_that_never_converge_stop_at_the_impact_limit_with_a_note() {
+    // e = 1: the rod bounces on its upper end for ever, every flight as long as the first
+    // (0.3679 s): no Zeno sequence, no rest. Asked to go on to 400 s, the run stops at its
+    // impact limit and says so, having kept the energy through every bounce.
+    let walker = liftoff_walker(1.0, 400.0);
+    let motion = walker.motion(&mut Work::default()).unwrap();
+    assert_eq!(motion.impacts.len(), MAX_IMPACTS);
+    let why = motion.halted.as_deref().expect("halted");
+    assert!(why.contains("neither came to rest nor converged"), "{why}");
+    assert!(motion.complete());
+    let flights: Vec<f64> = (motion.impacts.windows(2))
+        .map(|w| w[1].t - w[0].t)
+        .collect();
+    let first = flights[0];
+    assert!(
+        flights.iter().all(|f| ((f - first) / first).abs() < 1e-6),
+        "{first}"
+    );
+    let b = &walker.general;
+    let e0 = b.energy(&b.initial_state()).unwrap();
+    let end = motion.phases.last().unwrap().full_end_state().unwrap();
+    let e1 = b.energy(&end).unwrap();
+    assert!(((e1 - e0) / e0).abs() < 1e-8, "{e0} -> {e1}");
 }

@@ -1982,21 +1982,6 @@ fn dimensionless_record(dim: &Dimensionless, theta: &str) -> serde_json::Value {
     block
 }
 
-#[cfg(test)]
-mod tests {
-    use super::{one_line, tex_text};
-
-    #[test]
-    fn spec_text_cannot_leave_a_comment_or_run_as_tex() {
-        assert_eq!(one_line("a\n  pub fn evil() {}\r\n"), "a pub fn evil() {}");
-        assert_eq!(
-            tex_text("\\input{/etc/passwd} 50% of m_1 & N >= 0\n\\end"),
-            "\\textbackslash{}input\\{/etc/passwd\\} 50\\% of m\\_1 \\& N \\textgreater{}= 0 \\textbackslash{}end"
-        );
-        assert_eq!(tex_text("m/s^2"), "m/s\\^{}2");
-    }
-}
-
 /// An angle as Rust source: `std::f64::consts::FRAC_PI_2` and the like (with their sign) where
 /// the value is exactly one of them, so the generated code names the angle a reader knows;
 /// otherwise its exact float literal.
@@ -2015,5 +2000,20 @@ fn angle_literal(x: f64) -> String {
             format!("{sign}std::f64::consts::{name}")
         }
         None => super::expr::float_literal(x),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{one_line, tex_text};
+
+    #[test]
+    fn spec_text_cannot_leave_a_comment_or_run_as_tex() {
+        assert_eq!(one_line("a\n  pub fn evil() {}\r\n"), "a pub fn evil() {}");
+        assert_eq!(
+            tex_text("\\input{/etc/passwd} 50% of m_1 & N >= 0\n\\end"),
+            "\\textbackslash{}input\\{/etc/passwd\\} 50\\% of m\\_1 \\& N \\textgreater{}= 0 \\textbackslash{}end"
+        );
+        assert_eq!(tex_text("m/s^2"), "m/s\\^{}2");
     }
 }
