@@ -46,6 +46,7 @@ fn solve(mu: f64) -> Result<Point, Box<dyn Error>> {
         tol: 1e-12,
         rtol: 1e-13,
         route: Route::Fastest,
+        until: None,
     };
     // The contact phase: the first phase from release (the foot's friction acts, so the general
     // model is integrated with both contacts closed), to its first event.

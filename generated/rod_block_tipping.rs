@@ -64,7 +64,7 @@ static INFO: ModelInfo = ModelInfo {
     system_coordinates: &["x1", "y1", "theta", "xb", "yb", "phi"],
     reduced: 2,
     cyclic: &[0, 3, 5],
-    end_angle: 0.0,
+    end_angle: -std::f64::consts::FRAC_PI_2,
     contacts: &[
         ContactInfo {
             name: "contact_force",
@@ -102,6 +102,17 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "floor_normal",
             meaning: "the floor's upward push on the rod's foot, positive while they touch",
+            gap_unit: "m",
+            unit: "N",
+            bilateral: false,
+            edge: false,
+            eliminates: None,
+            closed: false,
+            restitution: "0",
+        },
+        ContactInfo {
+            name: "tip_floor",
+            meaning: "the floor's upward push on the rod's upper end, positive while they touch",
             gap_unit: "m",
             unit: "N",
             bilateral: false,
@@ -175,6 +186,7 @@ impl Model for RodBlockTipping {
         out[1] = 0.0;
         out[2] = 0.0;
         out[3] = 0.0;
+        out[4] = 0.0;
     }
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
@@ -353,6 +365,7 @@ impl Model for RodBlockTipping {
         out[1] = 0.0;
         out[2] = 0.0;
         out[3] = 0.0;
+        out[4] = 0.0;
     }
 
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
@@ -366,6 +379,7 @@ impl Model for RodBlockTipping {
         out[1] = -(k[8] * gt1) - (k[10] * gt0) + q[4];
         out[2] = -(k[8] * gt1) + (k[10] * gt0) + q[4];
         out[3] = q[1];
+        out[4] = (k[2] * rc_s) + q[1];
     }
 
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
@@ -403,6 +417,12 @@ impl Model for RodBlockTipping {
         jac[21] = 0.0;
         jac[22] = 0.0;
         jac[23] = 0.0;
+        jac[24] = 0.0;
+        jac[25] = 1.0;
+        jac[26] = k[2] * rc_c;
+        jac[27] = 0.0;
+        jac[28] = 0.0;
+        jac[29] = 0.0;
         bias[0] = -(k[23] * qd[5] * qd[2] * jt1 * rc_s) - (k[23] * qd[5] * qd[2] * jt0 * rc_c)
             + (2.0 * qd[5] * qd[0] * jt1)
             - (2.0 * qd[5] * qd[3] * jt1)
@@ -419,6 +439,7 @@ impl Model for RodBlockTipping {
         bias[1] = jt5 + (k[10] * jt3 * jt1);
         bias[2] = jt5 - (k[10] * jt3 * jt1);
         bias[3] = 0.0;
+        bias[4] = -k[2] * jt4 * rc_s;
     }
 
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
@@ -433,6 +454,7 @@ impl Model for RodBlockTipping {
         out[1] = f64::INFINITY;
         out[2] = f64::INFINITY;
         out[3] = f64::INFINITY;
+        out[4] = f64::INFINITY;
     }
 
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}

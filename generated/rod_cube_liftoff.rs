@@ -50,7 +50,7 @@ static INFO: ModelInfo = ModelInfo {
         },
         ParamInfo {
             name: "e",
-            meaning: "coefficient of restitution of the rod's tip on the cube and of its foot on the floor (0 plastic; 1 elastic)",
+            meaning: "coefficient of restitution of the rod's ends on the cube and on the floor (0 plastic; 1 elastic)",
             unit: "1",
             positive: false,
         },
@@ -64,7 +64,7 @@ static INFO: ModelInfo = ModelInfo {
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced: 2,
     cyclic: &[0, 3],
-    end_angle: 0.0,
+    end_angle: -std::f64::consts::FRAC_PI_2,
     contacts: &[
         ContactInfo {
             name: "contact_force",
@@ -80,6 +80,17 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "floor_normal",
             meaning: "the floor's upward push on the rod's foot, positive while they touch",
+            gap_unit: "m",
+            unit: "N",
+            bilateral: false,
+            edge: false,
+            eliminates: None,
+            closed: false,
+            restitution: "e",
+        },
+        ContactInfo {
+            name: "tip_floor",
+            meaning: "the floor's upward push on the rod's upper end, positive while they touch",
             gap_unit: "m",
             unit: "N",
             bilateral: false,
@@ -148,6 +159,7 @@ impl Model for RodCubeLiftoff {
         let k = p;
         out[0] = k[5];
         out[1] = k[5];
+        out[2] = k[5];
     }
 
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
@@ -266,18 +278,21 @@ impl Model for RodCubeLiftoff {
     fn forces_full(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _qdd: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
+        out[2] = 0.0;
     }
 
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
         let k = &k[..20]; // one bounds check for all constant loads
-        let rc_c = q[2].cos();
+        let (rc_s, rc_c) = q[2].sin_cos();
         out[0] = -(k[2] * rc_c) - q[0] + q[3];
         out[1] = q[1];
+        out[2] = (k[2] * rc_s) + q[1];
     }
 
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
         let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
+        let jt0 = qd[2] * qd[2];
         jac[0] = -1.0;
         jac[1] = 0.0;
         jac[2] = k[2] * rc_s;
@@ -286,13 +301,19 @@ impl Model for RodCubeLiftoff {
         jac[5] = 1.0;
         jac[6] = 0.0;
         jac[7] = 0.0;
-        bias[0] = k[2] * (qd[2] * qd[2]) * rc_c;
+        jac[8] = 0.0;
+        jac[9] = 1.0;
+        jac[10] = k[2] * rc_c;
+        jac[11] = 0.0;
+        bias[0] = k[2] * jt0 * rc_c;
         bias[1] = 0.0;
+        bias[2] = -k[2] * jt0 * rc_s;
     }
 
     fn edges(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
         out[0] = f64::INFINITY;
         out[1] = f64::INFINITY;
+        out[2] = f64::INFINITY;
     }
 
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}

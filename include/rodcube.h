@@ -168,6 +168,11 @@
 #define RODCUBE_ERR_TOO_MANY_SAMPLES 205
 
 /**
+ * The run's end time (`until`) is not a positive finite time.
+ */
+#define RODCUBE_ERR_UNTIL 206
+
+/**
  * Group: a solver failed (codes 301 to 399).
  */
 #define RODCUBE_ERR_SOLVE 300
@@ -356,6 +361,11 @@
  * A phase index past the phases of the run (a planner inconsistency).
  */
 #define RODCUBE_ERR_NO_SUCH_PHASE 336
+
+/**
+ * An impact at a contact with friction (tangential impulses are not modelled).
+ */
+#define RODCUBE_ERR_FRICTIONAL_IMPACT 337
 
 /**
  * Group: the scene was refused (codes 401 to 499). A scene's message lists every problem

@@ -22,7 +22,7 @@
 //! variant does not compile until it has a code here (and thereby in the header).
 
 use crate::model::Model;
-use crate::plan::{self, PlanError, Request};
+use crate::plan::{self, PlanError};
 use crate::scene::{Kind, Scene, SceneError};
 use crate::solve::SolveError;
 use crate::solve::lean::{LeanPoint, LeanSolver};
@@ -93,6 +93,8 @@ pub const RODCUBE_ERR_TOLERANCE: c_int = 203;
 pub const RODCUBE_ERR_TOO_FEW_SAMPLES: c_int = 204;
 /// More samples per series than accepted.
 pub const RODCUBE_ERR_TOO_MANY_SAMPLES: c_int = 205;
+/// The run's end time (`until`) is not a positive finite time.
+pub const RODCUBE_ERR_UNTIL: c_int = 206;
 
 /// Group: a solver failed (codes 301 to 399).
 pub const RODCUBE_ERR_SOLVE: c_int = 300;
@@ -173,6 +175,8 @@ pub const RODCUBE_ERR_NEXT_PHASE: c_int = 334;
 pub const RODCUBE_ERR_RESULT_NOT_FINITE: c_int = 335;
 /// A phase index past the phases of the run (a planner inconsistency).
 pub const RODCUBE_ERR_NO_SUCH_PHASE: c_int = 336;
+/// An impact at a contact with friction (tangential impulses are not modelled).
+pub const RODCUBE_ERR_FRICTIONAL_IMPACT: c_int = 337;
 
 /// Group: the scene was refused (codes 401 to 499). A scene's message lists every problem
 /// found; the code is the kind of the first, in file order. Returned alone only for a scene
@@ -249,6 +253,7 @@ static CODES: &[(c_int, &CStr)] = named![
     RODCUBE_ERR_TOLERANCE,
     RODCUBE_ERR_TOO_FEW_SAMPLES,
     RODCUBE_ERR_TOO_MANY_SAMPLES,
+    RODCUBE_ERR_UNTIL,
     RODCUBE_ERR_SOLVE,
     RODCUBE_ERR_NO_CONTACT,
     RODCUBE_ERR_BAD_POLYNOMIAL,
@@ -286,6 +291,7 @@ static CODES: &[(c_int, &CStr)] = named![
     RODCUBE_ERR_NEXT_PHASE,
     RODCUBE_ERR_RESULT_NOT_FINITE,
     RODCUBE_ERR_NO_SUCH_PHASE,
+    RODCUBE_ERR_FRICTIONAL_IMPACT,
     RODCUBE_ERR_SCENE,
     RODCUBE_ERR_SCENE_READ,
     RODCUBE_ERR_SCENE_SYNTAX,
@@ -349,6 +355,7 @@ fn solve_code(e: &SolveError) -> c_int {
         SolveError::AtRest { .. } => RODCUBE_ERR_AT_REST,
         SolveError::Overlap { .. } => RODCUBE_ERR_OVERLAP,
         SolveError::ImpactAtRelease { .. } => RODCUBE_ERR_IMPACT_AT_RELEASE,
+        SolveError::FrictionalImpact { .. } => RODCUBE_ERR_FRICTIONAL_IMPACT,
         SolveError::NotThisPhase { .. } => RODCUBE_ERR_NOT_THIS_PHASE,
         SolveError::SingularContacts { .. } => RODCUBE_ERR_SINGULAR_CONTACTS,
         SolveError::TooManySwitches { .. } => RODCUBE_ERR_TOO_MANY_SWITCHES,
@@ -376,6 +383,7 @@ fn plan_code(e: &PlanError) -> c_int {
         PlanError::BadTolerance { .. } => RODCUBE_ERR_TOLERANCE,
         PlanError::TooFewSamples { .. } => RODCUBE_ERR_TOO_FEW_SAMPLES,
         PlanError::TooManySamples { .. } => RODCUBE_ERR_TOO_MANY_SAMPLES,
+        PlanError::BadUntil { .. } => RODCUBE_ERR_UNTIL,
         PlanError::System(e) => system_code(e),
         PlanError::Solve(e) => solve_code(e),
         PlanError::NonFinite { .. } => RODCUBE_ERR_RESULT_NOT_FINITE,
@@ -803,10 +811,7 @@ pub unsafe extern "C" fn rodcube_run_scene(
             let slot = out_handle(results, "the results' out pointer")?;
             let yaml = text(scene_yaml, "the scene")?;
             let scene = Scene::parse(yaml, Path::new("<scene>"), crate::models::all())?;
-            let request = Request::new(scene.model, scene.parameters.clone())
-                .with_want(&scene.want)
-                .with_tolerance(scene.tolerance)
-                .with_samples(scene.samples);
+            let request = scene.request();
             let run = plan::run(&request)?;
             let json = crate::report::json::to_string(&run)
                 .map_err(|e| failure(RODCUBE_ERR_JSON, e.to_string()))?;

@@ -4,7 +4,7 @@
 
 use clap::{Args, Parser, Subcommand};
 use rodcube::io::{OutDir, check_name};
-use rodcube::plan::{self, PlanError, Request};
+use rodcube::plan::{self, PlanError};
 use rodcube::report;
 use rodcube::results::RunResults;
 use rodcube::scene::{Kind, Scene, SceneError};
@@ -44,6 +44,7 @@ A scene is a YAML file:
   want: [separation_angle, separation_time, theta_series, contact_force_series, tip_trajectory]
   tolerance: 1.0e-12        # relative, optional
   samples: 1000             # points in each series, optional
+  until: 0.6                # s from release: go on through impacts to this time, optional
 `rodcube models` lists each model's parameters and the quantities `want` may name.
 
 Examples:
@@ -309,10 +310,7 @@ fn default_out_dir(scene: &Scene) -> Result<PathBuf, Failure> {
 
 /// The one call into the planner ([`rodcube::plan::run`]).
 fn solve(scene: &Scene) -> Result<RunResults, Failure> {
-    let request = Request::new(scene.model, scene.parameters.clone())
-        .with_want(&scene.want)
-        .with_tolerance(scene.tolerance)
-        .with_samples(scene.samples);
+    let request = scene.request();
     plan::run(&request).map_err(|e| planner_failure(scene, e))
 }
 
@@ -339,6 +337,7 @@ fn planner_failure(scene: &Scene, error: PlanError) -> Failure {
         }
         PlanError::Unavailable { .. } => at("want".into(), Kind::UnavailableQuantity),
         PlanError::BadTolerance { .. } => at("tolerance".into(), Kind::OutOfRange),
+        PlanError::BadUntil { .. } => at("until".into(), Kind::OutOfRange),
         PlanError::TooFewSamples { .. } | PlanError::TooManySamples { .. } => {
             at("samples".into(), Kind::OutOfRange)
         }

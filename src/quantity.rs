@@ -30,6 +30,8 @@ pub enum Quantity {
     Trajectory(usize),
     /// The motion after separation, phase after phase, up to the rod lying on the floor.
     FloorImpact,
+    /// Every impact of the motion: times, contacts, normal velocities, impulses, energy lost.
+    Impacts,
     /// The physical assumptions and conservation laws, each pass/fail with its margin.
     Checks,
     /// Integration of the general model's equations, the contacts as constraints, to the
@@ -78,6 +80,11 @@ pub const FIXED: &[(&str, Quantity, &str)] = &[
         "floor_impact",
         Quantity::FloorImpact,
         "the motion after separation, to the floor",
+    ),
+    (
+        "impacts",
+        Quantity::Impacts,
+        "every impact: time, contacts, normal velocities before and after, impulses, energy lost",
     ),
     (
         "checks",
@@ -168,7 +175,8 @@ impl Quantity {
     /// Whether a model can provide this quantity: the separation needs a unilateral first
     /// contact, the contacts' ends a contact, the quantities of the energy integral (the time
     /// to the floor in contact, the cross-check against the quadrature) a fast phase that
-    /// starts at release, the linearised angle one with a separation polynomial, and an indexed
+    /// starts at release, the linearised angle one with a separation polynomial, the impacts a
+    /// unilateral contact the model does not eliminate (one that can close), and an indexed
     /// quantity an index the model has.
     pub fn available(&self, info: &ModelInfo) -> bool {
         let separates = info.contacts.first().is_some_and(|c| !c.bilateral);
@@ -176,6 +184,7 @@ impl Quantity {
         match self {
             Quantity::SeparationAngle | Quantity::SeparationTime => separates,
             Quantity::ContactEnd => !info.contacts.is_empty(),
+            Quantity::Impacts => (info.contacts.iter()).any(|c| !c.closed && !c.bilateral),
             Quantity::LinearisedSeparationAngle => {
                 separates && release.is_some_and(|p| p.separation_degree > 0)
             }

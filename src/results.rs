@@ -107,6 +107,41 @@ pub struct Work {
     pub phases: Vec<String>,
 }
 
+/// One contact's part in an impact.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ContactImpulse {
+    /// The contact's name.
+    pub contact: String,
+    /// Its normal velocity before the impact (negative: approaching).
+    pub normal_velocity_before: f64,
+    /// Its normal velocity after (zero: it stays closed; positive: it separates).
+    pub normal_velocity_after: f64,
+    /// The impulse it took (`>= 0` for a unilateral contact).
+    pub impulse: f64,
+    /// The unit of the normal velocities (`m/s`, or `rad/s` for an angular gap).
+    pub velocity_unit: &'static str,
+    /// The unit of the impulse (`N s`, or `N m s`).
+    pub impulse_unit: &'static str,
+}
+
+/// An impact: where a contact closed with an approach velocity, the impulses at every contact
+/// that took part and the kinetic energy they took out.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ImpactRecord {
+    /// Time from release (s).
+    pub time: f64,
+    /// The contact whose gap closed.
+    pub closing: String,
+    /// The contacts that took part (the closing one and those closed or touching then).
+    pub contacts: Vec<String>,
+    /// Per contact that took part, in the order of `contacts`.
+    pub per_contact: Vec<ContactImpulse>,
+    /// Kinetic energy lost (J), from the impulses: `-sum P (v- + v+) / 2`.
+    pub energy_lost: f64,
+    /// Whether this impact closed a converging (Zeno) sequence of bounces, made plastic.
+    pub zeno_limit: bool,
+}
+
 /// Everything one scene produced.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct RunResults {
@@ -129,6 +164,10 @@ pub struct RunResults {
     /// before the floor). A quantity is either in `results`/`series` or explained here.
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
     pub notes: BTreeMap<String, String>,
+    /// The impacts of the motion in order, when `impacts` was wanted (written under `results`
+    /// in JSON as `impacts: {value: [...], meaning}`).
+    #[serde(skip)]
+    pub impacts: Option<Vec<ImpactRecord>>,
     /// The bodies' motion over every phase the run solved, drawn into `motion.svg`; present
     /// when a trajectory was wanted. Not part of results.json.
     #[serde(skip)]

@@ -7,6 +7,7 @@
 //! want: [separation_angle, separation_time, theta_series]
 //! tolerance: 1.0e-12        # relative, optional
 //! samples: 1000             # points in each series, optional
+//! until: 0.6                # s: go on through impacts to this time, optional
 //! ```
 //!
 //! Loading runs in three passes over the text, each with exact positions ([`crate::yaml`]):
@@ -37,7 +38,14 @@ pub use crate::plan::{DEFAULT_SAMPLES, DEFAULT_TOLERANCE, TOLERANCE_RANGE};
 /// Accepted number of points per series (inclusive).
 pub const SAMPLES_RANGE: (usize, usize) = (2, 1_000_000);
 /// The keys a scene may have, in the order they are documented.
-pub const KEYS: &[&str] = &["model", "parameters", "want", "tolerance", "samples"];
+pub const KEYS: &[&str] = &[
+    "model",
+    "parameters",
+    "want",
+    "tolerance",
+    "samples",
+    "until",
+];
 
 /// A validated scene, ready for the planner.
 pub struct Scene {
@@ -53,6 +61,9 @@ pub struct Scene {
     pub tolerance: f64,
     /// Points in each series.
     pub samples: usize,
+    /// The time the motion goes on to through impacts (s from release); `None` ends it at its
+    /// first landing.
+    pub until: Option<f64>,
     /// The scene's text, kept to locate errors found later (e.g. by the planner).
     source: String,
 }
@@ -66,6 +77,7 @@ impl fmt::Debug for Scene {
             .field("want", &self.want)
             .field("tolerance", &self.tolerance)
             .field("samples", &self.samples)
+            .field("until", &self.until)
             .finish()
     }
 }
@@ -241,6 +253,8 @@ struct Raw {
     tolerance: Option<f64>,
     #[serde(default)]
     samples: Option<i64>,
+    #[serde(default)]
+    until: Option<f64>,
 }
 
 impl Scene {
@@ -311,6 +325,16 @@ impl Scene {
     /// The model's static description.
     pub fn info(&self) -> &'static ModelInfo {
         self.model.info()
+    }
+
+    /// The planner's request for this scene: its model, parameters, wanted quantities,
+    /// tolerance, samples and end time.
+    pub fn request(&self) -> crate::plan::Request<'static> {
+        crate::plan::Request::new(self.model, self.parameters.clone())
+            .with_want(&self.want)
+            .with_tolerance(self.tolerance)
+            .with_samples(self.samples)
+            .with_until(self.until)
     }
 
     /// Parameters by name.
@@ -460,6 +484,7 @@ impl Ctx<'_> {
     fn validate(&self, raw: Raw, registry: &[&'static dyn Model]) -> Result<Scene, SceneError> {
         let mut out: Vec<Diagnostic> = Vec::new();
         let (tolerance, samples) = self.settings(&raw, &mut out);
+        let until = self.until(&raw, &mut out);
         let Some(model) = self.model(&raw, registry, &mut out) else {
             return Err(finish(out));
         };
@@ -483,6 +508,7 @@ impl Ctx<'_> {
             want,
             tolerance,
             samples,
+            until,
             source: self.doc.text().to_string(),
         })
     }
@@ -530,6 +556,28 @@ impl Ctx<'_> {
         };
 
         (tolerance, samples)
+    }
+
+    /// `until`: a positive finite time, or absent.
+    fn until(&self, raw: &Raw, out: &mut Vec<Diagnostic>) -> Option<f64> {
+        let until = raw.until?;
+        let (kind, why) = if !until.is_finite() {
+            (Kind::NotFinite, "a finite number")
+        } else if until <= 0.0 {
+            (Kind::OutOfRange, "a positive time")
+        } else {
+            return Some(until);
+        };
+        out.push(self.diag(
+            kind,
+            "until",
+            At::Value,
+            format!(
+                "must be {why} in seconds from release (how long the motion goes on), not {}",
+                show(until)
+            ),
+        ));
+        None
     }
 
     /// The scene's model: a system in the registry (a phase model is refused, naming its

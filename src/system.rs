@@ -895,14 +895,25 @@ pub fn restitutions(model: &dyn Model, p: &[f64]) -> Result<Vec<f64>, SystemErro
     check_count(info, p)?;
     let mut out = vec![0.0; info.contacts.len()];
     model.restitutions(p, &mut out);
-    match (info.contacts.iter().zip(&out)).find(|(_, e)| !(0.0..=1.0).contains(*e)) {
+    check_restitutions(info, &out, || describe(info, p))?;
+    Ok(out)
+}
+
+/// The one check of coefficients of restitution (one per contact, each in `[0, 1]`);
+/// `parameters` says where they came from, for the message.
+pub fn check_restitutions(
+    info: &ModelInfo,
+    values: &[f64],
+    parameters: impl FnOnce() -> String,
+) -> Result<(), SystemError> {
+    match (info.contacts.iter().zip(values)).find(|(_, e)| !(0.0..=1.0).contains(*e)) {
         Some((c, &value)) => Err(SystemError::Restitution {
             model: info.name,
             contact: c.name,
             value,
-            parameters: describe(info, p),
+            parameters: parameters(),
         }),
-        None => Ok(out),
+        None => Ok(()),
     }
 }
 

@@ -755,6 +755,7 @@ fn the_solvers_refuse_a_state_of_another_length() {
             active: active.clone(),
             frictions: options.frictions.clone(),
             friction_work: 0.0,
+            stop_at: None,
         };
         input(
             &unpanicked("integrate", || {
@@ -799,6 +800,7 @@ fn the_solvers_refuse_a_state_of_another_length() {
             tol: 1e-10,
             rtol: 1e-12,
             route: Route::Fastest,
+            until: None,
         };
         let start = PhaseStart {
             state: bad.clone(),

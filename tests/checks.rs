@@ -15,7 +15,7 @@ use rodcube::solve::checks::{self, Conserved};
 use rodcube::solve::contacts::Active;
 use rodcube::solve::phases::{End, PhaseRun, ReducedRun, Route, Walker, phase_end};
 use rodcube::solve::series::{sample, sample_forces};
-use rodcube::solve::unreduced::{self, EndEvent, Start};
+use rodcube::solve::unreduced::{self, Start};
 use rodcube::system::{Bound, State, System};
 
 fn walker(registry: &'static [&'static dyn Model], route: Route) -> Walker<'static> {
@@ -25,6 +25,7 @@ fn walker(registry: &'static [&'static dyn Model], route: Route) -> Walker<'stat
         tol: 1e-12,
         rtol: 1e-12,
         route,
+        until: None,
     }
 }
 
@@ -127,6 +128,7 @@ fn energy_drift_is_judged_against_the_motion_not_a_constant_potential() {
         tol: 1e-12,
         rtol: 1e-12,
         route: Route::Fastest,
+        until: None,
     };
     let (start, _) = w.release().unwrap();
     let phase = w.solve(&start, &mut Work::default()).unwrap();
@@ -270,7 +272,7 @@ fn a_closed_gap_that_opens_fails_its_check() {
     let PhaseRun::Integrated(run) = &phase else {
         panic!("integrated route");
     };
-    assert_eq!(run.run.end, EndEvent::Force(0));
+    assert_eq!(run.run.end, End::Force(0));
     let mut states = run.run.states();
     let closed = vec![vec![true, true]; states.len()];
     let ctx = checks::Context::new("rod_cube.1");
@@ -339,15 +341,20 @@ fn a_cube_running_into_the_tip_ends_the_motion() {
         },
         frictions: vec![],
         friction_work: 0.0,
+        stop_at: None,
     };
     let ode = unreduced::integrate(&w.general, &start, 1e-12, None, 1.0, &mut work).unwrap();
-    assert_eq!(ode.end, EndEvent::Gap(0));
+    assert_eq!(ode.end, End::Contact(0));
     assert!(
         ((ode.t_end - t_meet) / t_meet).abs() < 1e-9,
         "{} vs {t_meet}",
         ode.t_end
     );
-    // The closing ends the motion for good.
-    assert!(!End::Contact(0).continues());
+    // The closing ends a motion that does not go on through impacts, and only that one.
+    let motion = rodcube::solve::phases::Motion::starting(run.clone().into_phase(), vec![], false);
+    assert!(!motion.goes_on_after(End::Contact(0)) && motion.complete());
+    let through = rodcube::solve::phases::Motion::starting(run.into_phase(), vec![], true);
+    assert!(through.goes_on_after(End::Contact(0)) && !through.complete());
+    assert!(!through.goes_on_after(End::Until));
     assert_eq!(End::Contact(0).cause(), "contact");
 }

@@ -119,6 +119,7 @@ fn walker(name: &str, params: &[(&str, f64)], route: Route) -> Walker<'static> {
         tol: 1e-12,
         rtol: 1e-13,
         route,
+        until: None,
     }
 }
 

@@ -92,6 +92,7 @@ fn walker(mu: f64, tol: f64, rtol: f64) -> Walker<'static> {
         tol,
         rtol,
         route: Route::Fastest,
+        until: None,
     }
 }
 

@@ -51,6 +51,7 @@ fn a_mass_matrix_without_an_inverse_is_an_error_not_a_guess() {
         tol: 1e-10,
         rtol: 1e-12,
         route: Route::Fastest,
+        until: None,
     };
     match walker.release() {
         Err(SolveError::SingularMassMatrix { t, q }) => {

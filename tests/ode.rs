@@ -16,7 +16,7 @@ use rodcube::solve::phases::fall_time_scale;
 use rodcube::solve::quadrature::TimeMesh;
 use rodcube::solve::separation::separation;
 use rodcube::solve::series::{delta_at_time, theta_dot_at};
-use rodcube::solve::unreduced::{EndEvent, Start, UnreducedRun, integrate, motion_scales};
+use rodcube::solve::unreduced::{End, Start, UnreducedRun, integrate, motion_scales};
 use rodcube::system::{Bound, State, System};
 
 /// Index of `theta` in the general model's coordinates.
@@ -50,6 +50,7 @@ fn integrate_general(
         },
         frictions: vec![],
         friction_work: 0.0,
+        stop_at: None,
     };
     let d = contacts::dynamics(general, &start.state, &start.active, 0.0).unwrap();
     let scales = motion_scales(
@@ -83,7 +84,7 @@ fn separation_time_agrees_with_quadrature_and_converges() {
     for rtol in [1e-6, 1e-8, 1e-10, 1e-12, 1e-13] {
         let mut work = Work::default();
         let run = from_release(&general, rtol, 1.0, &mut work);
-        assert_eq!(run.end, EndEvent::Force(0));
+        assert_eq!(run.end, End::Force(0));
         assert_eq!(run.method, Method::for_rtol(run.rtol));
         let rel = ((run.t_end - t_quad) / t_quad).abs();
         println!(
@@ -137,9 +138,10 @@ fn the_contact_force_vanishes_at_the_event() {
         active: active.clone(),
         frictions: vec![],
         friction_work: 0.0,
+        stop_at: None,
     };
     let run = integrate(bound, &start, 1e-12, None, 1.0, &mut Work::default()).unwrap();
-    assert_eq!(run.end, EndEvent::Force(0));
+    assert_eq!(run.end, End::Force(0));
     let d = contacts::dynamics(bound, &run.state_end, &active, run.t_end).unwrap();
     let f = bound.forces_full(&run.state_end, &d.qdd).unwrap()[0];
     assert!(f.abs() < 1e-10 * f0, "F = {f} N at the event (F0 = {f0} N)");
@@ -233,7 +235,7 @@ fn free_rod_reaches_the_floor_event() {
         1.0,
         &mut Work::default(),
     );
-    assert_eq!(run.end, EndEvent::Floor);
+    assert_eq!(run.end, End::Floor);
     assert!(((run.t_end - mesh.duration) / mesh.duration).abs() < 1e-9);
     assert!(run.state_end.q()[THETA].abs() < 1e-12);
 }

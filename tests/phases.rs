@@ -12,7 +12,7 @@ use rodcube::results::Work;
 use rodcube::solve::SolveError;
 use rodcube::solve::contacts::Active;
 use rodcube::solve::phases::{End, Motion, Route, Walker, phase_parameters};
-use rodcube::solve::unreduced::{EndEvent, Start, integrate};
+use rodcube::solve::unreduced::{Start, integrate};
 use rodcube::system::Bound;
 
 fn walker(registry: &'static [&'static dyn Model]) -> Walker<'static> {
@@ -22,6 +22,7 @@ fn walker(registry: &'static [&'static dyn Model]) -> Walker<'static> {
         tol: 1e-13,
         rtol: 1e-13,
         route: Route::Fastest,
+        until: None,
     }
 }
 
@@ -184,9 +185,10 @@ fn ode_agrees_on_the_free_phase() {
         },
         frictions: vec![],
         friction_work: 0.0,
+        stop_at: None,
     };
     let run = integrate(&w.general, &start, 1e-12, None, 1.0, &mut Work::default()).unwrap();
-    assert_eq!(run.end, EndEvent::Floor);
+    assert_eq!(run.end, End::Floor);
     assert!(
         ((run.t_end - fr.duration()) / fr.duration()).abs() < 1e-9,
         "{} vs {}",
@@ -198,6 +200,7 @@ fn ode_agrees_on_the_free_phase() {
     // The walker's own integrated route gives the same phase.
     let integrated = Walker {
         route: Route::Integrated,
+        until: None,
         ..w.clone()
     };
     let next = integrated.after(&motion.phases[0]).unwrap();

@@ -166,6 +166,7 @@ fn paper_results(m2: f64) -> RunResults {
             phases: vec!["rod_cube".into(), "rod_cube_free".into()],
         },
         notes: BTreeMap::new(),
+        impacts: None,
         motion: None,
     }
 }

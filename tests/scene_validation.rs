@@ -120,7 +120,7 @@ fn unknown_key_is_refused_at_its_line() {
     at(&d, Kind::UnknownKey, 5, 1, "tolerence");
     assert!(
         d.message
-            .contains("model, parameters, want, tolerance, samples"),
+            .contains("model, parameters, want, tolerance, samples, until"),
         "{d}"
     );
 }
@@ -309,6 +309,26 @@ fn tolerance_and_samples_out_of_range() {
     let d =
         only("model: rod_cube\nparameters: {m1: 1, m2: 3, ell: 1, a: 0.25, g: 9.81}\nwant: []\n");
     at(&d, Kind::OutOfRange, 3, 7, "want");
+}
+
+#[test]
+fn until_must_be_a_positive_time_and_is_kept() {
+    let base = "model: rod_cube\nparameters: {m1: 1, m2: 3, ell: 1, a: 0.25, g: 9.81}\nwant: [separation_angle]\n";
+    for (line, kind) in [
+        ("until: 0", Kind::OutOfRange),
+        ("until: -0.5", Kind::OutOfRange),
+        ("until: .nan", Kind::NotFinite),
+        ("until: .inf", Kind::NotFinite),
+    ] {
+        let d = only(&format!("{base}{line}\n"));
+        at(&d, kind, 4, 8, "until");
+        assert!(d.message.contains("seconds from release"), "{d}");
+    }
+    let parse_all = |t: &str| Scene::parse(t, Path::new(FILE), rodcube::models::all());
+    let s = parse_all(&format!("{base}until: 0.75\n")).unwrap();
+    assert_eq!(s.until, Some(0.75));
+    assert_eq!(s.request().until, Some(0.75));
+    assert_eq!(parse_all(base).unwrap().until, None);
 }
 
 #[test]

@@ -12,7 +12,7 @@ use rodcube::solve::phases::{Route, Walker};
 use rodcube::solve::quadrature::TimeMesh;
 use rodcube::solve::separation::separation;
 use rodcube::solve::series::sample_phase;
-use rodcube::solve::unreduced::{EndEvent, Start, integrate};
+use rodcube::solve::unreduced::{End, Start, integrate};
 use rodcube::system::{Bound, System};
 
 fn contact_mesh(sys: &System) -> TimeMesh {
@@ -76,6 +76,7 @@ fn series_agrees_with_the_ode_dense_output() {
             },
             frictions: vec![],
             friction_work: 0.0,
+            stop_at: None,
         };
         // Absolute tolerances from the motion's own scales (the foot's height, held at zero,
         // carries only rounding).
@@ -85,6 +86,7 @@ fn series_agrees_with_the_ode_dense_output() {
             tol: 1e-13,
             rtol: 1e-13,
             route: Route::Integrated,
+            until: None,
         };
         let scales = walker.scales(&start.state, &start.active).unwrap();
         let run = integrate(
@@ -96,7 +98,7 @@ fn series_agrees_with_the_ode_dense_output() {
             &mut Work::default(),
         )
         .unwrap();
-        assert_eq!(run.end, EndEvent::Force(0), "n = {n}, r = {r}");
+        assert_eq!(run.end, End::Force(0), "n = {n}, r = {r}");
         let theta = GENERAL.info().reduced;
         let mut worst = 0.0f64;
         for j in 0..101 {

@@ -19,6 +19,29 @@ class Check(TypedDict):
     margin: float
     meaning: str
 
+class ContactImpulse(TypedDict):
+    """One contact's part in an impact."""
+
+    contact: str
+    normal_velocity_before: float
+    """Negative: approaching."""
+    normal_velocity_after: float
+    impulse: float
+    velocity_unit: str
+    impulse_unit: str
+
+class Impact(TypedDict):
+    """An impact: where a contact closed, the impulses by Newton's law with complementarity."""
+
+    time: float
+    """s from release."""
+    closing: str
+    contacts: list[str]
+    per_contact: list[ContactImpulse]
+    energy_lost: float
+    """J, from the impulses."""
+    zeno_limit: bool
+
 class SweepResult(TypedDict):
     """What `sweep` returns; the arrays have the broadcast shape of its axes."""
 
@@ -42,11 +65,15 @@ def solve(
     want: Optional[Sequence[str]] = None,
     tolerance: Optional[float] = None,
     samples: Optional[int] = None,
+    until: Optional[float] = None,
     **parameters: float,
 ) -> dict[str, Any]:
     """Solves one parameter point (every parameter given) and returns what `want` names:
     scalars as `float`, words as `str`, series as `dict[str, NDArray[float64]]` by column,
-    `checks` as `dict[str, Check]`, and `notes: list[str]` when a wanted quantity has no value.
+    `checks` as `dict[str, Check]`, `impacts` as `list[Impact]`, and `notes: dict[str, str]`
+    (why a wanted quantity has no value, how the motion ended) when there are any. `until`
+    (s from release) carries the motion on through impacts to that time; without it the run
+    ends where the bodies first meet.
     """
 
 def sweep(

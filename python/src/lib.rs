@@ -9,7 +9,7 @@ use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
 use rodcube::axes::{Mapping, Target, resolve};
 use rodcube::model::{Model, ModelInfo, ParamInfo};
@@ -62,16 +62,18 @@ fn parameters(model: &str) -> PyResult<Vec<(&'static str, &'static str, &'static
 }
 
 /// Solves one parameter point and returns what `want` names: scalars as floats, words as
-/// strings, series as dicts of NumPy arrays by column, `checks` as dicts, and `notes` (why a
-/// wanted quantity has no value) when there are any.
+/// strings, series as dicts of NumPy arrays by column, `checks` as dicts, `impacts` as a list
+/// of dicts, and `notes` (why a wanted quantity has no value, how the motion ended) when there
+/// are any. `until` (s from release) carries the motion on through impacts to that time.
 #[pyfunction]
-#[pyo3(signature = (model, want=None, tolerance=None, samples=None, **parameters))]
+#[pyo3(signature = (model, want=None, tolerance=None, samples=None, until=None, **parameters))]
 fn solve<'py>(
     py: Python<'py>,
     model: &str,
     want: Option<Vec<String>>,
     tolerance: Option<f64>,
     samples: Option<usize>,
+    until: Option<f64>,
     parameters: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = find(model)?;
@@ -98,6 +100,7 @@ fn solve<'py>(
     if let Some(s) = samples {
         request = request.with_samples(s);
     }
+    request = request.with_until(until);
     let results = py.detach(|| plan::run(&request)).map_err(error)?;
     let out = PyDict::new(py);
     for (key, scalar) in &results.results {
@@ -123,6 +126,31 @@ fn solve<'py>(
             checks.set_item(name, c)?;
         }
         out.set_item("checks", checks)?;
+    }
+    if let Some(impacts) = &results.impacts {
+        let list = PyList::empty(py);
+        for record in impacts {
+            let entry = PyDict::new(py);
+            entry.set_item("time", record.time)?;
+            entry.set_item("closing", &record.closing)?;
+            entry.set_item("contacts", record.contacts.clone())?;
+            entry.set_item("energy_lost", record.energy_lost)?;
+            entry.set_item("zeno_limit", record.zeno_limit)?;
+            let per_contact = PyList::empty(py);
+            for c in &record.per_contact {
+                let d = PyDict::new(py);
+                d.set_item("contact", &c.contact)?;
+                d.set_item("normal_velocity_before", c.normal_velocity_before)?;
+                d.set_item("normal_velocity_after", c.normal_velocity_after)?;
+                d.set_item("impulse", c.impulse)?;
+                d.set_item("velocity_unit", c.velocity_unit)?;
+                d.set_item("impulse_unit", c.impulse_unit)?;
+                per_contact.append(d)?;
+            }
+            entry.set_item("per_contact", per_contact)?;
+            list.append(entry)?;
+        }
+        out.set_item("impacts", list)?;
     }
     if !results.notes.is_empty() {
         out.set_item("notes", results.notes.clone())?;

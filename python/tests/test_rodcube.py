@@ -316,6 +316,29 @@ def test_errors_are_exceptions_with_rodcubes_messages():
     assert issubclass(rodcube.RodcubeError, ValueError)
 
 
+def test_the_rod_lands_bounces_and_goes_on_to_until():
+    # The paper's rod and cube with every support a contact: it lands flat at the paper's
+    # landing time (0.187051069750276 s, by hand in tests/phases.rs) and, plastic, stays down.
+    r = rodcube.solve(
+        "rod_cube_liftoff", want=["impacts", "floor_impact", "theta_series"], tolerance=1e-12,
+        samples=50, until=0.3, e=0.0, **PAPER,
+    )
+    (impact,) = r["impacts"]
+    assert impact["closing"] == "tip_floor"
+    assert impact["time"] == pytest.approx(0.187051069750276, rel=1e-11, abs=0)
+    tip = next(c for c in impact["per_contact"] if c["contact"] == "tip_floor")
+    assert tip["normal_velocity_before"] < 0 and abs(tip["normal_velocity_after"]) < 1e-12
+    # By hand (the foot resting, the tip striking): P_tip = m ell |w| / 3 with w the landing
+    # rate, the energy lost (1/2)(1/12 + 1/4) m ell^2 w^2.
+    w = r["impact_angular_velocity"]
+    assert tip["impulse"] == pytest.approx(abs(w) / 3, rel=1e-12)
+    assert impact["energy_lost"] == pytest.approx(0.5 * (1 / 12 + 1 / 4) * w * w, rel=1e-12)
+    assert r["theta_series"]["t"][-1] == pytest.approx(0.3, rel=1e-12)
+    assert "until" in r["notes"]
+    with pytest.raises(rodcube.RodcubeError, match="until"):
+        rodcube.solve("rod_cube_liftoff", until=-1.0, e=0.0, **PAPER)
+
+
 def test_the_package_ships_its_type_stubs():
     # The installed package (a wheel built by maturin), not the source tree.
     package = pathlib.Path(rodcube.__file__).parent

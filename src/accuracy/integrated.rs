@@ -145,6 +145,7 @@ fn walker(
         tol: REFERENCE_RTOL,
         rtol,
         route,
+        until: None,
     })
 }
 

@@ -463,6 +463,7 @@ pub fn time_unreduced(sys: &System, rtol: f64, t_max: f64) -> Outcome<f64> {
         active: Active::of_model(sys.info()),
         frictions: Vec::new(),
         friction_work: 0.0,
+        stop_at: None,
     };
     let run = unreduced::integrate_with(
         sys,
@@ -474,7 +475,7 @@ pub fn time_unreduced(sys: &System, rtol: f64, t_max: f64) -> Outcome<f64> {
         &mut work,
     )
     .map_err(err)?;
-    if run.end != unreduced::EndEvent::Force(0) {
+    if run.end != unreduced::End::Force(0) {
         return Err("the phase ended before the first contact's force vanished".into());
     }
     Ok((run.t_end, work.ode_evaluations))

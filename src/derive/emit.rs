@@ -465,7 +465,7 @@ fn static_info(
         n_coordinates: d.coords.len(),
         reduced: d.reduced,
         cyclic: d.cyclic.clone(),
-        end_angle: super::expr::float_literal(spec.end_angle),
+        end_angle: angle_literal(spec.end_angle),
         system: d.system.clone(),
         system_coordinates: d.full_coords.clone(),
         contacts_info,
@@ -1980,6 +1980,27 @@ fn dimensionless_record(dim: &Dimensionless, theta: &str) -> serde_json::Value {
         block["note"] = "the integrated route has no closed-form results".into();
     }
     block
+}
+
+/// An angle as Rust source: `std::f64::consts::FRAC_PI_2` and the like (with their sign) where
+/// the value is exactly one of them, so the generated code names the angle a reader knows;
+/// otherwise its exact float literal.
+fn angle_literal(x: f64) -> String {
+    use std::f64::consts::{FRAC_PI_2, FRAC_PI_3, FRAC_PI_4, FRAC_PI_6, PI};
+    let named = [
+        (PI, "PI"),
+        (FRAC_PI_2, "FRAC_PI_2"),
+        (FRAC_PI_3, "FRAC_PI_3"),
+        (FRAC_PI_4, "FRAC_PI_4"),
+        (FRAC_PI_6, "FRAC_PI_6"),
+    ];
+    match named.iter().find(|(v, _)| *v == x.abs()) {
+        Some((_, name)) => {
+            let sign = if x < 0.0 { "-" } else { "" };
+            format!("{sign}std::f64::consts::{name}")
+        }
+        None => super::expr::float_literal(x),
+    }
 }
 
 #[cfg(test)]

@@ -123,6 +123,9 @@ pub struct Request<'m> {
     pub registry: &'m [&'m dyn Model],
     /// Which route solves the phases (default: the fast path where a phase has one).
     pub route: Route,
+    /// The time (s from release) the motion goes on to, through impacts and phases; `None`
+    /// (the default) ends it at its first landing: the floor, an edge or a contact that closes.
+    pub until: Option<f64>,
 }
 
 impl<'m> Request<'m> {
@@ -136,6 +139,7 @@ impl<'m> Request<'m> {
             samples: DEFAULT_SAMPLES,
             registry: crate::models::all(),
             route: Route::Fastest,
+            until: None,
         }
     }
 
@@ -180,6 +184,12 @@ impl<'m> Request<'m> {
         self
     }
 
+    /// Sets the time the motion goes on to, through impacts (`None`: to its first landing).
+    pub fn with_until(mut self, until: Option<f64>) -> Self {
+        self.until = until;
+        self
+    }
+
     /// Sets the registry for the fast phases.
     pub fn with_registry(mut self, registry: &'m [&'m dyn Model]) -> Self {
         self.registry = registry;
@@ -221,6 +231,12 @@ pub enum PlanError {
     BadTolerance {
         /// The tolerance given.
         tolerance: f64,
+    },
+    /// An end time that is not a positive finite number of seconds.
+    #[error("until {until} s: the run's end must be a positive, finite time from release")]
+    BadUntil {
+        /// The time given.
+        until: f64,
     },
     /// Fewer than 2 samples while a series or check is wanted.
     #[error("{samples} samples asked; series and checks need at least 2")]
@@ -281,6 +297,11 @@ fn wanted(request: &Request) -> Result<Vec<Quantity>, PlanError> {
     if !(tol >= TOLERANCE_RANGE.0 && tol <= TOLERANCE_RANGE.1) {
         return Err(PlanError::BadTolerance { tolerance: tol });
     }
+    if let Some(until) = request.until
+        && !(until > 0.0 && until.is_finite())
+    {
+        return Err(PlanError::BadUntil { until });
+    }
     let needs_samples = want.iter().any(|q| {
         matches!(
             q,
@@ -318,6 +339,7 @@ pub fn run(request: &Request) -> Result<RunResults, PlanError> {
         tol: request.tolerance,
         rtol: (request.tolerance * ODE_RTOL_FACTOR).max(ODE_RTOL_FLOOR),
         route: request.route,
+        until: request.until,
     };
     let mut plan = Plan::new(walker, request.samples);
     let mut out = RunResults {
@@ -333,6 +355,7 @@ pub fn run(request: &Request) -> Result<RunResults, PlanError> {
     if want.iter().any(|q| matches!(q, Quantity::Trajectory(_))) {
         plan.animation(&want, &mut out)?;
     }
+    plan.motion_notes(&mut out);
     out.work = plan.work;
     check_finite(&out)?;
     Ok(out)
@@ -538,10 +561,7 @@ impl<'m> Plan<'m> {
             }
             None => self.walker.solve(&start, &mut self.work)?,
         };
-        Ok(Motion {
-            phases: vec![first],
-            opened_at_release: opened,
-        })
+        Ok(Motion::starting(first, opened, self.walker.until.is_some()))
     }
 
     /// Extends the motion phase by phase until `done` says so or it ends for good.
@@ -558,21 +578,7 @@ impl<'m> Plan<'m> {
         } = self;
         let motion = slot.insert(motion);
         while !(done(motion) || motion.complete()) {
-            let Some(last) = motion.phases.last() else {
-                // A motion always has its first phase (`take_motion`).
-                return Err(SolveError::NoSuchPhase {
-                    index: 0,
-                    solved: 0,
-                });
-            };
-            if motion.phases.len() >= crate::solve::phases::MAX_PHASES {
-                return Err(SolveError::TooManyPhases {
-                    limit: crate::solve::phases::MAX_PHASES,
-                });
-            }
-            let start = walker.after(last)?;
-            let next = walker.solve(&start, work)?;
-            motion.phases.push(next);
+            walker.step(motion, work)?;
         }
         Ok(motion)
     }
@@ -666,6 +672,7 @@ impl<'m> Plan<'m> {
             active: start.active,
             frictions: start.frictions,
             friction_work: 0.0,
+            stop_at: None,
         };
         let bound = self.general().clone();
         let t_max = 2.0 * duration.max(f64::MIN_POSITIVE);
@@ -700,6 +707,7 @@ impl<'m> Plan<'m> {
             | Quantity::FrictionSeries(_)
             | Quantity::Trajectory(_) => self.series(q, out),
             Quantity::FloorImpact => self.floor_impact(out),
+            Quantity::Impacts => self.impacts(out),
             Quantity::CrossCheck => self.cross_check(out),
             Quantity::Checks => self.checks(want.contains(&Quantity::CrossCheck), out),
         }

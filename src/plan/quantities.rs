@@ -6,23 +6,26 @@ use super::{Plan, angle_name, column, motion_end, path, scalar};
 use crate::model::ModelInfo;
 use crate::quantity::Quantity;
 use crate::report::motion::{Animation, PhaseInput};
-use crate::results::{Label, RunResults, Series, format_number};
+use crate::results::{ContactImpulse, ImpactRecord, Label, RunResults, Series, format_number};
 use crate::solve::SolveError;
-use crate::solve::phases::{End, Motion, PhaseRun};
+use crate::solve::impact::Part;
+use crate::solve::phases::{End, ImpactAt, LANDING_TOLERANCE, Motion, PhaseRun};
 use crate::solve::separation::{SeparationOutcome, linearised_separation};
 use crate::solve::series::{PhaseSamples, sample_at, sample_forces, sample_friction};
+use crate::system::Bound;
 
 /// How a contact fared along the motion.
 #[derive(Debug, Clone, PartialEq)]
 pub(super) enum Fate {
-    /// It ended at this time from release and angle, for this cause (`force`, `edge` or
-    /// `contact`: the motion stopped where another contact closed).
+    /// It ended at this time from release and angle, for this cause (`force`, `edge`,
+    /// `contact`: the motion stopped where another contact closed, or `impact`: an impact's
+    /// impulses separated it).
     Ended {
         /// Time from release (s).
         t: f64,
         /// The reduced angle then (rad).
         theta: f64,
-        /// `force`, `edge` or `contact`.
+        /// `force`, `edge`, `contact` or `impact`.
         cause: &'static str,
     },
     /// It held to the end of the motion, which ended as `until` says.
@@ -36,11 +39,8 @@ pub(super) enum Fate {
 
 /// Contact `i`'s fate on `motion` as far as it is solved; `None` when the phases solved so
 /// far do not tell yet.
-pub(super) fn fate(
-    motion: &Motion,
-    info: &ModelInfo,
-    i: usize,
-) -> Result<Option<Fate>, SolveError> {
+pub(super) fn fate(motion: &Motion, general: &Bound, i: usize) -> Result<Option<Fate>, SolveError> {
+    let info = general.info();
     let Some(first) = motion.phases.first() else {
         return Ok(None);
     };
@@ -53,11 +53,18 @@ pub(super) fn fate(
             cause: "force",
         }));
     }
-    Ok(fate_along(motion, info, i))
+    // A run that ends where a contact closes with the body on the floor (the floor under the
+    // rod's end a contact) ends at its landing: the contacts still closed held to it.
+    let landed = match (motion.through_impacts, motion.phases.last()) {
+        (false, Some(last)) if matches!(last.end(), End::Contact(_)) => is_landing(general, last)?,
+        _ => false,
+    };
+    Ok(fate_along(motion, info, i, landed))
 }
 
-/// [`fate`] for a contact that did not open at release.
-fn fate_along(motion: &Motion, info: &ModelInfo, i: usize) -> Option<Fate> {
+/// [`fate`] for a contact that did not open at release; `landed`: the motion ends at a landing
+/// where a contact closes.
+fn fate_along(motion: &Motion, info: &ModelInfo, i: usize, landed: bool) -> Option<Fate> {
     let first = motion.phases.first()?;
     if !first.closed().get(i).copied().unwrap_or(false) {
         return Some(Fate::NeverClosed);
@@ -72,7 +79,35 @@ fn fate_along(motion: &Motion, info: &ModelInfo, i: usize) -> Option<Fate> {
         match phase.end() {
             End::Force(j) if j == i => return Some(ended("force")),
             End::Edge(j) if j == i => return Some(ended("edge")),
-            End::Contact(_) => return Some(ended("contact")),
+            End::Contact(j) if !motion.through_impacts && landed => {
+                return Some(Fate::Held {
+                    until: format!(
+                        "until the body lands, where contact `{}` closes at t = {} s",
+                        name(j),
+                        format_number(phase.t_end(), 6)
+                    ),
+                });
+            }
+            End::Contact(_) if !motion.through_impacts => return Some(ended("contact")),
+            End::Contact(_) => {
+                // An impact: it may have separated this contact.
+                let Some(next) = motion.phases.get(k + 1) else {
+                    return (motion.halted.as_ref()).map(|why| Fate::Held {
+                        until: format!("until {why}"),
+                    });
+                };
+                if !next.closed().get(i).copied().unwrap_or(false) {
+                    return Some(ended("impact"));
+                }
+            }
+            End::Until => {
+                return Some(Fate::Held {
+                    until: format!(
+                        "until the run's end at t = {} s",
+                        format_number(phase.t_end(), 6)
+                    ),
+                });
+            }
             End::Floor => {
                 return Some(Fate::Held {
                     until: format!("until {}", motion_end(info)),
@@ -89,7 +124,11 @@ fn fate_along(motion: &Motion, info: &ModelInfo, i: usize) -> Option<Fate> {
             }
             End::Force(_) => {
                 // Another contact opened; the decision there may have opened this one too.
-                let next = motion.phases.get(k + 1)?;
+                let Some(next) = motion.phases.get(k + 1) else {
+                    return (motion.halted.as_ref()).map(|why| Fate::Held {
+                        until: format!("until {why}"),
+                    });
+                };
                 if !next.closed().get(i).copied().unwrap_or(false) {
                     return Some(ended("force"));
                 }
@@ -99,22 +138,77 @@ fn fate_along(motion: &Motion, info: &ModelInfo, i: usize) -> Option<Fate> {
     None
 }
 
+/// Whether `phase` (of the system whose general model is `general`) ends where the body lands: at the model's end angle, or where a contact
+/// closes with the falling point on the floor (within [`LANDING_TOLERANCE`] of the system's
+/// length).
+fn is_landing(general: &Bound, phase: &PhaseRun) -> Result<bool, SolveError> {
+    match phase.end() {
+        End::Floor => Ok(true),
+        End::Contact(_) => {
+            let bound = general;
+            let state = phase.full_end_state()?;
+            let height = bound.points(&state)?.pos[bound.info().falling_point][1];
+            Ok(height.abs() <= LANDING_TOLERANCE * bound.length_scale(&state)?)
+        }
+        _ => Ok(false),
+    }
+}
+
+/// An impact as results hold it: names, normal velocities and impulses of the contacts that
+/// took part, with their units.
+fn impact_record(info: &ModelInfo, at: &ImpactAt) -> ImpactRecord {
+    let name = |i: usize| {
+        info.contacts
+            .get(i)
+            .map_or("a contact", |c| c.name)
+            .to_string()
+    };
+    let taking: Vec<usize> = (0..at.parts.len())
+        .filter(|&i| at.parts[i] != Part::None)
+        .collect();
+    let per_contact = (taking.iter())
+        .map(|&i| {
+            let angular = info.contacts.get(i).is_some_and(|c| c.gap_unit != "m");
+            ContactImpulse {
+                contact: name(i),
+                normal_velocity_before: at.impact.normal_velocity_before[i],
+                normal_velocity_after: at.impact.normal_velocity_after[i],
+                impulse: at.impact.impulse[i],
+                velocity_unit: if angular { "rad/s" } else { "m/s" },
+                impulse_unit: if angular { "N m s" } else { "N s" },
+            }
+        })
+        .collect();
+    ImpactRecord {
+        time: at.t,
+        closing: name(at.closing),
+        contacts: taking.iter().map(|&i| name(i)).collect(),
+        per_contact,
+        energy_lost: at.impact.energy_lost,
+        zeno_limit: at.zeno,
+    }
+}
+
 /// What a cause means, for the results' meanings.
 fn cause_words(cause: &str) -> &'static str {
     match cause {
         "force" => "its force reached zero (it would have had to pull)",
         "edge" => "its contact point ran off a body",
-        _ => "another contact closed there: the bodies meet, and impacts are not modelled yet",
+        "impact" => "the impulses of an impact elsewhere moved it away",
+        _ => {
+            "another contact closed there: the bodies meet, and the run ends at its first impact \
+             unless it is given a time to go on to (`until`)"
+        }
     }
 }
 
 impl Plan<'_> {
     /// Contact `i`'s fate, solving the motion as far as needed.
     pub(super) fn fate(&mut self, i: usize) -> Result<Fate, SolveError> {
-        let info = self.general().info();
+        let general = self.general().clone();
         // An error stops the extension; the call after it returns that error.
-        let motion = self.extend_until(|m| !matches!(fate(m, info, i), Ok(None)))?;
-        fate(motion, info, i)?.ok_or(SolveError::TooManyPhases {
+        let motion = self.extend_until(|m| !matches!(fate(m, &general, i), Ok(None)))?;
+        fate(motion, &general, i)?.ok_or(SolveError::TooManyPhases {
             limit: crate::solve::phases::MAX_PHASES,
         })
     }
@@ -343,6 +437,10 @@ impl Plan<'_> {
         } else {
             self.fate(0)?
         };
+        if self.walker.until.is_some() {
+            // A run with an end time covers the whole motion.
+            return Ok(self.complete()?.end_time());
+        }
         let end = match fate {
             Fate::Ended { t, .. } if t > 0.0 => t,
             Fate::Held { .. } => self.complete()?.end_time(),
@@ -487,6 +585,7 @@ impl Plan<'_> {
     /// otherwise; with friction, the work it did.
     pub(super) fn floor_impact(&mut self, out: &mut RunResults) -> Result<(), SolveError> {
         let info = self.general().info();
+        let general = self.general().clone();
         let motion = self.complete()?;
         if !info.frictions.is_empty() {
             let work = motion.phases.last().map_or(0.0, PhaseRun::friction_work);
@@ -503,25 +602,36 @@ impl Plan<'_> {
         }
         let path = path(motion);
         let name = |j: usize| info.contacts.get(j).map_or("a contact", |c| c.name);
-        let note = match motion.last_end() {
-            Some(End::Floor) => None,
-            Some(End::Edge(j)) => Some(format!(
-                "contact `{}` ran off an edge at t = {} s ({path}); the motion after that is not modelled",
-                name(j),
-                format_number(motion.end_time(), 6)
-            )),
-            Some(End::Contact(j)) => Some(format!(
-                "contact `{}` closed at t = {} s ({path}): the bodies meet, and impacts are not modelled yet",
-                name(j),
-                format_number(motion.end_time(), 6)
-            )),
-            _ => Some(format!("the motion ended before the floor ({path})")),
-        };
-        if let Some(note) = note {
+        let mut landing = None;
+        for phase in &motion.phases {
+            if is_landing(&general, phase)? {
+                landing = Some(phase);
+                break;
+            }
+        }
+        let Some(landing) = landing else {
+            let at = format_number(motion.end_time(), 6);
+            let note = match motion.last_end() {
+                Some(End::Edge(j)) => format!(
+                    "contact `{}` ran off an edge at t = {at} s ({path}); the motion after that is not modelled",
+                    name(j),
+                ),
+                Some(End::Contact(j)) => format!(
+                    "contact `{}` closed at t = {at} s ({path}): the bodies meet, and the run ends at its first impact unless the scene gives a time to go on to (`until`)",
+                    name(j),
+                ),
+                Some(End::Until) => {
+                    format!("the run reached its end at t = {at} s before the body landed ({path})")
+                }
+                _ => match &motion.halted {
+                    Some(why) => format!("the motion ended before the floor: {why} ({path})"),
+                    None => format!("the motion ended before the floor ({path})"),
+                },
+            };
             out.notes.insert("floor_impact".into(), note);
             return Ok(());
-        }
-        let (time, omega) = (motion.end_time(), motion.end_angular_velocity());
+        };
+        let (time, omega) = (landing.t_end(), landing.theta_dot_end());
         scalar(
             out,
             "floor_impact_time",
@@ -540,6 +650,79 @@ impl Plan<'_> {
             ),
         );
         Ok(())
+    }
+
+    /// Every impact of the motion (the motion to its end): where the run does not go on
+    /// through impacts and ends at a contact that closes, that impact is resolved too, and a
+    /// note says the run ends there.
+    pub(super) fn impacts(&mut self, out: &mut RunResults) -> Result<(), SolveError> {
+        self.complete()?;
+        let motion = self.take_motion()?;
+        let Plan {
+            motion: slot,
+            walker,
+            ..
+        } = self;
+        let motion = slot.insert(motion);
+        let info = walker.general.info();
+        let mut list = motion.impacts.clone();
+        if let (false, Some(End::Contact(i))) = (motion.through_impacts, motion.last_end()) {
+            match walker.impact(motion, i) {
+                Ok(at) => list.push(at),
+                Err(e @ SolveError::FrictionalImpact { .. }) => {
+                    out.notes.insert("impacts".into(), e.to_string());
+                }
+                Err(e) => return Err(e),
+            }
+            out.notes.entry("impacts".into()).or_insert_with(|| {
+                format!(
+                    "the run ends at its first impact (t = {} s); a scene's `until` carries the \
+                     motion on through impacts",
+                    format_number(motion.end_time(), 6)
+                )
+            });
+        }
+        if list.is_empty() {
+            out.notes.insert(
+                "impacts".into(),
+                format!(
+                    "no contact closed before the motion's end ({})",
+                    path(motion)
+                ),
+            );
+        }
+        out.impacts = Some(list.iter().map(|a| impact_record(info, a)).collect());
+        Ok(())
+    }
+
+    /// What the whole motion needs said, where it was solved to its end: whether it reached
+    /// the run's end time (`until`), a converging (Zeno) sequence of bounces closed, a run
+    /// halted at too many impacts.
+    pub(super) fn motion_notes(&self, out: &mut RunResults) {
+        let Some(motion) = self.motion.as_ref().filter(|m| m.complete()) else {
+            return;
+        };
+        if let Some(until) = self.walker.until {
+            let at = format_number(motion.end_time(), 6);
+            let impacts = motion.impacts.len();
+            let note = match (&motion.halted, motion.last_end()) {
+                (Some(why), _) => why.clone(),
+                (None, Some(End::Until)) => format!(
+                    "the motion was followed to the run's end, t = {at} s (`until`), through \
+                     {impacts} impact(s)"
+                ),
+                (None, end) => format!(
+                    "the motion ended at t = {at} s ({}), before the run's end (`until` = {} s), \
+                     after {impacts} impact(s)",
+                    end.map_or("", |e| e.cause()),
+                    format_number(until, 6)
+                ),
+            };
+            out.notes.insert("until".into(), note);
+        }
+        if !motion.notes.is_empty() {
+            out.notes.insert("zeno".into(), motion.notes.join("; "));
+        }
     }
 
     /// The bodies' motion for `motion.svg`: every phase this run solved (the first always, the

@@ -2,21 +2,22 @@
 //! integrated with the same contacts closed, and the physical checks of every phase.
 
 use super::{Plan, scalar};
-use crate::results::{CheckKind, RunResults, Work};
+use crate::results::{CheckKind, RunResults, Work, format_number};
 use crate::solve::SolveError;
 use crate::solve::checks::{self, Conserved, free_momenta};
 use crate::solve::phases::{End, PhaseRun};
 use crate::solve::series::{sample_forces, theta_dot_at};
-use crate::solve::unreduced::{EndEvent, UnreducedRun};
+use crate::solve::unreduced::UnreducedRun;
 
 /// The event of an integrated run in words.
 fn event_words(run: &UnreducedRun, info: &crate::model::ModelInfo) -> String {
     let name = |i: usize| info.contacts.get(i).map_or("a contact", |c| c.name);
     match run.end {
-        EndEvent::Force(i) => format!("contact `{}`'s force crossing zero", name(i)),
-        EndEvent::Edge(i) => format!("contact `{}`'s edge", name(i)),
-        EndEvent::Gap(i) => format!("contact `{}` closing", name(i)),
-        EndEvent::Floor => "the floor".into(),
+        End::Force(i) => format!("contact `{}`'s force crossing zero", name(i)),
+        End::Edge(i) => format!("contact `{}`'s edge", name(i)),
+        End::Contact(i) => format!("contact `{}` closing", name(i)),
+        End::Floor => "the floor".into(),
+        End::Until => "the run's end".into(),
     }
 }
 
@@ -56,7 +57,7 @@ impl Plan<'_> {
         };
         let t_quad = first.mesh.duration;
         let event = event_words(ode, info);
-        let same = End::from(ode.end) == first.end.end;
+        let same = ode.end == first.end.end;
         if !same {
             out.notes.insert(
                 "cross_check".into(),
@@ -171,6 +172,23 @@ impl Plan<'_> {
             ));
             found.extend(path_checks(run, samples, tol, &ctx)?);
             out.checks.extend(found);
+        }
+        for (k, at) in motion.impacts.iter().enumerate() {
+            let general = &walker.general;
+            let before = (motion.phases.get(at.phase))
+                .ok_or(SolveError::NoSuchPhase {
+                    index: at.phase,
+                    solved: motion.phases.len(),
+                })?
+                .full_end_state()?;
+            let ctx = checks::Context {
+                phase: format!("impact {} at t = {} s", k + 1, format_number(at.t, 9)),
+                key: format!("impact_{}", k + 1),
+                order: 2 * at.phase + 1,
+                t_start: at.t,
+            };
+            let (key, check) = checks::impact_energy(general, &before, &at.impact, tol, &ctx)?;
+            out.checks.insert(key, check);
         }
         if with_ode && let Some(ode) = ode.as_ref() {
             // The cross-check's path is held to its own accuracy: ten times its rtol at the

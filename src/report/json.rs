@@ -1,11 +1,21 @@
 //! results.json: the whole [`RunResults`] as one JSON object.
 //!
 //! Top-level keys: `model`, `parameters` (name → value, SI), `results` (key → `{value, unit,
-//! meaning}`, or `{value, meaning}` with a word as the value, e.g. `contact_end_cause`), `series` (name → `{columns: [{name, unit, values}]}`), `checks` (name →
+//! meaning}`, or `{value, meaning}` with a word as the value, e.g. `contact_end_cause`, or for
+//! `impacts` a list of impacts as the value, each `{time, closing, contacts, per_contact:
+//! [{contact, normal_velocity_before, normal_velocity_after, impulse, velocity_unit,
+//! impulse_unit}], energy_lost, zeno_limit}`), `series` (name → `{columns: [{name, unit,
+//! values}]}`), `checks` (name →
 //! `{passed, margin, meaning}`) and `work` (counters and phases). Values are SI (angles in
 //! radians); a non-finite number is written as `null`, as JSON has no NaN.
 
 use crate::results::RunResults;
+
+/// The meaning written beside `results.impacts`.
+pub const IMPACTS_MEANING: &str = "every impact of the motion in order: its time (s from release), the \
+     contact that closed, the contacts that took part with their normal velocities before and \
+     after (negative: approaching) and impulses by Newton's law of restitution with \
+     complementarity, and the kinetic energy lost (J)";
 
 /// Pretty-printed JSON of the results, ending with a newline.
 pub fn to_string(results: &RunResults) -> Result<String, serde_json::Error> {
@@ -13,6 +23,15 @@ pub fn to_string(results: &RunResults) -> Result<String, serde_json::Error> {
     if let Some(map) = value.get_mut("results").and_then(|r| r.as_object_mut()) {
         for (key, label) in &results.labels {
             map.insert(key.clone(), serde_json::to_value(label)?);
+        }
+        if let Some(impacts) = &results.impacts {
+            map.insert(
+                "impacts".into(),
+                serde_json::json!({
+                    "value": impacts,
+                    "meaning": IMPACTS_MEANING,
+                }),
+            );
         }
     }
     let mut s = serde_json::to_string_pretty(&value)?;

@@ -1,10 +1,17 @@
-//! Reports of a run: the human table, results.json, one CSV per series, SVG plots and the
-//! animated motion (`motion.svg`).
+//! Reports of a run: the human table, results.json, one CSV per series, `impacts.csv` when the
+//! run wanted impacts, SVG plots and the animated motion (`motion.svg`).
 //!
 //! Every writer here is a pure function from `RunResults` to text; only `write_all` touches
 //! the file system, through `OutDir` (atomic writes, checked names). Only [`json`] and
 //! [`motion`] (hand-written SVG text, no dependency) are built without the `cli` feature (the C
 //! ABI returns results.json; [`crate::results::RunResults`] holds the animation).
+//!
+//! `impacts.csv` (`csv::impacts`) has one row per contact taking part in each impact:
+//! `time [s]`, `contact`, `closing` (`true` for the contact whose gap closed),
+//! `normal_velocity_before`, `normal_velocity_after`, `velocity_unit`, `impulse`,
+//! `impulse_unit` (the units in their own columns, as they may differ from contact to
+//! contact), `energy_lost [J]` (the impact's, on each of its rows) and `zeno_limit` (`true` for
+//! the impact that closed a converging sequence of bounces).
 
 #[cfg(feature = "cli")]
 pub mod csv;
@@ -14,6 +21,7 @@ pub mod motion;
 pub mod plot;
 #[cfg(feature = "cli")]
 pub mod table;
+mod touch;
 
 #[cfg(feature = "cli")]
 use crate::io::OutDir;
@@ -26,6 +34,8 @@ use std::path::PathBuf;
 pub const RESULTS_JSON: &str = "results.json";
 /// Name of the animation of the bodies' motion ([`motion::svg`]).
 pub const MOTION_SVG: &str = "motion.svg";
+/// Name of the table of impacts (`csv::impacts`), written when the run wanted them.
+pub const IMPACTS_CSV: &str = "impacts.csv";
 
 /// Why a report could not be produced or written.
 #[derive(Debug, thiserror::Error)]
@@ -51,9 +61,9 @@ pub enum Error {
         len: usize,
     },
     /// CSV encoding failed.
-    #[error("cannot write series `{series}` as CSV: {message}")]
+    #[error("cannot write `{series}` as CSV: {message}")]
     Csv {
-        /// Series name.
+        /// The series' name, or `impacts` for [`IMPACTS_CSV`].
         series: String,
         /// What went wrong.
         message: String,
@@ -69,8 +79,10 @@ pub enum Error {
 }
 
 /// Writes `results.json`, `<series>.csv` for every series and `<series>.svg` for every series
-/// that can be plotted, then `motion.svg` when the run has the bodies' motion
-/// ([`RunResults::motion`]: it wanted a trajectory). Returns the paths written, in that order.
+/// that can be plotted, then `impacts.csv` when the run has impacts ([`RunResults::impacts`]:
+/// it wanted them; a header alone when there were none), then `motion.svg` when it has the
+/// bodies' motion ([`RunResults::motion`]: it wanted a trajectory). Returns the paths written,
+/// in that order.
 #[cfg(feature = "cli")]
 pub fn write_all(out: &OutDir, results: &RunResults) -> Result<Vec<PathBuf>, Error> {
     let mut written = vec![out.write(RESULTS_JSON, json::to_string(results)?.as_bytes())?];
@@ -82,6 +94,9 @@ pub fn write_all(out: &OutDir, results: &RunResults) -> Result<Vec<PathBuf>, Err
         if let Some(svg) = plot::svg(name, series, &results.model)? {
             written.push(out.write(&format!("{name}.svg"), svg.as_bytes())?);
         }
+    }
+    if let Some(impacts) = &results.impacts {
+        written.push(out.write(IMPACTS_CSV, csv::impacts(impacts)?.as_bytes())?);
     }
     if let Some(animation) = &results.motion {
         written.push(out.write(MOTION_SVG, motion::svg(animation).as_bytes())?);

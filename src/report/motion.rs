@@ -7,8 +7,11 @@
 //! the floor `y = 0`, the scenery, the bodies moved by `<animateTransform>` (linear between at
 //! most [`MAX_KEYFRAMES`] keyframes, evenly spread in time), the traced point's path (faint in
 //! full, drawn strong as the motion goes), the time and the phase as text that changes with the
-//! frames, and the moment the first phase's contact ends (a label and a faded copy of the bodies
-//! appear then). The slow-motion factor is a round number chosen so that the motion lasts about
+//! frames, the moment the first phase's contact ends (a label and a faded copy of the bodies
+//! appear then), and every impact (a contact closing between two phases, or at the motion's
+//! end): a star where the drawn bodies meet (`report/touch.rs` finds the place) appears at its
+//! frame, with a caption `impact at t = … s (contact)` shown until the next impact. The
+//! slow-motion factor is a round number chosen so that the motion lasts about
 //! [`TARGET_SECONDS`]; it is printed in the picture. The last frame holds for
 //! [`PAUSE_SECONDS`], then the animation repeats.
 //!
@@ -54,6 +57,14 @@ const MARGIN: f64 = 16.0;
 const COLOURS: &[&str] = &["#1f5fa8", "#d9731a", "#2a8a3e", "#8e44ad", "#b8860b"];
 /// Colour of the contact's end (its label, the faded bodies, the mark on the path).
 const END_COLOUR: &str = "#c0392b";
+/// Fill of an impact's star.
+const IMPACT_COLOUR: &str = "#f1c40f";
+/// Colour of an impact's caption and of its star's outline.
+const IMPACT_TEXT: &str = "#a04000";
+/// Most impacts marked (a star and a caption each); the picture's description counts the rest.
+pub const MAX_IMPACT_MARKS: usize = 100;
+/// How close, relative to the drawing's size, the drawn bodies must be to touch at an impact.
+const TOUCH_TOLERANCE: f64 = 1e-6;
 
 /// A shape of the drawing with its numbers (see [`ShapeKind`] for their order).
 #[derive(Debug, Clone, PartialEq)]
@@ -97,6 +108,19 @@ pub struct ContactEnd {
     pub frame: Frame,
 }
 
+/// An impact: a contact closing at the end of a phase (the next one starts from the state after
+/// it, or the motion ends there).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImpactMark {
+    /// Time from release (s).
+    pub t: f64,
+    /// The contact whose gap closed.
+    pub contact: String,
+    /// Where the drawn bodies meet then (m, world); `None` when the drawing does not show it
+    /// (then only the caption marks the impact).
+    pub at: Option<[f64; 2]>,
+}
+
 /// Everything `motion.svg` shows ([`svg`] draws it).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Animation {
@@ -112,6 +136,8 @@ pub struct Animation {
     pub frames: Vec<Frame>,
     /// The first phase's contact end, if it ended by its force or at an edge.
     pub contact_end: Option<ContactEnd>,
+    /// The impacts, in order: every phase that ended where a contact closed.
+    pub impacts: Vec<ImpactMark>,
     /// The name of the point whose path is traced, if any.
     pub traced: Option<String>,
     /// Frames left out for a NaN or infinite number, or for a state the model refuses.
@@ -168,10 +194,15 @@ impl Animation {
             });
             add_frames(&mut anim, phase, index, traced);
             let name = |c: usize| pinfo.contacts.get(c).map_or("a contact", |c| c.name);
+            if let End::Contact(c) = phase.end
+                && let Some(mark) = impact_mark(&anim, phase, index, name(c))
+            {
+                anim.impacts.push(mark);
+            }
             let cause = match phase.end {
                 End::Force(c) => Some(format!("{} lets go", name(c))),
                 End::Edge(c) => Some(format!("{} runs off an edge", name(c))),
-                End::Contact(_) | End::Floor => None,
+                End::Contact(_) | End::Floor | End::Until => None,
             };
             if anim.contact_end.is_none()
                 && let Some(cause) = cause
@@ -185,6 +216,36 @@ impl Animation {
         }
         anim
     }
+}
+
+/// The impact that ends `phase` (drawn as phase `index`) at contact `contact`, at its last
+/// sample: where the drawn bodies meet then (when that sample was drawn), having been apart in
+/// the frame before; `None` when the phase has no sample.
+fn impact_mark(
+    anim: &Animation,
+    phase: &PhaseInput,
+    index: usize,
+    contact: &str,
+) -> Option<ImpactMark> {
+    let t = phase.t_start + phase.samples.t.last()?;
+    let at = match anim.frames.split_last() {
+        Some((last, earlier)) if last.phase == index && last.t == t => {
+            earlier.last().and_then(|before| {
+                super::touch::impact_point(
+                    &anim.shapes,
+                    &before.poses,
+                    &last.poses,
+                    TOUCH_TOLERANCE,
+                )
+            })
+        }
+        _ => None,
+    };
+    Some(ImpactMark {
+        t,
+        contact: contact.to_string(),
+        at,
+    })
 }
 
 /// The first phase's shapes with their sizes (those with a NaN or infinite number, or naming a
@@ -349,7 +410,7 @@ fn id_part(name: &str) -> String {
 }
 
 /// A point of a shape moved into the world by a body's pose.
-fn place(pose: [f64; 3], p: [f64; 2]) -> [f64; 2] {
+pub(crate) fn place(pose: [f64; 3], p: [f64; 2]) -> [f64; 2] {
     let (s, c) = pose[2].sin_cos();
     [pose[0] + c * p[0] - s * p[1], pose[1] + s * p[0] + c * p[1]]
 }
@@ -584,8 +645,9 @@ pub fn svg(anim: &Animation) -> String {
 }
 
 /// `anim` with only what can be drawn: shapes with as many finite numbers as their kind has,
-/// frames with finite numbers in increasing time (the others counted in `dropped`), and a
-/// contact end with a finite frame.
+/// frames with finite numbers in increasing time (the others counted in `dropped`), a
+/// contact end with a finite frame, and impacts at a finite time (a place with a NaN or
+/// infinite number forgotten).
 fn drawable(anim: &Animation) -> Animation {
     let finite = |f: &Frame| {
         f.t.is_finite()
@@ -603,6 +665,13 @@ fn drawable(anim: &Animation) -> Animation {
             .cloned()
             .collect(),
         contact_end: anim.contact_end.clone().filter(|e| finite(&e.frame)),
+        impacts: (anim.impacts.iter())
+            .filter(|m| m.t.is_finite())
+            .map(|m| ImpactMark {
+                at: m.at.filter(|p| p.iter().all(|v| v.is_finite())),
+                ..m.clone()
+            })
+            .collect(),
         ..anim.clone()
     };
     for f in &anim.frames {
@@ -632,6 +701,18 @@ fn description(anim: &Animation, factor: f64) -> String {
             None => "no path traced".into(),
         }
     );
+    if !anim.impacts.is_empty() {
+        let list: Vec<String> = (anim.impacts.iter().take(MAX_IMPACT_MARKS))
+            .map(|m| format!("t = {} s ({})", num(m.t, 5), m.contact))
+            .collect();
+        let _ = write!(d, " Impacts at {}", list.join(", "));
+        if let Some(rest) = anim.impacts.len().checked_sub(MAX_IMPACT_MARKS)
+            && rest > 0
+        {
+            let _ = write!(d, " and {rest} more, not marked");
+        }
+        d.push('.');
+    }
     if anim.dropped > 0 {
         let _ = write!(
             d,
@@ -646,7 +727,7 @@ fn description(anim: &Animation, factor: f64) -> String {
 }
 
 /// The world group: floor, scenery, the faded bodies at the contact's end, the bodies, the
-/// traced path.
+/// traced path, the impacts' stars.
 fn write_world(
     out: &mut String,
     anim: &Animation,
@@ -685,6 +766,7 @@ fn write_world(
     }
     // Over the bodies: a path often runs along a body's face.
     write_path(out, anim, view, keys, clock);
+    write_impact_marks(out, anim, view, clock);
     out.push_str("</g>\n");
 }
 
@@ -905,8 +987,70 @@ fn write_ghost(
     out.push_str("</g>\n");
 }
 
+/// A star where the drawn bodies met at each impact (of the first [`MAX_IMPACT_MARKS`] that
+/// have a place), shown from its frame on.
+fn write_impact_marks(out: &mut String, anim: &Animation, view: &View, clock: Option<&Clock>) {
+    for (i, m) in anim.impacts.iter().take(MAX_IMPACT_MARKS).enumerate() {
+        let Some(at) = m.at else {
+            continue;
+        };
+        // Five points, alternately 9 and 4 pixels from the centre.
+        let points: Vec<String> = (0..10)
+            .map(|k| {
+                let r = if k % 2 == 0 { 9.0 } else { 4.0 } / view.scale;
+                let a = std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * k as f64 / 5.0;
+                view.pt([at[0] + r * a.cos(), at[1] + r * a.sin()])
+            })
+            .collect();
+        let _ = write!(
+            out,
+            r#"<polygon class="impact-mark" id="impact-{n}" points="{}" fill="{IMPACT_COLOUR}" stroke="{IMPACT_TEXT}" stroke-width="{}" visibility="{}">"#,
+            points.join(" "),
+            view.px(1.0),
+            if clock.is_some() { "hidden" } else { "visible" },
+            n = i + 1,
+        );
+        if let Some(c) = clock {
+            out.push_str(&visibility(c, c.key(m.t), None));
+        }
+        out.push_str("</polygon>\n");
+    }
+}
+
+/// The captions of the impacts, at the right under the slow-motion factor: each shown from its
+/// impact to the next one (on a static picture, the last one).
+fn write_impact_labels(out: &mut String, anim: &Animation, clock: Option<&Clock>) {
+    let marks = &anim.impacts[..anim.impacts.len().min(MAX_IMPACT_MARKS)];
+    let n = anim.impacts.len();
+    for (i, m) in marks.iter().enumerate() {
+        let text = if n > 1 {
+            format!(
+                "impact {} of {n} at t = {} s ({})",
+                i + 1,
+                num(m.t, 5),
+                m.contact
+            )
+        } else {
+            format!("impact at t = {} s ({})", num(m.t, 5), m.contact)
+        };
+        let shown = clock.is_none() && i + 1 == marks.len();
+        let _ = write!(
+            out,
+            r#"<text class="impact-label" x="{}" y="44" font-size="13" text-anchor="end" fill="{IMPACT_TEXT}" visibility="{}">{}"#,
+            WIDTH - MARGIN,
+            if shown { "visible" } else { "hidden" },
+            xml(&text)
+        );
+        if let Some(c) = clock {
+            let off = marks.get(i + 1).map(|next| c.key(next.t));
+            out.push_str(&visibility(c, c.key(m.t), off));
+        }
+        out.push_str("</text>\n");
+    }
+}
+
 /// The text: the time (changing with the frames), the slow-motion factor, the phase, the
-/// contact's end (appearing when it happens) and a footer.
+/// contact's end and the impacts (appearing when they happen) and a footer.
 fn write_labels(
     out: &mut String,
     anim: &Animation,
@@ -958,6 +1102,7 @@ fn write_labels(
         }
         out.push_str("</text>\n");
     }
+    write_impact_labels(out, anim, clock);
     let mut foot = format!("rodcube: {}", anim.model);
     if let Some(p) = &anim.traced {
         let _ = write!(foot, "; the path of `{p}` traced");
@@ -1086,6 +1231,7 @@ mod tests {
                 cause: "the push vanishes".into(),
                 frame: end,
             }),
+            impacts: Vec::new(),
             frames,
             traced: Some("tip".into()),
             dropped: 0,
@@ -1214,6 +1360,79 @@ mod tests {
         let drawn = &s[desc_end..];
         assert!(!drawn.contains("NaN") && !drawn.contains("inf"), "{s}");
         assert!(s[..desc_end].contains("3 frames with a NaN or infinite number left out"));
+    }
+
+    #[test]
+    fn impacts_get_a_star_where_placed_and_a_caption_each() {
+        let mut anim = sample(100, 100);
+        let t1 = anim.phases[1].t_start;
+        anim.impacts = vec![
+            ImpactMark {
+                t: t1,
+                contact: "floor_normal".into(),
+                at: Some([0.3, 0.0]),
+            },
+            ImpactMark {
+                t: 0.2,
+                contact: "a <contact>".into(),
+                at: None,
+            },
+            ImpactMark {
+                t: 0.2,
+                contact: "nan".into(),
+                at: Some([f64::NAN, 0.0]),
+            },
+        ];
+        let s = svg(&anim);
+        well_formed(&s);
+        // A star for the impact with a place only, shown from its frame on.
+        assert_eq!(s.matches(r#"class="impact-mark""#).count(), 1);
+        let star = &s[s.find(r#"id="impact-1""#).unwrap()..];
+        let star = &star[..star.find("</polygon>").unwrap()];
+        assert!(star.contains(r#"visibility="hidden""#), "{star}");
+        assert!(star.contains(r#"values="hidden;visible""#), "{star}");
+        assert!(!s.contains(r#"id="impact-2""#) && !s.contains(r#"id="impact-3""#));
+        // A caption each, the first hidden again at the second.
+        assert_eq!(s.matches(r#"class="impact-label""#).count(), 3);
+        let first = format!("impact 1 of 3 at t = {} s (floor_normal)", num(t1, 5));
+        assert!(s.contains(&first), "{s}");
+        assert!(s.contains("impact 2 of 3 at t = 0.2 s (a &lt;contact&gt;)"));
+        let caption = &s[s.find(&first).unwrap()..];
+        assert!(caption.contains(r#"values="hidden;visible;hidden""#));
+        assert!(s.contains("Impacts at t = "));
+        // A static picture shows every star and the last caption.
+        let mut one = sample(1, 0);
+        one.impacts = anim.impacts[..1].to_vec();
+        let s = svg(&one);
+        well_formed(&s);
+        assert!(s.contains(r#"class="impact-mark" id="impact-1""#));
+        assert!(
+            s.contains(r##"fill="#a04000" visibility="visible">impact at t ="##),
+            "{s}"
+        );
+    }
+
+    #[test]
+    fn impacts_beyond_the_most_marked_are_counted() {
+        let mut anim = sample(10, 10);
+        anim.impacts = (0..MAX_IMPACT_MARKS + 7)
+            .map(|i| ImpactMark {
+                t: 0.001 * i as f64,
+                contact: "c".into(),
+                at: Some([0.5, 0.0]),
+            })
+            .collect();
+        let s = svg(&anim);
+        well_formed(&s);
+        assert_eq!(
+            s.matches(r#"class="impact-mark""#).count(),
+            MAX_IMPACT_MARKS
+        );
+        assert_eq!(
+            s.matches(r#"class="impact-label""#).count(),
+            MAX_IMPACT_MARKS
+        );
+        assert!(s.contains("and 7 more, not marked."));
     }
 
     #[test]

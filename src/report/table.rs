@@ -1,11 +1,11 @@
 //! The human report: comfy-table tables of parameters, results (angles also in degrees, the
-//! paper's figures beside ours when the scene is the paper's), notes on quantities without a
-//! value, checks, series and work; and the `rodcube models` listing.
+//! paper's figures beside ours when the scene is the paper's), impacts, notes on quantities
+//! without a value, checks, series and work; and the `rodcube models` listing.
 
 use crate::model::ModelInfo;
 use crate::quantity::{FIXED, Quantity};
 pub use crate::results::format_number;
-use crate::results::{Check, CheckKind, RunResults};
+use crate::results::{Check, CheckKind, ImpactRecord, RunResults};
 use comfy_table::{CellAlignment, ColumnConstraint, ContentArrangement, Table, Width, presets};
 
 /// The paper's published figures (Section 3, three digits), by result key.
@@ -193,9 +193,13 @@ pub fn render(results: &RunResults, info: Option<&ModelInfo>, layout: &Layout) -
     if !results.results.is_empty() || !results.labels.is_empty() {
         scalars(&mut out, results, layout);
     }
-    // Wanted quantities without a value, and why.
+    if let Some(list) = results.impacts.as_deref().filter(|l| !l.is_empty()) {
+        impacts(&mut out, list, layout);
+    }
+    // Wanted quantities without a value and why, and what the motion's end and its impacts
+    // need said.
     if !results.notes.is_empty() {
-        let mut t = new_table(&["quantity", "why it has no value"], layout);
+        let mut t = new_table(&["about", "note"], layout);
         for (key, why) in &results.notes {
             t.add_row(vec![key.clone(), why.clone()]);
         }
@@ -294,6 +298,84 @@ fn scalars(out: &mut String, results: &RunResults, layout: &Layout) {
             layout.width,
             7,
         ));
+        out.push('\n');
+    }
+}
+
+/// The impacts: one row per contact taking part in each impact, the closing one marked `*`;
+/// the impact's time and energy lost on its first row, `(Zeno)` beside the energy of an impact
+/// that closed a converging sequence of bounces. A line of legend says what the marks mean
+/// (another for the Zeno mark, when there is one); with `verbose`, what the table is.
+fn impacts(out: &mut String, list: &[ImpactRecord], layout: &Layout) {
+    let mut rows: Vec<[String; 6]> = Vec::new();
+    for r in list {
+        let mut time = format_number(r.time, 6);
+        let mut energy = format_number(r.energy_lost, 6);
+        if r.zeno_limit {
+            energy.push_str(" (Zeno)");
+        }
+        let mark = |contact: &str| {
+            if contact == r.closing {
+                format!("{contact} *")
+            } else {
+                contact.to_string()
+            }
+        };
+        if r.per_contact.is_empty() {
+            let blank = String::new;
+            rows.push([time, mark(&r.closing), blank(), blank(), blank(), energy]);
+            continue;
+        }
+        for c in &r.per_contact {
+            rows.push([
+                std::mem::take(&mut time),
+                mark(&c.contact),
+                with_unit(c.normal_velocity_before, 6, c.velocity_unit),
+                with_unit(c.normal_velocity_after, 6, c.velocity_unit),
+                with_unit(c.impulse, 6, c.impulse_unit),
+                std::mem::take(&mut energy),
+            ]);
+        }
+    }
+    let header = [
+        "t (s)",
+        "contact",
+        "v before",
+        "v after",
+        "impulse",
+        "energy lost (J)",
+    ];
+    let mut t = new_table(&header, layout);
+    let mut widths = [0usize; 6];
+    for row in rows {
+        for (w, cell) in widths.iter_mut().zip(&row) {
+            *w = (*w).max(cell.chars().count());
+        }
+        t.add_row(row.to_vec());
+    }
+    // Names and numbers never wrap (a narrow terminal wraps the headers, or the table runs
+    // past its width).
+    for (i, w) in widths.iter().enumerate() {
+        if let Some(col) = t.column_mut(i) {
+            let w = u16::try_from(*w + 2).unwrap_or(u16::MAX);
+            col.set_constraint(ColumnConstraint::LowerBoundary(Width::Fixed(w)));
+        }
+    }
+    align_right(&mut t, &[0, 2, 3, 4, 5]);
+    out.push_str(&format!("\nImpacts ({})\n{t}\n", list.len()));
+    let mut legend = vec![
+        "* the contact whose gap closed; v: a contact's normal velocity (negative: approaching)",
+    ];
+    if list.iter().any(|r| r.zeno_limit) {
+        legend
+            .push("(Zeno): the impact that closed a converging sequence of bounces, made plastic");
+    }
+    for line in legend {
+        out.push_str(&wrap(line, layout.width, 2));
+        out.push('\n');
+    }
+    if layout.verbose {
+        out.push_str(&wrap(super::json::IMPACTS_MEANING, layout.width, 2));
         out.push('\n');
     }
 }

@@ -21,6 +21,7 @@
 
 use crate::results::{Check, CheckKind, format_number};
 use crate::solve::SolveError;
+use crate::solve::impact::Impact;
 use crate::solve::series::PhaseSamples;
 use crate::system::{Bound, State};
 use nalgebra::DMatrix;
@@ -536,6 +537,40 @@ pub fn drift(
         ));
     }
     Ok(out)
+}
+
+/// The energy an impact took out, two ways: the drop of the total energy across it (the
+/// configuration does not move, so it is the kinetic energy's) against the loss its impulses
+/// give, `-sum P (v- + v+) / 2`, relative to the kinetic energy before, beyond their rounding.
+/// Key `<key>.energy`.
+pub fn impact_energy(
+    sys: &Bound,
+    before: &State,
+    impact: &Impact,
+    tolerance: f64,
+    ctx: &Context,
+) -> Result<(String, Check), SolveError> {
+    let (e_before, e_after) = (sys.energy(before)?, sys.energy(&impact.after)?);
+    let kinetic_before = kinetic(sys, before)?;
+    let rounding = ROUNDING_ULPS * f64::EPSILON * (e_before.abs() + e_after.abs());
+    let dev = ((e_before - e_after - impact.energy_lost).abs() - rounding).max(0.0);
+    let drift = if kinetic_before > 0.0 {
+        dev / kinetic_before
+    } else {
+        dev
+    };
+    let meaning = format!(
+        "the energy lost in the impact ({} J by its impulses) against the drop of the total \
+         energy across it, beyond its rounding, relative to the kinetic energy before ({} J): \
+         relative difference <= {}",
+        format_number(impact.energy_lost, 6),
+        format_number(kinetic_before, 6),
+        format_number(tolerance, 3)
+    );
+    Ok((
+        format!("{}.energy", ctx.key),
+        drift_check(drift, tolerance, CheckKind::Identity, ctx, 2, meaning),
+    ))
 }
 
 /// How many units of rounding of the energy's largest terms the energy check allows.

@@ -666,6 +666,9 @@ pub fn decide(sys: &Bound, state: &State, options: &Options, t: f64) -> Result<A
     if rest::pins(sys, state, &active)? {
         return Err(at_rest(info, &active, t, "with"));
     }
+    if in_equilibrium(sys, state, &active, t)? {
+        return Err(at_rest(info, &active, t, "in equilibrium, with"));
+    }
     Ok(active)
 }
 
@@ -695,10 +698,31 @@ fn acc_scales(
             q: state.q.clone(),
         });
     };
+    let size = coordinate_scales(&rows, &inverse, info, active, d);
+    Ok((0..info.contacts.len())
+        .map(|i| {
+            let row = rows.row(&rows.jac, i);
+            let terms: f64 = row.iter().zip(&size).map(|(j, s)| (j * s).abs()).sum();
+            terms + rows.bias[i].abs()
+        })
+        .collect())
+}
+
+/// The size of each coordinate's acceleration in `d`, what its rounding is relative to: the
+/// sum of the sizes of what each force (the applied ones, then each closed contact's and acting
+/// friction's) contributes to it through the inverse mass matrix.
+fn coordinate_scales(
+    rows: &Rows,
+    inverse: &DMatrix<f64>,
+    info: &ModelInfo,
+    active: &Active,
+    d: &Dynamics,
+) -> Vec<f64> {
+    let n = rows.n;
     let mut size = vec![0.0f64; n];
     let mut add = |force: &[f64], times: f64| {
         let f = DVector::from_iterator(n, force.iter().map(|v| v * times));
-        for (s, c) in size.iter_mut().zip((&inverse * f).iter()) {
+        for (s, c) in size.iter_mut().zip((inverse * f).iter()) {
             *s += c.abs();
         }
     };
@@ -709,13 +733,25 @@ fn acc_scales(
     for j in (0..info.frictions.len()).filter(|&j| active.friction_acts(info, j)) {
         add(rows.row(&rows.tjac, j), d.fr[j]);
     }
-    Ok((0..info.contacts.len())
-        .map(|i| {
-            let row = rows.row(&rows.jac, i);
-            let terms: f64 = row.iter().zip(&size).map(|(j, s)| (j * s).abs()).sum();
-            terms + rows.bias[i].abs()
-        })
-        .collect())
+    size
+}
+
+/// Whether the system at `state` stays where it is with `active`: no coordinate moves and
+/// none accelerates beyond rounding ([`DECIDE_TOLERANCE`] of what the forces contribute to it).
+/// Such an equilibrium has no motion to follow (a rod lying flat on the floor against a
+/// cube, the supports taking its weight), whatever its free coordinates.
+fn in_equilibrium(sys: &Bound, state: &State, active: &Active, t: f64) -> Result<bool, SolveError> {
+    if state.qd.iter().any(|v| *v != 0.0) {
+        return Ok(false);
+    }
+    let d = dynamics(sys, state, active, t)?;
+    let rows = Rows::at(sys, state)?;
+    let mass = DMatrix::from_row_slice(rows.n, rows.n, &rows.mass);
+    let Some(inverse) = mass.try_inverse() else {
+        return Ok(false);
+    };
+    let size = coordinate_scales(&rows, &inverse, sys.info(), active, &d);
+    Ok((d.qdd.iter().zip(&size)).all(|(a, s)| a.abs() <= DECIDE_TOLERANCE * s))
 }
 
 /// The outcome of a system its supports hold at rest.

@@ -13,7 +13,7 @@
 //! `-sum_i P_i (v-_i + v+_i) / 2`, which is zero for `e = 1` and for resting contacts.
 
 use crate::solve::SolveError;
-use crate::system::{Bound, State, SystemError};
+use crate::system::{Bound, State, SystemError, check_restitutions};
 use nalgebra::{DMatrix, DVector};
 
 /// Normal velocities within this fraction of the impact's largest approach speed (or 1 m/s
@@ -55,6 +55,18 @@ pub struct Impact {
 /// the velocities after and the energy lost. A part list of the wrong length, impulses that are
 /// not unique or do not exist, are typed errors.
 pub fn resolve(sys: &Bound, state: &State, parts: &[Part], t: f64) -> Result<Impact, SolveError> {
+    resolve_with(sys, state, parts, sys.restitutions(), t)
+}
+
+/// [`resolve`] with the coefficients of restitution `restitution` (one per contact) in place of
+/// the system's: a bounce sequence converging as Zeno's is closed by a plastic impact.
+pub fn resolve_with(
+    sys: &Bound,
+    state: &State,
+    parts: &[Part],
+    restitution: &[f64],
+    t: f64,
+) -> Result<Impact, SolveError> {
     let info = sys.info();
     sys.check_state(state)?;
     let n = sys.n_coordinates();
@@ -65,15 +77,23 @@ pub fn resolve(sys: &Bound, state: &State, parts: &[Part], t: f64) -> Result<Imp
             .collect::<Vec<_>>()
             .join(", ")
     };
-    if parts.len() != m {
-        return Err(SystemError::Length {
-            model: info.name,
-            what: "impact parts",
-            expected: m,
-            got: parts.len(),
+    for (what, got) in [
+        ("impact parts", parts.len()),
+        ("restitutions", restitution.len()),
+    ] {
+        if got != m {
+            return Err(SystemError::Length {
+                model: info.name,
+                what,
+                expected: m,
+                got,
+            }
+            .into());
         }
-        .into());
     }
+    check_restitutions(info, restitution, || {
+        "the coefficients given to the impact".into()
+    })?;
     let (mass, _) = sys.equations(state)?;
     let (jac, _) = sys.constraints(state)?;
     let mass = DMatrix::from_row_slice(n, n, &mass);
@@ -93,7 +113,6 @@ pub fn resolve(sys: &Bound, state: &State, parts: &[Part], t: f64) -> Result<Imp
             "more than {MAX_IMPACT_CONTACTS} contacts take part in one impact"
         )));
     }
-    let restitution = sys.restitutions();
     // The target of a contact whose law holds with equality: v+ = -e v- (approaching), 0
     // (resting or separating; a separating contact that takes part can only stay so).
     let target = |i: usize| -restitution[i] * before[i].min(0.0);

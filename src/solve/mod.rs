@@ -277,9 +277,10 @@ pub enum SolveError {
         /// The gap's unit.
         unit: &'static str,
     },
-    /// A contact that closes with a velocity at release (an impact, not modelled yet).
+    /// A contact that closes with a velocity where a phase starts (at release, or after an
+    /// event that was not an impact).
     #[error(
-        "model `{model}`: contact `{contact}` is closing at release with normal velocity {velocity:e}: an impact, which rodcube does not model yet"
+        "model `{model}`: contact `{contact}` is closing with normal velocity {velocity:e} where a phase starts: the bodies would strike at once, which only an impact at a contact's closing resolves"
     )]
     ImpactAtRelease {
         /// Model name.
@@ -288,6 +289,19 @@ pub enum SolveError {
         contact: &'static str,
         /// Its normal velocity (negative: closing).
         velocity: f64,
+    },
+    /// An impact at a contact with friction: its tangential impulse (sticking or sliding
+    /// through the impact) is not modelled, so the motion after it is refused.
+    #[error(
+        "model `{model}` at t = {t:e} s: contact `{contact}` has friction and takes part in an impact; impulses with friction are not modelled, so the motion cannot go on past it (set its friction coefficient to 0, or end the run before it)"
+    )]
+    FrictionalImpact {
+        /// Model name.
+        model: &'static str,
+        /// Time from release (s).
+        t: f64,
+        /// The contact with friction.
+        contact: &'static str,
     },
     /// The phase the per-point solver solves is not the one the system starts in.
     #[error(

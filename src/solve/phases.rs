@@ -3,8 +3,10 @@
 //! a phase, solved on the fast path where the system has a fast phase for that set, otherwise
 //! by integrating the general model with the closed contacts as constraints; the motion goes on
 //! from phase to phase until the rod reaches the floor, a contact runs off an edge, or an open
-//! contact closes (the bodies meet: impacts are not modelled yet, so the run ends there with
-//! cause `contact`).
+//! contact closes (the bodies meet). Where the run is asked to go on to a time (`until`), a
+//! contact that closes is an impact ([`impact::resolve`]): the velocities jump by the impulses
+//! of Newton's law with complementarity, the contacts are decided again at the state after,
+//! and the motion goes on to that time; bounces whose times converge (Zeno) are caught.
 //!
 //! A fast phase that starts from a given state takes it as parameters (`<q>_0`,
 //! `<q>_dot_0`, bound from the system's state by coordinate name); the one that starts from
@@ -12,21 +14,37 @@
 //! absolute time of its start is kept in [`PhaseRun::t_start`].
 
 use crate::model::{Model, ModelInfo};
-use crate::results::Work;
+use crate::results::{Work, format_number};
 use crate::solve::SolveError;
 use crate::solve::contacts::{
-    self, Active, ContactOption, FrictionOption, Moment, Options, contact_options, friction_options,
+    self, Active, ContactOption, DECIDE_TOLERANCE, FrictionOption, Moment, Options,
+    contact_options, friction_options,
 };
+use crate::solve::impact::{self, Impact, Part};
 use crate::solve::ode::Method;
 use crate::solve::quadrature::TimeMesh;
 use crate::solve::roots::{self, changes_sign};
 use crate::solve::separation::{Separation, SeparationOutcome, edge, force_zero};
-use crate::solve::series::theta_dot_at;
-use crate::solve::unreduced::{self, EndEvent, Start, UnreducedRun, motion_scales};
+use crate::solve::series::{delta_at_time, theta_dot_at};
+use crate::solve::unreduced::{self, Start, UnreducedRun, motion_scales};
 use crate::system::{Bound, State, System};
 
-/// Most phases chained before giving up.
+/// Most phases chained between two impacts (or from release to the first) before giving up:
+/// contacts that keep opening and closing without an impact are chatter, not a motion.
 pub const MAX_PHASES: usize = 16;
+
+/// Most impacts in one run. A run that reaches it stops there with a note (a bouncing sequence
+/// that neither converges as Zeno's nor comes to rest).
+pub const MAX_IMPACTS: usize = 1000;
+
+/// Bounces at one contact whose intervals shrink by a steady ratio (the last
+/// [`ZENO_RATIOS`] ratios below one and within this fraction of each other) converge: once the
+/// time left to their limit, `dt r / (1 - r)`, is within the run's tolerance of the time from
+/// release, the rest of them is taken as one plastic impact.
+pub const ZENO_RATIO_SPREAD: f64 = 0.1;
+
+/// How many successive interval ratios must agree before bounces count as converging.
+pub const ZENO_RATIOS: usize = 3;
 
 /// An integrated phase that has not reached an event after this many free-fall times of its
 /// falling point is reported as [`SolveError::NoEvent`]. Generous: a light rod that pushes a
@@ -53,54 +71,7 @@ pub enum Route {
     Integrated,
 }
 
-/// Why a phase ended.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum End {
-    /// A closed contact's force reached zero: it opens (the first contact's is the separation).
-    Force(usize),
-    /// A closed contact's point ran off the edge of a body.
-    Edge(usize),
-    /// An open contact's gap closed: the bodies meet.
-    Contact(usize),
-    /// The reduced angle reached the model's end angle (the rod lies on the floor).
-    Floor,
-}
-
-impl End {
-    /// `"force"`, `"edge"`, `"contact"` or `"floor"`.
-    pub fn cause(self) -> &'static str {
-        match self {
-            End::Force(_) => "force",
-            End::Edge(_) => "edge",
-            End::Contact(_) => "contact",
-            End::Floor => "floor",
-        }
-    }
-
-    /// The contact the event is about (none at the floor).
-    pub fn contact(self) -> Option<usize> {
-        match self {
-            End::Force(i) | End::Edge(i) | End::Contact(i) => Some(i),
-            End::Floor => None,
-        }
-    }
-
-    /// Whether the motion goes on after it (only a contact that opens lets it).
-    pub fn continues(self) -> bool {
-        matches!(self, End::Force(_))
-    }
-}
-
-impl From<EndEvent> for End {
-    fn from(e: EndEvent) -> End {
-        match e {
-            EndEvent::Force(i) => End::Force(i),
-            EndEvent::Edge(i) => End::Edge(i),
-            EndEvent::Gap(i) => End::Contact(i),
-            EndEvent::Floor => End::Floor,
-        }
-    }
-}
+pub use crate::solve::unreduced::End;
 
 /// Where a phase on the fast path ends.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -278,7 +249,7 @@ fn first_gap_closing(
         let t = mesh.time_at_delta(sys, delta, work)?;
         Ok(sys.full_state(t, delta, theta_dot_at(sys, delta))?)
     };
-    let tol = contacts::DECIDE_TOLERANCE * sys.length_scale(&state_at(0.0, work)?)?;
+    let tol = DECIDE_TOLERANCE * sys.length_scale(&state_at(0.0, work)?)?;
     let mut best: Option<(usize, f64)> = None;
     for &i in &open {
         let mut gap = |delta: f64| -> Result<f64, SolveError> {
@@ -369,7 +340,7 @@ impl<'m> PhaseRun<'m> {
     pub fn end(&self) -> End {
         match self {
             PhaseRun::Reduced(r) => r.end.end,
-            PhaseRun::Integrated(r) => r.run.end.into(),
+            PhaseRun::Integrated(r) => r.run.end,
         }
     }
 
@@ -469,26 +440,73 @@ impl<'m> PhaseRun<'m> {
     }
 }
 
-/// `sqrt(2 h / g)` for the height `h` of the falling point at `state` (`sqrt(2 m / g)` when it
-/// is on the floor): the time scale of the motion.
+/// `sqrt(2 h / g)` for the height `h` of the falling point at `state` (the system's length
+/// scale in place of a height within [`LANDING_TOLERANCE`] of it: a body lying on the floor):
+/// the time scale of the motion.
 pub fn fall_time_scale(bound: &Bound, state: &State) -> Result<f64, SolveError> {
     let info = bound.info();
     let h = bound.points(state)?.pos[info.falling_point][1];
-    let h = if h > 0.0 { h } else { 1.0 };
+    let length = bound.length_scale(state)?;
+    let h = if h > LANDING_TOLERANCE * length {
+        h
+    } else {
+        length
+    };
     Ok((2.0 * h / bound.gravity()).sqrt())
+}
+
+/// An impact between two phases of a motion.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImpactAt {
+    /// Absolute time (s from release).
+    pub t: f64,
+    /// The phase that ended with it (an index into [`Motion::phases`]; the next one starts
+    /// from its state after).
+    pub phase: usize,
+    /// The contact whose gap closed.
+    pub closing: usize,
+    /// Each contact's part in it.
+    pub parts: Vec<Part>,
+    /// The impulses, the normal velocities and the state after.
+    pub impact: Impact,
+    /// Whether a converging (Zeno) sequence of bounces was closed by making this impact
+    /// plastic.
+    pub zeno: bool,
 }
 
 /// The whole motion, phase after phase.
 #[derive(Debug, Clone)]
 pub struct Motion<'m> {
-    /// The phases in order; the last one reaches the floor, an edge or a closing contact.
+    /// The phases in order; the last one reaches the floor, an edge, a closing contact (where
+    /// the run does not go on through impacts) or the run's end.
     pub phases: Vec<PhaseRun<'m>>,
     /// The contacts that touched at release but opened at once (their force would have had to
     /// pull).
     pub opened_at_release: Vec<usize>,
+    /// The impacts between phases, in order.
+    pub impacts: Vec<ImpactAt>,
+    /// Whether a contact that closes is an impact the motion goes on through (the run has an
+    /// end time), or the end of the motion.
+    pub through_impacts: bool,
+    /// Why the motion stopped before its end, if it did (too many impacts).
+    pub halted: Option<String>,
+    /// What the reader should know about how the motion was followed (a Zeno sequence closed).
+    pub notes: Vec<String>,
 }
 
 impl<'m> Motion<'m> {
+    /// A motion of its first phase.
+    pub fn starting(first: PhaseRun<'m>, opened_at_release: Vec<usize>, through: bool) -> Self {
+        Motion {
+            phases: vec![first],
+            opened_at_release,
+            impacts: Vec::new(),
+            through_impacts: through,
+            halted: None,
+            notes: Vec::new(),
+        }
+    }
+
     /// Absolute time the last phase ends (s).
     pub fn end_time(&self) -> f64 {
         self.phases.last().map_or(0.0, PhaseRun::t_end)
@@ -504,10 +522,25 @@ impl<'m> Motion<'m> {
         self.phases.last().map(PhaseRun::end)
     }
 
-    /// Whether the motion is complete: its last phase ends for good (the floor, an edge or a
-    /// contact that closes).
+    /// Whether the motion goes on after a phase that ended by `end`: after a contact that
+    /// opens, and after one that closes where the run goes on through impacts.
+    pub fn goes_on_after(&self, end: End) -> bool {
+        match end {
+            End::Force(_) => true,
+            End::Contact(_) => self.through_impacts,
+            End::Edge(_) | End::Floor | End::Until => false,
+        }
+    }
+
+    /// Whether the motion is complete: its last phase ends for good (the floor, an edge, the
+    /// run's end, or a contact that closes where impacts end the run), or it was halted.
     pub fn complete(&self) -> bool {
-        self.last_end().is_some_and(|e| !e.continues())
+        self.halted.is_some() || self.last_end().is_some_and(|e| !self.goes_on_after(e))
+    }
+
+    /// The impact that ended phase `k`, if one did.
+    pub fn impact_after(&self, k: usize) -> Option<&ImpactAt> {
+        self.impacts.iter().find(|i| i.phase == k)
     }
 }
 
@@ -525,6 +558,9 @@ pub struct Walker<'m> {
     pub rtol: f64,
     /// Which route solves the phases.
     pub route: Route,
+    /// The time the run goes on to (s from release), through impacts: `None` ends it at the
+    /// first event that ends the motion (the floor, an edge, or a contact that closes).
+    pub until: Option<f64>,
 }
 
 impl std::fmt::Debug for Walker<'_> {
@@ -534,6 +570,7 @@ impl std::fmt::Debug for Walker<'_> {
             .field("tol", &self.tol)
             .field("rtol", &self.rtol)
             .field("route", &self.route)
+            .field("until", &self.until)
             .finish()
     }
 }
@@ -672,7 +709,7 @@ impl<'m> Walker<'m> {
         work: &mut Work,
     ) -> Result<PhaseRun<'m>, SolveError> {
         match ReducedRun::with_end(sys, start.t, end, self.tol, work) {
-            Ok(run) => Ok(PhaseRun::Reduced(run)),
+            Ok(run) => Ok(PhaseRun::Reduced(self.cut(run, work)?)),
             Err(SolveError::TurningPoint { model, delta, .. })
                 if start.state.qd.iter().all(|v| *v == 0.0) =>
             {
@@ -685,6 +722,29 @@ impl<'m> Walker<'m> {
             Err(SolveError::TurningPoint { .. }) => self.integrate(start, work),
             Err(e) => Err(e),
         }
+    }
+
+    /// A fast phase that runs past the run's end ([`Walker::until`]) cut there: its mesh to the
+    /// angle fallen at that time, ended by [`End::Until`].
+    fn cut(&self, run: ReducedRun<'m>, work: &mut Work) -> Result<ReducedRun<'m>, SolveError> {
+        let Some(until) = self.until else {
+            return Ok(run);
+        };
+        let local = until - run.t_start;
+        if run.t_start + run.mesh.duration <= until || local.is_nan() || local <= 0.0 {
+            return Ok(run);
+        }
+        let delta = delta_at_time(&run.system, &run.mesh, local, work)?;
+        let mesh = TimeMesh::build(&run.system, delta, self.tol, work)?;
+        Ok(ReducedRun {
+            end: ReducedEnd {
+                end: End::Until,
+                at: None,
+                delta,
+            },
+            mesh,
+            ..run
+        })
     }
 
     /// Typical sizes of the motion from `state` with `active` closed over the fall's time
@@ -720,18 +780,14 @@ impl<'m> Walker<'m> {
             active: start.active.clone(),
             frictions: start.frictions.clone(),
             friction_work: start.friction_work,
+            stop_at: self.until.map(|u| u - start.t),
         };
-        let run = unreduced::integrate_with(
-            &bound,
-            &from,
-            self.rtol,
-            method,
-            Some(&scales),
-            time * MAX_FALL_TIMES,
-            work,
-        )
-        .map_err(|e| at_time(e, start.t))?;
-        if run.end == EndEvent::Floor {
+        // A run with an end time may go on to it however long its phases last.
+        let t_max = (time * MAX_FALL_TIMES).max(from.stop_at.unwrap_or(0.0));
+        let run =
+            unreduced::integrate_with(&bound, &from, self.rtol, method, Some(&scales), t_max, work)
+                .map_err(|e| at_time(e, start.t))?;
+        if run.end == End::Floor {
             self.landed(&run.state_end, start.t + run.t_end)?;
         }
         let phase = PhaseRun::Integrated(IntegratedRun {
@@ -769,29 +825,295 @@ impl<'m> Walker<'m> {
     pub fn motion(&self, work: &mut Work) -> Result<Motion<'m>, SolveError> {
         let (start, opened) = self.release()?;
         let first = self.solve(&start, work)?;
-        let mut motion = Motion {
-            phases: vec![first],
-            opened_at_release: opened,
-        };
+        let mut motion = Motion::starting(first, opened, self.until.is_some());
         self.extend(&mut motion, work)?;
         Ok(motion)
     }
 
     /// Continues a motion from its last phase until one ends for good.
     pub fn extend(&self, motion: &mut Motion<'m>, work: &mut Work) -> Result<(), SolveError> {
-        while let Some(last) = motion.phases.last() {
-            if !last.end().continues() {
-                return Ok(());
-            }
-            if motion.phases.len() >= MAX_PHASES {
-                return Err(SolveError::TooManyPhases { limit: MAX_PHASES });
-            }
-            let start = self.after(last)?;
-            let next = self.solve(&start, work)?;
-            motion.phases.push(next);
+        while !motion.complete() {
+            self.step(motion, work)?;
         }
         Ok(())
     }
+
+    /// Adds the next phase to a motion that goes on: after a contact that opens, the contacts
+    /// decided again; after one that closes, the impact first. A motion that has had
+    /// [`MAX_IMPACTS`] impacts is halted instead, with a note.
+    pub fn step(&self, motion: &mut Motion<'m>, work: &mut Work) -> Result<(), SolveError> {
+        let (end, friction_work) = {
+            let last = last_phase(motion)?;
+            (last.end(), last.friction_work())
+        };
+        let since = motion.phases.len() - motion.impacts.last().map_or(0, |i| i.phase + 1);
+        if since >= MAX_PHASES {
+            return Err(SolveError::TooManyPhases { limit: MAX_PHASES });
+        }
+        let start = match end {
+            End::Contact(i) => self.through_impact(motion, i, friction_work)?,
+            _ => match self.after(last_phase(motion)?) {
+                Ok(start) => Some(start),
+                // Another contact closes at the very moment this one opened (within the
+                // contacts' tolerance): an impact there.
+                Err(e @ SolveError::ImpactAtRelease { contact, .. }) => {
+                    let info = self.general.info();
+                    let Some(j) = info.contacts.iter().position(|c| c.name == contact) else {
+                        return Err(e);
+                    };
+                    if motion.through_impacts {
+                        self.through_impact(motion, j, friction_work)?
+                    } else {
+                        motion.halted = Some(format!(
+                            "contact `{contact}` closes at t = {} s, as the contact before it \
+                             opens: the bodies meet, and the run ends at its first impact unless \
+                             it is given a time to go on to (`until`)",
+                            format_number(motion.end_time(), 9)
+                        ));
+                        None
+                    }
+                }
+                Err(e) => return Err(e),
+            },
+        };
+        let Some(start) = start else {
+            return Ok(());
+        };
+        let next = self.solve(&start, work)?;
+        motion.phases.push(next);
+        Ok(())
+    }
+
+    /// The impact at the end of the motion's last phase where contact `closing` closes, and
+    /// where the motion starts again after it; `None` (with the motion halted and why) past
+    /// [`MAX_IMPACTS`], or where the impact leaves the system at rest.
+    fn through_impact(
+        &self,
+        motion: &mut Motion<'m>,
+        closing: usize,
+        friction_work: f64,
+    ) -> Result<Option<PhaseStart>, SolveError> {
+        if motion.impacts.len() >= MAX_IMPACTS {
+            motion.halted = Some(format!(
+                "the run stopped at its impact number {} at t = {} s: the bounces neither came \
+                 to rest nor converged",
+                MAX_IMPACTS + 1,
+                motion.end_time()
+            ));
+            return Ok(None);
+        }
+        let at = self.impact(motion, closing)?;
+        let start = self.after_impact(&at, friction_work);
+        motion.impacts.push(at);
+        match start {
+            Ok(start) => Ok(Some(start)),
+            // An impact that leaves the system at rest ends its motion.
+            Err(SolveError::AtRest { t, how, .. }) => {
+                motion.halted = Some(format!(
+                    "the system comes to rest at the impact at t = {} s, held {how}, and stays so",
+                    format_number(t, 9)
+                ));
+                Ok(None)
+            }
+            Err(e) => Err(e),
+        }
+    }
+
+    /// The impact that ends the motion's last phase, where contact `closing` closed: every
+    /// contact closed then, `closing` and any other open one that touches while approaching take
+    /// part; a contact with friction taking part is [`SolveError::FrictionalImpact`]. Bounces
+    /// converging as Zeno's (`zeno_limit`) are closed by a plastic impact, with a note.
+    pub fn impact(&self, motion: &mut Motion<'m>, closing: usize) -> Result<ImpactAt, SolveError> {
+        let general = &self.general;
+        let info = general.info();
+        let phase = motion.phases.len() - 1;
+        let last = &motion.phases[phase];
+        let (state, t, held) = (last.full_end_state()?, last.t_end(), last.closed_at_end());
+        let approaching = approaching_touches(general, &state)?;
+        let parts: Vec<Part> = (info.contacts.iter().enumerate())
+            .map(|(c, contact)| {
+                let takes_part = held.get(c) == Some(&true) || c == closing || approaching[c];
+                match (contact.closed, takes_part, contact.bilateral) {
+                    (true, _, _) | (false, false, _) => Part::None,
+                    (false, true, true) => Part::Bilateral,
+                    (false, true, false) => Part::Unilateral,
+                }
+            })
+            .collect();
+        let mu = general.friction_coefficients();
+        if let Some(f) = (info.frictions.iter().enumerate())
+            .find(|(j, f)| parts[f.contact] != Part::None && mu[*j] != 0.0)
+            .map(|(_, f)| f)
+        {
+            return Err(SolveError::FrictionalImpact {
+                model: info.name,
+                t,
+                contact: info.contacts[f.contact].name,
+            });
+        }
+        let name = info.contacts[closing].name;
+        let mut restitution = general.restitutions().to_vec();
+        let limit = zeno_limit(&motion.impacts, closing, t, self.tol);
+        if limit.is_some() {
+            restitution[closing] = 0.0;
+        }
+        let mut impact = impact::resolve_with(general, &state, &parts, &restitution, t)?;
+        let mut plastic = limit.is_some();
+        if let Some((ratio, t_limit, bounces)) = limit {
+            motion.notes.push(format!(
+                "contact `{name}` bounced {bounces} times with intervals shrinking by a steady \
+                 ratio {ratio:.4} (Zeno): their limit is t = {t_limit:.12} s, within the run's \
+                 tolerance of the bounce at t = {t:.12} s, which was made plastic for the rest"
+            ));
+        } else if let Some((rise, flight)) = self.unresolved_bounce(&impact, &parts, closing, t)? {
+            // The bounces left, each `e` times the one before: their flights sum to about
+            // `flight / (1 - e)`.
+            let left = flight / (1.0 - restitution[closing]).max(f64::EPSILON);
+            restitution[closing] = 0.0;
+            impact = impact::resolve_with(general, &state, &parts, &restitution, t)?;
+            plastic = true;
+            motion.notes.push(format!(
+                "contact `{name}` would bounce at t = {t:.12} s by {rise:.3e} of the length \
+                 scale, below the {DECIDE_TOLERANCE:e} at which a gap counts as open: the bounces \
+                 from there (a converging Zeno sequence, about {left:.3e} s in all) are taken as \
+                 one plastic impact, so the motion after it runs early by about that much"
+            ));
+        }
+        Ok(ImpactAt {
+            t,
+            phase,
+            closing,
+            parts,
+            impact,
+            zeno: plastic,
+        })
+    }
+
+    /// How high (relative to the system's length scale) contact `closing` would rise after
+    /// `impact`, where that is below [`DECIDE_TOLERANCE`] (the gap at which a contact counts as
+    /// open), and for how long (s): its normal velocity after squared over twice its normal
+    /// acceleration pulling it back, and twice the velocity over that acceleration, with it
+    /// open and the other contacts decided at the state after. `None` for a contact that stays
+    /// closed, is not pulled back, or rises clear.
+    fn unresolved_bounce(
+        &self,
+        impact: &Impact,
+        parts: &[Part],
+        closing: usize,
+        t: f64,
+    ) -> Result<Option<(f64, f64)>, SolveError> {
+        let u = impact.normal_velocity_after[closing];
+        if u <= 0.0 {
+            return Ok(None);
+        }
+        let state = &impact.after;
+        let held: Vec<bool> = parts.iter().map(|p| *p != Part::None).collect();
+        let moment = Moment::After {
+            t,
+            held: &held,
+            drift: self.tol,
+        };
+        let options = Options {
+            contacts: contact_options(&self.general, state, moment)?,
+            frictions: friction_options(&self.general, state)?,
+        };
+        let active = contacts::decide(&self.general, state, &options, t)?;
+        let pull = -contacts::dynamics(&self.general, state, &active, t)?.normal_acc[closing];
+        if pull <= 0.0 {
+            return Ok(None);
+        }
+        let info = self.general.info();
+        let scale = if info.contacts[closing].gap_unit == "m" {
+            self.general.length_scale(state)?
+        } else {
+            1.0
+        };
+        let rise = u * u / (2.0 * pull) / scale;
+        Ok((rise < DECIDE_TOLERANCE).then_some((rise, 2.0 * u / pull)))
+    }
+
+    /// What follows an impact at the end of `run`: the contacts decided again at the state
+    /// after it (a contact that took part and rests closes or opens as its force says; one
+    /// that separates is open).
+    fn after_impact(&self, at: &ImpactAt, friction_work: f64) -> Result<PhaseStart, SolveError> {
+        let state = at.impact.after.clone();
+        let held: Vec<bool> = (at.parts.iter()).map(|p| *p != Part::None).collect();
+        let moment = Moment::After {
+            t: at.t,
+            held: &held,
+            drift: self.tol,
+        };
+        let contacts = contact_options(&self.general, &state, moment)?;
+        let frictions = friction_options(&self.general, &state)?;
+        let options = Options {
+            contacts,
+            frictions: frictions.clone(),
+        };
+        let active = contacts::decide(&self.general, &state, &options, at.t)?;
+        Ok(PhaseStart {
+            state,
+            active,
+            frictions,
+            t: at.t,
+            friction_work,
+        })
+    }
+}
+
+/// The motion's last phase (a motion always has its first).
+fn last_phase<'a, 'm>(motion: &'a Motion<'m>) -> Result<&'a PhaseRun<'m>, SolveError> {
+    motion.phases.last().ok_or(SolveError::NoSuchPhase {
+        index: 0,
+        solved: 0,
+    })
+}
+
+/// Per contact: whether it is open (not eliminated, not bilateral), touches (a gap within
+/// [`contacts::DECIDE_TOLERANCE`] of the system's length) and approaches (a negative normal
+/// velocity) at `state`: it takes part in an impact there even if its own event was not the
+/// one that fired.
+fn approaching_touches(sys: &Bound, state: &State) -> Result<Vec<bool>, SolveError> {
+    let info = sys.info();
+    let n = sys.n_coordinates();
+    let gaps = sys.gaps(state)?;
+    let (jac, _) = sys.constraints(state)?;
+    let length = sys.length_scale(state)?;
+    Ok((info.contacts.iter().enumerate())
+        .map(|(i, c)| {
+            let scale = if c.gap_unit == "m" { length } else { 1.0 };
+            let v: f64 = (jac[i * n..(i + 1) * n].iter().zip(&state.qd))
+                .map(|(j, q)| j * q)
+                .sum();
+            !c.closed && !c.bilateral && gaps[i] <= DECIDE_TOLERANCE * scale && v < 0.0
+        })
+        .collect())
+}
+
+/// Whether the bounces at contact `closing` before an impact at `t` converge as Zeno's: the
+/// last [`ZENO_RATIOS`] ratios of successive intervals between impacts at that contact are
+/// below one and agree within [`ZENO_RATIO_SPREAD`], and the time left to their limit is within
+/// `tol` of `t`. Returns the ratio, the limit's time and the bounces counted.
+fn zeno_limit(impacts: &[ImpactAt], closing: usize, t: f64, tol: f64) -> Option<(f64, f64, usize)> {
+    let times: Vec<f64> = (impacts.iter().rev())
+        .take_while(|i| i.closing == closing)
+        .map(|i| i.t)
+        .collect::<Vec<_>>()
+        .into_iter()
+        .rev()
+        .chain([t])
+        .collect();
+    if times.len() < ZENO_RATIOS + 2 {
+        return None;
+    }
+    let dt: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
+    let ratios: Vec<f64> = dt.windows(2).map(|w| w[1] / w[0]).collect();
+    let recent = &ratios[ratios.len() - ZENO_RATIOS..];
+    let r = recent[recent.len() - 1];
+    let steady = recent
+        .iter()
+        .all(|q| *q > 0.0 && *q < 1.0 && (q - r).abs() <= ZENO_RATIO_SPREAD * r);
+    let left = dt[dt.len() - 1] * r / (1.0 - r);
+    (steady && left <= tol * t).then_some((r, t + left, times.len()))
 }
 
 /// A phase's error with the phase's start time added to the time it names (the integrator

@@ -38,7 +38,9 @@ use crate::solve::SolveError;
 use crate::solve::contacts::{
     self, Active, ContactOption, DECIDE_TOLERANCE, Dynamics, FrictionOption, Mode, Options,
 };
-use crate::solve::ode::{Method, OdeOptions, OdeProblem, OdeSolution, integrate as ode_integrate};
+use crate::solve::ode::{
+    Event, Method, OdeOptions, OdeProblem, OdeSolution, integrate as ode_integrate,
+};
 use crate::system::{Bound, State};
 use nalgebra::DMatrix;
 
@@ -76,17 +78,40 @@ pub fn mass_condition(sys: &Bound, state: &State) -> Result<f64, SolveError> {
     })
 }
 
-/// How an integrated phase ended.
+/// Why a phase ended (integrated or on the fast path).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum EndEvent {
-    /// A closed contact's force reached zero: it opens.
+pub enum End {
+    /// A closed contact's force reached zero: it opens (the first contact's is the separation).
     Force(usize),
-    /// A closed contact's point ran off its edge.
+    /// A closed contact's point ran off the edge of a body.
     Edge(usize),
     /// An open contact's gap closed: the bodies meet.
-    Gap(usize),
-    /// The reduced angle reached the model's end angle.
+    Contact(usize),
+    /// The reduced angle reached the model's end angle (the rod lies on the floor).
     Floor,
+    /// The run reached the time it was asked to go on to (a scene's `until`).
+    Until,
+}
+
+impl End {
+    /// `"force"`, `"edge"`, `"contact"`, `"floor"` or `"until"`.
+    pub fn cause(self) -> &'static str {
+        match self {
+            End::Force(_) => "force",
+            End::Edge(_) => "edge",
+            End::Contact(_) => "contact",
+            End::Floor => "floor",
+            End::Until => "until",
+        }
+    }
+
+    /// The contact the event is about (none at the floor or the run's end).
+    pub fn contact(self) -> Option<usize> {
+        match self {
+            End::Force(i) | End::Edge(i) | End::Contact(i) => Some(i),
+            End::Floor | End::Until => None,
+        }
+    }
 }
 
 /// What an event function measures.
@@ -140,7 +165,7 @@ pub struct UnreducedRun {
     /// Condition number of the mass matrix at the start.
     pub condition: f64,
     /// Which event ended it.
-    pub end: EndEvent,
+    pub end: End,
     /// Time of that event (s from the phase's start).
     pub t_end: f64,
     /// The state there.
@@ -450,12 +475,13 @@ impl OdeProblem for Problem<'_, '_> {
                 let watch = self.watches[k];
                 let arm_at = self.arm_at_for(watch);
                 // A gap or edge margin clear of zero on the wrong side (one that opened and
-                // closed again within one step: the bodies now overlap) goes through, and the
-                // integrator locates where it crossed.
+                // closed again without growing past `arm_at`, or within one step: the bodies
+                // now overlap) goes through and arms, so that the integrator locates where it
+                // crossed zero itself (its values inside the step are the true ones).
                 let through = matches!(watch, Watch::Gap(_) | Watch::Edge(_)) && *v < -arm_at;
-                if *v > arm_at {
+                if *v > arm_at || through {
                     self.armed[k] = true;
-                } else if !through {
+                } else {
                     // Unarmed: no crossing while it has not grown clear of zero.
                     *v = 1.0;
                 }
@@ -545,13 +571,55 @@ pub struct Start {
     pub frictions: Vec<FrictionOption>,
     /// Work done by friction before the start (J).
     pub friction_work: f64,
+    /// Where the run is asked to stop (s from this start) if no event comes first: it then
+    /// ends there with [`End::Until`]. `None`: only an event ends it.
+    pub stop_at: Option<f64>,
+}
+
+/// The integrator's absolute tolerances: `rtol` times each of `scales` (length `2 n`; none
+/// without them), and with friction the work's, held to the energy's own scale.
+fn absolute_tolerances(
+    sys: &Bound,
+    start: &Start,
+    scales: Option<&[f64]>,
+    rtol: f64,
+    with_work: bool,
+) -> Result<Vec<f64>, SolveError> {
+    let n = sys.n_coordinates();
+    let mut atol: Vec<f64> = match scales {
+        Some(s) if s.len() == 2 * n => s
+            .iter()
+            .map(|v| rtol * v.abs().max(f64::MIN_POSITIVE))
+            .collect(),
+        _ => Vec::new(),
+    };
+    if with_work && !atol.is_empty() {
+        let e = sys.energy(&start.state)?.abs();
+        atol.push(rtol * if e > 0.0 { e } else { 1.0 });
+    }
+    Ok(atol)
+}
+
+/// The end of a solution that reached the start's `stop_at` without an event, as an event at
+/// that time (its index is never read).
+fn until_event(solution: &OdeSolution, stop_at: Option<f64>) -> Option<Event> {
+    let stop = stop_at?;
+    let last = solution.steps.last()?;
+    let reached = (solution.t_final() - stop).abs() <= 4.0 * f64::EPSILON * stop.abs();
+    reached.then(|| Event {
+        index: usize::MAX,
+        t: stop,
+        y: last.y1.clone(),
+    })
 }
 
 /// Integrates `sys` from `start` until an event ends the phase, with relative tolerance
 /// `rtol` (raised to [`CONDITION_SAFETY`]` * eps * cond(M)`) by the method
 /// [`Method::for_rtol`] picks for it. `scales` (length `2 n`), when given, are typical
 /// magnitudes of the motion `y - y0` for the absolute tolerances; without them the control is
-/// relative to the largest deviation seen. `t_max` bounds the search.
+/// relative to the largest deviation seen. `t_max` bounds the search: reaching it is
+/// [`SolveError::NoEvent`], unless the start's `stop_at` comes first (the run then ends there,
+/// [`End::Until`]).
 pub fn integrate(
     sys: &Bound,
     start: &Start,
@@ -621,22 +689,12 @@ pub fn integrate_with(
     };
     let d = contacts::dynamics(sys, &start.state, &problem.active, 0.0)?;
     problem.watch(&d)?;
-    let mut atol: Vec<f64> = match scales {
-        Some(s) if s.len() == 2 * n => s
-            .iter()
-            .map(|v| rtol * v.abs().max(f64::MIN_POSITIVE))
-            .collect(),
-        _ => Vec::new(),
-    };
-    if with_work && !atol.is_empty() {
-        // The work of friction is held to the energy's own scale.
-        let e = sys.energy(&start.state)?.abs();
-        atol.push(rtol * if e > 0.0 { e } else { 1.0 });
-    }
+    let atol = absolute_tolerances(sys, start, scales, rtol, with_work)?;
+    let stop_at = start.stop_at.filter(|s| *s <= t_max);
     let opts = OdeOptions {
         rtol,
         atol,
-        t_max,
+        t_max: stop_at.unwrap_or(t_max),
         max_steps: MAX_STEPS,
     };
     let mut segments = Vec::new();
@@ -646,7 +704,11 @@ pub fn integrate_with(
         work.ode_evaluations += std::mem::take(&mut problem.evaluations);
         let solution = solution?;
         work.ode_steps += solution.total_steps();
-        let Some(event) = solution.event.clone() else {
+        let Some(event) = solution
+            .event
+            .clone()
+            .or_else(|| until_event(&solution, stop_at))
+        else {
             return Err(SolveError::NoEvent { t_max });
         };
         let y: Vec<f64> = (event.y.iter().zip(&y0)).map(|(z, y0)| y0 + z).collect();
@@ -660,35 +722,41 @@ pub fn integrate_with(
             q: y[..n].to_vec(),
             qd: y[n..2 * n].to_vec(),
         };
-        let watch =
-            problem
-                .watches
-                .get(event.index)
-                .copied()
-                .ok_or_else(|| SolveError::OdeNonFinite {
-                    what: "event index outside the watched events",
-                    t: event.t,
-                    y: y.clone(),
-                })?;
-        let end = match watch {
-            Watch::Force(i) => Some(EndEvent::Force(i)),
-            Watch::Gap(i) => Some(EndEvent::Gap(i)),
-            Watch::Edge(i) => Some(EndEvent::Edge(i)),
-            Watch::Floor => Some(EndEvent::Floor),
-            _ => None,
+        // The run's end, or the watch whose switch goes on with it.
+        let next: Result<End, Watch> =
+            if segments.last().is_some_and(|g| g.solution.event.is_none()) {
+                Ok(End::Until)
+            } else {
+                match problem.watches.get(event.index).copied() {
+                    Some(Watch::Force(i)) => Ok(End::Force(i)),
+                    Some(Watch::Gap(i)) => Ok(End::Contact(i)),
+                    Some(Watch::Edge(i)) => Ok(End::Edge(i)),
+                    Some(Watch::Floor) => Ok(End::Floor),
+                    Some(watch) => Err(watch),
+                    None => {
+                        return Err(SolveError::OdeNonFinite {
+                            what: "event index outside the watched events",
+                            t: event.t,
+                            y,
+                        });
+                    }
+                }
+            };
+        let watch = match next {
+            Ok(end) => {
+                return Ok(UnreducedRun {
+                    segments,
+                    rtol,
+                    method,
+                    condition,
+                    end,
+                    t_end: event.t,
+                    friction_work: if with_work { y[2 * n] } else { 0.0 },
+                    state_end: state,
+                });
+            }
+            Err(watch) => watch,
         };
-        if let Some(end) = end {
-            return Ok(UnreducedRun {
-                segments,
-                rtol,
-                method,
-                condition,
-                end,
-                t_end: event.t,
-                friction_work: if with_work { y[2 * n] } else { 0.0 },
-                state_end: state,
-            });
-        }
         if segments.len() > MAX_SWITCHES {
             return Err(SolveError::TooManySwitches {
                 model: info.name,
