@@ -1007,17 +1007,7 @@ impl<'m> Walker<'m> {
             return Ok(None);
         }
         let state = &impact.after;
-        let held: Vec<bool> = parts.iter().map(|p| *p != Part::None).collect();
-        let moment = Moment::After {
-            t,
-            held: &held,
-            drift: self.tol,
-        };
-        let options = Options {
-            contacts: contact_options(&self.general, state, moment)?,
-            frictions: friction_options(&self.general, state)?,
-        };
-        let active = contacts::decide(&self.general, state, &options, t)?;
+        let (active, _) = self.decide_after(state, parts, t)?;
         let pull = -contacts::dynamics(&self.general, state, &active, t)?.normal_acc[closing];
         if pull <= 0.0 {
             return Ok(None);
@@ -1036,27 +1026,40 @@ impl<'m> Walker<'m> {
     /// after it (a contact that took part and rests closes or opens as its force says; one
     /// that separates is open).
     fn after_impact(&self, at: &ImpactAt, friction_work: f64) -> Result<PhaseStart, SolveError> {
-        let state = at.impact.after.clone();
-        let held: Vec<bool> = (at.parts.iter()).map(|p| *p != Part::None).collect();
-        let moment = Moment::After {
-            t: at.t,
-            held: &held,
-            drift: self.tol,
-        };
-        let contacts = contact_options(&self.general, &state, moment)?;
-        let frictions = friction_options(&self.general, &state)?;
-        let options = Options {
-            contacts,
-            frictions: frictions.clone(),
-        };
-        let active = contacts::decide(&self.general, &state, &options, at.t)?;
+        let (active, frictions) = self.decide_after(&at.impact.after, &at.parts, at.t)?;
         Ok(PhaseStart {
-            state,
+            state: at.impact.after.clone(),
             active,
             frictions,
             t: at.t,
             friction_work,
         })
+    }
+
+    /// The contacts and friction modes at `state`, just after an impact at `t` in which
+    /// `parts` took part (those touch within the run's drift), with the friction options they
+    /// were decided from.
+    fn decide_after(
+        &self,
+        state: &State,
+        parts: &[Part],
+        t: f64,
+    ) -> Result<(Active, Vec<FrictionOption>), SolveError> {
+        let held: Vec<bool> = parts.iter().map(|p| *p != Part::None).collect();
+        let moment = Moment::After {
+            t,
+            held: &held,
+            drift: self.tol,
+        };
+        let frictions = friction_options(&self.general, state)?;
+        let options = Options {
+            contacts: contact_options(&self.general, state, moment)?,
+            frictions: frictions.clone(),
+        };
+        Ok((
+            contacts::decide(&self.general, state, &options, t)?,
+            frictions,
+        ))
     }
 }
 
