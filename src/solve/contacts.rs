@@ -491,7 +491,7 @@ pub fn contact_options(
             continue;
         }
         let row = &jac[i * n..(i + 1) * n];
-        let v: f64 = row.iter().zip(&state.qd).map(|(j, q)| j * q).sum();
+        let v = normal_velocity(row, state);
         let size: f64 = fastest * row.iter().map(|j| j.abs()).sum::<f64>();
         let at_rest = v == 0.0 || v.abs() <= REST * size;
         out.push(match (c.bilateral, at_rest) {
@@ -508,6 +508,11 @@ pub fn contact_options(
         });
     }
     Ok(out)
+}
+
+/// A contact's normal velocity `J_i qd` (negative: closing), from its Jacobian row.
+pub fn normal_velocity(row: &[f64], state: &State) -> f64 {
+    row.iter().zip(&state.qd).map(|(j, q)| j * q).sum()
 }
 
 /// Whether a candidate combination is consistent: closed candidates push (within

@@ -1084,9 +1084,7 @@ fn approaching_touches(sys: &Bound, state: &State) -> Result<Vec<bool>, SolveErr
     Ok((info.contacts.iter().enumerate())
         .map(|(i, c)| {
             let scale = if c.gap_unit == "m" { length } else { 1.0 };
-            let v: f64 = (jac[i * n..(i + 1) * n].iter().zip(&state.qd))
-                .map(|(j, q)| j * q)
-                .sum();
+            let v = contacts::normal_velocity(&jac[i * n..(i + 1) * n], state);
             !c.closed && !c.bilateral && gaps[i] <= DECIDE_TOLERANCE * scale && v < 0.0
         })
         .collect())
