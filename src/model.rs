@@ -329,8 +329,9 @@ pub trait Model: Send + Sync {
     fn info(&self) -> &'static ModelInfo;
 
     /// The per-point solver's inputs for the parameters `p` in one call: `Some` only when the
-    /// parameters pass [`check_parameters`](crate::system::check_parameters)' quick test (so
-    /// that the full check would accept them too), the model holds every contact of its system
+    /// parameters pass [`parameters_pass`], the quick test of
+    /// [`check_parameters`](crate::system::check_parameters) (so that the full check would
+    /// accept them too), the model holds every contact of its system
     /// closed, has a fast path whose first contact's force is a polynomial of degree at most 3
     /// and whose other closed unilateral contacts' forces are polynomials too, and a fall
     /// polynomial of degree at most 2; `None` says nothing about why (the checked route then
@@ -345,7 +346,7 @@ pub trait Model: Send + Sync {
         let fall_len = layout.fall_degree? + 1;
         let mut margins = [0.0; LEAN_MAX_REQUIREMENTS];
         let margins = margins.get_mut(..info.requirements.len())?;
-        if !crate::system::parameters_pass(self, p, margins) {
+        if !parameters_pass(self, p, margins) {
             return None;
         }
         let red = self.reduction()?;
@@ -377,53 +378,6 @@ pub trait Model: Send + Sync {
             fall,
             others,
             n_others,
-        })
-    }
-
-    /// The per-point solver's unchecked route for the parameters `p`: [`Model::lean_start`]
-    /// and the root, integrand and a-priori plan of [`LeanSolver`](crate::solve::lean::LeanSolver)
-    /// (to `prior`'s tolerance, with the root's bracket's low end at `sin_end`), with `evals`
-    /// counting the evaluations. `None` says nothing about why: the solver then takes its
-    /// checked route, which decides and names the error. A default method, so that each
-    /// model's copy is compiled with its generated functions inlined (its literal zeros and
-    /// constants folded into the whole route).
-    #[inline]
-    fn lean_point(
-        &self,
-        p: &[f64],
-        prior: &crate::solve::prior::Prior,
-        sin_end: f64,
-        evals: &mut u64,
-    ) -> Option<crate::solve::lean::LeanPoint> {
-        let start = self.lean_start(p)?;
-        crate::solve::lean::quick_route(&start, prior, sin_end, evals, |f, rule, a, b| {
-            f.panel(rule, a, b, a == 0.0)
-        })
-    }
-
-    /// [`Model::lean_point`] compiled for AVX2 (VEX encoding and four lanes), with the same
-    /// result to the bit: the same operations in the same order, correctly rounded in every
-    /// lane (no fused multiply-add). [`LeanSolver`](crate::solve::lean::LeanSolver) calls it
-    /// where the CPU has AVX2.
-    ///
-    /// The body repeats `lean_point`'s with the panel's AVX2 build named: calling
-    /// `self.lean_point` here instead left the panel out of line in the baseline instruction
-    /// set (1,023 instructions per point against 851, `examples/per_point.rs`).
-    ///
-    /// # Safety
-    /// The CPU must have AVX2 (`is_x86_feature_detected!("avx2")`).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn lean_point_avx2(
-        &self,
-        p: &[f64],
-        prior: &crate::solve::prior::Prior,
-        sin_end: f64,
-        evals: &mut u64,
-    ) -> Option<crate::solve::lean::LeanPoint> {
-        let start = self.lean_start(p)?;
-        crate::solve::lean::quick_route(&start, prior, sin_end, evals, |f, rule, a, b| {
-            f.panel_avx2(rule, a, b, a == 0.0)
         })
     }
 
@@ -558,6 +512,36 @@ pub trait Reduction: Send + Sync {
     );
 }
 
+/// The quick test of a model's parameter values (the full check with its messages is
+/// [`check_parameters`](crate::system::check_parameters)): the right counts, every value
+/// positive and finite and every requirement's margin (written to `margins`, one entry per
+/// requirement) positive. Passing it means the full check accepts; failing it leaves the
+/// verdict to the full check.
+#[inline(always)]
+pub(crate) fn parameters_pass<M: Model + ?Sized>(
+    model: &M,
+    p: &[f64],
+    margins: &mut [f64],
+) -> bool {
+    let info = model.info();
+    if p.len() != info.parameters.len()
+        || margins.len() != info.requirements.len()
+        || !p.iter().all(|&v| positive_finite(v))
+    {
+        return false;
+    }
+    model.requirements(p, margins);
+    margins.iter().all(|&m| m > 0.0)
+}
+
+/// Whether `v` is positive and finite, by one integer comparison: as bits, the positive finite
+/// floats are exactly `1..=f64::MAX.to_bits()` (zero is 0, negatives have the sign bit set,
+/// infinity and NaN lie above `f64::MAX`).
+#[inline(always)]
+pub(crate) fn positive_finite(v: f64) -> bool {
+    v.to_bits().wrapping_sub(1) < f64::MAX.to_bits()
+}
+
 /// The reduced state at one angle.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Reduced {
@@ -586,4 +570,31 @@ pub fn start_offsets(theta_i: f64, sin_i: f64, cos_i: f64, delta: f64) -> (f64, 
     let dc = cos_i * vers - sin_i * sin_delta;
     let (s, c) = (theta_i - delta).sin_cos();
     (s, c, ds, dc)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::positive_finite;
+
+    #[test]
+    fn positive_finite_is_the_two_comparisons() {
+        let values = [
+            0.0,
+            -0.0,
+            f64::MIN_POSITIVE,
+            f64::from_bits(1),
+            1.0,
+            f64::MAX,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            -f64::NAN,
+            -1.0,
+            -f64::from_bits(1),
+            -f64::MAX,
+        ];
+        for v in values {
+            assert_eq!(positive_finite(v), v > 0.0 && v < f64::INFINITY, "{v:e}");
+        }
+    }
 }

@@ -16,7 +16,7 @@
 //! values), so one comparison checks it. The checks cost a comparison per call; the per-point
 //! solver's route never comes through here.
 
-use crate::model::{Model, ModelInfo, Reduced, Reduction, ReductionInfo};
+use crate::model::{Model, ModelInfo, Reduced, Reduction, ReductionInfo, parameters_pass};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
@@ -934,26 +934,6 @@ pub fn check_parameters(
     parameters_refused(model, p, margins)
 }
 
-/// [`check_parameters`]' quick test: the right counts, every value positive and finite and
-/// every requirement's margin (written to `margins`) positive. Passing it means the full check
-/// accepts; failing it leaves the verdict to the full check.
-#[inline(always)]
-pub(crate) fn parameters_pass<M: Model + ?Sized>(
-    model: &M,
-    p: &[f64],
-    margins: &mut [f64],
-) -> bool {
-    let info = model.info();
-    if p.len() != info.parameters.len()
-        || margins.len() != info.requirements.len()
-        || !p.iter().all(|&v| positive_finite(v))
-    {
-        return false;
-    }
-    model.requirements(p, margins);
-    margins.iter().all(|&m| m > 0.0)
-}
-
 /// [`check_parameters`]' verdict on parameters that did not pass its quick tests: the first
 /// failure by name, or `Ok` (a value that is zero or negative where that is allowed).
 #[cold]
@@ -984,14 +964,6 @@ fn parameters_refused(
         });
     }
     Ok(())
-}
-
-/// Whether `v` is positive and finite, by one integer comparison: as bits, the positive finite
-/// floats are exactly `1..=f64::MAX.to_bits()` (zero is 0, negatives have the sign bit set,
-/// infinity and NaN lie above `f64::MAX`).
-#[inline(always)]
-pub(crate) fn positive_finite(v: f64) -> bool {
-    v.to_bits().wrapping_sub(1) < f64::MAX.to_bits()
 }
 
 /// Prepares the model's constants `k` (of length [`ModelInfo::n_constants`]) from checked
@@ -1033,31 +1005,4 @@ fn describe(info: &ModelInfo, p: &[f64]) -> String {
         let _ = write!(out, "{} = {v}", param.name);
     }
     out
-}
-
-#[cfg(test)]
-mod tests {
-    use super::positive_finite;
-
-    #[test]
-    fn positive_finite_is_the_two_comparisons() {
-        let values = [
-            0.0,
-            -0.0,
-            f64::MIN_POSITIVE,
-            f64::from_bits(1),
-            1.0,
-            f64::MAX,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::NAN,
-            -f64::NAN,
-            -1.0,
-            -f64::from_bits(1),
-            -f64::MAX,
-        ];
-        for v in values {
-            assert_eq!(positive_finite(v), v > 0.0 && v < f64::INFINITY, "{v:e}");
-        }
-    }
 }

@@ -10,15 +10,15 @@
 //! ([`Reduction::prepare_lean`]) and takes the node
 //! counts a priori from the integrand's singularities ([`prior`](crate::solve::prior)): about
 //! 7 evaluations per point instead of 19, at `2^-53` relative. Such a point is first solved on
-//! an unchecked route ([`Model::lean_point`], a default trait method, so each model's copy is
-//! compiled with its generated functions inlined and their literal zeros and constants folded
-//! into the route): its inputs come from [`Model::lean_start`] (the parameters' quick test and
-//! the start and polynomials), then the same root, integrand and plan with nothing but numbers
-//! between them (no error values built). Anything short of a clean solve there (a parameter the quick
+//! an unchecked route ([`LeanRoute::lean_point`], implemented here for every model type): its
+//! inputs come from [`Model::lean_start`] (a default trait method, so each model's copy is
+//! compiled with its generated functions inlined: the parameters' quick test and the start and
+//! polynomials), then the same root, integrand and plan with nothing but numbers between them
+//! (no error values built). Anything short of a clean solve there (a parameter the quick
 //! test does not pass, a value not finite, no root, a phase that does not fall, too many panels)
 //! sends the point through the checked route (`LeanSolver::checked`), which solves it again and
 //! names what failed; so the unchecked route never decides an error. The unchecked route has a
-//! second compiled copy, [`Model::lean_point_avx2`], the same source built for AVX2 (4-wide
+//! second compiled copy, [`LeanRoute::lean_point_avx2`], the same source built for AVX2 (4-wide
 //! division and root in the integrand) and taken when the CPU reports AVX2 at the solver's
 //! construction; it gives the same bits as the baseline copy ([`LeanSolver::baseline_only`]
 //! turns it off for comparison).
@@ -28,7 +28,7 @@
 //! `a/ell` from 1e-10 to `1 - 1e-9`.
 
 use crate::model::PhaseInfo;
-use crate::model::{LeanStart, Model, ModelInfo, Reduction, ReductionInfo};
+use crate::model::{LeanStart, Model, ModelInfo, Reduction, ReductionInfo, positive_finite};
 use crate::results::Work;
 use crate::solve::SolveError;
 use crate::solve::phases::{End, phase_end};
@@ -38,9 +38,7 @@ use crate::solve::prior::{PRIOR_TOL, Prior, Singularities, integrate_prior, prio
 use crate::solve::quadrature::{
     self, ACCEPT, Control, Fall, FallIntegrand, HalfRule, PanelSum, RuleStep, SCHEDULE, v_at_drop,
 };
-use crate::system::{
-    System, SystemError, check_parameters, ordered_values, positive_finite, prepare_constants,
-};
+use crate::system::{System, SystemError, check_parameters, ordered_values, prepare_constants};
 
 /// The fast phase a system starts in (its release phase), looked up in the registry; a model
 /// that is not a system's general model is taken as it is.
@@ -285,7 +283,7 @@ impl<'m> LeanSolver<'m> {
         self.wide = false;
     }
 
-    /// Whether points are solved by the AVX2 copy of the route ([`Model::lean_point_avx2`]).
+    /// Whether points are solved by the AVX2 copy of the route ([`LeanRoute::lean_point_avx2`]).
     pub fn wide(&self) -> bool {
         self.wide
     }
@@ -422,6 +420,78 @@ impl<'m> LeanSolver<'m> {
     }
 }
 
+/// The per-point solver's unchecked route of one model: [`Model::lean_start`] and the root,
+/// integrand and a-priori plan of [`quick_route`], with `evals` counting the evaluations.
+/// `None` says nothing about why: [`LeanSolver`] then takes its checked route, which decides
+/// and names the error.
+///
+/// Implemented for every model by the blanket impl below. [`LeanSolver`] runs the copy for
+/// `dyn Model`, which calls the model's own compiled [`Model::lean_start`] (its generated
+/// functions inlined) once per point and has the rest of the route inlined into the solver's
+/// caller; a program holding a generated model's type
+/// ([`generated`](crate::models::generated)) can call that type's copy, with the start
+/// inlined too.
+pub trait LeanRoute {
+    /// The route for the parameters `p`, to `prior`'s tolerance, with the root's bracket's low
+    /// end at `sin_end`.
+    fn lean_point(
+        &self,
+        p: &[f64],
+        prior: &Prior,
+        sin_end: f64,
+        evals: &mut u64,
+    ) -> Option<LeanPoint>;
+
+    /// [`LeanRoute::lean_point`] compiled for AVX2 (VEX encoding and four lanes), with the
+    /// same result to the bit: the same operations in the same order, correctly rounded in
+    /// every lane (no fused multiply-add). [`LeanSolver`] calls it where the CPU has AVX2.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2 (`is_x86_feature_detected!("avx2")`).
+    #[cfg(target_arch = "x86_64")]
+    unsafe fn lean_point_avx2(
+        &self,
+        p: &[f64],
+        prior: &Prior,
+        sin_end: f64,
+        evals: &mut u64,
+    ) -> Option<LeanPoint>;
+}
+
+impl<M: Model + ?Sized> LeanRoute for M {
+    #[inline]
+    fn lean_point(
+        &self,
+        p: &[f64],
+        prior: &Prior,
+        sin_end: f64,
+        evals: &mut u64,
+    ) -> Option<LeanPoint> {
+        let start = self.lean_start(p)?;
+        quick_route(&start, prior, sin_end, evals, |f, rule, a, b| {
+            f.panel(rule, a, b, a == 0.0)
+        })
+    }
+
+    /// The body repeats `lean_point`'s with the panel's AVX2 build named: calling
+    /// `self.lean_point` here instead left the panel out of line in the baseline instruction
+    /// set (1,023 instructions per point against 851, `examples/per_point.rs`).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn lean_point_avx2(
+        &self,
+        p: &[f64],
+        prior: &Prior,
+        sin_end: f64,
+        evals: &mut u64,
+    ) -> Option<LeanPoint> {
+        let start = self.lean_start(p)?;
+        quick_route(&start, prior, sin_end, evals, |f, rule, a, b| {
+            f.panel_avx2(rule, a, b, a == 0.0)
+        })
+    }
+}
+
 /// Whether the CPU has AVX2 (where the unchecked route has a copy for it).
 fn has_avx2() -> bool {
     #[cfg(target_arch = "x86_64")]
@@ -436,9 +506,7 @@ fn has_avx2() -> bool {
 /// ([`prior_panels`]), each the one copy the checked route also uses. `None` on anything short
 /// of a phase that falls from rest to a separation inside it with positive finite values at
 /// every node: the checked route ([`LeanSolver::solve`]) then solves the point again and names
-/// what failed. Called from [`Model::lean_point`], so that each model's copy is compiled with
-/// its generated start inlined (its literal zeros and constants folded into the root, the plan
-/// and the integrand).
+/// what failed. Called from [`LeanRoute::lean_point`], once per compiled copy of the route.
 #[inline(always)]
 pub(crate) fn quick_route(
     start: &LeanStart,
