@@ -2,17 +2,21 @@
 //! `theta(t)` series, the unreduced ODE cross-check, phase chaining and physical checks.
 //!
 //! Data flows one way: [`separation`] finds where a phase ends, [`quadrature`] builds `t(theta)`
-//! on that phase, [`series`] inverts it at uniform times, [`phases`] chains a phase to the next
-//! model, [`unreduced`] integrates `M(q) qdd = F(q, qd)` with the generic [`ode`] integrator,
-//! and [`checks`] turns sampled motion into pass/fail margins.
+//! on that phase and [`inversion`] inverts it, [`phases`] chains a phase to the next model,
+//! [`unreduced`] integrates `M(q) qdd = F(q, qd)` with the generic [`ode`] integrator,
+//! [`series`] samples a phase at uniform times, and [`checks`] turns sampled motion into
+//! pass/fail margins. At one state, [`active`] holds which contacts are closed, [`rest`] whether
+//! such a set stays at rest and [`contacts`] decides it.
 //!
 //! Architecture invariant: nothing here panics or returns NaN on bad numbers; every failure is
 //! a [`SolveError`] carrying the offending values. Every evaluation is counted in a
 //! [`Work`](crate::results::Work) passed down by the caller.
 
+pub mod active;
 pub mod checks;
 pub mod contacts;
 pub mod impact;
+pub mod inversion;
 pub mod lean;
 pub mod ode;
 pub mod phases;

@@ -21,11 +21,11 @@ use crate::solve::contacts::{
     contact_options, friction_options,
 };
 use crate::solve::impact::{self, Impact, Part};
+use crate::solve::inversion::{delta_at_time, theta_dot_at};
 use crate::solve::ode::Method;
 use crate::solve::quadrature::TimeMesh;
 use crate::solve::roots::{self, changes_sign};
 use crate::solve::separation::{Separation, SeparationOutcome, edge, force_zero};
-use crate::solve::series::{delta_at_time, theta_dot_at};
 use crate::solve::unreduced::{self, Start, UnreducedRun, motion_scales};
 use crate::system::{Bound, State, System};
 

@@ -10,7 +10,7 @@
 
 use crate::model::ModelInfo;
 use crate::solve::SolveError;
-use crate::solve::contacts::{Active, DECIDE_TOLERANCE, Mode};
+use crate::solve::active::{Active, DECIDE_TOLERANCE, Mode, check_active};
 use crate::system::{Bound, State};
 use nalgebra::{DMatrix, DVector};
 
@@ -63,7 +63,7 @@ fn stacked(
 pub fn pins(sys: &Bound, state: &State, active: &Active) -> Result<bool, SolveError> {
     let info = sys.info();
     sys.check_state(state)?;
-    crate::solve::contacts::check_active(info, active)?;
+    check_active(info, active)?;
     let Some((kkt, acting)) = support_rows(info, active) else {
         return Ok(false);
     };
