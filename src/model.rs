@@ -329,15 +329,14 @@ pub trait Model: Send + Sync {
     fn info(&self) -> &'static ModelInfo;
 
     /// The per-point solver's inputs for the parameters `p` in one call: `Some` only when the
-    /// parameters pass [`parameters_pass`], the quick test of
-    /// [`check_parameters`](crate::system::check_parameters) (so that the full check would
-    /// accept them too), the model holds every contact of its system
-    /// closed, has a fast path whose first contact's force is a polynomial of degree at most 3
-    /// and whose other closed unilateral contacts' forces are polynomials too, and a fall
-    /// polynomial of degree at most 2; `None` says nothing about why (the checked route then
-    /// decides and names it). A default method, so that each model's copy calls its own
-    /// generated functions directly and the compiler can fuse them (no constant vector in
-    /// memory, no virtual call).
+    /// parameters pass `parameters_pass`, the quick test of
+    /// [`check_parameters`](crate::system::check_parameters) (so that the full check would accept
+    /// them too), the model holds every contact of its system closed, has a fast path whose first
+    /// contact's force is a polynomial of degree at most 3 and whose other closed unilateral
+    /// contacts' forces are polynomials too, and a fall polynomial of degree at most 2; `None` says
+    /// nothing about why (the checked route then decides and names it). A default method, so that
+    /// each model's copy calls its own generated functions directly and the compiler can fuse them
+    /// (no constant vector in memory, no virtual call).
     #[inline(always)]
     fn lean_start(&self, p: &[f64]) -> Option<LeanStart> {
         let info = self.info();

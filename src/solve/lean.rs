@@ -421,7 +421,7 @@ impl<'m> LeanSolver<'m> {
 }
 
 /// The per-point solver's unchecked route of one model: [`Model::lean_start`] and the root,
-/// integrand and a-priori plan of [`quick_route`], with `evals` counting the evaluations.
+/// integrand and a-priori plan of `quick_route`, with `evals` counting the evaluations.
 /// `None` says nothing about why: [`LeanSolver`] then takes its checked route, which decides
 /// and names the error.
 ///
