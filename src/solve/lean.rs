@@ -575,7 +575,44 @@ pub(crate) fn quick_route(
 
 #[cfg(test)]
 mod tests {
-    use super::LeanPoint;
+    use super::{LeanPoint, LeanRoute};
+    use crate::model::Model;
+    use crate::models::generated::rod_cube_closed::RodCubeClosed;
+    use crate::solve::prior::{PRIOR_TOL, Prior};
+
+    #[test]
+    fn a_model_types_route_is_the_dyn_route() {
+        // The copy compiled for the generated type and the one the solver runs (`dyn Model`)
+        // give the same bits, the same refusals and the same evaluation counts.
+        let prior = Prior::new(PRIOR_TOL);
+        let dynamic: &dyn Model = &RodCubeClosed;
+        let sin_end = dynamic.info().end_angle.sin();
+        let mut served = 0;
+        for (m2, a) in [
+            (3.0, 0.25),
+            (1e-3, 0.01),
+            (1e3, 0.99),
+            (1.0, 2.0),
+            (f64::NAN, 0.5),
+        ] {
+            let p = [1.0, m2, 1.0, a, 9.81];
+            let (mut e1, mut e2) = (0, 0);
+            let typed = RodCubeClosed.lean_point(&p, &prior, sin_end, &mut e1);
+            let erased = dynamic.lean_point(&p, &prior, sin_end, &mut e2);
+            assert_eq!(typed, erased, "{p:?}");
+            assert_eq!(e1, e2, "{p:?}");
+            #[cfg(target_arch = "x86_64")]
+            if std::arch::is_x86_feature_detected!("avx2") {
+                let mut e3 = 0;
+                // SAFETY: the CPU has AVX2.
+                let wide = unsafe { RodCubeClosed.lean_point_avx2(&p, &prior, sin_end, &mut e3) };
+                assert_eq!(wide, erased, "{p:?}");
+                assert_eq!(e3, e2, "{p:?}");
+            }
+            served += usize::from(typed.is_some());
+        }
+        assert_eq!(served, 3);
+    }
 
     fn point(si: f64, s: f64) -> LeanPoint {
         LeanPoint {
