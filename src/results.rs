@@ -1,6 +1,6 @@
 //! The results of a run: scalars, series, checks and the work done, ready for any report.
 
-use crate::model::ModelInfo;
+use crate::model::{ModelInfo, ShapeInfo};
 use crate::quantity::Quantity;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -142,6 +142,74 @@ pub struct ImpactRecord {
     pub zeno_limit: bool,
 }
 
+/// Why a solved phase ended, as the drawing of the motion tells it (a contact by its name).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum PhaseEnd {
+    /// The named contact's force reached zero: it opened.
+    Force(String),
+    /// The named contact's point ran off the edge of a body.
+    Edge(String),
+    /// The named contact's gap closed: an impact.
+    Contact(String),
+    /// The reduced angle reached the model's end angle.
+    Floor,
+    /// The run reached its end time.
+    Until,
+}
+
+/// The drawing's numbers at one sample: every body's pose and the traced point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pose {
+    /// Every body's pose `[x, y, angle]` (m, m, rad), in the order of the phase's bodies.
+    pub bodies: Vec<[f64; 3]>,
+    /// The traced point's position `[x, y]` (m), when a point is traced and the phase has it.
+    pub traced: Option<[f64; 2]>,
+}
+
+/// One sample of a phase as drawn.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DrawnSample {
+    /// Time from the phase's start (s).
+    pub t: f64,
+    /// The poses, or the model's refusal of the sample's state (its message).
+    pub pose: Result<Pose, String>,
+}
+
+/// One solved phase as drawn.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DrawnPhase {
+    /// Its model's name.
+    pub model: String,
+    /// Its bodies' names.
+    pub bodies: Vec<String>,
+    /// When it starts (s from release).
+    pub t_start: f64,
+    /// Why it ended.
+    pub end: PhaseEnd,
+    /// Its samples, in order.
+    pub samples: Vec<DrawnSample>,
+}
+
+/// The bodies' motion as the model draws it, every solved phase sampled: plain numbers from
+/// which `report::motion` computes the animation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Drawing {
+    /// The system drawn (the first phase's).
+    pub system: String,
+    /// The shapes of the first phase's model: kind, body and where its numbers start in
+    /// `sizes`.
+    pub shapes: Vec<ShapeInfo>,
+    /// The shapes' numbers at the first phase's start, or the model's refusal (its message).
+    pub sizes: Result<Vec<f64>, String>,
+    /// The name of the point whose path is traced, if any.
+    pub traced: Option<String>,
+    /// The phases drawn, in order.
+    pub phases: Vec<DrawnPhase>,
+    /// The phase (its index) before which the drawing stops, when a phase could not be
+    /// sampled, with the reason (the error's message).
+    pub stopped: Option<(usize, String)>,
+}
+
 /// Everything one scene produced.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct RunResults {
@@ -168,10 +236,11 @@ pub struct RunResults {
     /// in JSON as `impacts: {value: [...], meaning}`).
     #[serde(skip)]
     pub impacts: Option<Vec<ImpactRecord>>,
-    /// The bodies' motion over every phase the run solved, drawn into `motion.svg`; present
-    /// when a trajectory was wanted. Not part of results.json.
+    /// The bodies' poses over every phase the run solved, from which the report computes the
+    /// animation in `motion.svg`; present when a trajectory was wanted. Not part of
+    /// results.json.
     #[serde(skip)]
-    pub motion: Option<crate::report::motion::Animation>,
+    pub drawing: Option<Drawing>,
 }
 
 impl RunResults {

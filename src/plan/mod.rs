@@ -14,8 +14,9 @@
 //! - `point_mass_fall_time`: the release state only;
 //! - `theta_series`, `<contact>_series`, `<friction>_series`, `<point>_trajectory`: `samples`
 //!   uniform times from release to the first contact's end (or to the end of the motion);
-//! - any `<point>_trajectory` also gives the bodies' motion ([`RunResults::motion`], drawn
-//!   into `motion.svg`) over every phase the run solved anyway, each sampled once;
+//! - any `<point>_trajectory` also gives the bodies' poses ([`RunResults::drawing`], from
+//!   which the report computes `motion.svg`) over every phase the run solved anyway, each
+//!   sampled once;
 //! - `floor_impact`: every phase to the end of the motion;
 //! - `cross_check`: the release fast phase and the general model integrated from release with
 //!   the same contacts closed, to its first event;
@@ -38,6 +39,7 @@
 //! (`t, x, y, vx, vy`). A wanted quantity without a value (e.g. no separation, or a mass matrix
 //! too ill-conditioned for the cross-check) is explained in [`RunResults::notes`] under its key.
 
+pub mod drawing;
 mod quantities;
 mod verify;
 
@@ -353,7 +355,7 @@ pub fn run(request: &Request) -> Result<RunResults, PlanError> {
         plan.quantity(*q, &want, &mut out)?;
     }
     if want.iter().any(|q| matches!(q, Quantity::Trajectory(_))) {
-        plan.animation(&want, &mut out)?;
+        plan.drawing(&want, &mut out)?;
     }
     plan.motion_notes(&mut out);
     out.work = plan.work;

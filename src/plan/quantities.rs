@@ -2,10 +2,10 @@
 //! the floor in contact, the point mass's fall, the series over the first contact's span and
 //! the landing, each computing only what it needs of the motion.
 
+use super::drawing::{PhaseInput, record};
 use super::{Plan, angle_name, column, motion_end, path, scalar};
 use crate::model::ModelInfo;
 use crate::quantity::Quantity;
-use crate::report::motion::{Animation, PhaseInput};
 use crate::results::{ContactImpulse, ImpactRecord, Label, RunResults, Series, format_number};
 use crate::solve::SolveError;
 use crate::solve::impact::Part;
@@ -725,20 +725,20 @@ impl Plan<'_> {
         }
     }
 
-    /// The bodies' motion for `motion.svg`: every phase this run solved (the first always, the
+    /// The bodies' poses for `motion.svg`: every phase this run solved (the first always, the
     /// next ones when other quantities asked for them), each sampled once, with the path of the
     /// first point whose trajectory is wanted. A later phase that cannot be sampled ends the
-    /// animation there, with a note in it.
-    pub(super) fn animation(
+    /// drawing there, which says why.
+    pub(super) fn drawing(
         &mut self,
         want: &[Quantity],
         out: &mut RunResults,
     ) -> Result<(), SolveError> {
         let n = self.motion()?.phases.len();
-        let mut notes = Vec::new();
+        let mut stopped = None;
         for i in 0..n {
             if let Err(e) = self.samples_of(i) {
-                notes.push(format!("the animation stops before phase {}: {e}", i + 1));
+                stopped = Some((i, e.to_string()));
                 break;
             }
         }
@@ -764,9 +764,9 @@ impl Plan<'_> {
                 end: run.end(),
             })
             .collect();
-        let mut animation = Animation::build(&phases, traced);
-        animation.notes.extend(notes);
-        out.motion = Some(animation);
+        let mut drawing = record(&phases, traced);
+        drawing.stopped = stopped;
+        out.drawing = Some(drawing);
         Ok(())
     }
 }
