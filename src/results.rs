@@ -88,8 +88,69 @@ pub struct Check {
     pub at_time: Option<f64>,
     /// How many samples or states it looked at.
     pub samples: usize,
-    /// What was checked and against what, in a sentence.
-    pub meaning: String,
+    /// What was checked, with the names and numbers its sentence gives (`report::prose`
+    /// writes the sentence, results.json's `meaning`).
+    #[serde(skip)]
+    pub subject: CheckSubject,
+}
+
+/// What a [`Check`] is about: the quantity tested, named, with the numbers that scale it.
+/// The check's own `samples`, `kind` and `limit` (the tolerance of a drift) complete it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CheckSubject {
+    /// A spec's monitor over a phase's samples.
+    Monitor {
+        /// The model sampled.
+        model: String,
+        /// The monitor's name.
+        monitor: String,
+        /// The monitor's meaning, as its spec gives it.
+        meaning: String,
+    },
+    /// A closed unilateral contact's force over a phase's samples.
+    Pushes {
+        /// The model sampled.
+        model: String,
+        /// The contact.
+        contact: String,
+    },
+    /// The gap of a contact the integrator holds closed, relative to the system's length.
+    Gap {
+        /// The model integrated.
+        model: String,
+        /// The contact.
+        contact: String,
+        /// The system's length (m).
+        length: f64,
+    },
+    /// The total energy along a path (with friction, the balance: energy lost = work of
+    /// friction), beyond its rounding, relative to its scale.
+    Energy {
+        /// The model of the path.
+        model: String,
+        /// Whether it is the balance with the work of friction.
+        friction: bool,
+        /// What rounding alone leaves in the energy (J), not counted as drift.
+        rounding: f64,
+        /// The scale: the largest kinetic energy plus the potential's range (J).
+        scale: f64,
+    },
+    /// A conserved combination of cyclic momenta along a path.
+    Momentum {
+        /// The model of the path.
+        model: String,
+        /// Its name (`momentum_x`, `momentum_x_x2`).
+        name: String,
+        /// The scale its drift is relative to.
+        scale: f64,
+    },
+    /// The energy an impact took out: its impulses' loss against the drop of the total energy.
+    Impact {
+        /// The loss by the impulses (J).
+        energy_lost: f64,
+        /// The kinetic energy before (J), the scale.
+        kinetic_before: f64,
+    },
 }
 
 /// What a run computed, to prove that a scene gets only what it asks for.

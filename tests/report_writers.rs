@@ -5,7 +5,7 @@
 
 use rodcube::io::OutDir;
 use rodcube::report::{self, csv, json, plot, table};
-use rodcube::results::{Check, CheckKind, Column, RunResults, Scalar, Series, Work};
+use rodcube::results::{Check, CheckKind, CheckSubject, Column, RunResults, Scalar, Series, Work};
 use std::collections::BTreeMap;
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -123,7 +123,11 @@ fn paper_results(m2: f64) -> RunResults {
             margin: 2.45,
             at_time: Some(0.1085),
             samples: 1000,
-            meaning: "floor normal force >= 0 (N)".into(),
+            subject: CheckSubject::Monitor {
+                model: "rod_cube".into(),
+                monitor: "foot_on_floor".into(),
+                meaning: "floor normal force >= 0 (N)".into(),
+            },
         },
     );
     checks.insert(
@@ -139,7 +143,12 @@ fn paper_results(m2: f64) -> RunResults {
             margin: -3e-9,
             at_time: None,
             samples: 79,
-            meaning: "relative energy drift below tolerance".into(),
+            subject: CheckSubject::Energy {
+                model: "rod_cube_free".into(),
+                friction: false,
+                rounding: 1e-15,
+                scale: 2.5,
+            },
         },
     );
     RunResults {

@@ -122,7 +122,7 @@ fn solve<'py>(
             let c = PyDict::new(py);
             c.set_item("passed", check.passed)?;
             c.set_item("margin", check.margin)?;
-            c.set_item("meaning", &check.meaning)?;
+            c.set_item("meaning", rodcube::report::prose::check_meaning(check))?;
             checks.set_item(name, c)?;
         }
         out.set_item("checks", checks)?;

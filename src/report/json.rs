@@ -9,6 +9,7 @@
 //! `{passed, margin, meaning}`) and `work` (counters and phases). Values are SI (angles in
 //! radians); a non-finite number is written as `null`, as JSON has no NaN.
 
+use super::prose::check_meaning;
 use crate::results::RunResults;
 
 /// The meaning written beside `results.impacts`.
@@ -20,6 +21,13 @@ pub const IMPACTS_MEANING: &str = "every impact of the motion in order: its time
 /// Pretty-printed JSON of the results, ending with a newline.
 pub fn to_string(results: &RunResults) -> Result<String, serde_json::Error> {
     let mut value = serde_json::to_value(results)?;
+    if let Some(map) = value.get_mut("checks").and_then(|c| c.as_object_mut()) {
+        for (key, check) in &results.checks {
+            if let Some(entry) = map.get_mut(key).and_then(|e| e.as_object_mut()) {
+                entry.insert("meaning".into(), check_meaning(check).into());
+            }
+        }
+    }
     if let Some(map) = value.get_mut("results").and_then(|r| r.as_object_mut()) {
         for (key, label) in &results.labels {
             map.insert(key.clone(), serde_json::to_value(label)?);

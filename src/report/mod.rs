@@ -2,7 +2,7 @@
 //! run wanted impacts, SVG plots and the animated motion (`motion.svg`).
 //!
 //! Every writer here is a pure function from `RunResults` to text; only `write_all` touches
-//! the file system, through `OutDir` (atomic writes, checked names). Only [`json`] and
+//! the file system, through `OutDir` (atomic writes, checked names). Only [`json`], [`prose`] and
 //! [`motion`] (the animation computed from [`crate::results::Drawing`], then hand-written SVG
 //! text, no dependency) are built without the `cli` feature (the C ABI returns results.json).
 //!
@@ -19,6 +19,7 @@ pub mod json;
 pub mod motion;
 #[cfg(feature = "cli")]
 pub mod plot;
+pub mod prose;
 #[cfg(feature = "cli")]
 pub mod table;
 mod touch;

@@ -413,7 +413,7 @@ fn checks(out: &mut String, results: &RunResults, layout: &Layout) {
         let mut t = new_table(&header, layout);
         for (c, row) in &cells[group..end] {
             t.add_row(row.to_vec());
-            legend.push((row[0].clone(), c.meaning.clone()));
+            legend.push((row[0].clone(), super::prose::check_meaning(c)));
         }
         // The same widths in every group, where they fit the line; else each group wraps.
         let total: usize = widths.iter().map(|w| w + 3).sum::<usize>() + 1;
