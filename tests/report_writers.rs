@@ -5,7 +5,9 @@
 
 use rodcube::io::OutDir;
 use rodcube::report::{self, csv, json, plot, table};
-use rodcube::results::{Check, CheckKind, CheckSubject, Column, RunResults, Scalar, Series, Work};
+use rodcube::results::{
+    Check, CheckKind, CheckSubject, Column, Held, Note, RunResults, Scalar, Series, Work,
+};
 use std::collections::BTreeMap;
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -176,7 +178,7 @@ fn paper_results(m2: f64) -> RunResults {
         },
         notes: BTreeMap::new(),
         impacts: None,
-        motion: None,
+        drawing: None,
     }
 }
 
@@ -557,11 +559,18 @@ fn table_explains_quantities_without_a_value() {
     let mut r = paper_results(4.0);
     r.notes.insert(
         "separation_angle".into(),
-        "the rod reaches the floor before separating".into(),
+        Note::NoSeparationHolds {
+            contact: "contact_force".into(),
+            held: Held::Floor {
+                angle: "theta".into(),
+                end_angle: 0.0,
+            },
+        },
     );
     let text = table::render(&r, None, &table::Layout::default());
     assert!(
-        text.contains("Notes") && text.contains("reaches the floor before"),
+        text.contains("Notes")
+            && text.contains("no separation: contact `contact_force` holds until `theta` = 0 rad"),
         "{text}"
     );
 }

@@ -153,7 +153,10 @@ fn solve<'py>(
         out.set_item("impacts", list)?;
     }
     if !results.notes.is_empty() {
-        out.set_item("notes", results.notes.clone())?;
+        let notes: std::collections::BTreeMap<&str, String> = (results.notes.iter())
+            .map(|(key, n)| (key.as_str(), rodcube::report::prose::note(n)))
+            .collect();
+        out.set_item("notes", notes)?;
     }
     Ok(out)
 }

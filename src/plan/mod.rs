@@ -441,13 +441,15 @@ fn motion_end(info: &ModelInfo) -> String {
 
 /// The reduced coordinate's name, in backquotes.
 fn angle_name(info: &ModelInfo) -> String {
-    format!(
-        "`{}`",
-        info.coordinates
-            .get(info.reduced)
-            .copied()
-            .unwrap_or("theta")
-    )
+    format!("`{}`", angle_coordinate(info))
+}
+
+/// The reduced coordinate's name.
+fn angle_coordinate(info: &ModelInfo) -> &'static str {
+    info.coordinates
+        .get(info.reduced)
+        .copied()
+        .unwrap_or("theta")
 }
 
 impl<'m> Plan<'m> {
@@ -718,6 +720,10 @@ impl<'m> Plan<'m> {
 
 /// The phases' labels as one path: `rod_cube_closed -> rod_cube_free`.
 fn path(motion: &Motion) -> String {
-    let names: Vec<String> = motion.phases.iter().flat_map(PhaseRun::labels).collect();
-    names.join(" -> ")
+    phase_labels(motion).join(" -> ")
+}
+
+/// The labels of the phases the motion went through, in order.
+fn phase_labels(motion: &Motion) -> Vec<String> {
+    motion.phases.iter().flat_map(PhaseRun::labels).collect()
 }

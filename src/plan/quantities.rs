@@ -3,10 +3,13 @@
 //! the landing, each computing only what it needs of the motion.
 
 use super::drawing::{PhaseInput, record};
-use super::{Plan, angle_name, column, motion_end, path, scalar};
+use super::{Plan, angle_coordinate, angle_name, column, motion_end, path, phase_labels, scalar};
 use crate::model::ModelInfo;
 use crate::quantity::Quantity;
-use crate::results::{ContactImpulse, ImpactRecord, Label, RunResults, Series, format_number};
+use crate::results::{
+    ContactImpulse, Held, ImpactRecord, Label, Note, RunResults, Series, Unlanded, UntilNote,
+    format_number,
+};
 use crate::solve::SolveError;
 use crate::solve::impact::Part;
 use crate::solve::phases::{End, ImpactAt, LANDING_TOLERANCE, Motion, PhaseRun};
@@ -31,7 +34,7 @@ pub(super) enum Fate {
     /// It held to the end of the motion, which ended as `until` says.
     Held {
         /// How the motion ended.
-        until: String,
+        until: Held,
     },
     /// It was open from release on.
     NeverClosed,
@@ -81,11 +84,10 @@ fn fate_along(motion: &Motion, info: &ModelInfo, i: usize, landed: bool) -> Opti
             End::Edge(j) if j == i => return Some(ended("edge")),
             End::Contact(j) if !motion.through_impacts && landed => {
                 return Some(Fate::Held {
-                    until: format!(
-                        "until the body lands, where contact `{}` closes at t = {} s",
-                        name(j),
-                        format_number(phase.t_end(), 6)
-                    ),
+                    until: Held::Lands {
+                        contact: name(j).to_string(),
+                        t: phase.t_end(),
+                    },
                 });
             }
             End::Contact(_) if !motion.through_impacts => return Some(ended("contact")),
@@ -93,7 +95,7 @@ fn fate_along(motion: &Motion, info: &ModelInfo, i: usize, landed: bool) -> Opti
                 // An impact: it may have separated this contact.
                 let Some(next) = motion.phases.get(k + 1) else {
                     return (motion.halted.as_ref()).map(|why| Fate::Held {
-                        until: format!("until {why}"),
+                        until: Held::Halted(why.clone()),
                     });
                 };
                 if !next.closed().get(i).copied().unwrap_or(false) {
@@ -102,31 +104,30 @@ fn fate_along(motion: &Motion, info: &ModelInfo, i: usize, landed: bool) -> Opti
             }
             End::Until => {
                 return Some(Fate::Held {
-                    until: format!(
-                        "until the run's end at t = {} s",
-                        format_number(phase.t_end(), 6)
-                    ),
+                    until: Held::RunsEnd { t: phase.t_end() },
                 });
             }
             End::Floor => {
                 return Some(Fate::Held {
-                    until: format!("until {}", motion_end(info)),
+                    until: Held::Floor {
+                        angle: angle_coordinate(info).to_string(),
+                        end_angle: info.end_angle,
+                    },
                 });
             }
             End::Edge(j) => {
                 return Some(Fate::Held {
-                    until: format!(
-                        "until contact `{}` ran off an edge at t = {} s, where the motion stops",
-                        name(j),
-                        format_number(phase.t_end(), 6)
-                    ),
+                    until: Held::Edge {
+                        contact: name(j).to_string(),
+                        t: phase.t_end(),
+                    },
                 });
             }
             End::Force(_) => {
                 // Another contact opened; the decision there may have opened this one too.
                 let Some(next) = motion.phases.get(k + 1) else {
                     return (motion.halted.as_ref()).map(|why| Fate::Held {
-                        until: format!("until {why}"),
+                        until: Held::Halted(why.clone()),
                     });
                 };
                 if !next.closed().get(i).copied().unwrap_or(false) {
@@ -264,23 +265,22 @@ impl Plan<'_> {
         Ok(())
     }
 
-    /// Why the first contact does not separate, in words.
-    fn why_no_separation(&self, fate: &Fate) -> String {
+    /// Why the first contact does not separate.
+    fn why_no_separation(&self, fate: &Fate) -> Note {
         let info = self.general().info();
-        let first = info
-            .contacts
-            .first()
-            .map_or("the first contact", |c| c.name);
+        let contact = (info.contacts.first())
+            .map_or("the first contact", |c| c.name)
+            .to_string();
         match fate {
-            Fate::Ended { cause, .. } => format!(
-                "no separation: contact `{first}` ended before its force vanished ({}; \
-                 `contact_end` says when)",
-                cause_words(cause)
-            ),
-            Fate::Held { until } => {
-                format!("no separation: contact `{first}` holds {until}")
-            }
-            Fate::NeverClosed => format!("no separation: contact `{first}` is open at release"),
+            Fate::Ended { cause, .. } => Note::NoSeparationEnded {
+                contact,
+                cause: cause.to_string(),
+            },
+            Fate::Held { until } => Note::NoSeparationHolds {
+                contact,
+                held: until.clone(),
+            },
+            Fate::NeverClosed => Note::NoSeparationOpen { contact },
         }
     }
 
@@ -297,10 +297,7 @@ impl Plan<'_> {
                 "separation angle with the polynomial's terms above degree 1 dropped".into(),
             ),
             SeparationOutcome::NoSeparationBeforeFloor => {
-                out.notes.insert(
-                    key,
-                    "the linearised polynomial has no root between the floor and the start".into(),
-                );
+                out.notes.insert(key, Note::NoLinearisedRoot);
             }
         }
         Ok(())
@@ -341,12 +338,13 @@ impl Plan<'_> {
                         );
                     }
                     Fate::Held { until } => {
-                        out.notes
-                            .insert(key, format!("contact `{name}` holds {until}"));
+                        let held = until.clone();
+                        let contact = name.to_string();
+                        out.notes.insert(key, Note::Holds { contact, held });
                     }
                     Fate::NeverClosed => {
-                        out.notes
-                            .insert(key, format!("contact `{name}` is open at release"));
+                        let contact = name.to_string();
+                        out.notes.insert(key, Note::OpenAtRelease { contact });
                     }
                 }
             }
@@ -610,23 +608,19 @@ impl Plan<'_> {
             }
         }
         let Some(landing) = landing else {
-            let at = format_number(motion.end_time(), 6);
-            let note = match motion.last_end() {
-                Some(End::Edge(j)) => format!(
-                    "contact `{}` ran off an edge at t = {at} s ({path}); the motion after that is not modelled",
-                    name(j),
-                ),
-                Some(End::Contact(j)) => format!(
-                    "contact `{}` closed at t = {at} s ({path}): the bodies meet, and the run ends at its first impact unless the scene gives a time to go on to (`until`)",
-                    name(j),
-                ),
-                Some(End::Until) => {
-                    format!("the run reached its end at t = {at} s before the body landed ({path})")
-                }
+            let end = match motion.last_end() {
+                Some(End::Edge(j)) => Unlanded::Edge(name(j).to_string()),
+                Some(End::Contact(j)) => Unlanded::Contact(name(j).to_string()),
+                Some(End::Until) => Unlanded::Until,
                 _ => match &motion.halted {
-                    Some(why) => format!("the motion ended before the floor: {why} ({path})"),
-                    None => format!("the motion ended before the floor ({path})"),
+                    Some(why) => Unlanded::Halted(why.clone()),
+                    None => Unlanded::Ended,
                 },
+            };
+            let note = Note::NoLanding {
+                t: motion.end_time(),
+                path: phase_labels(motion),
+                end,
             };
             out.notes.insert("floor_impact".into(), note);
             return Ok(());
@@ -670,26 +664,18 @@ impl Plan<'_> {
             match walker.impact(motion, i) {
                 Ok(at) => list.push(at),
                 Err(e @ SolveError::FrictionalImpact { .. }) => {
-                    out.notes.insert("impacts".into(), e.to_string());
+                    out.notes
+                        .insert("impacts".into(), Note::Refused(e.to_string()));
                 }
                 Err(e) => return Err(e),
             }
-            out.notes.entry("impacts".into()).or_insert_with(|| {
-                format!(
-                    "the run ends at its first impact (t = {} s); a scene's `until` carries the \
-                     motion on through impacts",
-                    format_number(motion.end_time(), 6)
-                )
+            (out.notes.entry("impacts".into())).or_insert(Note::FirstImpactEnds {
+                t: motion.end_time(),
             });
         }
         if list.is_empty() {
-            out.notes.insert(
-                "impacts".into(),
-                format!(
-                    "no contact closed before the motion's end ({})",
-                    path(motion)
-                ),
-            );
+            let path = phase_labels(motion);
+            out.notes.insert("impacts".into(), Note::NoImpact { path });
         }
         out.impacts = Some(list.iter().map(|a| impact_record(info, a)).collect());
         Ok(())
@@ -703,25 +689,22 @@ impl Plan<'_> {
             return;
         };
         if let Some(until) = self.walker.until {
-            let at = format_number(motion.end_time(), 6);
-            let impacts = motion.impacts.len();
+            let (t, impacts) = (motion.end_time(), motion.impacts.len());
             let note = match (&motion.halted, motion.last_end()) {
-                (Some(why), _) => why.clone(),
-                (None, Some(End::Until)) => format!(
-                    "the motion was followed to the run's end, t = {at} s (`until`), through \
-                     {impacts} impact(s)"
-                ),
-                (None, end) => format!(
-                    "the motion ended at t = {at} s ({}), before the run's end (`until` = {} s), \
-                     after {impacts} impact(s)",
-                    end.map_or("", |e| e.cause()),
-                    format_number(until, 6)
-                ),
+                (Some(why), _) => UntilNote::Halted(why.clone()),
+                (None, Some(End::Until)) => UntilNote::Reached { t, impacts },
+                (None, end) => UntilNote::EndedBefore {
+                    t,
+                    cause: end.map_or("", |e| e.cause()).to_string(),
+                    until,
+                    impacts,
+                },
             };
-            out.notes.insert("until".into(), note);
+            out.notes.insert("until".into(), Note::Until(note));
         }
         if !motion.notes.is_empty() {
-            out.notes.insert("zeno".into(), motion.notes.join("; "));
+            out.notes
+                .insert("zeno".into(), Note::Zeno(motion.notes.clone()));
         }
     }
 

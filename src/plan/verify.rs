@@ -2,22 +2,26 @@
 //! integrated with the same contacts closed, and the physical checks of every phase.
 
 use super::{Plan, scalar};
-use crate::results::{CheckKind, RunResults, Work, format_number};
+use crate::results::{CheckKind, Note, PhaseEnd, RunResults, Work, format_number};
 use crate::solve::SolveError;
 use crate::solve::checks::{self, Conserved, free_momenta};
 use crate::solve::phases::{End, PhaseRun};
 use crate::solve::series::{sample_forces, theta_dot_at};
 use crate::solve::unreduced::UnreducedRun;
 
-/// The event of an integrated run in words.
-fn event_words(run: &UnreducedRun, info: &crate::model::ModelInfo) -> String {
-    let name = |i: usize| info.contacts.get(i).map_or("a contact", |c| c.name);
+/// The event that ended an integrated run, its contact named.
+fn ended_at(run: &UnreducedRun, info: &crate::model::ModelInfo) -> PhaseEnd {
+    let name = |i: usize| {
+        (info.contacts.get(i))
+            .map_or("a contact", |c| c.name)
+            .to_string()
+    };
     match run.end {
-        End::Force(i) => format!("contact `{}`'s force crossing zero", name(i)),
-        End::Edge(i) => format!("contact `{}`'s edge", name(i)),
-        End::Contact(i) => format!("contact `{}` closing", name(i)),
-        End::Floor => "the floor".into(),
-        End::Until => "the run's end".into(),
+        End::Force(i) => PhaseEnd::Force(name(i)),
+        End::Edge(i) => PhaseEnd::Edge(name(i)),
+        End::Contact(i) => PhaseEnd::Contact(name(i)),
+        End::Floor => PhaseEnd::Floor,
+        End::Until => PhaseEnd::Until,
     }
 }
 
@@ -31,7 +35,8 @@ impl Plan<'_> {
             Ok(ode) => ode,
             // Not an error of the run: the integrated route has nothing to say here.
             Err(e @ SolveError::IllConditioned { .. }) => {
-                out.notes.insert("cross_check".into(), e.to_string());
+                out.notes
+                    .insert("cross_check".into(), Note::Refused(e.to_string()));
                 return Ok(());
             }
             Err(e) => return Err(e),
@@ -56,17 +61,14 @@ impl Plan<'_> {
             });
         };
         let t_quad = first.mesh.duration;
-        let event = event_words(ode, info);
+        let event = crate::report::prose::event_words(&ended_at(ode, info));
         let same = ode.end == first.end.end;
         if !same {
-            out.notes.insert(
-                "cross_check".into(),
-                format!(
-                    "the integrated route ended at {event}, the fast path at {:?}: they disagree \
-                     on the first event",
-                    first.end.end
-                ),
-            );
+            let note = Note::CrossCheckDisagrees {
+                integrated: ended_at(ode, info),
+                fast: format!("{:?}", first.end.end),
+            };
+            out.notes.insert("cross_check".into(), note);
         }
         let rel = if t_quad > 0.0 {
             (ode.t_end - t_quad).abs() / t_quad

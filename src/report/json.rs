@@ -9,7 +9,7 @@
 //! `{passed, margin, meaning}`) and `work` (counters and phases). Values are SI (angles in
 //! radians); a non-finite number is written as `null`, as JSON has no NaN.
 
-use super::prose::check_meaning;
+use super::prose::{check_meaning, note};
 use crate::results::RunResults;
 
 /// The meaning written beside `results.impacts`.
@@ -27,6 +27,14 @@ pub fn to_string(results: &RunResults) -> Result<String, serde_json::Error> {
                 entry.insert("meaning".into(), check_meaning(check).into());
             }
         }
+    }
+    if !results.notes.is_empty()
+        && let Some(map) = value.as_object_mut()
+    {
+        let notes: serde_json::Map<String, serde_json::Value> = (results.notes.iter())
+            .map(|(key, n)| (key.clone(), note(n).into()))
+            .collect();
+        map.insert("notes".into(), notes.into());
     }
     if let Some(map) = value.get_mut("results").and_then(|r| r.as_object_mut()) {
         for (key, label) in &results.labels {

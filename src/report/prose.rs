@@ -3,7 +3,10 @@
 //! why a quantity has no value ([`note`]). Results carry only names and numbers; the words
 //! are all here.
 
-use crate::results::{Check, CheckKind, CheckSubject, format_number};
+use crate::results::{
+    Check, CheckKind, CheckSubject, Halt, Held, Note, PhaseEnd, Unlanded, UntilNote, Zeno,
+    format_number,
+};
 
 /// What a check tested and against what, in a sentence.
 pub fn check_meaning(check: &Check) -> String {
@@ -82,6 +85,194 @@ fn conserved(check: &Check, what: &str, model: &str) -> String {
         CheckKind::Drift | CheckKind::Monitor => format!(
             "{what} along the {states} integrated states of `{model}`: largest relative drift \
              <= {tolerance}"
+        ),
+    }
+}
+
+/// Why a quantity has no value, or what the motion needs said, in words.
+pub fn note(note: &Note) -> String {
+    match note {
+        Note::Refused(why) => why.clone(),
+        Note::NoSeparationEnded { contact, cause } => format!(
+            "no separation: contact `{contact}` ended before its force vanished ({}; \
+             `contact_end` says when)",
+            cause_words(cause)
+        ),
+        Note::NoSeparationHolds { contact, held } => {
+            format!(
+                "no separation: contact `{contact}` holds {}",
+                held_words(held)
+            )
+        }
+        Note::NoSeparationOpen { contact } => {
+            format!("no separation: contact `{contact}` is open at release")
+        }
+        Note::NoLinearisedRoot => {
+            "the linearised polynomial has no root between the floor and the start".into()
+        }
+        Note::Holds { contact, held } => format!("contact `{contact}` holds {}", held_words(held)),
+        Note::OpenAtRelease { contact } => format!("contact `{contact}` is open at release"),
+        Note::CrossCheckDisagrees { integrated, fast } => format!(
+            "the integrated route ended at {}, the fast path at {fast}: they disagree on the \
+             first event",
+            event_words(integrated)
+        ),
+        Note::NoLanding { t, path, end } => no_landing(*t, &path.join(" -> "), end),
+        Note::FirstImpactEnds { t } => format!(
+            "the run ends at its first impact (t = {} s); a scene's `until` carries the motion \
+             on through impacts",
+            format_number(*t, 6)
+        ),
+        Note::NoImpact { path } => format!(
+            "no contact closed before the motion's end ({})",
+            path.join(" -> ")
+        ),
+        Note::Until(until) => until_words(until),
+        Note::Zeno(list) => list.iter().map(zeno_words).collect::<Vec<_>>().join("; "),
+    }
+}
+
+/// What a contact's end cause (`force`, `edge`, `impact`, `contact`) means.
+pub fn cause_words(cause: &str) -> &'static str {
+    match cause {
+        "force" => "its force reached zero (it would have had to pull)",
+        "edge" => "its contact point ran off a body",
+        "impact" => "the impulses of an impact elsewhere moved it away",
+        _ => {
+            "another contact closed there: the bodies meet, and the run ends at its first impact \
+             unless it is given a time to go on to (`until`)"
+        }
+    }
+}
+
+/// An event that ends a phase, in words (the cross-check's).
+pub fn event_words(end: &PhaseEnd) -> String {
+    match end {
+        PhaseEnd::Force(name) => format!("contact `{name}`'s force crossing zero"),
+        PhaseEnd::Edge(name) => format!("contact `{name}`'s edge"),
+        PhaseEnd::Contact(name) => format!("contact `{name}` closing"),
+        PhaseEnd::Floor => "the floor".into(),
+        PhaseEnd::Until => "the run's end".into(),
+    }
+}
+
+/// Why the motion was halted.
+pub fn halt_words(halt: &Halt) -> String {
+    match halt {
+        Halt::ClosesAsOneOpens { contact, t } => format!(
+            "contact `{contact}` closes at t = {} s, as the contact before it opens: the bodies \
+             meet, and the run ends at its first impact unless it is given a time to go on to \
+             (`until`)",
+            format_number(*t, 9)
+        ),
+        Halt::TooManyImpacts { number, t } => format!(
+            "the run stopped at its impact number {number} at t = {t} s: the bounces neither \
+             came to rest nor converged"
+        ),
+        Halt::AtRest { t, how } => format!(
+            "the system comes to rest at the impact at t = {} s, held {how}, and stays so",
+            format_number(*t, 9)
+        ),
+    }
+}
+
+/// Until when a contact held: `until …`.
+fn held_words(held: &Held) -> String {
+    match held {
+        Held::Lands { contact, t } => format!(
+            "until the body lands, where contact `{contact}` closes at t = {} s",
+            format_number(*t, 6)
+        ),
+        Held::Halted(halt) => format!("until {}", halt_words(halt)),
+        Held::RunsEnd { t } => {
+            format!("until the run's end at t = {} s", format_number(*t, 6))
+        }
+        Held::Floor { angle, end_angle } => {
+            format!("until {}", end_angle_words(angle, *end_angle))
+        }
+        Held::Edge { contact, t } => format!(
+            "until contact `{contact}` ran off an edge at t = {} s, where the motion stops",
+            format_number(*t, 6)
+        ),
+    }
+}
+
+/// The end of a model's reduced motion: `` `theta` = 0 rad ``.
+pub fn end_angle_words(angle: &str, end_angle: f64) -> String {
+    format!("`{angle}` = {} rad", format_number(end_angle, 6))
+}
+
+/// Why the body did not land, at `t`, along `path`.
+fn no_landing(t: f64, path: &str, end: &Unlanded) -> String {
+    let at = format_number(t, 6);
+    match end {
+        Unlanded::Edge(contact) => format!(
+            "contact `{contact}` ran off an edge at t = {at} s ({path}); the motion after that is \
+             not modelled"
+        ),
+        Unlanded::Contact(contact) => format!(
+            "contact `{contact}` closed at t = {at} s ({path}): the bodies meet, and the run ends \
+             at its first impact unless the scene gives a time to go on to (`until`)"
+        ),
+        Unlanded::Until => {
+            format!("the run reached its end at t = {at} s before the body landed ({path})")
+        }
+        Unlanded::Halted(halt) => format!(
+            "the motion ended before the floor: {} ({path})",
+            halt_words(halt)
+        ),
+        Unlanded::Ended => format!("the motion ended before the floor ({path})"),
+    }
+}
+
+/// How the motion went with respect to the run's end time.
+fn until_words(until: &UntilNote) -> String {
+    match until {
+        UntilNote::Halted(halt) => halt_words(halt),
+        UntilNote::Reached { t, impacts } => format!(
+            "the motion was followed to the run's end, t = {} s (`until`), through {impacts} \
+             impact(s)",
+            format_number(*t, 6)
+        ),
+        UntilNote::EndedBefore {
+            t,
+            cause,
+            until,
+            impacts,
+        } => format!(
+            "the motion ended at t = {} s ({cause}), before the run's end (`until` = {} s), \
+             after {impacts} impact(s)",
+            format_number(*t, 6),
+            format_number(*until, 6)
+        ),
+    }
+}
+
+/// A converging sequence of bounces closed, in words.
+fn zeno_words(zeno: &Zeno) -> String {
+    match zeno {
+        Zeno::Limit {
+            contact,
+            bounces,
+            ratio,
+            t_limit,
+            t,
+        } => format!(
+            "contact `{contact}` bounced {bounces} times with intervals shrinking by a steady \
+             ratio {ratio:.4} (Zeno): their limit is t = {t_limit:.12} s, within the run's \
+             tolerance of the bounce at t = {t:.12} s, which was made plastic for the rest"
+        ),
+        Zeno::Unresolved {
+            contact,
+            t,
+            rise,
+            open_gap,
+            left,
+        } => format!(
+            "contact `{contact}` would bounce at t = {t:.12} s by {rise:.3e} of the length \
+             scale, below the {open_gap:e} at which a gap counts as open: the bounces from there \
+             (a converging Zeno sequence, about {left:.3e} s in all) are taken as one plastic \
+             impact, so the motion after it runs early by about that much"
         ),
     }
 }

@@ -201,7 +201,7 @@ pub fn render(results: &RunResults, info: Option<&ModelInfo>, layout: &Layout) -
     if !results.notes.is_empty() {
         let mut t = new_table(&["about", "note"], layout);
         for (key, why) in &results.notes {
-            t.add_row(vec![key.clone(), why.clone()]);
+            t.add_row(vec![key.clone(), super::prose::note(why)]);
         }
         no_wrap(&mut t, &[0]);
         out.push_str(&format!("\nNotes\n{t}\n"));

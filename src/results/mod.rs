@@ -1,9 +1,16 @@
-//! The results of a run: scalars, series, checks and the work done, ready for any report.
+//! The results of a run as plain data: scalars, series, checks, notes, the drawing of the
+//! motion and the work done, ready for any report (which writes every sentence).
 
-use crate::model::{ModelInfo, ShapeInfo};
+use crate::model::ModelInfo;
 use crate::quantity::Quantity;
 use serde::Serialize;
 use std::collections::BTreeMap;
+
+mod drawing;
+mod notes;
+
+pub use drawing::{Drawing, DrawnPhase, DrawnSample, PhaseEnd, Pose};
+pub use notes::{Halt, Held, Note, Unlanded, UntilNote, Zeno};
 
 /// A scalar result with its unit.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -203,74 +210,6 @@ pub struct ImpactRecord {
     pub zeno_limit: bool,
 }
 
-/// Why a solved phase ended, as the drawing of the motion tells it (a contact by its name).
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum PhaseEnd {
-    /// The named contact's force reached zero: it opened.
-    Force(String),
-    /// The named contact's point ran off the edge of a body.
-    Edge(String),
-    /// The named contact's gap closed: an impact.
-    Contact(String),
-    /// The reduced angle reached the model's end angle.
-    Floor,
-    /// The run reached its end time.
-    Until,
-}
-
-/// The drawing's numbers at one sample: every body's pose and the traced point.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Pose {
-    /// Every body's pose `[x, y, angle]` (m, m, rad), in the order of the phase's bodies.
-    pub bodies: Vec<[f64; 3]>,
-    /// The traced point's position `[x, y]` (m), when a point is traced and the phase has it.
-    pub traced: Option<[f64; 2]>,
-}
-
-/// One sample of a phase as drawn.
-#[derive(Debug, Clone, PartialEq)]
-pub struct DrawnSample {
-    /// Time from the phase's start (s).
-    pub t: f64,
-    /// The poses, or the model's refusal of the sample's state (its message).
-    pub pose: Result<Pose, String>,
-}
-
-/// One solved phase as drawn.
-#[derive(Debug, Clone, PartialEq)]
-pub struct DrawnPhase {
-    /// Its model's name.
-    pub model: String,
-    /// Its bodies' names.
-    pub bodies: Vec<String>,
-    /// When it starts (s from release).
-    pub t_start: f64,
-    /// Why it ended.
-    pub end: PhaseEnd,
-    /// Its samples, in order.
-    pub samples: Vec<DrawnSample>,
-}
-
-/// The bodies' motion as the model draws it, every solved phase sampled: plain numbers from
-/// which `report::motion` computes the animation.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Drawing {
-    /// The system drawn (the first phase's).
-    pub system: String,
-    /// The shapes of the first phase's model: kind, body and where its numbers start in
-    /// `sizes`.
-    pub shapes: Vec<ShapeInfo>,
-    /// The shapes' numbers at the first phase's start, or the model's refusal (its message).
-    pub sizes: Result<Vec<f64>, String>,
-    /// The name of the point whose path is traced, if any.
-    pub traced: Option<String>,
-    /// The phases drawn, in order.
-    pub phases: Vec<DrawnPhase>,
-    /// The phase (its index) before which the drawing stops, when a phase could not be
-    /// sampled, with the reason (the error's message).
-    pub stopped: Option<(usize, String)>,
-}
-
 /// Everything one scene produced.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct RunResults {
@@ -291,8 +230,10 @@ pub struct RunResults {
     pub work: Work,
     /// Why a wanted quantity has no value, by its key (e.g. `separation_angle`: no separation
     /// before the floor). A quantity is either in `results`/`series` or explained here.
-    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
-    pub notes: BTreeMap<String, String>,
+    /// Written in JSON (when not empty) as `notes: {key: sentence}`, the sentences by
+    /// `report::prose`.
+    #[serde(skip)]
+    pub notes: BTreeMap<String, Note>,
     /// The impacts of the motion in order, when `impacts` was wanted (written under `results`
     /// in JSON as `impacts: {value: [...], meaning}`).
     #[serde(skip)]
@@ -343,9 +284,10 @@ impl RunResults {
         self.series.get(&quantity.name(info))
     }
 
-    /// Why a wanted quantity has no value, if it has none.
-    pub fn note(&self, quantity: Quantity, info: &ModelInfo) -> Option<&str> {
-        self.notes.get(&quantity.name(info)).map(String::as_str)
+    /// Why a wanted quantity has no value, if it has none (`report::prose::note` says it in
+    /// words).
+    pub fn note(&self, quantity: Quantity, info: &ModelInfo) -> Option<&Note> {
+        self.notes.get(&quantity.name(info))
     }
 }
 
