@@ -45,7 +45,7 @@ mod verify;
 
 use crate::model::{Model, ModelInfo};
 use crate::quantity::Quantity;
-use crate::results::{Column, RunResults, Scalar, Work, format_number};
+use crate::results::{Column, Meaning, RunResults, Scalar, Work};
 use crate::solve::SolveError;
 use crate::solve::phases::{
     End, Motion, PhaseRun, PhaseStart, ReducedEnd, ReducedRun, Route, Walker, phase_end,
@@ -410,7 +410,7 @@ struct Plan<'m> {
     ode: Option<UnreducedRun>,
 }
 
-fn scalar(out: &mut RunResults, key: &str, value: f64, unit: &'static str, meaning: String) {
+fn scalar(out: &mut RunResults, key: &str, value: f64, unit: &'static str, meaning: Meaning) {
     out.results.insert(
         key.to_string(),
         Scalar {
@@ -427,21 +427,6 @@ fn column(name: &str, unit: &'static str, values: Vec<f64>) -> Column {
         unit,
         values,
     }
-}
-
-/// The end of a model's motion in its own terms: `` `theta` = 0 rad `` (the reduced coordinate
-/// at its `end_angle`).
-fn motion_end(info: &ModelInfo) -> String {
-    format!(
-        "{} = {} rad",
-        angle_name(info),
-        format_number(info.end_angle, 6)
-    )
-}
-
-/// The reduced coordinate's name, in backquotes.
-fn angle_name(info: &ModelInfo) -> String {
-    format!("`{}`", angle_coordinate(info))
 }
 
 /// The reduced coordinate's name.
@@ -716,11 +701,6 @@ impl<'m> Plan<'m> {
             Quantity::Checks => self.checks(want.contains(&Quantity::CrossCheck), out),
         }
     }
-}
-
-/// The phases' labels as one path: `rod_cube_closed -> rod_cube_free`.
-fn path(motion: &Motion) -> String {
-    phase_labels(motion).join(" -> ")
 }
 
 /// The labels of the phases the motion went through, in order.

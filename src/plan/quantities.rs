@@ -3,12 +3,12 @@
 //! the landing, each computing only what it needs of the motion.
 
 use super::drawing::{PhaseInput, record};
-use super::{Plan, angle_coordinate, angle_name, column, motion_end, path, phase_labels, scalar};
+use super::{Plan, angle_coordinate, column, phase_labels, scalar};
 use crate::model::ModelInfo;
 use crate::quantity::Quantity;
 use crate::results::{
-    ContactImpulse, Held, ImpactRecord, Label, Note, RunResults, Series, Unlanded, UntilNote,
-    format_number,
+    ContactImpulse, Held, ImpactRecord, Label, Meaning, Note, RunResults, Series, Unlanded,
+    UntilNote, format_number,
 };
 use crate::solve::SolveError;
 use crate::solve::impact::Part;
@@ -190,19 +190,6 @@ fn impact_record(info: &ModelInfo, at: &ImpactAt) -> ImpactRecord {
     }
 }
 
-/// What a cause means, for the results' meanings.
-fn cause_words(cause: &str) -> &'static str {
-    match cause {
-        "force" => "its force reached zero (it would have had to pull)",
-        "edge" => "its contact point ran off a body",
-        "impact" => "the impulses of an impact elsewhere moved it away",
-        _ => {
-            "another contact closed there: the bodies meet, and the run ends at its first impact \
-             unless it is given a time to go on to (`until`)"
-        }
-    }
-}
-
 impl Plan<'_> {
     /// Contact `i`'s fate, solving the motion as far as needed.
     pub(super) fn fate(&mut self, i: usize) -> Result<Fate, SolveError> {
@@ -235,11 +222,14 @@ impl Plan<'_> {
             && end.end == End::Force(0)
             && let Some(at) = end.at
         {
-            let meaning = format!(
-                "{} where the first contact's force vanishes",
-                angle_name(info)
+            let angle = angle_coordinate(info).to_string();
+            scalar(
+                out,
+                &key,
+                at.theta,
+                "rad",
+                Meaning::SeparationAngle { angle },
             );
-            scalar(out, &key, at.theta, "rad", meaning);
             return Ok(());
         }
         match self.fate(0)? {
@@ -249,13 +239,10 @@ impl Plan<'_> {
                 cause: "force",
             } => {
                 if q == Quantity::SeparationAngle {
-                    let meaning = format!(
-                        "{} where the first contact's force vanishes",
-                        angle_name(info)
-                    );
-                    scalar(out, &key, theta, "rad", meaning);
+                    let angle = angle_coordinate(info).to_string();
+                    scalar(out, &key, theta, "rad", Meaning::SeparationAngle { angle });
                 } else {
-                    scalar(out, &key, t, "s", "time from release to separation".into());
+                    scalar(out, &key, t, "s", Meaning::SeparationTime);
                 }
             }
             other => {
@@ -294,7 +281,7 @@ impl Plan<'_> {
                 &key,
                 s.theta,
                 "rad",
-                "separation angle with the polynomial's terms above degree 1 dropped".into(),
+                Meaning::LinearisedSeparationAngle,
             ),
             SeparationOutcome::NoSeparationBeforeFloor => {
                 out.notes.insert(key, Note::NoLinearisedRoot);
@@ -318,22 +305,23 @@ impl Plan<'_> {
             for key in keys {
                 match &fate {
                     Fate::Ended { t, theta, cause } => {
-                        let why = cause_words(cause);
-                        let meaning =
-                            format!("time from release until contact `{name}` ends: {why}");
+                        let (contact, cause) = (name.to_string(), cause.to_string());
+                        let meaning = Meaning::ContactEndTime {
+                            contact: contact.clone(),
+                            cause: cause.clone(),
+                        };
                         scalar(out, &format!("{key}_time"), *t, "s", meaning);
-                        let meaning =
-                            format!("{} where contact `{name}` ends: {why}", angle_name(info));
+                        let meaning = Meaning::ContactEndAngle {
+                            angle: angle_coordinate(info).to_string(),
+                            contact: contact.clone(),
+                            cause: cause.clone(),
+                        };
                         scalar(out, &format!("{key}_angle"), *theta, "rad", meaning);
                         out.labels.insert(
                             format!("{key}_cause"),
                             Label {
-                                value: cause.to_string(),
-                                meaning: format!(
-                                    "why contact `{name}` ended: `force` (its force reached zero), \
-                                     `edge` (its point ran off a body) or `contact` (another \
-                                     contact closed, where the motion stops)"
-                                ),
+                                value: cause,
+                                meaning: Meaning::ContactEndCause { contact },
                             },
                         );
                     }
@@ -371,7 +359,7 @@ impl Plan<'_> {
             "contact_end_friction_work",
             work,
             "J",
-            "work done by friction over the first contact's phase (energy lost)".into(),
+            Meaning::ContactEndFrictionWork,
         );
         let sequence = (phases.iter().flat_map(|p| p.stretches()))
             .map(|(t, m)| format!("{m} from t = {} s", format_number(t, 6)))
@@ -381,10 +369,7 @@ impl Plan<'_> {
             "contact_end_contact_modes".into(),
             Label {
                 value: sequence,
-                meaning: "the closed contacts and how each friction contact moves over the first \
-                          contact's phase: sticks, or slides + / - along its direction, each from \
-                          the time the set began (switches located as events)"
-                    .into(),
+                meaning: Meaning::ContactModes,
             },
         );
         Ok(())
@@ -395,10 +380,10 @@ impl Plan<'_> {
         let info = self.general().info();
         let t = self.floor_mesh()?.duration;
         let key = Quantity::ContactTimeToFloor.name(info);
-        let meaning = format!(
-            "time to {} if the release contacts held all the way",
-            motion_end(info)
-        );
+        let meaning = Meaning::ContactTimeToFloor {
+            angle: angle_coordinate(info).to_string(),
+            end_angle: info.end_angle,
+        };
         scalar(out, &key, t, "s", meaning);
         Ok(())
     }
@@ -410,11 +395,10 @@ impl Plan<'_> {
         let pts = general.points(&general.initial_state())?;
         let h = pts.pos[info.falling_point][1];
         let t = (2.0 * h.max(0.0) / general.gravity()).sqrt();
-        let meaning = format!(
-            "free fall of a point mass from the release height of `{}` ({} m)",
-            info.points[info.falling_point].name,
-            format_number(h, 6)
-        );
+        let meaning = Meaning::PointMassFallTime {
+            point: info.points[info.falling_point].name.to_string(),
+            height: h,
+        };
         scalar(
             out,
             &Quantity::PointMassFallTime.name(info),
@@ -592,13 +576,12 @@ impl Plan<'_> {
                 "floor_impact_friction_work",
                 work,
                 "J",
-                format!(
-                    "work done by friction from release until {} (energy lost)",
-                    motion_end(info)
-                ),
+                Meaning::FloorImpactFrictionWork {
+                    angle: angle_coordinate(info).to_string(),
+                    end_angle: info.end_angle,
+                },
             );
         }
-        let path = path(motion);
         let name = |j: usize| info.contacts.get(j).map_or("a contact", |c| c.name);
         let mut landing = None;
         for phase in &motion.phases {
@@ -626,23 +609,15 @@ impl Plan<'_> {
             return Ok(());
         };
         let (time, omega) = (landing.t_end(), landing.theta_dot_end());
-        scalar(
-            out,
-            "floor_impact_time",
-            time,
-            "s",
-            format!("time from release until {} ({path})", motion_end(info)),
-        );
-        scalar(
-            out,
-            "impact_angular_velocity",
-            omega,
-            "rad/s",
-            format!(
-                "rate of {} when it reaches its end ({path})",
-                angle_name(info)
-            ),
-        );
+        let (angle, path) = (angle_coordinate(info).to_string(), phase_labels(motion));
+        let meaning = Meaning::FloorImpactTime {
+            angle: angle.clone(),
+            end_angle: info.end_angle,
+            path: path.clone(),
+        };
+        scalar(out, "floor_impact_time", time, "s", meaning);
+        let meaning = Meaning::ImpactAngularVelocity { angle, path };
+        scalar(out, "impact_angular_velocity", omega, "rad/s", meaning);
         Ok(())
     }
 

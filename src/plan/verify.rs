@@ -2,7 +2,7 @@
 //! integrated with the same contacts closed, and the physical checks of every phase.
 
 use super::{Plan, scalar};
-use crate::results::{CheckKind, Note, PhaseEnd, RunResults, Work, format_number};
+use crate::results::{CheckKind, Meaning, Note, PhaseEnd, RunResults, Work, format_number};
 use crate::solve::SolveError;
 use crate::solve::checks::{self, Conserved, free_momenta};
 use crate::solve::phases::{End, PhaseRun};
@@ -61,7 +61,6 @@ impl Plan<'_> {
             });
         };
         let t_quad = first.mesh.duration;
-        let event = crate::report::prose::event_words(&ended_at(ode, info));
         let same = ode.end == first.end.end;
         if !same {
             let note = Note::CrossCheckDisagrees {
@@ -77,50 +76,26 @@ impl Plan<'_> {
         };
         let (dt_max, dy_max, nodes) = path_deviation(first, ode, info.reduced, work)?;
         let steps = ode.steps();
-        scalar(
-            out,
-            "cross_check_time",
-            ode.t_end,
-            "s",
-            format!(
-                "the general model ({}, {steps} steps) integrated to {event}",
-                ode.method.name()
-            ),
-        );
-        scalar(
-            out,
-            "cross_check_relative_difference",
-            rel,
-            "1",
-            format!(
-                "|t_ode - t_quadrature| / t_quadrature at {event} (quadrature: {t_quad:.15e} s; \
-                 ODE rtol {:.1e}, mass-matrix condition {:.1e})",
-                ode.rtol, ode.condition
-            ),
-        );
-        scalar(
-            out,
-            "cross_check_rtol",
-            ode.rtol,
-            "1",
-            "relative tolerance the integrator ran with: the one asked, raised to 10 eps cond(M) when the mass matrix is ill-conditioned".into(),
-        );
-        scalar(
-            out,
-            "cross_check_time_deviation",
-            dt_max,
-            "s",
-            format!("largest |t_ode - t(theta_ode)| over {nodes} integrator steps"),
-        );
-        scalar(
-            out,
-            "cross_check_state_deviation",
-            dy_max,
-            "1",
-            format!(
-                "largest difference between the integrated and the reduced states over {nodes} steps, relative to the largest coordinate (or velocity) on the path"
-            ),
-        );
+        let event = ended_at(ode, info);
+        let meaning = Meaning::CrossCheckTime {
+            method: ode.method.name().to_string(),
+            steps,
+            event: event.clone(),
+        };
+        scalar(out, "cross_check_time", ode.t_end, "s", meaning);
+        let meaning = Meaning::CrossCheckRelativeDifference {
+            event,
+            t_quad,
+            rtol: ode.rtol,
+            condition: ode.condition,
+        };
+        scalar(out, "cross_check_relative_difference", rel, "1", meaning);
+        let meaning = Meaning::CrossCheckRtol;
+        scalar(out, "cross_check_rtol", ode.rtol, "1", meaning);
+        let meaning = Meaning::CrossCheckTimeDeviation { nodes };
+        scalar(out, "cross_check_time_deviation", dt_max, "s", meaning);
+        let meaning = Meaning::CrossCheckStateDeviation { nodes };
+        scalar(out, "cross_check_state_deviation", dy_max, "1", meaning);
         Ok(())
     }
 

@@ -9,7 +9,7 @@
 //! `{passed, margin, meaning}`) and `work` (counters and phases). Values are SI (angles in
 //! radians); a non-finite number is written as `null`, as JSON has no NaN.
 
-use super::prose::{check_meaning, note};
+use super::prose::{check_meaning, meaning, note};
 use crate::results::RunResults;
 
 /// The meaning written beside `results.impacts`.
@@ -37,8 +37,17 @@ pub fn to_string(results: &RunResults) -> Result<String, serde_json::Error> {
         map.insert("notes".into(), notes.into());
     }
     if let Some(map) = value.get_mut("results").and_then(|r| r.as_object_mut()) {
+        for (key, scalar) in &results.results {
+            if let Some(entry) = map.get_mut(key).and_then(|e| e.as_object_mut()) {
+                entry.insert("meaning".into(), meaning(&scalar.meaning).into());
+            }
+        }
         for (key, label) in &results.labels {
-            map.insert(key.clone(), serde_json::to_value(label)?);
+            let mut entry = serde_json::to_value(label)?;
+            if let Some(fields) = entry.as_object_mut() {
+                fields.insert("meaning".into(), meaning(&label.meaning).into());
+            }
+            map.insert(key.clone(), entry);
         }
         if let Some(impacts) = &results.impacts {
             map.insert(

@@ -4,7 +4,7 @@
 //! are all here.
 
 use crate::results::{
-    Check, CheckKind, CheckSubject, Halt, Held, Note, PhaseEnd, Unlanded, UntilNote, Zeno,
+    Check, CheckKind, CheckSubject, Halt, Held, Meaning, Note, PhaseEnd, Unlanded, UntilNote, Zeno,
     format_number,
 };
 
@@ -146,7 +146,7 @@ pub fn cause_words(cause: &str) -> &'static str {
 }
 
 /// An event that ends a phase, in words (the cross-check's).
-pub fn event_words(end: &PhaseEnd) -> String {
+fn event_words(end: &PhaseEnd) -> String {
     match end {
         PhaseEnd::Force(name) => format!("contact `{name}`'s force crossing zero"),
         PhaseEnd::Edge(name) => format!("contact `{name}`'s edge"),
@@ -273,6 +273,97 @@ fn zeno_words(zeno: &Zeno) -> String {
              scale, below the {open_gap:e} at which a gap counts as open: the bounces from there \
              (a converging Zeno sequence, about {left:.3e} s in all) are taken as one plastic \
              impact, so the motion after it runs early by about that much"
+        ),
+    }
+}
+
+/// What a scalar or word-valued result is, in words.
+pub fn meaning(meaning: &Meaning) -> String {
+    match meaning {
+        Meaning::SeparationAngle { angle } => {
+            format!("`{angle}` where the first contact's force vanishes")
+        }
+        Meaning::SeparationTime => "time from release to separation".into(),
+        Meaning::LinearisedSeparationAngle => {
+            "separation angle with the polynomial's terms above degree 1 dropped".into()
+        }
+        Meaning::ContactEndTime { contact, cause } => format!(
+            "time from release until contact `{contact}` ends: {}",
+            cause_words(cause)
+        ),
+        Meaning::ContactEndAngle {
+            angle,
+            contact,
+            cause,
+        } => format!(
+            "`{angle}` where contact `{contact}` ends: {}",
+            cause_words(cause)
+        ),
+        Meaning::ContactEndCause { contact } => format!(
+            "why contact `{contact}` ended: `force` (its force reached zero), `edge` (its point \
+             ran off a body) or `contact` (another contact closed, where the motion stops)"
+        ),
+        Meaning::ContactModes => "the closed contacts and how each friction contact moves over \
+                                  the first contact's phase: sticks, or slides + / - along its \
+                                  direction, each from the time the set began (switches located \
+                                  as events)"
+            .into(),
+        Meaning::ContactEndFrictionWork => {
+            "work done by friction over the first contact's phase (energy lost)".into()
+        }
+        Meaning::ContactTimeToFloor { angle, end_angle } => format!(
+            "time to {} if the release contacts held all the way",
+            end_angle_words(angle, *end_angle)
+        ),
+        Meaning::PointMassFallTime { point, height } => format!(
+            "free fall of a point mass from the release height of `{point}` ({} m)",
+            format_number(*height, 6)
+        ),
+        Meaning::FloorImpactFrictionWork { angle, end_angle } => format!(
+            "work done by friction from release until {} (energy lost)",
+            end_angle_words(angle, *end_angle)
+        ),
+        Meaning::FloorImpactTime {
+            angle,
+            end_angle,
+            path,
+        } => format!(
+            "time from release until {} ({})",
+            end_angle_words(angle, *end_angle),
+            path.join(" -> ")
+        ),
+        Meaning::ImpactAngularVelocity { angle, path } => format!(
+            "rate of `{angle}` when it reaches its end ({})",
+            path.join(" -> ")
+        ),
+        Meaning::CrossCheckTime {
+            method,
+            steps,
+            event,
+        } => format!(
+            "the general model ({method}, {steps} steps) integrated to {}",
+            event_words(event)
+        ),
+        Meaning::CrossCheckRelativeDifference {
+            event,
+            t_quad,
+            rtol,
+            condition,
+        } => format!(
+            "|t_ode - t_quadrature| / t_quadrature at {} (quadrature: {t_quad:.15e} s; ODE rtol \
+             {rtol:.1e}, mass-matrix condition {condition:.1e})",
+            event_words(event)
+        ),
+        Meaning::CrossCheckRtol => "relative tolerance the integrator ran with: the one asked, \
+                                    raised to 10 eps cond(M) when the mass matrix is \
+                                    ill-conditioned"
+            .into(),
+        Meaning::CrossCheckTimeDeviation { nodes } => {
+            format!("largest |t_ode - t(theta_ode)| over {nodes} integrator steps")
+        }
+        Meaning::CrossCheckStateDeviation { nodes } => format!(
+            "largest difference between the integrated and the reduced states over {nodes} \
+             steps, relative to the largest coordinate (or velocity) on the path"
         ),
     }
 }

@@ -272,7 +272,7 @@ fn scalars(out: &mut String, results: &RunResults, layout: &Layout) {
             row.push(fig.to_string());
         }
         t.add_row(row);
-        legend.push((key.clone(), s.meaning.clone()));
+        legend.push((key.clone(), super::prose::meaning(&s.meaning)));
     }
     for (key, label) in &results.labels {
         let mut row = vec![
@@ -285,7 +285,7 @@ fn scalars(out: &mut String, results: &RunResults, layout: &Layout) {
             row.push(String::new());
         }
         t.add_row(row);
-        legend.push((key.clone(), label.meaning.clone()));
+        legend.push((key.clone(), super::prose::meaning(&label.meaning)));
     }
     align_right(&mut t, &[1, 3]);
     no_wrap(&mut t, if paper { &[0, 2, 3, 4] } else { &[0, 2, 3] });

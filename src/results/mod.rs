@@ -7,9 +7,11 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 
 mod drawing;
+mod meanings;
 mod notes;
 
 pub use drawing::{Drawing, DrawnPhase, DrawnSample, PhaseEnd, Pose};
+pub use meanings::Meaning;
 pub use notes::{Halt, Held, Note, Unlanded, UntilNote, Zeno};
 
 /// A scalar result with its unit.
@@ -19,8 +21,9 @@ pub struct Scalar {
     pub value: f64,
     /// Unit (`rad`, `s`, `N`, `m/s`, ...).
     pub unit: &'static str,
-    /// What it is, for people.
-    pub meaning: String,
+    /// What it is (`report::prose::meaning` says it in words: results.json's `meaning`).
+    #[serde(skip)]
+    pub meaning: Meaning,
 }
 
 /// A result that is a word rather than a number (e.g. why a contact ended).
@@ -28,8 +31,9 @@ pub struct Scalar {
 pub struct Label {
     /// The word.
     pub value: String,
-    /// What it is and which words it can be.
-    pub meaning: String,
+    /// What it is and which words it can be (`report::prose::meaning` says it in words).
+    #[serde(skip)]
+    pub meaning: Meaning,
 }
 
 /// One column of a series.
