@@ -239,7 +239,7 @@ fn check_fast_phase(model: &'static dyn Model, u: &[f64], spread: u8) -> Result<
         prop_assert!(
             check.passed,
             "{key}: {} at {p:?}",
-            rodcube::report::prose::check_meaning(check)
+            rodcube::report::prose::check_meaning(&check)
         );
     }
     Ok(())

@@ -773,7 +773,7 @@ fn num_fixed(x: f64, decimals: usize) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::super::animation::{Frame, PhaseSpan};
+    use super::super::animation::{Frame, ImpactMark, MAX_KEYFRAMES, PhaseSpan};
     use super::*;
 
     /// A rod turning about its foot and a square sliding, over `n` frames of one phase and `m`
