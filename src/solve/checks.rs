@@ -18,6 +18,9 @@
 //!   every state of the path), such as the rod's and the cube's horizontal momenta together
 //!   while the tip pushes the cube. With friction the energy check is the balance
 //!   `E - E(0) = W_friction`.
+//!
+//! A check carries what it tested as data (a [`CheckSubject`]: the quantity named, with the
+//! numbers that scale it); `report::prose::check_meaning` writes its sentence.
 
 use crate::results::{Check, CheckKind, CheckSubject};
 use crate::solve::SolveError;
