@@ -1,9 +1,11 @@
 //! The motion to watch, `motion.svg`: the bodies of every solved phase moving in real time
 //! slowed to a readable pace, as an animated SVG (SMIL, no script), drawn from the spec's shapes.
 //!
-//! [`Animation::build`] evaluates each phase's generated [`Model::drawing`](crate::model::Model)
-//! at its samples: one [`Frame`] per sample (every body's pose and the traced point), the
-//! shapes' sizes once. [`svg`] writes the picture: a fixed view box covering every frame, y up,
+//! [`Animation::build`] (in `animation.rs`) computes the animation from the run's
+//! [`Drawing`](crate::results::Drawing), each phase's generated
+//! [`Model::drawing`](crate::model::Model) evaluated at its samples by the planner: one
+//! [`Frame`] per sample (every body's pose and the traced point), the shapes' sizes once.
+//! [`svg`] (in `svg.rs`) writes the picture: a fixed view box covering every frame, y up,
 //! the floor `y = 0`, the scenery, the bodies moved by `<animateTransform>` (linear between at
 //! most [`MAX_KEYFRAMES`] keyframes, evenly spread in time), the traced point's path (faint in
 //! full, drawn strong as the motion goes), the time and the phase as text that changes with the
