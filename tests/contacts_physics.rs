@@ -183,7 +183,7 @@ fn rod_cube_liftoff_separates_as_rod_cube_with_the_floor_pushing() {
     match lift.results.get("floor_normal_end_time") {
         Some(end) => assert!(end.value > t, "the foot lifted at {} s", end.value),
         None => assert!(
-            lift.notes["floor_normal_end"].contains("holds"),
+            rodcube::report::prose::note(&lift.notes["floor_normal_end"]).contains("holds"),
             "{:?}",
             lift.notes
         ),

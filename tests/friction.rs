@@ -240,7 +240,8 @@ fn energy_lost_is_the_work_of_friction() {
         assert!(!energy.is_empty());
         for (k, c) in energy {
             assert!(c.passed, "mu {mu}: {k}: {c:?}");
-            assert!(c.meaning.contains("work of friction"), "{k}: {}", c.meaning);
+            let meaning = rodcube::report::prose::check_meaning(c);
+            assert!(meaning.contains("work of friction"), "{k}: {meaning}");
         }
         println!(
             "mu = {mu}: friction work {work:.6e} J, phases {:?}",

@@ -270,7 +270,7 @@ fn energy_is_conserved_along_the_motion_to_the_tolerance_asked() {
                 assert!(
                     check.passed && check.margin.is_finite(),
                     "{family:?} n={n} r={r} tol={tol}: {key}: {}",
-                    check.meaning
+                    rodcube::report::prose::check_meaning(check)
                 );
             }
         }

@@ -346,7 +346,7 @@ fn the_rod_striking_the_cylinder_is_marked_where_they_meet() {
             .unwrap();
     let results = rodcube::plan::run(&scene.request()).unwrap();
     let impacts = results.impacts.as_ref().unwrap();
-    let anim = results.motion.as_ref().unwrap();
+    let anim = &Animation::build(results.drawing.as_ref().unwrap());
     assert!(!impacts.is_empty());
     assert_eq!(anim.impacts.len(), impacts.len());
     for (mark, record) in anim.impacts.iter().zip(impacts) {

@@ -246,7 +246,7 @@ fn a_run_says_it_reached_its_end_and_refuses_a_bad_one() {
     )
     .unwrap();
     assert!(
-        run.notes["until"].contains("followed to the run's end"),
+        rodcube::report::prose::note(&run.notes["until"]).contains("followed to the run's end"),
         "{:?}",
         run.notes
     );
@@ -275,7 +275,9 @@ fn a_run_says_it_reached_its_end_and_refuses_a_bad_one() {
     )
     .unwrap();
     assert_eq!(first.impacts.as_ref().unwrap().len(), 1);
-    assert!(first.notes["impacts"].contains("ends at its first impact"));
+    assert!(
+        rodcube::report::prose::note(&first.notes["impacts"]).contains("ends at its first impact")
+    );
     for until in [0.0, -1.0, f64::NAN, f64::INFINITY] {
         let err =
             plan::run(&Request::new(model, params.as_slice()).with_until(Some(until))).unwrap_err();
@@ -363,7 +365,7 @@ fn elastic_bounces_that_never_converge_stop_at_the_impact_limit_with_a_note() {
     let walker = liftoff_walker(1.0, 400.0);
     let motion = walker.motion(&mut Work::default()).unwrap();
     assert_eq!(motion.impacts.len(), MAX_IMPACTS);
-    let why = motion.halted.as_deref().expect("halted");
+    let why = rodcube::report::prose::halt_words(motion.halted.as_ref().expect("halted"));
     assert!(why.contains("neither came to rest nor converged"), "{why}");
     assert!(motion.complete());
     let flights: Vec<f64> = (motion.impacts.windows(2))

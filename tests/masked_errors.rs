@@ -9,9 +9,10 @@ mod common;
 use common::paper::{GENERAL, MODELS, paper};
 use common::tweaked::{NAN_FORCE, registry};
 use rodcube::model::{Model, ModelInfo, Reduced, Reduction};
+use rodcube::plan::drawing::{PhaseInput, record};
 use rodcube::plan::{self, PlanError, Request};
 use rodcube::quantity::Quantity;
-use rodcube::report::motion::{Animation, PhaseInput};
+use rodcube::report::motion::Animation;
 use rodcube::results::Work;
 use rodcube::solve::SolveError;
 use rodcube::solve::phases::{End, PhaseRun, ReducedEnd, ReducedRun, Route, Walker};
@@ -317,7 +318,7 @@ fn a_frame_the_model_refuses_is_dropped_with_a_note() {
         t_start: 0.0,
         end: End::Floor,
     };
-    let animation = Animation::build(&[input], Some("tip"));
+    let animation = Animation::build(&record(&[input], Some("tip")));
     assert_eq!(animation.frames.len(), 2);
     assert_eq!(animation.dropped, 1);
     assert!(
@@ -340,7 +341,7 @@ fn a_frame_the_model_refuses_is_dropped_with_a_note() {
         t_start: 0.0,
         end: End::Floor,
     };
-    let animation = Animation::build(&[input], None);
+    let animation = Animation::build(&record(&[input], None));
     assert!(animation.shapes.is_empty() && animation.frames.is_empty());
     assert_eq!(animation.dropped, 1);
     assert!(

@@ -13,6 +13,7 @@
 use rodcube::model::ShapeKind;
 use rodcube::plan::{self, Request};
 use rodcube::quantity::Quantity;
+use rodcube::report::motion::Animation;
 use rodcube::scene::Scene;
 use serde_json::Value;
 use std::fs;
@@ -382,7 +383,7 @@ fn every_shipped_scene_draws_its_rod_through_the_tip() {
             .with_want(&want)
             .with_samples(50);
         let r = plan::run(&request).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        let anim = r.motion.as_ref().expect("a trajectory gives the motion");
+        let anim = &Animation::build(r.drawing.as_ref().expect("a trajectory gives the motion"));
         let name = &anim.model;
         assert_eq!(anim.traced.as_deref(), Some("tip"));
         assert_eq!(anim.dropped, 0, "{name}");

@@ -204,7 +204,11 @@ fn ode_path_conserves_energy_and_momentum() {
     let keys: Vec<&str> = found.iter().map(|(k, _)| k.as_str()).collect();
     assert_eq!(keys, ["ode.energy", "ode.momentum_x1_x2"]);
     for (name, check) in &found {
-        println!("{name}: drift {:.3e} ({})", check.value, check.meaning);
+        println!(
+            "{name}: drift {:.3e} ({})",
+            check.value,
+            rodcube::report::prose::check_meaning(check)
+        );
         assert_eq!(check.margin, check.limit - check.value);
         assert!(check.passed, "{name}: {check:?}");
     }

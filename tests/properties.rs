@@ -236,7 +236,11 @@ fn check_fast_phase(model: &'static dyn Model, u: &[f64], spread: u8) -> Result<
     .expect("the samples are the model's states");
     prop_assert!(found.iter().any(|(k, _)| k.ends_with(".energy")));
     for (key, check) in found {
-        prop_assert!(check.passed, "{key}: {} at {p:?}", check.meaning);
+        prop_assert!(
+            check.passed,
+            "{key}: {} at {p:?}",
+            rodcube::report::prose::check_meaning(&check)
+        );
     }
     Ok(())
 }
@@ -308,7 +312,11 @@ fn check_contact_end(model: &'static dyn Model, p: &[f64]) -> Result<(), TestCas
         .collect();
     prop_assert!(!energy.is_empty());
     for (key, check) in energy {
-        prop_assert!(check.passed, "{key}: {} at {p:?}", check.meaning);
+        prop_assert!(
+            check.passed,
+            "{key}: {} at {p:?}",
+            rodcube::report::prose::check_meaning(check)
+        );
     }
     Ok(())
 }

@@ -5,7 +5,9 @@
 
 use rodcube::io::OutDir;
 use rodcube::report::{self, csv, json, plot, table};
-use rodcube::results::{Check, CheckKind, Column, RunResults, Scalar, Series, Work};
+use rodcube::results::{
+    Check, CheckKind, CheckSubject, Column, Held, Meaning, Note, RunResults, Scalar, Series, Work,
+};
 use std::collections::BTreeMap;
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -20,12 +22,17 @@ fn col(name: &str, unit: &'static str, values: Vec<f64>) -> Column {
     }
 }
 
-fn scalar(value: f64, unit: &'static str, meaning: &str) -> Scalar {
+fn scalar(value: f64, unit: &'static str, meaning: Meaning) -> Scalar {
     Scalar {
         value,
         unit,
-        meaning: meaning.to_string(),
+        meaning,
     }
+}
+
+/// The paper's rod angle, as the meanings name it.
+fn angle() -> String {
+    "theta".into()
 }
 
 /// Results shaped like the planner's for the paper's scene: inputs to the writers, not physics
@@ -56,25 +63,58 @@ fn paper_results(m2: f64) -> RunResults {
     let mut results = BTreeMap::new();
     results.insert(
         "separation_angle".into(),
-        scalar(theta_sep, "rad", "angle where the contact force vanishes"),
+        scalar(
+            theta_sep,
+            "rad",
+            Meaning::SeparationAngle { angle: angle() },
+        ),
     );
     results.insert(
         "linearised_separation_angle".into(),
-        scalar((1.0f64 / 6.0).asin(), "rad", "linearised"),
+        scalar(
+            (1.0f64 / 6.0).asin(),
+            "rad",
+            Meaning::LinearisedSeparationAngle,
+        ),
     );
     results.insert(
         "separation_time".into(),
-        scalar(t_sep, "s", "time to separation"),
+        scalar(t_sep, "s", Meaning::SeparationTime),
     );
     results.insert(
         "contact_time_to_floor".into(),
-        scalar(0.18693, "s", "eq. (10)"),
+        scalar(
+            0.18693,
+            "s",
+            Meaning::ContactTimeToFloor {
+                angle: angle(),
+                end_angle: 0.0,
+            },
+        ),
     );
     results.insert(
         "point_mass_fall_time".into(),
-        scalar(0.15964, "s", "sqrt(a/g)"),
+        scalar(
+            0.15964,
+            "s",
+            Meaning::PointMassFallTime {
+                point: "tip".into(),
+                height: 0.125,
+            },
+        ),
     );
-    results.insert("floor_impact_time".into(), scalar(0.1989, "s", "rod lands"));
+    results.insert(
+        "floor_impact_time".into(),
+        scalar(
+            0.1989,
+            "s",
+            Meaning::FloorImpactTime {
+                angle: angle(),
+                end_angle: 0.0,
+                path: vec!["rod_cube_closed".into(), "rod_cube_free".into()],
+            },
+        ),
+    );
     let mut series = BTreeMap::new();
     series.insert(
         "theta_series".into(),
@@ -123,7 +163,11 @@ fn paper_results(m2: f64) -> RunResults {
             margin: 2.45,
             at_time: Some(0.1085),
             samples: 1000,
-            meaning: "floor normal force >= 0 (N)".into(),
+            subject: CheckSubject::Monitor {
+                model: "rod_cube".into(),
+                monitor: "foot_on_floor".into(),
+                meaning: "floor normal force >= 0 (N)".into(),
+            },
         },
     );
     checks.insert(
@@ -139,7 +183,12 @@ fn paper_results(m2: f64) -> RunResults {
             margin: -3e-9,
             at_time: None,
             samples: 79,
-            meaning: "relative energy drift below tolerance".into(),
+            subject: CheckSubject::Energy {
+                model: "rod_cube_free".into(),
+                friction: false,
+                rounding: 1e-15,
+                scale: 2.5,
+            },
         },
     );
     RunResults {
@@ -167,7 +216,7 @@ fn paper_results(m2: f64) -> RunResults {
         },
         notes: BTreeMap::new(),
         impacts: None,
-        motion: None,
+        drawing: None,
     }
 }
 
@@ -295,8 +344,10 @@ fn results_json_has_the_documented_top_level_objects() {
 #[test]
 fn json_writes_non_finite_numbers_as_null() {
     let mut r = paper_results(3.0);
-    r.results
-        .insert("broken".into(), scalar(f64::NAN, "s", "no value"));
+    r.results.insert(
+        "broken".into(),
+        scalar(f64::NAN, "s", Meaning::SeparationTime),
+    );
     let v: serde_json::Value = serde_json::from_str(&json::to_string(&r).unwrap()).unwrap();
     assert!(v["results"]["broken"]["value"].is_null());
 }
@@ -548,11 +599,18 @@ fn table_explains_quantities_without_a_value() {
     let mut r = paper_results(4.0);
     r.notes.insert(
         "separation_angle".into(),
-        "the rod reaches the floor before separating".into(),
+        Note::NoSeparationHolds {
+            contact: "contact_force".into(),
+            held: Held::Floor {
+                angle: "theta".into(),
+                end_angle: 0.0,
+            },
+        },
     );
     let text = table::render(&r, None, &table::Layout::default());
     assert!(
-        text.contains("Notes") && text.contains("reaches the floor before"),
+        text.contains("Notes")
+            && text.contains("no separation: contact `contact_force` holds until `theta` = 0 rad"),
         "{text}"
     );
 }

@@ -122,7 +122,7 @@ fn solve<'py>(
             let c = PyDict::new(py);
             c.set_item("passed", check.passed)?;
             c.set_item("margin", check.margin)?;
-            c.set_item("meaning", &check.meaning)?;
+            c.set_item("meaning", rodcube::report::prose::check_meaning(check))?;
             checks.set_item(name, c)?;
         }
         out.set_item("checks", checks)?;
@@ -153,7 +153,10 @@ fn solve<'py>(
         out.set_item("impacts", list)?;
     }
     if !results.notes.is_empty() {
-        out.set_item("notes", results.notes.clone())?;
+        let notes: std::collections::BTreeMap<&str, String> = (results.notes.iter())
+            .map(|(key, n)| (key.as_str(), rodcube::report::prose::note(n)))
+            .collect();
+        out.set_item("notes", notes)?;
     }
     Ok(out)
 }

@@ -14,8 +14,9 @@
 //! - `point_mass_fall_time`: the release state only;
 //! - `theta_series`, `<contact>_series`, `<friction>_series`, `<point>_trajectory`: `samples`
 //!   uniform times from release to the first contact's end (or to the end of the motion);
-//! - any `<point>_trajectory` also gives the bodies' motion ([`RunResults::motion`], drawn
-//!   into `motion.svg`) over every phase the run solved anyway, each sampled once;
+//! - any `<point>_trajectory` also gives the bodies' poses ([`RunResults::drawing`], from
+//!   which the report computes `motion.svg`) over every phase the run solved anyway, each
+//!   sampled once;
 //! - `floor_impact`: every phase to the end of the motion;
 //! - `cross_check`: the release fast phase and the general model integrated from release with
 //!   the same contacts closed, to its first event;
@@ -38,12 +39,13 @@
 //! (`t, x, y, vx, vy`). A wanted quantity without a value (e.g. no separation, or a mass matrix
 //! too ill-conditioned for the cross-check) is explained in [`RunResults::notes`] under its key.
 
+pub mod drawing;
 mod quantities;
 mod verify;
 
 use crate::model::{Model, ModelInfo};
 use crate::quantity::Quantity;
-use crate::results::{Column, RunResults, Scalar, Work, format_number};
+use crate::results::{Column, Meaning, RunResults, Scalar, Work};
 use crate::solve::SolveError;
 use crate::solve::phases::{
     End, Motion, PhaseRun, PhaseStart, ReducedEnd, ReducedRun, Route, Walker, phase_end,
@@ -353,7 +355,7 @@ pub fn run(request: &Request) -> Result<RunResults, PlanError> {
         plan.quantity(*q, &want, &mut out)?;
     }
     if want.iter().any(|q| matches!(q, Quantity::Trajectory(_))) {
-        plan.animation(&want, &mut out)?;
+        plan.drawing(&want, &mut out)?;
     }
     plan.motion_notes(&mut out);
     out.work = plan.work;
@@ -408,7 +410,7 @@ struct Plan<'m> {
     ode: Option<UnreducedRun>,
 }
 
-fn scalar(out: &mut RunResults, key: &str, value: f64, unit: &'static str, meaning: String) {
+fn scalar(out: &mut RunResults, key: &str, value: f64, unit: &'static str, meaning: Meaning) {
     out.results.insert(
         key.to_string(),
         Scalar {
@@ -427,25 +429,12 @@ fn column(name: &str, unit: &'static str, values: Vec<f64>) -> Column {
     }
 }
 
-/// The end of a model's motion in its own terms: `` `theta` = 0 rad `` (the reduced coordinate
-/// at its `end_angle`).
-fn motion_end(info: &ModelInfo) -> String {
-    format!(
-        "{} = {} rad",
-        angle_name(info),
-        format_number(info.end_angle, 6)
-    )
-}
-
-/// The reduced coordinate's name, in backquotes.
-fn angle_name(info: &ModelInfo) -> String {
-    format!(
-        "`{}`",
-        info.coordinates
-            .get(info.reduced)
-            .copied()
-            .unwrap_or("theta")
-    )
+/// The reduced coordinate's name.
+fn angle_coordinate(info: &ModelInfo) -> &'static str {
+    info.coordinates
+        .get(info.reduced)
+        .copied()
+        .unwrap_or("theta")
 }
 
 impl<'m> Plan<'m> {
@@ -714,8 +703,7 @@ impl<'m> Plan<'m> {
     }
 }
 
-/// The phases' labels as one path: `rod_cube_closed -> rod_cube_free`.
-fn path(motion: &Motion) -> String {
-    let names: Vec<String> = motion.phases.iter().flat_map(PhaseRun::labels).collect();
-    names.join(" -> ")
+/// The labels of the phases the motion went through, in order.
+fn phase_labels(motion: &Motion) -> Vec<String> {
+    motion.phases.iter().flat_map(PhaseRun::labels).collect()
 }

@@ -2,11 +2,14 @@
 //! the floor in contact, the point mass's fall, the series over the first contact's span and
 //! the landing, each computing only what it needs of the motion.
 
-use super::{Plan, angle_name, column, motion_end, path, scalar};
+use super::drawing::{PhaseInput, record};
+use super::{Plan, angle_coordinate, column, phase_labels, scalar};
 use crate::model::ModelInfo;
 use crate::quantity::Quantity;
-use crate::report::motion::{Animation, PhaseInput};
-use crate::results::{ContactImpulse, ImpactRecord, Label, RunResults, Series, format_number};
+use crate::results::{
+    ContactImpulse, Held, ImpactRecord, Label, Meaning, Note, RunResults, Series, Unlanded,
+    UntilNote, format_number,
+};
 use crate::solve::SolveError;
 use crate::solve::impact::Part;
 use crate::solve::phases::{End, ImpactAt, LANDING_TOLERANCE, Motion, PhaseRun};
@@ -31,7 +34,7 @@ pub(super) enum Fate {
     /// It held to the end of the motion, which ended as `until` says.
     Held {
         /// How the motion ended.
-        until: String,
+        until: Held,
     },
     /// It was open from release on.
     NeverClosed,
@@ -81,11 +84,10 @@ fn fate_along(motion: &Motion, info: &ModelInfo, i: usize, landed: bool) -> Opti
             End::Edge(j) if j == i => return Some(ended("edge")),
             End::Contact(j) if !motion.through_impacts && landed => {
                 return Some(Fate::Held {
-                    until: format!(
-                        "until the body lands, where contact `{}` closes at t = {} s",
-                        name(j),
-                        format_number(phase.t_end(), 6)
-                    ),
+                    until: Held::Lands {
+                        contact: name(j).to_string(),
+                        t: phase.t_end(),
+                    },
                 });
             }
             End::Contact(_) if !motion.through_impacts => return Some(ended("contact")),
@@ -93,7 +95,7 @@ fn fate_along(motion: &Motion, info: &ModelInfo, i: usize, landed: bool) -> Opti
                 // An impact: it may have separated this contact.
                 let Some(next) = motion.phases.get(k + 1) else {
                     return (motion.halted.as_ref()).map(|why| Fate::Held {
-                        until: format!("until {why}"),
+                        until: Held::Halted(why.clone()),
                     });
                 };
                 if !next.closed().get(i).copied().unwrap_or(false) {
@@ -102,31 +104,30 @@ fn fate_along(motion: &Motion, info: &ModelInfo, i: usize, landed: bool) -> Opti
             }
             End::Until => {
                 return Some(Fate::Held {
-                    until: format!(
-                        "until the run's end at t = {} s",
-                        format_number(phase.t_end(), 6)
-                    ),
+                    until: Held::RunsEnd { t: phase.t_end() },
                 });
             }
             End::Floor => {
                 return Some(Fate::Held {
-                    until: format!("until {}", motion_end(info)),
+                    until: Held::Floor {
+                        angle: angle_coordinate(info).to_string(),
+                        end_angle: info.end_angle,
+                    },
                 });
             }
             End::Edge(j) => {
                 return Some(Fate::Held {
-                    until: format!(
-                        "until contact `{}` ran off an edge at t = {} s, where the motion stops",
-                        name(j),
-                        format_number(phase.t_end(), 6)
-                    ),
+                    until: Held::Edge {
+                        contact: name(j).to_string(),
+                        t: phase.t_end(),
+                    },
                 });
             }
             End::Force(_) => {
                 // Another contact opened; the decision there may have opened this one too.
                 let Some(next) = motion.phases.get(k + 1) else {
                     return (motion.halted.as_ref()).map(|why| Fate::Held {
-                        until: format!("until {why}"),
+                        until: Held::Halted(why.clone()),
                     });
                 };
                 if !next.closed().get(i).copied().unwrap_or(false) {
@@ -189,19 +190,6 @@ fn impact_record(info: &ModelInfo, at: &ImpactAt) -> ImpactRecord {
     }
 }
 
-/// What a cause means, for the results' meanings.
-fn cause_words(cause: &str) -> &'static str {
-    match cause {
-        "force" => "its force reached zero (it would have had to pull)",
-        "edge" => "its contact point ran off a body",
-        "impact" => "the impulses of an impact elsewhere moved it away",
-        _ => {
-            "another contact closed there: the bodies meet, and the run ends at its first impact \
-             unless it is given a time to go on to (`until`)"
-        }
-    }
-}
-
 impl Plan<'_> {
     /// Contact `i`'s fate, solving the motion as far as needed.
     pub(super) fn fate(&mut self, i: usize) -> Result<Fate, SolveError> {
@@ -234,11 +222,14 @@ impl Plan<'_> {
             && end.end == End::Force(0)
             && let Some(at) = end.at
         {
-            let meaning = format!(
-                "{} where the first contact's force vanishes",
-                angle_name(info)
+            let angle = angle_coordinate(info).to_string();
+            scalar(
+                out,
+                &key,
+                at.theta,
+                "rad",
+                Meaning::SeparationAngle { angle },
             );
-            scalar(out, &key, at.theta, "rad", meaning);
             return Ok(());
         }
         match self.fate(0)? {
@@ -248,13 +239,10 @@ impl Plan<'_> {
                 cause: "force",
             } => {
                 if q == Quantity::SeparationAngle {
-                    let meaning = format!(
-                        "{} where the first contact's force vanishes",
-                        angle_name(info)
-                    );
-                    scalar(out, &key, theta, "rad", meaning);
+                    let angle = angle_coordinate(info).to_string();
+                    scalar(out, &key, theta, "rad", Meaning::SeparationAngle { angle });
                 } else {
-                    scalar(out, &key, t, "s", "time from release to separation".into());
+                    scalar(out, &key, t, "s", Meaning::SeparationTime);
                 }
             }
             other => {
@@ -264,23 +252,22 @@ impl Plan<'_> {
         Ok(())
     }
 
-    /// Why the first contact does not separate, in words.
-    fn why_no_separation(&self, fate: &Fate) -> String {
+    /// Why the first contact does not separate.
+    fn why_no_separation(&self, fate: &Fate) -> Note {
         let info = self.general().info();
-        let first = info
-            .contacts
-            .first()
-            .map_or("the first contact", |c| c.name);
+        let contact = (info.contacts.first())
+            .map_or("the first contact", |c| c.name)
+            .to_string();
         match fate {
-            Fate::Ended { cause, .. } => format!(
-                "no separation: contact `{first}` ended before its force vanished ({}; \
-                 `contact_end` says when)",
-                cause_words(cause)
-            ),
-            Fate::Held { until } => {
-                format!("no separation: contact `{first}` holds {until}")
-            }
-            Fate::NeverClosed => format!("no separation: contact `{first}` is open at release"),
+            Fate::Ended { cause, .. } => Note::NoSeparationEnded {
+                contact,
+                cause: cause.to_string(),
+            },
+            Fate::Held { until } => Note::NoSeparationHolds {
+                contact,
+                held: until.clone(),
+            },
+            Fate::NeverClosed => Note::NoSeparationOpen { contact },
         }
     }
 
@@ -294,13 +281,10 @@ impl Plan<'_> {
                 &key,
                 s.theta,
                 "rad",
-                "separation angle with the polynomial's terms above degree 1 dropped".into(),
+                Meaning::LinearisedSeparationAngle,
             ),
             SeparationOutcome::NoSeparationBeforeFloor => {
-                out.notes.insert(
-                    key,
-                    "the linearised polynomial has no root between the floor and the start".into(),
-                );
+                out.notes.insert(key, Note::NoLinearisedRoot);
             }
         }
         Ok(())
@@ -321,32 +305,34 @@ impl Plan<'_> {
             for key in keys {
                 match &fate {
                     Fate::Ended { t, theta, cause } => {
-                        let why = cause_words(cause);
-                        let meaning =
-                            format!("time from release until contact `{name}` ends: {why}");
+                        let (contact, cause) = (name.to_string(), cause.to_string());
+                        let meaning = Meaning::ContactEndTime {
+                            contact: contact.clone(),
+                            cause: cause.clone(),
+                        };
                         scalar(out, &format!("{key}_time"), *t, "s", meaning);
-                        let meaning =
-                            format!("{} where contact `{name}` ends: {why}", angle_name(info));
+                        let meaning = Meaning::ContactEndAngle {
+                            angle: angle_coordinate(info).to_string(),
+                            contact: contact.clone(),
+                            cause: cause.clone(),
+                        };
                         scalar(out, &format!("{key}_angle"), *theta, "rad", meaning);
                         out.labels.insert(
                             format!("{key}_cause"),
                             Label {
-                                value: cause.to_string(),
-                                meaning: format!(
-                                    "why contact `{name}` ended: `force` (its force reached zero), \
-                                     `edge` (its point ran off a body) or `contact` (another \
-                                     contact closed, where the motion stops)"
-                                ),
+                                value: cause,
+                                meaning: Meaning::ContactEndCause { contact },
                             },
                         );
                     }
                     Fate::Held { until } => {
-                        out.notes
-                            .insert(key, format!("contact `{name}` holds {until}"));
+                        let held = until.clone();
+                        let contact = name.to_string();
+                        out.notes.insert(key, Note::Holds { contact, held });
                     }
                     Fate::NeverClosed => {
-                        out.notes
-                            .insert(key, format!("contact `{name}` is open at release"));
+                        let contact = name.to_string();
+                        out.notes.insert(key, Note::OpenAtRelease { contact });
                     }
                 }
             }
@@ -373,7 +359,7 @@ impl Plan<'_> {
             "contact_end_friction_work",
             work,
             "J",
-            "work done by friction over the first contact's phase (energy lost)".into(),
+            Meaning::ContactEndFrictionWork,
         );
         let sequence = (phases.iter().flat_map(|p| p.stretches()))
             .map(|(t, m)| format!("{m} from t = {} s", format_number(t, 6)))
@@ -383,10 +369,7 @@ impl Plan<'_> {
             "contact_end_contact_modes".into(),
             Label {
                 value: sequence,
-                meaning: "the closed contacts and how each friction contact moves over the first \
-                          contact's phase: sticks, or slides + / - along its direction, each from \
-                          the time the set began (switches located as events)"
-                    .into(),
+                meaning: Meaning::ContactModes,
             },
         );
         Ok(())
@@ -397,10 +380,10 @@ impl Plan<'_> {
         let info = self.general().info();
         let t = self.floor_mesh()?.duration;
         let key = Quantity::ContactTimeToFloor.name(info);
-        let meaning = format!(
-            "time to {} if the release contacts held all the way",
-            motion_end(info)
-        );
+        let meaning = Meaning::ContactTimeToFloor {
+            angle: angle_coordinate(info).to_string(),
+            end_angle: info.end_angle,
+        };
         scalar(out, &key, t, "s", meaning);
         Ok(())
     }
@@ -412,11 +395,10 @@ impl Plan<'_> {
         let pts = general.points(&general.initial_state())?;
         let h = pts.pos[info.falling_point][1];
         let t = (2.0 * h.max(0.0) / general.gravity()).sqrt();
-        let meaning = format!(
-            "free fall of a point mass from the release height of `{}` ({} m)",
-            info.points[info.falling_point].name,
-            format_number(h, 6)
-        );
+        let meaning = Meaning::PointMassFallTime {
+            point: info.points[info.falling_point].name.to_string(),
+            height: h,
+        };
         scalar(
             out,
             &Quantity::PointMassFallTime.name(info),
@@ -594,13 +576,12 @@ impl Plan<'_> {
                 "floor_impact_friction_work",
                 work,
                 "J",
-                format!(
-                    "work done by friction from release until {} (energy lost)",
-                    motion_end(info)
-                ),
+                Meaning::FloorImpactFrictionWork {
+                    angle: angle_coordinate(info).to_string(),
+                    end_angle: info.end_angle,
+                },
             );
         }
-        let path = path(motion);
         let name = |j: usize| info.contacts.get(j).map_or("a contact", |c| c.name);
         let mut landing = None;
         for phase in &motion.phases {
@@ -610,45 +591,33 @@ impl Plan<'_> {
             }
         }
         let Some(landing) = landing else {
-            let at = format_number(motion.end_time(), 6);
-            let note = match motion.last_end() {
-                Some(End::Edge(j)) => format!(
-                    "contact `{}` ran off an edge at t = {at} s ({path}); the motion after that is not modelled",
-                    name(j),
-                ),
-                Some(End::Contact(j)) => format!(
-                    "contact `{}` closed at t = {at} s ({path}): the bodies meet, and the run ends at its first impact unless the scene gives a time to go on to (`until`)",
-                    name(j),
-                ),
-                Some(End::Until) => {
-                    format!("the run reached its end at t = {at} s before the body landed ({path})")
-                }
+            let end = match motion.last_end() {
+                Some(End::Edge(j)) => Unlanded::Edge(name(j).to_string()),
+                Some(End::Contact(j)) => Unlanded::Contact(name(j).to_string()),
+                Some(End::Until) => Unlanded::Until,
                 _ => match &motion.halted {
-                    Some(why) => format!("the motion ended before the floor: {why} ({path})"),
-                    None => format!("the motion ended before the floor ({path})"),
+                    Some(why) => Unlanded::Halted(why.clone()),
+                    None => Unlanded::Ended,
                 },
+            };
+            let note = Note::NoLanding {
+                t: motion.end_time(),
+                path: phase_labels(motion),
+                end,
             };
             out.notes.insert("floor_impact".into(), note);
             return Ok(());
         };
         let (time, omega) = (landing.t_end(), landing.theta_dot_end());
-        scalar(
-            out,
-            "floor_impact_time",
-            time,
-            "s",
-            format!("time from release until {} ({path})", motion_end(info)),
-        );
-        scalar(
-            out,
-            "impact_angular_velocity",
-            omega,
-            "rad/s",
-            format!(
-                "rate of {} when it reaches its end ({path})",
-                angle_name(info)
-            ),
-        );
+        let (angle, path) = (angle_coordinate(info).to_string(), phase_labels(motion));
+        let meaning = Meaning::FloorImpactTime {
+            angle: angle.clone(),
+            end_angle: info.end_angle,
+            path: path.clone(),
+        };
+        scalar(out, "floor_impact_time", time, "s", meaning);
+        let meaning = Meaning::ImpactAngularVelocity { angle, path };
+        scalar(out, "impact_angular_velocity", omega, "rad/s", meaning);
         Ok(())
     }
 
@@ -670,26 +639,18 @@ impl Plan<'_> {
             match walker.impact(motion, i) {
                 Ok(at) => list.push(at),
                 Err(e @ SolveError::FrictionalImpact { .. }) => {
-                    out.notes.insert("impacts".into(), e.to_string());
+                    out.notes
+                        .insert("impacts".into(), Note::Refused(e.to_string()));
                 }
                 Err(e) => return Err(e),
             }
-            out.notes.entry("impacts".into()).or_insert_with(|| {
-                format!(
-                    "the run ends at its first impact (t = {} s); a scene's `until` carries the \
-                     motion on through impacts",
-                    format_number(motion.end_time(), 6)
-                )
+            (out.notes.entry("impacts".into())).or_insert(Note::FirstImpactEnds {
+                t: motion.end_time(),
             });
         }
         if list.is_empty() {
-            out.notes.insert(
-                "impacts".into(),
-                format!(
-                    "no contact closed before the motion's end ({})",
-                    path(motion)
-                ),
-            );
+            let path = phase_labels(motion);
+            out.notes.insert("impacts".into(), Note::NoImpact { path });
         }
         out.impacts = Some(list.iter().map(|a| impact_record(info, a)).collect());
         Ok(())
@@ -703,42 +664,39 @@ impl Plan<'_> {
             return;
         };
         if let Some(until) = self.walker.until {
-            let at = format_number(motion.end_time(), 6);
-            let impacts = motion.impacts.len();
+            let (t, impacts) = (motion.end_time(), motion.impacts.len());
             let note = match (&motion.halted, motion.last_end()) {
-                (Some(why), _) => why.clone(),
-                (None, Some(End::Until)) => format!(
-                    "the motion was followed to the run's end, t = {at} s (`until`), through \
-                     {impacts} impact(s)"
-                ),
-                (None, end) => format!(
-                    "the motion ended at t = {at} s ({}), before the run's end (`until` = {} s), \
-                     after {impacts} impact(s)",
-                    end.map_or("", |e| e.cause()),
-                    format_number(until, 6)
-                ),
+                (Some(why), _) => UntilNote::Halted(why.clone()),
+                (None, Some(End::Until)) => UntilNote::Reached { t, impacts },
+                (None, end) => UntilNote::EndedBefore {
+                    t,
+                    cause: end.map_or("", |e| e.cause()).to_string(),
+                    until,
+                    impacts,
+                },
             };
-            out.notes.insert("until".into(), note);
+            out.notes.insert("until".into(), Note::Until(note));
         }
         if !motion.notes.is_empty() {
-            out.notes.insert("zeno".into(), motion.notes.join("; "));
+            out.notes
+                .insert("zeno".into(), Note::Zeno(motion.notes.clone()));
         }
     }
 
-    /// The bodies' motion for `motion.svg`: every phase this run solved (the first always, the
+    /// The bodies' poses for `motion.svg`: every phase this run solved (the first always, the
     /// next ones when other quantities asked for them), each sampled once, with the path of the
     /// first point whose trajectory is wanted. A later phase that cannot be sampled ends the
-    /// animation there, with a note in it.
-    pub(super) fn animation(
+    /// drawing there, which says why.
+    pub(super) fn drawing(
         &mut self,
         want: &[Quantity],
         out: &mut RunResults,
     ) -> Result<(), SolveError> {
         let n = self.motion()?.phases.len();
-        let mut notes = Vec::new();
+        let mut stopped = None;
         for i in 0..n {
             if let Err(e) = self.samples_of(i) {
-                notes.push(format!("the animation stops before phase {}: {e}", i + 1));
+                stopped = Some((i, e.to_string()));
                 break;
             }
         }
@@ -764,9 +722,9 @@ impl Plan<'_> {
                 end: run.end(),
             })
             .collect();
-        let mut animation = Animation::build(&phases, traced);
-        animation.notes.extend(notes);
-        out.motion = Some(animation);
+        let mut drawing = record(&phases, traced);
+        drawing.stopped = stopped;
+        out.drawing = Some(drawing);
         Ok(())
     }
 }

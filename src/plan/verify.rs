@@ -2,22 +2,26 @@
 //! integrated with the same contacts closed, and the physical checks of every phase.
 
 use super::{Plan, scalar};
-use crate::results::{CheckKind, RunResults, Work, format_number};
+use crate::results::{CheckKind, Meaning, Note, PhaseEnd, RunResults, Work, format_number};
 use crate::solve::SolveError;
 use crate::solve::checks::{self, Conserved, free_momenta};
 use crate::solve::phases::{End, PhaseRun};
 use crate::solve::series::{sample_forces, theta_dot_at};
 use crate::solve::unreduced::UnreducedRun;
 
-/// The event of an integrated run in words.
-fn event_words(run: &UnreducedRun, info: &crate::model::ModelInfo) -> String {
-    let name = |i: usize| info.contacts.get(i).map_or("a contact", |c| c.name);
+/// The event that ended an integrated run, its contact named.
+fn ended_at(run: &UnreducedRun, info: &crate::model::ModelInfo) -> PhaseEnd {
+    let name = |i: usize| {
+        (info.contacts.get(i))
+            .map_or("a contact", |c| c.name)
+            .to_string()
+    };
     match run.end {
-        End::Force(i) => format!("contact `{}`'s force crossing zero", name(i)),
-        End::Edge(i) => format!("contact `{}`'s edge", name(i)),
-        End::Contact(i) => format!("contact `{}` closing", name(i)),
-        End::Floor => "the floor".into(),
-        End::Until => "the run's end".into(),
+        End::Force(i) => PhaseEnd::Force(name(i)),
+        End::Edge(i) => PhaseEnd::Edge(name(i)),
+        End::Contact(i) => PhaseEnd::Contact(name(i)),
+        End::Floor => PhaseEnd::Floor,
+        End::Until => PhaseEnd::Until,
     }
 }
 
@@ -31,7 +35,8 @@ impl Plan<'_> {
             Ok(ode) => ode,
             // Not an error of the run: the integrated route has nothing to say here.
             Err(e @ SolveError::IllConditioned { .. }) => {
-                out.notes.insert("cross_check".into(), e.to_string());
+                out.notes
+                    .insert("cross_check".into(), Note::Refused(e.to_string()));
                 return Ok(());
             }
             Err(e) => return Err(e),
@@ -56,17 +61,13 @@ impl Plan<'_> {
             });
         };
         let t_quad = first.mesh.duration;
-        let event = event_words(ode, info);
         let same = ode.end == first.end.end;
         if !same {
-            out.notes.insert(
-                "cross_check".into(),
-                format!(
-                    "the integrated route ended at {event}, the fast path at {:?}: they disagree \
-                     on the first event",
-                    first.end.end
-                ),
-            );
+            let note = Note::CrossCheckDisagrees {
+                integrated: ended_at(ode, info),
+                fast: format!("{:?}", first.end.end),
+            };
+            out.notes.insert("cross_check".into(), note);
         }
         let rel = if t_quad > 0.0 {
             (ode.t_end - t_quad).abs() / t_quad
@@ -75,50 +76,26 @@ impl Plan<'_> {
         };
         let (dt_max, dy_max, nodes) = path_deviation(first, ode, info.reduced, work)?;
         let steps = ode.steps();
-        scalar(
-            out,
-            "cross_check_time",
-            ode.t_end,
-            "s",
-            format!(
-                "the general model ({}, {steps} steps) integrated to {event}",
-                ode.method.name()
-            ),
-        );
-        scalar(
-            out,
-            "cross_check_relative_difference",
-            rel,
-            "1",
-            format!(
-                "|t_ode - t_quadrature| / t_quadrature at {event} (quadrature: {t_quad:.15e} s; \
-                 ODE rtol {:.1e}, mass-matrix condition {:.1e})",
-                ode.rtol, ode.condition
-            ),
-        );
-        scalar(
-            out,
-            "cross_check_rtol",
-            ode.rtol,
-            "1",
-            "relative tolerance the integrator ran with: the one asked, raised to 10 eps cond(M) when the mass matrix is ill-conditioned".into(),
-        );
-        scalar(
-            out,
-            "cross_check_time_deviation",
-            dt_max,
-            "s",
-            format!("largest |t_ode - t(theta_ode)| over {nodes} integrator steps"),
-        );
-        scalar(
-            out,
-            "cross_check_state_deviation",
-            dy_max,
-            "1",
-            format!(
-                "largest difference between the integrated and the reduced states over {nodes} steps, relative to the largest coordinate (or velocity) on the path"
-            ),
-        );
+        let event = ended_at(ode, info);
+        let meaning = Meaning::CrossCheckTime {
+            method: ode.method.name().to_string(),
+            steps,
+            event: event.clone(),
+        };
+        scalar(out, "cross_check_time", ode.t_end, "s", meaning);
+        let meaning = Meaning::CrossCheckRelativeDifference {
+            event,
+            t_quad,
+            rtol: ode.rtol,
+            condition: ode.condition,
+        };
+        scalar(out, "cross_check_relative_difference", rel, "1", meaning);
+        let meaning = Meaning::CrossCheckRtol;
+        scalar(out, "cross_check_rtol", ode.rtol, "1", meaning);
+        let meaning = Meaning::CrossCheckTimeDeviation { nodes };
+        scalar(out, "cross_check_time_deviation", dt_max, "s", meaning);
+        let meaning = Meaning::CrossCheckStateDeviation { nodes };
+        scalar(out, "cross_check_state_deviation", dy_max, "1", meaning);
         Ok(())
     }
 

@@ -9,6 +9,7 @@
 //! `{passed, margin, meaning}`) and `work` (counters and phases). Values are SI (angles in
 //! radians); a non-finite number is written as `null`, as JSON has no NaN.
 
+use super::prose::{check_meaning, meaning, note};
 use crate::results::RunResults;
 
 /// The meaning written beside `results.impacts`.
@@ -20,9 +21,33 @@ pub const IMPACTS_MEANING: &str = "every impact of the motion in order: its time
 /// Pretty-printed JSON of the results, ending with a newline.
 pub fn to_string(results: &RunResults) -> Result<String, serde_json::Error> {
     let mut value = serde_json::to_value(results)?;
+    if let Some(map) = value.get_mut("checks").and_then(|c| c.as_object_mut()) {
+        for (key, check) in &results.checks {
+            if let Some(entry) = map.get_mut(key).and_then(|e| e.as_object_mut()) {
+                entry.insert("meaning".into(), check_meaning(check).into());
+            }
+        }
+    }
+    if !results.notes.is_empty()
+        && let Some(map) = value.as_object_mut()
+    {
+        let notes: serde_json::Map<String, serde_json::Value> = (results.notes.iter())
+            .map(|(key, n)| (key.clone(), note(n).into()))
+            .collect();
+        map.insert("notes".into(), notes.into());
+    }
     if let Some(map) = value.get_mut("results").and_then(|r| r.as_object_mut()) {
+        for (key, scalar) in &results.results {
+            if let Some(entry) = map.get_mut(key).and_then(|e| e.as_object_mut()) {
+                entry.insert("meaning".into(), meaning(&scalar.meaning).into());
+            }
+        }
         for (key, label) in &results.labels {
-            map.insert(key.clone(), serde_json::to_value(label)?);
+            let mut entry = serde_json::to_value(label)?;
+            if let Some(fields) = entry.as_object_mut() {
+                fields.insert("meaning".into(), meaning(&label.meaning).into());
+            }
+            map.insert(key.clone(), entry);
         }
         if let Some(impacts) = &results.impacts {
             map.insert(

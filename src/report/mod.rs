@@ -2,9 +2,9 @@
 //! run wanted impacts, SVG plots and the animated motion (`motion.svg`).
 //!
 //! Every writer here is a pure function from `RunResults` to text; only `write_all` touches
-//! the file system, through `OutDir` (atomic writes, checked names). Only [`json`] and
-//! [`motion`] (hand-written SVG text, no dependency) are built without the `cli` feature (the C
-//! ABI returns results.json; [`crate::results::RunResults`] holds the animation).
+//! the file system, through `OutDir` (atomic writes, checked names). Only [`json`], [`prose`] and
+//! [`motion`] (the animation computed from [`crate::results::Drawing`], then hand-written SVG
+//! text, no dependency) are built without the `cli` feature (the C ABI returns results.json).
 //!
 //! `impacts.csv` (`csv::impacts`) has one row per contact taking part in each impact:
 //! `time [s]`, `contact`, `closing` (`true` for the contact whose gap closed),
@@ -19,6 +19,7 @@ pub mod json;
 pub mod motion;
 #[cfg(feature = "cli")]
 pub mod plot;
+pub mod prose;
 #[cfg(feature = "cli")]
 pub mod table;
 mod touch;
@@ -81,7 +82,7 @@ pub enum Error {
 /// Writes `results.json`, `<series>.csv` for every series and `<series>.svg` for every series
 /// that can be plotted, then `impacts.csv` when the run has impacts ([`RunResults::impacts`]:
 /// it wanted them; a header alone when there were none), then `motion.svg` when it has the
-/// bodies' motion ([`RunResults::motion`]: it wanted a trajectory). Returns the paths written,
+/// bodies' drawing ([`RunResults::drawing`]: it wanted a trajectory). Returns the paths written,
 /// in that order.
 #[cfg(feature = "cli")]
 pub fn write_all(out: &OutDir, results: &RunResults) -> Result<Vec<PathBuf>, Error> {
@@ -98,8 +99,9 @@ pub fn write_all(out: &OutDir, results: &RunResults) -> Result<Vec<PathBuf>, Err
     if let Some(impacts) = &results.impacts {
         written.push(out.write(IMPACTS_CSV, csv::impacts(impacts)?.as_bytes())?);
     }
-    if let Some(animation) = &results.motion {
-        written.push(out.write(MOTION_SVG, motion::svg(animation).as_bytes())?);
+    if let Some(drawing) = &results.drawing {
+        let animation = motion::Animation::build(drawing);
+        written.push(out.write(MOTION_SVG, motion::svg(&animation).as_bytes())?);
     }
     Ok(written)
 }

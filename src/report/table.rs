@@ -201,7 +201,7 @@ pub fn render(results: &RunResults, info: Option<&ModelInfo>, layout: &Layout) -
     if !results.notes.is_empty() {
         let mut t = new_table(&["about", "note"], layout);
         for (key, why) in &results.notes {
-            t.add_row(vec![key.clone(), why.clone()]);
+            t.add_row(vec![key.clone(), super::prose::note(why)]);
         }
         no_wrap(&mut t, &[0]);
         out.push_str(&format!("\nNotes\n{t}\n"));
@@ -272,7 +272,7 @@ fn scalars(out: &mut String, results: &RunResults, layout: &Layout) {
             row.push(fig.to_string());
         }
         t.add_row(row);
-        legend.push((key.clone(), s.meaning.clone()));
+        legend.push((key.clone(), super::prose::meaning(&s.meaning)));
     }
     for (key, label) in &results.labels {
         let mut row = vec![
@@ -285,7 +285,7 @@ fn scalars(out: &mut String, results: &RunResults, layout: &Layout) {
             row.push(String::new());
         }
         t.add_row(row);
-        legend.push((key.clone(), label.meaning.clone()));
+        legend.push((key.clone(), super::prose::meaning(&label.meaning)));
     }
     align_right(&mut t, &[1, 3]);
     no_wrap(&mut t, if paper { &[0, 2, 3, 4] } else { &[0, 2, 3] });
@@ -413,7 +413,7 @@ fn checks(out: &mut String, results: &RunResults, layout: &Layout) {
         let mut t = new_table(&header, layout);
         for (c, row) in &cells[group..end] {
             t.add_row(row.to_vec());
-            legend.push((row[0].clone(), c.meaning.clone()));
+            legend.push((row[0].clone(), super::prose::check_meaning(c)));
         }
         // The same widths in every group, where they fit the line; else each group wraps.
         let total: usize = widths.iter().map(|w| w + 3).sum::<usize>() + 1;

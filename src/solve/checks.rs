@@ -18,8 +18,11 @@
 //!   every state of the path), such as the rod's and the cube's horizontal momenta together
 //!   while the tip pushes the cube. With friction the energy check is the balance
 //!   `E - E(0) = W_friction`.
+//!
+//! A check carries what it tested as data (a [`CheckSubject`]: the quantity named, with the
+//! numbers that scale it); `report::prose::check_meaning` writes its sentence.
 
-use crate::results::{Check, CheckKind, format_number};
+use crate::results::{Check, CheckKind, CheckSubject};
 use crate::solve::SolveError;
 use crate::solve::impact::Impact;
 use crate::solve::series::PhaseSamples;
@@ -103,7 +106,7 @@ fn lowest_check(
     unit: &str,
     samples: usize,
     ctx: &Context,
-    meaning: String,
+    subject: CheckSubject,
 ) -> Check {
     Check {
         passed: low.passed(tolerance),
@@ -116,7 +119,7 @@ fn lowest_check(
         margin: low.value - low.limit(tolerance),
         at_time: Some(ctx.t_start + low.at),
         samples,
-        meaning,
+        subject,
     }
 }
 
@@ -140,13 +143,12 @@ pub fn monitors(
     }
     Ok((info.monitors.iter().zip(low))
         .map(|(mon, low)| {
-            let meaning = format!(
-                "{}: the smallest value over {} samples of `{}` must be >= 0",
-                mon.meaning,
-                samples.len(),
-                info.name,
-            );
-            let check = lowest_check(&low, tolerance, mon.unit, samples.len(), ctx, meaning);
+            let subject = CheckSubject::Monitor {
+                model: info.name.to_string(),
+                monitor: mon.name.to_string(),
+                meaning: mon.meaning.to_string(),
+            };
+            let check = lowest_check(&low, tolerance, mon.unit, samples.len(), ctx, subject);
             (format!("{}.{}", ctx.key, mon.name), check)
         })
         .collect())
@@ -172,14 +174,11 @@ pub fn contact_forces(
         for (&t, f) in samples.t.iter().zip(forces) {
             low.add(f.get(i).copied().unwrap_or(f64::NAN), t);
         }
-        let meaning = format!(
-            "contact `{}` is closed in `{}`: its force must push (>= 0) at each of {} samples, \
-             or the contact should have opened",
-            c.name,
-            info.name,
-            samples.len()
-        );
-        let check = lowest_check(&low, tolerance, c.unit, samples.len(), ctx, meaning);
+        let subject = CheckSubject::Pushes {
+            model: info.name.to_string(),
+            contact: c.name.to_string(),
+        };
+        let check = lowest_check(&low, tolerance, c.unit, samples.len(), ctx, subject);
         out.push((format!("{}.{}_pushes", ctx.key, c.name), check));
     }
     out
@@ -192,7 +191,7 @@ fn drift_check(
     kind: CheckKind,
     ctx: &Context,
     samples: usize,
-    meaning: String,
+    subject: CheckSubject,
 ) -> Check {
     Check {
         passed: drift.is_finite() && drift <= tolerance,
@@ -205,7 +204,7 @@ fn drift_check(
         margin: tolerance - drift,
         at_time: None,
         samples,
-        meaning,
+        subject,
     }
 }
 
@@ -246,22 +245,18 @@ pub fn constraint_drift(
         .filter_map(|i| {
             let drift = worst[i]?;
             let c = &info.contacts[i];
-            let meaning = format!(
-                "contact `{}` is held closed by the integrator of `{}`: its largest gap over {} \
-                 states, relative to the system's length ({} m), stays <= {}",
-                c.name,
-                info.name,
-                states.len(),
-                format_number(length, 4),
-                format_number(tolerance, 3)
-            );
+            let subject = CheckSubject::Gap {
+                model: info.name.to_string(),
+                contact: c.name.to_string(),
+                length,
+            };
             let check = drift_check(
                 drift,
                 tolerance,
                 CheckKind::Drift,
                 ctx,
                 states.len(),
-                meaning,
+                subject,
             );
             Some((format!("{}.{}_gap", ctx.key, c.name), check))
         })
@@ -492,48 +487,28 @@ pub fn drift(
         (e_dev - rounding).max(0.0)
     };
     let rel = |dev: f64, scale: f64| if scale > 0.0 { dev / scale } else { dev };
-    let meaning = |what: String| match kind {
-        CheckKind::Identity => format!(
-            "{what} is conserved by construction on the reduced path of `{}`; this checks that the generated function agrees with it over {} states: relative difference <= {}",
-            info.name,
-            states.len(),
-            format_number(tolerance, 3)
-        ),
-        _ => format!(
-            "{what} along the {} integrated states of `{}`: largest relative drift <= {}",
-            states.len(),
-            info.name,
-            format_number(tolerance, 3)
-        ),
+    let check = |drift: f64, subject: CheckSubject| {
+        drift_check(drift, tolerance, kind, ctx, states.len(), subject)
     };
-    let energy = if conserved.friction_work.is_some() {
-        "the energy balance (energy lost = work of friction)"
-    } else {
-        "the total energy"
-    };
-    let energy = format!(
-        "{energy}, beyond its rounding ({} J), relative to the largest kinetic energy plus the potential's range ({} J),",
-        format_number(rounding, 3),
-        format_number(e_scale, 5)
-    );
-    let check = |drift: f64, what: String| {
-        drift_check(drift, tolerance, kind, ctx, states.len(), meaning(what))
+    let energy = CheckSubject::Energy {
+        model: info.name.to_string(),
+        friction: conserved.friction_work.is_some(),
+        rounding,
+        scale: e_scale,
     };
     let mut out = vec![(
         format!("{}.energy", ctx.key),
         check(rel(e_dev, e_scale), energy),
     )];
     for (c, (name, _)) in conserved.momenta.iter().enumerate() {
+        let momentum = CheckSubject::Momentum {
+            model: info.name.to_string(),
+            name: name.clone(),
+            scale: p_scale[c],
+        };
         out.push((
             format!("{}.{name}", ctx.key),
-            check(
-                rel(p_dev[c], p_scale[c]),
-                format!(
-                    "the {} conserved, relative to {},",
-                    name.replace('_', " "),
-                    format_number(p_scale[c], 5)
-                ),
-            ),
+            check(rel(p_dev[c], p_scale[c]), momentum),
         ));
     }
     Ok(out)
@@ -559,17 +534,13 @@ pub fn impact_energy(
     } else {
         dev
     };
-    let meaning = format!(
-        "the energy lost in the impact ({} J by its impulses) against the drop of the total \
-         energy across it, beyond its rounding, relative to the kinetic energy before ({} J): \
-         relative difference <= {}",
-        format_number(impact.energy_lost, 6),
-        format_number(kinetic_before, 6),
-        format_number(tolerance, 3)
-    );
+    let subject = CheckSubject::Impact {
+        energy_lost: impact.energy_lost,
+        kinetic_before,
+    };
     Ok((
         format!("{}.energy", ctx.key),
-        drift_check(drift, tolerance, CheckKind::Identity, ctx, 2, meaning),
+        drift_check(drift, tolerance, CheckKind::Identity, ctx, 2, subject),
     ))
 }
 

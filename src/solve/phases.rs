@@ -14,7 +14,7 @@
 //! absolute time of its start is kept in [`PhaseRun::t_start`].
 
 use crate::model::{Model, ModelInfo};
-use crate::results::{Work, format_number};
+use crate::results::{Halt, Work, Zeno};
 use crate::solve::SolveError;
 use crate::solve::contacts::{
     self, Active, ContactOption, DECIDE_TOLERANCE, FrictionOption, Moment, Options,
@@ -489,9 +489,10 @@ pub struct Motion<'m> {
     /// end time), or the end of the motion.
     pub through_impacts: bool,
     /// Why the motion stopped before its end, if it did (too many impacts).
-    pub halted: Option<String>,
-    /// What the reader should know about how the motion was followed (a Zeno sequence closed).
-    pub notes: Vec<String>,
+    pub halted: Option<Halt>,
+    /// What the reader should know about how the motion was followed: each converging (Zeno)
+    /// sequence of bounces closed.
+    pub notes: Vec<Zeno>,
 }
 
 impl<'m> Motion<'m> {
@@ -864,12 +865,10 @@ impl<'m> Walker<'m> {
                     if motion.through_impacts {
                         self.through_impact(motion, j, friction_work)?
                     } else {
-                        motion.halted = Some(format!(
-                            "contact `{contact}` closes at t = {} s, as the contact before it \
-                             opens: the bodies meet, and the run ends at its first impact unless \
-                             it is given a time to go on to (`until`)",
-                            format_number(motion.end_time(), 9)
-                        ));
+                        motion.halted = Some(Halt::ClosesAsOneOpens {
+                            contact: contact.to_string(),
+                            t: motion.end_time(),
+                        });
                         None
                     }
                 }
@@ -894,12 +893,10 @@ impl<'m> Walker<'m> {
         friction_work: f64,
     ) -> Result<Option<PhaseStart>, SolveError> {
         if motion.impacts.len() >= MAX_IMPACTS {
-            motion.halted = Some(format!(
-                "the run stopped at its impact number {} at t = {} s: the bounces neither came \
-                 to rest nor converged",
-                MAX_IMPACTS + 1,
-                motion.end_time()
-            ));
+            motion.halted = Some(Halt::TooManyImpacts {
+                number: MAX_IMPACTS + 1,
+                t: motion.end_time(),
+            });
             return Ok(None);
         }
         let at = self.impact(motion, closing)?;
@@ -909,10 +906,7 @@ impl<'m> Walker<'m> {
             Ok(start) => Ok(Some(start)),
             // An impact that leaves the system at rest ends its motion.
             Err(SolveError::AtRest { t, how, .. }) => {
-                motion.halted = Some(format!(
-                    "the system comes to rest at the impact at t = {} s, held {how}, and stays so",
-                    format_number(t, 9)
-                ));
+                motion.halted = Some(Halt::AtRest { t, how });
                 Ok(None)
             }
             Err(e) => Err(e),
@@ -960,11 +954,13 @@ impl<'m> Walker<'m> {
         let mut impact = impact::resolve_with(general, &state, &parts, &restitution, t)?;
         let mut plastic = limit.is_some();
         if let Some((ratio, t_limit, bounces)) = limit {
-            motion.notes.push(format!(
-                "contact `{name}` bounced {bounces} times with intervals shrinking by a steady \
-                 ratio {ratio:.4} (Zeno): their limit is t = {t_limit:.12} s, within the run's \
-                 tolerance of the bounce at t = {t:.12} s, which was made plastic for the rest"
-            ));
+            motion.notes.push(Zeno::Limit {
+                contact: name.to_string(),
+                bounces,
+                ratio,
+                t_limit,
+                t,
+            });
         } else if let Some((rise, flight)) = self.unresolved_bounce(&impact, &parts, closing, t)? {
             // The bounces left, each `e` times the one before: their flights sum to about
             // `flight / (1 - e)`.
@@ -972,12 +968,13 @@ impl<'m> Walker<'m> {
             restitution[closing] = 0.0;
             impact = impact::resolve_with(general, &state, &parts, &restitution, t)?;
             plastic = true;
-            motion.notes.push(format!(
-                "contact `{name}` would bounce at t = {t:.12} s by {rise:.3e} of the length \
-                 scale, below the {DECIDE_TOLERANCE:e} at which a gap counts as open: the bounces \
-                 from there (a converging Zeno sequence, about {left:.3e} s in all) are taken as \
-                 one plastic impact, so the motion after it runs early by about that much"
-            ));
+            motion.notes.push(Zeno::Unresolved {
+                contact: name.to_string(),
+                t,
+                rise,
+                open_gap: DECIDE_TOLERANCE,
+                left,
+            });
         }
         Ok(ImpactAt {
             t,

@@ -471,7 +471,7 @@ fn separation_by_planner(
             .notes
             .values()
             .next()
-            .cloned()
+            .map(crate::report::prose::note)
             .unwrap_or_else(|| "no separation".into())),
     }
 }

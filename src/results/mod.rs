@@ -1,9 +1,18 @@
-//! The results of a run: scalars, series, checks and the work done, ready for any report.
+//! The results of a run as plain data: scalars, series, checks, notes, the drawing of the
+//! motion and the work done, ready for any report (which writes every sentence).
 
 use crate::model::ModelInfo;
 use crate::quantity::Quantity;
 use serde::Serialize;
 use std::collections::BTreeMap;
+
+mod drawing;
+mod meanings;
+mod notes;
+
+pub use drawing::{Drawing, DrawnPhase, DrawnSample, PhaseEnd, Pose};
+pub use meanings::Meaning;
+pub use notes::{Halt, Held, Note, Unlanded, UntilNote, Zeno};
 
 /// A scalar result with its unit.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -12,8 +21,9 @@ pub struct Scalar {
     pub value: f64,
     /// Unit (`rad`, `s`, `N`, `m/s`, ...).
     pub unit: &'static str,
-    /// What it is, for people.
-    pub meaning: String,
+    /// What it is (`report::prose::meaning` says it in words: results.json's `meaning`).
+    #[serde(skip)]
+    pub meaning: Meaning,
 }
 
 /// A result that is a word rather than a number (e.g. why a contact ended).
@@ -21,8 +31,9 @@ pub struct Scalar {
 pub struct Label {
     /// The word.
     pub value: String,
-    /// What it is and which words it can be.
-    pub meaning: String,
+    /// What it is and which words it can be (`report::prose::meaning` says it in words).
+    #[serde(skip)]
+    pub meaning: Meaning,
 }
 
 /// One column of a series.
@@ -88,8 +99,69 @@ pub struct Check {
     pub at_time: Option<f64>,
     /// How many samples or states it looked at.
     pub samples: usize,
-    /// What was checked and against what, in a sentence.
-    pub meaning: String,
+    /// What was checked, with the names and numbers its sentence gives (`report::prose`
+    /// writes the sentence, results.json's `meaning`).
+    #[serde(skip)]
+    pub subject: CheckSubject,
+}
+
+/// What a [`Check`] is about: the quantity tested, named, with the numbers that scale it.
+/// The check's own `samples`, `kind` and `limit` (the tolerance of a drift) complete it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CheckSubject {
+    /// A spec's monitor over a phase's samples.
+    Monitor {
+        /// The model sampled.
+        model: String,
+        /// The monitor's name.
+        monitor: String,
+        /// The monitor's meaning, as its spec gives it.
+        meaning: String,
+    },
+    /// A closed unilateral contact's force over a phase's samples.
+    Pushes {
+        /// The model sampled.
+        model: String,
+        /// The contact.
+        contact: String,
+    },
+    /// The gap of a contact the integrator holds closed, relative to the system's length.
+    Gap {
+        /// The model integrated.
+        model: String,
+        /// The contact.
+        contact: String,
+        /// The system's length (m).
+        length: f64,
+    },
+    /// The total energy along a path (with friction, the balance: energy lost = work of
+    /// friction), beyond its rounding, relative to its scale.
+    Energy {
+        /// The model of the path.
+        model: String,
+        /// Whether it is the balance with the work of friction.
+        friction: bool,
+        /// What rounding alone leaves in the energy (J), not counted as drift.
+        rounding: f64,
+        /// The scale: the largest kinetic energy plus the potential's range (J).
+        scale: f64,
+    },
+    /// A conserved combination of cyclic momenta along a path.
+    Momentum {
+        /// The model of the path.
+        model: String,
+        /// Its name (`momentum_x`, `momentum_x_x2`).
+        name: String,
+        /// The scale its drift is relative to.
+        scale: f64,
+    },
+    /// The energy an impact took out: its impulses' loss against the drop of the total energy.
+    Impact {
+        /// The loss by the impulses (J).
+        energy_lost: f64,
+        /// The kinetic energy before (J), the scale.
+        kinetic_before: f64,
+    },
 }
 
 /// What a run computed, to prove that a scene gets only what it asks for.
@@ -162,16 +234,19 @@ pub struct RunResults {
     pub work: Work,
     /// Why a wanted quantity has no value, by its key (e.g. `separation_angle`: no separation
     /// before the floor). A quantity is either in `results`/`series` or explained here.
-    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
-    pub notes: BTreeMap<String, String>,
+    /// Written in JSON (when not empty) as `notes: {key: sentence}`, the sentences by
+    /// `report::prose`.
+    #[serde(skip)]
+    pub notes: BTreeMap<String, Note>,
     /// The impacts of the motion in order, when `impacts` was wanted (written under `results`
     /// in JSON as `impacts: {value: [...], meaning}`).
     #[serde(skip)]
     pub impacts: Option<Vec<ImpactRecord>>,
-    /// The bodies' motion over every phase the run solved, drawn into `motion.svg`; present
-    /// when a trajectory was wanted. Not part of results.json.
+    /// The bodies' poses over every phase the run solved, from which the report computes the
+    /// animation in `motion.svg`; present when a trajectory was wanted. Not part of
+    /// results.json.
     #[serde(skip)]
-    pub motion: Option<crate::report::motion::Animation>,
+    pub drawing: Option<Drawing>,
 }
 
 impl RunResults {
@@ -213,9 +288,10 @@ impl RunResults {
         self.series.get(&quantity.name(info))
     }
 
-    /// Why a wanted quantity has no value, if it has none.
-    pub fn note(&self, quantity: Quantity, info: &ModelInfo) -> Option<&str> {
-        self.notes.get(&quantity.name(info)).map(String::as_str)
+    /// Why a wanted quantity has no value, if it has none (`report::prose::note` says it in
+    /// words).
+    pub fn note(&self, quantity: Quantity, info: &ModelInfo) -> Option<&Note> {
+        self.notes.get(&quantity.name(info))
     }
 }
 

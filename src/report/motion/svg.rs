@@ -1,48 +1,14 @@
-//! The motion to watch, `motion.svg`: the bodies of every solved phase moving in real time
-//! slowed to a readable pace, as an animated SVG (SMIL, no script), drawn from the spec's shapes.
-//!
-//! [`Animation::build`] evaluates each phase's generated [`Model::drawing`](crate::model::Model)
-//! at its samples: one [`Frame`] per sample (every body's pose and the traced point), the
-//! shapes' sizes once. [`svg`] writes the picture: a fixed view box covering every frame, y up,
-//! the floor `y = 0`, the scenery, the bodies moved by `<animateTransform>` (linear between at
-//! most [`MAX_KEYFRAMES`] keyframes, evenly spread in time), the traced point's path (faint in
-//! full, drawn strong as the motion goes), the time and the phase as text that changes with the
-//! frames, the moment the first phase's contact ends (a label and a faded copy of the bodies
-//! appear then), and every impact (a contact closing between two phases, or at the motion's
-//! end): a star where the drawn bodies meet (`report/touch.rs` finds the place) appears at its
-//! frame, with a caption `impact at t = … s (contact)` shown until the next impact. The
-//! slow-motion factor is a round number chosen so that the motion lasts about
-//! [`TARGET_SECONDS`]; it is printed in the picture. The last frame holds for
-//! [`PAUSE_SECONDS`], then the animation repeats.
-//!
-//! Nothing here panics on bad numbers: a frame with a NaN or infinite number, or whose state the
-//! model refuses (a length not its own), is left out (and counted in [`Animation::dropped`],
-//! the refusal in a note), a shape with one is not drawn; with a single frame, or a
-//! motion of zero duration, the picture is static (that frame, with a note saying so); with
-//! none, it shows the floor and the note.
-//!
-//! The SVG root carries `data-slow-motion` (the factor) and `data-t0` (the time of the first
-//! frame, s): a frame at time `t` shows at `(t - t0) * factor` seconds into the animation. The
-//! world is the group `#world` (world coordinates in metres, y up); each drawn body is the group
-//! `#body-<name>` (translated to its centre of mass) holding `#body-<name>-turn` (rotated by its
-//! angle), which holds its shapes in the body's own frame.
+//! Writing `motion.svg`: the [`Animation`] as an animated SVG (SMIL, no script), laid out as
+//! the module `report::motion` describes.
 
+use super::animation::{
+    Animation, ContactEnd, PAUSE_SECONDS, Shape, drawable, keyframes, place, slow_motion,
+};
 use crate::model::ShapeKind;
-use crate::solve::phases::End;
-use crate::solve::series::PhaseSamples;
-use crate::system::Bound;
 use std::fmt::Write;
 
-/// Most keyframes of the animation: frames are thinned to about this many, evenly in time
-/// (every phase's first and last frame kept).
-pub const MAX_KEYFRAMES: usize = 300;
 /// Most distinct time labels (the time shown changes at most this often).
 pub const MAX_TIME_LABELS: usize = 120;
-/// How long the motion should take on screen, in seconds: the slow-motion factor is the round
-/// number (1, 2, 4 or 5 times a power of ten) that brings it closest.
-pub const TARGET_SECONDS: f64 = 6.0;
-/// How long the last frame holds before the animation repeats, in seconds.
-pub const PAUSE_SECONDS: f64 = 1.5;
 /// Width of the picture in pixels.
 const WIDTH: f64 = 720.0;
 /// Largest height of the drawing area (below the text) in pixels.
@@ -63,299 +29,6 @@ const IMPACT_COLOUR: &str = "#f1c40f";
 const IMPACT_TEXT: &str = "#a04000";
 /// Most impacts marked (a star and a caption each); the picture's description counts the rest.
 pub const MAX_IMPACT_MARKS: usize = 100;
-/// How close, relative to the drawing's size, the drawn bodies must be to touch at an impact.
-const TOUCH_TOLERANCE: f64 = 1e-6;
-
-/// A shape of the drawing with its numbers (see [`ShapeKind`] for their order).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Shape {
-    /// What it is.
-    pub kind: ShapeKind,
-    /// Index in [`Animation::bodies`] of the body it moves with; `None` for fixed scenery.
-    pub body: Option<usize>,
-    /// Its numbers, in its body's frame (or the world's, for scenery), in metres.
-    pub numbers: Vec<f64>,
-}
-
-/// The bodies at one instant.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Frame {
-    /// Time from release (s).
-    pub t: f64,
-    /// Index in [`Animation::phases`] of the phase it belongs to.
-    pub phase: usize,
-    /// Every body's pose `[x, y, angle]` (m, m, rad), in the order of [`Animation::bodies`].
-    pub poses: Vec<[f64; 3]>,
-    /// The traced point's position `[x, y]` (m), when a point is traced.
-    pub traced: Option<[f64; 2]>,
-}
-
-/// One phase of the motion, on the common clock.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PhaseSpan {
-    /// Its model's name.
-    pub name: String,
-    /// When it starts (s from release).
-    pub t_start: f64,
-}
-
-/// Where and why the first phase's contact ended.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ContactEnd {
-    /// Why, in words (`the push vanishes`, `the contact point runs off an edge`).
-    pub cause: String,
-    /// The bodies then (its time is the moment of the end).
-    pub frame: Frame,
-}
-
-/// An impact: a contact closing at the end of a phase (the next one starts from the state after
-/// it, or the motion ends there).
-#[derive(Debug, Clone, PartialEq)]
-pub struct ImpactMark {
-    /// Time from release (s).
-    pub t: f64,
-    /// The contact whose gap closed.
-    pub contact: String,
-    /// Where the drawn bodies meet then (m, world); `None` when the drawing does not show it
-    /// (then only the caption marks the impact).
-    pub at: Option<[f64; 2]>,
-}
-
-/// Everything `motion.svg` shows ([`svg`] draws it).
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct Animation {
-    /// The first phase's model.
-    pub model: String,
-    /// The bodies' names.
-    pub bodies: Vec<String>,
-    /// The shapes drawn: the bodies' and the scenery.
-    pub shapes: Vec<Shape>,
-    /// The phases, in order.
-    pub phases: Vec<PhaseSpan>,
-    /// The frames, in increasing time.
-    pub frames: Vec<Frame>,
-    /// The first phase's contact end, if it ended by its force or at an edge.
-    pub contact_end: Option<ContactEnd>,
-    /// The impacts, in order: every phase that ended where a contact closed.
-    pub impacts: Vec<ImpactMark>,
-    /// The name of the point whose path is traced, if any.
-    pub traced: Option<String>,
-    /// Frames left out for a NaN or infinite number, or for a state the model refuses.
-    pub dropped: usize,
-    /// What could not be drawn, and why.
-    pub notes: Vec<String>,
-}
-
-/// One solved phase, as [`Animation::build`] reads it.
-pub struct PhaseInput<'a, 'm> {
-    /// Its model with its parameters.
-    pub bound: &'a Bound<'m>,
-    /// Its samples (full states at uniform times from its start).
-    pub samples: &'a PhaseSamples,
-    /// When it starts (s from release).
-    pub t_start: f64,
-    /// Why it ended.
-    pub end: End,
-}
-
-impl Animation {
-    /// The frames of the phases, in order, with the path of the point named `traced` (looked
-    /// up in each phase's model). The bodies and shapes are the first phase's; a later phase
-    /// with other bodies is not drawn (a note says so). The shapes' sizes depend on the
-    /// parameters only, and are read at the first phase's start.
-    pub fn build(phases: &[PhaseInput], traced: Option<&str>) -> Animation {
-        let Some(first) = phases.first() else {
-            return Animation {
-                notes: vec!["no phase was solved".into()],
-                ..Animation::default()
-            };
-        };
-        let info = first.bound.info();
-        let mut anim = Animation {
-            model: info.system.to_string(),
-            bodies: info.bodies.iter().map(|b| b.to_string()).collect(),
-            traced: traced.map(str::to_string),
-            ..Animation::default()
-        };
-        anim.shapes = first_shapes(first, &mut anim.notes);
-        for phase in phases {
-            let pinfo = phase.bound.info();
-            if pinfo.bodies != info.bodies {
-                anim.notes.push(format!(
-                    "phase `{}` has other bodies than `{}`: not drawn",
-                    pinfo.name, info.name
-                ));
-                break;
-            }
-            let index = anim.phases.len();
-            anim.phases.push(PhaseSpan {
-                name: pinfo.name.to_string(),
-                t_start: phase.t_start,
-            });
-            add_frames(&mut anim, phase, index, traced);
-            let name = |c: usize| pinfo.contacts.get(c).map_or("a contact", |c| c.name);
-            if let End::Contact(c) = phase.end
-                && let Some(mark) = impact_mark(&anim, phase, index, name(c))
-            {
-                anim.impacts.push(mark);
-            }
-            let cause = match phase.end {
-                End::Force(c) => Some(format!("{} lets go", name(c))),
-                End::Edge(c) => Some(format!("{} runs off an edge", name(c))),
-                End::Contact(_) | End::Floor | End::Until => None,
-            };
-            if anim.contact_end.is_none()
-                && let Some(cause) = cause
-                && let Some(last) = anim.frames.last()
-            {
-                anim.contact_end = Some(ContactEnd {
-                    cause,
-                    frame: last.clone(),
-                });
-            }
-        }
-        anim
-    }
-}
-
-/// The impact that ends `phase` (drawn as phase `index`) at contact `contact`, at its last
-/// sample: where the drawn bodies meet then (when that sample was drawn), having been apart in
-/// the frame before; `None` when the phase has no sample.
-fn impact_mark(
-    anim: &Animation,
-    phase: &PhaseInput,
-    index: usize,
-    contact: &str,
-) -> Option<ImpactMark> {
-    let t = phase.t_start + phase.samples.t.last()?;
-    let at = match anim.frames.split_last() {
-        Some((last, earlier)) if last.phase == index && last.t == t => {
-            earlier.last().and_then(|before| {
-                super::touch::impact_point(
-                    &anim.shapes,
-                    &before.poses,
-                    &last.poses,
-                    TOUCH_TOLERANCE,
-                )
-            })
-        }
-        _ => None,
-    };
-    Some(ImpactMark {
-        t,
-        contact: contact.to_string(),
-        at,
-    })
-}
-
-/// The first phase's shapes with their sizes (those with a NaN or infinite number, or naming a
-/// body that does not exist, are left out with a note).
-fn first_shapes(first: &PhaseInput, notes: &mut Vec<String>) -> Vec<Shape> {
-    let info = first.bound.info();
-    let start = match first.samples.states.first() {
-        Some(s) => s.clone(),
-        None => first.bound.initial_state(),
-    };
-    let (poses, sizes) = match first.bound.drawing(&start) {
-        Ok(drawn) => drawn,
-        Err(e) => {
-            notes.push(format!("the shapes of `{}` are not drawn: {e}", info.name));
-            return Vec::new();
-        }
-    };
-    let mut shapes = Vec::new();
-    for (i, s) in info.shapes.iter().enumerate() {
-        let numbers = sizes.get(s.first..s.first + s.kind.numbers());
-        match numbers {
-            Some(n)
-                if n.iter().all(|v| v.is_finite()) && s.body.is_none_or(|b| b < poses.len()) =>
-            {
-                shapes.push(Shape {
-                    kind: s.kind,
-                    body: s.body,
-                    numbers: n.to_vec(),
-                });
-            }
-            _ => notes.push(format!(
-                "shape {i} of `{}` has no finite size or no body: not drawn",
-                info.name
-            )),
-        }
-    }
-    shapes
-}
-
-/// The frames of one phase (a frame no later than the one before, as a phase's first at the
-/// previous one's last, is skipped; one with a NaN or infinite number is dropped).
-fn add_frames(anim: &mut Animation, phase: &PhaseInput, index: usize, traced: Option<&str>) {
-    let bound = phase.bound;
-    let point = traced.and_then(|name| bound.point_index(name));
-    let mut refused = None;
-    for (t, state) in phase.samples.t.iter().zip(&phase.samples.states) {
-        let t = phase.t_start + t;
-        if anim.frames.last().is_some_and(|f| t <= f.t) {
-            continue;
-        }
-        let drawn = bound.drawing(state).and_then(|(poses, _)| {
-            let traced = match point {
-                Some(i) => bound.points(state)?.pos.get(i).copied(),
-                None => None,
-            };
-            Ok((poses, traced))
-        });
-        let (poses, traced) = match drawn {
-            Ok(drawn) => drawn,
-            Err(e) => {
-                anim.dropped += 1;
-                refused.get_or_insert(e);
-                continue;
-            }
-        };
-        let finite = t.is_finite()
-            && poses.iter().flatten().all(|v| v.is_finite())
-            && traced.is_none_or(|p| p.iter().all(|v| v.is_finite()));
-        if finite {
-            anim.frames.push(Frame {
-                t,
-                phase: index,
-                poses,
-                traced,
-            });
-        } else {
-            anim.dropped += 1;
-        }
-    }
-    if let Some(e) = refused {
-        anim.notes.push(format!(
-            "frames of phase `{}` not drawn: {e}",
-            bound.info().name
-        ));
-    }
-}
-
-/// The slow-motion factor for a motion of `duration` seconds: the number `f` among 1, 2, 4 and
-/// 5 times a power of ten that brings `duration * f` closest to [`TARGET_SECONDS`] (in ratio);
-/// 1 for a duration that is not positive and finite.
-pub fn slow_motion(duration: f64) -> f64 {
-    if !(duration > 0.0 && duration.is_finite()) {
-        return 1.0;
-    }
-    let ideal = TARGET_SECONDS / duration;
-    let decade = 10f64.powf(ideal.log10().floor());
-    let mut best = 1.0;
-    let mut best_err = f64::INFINITY;
-    for scale in [decade / 10.0, decade, decade * 10.0] {
-        for m in [1.0, 2.0, 4.0, 5.0] {
-            let f = m * scale;
-            let err = (duration * f / TARGET_SECONDS).ln().abs();
-            if f.is_finite() && f > 0.0 && err < best_err {
-                best = f;
-                best_err = err;
-            }
-        }
-    }
-    best
-}
 
 /// `x` with `decimals` decimals, trailing zeros dropped, never `-0`.
 fn num(x: f64, decimals: usize) -> String {
@@ -407,12 +80,6 @@ fn id_part(name: &str) -> String {
             }
         })
         .collect()
-}
-
-/// A point of a shape moved into the world by a body's pose.
-pub(crate) fn place(pose: [f64; 3], p: [f64; 2]) -> [f64; 2] {
-    let (s, c) = pose[2].sin_cos();
-    [pose[0] + c * p[0] - s * p[1], pose[1] + s * p[0] + c * p[1]]
 }
 
 /// The extreme points of a shape in its own frame.
@@ -574,37 +241,6 @@ fn key_times(keys: &[f64]) -> String {
         .join(";")
 }
 
-/// The indices of the keyframes: about [`MAX_KEYFRAMES`] frames evenly spread in time (the
-/// nearest frame to each of as many even times), every phase's first and last frame, and the
-/// last frame; all of them when there are few.
-fn keyframes(frames: &[Frame]) -> Vec<usize> {
-    let n = frames.len();
-    if n <= MAX_KEYFRAMES {
-        return (0..n).collect();
-    }
-    let mut keep: Vec<usize> = vec![0, n - 1];
-    for i in 1..n {
-        if frames[i].phase != frames[i - 1].phase {
-            keep.extend([i - 1, i]);
-        }
-    }
-    let budget = MAX_KEYFRAMES.saturating_sub(keep.len()).max(2);
-    let (t0, t1) = (frames[0].t, frames[n - 1].t);
-    for j in 0..budget {
-        let target = t0 + (t1 - t0) * j as f64 / (budget - 1) as f64;
-        let i = frames.partition_point(|f| f.t < target).min(n - 1);
-        let nearer = if i > 0 && (target - frames[i - 1].t) < (frames[i].t - target) {
-            i - 1
-        } else {
-            i
-        };
-        keep.push(nearer);
-    }
-    keep.sort_unstable();
-    keep.dedup();
-    keep
-}
-
 /// The picture of an animation (see the module's documentation). Never fails: what cannot be
 /// drawn is left out and said in the picture.
 pub fn svg(anim: &Animation) -> String {
@@ -641,46 +277,6 @@ pub fn svg(anim: &Animation) -> String {
     write_world(&mut out, anim, &view, &keys, animated.then_some(&clock));
     write_labels(&mut out, anim, &view, &keys, animated.then_some(&clock));
     out.push_str("</svg>\n");
-    out
-}
-
-/// `anim` with only what can be drawn: shapes with as many finite numbers as their kind has,
-/// frames with finite numbers in increasing time (the others counted in `dropped`), a
-/// contact end with a finite frame, and impacts at a finite time (a place with a NaN or
-/// infinite number forgotten).
-fn drawable(anim: &Animation) -> Animation {
-    let finite = |f: &Frame| {
-        f.t.is_finite()
-            && f.poses.iter().flatten().all(|v| v.is_finite())
-            && f.traced.is_none_or(|p| p.iter().all(|v| v.is_finite()))
-    };
-    let mut out = Animation {
-        frames: Vec::with_capacity(anim.frames.len()),
-        shapes: anim
-            .shapes
-            .iter()
-            .filter(|s| {
-                s.numbers.len() == s.kind.numbers() && s.numbers.iter().all(|v| v.is_finite())
-            })
-            .cloned()
-            .collect(),
-        contact_end: anim.contact_end.clone().filter(|e| finite(&e.frame)),
-        impacts: (anim.impacts.iter())
-            .filter(|m| m.t.is_finite())
-            .map(|m| ImpactMark {
-                at: m.at.filter(|p| p.iter().all(|v| v.is_finite())),
-                ..m.clone()
-            })
-            .collect(),
-        ..anim.clone()
-    };
-    for f in &anim.frames {
-        if finite(f) && out.frames.last().is_none_or(|last| f.t > last.t) {
-            out.frames.push(f.clone());
-        } else {
-            out.dropped += 1;
-        }
-    }
     out
 }
 
@@ -1177,6 +773,7 @@ fn num_fixed(x: f64, decimals: usize) -> String {
 
 #[cfg(test)]
 mod tests {
+    use super::super::animation::{Frame, ImpactMark, MAX_KEYFRAMES, PhaseSpan};
     use super::*;
 
     /// A rod turning about its foot and a square sliding, over `n` frames of one phase and `m`

@@ -1,0 +1,369 @@
+//! The sentences for people about a run: what each check tested ([`check_meaning`], written
+//! as results.json's `meaning`, the table's legend and the Python binding's `meaning`) and
+//! why a quantity has no value ([`note`]). Results carry only names and numbers; the words
+//! are all here.
+
+use crate::results::{
+    Check, CheckKind, CheckSubject, Halt, Held, Meaning, Note, PhaseEnd, Unlanded, UntilNote, Zeno,
+    format_number,
+};
+
+/// What a check tested and against what, in a sentence.
+pub fn check_meaning(check: &Check) -> String {
+    let (samples, tolerance) = (check.samples, check.limit);
+    match &check.subject {
+        CheckSubject::Monitor { model, meaning, .. } => {
+            format!(
+                "{meaning}: the smallest value over {samples} samples of `{model}` must be >= 0"
+            )
+        }
+        CheckSubject::Pushes { model, contact } => format!(
+            "contact `{contact}` is closed in `{model}`: its force must push (>= 0) at each of \
+             {samples} samples, or the contact should have opened"
+        ),
+        CheckSubject::Gap {
+            model,
+            contact,
+            length,
+        } => format!(
+            "contact `{contact}` is held closed by the integrator of `{model}`: its largest gap \
+             over {samples} states, relative to the system's length ({} m), stays <= {}",
+            format_number(*length, 4),
+            format_number(tolerance, 3)
+        ),
+        CheckSubject::Energy {
+            model,
+            friction,
+            rounding,
+            scale,
+        } => {
+            let energy = if *friction {
+                "the energy balance (energy lost = work of friction)"
+            } else {
+                "the total energy"
+            };
+            let what = format!(
+                "{energy}, beyond its rounding ({} J), relative to the largest kinetic energy \
+                 plus the potential's range ({} J),",
+                format_number(*rounding, 3),
+                format_number(*scale, 5)
+            );
+            conserved(check, &what, model)
+        }
+        CheckSubject::Momentum { model, name, scale } => {
+            let what = format!(
+                "the {} conserved, relative to {},",
+                name.replace('_', " "),
+                format_number(*scale, 5)
+            );
+            conserved(check, &what, model)
+        }
+        CheckSubject::Impact {
+            energy_lost,
+            kinetic_before,
+        } => format!(
+            "the energy lost in the impact ({} J by its impulses) against the drop of the total \
+             energy across it, beyond its rounding, relative to the kinetic energy before \
+             ({} J): relative difference <= {}",
+            format_number(*energy_lost, 6),
+            format_number(*kinetic_before, 6),
+            format_number(tolerance, 3)
+        ),
+    }
+}
+
+/// The sentence of a conservation check on `what` along the path of `model`: a drift on an
+/// integrated path, an agreement on the reduced path, where it holds by construction.
+fn conserved(check: &Check, what: &str, model: &str) -> String {
+    let (states, tolerance) = (check.samples, format_number(check.limit, 3));
+    match check.kind {
+        CheckKind::Identity => format!(
+            "{what} is conserved by construction on the reduced path of `{model}`; this checks \
+             that the generated function agrees with it over {states} states: relative \
+             difference <= {tolerance}"
+        ),
+        CheckKind::Drift | CheckKind::Monitor => format!(
+            "{what} along the {states} integrated states of `{model}`: largest relative drift \
+             <= {tolerance}"
+        ),
+    }
+}
+
+/// Why a quantity has no value, or what the motion needs said, in words.
+pub fn note(note: &Note) -> String {
+    match note {
+        Note::Refused(why) => why.clone(),
+        Note::NoSeparationEnded { contact, cause } => format!(
+            "no separation: contact `{contact}` ended before its force vanished ({}; \
+             `contact_end` says when)",
+            cause_words(cause)
+        ),
+        Note::NoSeparationHolds { contact, held } => {
+            format!(
+                "no separation: contact `{contact}` holds {}",
+                held_words(held)
+            )
+        }
+        Note::NoSeparationOpen { contact } => {
+            format!("no separation: contact `{contact}` is open at release")
+        }
+        Note::NoLinearisedRoot => {
+            "the linearised polynomial has no root between the floor and the start".into()
+        }
+        Note::Holds { contact, held } => format!("contact `{contact}` holds {}", held_words(held)),
+        Note::OpenAtRelease { contact } => format!("contact `{contact}` is open at release"),
+        Note::CrossCheckDisagrees { integrated, fast } => format!(
+            "the integrated route ended at {}, the fast path at {fast}: they disagree on the \
+             first event",
+            event_words(integrated)
+        ),
+        Note::NoLanding { t, path, end } => no_landing(*t, &path.join(" -> "), end),
+        Note::FirstImpactEnds { t } => format!(
+            "the run ends at its first impact (t = {} s); a scene's `until` carries the motion \
+             on through impacts",
+            format_number(*t, 6)
+        ),
+        Note::NoImpact { path } => format!(
+            "no contact closed before the motion's end ({})",
+            path.join(" -> ")
+        ),
+        Note::Until(until) => until_words(until),
+        Note::Zeno(list) => list.iter().map(zeno_words).collect::<Vec<_>>().join("; "),
+    }
+}
+
+/// What a contact's end cause (`force`, `edge`, `impact`, `contact`) means.
+pub fn cause_words(cause: &str) -> &'static str {
+    match cause {
+        "force" => "its force reached zero (it would have had to pull)",
+        "edge" => "its contact point ran off a body",
+        "impact" => "the impulses of an impact elsewhere moved it away",
+        _ => {
+            "another contact closed there: the bodies meet, and the run ends at its first impact \
+             unless it is given a time to go on to (`until`)"
+        }
+    }
+}
+
+/// An event that ends a phase, in words (the cross-check's).
+fn event_words(end: &PhaseEnd) -> String {
+    match end {
+        PhaseEnd::Force(name) => format!("contact `{name}`'s force crossing zero"),
+        PhaseEnd::Edge(name) => format!("contact `{name}`'s edge"),
+        PhaseEnd::Contact(name) => format!("contact `{name}` closing"),
+        PhaseEnd::Floor => "the floor".into(),
+        PhaseEnd::Until => "the run's end".into(),
+    }
+}
+
+/// Why the motion was halted.
+pub fn halt_words(halt: &Halt) -> String {
+    match halt {
+        Halt::ClosesAsOneOpens { contact, t } => format!(
+            "contact `{contact}` closes at t = {} s, as the contact before it opens: the bodies \
+             meet, and the run ends at its first impact unless it is given a time to go on to \
+             (`until`)",
+            format_number(*t, 9)
+        ),
+        Halt::TooManyImpacts { number, t } => format!(
+            "the run stopped at its impact number {number} at t = {t} s: the bounces neither \
+             came to rest nor converged"
+        ),
+        Halt::AtRest { t, how } => format!(
+            "the system comes to rest at the impact at t = {} s, held {how}, and stays so",
+            format_number(*t, 9)
+        ),
+    }
+}
+
+/// Until when a contact held: `until …`.
+fn held_words(held: &Held) -> String {
+    match held {
+        Held::Lands { contact, t } => format!(
+            "until the body lands, where contact `{contact}` closes at t = {} s",
+            format_number(*t, 6)
+        ),
+        Held::Halted(halt) => format!("until {}", halt_words(halt)),
+        Held::RunsEnd { t } => {
+            format!("until the run's end at t = {} s", format_number(*t, 6))
+        }
+        Held::Floor { angle, end_angle } => {
+            format!("until {}", end_angle_words(angle, *end_angle))
+        }
+        Held::Edge { contact, t } => format!(
+            "until contact `{contact}` ran off an edge at t = {} s, where the motion stops",
+            format_number(*t, 6)
+        ),
+    }
+}
+
+/// The end of a model's reduced motion: `` `theta` = 0 rad ``.
+pub fn end_angle_words(angle: &str, end_angle: f64) -> String {
+    format!("`{angle}` = {} rad", format_number(end_angle, 6))
+}
+
+/// Why the body did not land, at `t`, along `path`.
+fn no_landing(t: f64, path: &str, end: &Unlanded) -> String {
+    let at = format_number(t, 6);
+    match end {
+        Unlanded::Edge(contact) => format!(
+            "contact `{contact}` ran off an edge at t = {at} s ({path}); the motion after that is \
+             not modelled"
+        ),
+        Unlanded::Contact(contact) => format!(
+            "contact `{contact}` closed at t = {at} s ({path}): the bodies meet, and the run ends \
+             at its first impact unless the scene gives a time to go on to (`until`)"
+        ),
+        Unlanded::Until => {
+            format!("the run reached its end at t = {at} s before the body landed ({path})")
+        }
+        Unlanded::Halted(halt) => format!(
+            "the motion ended before the floor: {} ({path})",
+            halt_words(halt)
+        ),
+        Unlanded::Ended => format!("the motion ended before the floor ({path})"),
+    }
+}
+
+/// How the motion went with respect to the run's end time.
+fn until_words(until: &UntilNote) -> String {
+    match until {
+        UntilNote::Halted(halt) => halt_words(halt),
+        UntilNote::Reached { t, impacts } => format!(
+            "the motion was followed to the run's end, t = {} s (`until`), through {impacts} \
+             impact(s)",
+            format_number(*t, 6)
+        ),
+        UntilNote::EndedBefore {
+            t,
+            cause,
+            until,
+            impacts,
+        } => format!(
+            "the motion ended at t = {} s ({cause}), before the run's end (`until` = {} s), \
+             after {impacts} impact(s)",
+            format_number(*t, 6),
+            format_number(*until, 6)
+        ),
+    }
+}
+
+/// A converging sequence of bounces closed, in words.
+fn zeno_words(zeno: &Zeno) -> String {
+    match zeno {
+        Zeno::Limit {
+            contact,
+            bounces,
+            ratio,
+            t_limit,
+            t,
+        } => format!(
+            "contact `{contact}` bounced {bounces} times with intervals shrinking by a steady \
+             ratio {ratio:.4} (Zeno): their limit is t = {t_limit:.12} s, within the run's \
+             tolerance of the bounce at t = {t:.12} s, which was made plastic for the rest"
+        ),
+        Zeno::Unresolved {
+            contact,
+            t,
+            rise,
+            open_gap,
+            left,
+        } => format!(
+            "contact `{contact}` would bounce at t = {t:.12} s by {rise:.3e} of the length \
+             scale, below the {open_gap:e} at which a gap counts as open: the bounces from there \
+             (a converging Zeno sequence, about {left:.3e} s in all) are taken as one plastic \
+             impact, so the motion after it runs early by about that much"
+        ),
+    }
+}
+
+/// What a scalar or word-valued result is, in words.
+pub fn meaning(meaning: &Meaning) -> String {
+    match meaning {
+        Meaning::SeparationAngle { angle } => {
+            format!("`{angle}` where the first contact's force vanishes")
+        }
+        Meaning::SeparationTime => "time from release to separation".into(),
+        Meaning::LinearisedSeparationAngle => {
+            "separation angle with the polynomial's terms above degree 1 dropped".into()
+        }
+        Meaning::ContactEndTime { contact, cause } => format!(
+            "time from release until contact `{contact}` ends: {}",
+            cause_words(cause)
+        ),
+        Meaning::ContactEndAngle {
+            angle,
+            contact,
+            cause,
+        } => format!(
+            "`{angle}` where contact `{contact}` ends: {}",
+            cause_words(cause)
+        ),
+        Meaning::ContactEndCause { contact } => format!(
+            "why contact `{contact}` ended: `force` (its force reached zero), `edge` (its point \
+             ran off a body) or `contact` (another contact closed, where the motion stops)"
+        ),
+        Meaning::ContactModes => "the closed contacts and how each friction contact moves over \
+                                  the first contact's phase: sticks, or slides + / - along its \
+                                  direction, each from the time the set began (switches located \
+                                  as events)"
+            .into(),
+        Meaning::ContactEndFrictionWork => {
+            "work done by friction over the first contact's phase (energy lost)".into()
+        }
+        Meaning::ContactTimeToFloor { angle, end_angle } => format!(
+            "time to {} if the release contacts held all the way",
+            end_angle_words(angle, *end_angle)
+        ),
+        Meaning::PointMassFallTime { point, height } => format!(
+            "free fall of a point mass from the release height of `{point}` ({} m)",
+            format_number(*height, 6)
+        ),
+        Meaning::FloorImpactFrictionWork { angle, end_angle } => format!(
+            "work done by friction from release until {} (energy lost)",
+            end_angle_words(angle, *end_angle)
+        ),
+        Meaning::FloorImpactTime {
+            angle,
+            end_angle,
+            path,
+        } => format!(
+            "time from release until {} ({})",
+            end_angle_words(angle, *end_angle),
+            path.join(" -> ")
+        ),
+        Meaning::ImpactAngularVelocity { angle, path } => format!(
+            "rate of `{angle}` when it reaches its end ({})",
+            path.join(" -> ")
+        ),
+        Meaning::CrossCheckTime {
+            method,
+            steps,
+            event,
+        } => format!(
+            "the general model ({method}, {steps} steps) integrated to {}",
+            event_words(event)
+        ),
+        Meaning::CrossCheckRelativeDifference {
+            event,
+            t_quad,
+            rtol,
+            condition,
+        } => format!(
+            "|t_ode - t_quadrature| / t_quadrature at {} (quadrature: {t_quad:.15e} s; ODE rtol \
+             {rtol:.1e}, mass-matrix condition {condition:.1e})",
+            event_words(event)
+        ),
+        Meaning::CrossCheckRtol => "relative tolerance the integrator ran with: the one asked, \
+                                    raised to 10 eps cond(M) when the mass matrix is \
+                                    ill-conditioned"
+            .into(),
+        Meaning::CrossCheckTimeDeviation { nodes } => {
+            format!("largest |t_ode - t(theta_ode)| over {nodes} integrator steps")
+        }
+        Meaning::CrossCheckStateDeviation { nodes } => format!(
+            "largest difference between the integrated and the reduced states over {nodes} \
+             steps, relative to the largest coordinate (or velocity) on the path"
+        ),
+    }
+}

@@ -1,0 +1,211 @@
+//! What a reader should know about a run that is not a number: why a wanted quantity has no
+//! value and how the motion was followed, each a [`Note`] of names, keywords and numbers
+//! (`report::prose` writes the sentence).
+
+use super::PhaseEnd;
+
+/// Why the motion stopped before its end (the solver's halt).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Halt {
+    /// A contact closed as the contact before it opened, where the run ends at its first
+    /// impact.
+    ClosesAsOneOpens {
+        /// The contact that closed.
+        contact: String,
+        /// When (s from release).
+        t: f64,
+    },
+    /// The run stopped at its impact limit: the bounces neither came to rest nor converged.
+    TooManyImpacts {
+        /// The number of the impact it stopped at.
+        number: usize,
+        /// When (s from release).
+        t: f64,
+    },
+    /// An impact left the system at rest.
+    AtRest {
+        /// When (s from release).
+        t: f64,
+        /// The supports that hold it, as the solver names them.
+        how: String,
+    },
+}
+
+/// A converging (Zeno) sequence of bounces, closed by a plastic impact.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Zeno {
+    /// The intervals between bounces shrank by a steady ratio, and their limit was within the
+    /// run's tolerance of a bounce.
+    Limit {
+        /// The contact that bounced.
+        contact: String,
+        /// How many times it bounced.
+        bounces: usize,
+        /// The ratio of successive intervals.
+        ratio: f64,
+        /// The limit of the bounces' times (s from release).
+        t_limit: f64,
+        /// The bounce made plastic (s from release).
+        t: f64,
+    },
+    /// A bounce too small to open the gap: the rest of the sequence taken as one plastic
+    /// impact.
+    Unresolved {
+        /// The contact that would bounce.
+        contact: String,
+        /// When (s from release).
+        t: f64,
+        /// How far it would rise, relative to the length scale.
+        rise: f64,
+        /// The relative gap at which a contact counts as open.
+        open_gap: f64,
+        /// About how long the bounces left would last in all (s).
+        left: f64,
+    },
+}
+
+/// Until when a contact held.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Held {
+    /// Until the body landed, where the named contact closed.
+    Lands {
+        /// The contact that closed.
+        contact: String,
+        /// When (s from release).
+        t: f64,
+    },
+    /// Until the motion was halted.
+    Halted(Halt),
+    /// Until the run's end time.
+    RunsEnd {
+        /// When (s from release).
+        t: f64,
+    },
+    /// Until the reduced angle reached the model's end angle.
+    Floor {
+        /// The reduced coordinate's name.
+        angle: String,
+        /// The end angle (rad).
+        end_angle: f64,
+    },
+    /// Until the named contact ran off an edge, where the motion stops.
+    Edge {
+        /// The contact.
+        contact: String,
+        /// When (s from release).
+        t: f64,
+    },
+}
+
+/// How the motion ended before the body landed.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Unlanded {
+    /// The named contact ran off an edge.
+    Edge(String),
+    /// The named contact closed, where the run ends at its first impact.
+    Contact(String),
+    /// The run reached its end time.
+    Until,
+    /// The motion was halted.
+    Halted(Halt),
+    /// The motion ended otherwise.
+    Ended,
+}
+
+/// How the motion went with respect to the run's end time (`until`).
+#[derive(Debug, Clone, PartialEq)]
+pub enum UntilNote {
+    /// The motion was halted.
+    Halted(Halt),
+    /// It was followed to the run's end.
+    Reached {
+        /// The end (s from release).
+        t: f64,
+        /// The impacts on the way.
+        impacts: usize,
+    },
+    /// It ended before the run's end.
+    EndedBefore {
+        /// When (s from release).
+        t: f64,
+        /// Why, as a keyword (`force`, `edge`, `contact`, `floor`; empty when unknown).
+        cause: String,
+        /// The run's end (s).
+        until: f64,
+        /// The impacts on the way.
+        impacts: usize,
+    },
+}
+
+/// Why a wanted quantity has no value, or what the motion needs said, under its key in
+/// [`RunResults::notes`](super::RunResults).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Note {
+    /// A refusal: the error's message (the cross-check's matrix too ill-conditioned, an
+    /// impact with friction).
+    Refused(String),
+    /// The first contact ended by another cause than its force (a keyword: `edge`,
+    /// `contact`, `impact`), so it does not separate.
+    NoSeparationEnded {
+        /// The contact.
+        contact: String,
+        /// Why it ended.
+        cause: String,
+    },
+    /// The first contact held, so it does not separate.
+    NoSeparationHolds {
+        /// The contact.
+        contact: String,
+        /// Until when.
+        held: Held,
+    },
+    /// The first contact is open at release, so it does not separate.
+    NoSeparationOpen {
+        /// The contact.
+        contact: String,
+    },
+    /// The linearised separation polynomial has no root between the floor and the start.
+    NoLinearisedRoot,
+    /// A contact held.
+    Holds {
+        /// The contact.
+        contact: String,
+        /// Until when.
+        held: Held,
+    },
+    /// A contact is open at release.
+    OpenAtRelease {
+        /// The contact.
+        contact: String,
+    },
+    /// The cross-check's integrated route ended at another event than the fast path.
+    CrossCheckDisagrees {
+        /// The integrated route's event.
+        integrated: PhaseEnd,
+        /// The fast path's event, in the solver's debug form (`Force(0)`).
+        fast: String,
+    },
+    /// The body did not land.
+    NoLanding {
+        /// When the motion ended (s from release).
+        t: f64,
+        /// The phases it went through, in order.
+        path: Vec<String>,
+        /// How it ended.
+        end: Unlanded,
+    },
+    /// The run ends at its first impact.
+    FirstImpactEnds {
+        /// When (s from release).
+        t: f64,
+    },
+    /// No contact closed before the motion's end.
+    NoImpact {
+        /// The phases the motion went through, in order.
+        path: Vec<String>,
+    },
+    /// How the motion went with respect to the run's end time.
+    Until(UntilNote),
+    /// The converging sequences of bounces closed, in order.
+    Zeno(Vec<Zeno>),
+}
