@@ -19,35 +19,8 @@ use super::cas::{self, A};
 use super::expr::{Expr, product, sum};
 use super::present::{Presenter, Shape, operations};
 use super::types::Derivation;
+pub use super::types::{Shown, Steps};
 use std::collections::BTreeMap;
-
-/// One step as shown, over `rc_s`, `rc_c` like the derivation.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Shown {
-    /// The expression shown.
-    pub expr: Expr,
-    /// The expression as derived (what `expr` equals).
-    pub derived: Expr,
-    /// Why it is shown as derived rather than in a grouped form, if it is.
-    pub as_derived: Option<String>,
-}
-
-/// Every step of a phase as shown.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Steps {
-    /// `T`.
-    pub kinetic: Shown,
-    /// `V`.
-    pub potential: Shown,
-    /// `L = T - V`.
-    pub lagrangian: Shown,
-    /// One Euler–Lagrange expression per coordinate (each `= 0`).
-    pub euler_lagrange: Vec<Shown>,
-    /// The conjugate momenta of the cyclic coordinates.
-    pub momenta: Vec<Shown>,
-    /// The reduced results by their key in `Reduction::plain`.
-    pub reduced: BTreeMap<String, Shown>,
-}
 
 /// The steps of `d` as shown.
 pub fn derive(d: &Derivation) -> Steps {

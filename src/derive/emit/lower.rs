@@ -1,7 +1,7 @@
 //! Lowers derived expressions to straight-line Rust: shared subexpressions become `let`s,
 //! parameter-only subexpressions are hoisted into the prepared constants `k`.
 
-use super::expr::{Expr, float_literal};
+use crate::derive::expr::{Expr, float_literal};
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 
 /// Names an expression's free symbols resolve to in generated code.
@@ -114,7 +114,7 @@ fn negated(e: &Expr) -> Expr {
                 Some(i) => v[i] = negated(&v[i]),
                 None => v.insert(0, Expr::int(-1)),
             }
-            super::expr::product(v)
+            crate::derive::expr::product(v)
         }
         _ => Expr::Mul(vec![Expr::int(-1), e.clone()]),
     }
@@ -247,19 +247,21 @@ fn hoist_constants(e: &Expr, scope: &Scope, h: &mut Hoisted) -> Expr {
             };
             let (coef, rest): (Vec<Expr>, Vec<Expr>) =
                 factors.into_iter().partition(|f| constant_only(f, scope));
-            let rest = super::expr::product(rest);
+            let rest = crate::derive::expr::product(rest);
             let key = rest.to_infix();
             match groups.iter_mut().find(|g| g.0 == key) {
-                Some(g) => g.2.push(super::expr::product(coef)),
-                None => groups.push((key, rest, vec![super::expr::product(coef)])),
+                Some(g) => g.2.push(crate::derive::expr::product(coef)),
+                None => groups.push((key, rest, vec![crate::derive::expr::product(coef)])),
             }
         }
         if groups.len() < v.len() {
             let terms = groups
                 .into_iter()
-                .map(|(_, rest, coefs)| Expr::Mul(vec![super::expr::sum(coefs), rest]).tidy())
+                .map(|(_, rest, coefs)| {
+                    Expr::Mul(vec![crate::derive::expr::sum(coefs), rest]).tidy()
+                })
                 .collect();
-            let grouped = super::expr::sum(terms);
+            let grouped = crate::derive::expr::sum(terms);
             // Only a sum the grouping shortened is taken apart again (tidying a grouped term
             // may spread it back into as many terms, which would recurse for ever).
             let shorter = match &grouped {
@@ -292,9 +294,9 @@ fn hoist_constants(e: &Expr, scope: &Scope, h: &mut Hoisted) -> Expr {
             let has_const = group.iter().any(|c| !c.symbols().is_empty());
             if has_const {
                 let g = if matches!(e, Expr::Mul(_)) {
-                    super::expr::product(group)
+                    crate::derive::expr::product(group)
                 } else {
-                    super::expr::sum(group)
+                    crate::derive::expr::sum(group)
                 };
                 let (neg, x) = h.constant(&g, scope);
                 if matches!(e, Expr::Mul(_)) {
@@ -310,9 +312,9 @@ fn hoist_constants(e: &Expr, scope: &Scope, h: &mut Hoisted) -> Expr {
             }
             out.extend(rest.into_iter().map(|c| hoist_constants(c, scope, h)));
             if matches!(e, Expr::Mul(_)) {
-                super::expr::product(out)
+                crate::derive::expr::product(out)
             } else {
-                super::expr::sum(out)
+                crate::derive::expr::sum(out)
             }
         }
         Expr::Pow(b, x) => Expr::Pow(
@@ -383,7 +385,7 @@ fn emit_node(
         }
         Expr::Add(v) => {
             let mut out = String::from("(");
-            super::expr::write_signed_sum(&mut out, v, |o, mag| o.push_str(&sub(mag)));
+            crate::derive::expr::write_signed_sum(&mut out, v, |o, mag| o.push_str(&sub(mag)));
             out.push(')');
             out
         }
