@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 16,
+    n_constants: 14,
     coordinates: &["x1", "y1", "theta"],
     system_coordinates: &["x1", "y1", "theta"],
     reduced: 2,
@@ -170,24 +170,20 @@ impl Model for FixedCylinder {
         k[7] = 2.0 * k[2];
         // k[8] = ell*m1/2
         k[8] = k[1] * k[0] / 2.0;
-        // k[9] = ell^2*m1/24
-        k[9] = (k[1] * k[1]) * k[0] / 24.0;
-        // k[10] = ell^2*m1/8
-        k[10] = (k[1] * k[1]) * k[0] / 8.0;
-        // k[11] = m1/2
-        k[11] = k[0] / 2.0;
-        // k[12] = ell*g*m1/2
-        k[12] = k[1] * k[4] * k[0] / 2.0;
-        // k[13] = g*m1
-        k[13] = k[4] * k[0];
-        // k[14] = ell^2*m1/12
-        k[14] = (k[1] * k[1]) * k[0] / 12.0;
-        // k[15] = ell^2*m1/4
-        k[15] = (k[1] * k[1]) * k[0] / 4.0;
+        // k[9] = ell^2*m1/6
+        k[9] = (k[1] * k[1]) * k[0] / 6.0;
+        // k[10] = m1/2
+        k[10] = k[0] / 2.0;
+        // k[11] = ell*g*m1/2
+        k[11] = k[1] * k[4] * k[0] / 2.0;
+        // k[12] = g*m1
+        k[12] = k[4] * k[0];
+        // k[13] = ell^2*m1/3
+        k[13] = (k[1] * k[1]) * k[0] / 3.0;
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         q[0] = -k[5];
         qd[0] = 0.0;
         q[1] = 0.0;
@@ -197,10 +193,10 @@ impl Model for FixedCylinder {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let pt0 = rc_c * rc_c;
-        let pt1 = rc_s * rc_s;
+        let pt0 = rc_s * rc_s;
+        let pt1 = rc_c * rc_c;
         pos[0] = [q[0], q[1]];
         vel[0] = [qd[0], qd[1]];
         pos[1] = [(k[1] * rc_c) + q[0], (k[1] * rc_s) + q[1]];
@@ -214,49 +210,44 @@ impl Model for FixedCylinder {
             (k[6] * qd[2] * rc_c) + qd[1],
         ];
         pos[3] = [
-            (k[2] * rc_s * rc_c) + q[0] - (q[0] * pt0) - (q[1] * rc_s * rc_c),
-            (k[2] * pt1) - (q[0] * rc_s * rc_c) + q[1] - (q[1] * pt1),
+            (k[2] * rc_s * rc_c) + (q[0] * pt0) - (q[1] * rc_s * rc_c),
+            (k[2] * pt0) - (q[0] * rc_s * rc_c) + (q[1] * pt1),
         ];
         vel[3] = [
-            -(k[2] * qd[2] * pt1)
-                + (k[2] * qd[2] * pt0)
+            -(k[2] * qd[2] * pt0)
+                + (k[2] * qd[2] * pt1)
                 + (2.0 * qd[2] * q[0] * rc_s * rc_c)
-                + (qd[2] * q[1] * pt1)
-                - (qd[2] * q[1] * pt0)
-                + qd[0]
-                - (qd[0] * pt0)
+                + (qd[2] * q[1] * pt0)
+                - (qd[2] * q[1] * pt1)
+                + (qd[0] * pt0)
                 - (qd[1] * rc_s * rc_c),
-            (k[7] * qd[2] * rc_s * rc_c) + (qd[2] * q[0] * pt1)
-                - (qd[2] * q[0] * pt0)
+            (k[7] * qd[2] * rc_s * rc_c) + (qd[2] * q[0] * pt0)
+                - (qd[2] * q[0] * pt1)
                 - (2.0 * qd[2] * q[1] * rc_s * rc_c)
                 - (qd[0] * rc_s * rc_c)
-                + qd[1]
-                - (qd[1] * pt1),
+                + (qd[1] * pt1),
         ];
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let et0 = qd[2] * qd[2];
         (-(k[8] * qd[2] * qd[0] * rc_s)
             + (k[8] * qd[2] * qd[1] * rc_c)
-            + (k[9] * et0)
-            + (k[10] * et0 * (rc_s * rc_s))
-            + (k[10] * et0 * (rc_c * rc_c))
-            + (k[11] * (qd[0] * qd[0]))
-            + (k[11] * (qd[1] * qd[1])))
-            + ((k[12] * rc_s) + (k[13] * q[1]))
+            + (k[9] * (qd[2] * qd[2]))
+            + (k[10] * (qd[0] * qd[0]))
+            + (k[10] * (qd[1] * qd[1])))
+            + ((k[11] * rc_s) + (k[12] * q[1]))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         out[0] = -(k[8] * qd[2] * rc_s) + (k[0] * qd[0]);
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let qt0 = -k[8] * rc_s;
         let qt1 = k[8] * rc_c;
@@ -269,10 +260,10 @@ impl Model for FixedCylinder {
         mass[5] = qt1;
         mass[6] = qt0;
         mass[7] = qt1;
-        mass[8] = k[14] + (k[15] * (rc_s * rc_s)) + (k[15] * (rc_c * rc_c));
+        mass[8] = k[13];
         rhs[0] = k[8] * qt2 * rc_c;
-        rhs[1] = -k[13] + (k[8] * qt2 * rc_s);
-        rhs[2] = -k[12] * rc_c;
+        rhs[1] = -k[12] + (k[8] * qt2 * rc_s);
+        rhs[2] = -k[11] * rc_c;
     }
 
     fn forces_full(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _qdd: &[f64], out: &mut [f64]) {
@@ -281,14 +272,14 @@ impl Model for FixedCylinder {
     }
 
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         out[0] = -k[2] - (k[2] * rc_c) - (q[0] * rc_s) + (q[1] * rc_c);
         out[1] = q[1];
     }
 
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let jt0 = qd[2] * qd[2];
         jac[0] = -rc_s;
@@ -304,7 +295,7 @@ impl Model for FixedCylinder {
     }
 
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         out[0] = k[1] - (k[2] * rc_s) + (q[0] * rc_c) + (q[1] * rc_s);
         out[1] = f64::INFINITY;
@@ -332,7 +323,7 @@ impl Model for FixedCylinder {
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         poses[0] = [(k[6] * rc_c) + q[0], (k[6] * rc_s) + q[1], q[2]];
         sizes[0] = -k[6];

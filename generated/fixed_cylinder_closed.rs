@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 39,
+    n_constants: 37,
     coordinates: &["theta"],
     system_coordinates: &["x1", "y1", "theta"],
     reduced: 0,
@@ -178,108 +178,100 @@ impl Model for FixedCylinderClosed {
         k[9] = 2.0 * k[2];
         // k[10] = R*ell*m1/2
         k[10] = k[2] * k[1] * k[0] / 2.0;
-        // k[11] = R^2*m1/2 + ell^2*m1/24
-        k[11] = ((k[2] * k[2]) * k[0] / 2.0) + ((k[1] * k[1]) * k[0] / 24.0);
+        // k[11] = R^2*m1/2 + ell^2*m1/6
+        k[11] = ((k[2] * k[2]) * k[0] / 2.0) + ((k[1] * k[1]) * k[0] / 6.0);
         // k[12] = R^2*m1
         k[12] = (k[2] * k[2]) * k[0];
         // k[13] = R^2*m1/2
         k[13] = (k[2] * k[2]) * k[0] / 2.0;
-        // k[14] = ell^2*m1/8
-        k[14] = (k[1] * k[1]) * k[0] / 8.0;
-        // k[15] = ell*g*m1/2
-        k[15] = k[1] * k[4] * k[0] / 2.0;
-        // k[16] = R^2*m1 + ell^2*m1/12
-        k[16] = ((k[2] * k[2]) * k[0]) + ((k[1] * k[1]) * k[0] / 12.0);
-        // k[17] = R*ell*m1
-        k[17] = k[2] * k[1] * k[0];
-        // k[18] = 2*R^2*m1
-        k[18] = 2.0 * (k[2] * k[2]) * k[0];
-        // k[19] = ell^2*m1/4
-        k[19] = (k[1] * k[1]) * k[0] / 4.0;
-        // k[20] = 5*R^2*m1
-        k[20] = 5.0 * (k[2] * k[2]) * k[0];
-        // k[21] = 4*R^2*m1
-        k[21] = 4.0 * (k[2] * k[2]) * k[0];
-        // k[22] = ell*m1/2
-        k[22] = k[1] * k[0] / 2.0;
-        // k[23] = 2*R*m1
-        k[23] = 2.0 * k[2] * k[0];
-        // k[24] = 4*R*m1
-        k[24] = 4.0 * k[2] * k[0];
-        // k[25] = 2*g*m1
-        k[25] = 2.0 * k[4] * k[0];
-        // k[26] = ell*m1
-        k[26] = k[1] * k[0];
-        // k[27] = 3*ell*g
-        k[27] = 3.0 * k[1] * k[4];
-        // k[28] = 6*R^2
-        k[28] = 6.0 * (k[2] * k[2]);
-        // k[29] = 3*R*ell
-        k[29] = 3.0 * k[2] * k[1];
-        // k[30] = 3*R^2
-        k[30] = 3.0 * (k[2] * k[2]);
-        // k[31] = ell^2
-        k[31] = k[1] * k[1];
-        // k[32] = 3*R*ell^2*g
-        k[32] = 3.0 * k[2] * (k[1] * k[1]) * k[4];
-        // k[33] = 24*R^2*ell*g
-        k[33] = 24.0 * (k[2] * k[2]) * k[1] * k[4];
-        // k[34] = 6*R^2*ell*g
-        k[34] = 6.0 * (k[2] * k[2]) * k[1] * k[4];
-        // k[35] = 3*R^2*ell*g
-        k[35] = 3.0 * (k[2] * k[2]) * k[1] * k[4];
-        // k[36] = ell^3*g
-        k[36] = k[1].powi(3) * k[4];
-        // k[37] = R*m1
-        k[37] = k[2] * k[0];
-        // k[38] = g*m1
-        k[38] = k[4] * k[0];
+        // k[14] = ell*g*m1/2
+        k[14] = k[1] * k[4] * k[0] / 2.0;
+        // k[15] = R^2*m1 + ell^2*m1/3
+        k[15] = ((k[2] * k[2]) * k[0]) + ((k[1] * k[1]) * k[0] / 3.0);
+        // k[16] = R*ell*m1
+        k[16] = k[2] * k[1] * k[0];
+        // k[17] = 2*R^2*m1
+        k[17] = 2.0 * (k[2] * k[2]) * k[0];
+        // k[18] = 5*R^2*m1
+        k[18] = 5.0 * (k[2] * k[2]) * k[0];
+        // k[19] = 4*R^2*m1
+        k[19] = 4.0 * (k[2] * k[2]) * k[0];
+        // k[20] = ell*m1/2
+        k[20] = k[1] * k[0] / 2.0;
+        // k[21] = 2*R*m1
+        k[21] = 2.0 * k[2] * k[0];
+        // k[22] = 4*R*m1
+        k[22] = 4.0 * k[2] * k[0];
+        // k[23] = 2*g*m1
+        k[23] = 2.0 * k[4] * k[0];
+        // k[24] = ell*m1
+        k[24] = k[1] * k[0];
+        // k[25] = 3*ell*g
+        k[25] = 3.0 * k[1] * k[4];
+        // k[26] = 6*R^2
+        k[26] = 6.0 * (k[2] * k[2]);
+        // k[27] = 3*R*ell
+        k[27] = 3.0 * k[2] * k[1];
+        // k[28] = 3*R^2
+        k[28] = 3.0 * (k[2] * k[2]);
+        // k[29] = ell^2
+        k[29] = k[1] * k[1];
+        // k[30] = 3*R*ell^2*g
+        k[30] = 3.0 * k[2] * (k[1] * k[1]) * k[4];
+        // k[31] = 24*R^2*ell*g
+        k[31] = 24.0 * (k[2] * k[2]) * k[1] * k[4];
+        // k[32] = 6*R^2*ell*g
+        k[32] = 6.0 * (k[2] * k[2]) * k[1] * k[4];
+        // k[33] = 3*R^2*ell*g
+        k[33] = 3.0 * (k[2] * k[2]) * k[1] * k[4];
+        // k[34] = ell^3*g
+        k[34] = k[1].powi(3) * k[4];
+        // k[35] = R*m1
+        k[35] = k[2] * k[0];
+        // k[36] = g*m1
+        k[36] = k[4] * k[0];
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         q[0] = k[3];
         qd[0] = 0.0;
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        let pt0 = rc_c * rc_c;
-        let pt1 = rc_c.powi(3);
-        let pt2 = rc_s * rc_s;
-        let pt3 = k[2] * qd[0];
-        let pt4 = k[2] * qd[0] * rc_c / pt2;
-        let pt5 = k[2] * qd[0] * pt0 / pt2;
+        let pt0 = rc_s * rc_s;
+        let pt1 = k[2] * qd[0];
+        let pt2 = k[2] * qd[0] * rc_c / pt0;
+        let pt3 = rc_c * rc_c;
+        let pt4 = k[2] * qd[0] * pt3 / pt0;
         pos[0] = [-(k[2] / rc_s) - (k[2] * rc_c / rc_s), 0.0];
-        vel[0] = [pt3 + pt4 + pt5, 0.0];
+        vel[0] = [pt1 + pt2 + pt4, 0.0];
         pos[1] = [
             -(k[2] / rc_s) - (k[2] * rc_c / rc_s) + (k[1] * rc_c),
             k[1] * rc_s,
         ];
-        vel[1] = [pt3 + pt4 + pt5 - (k[1] * qd[0] * rc_s), k[1] * qd[0] * rc_c];
+        vel[1] = [pt1 + pt2 + pt4 - (k[1] * qd[0] * rc_s), k[1] * qd[0] * rc_c];
         pos[2] = [
             -(k[2] / rc_s) - (k[2] * rc_c / rc_s) + (k[8] * rc_c),
             k[8] * rc_s,
         ];
-        vel[2] = [pt3 + pt4 + pt5 - (k[8] * qd[0] * rc_s), k[8] * qd[0] * rc_c];
+        vel[2] = [pt1 + pt2 + pt4 - (k[8] * qd[0] * rc_s), k[8] * qd[0] * rc_c];
         pos[3] = [
-            (k[2] * rc_s * rc_c) - (k[2] / rc_s) - (k[2] * rc_c / rc_s)
-                + (k[2] * pt0 / rc_s)
-                + (k[2] * pt1 / rc_s),
-            (k[2] * rc_c) + (k[2] * pt2) + (k[2] * pt0),
+            (k[2] * rc_s * rc_c) - (k[2] * pt0 / rc_s) - (k[2] * pt0 * rc_c / rc_s),
+            k[2] + (k[2] * rc_c),
         ];
         vel[3] = [
-            pt3 - (k[9] * qd[0] * rc_c) - (k[2] * qd[0] * pt2) + pt4 + pt5
-                - (k[2] * qd[0] * pt1 / pt2)
-                - (k[2] * qd[0] * rc_c.powi(4) / pt2)
-                - (k[9] * qd[0] * pt0),
+            -(k[2] * qd[0] * pt3) - (k[9] * qd[0] * rc_c)
+                + (k[2] * qd[0] * pt0 * rc_c / pt0)
+                + (k[2] * qd[0] * pt0 * pt3 / pt0),
             -k[2] * qd[0] * rc_s,
         ];
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let et0 = qd[0] * qd[0];
         let et1 = rc_c * rc_c;
@@ -289,71 +281,63 @@ impl Model for FixedCylinderClosed {
             + (k[12] * et0 * et1 / (rc_s * rc_s))
             + (k[13] * et0 * et1 / rc_s.powi(4))
             + (k[12] * et0 * rc_c.powi(3) / rc_s.powi(4))
-            + (k[13] * et0 * rc_c.powi(4) / rc_s.powi(4))
-            + (k[14] * et0 * (rc_s * rc_s))
-            + (k[14] * et0 * et1))
-            + (k[15] * rc_s)
+            + (k[13] * et0 * rc_c.powi(4) / rc_s.powi(4)))
+            + (k[14] * rc_s)
     }
 
     fn momenta(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let qt0 = rc_c * rc_c;
         let qt1 = rc_c.powi(3);
         let qt2 = rc_c.powi(4);
         let qt3 = qd[0] * qd[0];
-        mass[0] = k[16] - (k[17] * rc_s) - (k[17] * rc_c / rc_s) - (k[17] * qt0 / rc_s)
-            + (k[18] * rc_c / (rc_s * rc_s))
-            + (k[18] * qt0 / (rc_s * rc_s))
+        mass[0] = k[15] - (k[16] * rc_s) - (k[16] * rc_c / rc_s) - (k[16] * qt0 / rc_s)
+            + (k[17] * rc_c / (rc_s * rc_s))
+            + (k[17] * qt0 / (rc_s * rc_s))
             + (k[12] * qt0 / rc_s.powi(4))
-            + (k[18] * qt1 / rc_s.powi(4))
-            + (k[12] * qt2 / rc_s.powi(4))
-            + (k[19] * (rc_s * rc_s))
-            + (k[19] * qt0);
+            + (k[17] * qt1 / rc_s.powi(4))
+            + (k[12] * qt2 / rc_s.powi(4));
         rhs[0] = -(k[10] * qt3)
             - (k[10] * qt3 * rc_c)
             - (k[10] * qt3 * qt0 / (rc_s * rc_s))
             - (k[10] * qt3 * qt1 / (rc_s * rc_s))
-            - (k[15] * rc_c)
+            - (k[14] * rc_c)
             + (k[12] * qt3 / rc_s)
-            + (k[18] * qt3 * rc_c / rc_s)
+            + (k[17] * qt3 * rc_c / rc_s)
             + (k[12] * qt3 * rc_c / rc_s.powi(3))
-            + (k[20] * qt3 * qt0 / rc_s.powi(3))
-            + (k[21] * qt3 * qt1 / rc_s.powi(3))
-            + (k[18] * qt3 * qt1 / rc_s.powi(5))
-            + (k[21] * qt3 * qt2 / rc_s.powi(5))
-            + (k[18] * qt3 * rc_c.powi(5) / rc_s.powi(5));
+            + (k[18] * qt3 * qt0 / rc_s.powi(3))
+            + (k[19] * qt3 * qt1 / rc_s.powi(3))
+            + (k[17] * qt3 * qt1 / rc_s.powi(5))
+            + (k[19] * qt3 * qt2 / rc_s.powi(5))
+            + (k[17] * qt3 * rc_c.powi(5) / rc_s.powi(5));
     }
 
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        let ft0 = rc_s * rc_s;
-        let ft1 = rc_c * rc_c;
-        let ft2 = qd[0] * qd[0];
-        let ft3 = rc_s.powi(3);
-        let ft4 = rc_c.powi(3);
-        out[0] = -(-(k[22] * qdd[0] * rc_s)
+        let ft0 = rc_c * rc_c;
+        let ft1 = qd[0] * qd[0];
+        let ft2 = rc_c.powi(3);
+        out[0] = -(-(k[20] * qdd[0] * rc_s)
             + (k[0]
-                * ((k[2] * qdd[0]) + (k[2] * qdd[0] * rc_c / ft0) + (k[2] * qdd[0] * ft1 / ft0)
-                    - (k[2] * ft2 / rc_s)
-                    - (k[9] * ft2 * rc_c / rc_s)
-                    - (k[9] * ft2 * ft1 / ft3)
-                    - (k[9] * ft2 * ft4 / ft3)))
-            - (k[22] * ft2 * rc_c))
+                * ((k[2] * qdd[0])
+                    + (k[2] * qdd[0] * rc_c / (rc_s * rc_s))
+                    + (k[2] * qdd[0] * ft0 / (rc_s * rc_s))
+                    - (k[2] * ft1 / rc_s)
+                    - (k[9] * ft1 * rc_c / rc_s)
+                    - (k[9] * ft1 * ft0 / rc_s.powi(3))
+                    - (k[9] * ft1 * ft2 / rc_s.powi(3))))
+            - (k[20] * ft1 * rc_c))
             / rc_s;
-        out[1] = ((k[23] * qdd[0] * rc_s * ft1)
-            + (k[23] * qdd[0] * rc_s * ft4)
-            + (k[23] * qdd[0] * ft3 * rc_c)
-            - (k[23] * ft2 * ft0 * rc_c)
-            - (k[24] * ft2 * ft0 * ft1)
-            - (k[24] * ft2 * ft4)
-            - (k[24] * ft2 * rc_c.powi(4))
-            + (k[25] * rc_s.powi(4))
-            - (k[26] * ft2 * ft3 * ft1)
-            - (k[26] * ft2 * rc_s.powi(5)))
+        out[1] = ((k[21] * qdd[0] * rc_s * ft0) + (k[21] * qdd[0] * rc_s * rc_c)
+            - (k[21] * ft1 * (rc_s * rc_s) * rc_c)
+            - (k[22] * ft1 * ft0)
+            - (k[22] * ft1 * ft2)
+            + (k[23] * rc_s.powi(4))
+            - (k[24] * ft1 * rc_s.powi(3)))
             / 2.0
             / rc_s.powi(4);
     }
@@ -371,7 +355,7 @@ impl Model for FixedCylinderClosed {
     }
 
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         out[0] = k[1] - (k[2] * rc_s) - (k[2] * rc_c / rc_s) - (k[2] * (rc_c * rc_c) / rc_s);
         out[1] = f64::INFINITY;
@@ -390,7 +374,7 @@ impl Model for FixedCylinderClosed {
     }
 
     fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         q_full[0] = -(k[2] / rc_s) - (k[2] * rc_c / rc_s);
         qd_full[0] = (k[2] * qd[0])
@@ -403,7 +387,7 @@ impl Model for FixedCylinderClosed {
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         poses[0] = [
             -(k[2] / rc_s) - (k[2] * rc_c / rc_s) + (k[8] * rc_c),
@@ -426,13 +410,13 @@ impl Model for FixedCylinderClosed {
 
 impl Reduction for FixedCylinderClosed {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[3], k[6], k[7], delta);
         let rt0 = rc_s.powi(4);
         let rt1 = rc_s.powi(3);
-        let rt2 = k[28] - (k[29] * rt1) - (k[29] * rt1 * rc_c) + (k[28] * rc_c)
-            - (k[30] * (rc_s * rc_s))
-            + (k[31] * rt0);
+        let rt2 = k[26] - (k[27] * rt1) - (k[27] * rt1 * rc_c) + (k[26] * rc_c)
+            - (k[28] * (rc_s * rc_s))
+            + (k[29] * rt0);
         let rt3 = rc_s.powi(6);
         let rt4 = rc_c * rc_c;
         let rt5 = rc_s.powi(7);
@@ -441,84 +425,84 @@ impl Reduction for FixedCylinderClosed {
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: k[27] * rt0 * rc_ds / rt2,
+            theta_dot_sq: k[25] * rt0 * rc_ds / rt2,
             theta_ddot: -3.0
-                * ((k[32] * rt3 * rc_c * rc_ds) + (k[32] * rt3 * rt4 * rc_ds)
-                    - (k[32] * rt5 * rc_c)
-                    - (k[32] * rt5 * rt4)
-                    + (k[32] * rt6 * rc_ds)
-                    - (k[33] * rt1 * rc_c * rc_ds)
-                    - (k[33] * rt1 * rt4 * rc_ds)
-                    + (k[34] * rt0 * rc_c)
-                    + (k[34] * rt0 * rt4)
-                    + (k[34] * rt7 * rc_c * rc_ds)
-                    - (k[34] * rt7 * rc_ds)
-                    - (k[35] * rt3 * rc_c)
-                    + (k[36] * rt6 * rc_c))
+                * ((k[30] * rt3 * rc_c * rc_ds) + (k[30] * rt3 * rt4 * rc_ds)
+                    - (k[30] * rt5 * rc_c)
+                    - (k[30] * rt5 * rt4)
+                    + (k[30] * rt6 * rc_ds)
+                    - (k[31] * rt1 * rc_c * rc_ds)
+                    - (k[31] * rt1 * rt4 * rc_ds)
+                    + (k[32] * rt0 * rc_c)
+                    + (k[32] * rt0 * rt4)
+                    + (k[32] * rt7 * rc_c * rc_ds)
+                    - (k[32] * rt7 * rc_ds)
+                    - (k[33] * rt3 * rc_c)
+                    + (k[34] * rt6 * rc_c))
                 / 2.0
                 / (rt2 * rt2),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let rt0 = rc_s.powi(4);
         let rt1 = rc_s.powi(3);
-        k[27] * rt0 * rc_ds
-            / (k[28] - (k[29] * rt1) - (k[29] * rt1 * rc_c) + (k[28] * rc_c)
-                - (k[30] * (rc_s * rc_s))
-                + (k[31] * rt0))
+        k[25] * rt0 * rc_ds
+            / (k[26] - (k[27] * rt1) - (k[27] * rt1 * rc_c) + (k[26] * rc_c)
+                - (k[28] * (rc_s * rc_s))
+                + (k[29] * rt0))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[3], k[6], k[7], delta);
         let rt0 = rc_s.powi(4);
         let rt1 = rc_s.powi(3);
-        let rt2 = k[28] - (k[29] * rt1) - (k[29] * rt1 * rc_c) + (k[28] * rc_c)
-            - (k[30] * (rc_s * rc_s))
-            + (k[31] * rt0);
+        let rt2 = k[26] - (k[27] * rt1) - (k[27] * rt1 * rc_c) + (k[26] * rc_c)
+            - (k[28] * (rc_s * rc_s))
+            + (k[29] * rt0);
         let rt3 = rc_s.powi(6);
         let rt4 = rc_c * rc_c;
         let rt5 = rc_s.powi(7);
         let rt6 = rc_s.powi(8);
         let rt7 = rc_s.powi(5);
-        let rc_w2 = k[27] * rt0 * rc_ds / rt2;
+        let rc_w2 = k[25] * rt0 * rc_ds / rt2;
         let rc_acc = -3.0
-            * ((k[32] * rt3 * rc_c * rc_ds) + (k[32] * rt3 * rt4 * rc_ds)
-                - (k[32] * rt5 * rc_c)
-                - (k[32] * rt5 * rt4)
-                + (k[32] * rt6 * rc_ds)
-                - (k[33] * rt1 * rc_c * rc_ds)
-                - (k[33] * rt1 * rt4 * rc_ds)
-                + (k[34] * rt0 * rc_c)
-                + (k[34] * rt0 * rt4)
-                + (k[34] * rt7 * rc_c * rc_ds)
-                - (k[34] * rt7 * rc_ds)
-                - (k[35] * rt3 * rc_c)
-                + (k[36] * rt6 * rc_c))
+            * ((k[30] * rt3 * rc_c * rc_ds) + (k[30] * rt3 * rt4 * rc_ds)
+                - (k[30] * rt5 * rc_c)
+                - (k[30] * rt5 * rt4)
+                + (k[30] * rt6 * rc_ds)
+                - (k[31] * rt1 * rc_c * rc_ds)
+                - (k[31] * rt1 * rt4 * rc_ds)
+                + (k[32] * rt0 * rc_c)
+                + (k[32] * rt0 * rt4)
+                + (k[32] * rt7 * rc_c * rc_ds)
+                - (k[32] * rt7 * rc_ds)
+                - (k[33] * rt3 * rc_c)
+                + (k[34] * rt6 * rc_c))
             / 2.0
             / (rt2 * rt2);
         let ft0 = rc_c * rc_c;
         let ft1 = rc_c.powi(3);
-        out[0] = -(k[37] * rc_acc / rc_s)
-            + (k[23] * rc_c * rc_w2 / (rc_s * rc_s))
-            + (k[37] * rc_w2 / (rc_s * rc_s))
-            - (k[37] * rc_c * rc_acc / rc_s.powi(3))
-            - (k[37] * ft0 * rc_acc / rc_s.powi(3))
-            + (k[23] * ft0 * rc_w2 / rc_s.powi(4))
-            + (k[23] * ft1 * rc_w2 / rc_s.powi(4))
-            + (k[22] * rc_acc)
-            + (k[22] * rc_c * rc_w2 / rc_s);
-        out[1] = k[38] + (k[37] * rc_c * rc_acc / rc_s)
-            - (k[37] * rc_c * rc_w2 / (rc_s * rc_s))
-            - (k[23] * ft0 * rc_w2 / (rc_s * rc_s))
-            + (k[37] * ft0 * rc_acc / rc_s.powi(3))
-            + (k[37] * ft1 * rc_acc / rc_s.powi(3))
-            - (k[23] * ft1 * rc_w2 / rc_s.powi(4))
-            - (k[23] * rc_c.powi(4) * rc_w2 / rc_s.powi(4))
-            - (k[22] * rc_s * rc_w2)
-            - (k[22] * ft0 * rc_w2 / rc_s);
+        out[0] = -(k[35] * rc_acc / rc_s)
+            + (k[21] * rc_c * rc_w2 / (rc_s * rc_s))
+            + (k[35] * rc_w2 / (rc_s * rc_s))
+            - (k[35] * rc_c * rc_acc / rc_s.powi(3))
+            - (k[35] * ft0 * rc_acc / rc_s.powi(3))
+            + (k[21] * ft0 * rc_w2 / rc_s.powi(4))
+            + (k[21] * ft1 * rc_w2 / rc_s.powi(4))
+            + (k[20] * rc_acc)
+            + (k[20] * rc_c * rc_w2 / rc_s);
+        out[1] = k[36] + (k[35] * rc_c * rc_acc / rc_s)
+            - (k[35] * rc_c * rc_w2 / (rc_s * rc_s))
+            - (k[21] * ft0 * rc_w2 / (rc_s * rc_s))
+            + (k[35] * ft0 * rc_acc / rc_s.powi(3))
+            + (k[35] * ft1 * rc_acc / rc_s.powi(3))
+            - (k[21] * ft1 * rc_w2 / rc_s.powi(4))
+            - (k[21] * rc_c.powi(4) * rc_w2 / rc_s.powi(4))
+            - (k[20] * rc_s * rc_w2)
+            - (k[20] * ft0 * rc_w2 / rc_s);
     }
 
     fn force_polynomial(&self, _k: &[f64], _contact: usize, _out: &mut [f64]) {}
@@ -544,7 +528,7 @@ impl Reduction for FixedCylinderClosed {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         q[0] = k[3] - delta;
         qd[0] = theta_dot;
     }

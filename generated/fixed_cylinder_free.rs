@@ -83,7 +83,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 33,
+    n_constants: 31,
     coordinates: &["x1", "theta"],
     system_coordinates: &["x1", "y1", "theta"],
     reduced: 1,
@@ -170,7 +170,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 10,
         force_degrees: &[0, 2],
         fall_degree: None,
-        lean_constants: &[9, 10, 12, 28, 29, 31],
+        lean_constants: &[9, 10, 12, 26, 27, 29],
     }),
     route_note: "",
 };
@@ -206,38 +206,34 @@ impl Model for FixedCylinderFree {
         k[14] = 2.0 * k[2];
         // k[15] = ell*m1/2
         k[15] = k[1] * k[0] / 2.0;
-        // k[16] = ell^2*m1/24
-        k[16] = (k[1] * k[1]) * k[0] / 24.0;
-        // k[17] = ell^2*m1/8
-        k[17] = (k[1] * k[1]) * k[0] / 8.0;
-        // k[18] = m1/2
-        k[18] = k[0] / 2.0;
-        // k[19] = ell*g*m1/2
-        k[19] = k[1] * k[4] * k[0] / 2.0;
-        // k[20] = ell^2*m1/12
-        k[20] = (k[1] * k[1]) * k[0] / 12.0;
-        // k[21] = ell^2*m1/4
-        k[21] = (k[1] * k[1]) * k[0] / 4.0;
-        // k[22] = g*m1
-        k[22] = k[4] * k[0];
-        // k[23] = 12/(ell^2*m1)
-        k[23] = 12.0 / (k[1] * k[1]) / k[0];
-        // k[24] = rc_wi^2*rc_ai
-        k[24] = (k[8] * k[8]) * k[12];
-        // k[25] = ell*g*m1
-        k[25] = k[1] * k[4] * k[0];
-        // k[26] = 6/(ell^2*m1)
-        k[26] = 6.0 / (k[1] * k[1]) / k[0];
-        // k[27] = 6*ell*g*m1
-        k[27] = 6.0 * k[1] * k[4] * k[0];
-        // k[30] = 6*rc_wi^2*rc_ai
-        k[30] = 6.0 * (k[8] * k[8]) * k[12];
-        // k[32] = rc_p0/m1
-        k[32] = k[11] / k[0];
+        // k[16] = ell^2*m1/6
+        k[16] = (k[1] * k[1]) * k[0] / 6.0;
+        // k[17] = m1/2
+        k[17] = k[0] / 2.0;
+        // k[18] = ell*g*m1/2
+        k[18] = k[1] * k[4] * k[0] / 2.0;
+        // k[19] = ell^2*m1/3
+        k[19] = (k[1] * k[1]) * k[0] / 3.0;
+        // k[20] = g*m1
+        k[20] = k[4] * k[0];
+        // k[21] = 12/(ell^2*m1)
+        k[21] = 12.0 / (k[1] * k[1]) / k[0];
+        // k[22] = rc_wi^2*rc_ai
+        k[22] = (k[8] * k[8]) * k[12];
+        // k[23] = ell*g*m1
+        k[23] = k[1] * k[4] * k[0];
+        // k[24] = 6/(ell^2*m1)
+        k[24] = 6.0 / (k[1] * k[1]) / k[0];
+        // k[25] = 6*ell*g*m1
+        k[25] = 6.0 * k[1] * k[4] * k[0];
+        // k[28] = 6*rc_wi^2*rc_ai
+        k[28] = 6.0 * (k[8] * k[8]) * k[12];
+        // k[30] = rc_p0/m1
+        k[30] = k[11] / k[0];
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         q[0] = k[5];
         qd[0] = k[7];
         q[1] = k[6];
@@ -245,10 +241,10 @@ impl Model for FixedCylinderFree {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let pt0 = rc_c * rc_c;
-        let pt1 = rc_s * rc_s;
+        let pt0 = rc_s * rc_s;
+        let pt1 = rc_c * rc_c;
         pos[0] = [q[0], 0.0];
         vel[0] = [qd[0], 0.0];
         pos[1] = [(k[1] * rc_c) + q[0], k[1] * rc_s];
@@ -256,67 +252,61 @@ impl Model for FixedCylinderFree {
         pos[2] = [(k[13] * rc_c) + q[0], k[13] * rc_s];
         vel[2] = [-(k[13] * qd[1] * rc_s) + qd[0], k[13] * qd[1] * rc_c];
         pos[3] = [
-            (k[2] * rc_s * rc_c) + q[0] - (q[0] * pt0),
-            (k[2] * pt1) - (q[0] * rc_s * rc_c),
+            (k[2] * rc_s * rc_c) + (q[0] * pt0),
+            (k[2] * pt0) - (q[0] * rc_s * rc_c),
         ];
         vel[3] = [
-            -(k[2] * qd[1] * pt1)
-                + (k[2] * qd[1] * pt0)
+            -(k[2] * qd[1] * pt0)
+                + (k[2] * qd[1] * pt1)
                 + (2.0 * qd[1] * q[0] * rc_s * rc_c)
-                + qd[0]
-                - (qd[0] * pt0),
-            (k[14] * qd[1] * rc_s * rc_c) + (qd[1] * q[0] * pt1)
-                - (qd[1] * q[0] * pt0)
+                + (qd[0] * pt0),
+            (k[14] * qd[1] * rc_s * rc_c) + (qd[1] * q[0] * pt0)
+                - (qd[1] * q[0] * pt1)
                 - (qd[0] * rc_s * rc_c),
         ];
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..33]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let et0 = qd[1] * qd[1];
-        (-(k[15] * qd[1] * qd[0] * rc_s)
-            + (k[16] * et0)
-            + (k[17] * et0 * (rc_s * rc_s))
-            + (k[17] * et0 * (rc_c * rc_c))
-            + (k[18] * (qd[0] * qd[0])))
-            + (k[19] * rc_s)
+        let k = &k[..31]; // one bounds check for all constant loads
+        let rc_s = q[1].sin();
+        (-(k[15] * qd[1] * qd[0] * rc_s) + (k[16] * (qd[1] * qd[1])) + (k[17] * (qd[0] * qd[0])))
+            + (k[18] * rc_s)
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
         out[0] = -(k[15] * qd[1] * rc_s) + (k[0] * qd[0]);
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let qt0 = -k[15] * rc_s;
         mass[0] = k[0];
         mass[1] = qt0;
         mass[2] = qt0;
-        mass[3] = k[20] + (k[21] * (rc_s * rc_s)) + (k[21] * (rc_c * rc_c));
+        mass[3] = k[19];
         rhs[0] = k[15] * (qd[1] * qd[1]) * rc_c;
-        rhs[1] = -k[19] * rc_c;
+        rhs[1] = -k[18] * rc_c;
     }
 
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = 0.0;
-        out[1] = k[22] + (k[15] * qdd[1] * rc_c) - (k[15] * (qd[1] * qd[1]) * rc_s);
+        out[1] = k[20] + (k[15] * qdd[1] * rc_c) - (k[15] * (qd[1] * qd[1]) * rc_s);
     }
 
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = -k[2] - (k[2] * rc_c) - (q[0] * rc_s);
         out[1] = 0.0;
     }
 
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let jt0 = qd[1] * qd[1];
         jac[0] = -rc_s;
@@ -328,7 +318,7 @@ impl Model for FixedCylinderFree {
     }
 
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = k[1] - (k[2] * rc_s) + (q[0] * rc_c);
         out[1] = f64::INFINITY;
@@ -356,7 +346,7 @@ impl Model for FixedCylinderFree {
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         poses[0] = [(k[13] * rc_c) + q[0], k[13] * rc_s, q[1]];
         sizes[0] = -k[13];
@@ -375,49 +365,49 @@ impl Model for FixedCylinderFree {
 
 impl Reduction for FixedCylinderFree {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[6], k[9], k[10], delta);
         let rt0 = rc_s * rc_s;
         let rt1 = -4.0 + (3.0 * rt0);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: -k[23] * (k[24] + (k[25] * rc_ds)) / rt1,
-            theta_ddot: k[26]
-                * ((k[27] * rc_s * rc_c * rc_ds) - (k[28] * rc_c)
-                    + (k[29] * rt0 * rc_c)
-                    + (k[30] * rc_s * rc_c))
+            theta_dot_sq: -k[21] * (k[22] + (k[23] * rc_ds)) / rt1,
+            theta_ddot: k[24]
+                * ((k[25] * rc_s * rc_c * rc_ds) - (k[26] * rc_c)
+                    + (k[27] * rt0 * rc_c)
+                    + (k[28] * rc_s * rc_c))
                 / (rt1 * rt1),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..33]; // one bounds check for all constant loads
-        -k[23] * (k[24] + (k[25] * rc_ds)) / (-4.0 + (3.0 * (rc_s * rc_s)))
+        let k = &k[..31]; // one bounds check for all constant loads
+        -k[21] * (k[22] + (k[23] * rc_ds)) / (-4.0 + (3.0 * (rc_s * rc_s)))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[6], k[9], k[10], delta);
         let rt0 = rc_s * rc_s;
         let rt1 = -4.0 + (3.0 * rt0);
-        let rc_w2 = -k[23] * (k[24] + (k[25] * rc_ds)) / rt1;
-        let rc_acc = k[26]
-            * ((k[27] * rc_s * rc_c * rc_ds) - (k[28] * rc_c)
-                + (k[29] * rt0 * rc_c)
-                + (k[30] * rc_s * rc_c))
+        let rc_w2 = -k[21] * (k[22] + (k[23] * rc_ds)) / rt1;
+        let rc_acc = k[24]
+            * ((k[25] * rc_s * rc_c * rc_ds) - (k[26] * rc_c)
+                + (k[27] * rt0 * rc_c)
+                + (k[28] * rc_s * rc_c))
             / (rt1 * rt1);
         out[0] = 0.0;
-        out[1] = k[22] - (k[15] * rc_s * rc_w2) + (k[15] * rc_c * rc_acc);
+        out[1] = k[20] - (k[15] * rc_s * rc_w2) + (k[15] * rc_c * rc_acc);
     }
 
     fn force_polynomial(&self, k: &[f64], contact: usize, out: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         match contact {
             1 => {
-                out[0] = k[28];
-                out[1] = -k[31];
-                out[2] = k[29];
+                out[0] = k[26];
+                out[1] = -k[29];
+                out[2] = k[27];
             }
             _ => {}
         }
@@ -432,12 +422,12 @@ impl Reduction for FixedCylinderFree {
         // k[12] = rc_ai = ell^2*m1/3 - ell^2*m1*rc_si^2/4
         let c6_t0 = k[1] * k[1];
         k[12] = (c6_t0 * k[0] / 3.0) - (c6_t0 * k[0] * (k[9] * k[9]) / 4.0);
-        // k[28] = 4*ell*g*m1
-        k[28] = 4.0 * k[1] * k[4] * k[0];
-        // k[29] = 3*ell*g*m1
-        k[29] = 3.0 * k[1] * k[4] * k[0];
-        // k[31] = 6*ell*g*m1*rc_si + 6*rc_wi^2*rc_ai
-        k[31] = (6.0 * k[1] * k[4] * k[0] * k[9]) + (6.0 * (k[8] * k[8]) * k[12]);
+        // k[26] = 4*ell*g*m1
+        k[26] = 4.0 * k[1] * k[4] * k[0];
+        // k[27] = 3*ell*g*m1
+        k[27] = 3.0 * k[1] * k[4] * k[0];
+        // k[29] = 6*ell*g*m1*rc_si + 6*rc_wi^2*rc_ai
+        k[29] = (6.0 * k[1] * k[4] * k[0] * k[9]) + (6.0 * (k[8] * k[8]) * k[12]);
     }
 
     fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
@@ -451,13 +441,13 @@ impl Reduction for FixedCylinderFree {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, _, _, rc_dc) = start_offsets(k[6], k[9], k[10], delta);
         let rc_t = t;
         let rc_w = theta_dot;
         q[1] = k[6] - delta;
         qd[1] = theta_dot;
-        q[0] = k[5] + (k[13] * rc_dc) + (k[32] * rc_t);
-        qd[0] = k[32] + (k[13] * rc_s * rc_w);
+        q[0] = k[5] + (k[13] * rc_dc) + (k[30] * rc_t);
+        qd[0] = k[30] + (k[13] * rc_s * rc_w);
     }
 }

@@ -65,7 +65,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 37,
+    n_constants: 35,
     coordinates: &["theta"],
     system_coordinates: &["x1", "y1", "theta", "xc"],
     reduced: 0,
@@ -192,70 +192,66 @@ impl Model for HingedCylinderClosed {
         Reduction::prepare_lean(self, p, k);
         // k[9] = ell/2
         k[9] = k[2] / 2.0;
-        // k[10] = R^2*m2/2 + ell^2*m1/24
-        k[10] = ((k[3] * k[3]) * k[1] / 2.0) + ((k[2] * k[2]) * k[0] / 24.0);
+        // k[10] = R^2*m2/2 + ell^2*m1/6
+        k[10] = ((k[3] * k[3]) * k[1] / 2.0) + ((k[2] * k[2]) * k[0] / 6.0);
         // k[11] = R^2*m2
         k[11] = (k[3] * k[3]) * k[1];
         // k[12] = R^2*m2/2
         k[12] = (k[3] * k[3]) * k[1] / 2.0;
-        // k[13] = ell^2*m1/8
-        k[13] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[14] = R*g*m2
-        k[14] = k[3] * k[5] * k[1];
-        // k[15] = ell*g*m1/2
-        k[15] = k[2] * k[5] * k[0] / 2.0;
-        // k[16] = R^2*m2 + ell^2*m1/12
-        k[16] = ((k[3] * k[3]) * k[1]) + ((k[2] * k[2]) * k[0] / 12.0);
-        // k[17] = 2*R^2*m2
-        k[17] = 2.0 * (k[3] * k[3]) * k[1];
-        // k[18] = ell^2*m1/4
-        k[18] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[19] = 5*R^2*m2
-        k[19] = 5.0 * (k[3] * k[3]) * k[1];
-        // k[20] = 4*R^2*m2
-        k[20] = 4.0 * (k[3] * k[3]) * k[1];
-        // k[21] = 2*R
-        k[21] = 2.0 * k[3];
-        // k[22] = 2*R*m2
-        k[22] = 2.0 * k[3] * k[1];
-        // k[23] = 4*R*m2
-        k[23] = 4.0 * k[3] * k[1];
-        // k[24] = ell*m1
-        k[24] = k[2] * k[0];
-        // k[25] = 2*g*m1
-        k[25] = 2.0 * k[5] * k[0];
-        // k[26] = 3*ell*g*m1
-        k[26] = 3.0 * k[2] * k[5] * k[0];
-        // k[27] = 6*R^2*m2
-        k[27] = 6.0 * (k[3] * k[3]) * k[1];
-        // k[28] = 3*R^2*m2
-        k[28] = 3.0 * (k[3] * k[3]) * k[1];
-        // k[29] = ell^2*m1
-        k[29] = (k[2] * k[2]) * k[0];
-        // k[30] = 24*R^2*ell*g*m1*m2
-        k[30] = 24.0 * (k[3] * k[3]) * k[2] * k[5] * k[0] * k[1];
-        // k[31] = 6*R^2*ell*g*m1*m2
-        k[31] = 6.0 * (k[3] * k[3]) * k[2] * k[5] * k[0] * k[1];
-        // k[32] = 3*R^2*ell*g*m1*m2
-        k[32] = 3.0 * (k[3] * k[3]) * k[2] * k[5] * k[0] * k[1];
-        // k[33] = ell^3*g*m1^2
-        k[33] = k[2].powi(3) * k[5] * (k[0] * k[0]);
-        // k[34] = R*m2
-        k[34] = k[3] * k[1];
-        // k[35] = ell*m1/2
-        k[35] = k[2] * k[0] / 2.0;
-        // k[36] = g*m1
-        k[36] = k[5] * k[0];
+        // k[13] = R*g*m2
+        k[13] = k[3] * k[5] * k[1];
+        // k[14] = ell*g*m1/2
+        k[14] = k[2] * k[5] * k[0] / 2.0;
+        // k[15] = R^2*m2 + ell^2*m1/3
+        k[15] = ((k[3] * k[3]) * k[1]) + ((k[2] * k[2]) * k[0] / 3.0);
+        // k[16] = 2*R^2*m2
+        k[16] = 2.0 * (k[3] * k[3]) * k[1];
+        // k[17] = 5*R^2*m2
+        k[17] = 5.0 * (k[3] * k[3]) * k[1];
+        // k[18] = 4*R^2*m2
+        k[18] = 4.0 * (k[3] * k[3]) * k[1];
+        // k[19] = 2*R
+        k[19] = 2.0 * k[3];
+        // k[20] = 2*R*m2
+        k[20] = 2.0 * k[3] * k[1];
+        // k[21] = 4*R*m2
+        k[21] = 4.0 * k[3] * k[1];
+        // k[22] = ell*m1
+        k[22] = k[2] * k[0];
+        // k[23] = 2*g*m1
+        k[23] = 2.0 * k[5] * k[0];
+        // k[24] = 3*ell*g*m1
+        k[24] = 3.0 * k[2] * k[5] * k[0];
+        // k[25] = 6*R^2*m2
+        k[25] = 6.0 * (k[3] * k[3]) * k[1];
+        // k[26] = 3*R^2*m2
+        k[26] = 3.0 * (k[3] * k[3]) * k[1];
+        // k[27] = ell^2*m1
+        k[27] = (k[2] * k[2]) * k[0];
+        // k[28] = 24*R^2*ell*g*m1*m2
+        k[28] = 24.0 * (k[3] * k[3]) * k[2] * k[5] * k[0] * k[1];
+        // k[29] = 6*R^2*ell*g*m1*m2
+        k[29] = 6.0 * (k[3] * k[3]) * k[2] * k[5] * k[0] * k[1];
+        // k[30] = 3*R^2*ell*g*m1*m2
+        k[30] = 3.0 * (k[3] * k[3]) * k[2] * k[5] * k[0] * k[1];
+        // k[31] = ell^3*g*m1^2
+        k[31] = k[2].powi(3) * k[5] * (k[0] * k[0]);
+        // k[32] = R*m2
+        k[32] = k[3] * k[1];
+        // k[33] = ell*m1/2
+        k[33] = k[2] * k[0] / 2.0;
+        // k[34] = g*m1
+        k[34] = k[5] * k[0];
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         q[0] = k[4];
         qd[0] = 0.0;
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         pos[0] = [0.0, 0.0];
         vel[0] = [0.0, 0.0];
@@ -273,7 +269,7 @@ impl Model for HingedCylinderClosed {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let et0 = qd[0] * qd[0];
         let et1 = rc_c * rc_c;
@@ -282,75 +278,68 @@ impl Model for HingedCylinderClosed {
             + (k[11] * et0 * et1 / (rc_s * rc_s))
             + (k[12] * et0 * et1 / rc_s.powi(4))
             + (k[11] * et0 * rc_c.powi(3) / rc_s.powi(4))
-            + (k[12] * et0 * rc_c.powi(4) / rc_s.powi(4))
-            + (k[13] * et0 * (rc_s * rc_s))
-            + (k[13] * et0 * et1))
-            + (k[14] + (k[15] * rc_s))
+            + (k[12] * et0 * rc_c.powi(4) / rc_s.powi(4)))
+            + (k[13] + (k[14] * rc_s))
     }
 
     fn momenta(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let qt0 = rc_c * rc_c;
         let qt1 = rc_c.powi(3);
         let qt2 = rc_c.powi(4);
         let qt3 = qd[0] * qd[0];
-        mass[0] = k[16]
-            + (k[17] * rc_c / (rc_s * rc_s))
-            + (k[17] * qt0 / (rc_s * rc_s))
+        mass[0] = k[15]
+            + (k[16] * rc_c / (rc_s * rc_s))
+            + (k[16] * qt0 / (rc_s * rc_s))
             + (k[11] * qt0 / rc_s.powi(4))
-            + (k[17] * qt1 / rc_s.powi(4))
-            + (k[11] * qt2 / rc_s.powi(4))
-            + (k[18] * (rc_s * rc_s))
-            + (k[18] * qt0);
-        rhs[0] = -(k[15] * rc_c)
+            + (k[16] * qt1 / rc_s.powi(4))
+            + (k[11] * qt2 / rc_s.powi(4));
+        rhs[0] = -(k[14] * rc_c)
             + (k[11] * qt3 / rc_s)
-            + (k[17] * qt3 * rc_c / rc_s)
+            + (k[16] * qt3 * rc_c / rc_s)
             + (k[11] * qt3 * rc_c / rc_s.powi(3))
-            + (k[19] * qt3 * qt0 / rc_s.powi(3))
-            + (k[20] * qt3 * qt1 / rc_s.powi(3))
-            + (k[17] * qt3 * qt1 / rc_s.powi(5))
-            + (k[20] * qt3 * qt2 / rc_s.powi(5))
-            + (k[17] * qt3 * rc_c.powi(5) / rc_s.powi(5));
+            + (k[17] * qt3 * qt0 / rc_s.powi(3))
+            + (k[18] * qt3 * qt1 / rc_s.powi(3))
+            + (k[16] * qt3 * qt1 / rc_s.powi(5))
+            + (k[18] * qt3 * qt2 / rc_s.powi(5))
+            + (k[16] * qt3 * rc_c.powi(5) / rc_s.powi(5));
     }
 
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ft0 = rc_s * rc_s;
         let ft1 = rc_c * rc_c;
         let ft2 = qd[0] * qd[0];
-        let ft3 = rc_s.powi(3);
-        let ft4 = rc_c.powi(3);
-        let ft5 = k[22] * qdd[0] * rc_s * ft1;
-        let ft6 = rc_s.powi(4);
+        let ft3 = rc_c.powi(3);
+        let ft4 = k[20] * qdd[0] * rc_s * rc_c;
+        let ft5 = rc_s.powi(4);
         out[0] = k[1]
             * (-(k[3] * qdd[0]) - (k[3] * qdd[0] * rc_c / ft0) - (k[3] * qdd[0] * ft1 / ft0)
                 + (k[3] * ft2 / rc_s)
-                + (k[21] * ft2 * rc_c / rc_s)
-                + (k[21] * ft2 * ft1 / ft3)
-                + (k[21] * ft2 * ft4 / ft3));
-        out[1] = -((k[22] * qdd[0] * rc_s * rc_c) + ft5 + (k[22] * qdd[0] * ft3)
-            - (k[22] * ft2 * ft0)
-            - (k[23] * ft2 * ft0 * rc_c)
-            - (k[23] * ft2 * ft1)
-            - (k[23] * ft2 * ft4)
-            + (k[24] * qdd[0] * ft6)
-            + (k[24] * ft2 * ft3 * rc_c))
+                + (k[19] * ft2 * rc_c / rc_s)
+                + (k[19] * ft2 * ft1 / rc_s.powi(3))
+                + (k[19] * ft2 * ft3 / rc_s.powi(3)));
+        out[1] = -(ft4 + (k[20] * qdd[0] * rc_s)
+            - (k[20] * ft2 * ft0)
+            - (k[21] * ft2 * rc_c)
+            - (k[21] * ft2 * ft1)
+            + (k[22] * qdd[0] * ft5)
+            + (k[22] * ft2 * rc_s.powi(3) * rc_c))
             / 2.0
-            / ft3;
-        out[2] = (ft5 + (k[22] * qdd[0] * rc_s * ft4) + (k[22] * qdd[0] * ft3 * rc_c)
-            - (k[22] * ft2 * ft0 * rc_c)
-            - (k[23] * ft2 * ft0 * ft1)
-            - (k[23] * ft2 * ft4)
-            - (k[23] * ft2 * rc_c.powi(4))
-            + (k[24] * qdd[0] * ft6 * rc_c)
-            + (k[25] * ft6)
-            - (k[24] * ft2 * rc_s.powi(5)))
+            / rc_s.powi(3);
+        out[2] = ((k[20] * qdd[0] * rc_s * ft1) + ft4
+            - (k[20] * ft2 * ft0 * rc_c)
+            - (k[21] * ft2 * ft1)
+            - (k[21] * ft2 * ft3)
+            + (k[22] * qdd[0] * ft5 * rc_c)
+            + (k[23] * ft5)
+            - (k[22] * ft2 * rc_s.powi(5)))
             / 2.0
-            / ft6;
+            / ft5;
     }
 
     fn gaps(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
@@ -369,7 +358,7 @@ impl Model for HingedCylinderClosed {
     }
 
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         out[0] = k[2] - (k[3] * rc_s) - (k[3] * rc_c / rc_s) - (k[3] * (rc_c * rc_c) / rc_s);
         out[1] = f64::INFINITY;
@@ -389,7 +378,7 @@ impl Model for HingedCylinderClosed {
     }
 
     fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         q_full[0] = 0.0;
         qd_full[0] = 0.0;
@@ -404,7 +393,7 @@ impl Model for HingedCylinderClosed {
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         poses[0] = [k[9] * rc_c, k[9] * rc_s, q[0]];
         poses[1] = [(k[3] / rc_s) + (k[3] * rc_c / rc_s), k[3], 0.0];
@@ -424,82 +413,82 @@ impl Model for HingedCylinderClosed {
 
 impl Reduction for HingedCylinderClosed {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[4], k[7], k[8], delta);
         let rt0 = rc_s.powi(4);
-        let rt1 = k[27] + (k[27] * rc_c) - (k[28] * (rc_s * rc_s)) + (k[29] * rt0);
+        let rt1 = k[25] + (k[25] * rc_c) - (k[26] * (rc_s * rc_s)) + (k[27] * rt0);
         let rt2 = rc_s.powi(3);
         let rt3 = rc_c * rc_c;
         let rt4 = rc_s.powi(5);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: k[26] * rt0 * rc_ds / rt1,
+            theta_dot_sq: k[24] * rt0 * rc_ds / rt1,
             theta_ddot: -3.0
-                * (-(k[30] * rt2 * rc_c * rc_ds) - (k[30] * rt2 * rt3 * rc_ds)
-                    + (k[31] * rt0 * rc_c)
-                    + (k[31] * rt0 * rt3)
-                    + (k[31] * rt4 * rc_c * rc_ds)
-                    - (k[31] * rt4 * rc_ds)
-                    - (k[32] * rc_s.powi(6) * rc_c)
-                    + (k[33] * rc_s.powi(8) * rc_c))
+                * (-(k[28] * rt2 * rc_c * rc_ds) - (k[28] * rt2 * rt3 * rc_ds)
+                    + (k[29] * rt0 * rc_c)
+                    + (k[29] * rt0 * rt3)
+                    + (k[29] * rt4 * rc_c * rc_ds)
+                    - (k[29] * rt4 * rc_ds)
+                    - (k[30] * rc_s.powi(6) * rc_c)
+                    + (k[31] * rc_s.powi(8) * rc_c))
                 / 2.0
                 / (rt1 * rt1),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let rt0 = rc_s.powi(4);
-        k[26] * rt0 * rc_ds / (k[27] + (k[27] * rc_c) - (k[28] * (rc_s * rc_s)) + (k[29] * rt0))
+        k[24] * rt0 * rc_ds / (k[25] + (k[25] * rc_c) - (k[26] * (rc_s * rc_s)) + (k[27] * rt0))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[4], k[7], k[8], delta);
         let rt0 = rc_s.powi(4);
-        let rt1 = k[27] + (k[27] * rc_c) - (k[28] * (rc_s * rc_s)) + (k[29] * rt0);
+        let rt1 = k[25] + (k[25] * rc_c) - (k[26] * (rc_s * rc_s)) + (k[27] * rt0);
         let rt2 = rc_s.powi(3);
         let rt3 = rc_c * rc_c;
         let rt4 = rc_s.powi(5);
-        let rc_w2 = k[26] * rt0 * rc_ds / rt1;
+        let rc_w2 = k[24] * rt0 * rc_ds / rt1;
         let rc_acc = -3.0
-            * (-(k[30] * rt2 * rc_c * rc_ds) - (k[30] * rt2 * rt3 * rc_ds)
-                + (k[31] * rt0 * rc_c)
-                + (k[31] * rt0 * rt3)
-                + (k[31] * rt4 * rc_c * rc_ds)
-                - (k[31] * rt4 * rc_ds)
-                - (k[32] * rc_s.powi(6) * rc_c)
-                + (k[33] * rc_s.powi(8) * rc_c))
+            * (-(k[28] * rt2 * rc_c * rc_ds) - (k[28] * rt2 * rt3 * rc_ds)
+                + (k[29] * rt0 * rc_c)
+                + (k[29] * rt0 * rt3)
+                + (k[29] * rt4 * rc_c * rc_ds)
+                - (k[29] * rt4 * rc_ds)
+                - (k[30] * rc_s.powi(6) * rc_c)
+                + (k[31] * rc_s.powi(8) * rc_c))
             / 2.0
             / (rt1 * rt1);
-        let ft0 = k[22] * rc_c * rc_w2 / rc_s;
-        let ft1 = k[34] * rc_w2 / rc_s;
+        let ft0 = k[20] * rc_c * rc_w2 / rc_s;
+        let ft1 = k[32] * rc_w2 / rc_s;
         let ft2 = rc_c * rc_c;
-        let ft3 = k[22] * ft2 * rc_w2 / rc_s.powi(3);
+        let ft3 = k[20] * ft2 * rc_w2 / rc_s.powi(3);
         let ft4 = rc_c.powi(3);
-        let ft5 = k[22] * ft4 * rc_w2 / rc_s.powi(3);
-        out[0] = -(k[34] * rc_acc) + ft0 + ft1
-            - (k[34] * rc_c * rc_acc / (rc_s * rc_s))
-            - (k[34] * ft2 * rc_acc / (rc_s * rc_s))
+        let ft5 = k[20] * ft4 * rc_w2 / rc_s.powi(3);
+        out[0] = -(k[32] * rc_acc) + ft0 + ft1
+            - (k[32] * rc_c * rc_acc / (rc_s * rc_s))
+            - (k[32] * ft2 * rc_acc / (rc_s * rc_s))
             + ft3
             + ft5;
-        out[1] = -(k[34] * rc_acc) + ft0 + ft1
-            - (k[34] * rc_c * rc_acc / (rc_s * rc_s))
-            - (k[34] * ft2 * rc_acc / (rc_s * rc_s))
+        out[1] = -(k[32] * rc_acc) + ft0 + ft1
+            - (k[32] * rc_c * rc_acc / (rc_s * rc_s))
+            - (k[32] * ft2 * rc_acc / (rc_s * rc_s))
             + ft3
             + ft5
-            - (k[35] * rc_s * rc_acc)
-            - (k[35] * rc_c * rc_w2);
-        out[2] = k[36] + (k[34] * rc_c * rc_acc / rc_s)
-            - (k[34] * rc_c * rc_w2 / (rc_s * rc_s))
-            - (k[22] * ft2 * rc_w2 / (rc_s * rc_s))
-            + (k[34] * ft2 * rc_acc / rc_s.powi(3))
-            + (k[34] * ft4 * rc_acc / rc_s.powi(3))
-            - (k[22] * ft4 * rc_w2 / rc_s.powi(4))
-            - (k[22] * rc_c.powi(4) * rc_w2 / rc_s.powi(4))
-            - (k[35] * rc_s * rc_w2)
-            + (k[35] * rc_c * rc_acc);
+            - (k[33] * rc_s * rc_acc)
+            - (k[33] * rc_c * rc_w2);
+        out[2] = k[34] + (k[32] * rc_c * rc_acc / rc_s)
+            - (k[32] * rc_c * rc_w2 / (rc_s * rc_s))
+            - (k[20] * ft2 * rc_w2 / (rc_s * rc_s))
+            + (k[32] * ft2 * rc_acc / rc_s.powi(3))
+            + (k[32] * ft4 * rc_acc / rc_s.powi(3))
+            - (k[20] * ft4 * rc_w2 / rc_s.powi(4))
+            - (k[20] * rc_c.powi(4) * rc_w2 / rc_s.powi(4))
+            - (k[33] * rc_s * rc_w2)
+            + (k[33] * rc_c * rc_acc);
     }
 
     fn force_polynomial(&self, _k: &[f64], _contact: usize, _out: &mut [f64]) {}
@@ -525,7 +514,7 @@ impl Reduction for HingedCylinderClosed {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         q[0] = k[4] - delta;
         qd[0] = theta_dot;
     }

@@ -89,7 +89,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 30,
+    n_constants: 27,
     coordinates: &["theta", "xc"],
     system_coordinates: &["x1", "y1", "theta", "xc"],
     reduced: 0,
@@ -222,40 +222,34 @@ impl Model for HingedCylinderFree {
         k[13] = (k[2] * k[2]) * k[0] / 3.0;
         // k[14] = ell/2
         k[14] = k[2] / 2.0;
-        // k[15] = ell^2*m1/24
-        k[15] = (k[2] * k[2]) * k[0] / 24.0;
-        // k[16] = ell^2*m1/8
-        k[16] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[17] = m2/2
-        k[17] = k[1] / 2.0;
-        // k[18] = R*g*m2
-        k[18] = k[3] * k[5] * k[1];
-        // k[19] = ell*g*m1/2
-        k[19] = k[2] * k[5] * k[0] / 2.0;
-        // k[20] = ell^2*m1/12
-        k[20] = (k[2] * k[2]) * k[0] / 12.0;
-        // k[21] = ell^2*m1/4
-        k[21] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[22] = ell*m1/2
-        k[22] = k[2] * k[0] / 2.0;
-        // k[23] = g*m1
-        k[23] = k[5] * k[0];
-        // k[24] = 2*R
-        k[24] = 2.0 * k[3];
-        // k[25] = 3/(ell^2*m1)
-        k[25] = 3.0 / (k[2] * k[2]) / k[0];
-        // k[26] = rc_wi^2*rc_ai
-        k[26] = (k[8] * k[8]) * k[13];
-        // k[27] = ell*g*m1
-        k[27] = k[2] * k[5] * k[0];
-        // k[28] = 3*g/(2*ell)
-        k[28] = 3.0 * k[5] / 2.0 / k[2];
-        // k[29] = rc_p0/m2
-        k[29] = k[12] / k[1];
+        // k[15] = ell^2*m1/6
+        k[15] = (k[2] * k[2]) * k[0] / 6.0;
+        // k[16] = m2/2
+        k[16] = k[1] / 2.0;
+        // k[17] = R*g*m2
+        k[17] = k[3] * k[5] * k[1];
+        // k[18] = ell*g*m1/2
+        k[18] = k[2] * k[5] * k[0] / 2.0;
+        // k[19] = ell*m1/2
+        k[19] = k[2] * k[0] / 2.0;
+        // k[20] = g*m1
+        k[20] = k[5] * k[0];
+        // k[21] = 2*R
+        k[21] = 2.0 * k[3];
+        // k[22] = 3/(ell^2*m1)
+        k[22] = 3.0 / (k[2] * k[2]) / k[0];
+        // k[23] = rc_wi^2*rc_ai
+        k[23] = (k[8] * k[8]) * k[13];
+        // k[24] = ell*g*m1
+        k[24] = k[2] * k[5] * k[0];
+        // k[25] = 3*g/(2*ell)
+        k[25] = 3.0 * k[5] / 2.0 / k[2];
+        // k[26] = rc_p0/m2
+        k[26] = k[12] / k[1];
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         q[0] = k[6];
         qd[0] = k[8];
         q[1] = k[7];
@@ -263,7 +257,7 @@ impl Model for HingedCylinderFree {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         pos[0] = [0.0, 0.0];
         vel[0] = [0.0, 0.0];
@@ -276,43 +270,38 @@ impl Model for HingedCylinderFree {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..30]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        let et0 = qd[0] * qd[0];
-        ((k[15] * et0)
-            + (k[16] * et0 * (rc_s * rc_s))
-            + (k[16] * et0 * (rc_c * rc_c))
-            + (k[17] * (qd[1] * qd[1])))
-            + (k[18] + (k[19] * rc_s))
+        let k = &k[..27]; // one bounds check for all constant loads
+        let rc_s = q[0].sin();
+        ((k[15] * (qd[0] * qd[0])) + (k[16] * (qd[1] * qd[1]))) + (k[17] + (k[18] * rc_s))
     }
 
     fn momenta(&self, k: &[f64], _q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         out[0] = k[1] * qd[1];
     }
 
     fn equations(&self, k: &[f64], q: &[f64], _qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        mass[0] = k[20] + (k[21] * (rc_s * rc_s)) + (k[21] * (rc_c * rc_c));
+        let k = &k[..27]; // one bounds check for all constant loads
+        let rc_c = q[0].cos();
+        mass[0] = k[13];
         mass[1] = 0.0;
         mass[2] = 0.0;
         mass[3] = k[1];
-        rhs[0] = -k[19] * rc_c;
+        rhs[0] = -k[18] * rc_c;
         rhs[1] = 0.0;
     }
 
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ft0 = qd[0] * qd[0];
         out[0] = 0.0;
-        out[1] = -(k[22] * qdd[0] * rc_s) - (k[22] * ft0 * rc_c);
-        out[2] = k[23] + (k[22] * qdd[0] * rc_c) - (k[22] * ft0 * rc_s);
+        out[1] = -(k[19] * qdd[0] * rc_s) - (k[19] * ft0 * rc_c);
+        out[2] = k[20] + (k[19] * qdd[0] * rc_c) - (k[19] * ft0 * rc_s);
     }
 
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         out[0] = -(k[3] / rc_s) - (k[3] * rc_c / rc_s) + q[1];
         out[1] = 0.0;
@@ -320,7 +309,7 @@ impl Model for HingedCylinderFree {
     }
 
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let jt0 = rc_c * rc_c;
         let jt1 = qd[0] * qd[0];
@@ -331,15 +320,15 @@ impl Model for HingedCylinderFree {
         jac[4] = 0.0;
         jac[5] = 0.0;
         bias[0] = -(k[3] * jt1 / rc_s)
-            - (k[24] * jt1 * rc_c / rc_s)
-            - (k[24] * jt1 * jt0 / rc_s.powi(3))
-            - (k[24] * jt1 * rc_c.powi(3) / rc_s.powi(3));
+            - (k[21] * jt1 * rc_c / rc_s)
+            - (k[21] * jt1 * jt0 / rc_s.powi(3))
+            - (k[21] * jt1 * rc_c.powi(3) / rc_s.powi(3));
         bias[1] = 0.0;
         bias[2] = 0.0;
     }
 
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         out[0] = k[2] - (k[3] * rc_s) - (q[1] * rc_c);
         out[1] = f64::INFINITY;
@@ -370,7 +359,7 @@ impl Model for HingedCylinderFree {
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         poses[0] = [k[14] * rc_c, k[14] * rc_s, q[0]];
         poses[1] = [q[1], k[3], 0.0];
@@ -390,29 +379,29 @@ impl Model for HingedCylinderFree {
 
 impl Reduction for HingedCylinderFree {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[6], k[10], k[11], delta);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: k[25] * (k[26] + (k[27] * rc_ds)),
-            theta_ddot: -k[28] * rc_c,
+            theta_dot_sq: k[22] * (k[23] + (k[24] * rc_ds)),
+            theta_ddot: -k[25] * rc_c,
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], _rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..30]; // one bounds check for all constant loads
-        k[25] * (k[26] + (k[27] * rc_ds))
+        let k = &k[..27]; // one bounds check for all constant loads
+        k[22] * (k[23] + (k[24] * rc_ds))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[6], k[10], k[11], delta);
-        let rc_w2 = k[25] * (k[26] + (k[27] * rc_ds));
-        let rc_acc = -k[28] * rc_c;
+        let rc_w2 = k[22] * (k[23] + (k[24] * rc_ds));
+        let rc_acc = -k[25] * rc_c;
         out[0] = 0.0;
-        out[1] = -(k[22] * rc_s * rc_acc) - (k[22] * rc_c * rc_w2);
-        out[2] = k[23] - (k[22] * rc_s * rc_w2) + (k[22] * rc_c * rc_acc);
+        out[1] = -(k[19] * rc_s * rc_acc) - (k[19] * rc_c * rc_w2);
+        out[2] = k[20] - (k[19] * rc_s * rc_w2) + (k[19] * rc_c * rc_acc);
     }
 
     fn force_polynomial(&self, _k: &[f64], _contact: usize, _out: &mut [f64]) {}
@@ -436,11 +425,11 @@ impl Reduction for HingedCylinderFree {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let rc_t = t;
         q[0] = k[6] - delta;
         qd[0] = theta_dot;
-        q[1] = k[7] + (k[29] * rc_t);
-        qd[1] = k[29];
+        q[1] = k[7] + (k[26] * rc_t);
+        qd[1] = k[26];
     }
 }

@@ -53,7 +53,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 35,
+    n_constants: 32,
     coordinates: &["theta"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced: 0,
@@ -155,7 +155,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 8,
         force_degrees: &[3, 0, 0],
         fall_degree: Some(2),
-        lean_constants: &[6, 7, 8, 24, 31, 32, 33, 34],
+        lean_constants: &[6, 7, 8, 21, 28, 29, 30, 31],
     }),
     route_note: "",
 };
@@ -183,58 +183,50 @@ impl Model for HingedRodClosed {
         k[5] = (k[3] / k[2]).asin();
         // k[9] = ell/2
         k[9] = k[2] / 2.0;
-        // k[10] = ell^2*m1/24
-        k[10] = (k[2] * k[2]) * k[0] / 24.0;
-        // k[11] = ell^2*m1/8 + ell^2*m2/2
-        let h11_t0 = k[2] * k[2];
-        k[11] = (h11_t0 * k[0] / 8.0) + (h11_t0 * k[1] / 2.0);
-        // k[12] = ell^2*m1/8
-        k[12] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[13] = a*g*m2/2
-        k[13] = k[3] * k[4] * k[1] / 2.0;
-        // k[14] = ell*g*m1/2
-        k[14] = k[2] * k[4] * k[0] / 2.0;
-        // k[15] = ell^2*m1/12
-        k[15] = (k[2] * k[2]) * k[0] / 12.0;
-        // k[16] = ell^2*m1/4 + ell^2*m2
-        let h16_t0 = k[2] * k[2];
-        k[16] = (h16_t0 * k[0] / 4.0) + (h16_t0 * k[1]);
-        // k[17] = ell^2*m1/4
-        k[17] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[18] = ell^2*m2
-        k[18] = (k[2] * k[2]) * k[1];
-        // k[19] = ell*m1 + 2*ell*m2
-        k[19] = (k[2] * k[0]) + (2.0 * k[2] * k[1]);
-        // k[20] = g*m1
-        k[20] = k[4] * k[0];
-        // k[21] = ell*m1/2
-        k[21] = k[2] * k[0] / 2.0;
-        // k[22] = a/2
-        k[22] = k[3] / 2.0;
-        // k[23] = 3*g*m1/ell
-        k[23] = 3.0 * k[4] * k[0] / k[2];
-        // k[25] = 3/(2*ell)
-        k[25] = 3.0 / 2.0 / k[2];
-        // k[26] = 6*g*m1*m2
-        k[26] = 6.0 * k[4] * k[0] * k[1];
-        // k[27] = 3*g*m1*m2
-        k[27] = 3.0 * k[4] * k[0] * k[1];
-        // k[28] = g*m1^2
-        k[28] = k[4] * (k[0] * k[0]);
-        // k[29] = ell*m2
-        k[29] = k[2] * k[1];
-        // k[30] = (ell*m1 + 2*ell*m2)/2
-        k[30] = ((k[2] * k[0]) + (2.0 * k[2] * k[1])) / 2.0;
+        // k[10] = ell^2*m1/6
+        k[10] = (k[2] * k[2]) * k[0] / 6.0;
+        // k[11] = ell^2*m2/2
+        k[11] = (k[2] * k[2]) * k[1] / 2.0;
+        // k[12] = a*g*m2/2
+        k[12] = k[3] * k[4] * k[1] / 2.0;
+        // k[13] = ell*g*m1/2
+        k[13] = k[2] * k[4] * k[0] / 2.0;
+        // k[14] = ell^2*m1/3
+        k[14] = (k[2] * k[2]) * k[0] / 3.0;
+        // k[15] = ell^2*m2
+        k[15] = (k[2] * k[2]) * k[1];
+        // k[16] = ell*m1 + 2*ell*m2
+        k[16] = (k[2] * k[0]) + (2.0 * k[2] * k[1]);
+        // k[17] = g*m1
+        k[17] = k[4] * k[0];
+        // k[18] = ell*m1/2
+        k[18] = k[2] * k[0] / 2.0;
+        // k[19] = a/2
+        k[19] = k[3] / 2.0;
+        // k[20] = 3*g*m1/ell
+        k[20] = 3.0 * k[4] * k[0] / k[2];
+        // k[22] = 3/(2*ell)
+        k[22] = 3.0 / 2.0 / k[2];
+        // k[23] = 6*g*m1*m2
+        k[23] = 6.0 * k[4] * k[0] * k[1];
+        // k[24] = 3*g*m1*m2
+        k[24] = 3.0 * k[4] * k[0] * k[1];
+        // k[25] = g*m1^2
+        k[25] = k[4] * (k[0] * k[0]);
+        // k[26] = ell*m2
+        k[26] = k[2] * k[1];
+        // k[27] = (ell*m1 + 2*ell*m2)/2
+        k[27] = ((k[2] * k[0]) + (2.0 * k[2] * k[1])) / 2.0;
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         q[0] = k[5];
         qd[0] = 0.0;
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let pt0 = k[2] * rc_c;
         let pt1 = -k[2] * qd[0] * rc_s;
@@ -249,29 +241,28 @@ impl Model for HingedRodClosed {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..35]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
+        let k = &k[..32]; // one bounds check for all constant loads
+        let rc_s = q[0].sin();
         let et0 = qd[0] * qd[0];
-        ((k[10] * et0) + (k[11] * et0 * (rc_s * rc_s)) + (k[12] * et0 * (rc_c * rc_c)))
-            + (k[13] + (k[14] * rc_s))
+        ((k[10] * et0) + (k[11] * et0 * (rc_s * rc_s))) + (k[12] + (k[13] * rc_s))
     }
 
     fn momenta(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        mass[0] = k[15] + (k[16] * (rc_s * rc_s)) + (k[17] * (rc_c * rc_c));
-        rhs[0] = -(k[14] * rc_c) - (k[18] * (qd[0] * qd[0]) * rc_s * rc_c);
+        mass[0] = k[14] + (k[15] * (rc_s * rc_s));
+        rhs[0] = -(k[13] * rc_c) - (k[15] * (qd[0] * qd[0]) * rc_s * rc_c);
     }
 
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ft0 = qd[0] * qd[0];
         out[0] = k[1] * (-(k[2] * qdd[0] * rc_s) - (k[2] * ft0 * rc_c));
-        out[1] = -((k[19] * qdd[0] * rc_s) + (k[19] * ft0 * rc_c)) / 2.0;
-        out[2] = k[20] + (k[21] * qdd[0] * rc_c) - (k[21] * ft0 * rc_s);
+        out[1] = -((k[16] * qdd[0] * rc_s) + (k[16] * ft0 * rc_c)) / 2.0;
+        out[2] = k[17] + (k[18] * qdd[0] * rc_c) - (k[18] * ft0 * rc_s);
     }
 
     fn gaps(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
@@ -298,13 +289,13 @@ impl Model for HingedRodClosed {
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let rc_s = q[0].sin();
-        out[0] = k[13] - (forces[0] * (-k[22] + (k[2] * rc_s)));
+        out[0] = k[12] - (forces[0] * (-k[19] + (k[2] * rc_s)));
     }
 
     fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         q_full[0] = 0.0;
         qd_full[0] = 0.0;
@@ -317,10 +308,10 @@ impl Model for HingedRodClosed {
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         poses[0] = [k[9] * rc_c, k[9] * rc_s, q[0]];
-        poses[1] = [k[22] + (k[2] * rc_c), k[22], 0.0];
+        poses[1] = [k[19] + (k[2] * rc_c), k[19], 0.0];
         sizes[0] = -k[9];
         sizes[1] = 0.0;
         sizes[2] = k[9];
@@ -338,47 +329,47 @@ impl Model for HingedRodClosed {
 
 impl Reduction for HingedRodClosed {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[7], k[8], delta);
         let rt0 = rc_s * rc_s;
-        let rt1 = k[0] + (k[24] * rt0);
+        let rt1 = k[0] + (k[21] * rt0);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: k[23] * rc_ds / rt1,
-            theta_ddot: -k[25]
-                * ((k[26] * rc_s * rc_c * rc_ds) + (k[27] * rt0 * rc_c) + (k[28] * rc_c))
+            theta_dot_sq: k[20] * rc_ds / rt1,
+            theta_ddot: -k[22]
+                * ((k[23] * rc_s * rc_c * rc_ds) + (k[24] * rt0 * rc_c) + (k[25] * rc_c))
                 / (rt1 * rt1),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..35]; // one bounds check for all constant loads
-        k[23] * rc_ds / (k[0] + (k[24] * (rc_s * rc_s)))
+        let k = &k[..32]; // one bounds check for all constant loads
+        k[20] * rc_ds / (k[0] + (k[21] * (rc_s * rc_s)))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[7], k[8], delta);
         let rt0 = rc_s * rc_s;
-        let rt1 = k[0] + (k[24] * rt0);
-        let rc_w2 = k[23] * rc_ds / rt1;
-        let rc_acc = -k[25]
-            * ((k[26] * rc_s * rc_c * rc_ds) + (k[27] * rt0 * rc_c) + (k[28] * rc_c))
+        let rt1 = k[0] + (k[21] * rt0);
+        let rc_w2 = k[20] * rc_ds / rt1;
+        let rc_acc = -k[22]
+            * ((k[23] * rc_s * rc_c * rc_ds) + (k[24] * rt0 * rc_c) + (k[25] * rc_c))
             / (rt1 * rt1);
-        out[0] = -(k[29] * rc_s * rc_acc) - (k[29] * rc_c * rc_w2);
-        out[1] = -(k[30] * rc_s * rc_acc) - (k[30] * rc_c * rc_w2);
-        out[2] = k[20] - (k[21] * rc_s * rc_w2) + (k[21] * rc_c * rc_acc);
+        out[0] = -(k[26] * rc_s * rc_acc) - (k[26] * rc_c * rc_w2);
+        out[1] = -(k[27] * rc_s * rc_acc) - (k[27] * rc_c * rc_w2);
+        out[2] = k[17] - (k[18] * rc_s * rc_w2) + (k[18] * rc_c * rc_acc);
     }
 
     fn force_polynomial(&self, k: &[f64], contact: usize, out: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         match contact {
             0 => {
-                out[0] = -k[31];
-                out[1] = k[32];
+                out[0] = -k[28];
+                out[1] = k[29];
                 out[2] = 0.0;
-                out[3] = k[24];
+                out[3] = k[21];
             }
             _ => {}
         }
@@ -393,23 +384,23 @@ impl Reduction for HingedRodClosed {
         // k[8] = rc_ci = ((1 - a/ell)*(1 + a/ell))^(1/2)
         let c3_t0 = k[3] / k[2];
         k[8] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
-        // k[24] = 3*m2
-        k[24] = 3.0 * k[1];
-        // k[31] = 2*m1*rc_si
-        k[31] = 2.0 * k[0] * k[7];
-        // k[32] = 3*m1
-        k[32] = 3.0 * k[0];
-        // k[33] = ell/(3*g)
-        k[33] = k[2] / 3.0 / k[4];
-        // k[34] = ell*m2/(g*m1)
-        k[34] = k[2] * k[1] / k[4] / k[0];
+        // k[21] = 3*m2
+        k[21] = 3.0 * k[1];
+        // k[28] = 2*m1*rc_si
+        k[28] = 2.0 * k[0] * k[7];
+        // k[29] = 3*m1
+        k[29] = 3.0 * k[0];
+        // k[30] = ell/(3*g)
+        k[30] = k[2] / 3.0 / k[4];
+        // k[31] = ell*m2/(g*m1)
+        k[31] = k[2] * k[1] / k[4] / k[0];
     }
 
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
-        out[0] = k[33];
+        let k = &k[..32]; // one bounds check for all constant loads
+        out[0] = k[30];
         out[1] = 0.0;
-        out[2] = k[34];
+        out[2] = k[31];
     }
 
     fn full_state(
@@ -421,7 +412,7 @@ impl Reduction for HingedRodClosed {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         q[0] = k[5] - delta;
         qd[0] = theta_dot;
     }

@@ -77,7 +77,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 29,
+    n_constants: 26,
     coordinates: &["theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced: 0,
@@ -212,40 +212,34 @@ impl Model for HingedRodFree {
         k[12] = (k[2] * k[2]) * k[0] / 3.0;
         // k[13] = ell/2
         k[13] = k[2] / 2.0;
-        // k[14] = ell^2*m1/24
-        k[14] = (k[2] * k[2]) * k[0] / 24.0;
-        // k[15] = ell^2*m1/8
-        k[15] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[16] = m2/2
-        k[16] = k[1] / 2.0;
-        // k[17] = a*g*m2/2
-        k[17] = k[3] * k[4] * k[1] / 2.0;
-        // k[18] = ell*g*m1/2
-        k[18] = k[2] * k[4] * k[0] / 2.0;
-        // k[19] = ell^2*m1/12
-        k[19] = (k[2] * k[2]) * k[0] / 12.0;
-        // k[20] = ell^2*m1/4
-        k[20] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[21] = ell*m1/2
-        k[21] = k[2] * k[0] / 2.0;
-        // k[22] = g*m1
-        k[22] = k[4] * k[0];
-        // k[23] = a/2
-        k[23] = k[3] / 2.0;
-        // k[24] = 3/(ell^2*m1)
-        k[24] = 3.0 / (k[2] * k[2]) / k[0];
-        // k[25] = rc_wi^2*rc_ai
-        k[25] = (k[7] * k[7]) * k[12];
-        // k[26] = ell*g*m1
-        k[26] = k[2] * k[4] * k[0];
-        // k[27] = 3*g/(2*ell)
-        k[27] = 3.0 * k[4] / 2.0 / k[2];
-        // k[28] = rc_p0/m2
-        k[28] = k[11] / k[1];
+        // k[14] = ell^2*m1/6
+        k[14] = (k[2] * k[2]) * k[0] / 6.0;
+        // k[15] = m2/2
+        k[15] = k[1] / 2.0;
+        // k[16] = a*g*m2/2
+        k[16] = k[3] * k[4] * k[1] / 2.0;
+        // k[17] = ell*g*m1/2
+        k[17] = k[2] * k[4] * k[0] / 2.0;
+        // k[18] = ell*m1/2
+        k[18] = k[2] * k[0] / 2.0;
+        // k[19] = g*m1
+        k[19] = k[4] * k[0];
+        // k[20] = a/2
+        k[20] = k[3] / 2.0;
+        // k[21] = 3/(ell^2*m1)
+        k[21] = 3.0 / (k[2] * k[2]) / k[0];
+        // k[22] = rc_wi^2*rc_ai
+        k[22] = (k[7] * k[7]) * k[12];
+        // k[23] = ell*g*m1
+        k[23] = k[2] * k[4] * k[0];
+        // k[24] = 3*g/(2*ell)
+        k[24] = 3.0 * k[4] / 2.0 / k[2];
+        // k[25] = rc_p0/m2
+        k[25] = k[11] / k[1];
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         q[0] = k[5];
         qd[0] = k[7];
         q[1] = k[6];
@@ -253,7 +247,7 @@ impl Model for HingedRodFree {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         pos[0] = [0.0, 0.0];
         vel[0] = [0.0, 0.0];
@@ -266,43 +260,38 @@ impl Model for HingedRodFree {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..29]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        let et0 = qd[0] * qd[0];
-        ((k[14] * et0)
-            + (k[15] * et0 * (rc_s * rc_s))
-            + (k[15] * et0 * (rc_c * rc_c))
-            + (k[16] * (qd[1] * qd[1])))
-            + (k[17] + (k[18] * rc_s))
+        let k = &k[..26]; // one bounds check for all constant loads
+        let rc_s = q[0].sin();
+        ((k[14] * (qd[0] * qd[0])) + (k[15] * (qd[1] * qd[1]))) + (k[16] + (k[17] * rc_s))
     }
 
     fn momenta(&self, k: &[f64], _q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         out[0] = k[1] * qd[1];
     }
 
     fn equations(&self, k: &[f64], q: &[f64], _qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        mass[0] = k[19] + (k[20] * (rc_s * rc_s)) + (k[20] * (rc_c * rc_c));
+        let k = &k[..26]; // one bounds check for all constant loads
+        let rc_c = q[0].cos();
+        mass[0] = k[12];
         mass[1] = 0.0;
         mass[2] = 0.0;
         mass[3] = k[1];
-        rhs[0] = -k[18] * rc_c;
+        rhs[0] = -k[17] * rc_c;
         rhs[1] = 0.0;
     }
 
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ft0 = qd[0] * qd[0];
         out[0] = 0.0;
-        out[1] = -(k[21] * qdd[0] * rc_s) - (k[21] * ft0 * rc_c);
-        out[2] = k[22] + (k[21] * qdd[0] * rc_c) - (k[21] * ft0 * rc_s);
+        out[1] = -(k[18] * qdd[0] * rc_s) - (k[18] * ft0 * rc_c);
+        out[2] = k[19] + (k[18] * qdd[0] * rc_c) - (k[18] * ft0 * rc_s);
     }
 
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let rc_c = q[0].cos();
         out[0] = -(k[2] * rc_c) + q[1];
         out[1] = 0.0;
@@ -310,7 +299,7 @@ impl Model for HingedRodFree {
     }
 
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         jac[0] = k[2] * rc_s;
         jac[1] = 1.0;
@@ -332,9 +321,9 @@ impl Model for HingedRodFree {
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let rc_s = q[0].sin();
-        out[0] = k[17] - (forces[0] * (-k[23] + (k[2] * rc_s)));
+        out[0] = k[16] - (forces[0] * (-k[20] + (k[2] * rc_s)));
     }
 
     fn to_full(&self, _k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
@@ -349,10 +338,10 @@ impl Model for HingedRodFree {
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         poses[0] = [k[13] * rc_c, k[13] * rc_s, q[0]];
-        poses[1] = [k[23] + q[1], k[23], 0.0];
+        poses[1] = [k[20] + q[1], k[20], 0.0];
         sizes[0] = -k[13];
         sizes[1] = 0.0;
         sizes[2] = k[13];
@@ -370,29 +359,29 @@ impl Model for HingedRodFree {
 
 impl Reduction for HingedRodFree {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[9], k[10], delta);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: k[24] * (k[25] + (k[26] * rc_ds)),
-            theta_ddot: -k[27] * rc_c,
+            theta_dot_sq: k[21] * (k[22] + (k[23] * rc_ds)),
+            theta_ddot: -k[24] * rc_c,
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], _rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..29]; // one bounds check for all constant loads
-        k[24] * (k[25] + (k[26] * rc_ds))
+        let k = &k[..26]; // one bounds check for all constant loads
+        k[21] * (k[22] + (k[23] * rc_ds))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[9], k[10], delta);
-        let rc_w2 = k[24] * (k[25] + (k[26] * rc_ds));
-        let rc_acc = -k[27] * rc_c;
+        let rc_w2 = k[21] * (k[22] + (k[23] * rc_ds));
+        let rc_acc = -k[24] * rc_c;
         out[0] = 0.0;
-        out[1] = -(k[21] * rc_s * rc_acc) - (k[21] * rc_c * rc_w2);
-        out[2] = k[22] - (k[21] * rc_s * rc_w2) + (k[21] * rc_c * rc_acc);
+        out[1] = -(k[18] * rc_s * rc_acc) - (k[18] * rc_c * rc_w2);
+        out[2] = k[19] - (k[18] * rc_s * rc_w2) + (k[18] * rc_c * rc_acc);
     }
 
     fn force_polynomial(&self, _k: &[f64], _contact: usize, _out: &mut [f64]) {}
@@ -416,11 +405,11 @@ impl Reduction for HingedRodFree {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let rc_t = t;
         q[0] = k[5] - delta;
         qd[0] = theta_dot;
-        q[1] = k[6] + (k[28] * rc_t);
-        qd[1] = k[28];
+        q[1] = k[6] + (k[25] * rc_t);
+        qd[1] = k[25];
     }
 }

@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 44,
+    n_constants: 41,
     coordinates: &["theta"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced: 0,
@@ -177,87 +177,79 @@ impl Model for HingedRodSpringClosed {
         k[6] = (k[3] / k[2]).asin();
         // k[10] = ell/2
         k[10] = k[2] / 2.0;
-        // k[11] = ell^2*m1/24
-        k[11] = (k[2] * k[2]) * k[0] / 24.0;
-        // k[12] = ell^2*m1/8 + ell^2*m2/2
-        let h12_t0 = k[2] * k[2];
-        k[12] = (h12_t0 * k[0] / 8.0) + (h12_t0 * k[1] / 2.0);
-        // k[13] = ell^2*m1/8
-        k[13] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[14] = a*g*m2/2
-        k[14] = k[3] * k[4] * k[1] / 2.0;
-        // k[15] = ell*g*m1/2
-        k[15] = k[2] * k[4] * k[0] / 2.0;
-        // k[16] = k/2
-        k[16] = k[5] / 2.0;
-        // k[17] = ell*cos(asin(a/ell))
-        k[17] = k[2] * (k[3] / k[2]).asin().cos();
-        // k[18] = ell^2*m1/12
-        k[18] = (k[2] * k[2]) * k[0] / 12.0;
-        // k[19] = ell^2*m1/4 + ell^2*m2
-        let h19_t0 = k[2] * k[2];
-        k[19] = (h19_t0 * k[0] / 4.0) + (h19_t0 * k[1]);
-        // k[20] = ell^2*m1/4
-        k[20] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[21] = ell*k
-        k[21] = k[2] * k[5];
-        // k[22] = ell^2*m2
-        k[22] = (k[2] * k[2]) * k[1];
-        // k[23] = 2*ell*k*cos(asin(a/ell))
-        k[23] = 2.0 * k[2] * k[5] * (k[3] / k[2]).asin().cos();
-        // k[24] = ell*m1 + 2*ell*m2
-        k[24] = (k[2] * k[0]) + (2.0 * k[2] * k[1]);
-        // k[25] = 2*ell*k
-        k[25] = 2.0 * k[2] * k[5];
-        // k[26] = g*m1
-        k[26] = k[4] * k[0];
-        // k[27] = ell*m1/2
-        k[27] = k[2] * k[0] / 2.0;
-        // k[28] = 3/ell
-        k[28] = 3.0 / k[2];
-        // k[29] = 3*m2
-        k[29] = 3.0 * k[1];
-        // k[30] = 2*ell*k*rc_ci - 2*ell*k*cos(asin(a/ell))
-        k[30] = (2.0 * k[2] * k[5] * k[9]) - (2.0 * k[2] * k[5] * (k[3] / k[2]).asin().cos());
-        // k[31] = 3/(2*ell)
-        k[31] = 3.0 / 2.0 / k[2];
-        // k[32] = 2*ell*k*m1
-        k[32] = 2.0 * k[2] * k[5] * k[0];
-        // k[33] = 2*ell*k*m1*rc_ci - 2*ell*k*m1*cos(asin(a/ell))
-        k[33] = (2.0 * k[2] * k[5] * k[0] * k[9])
+        // k[11] = ell^2*m1/6
+        k[11] = (k[2] * k[2]) * k[0] / 6.0;
+        // k[12] = ell^2*m2/2
+        k[12] = (k[2] * k[2]) * k[1] / 2.0;
+        // k[13] = a*g*m2/2
+        k[13] = k[3] * k[4] * k[1] / 2.0;
+        // k[14] = ell*g*m1/2
+        k[14] = k[2] * k[4] * k[0] / 2.0;
+        // k[15] = k/2
+        k[15] = k[5] / 2.0;
+        // k[16] = ell*cos(asin(a/ell))
+        k[16] = k[2] * (k[3] / k[2]).asin().cos();
+        // k[17] = ell^2*m1/3
+        k[17] = (k[2] * k[2]) * k[0] / 3.0;
+        // k[18] = ell^2*m2
+        k[18] = (k[2] * k[2]) * k[1];
+        // k[19] = ell*k
+        k[19] = k[2] * k[5];
+        // k[20] = 2*ell*k*cos(asin(a/ell))
+        k[20] = 2.0 * k[2] * k[5] * (k[3] / k[2]).asin().cos();
+        // k[21] = ell*m1 + 2*ell*m2
+        k[21] = (k[2] * k[0]) + (2.0 * k[2] * k[1]);
+        // k[22] = 2*ell*k
+        k[22] = 2.0 * k[2] * k[5];
+        // k[23] = g*m1
+        k[23] = k[4] * k[0];
+        // k[24] = ell*m1/2
+        k[24] = k[2] * k[0] / 2.0;
+        // k[25] = 3/ell
+        k[25] = 3.0 / k[2];
+        // k[26] = 3*m2
+        k[26] = 3.0 * k[1];
+        // k[27] = 2*ell*k*rc_ci - 2*ell*k*cos(asin(a/ell))
+        k[27] = (2.0 * k[2] * k[5] * k[9]) - (2.0 * k[2] * k[5] * (k[3] / k[2]).asin().cos());
+        // k[28] = 3/(2*ell)
+        k[28] = 3.0 / 2.0 / k[2];
+        // k[29] = 2*ell*k*m1
+        k[29] = 2.0 * k[2] * k[5] * k[0];
+        // k[30] = 2*ell*k*m1*rc_ci - 2*ell*k*m1*cos(asin(a/ell))
+        k[30] = (2.0 * k[2] * k[5] * k[0] * k[9])
             - (2.0 * k[2] * k[5] * k[0] * (k[3] / k[2]).asin().cos());
-        // k[34] = 12*ell*k*m2*rc_ci - 12*ell*k*m2*cos(asin(a/ell))
-        k[34] = (12.0 * k[2] * k[5] * k[1] * k[9])
+        // k[31] = 12*ell*k*m2*rc_ci - 12*ell*k*m2*cos(asin(a/ell))
+        k[31] = (12.0 * k[2] * k[5] * k[1] * k[9])
             - (12.0 * k[2] * k[5] * k[1] * (k[3] / k[2]).asin().cos());
-        // k[35] = 6*ell*k*m2
-        k[35] = 6.0 * k[2] * k[5] * k[1];
-        // k[36] = 6*ell*k*m2*rc_ci - 6*ell*k*m2*cos(asin(a/ell))
-        k[36] = (6.0 * k[2] * k[5] * k[1] * k[9])
+        // k[32] = 6*ell*k*m2
+        k[32] = 6.0 * k[2] * k[5] * k[1];
+        // k[33] = 6*ell*k*m2*rc_ci - 6*ell*k*m2*cos(asin(a/ell))
+        k[33] = (6.0 * k[2] * k[5] * k[1] * k[9])
             - (6.0 * k[2] * k[5] * k[1] * (k[3] / k[2]).asin().cos());
-        // k[37] = 6*g*m1*m2
-        k[37] = 6.0 * k[4] * k[0] * k[1];
-        // k[38] = 3*g*m1*m2
-        k[38] = 3.0 * k[4] * k[0] * k[1];
-        // k[39] = g*m1^2
-        k[39] = k[4] * (k[0] * k[0]);
-        // k[40] = ell*k*cos(asin(a/ell))
-        k[40] = k[2] * k[5] * (k[3] / k[2]).asin().cos();
-        // k[41] = ell*m2
-        k[41] = k[2] * k[1];
-        // k[42] = (ell*m1 + 2*ell*m2)/2
-        k[42] = ((k[2] * k[0]) + (2.0 * k[2] * k[1])) / 2.0;
-        // k[43] = a/2
-        k[43] = k[3] / 2.0;
+        // k[34] = 6*g*m1*m2
+        k[34] = 6.0 * k[4] * k[0] * k[1];
+        // k[35] = 3*g*m1*m2
+        k[35] = 3.0 * k[4] * k[0] * k[1];
+        // k[36] = g*m1^2
+        k[36] = k[4] * (k[0] * k[0]);
+        // k[37] = ell*k*cos(asin(a/ell))
+        k[37] = k[2] * k[5] * (k[3] / k[2]).asin().cos();
+        // k[38] = ell*m2
+        k[38] = k[2] * k[1];
+        // k[39] = (ell*m1 + 2*ell*m2)/2
+        k[39] = ((k[2] * k[0]) + (2.0 * k[2] * k[1])) / 2.0;
+        // k[40] = a/2
+        k[40] = k[3] / 2.0;
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         q[0] = k[6];
         qd[0] = 0.0;
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let pt0 = k[2] * rc_c;
         let pt1 = -k[2] * qd[0] * rc_s;
@@ -272,33 +264,33 @@ impl Model for HingedRodSpringClosed {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let et0 = qd[0] * qd[0];
-        ((k[11] * et0) + (k[12] * et0 * (rc_s * rc_s)) + (k[13] * et0 * (rc_c * rc_c)))
-            + (k[14]
-                + (k[15] * rc_s)
-                + (k[16] * ((-k[17] + (k[2] * rc_c)) * (-k[17] + (k[2] * rc_c)))))
+        ((k[11] * et0) + (k[12] * et0 * (rc_s * rc_s)))
+            + (k[13]
+                + (k[14] * rc_s)
+                + (k[15] * ((-k[16] + (k[2] * rc_c)) * (-k[16] + (k[2] * rc_c)))))
     }
 
     fn momenta(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        mass[0] = k[18] + (k[19] * (rc_s * rc_s)) + (k[20] * (rc_c * rc_c));
-        rhs[0] = -(k[15] * rc_c) + (k[21] * (-k[17] + (k[2] * rc_c)) * rc_s)
-            - (k[22] * (qd[0] * qd[0]) * rc_s * rc_c);
+        mass[0] = k[17] + (k[18] * (rc_s * rc_s));
+        rhs[0] = -(k[14] * rc_c) + (k[19] * (-k[16] + (k[2] * rc_c)) * rc_s)
+            - (k[18] * (qd[0] * qd[0]) * rc_s * rc_c);
     }
 
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ft0 = qd[0] * qd[0];
-        out[0] = (k[5] * (-k[17] + (k[2] * rc_c)))
+        out[0] = (k[5] * (-k[16] + (k[2] * rc_c)))
             + (k[1] * (-(k[2] * qdd[0] * rc_s) - (k[2] * ft0 * rc_c)));
-        out[1] = -(k[23] + (k[24] * qdd[0] * rc_s) - (k[25] * rc_c) + (k[24] * ft0 * rc_c)) / 2.0;
-        out[2] = k[26] + (k[27] * qdd[0] * rc_c) - (k[27] * ft0 * rc_s);
+        out[1] = -(k[20] + (k[21] * qdd[0] * rc_s) - (k[22] * rc_c) + (k[21] * ft0 * rc_c)) / 2.0;
+        out[2] = k[23] + (k[24] * qdd[0] * rc_c) - (k[24] * ft0 * rc_s);
     }
 
     fn gaps(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
@@ -335,7 +327,7 @@ impl Model for HingedRodSpringClosed {
     }
 
     fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         q_full[0] = 0.0;
         qd_full[0] = 0.0;
@@ -348,10 +340,10 @@ impl Model for HingedRodSpringClosed {
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         poses[0] = [k[10] * rc_c, k[10] * rc_s, q[0]];
-        poses[1] = [k[43] + (k[2] * rc_c), k[43], 0.0];
+        poses[1] = [k[40] + (k[2] * rc_c), k[40], 0.0];
         sizes[0] = -k[10];
         sizes[1] = 0.0;
         sizes[2] = k[10];
@@ -369,55 +361,55 @@ impl Model for HingedRodSpringClosed {
 
 impl Reduction for HingedRodSpringClosed {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let rt0 = rc_dc * rc_dc;
         let rt1 = rc_s * rc_s;
-        let rt2 = k[0] + (k[29] * rt1);
+        let rt2 = k[0] + (k[26] * rt1);
         let rt3 = rc_s.powi(3);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: -k[28] * (-(k[30] * rc_dc) + (k[21] * rt0) - (k[26] * rc_ds)) / rt2,
-            theta_ddot: -k[31]
-                * ((k[32] * rc_s * rc_dc) - (k[33] * rc_s) + (k[34] * rc_s * rc_c * rc_dc)
-                    - (k[35] * rc_s * rc_c * rt0)
-                    + (k[35] * rt3 * rc_dc)
-                    - (k[36] * rt3)
-                    + (k[37] * rc_s * rc_c * rc_ds)
-                    + (k[38] * rt1 * rc_c)
-                    + (k[39] * rc_c))
+            theta_dot_sq: -k[25] * (-(k[27] * rc_dc) + (k[19] * rt0) - (k[23] * rc_ds)) / rt2,
+            theta_ddot: -k[28]
+                * ((k[29] * rc_s * rc_dc) - (k[30] * rc_s) + (k[31] * rc_s * rc_c * rc_dc)
+                    - (k[32] * rc_s * rc_c * rt0)
+                    + (k[32] * rt3 * rc_dc)
+                    - (k[33] * rt3)
+                    + (k[34] * rc_s * rc_c * rc_ds)
+                    + (k[35] * rt1 * rc_c)
+                    + (k[36] * rc_c))
                 / (rt2 * rt2),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
-        let k = &k[..44]; // one bounds check for all constant loads
-        -k[28] * (-(k[30] * rc_dc) + (k[21] * (rc_dc * rc_dc)) - (k[26] * rc_ds))
-            / (k[0] + (k[29] * (rc_s * rc_s)))
+        let k = &k[..41]; // one bounds check for all constant loads
+        -k[25] * (-(k[27] * rc_dc) + (k[19] * (rc_dc * rc_dc)) - (k[23] * rc_ds))
+            / (k[0] + (k[26] * (rc_s * rc_s)))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let rt0 = rc_dc * rc_dc;
         let rt1 = rc_s * rc_s;
-        let rt2 = k[0] + (k[29] * rt1);
+        let rt2 = k[0] + (k[26] * rt1);
         let rt3 = rc_s.powi(3);
-        let rc_w2 = -k[28] * (-(k[30] * rc_dc) + (k[21] * rt0) - (k[26] * rc_ds)) / rt2;
-        let rc_acc = -k[31]
-            * ((k[32] * rc_s * rc_dc) - (k[33] * rc_s) + (k[34] * rc_s * rc_c * rc_dc)
-                - (k[35] * rc_s * rc_c * rt0)
-                + (k[35] * rt3 * rc_dc)
-                - (k[36] * rt3)
-                + (k[37] * rc_s * rc_c * rc_ds)
-                + (k[38] * rt1 * rc_c)
-                + (k[39] * rc_c))
+        let rc_w2 = -k[25] * (-(k[27] * rc_dc) + (k[19] * rt0) - (k[23] * rc_ds)) / rt2;
+        let rc_acc = -k[28]
+            * ((k[29] * rc_s * rc_dc) - (k[30] * rc_s) + (k[31] * rc_s * rc_c * rc_dc)
+                - (k[32] * rc_s * rc_c * rt0)
+                + (k[32] * rt3 * rc_dc)
+                - (k[33] * rt3)
+                + (k[34] * rc_s * rc_c * rc_ds)
+                + (k[35] * rt1 * rc_c)
+                + (k[36] * rc_c))
             / (rt2 * rt2);
-        let ft0 = k[21] * rc_c;
-        out[0] = -k[40] + ft0 - (k[41] * rc_s * rc_acc) - (k[41] * rc_c * rc_w2);
-        out[1] = -k[40] + ft0 - (k[42] * rc_s * rc_acc) - (k[42] * rc_c * rc_w2);
-        out[2] = k[26] - (k[27] * rc_s * rc_w2) + (k[27] * rc_c * rc_acc);
+        let ft0 = k[19] * rc_c;
+        out[0] = -k[37] + ft0 - (k[38] * rc_s * rc_acc) - (k[38] * rc_c * rc_w2);
+        out[1] = -k[37] + ft0 - (k[39] * rc_s * rc_acc) - (k[39] * rc_c * rc_w2);
+        out[2] = k[23] - (k[24] * rc_s * rc_w2) + (k[24] * rc_c * rc_acc);
     }
 
     fn force_polynomial(&self, _k: &[f64], _contact: usize, _out: &mut [f64]) {}
@@ -444,7 +436,7 @@ impl Reduction for HingedRodSpringClosed {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         q[0] = k[6] - delta;
         qd[0] = theta_dot;
     }

@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "ladder_leans",
         meaning: "the top must start below the ladder's length (a < ell)",
     }],
-    n_constants: 18,
+    n_constants: 16,
     coordinates: &["x1", "y1", "theta"],
     system_coordinates: &["x1", "y1", "theta"],
     reduced: 2,
@@ -164,26 +164,22 @@ impl Model for LadderFriction {
         k[8] = k[1] / 2.0;
         // k[9] = ell*m1/2
         k[9] = k[1] * k[0] / 2.0;
-        // k[10] = ell^2*m1/24
-        k[10] = (k[1] * k[1]) * k[0] / 24.0;
-        // k[11] = ell^2*m1/8
-        k[11] = (k[1] * k[1]) * k[0] / 8.0;
-        // k[12] = m1/2
-        k[12] = k[0] / 2.0;
-        // k[13] = ell*g*m1/2
-        k[13] = k[1] * k[3] * k[0] / 2.0;
-        // k[14] = g*m1
-        k[14] = k[3] * k[0];
-        // k[15] = ell^2*m1/12
-        k[15] = (k[1] * k[1]) * k[0] / 12.0;
-        // k[16] = ell^2*m1/4
-        k[16] = (k[1] * k[1]) * k[0] / 4.0;
-        // k[17] = 0.0 + ell
-        k[17] = 0.0 + k[1];
+        // k[10] = ell^2*m1/6
+        k[10] = (k[1] * k[1]) * k[0] / 6.0;
+        // k[11] = m1/2
+        k[11] = k[0] / 2.0;
+        // k[12] = ell*g*m1/2
+        k[12] = k[1] * k[3] * k[0] / 2.0;
+        // k[13] = g*m1
+        k[13] = k[3] * k[0];
+        // k[14] = ell^2*m1/3
+        k[14] = (k[1] * k[1]) * k[0] / 3.0;
+        // k[15] = 0.0 + ell
+        k[15] = 0.0 + k[1];
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..18]; // one bounds check for all constant loads
+        let k = &k[..16]; // one bounds check for all constant loads
         q[0] = -k[6];
         qd[0] = 0.0;
         q[1] = 0.0;
@@ -193,7 +189,7 @@ impl Model for LadderFriction {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..18]; // one bounds check for all constant loads
+        let k = &k[..16]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         pos[0] = [q[0], q[1]];
         vel[0] = [qd[0], qd[1]];
@@ -210,27 +206,24 @@ impl Model for LadderFriction {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..18]; // one bounds check for all constant loads
+        let k = &k[..16]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let et0 = qd[2] * qd[2];
         (-(k[9] * qd[2] * qd[0] * rc_s)
             + (k[9] * qd[2] * qd[1] * rc_c)
-            + (k[10] * et0)
-            + (k[11] * et0 * (rc_s * rc_s))
-            + (k[11] * et0 * (rc_c * rc_c))
-            + (k[12] * (qd[0] * qd[0]))
-            + (k[12] * (qd[1] * qd[1])))
-            + ((k[13] * rc_s) + (k[14] * q[1]))
+            + (k[10] * (qd[2] * qd[2]))
+            + (k[11] * (qd[0] * qd[0]))
+            + (k[11] * (qd[1] * qd[1])))
+            + ((k[12] * rc_s) + (k[13] * q[1]))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..18]; // one bounds check for all constant loads
+        let k = &k[..16]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         out[0] = -(k[9] * qd[2] * rc_s) + (k[0] * qd[0]);
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..18]; // one bounds check for all constant loads
+        let k = &k[..16]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let qt0 = -k[9] * rc_s;
         let qt1 = k[9] * rc_c;
@@ -243,10 +236,10 @@ impl Model for LadderFriction {
         mass[5] = qt1;
         mass[6] = qt0;
         mass[7] = qt1;
-        mass[8] = k[15] + (k[16] * (rc_s * rc_s)) + (k[16] * (rc_c * rc_c));
+        mass[8] = k[14];
         rhs[0] = k[9] * qt2 * rc_c;
-        rhs[1] = -k[14] + (k[9] * qt2 * rc_s);
-        rhs[2] = -k[13] * rc_c;
+        rhs[1] = -k[13] + (k[9] * qt2 * rc_s);
+        rhs[2] = -k[12] * rc_c;
     }
 
     fn forces_full(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _qdd: &[f64], out: &mut [f64]) {
@@ -255,14 +248,14 @@ impl Model for LadderFriction {
     }
 
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..18]; // one bounds check for all constant loads
+        let k = &k[..16]; // one bounds check for all constant loads
         let rc_c = q[2].cos();
         out[0] = -(k[1] * rc_c) - q[0];
         out[1] = q[1];
     }
 
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..18]; // one bounds check for all constant loads
+        let k = &k[..16]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         jac[0] = -1.0;
         jac[1] = 0.0;
@@ -280,7 +273,7 @@ impl Model for LadderFriction {
     }
 
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..18]; // one bounds check for all constant loads
+        let k = &k[..16]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         jac[0] = 1.0;
         jac[1] = 0.0;
@@ -312,7 +305,7 @@ impl Model for LadderFriction {
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..18]; // one bounds check for all constant loads
+        let k = &k[..16]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let dt0 = 0.0 + 0.0;
         poses[0] = [(k[8] * rc_c) + q[0], (k[8] * rc_s) + q[1], q[2]];
@@ -323,7 +316,7 @@ impl Model for LadderFriction {
         sizes[4] = dt0;
         sizes[5] = dt0;
         sizes[6] = dt0;
-        sizes[7] = k[17];
+        sizes[7] = k[15];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {

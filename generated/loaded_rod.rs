@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 24,
+    n_constants: 22,
     coordinates: &["x1", "y1", "theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced: 2,
@@ -181,52 +181,50 @@ impl Model for LoadedRod {
         k[10] = (3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
             + (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
             + (k[3] * (k[2] * k[2]) / (k[0] + k[2]));
-        // k[11] = ell^2*m1/24 + ell^2*m1*m3/(8*(m1 + m3))
+        // k[11] = ell^2*m1/24 + ell^2*m1*m3/(8*(m1 + m3)) + ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*(2*m1*m3 + m1^2 + m3^2))
         let h11_t0 = k[3] * k[3];
-        k[11] = (h11_t0 * k[0] / 24.0) + (h11_t0 * k[0] * k[2] / 8.0 / (k[0] + k[2]));
-        // k[12] = ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*(2*m1*m3 + m1^2 + m3^2))
-        let h12_t0 = k[3] * k[3];
-        let h12_t1 = k[2] * k[2];
-        let h12_t2 = k[0] * k[0];
-        k[12] = (h12_t0 * k[0] * h12_t1 / ((2.0 * k[0] * k[2]) + h12_t2 + h12_t1))
-            + (5.0 * h12_t0 * h12_t2 * k[2] / 8.0 / ((2.0 * k[0] * k[2]) + h12_t2 + h12_t1))
-            + (h12_t0 * k[0].powi(3) / 8.0 / ((2.0 * k[0] * k[2]) + h12_t2 + h12_t1))
-            + (h12_t0 * k[2].powi(3) / 2.0 / ((2.0 * k[0] * k[2]) + h12_t2 + h12_t1));
-        // k[13] = m1/2 + m3/2
-        k[13] = (k[0] / 2.0) + (k[2] / 2.0);
-        // k[14] = m2/2
-        k[14] = k[1] / 2.0;
-        // k[15] = a*g*m2/2
-        k[15] = k[4] * k[5] * k[1] / 2.0;
-        // k[16] = 3*ell*g*m1*m3/(2*(m1 + m3)) + ell*g*m1^2/(2*(m1 + m3)) + ell*g*m3^2/(m1 + m3)
-        k[16] = (3.0 * k[3] * k[5] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
+        let h11_t1 = k[2] * k[2];
+        let h11_t2 = k[0] * k[0];
+        k[11] = (h11_t0 * k[0] / 24.0)
+            + (h11_t0 * k[0] * k[2] / 8.0 / (k[0] + k[2]))
+            + (h11_t0 * k[0] * h11_t1 / ((2.0 * k[0] * k[2]) + h11_t2 + h11_t1))
+            + (5.0 * h11_t0 * h11_t2 * k[2] / 8.0 / ((2.0 * k[0] * k[2]) + h11_t2 + h11_t1))
+            + (h11_t0 * k[0].powi(3) / 8.0 / ((2.0 * k[0] * k[2]) + h11_t2 + h11_t1))
+            + (h11_t0 * k[2].powi(3) / 2.0 / ((2.0 * k[0] * k[2]) + h11_t2 + h11_t1));
+        // k[12] = m1/2 + m3/2
+        k[12] = (k[0] / 2.0) + (k[2] / 2.0);
+        // k[13] = m2/2
+        k[13] = k[1] / 2.0;
+        // k[14] = a*g*m2/2
+        k[14] = k[4] * k[5] * k[1] / 2.0;
+        // k[15] = 3*ell*g*m1*m3/(2*(m1 + m3)) + ell*g*m1^2/(2*(m1 + m3)) + ell*g*m3^2/(m1 + m3)
+        k[15] = (3.0 * k[3] * k[5] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
             + (k[3] * k[5] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
             + (k[3] * k[5] * (k[2] * k[2]) / (k[0] + k[2]));
-        // k[17] = g*m1 + g*m3
-        k[17] = (k[5] * k[0]) + (k[5] * k[2]);
-        // k[18] = m1 + m3
-        k[18] = k[0] + k[2];
-        // k[19] = ell^2*m1/12 + ell^2*m1*m3/(4*(m1 + m3))
-        let h19_t0 = k[3] * k[3];
-        k[19] = (h19_t0 * k[0] / 12.0) + (h19_t0 * k[0] * k[2] / 4.0 / (k[0] + k[2]));
-        // k[20] = 2*ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*m1*m3 + m1^2 + m3^2)
-        let h20_t0 = k[3] * k[3];
-        let h20_t1 = k[2] * k[2];
-        let h20_t2 = k[0] * k[0];
-        k[20] = (2.0 * h20_t0 * k[0] * h20_t1 / ((2.0 * k[0] * k[2]) + h20_t2 + h20_t1))
-            + (5.0 * h20_t0 * h20_t2 * k[2] / 4.0 / ((2.0 * k[0] * k[2]) + h20_t2 + h20_t1))
-            + (h20_t0 * k[0].powi(3) / 4.0 / ((2.0 * k[0] * k[2]) + h20_t2 + h20_t1))
-            + (h20_t0 * k[2].powi(3) / ((2.0 * k[0] * k[2]) + h20_t2 + h20_t1));
-        // k[21] = a/2
-        k[21] = k[4] / 2.0;
-        // k[22] = ell*(m1/2 + m3)/(m1 + m3)
-        k[22] = k[3] * ((k[0] / 2.0) + k[2]) / (k[0] + k[2]);
-        // k[23] = ell*m1/(2*(m1 + m3))
-        k[23] = k[3] * k[0] / (2.0 * (k[0] + k[2]));
+        // k[16] = g*m1 + g*m3
+        k[16] = (k[5] * k[0]) + (k[5] * k[2]);
+        // k[17] = m1 + m3
+        k[17] = k[0] + k[2];
+        // k[18] = ell^2*m1/12 + ell^2*m1*m3/(4*(m1 + m3)) + 2*ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*m1*m3 + m1^2 + m3^2)
+        let h18_t0 = k[3] * k[3];
+        let h18_t1 = k[2] * k[2];
+        let h18_t2 = k[0] * k[0];
+        k[18] = (h18_t0 * k[0] / 12.0)
+            + (h18_t0 * k[0] * k[2] / 4.0 / (k[0] + k[2]))
+            + (2.0 * h18_t0 * k[0] * h18_t1 / ((2.0 * k[0] * k[2]) + h18_t2 + h18_t1))
+            + (5.0 * h18_t0 * h18_t2 * k[2] / 4.0 / ((2.0 * k[0] * k[2]) + h18_t2 + h18_t1))
+            + (h18_t0 * k[0].powi(3) / 4.0 / ((2.0 * k[0] * k[2]) + h18_t2 + h18_t1))
+            + (h18_t0 * k[2].powi(3) / ((2.0 * k[0] * k[2]) + h18_t2 + h18_t1));
+        // k[19] = a/2
+        k[19] = k[4] / 2.0;
+        // k[20] = ell*(m1/2 + m3)/(m1 + m3)
+        k[20] = k[3] * ((k[0] / 2.0) + k[2]) / (k[0] + k[2]);
+        // k[21] = ell*m1/(2*(m1 + m3))
+        k[21] = k[3] * k[0] / (2.0 * (k[0] + k[2]));
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = 0.0;
@@ -238,7 +236,7 @@ impl Model for LoadedRod {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         pos[0] = [q[0], q[1]];
         vel[0] = [qd[0], qd[1]];
@@ -262,52 +260,49 @@ impl Model for LoadedRod {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let et0 = qd[2] * qd[2];
         (-(k[10] * qd[2] * qd[0] * rc_s)
             + (k[10] * qd[2] * qd[1] * rc_c)
-            + (k[11] * et0)
-            + (k[12] * et0 * (rc_s * rc_s))
-            + (k[12] * et0 * (rc_c * rc_c))
-            + (k[13] * (qd[0] * qd[0]))
-            + (k[14] * (qd[3] * qd[3]))
-            + (k[13] * (qd[1] * qd[1])))
-            + (k[15] + (k[16] * rc_s) + (k[17] * q[1]))
+            + (k[11] * (qd[2] * qd[2]))
+            + (k[12] * (qd[0] * qd[0]))
+            + (k[13] * (qd[3] * qd[3]))
+            + (k[12] * (qd[1] * qd[1])))
+            + (k[14] + (k[15] * rc_s) + (k[16] * q[1]))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
-        out[0] = -(k[10] * qd[2] * rc_s) + (k[18] * qd[0]);
+        out[0] = -(k[10] * qd[2] * rc_s) + (k[17] * qd[0]);
         out[1] = k[1] * qd[3];
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let qt0 = -k[10] * rc_s;
         let qt1 = k[10] * rc_c;
         let qt2 = qd[2] * qd[2];
-        mass[0] = k[18];
+        mass[0] = k[17];
         mass[1] = 0.0;
         mass[2] = qt0;
         mass[3] = 0.0;
         mass[4] = 0.0;
-        mass[5] = k[18];
+        mass[5] = k[17];
         mass[6] = qt1;
         mass[7] = 0.0;
         mass[8] = qt0;
         mass[9] = qt1;
-        mass[10] = k[19] + (k[20] * (rc_s * rc_s)) + (k[20] * (rc_c * rc_c));
+        mass[10] = k[18];
         mass[11] = 0.0;
         mass[12] = 0.0;
         mass[13] = 0.0;
         mass[14] = 0.0;
         mass[15] = k[1];
         rhs[0] = k[10] * qt2 * rc_c;
-        rhs[1] = -k[17] + (k[10] * qt2 * rc_s);
-        rhs[2] = -k[16] * rc_c;
+        rhs[1] = -k[16] + (k[10] * qt2 * rc_s);
+        rhs[2] = -k[15] * rc_c;
         rhs[3] = 0.0;
     }
 
@@ -317,14 +312,14 @@ impl Model for LoadedRod {
     }
 
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let rc_c = q[2].cos();
         out[0] = -(k[3] * rc_c) - q[0] + q[3];
         out[1] = q[1];
     }
 
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         jac[0] = -1.0;
         jac[1] = 0.0;
@@ -346,9 +341,9 @@ impl Model for LoadedRod {
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
-        out[0] = k[15] - (forces[0] * (-k[21] + (k[3] * rc_s)));
+        out[0] = k[14] - (forces[0] * (-k[19] + (k[3] * rc_s)));
     }
 
     fn to_full(&self, _k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
@@ -363,13 +358,13 @@ impl Model for LoadedRod {
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         poses[0] = [(k[9] * rc_c) + q[0], (k[9] * rc_s) + q[1], q[2]];
-        poses[1] = [k[21] + q[3], k[21], 0.0];
-        sizes[0] = -k[22];
+        poses[1] = [k[19] + q[3], k[19], 0.0];
+        sizes[0] = -k[20];
         sizes[1] = 0.0;
-        sizes[2] = k[23];
+        sizes[2] = k[21];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;

@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 49,
+    n_constants: 46,
     coordinates: &["x1", "theta"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced: 1,
@@ -154,7 +154,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 9,
         force_degrees: &[3, 4],
         fall_degree: Some(2),
-        lean_constants: &[7, 8, 9, 31, 38, 39, 40, 41, 42, 43, 44, 45],
+        lean_constants: &[7, 8, 9, 28, 35, 36, 37, 38, 39, 40, 41, 42],
     }),
     route_note: "",
 };
@@ -190,148 +190,130 @@ impl Model for LoadedRodClosed {
             + (k[3] * k[1])
             + (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
             + (k[3] * (k[2] * k[2]) / (k[0] + k[2]));
-        // k[14] = ell^2*m1/24 + ell^2*m1*m3/(8*(m1 + m3))
+        // k[14] = ell^2*m1/24 + ell^2*m1*m3/(8*(m1 + m3)) + ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*(2*m1*m3 + m1^2 + m3^2))
         let h14_t0 = k[3] * k[3];
-        k[14] = (h14_t0 * k[0] / 24.0) + (h14_t0 * k[0] * k[2] / 8.0 / (k[0] + k[2]));
-        // k[15] = ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + ell^2*m2/2 + 5*ell^2*m1^2*m3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*(2*m1*m3 + m1^2 + m3^2))
-        let h15_t0 = k[3] * k[3];
-        let h15_t1 = k[2] * k[2];
-        let h15_t2 = k[0] * k[0];
-        k[15] = (h15_t0 * k[0] * h15_t1 / ((2.0 * k[0] * k[2]) + h15_t2 + h15_t1))
-            + (h15_t0 * k[1] / 2.0)
-            + (5.0 * h15_t0 * h15_t2 * k[2] / 8.0 / ((2.0 * k[0] * k[2]) + h15_t2 + h15_t1))
-            + (h15_t0 * k[0].powi(3) / 8.0 / ((2.0 * k[0] * k[2]) + h15_t2 + h15_t1))
-            + (h15_t0 * k[2].powi(3) / 2.0 / ((2.0 * k[0] * k[2]) + h15_t2 + h15_t1));
-        // k[16] = ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*(2*m1*m3 + m1^2 + m3^2))
-        let h16_t0 = k[3] * k[3];
-        let h16_t1 = k[2] * k[2];
-        let h16_t2 = k[0] * k[0];
-        k[16] = (h16_t0 * k[0] * h16_t1 / ((2.0 * k[0] * k[2]) + h16_t2 + h16_t1))
-            + (5.0 * h16_t0 * h16_t2 * k[2] / 8.0 / ((2.0 * k[0] * k[2]) + h16_t2 + h16_t1))
-            + (h16_t0 * k[0].powi(3) / 8.0 / ((2.0 * k[0] * k[2]) + h16_t2 + h16_t1))
-            + (h16_t0 * k[2].powi(3) / 2.0 / ((2.0 * k[0] * k[2]) + h16_t2 + h16_t1));
-        // k[17] = m1/2 + m2/2 + m3/2
-        k[17] = (k[0] / 2.0) + (k[1] / 2.0) + (k[2] / 2.0);
-        // k[18] = a*g*m2/2
-        k[18] = k[4] * k[5] * k[1] / 2.0;
-        // k[19] = ell*g*m1/2 + ell*g*m3
-        k[19] = (k[3] * k[5] * k[0] / 2.0) + (k[3] * k[5] * k[2]);
-        // k[20] = m1 + m2 + m3
-        k[20] = k[0] + k[1] + k[2];
-        // k[21] = ell^2*m1/12 + ell^2*m1*m3/(4*(m1 + m3))
-        let h21_t0 = k[3] * k[3];
-        k[21] = (h21_t0 * k[0] / 12.0) + (h21_t0 * k[0] * k[2] / 4.0 / (k[0] + k[2]));
-        // k[22] = 2*ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + ell^2*m2 + 5*ell^2*m1^2*m3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*m1*m3 + m1^2 + m3^2)
-        let h22_t0 = k[3] * k[3];
-        let h22_t1 = k[2] * k[2];
-        let h22_t2 = k[0] * k[0];
-        k[22] = (2.0 * h22_t0 * k[0] * h22_t1 / ((2.0 * k[0] * k[2]) + h22_t2 + h22_t1))
-            + (h22_t0 * k[1])
-            + (5.0 * h22_t0 * h22_t2 * k[2] / 4.0 / ((2.0 * k[0] * k[2]) + h22_t2 + h22_t1))
-            + (h22_t0 * k[0].powi(3) / 4.0 / ((2.0 * k[0] * k[2]) + h22_t2 + h22_t1))
-            + (h22_t0 * k[2].powi(3) / ((2.0 * k[0] * k[2]) + h22_t2 + h22_t1));
-        // k[23] = 2*ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*m1*m3 + m1^2 + m3^2)
-        let h23_t0 = k[3] * k[3];
-        let h23_t1 = k[2] * k[2];
-        let h23_t2 = k[0] * k[0];
-        k[23] = (2.0 * h23_t0 * k[0] * h23_t1 / ((2.0 * k[0] * k[2]) + h23_t2 + h23_t1))
-            + (5.0 * h23_t0 * h23_t2 * k[2] / 4.0 / ((2.0 * k[0] * k[2]) + h23_t2 + h23_t1))
-            + (h23_t0 * k[0].powi(3) / 4.0 / ((2.0 * k[0] * k[2]) + h23_t2 + h23_t1))
-            + (h23_t0 * k[2].powi(3) / ((2.0 * k[0] * k[2]) + h23_t2 + h23_t1));
-        // k[24] = ell^2*m2
-        k[24] = (k[3] * k[3]) * k[1];
-        // k[25] = g*m1 + g*m3
-        k[25] = (k[5] * k[0]) + (k[5] * k[2]);
-        // k[26] = 3*ell*m1*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3)
-        k[26] = (3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
+        let h14_t1 = k[2] * k[2];
+        let h14_t2 = k[0] * k[0];
+        k[14] = (h14_t0 * k[0] / 24.0)
+            + (h14_t0 * k[0] * k[2] / 8.0 / (k[0] + k[2]))
+            + (h14_t0 * k[0] * h14_t1 / ((2.0 * k[0] * k[2]) + h14_t2 + h14_t1))
+            + (5.0 * h14_t0 * h14_t2 * k[2] / 8.0 / ((2.0 * k[0] * k[2]) + h14_t2 + h14_t1))
+            + (h14_t0 * k[0].powi(3) / 8.0 / ((2.0 * k[0] * k[2]) + h14_t2 + h14_t1))
+            + (h14_t0 * k[2].powi(3) / 2.0 / ((2.0 * k[0] * k[2]) + h14_t2 + h14_t1));
+        // k[15] = ell^2*m2/2
+        k[15] = (k[3] * k[3]) * k[1] / 2.0;
+        // k[16] = m1/2 + m2/2 + m3/2
+        k[16] = (k[0] / 2.0) + (k[1] / 2.0) + (k[2] / 2.0);
+        // k[17] = a*g*m2/2
+        k[17] = k[4] * k[5] * k[1] / 2.0;
+        // k[18] = ell*g*m1/2 + ell*g*m3
+        k[18] = (k[3] * k[5] * k[0] / 2.0) + (k[3] * k[5] * k[2]);
+        // k[19] = m1 + m2 + m3
+        k[19] = k[0] + k[1] + k[2];
+        // k[20] = ell^2*m1/12 + ell^2*m1*m3/(4*(m1 + m3)) + 2*ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*m1*m3 + m1^2 + m3^2)
+        let h20_t0 = k[3] * k[3];
+        let h20_t1 = k[2] * k[2];
+        let h20_t2 = k[0] * k[0];
+        k[20] = (h20_t0 * k[0] / 12.0)
+            + (h20_t0 * k[0] * k[2] / 4.0 / (k[0] + k[2]))
+            + (2.0 * h20_t0 * k[0] * h20_t1 / ((2.0 * k[0] * k[2]) + h20_t2 + h20_t1))
+            + (5.0 * h20_t0 * h20_t2 * k[2] / 4.0 / ((2.0 * k[0] * k[2]) + h20_t2 + h20_t1))
+            + (h20_t0 * k[0].powi(3) / 4.0 / ((2.0 * k[0] * k[2]) + h20_t2 + h20_t1))
+            + (h20_t0 * k[2].powi(3) / ((2.0 * k[0] * k[2]) + h20_t2 + h20_t1));
+        // k[21] = ell^2*m2
+        k[21] = (k[3] * k[3]) * k[1];
+        // k[22] = g*m1 + g*m3
+        k[22] = (k[5] * k[0]) + (k[5] * k[2]);
+        // k[23] = 3*ell*m1*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3)
+        k[23] = (3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
             + (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
             + (k[3] * (k[2] * k[2]) / (k[0] + k[2]));
-        // k[27] = a/2
-        k[27] = k[4] / 2.0;
-        // k[28] = 12/ell
-        k[28] = 12.0 / k[3];
-        // k[29] = g*m1*m2 + 3*g*m1*m3 + 2*g*m2*m3 + g*m1^2 + 2*g*m3^2
-        k[29] = (k[5] * k[0] * k[1])
+        // k[24] = a/2
+        k[24] = k[4] / 2.0;
+        // k[25] = 12/ell
+        k[25] = 12.0 / k[3];
+        // k[26] = g*m1*m2 + 3*g*m1*m3 + 2*g*m2*m3 + g*m1^2 + 2*g*m3^2
+        k[26] = (k[5] * k[0] * k[1])
             + (3.0 * k[5] * k[0] * k[2])
             + (2.0 * k[5] * k[1] * k[2])
             + (k[5] * (k[0] * k[0]))
             + (2.0 * k[5] * (k[2] * k[2]));
-        // k[30] = 4*m1*m2 + 16*m1*m3 + 12*m2*m3 + 4*m1^2 + 12*m3^2
-        k[30] = (4.0 * k[0] * k[1])
+        // k[27] = 4*m1*m2 + 16*m1*m3 + 12*m2*m3 + 4*m1^2 + 12*m3^2
+        k[27] = (4.0 * k[0] * k[1])
             + (16.0 * k[0] * k[2])
             + (12.0 * k[1] * k[2])
             + (4.0 * (k[0] * k[0]))
             + (12.0 * (k[2] * k[2]));
-        // k[32] = 6/ell
-        k[32] = 6.0 / k[3];
-        // k[33] = 144*g*m1*m2*m3^2 + 24*g*m1*m2^2*m3 + 120*g*m1*m3^3 + 96*g*m2*m3^3 + 60*g*m1^2*m2*m3 + 108*g*m1^2*m3^2 + 6*g*m1^3*m2 + 42*g*m1^3*m3 + 6*g*m1^4 + 48*g*m2^2*m3^2 + 48*g*m3^4
-        let h33_t0 = k[2] * k[2];
-        let h33_t1 = k[1] * k[1];
-        let h33_t2 = k[2].powi(3);
-        let h33_t3 = k[0] * k[0];
-        let h33_t4 = k[0].powi(3);
-        k[33] = (144.0 * k[5] * k[0] * k[1] * h33_t0)
-            + (24.0 * k[5] * k[0] * h33_t1 * k[2])
-            + (120.0 * k[5] * k[0] * h33_t2)
-            + (96.0 * k[5] * k[1] * h33_t2)
-            + (60.0 * k[5] * h33_t3 * k[1] * k[2])
-            + (108.0 * k[5] * h33_t3 * h33_t0)
-            + (6.0 * k[5] * h33_t4 * k[1])
-            + (42.0 * k[5] * h33_t4 * k[2])
+        // k[29] = 6/ell
+        k[29] = 6.0 / k[3];
+        // k[30] = 144*g*m1*m2*m3^2 + 24*g*m1*m2^2*m3 + 120*g*m1*m3^3 + 96*g*m2*m3^3 + 60*g*m1^2*m2*m3 + 108*g*m1^2*m3^2 + 6*g*m1^3*m2 + 42*g*m1^3*m3 + 6*g*m1^4 + 48*g*m2^2*m3^2 + 48*g*m3^4
+        let h30_t0 = k[2] * k[2];
+        let h30_t1 = k[1] * k[1];
+        let h30_t2 = k[2].powi(3);
+        let h30_t3 = k[0] * k[0];
+        let h30_t4 = k[0].powi(3);
+        k[30] = (144.0 * k[5] * k[0] * k[1] * h30_t0)
+            + (24.0 * k[5] * k[0] * h30_t1 * k[2])
+            + (120.0 * k[5] * k[0] * h30_t2)
+            + (96.0 * k[5] * k[1] * h30_t2)
+            + (60.0 * k[5] * h30_t3 * k[1] * k[2])
+            + (108.0 * k[5] * h30_t3 * h30_t0)
+            + (6.0 * k[5] * h30_t4 * k[1])
+            + (42.0 * k[5] * h30_t4 * k[2])
             + (6.0 * k[5] * k[0].powi(4))
-            + (48.0 * k[5] * h33_t1 * h33_t0)
+            + (48.0 * k[5] * h30_t1 * h30_t0)
             + (48.0 * k[5] * k[2].powi(4));
-        // k[34] = 88*g*m1*m2*m3^2 + 20*g*m1*m2^2*m3 + 68*g*m1*m3^3 + 48*g*m2*m3^3 + 48*g*m1^2*m2*m3 + 4*g*m1^2*m2^2 + 68*g*m1^2*m3^2 + 8*g*m1^3*m2 + 28*g*m1^3*m3 + 4*g*m1^4 + 24*g*m2^2*m3^2 + 24*g*m3^4
-        let h34_t0 = k[2] * k[2];
-        let h34_t1 = k[1] * k[1];
-        let h34_t2 = k[2].powi(3);
-        let h34_t3 = k[0] * k[0];
-        let h34_t4 = k[0].powi(3);
-        k[34] = (88.0 * k[5] * k[0] * k[1] * h34_t0)
-            + (20.0 * k[5] * k[0] * h34_t1 * k[2])
-            + (68.0 * k[5] * k[0] * h34_t2)
-            + (48.0 * k[5] * k[1] * h34_t2)
-            + (48.0 * k[5] * h34_t3 * k[1] * k[2])
-            + (4.0 * k[5] * h34_t3 * h34_t1)
-            + (68.0 * k[5] * h34_t3 * h34_t0)
-            + (8.0 * k[5] * h34_t4 * k[1])
-            + (28.0 * k[5] * h34_t4 * k[2])
+        // k[31] = 88*g*m1*m2*m3^2 + 20*g*m1*m2^2*m3 + 68*g*m1*m3^3 + 48*g*m2*m3^3 + 48*g*m1^2*m2*m3 + 4*g*m1^2*m2^2 + 68*g*m1^2*m3^2 + 8*g*m1^3*m2 + 28*g*m1^3*m3 + 4*g*m1^4 + 24*g*m2^2*m3^2 + 24*g*m3^4
+        let h31_t0 = k[2] * k[2];
+        let h31_t1 = k[1] * k[1];
+        let h31_t2 = k[2].powi(3);
+        let h31_t3 = k[0] * k[0];
+        let h31_t4 = k[0].powi(3);
+        k[31] = (88.0 * k[5] * k[0] * k[1] * h31_t0)
+            + (20.0 * k[5] * k[0] * h31_t1 * k[2])
+            + (68.0 * k[5] * k[0] * h31_t2)
+            + (48.0 * k[5] * k[1] * h31_t2)
+            + (48.0 * k[5] * h31_t3 * k[1] * k[2])
+            + (4.0 * k[5] * h31_t3 * h31_t1)
+            + (68.0 * k[5] * h31_t3 * h31_t0)
+            + (8.0 * k[5] * h31_t4 * k[1])
+            + (28.0 * k[5] * h31_t4 * k[2])
             + (4.0 * k[5] * k[0].powi(4))
-            + (24.0 * k[5] * h34_t1 * h34_t0)
+            + (24.0 * k[5] * h31_t1 * h31_t0)
             + (24.0 * k[5] * k[2].powi(4));
-        // k[35] = 72*g*m1*m2*m3^2 + 12*g*m1*m2^2*m3 + 60*g*m1*m3^3 + 48*g*m2*m3^3 + 30*g*m1^2*m2*m3 + 54*g*m1^2*m3^2 + 3*g*m1^3*m2 + 21*g*m1^3*m3 + 3*g*m1^4 + 24*g*m2^2*m3^2 + 24*g*m3^4
-        let h35_t0 = k[2] * k[2];
-        let h35_t1 = k[1] * k[1];
-        let h35_t2 = k[2].powi(3);
-        let h35_t3 = k[0] * k[0];
-        let h35_t4 = k[0].powi(3);
-        k[35] = (72.0 * k[5] * k[0] * k[1] * h35_t0)
-            + (12.0 * k[5] * k[0] * h35_t1 * k[2])
-            + (60.0 * k[5] * k[0] * h35_t2)
-            + (48.0 * k[5] * k[1] * h35_t2)
-            + (30.0 * k[5] * h35_t3 * k[1] * k[2])
-            + (54.0 * k[5] * h35_t3 * h35_t0)
-            + (3.0 * k[5] * h35_t4 * k[1])
-            + (21.0 * k[5] * h35_t4 * k[2])
+        // k[32] = 72*g*m1*m2*m3^2 + 12*g*m1*m2^2*m3 + 60*g*m1*m3^3 + 48*g*m2*m3^3 + 30*g*m1^2*m2*m3 + 54*g*m1^2*m3^2 + 3*g*m1^3*m2 + 21*g*m1^3*m3 + 3*g*m1^4 + 24*g*m2^2*m3^2 + 24*g*m3^4
+        let h32_t0 = k[2] * k[2];
+        let h32_t1 = k[1] * k[1];
+        let h32_t2 = k[2].powi(3);
+        let h32_t3 = k[0] * k[0];
+        let h32_t4 = k[0].powi(3);
+        k[32] = (72.0 * k[5] * k[0] * k[1] * h32_t0)
+            + (12.0 * k[5] * k[0] * h32_t1 * k[2])
+            + (60.0 * k[5] * k[0] * h32_t2)
+            + (48.0 * k[5] * k[1] * h32_t2)
+            + (30.0 * k[5] * h32_t3 * k[1] * k[2])
+            + (54.0 * k[5] * h32_t3 * h32_t0)
+            + (3.0 * k[5] * h32_t4 * k[1])
+            + (21.0 * k[5] * h32_t4 * k[2])
             + (3.0 * k[5] * k[0].powi(4))
-            + (24.0 * k[5] * h35_t1 * h35_t0)
+            + (24.0 * k[5] * h32_t1 * h32_t0)
             + (24.0 * k[5] * k[2].powi(4));
-        // k[36] = ell*m1*m2/(2*(m1 + m2 + m3))
-        k[36] = k[3] * k[0] * k[1] / 2.0 / (k[0] + k[1] + k[2]);
-        // k[37] = (ell*m1 + 2*ell*m3)/2
-        k[37] = ((k[3] * k[0]) + (2.0 * k[3] * k[2])) / 2.0;
-        // k[46] = ell*m1/(2*(m1 + m2 + m3)) + ell*m2/(m1 + m2 + m3) + ell*m3/(m1 + m2 + m3)
-        k[46] = (k[3] * k[0] / 2.0 / (k[0] + k[1] + k[2]))
+        // k[33] = ell*m1*m2/(2*(m1 + m2 + m3))
+        k[33] = k[3] * k[0] * k[1] / 2.0 / (k[0] + k[1] + k[2]);
+        // k[34] = (ell*m1 + 2*ell*m3)/2
+        k[34] = ((k[3] * k[0]) + (2.0 * k[3] * k[2])) / 2.0;
+        // k[43] = ell*m1/(2*(m1 + m2 + m3)) + ell*m2/(m1 + m2 + m3) + ell*m3/(m1 + m2 + m3)
+        k[43] = (k[3] * k[0] / 2.0 / (k[0] + k[1] + k[2]))
             + (k[3] * k[1] / (k[0] + k[1] + k[2]))
             + (k[3] * k[2] / (k[0] + k[1] + k[2]));
-        // k[47] = ell*(m1/2 + m3)/(m1 + m3)
-        k[47] = k[3] * ((k[0] / 2.0) + k[2]) / (k[0] + k[2]);
-        // k[48] = ell*m1/(2*(m1 + m3))
-        k[48] = k[3] * k[0] / (2.0 * (k[0] + k[2]));
+        // k[44] = ell*(m1/2 + m3)/(m1 + m3)
+        k[44] = k[3] * ((k[0] / 2.0) + k[2]) / (k[0] + k[2]);
+        // k[45] = ell*m1/(2*(m1 + m3))
+        k[45] = k[3] * k[0] / (2.0 * (k[0] + k[2]));
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = k[6];
@@ -339,7 +321,7 @@ impl Model for LoadedRodClosed {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let pt0 = (k[3] * rc_c) + q[0];
         let pt1 = -(k[3] * qd[1] * rc_s) + qd[0];
@@ -356,42 +338,41 @@ impl Model for LoadedRodClosed {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..49]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
+        let k = &k[..46]; // one bounds check for all constant loads
+        let rc_s = q[1].sin();
         let et0 = qd[1] * qd[1];
         (-(k[13] * qd[1] * qd[0] * rc_s)
             + (k[14] * et0)
             + (k[15] * et0 * (rc_s * rc_s))
-            + (k[16] * et0 * (rc_c * rc_c))
-            + (k[17] * (qd[0] * qd[0])))
-            + (k[18] + (k[19] * rc_s))
+            + (k[16] * (qd[0] * qd[0])))
+            + (k[17] + (k[18] * rc_s))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
-        out[0] = -(k[13] * qd[1] * rc_s) + (k[20] * qd[0]);
+        out[0] = -(k[13] * qd[1] * rc_s) + (k[19] * qd[0]);
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let qt0 = -k[13] * rc_s;
         let qt1 = qd[1] * qd[1];
-        mass[0] = k[20];
+        mass[0] = k[19];
         mass[1] = qt0;
         mass[2] = qt0;
-        mass[3] = k[21] + (k[22] * (rc_s * rc_s)) + (k[23] * (rc_c * rc_c));
+        mass[3] = k[20] + (k[21] * (rc_s * rc_s));
         rhs[0] = k[13] * qt1 * rc_c;
-        rhs[1] = -(k[19] * rc_c) - (k[24] * qt1 * rc_s * rc_c);
+        rhs[1] = -(k[18] * rc_c) - (k[21] * qt1 * rc_s * rc_c);
     }
 
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let ft0 = qd[1] * qd[1];
         out[0] = k[1] * (-(k[3] * qdd[1] * rc_s) + qdd[0] - (k[3] * ft0 * rc_c));
-        out[1] = k[25] + (k[26] * qdd[1] * rc_c) - (k[26] * ft0 * rc_s);
+        out[1] = k[22] + (k[23] * qdd[1] * rc_c) - (k[23] * ft0 * rc_s);
     }
 
     fn gaps(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
@@ -416,13 +397,13 @@ impl Model for LoadedRodClosed {
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
-        out[0] = k[18] - (forces[0] * (-k[27] + (k[3] * rc_s)));
+        out[0] = k[17] - (forces[0] * (-k[24] + (k[3] * rc_s)));
     }
 
     fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         q_full[0] = q[0];
         qd_full[0] = qd[0];
@@ -435,13 +416,13 @@ impl Model for LoadedRodClosed {
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         poses[0] = [(k[12] * rc_c) + q[0], k[12] * rc_s, q[1]];
-        poses[1] = [k[27] + (k[3] * rc_c) + q[0], k[27], 0.0];
-        sizes[0] = -k[47];
+        poses[1] = [k[24] + (k[3] * rc_c) + q[0], k[24], 0.0];
+        sizes[0] = -k[44];
         sizes[1] = 0.0;
-        sizes[2] = k[48];
+        sizes[2] = k[45];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
@@ -456,53 +437,53 @@ impl Model for LoadedRodClosed {
 
 impl Reduction for LoadedRodClosed {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[6], k[8], k[9], delta);
         let rt0 = rc_s * rc_s;
-        let rt1 = -k[30] + (k[31] * rt0);
+        let rt1 = -k[27] + (k[28] * rt0);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: -k[28] * (k[29] * rc_ds) / rt1,
-            theta_ddot: k[32]
-                * ((k[33] * rc_s * rc_c * rc_ds) - (k[34] * rc_c) + (k[35] * rt0 * rc_c))
+            theta_dot_sq: -k[25] * (k[26] * rc_ds) / rt1,
+            theta_ddot: k[29]
+                * ((k[30] * rc_s * rc_c * rc_ds) - (k[31] * rc_c) + (k[32] * rt0 * rc_c))
                 / (rt1 * rt1),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..49]; // one bounds check for all constant loads
-        -k[28] * (k[29] * rc_ds) / (-k[30] + (k[31] * (rc_s * rc_s)))
+        let k = &k[..46]; // one bounds check for all constant loads
+        -k[25] * (k[26] * rc_ds) / (-k[27] + (k[28] * (rc_s * rc_s)))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[6], k[8], k[9], delta);
         let rt0 = rc_s * rc_s;
-        let rt1 = -k[30] + (k[31] * rt0);
-        let rc_w2 = -k[28] * (k[29] * rc_ds) / rt1;
-        let rc_acc = k[32]
-            * ((k[33] * rc_s * rc_c * rc_ds) - (k[34] * rc_c) + (k[35] * rt0 * rc_c))
+        let rt1 = -k[27] + (k[28] * rt0);
+        let rc_w2 = -k[25] * (k[26] * rc_ds) / rt1;
+        let rc_acc = k[29]
+            * ((k[30] * rc_s * rc_c * rc_ds) - (k[31] * rc_c) + (k[32] * rt0 * rc_c))
             / (rt1 * rt1);
-        out[0] = -(k[36] * rc_s * rc_acc) - (k[36] * rc_c * rc_w2);
-        out[1] = k[25] - (k[37] * rc_s * rc_w2) + (k[37] * rc_c * rc_acc);
+        out[0] = -(k[33] * rc_s * rc_acc) - (k[33] * rc_c * rc_w2);
+        out[1] = k[22] - (k[34] * rc_s * rc_w2) + (k[34] * rc_c * rc_acc);
     }
 
     fn force_polynomial(&self, k: &[f64], contact: usize, out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         match contact {
             0 => {
-                out[0] = -k[38];
-                out[1] = k[39];
+                out[0] = -k[35];
+                out[1] = k[36];
                 out[2] = 0.0;
-                out[3] = -k[31];
+                out[3] = -k[28];
             }
             1 => {
-                out[0] = k[40];
-                out[1] = -k[41];
-                out[2] = k[42];
+                out[0] = k[37];
+                out[1] = -k[38];
+                out[2] = k[39];
                 out[3] = 0.0;
-                out[4] = -k[43];
+                out[4] = -k[40];
             }
             _ => {}
         }
@@ -517,86 +498,86 @@ impl Reduction for LoadedRodClosed {
         // k[9] = rc_ci = ((1 - a/ell)*(1 + a/ell))^(1/2)
         let c3_t0 = k[4] / k[3];
         k[9] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
-        // k[31] = 12*m1*m3 + 12*m2*m3 + 3*m1^2 + 12*m3^2
-        k[31] = (12.0 * k[0] * k[2])
+        // k[28] = 12*m1*m3 + 12*m2*m3 + 3*m1^2 + 12*m3^2
+        k[28] = (12.0 * k[0] * k[2])
             + (12.0 * k[1] * k[2])
             + (3.0 * (k[0] * k[0]))
             + (12.0 * (k[2] * k[2]));
-        // k[38] = 8*m1*m2*rc_si + 32*m1*m3*rc_si + 24*m2*m3*rc_si + 8*m1^2*rc_si + 24*m3^2*rc_si
-        k[38] = (8.0 * k[0] * k[1] * k[8])
+        // k[35] = 8*m1*m2*rc_si + 32*m1*m3*rc_si + 24*m2*m3*rc_si + 8*m1^2*rc_si + 24*m3^2*rc_si
+        k[35] = (8.0 * k[0] * k[1] * k[8])
             + (32.0 * k[0] * k[2] * k[8])
             + (24.0 * k[1] * k[2] * k[8])
             + (8.0 * (k[0] * k[0]) * k[8])
             + (24.0 * (k[2] * k[2]) * k[8]);
-        // k[39] = 12*m1*m2 + 48*m1*m3 + 36*m2*m3 + 12*m1^2 + 36*m3^2
-        k[39] = (12.0 * k[0] * k[1])
+        // k[36] = 12*m1*m2 + 48*m1*m3 + 36*m2*m3 + 12*m1^2 + 36*m3^2
+        k[36] = (12.0 * k[0] * k[1])
             + (48.0 * k[0] * k[2])
             + (36.0 * k[1] * k[2])
             + (12.0 * (k[0] * k[0]))
             + (36.0 * (k[2] * k[2]));
-        // k[40] = 152*m1*m2*m3^2 + 28*m1*m2^2*m3 + 124*m1*m3^3 + 96*m2*m3^3 + 64*m1^2*m2*m3 + 4*m1^2*m2^2 + 108*m1^2*m3^2 + 8*m1^3*m2 + 36*m1^3*m3 + 4*m1^4 + 48*m2^2*m3^2 + 48*m3^4
-        let h40_t0 = k[2] * k[2];
-        let h40_t1 = k[1] * k[1];
-        let h40_t2 = k[2].powi(3);
-        let h40_t3 = k[0] * k[0];
-        let h40_t4 = k[0].powi(3);
-        k[40] = (152.0 * k[0] * k[1] * h40_t0)
-            + (28.0 * k[0] * h40_t1 * k[2])
-            + (124.0 * k[0] * h40_t2)
-            + (96.0 * k[1] * h40_t2)
-            + (64.0 * h40_t3 * k[1] * k[2])
-            + (4.0 * h40_t3 * h40_t1)
-            + (108.0 * h40_t3 * h40_t0)
-            + (8.0 * h40_t4 * k[1])
-            + (36.0 * h40_t4 * k[2])
+        // k[37] = 152*m1*m2*m3^2 + 28*m1*m2^2*m3 + 124*m1*m3^3 + 96*m2*m3^3 + 64*m1^2*m2*m3 + 4*m1^2*m2^2 + 108*m1^2*m3^2 + 8*m1^3*m2 + 36*m1^3*m3 + 4*m1^4 + 48*m2^2*m3^2 + 48*m3^4
+        let h37_t0 = k[2] * k[2];
+        let h37_t1 = k[1] * k[1];
+        let h37_t2 = k[2].powi(3);
+        let h37_t3 = k[0] * k[0];
+        let h37_t4 = k[0].powi(3);
+        k[37] = (152.0 * k[0] * k[1] * h37_t0)
+            + (28.0 * k[0] * h37_t1 * k[2])
+            + (124.0 * k[0] * h37_t2)
+            + (96.0 * k[1] * h37_t2)
+            + (64.0 * h37_t3 * k[1] * k[2])
+            + (4.0 * h37_t3 * h37_t1)
+            + (108.0 * h37_t3 * h37_t0)
+            + (8.0 * h37_t4 * k[1])
+            + (36.0 * h37_t4 * k[2])
             + (4.0 * k[0].powi(4))
-            + (48.0 * h40_t1 * h40_t0)
+            + (48.0 * h37_t1 * h37_t0)
             + (48.0 * k[2].powi(4));
-        // k[41] = 312*m1*m2*m3^2*rc_si + 96*m1*m2^2*m3*rc_si + 216*m1*m3^3*rc_si + 192*m2*m3^3*rc_si + 168*m1^2*m2*m3*rc_si + 24*m1^2*m2^2*rc_si + 168*m1^2*m3^2*rc_si + 30*m1^3*m2*rc_si + 54*m1^3*m3*rc_si + 6*m1^4*rc_si + 96*m2^2*m3^2*rc_si + 96*m3^4*rc_si
-        let h41_t0 = k[2] * k[2];
-        let h41_t1 = k[1] * k[1];
-        let h41_t2 = k[2].powi(3);
-        let h41_t3 = k[0] * k[0];
-        let h41_t4 = k[0].powi(3);
-        k[41] = (312.0 * k[0] * k[1] * h41_t0 * k[8])
-            + (96.0 * k[0] * h41_t1 * k[2] * k[8])
-            + (216.0 * k[0] * h41_t2 * k[8])
-            + (192.0 * k[1] * h41_t2 * k[8])
-            + (168.0 * h41_t3 * k[1] * k[2] * k[8])
-            + (24.0 * h41_t3 * h41_t1 * k[8])
-            + (168.0 * h41_t3 * h41_t0 * k[8])
-            + (30.0 * h41_t4 * k[1] * k[8])
-            + (54.0 * h41_t4 * k[2] * k[8])
+        // k[38] = 312*m1*m2*m3^2*rc_si + 96*m1*m2^2*m3*rc_si + 216*m1*m3^3*rc_si + 192*m2*m3^3*rc_si + 168*m1^2*m2*m3*rc_si + 24*m1^2*m2^2*rc_si + 168*m1^2*m3^2*rc_si + 30*m1^3*m2*rc_si + 54*m1^3*m3*rc_si + 6*m1^4*rc_si + 96*m2^2*m3^2*rc_si + 96*m3^4*rc_si
+        let h38_t0 = k[2] * k[2];
+        let h38_t1 = k[1] * k[1];
+        let h38_t2 = k[2].powi(3);
+        let h38_t3 = k[0] * k[0];
+        let h38_t4 = k[0].powi(3);
+        k[38] = (312.0 * k[0] * k[1] * h38_t0 * k[8])
+            + (96.0 * k[0] * h38_t1 * k[2] * k[8])
+            + (216.0 * k[0] * h38_t2 * k[8])
+            + (192.0 * k[1] * h38_t2 * k[8])
+            + (168.0 * h38_t3 * k[1] * k[2] * k[8])
+            + (24.0 * h38_t3 * h38_t1 * k[8])
+            + (168.0 * h38_t3 * h38_t0 * k[8])
+            + (30.0 * h38_t4 * k[1] * k[8])
+            + (54.0 * h38_t4 * k[2] * k[8])
             + (6.0 * k[0].powi(4) * k[8])
-            + (96.0 * h41_t1 * h41_t0 * k[8])
+            + (96.0 * h38_t1 * h38_t0 * k[8])
             + (96.0 * k[2].powi(4) * k[8]);
-        // k[42] = 228*m1*m2*m3^2 + 120*m1*m2^2*m3 + 108*m1*m3^3 + 96*m2*m3^3 + 180*m1^2*m2*m3 + 36*m1^2*m2^2 + 84*m1^2*m3^2 + 39*m1^3*m2 + 27*m1^3*m3 + 3*m1^4 + 48*m2^2*m3^2 + 48*m3^4
-        let h42_t0 = k[2] * k[2];
-        let h42_t1 = k[1] * k[1];
-        let h42_t2 = k[2].powi(3);
-        let h42_t3 = k[0] * k[0];
-        let h42_t4 = k[0].powi(3);
-        k[42] = (228.0 * k[0] * k[1] * h42_t0)
-            + (120.0 * k[0] * h42_t1 * k[2])
-            + (108.0 * k[0] * h42_t2)
-            + (96.0 * k[1] * h42_t2)
-            + (180.0 * h42_t3 * k[1] * k[2])
-            + (36.0 * h42_t3 * h42_t1)
-            + (84.0 * h42_t3 * h42_t0)
-            + (39.0 * h42_t4 * k[1])
-            + (27.0 * h42_t4 * k[2])
+        // k[39] = 228*m1*m2*m3^2 + 120*m1*m2^2*m3 + 108*m1*m3^3 + 96*m2*m3^3 + 180*m1^2*m2*m3 + 36*m1^2*m2^2 + 84*m1^2*m3^2 + 39*m1^3*m2 + 27*m1^3*m3 + 3*m1^4 + 48*m2^2*m3^2 + 48*m3^4
+        let h39_t0 = k[2] * k[2];
+        let h39_t1 = k[1] * k[1];
+        let h39_t2 = k[2].powi(3);
+        let h39_t3 = k[0] * k[0];
+        let h39_t4 = k[0].powi(3);
+        k[39] = (228.0 * k[0] * k[1] * h39_t0)
+            + (120.0 * k[0] * h39_t1 * k[2])
+            + (108.0 * k[0] * h39_t2)
+            + (96.0 * k[1] * h39_t2)
+            + (180.0 * h39_t3 * k[1] * k[2])
+            + (36.0 * h39_t3 * h39_t1)
+            + (84.0 * h39_t3 * h39_t0)
+            + (39.0 * h39_t4 * k[1])
+            + (27.0 * h39_t4 * k[2])
             + (3.0 * k[0].powi(4))
-            + (48.0 * h42_t1 * h42_t0)
+            + (48.0 * h39_t1 * h39_t0)
             + (48.0 * k[2].powi(4));
-        // k[43] = 36*m1*m2*m3^2 + 36*m1*m2^2*m3 + 36*m1^2*m2*m3 + 9*m1^3*m2
-        k[43] = (36.0 * k[0] * k[1] * (k[2] * k[2]))
+        // k[40] = 36*m1*m2*m3^2 + 36*m1*m2^2*m3 + 36*m1^2*m2*m3 + 9*m1^3*m2
+        k[40] = (36.0 * k[0] * k[1] * (k[2] * k[2]))
             + (36.0 * k[0] * (k[1] * k[1]) * k[2])
             + (36.0 * (k[0] * k[0]) * k[1] * k[2])
             + (9.0 * k[0].powi(3) * k[1]);
-        // k[44] = (ell*m1 + 3*ell*m3)/(3*g*(m1 + 2*m3))
-        k[44] = ((k[3] * k[0]) + (3.0 * k[3] * k[2])) / 3.0 / k[5] / (k[0] + (2.0 * k[2]));
-        // k[45] = (4*ell*m1*m3 + 4*ell*m2*m3 + ell*m1^2 + 4*ell*m3^2)/(4*g*(m1 + 2*m3)*(m1 + m2 + m3))
-        k[45] = ((4.0 * k[3] * k[0] * k[2])
+        // k[41] = (ell*m1 + 3*ell*m3)/(3*g*(m1 + 2*m3))
+        k[41] = ((k[3] * k[0]) + (3.0 * k[3] * k[2])) / 3.0 / k[5] / (k[0] + (2.0 * k[2]));
+        // k[42] = (4*ell*m1*m3 + 4*ell*m2*m3 + ell*m1^2 + 4*ell*m3^2)/(4*g*(m1 + 2*m3)*(m1 + m2 + m3))
+        k[42] = ((4.0 * k[3] * k[0] * k[2])
             + (4.0 * k[3] * k[1] * k[2])
             + (k[3] * (k[0] * k[0]))
             + (4.0 * k[3] * (k[2] * k[2])))
@@ -607,10 +588,10 @@ impl Reduction for LoadedRodClosed {
     }
 
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
-        out[0] = k[44];
+        let k = &k[..46]; // one bounds check for all constant loads
+        out[0] = k[41];
         out[1] = 0.0;
-        out[2] = -k[45];
+        out[2] = -k[42];
     }
 
     fn full_state(
@@ -622,12 +603,12 @@ impl Reduction for LoadedRodClosed {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, _, _, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let rc_w = theta_dot;
         q[1] = k[6] - delta;
         qd[1] = theta_dot;
-        q[0] = k[10] + (k[46] * rc_dc);
-        qd[0] = k[46] * rc_s * rc_w;
+        q[0] = k[10] + (k[43] * rc_dc);
+        qd[0] = k[43] * rc_s * rc_w;
     }
 }

@@ -95,7 +95,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 49,
+    n_constants: 47,
     coordinates: &["x1", "theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced: 1,
@@ -190,7 +190,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 13,
         force_degrees: &[0, 2],
         fall_degree: None,
-        lean_constants: &[12, 13, 16, 42, 43, 44],
+        lean_constants: &[12, 13, 16, 40, 41, 42],
     }),
     route_note: "",
 };
@@ -233,95 +233,93 @@ impl Model for LoadedRodFree {
         k[19] = (3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
             + (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
             + (k[3] * (k[2] * k[2]) / (k[0] + k[2]));
-        // k[20] = ell^2*m1/24 + ell^2*m1*m3/(8*(m1 + m3))
+        // k[20] = ell^2*m1/24 + ell^2*m1*m3/(8*(m1 + m3)) + ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*(2*m1*m3 + m1^2 + m3^2))
         let h20_t0 = k[3] * k[3];
-        k[20] = (h20_t0 * k[0] / 24.0) + (h20_t0 * k[0] * k[2] / 8.0 / (k[0] + k[2]));
-        // k[21] = ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*(2*m1*m3 + m1^2 + m3^2))
-        let h21_t0 = k[3] * k[3];
-        let h21_t1 = k[2] * k[2];
-        let h21_t2 = k[0] * k[0];
-        k[21] = (h21_t0 * k[0] * h21_t1 / ((2.0 * k[0] * k[2]) + h21_t2 + h21_t1))
-            + (5.0 * h21_t0 * h21_t2 * k[2] / 8.0 / ((2.0 * k[0] * k[2]) + h21_t2 + h21_t1))
-            + (h21_t0 * k[0].powi(3) / 8.0 / ((2.0 * k[0] * k[2]) + h21_t2 + h21_t1))
-            + (h21_t0 * k[2].powi(3) / 2.0 / ((2.0 * k[0] * k[2]) + h21_t2 + h21_t1));
-        // k[22] = m1/2 + m3/2
-        k[22] = (k[0] / 2.0) + (k[2] / 2.0);
-        // k[23] = m2/2
-        k[23] = k[1] / 2.0;
-        // k[24] = a*g*m2/2
-        k[24] = k[4] * k[5] * k[1] / 2.0;
-        // k[25] = ell*g*m1/2 + ell*g*m3
-        k[25] = (k[3] * k[5] * k[0] / 2.0) + (k[3] * k[5] * k[2]);
-        // k[26] = m1 + m3
-        k[26] = k[0] + k[2];
-        // k[27] = ell^2*m1/12 + ell^2*m1*m3/(4*(m1 + m3))
-        let h27_t0 = k[3] * k[3];
-        k[27] = (h27_t0 * k[0] / 12.0) + (h27_t0 * k[0] * k[2] / 4.0 / (k[0] + k[2]));
-        // k[28] = 2*ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*m1*m3 + m1^2 + m3^2)
-        let h28_t0 = k[3] * k[3];
-        let h28_t1 = k[2] * k[2];
-        let h28_t2 = k[0] * k[0];
-        k[28] = (2.0 * h28_t0 * k[0] * h28_t1 / ((2.0 * k[0] * k[2]) + h28_t2 + h28_t1))
-            + (5.0 * h28_t0 * h28_t2 * k[2] / 4.0 / ((2.0 * k[0] * k[2]) + h28_t2 + h28_t1))
-            + (h28_t0 * k[0].powi(3) / 4.0 / ((2.0 * k[0] * k[2]) + h28_t2 + h28_t1))
-            + (h28_t0 * k[2].powi(3) / ((2.0 * k[0] * k[2]) + h28_t2 + h28_t1));
-        // k[29] = g*m1 + g*m3
-        k[29] = (k[5] * k[0]) + (k[5] * k[2]);
-        // k[30] = a/2
-        k[30] = k[4] / 2.0;
-        // k[31] = 12/ell^2
-        k[31] = 12.0 / (k[3] * k[3]);
-        // k[32] = m1*rc_wi^2*rc_ai + m3*rc_wi^2*rc_ai
-        let h32_t0 = k[10] * k[10];
-        k[32] = (k[0] * h32_t0 * k[16]) + (k[2] * h32_t0 * k[16]);
-        // k[33] = 3*ell*g*m1*m3 + ell*g*m1^2 + 2*ell*g*m3^2
-        k[33] = (3.0 * k[3] * k[5] * k[0] * k[2])
+        let h20_t1 = k[2] * k[2];
+        let h20_t2 = k[0] * k[0];
+        k[20] = (h20_t0 * k[0] / 24.0)
+            + (h20_t0 * k[0] * k[2] / 8.0 / (k[0] + k[2]))
+            + (h20_t0 * k[0] * h20_t1 / ((2.0 * k[0] * k[2]) + h20_t2 + h20_t1))
+            + (5.0 * h20_t0 * h20_t2 * k[2] / 8.0 / ((2.0 * k[0] * k[2]) + h20_t2 + h20_t1))
+            + (h20_t0 * k[0].powi(3) / 8.0 / ((2.0 * k[0] * k[2]) + h20_t2 + h20_t1))
+            + (h20_t0 * k[2].powi(3) / 2.0 / ((2.0 * k[0] * k[2]) + h20_t2 + h20_t1));
+        // k[21] = m1/2 + m3/2
+        k[21] = (k[0] / 2.0) + (k[2] / 2.0);
+        // k[22] = m2/2
+        k[22] = k[1] / 2.0;
+        // k[23] = a*g*m2/2
+        k[23] = k[4] * k[5] * k[1] / 2.0;
+        // k[24] = ell*g*m1/2 + ell*g*m3
+        k[24] = (k[3] * k[5] * k[0] / 2.0) + (k[3] * k[5] * k[2]);
+        // k[25] = m1 + m3
+        k[25] = k[0] + k[2];
+        // k[26] = ell^2*m1/12 + ell^2*m1*m3/(4*(m1 + m3)) + 2*ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*m1*m3 + m1^2 + m3^2)
+        let h26_t0 = k[3] * k[3];
+        let h26_t1 = k[2] * k[2];
+        let h26_t2 = k[0] * k[0];
+        k[26] = (h26_t0 * k[0] / 12.0)
+            + (h26_t0 * k[0] * k[2] / 4.0 / (k[0] + k[2]))
+            + (2.0 * h26_t0 * k[0] * h26_t1 / ((2.0 * k[0] * k[2]) + h26_t2 + h26_t1))
+            + (5.0 * h26_t0 * h26_t2 * k[2] / 4.0 / ((2.0 * k[0] * k[2]) + h26_t2 + h26_t1))
+            + (h26_t0 * k[0].powi(3) / 4.0 / ((2.0 * k[0] * k[2]) + h26_t2 + h26_t1))
+            + (h26_t0 * k[2].powi(3) / ((2.0 * k[0] * k[2]) + h26_t2 + h26_t1));
+        // k[27] = g*m1 + g*m3
+        k[27] = (k[5] * k[0]) + (k[5] * k[2]);
+        // k[28] = a/2
+        k[28] = k[4] / 2.0;
+        // k[29] = 12/ell^2
+        k[29] = 12.0 / (k[3] * k[3]);
+        // k[30] = m1*rc_wi^2*rc_ai + m3*rc_wi^2*rc_ai
+        let h30_t0 = k[10] * k[10];
+        k[30] = (k[0] * h30_t0 * k[16]) + (k[2] * h30_t0 * k[16]);
+        // k[31] = 3*ell*g*m1*m3 + ell*g*m1^2 + 2*ell*g*m3^2
+        k[31] = (3.0 * k[3] * k[5] * k[0] * k[2])
             + (k[3] * k[5] * (k[0] * k[0]))
             + (2.0 * k[3] * k[5] * (k[2] * k[2]));
-        // k[34] = 16*m1*m3 + 4*m1^2 + 12*m3^2
-        k[34] = (16.0 * k[0] * k[2]) + (4.0 * (k[0] * k[0])) + (12.0 * (k[2] * k[2]));
-        // k[35] = 12*m1*m3 + 3*m1^2 + 12*m3^2
-        k[35] = (12.0 * k[0] * k[2]) + (3.0 * (k[0] * k[0])) + (12.0 * (k[2] * k[2]));
-        // k[36] = 6/ell^2
-        k[36] = 6.0 / (k[3] * k[3]);
-        // k[37] = 120*ell*g*m1*m3^3 + 108*ell*g*m1^2*m3^2 + 42*ell*g*m1^3*m3 + 6*ell*g*m1^4 + 48*ell*g*m3^4
-        k[37] = (120.0 * k[3] * k[5] * k[0] * k[2].powi(3))
+        // k[32] = 16*m1*m3 + 4*m1^2 + 12*m3^2
+        k[32] = (16.0 * k[0] * k[2]) + (4.0 * (k[0] * k[0])) + (12.0 * (k[2] * k[2]));
+        // k[33] = 12*m1*m3 + 3*m1^2 + 12*m3^2
+        k[33] = (12.0 * k[0] * k[2]) + (3.0 * (k[0] * k[0])) + (12.0 * (k[2] * k[2]));
+        // k[34] = 6/ell^2
+        k[34] = 6.0 / (k[3] * k[3]);
+        // k[35] = 120*ell*g*m1*m3^3 + 108*ell*g*m1^2*m3^2 + 42*ell*g*m1^3*m3 + 6*ell*g*m1^4 + 48*ell*g*m3^4
+        k[35] = (120.0 * k[3] * k[5] * k[0] * k[2].powi(3))
             + (108.0 * k[3] * k[5] * (k[0] * k[0]) * (k[2] * k[2]))
             + (42.0 * k[3] * k[5] * k[0].powi(3) * k[2])
             + (6.0 * k[3] * k[5] * k[0].powi(4))
             + (48.0 * k[3] * k[5] * k[2].powi(4));
-        // k[38] = 68*ell*g*m1*m3^3 + 68*ell*g*m1^2*m3^2 + 28*ell*g*m1^3*m3 + 4*ell*g*m1^4 + 24*ell*g*m3^4
-        k[38] = (68.0 * k[3] * k[5] * k[0] * k[2].powi(3))
+        // k[36] = 68*ell*g*m1*m3^3 + 68*ell*g*m1^2*m3^2 + 28*ell*g*m1^3*m3 + 4*ell*g*m1^4 + 24*ell*g*m3^4
+        k[36] = (68.0 * k[3] * k[5] * k[0] * k[2].powi(3))
             + (68.0 * k[3] * k[5] * (k[0] * k[0]) * (k[2] * k[2]))
             + (28.0 * k[3] * k[5] * k[0].powi(3) * k[2])
             + (4.0 * k[3] * k[5] * k[0].powi(4))
             + (24.0 * k[3] * k[5] * k[2].powi(4));
-        // k[39] = 60*ell*g*m1*m3^3 + 54*ell*g*m1^2*m3^2 + 21*ell*g*m1^3*m3 + 3*ell*g*m1^4 + 24*ell*g*m3^4
-        k[39] = (60.0 * k[3] * k[5] * k[0] * k[2].powi(3))
+        // k[37] = 60*ell*g*m1*m3^3 + 54*ell*g*m1^2*m3^2 + 21*ell*g*m1^3*m3 + 3*ell*g*m1^4 + 24*ell*g*m3^4
+        k[37] = (60.0 * k[3] * k[5] * k[0] * k[2].powi(3))
             + (54.0 * k[3] * k[5] * (k[0] * k[0]) * (k[2] * k[2]))
             + (21.0 * k[3] * k[5] * k[0].powi(3) * k[2])
             + (3.0 * k[3] * k[5] * k[0].powi(4))
             + (24.0 * k[3] * k[5] * k[2].powi(4));
-        // k[40] = 48*m1*m3^2*rc_wi^2*rc_ai + 30*m1^2*m3*rc_wi^2*rc_ai + 6*m1^3*rc_wi^2*rc_ai + 24*m3^3*rc_wi^2*rc_ai
-        let h40_t0 = k[10] * k[10];
-        k[40] = (48.0 * k[0] * (k[2] * k[2]) * h40_t0 * k[16])
-            + (30.0 * (k[0] * k[0]) * k[2] * h40_t0 * k[16])
-            + (6.0 * k[0].powi(3) * h40_t0 * k[16])
-            + (24.0 * k[2].powi(3) * h40_t0 * k[16]);
-        // k[41] = (ell*m1 + 2*ell*m3)/2
-        k[41] = ((k[3] * k[0]) + (2.0 * k[3] * k[2])) / 2.0;
-        // k[45] = rc_p0/(m1 + m3)
-        k[45] = k[14] / (k[0] + k[2]);
-        // k[46] = rc_p1/m2
-        k[46] = k[15] / k[1];
-        // k[47] = ell*(m1/2 + m3)/(m1 + m3)
-        k[47] = k[3] * ((k[0] / 2.0) + k[2]) / (k[0] + k[2]);
-        // k[48] = ell*m1/(2*(m1 + m3))
-        k[48] = k[3] * k[0] / (2.0 * (k[0] + k[2]));
+        // k[38] = 48*m1*m3^2*rc_wi^2*rc_ai + 30*m1^2*m3*rc_wi^2*rc_ai + 6*m1^3*rc_wi^2*rc_ai + 24*m3^3*rc_wi^2*rc_ai
+        let h38_t0 = k[10] * k[10];
+        k[38] = (48.0 * k[0] * (k[2] * k[2]) * h38_t0 * k[16])
+            + (30.0 * (k[0] * k[0]) * k[2] * h38_t0 * k[16])
+            + (6.0 * k[0].powi(3) * h38_t0 * k[16])
+            + (24.0 * k[2].powi(3) * h38_t0 * k[16]);
+        // k[39] = (ell*m1 + 2*ell*m3)/2
+        k[39] = ((k[3] * k[0]) + (2.0 * k[3] * k[2])) / 2.0;
+        // k[43] = rc_p0/(m1 + m3)
+        k[43] = k[14] / (k[0] + k[2]);
+        // k[44] = rc_p1/m2
+        k[44] = k[15] / k[1];
+        // k[45] = ell*(m1/2 + m3)/(m1 + m3)
+        k[45] = k[3] * ((k[0] / 2.0) + k[2]) / (k[0] + k[2]);
+        // k[46] = ell*m1/(2*(m1 + m3))
+        k[46] = k[3] * k[0] / (2.0 * (k[0] + k[2]));
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         q[0] = k[6];
         qd[0] = k[9];
         q[1] = k[7];
@@ -331,7 +329,7 @@ impl Model for LoadedRodFree {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         pos[0] = [q[0], 0.0];
         vel[0] = [qd[0], 0.0];
@@ -346,59 +344,56 @@ impl Model for LoadedRodFree {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..49]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let et0 = qd[1] * qd[1];
+        let k = &k[..47]; // one bounds check for all constant loads
+        let rc_s = q[1].sin();
         (-(k[19] * qd[1] * qd[0] * rc_s)
-            + (k[20] * et0)
-            + (k[21] * et0 * (rc_s * rc_s))
-            + (k[21] * et0 * (rc_c * rc_c))
-            + (k[22] * (qd[0] * qd[0]))
-            + (k[23] * (qd[2] * qd[2])))
-            + (k[24] + (k[25] * rc_s))
+            + (k[20] * (qd[1] * qd[1]))
+            + (k[21] * (qd[0] * qd[0]))
+            + (k[22] * (qd[2] * qd[2])))
+            + (k[23] + (k[24] * rc_s))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
-        out[0] = -(k[19] * qd[1] * rc_s) + (k[26] * qd[0]);
+        out[0] = -(k[19] * qd[1] * rc_s) + (k[25] * qd[0]);
         out[1] = k[1] * qd[2];
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let qt0 = -k[19] * rc_s;
-        mass[0] = k[26];
+        mass[0] = k[25];
         mass[1] = qt0;
         mass[2] = 0.0;
         mass[3] = qt0;
-        mass[4] = k[27] + (k[28] * (rc_s * rc_s)) + (k[28] * (rc_c * rc_c));
+        mass[4] = k[26];
         mass[5] = 0.0;
         mass[6] = 0.0;
         mass[7] = 0.0;
         mass[8] = k[1];
         rhs[0] = k[19] * (qd[1] * qd[1]) * rc_c;
-        rhs[1] = -k[25] * rc_c;
+        rhs[1] = -k[24] * rc_c;
         rhs[2] = 0.0;
     }
 
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = 0.0;
-        out[1] = k[29] + (k[19] * qdd[1] * rc_c) - (k[19] * (qd[1] * qd[1]) * rc_s);
+        out[1] = k[27] + (k[19] * qdd[1] * rc_c) - (k[19] * (qd[1] * qd[1]) * rc_s);
     }
 
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         let rc_c = q[1].cos();
         out[0] = -(k[3] * rc_c) - q[0] + q[2];
         out[1] = 0.0;
     }
 
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         jac[0] = -1.0;
         jac[1] = k[3] * rc_s;
@@ -418,9 +413,9 @@ impl Model for LoadedRodFree {
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
-        out[0] = k[24] - (forces[0] * (-k[30] + (k[3] * rc_s)));
+        out[0] = k[23] - (forces[0] * (-k[28] + (k[3] * rc_s)));
     }
 
     fn to_full(&self, _k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
@@ -435,13 +430,13 @@ impl Model for LoadedRodFree {
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         poses[0] = [(k[18] * rc_c) + q[0], k[18] * rc_s, q[1]];
-        poses[1] = [k[30] + q[2], k[30], 0.0];
-        sizes[0] = -k[47];
+        poses[1] = [k[28] + q[2], k[28], 0.0];
+        sizes[0] = -k[45];
         sizes[1] = 0.0;
-        sizes[2] = k[48];
+        sizes[2] = k[46];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
@@ -456,49 +451,49 @@ impl Model for LoadedRodFree {
 
 impl Reduction for LoadedRodFree {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[7], k[12], k[13], delta);
         let rt0 = rc_s * rc_s;
-        let rt1 = -k[34] + (k[35] * rt0);
+        let rt1 = -k[32] + (k[33] * rt0);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: -k[31] * (k[32] + (k[33] * rc_ds)) / rt1,
-            theta_ddot: k[36]
-                * ((k[37] * rc_s * rc_c * rc_ds) - (k[38] * rc_c)
-                    + (k[39] * rt0 * rc_c)
-                    + (k[40] * rc_s * rc_c))
+            theta_dot_sq: -k[29] * (k[30] + (k[31] * rc_ds)) / rt1,
+            theta_ddot: k[34]
+                * ((k[35] * rc_s * rc_c * rc_ds) - (k[36] * rc_c)
+                    + (k[37] * rt0 * rc_c)
+                    + (k[38] * rc_s * rc_c))
                 / (rt1 * rt1),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..49]; // one bounds check for all constant loads
-        -k[31] * (k[32] + (k[33] * rc_ds)) / (-k[34] + (k[35] * (rc_s * rc_s)))
+        let k = &k[..47]; // one bounds check for all constant loads
+        -k[29] * (k[30] + (k[31] * rc_ds)) / (-k[32] + (k[33] * (rc_s * rc_s)))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[7], k[12], k[13], delta);
         let rt0 = rc_s * rc_s;
-        let rt1 = -k[34] + (k[35] * rt0);
-        let rc_w2 = -k[31] * (k[32] + (k[33] * rc_ds)) / rt1;
-        let rc_acc = k[36]
-            * ((k[37] * rc_s * rc_c * rc_ds) - (k[38] * rc_c)
-                + (k[39] * rt0 * rc_c)
-                + (k[40] * rc_s * rc_c))
+        let rt1 = -k[32] + (k[33] * rt0);
+        let rc_w2 = -k[29] * (k[30] + (k[31] * rc_ds)) / rt1;
+        let rc_acc = k[34]
+            * ((k[35] * rc_s * rc_c * rc_ds) - (k[36] * rc_c)
+                + (k[37] * rt0 * rc_c)
+                + (k[38] * rc_s * rc_c))
             / (rt1 * rt1);
         out[0] = 0.0;
-        out[1] = k[29] - (k[41] * rc_s * rc_w2) + (k[41] * rc_c * rc_acc);
+        out[1] = k[27] - (k[39] * rc_s * rc_w2) + (k[39] * rc_c * rc_acc);
     }
 
     fn force_polynomial(&self, k: &[f64], contact: usize, out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         match contact {
             1 => {
-                out[0] = k[42];
-                out[1] = -k[43];
-                out[2] = k[44];
+                out[0] = k[40];
+                out[1] = -k[41];
+                out[2] = k[42];
             }
             _ => {}
         }
@@ -521,19 +516,19 @@ impl Reduction for LoadedRodFree {
             + (c8_t0 * c8_t2 / 3.0 / (k[0] + k[2]))
             - (c8_t0 * c8_t3 * c8_t1 / (k[0] + k[2]))
             + (c8_t0 * c8_t3 / (k[0] + k[2]));
-        // k[42] = 16*ell*g*m1*m3 + 4*ell*g*m1^2 + 12*ell*g*m3^2
-        k[42] = (16.0 * k[3] * k[5] * k[0] * k[2])
+        // k[40] = 16*ell*g*m1*m3 + 4*ell*g*m1^2 + 12*ell*g*m3^2
+        k[40] = (16.0 * k[3] * k[5] * k[0] * k[2])
             + (4.0 * k[3] * k[5] * (k[0] * k[0]))
             + (12.0 * k[3] * k[5] * (k[2] * k[2]));
-        // k[43] = 24*ell*g*m1*m3*rc_si + 6*ell*g*m1^2*rc_si + 24*ell*g*m3^2*rc_si + 6*m1*rc_wi^2*rc_ai + 12*m3*rc_wi^2*rc_ai
-        let h43_t0 = k[10] * k[10];
-        k[43] = (24.0 * k[3] * k[5] * k[0] * k[2] * k[12])
+        // k[41] = 24*ell*g*m1*m3*rc_si + 6*ell*g*m1^2*rc_si + 24*ell*g*m3^2*rc_si + 6*m1*rc_wi^2*rc_ai + 12*m3*rc_wi^2*rc_ai
+        let h41_t0 = k[10] * k[10];
+        k[41] = (24.0 * k[3] * k[5] * k[0] * k[2] * k[12])
             + (6.0 * k[3] * k[5] * (k[0] * k[0]) * k[12])
             + (24.0 * k[3] * k[5] * (k[2] * k[2]) * k[12])
-            + (6.0 * k[0] * h43_t0 * k[16])
-            + (12.0 * k[2] * h43_t0 * k[16]);
-        // k[44] = 12*ell*g*m1*m3 + 3*ell*g*m1^2 + 12*ell*g*m3^2
-        k[44] = (12.0 * k[3] * k[5] * k[0] * k[2])
+            + (6.0 * k[0] * h41_t0 * k[16])
+            + (12.0 * k[2] * h41_t0 * k[16]);
+        // k[42] = 12*ell*g*m1*m3 + 3*ell*g*m1^2 + 12*ell*g*m3^2
+        k[42] = (12.0 * k[3] * k[5] * k[0] * k[2])
             + (3.0 * k[3] * k[5] * (k[0] * k[0]))
             + (12.0 * k[3] * k[5] * (k[2] * k[2]));
     }
@@ -549,15 +544,15 @@ impl Reduction for LoadedRodFree {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, _, _, rc_dc) = start_offsets(k[7], k[12], k[13], delta);
         let rc_t = t;
         let rc_w = theta_dot;
         q[1] = k[7] - delta;
         qd[1] = theta_dot;
-        q[0] = k[6] + (k[18] * rc_dc) + (k[45] * rc_t);
-        qd[0] = k[45] + (k[18] * rc_s * rc_w);
-        q[2] = k[8] + (k[46] * rc_t);
-        qd[2] = k[46];
+        q[0] = k[6] + (k[18] * rc_dc) + (k[43] * rc_t);
+        qd[0] = k[43] + (k[18] * rc_s * rc_w);
+        q[2] = k[8] + (k[44] * rc_t);
+        qd[2] = k[44];
     }
 }

@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the block must be lower than the rod is long (h < ell)",
     }],
-    n_constants: 24,
+    n_constants: 22,
     coordinates: &["x1", "y1", "theta", "xb", "yb", "phi"],
     system_coordinates: &["x1", "y1", "theta", "xb", "yb", "phi"],
     reduced: 2,
@@ -205,32 +205,28 @@ impl Model for RodBlockTipping {
         k[11] = k[2] * k[0] / 2.0;
         // k[12] = m2*w^2/24 + h^2*m2/24
         k[12] = (k[1] * (k[3] * k[3]) / 24.0) + ((k[4] * k[4]) * k[1] / 24.0);
-        // k[13] = ell^2*m1/24
-        k[13] = (k[2] * k[2]) * k[0] / 24.0;
-        // k[14] = ell^2*m1/8
-        k[14] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[15] = m1/2
-        k[15] = k[0] / 2.0;
-        // k[16] = m2/2
-        k[16] = k[1] / 2.0;
-        // k[17] = ell*g*m1/2
-        k[17] = k[2] * k[5] * k[0] / 2.0;
-        // k[18] = g*m1
-        k[18] = k[5] * k[0];
-        // k[19] = g*m2
-        k[19] = k[5] * k[1];
-        // k[20] = m2*w^2/12 + h^2*m2/12
-        k[20] = (k[1] * (k[3] * k[3]) / 12.0) + ((k[4] * k[4]) * k[1] / 12.0);
-        // k[21] = ell^2*m1/12
-        k[21] = (k[2] * k[2]) * k[0] / 12.0;
-        // k[22] = ell^2*m1/4
-        k[22] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[23] = 2*ell
-        k[23] = 2.0 * k[2];
+        // k[13] = ell^2*m1/6
+        k[13] = (k[2] * k[2]) * k[0] / 6.0;
+        // k[14] = m1/2
+        k[14] = k[0] / 2.0;
+        // k[15] = m2/2
+        k[15] = k[1] / 2.0;
+        // k[16] = ell*g*m1/2
+        k[16] = k[2] * k[5] * k[0] / 2.0;
+        // k[17] = g*m1
+        k[17] = k[5] * k[0];
+        // k[18] = g*m2
+        k[18] = k[5] * k[1];
+        // k[19] = m2*w^2/12 + h^2*m2/12
+        k[19] = (k[1] * (k[3] * k[3]) / 12.0) + ((k[4] * k[4]) * k[1] / 12.0);
+        // k[20] = ell^2*m1/3
+        k[20] = (k[2] * k[2]) * k[0] / 3.0;
+        // k[21] = 2*ell
+        k[21] = 2.0 * k[2];
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = 0.0;
@@ -246,7 +242,7 @@ impl Model for RodBlockTipping {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let pt0 = q[5].sin();
         let pt1 = k[8] * pt0;
@@ -286,32 +282,29 @@ impl Model for RodBlockTipping {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let et0 = qd[2] * qd[2];
         (-(k[11] * qd[2] * qd[0] * rc_s)
             + (k[11] * qd[2] * qd[1] * rc_c)
             + (k[12] * (qd[5] * qd[5]))
-            + (k[13] * et0)
-            + (k[14] * et0 * (rc_s * rc_s))
-            + (k[14] * et0 * (rc_c * rc_c))
-            + (k[15] * (qd[0] * qd[0]))
-            + (k[16] * (qd[3] * qd[3]))
-            + (k[15] * (qd[1] * qd[1]))
-            + (k[16] * (qd[4] * qd[4])))
-            + ((k[17] * rc_s) + (k[18] * q[1]) + (k[19] * q[4]))
+            + (k[13] * (qd[2] * qd[2]))
+            + (k[14] * (qd[0] * qd[0]))
+            + (k[15] * (qd[3] * qd[3]))
+            + (k[14] * (qd[1] * qd[1]))
+            + (k[15] * (qd[4] * qd[4])))
+            + ((k[16] * rc_s) + (k[17] * q[1]) + (k[18] * q[4]))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         out[0] = -(k[11] * qd[2] * rc_s) + (k[0] * qd[0]);
         out[1] = k[1] * qd[3];
-        out[2] = k[20] * qd[5];
+        out[2] = k[19] * qd[5];
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let qt0 = -k[11] * rc_s;
         let qt1 = k[11] * rc_c;
@@ -330,7 +323,7 @@ impl Model for RodBlockTipping {
         mass[11] = 0.0;
         mass[12] = qt0;
         mass[13] = qt1;
-        mass[14] = k[21] + (k[22] * (rc_s * rc_s)) + (k[22] * (rc_c * rc_c));
+        mass[14] = k[20];
         mass[15] = 0.0;
         mass[16] = 0.0;
         mass[17] = 0.0;
@@ -351,12 +344,12 @@ impl Model for RodBlockTipping {
         mass[32] = 0.0;
         mass[33] = 0.0;
         mass[34] = 0.0;
-        mass[35] = k[20];
+        mass[35] = k[19];
         rhs[0] = k[11] * qt2 * rc_c;
-        rhs[1] = -k[18] + (k[11] * qt2 * rc_s);
-        rhs[2] = -k[17] * rc_c;
+        rhs[1] = -k[17] + (k[11] * qt2 * rc_s);
+        rhs[2] = -k[16] * rc_c;
         rhs[3] = 0.0;
-        rhs[4] = -k[19];
+        rhs[4] = -k[18];
         rhs[5] = 0.0;
     }
 
@@ -369,7 +362,7 @@ impl Model for RodBlockTipping {
     }
 
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let gt0 = q[5].sin();
         let gt1 = q[5].cos();
@@ -383,7 +376,7 @@ impl Model for RodBlockTipping {
     }
 
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let jt0 = q[5].cos();
         let jt1 = q[5].sin();
@@ -423,7 +416,7 @@ impl Model for RodBlockTipping {
         jac[27] = 0.0;
         jac[28] = 0.0;
         jac[29] = 0.0;
-        bias[0] = -(k[23] * qd[5] * qd[2] * jt1 * rc_s) - (k[23] * qd[5] * qd[2] * jt0 * rc_c)
+        bias[0] = -(k[21] * qd[5] * qd[2] * jt1 * rc_s) - (k[21] * qd[5] * qd[2] * jt0 * rc_c)
             + (2.0 * qd[5] * qd[0] * jt1)
             - (2.0 * qd[5] * qd[3] * jt1)
             - (2.0 * qd[5] * qd[1] * jt0)
@@ -443,7 +436,7 @@ impl Model for RodBlockTipping {
     }
 
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let et0 = q[5].sin();
         let et1 = q[5].cos();
@@ -485,7 +478,7 @@ impl Model for RodBlockTipping {
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         poses[0] = [(k[9] * rc_c) + q[0], (k[9] * rc_s) + q[1], q[2]];
         poses[1] = [q[3], q[4], q[5]];

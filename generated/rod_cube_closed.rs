@@ -53,7 +53,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 44,
+    n_constants: 41,
     coordinates: &["x1", "theta"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced: 1,
@@ -144,7 +144,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 8,
         force_degrees: &[3, 4],
         fall_degree: Some(2),
-        lean_constants: &[6, 7, 8, 29, 35, 36, 37, 38, 39, 40, 41, 42],
+        lean_constants: &[6, 7, 8, 26, 32, 33, 34, 35, 36, 37, 38, 39],
     }),
     route_note: "",
 };
@@ -175,60 +175,52 @@ impl Model for RodCubeClosed {
         k[10] = k[2] / 2.0;
         // k[11] = ell*m1/2 + ell*m2
         k[11] = (k[2] * k[0] / 2.0) + (k[2] * k[1]);
-        // k[12] = ell^2*m1/24
-        k[12] = (k[2] * k[2]) * k[0] / 24.0;
-        // k[13] = ell^2*m1/8 + ell^2*m2/2
-        let h13_t0 = k[2] * k[2];
-        k[13] = (h13_t0 * k[0] / 8.0) + (h13_t0 * k[1] / 2.0);
-        // k[14] = ell^2*m1/8
-        k[14] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[15] = m1/2 + m2/2
-        k[15] = (k[0] / 2.0) + (k[1] / 2.0);
-        // k[16] = a*g*m2/2
-        k[16] = k[3] * k[4] * k[1] / 2.0;
-        // k[17] = ell*g*m1/2
-        k[17] = k[2] * k[4] * k[0] / 2.0;
-        // k[18] = m1 + m2
-        k[18] = k[0] + k[1];
-        // k[19] = ell^2*m1/12
-        k[19] = (k[2] * k[2]) * k[0] / 12.0;
-        // k[20] = ell^2*m1/4 + ell^2*m2
-        let h20_t0 = k[2] * k[2];
-        k[20] = (h20_t0 * k[0] / 4.0) + (h20_t0 * k[1]);
-        // k[21] = ell^2*m1/4
-        k[21] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[22] = ell^2*m2
-        k[22] = (k[2] * k[2]) * k[1];
-        // k[23] = g*m1
-        k[23] = k[4] * k[0];
-        // k[24] = ell*m1/2
-        k[24] = k[2] * k[0] / 2.0;
-        // k[25] = a/2
-        k[25] = k[3] / 2.0;
-        // k[26] = 12/ell
-        k[26] = 12.0 / k[2];
-        // k[27] = g*m1 + g*m2
-        k[27] = (k[4] * k[0]) + (k[4] * k[1]);
-        // k[28] = 4*m1 + 4*m2
-        k[28] = (4.0 * k[0]) + (4.0 * k[1]);
-        // k[30] = 6/ell
-        k[30] = 6.0 / k[2];
-        // k[31] = 6*g*m1*m2 + 6*g*m1^2
-        k[31] = (6.0 * k[4] * k[0] * k[1]) + (6.0 * k[4] * (k[0] * k[0]));
-        // k[32] = 8*g*m1*m2 + 4*g*m1^2 + 4*g*m2^2
-        k[32] = (8.0 * k[4] * k[0] * k[1])
+        // k[12] = ell^2*m1/6
+        k[12] = (k[2] * k[2]) * k[0] / 6.0;
+        // k[13] = ell^2*m2/2
+        k[13] = (k[2] * k[2]) * k[1] / 2.0;
+        // k[14] = m1/2 + m2/2
+        k[14] = (k[0] / 2.0) + (k[1] / 2.0);
+        // k[15] = a*g*m2/2
+        k[15] = k[3] * k[4] * k[1] / 2.0;
+        // k[16] = ell*g*m1/2
+        k[16] = k[2] * k[4] * k[0] / 2.0;
+        // k[17] = m1 + m2
+        k[17] = k[0] + k[1];
+        // k[18] = ell^2*m1/3
+        k[18] = (k[2] * k[2]) * k[0] / 3.0;
+        // k[19] = ell^2*m2
+        k[19] = (k[2] * k[2]) * k[1];
+        // k[20] = g*m1
+        k[20] = k[4] * k[0];
+        // k[21] = ell*m1/2
+        k[21] = k[2] * k[0] / 2.0;
+        // k[22] = a/2
+        k[22] = k[3] / 2.0;
+        // k[23] = 12/ell
+        k[23] = 12.0 / k[2];
+        // k[24] = g*m1 + g*m2
+        k[24] = (k[4] * k[0]) + (k[4] * k[1]);
+        // k[25] = 4*m1 + 4*m2
+        k[25] = (4.0 * k[0]) + (4.0 * k[1]);
+        // k[27] = 6/ell
+        k[27] = 6.0 / k[2];
+        // k[28] = 6*g*m1*m2 + 6*g*m1^2
+        k[28] = (6.0 * k[4] * k[0] * k[1]) + (6.0 * k[4] * (k[0] * k[0]));
+        // k[29] = 8*g*m1*m2 + 4*g*m1^2 + 4*g*m2^2
+        k[29] = (8.0 * k[4] * k[0] * k[1])
             + (4.0 * k[4] * (k[0] * k[0]))
             + (4.0 * k[4] * (k[1] * k[1]));
-        // k[33] = 3*g*m1*m2 + 3*g*m1^2
-        k[33] = (3.0 * k[4] * k[0] * k[1]) + (3.0 * k[4] * (k[0] * k[0]));
-        // k[34] = ell*m1*m2/(2*(m1 + m2))
-        k[34] = k[2] * k[0] * k[1] / 2.0 / (k[0] + k[1]);
-        // k[43] = ell*m1/(2*(m1 + m2)) + ell*m2/(m1 + m2)
-        k[43] = (k[2] * k[0] / 2.0 / (k[0] + k[1])) + (k[2] * k[1] / (k[0] + k[1]));
+        // k[30] = 3*g*m1*m2 + 3*g*m1^2
+        k[30] = (3.0 * k[4] * k[0] * k[1]) + (3.0 * k[4] * (k[0] * k[0]));
+        // k[31] = ell*m1*m2/(2*(m1 + m2))
+        k[31] = k[2] * k[0] * k[1] / 2.0 / (k[0] + k[1]);
+        // k[40] = ell*m1/(2*(m1 + m2)) + ell*m2/(m1 + m2)
+        k[40] = (k[2] * k[0] / 2.0 / (k[0] + k[1])) + (k[2] * k[1] / (k[0] + k[1]));
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = k[5];
@@ -236,7 +228,7 @@ impl Model for RodCubeClosed {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let pt0 = (k[2] * rc_c) + q[0];
         let pt1 = -(k[2] * qd[1] * rc_s) + qd[0];
@@ -251,42 +243,41 @@ impl Model for RodCubeClosed {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..44]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
+        let k = &k[..41]; // one bounds check for all constant loads
+        let rc_s = q[1].sin();
         let et0 = qd[1] * qd[1];
         (-(k[11] * qd[1] * qd[0] * rc_s)
             + (k[12] * et0)
             + (k[13] * et0 * (rc_s * rc_s))
-            + (k[14] * et0 * (rc_c * rc_c))
-            + (k[15] * (qd[0] * qd[0])))
-            + (k[16] + (k[17] * rc_s))
+            + (k[14] * (qd[0] * qd[0])))
+            + (k[15] + (k[16] * rc_s))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
-        out[0] = -(k[11] * qd[1] * rc_s) + (k[18] * qd[0]);
+        out[0] = -(k[11] * qd[1] * rc_s) + (k[17] * qd[0]);
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let qt0 = -k[11] * rc_s;
         let qt1 = qd[1] * qd[1];
-        mass[0] = k[18];
+        mass[0] = k[17];
         mass[1] = qt0;
         mass[2] = qt0;
-        mass[3] = k[19] + (k[20] * (rc_s * rc_s)) + (k[21] * (rc_c * rc_c));
+        mass[3] = k[18] + (k[19] * (rc_s * rc_s));
         rhs[0] = k[11] * qt1 * rc_c;
-        rhs[1] = -(k[17] * rc_c) - (k[22] * qt1 * rc_s * rc_c);
+        rhs[1] = -(k[16] * rc_c) - (k[19] * qt1 * rc_s * rc_c);
     }
 
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let ft0 = qd[1] * qd[1];
         out[0] = k[1] * (-(k[2] * qdd[1] * rc_s) + qdd[0] - (k[2] * ft0 * rc_c));
-        out[1] = k[23] + (k[24] * qdd[1] * rc_c) - (k[24] * ft0 * rc_s);
+        out[1] = k[20] + (k[21] * qdd[1] * rc_c) - (k[21] * ft0 * rc_s);
     }
 
     fn gaps(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
@@ -311,13 +302,13 @@ impl Model for RodCubeClosed {
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
-        out[0] = k[16] - (forces[0] * (-k[25] + (k[2] * rc_s)));
+        out[0] = k[15] - (forces[0] * (-k[22] + (k[2] * rc_s)));
     }
 
     fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         q_full[0] = q[0];
         qd_full[0] = qd[0];
@@ -330,10 +321,10 @@ impl Model for RodCubeClosed {
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         poses[0] = [(k[10] * rc_c) + q[0], k[10] * rc_s, q[1]];
-        poses[1] = [k[25] + (k[2] * rc_c) + q[0], k[25], 0.0];
+        poses[1] = [k[22] + (k[2] * rc_c) + q[0], k[22], 0.0];
         sizes[0] = -k[10];
         sizes[1] = 0.0;
         sizes[2] = k[10];
@@ -351,53 +342,53 @@ impl Model for RodCubeClosed {
 
 impl Reduction for RodCubeClosed {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[7], k[8], delta);
         let rt0 = rc_s * rc_s;
-        let rt1 = -k[28] + (k[29] * rt0);
+        let rt1 = -k[25] + (k[26] * rt0);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: -k[26] * (k[27] * rc_ds) / rt1,
-            theta_ddot: k[30]
-                * ((k[31] * rc_s * rc_c * rc_ds) - (k[32] * rc_c) + (k[33] * rt0 * rc_c))
+            theta_dot_sq: -k[23] * (k[24] * rc_ds) / rt1,
+            theta_ddot: k[27]
+                * ((k[28] * rc_s * rc_c * rc_ds) - (k[29] * rc_c) + (k[30] * rt0 * rc_c))
                 / (rt1 * rt1),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..44]; // one bounds check for all constant loads
-        -k[26] * (k[27] * rc_ds) / (-k[28] + (k[29] * (rc_s * rc_s)))
+        let k = &k[..41]; // one bounds check for all constant loads
+        -k[23] * (k[24] * rc_ds) / (-k[25] + (k[26] * (rc_s * rc_s)))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[7], k[8], delta);
         let rt0 = rc_s * rc_s;
-        let rt1 = -k[28] + (k[29] * rt0);
-        let rc_w2 = -k[26] * (k[27] * rc_ds) / rt1;
-        let rc_acc = k[30]
-            * ((k[31] * rc_s * rc_c * rc_ds) - (k[32] * rc_c) + (k[33] * rt0 * rc_c))
+        let rt1 = -k[25] + (k[26] * rt0);
+        let rc_w2 = -k[23] * (k[24] * rc_ds) / rt1;
+        let rc_acc = k[27]
+            * ((k[28] * rc_s * rc_c * rc_ds) - (k[29] * rc_c) + (k[30] * rt0 * rc_c))
             / (rt1 * rt1);
-        out[0] = -(k[34] * rc_s * rc_acc) - (k[34] * rc_c * rc_w2);
-        out[1] = k[23] - (k[24] * rc_s * rc_w2) + (k[24] * rc_c * rc_acc);
+        out[0] = -(k[31] * rc_s * rc_acc) - (k[31] * rc_c * rc_w2);
+        out[1] = k[20] - (k[21] * rc_s * rc_w2) + (k[21] * rc_c * rc_acc);
     }
 
     fn force_polynomial(&self, k: &[f64], contact: usize, out: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         match contact {
             0 => {
-                out[0] = -k[35];
-                out[1] = k[36];
+                out[0] = -k[32];
+                out[1] = k[33];
                 out[2] = 0.0;
-                out[3] = -k[29];
+                out[3] = -k[26];
             }
             1 => {
-                out[0] = k[37];
-                out[1] = -k[38];
-                out[2] = k[39];
+                out[0] = k[34];
+                out[1] = -k[35];
+                out[2] = k[36];
                 out[3] = 0.0;
-                out[4] = -k[40];
+                out[4] = -k[37];
             }
             _ => {}
         }
@@ -412,33 +403,33 @@ impl Reduction for RodCubeClosed {
         // k[8] = rc_ci = ((1 - a/ell)*(1 + a/ell))^(1/2)
         let c3_t0 = k[3] / k[2];
         k[8] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
-        // k[29] = 3*m1
-        k[29] = 3.0 * k[0];
-        // k[35] = 8*m1*rc_si + 8*m2*rc_si
-        k[35] = (8.0 * k[0] * k[7]) + (8.0 * k[1] * k[7]);
-        // k[36] = 12*m1 + 12*m2
-        k[36] = (12.0 * k[0]) + (12.0 * k[1]);
-        // k[37] = 8*m1*m2 + 4*m1^2 + 4*m2^2
-        k[37] = (8.0 * k[0] * k[1]) + (4.0 * (k[0] * k[0])) + (4.0 * (k[1] * k[1]));
-        // k[38] = 30*m1*m2*rc_si + 6*m1^2*rc_si + 24*m2^2*rc_si
-        k[38] = (30.0 * k[0] * k[1] * k[7])
+        // k[26] = 3*m1
+        k[26] = 3.0 * k[0];
+        // k[32] = 8*m1*rc_si + 8*m2*rc_si
+        k[32] = (8.0 * k[0] * k[7]) + (8.0 * k[1] * k[7]);
+        // k[33] = 12*m1 + 12*m2
+        k[33] = (12.0 * k[0]) + (12.0 * k[1]);
+        // k[34] = 8*m1*m2 + 4*m1^2 + 4*m2^2
+        k[34] = (8.0 * k[0] * k[1]) + (4.0 * (k[0] * k[0])) + (4.0 * (k[1] * k[1]));
+        // k[35] = 30*m1*m2*rc_si + 6*m1^2*rc_si + 24*m2^2*rc_si
+        k[35] = (30.0 * k[0] * k[1] * k[7])
             + (6.0 * (k[0] * k[0]) * k[7])
             + (24.0 * (k[1] * k[1]) * k[7]);
-        // k[39] = 39*m1*m2 + 3*m1^2 + 36*m2^2
-        k[39] = (39.0 * k[0] * k[1]) + (3.0 * (k[0] * k[0])) + (36.0 * (k[1] * k[1]));
-        // k[40] = 9*m1*m2
-        k[40] = 9.0 * k[0] * k[1];
-        // k[41] = ell/(3*g)
-        k[41] = k[2] / 3.0 / k[4];
-        // k[42] = ell*m1/(4*g*(m1 + m2))
-        k[42] = k[2] * k[0] / 4.0 / k[4] / (k[0] + k[1]);
+        // k[36] = 39*m1*m2 + 3*m1^2 + 36*m2^2
+        k[36] = (39.0 * k[0] * k[1]) + (3.0 * (k[0] * k[0])) + (36.0 * (k[1] * k[1]));
+        // k[37] = 9*m1*m2
+        k[37] = 9.0 * k[0] * k[1];
+        // k[38] = ell/(3*g)
+        k[38] = k[2] / 3.0 / k[4];
+        // k[39] = ell*m1/(4*g*(m1 + m2))
+        k[39] = k[2] * k[0] / 4.0 / k[4] / (k[0] + k[1]);
     }
 
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
-        out[0] = k[41];
+        let k = &k[..41]; // one bounds check for all constant loads
+        out[0] = k[38];
         out[1] = 0.0;
-        out[2] = -k[42];
+        out[2] = -k[39];
     }
 
     fn full_state(
@@ -450,12 +441,12 @@ impl Reduction for RodCubeClosed {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, _, _, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_w = theta_dot;
         q[1] = k[5] - delta;
         qd[1] = theta_dot;
-        q[0] = k[9] + (k[43] * rc_dc);
-        qd[0] = k[43] * rc_s * rc_w;
+        q[0] = k[9] + (k[40] * rc_dc);
+        qd[0] = k[40] * rc_s * rc_w;
     }
 }

@@ -89,7 +89,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 39,
+    n_constants: 37,
     coordinates: &["x1", "theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced: 1,
@@ -180,7 +180,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 12,
         force_degrees: &[0, 2],
         fall_degree: None,
-        lean_constants: &[11, 12, 15, 33, 34, 36],
+        lean_constants: &[11, 12, 15, 31, 32, 34],
     }),
     route_note: "",
 };
@@ -215,46 +215,42 @@ impl Model for RodCubeFree {
         k[16] = k[2] / 2.0;
         // k[17] = ell*m1/2
         k[17] = k[2] * k[0] / 2.0;
-        // k[18] = ell^2*m1/24
-        k[18] = (k[2] * k[2]) * k[0] / 24.0;
-        // k[19] = ell^2*m1/8
-        k[19] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[20] = m1/2
-        k[20] = k[0] / 2.0;
-        // k[21] = m2/2
-        k[21] = k[1] / 2.0;
-        // k[22] = a*g*m2/2
-        k[22] = k[3] * k[4] * k[1] / 2.0;
-        // k[23] = ell*g*m1/2
-        k[23] = k[2] * k[4] * k[0] / 2.0;
-        // k[24] = ell^2*m1/12
-        k[24] = (k[2] * k[2]) * k[0] / 12.0;
-        // k[25] = ell^2*m1/4
-        k[25] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[26] = g*m1
-        k[26] = k[4] * k[0];
-        // k[27] = a/2
-        k[27] = k[3] / 2.0;
-        // k[28] = 12/(ell^2*m1)
-        k[28] = 12.0 / (k[2] * k[2]) / k[0];
-        // k[29] = rc_wi^2*rc_ai
-        k[29] = (k[9] * k[9]) * k[15];
-        // k[30] = ell*g*m1
-        k[30] = k[2] * k[4] * k[0];
-        // k[31] = 6/(ell^2*m1)
-        k[31] = 6.0 / (k[2] * k[2]) / k[0];
-        // k[32] = 6*ell*g*m1
-        k[32] = 6.0 * k[2] * k[4] * k[0];
-        // k[35] = 6*rc_wi^2*rc_ai
-        k[35] = 6.0 * (k[9] * k[9]) * k[15];
-        // k[37] = rc_p0/m1
-        k[37] = k[13] / k[0];
-        // k[38] = rc_p1/m2
-        k[38] = k[14] / k[1];
+        // k[18] = ell^2*m1/6
+        k[18] = (k[2] * k[2]) * k[0] / 6.0;
+        // k[19] = m1/2
+        k[19] = k[0] / 2.0;
+        // k[20] = m2/2
+        k[20] = k[1] / 2.0;
+        // k[21] = a*g*m2/2
+        k[21] = k[3] * k[4] * k[1] / 2.0;
+        // k[22] = ell*g*m1/2
+        k[22] = k[2] * k[4] * k[0] / 2.0;
+        // k[23] = ell^2*m1/3
+        k[23] = (k[2] * k[2]) * k[0] / 3.0;
+        // k[24] = g*m1
+        k[24] = k[4] * k[0];
+        // k[25] = a/2
+        k[25] = k[3] / 2.0;
+        // k[26] = 12/(ell^2*m1)
+        k[26] = 12.0 / (k[2] * k[2]) / k[0];
+        // k[27] = rc_wi^2*rc_ai
+        k[27] = (k[9] * k[9]) * k[15];
+        // k[28] = ell*g*m1
+        k[28] = k[2] * k[4] * k[0];
+        // k[29] = 6/(ell^2*m1)
+        k[29] = 6.0 / (k[2] * k[2]) / k[0];
+        // k[30] = 6*ell*g*m1
+        k[30] = 6.0 * k[2] * k[4] * k[0];
+        // k[33] = 6*rc_wi^2*rc_ai
+        k[33] = 6.0 * (k[9] * k[9]) * k[15];
+        // k[35] = rc_p0/m1
+        k[35] = k[13] / k[0];
+        // k[36] = rc_p1/m2
+        k[36] = k[14] / k[1];
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         q[0] = k[5];
         qd[0] = k[8];
         q[1] = k[6];
@@ -264,7 +260,7 @@ impl Model for RodCubeFree {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         pos[0] = [q[0], 0.0];
         vel[0] = [qd[0], 0.0];
@@ -277,59 +273,56 @@ impl Model for RodCubeFree {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..39]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let et0 = qd[1] * qd[1];
+        let k = &k[..37]; // one bounds check for all constant loads
+        let rc_s = q[1].sin();
         (-(k[17] * qd[1] * qd[0] * rc_s)
-            + (k[18] * et0)
-            + (k[19] * et0 * (rc_s * rc_s))
-            + (k[19] * et0 * (rc_c * rc_c))
-            + (k[20] * (qd[0] * qd[0]))
-            + (k[21] * (qd[2] * qd[2])))
-            + (k[22] + (k[23] * rc_s))
+            + (k[18] * (qd[1] * qd[1]))
+            + (k[19] * (qd[0] * qd[0]))
+            + (k[20] * (qd[2] * qd[2])))
+            + (k[21] + (k[22] * rc_s))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
         out[0] = -(k[17] * qd[1] * rc_s) + (k[0] * qd[0]);
         out[1] = k[1] * qd[2];
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let qt0 = -k[17] * rc_s;
         mass[0] = k[0];
         mass[1] = qt0;
         mass[2] = 0.0;
         mass[3] = qt0;
-        mass[4] = k[24] + (k[25] * (rc_s * rc_s)) + (k[25] * (rc_c * rc_c));
+        mass[4] = k[23];
         mass[5] = 0.0;
         mass[6] = 0.0;
         mass[7] = 0.0;
         mass[8] = k[1];
         rhs[0] = k[17] * (qd[1] * qd[1]) * rc_c;
-        rhs[1] = -k[23] * rc_c;
+        rhs[1] = -k[22] * rc_c;
         rhs[2] = 0.0;
     }
 
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = 0.0;
-        out[1] = k[26] + (k[17] * qdd[1] * rc_c) - (k[17] * (qd[1] * qd[1]) * rc_s);
+        out[1] = k[24] + (k[17] * qdd[1] * rc_c) - (k[17] * (qd[1] * qd[1]) * rc_s);
     }
 
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let rc_c = q[1].cos();
         out[0] = -(k[2] * rc_c) - q[0] + q[2];
         out[1] = 0.0;
     }
 
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         jac[0] = -1.0;
         jac[1] = k[2] * rc_s;
@@ -349,9 +342,9 @@ impl Model for RodCubeFree {
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
-        out[0] = k[22] - (forces[0] * (-k[27] + (k[2] * rc_s)));
+        out[0] = k[21] - (forces[0] * (-k[25] + (k[2] * rc_s)));
     }
 
     fn to_full(&self, _k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
@@ -366,10 +359,10 @@ impl Model for RodCubeFree {
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         poses[0] = [(k[16] * rc_c) + q[0], k[16] * rc_s, q[1]];
-        poses[1] = [k[27] + q[2], k[27], 0.0];
+        poses[1] = [k[25] + q[2], k[25], 0.0];
         sizes[0] = -k[16];
         sizes[1] = 0.0;
         sizes[2] = k[16];
@@ -387,49 +380,49 @@ impl Model for RodCubeFree {
 
 impl Reduction for RodCubeFree {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[6], k[11], k[12], delta);
         let rt0 = rc_s * rc_s;
         let rt1 = -4.0 + (3.0 * rt0);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: -k[28] * (k[29] + (k[30] * rc_ds)) / rt1,
-            theta_ddot: k[31]
-                * ((k[32] * rc_s * rc_c * rc_ds) - (k[33] * rc_c)
-                    + (k[34] * rt0 * rc_c)
-                    + (k[35] * rc_s * rc_c))
+            theta_dot_sq: -k[26] * (k[27] + (k[28] * rc_ds)) / rt1,
+            theta_ddot: k[29]
+                * ((k[30] * rc_s * rc_c * rc_ds) - (k[31] * rc_c)
+                    + (k[32] * rt0 * rc_c)
+                    + (k[33] * rc_s * rc_c))
                 / (rt1 * rt1),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..39]; // one bounds check for all constant loads
-        -k[28] * (k[29] + (k[30] * rc_ds)) / (-4.0 + (3.0 * (rc_s * rc_s)))
+        let k = &k[..37]; // one bounds check for all constant loads
+        -k[26] * (k[27] + (k[28] * rc_ds)) / (-4.0 + (3.0 * (rc_s * rc_s)))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[6], k[11], k[12], delta);
         let rt0 = rc_s * rc_s;
         let rt1 = -4.0 + (3.0 * rt0);
-        let rc_w2 = -k[28] * (k[29] + (k[30] * rc_ds)) / rt1;
-        let rc_acc = k[31]
-            * ((k[32] * rc_s * rc_c * rc_ds) - (k[33] * rc_c)
-                + (k[34] * rt0 * rc_c)
-                + (k[35] * rc_s * rc_c))
+        let rc_w2 = -k[26] * (k[27] + (k[28] * rc_ds)) / rt1;
+        let rc_acc = k[29]
+            * ((k[30] * rc_s * rc_c * rc_ds) - (k[31] * rc_c)
+                + (k[32] * rt0 * rc_c)
+                + (k[33] * rc_s * rc_c))
             / (rt1 * rt1);
         out[0] = 0.0;
-        out[1] = k[26] - (k[17] * rc_s * rc_w2) + (k[17] * rc_c * rc_acc);
+        out[1] = k[24] - (k[17] * rc_s * rc_w2) + (k[17] * rc_c * rc_acc);
     }
 
     fn force_polynomial(&self, k: &[f64], contact: usize, out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         match contact {
             1 => {
-                out[0] = k[33];
-                out[1] = -k[36];
-                out[2] = k[34];
+                out[0] = k[31];
+                out[1] = -k[34];
+                out[2] = k[32];
             }
             _ => {}
         }
@@ -444,12 +437,12 @@ impl Reduction for RodCubeFree {
         // k[15] = rc_ai = ell^2*m1/3 - ell^2*m1*rc_si^2/4
         let c8_t0 = k[2] * k[2];
         k[15] = (c8_t0 * k[0] / 3.0) - (c8_t0 * k[0] * (k[11] * k[11]) / 4.0);
-        // k[33] = 4*ell*g*m1
-        k[33] = 4.0 * k[2] * k[4] * k[0];
-        // k[34] = 3*ell*g*m1
-        k[34] = 3.0 * k[2] * k[4] * k[0];
-        // k[36] = 6*ell*g*m1*rc_si + 6*rc_wi^2*rc_ai
-        k[36] = (6.0 * k[2] * k[4] * k[0] * k[11]) + (6.0 * (k[9] * k[9]) * k[15]);
+        // k[31] = 4*ell*g*m1
+        k[31] = 4.0 * k[2] * k[4] * k[0];
+        // k[32] = 3*ell*g*m1
+        k[32] = 3.0 * k[2] * k[4] * k[0];
+        // k[34] = 6*ell*g*m1*rc_si + 6*rc_wi^2*rc_ai
+        k[34] = (6.0 * k[2] * k[4] * k[0] * k[11]) + (6.0 * (k[9] * k[9]) * k[15]);
     }
 
     fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
@@ -463,15 +456,15 @@ impl Reduction for RodCubeFree {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, _, _, rc_dc) = start_offsets(k[6], k[11], k[12], delta);
         let rc_t = t;
         let rc_w = theta_dot;
         q[1] = k[6] - delta;
         qd[1] = theta_dot;
-        q[0] = k[5] + (k[16] * rc_dc) + (k[37] * rc_t);
-        qd[0] = k[37] + (k[16] * rc_s * rc_w);
-        q[2] = k[7] + (k[38] * rc_t);
-        qd[2] = k[38];
+        q[0] = k[5] + (k[16] * rc_dc) + (k[35] * rc_t);
+        qd[0] = k[35] + (k[16] * rc_s * rc_w);
+        q[2] = k[7] + (k[36] * rc_t);
+        qd[2] = k[36];
     }
 }

@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 22,
+    n_constants: 20,
     coordinates: &["x1", "y1", "theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced: 2,
@@ -156,34 +156,30 @@ impl Model for RodCubeSpring {
         k[8] = k[2] / 2.0;
         // k[9] = ell*m1/2
         k[9] = k[2] * k[0] / 2.0;
-        // k[10] = ell^2*m1/24
-        k[10] = (k[2] * k[2]) * k[0] / 24.0;
-        // k[11] = ell^2*m1/8
-        k[11] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[12] = m1/2
-        k[12] = k[0] / 2.0;
-        // k[13] = m2/2
-        k[13] = k[1] / 2.0;
-        // k[14] = a*g*m2/2
-        k[14] = k[3] * k[4] * k[1] / 2.0;
-        // k[15] = ell*g*m1/2
-        k[15] = k[2] * k[4] * k[0] / 2.0;
-        // k[16] = g*m1
-        k[16] = k[4] * k[0];
-        // k[17] = k/2
-        k[17] = k[5] / 2.0;
-        // k[18] = (-a^2 + ell^2)^(1/2)
-        k[18] = (-(k[3] * k[3]) + (k[2] * k[2])).sqrt();
-        // k[19] = ell^2*m1/12
-        k[19] = (k[2] * k[2]) * k[0] / 12.0;
-        // k[20] = ell^2*m1/4
-        k[20] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[21] = a/2
-        k[21] = k[3] / 2.0;
+        // k[10] = ell^2*m1/6
+        k[10] = (k[2] * k[2]) * k[0] / 6.0;
+        // k[11] = m1/2
+        k[11] = k[0] / 2.0;
+        // k[12] = m2/2
+        k[12] = k[1] / 2.0;
+        // k[13] = a*g*m2/2
+        k[13] = k[3] * k[4] * k[1] / 2.0;
+        // k[14] = ell*g*m1/2
+        k[14] = k[2] * k[4] * k[0] / 2.0;
+        // k[15] = g*m1
+        k[15] = k[4] * k[0];
+        // k[16] = k/2
+        k[16] = k[5] / 2.0;
+        // k[17] = (-a^2 + ell^2)^(1/2)
+        k[17] = (-(k[3] * k[3]) + (k[2] * k[2])).sqrt();
+        // k[18] = ell^2*m1/3
+        k[18] = (k[2] * k[2]) * k[0] / 3.0;
+        // k[19] = a/2
+        k[19] = k[3] / 2.0;
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = 0.0;
@@ -195,7 +191,7 @@ impl Model for RodCubeSpring {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         pos[0] = [q[0], q[1]];
         vel[0] = [qd[0], qd[1]];
@@ -214,31 +210,28 @@ impl Model for RodCubeSpring {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let et0 = qd[2] * qd[2];
         (-(k[9] * qd[2] * qd[0] * rc_s)
             + (k[9] * qd[2] * qd[1] * rc_c)
-            + (k[10] * et0)
-            + (k[11] * et0 * (rc_s * rc_s))
-            + (k[11] * et0 * (rc_c * rc_c))
-            + (k[12] * (qd[0] * qd[0]))
-            + (k[13] * (qd[3] * qd[3]))
-            + (k[12] * (qd[1] * qd[1])))
-            + (k[14]
-                + (k[15] * rc_s)
-                + (k[16] * q[1])
-                + (k[17] * ((-k[18] + q[3]) * (-k[18] + q[3]))))
+            + (k[10] * (qd[2] * qd[2]))
+            + (k[11] * (qd[0] * qd[0]))
+            + (k[12] * (qd[3] * qd[3]))
+            + (k[11] * (qd[1] * qd[1])))
+            + (k[13]
+                + (k[14] * rc_s)
+                + (k[15] * q[1])
+                + (k[16] * ((-k[17] + q[3]) * (-k[17] + q[3]))))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         out[0] = -(k[9] * qd[2] * rc_s) + (k[0] * qd[0]);
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let qt0 = -k[9] * rc_s;
         let qt1 = k[9] * rc_c;
@@ -253,16 +246,16 @@ impl Model for RodCubeSpring {
         mass[7] = 0.0;
         mass[8] = qt0;
         mass[9] = qt1;
-        mass[10] = k[19] + (k[20] * (rc_s * rc_s)) + (k[20] * (rc_c * rc_c));
+        mass[10] = k[18];
         mass[11] = 0.0;
         mass[12] = 0.0;
         mass[13] = 0.0;
         mass[14] = 0.0;
         mass[15] = k[1];
         rhs[0] = k[9] * qt2 * rc_c;
-        rhs[1] = -k[16] + (k[9] * qt2 * rc_s);
-        rhs[2] = -k[15] * rc_c;
-        rhs[3] = -k[5] * (-k[18] + q[3]);
+        rhs[1] = -k[15] + (k[9] * qt2 * rc_s);
+        rhs[2] = -k[14] * rc_c;
+        rhs[3] = -k[5] * (-k[17] + q[3]);
     }
 
     fn forces_full(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _qdd: &[f64], out: &mut [f64]) {
@@ -271,14 +264,14 @@ impl Model for RodCubeSpring {
     }
 
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let rc_c = q[2].cos();
         out[0] = -(k[2] * rc_c) - q[0] + q[3];
         out[1] = q[1];
     }
 
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         jac[0] = -1.0;
         jac[1] = 0.0;
@@ -321,10 +314,10 @@ impl Model for RodCubeSpring {
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         poses[0] = [(k[8] * rc_c) + q[0], (k[8] * rc_s) + q[1], q[2]];
-        poses[1] = [k[21] + q[3], k[21], 0.0];
+        poses[1] = [k[19] + q[3], k[19], 0.0];
         sizes[0] = -k[8];
         sizes[1] = 0.0;
         sizes[2] = k[8];

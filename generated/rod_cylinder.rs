@@ -65,7 +65,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 19,
+    n_constants: 17,
     coordinates: &["x1", "y1", "theta", "xc"],
     system_coordinates: &["x1", "y1", "theta", "xc"],
     reduced: 2,
@@ -172,28 +172,24 @@ impl Model for RodCylinder {
         k[8] = 2.0 * k[3];
         // k[9] = ell*m1/2
         k[9] = k[2] * k[0] / 2.0;
-        // k[10] = ell^2*m1/24
-        k[10] = (k[2] * k[2]) * k[0] / 24.0;
-        // k[11] = ell^2*m1/8
-        k[11] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[12] = m1/2
-        k[12] = k[0] / 2.0;
-        // k[13] = m2/2
-        k[13] = k[1] / 2.0;
-        // k[14] = R*g*m2
-        k[14] = k[3] * k[5] * k[1];
-        // k[15] = ell*g*m1/2
-        k[15] = k[2] * k[5] * k[0] / 2.0;
-        // k[16] = g*m1
-        k[16] = k[5] * k[0];
-        // k[17] = ell^2*m1/12
-        k[17] = (k[2] * k[2]) * k[0] / 12.0;
-        // k[18] = ell^2*m1/4
-        k[18] = (k[2] * k[2]) * k[0] / 4.0;
+        // k[10] = ell^2*m1/6
+        k[10] = (k[2] * k[2]) * k[0] / 6.0;
+        // k[11] = m1/2
+        k[11] = k[0] / 2.0;
+        // k[12] = m2/2
+        k[12] = k[1] / 2.0;
+        // k[13] = R*g*m2
+        k[13] = k[3] * k[5] * k[1];
+        // k[14] = ell*g*m1/2
+        k[14] = k[2] * k[5] * k[0] / 2.0;
+        // k[15] = g*m1
+        k[15] = k[5] * k[0];
+        // k[16] = ell^2*m1/3
+        k[16] = (k[2] * k[2]) * k[0] / 3.0;
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..17]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = 0.0;
@@ -205,10 +201,10 @@ impl Model for RodCylinder {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..17]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let pt0 = rc_c * rc_c;
-        let pt1 = rc_s * rc_s;
+        let pt0 = rc_s * rc_s;
+        let pt1 = rc_c * rc_c;
         pos[0] = [q[0], q[1]];
         vel[0] = [qd[0], qd[1]];
         pos[1] = [(k[2] * rc_c) + q[0], (k[2] * rc_s) + q[1]];
@@ -224,54 +220,49 @@ impl Model for RodCylinder {
         pos[3] = [q[3], k[3]];
         vel[3] = [qd[3], 0.0];
         pos[4] = [
-            (k[3] * rc_s * rc_c) + q[0] - (q[0] * pt0) + (q[3] * pt0) - (q[1] * rc_s * rc_c),
-            (k[3] * pt1) - (q[0] * rc_s * rc_c) + (q[3] * rc_s * rc_c) + q[1] - (q[1] * pt1),
+            (k[3] * rc_s * rc_c) + (q[0] * pt0) + (q[3] * pt1) - (q[1] * rc_s * rc_c),
+            (k[3] * pt0) - (q[0] * rc_s * rc_c) + (q[3] * rc_s * rc_c) + (q[1] * pt1),
         ];
         vel[4] = [
-            -(k[3] * qd[2] * pt1) + (k[3] * qd[2] * pt0) + (2.0 * qd[2] * q[0] * rc_s * rc_c)
+            -(k[3] * qd[2] * pt0) + (k[3] * qd[2] * pt1) + (2.0 * qd[2] * q[0] * rc_s * rc_c)
                 - (2.0 * qd[2] * q[3] * rc_s * rc_c)
-                + (qd[2] * q[1] * pt1)
-                - (qd[2] * q[1] * pt0)
-                + qd[0]
-                - (qd[0] * pt0)
-                + (qd[3] * pt0)
+                + (qd[2] * q[1] * pt0)
+                - (qd[2] * q[1] * pt1)
+                + (qd[0] * pt0)
+                + (qd[3] * pt1)
                 - (qd[1] * rc_s * rc_c),
-            (k[8] * qd[2] * rc_s * rc_c) + (qd[2] * q[0] * pt1)
-                - (qd[2] * q[0] * pt0)
-                - (qd[2] * q[3] * pt1)
-                + (qd[2] * q[3] * pt0)
+            (k[8] * qd[2] * rc_s * rc_c) + (qd[2] * q[0] * pt0)
+                - (qd[2] * q[0] * pt1)
+                - (qd[2] * q[3] * pt0)
+                + (qd[2] * q[3] * pt1)
                 - (2.0 * qd[2] * q[1] * rc_s * rc_c)
                 - (qd[0] * rc_s * rc_c)
                 + (qd[3] * rc_s * rc_c)
-                + qd[1]
-                - (qd[1] * pt1),
+                + (qd[1] * pt1),
         ];
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..17]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let et0 = qd[2] * qd[2];
         (-(k[9] * qd[2] * qd[0] * rc_s)
             + (k[9] * qd[2] * qd[1] * rc_c)
-            + (k[10] * et0)
-            + (k[11] * et0 * (rc_s * rc_s))
-            + (k[11] * et0 * (rc_c * rc_c))
-            + (k[12] * (qd[0] * qd[0]))
-            + (k[13] * (qd[3] * qd[3]))
-            + (k[12] * (qd[1] * qd[1])))
-            + (k[14] + (k[15] * rc_s) + (k[16] * q[1]))
+            + (k[10] * (qd[2] * qd[2]))
+            + (k[11] * (qd[0] * qd[0]))
+            + (k[12] * (qd[3] * qd[3]))
+            + (k[11] * (qd[1] * qd[1])))
+            + (k[13] + (k[14] * rc_s) + (k[15] * q[1]))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..17]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         out[0] = -(k[9] * qd[2] * rc_s) + (k[0] * qd[0]);
         out[1] = k[1] * qd[3];
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..17]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let qt0 = -k[9] * rc_s;
         let qt1 = k[9] * rc_c;
@@ -286,15 +277,15 @@ impl Model for RodCylinder {
         mass[7] = 0.0;
         mass[8] = qt0;
         mass[9] = qt1;
-        mass[10] = k[17] + (k[18] * (rc_s * rc_s)) + (k[18] * (rc_c * rc_c));
+        mass[10] = k[16];
         mass[11] = 0.0;
         mass[12] = 0.0;
         mass[13] = 0.0;
         mass[14] = 0.0;
         mass[15] = k[1];
         rhs[0] = k[9] * qt2 * rc_c;
-        rhs[1] = -k[16] + (k[9] * qt2 * rc_s);
-        rhs[2] = -k[15] * rc_c;
+        rhs[1] = -k[15] + (k[9] * qt2 * rc_s);
+        rhs[2] = -k[14] * rc_c;
         rhs[3] = 0.0;
     }
 
@@ -304,14 +295,14 @@ impl Model for RodCylinder {
     }
 
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..17]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         out[0] = -k[3] - (k[3] * rc_c) - (q[0] * rc_s) + (q[3] * rc_s) + (q[1] * rc_c);
         out[1] = q[1];
     }
 
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..17]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let jt0 = qd[2] * qd[2];
         jac[0] = -rc_s;
@@ -331,7 +322,7 @@ impl Model for RodCylinder {
     }
 
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..17]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         out[0] = k[2] - (k[3] * rc_s) + (q[0] * rc_c) - (q[3] * rc_c) + (q[1] * rc_s);
         out[1] = f64::INFINITY;
@@ -361,7 +352,7 @@ impl Model for RodCylinder {
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..17]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         poses[0] = [(k[7] * rc_c) + q[0], (k[7] * rc_s) + q[1], q[2]];
         poses[1] = [q[3], k[3], 0.0];

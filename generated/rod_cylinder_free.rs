@@ -101,7 +101,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 40,
+    n_constants: 38,
     coordinates: &["x1", "theta", "xc"],
     system_coordinates: &["x1", "y1", "theta", "xc"],
     reduced: 1,
@@ -184,7 +184,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 13,
         force_degrees: &[0, 2],
         fall_degree: None,
-        lean_constants: &[12, 13, 16, 34, 35, 37],
+        lean_constants: &[12, 13, 16, 32, 33, 35],
     }),
     route_note: "",
 };
@@ -223,44 +223,40 @@ impl Model for RodCylinderFree {
         k[18] = 2.0 * k[3];
         // k[19] = ell*m1/2
         k[19] = k[2] * k[0] / 2.0;
-        // k[20] = ell^2*m1/24
-        k[20] = (k[2] * k[2]) * k[0] / 24.0;
-        // k[21] = ell^2*m1/8
-        k[21] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[22] = m1/2
-        k[22] = k[0] / 2.0;
-        // k[23] = m2/2
-        k[23] = k[1] / 2.0;
-        // k[24] = R*g*m2
-        k[24] = k[3] * k[5] * k[1];
-        // k[25] = ell*g*m1/2
-        k[25] = k[2] * k[5] * k[0] / 2.0;
-        // k[26] = ell^2*m1/12
-        k[26] = (k[2] * k[2]) * k[0] / 12.0;
-        // k[27] = ell^2*m1/4
-        k[27] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[28] = g*m1
-        k[28] = k[5] * k[0];
-        // k[29] = 12/(ell^2*m1)
-        k[29] = 12.0 / (k[2] * k[2]) / k[0];
-        // k[30] = rc_wi^2*rc_ai
-        k[30] = (k[10] * k[10]) * k[16];
-        // k[31] = ell*g*m1
-        k[31] = k[2] * k[5] * k[0];
-        // k[32] = 6/(ell^2*m1)
-        k[32] = 6.0 / (k[2] * k[2]) / k[0];
-        // k[33] = 6*ell*g*m1
-        k[33] = 6.0 * k[2] * k[5] * k[0];
-        // k[36] = 6*rc_wi^2*rc_ai
-        k[36] = 6.0 * (k[10] * k[10]) * k[16];
-        // k[38] = rc_p0/m1
-        k[38] = k[14] / k[0];
-        // k[39] = rc_p1/m2
-        k[39] = k[15] / k[1];
+        // k[20] = ell^2*m1/6
+        k[20] = (k[2] * k[2]) * k[0] / 6.0;
+        // k[21] = m1/2
+        k[21] = k[0] / 2.0;
+        // k[22] = m2/2
+        k[22] = k[1] / 2.0;
+        // k[23] = R*g*m2
+        k[23] = k[3] * k[5] * k[1];
+        // k[24] = ell*g*m1/2
+        k[24] = k[2] * k[5] * k[0] / 2.0;
+        // k[25] = ell^2*m1/3
+        k[25] = (k[2] * k[2]) * k[0] / 3.0;
+        // k[26] = g*m1
+        k[26] = k[5] * k[0];
+        // k[27] = 12/(ell^2*m1)
+        k[27] = 12.0 / (k[2] * k[2]) / k[0];
+        // k[28] = rc_wi^2*rc_ai
+        k[28] = (k[10] * k[10]) * k[16];
+        // k[29] = ell*g*m1
+        k[29] = k[2] * k[5] * k[0];
+        // k[30] = 6/(ell^2*m1)
+        k[30] = 6.0 / (k[2] * k[2]) / k[0];
+        // k[31] = 6*ell*g*m1
+        k[31] = 6.0 * k[2] * k[5] * k[0];
+        // k[34] = 6*rc_wi^2*rc_ai
+        k[34] = 6.0 * (k[10] * k[10]) * k[16];
+        // k[36] = rc_p0/m1
+        k[36] = k[14] / k[0];
+        // k[37] = rc_p1/m2
+        k[37] = k[15] / k[1];
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         q[0] = k[6];
         qd[0] = k[9];
         q[1] = k[7];
@@ -270,10 +266,10 @@ impl Model for RodCylinderFree {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let pt0 = rc_c * rc_c;
-        let pt1 = rc_s * rc_s;
+        let pt0 = rc_s * rc_s;
+        let pt1 = rc_c * rc_c;
         pos[0] = [q[0], 0.0];
         vel[0] = [qd[0], 0.0];
         pos[1] = [(k[2] * rc_c) + q[0], k[2] * rc_s];
@@ -283,78 +279,74 @@ impl Model for RodCylinderFree {
         pos[3] = [q[2], k[3]];
         vel[3] = [qd[2], 0.0];
         pos[4] = [
-            (k[3] * rc_s * rc_c) + q[0] - (q[0] * pt0) + (q[2] * pt0),
-            (k[3] * pt1) - (q[0] * rc_s * rc_c) + (q[2] * rc_s * rc_c),
+            (k[3] * rc_s * rc_c) + (q[0] * pt0) + (q[2] * pt1),
+            (k[3] * pt0) - (q[0] * rc_s * rc_c) + (q[2] * rc_s * rc_c),
         ];
         vel[4] = [
-            -(k[3] * qd[1] * pt1) + (k[3] * qd[1] * pt0) + (2.0 * qd[1] * q[0] * rc_s * rc_c)
+            -(k[3] * qd[1] * pt0) + (k[3] * qd[1] * pt1) + (2.0 * qd[1] * q[0] * rc_s * rc_c)
                 - (2.0 * qd[1] * q[2] * rc_s * rc_c)
-                + qd[0]
-                - (qd[0] * pt0)
-                + (qd[2] * pt0),
-            (k[18] * qd[1] * rc_s * rc_c) + (qd[1] * q[0] * pt1)
-                - (qd[1] * q[0] * pt0)
-                - (qd[1] * q[2] * pt1)
-                + (qd[1] * q[2] * pt0)
+                + (qd[0] * pt0)
+                + (qd[2] * pt1),
+            (k[18] * qd[1] * rc_s * rc_c) + (qd[1] * q[0] * pt0)
+                - (qd[1] * q[0] * pt1)
+                - (qd[1] * q[2] * pt0)
+                + (qd[1] * q[2] * pt1)
                 - (qd[0] * rc_s * rc_c)
                 + (qd[2] * rc_s * rc_c),
         ];
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..40]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let et0 = qd[1] * qd[1];
+        let k = &k[..38]; // one bounds check for all constant loads
+        let rc_s = q[1].sin();
         (-(k[19] * qd[1] * qd[0] * rc_s)
-            + (k[20] * et0)
-            + (k[21] * et0 * (rc_s * rc_s))
-            + (k[21] * et0 * (rc_c * rc_c))
-            + (k[22] * (qd[0] * qd[0]))
-            + (k[23] * (qd[2] * qd[2])))
-            + (k[24] + (k[25] * rc_s))
+            + (k[20] * (qd[1] * qd[1]))
+            + (k[21] * (qd[0] * qd[0]))
+            + (k[22] * (qd[2] * qd[2])))
+            + (k[23] + (k[24] * rc_s))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
         out[0] = -(k[19] * qd[1] * rc_s) + (k[0] * qd[0]);
         out[1] = k[1] * qd[2];
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let qt0 = -k[19] * rc_s;
         mass[0] = k[0];
         mass[1] = qt0;
         mass[2] = 0.0;
         mass[3] = qt0;
-        mass[4] = k[26] + (k[27] * (rc_s * rc_s)) + (k[27] * (rc_c * rc_c));
+        mass[4] = k[25];
         mass[5] = 0.0;
         mass[6] = 0.0;
         mass[7] = 0.0;
         mass[8] = k[1];
         rhs[0] = k[19] * (qd[1] * qd[1]) * rc_c;
-        rhs[1] = -k[25] * rc_c;
+        rhs[1] = -k[24] * rc_c;
         rhs[2] = 0.0;
     }
 
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = 0.0;
-        out[1] = k[28] + (k[19] * qdd[1] * rc_c) - (k[19] * (qd[1] * qd[1]) * rc_s);
+        out[1] = k[26] + (k[19] * qdd[1] * rc_c) - (k[19] * (qd[1] * qd[1]) * rc_s);
     }
 
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = -k[3] - (k[3] * rc_c) - (q[0] * rc_s) + (q[2] * rc_s);
         out[1] = 0.0;
     }
 
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let jt0 = qd[1] * qd[1];
         jac[0] = -rc_s;
@@ -371,7 +363,7 @@ impl Model for RodCylinderFree {
     }
 
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = k[2] - (k[3] * rc_s) + (q[0] * rc_c) - (q[2] * rc_c);
         out[1] = f64::INFINITY;
@@ -401,7 +393,7 @@ impl Model for RodCylinderFree {
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         poses[0] = [(k[17] * rc_c) + q[0], k[17] * rc_s, q[1]];
         poses[1] = [q[2], k[3], 0.0];
@@ -421,49 +413,49 @@ impl Model for RodCylinderFree {
 
 impl Reduction for RodCylinderFree {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[7], k[12], k[13], delta);
         let rt0 = rc_s * rc_s;
         let rt1 = -4.0 + (3.0 * rt0);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: -k[29] * (k[30] + (k[31] * rc_ds)) / rt1,
-            theta_ddot: k[32]
-                * ((k[33] * rc_s * rc_c * rc_ds) - (k[34] * rc_c)
-                    + (k[35] * rt0 * rc_c)
-                    + (k[36] * rc_s * rc_c))
+            theta_dot_sq: -k[27] * (k[28] + (k[29] * rc_ds)) / rt1,
+            theta_ddot: k[30]
+                * ((k[31] * rc_s * rc_c * rc_ds) - (k[32] * rc_c)
+                    + (k[33] * rt0 * rc_c)
+                    + (k[34] * rc_s * rc_c))
                 / (rt1 * rt1),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..40]; // one bounds check for all constant loads
-        -k[29] * (k[30] + (k[31] * rc_ds)) / (-4.0 + (3.0 * (rc_s * rc_s)))
+        let k = &k[..38]; // one bounds check for all constant loads
+        -k[27] * (k[28] + (k[29] * rc_ds)) / (-4.0 + (3.0 * (rc_s * rc_s)))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[7], k[12], k[13], delta);
         let rt0 = rc_s * rc_s;
         let rt1 = -4.0 + (3.0 * rt0);
-        let rc_w2 = -k[29] * (k[30] + (k[31] * rc_ds)) / rt1;
-        let rc_acc = k[32]
-            * ((k[33] * rc_s * rc_c * rc_ds) - (k[34] * rc_c)
-                + (k[35] * rt0 * rc_c)
-                + (k[36] * rc_s * rc_c))
+        let rc_w2 = -k[27] * (k[28] + (k[29] * rc_ds)) / rt1;
+        let rc_acc = k[30]
+            * ((k[31] * rc_s * rc_c * rc_ds) - (k[32] * rc_c)
+                + (k[33] * rt0 * rc_c)
+                + (k[34] * rc_s * rc_c))
             / (rt1 * rt1);
         out[0] = 0.0;
-        out[1] = k[28] - (k[19] * rc_s * rc_w2) + (k[19] * rc_c * rc_acc);
+        out[1] = k[26] - (k[19] * rc_s * rc_w2) + (k[19] * rc_c * rc_acc);
     }
 
     fn force_polynomial(&self, k: &[f64], contact: usize, out: &mut [f64]) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         match contact {
             1 => {
-                out[0] = k[34];
-                out[1] = -k[37];
-                out[2] = k[35];
+                out[0] = k[32];
+                out[1] = -k[35];
+                out[2] = k[33];
             }
             _ => {}
         }
@@ -478,12 +470,12 @@ impl Reduction for RodCylinderFree {
         // k[16] = rc_ai = ell^2*m1/3 - ell^2*m1*rc_si^2/4
         let c8_t0 = k[2] * k[2];
         k[16] = (c8_t0 * k[0] / 3.0) - (c8_t0 * k[0] * (k[12] * k[12]) / 4.0);
-        // k[34] = 4*ell*g*m1
-        k[34] = 4.0 * k[2] * k[5] * k[0];
-        // k[35] = 3*ell*g*m1
-        k[35] = 3.0 * k[2] * k[5] * k[0];
-        // k[37] = 6*ell*g*m1*rc_si + 6*rc_wi^2*rc_ai
-        k[37] = (6.0 * k[2] * k[5] * k[0] * k[12]) + (6.0 * (k[10] * k[10]) * k[16]);
+        // k[32] = 4*ell*g*m1
+        k[32] = 4.0 * k[2] * k[5] * k[0];
+        // k[33] = 3*ell*g*m1
+        k[33] = 3.0 * k[2] * k[5] * k[0];
+        // k[35] = 6*ell*g*m1*rc_si + 6*rc_wi^2*rc_ai
+        k[35] = (6.0 * k[2] * k[5] * k[0] * k[12]) + (6.0 * (k[10] * k[10]) * k[16]);
     }
 
     fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
@@ -497,15 +489,15 @@ impl Reduction for RodCylinderFree {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..40]; // one bounds check for all constant loads
+        let k = &k[..38]; // one bounds check for all constant loads
         let (rc_s, _, _, rc_dc) = start_offsets(k[7], k[12], k[13], delta);
         let rc_t = t;
         let rc_w = theta_dot;
         q[1] = k[7] - delta;
         qd[1] = theta_dot;
-        q[0] = k[6] + (k[17] * rc_dc) + (k[38] * rc_t);
-        qd[0] = k[38] + (k[17] * rc_s * rc_w);
-        q[2] = k[8] + (k[39] * rc_t);
-        qd[2] = k[39];
+        q[0] = k[6] + (k[17] * rc_dc) + (k[36] * rc_t);
+        qd[0] = k[36] + (k[17] * rc_s * rc_w);
+        q[2] = k[8] + (k[37] * rc_t);
+        qd[2] = k[37];
     }
 }

@@ -47,7 +47,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "ladder_leans",
         meaning: "the top must start below the ladder's length (a < ell)",
     }],
-    n_constants: 16,
+    n_constants: 14,
     coordinates: &["x1", "y1", "theta"],
     system_coordinates: &["x1", "y1", "theta"],
     reduced: 2,
@@ -157,26 +157,22 @@ impl Model for WallLadder {
         k[6] = k[1] / 2.0;
         // k[7] = ell*m1/2
         k[7] = k[1] * k[0] / 2.0;
-        // k[8] = ell^2*m1/24
-        k[8] = (k[1] * k[1]) * k[0] / 24.0;
-        // k[9] = ell^2*m1/8
-        k[9] = (k[1] * k[1]) * k[0] / 8.0;
-        // k[10] = m1/2
-        k[10] = k[0] / 2.0;
-        // k[11] = ell*g*m1/2
-        k[11] = k[1] * k[3] * k[0] / 2.0;
-        // k[12] = g*m1
-        k[12] = k[3] * k[0];
-        // k[13] = ell^2*m1/12
-        k[13] = (k[1] * k[1]) * k[0] / 12.0;
-        // k[14] = ell^2*m1/4
-        k[14] = (k[1] * k[1]) * k[0] / 4.0;
-        // k[15] = 0.0 + ell
-        k[15] = 0.0 + k[1];
+        // k[8] = ell^2*m1/6
+        k[8] = (k[1] * k[1]) * k[0] / 6.0;
+        // k[9] = m1/2
+        k[9] = k[0] / 2.0;
+        // k[10] = ell*g*m1/2
+        k[10] = k[1] * k[3] * k[0] / 2.0;
+        // k[11] = g*m1
+        k[11] = k[3] * k[0];
+        // k[12] = ell^2*m1/3
+        k[12] = (k[1] * k[1]) * k[0] / 3.0;
+        // k[13] = 0.0 + ell
+        k[13] = 0.0 + k[1];
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         q[0] = -k[4];
         qd[0] = 0.0;
         q[1] = 0.0;
@@ -186,7 +182,7 @@ impl Model for WallLadder {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         pos[0] = [q[0], q[1]];
         vel[0] = [qd[0], qd[1]];
@@ -205,27 +201,24 @@ impl Model for WallLadder {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let et0 = qd[2] * qd[2];
         (-(k[7] * qd[2] * qd[0] * rc_s)
             + (k[7] * qd[2] * qd[1] * rc_c)
-            + (k[8] * et0)
-            + (k[9] * et0 * (rc_s * rc_s))
-            + (k[9] * et0 * (rc_c * rc_c))
-            + (k[10] * (qd[0] * qd[0]))
-            + (k[10] * (qd[1] * qd[1])))
-            + ((k[11] * rc_s) + (k[12] * q[1]))
+            + (k[8] * (qd[2] * qd[2]))
+            + (k[9] * (qd[0] * qd[0]))
+            + (k[9] * (qd[1] * qd[1])))
+            + ((k[10] * rc_s) + (k[11] * q[1]))
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         out[0] = -(k[7] * qd[2] * rc_s) + (k[0] * qd[0]);
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let qt0 = -k[7] * rc_s;
         let qt1 = k[7] * rc_c;
@@ -238,10 +231,10 @@ impl Model for WallLadder {
         mass[5] = qt1;
         mass[6] = qt0;
         mass[7] = qt1;
-        mass[8] = k[13] + (k[14] * (rc_s * rc_s)) + (k[14] * (rc_c * rc_c));
+        mass[8] = k[12];
         rhs[0] = k[7] * qt2 * rc_c;
-        rhs[1] = -k[12] + (k[7] * qt2 * rc_s);
-        rhs[2] = -k[11] * rc_c;
+        rhs[1] = -k[11] + (k[7] * qt2 * rc_s);
+        rhs[2] = -k[10] * rc_c;
     }
 
     fn forces_full(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _qdd: &[f64], out: &mut [f64]) {
@@ -250,14 +243,14 @@ impl Model for WallLadder {
     }
 
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         let rc_c = q[2].cos();
         out[0] = -(k[1] * rc_c) - q[0];
         out[1] = q[1];
     }
 
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         jac[0] = -1.0;
         jac[1] = 0.0;
@@ -296,7 +289,7 @@ impl Model for WallLadder {
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let dt0 = 0.0 + 0.0;
         poses[0] = [(k[6] * rc_c) + q[0], (k[6] * rc_s) + q[1], q[2]];
@@ -307,7 +300,7 @@ impl Model for WallLadder {
         sizes[4] = dt0;
         sizes[5] = dt0;
         sizes[6] = dt0;
-        sizes[7] = k[15];
+        sizes[7] = k[13];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {

@@ -47,7 +47,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "ladder_leans",
         meaning: "the top must start below the ladder's length (a < ell)",
     }],
-    n_constants: 22,
+    n_constants: 20,
     coordinates: &["theta"],
     system_coordinates: &["x1", "y1", "theta"],
     reduced: 0,
@@ -134,7 +134,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 7,
         force_degrees: &[1, 2],
         fall_degree: Some(0),
-        lean_constants: &[5, 6, 7, 18, 19, 20],
+        lean_constants: &[5, 6, 7, 16, 17, 18],
     }),
     route_note: "",
 };
@@ -159,74 +159,68 @@ impl Model for WallLadderClosed {
         Reduction::prepare_lean(self, p, k);
         // k[4] = rc_thi = asin(a/ell)
         k[4] = (k[2] / k[1]).asin();
-        // k[8] = ell/2
-        k[8] = k[1] / 2.0;
-        // k[9] = ell^2*m1/24
-        k[9] = (k[1] * k[1]) * k[0] / 24.0;
-        // k[10] = ell^2*m1/8
-        k[10] = (k[1] * k[1]) * k[0] / 8.0;
+        // k[8] = rc_ai = ell^2*m1/3
+        k[8] = (k[1] * k[1]) * k[0] / 3.0;
+        // k[9] = ell/2
+        k[9] = k[1] / 2.0;
+        // k[10] = ell^2*m1/6
+        k[10] = (k[1] * k[1]) * k[0] / 6.0;
         // k[11] = ell*g*m1/2
         k[11] = k[1] * k[3] * k[0] / 2.0;
-        // k[12] = ell^2*m1/12
-        k[12] = (k[1] * k[1]) * k[0] / 12.0;
-        // k[13] = ell^2*m1/4
-        k[13] = (k[1] * k[1]) * k[0] / 4.0;
-        // k[14] = ell*m1/2
-        k[14] = k[1] * k[0] / 2.0;
-        // k[15] = g*m1
-        k[15] = k[3] * k[0];
-        // k[16] = 3*g/ell
-        k[16] = 3.0 * k[3] / k[1];
-        // k[17] = 3*g/(2*ell)
-        k[17] = 3.0 * k[3] / 2.0 / k[1];
-        // k[21] = 0.0 + ell
-        k[21] = 0.0 + k[1];
+        // k[12] = ell*m1/2
+        k[12] = k[1] * k[0] / 2.0;
+        // k[13] = g*m1
+        k[13] = k[3] * k[0];
+        // k[14] = 3*g/ell
+        k[14] = 3.0 * k[3] / k[1];
+        // k[15] = 3*g/(2*ell)
+        k[15] = 3.0 * k[3] / 2.0 / k[1];
+        // k[19] = 0.0 + ell
+        k[19] = 0.0 + k[1];
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         q[0] = k[4];
         qd[0] = 0.0;
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         pos[0] = [-k[1] * rc_c, 0.0];
         vel[0] = [k[1] * qd[0] * rc_s, 0.0];
         pos[1] = [0.0, k[1] * rc_s];
         vel[1] = [0.0, k[1] * qd[0] * rc_c];
-        pos[2] = [-k[8] * rc_c, k[8] * rc_s];
-        vel[2] = [k[8] * qd[0] * rc_s, k[8] * qd[0] * rc_c];
+        pos[2] = [-k[9] * rc_c, k[9] * rc_s];
+        vel[2] = [k[9] * qd[0] * rc_s, k[9] * qd[0] * rc_c];
         pos[3] = [0.0, 0.0];
         vel[3] = [0.0, 0.0];
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..22]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        let et0 = qd[0] * qd[0];
-        ((k[9] * et0) + (k[10] * et0 * (rc_s * rc_s)) + (k[10] * et0 * (rc_c * rc_c)))
-            + (k[11] * rc_s)
+        let k = &k[..20]; // one bounds check for all constant loads
+        let rc_s = q[0].sin();
+        (k[10] * (qd[0] * qd[0])) + (k[11] * rc_s)
     }
 
     fn momenta(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
 
     fn equations(&self, k: &[f64], q: &[f64], _qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        mass[0] = k[12] + (k[13] * (rc_s * rc_s)) + (k[13] * (rc_c * rc_c));
+        let k = &k[..20]; // one bounds check for all constant loads
+        let rc_c = q[0].cos();
+        mass[0] = k[8];
         rhs[0] = -k[11] * rc_c;
     }
 
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ft0 = qd[0] * qd[0];
-        out[0] = -(-(k[14] * qdd[0] * rc_s)
+        out[0] = -(-(k[12] * qdd[0] * rc_s)
             + (k[0] * ((k[1] * qdd[0] * rc_s) + (k[1] * ft0 * rc_c)))
-            - (k[14] * ft0 * rc_c));
-        out[1] = k[15] + (k[14] * qdd[0] * rc_c) - (k[14] * ft0 * rc_s);
+            - (k[12] * ft0 * rc_c));
+        out[1] = k[13] + (k[12] * qdd[0] * rc_c) - (k[12] * ft0 * rc_s);
     }
 
     fn gaps(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
@@ -259,7 +253,7 @@ impl Model for WallLadderClosed {
     }
 
     fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         q_full[0] = -k[1] * rc_c;
         qd_full[0] = k[1] * qd[0] * rc_s;
@@ -270,18 +264,18 @@ impl Model for WallLadderClosed {
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let dt0 = 0.0 + 0.0;
-        poses[0] = [-k[8] * rc_c, k[8] * rc_s, q[0]];
-        sizes[0] = -k[8];
+        poses[0] = [-k[9] * rc_c, k[9] * rc_s, q[0]];
+        sizes[0] = -k[9];
         sizes[1] = 0.0;
-        sizes[2] = k[8];
+        sizes[2] = k[9];
         sizes[3] = 0.0;
         sizes[4] = dt0;
         sizes[5] = dt0;
         sizes[6] = dt0;
-        sizes[7] = k[21];
+        sizes[7] = k[19];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -291,40 +285,40 @@ impl Model for WallLadderClosed {
 
 impl Reduction for WallLadderClosed {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[4], k[6], k[7], delta);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: k[16] * rc_ds,
-            theta_ddot: -k[17] * rc_c,
+            theta_dot_sq: k[14] * rc_ds,
+            theta_ddot: -k[15] * rc_c,
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], _rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..22]; // one bounds check for all constant loads
-        k[16] * rc_ds
+        let k = &k[..20]; // one bounds check for all constant loads
+        k[14] * rc_ds
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[4], k[6], k[7], delta);
-        let rc_w2 = k[16] * rc_ds;
-        let rc_acc = -k[17] * rc_c;
-        out[0] = -(k[14] * rc_s * rc_acc) - (k[14] * rc_c * rc_w2);
-        out[1] = k[15] - (k[14] * rc_s * rc_w2) + (k[14] * rc_c * rc_acc);
+        let rc_w2 = k[14] * rc_ds;
+        let rc_acc = -k[15] * rc_c;
+        out[0] = -(k[12] * rc_s * rc_acc) - (k[12] * rc_c * rc_w2);
+        out[1] = k[13] - (k[12] * rc_s * rc_w2) + (k[12] * rc_c * rc_acc);
     }
 
     fn force_polynomial(&self, k: &[f64], contact: usize, out: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         match contact {
             0 => {
-                out[0] = -k[18];
+                out[0] = -k[16];
                 out[1] = 3.0;
             }
             1 => {
                 out[0] = 1.0;
-                out[1] = -k[19];
+                out[1] = -k[17];
                 out[2] = 9.0;
             }
             _ => {}
@@ -340,17 +334,17 @@ impl Reduction for WallLadderClosed {
         // k[7] = rc_ci = ((1 - a/ell)*(1 + a/ell))^(1/2)
         let c3_t0 = k[2] / k[1];
         k[7] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
-        // k[18] = 2*rc_si
-        k[18] = 2.0 * k[6];
-        // k[19] = 6*rc_si
-        k[19] = 6.0 * k[6];
-        // k[20] = ell/(3*g)
-        k[20] = k[1] / 3.0 / k[3];
+        // k[16] = 2*rc_si
+        k[16] = 2.0 * k[6];
+        // k[17] = 6*rc_si
+        k[17] = 6.0 * k[6];
+        // k[18] = ell/(3*g)
+        k[18] = k[1] / 3.0 / k[3];
     }
 
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
-        out[0] = k[20];
+        let k = &k[..20]; // one bounds check for all constant loads
+        out[0] = k[18];
     }
 
     fn full_state(
@@ -362,7 +356,7 @@ impl Reduction for WallLadderClosed {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         q[0] = k[4] - delta;
         qd[0] = theta_dot;
     }

@@ -71,7 +71,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "ladder_leans",
         meaning: "the top must start below the ladder's length (a < ell)",
     }],
-    n_constants: 32,
+    n_constants: 30,
     coordinates: &["x1", "theta"],
     system_coordinates: &["x1", "y1", "theta"],
     reduced: 1,
@@ -158,7 +158,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 9,
         force_degrees: &[0, 2],
         fall_degree: None,
-        lean_constants: &[8, 9, 11, 26, 27, 29],
+        lean_constants: &[8, 9, 11, 24, 25, 27],
     }),
     route_note: "",
 };
@@ -190,40 +190,36 @@ impl Model for WallLadderFree {
         k[12] = k[1] / 2.0;
         // k[13] = ell*m1/2
         k[13] = k[1] * k[0] / 2.0;
-        // k[14] = ell^2*m1/24
-        k[14] = (k[1] * k[1]) * k[0] / 24.0;
-        // k[15] = ell^2*m1/8
-        k[15] = (k[1] * k[1]) * k[0] / 8.0;
-        // k[16] = m1/2
-        k[16] = k[0] / 2.0;
-        // k[17] = ell*g*m1/2
-        k[17] = k[1] * k[3] * k[0] / 2.0;
-        // k[18] = ell^2*m1/12
-        k[18] = (k[1] * k[1]) * k[0] / 12.0;
-        // k[19] = ell^2*m1/4
-        k[19] = (k[1] * k[1]) * k[0] / 4.0;
-        // k[20] = g*m1
-        k[20] = k[3] * k[0];
-        // k[21] = 12/(ell^2*m1)
-        k[21] = 12.0 / (k[1] * k[1]) / k[0];
-        // k[22] = rc_wi^2*rc_ai
-        k[22] = (k[7] * k[7]) * k[11];
-        // k[23] = ell*g*m1
-        k[23] = k[1] * k[3] * k[0];
-        // k[24] = 6/(ell^2*m1)
-        k[24] = 6.0 / (k[1] * k[1]) / k[0];
-        // k[25] = 6*ell*g*m1
-        k[25] = 6.0 * k[1] * k[3] * k[0];
-        // k[28] = 6*rc_wi^2*rc_ai
-        k[28] = 6.0 * (k[7] * k[7]) * k[11];
-        // k[30] = rc_p0/m1
-        k[30] = k[10] / k[0];
-        // k[31] = 0.0 + ell
-        k[31] = 0.0 + k[1];
+        // k[14] = ell^2*m1/6
+        k[14] = (k[1] * k[1]) * k[0] / 6.0;
+        // k[15] = m1/2
+        k[15] = k[0] / 2.0;
+        // k[16] = ell*g*m1/2
+        k[16] = k[1] * k[3] * k[0] / 2.0;
+        // k[17] = ell^2*m1/3
+        k[17] = (k[1] * k[1]) * k[0] / 3.0;
+        // k[18] = g*m1
+        k[18] = k[3] * k[0];
+        // k[19] = 12/(ell^2*m1)
+        k[19] = 12.0 / (k[1] * k[1]) / k[0];
+        // k[20] = rc_wi^2*rc_ai
+        k[20] = (k[7] * k[7]) * k[11];
+        // k[21] = ell*g*m1
+        k[21] = k[1] * k[3] * k[0];
+        // k[22] = 6/(ell^2*m1)
+        k[22] = 6.0 / (k[1] * k[1]) / k[0];
+        // k[23] = 6*ell*g*m1
+        k[23] = 6.0 * k[1] * k[3] * k[0];
+        // k[26] = 6*rc_wi^2*rc_ai
+        k[26] = 6.0 * (k[7] * k[7]) * k[11];
+        // k[28] = rc_p0/m1
+        k[28] = k[10] / k[0];
+        // k[29] = 0.0 + ell
+        k[29] = 0.0 + k[1];
     }
 
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..32]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         q[0] = k[4];
         qd[0] = k[6];
         q[1] = k[5];
@@ -231,7 +227,7 @@ impl Model for WallLadderFree {
     }
 
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..32]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         pos[0] = [q[0], 0.0];
         vel[0] = [qd[0], 0.0];
@@ -244,51 +240,46 @@ impl Model for WallLadderFree {
     }
 
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..32]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let et0 = qd[1] * qd[1];
-        (-(k[13] * qd[1] * qd[0] * rc_s)
-            + (k[14] * et0)
-            + (k[15] * et0 * (rc_s * rc_s))
-            + (k[15] * et0 * (rc_c * rc_c))
-            + (k[16] * (qd[0] * qd[0])))
-            + (k[17] * rc_s)
+        let k = &k[..30]; // one bounds check for all constant loads
+        let rc_s = q[1].sin();
+        (-(k[13] * qd[1] * qd[0] * rc_s) + (k[14] * (qd[1] * qd[1])) + (k[15] * (qd[0] * qd[0])))
+            + (k[16] * rc_s)
     }
 
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..32]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
         out[0] = -(k[13] * qd[1] * rc_s) + (k[0] * qd[0]);
     }
 
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..32]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let qt0 = -k[13] * rc_s;
         mass[0] = k[0];
         mass[1] = qt0;
         mass[2] = qt0;
-        mass[3] = k[18] + (k[19] * (rc_s * rc_s)) + (k[19] * (rc_c * rc_c));
+        mass[3] = k[17];
         rhs[0] = k[13] * (qd[1] * qd[1]) * rc_c;
-        rhs[1] = -k[17] * rc_c;
+        rhs[1] = -k[16] * rc_c;
     }
 
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..32]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         out[0] = 0.0;
-        out[1] = k[20] + (k[13] * qdd[1] * rc_c) - (k[13] * (qd[1] * qd[1]) * rc_s);
+        out[1] = k[18] + (k[13] * qdd[1] * rc_c) - (k[13] * (qd[1] * qd[1]) * rc_s);
     }
 
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..32]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let rc_c = q[1].cos();
         out[0] = -(k[1] * rc_c) - q[0];
         out[1] = 0.0;
     }
 
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..32]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         jac[0] = -1.0;
         jac[1] = k[1] * rc_s;
@@ -325,7 +316,7 @@ impl Model for WallLadderFree {
     }
 
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..32]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
         let dt0 = 0.0 + 0.0;
         poses[0] = [(k[12] * rc_c) + q[0], k[12] * rc_s, q[1]];
@@ -336,7 +327,7 @@ impl Model for WallLadderFree {
         sizes[4] = dt0;
         sizes[5] = dt0;
         sizes[6] = dt0;
-        sizes[7] = k[31];
+        sizes[7] = k[29];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -346,49 +337,49 @@ impl Model for WallLadderFree {
 
 impl Reduction for WallLadderFree {
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..32]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[8], k[9], delta);
         let rt0 = rc_s * rc_s;
         let rt1 = -4.0 + (3.0 * rt0);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: -k[21] * (k[22] + (k[23] * rc_ds)) / rt1,
-            theta_ddot: k[24]
-                * ((k[25] * rc_s * rc_c * rc_ds) - (k[26] * rc_c)
-                    + (k[27] * rt0 * rc_c)
-                    + (k[28] * rc_s * rc_c))
+            theta_dot_sq: -k[19] * (k[20] + (k[21] * rc_ds)) / rt1,
+            theta_ddot: k[22]
+                * ((k[23] * rc_s * rc_c * rc_ds) - (k[24] * rc_c)
+                    + (k[25] * rt0 * rc_c)
+                    + (k[26] * rc_s * rc_c))
                 / (rt1 * rt1),
         }
     }
 
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..32]; // one bounds check for all constant loads
-        -k[21] * (k[22] + (k[23] * rc_ds)) / (-4.0 + (3.0 * (rc_s * rc_s)))
+        let k = &k[..30]; // one bounds check for all constant loads
+        -k[19] * (k[20] + (k[21] * rc_ds)) / (-4.0 + (3.0 * (rc_s * rc_s)))
     }
 
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..32]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[8], k[9], delta);
         let rt0 = rc_s * rc_s;
         let rt1 = -4.0 + (3.0 * rt0);
-        let rc_w2 = -k[21] * (k[22] + (k[23] * rc_ds)) / rt1;
-        let rc_acc = k[24]
-            * ((k[25] * rc_s * rc_c * rc_ds) - (k[26] * rc_c)
-                + (k[27] * rt0 * rc_c)
-                + (k[28] * rc_s * rc_c))
+        let rc_w2 = -k[19] * (k[20] + (k[21] * rc_ds)) / rt1;
+        let rc_acc = k[22]
+            * ((k[23] * rc_s * rc_c * rc_ds) - (k[24] * rc_c)
+                + (k[25] * rt0 * rc_c)
+                + (k[26] * rc_s * rc_c))
             / (rt1 * rt1);
         out[0] = 0.0;
-        out[1] = k[20] - (k[13] * rc_s * rc_w2) + (k[13] * rc_c * rc_acc);
+        out[1] = k[18] - (k[13] * rc_s * rc_w2) + (k[13] * rc_c * rc_acc);
     }
 
     fn force_polynomial(&self, k: &[f64], contact: usize, out: &mut [f64]) {
-        let k = &k[..32]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         match contact {
             1 => {
-                out[0] = k[26];
-                out[1] = -k[29];
-                out[2] = k[27];
+                out[0] = k[24];
+                out[1] = -k[27];
+                out[2] = k[25];
             }
             _ => {}
         }
@@ -403,12 +394,12 @@ impl Reduction for WallLadderFree {
         // k[11] = rc_ai = ell^2*m1/3 - ell^2*m1*rc_si^2/4
         let c6_t0 = k[1] * k[1];
         k[11] = (c6_t0 * k[0] / 3.0) - (c6_t0 * k[0] * (k[8] * k[8]) / 4.0);
-        // k[26] = 4*ell*g*m1
-        k[26] = 4.0 * k[1] * k[3] * k[0];
-        // k[27] = 3*ell*g*m1
-        k[27] = 3.0 * k[1] * k[3] * k[0];
-        // k[29] = 6*ell*g*m1*rc_si + 6*rc_wi^2*rc_ai
-        k[29] = (6.0 * k[1] * k[3] * k[0] * k[8]) + (6.0 * (k[7] * k[7]) * k[11]);
+        // k[24] = 4*ell*g*m1
+        k[24] = 4.0 * k[1] * k[3] * k[0];
+        // k[25] = 3*ell*g*m1
+        k[25] = 3.0 * k[1] * k[3] * k[0];
+        // k[27] = 6*ell*g*m1*rc_si + 6*rc_wi^2*rc_ai
+        k[27] = (6.0 * k[1] * k[3] * k[0] * k[8]) + (6.0 * (k[7] * k[7]) * k[11]);
     }
 
     fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
@@ -422,13 +413,13 @@ impl Reduction for WallLadderFree {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..32]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, _, _, rc_dc) = start_offsets(k[5], k[8], k[9], delta);
         let rc_t = t;
         let rc_w = theta_dot;
         q[1] = k[5] - delta;
         qd[1] = theta_dot;
-        q[0] = k[4] + (k[12] * rc_dc) + (k[30] * rc_t);
-        qd[0] = k[30] + (k[12] * rc_s * rc_w);
+        q[0] = k[4] + (k[12] * rc_dc) + (k[28] * rc_t);
+        qd[0] = k[28] + (k[12] * rc_s * rc_w);
     }
 }
