@@ -39,6 +39,7 @@ const EMIT: &[&str] = &[
     "common",
     "code",
     "info",
+    "docs",
     "reduced",
     "constants",
     "state",

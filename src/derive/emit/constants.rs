@@ -2,7 +2,7 @@
 //! named constants, then hoisted subexpressions), `prepare`'s lines that fill it, the part the
 //! per-point solver reads (`prepare_lean`) and the named constants nothing reads.
 
-use super::code::Code;
+use super::code::{Code, parameter_local};
 use super::lower::{Hoisted, Scope, lower};
 use super::reduced::ReducedCode;
 use crate::derive::expr::Expr;
@@ -82,6 +82,7 @@ pub(super) fn constant_layout(
     let mut scope = Scope::default();
     for (i, p) in d.params.iter().enumerate() {
         scope.constants.insert(p.name.clone(), i);
+        scope.named.insert(i, parameter_local(&p.name));
     }
     let mut prepare = Code::default();
     let constants = match &d.reduction {

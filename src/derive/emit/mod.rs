@@ -3,12 +3,14 @@
 //!
 //! Below the writers: [`latex`] (an expression as LaTeX), [`lower`] (expressions as
 //! straight-line Rust) and [`method`] (a generated method's head and preamble). The Rust writer
-//! ([`rust`]) is built from [`code`], [`info`], [`constants`], [`state`] and [`reduced`]; the
-//! LaTeX writer is [`tex`], the JSON writer [`json`]; [`common`] holds what they share.
+//! ([`rust`]) is built from [`code`], [`info`], [`docs`], [`constants`], [`state`] and
+//! [`reduced`]; the LaTeX writer is [`tex`], the JSON writer [`json`]; [`common`] holds what
+//! they share.
 
 pub mod code;
 pub mod common;
 pub mod constants;
+pub mod docs;
 pub mod info;
 pub mod json;
 pub mod latex;

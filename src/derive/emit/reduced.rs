@@ -2,7 +2,7 @@
 //! reduced motion, `theta_dot^2`, the forces, their polynomials, the fall polynomial) and the
 //! `ReductionInfo` literal.
 
-use super::code::{Code, DELTA, K, OUT, out_lines};
+use super::code::{Code, DELTA, K, Locals, OUT, out_lines};
 use super::lower::{Hoisted, Scope, lower, unbound};
 use super::method::Preamble;
 use crate::derive::types::{Derivation, Reduction};
@@ -45,8 +45,9 @@ impl ReducedCode {
 
     /// Each method's arguments and lines; `n` is the length of `k`, `np` the number of
     /// parameters, `reduced` the index of the reduced coordinate.
-    pub(super) fn finish(&mut self, n: usize, np: usize, reduced: usize) {
+    pub(super) fn finish(&mut self, n: usize, np: usize, reduced: usize, locals: &Locals) {
         let slice = Preamble::Slice(n);
+        let params = Preamble::Names(&locals.params, "k");
         let start =
             Preamble::Offsets([self.k_theta_initial, self.k_sin_initial, self.k_cos_initial]);
         let delta = Preamble::Let("rc_delta", "delta");
@@ -56,21 +57,24 @@ impl ReducedCode {
             )];
         }
         self.reduced_code
-            .finish(&[K, DELTA], &[slice, start, delta]);
+            .finish(&[K, DELTA], &[slice, params, start, delta]);
         let sc = ["rc_s", "rc_c", "rc_ds", "rc_dc"].map(|s| (s, "f64"));
         self.theta_dot_sq_code
-            .finish(&[K, sc[0], sc[1], sc[2], sc[3]], &[slice]);
+            .finish(&[K, sc[0], sc[1], sc[2], sc[3]], &[slice, params]);
         self.forces.outputs = out_lines(&self.forces.outputs);
-        self.forces.finish(&[K, DELTA, OUT], &[slice, start, delta]);
+        self.forces
+            .finish(&[K, DELTA, OUT], &[slice, params, start, delta]);
         self.force_polynomial
-            .finish(&[K, ("contact", "usize"), OUT], &[slice]);
+            .finish(&[K, ("contact", "usize"), OUT], &[slice, params]);
         self.fall.outputs = out_lines(&self.fall.outputs);
-        self.fall.finish(&[K, OUT], &[slice]);
+        self.fall.finish(&[K, OUT], &[slice, params]);
         self.prepare_lean
             .stmts
             .insert(0, format!("k[..{np}].copy_from_slice(p);"));
-        self.prepare_lean
-            .finish(&[("p", "&[f64]"), ("k", "&mut [f64]")], &[]);
+        self.prepare_lean.finish(
+            &[("p", "&[f64]"), ("k", "&mut [f64]")],
+            &[Preamble::Names(&locals.params, "p")],
+        );
         let head = [
             format!("q[{reduced}] = k[{}] - delta;", self.k_theta_initial),
             format!("qd[{reduced}] = theta_dot;"),
@@ -90,7 +94,7 @@ impl ReducedCode {
             Preamble::Let("rc_w", "theta_dot"),
         ];
         self.full_state
-            .finish(&args, &[slice, start, lets[0], lets[1], lets[2]]);
+            .finish(&args, &[slice, params, start, lets[0], lets[1], lets[2]]);
     }
 }
 

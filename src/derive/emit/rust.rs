@@ -1,9 +1,10 @@
 //! The Rust writer: [`RustContext`], everything `templates/model.rs.tera` needs for one
-//! phase, built from the parts ([`info`](super::info), [`constants`](super::constants),
+//! phase, built from the parts ([`info`](super::info), [`docs`](super::docs), [`constants`](super::constants),
 //! [`state`](super::state), [`reduced`](super::reduced)) once the constant layout is known.
 
-use super::code::{Code, K, OUT, Q, out_lines};
+use super::code::{Code, K, Locals, OUT, Q, out_lines, parameter_local};
 use super::constants::{constant_layout, prepare_code, unread_constants};
+use super::docs::{Docs, model_docs, reduction_docs};
 use super::info::{PhaseEntry, StaticInfo, static_info};
 use super::lower::{Hoisted, Scope, lower};
 use super::method::Preamble;
@@ -33,6 +34,8 @@ pub struct RustContext {
     #[serde(flatten)]
     general: FullStateCode,
     reduction: Option<ReducedCode>,
+    /// Each method's doc comment, by the method's name.
+    docs: Docs,
     /// The reduction's named constants that nothing reads (see [`rust_context`]).
     #[serde(skip)]
     unread: BTreeSet<String>,
@@ -95,25 +98,40 @@ fn context_without(
     prepare
         .stmts
         .insert(0, format!("k[..{np}].copy_from_slice(p);"));
-    prepare.finish(&[("p", "&[f64]"), ("k", "&mut [f64]")], &[]);
-    requirements.finish(&[("p", "&[f64]"), OUT], &[Preamble::Let("k", "p")]);
-    restitutions.finish(&[("p", "&[f64]"), OUT], &[Preamble::Let("k", "p")]);
-    general.finish(n_constants, d.reduced);
+    let locals = Locals::of(d)?;
+    let from_p = [
+        Preamble::Let("k", "p"),
+        Preamble::Names(&locals.params, "p"),
+    ];
+    prepare.finish(&[("p", "&[f64]"), ("k", "&mut [f64]")], &from_p[1..]);
+    requirements.finish(&[("p", "&[f64]"), OUT], &from_p);
+    restitutions.finish(&[("p", "&[f64]"), OUT], &from_p);
+    general.finish(n_constants, d.reduced, &locals);
     if let Some(code) = reduction.as_mut() {
-        code.finish(n_constants, np, d.reduced);
+        code.finish(n_constants, np, d.reduced, &locals);
     }
     let poses = ("poses", "&mut [[f64; 3]]");
     let sizes = ("sizes", "&mut [f64]");
     drawing.finish(
         &[K, Q, poses, sizes],
-        &[Preamble::Slice(n_constants), Preamble::Angle(d.reduced)],
+        &[
+            Preamble::Slice(n_constants),
+            Preamble::Angle(d.reduced),
+            Preamble::Names(&locals.params, "k"),
+            Preamble::State(&locals.coords),
+        ],
     );
     let mut codes: Vec<&Code> = vec![&requirements, &restitutions, &prepare, &drawing];
     codes.extend(general.codes());
     codes.extend(reduction.iter().flat_map(ReducedCode::codes));
     let unread = unread_constants(d, &own, &codes);
+    let mut docs = model_docs(checked, d);
+    if let Ok(r) = &d.reduction {
+        docs.extend(reduction_docs(d, r));
+    }
     Ok(RustContext {
         info: static_info(checked, d, phases)?,
+        docs,
         n_constants,
         shapes_info,
         drawing,
@@ -134,6 +152,7 @@ fn parameters_code(exprs: &[Expr], d: &Derivation) -> Code {
     let mut scope = Scope::default();
     for (i, p) in d.params.iter().enumerate() {
         scope.constants.insert(p.name.clone(), i);
+        scope.named.insert(i, parameter_local(&p.name));
     }
     let out = code.push_body(lower(exprs, &scope, None, "q"));
     code.outputs = out_lines(&out);

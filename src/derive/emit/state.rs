@@ -2,7 +2,7 @@
 //! points, energy, momenta, equations of motion, the contacts' forces, gaps, rows and edges,
 //! the frictions' slip rows, the monitors, `to_full` and the drawing.
 
-use super::code::{Code, K, OUT, Q, QD, out_lines};
+use super::code::{Code, K, Locals, OUT, Q, QD, coordinate_local, out_lines};
 use super::lower::{Hoisted, Scope, lower, unbound};
 use super::method::Preamble;
 use crate::derive::algebra::to_sc_expr;
@@ -48,12 +48,13 @@ impl FullStateCode {
 
     /// Each method's arguments and lines; `n` is the length of `k`, `reduced` the index of the
     /// reduced coordinate.
-    pub(super) fn finish(&mut self, n: usize, reduced: usize) {
+    pub(super) fn finish(&mut self, n: usize, reduced: usize, locals: &Locals) {
         let (slice, angle) = (Preamble::Slice(n), Preamble::Angle(reduced));
-        let state = [slice, angle];
+        let params = Preamble::Names(&locals.params, "k");
+        let state = [slice, angle, params, Preamble::State(&locals.coords)];
         let qm = ("q", "&mut [f64]");
         let qdm = ("qd", "&mut [f64]");
-        self.initial_state.finish(&[K, qm, qdm], &[slice]);
+        self.initial_state.finish(&[K, qm, qdm], &[slice, params]);
         let pos = ("pos", "&mut [[f64; 2]]");
         let vel = ("vel", "&mut [[f64; 2]]");
         self.points.finish(&[K, Q, QD, pos, vel], &state);
@@ -79,19 +80,21 @@ impl FullStateCode {
 }
 
 /// The scope of the full-state functions: the constants, `rc_s`, `rc_c` (the template's
-/// preamble) and the state `q`, `qd`, `qdd`.
+/// preamble) and the state by the coordinates' names (bound to `q`, `qd`, `qdd` by the
+/// preamble, [`Preamble::State`]).
 fn state_scope(d: &Derivation, scope: &Scope) -> Scope {
     let mut full_scope = scope.clone();
     full_scope.locals.insert("rc_s".into(), "rc_s".into());
     full_scope.locals.insert("rc_c".into(), "rc_c".into());
-    for (i, c) in d.coords.iter().enumerate() {
-        full_scope.locals.insert(c.clone(), format!("q[{i}]"));
+    for c in &d.coords {
+        let local = coordinate_local(c);
         full_scope
             .locals
-            .insert(format!("dot_{c}"), format!("qd[{i}]"));
+            .insert(format!("dot_{c}"), format!("{local}_dot"));
         full_scope
             .locals
-            .insert(format!("ddot_{c}"), format!("qdd[{i}]"));
+            .insert(format!("ddot_{c}"), format!("{local}_ddot"));
+        full_scope.locals.insert(c.clone(), local);
     }
     full_scope
 }
