@@ -22,7 +22,6 @@
 //! force; constants `rc_thi`, `rc_wi`, `rc_si`, `rc_ci`, `rc_ai` (reduced inertia at the
 //! start), `rc_x<j>i` (initial cyclic positions) and `rc_p<j>` (conserved momenta).
 
-use super::algebra::with_pythagoras;
 pub use super::algebra::{from_sc, is_zero_trig, reduce_cos_sq, simplify_inverse_trig, to_sc_expr};
 pub use super::types::*;
 
@@ -444,7 +443,7 @@ fn derive_phase(
     let list = |v: &[A], what: &str| -> Result<Vec<Expr>, DeriveError> {
         v.iter().map(|e| to_expr(e, what)).collect()
     };
-    with_identities(Derivation {
+    Ok(Derivation {
         name: plan.name.clone(),
         system: spec.name.clone(),
         plan: plan.clone(),
@@ -480,49 +479,4 @@ fn derive_phase(
         dimensionless: None,
         steps: None,
     })
-}
-
-/// `d` with `sin^2 + cos^2 = 1` applied to every expression over the full state, as the
-/// generated code and the JSON record print them (each checked equal by
-/// [`with_pythagoras`]): `k T sin^2 + k T cos^2` is `k T`.
-fn with_identities(mut d: Derivation) -> Result<Derivation, DeriveError> {
-    let theta = d.theta().to_string();
-    let one = |e: &mut Expr, what: &str| -> Result<(), DeriveError> {
-        *e = with_pythagoras(e, &theta, what)?;
-        Ok(())
-    };
-    let all = |v: &mut [Expr], what: &str| v.iter_mut().try_for_each(|e| one(e, what));
-    one(&mut d.kinetic, "kinetic energy")?;
-    one(&mut d.potential, "potential energy")?;
-    one(&mut d.lagrangian, "lagrangian")?;
-    all(&mut d.euler_lagrange, "equation")?;
-    for row in &mut d.mass {
-        all(row, "mass matrix")?;
-    }
-    all(&mut d.rhs, "forces")?;
-    all(&mut d.momenta, "momentum")?;
-    for p in d.point_pos.iter_mut().chain(&mut d.point_vel) {
-        all(p, "point")?;
-    }
-    for c in &mut d.contacts {
-        one(&mut c.gap, "gap")?;
-        all(&mut c.jacobian, "gap Jacobian")?;
-        one(&mut c.bias, "gap bias")?;
-        for e in c.edge.iter_mut().chain(&mut c.force) {
-            one(e, "contact")?;
-        }
-    }
-    all(&mut d.monitors_full, "monitor")?;
-    for pose in &mut d.body_pose {
-        all(pose, "body pose")?;
-    }
-    for f in &mut d.frictions {
-        one(&mut f.slip, "slip velocity")?;
-        all(&mut f.jacobian, "slip Jacobian")?;
-        one(&mut f.bias, "slip bias")?;
-    }
-    for state in &mut d.to_full {
-        all(state, "full state")?;
-    }
-    Ok(d)
 }

@@ -230,12 +230,14 @@ fn to_spec_error(checked: &Checked, err: mechanics::DeriveError) -> SpecError {
 
 /// One spec through every stage: the derivation proper ([`mechanics::derive`]: read → setup →
 /// Lagrangian → equations → constraints → reduction → forces, for each phase), then its
-/// presentation ([`dimensionless::derive`], [`steps::derive`]).
+/// presentation ([`dimensionless::derive`], [`steps::derive`], and `sin^2 + cos^2 = 1` applied
+/// to what the generated code and records print, [`present::with_identities`]).
 fn derive_and_present(c: &Checked) -> Result<Vec<Derivation>, mechanics::DeriveError> {
     let mut phases = mechanics::derive(c)?;
     for d in &mut phases {
         d.dimensionless = dimensionless::derive(&c.spec, d)?;
         d.steps = Some(steps::derive(d));
+        present::with_identities(d)?;
     }
     Ok(phases)
 }

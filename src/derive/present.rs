@@ -18,10 +18,15 @@
 //! difference is zero as a rational function modulo `sin^2 + cos^2 = 1`); one that is not is
 //! a typed error, never printed. The others are not checked: they are never printed, and
 //! checking each cost most of the derivation's time.
+//!
+//! What the generated code and the JSON record print is the derivation with
+//! `sin^2 + cos^2 = 1` applied where it joins two terms into one ([`with_identities`]), each
+//! expression checked equal.
 
-use super::algebra::{is_zero_trig, reduce_cos_sq};
+use super::algebra::{is_zero_trig, reduce_cos_sq, with_pythagoras};
 use super::cas::{self, A};
 use super::expr::{Expr, product, sum};
+use super::types::{Derivation, DeriveError};
 
 /// A candidate form ranked: operations, characters, order made, the form, and the constant
 /// factor dropped from it.
@@ -464,4 +469,50 @@ impl<'a> Presenter<'a> {
     fn assemble(&self, f: &Factored) -> Expr {
         product(self.ordered(f))
     }
+}
+
+/// `sin^2 + cos^2 = 1` applied to every expression of `d` over the full state, as the
+/// generated code and the JSON record print them (each checked equal by
+/// [`with_pythagoras`]): `k T sin^2 + k T cos^2` is `k T`. Run after the steps
+/// ([`super::steps`]), which show the expressions as derived.
+pub fn with_identities(d: &mut Derivation) -> Result<(), DeriveError> {
+    let theta = d.theta().to_string();
+    let one = |e: &mut Expr, what: &str| -> Result<(), DeriveError> {
+        *e = with_pythagoras(e, &theta, what)?;
+        Ok(())
+    };
+    let all = |v: &mut [Expr], what: &str| v.iter_mut().try_for_each(|e| one(e, what));
+    one(&mut d.kinetic, "kinetic energy")?;
+    one(&mut d.potential, "potential energy")?;
+    one(&mut d.lagrangian, "lagrangian")?;
+    all(&mut d.euler_lagrange, "equation")?;
+    for row in &mut d.mass {
+        all(row, "mass matrix")?;
+    }
+    all(&mut d.rhs, "forces")?;
+    all(&mut d.momenta, "momentum")?;
+    for p in d.point_pos.iter_mut().chain(&mut d.point_vel) {
+        all(p, "point")?;
+    }
+    for c in &mut d.contacts {
+        one(&mut c.gap, "gap")?;
+        all(&mut c.jacobian, "gap Jacobian")?;
+        one(&mut c.bias, "gap bias")?;
+        for e in c.edge.iter_mut().chain(&mut c.force) {
+            one(e, "contact")?;
+        }
+    }
+    all(&mut d.monitors_full, "monitor")?;
+    for pose in &mut d.body_pose {
+        all(pose, "body pose")?;
+    }
+    for f in &mut d.frictions {
+        one(&mut f.slip, "slip velocity")?;
+        all(&mut f.jacobian, "slip Jacobian")?;
+        one(&mut f.bias, "slip bias")?;
+    }
+    for state in &mut d.to_full {
+        all(state, "full state")?;
+    }
+    Ok(())
 }
