@@ -12,8 +12,8 @@ use std::path::Path;
 const DERIVE: &[&str] = &[
     "spec",
     "expr",
-    "cas",
     "types",
+    "cas",
     "algebra",
     "read",
     "setup",

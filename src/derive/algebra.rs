@@ -6,7 +6,7 @@
 
 use super::cas::{self, A};
 use super::expr::{Expr, gcd, product, sum};
-use super::types::{Constant, DeriveError, at};
+use super::types::{Constant, DeriveError, StepError, at};
 
 /// A Symbolica atom as an expression, or the error of the step `what`.
 pub fn to_expr(a: &A, what: &str) -> Result<Expr, DeriveError> {
@@ -246,7 +246,7 @@ pub fn with_pythagoras(e: &Expr, theta: &str, what: &str) -> Result<Expr, Derive
 
 /// Whether a rational expression of `rc_s`, `rc_c` (and anything else) is zero modulo
 /// `sin^2 + cos^2 = 1`.
-pub fn is_zero_trig(a: &A) -> Result<bool, String> {
+pub fn is_zero_trig(a: &A) -> Result<bool, StepError> {
     let t = cas::together(a);
     let e = cas::expr(&t)?;
     let (num, _) = e.num_den();

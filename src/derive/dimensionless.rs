@@ -193,7 +193,7 @@ pub fn derive(spec: &Spec, d: &Derivation) -> Result<Option<Dimensionless>, Deri
         if shape == Shape::Polynomial {
             value = condition(&value, &positive_symbols)?;
         }
-        let e = cas::expr(&value).map_err(at)?;
+        let e = cas::expr(&value).map_err(|m| at(m.to_string()))?;
         if let Some(s) = e.symbols().into_iter().find(|s| !allowed.contains(s)) {
             return Err(at(format!(
                 "`{key}` of model `{}` still depends on `{s}` when written in the groups ({}) \
@@ -229,7 +229,7 @@ pub fn derive(spec: &Spec, d: &Derivation) -> Result<Option<Dimensionless>, Deri
 /// A condition `value = 0` as a polynomial: its numerator with positive theta-free factors
 /// removed (the denominator must be positive).
 fn condition(value: &A, positive_symbols: &[String]) -> Result<A, DeriveError> {
-    let e = cas::expr(value).map_err(at)?;
+    let e = cas::expr(value).map_err(|m| at(m.to_string()))?;
     let (num, den) = e.num_den();
     let den = super::expr::product(den);
     if !positive(&den, positive_symbols) {

@@ -4,9 +4,10 @@
 //! The modules form layers, bottom-up; each imports only the layers below it and, within the
 //! stages, only earlier stages (no module imports a later one, no two import each other):
 //!
-//! 1. shared by every stage, below them all: [`cas`] (the only module that calls Symbolica),
-//!    [`types`] (what the stages hand each other, the presentation's results included) and
-//!    [`algebra`] (trigonometric rewriting and polynomial helpers);
+//! 1. shared by every stage, below them all: [`types`] (what the stages hand each other, the
+//!    presentation's results included, and the layer's errors: [`types::StepError`] of a step,
+//!    [`types::DeriveError`] placed at a spec field), [`cas`] (the only module that calls
+//!    Symbolica) and [`algebra`] (trigonometric rewriting and polynomial helpers);
 //! 2. the stages of the derivation proper, a file each: [`read`] (the spec's expressions) →
 //!    [`setup`] → [`lagrangian`] → [`equations`] → [`constraints`] → [`reduction`] →
 //!    [`forces`]; [`mechanics`] runs them in that order for each phase of a spec;
@@ -341,13 +342,13 @@ fn render_phase(
     phases: &[emit::PhaseEntry],
 ) -> Result<Vec<Rendered>, Error> {
     // A model the emitter cannot write is reported against its spec file.
-    let refused = |message: String| {
+    let refused = |error: mechanics::StepError| {
         Error::Spec(SpecError {
             file: c.file.clone(),
             line: 0,
             column: 0,
             field: String::new(),
-            message: format!("model `{}`: {message}", d.name),
+            message: format!("model `{}`: {error}", d.name),
             source_line: String::new(),
             width: 0,
         })

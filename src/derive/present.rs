@@ -26,7 +26,7 @@
 use super::algebra::{is_zero_trig, reduce_cos_sq, with_pythagoras};
 use super::cas::{self, A};
 use super::expr::{Expr, product, sum};
-use super::types::{Derivation, DeriveError};
+use super::types::{Derivation, DeriveError, StepError};
 
 /// A candidate form ranked: operations, characters, order made, the form, and the constant
 /// factor dropped from it.
@@ -129,7 +129,7 @@ struct Factored {
 }
 
 /// The factors of a product as Symbolica's `factor` prints them.
-fn factors_of(e: &Expr, sign: i128, out: &mut Factored) -> Result<(), String> {
+fn factors_of(e: &Expr, sign: i128, out: &mut Factored) -> Result<(), StepError> {
     let list = match e {
         Expr::Mul(v) => v.clone(),
         e => vec![e.clone()],
@@ -139,8 +139,8 @@ fn factors_of(e: &Expr, sign: i128, out: &mut Factored) -> Result<(), String> {
             Expr::Rational(n, d) => {
                 let (cn, cd) = out.coefficient;
                 let (n, d) = if sign > 0 { (n, d) } else { (d, n) };
-                let num = cn.checked_mul(n).ok_or("coefficient overflow")?;
-                let den = cd.checked_mul(d).ok_or("coefficient overflow")?;
+                let num = cn.checked_mul(n).ok_or(StepError::Overflow)?;
+                let den = cd.checked_mul(d).ok_or(StepError::Overflow)?;
                 out.coefficient = reduced(num, den);
             }
             Expr::Pow(b, k) => match k.as_integer() {
@@ -182,7 +182,7 @@ impl<'a> Presenter<'a> {
 
     /// The presentation form of `a` (over `rc_s`, `rc_c` and theta-free symbols), checked equal
     /// to it.
-    pub fn present(&self, a: &A, shape: Shape) -> Result<Form, String> {
+    pub fn present(&self, a: &A, shape: Shape) -> Result<Form, StepError> {
         let mut candidates = vec![self.factored(a, shape, shape)?];
         if shape == Shape::Fraction {
             // The numerator's sums also as polynomials (highest power first), which can spare
@@ -210,15 +210,18 @@ impl<'a> Presenter<'a> {
         ranked.sort_by_key(|r| (r.0, r.1, r.2));
         // The best form is printed only once Symbolica finds it equal to the result; a form
         // that is not is a bug in its maker, reported rather than skipped.
-        let (ops, _, _, expr, dropped) = ranked.into_iter().next().ok_or("no presentation form")?;
+        let (ops, _, _, expr, dropped) = ranked
+            .into_iter()
+            .next()
+            .ok_or_else(|| StepError::Presentation("no presentation form".into()))?;
         let factor = cas::atom(&Expr::Rational(dropped.0, dropped.1));
         let diff = cas::atom(&expr) * factor - a.clone();
         if !is_zero_trig(&diff)? {
-            return Err(format!(
+            return Err(StepError::Presentation(format!(
                 "the presentation form `{}` is not equal to the result `{}`",
                 expr.to_infix(),
                 cas::expr(a)?.to_infix()
-            ));
+            )));
         }
         Ok(Form {
             expr,
@@ -229,7 +232,7 @@ impl<'a> Presenter<'a> {
 
     /// Candidate (1): together, `sin^2 + cos^2 = 1`, factor, sums collected and signed, the
     /// denominator's as `shape` says, the numerator's as `top` says.
-    fn factored(&self, a: &A, shape: Shape, top: Shape) -> Result<Factored, String> {
+    fn factored(&self, a: &A, shape: Shape, top: Shape) -> Result<Factored, StepError> {
         let t = cas::expr(&cas::together(a))?;
         let (num, den) = t.num_den();
         let mut out = Factored {
@@ -257,7 +260,7 @@ impl<'a> Presenter<'a> {
     }
 
     /// Candidates (2): a theta-free factor of the numerator moved into the denominator's sum.
-    fn moved_into_denominator(&self, f: &Factored) -> Result<Vec<Factored>, String> {
+    fn moved_into_denominator(&self, f: &Factored) -> Result<Vec<Factored>, StepError> {
         let below: Vec<&Factor> = f.factors.iter().filter(|x| x.1 < 0).collect();
         let [(d_sum, d_pow)] = below.as_slice() else {
             return Ok(Vec::new());
@@ -327,7 +330,7 @@ impl<'a> Presenter<'a> {
     }
 
     /// A theta-free coefficient as ordered factors (number first).
-    fn arrange_coefficient(&self, c: &A) -> Result<Vec<Expr>, String> {
+    fn arrange_coefficient(&self, c: &A) -> Result<Vec<Expr>, StepError> {
         let mut f = Factored {
             coefficient: (1, 1),
             factors: Vec::new(),
@@ -397,7 +400,7 @@ impl<'a> Presenter<'a> {
 
     /// A sum collected in powers of sin and cos (each coefficient factored), in the order of
     /// `shape`, and whether its sign was flipped to make its first term positive.
-    fn arrange_sum(&self, e: &Expr, shape: Shape) -> Result<(bool, Expr), String> {
+    fn arrange_sum(&self, e: &Expr, shape: Shape) -> Result<(bool, Expr), StepError> {
         let Expr::Add(terms) = e else {
             return Ok((false, e.clone()));
         };

@@ -18,7 +18,7 @@ use super::algebra::{is_zero_trig, to_sc_expr};
 use super::cas::{self, A};
 use super::expr::{Expr, product, sum};
 use super::present::{Presenter, Shape, operations};
-use super::types::Derivation;
+use super::types::{Derivation, StepError};
 pub use super::types::{Shown, Steps};
 use std::collections::BTreeMap;
 
@@ -65,7 +65,7 @@ pub fn derive(d: &Derivation) -> Steps {
 /// `e` in the form `form` makes of it (a form checked by its maker) when that has no more
 /// operations, else as derived. A form that fails to be made leaves `e` as derived with the
 /// reason.
-fn show(e: &Expr, form: impl Fn(&A) -> Result<Expr, String>) -> Shown {
+fn show(e: &Expr, form: impl Fn(&A) -> Result<Expr, StepError>) -> Shown {
     let a = cas::atom(e);
     let raw = e.clone();
     let candidate = match form(&a) {
@@ -74,7 +74,7 @@ fn show(e: &Expr, form: impl Fn(&A) -> Result<Expr, String>) -> Shown {
             return Shown {
                 expr: raw.clone(),
                 derived: raw,
-                as_derived: Some(why),
+                as_derived: Some(why.to_string()),
             };
         }
     };
@@ -97,7 +97,7 @@ fn show(e: &Expr, form: impl Fn(&A) -> Result<Expr, String>) -> Shown {
 /// monomials, each coefficient in its presentation form: accelerations first, then velocity
 /// products, then the part without either; within each, in the order of `motion`, higher
 /// powers first.
-fn in_motion(presenter: &Presenter, a: &A, motion: &[String]) -> Result<Expr, String> {
+fn in_motion(presenter: &Presenter, a: &A, motion: &[String]) -> Result<Expr, StepError> {
     let expanded = cas::expr(&cas::expand(a))?;
     let terms = match expanded {
         Expr::Add(v) => v,
@@ -149,11 +149,11 @@ fn in_motion(presenter: &Presenter, a: &A, motion: &[String]) -> Result<Expr, St
     shown.extend(free);
     let grouped = sum(shown);
     if !is_zero_trig(&(cas::atom(&grouped) - a.clone()))? {
-        return Err(format!(
+        return Err(StepError::Presentation(format!(
             "the grouped form `{}` is not equal to `{}`",
             grouped.to_infix(),
             cas::expr(a)?.to_infix()
-        ));
+        )));
     }
     Ok(grouped)
 }

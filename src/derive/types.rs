@@ -1,5 +1,6 @@
 //! What the derivation produces, stage by stage: the typed values that every stage of
-//! `derive/` hands to the next (and the errors placed at a spec field), below all of them.
+//! `derive/` hands to the next, and the layer's errors (`StepError` of a step, `DeriveError`
+//! placed at a spec field), below all of them.
 //!
 //! A spec describes a *system*: its coordinates, bodies, potentials, obstacles and contacts.
 //! Each derived model is one *phase* of it, named by the contacts it holds closed by
@@ -9,7 +10,52 @@
 
 use super::expr::Expr;
 pub use crate::model::ShapeKind;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
+
+/// A derivation step that failed, before it is placed at a spec field ([`DeriveError`]) or
+/// reported by the tool as a refused model: the derive layer's error.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum StepError {
+    /// Symbolica gave back an atom that the derivation's expressions cannot hold.
+    #[error("cannot read back Symbolica's `{atom}`: {why}")]
+    Unreadable {
+        /// The atom, as Symbolica prints it.
+        atom: String,
+        /// What could not be held (a complex number, a rational beyond 128 bits).
+        why: String,
+    },
+    /// A coefficient outgrew 128 bits.
+    #[error("coefficient overflow")]
+    Overflow,
+    /// No presentation form could be made, or the one made is not equal to the result.
+    #[error("{0}")]
+    Presentation(String),
+    /// The derivation lacks what the emitter needs (a constant, a point, a parameter, the
+    /// presented steps).
+    #[error("{0}")]
+    Missing(String),
+    /// Expressions of a generated method read symbols the method does not have.
+    #[error("{what} {} besides {besides}", .symbols.join(", "))]
+    Unbound {
+        /// What depends on them (`the forces depend on`).
+        what: &'static str,
+        /// The symbols.
+        symbols: Vec<String>,
+        /// What the method has (`the state and the parameters`).
+        besides: &'static str,
+    },
+    /// Named constants that nothing reads even after dropping the unread ones.
+    #[error("constants still unread after dropping the unread ones: {0:?}")]
+    Unread(BTreeSet<String>),
+    /// Two symbols would be the same local in the generated code.
+    #[error("two symbols of `{model}` would both be the local `{local}` in the generated code")]
+    LocalClash {
+        /// The model.
+        model: String,
+        /// The local.
+        local: String,
+    },
+}
 
 /// Where a derivation error belongs in the spec: a dotted field path and a message.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -3,7 +3,7 @@
 
 use super::lower::Body;
 use super::method::{Preamble, method};
-use crate::derive::types::Derivation;
+use crate::derive::types::{Derivation, StepError};
 use serde::Serialize;
 use std::collections::BTreeSet;
 
@@ -182,7 +182,7 @@ pub(super) struct Locals {
 
 impl Locals {
     /// The locals of `d`'s symbols; an error if two would be the same.
-    pub(super) fn of(d: &Derivation) -> Result<Locals, String> {
+    pub(super) fn of(d: &Derivation) -> Result<Locals, StepError> {
         let params: Vec<String> = d.params.iter().map(|p| parameter_local(&p.name)).collect();
         let coords: Vec<String> = d.coords.iter().map(|c| coordinate_local(c)).collect();
         let mut seen = BTreeSet::new();
@@ -190,10 +190,10 @@ impl Locals {
             (coords.iter()).flat_map(|c| [c.clone(), format!("{c}_dot"), format!("{c}_ddot")]);
         for name in params.iter().cloned().chain(state) {
             if !seen.insert(name.clone()) {
-                return Err(format!(
-                    "two symbols of `{}` would both be the local `{name}` in the generated code",
-                    d.name
-                ));
+                return Err(StepError::LocalClash {
+                    model: d.name.clone(),
+                    local: name,
+                });
             }
         }
         Ok(Locals { params, coords })

@@ -4,9 +4,9 @@
 
 use super::code::{Code, parameter_local};
 use super::lower::{Hoisted, Scope, lower};
-use super::reduced::ReducedCode;
+use super::reduced::{ReducedCode, missing_constant};
 use crate::derive::expr::Expr;
-use crate::derive::types::{Derivation, Reduction};
+use crate::derive::types::{Derivation, Reduction, StepError};
 use std::collections::BTreeSet;
 
 /// `Model::prepare` after the parameters: with a fast path, the per-point solver's constants
@@ -20,7 +20,7 @@ pub(super) fn prepare_code(
     scope: &Scope,
     hoisted: &Hoisted,
     code: Option<&mut ReducedCode>,
-) -> Result<Code, String> {
+) -> Result<Code, StepError> {
     let np = d.params.len();
     let mut prepare = start;
     let mut lean_indices = Vec::new();
@@ -163,7 +163,7 @@ fn lean_prepare(
     scope: &Scope,
     hoisted: &Hoisted,
     code: &ReducedCode,
-) -> Result<(Code, Vec<usize>), String> {
+) -> Result<(Code, Vec<usize>), StepError> {
     let index = |name: &str| scope.constants.get(name).copied();
     let definition = |i: usize| -> Option<&Expr> {
         own.iter()
@@ -177,7 +177,7 @@ fn lean_prepare(
                     .map(|(_, e)| e)
             })
     };
-    let wi = index("rc_wi").ok_or("the reduction has no constant `rc_wi`")?;
+    let wi = index("rc_wi").ok_or_else(|| missing_constant("rc_wi"))?;
     // The start enters the lean path through its sine, cosine and rate only: the angle itself
     // (an `asin`) is left to the full `prepare`.
     let mut stack = vec![code.k_sin_initial, code.k_cos_initial, wi];

@@ -3,7 +3,7 @@
 
 use super::common::{COMMAND, one_line, spec_path};
 use crate::derive::spec::Checked;
-use crate::derive::types::Derivation;
+use crate::derive::types::{Derivation, StepError};
 use serde::Serialize;
 
 #[derive(Debug, Clone, Serialize)]
@@ -97,12 +97,12 @@ pub(super) fn static_info(
     checked: &Checked,
     d: &Derivation,
     phases: &[PhaseEntry],
-) -> Result<StaticInfo, String> {
+) -> Result<StaticInfo, StepError> {
     let spec = &checked.spec;
     let np = d.params.len();
     let point_index = |name: &str| {
         (spec.points.iter().position(|p| p.name == name))
-            .ok_or_else(|| format!("`{name}` is not one of the points"))
+            .ok_or_else(|| StepError::Missing(format!("`{name}` is not one of the points")))
     };
     let lit = |s: &str| format!("{s:?}");
     let contacts_info = (d.contacts.iter())
@@ -183,7 +183,7 @@ pub(super) fn static_info(
             .collect(),
         falling_point: point_index(&spec.falling_point)?,
         gravity: (d.params.iter().position(|p| p.name == spec.gravity))
-            .ok_or_else(|| format!("`{}` is not a parameter", spec.gravity))?,
+            .ok_or_else(|| StepError::Missing(format!("`{}` is not a parameter", spec.gravity)))?,
         monitors_info: (d.monitors.iter())
             .map(|m| Monitor {
                 name: lit(&m.name),

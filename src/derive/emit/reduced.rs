@@ -5,7 +5,12 @@
 use super::code::{Code, DELTA, K, Locals, OUT, out_lines};
 use super::lower::{Hoisted, Scope, lower, unbound};
 use super::method::Preamble;
-use crate::derive::types::{Derivation, Reduction};
+use crate::derive::types::{Derivation, Reduction, StepError};
+
+/// The error of a reduction constant that the emitter needs and the derivation lacks.
+pub(super) fn missing_constant(name: &str) -> StepError {
+    StepError::Missing(format!("the reduction has no constant `{name}`"))
+}
 use serde::Serialize;
 
 /// The fast path's functions.
@@ -104,12 +109,12 @@ pub(super) fn reduction_info(
     r: &Reduction,
     code: &ReducedCode,
     scope: &Scope,
-) -> Result<String, String> {
+) -> Result<String, StepError> {
     let wi = scope
         .constants
         .get("rc_wi")
         .copied()
-        .ok_or("the reduction has no constant `rc_wi`")?;
+        .ok_or_else(|| missing_constant("rc_wi"))?;
     let degrees: Vec<usize> = (r.force_polynomials.iter())
         .map(|p| p.as_ref().map_or(0, |s| s.coefficients.len() - 1))
         .collect();
@@ -130,14 +135,14 @@ pub(super) fn reduced_code(
     r: &Reduction,
     scope: &Scope,
     hoisted: &mut Hoisted,
-) -> Result<ReducedCode, String> {
+) -> Result<ReducedCode, StepError> {
     let theta = d.theta().to_string();
     let idx = |s: &str| {
         scope
             .constants
             .get(s)
             .copied()
-            .ok_or_else(|| format!("the reduction has no constant `{s}`"))
+            .ok_or_else(|| missing_constant(s))
     };
     // rc_s, rc_c, rc_ds, rc_dc are locals set by the template's preamble.
     let mut red_scope = scope.clone();
@@ -162,10 +167,11 @@ pub(super) fn reduced_code(
     }
     let stray = unbound(std::slice::from_ref(&r.theta_dot_sq), &sc_scope);
     if !stray.is_empty() {
-        return Err(format!(
-            "theta_dot^2 depends on {} besides sin, cos and constants",
-            stray.into_iter().collect::<Vec<_>>().join(", ")
-        ));
+        return Err(StepError::Unbound {
+            what: "theta_dot^2 depends on",
+            symbols: stray.into_iter().collect(),
+            besides: "sin, cos and constants",
+        });
     }
     let mut theta_dot_sq = Code::default();
     theta_dot_sq.outputs = theta_dot_sq.push_body(lower(

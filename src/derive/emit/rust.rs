@@ -12,7 +12,7 @@ use super::reduced::{ReducedCode, reduced_code, reduction_info};
 use super::state::{FullStateCode, drawing_code, full_state_code};
 use crate::derive::expr::Expr;
 use crate::derive::spec::Checked;
-use crate::derive::types::Derivation;
+use crate::derive::types::{Derivation, StepError};
 use serde::Serialize;
 use std::collections::BTreeSet;
 
@@ -50,7 +50,7 @@ pub fn rust_context(
     checked: &Checked,
     d: &Derivation,
     phases: &[PhaseEntry],
-) -> Result<RustContext, String> {
+) -> Result<RustContext, StepError> {
     let first = context_without(checked, d, phases, &BTreeSet::new())?;
     if first.unread.is_empty() {
         return Ok(first);
@@ -58,10 +58,7 @@ pub fn rust_context(
     let second = context_without(checked, d, phases, &first.unread)?;
     match second.unread.is_empty() {
         true => Ok(second),
-        false => Err(format!(
-            "constants still unread after dropping the unread ones: {:?}",
-            second.unread
-        )),
+        false => Err(StepError::Unread(second.unread)),
     }
 }
 
@@ -71,7 +68,7 @@ fn context_without(
     d: &Derivation,
     phases: &[PhaseEntry],
     skip: &BTreeSet<String>,
-) -> Result<RustContext, String> {
+) -> Result<RustContext, StepError> {
     let np = d.params.len();
     let (scope, start, own) = constant_layout(d, skip);
     let mut hoisted = Hoisted::new(np + own.len());

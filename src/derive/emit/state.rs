@@ -7,7 +7,7 @@ use super::lower::{Hoisted, Scope, lower, unbound};
 use super::method::Preamble;
 use crate::derive::algebra::to_sc_expr;
 use crate::derive::expr::Expr;
-use crate::derive::types::{ContactRow, Derivation};
+use crate::derive::types::{ContactRow, Derivation, StepError};
 use serde::Serialize;
 
 /// The functions of the full state, every model has them.
@@ -149,7 +149,7 @@ pub(super) fn full_state_code(
     d: &Derivation,
     scope: &Scope,
     hoisted: &mut Hoisted,
-) -> Result<FullStateCode, String> {
+) -> Result<FullStateCode, StepError> {
     let theta = d.theta().to_string();
     let full_scope = state_scope(d, scope);
     let sc = |e: &Expr| to_sc_expr(e, &theta);
@@ -278,7 +278,7 @@ fn contact_code(
     d: &Derivation,
     full_scope: &Scope,
     hoisted: &mut Hoisted,
-) -> Result<ContactCode, String> {
+) -> Result<ContactCode, StepError> {
     let theta = d.theta().to_string();
     let sc = |e: &Expr| to_sc_expr(e, &theta);
     let nc = d.coords.len();
@@ -290,10 +290,11 @@ fn contact_code(
     let forces: Vec<Expr> = d.contacts.iter().filter_map(|c| c.force.clone()).collect();
     let stray = unbound(&forces, full_scope);
     if !stray.is_empty() {
-        return Err(format!(
-            "the forces depend on {} besides the state and the parameters",
-            stray.into_iter().collect::<Vec<_>>().join(", ")
-        ));
+        return Err(StepError::Unbound {
+            what: "the forces depend on",
+            symbols: stray.into_iter().collect(),
+            besides: "the state and the parameters",
+        });
     }
     let forces_full = per_contact(d, &|c| c.force.clone(), "0.0", "f", full_scope, hoisted);
     let open = |c: &ContactRow| (!c.closed).then(|| c.gap.clone());

@@ -6,7 +6,9 @@ use crate::derive::algebra::from_sc;
 use crate::derive::expr::Expr;
 use crate::derive::present;
 use crate::derive::spec::Checked;
-use crate::derive::types::{ContactRow, Derivation, Dimensionless, Reduction, Shown, Steps};
+use crate::derive::types::{
+    ContactRow, Derivation, Dimensionless, Reduction, Shown, StepError, Steps,
+};
 use serde::Serialize;
 
 /// `text` as LaTeX text on one line: every character TeX would read as a command or as
@@ -182,11 +184,10 @@ pub struct TexContext {
 }
 
 /// Builds the LaTeX context: the derivation's steps as displayed equations.
-pub fn tex_context(checked: &Checked, d: &Derivation) -> Result<TexContext, String> {
-    let steps = d
-        .steps
-        .as_ref()
-        .ok_or("the steps were not presented before the LaTeX")?;
+pub fn tex_context(checked: &Checked, d: &Derivation) -> Result<TexContext, StepError> {
+    let steps = d.steps.as_ref().ok_or_else(|| {
+        StepError::Missing("the steps were not presented before the LaTeX".into())
+    })?;
     let theta = d.theta().to_string();
     let name = |s: &str| match s
         .strip_prefix("rc_fr")
@@ -534,13 +535,15 @@ fn reduced_equations(
     steps: &Steps,
     name: &dyn Fn(&str) -> String,
     eqs: &mut Vec<Equation>,
-) -> Result<(), String> {
+) -> Result<(), StepError> {
     // Every result the reduction derived is shown in its presented form.
-    let shown = |key: &str| -> Result<Option<&Shown>, String> {
+    let shown = |key: &str| -> Result<Option<&Shown>, StepError> {
         match (r.plain.get(key), steps.reduced.get(key)) {
             (None, _) => Ok(None),
             (Some(_), Some(s)) => Ok(Some(s)),
-            (Some(_), None) => Err(format!("the result `{key}` was not presented")),
+            (Some(_), None) => Err(StepError::Missing(format!(
+                "the result `{key}` was not presented"
+            ))),
         }
     };
     let theta = d.theta().to_string();
