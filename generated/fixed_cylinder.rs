@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 16,
+    n_constants: 14,
     coordinates: &["x1", "y1", "theta"],
     system_coordinates: &["x1", "y1", "theta"],
     reduced: 2,
@@ -148,170 +148,257 @@ impl Model for FixedCylinder {
         &INFO
     }
 
+    /// The requirements' margins over the parameters, each `>= 0` where it holds.
+    ///
+    /// - `leans_forward = cos(th0)`
+    /// - `touches_the_rod = ell - R*(1 + cos(th0))/sin(th0)`
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
-        let k = p;
-        let qt0 = k[3].cos();
+        let ell = p[1];
+        let r = p[2];
+        let th0 = p[3];
+        let qt0 = th0.cos();
         out[0] = qt0;
-        out[1] = k[1] - (k[2] * (1.0 + qt0) / k[3].sin());
+        out[1] = ell - (r * (1.0 + qt0) / th0.sin());
     }
 
+    /// Each contact's coefficient of restitution over the parameters.
+    ///
+    /// - `cylinder_push = 0`
+    /// - `floor_normal = 0`
     fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
     }
 
+    /// The constants `k`: the parameters, then the constants derived from them.
+    ///
+    /// `k[..5]` holds the parameters `m1, ell, R, th0, g`; each later slot's definition is the comment above the line that fills it.
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
+        let m1 = p[0];
+        let ell = p[1];
+        let r = p[2];
+        let th0 = p[3];
+        let g = p[4];
         k[..5].copy_from_slice(p);
         // k[5] = R/sin(th0) + R*cos(th0)/sin(th0)
-        k[5] = (k[2] / k[3].sin()) + (k[2] * k[3].cos() / k[3].sin());
+        k[5] = (r / th0.sin()) + (r * th0.cos() / th0.sin());
         // k[6] = ell/2
-        k[6] = k[1] / 2.0;
+        k[6] = ell / 2.0;
         // k[7] = 2*R
-        k[7] = 2.0 * k[2];
+        k[7] = 2.0 * r;
         // k[8] = ell*m1/2
-        k[8] = k[1] * k[0] / 2.0;
-        // k[9] = ell^2*m1/24
-        k[9] = (k[1] * k[1]) * k[0] / 24.0;
-        // k[10] = ell^2*m1/8
-        k[10] = (k[1] * k[1]) * k[0] / 8.0;
-        // k[11] = m1/2
-        k[11] = k[0] / 2.0;
-        // k[12] = ell*g*m1/2
-        k[12] = k[1] * k[4] * k[0] / 2.0;
-        // k[13] = g*m1
-        k[13] = k[4] * k[0];
-        // k[14] = ell^2*m1/12
-        k[14] = (k[1] * k[1]) * k[0] / 12.0;
-        // k[15] = ell^2*m1/4
-        k[15] = (k[1] * k[1]) * k[0] / 4.0;
+        k[8] = ell * m1 / 2.0;
+        // k[9] = ell^2*m1/6
+        k[9] = (ell * ell) * m1 / 6.0;
+        // k[10] = m1/2
+        k[10] = m1 / 2.0;
+        // k[11] = ell*g*m1/2
+        k[11] = ell * g * m1 / 2.0;
+        // k[12] = g*m1
+        k[12] = g * m1;
+        // k[13] = ell^2*m1/3
+        k[13] = (ell * ell) * m1 / 3.0;
     }
 
+    /// The state at release, over the parameters.
+    ///
+    /// - `x1 = -R/sin(th0) - R*cos(th0)/sin(th0)`
+    /// - `dot_x1 = 0`
+    /// - `y1 = 0`
+    /// - `dot_y1 = 0`
+    /// - `theta = th0`
+    /// - `dot_theta = 0.0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
+        let th0 = k[3];
         q[0] = -k[5];
         qd[0] = 0.0;
         q[1] = 0.0;
         qd[1] = 0.0;
-        q[2] = k[3];
+        q[2] = th0;
         qd[2] = 0.0;
     }
 
+    /// Each point's position over the state (`pos`), and its time derivative (`vel`).
+    ///
+    /// - `foot_x = x1`
+    /// - `foot_y = y1`
+    /// - `tip_x = ell*cos(theta) + x1`
+    /// - `tip_y = ell*sin(theta) + y1`
+    /// - `rod_centre_x = ell*cos(theta)/2 + x1`
+    /// - `rod_centre_y = ell*sin(theta)/2 + y1`
+    /// - `touch_x = R*sin(theta)*cos(theta) + x1*sin(theta)^2 - y1*sin(theta)*cos(theta)`
+    /// - `touch_y = R*sin(theta)^2 - x1*sin(theta)*cos(theta) + y1*cos(theta)^2`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let pt0 = rc_c * rc_c;
-        let pt1 = rc_s * rc_s;
-        pos[0] = [q[0], q[1]];
-        vel[0] = [qd[0], qd[1]];
-        pos[1] = [(k[1] * rc_c) + q[0], (k[1] * rc_s) + q[1]];
+        let ell = k[1];
+        let r = k[2];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let y1 = q[1];
+        let y1_dot = qd[1];
+        let theta_dot = qd[2];
+        let pt0 = rc_s * rc_s;
+        let pt1 = rc_c * rc_c;
+        pos[0] = [x1, y1];
+        vel[0] = [x1_dot, y1_dot];
+        pos[1] = [(ell * rc_c) + x1, (ell * rc_s) + y1];
         vel[1] = [
-            -(k[1] * qd[2] * rc_s) + qd[0],
-            (k[1] * qd[2] * rc_c) + qd[1],
+            -(ell * theta_dot * rc_s) + x1_dot,
+            (ell * theta_dot * rc_c) + y1_dot,
         ];
-        pos[2] = [(k[6] * rc_c) + q[0], (k[6] * rc_s) + q[1]];
+        pos[2] = [(k[6] * rc_c) + x1, (k[6] * rc_s) + y1];
         vel[2] = [
-            -(k[6] * qd[2] * rc_s) + qd[0],
-            (k[6] * qd[2] * rc_c) + qd[1],
+            -(k[6] * theta_dot * rc_s) + x1_dot,
+            (k[6] * theta_dot * rc_c) + y1_dot,
         ];
         pos[3] = [
-            (k[2] * rc_s * rc_c) + q[0] - (q[0] * pt0) - (q[1] * rc_s * rc_c),
-            (k[2] * pt1) - (q[0] * rc_s * rc_c) + q[1] - (q[1] * pt1),
+            (r * rc_s * rc_c) + (x1 * pt0) - (y1 * rc_s * rc_c),
+            (r * pt0) - (x1 * rc_s * rc_c) + (y1 * pt1),
         ];
         vel[3] = [
-            -(k[2] * qd[2] * pt1)
-                + (k[2] * qd[2] * pt0)
-                + (2.0 * qd[2] * q[0] * rc_s * rc_c)
-                + (qd[2] * q[1] * pt1)
-                - (qd[2] * q[1] * pt0)
-                + qd[0]
-                - (qd[0] * pt0)
-                - (qd[1] * rc_s * rc_c),
-            (k[7] * qd[2] * rc_s * rc_c) + (qd[2] * q[0] * pt1)
-                - (qd[2] * q[0] * pt0)
-                - (2.0 * qd[2] * q[1] * rc_s * rc_c)
-                - (qd[0] * rc_s * rc_c)
-                + qd[1]
-                - (qd[1] * pt1),
+            -(r * theta_dot * pt0)
+                + (r * theta_dot * pt1)
+                + (2.0 * theta_dot * x1 * rc_s * rc_c)
+                + (theta_dot * y1 * pt0)
+                - (theta_dot * y1 * pt1)
+                + (x1_dot * pt0)
+                - (y1_dot * rc_s * rc_c),
+            (k[7] * theta_dot * rc_s * rc_c) + (theta_dot * x1 * pt0)
+                - (theta_dot * x1 * pt1)
+                - (2.0 * theta_dot * y1 * rc_s * rc_c)
+                - (x1_dot * rc_s * rc_c)
+                + (y1_dot * pt1),
         ];
     }
 
+    /// The total energy `E = T + V`.
+    ///
+    /// - `T = -dot_theta*dot_x1*ell*m1*sin(theta)/2 + dot_theta*dot_y1*ell*m1*cos(theta)/2 + dot_theta^2*ell^2*m1/6 + dot_x1^2*m1/2 + dot_y1^2*m1/2`
+    /// - `V = ell*g*m1*sin(theta)/2 + g*m1*y1`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let et0 = qd[2] * qd[2];
-        (-(k[8] * qd[2] * qd[0] * rc_s)
-            + (k[8] * qd[2] * qd[1] * rc_c)
-            + (k[9] * et0)
-            + (k[10] * et0 * (rc_s * rc_s))
-            + (k[10] * et0 * (rc_c * rc_c))
-            + (k[11] * (qd[0] * qd[0]))
-            + (k[11] * (qd[1] * qd[1])))
-            + ((k[12] * rc_s) + (k[13] * q[1]))
+        let x1_dot = qd[0];
+        let y1 = q[1];
+        let y1_dot = qd[1];
+        let theta_dot = qd[2];
+        (-(k[8] * theta_dot * x1_dot * rc_s)
+            + (k[8] * theta_dot * y1_dot * rc_c)
+            + (k[9] * (theta_dot * theta_dot))
+            + (k[10] * (x1_dot * x1_dot))
+            + (k[10] * (y1_dot * y1_dot)))
+            + ((k[11] * rc_s) + (k[12] * y1))
     }
 
+    /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
+    ///
+    /// - `p_x1 = -dot_theta*ell*m1*sin(theta)/2 + dot_x1*m1`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
-        out[0] = -(k[8] * qd[2] * rc_s) + (k[0] * qd[0]);
+        let m1 = k[0];
+        let x1_dot = qd[0];
+        let theta_dot = qd[2];
+        out[0] = -(k[8] * theta_dot * rc_s) + (m1 * x1_dot);
     }
 
+    /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
+    ///
+    /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
+    /// - `L = T - V`: 169 characters, written out in `generated/fixed_cylinder.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let qt0 = -k[8] * rc_s;
-        let qt1 = k[8] * rc_c;
-        let qt2 = qd[2] * qd[2];
-        mass[0] = k[0];
+        let m1 = k[0];
+        let theta_dot = qd[2];
+        let qt0 = -k[8] * rc_s; // -(ell*m1*rc_s/2)
+        let qt1 = k[8] * rc_c; // ell*m1*rc_c/2
+        let qt2 = theta_dot * theta_dot;
+        mass[0] = m1;
         mass[1] = 0.0;
         mass[2] = qt0;
         mass[3] = 0.0;
-        mass[4] = k[0];
+        mass[4] = m1;
         mass[5] = qt1;
         mass[6] = qt0;
         mass[7] = qt1;
-        mass[8] = k[14] + (k[15] * (rc_s * rc_s)) + (k[15] * (rc_c * rc_c));
+        mass[8] = k[13];
         rhs[0] = k[8] * qt2 * rc_c;
-        rhs[1] = -k[13] + (k[8] * qt2 * rc_s);
-        rhs[2] = -k[12] * rc_c;
+        rhs[1] = -k[12] + (k[8] * qt2 * rc_s);
+        rhs[2] = -k[11] * rc_c;
     }
 
+    /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
+    ///
+    /// No contact is closed in this phase.
     fn forces_full(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _qdd: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
     }
 
+    /// Each contact's gap `g(q)`, `>= 0` while apart (zero for a contact held closed).
+    ///
+    /// - `cylinder_push = -R - R*cos(theta) - x1*sin(theta) + y1*cos(theta)`
+    /// - `floor_normal = y1`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        out[0] = -k[2] - (k[2] * rc_c) - (q[0] * rc_s) + (q[1] * rc_c);
-        out[1] = q[1];
+        let r = k[2];
+        let x1 = q[0];
+        let y1 = q[1];
+        out[0] = -r - (r * rc_c) - (x1 * rc_s) + (y1 * rc_c);
+        out[1] = y1;
     }
 
+    /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let jt0 = qd[2] * qd[2];
+        let r = k[2];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let y1 = q[1];
+        let y1_dot = qd[1];
+        let theta_dot = qd[2];
+        let jt0 = theta_dot * theta_dot;
         jac[0] = -rc_s;
         jac[1] = rc_c;
-        jac[2] = (k[2] * rc_s) - (q[0] * rc_c) - (q[1] * rc_s);
+        jac[2] = (r * rc_s) - (x1 * rc_c) - (y1 * rc_s);
         jac[3] = 0.0;
         jac[4] = 1.0;
         jac[5] = 0.0;
-        bias[0] = (k[2] * jt0 * rc_c) - (2.0 * qd[2] * qd[0] * rc_c) - (2.0 * qd[2] * qd[1] * rc_s)
-            + (jt0 * q[0] * rc_s)
-            - (jt0 * q[1] * rc_c);
+        bias[0] = (r * jt0 * rc_c)
+            - (2.0 * theta_dot * x1_dot * rc_c)
+            - (2.0 * theta_dot * y1_dot * rc_s)
+            + (jt0 * x1 * rc_s)
+            - (jt0 * y1 * rc_c);
         bias[1] = 0.0;
     }
 
+    /// Each contact's edge margin, `>= 0` while the contact point is on the edge (infinite without one).
+    ///
+    /// - `cylinder_push = -R*sin(theta) + ell + x1*cos(theta) + y1*sin(theta)`
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        out[0] = k[1] - (k[2] * rc_s) + (q[0] * rc_c) + (q[1] * rc_s);
+        let ell = k[1];
+        let r = k[2];
+        let x1 = q[0];
+        let y1 = q[1];
+        out[0] = ell - (r * rc_s) + (x1 * rc_c) + (y1 * rc_s);
         out[1] = f64::INFINITY;
     }
 
+    /// Each friction's slip velocity `v = J(q) qd`: `jac` holds `J`, `bias` holds `dJ/dt qd`.
+    ///
+    /// No friction.
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
+    /// The monitors over the state and the contacts' forces `rc_f<i>`.
+    ///
+    /// No monitor.
     fn monitors_full(
         &self,
         _k: &[f64],
@@ -322,26 +409,45 @@ impl Model for FixedCylinder {
     ) {
     }
 
+    /// The system's state (its general model's) that this phase's state stands for.
+    ///
+    /// - `x1 = x1`
+    /// - `dot_x1 = dot_x1`
+    /// - `y1 = y1`
+    /// - `dot_y1 = dot_y1`
+    /// - `theta = theta`
+    /// - `dot_theta = dot_theta`
     fn to_full(&self, _k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        q_full[0] = q[0];
-        qd_full[0] = qd[0];
-        q_full[1] = q[1];
-        qd_full[1] = qd[1];
-        q_full[2] = q[2];
-        qd_full[2] = qd[2];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let y1 = q[1];
+        let y1_dot = qd[1];
+        let theta = q[2];
+        let theta_dot = qd[2];
+        q_full[0] = x1;
+        qd_full[0] = x1_dot;
+        q_full[1] = y1;
+        qd_full[1] = y1_dot;
+        q_full[2] = theta;
+        qd_full[2] = theta_dot;
     }
 
+    /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..16]; // one bounds check for all constant loads
+        let k = &k[..14]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        poses[0] = [(k[6] * rc_c) + q[0], (k[6] * rc_s) + q[1], q[2]];
+        let r = k[2];
+        let x1 = q[0];
+        let y1 = q[1];
+        let theta = q[2];
+        poses[0] = [(k[6] * rc_c) + x1, (k[6] * rc_s) + y1, theta];
         sizes[0] = -k[6];
         sizes[1] = 0.0;
         sizes[2] = k[6];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
-        sizes[5] = k[2];
-        sizes[6] = k[2];
+        sizes[5] = r;
+        sizes[6] = r;
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {

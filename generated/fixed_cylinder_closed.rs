@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 39,
+    n_constants: 37,
     coordinates: &["theta"],
     system_coordinates: &["x1", "y1", "theta"],
     reduced: 0,
@@ -156,132 +156,164 @@ impl Model for FixedCylinderClosed {
         &INFO
     }
 
+    /// The requirements' margins over the parameters, each `>= 0` where it holds.
+    ///
+    /// - `leans_forward = cos(th0)`
+    /// - `touches_the_rod = ell - R*(1 + cos(th0))/sin(th0)`
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
-        let k = p;
-        let qt0 = k[3].cos();
+        let ell = p[1];
+        let r = p[2];
+        let th0 = p[3];
+        let qt0 = th0.cos();
         out[0] = qt0;
-        out[1] = k[1] - (k[2] * (1.0 + qt0) / k[3].sin());
+        out[1] = ell - (r * (1.0 + qt0) / th0.sin());
     }
 
+    /// Each contact's coefficient of restitution over the parameters.
+    ///
+    /// - `cylinder_push = 0`
+    /// - `floor_normal = 0`
     fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
     }
 
+    /// The constants `k`: the parameters, then the constants derived from them.
+    ///
+    /// `k[..5]` holds the parameters `m1, ell, R, th0, g`; each later slot's definition is the comment above the line that fills it.
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
+        let m1 = p[0];
+        let ell = p[1];
+        let r = p[2];
+        let g = p[4];
         k[..5].copy_from_slice(p);
         // k[3] also holds rc_thi = th0
         Reduction::prepare_lean(self, p, k);
         // k[8] = ell/2
-        k[8] = k[1] / 2.0;
+        k[8] = ell / 2.0;
         // k[9] = 2*R
-        k[9] = 2.0 * k[2];
+        k[9] = 2.0 * r;
         // k[10] = R*ell*m1/2
-        k[10] = k[2] * k[1] * k[0] / 2.0;
-        // k[11] = R^2*m1/2 + ell^2*m1/24
-        k[11] = ((k[2] * k[2]) * k[0] / 2.0) + ((k[1] * k[1]) * k[0] / 24.0);
+        k[10] = r * ell * m1 / 2.0;
+        // k[11] = R^2*m1/2 + ell^2*m1/6
+        k[11] = ((r * r) * m1 / 2.0) + ((ell * ell) * m1 / 6.0);
         // k[12] = R^2*m1
-        k[12] = (k[2] * k[2]) * k[0];
+        k[12] = (r * r) * m1;
         // k[13] = R^2*m1/2
-        k[13] = (k[2] * k[2]) * k[0] / 2.0;
-        // k[14] = ell^2*m1/8
-        k[14] = (k[1] * k[1]) * k[0] / 8.0;
-        // k[15] = ell*g*m1/2
-        k[15] = k[1] * k[4] * k[0] / 2.0;
-        // k[16] = R^2*m1 + ell^2*m1/12
-        k[16] = ((k[2] * k[2]) * k[0]) + ((k[1] * k[1]) * k[0] / 12.0);
-        // k[17] = R*ell*m1
-        k[17] = k[2] * k[1] * k[0];
-        // k[18] = 2*R^2*m1
-        k[18] = 2.0 * (k[2] * k[2]) * k[0];
-        // k[19] = ell^2*m1/4
-        k[19] = (k[1] * k[1]) * k[0] / 4.0;
-        // k[20] = 5*R^2*m1
-        k[20] = 5.0 * (k[2] * k[2]) * k[0];
-        // k[21] = 4*R^2*m1
-        k[21] = 4.0 * (k[2] * k[2]) * k[0];
-        // k[22] = ell*m1/2
-        k[22] = k[1] * k[0] / 2.0;
-        // k[23] = 2*R*m1
-        k[23] = 2.0 * k[2] * k[0];
-        // k[24] = 4*R*m1
-        k[24] = 4.0 * k[2] * k[0];
-        // k[25] = 2*g*m1
-        k[25] = 2.0 * k[4] * k[0];
-        // k[26] = ell*m1
-        k[26] = k[1] * k[0];
-        // k[27] = 3*ell*g
-        k[27] = 3.0 * k[1] * k[4];
-        // k[28] = 6*R^2
-        k[28] = 6.0 * (k[2] * k[2]);
-        // k[29] = 3*R*ell
-        k[29] = 3.0 * k[2] * k[1];
-        // k[30] = 3*R^2
-        k[30] = 3.0 * (k[2] * k[2]);
-        // k[31] = ell^2
-        k[31] = k[1] * k[1];
-        // k[32] = 3*R*ell^2*g
-        k[32] = 3.0 * k[2] * (k[1] * k[1]) * k[4];
-        // k[33] = 24*R^2*ell*g
-        k[33] = 24.0 * (k[2] * k[2]) * k[1] * k[4];
-        // k[34] = 6*R^2*ell*g
-        k[34] = 6.0 * (k[2] * k[2]) * k[1] * k[4];
-        // k[35] = 3*R^2*ell*g
-        k[35] = 3.0 * (k[2] * k[2]) * k[1] * k[4];
-        // k[36] = ell^3*g
-        k[36] = k[1].powi(3) * k[4];
-        // k[37] = R*m1
-        k[37] = k[2] * k[0];
-        // k[38] = g*m1
-        k[38] = k[4] * k[0];
+        k[13] = (r * r) * m1 / 2.0;
+        // k[14] = ell*g*m1/2
+        k[14] = ell * g * m1 / 2.0;
+        // k[15] = R^2*m1 + ell^2*m1/3
+        k[15] = ((r * r) * m1) + ((ell * ell) * m1 / 3.0);
+        // k[16] = R*ell*m1
+        k[16] = r * ell * m1;
+        // k[17] = 2*R^2*m1
+        k[17] = 2.0 * (r * r) * m1;
+        // k[18] = 5*R^2*m1
+        k[18] = 5.0 * (r * r) * m1;
+        // k[19] = 4*R^2*m1
+        k[19] = 4.0 * (r * r) * m1;
+        // k[20] = ell*m1/2
+        k[20] = ell * m1 / 2.0;
+        // k[21] = 2*R*m1
+        k[21] = 2.0 * r * m1;
+        // k[22] = 4*R*m1
+        k[22] = 4.0 * r * m1;
+        // k[23] = 2*g*m1
+        k[23] = 2.0 * g * m1;
+        // k[24] = ell*m1
+        k[24] = ell * m1;
+        // k[25] = 3*ell*g
+        k[25] = 3.0 * ell * g;
+        // k[26] = 6*R^2
+        k[26] = 6.0 * (r * r);
+        // k[27] = 3*R*ell
+        k[27] = 3.0 * r * ell;
+        // k[28] = 3*R^2
+        k[28] = 3.0 * (r * r);
+        // k[29] = ell^2
+        k[29] = ell * ell;
+        // k[30] = 3*R*ell^2*g
+        k[30] = 3.0 * r * (ell * ell) * g;
+        // k[31] = 24*R^2*ell*g
+        k[31] = 24.0 * (r * r) * ell * g;
+        // k[32] = 6*R^2*ell*g
+        k[32] = 6.0 * (r * r) * ell * g;
+        // k[33] = 3*R^2*ell*g
+        k[33] = 3.0 * (r * r) * ell * g;
+        // k[34] = ell^3*g
+        k[34] = ell.powi(3) * g;
+        // k[35] = R*m1
+        k[35] = r * m1;
+        // k[36] = g*m1
+        k[36] = g * m1;
     }
 
+    /// The state at release, over the parameters.
+    ///
+    /// - `theta = th0`
+    /// - `dot_theta = 0.0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
-        q[0] = k[3];
+        let k = &k[..37]; // one bounds check for all constant loads
+        let th0 = k[3];
+        q[0] = th0;
         qd[0] = 0.0;
     }
 
+    /// Each point's position over the state (`pos`), and its time derivative (`vel`).
+    ///
+    /// - `foot_x = -R/sin(theta) - R*cos(theta)/sin(theta)`
+    /// - `foot_y = 0`
+    /// - `tip_x = -R/sin(theta) - R*cos(theta)/sin(theta) + ell*cos(theta)`
+    /// - `tip_y = ell*sin(theta)`
+    /// - `rod_centre_x = -R/sin(theta) - R*cos(theta)/sin(theta) + ell*cos(theta)/2`
+    /// - `rod_centre_y = ell*sin(theta)/2`
+    /// - `touch_x = R*sin(theta)*cos(theta) - R*sin(theta)^2/sin(theta) - R*sin(theta)^2*cos(theta)/sin(theta)`
+    /// - `touch_y = R*cos(theta) + R`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        let pt0 = rc_c * rc_c;
-        let pt1 = rc_c.powi(3);
-        let pt2 = rc_s * rc_s;
-        let pt3 = k[2] * qd[0];
-        let pt4 = k[2] * qd[0] * rc_c / pt2;
-        let pt5 = k[2] * qd[0] * pt0 / pt2;
-        pos[0] = [-(k[2] / rc_s) - (k[2] * rc_c / rc_s), 0.0];
-        vel[0] = [pt3 + pt4 + pt5, 0.0];
-        pos[1] = [
-            -(k[2] / rc_s) - (k[2] * rc_c / rc_s) + (k[1] * rc_c),
-            k[1] * rc_s,
+        let ell = k[1];
+        let r = k[2];
+        let theta_dot = qd[0];
+        let pt0 = rc_s * rc_s;
+        let pt1 = r * theta_dot;
+        let pt2 = r * theta_dot * rc_c / pt0;
+        let pt3 = rc_c * rc_c;
+        let pt4 = r * theta_dot * pt3 / pt0;
+        pos[0] = [-(r / rc_s) - (r * rc_c / rc_s), 0.0];
+        vel[0] = [pt1 + pt2 + pt4, 0.0];
+        pos[1] = [-(r / rc_s) - (r * rc_c / rc_s) + (ell * rc_c), ell * rc_s];
+        vel[1] = [
+            pt1 + pt2 + pt4 - (ell * theta_dot * rc_s),
+            ell * theta_dot * rc_c,
         ];
-        vel[1] = [pt3 + pt4 + pt5 - (k[1] * qd[0] * rc_s), k[1] * qd[0] * rc_c];
-        pos[2] = [
-            -(k[2] / rc_s) - (k[2] * rc_c / rc_s) + (k[8] * rc_c),
-            k[8] * rc_s,
+        pos[2] = [-(r / rc_s) - (r * rc_c / rc_s) + (k[8] * rc_c), k[8] * rc_s];
+        vel[2] = [
+            pt1 + pt2 + pt4 - (k[8] * theta_dot * rc_s),
+            k[8] * theta_dot * rc_c,
         ];
-        vel[2] = [pt3 + pt4 + pt5 - (k[8] * qd[0] * rc_s), k[8] * qd[0] * rc_c];
         pos[3] = [
-            (k[2] * rc_s * rc_c) - (k[2] / rc_s) - (k[2] * rc_c / rc_s)
-                + (k[2] * pt0 / rc_s)
-                + (k[2] * pt1 / rc_s),
-            (k[2] * rc_c) + (k[2] * pt2) + (k[2] * pt0),
+            (r * rc_s * rc_c) - (r * pt0 / rc_s) - (r * pt0 * rc_c / rc_s),
+            r + (r * rc_c),
         ];
         vel[3] = [
-            pt3 - (k[9] * qd[0] * rc_c) - (k[2] * qd[0] * pt2) + pt4 + pt5
-                - (k[2] * qd[0] * pt1 / pt2)
-                - (k[2] * qd[0] * rc_c.powi(4) / pt2)
-                - (k[9] * qd[0] * pt0),
-            -k[2] * qd[0] * rc_s,
+            -(r * theta_dot * pt3) - (k[9] * theta_dot * rc_c)
+                + (r * theta_dot * pt0 * rc_c / pt0)
+                + (r * theta_dot * pt0 * pt3 / pt0),
+            -r * theta_dot * rc_s,
         ];
     }
 
+    /// The total energy `E = T + V`.
+    ///
+    /// - `T`: 423 characters, written out in `generated/fixed_cylinder_closed.tex`
+    /// - `V = ell*g*m1*sin(theta)/2`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        let et0 = qd[0] * qd[0];
+        let theta_dot = qd[0];
+        let et0 = theta_dot * theta_dot;
         let et1 = rc_c * rc_c;
         (-(k[10] * et0 * rc_s) - (k[10] * et0 * rc_c / rc_s) - (k[10] * et0 * et1 / rc_s)
             + (k[11] * et0)
@@ -289,80 +321,92 @@ impl Model for FixedCylinderClosed {
             + (k[12] * et0 * et1 / (rc_s * rc_s))
             + (k[13] * et0 * et1 / rc_s.powi(4))
             + (k[12] * et0 * rc_c.powi(3) / rc_s.powi(4))
-            + (k[13] * et0 * rc_c.powi(4) / rc_s.powi(4))
-            + (k[14] * et0 * (rc_s * rc_s))
-            + (k[14] * et0 * et1))
-            + (k[15] * rc_s)
+            + (k[13] * et0 * rc_c.powi(4) / rc_s.powi(4)))
+            + (k[14] * rc_s)
     }
 
+    /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
+    ///
+    /// No cyclic coordinate.
     fn momenta(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
 
+    /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
+    ///
+    /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
+    /// - `L = T - V`: 447 characters, written out in `generated/fixed_cylinder_closed.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
+        let theta_dot = qd[0];
         let qt0 = rc_c * rc_c;
         let qt1 = rc_c.powi(3);
         let qt2 = rc_c.powi(4);
-        let qt3 = qd[0] * qd[0];
-        mass[0] = k[16] - (k[17] * rc_s) - (k[17] * rc_c / rc_s) - (k[17] * qt0 / rc_s)
-            + (k[18] * rc_c / (rc_s * rc_s))
-            + (k[18] * qt0 / (rc_s * rc_s))
+        let qt3 = theta_dot * theta_dot;
+        mass[0] = k[15] - (k[16] * rc_s) - (k[16] * rc_c / rc_s) - (k[16] * qt0 / rc_s)
+            + (k[17] * rc_c / (rc_s * rc_s))
+            + (k[17] * qt0 / (rc_s * rc_s))
             + (k[12] * qt0 / rc_s.powi(4))
-            + (k[18] * qt1 / rc_s.powi(4))
-            + (k[12] * qt2 / rc_s.powi(4))
-            + (k[19] * (rc_s * rc_s))
-            + (k[19] * qt0);
+            + (k[17] * qt1 / rc_s.powi(4))
+            + (k[12] * qt2 / rc_s.powi(4));
         rhs[0] = -(k[10] * qt3)
             - (k[10] * qt3 * rc_c)
             - (k[10] * qt3 * qt0 / (rc_s * rc_s))
             - (k[10] * qt3 * qt1 / (rc_s * rc_s))
-            - (k[15] * rc_c)
+            - (k[14] * rc_c)
             + (k[12] * qt3 / rc_s)
-            + (k[18] * qt3 * rc_c / rc_s)
+            + (k[17] * qt3 * rc_c / rc_s)
             + (k[12] * qt3 * rc_c / rc_s.powi(3))
-            + (k[20] * qt3 * qt0 / rc_s.powi(3))
-            + (k[21] * qt3 * qt1 / rc_s.powi(3))
-            + (k[18] * qt3 * qt1 / rc_s.powi(5))
-            + (k[21] * qt3 * qt2 / rc_s.powi(5))
-            + (k[18] * qt3 * rc_c.powi(5) / rc_s.powi(5));
+            + (k[18] * qt3 * qt0 / rc_s.powi(3))
+            + (k[19] * qt3 * qt1 / rc_s.powi(3))
+            + (k[17] * qt3 * qt1 / rc_s.powi(5))
+            + (k[19] * qt3 * qt2 / rc_s.powi(5))
+            + (k[17] * qt3 * rc_c.powi(5) / rc_s.powi(5));
     }
 
+    /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
+    ///
+    /// - `cylinder_push`: 336 characters, written out in `generated/fixed_cylinder_closed.tex`
+    /// - `floor_normal`: 271 characters, written out in `generated/fixed_cylinder_closed.tex`
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        let ft0 = rc_s * rc_s;
-        let ft1 = rc_c * rc_c;
-        let ft2 = qd[0] * qd[0];
-        let ft3 = rc_s.powi(3);
-        let ft4 = rc_c.powi(3);
-        out[0] = -(-(k[22] * qdd[0] * rc_s)
-            + (k[0]
-                * ((k[2] * qdd[0]) + (k[2] * qdd[0] * rc_c / ft0) + (k[2] * qdd[0] * ft1 / ft0)
-                    - (k[2] * ft2 / rc_s)
-                    - (k[9] * ft2 * rc_c / rc_s)
-                    - (k[9] * ft2 * ft1 / ft3)
-                    - (k[9] * ft2 * ft4 / ft3)))
-            - (k[22] * ft2 * rc_c))
+        let m1 = k[0];
+        let r = k[2];
+        let theta_dot = qd[0];
+        let theta_ddot = qdd[0];
+        let ft0 = rc_c * rc_c;
+        let ft1 = theta_dot * theta_dot;
+        let ft2 = rc_c.powi(3);
+        out[0] = -(-(k[20] * theta_ddot * rc_s)
+            + (m1
+                * ((r * theta_ddot)
+                    + (r * theta_ddot * rc_c / (rc_s * rc_s))
+                    + (r * theta_ddot * ft0 / (rc_s * rc_s))
+                    - (r * ft1 / rc_s)
+                    - (k[9] * ft1 * rc_c / rc_s)
+                    - (k[9] * ft1 * ft0 / rc_s.powi(3))
+                    - (k[9] * ft1 * ft2 / rc_s.powi(3))))
+            - (k[20] * ft1 * rc_c))
             / rc_s;
-        out[1] = ((k[23] * qdd[0] * rc_s * ft1)
-            + (k[23] * qdd[0] * rc_s * ft4)
-            + (k[23] * qdd[0] * ft3 * rc_c)
-            - (k[23] * ft2 * ft0 * rc_c)
-            - (k[24] * ft2 * ft0 * ft1)
-            - (k[24] * ft2 * ft4)
-            - (k[24] * ft2 * rc_c.powi(4))
-            + (k[25] * rc_s.powi(4))
-            - (k[26] * ft2 * ft3 * ft1)
-            - (k[26] * ft2 * rc_s.powi(5)))
+        out[1] = ((k[21] * theta_ddot * rc_s * ft0) + (k[21] * theta_ddot * rc_s * rc_c)
+            - (k[21] * ft1 * (rc_s * rc_s) * rc_c)
+            - (k[22] * ft1 * ft0)
+            - (k[22] * ft1 * ft2)
+            + (k[23] * rc_s.powi(4))
+            - (k[24] * ft1 * rc_s.powi(3)))
             / 2.0
             / rc_s.powi(4);
     }
 
+    /// Each contact's gap `g(q)`, `>= 0` while apart (zero for a contact held closed).
+    ///
+    /// No open contact.
     fn gaps(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
     }
 
+    /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, _k: &[f64], _q: &[f64], _qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
         jac[0] = 0.0;
         jac[1] = 0.0;
@@ -370,15 +414,26 @@ impl Model for FixedCylinderClosed {
         bias[1] = 0.0;
     }
 
+    /// Each contact's edge margin, `>= 0` while the contact point is on the edge (infinite without one).
+    ///
+    /// - `cylinder_push = -R*sin(theta) - R*cos(theta)/sin(theta) - R*cos(theta)^2/sin(theta) + ell`
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        out[0] = k[1] - (k[2] * rc_s) - (k[2] * rc_c / rc_s) - (k[2] * (rc_c * rc_c) / rc_s);
+        let ell = k[1];
+        let r = k[2];
+        out[0] = ell - (r * rc_s) - (r * rc_c / rc_s) - (r * (rc_c * rc_c) / rc_s);
         out[1] = f64::INFINITY;
     }
 
+    /// Each friction's slip velocity `v = J(q) qd`: `jac` holds `J`, `bias` holds `dJ/dt qd`.
+    ///
+    /// No friction.
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
+    /// The monitors over the state and the contacts' forces `rc_f<i>`.
+    ///
+    /// No monitor.
     fn monitors_full(
         &self,
         _k: &[f64],
@@ -389,34 +444,48 @@ impl Model for FixedCylinderClosed {
     ) {
     }
 
+    /// The system's state (its general model's) that this phase's state stands for.
+    ///
+    /// - `x1 = -R/sin(theta) - R*cos(theta)/sin(theta)`
+    /// - `dot_x1 = R*dot_theta + R*dot_theta*cos(theta)/sin(theta)^2 + R*dot_theta*cos(theta)^2/sin(theta)^2`
+    /// - `y1 = 0`
+    /// - `dot_y1 = 0`
+    /// - `theta = theta`
+    /// - `dot_theta = dot_theta`
     fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        q_full[0] = -(k[2] / rc_s) - (k[2] * rc_c / rc_s);
-        qd_full[0] = (k[2] * qd[0])
-            + (k[2] * qd[0] * rc_c / (rc_s * rc_s))
-            + (k[2] * qd[0] * (rc_c * rc_c) / (rc_s * rc_s));
+        let r = k[2];
+        let theta = q[0];
+        let theta_dot = qd[0];
+        q_full[0] = -(r / rc_s) - (r * rc_c / rc_s);
+        qd_full[0] = (r * theta_dot)
+            + (r * theta_dot * rc_c / (rc_s * rc_s))
+            + (r * theta_dot * (rc_c * rc_c) / (rc_s * rc_s));
         q_full[1] = 0.0;
         qd_full[1] = 0.0;
-        q_full[2] = q[0];
-        qd_full[2] = qd[0];
+        q_full[2] = theta;
+        qd_full[2] = theta_dot;
     }
 
+    /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
+        let r = k[2];
+        let theta = q[0];
         poses[0] = [
-            -(k[2] / rc_s) - (k[2] * rc_c / rc_s) + (k[8] * rc_c),
+            -(r / rc_s) - (r * rc_c / rc_s) + (k[8] * rc_c),
             k[8] * rc_s,
-            q[0],
+            theta,
         ];
         sizes[0] = -k[8];
         sizes[1] = 0.0;
         sizes[2] = k[8];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
-        sizes[5] = k[2];
-        sizes[6] = k[2];
+        sizes[5] = r;
+        sizes[6] = r;
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -425,14 +494,18 @@ impl Model for FixedCylinderClosed {
 }
 
 impl Reduction for FixedCylinderClosed {
+    /// The reduced motion at `theta = theta_i - delta`: `theta_dot^2` from the energy integral, and `theta_ddot`.
+    ///
+    /// - `theta_dot^2`: 183 characters, written out in `generated/fixed_cylinder_closed.tex`
+    /// - `theta_ddot`: 994 characters, written out in `generated/fixed_cylinder_closed.tex`
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[3], k[6], k[7], delta);
         let rt0 = rc_s.powi(4);
         let rt1 = rc_s.powi(3);
-        let rt2 = k[28] - (k[29] * rt1) - (k[29] * rt1 * rc_c) + (k[28] * rc_c)
-            - (k[30] * (rc_s * rc_s))
-            + (k[31] * rt0);
+        let rt2 = k[26] - (k[27] * rt1) - (k[27] * rt1 * rc_c) + (k[26] * rc_c)
+            - (k[28] * (rc_s * rc_s))
+            + (k[29] * rt0); // 6*R^2 - 3*R*ell*rc_s^3 - 3*R*ell*rc_s^3*rc_c + 6*R^2*rc_c - 3*R^2*rc_s^2 + ell^2*rc_s^4
         let rt3 = rc_s.powi(6);
         let rt4 = rc_c * rc_c;
         let rt5 = rc_s.powi(7);
@@ -441,100 +514,112 @@ impl Reduction for FixedCylinderClosed {
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: k[27] * rt0 * rc_ds / rt2,
+            theta_dot_sq: k[25] * rt0 * rc_ds / rt2,
             theta_ddot: -3.0
-                * ((k[32] * rt3 * rc_c * rc_ds) + (k[32] * rt3 * rt4 * rc_ds)
-                    - (k[32] * rt5 * rc_c)
-                    - (k[32] * rt5 * rt4)
-                    + (k[32] * rt6 * rc_ds)
-                    - (k[33] * rt1 * rc_c * rc_ds)
-                    - (k[33] * rt1 * rt4 * rc_ds)
-                    + (k[34] * rt0 * rc_c)
-                    + (k[34] * rt0 * rt4)
-                    + (k[34] * rt7 * rc_c * rc_ds)
-                    - (k[34] * rt7 * rc_ds)
-                    - (k[35] * rt3 * rc_c)
-                    + (k[36] * rt6 * rc_c))
+                * ((k[30] * rt3 * rc_c * rc_ds) + (k[30] * rt3 * rt4 * rc_ds)
+                    - (k[30] * rt5 * rc_c)
+                    - (k[30] * rt5 * rt4)
+                    + (k[30] * rt6 * rc_ds)
+                    - (k[31] * rt1 * rc_c * rc_ds)
+                    - (k[31] * rt1 * rt4 * rc_ds)
+                    + (k[32] * rt0 * rc_c)
+                    + (k[32] * rt0 * rt4)
+                    + (k[32] * rt7 * rc_c * rc_ds)
+                    - (k[32] * rt7 * rc_ds)
+                    - (k[33] * rt3 * rc_c)
+                    + (k[34] * rt6 * rc_c))
                 / 2.0
                 / (rt2 * rt2),
         }
     }
 
+    /// `theta_dot^2` over `sin(theta)`, `cos(theta)` and their drops from the start (the per-point solver's integrand).
+    ///
+    /// - `theta_dot^2`: 183 characters, written out in `generated/fixed_cylinder_closed.tex`
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let rt0 = rc_s.powi(4);
         let rt1 = rc_s.powi(3);
-        k[27] * rt0 * rc_ds
-            / (k[28] - (k[29] * rt1) - (k[29] * rt1 * rc_c) + (k[28] * rc_c)
-                - (k[30] * (rc_s * rc_s))
-                + (k[31] * rt0))
+        k[25] * rt0 * rc_ds
+            / (k[26] - (k[27] * rt1) - (k[27] * rt1 * rc_c) + (k[26] * rc_c)
+                - (k[28] * (rc_s * rc_s))
+                + (k[29] * rt0))
     }
 
+    /// Each contact's force on the reduced motion (zero for a contact open in the phase).
+    ///
+    /// - `cylinder_push`: 1288 characters, written out in `generated/fixed_cylinder_closed.tex`
+    /// - `floor_normal`: 1636 characters, written out in `generated/fixed_cylinder_closed.tex`
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[3], k[6], k[7], delta);
         let rt0 = rc_s.powi(4);
         let rt1 = rc_s.powi(3);
-        let rt2 = k[28] - (k[29] * rt1) - (k[29] * rt1 * rc_c) + (k[28] * rc_c)
-            - (k[30] * (rc_s * rc_s))
-            + (k[31] * rt0);
+        let rt2 = k[26] - (k[27] * rt1) - (k[27] * rt1 * rc_c) + (k[26] * rc_c)
+            - (k[28] * (rc_s * rc_s))
+            + (k[29] * rt0); // 6*R^2 - 3*R*ell*rc_s^3 - 3*R*ell*rc_s^3*rc_c + 6*R^2*rc_c - 3*R^2*rc_s^2 + ell^2*rc_s^4
         let rt3 = rc_s.powi(6);
         let rt4 = rc_c * rc_c;
         let rt5 = rc_s.powi(7);
         let rt6 = rc_s.powi(8);
         let rt7 = rc_s.powi(5);
-        let rc_w2 = k[27] * rt0 * rc_ds / rt2;
+        let rc_w2 = k[25] * rt0 * rc_ds / rt2;
         let rc_acc = -3.0
-            * ((k[32] * rt3 * rc_c * rc_ds) + (k[32] * rt3 * rt4 * rc_ds)
-                - (k[32] * rt5 * rc_c)
-                - (k[32] * rt5 * rt4)
-                + (k[32] * rt6 * rc_ds)
-                - (k[33] * rt1 * rc_c * rc_ds)
-                - (k[33] * rt1 * rt4 * rc_ds)
-                + (k[34] * rt0 * rc_c)
-                + (k[34] * rt0 * rt4)
-                + (k[34] * rt7 * rc_c * rc_ds)
-                - (k[34] * rt7 * rc_ds)
-                - (k[35] * rt3 * rc_c)
-                + (k[36] * rt6 * rc_c))
+            * ((k[30] * rt3 * rc_c * rc_ds) + (k[30] * rt3 * rt4 * rc_ds)
+                - (k[30] * rt5 * rc_c)
+                - (k[30] * rt5 * rt4)
+                + (k[30] * rt6 * rc_ds)
+                - (k[31] * rt1 * rc_c * rc_ds)
+                - (k[31] * rt1 * rt4 * rc_ds)
+                + (k[32] * rt0 * rc_c)
+                + (k[32] * rt0 * rt4)
+                + (k[32] * rt7 * rc_c * rc_ds)
+                - (k[32] * rt7 * rc_ds)
+                - (k[33] * rt3 * rc_c)
+                + (k[34] * rt6 * rc_c))
             / 2.0
             / (rt2 * rt2);
         let ft0 = rc_c * rc_c;
         let ft1 = rc_c.powi(3);
-        out[0] = -(k[37] * rc_acc / rc_s)
-            + (k[23] * rc_c * rc_w2 / (rc_s * rc_s))
-            + (k[37] * rc_w2 / (rc_s * rc_s))
-            - (k[37] * rc_c * rc_acc / rc_s.powi(3))
-            - (k[37] * ft0 * rc_acc / rc_s.powi(3))
-            + (k[23] * ft0 * rc_w2 / rc_s.powi(4))
-            + (k[23] * ft1 * rc_w2 / rc_s.powi(4))
-            + (k[22] * rc_acc)
-            + (k[22] * rc_c * rc_w2 / rc_s);
-        out[1] = k[38] + (k[37] * rc_c * rc_acc / rc_s)
-            - (k[37] * rc_c * rc_w2 / (rc_s * rc_s))
-            - (k[23] * ft0 * rc_w2 / (rc_s * rc_s))
-            + (k[37] * ft0 * rc_acc / rc_s.powi(3))
-            + (k[37] * ft1 * rc_acc / rc_s.powi(3))
-            - (k[23] * ft1 * rc_w2 / rc_s.powi(4))
-            - (k[23] * rc_c.powi(4) * rc_w2 / rc_s.powi(4))
-            - (k[22] * rc_s * rc_w2)
-            - (k[22] * ft0 * rc_w2 / rc_s);
+        out[0] = -(k[35] * rc_acc / rc_s)
+            + (k[21] * rc_c * rc_w2 / (rc_s * rc_s))
+            + (k[35] * rc_w2 / (rc_s * rc_s))
+            - (k[35] * rc_c * rc_acc / rc_s.powi(3))
+            - (k[35] * ft0 * rc_acc / rc_s.powi(3))
+            + (k[21] * ft0 * rc_w2 / rc_s.powi(4))
+            + (k[21] * ft1 * rc_w2 / rc_s.powi(4))
+            + (k[20] * rc_acc)
+            + (k[20] * rc_c * rc_w2 / rc_s);
+        out[1] = k[36] + (k[35] * rc_c * rc_acc / rc_s)
+            - (k[35] * rc_c * rc_w2 / (rc_s * rc_s))
+            - (k[21] * ft0 * rc_w2 / (rc_s * rc_s))
+            + (k[35] * ft0 * rc_acc / rc_s.powi(3))
+            + (k[35] * ft1 * rc_acc / rc_s.powi(3))
+            - (k[21] * ft1 * rc_w2 / rc_s.powi(4))
+            - (k[21] * rc_c.powi(4) * rc_w2 / rc_s.powi(4))
+            - (k[20] * rc_s * rc_w2)
+            - (k[20] * ft0 * rc_w2 / rc_s);
     }
 
+    /// The coefficients, constant term first, of a contact's force zero as a polynomial in `sin(theta)`, where it is one.
     fn force_polynomial(&self, _k: &[f64], _contact: usize, _out: &mut [f64]) {}
 
+    /// The constants of `prepare` that the per-point solver reads, and only those.
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let th0 = p[3];
         k[..5].copy_from_slice(p);
         // k[5] = rc_wi = 0.0
         k[5] = 0.0;
         // k[6] = rc_si = sin(rc_thi)
-        k[6] = k[3].sin();
+        k[6] = th0.sin();
         // k[7] = rc_ci = cos(rc_thi)
-        k[7] = k[3].cos();
+        k[7] = th0.cos();
     }
 
+    /// The coefficients, constant term first, of the fall polynomial `P(s) = (sin(theta_i) - s) / theta_dot^2` in `s = sin(theta)`.
     fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
 
+    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
     fn full_state(
         &self,
         k: &[f64],
@@ -544,7 +629,7 @@ impl Reduction for FixedCylinderClosed {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         q[0] = k[3] - delta;
         qd[0] = theta_dot;
     }

@@ -83,7 +83,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 33,
+    n_constants: 31,
     coordinates: &["x1", "theta"],
     system_coordinates: &["x1", "y1", "theta"],
     reduced: 1,
@@ -170,7 +170,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 10,
         force_degrees: &[0, 2],
         fall_degree: None,
-        lean_constants: &[9, 10, 12, 28, 29, 31],
+        lean_constants: &[9, 10, 12, 26, 27, 29],
     }),
     route_note: "",
 };
@@ -180,162 +180,246 @@ impl Model for FixedCylinderFree {
         &INFO
     }
 
+    /// The requirements' margins over the parameters, each `>= 0` where it holds.
+    ///
+    /// - `leans_forward = cos(th0)`
+    /// - `touches_the_rod = ell - R*(1 + cos(th0))/sin(th0)`
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
-        let k = p;
-        let qt0 = k[3].cos();
+        let ell = p[1];
+        let r = p[2];
+        let th0 = p[3];
+        let qt0 = th0.cos();
         out[0] = qt0;
-        out[1] = k[1] - (k[2] * (1.0 + qt0) / k[3].sin());
+        out[1] = ell - (r * (1.0 + qt0) / th0.sin());
     }
 
+    /// Each contact's coefficient of restitution over the parameters.
+    ///
+    /// - `cylinder_push = 0`
+    /// - `floor_normal = 0`
     fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
     }
 
+    /// The constants `k`: the parameters, then the constants derived from them.
+    ///
+    /// `k[..9]` holds the parameters `m1, ell, R, th0, g, x1_0, theta_0, x1_dot_0, theta_dot_0`; each later slot's definition is the comment above the line that fills it.
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
+        let m1 = p[0];
+        let ell = p[1];
+        let r = p[2];
+        let g = p[4];
+        let x1_dot_0 = p[7];
+        let theta_dot_0 = p[8];
         k[..9].copy_from_slice(p);
         // k[6] also holds rc_thi = theta_0
         // k[8] also holds rc_wi = theta_dot_0
         // k[5] also holds rc_x0i = x1_0
         Reduction::prepare_lean(self, p, k);
         // k[11] = rc_p0 = -ell*m1*rc_wi*rc_si/2 + m1*x1_dot_0
-        k[11] = -(k[1] * k[0] * k[8] * k[9] / 2.0) + (k[0] * k[7]);
+        k[11] = -(ell * m1 * theta_dot_0 * k[9] / 2.0) + (m1 * x1_dot_0);
         // k[13] = ell/2
-        k[13] = k[1] / 2.0;
+        k[13] = ell / 2.0;
         // k[14] = 2*R
-        k[14] = 2.0 * k[2];
+        k[14] = 2.0 * r;
         // k[15] = ell*m1/2
-        k[15] = k[1] * k[0] / 2.0;
-        // k[16] = ell^2*m1/24
-        k[16] = (k[1] * k[1]) * k[0] / 24.0;
-        // k[17] = ell^2*m1/8
-        k[17] = (k[1] * k[1]) * k[0] / 8.0;
-        // k[18] = m1/2
-        k[18] = k[0] / 2.0;
-        // k[19] = ell*g*m1/2
-        k[19] = k[1] * k[4] * k[0] / 2.0;
-        // k[20] = ell^2*m1/12
-        k[20] = (k[1] * k[1]) * k[0] / 12.0;
-        // k[21] = ell^2*m1/4
-        k[21] = (k[1] * k[1]) * k[0] / 4.0;
-        // k[22] = g*m1
-        k[22] = k[4] * k[0];
-        // k[23] = 12/(ell^2*m1)
-        k[23] = 12.0 / (k[1] * k[1]) / k[0];
-        // k[24] = rc_wi^2*rc_ai
-        k[24] = (k[8] * k[8]) * k[12];
-        // k[25] = ell*g*m1
-        k[25] = k[1] * k[4] * k[0];
-        // k[26] = 6/(ell^2*m1)
-        k[26] = 6.0 / (k[1] * k[1]) / k[0];
-        // k[27] = 6*ell*g*m1
-        k[27] = 6.0 * k[1] * k[4] * k[0];
-        // k[30] = 6*rc_wi^2*rc_ai
-        k[30] = 6.0 * (k[8] * k[8]) * k[12];
-        // k[32] = rc_p0/m1
-        k[32] = k[11] / k[0];
+        k[15] = ell * m1 / 2.0;
+        // k[16] = ell^2*m1/6
+        k[16] = (ell * ell) * m1 / 6.0;
+        // k[17] = m1/2
+        k[17] = m1 / 2.0;
+        // k[18] = ell*g*m1/2
+        k[18] = ell * g * m1 / 2.0;
+        // k[19] = ell^2*m1/3
+        k[19] = (ell * ell) * m1 / 3.0;
+        // k[20] = g*m1
+        k[20] = g * m1;
+        // k[21] = 12/(ell^2*m1)
+        k[21] = 12.0 / (ell * ell) / m1;
+        // k[22] = rc_wi^2*rc_ai
+        k[22] = (theta_dot_0 * theta_dot_0) * k[12];
+        // k[23] = ell*g*m1
+        k[23] = ell * g * m1;
+        // k[24] = 6/(ell^2*m1)
+        k[24] = 6.0 / (ell * ell) / m1;
+        // k[25] = 6*ell*g*m1
+        k[25] = 6.0 * ell * g * m1;
+        // k[28] = 6*rc_wi^2*rc_ai
+        k[28] = 6.0 * (theta_dot_0 * theta_dot_0) * k[12];
+        // k[30] = rc_p0/m1
+        k[30] = k[11] / m1;
     }
 
+    /// The state at release, over the parameters.
+    ///
+    /// - `x1 = x1_0`
+    /// - `dot_x1 = x1_dot_0`
+    /// - `theta = theta_0`
+    /// - `dot_theta = theta_dot_0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
-        q[0] = k[5];
-        qd[0] = k[7];
-        q[1] = k[6];
-        qd[1] = k[8];
+        let k = &k[..31]; // one bounds check for all constant loads
+        let x1_0 = k[5];
+        let theta_0 = k[6];
+        let x1_dot_0 = k[7];
+        let theta_dot_0 = k[8];
+        q[0] = x1_0;
+        qd[0] = x1_dot_0;
+        q[1] = theta_0;
+        qd[1] = theta_dot_0;
     }
 
+    /// Each point's position over the state (`pos`), and its time derivative (`vel`).
+    ///
+    /// - `foot_x = x1`
+    /// - `foot_y = 0`
+    /// - `tip_x = ell*cos(theta) + x1`
+    /// - `tip_y = ell*sin(theta)`
+    /// - `rod_centre_x = ell*cos(theta)/2 + x1`
+    /// - `rod_centre_y = ell*sin(theta)/2`
+    /// - `touch_x = R*sin(theta)*cos(theta) + x1*sin(theta)^2`
+    /// - `touch_y = R*sin(theta)^2 - x1*sin(theta)*cos(theta)`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let pt0 = rc_c * rc_c;
-        let pt1 = rc_s * rc_s;
-        pos[0] = [q[0], 0.0];
-        vel[0] = [qd[0], 0.0];
-        pos[1] = [(k[1] * rc_c) + q[0], k[1] * rc_s];
-        vel[1] = [-(k[1] * qd[1] * rc_s) + qd[0], k[1] * qd[1] * rc_c];
-        pos[2] = [(k[13] * rc_c) + q[0], k[13] * rc_s];
-        vel[2] = [-(k[13] * qd[1] * rc_s) + qd[0], k[13] * qd[1] * rc_c];
+        let ell = k[1];
+        let r = k[2];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let theta_dot = qd[1];
+        let pt0 = rc_s * rc_s;
+        let pt1 = rc_c * rc_c;
+        pos[0] = [x1, 0.0];
+        vel[0] = [x1_dot, 0.0];
+        pos[1] = [(ell * rc_c) + x1, ell * rc_s];
+        vel[1] = [-(ell * theta_dot * rc_s) + x1_dot, ell * theta_dot * rc_c];
+        pos[2] = [(k[13] * rc_c) + x1, k[13] * rc_s];
+        vel[2] = [
+            -(k[13] * theta_dot * rc_s) + x1_dot,
+            k[13] * theta_dot * rc_c,
+        ];
         pos[3] = [
-            (k[2] * rc_s * rc_c) + q[0] - (q[0] * pt0),
-            (k[2] * pt1) - (q[0] * rc_s * rc_c),
+            (r * rc_s * rc_c) + (x1 * pt0),
+            (r * pt0) - (x1 * rc_s * rc_c),
         ];
         vel[3] = [
-            -(k[2] * qd[1] * pt1)
-                + (k[2] * qd[1] * pt0)
-                + (2.0 * qd[1] * q[0] * rc_s * rc_c)
-                + qd[0]
-                - (qd[0] * pt0),
-            (k[14] * qd[1] * rc_s * rc_c) + (qd[1] * q[0] * pt1)
-                - (qd[1] * q[0] * pt0)
-                - (qd[0] * rc_s * rc_c),
+            -(r * theta_dot * pt0)
+                + (r * theta_dot * pt1)
+                + (2.0 * theta_dot * x1 * rc_s * rc_c)
+                + (x1_dot * pt0),
+            (k[14] * theta_dot * rc_s * rc_c) + (theta_dot * x1 * pt0)
+                - (theta_dot * x1 * pt1)
+                - (x1_dot * rc_s * rc_c),
         ];
     }
 
+    /// The total energy `E = T + V`.
+    ///
+    /// - `T = -dot_theta*dot_x1*ell*m1*sin(theta)/2 + dot_theta^2*ell^2*m1/6 + dot_x1^2*m1/2`
+    /// - `V = ell*g*m1*sin(theta)/2`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..33]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let et0 = qd[1] * qd[1];
-        (-(k[15] * qd[1] * qd[0] * rc_s)
-            + (k[16] * et0)
-            + (k[17] * et0 * (rc_s * rc_s))
-            + (k[17] * et0 * (rc_c * rc_c))
-            + (k[18] * (qd[0] * qd[0])))
-            + (k[19] * rc_s)
-    }
-
-    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
-        out[0] = -(k[15] * qd[1] * rc_s) + (k[0] * qd[0]);
+        let x1_dot = qd[0];
+        let theta_dot = qd[1];
+        (-(k[15] * theta_dot * x1_dot * rc_s)
+            + (k[16] * (theta_dot * theta_dot))
+            + (k[17] * (x1_dot * x1_dot)))
+            + (k[18] * rc_s)
     }
 
+    /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
+    ///
+    /// - `p_x1 = -dot_theta*ell*m1*sin(theta)/2 + dot_x1*m1`
+    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let k = &k[..31]; // one bounds check for all constant loads
+        let rc_s = q[1].sin();
+        let m1 = k[0];
+        let x1_dot = qd[0];
+        let theta_dot = qd[1];
+        out[0] = -(k[15] * theta_dot * rc_s) + (m1 * x1_dot);
+    }
+
+    /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
+    ///
+    /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
+    /// - `L = T - V = -dot_theta*dot_x1*ell*m1*sin(theta)/2 - ell*g*m1*sin(theta)/2 + dot_theta^2*ell^2*m1/6 + dot_x1^2*m1/2`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let qt0 = -k[15] * rc_s;
-        mass[0] = k[0];
+        let m1 = k[0];
+        let theta_dot = qd[1];
+        let qt0 = -k[15] * rc_s; // -(ell*m1*rc_s/2)
+        mass[0] = m1;
         mass[1] = qt0;
         mass[2] = qt0;
-        mass[3] = k[20] + (k[21] * (rc_s * rc_s)) + (k[21] * (rc_c * rc_c));
-        rhs[0] = k[15] * (qd[1] * qd[1]) * rc_c;
-        rhs[1] = -k[19] * rc_c;
+        mass[3] = k[19];
+        rhs[0] = k[15] * (theta_dot * theta_dot) * rc_c;
+        rhs[1] = -k[18] * rc_c;
     }
 
+    /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
+    ///
+    /// - `floor_normal = ddot_theta*ell*m1*cos(theta)/2 + g*m1 - dot_theta^2*ell*m1*sin(theta)/2`
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
+        let theta_dot = qd[1];
+        let theta_ddot = qdd[1];
         out[0] = 0.0;
-        out[1] = k[22] + (k[15] * qdd[1] * rc_c) - (k[15] * (qd[1] * qd[1]) * rc_s);
+        out[1] = k[20] + (k[15] * theta_ddot * rc_c) - (k[15] * (theta_dot * theta_dot) * rc_s);
     }
 
+    /// Each contact's gap `g(q)`, `>= 0` while apart (zero for a contact held closed).
+    ///
+    /// - `cylinder_push = -R - R*cos(theta) - x1*sin(theta)`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        out[0] = -k[2] - (k[2] * rc_c) - (q[0] * rc_s);
+        let r = k[2];
+        let x1 = q[0];
+        out[0] = -r - (r * rc_c) - (x1 * rc_s);
         out[1] = 0.0;
     }
 
+    /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let jt0 = qd[1] * qd[1];
+        let r = k[2];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let theta_dot = qd[1];
+        let jt0 = theta_dot * theta_dot;
         jac[0] = -rc_s;
-        jac[1] = (k[2] * rc_s) - (q[0] * rc_c);
+        jac[1] = (r * rc_s) - (x1 * rc_c);
         jac[2] = 0.0;
         jac[3] = 0.0;
-        bias[0] = (k[2] * jt0 * rc_c) - (2.0 * qd[1] * qd[0] * rc_c) + (jt0 * q[0] * rc_s);
+        bias[0] = (r * jt0 * rc_c) - (2.0 * theta_dot * x1_dot * rc_c) + (jt0 * x1 * rc_s);
         bias[1] = 0.0;
     }
 
+    /// Each contact's edge margin, `>= 0` while the contact point is on the edge (infinite without one).
+    ///
+    /// - `cylinder_push = -R*sin(theta) + ell + x1*cos(theta)`
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        out[0] = k[1] - (k[2] * rc_s) + (q[0] * rc_c);
+        let ell = k[1];
+        let r = k[2];
+        let x1 = q[0];
+        out[0] = ell - (r * rc_s) + (x1 * rc_c);
         out[1] = f64::INFINITY;
     }
 
+    /// Each friction's slip velocity `v = J(q) qd`: `jac` holds `J`, `bias` holds `dJ/dt qd`.
+    ///
+    /// No friction.
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
+    /// The monitors over the state and the contacts' forces `rc_f<i>`.
+    ///
+    /// No monitor.
     fn monitors_full(
         &self,
         _k: &[f64],
@@ -346,26 +430,42 @@ impl Model for FixedCylinderFree {
     ) {
     }
 
+    /// The system's state (its general model's) that this phase's state stands for.
+    ///
+    /// - `x1 = x1`
+    /// - `dot_x1 = dot_x1`
+    /// - `y1 = 0`
+    /// - `dot_y1 = 0`
+    /// - `theta = theta`
+    /// - `dot_theta = dot_theta`
     fn to_full(&self, _k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        q_full[0] = q[0];
-        qd_full[0] = qd[0];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let theta = q[1];
+        let theta_dot = qd[1];
+        q_full[0] = x1;
+        qd_full[0] = x1_dot;
         q_full[1] = 0.0;
         qd_full[1] = 0.0;
-        q_full[2] = q[1];
-        qd_full[2] = qd[1];
+        q_full[2] = theta;
+        qd_full[2] = theta_dot;
     }
 
+    /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        poses[0] = [(k[13] * rc_c) + q[0], k[13] * rc_s, q[1]];
+        let r = k[2];
+        let x1 = q[0];
+        let theta = q[1];
+        poses[0] = [(k[13] * rc_c) + x1, k[13] * rc_s, theta];
         sizes[0] = -k[13];
         sizes[1] = 0.0;
         sizes[2] = k[13];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
-        sizes[5] = k[2];
-        sizes[6] = k[2];
+        sizes[5] = r;
+        sizes[6] = r;
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -374,74 +474,93 @@ impl Model for FixedCylinderFree {
 }
 
 impl Reduction for FixedCylinderFree {
+    /// The reduced motion at `theta = theta_i - delta`: `theta_dot^2` from the energy integral, and `theta_ddot`.
+    ///
+    /// - `theta_dot^2 = (-4*ell*theta_dot_0^2 + 3*ell*theta_dot_0^2*sin(theta_0)^2 + 12*g*sin(theta) - 12*g*sin(theta_0))/(ell*(-4 + 3*sin(theta)^2))`
+    /// - `theta_ddot`: 227 characters, written out in `generated/fixed_cylinder_free.tex`
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[6], k[9], k[10], delta);
         let rt0 = rc_s * rc_s;
         let rt1 = -4.0 + (3.0 * rt0);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: -k[23] * (k[24] + (k[25] * rc_ds)) / rt1,
-            theta_ddot: k[26]
-                * ((k[27] * rc_s * rc_c * rc_ds) - (k[28] * rc_c)
-                    + (k[29] * rt0 * rc_c)
-                    + (k[30] * rc_s * rc_c))
+            theta_dot_sq: -k[21] * (k[22] + (k[23] * rc_ds)) / rt1,
+            theta_ddot: k[24]
+                * ((k[25] * rc_s * rc_c * rc_ds) - (k[26] * rc_c)
+                    + (k[27] * rt0 * rc_c)
+                    + (k[28] * rc_s * rc_c))
                 / (rt1 * rt1),
         }
     }
 
+    /// `theta_dot^2` over `sin(theta)`, `cos(theta)` and their drops from the start (the per-point solver's integrand).
+    ///
+    /// - `theta_dot^2 = (-4*ell*theta_dot_0^2 + 3*ell*theta_dot_0^2*sin(theta_0)^2 + 12*g*sin(theta) - 12*g*sin(theta_0))/(ell*(-4 + 3*sin(theta)^2))`
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..33]; // one bounds check for all constant loads
-        -k[23] * (k[24] + (k[25] * rc_ds)) / (-4.0 + (3.0 * (rc_s * rc_s)))
+        let k = &k[..31]; // one bounds check for all constant loads
+        -k[21] * (k[22] + (k[23] * rc_ds)) / (-4.0 + (3.0 * (rc_s * rc_s)))
     }
 
+    /// Each contact's force on the reduced motion (zero for a contact open in the phase).
+    ///
+    /// - `floor_normal`: 180 characters, written out in `generated/fixed_cylinder_free.tex`
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[6], k[9], k[10], delta);
         let rt0 = rc_s * rc_s;
         let rt1 = -4.0 + (3.0 * rt0);
-        let rc_w2 = -k[23] * (k[24] + (k[25] * rc_ds)) / rt1;
-        let rc_acc = k[26]
-            * ((k[27] * rc_s * rc_c * rc_ds) - (k[28] * rc_c)
-                + (k[29] * rt0 * rc_c)
-                + (k[30] * rc_s * rc_c))
+        let rc_w2 = -k[21] * (k[22] + (k[23] * rc_ds)) / rt1;
+        let rc_acc = k[24]
+            * ((k[25] * rc_s * rc_c * rc_ds) - (k[26] * rc_c)
+                + (k[27] * rt0 * rc_c)
+                + (k[28] * rc_s * rc_c))
             / (rt1 * rt1);
         out[0] = 0.0;
-        out[1] = k[22] - (k[15] * rc_s * rc_w2) + (k[15] * rc_c * rc_acc);
+        out[1] = k[20] - (k[15] * rc_s * rc_w2) + (k[15] * rc_c * rc_acc);
     }
 
+    /// The coefficients, constant term first, of a contact's force zero as a polynomial in `sin(theta)`, where it is one.
     fn force_polynomial(&self, k: &[f64], contact: usize, out: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
         match contact {
             1 => {
-                out[0] = k[28];
-                out[1] = -k[31];
-                out[2] = k[29];
+                out[0] = k[26];
+                out[1] = -k[29];
+                out[2] = k[27];
             }
             _ => {}
         }
     }
 
+    /// The constants of `prepare` that the per-point solver reads, and only those.
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let m1 = p[0];
+        let ell = p[1];
+        let g = p[4];
+        let theta_0 = p[6];
+        let theta_dot_0 = p[8];
         k[..9].copy_from_slice(p);
         // k[9] = rc_si = sin(rc_thi)
-        k[9] = k[6].sin();
+        k[9] = theta_0.sin();
         // k[10] = rc_ci = cos(rc_thi)
-        k[10] = k[6].cos();
+        k[10] = theta_0.cos();
         // k[12] = rc_ai = ell^2*m1/3 - ell^2*m1*rc_si^2/4
-        let c6_t0 = k[1] * k[1];
-        k[12] = (c6_t0 * k[0] / 3.0) - (c6_t0 * k[0] * (k[9] * k[9]) / 4.0);
-        // k[28] = 4*ell*g*m1
-        k[28] = 4.0 * k[1] * k[4] * k[0];
-        // k[29] = 3*ell*g*m1
-        k[29] = 3.0 * k[1] * k[4] * k[0];
-        // k[31] = 6*ell*g*m1*rc_si + 6*rc_wi^2*rc_ai
-        k[31] = (6.0 * k[1] * k[4] * k[0] * k[9]) + (6.0 * (k[8] * k[8]) * k[12]);
+        let c6_t0 = ell * ell;
+        k[12] = (c6_t0 * m1 / 3.0) - (c6_t0 * m1 * (k[9] * k[9]) / 4.0);
+        // k[26] = 4*ell*g*m1
+        k[26] = 4.0 * ell * g * m1;
+        // k[27] = 3*ell*g*m1
+        k[27] = 3.0 * ell * g * m1;
+        // k[29] = 6*ell*g*m1*rc_si + 6*rc_wi^2*rc_ai
+        k[29] = (6.0 * ell * g * m1 * k[9]) + (6.0 * (theta_dot_0 * theta_dot_0) * k[12]);
     }
 
+    /// The coefficients, constant term first, of the fall polynomial `P(s) = (sin(theta_i) - s) / theta_dot^2` in `s = sin(theta)`.
     fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
 
+    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
     fn full_state(
         &self,
         k: &[f64],
@@ -451,13 +570,14 @@ impl Reduction for FixedCylinderFree {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..31]; // one bounds check for all constant loads
+        let x1_0 = k[5];
         let (rc_s, _, _, rc_dc) = start_offsets(k[6], k[9], k[10], delta);
         let rc_t = t;
         let rc_w = theta_dot;
         q[1] = k[6] - delta;
         qd[1] = theta_dot;
-        q[0] = k[5] + (k[13] * rc_dc) + (k[32] * rc_t);
-        qd[0] = k[32] + (k[13] * rc_s * rc_w);
+        q[0] = x1_0 + (k[13] * rc_dc) + (k[30] * rc_t);
+        qd[0] = k[30] + (k[13] * rc_s * rc_w);
     }
 }

@@ -65,7 +65,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 37,
+    n_constants: 35,
     coordinates: &["theta"],
     system_coordinates: &["x1", "y1", "theta", "xc"],
     reduced: 0,
@@ -173,192 +173,244 @@ impl Model for HingedCylinderClosed {
         &INFO
     }
 
+    /// The requirements' margins over the parameters, each `>= 0` where it holds.
+    ///
+    /// - `leans_forward = cos(th0)`
+    /// - `touches_the_rod = ell - R*(1 + cos(th0))/sin(th0)`
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
-        let k = p;
-        let qt0 = k[4].cos();
+        let ell = p[2];
+        let r = p[3];
+        let th0 = p[4];
+        let qt0 = th0.cos();
         out[0] = qt0;
-        out[1] = k[2] - (k[3] * (1.0 + qt0) / k[4].sin());
+        out[1] = ell - (r * (1.0 + qt0) / th0.sin());
     }
 
+    /// Each contact's coefficient of restitution over the parameters.
+    ///
+    /// - `contact_force = 0`
+    /// - `hinge_horizontal = 0`
+    /// - `hinge_vertical = 0`
     fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
         out[2] = 0.0;
     }
 
+    /// The constants `k`: the parameters, then the constants derived from them.
+    ///
+    /// `k[..6]` holds the parameters `m1, m2, ell, R, th0, g`; each later slot's definition is the comment above the line that fills it.
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
+        let m1 = p[0];
+        let m2 = p[1];
+        let ell = p[2];
+        let r = p[3];
+        let g = p[5];
         k[..6].copy_from_slice(p);
         // k[4] also holds rc_thi = th0
         Reduction::prepare_lean(self, p, k);
         // k[9] = ell/2
-        k[9] = k[2] / 2.0;
-        // k[10] = R^2*m2/2 + ell^2*m1/24
-        k[10] = ((k[3] * k[3]) * k[1] / 2.0) + ((k[2] * k[2]) * k[0] / 24.0);
+        k[9] = ell / 2.0;
+        // k[10] = R^2*m2/2 + ell^2*m1/6
+        k[10] = ((r * r) * m2 / 2.0) + ((ell * ell) * m1 / 6.0);
         // k[11] = R^2*m2
-        k[11] = (k[3] * k[3]) * k[1];
+        k[11] = (r * r) * m2;
         // k[12] = R^2*m2/2
-        k[12] = (k[3] * k[3]) * k[1] / 2.0;
-        // k[13] = ell^2*m1/8
-        k[13] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[14] = R*g*m2
-        k[14] = k[3] * k[5] * k[1];
-        // k[15] = ell*g*m1/2
-        k[15] = k[2] * k[5] * k[0] / 2.0;
-        // k[16] = R^2*m2 + ell^2*m1/12
-        k[16] = ((k[3] * k[3]) * k[1]) + ((k[2] * k[2]) * k[0] / 12.0);
-        // k[17] = 2*R^2*m2
-        k[17] = 2.0 * (k[3] * k[3]) * k[1];
-        // k[18] = ell^2*m1/4
-        k[18] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[19] = 5*R^2*m2
-        k[19] = 5.0 * (k[3] * k[3]) * k[1];
-        // k[20] = 4*R^2*m2
-        k[20] = 4.0 * (k[3] * k[3]) * k[1];
-        // k[21] = 2*R
-        k[21] = 2.0 * k[3];
-        // k[22] = 2*R*m2
-        k[22] = 2.0 * k[3] * k[1];
-        // k[23] = 4*R*m2
-        k[23] = 4.0 * k[3] * k[1];
-        // k[24] = ell*m1
-        k[24] = k[2] * k[0];
-        // k[25] = 2*g*m1
-        k[25] = 2.0 * k[5] * k[0];
-        // k[26] = 3*ell*g*m1
-        k[26] = 3.0 * k[2] * k[5] * k[0];
-        // k[27] = 6*R^2*m2
-        k[27] = 6.0 * (k[3] * k[3]) * k[1];
-        // k[28] = 3*R^2*m2
-        k[28] = 3.0 * (k[3] * k[3]) * k[1];
-        // k[29] = ell^2*m1
-        k[29] = (k[2] * k[2]) * k[0];
-        // k[30] = 24*R^2*ell*g*m1*m2
-        k[30] = 24.0 * (k[3] * k[3]) * k[2] * k[5] * k[0] * k[1];
-        // k[31] = 6*R^2*ell*g*m1*m2
-        k[31] = 6.0 * (k[3] * k[3]) * k[2] * k[5] * k[0] * k[1];
-        // k[32] = 3*R^2*ell*g*m1*m2
-        k[32] = 3.0 * (k[3] * k[3]) * k[2] * k[5] * k[0] * k[1];
-        // k[33] = ell^3*g*m1^2
-        k[33] = k[2].powi(3) * k[5] * (k[0] * k[0]);
-        // k[34] = R*m2
-        k[34] = k[3] * k[1];
-        // k[35] = ell*m1/2
-        k[35] = k[2] * k[0] / 2.0;
-        // k[36] = g*m1
-        k[36] = k[5] * k[0];
+        k[12] = (r * r) * m2 / 2.0;
+        // k[13] = R*g*m2
+        k[13] = r * g * m2;
+        // k[14] = ell*g*m1/2
+        k[14] = ell * g * m1 / 2.0;
+        // k[15] = R^2*m2 + ell^2*m1/3
+        k[15] = ((r * r) * m2) + ((ell * ell) * m1 / 3.0);
+        // k[16] = 2*R^2*m2
+        k[16] = 2.0 * (r * r) * m2;
+        // k[17] = 5*R^2*m2
+        k[17] = 5.0 * (r * r) * m2;
+        // k[18] = 4*R^2*m2
+        k[18] = 4.0 * (r * r) * m2;
+        // k[19] = 2*R
+        k[19] = 2.0 * r;
+        // k[20] = 2*R*m2
+        k[20] = 2.0 * r * m2;
+        // k[21] = 4*R*m2
+        k[21] = 4.0 * r * m2;
+        // k[22] = ell*m1
+        k[22] = ell * m1;
+        // k[23] = 2*g*m1
+        k[23] = 2.0 * g * m1;
+        // k[24] = 3*ell*g*m1
+        k[24] = 3.0 * ell * g * m1;
+        // k[25] = 6*R^2*m2
+        k[25] = 6.0 * (r * r) * m2;
+        // k[26] = 3*R^2*m2
+        k[26] = 3.0 * (r * r) * m2;
+        // k[27] = ell^2*m1
+        k[27] = (ell * ell) * m1;
+        // k[28] = 24*R^2*ell*g*m1*m2
+        k[28] = 24.0 * (r * r) * ell * g * m1 * m2;
+        // k[29] = 6*R^2*ell*g*m1*m2
+        k[29] = 6.0 * (r * r) * ell * g * m1 * m2;
+        // k[30] = 3*R^2*ell*g*m1*m2
+        k[30] = 3.0 * (r * r) * ell * g * m1 * m2;
+        // k[31] = ell^3*g*m1^2
+        k[31] = ell.powi(3) * g * (m1 * m1);
+        // k[32] = R*m2
+        k[32] = r * m2;
+        // k[33] = ell*m1/2
+        k[33] = ell * m1 / 2.0;
+        // k[34] = g*m1
+        k[34] = g * m1;
     }
 
+    /// The state at release, over the parameters.
+    ///
+    /// - `theta = th0`
+    /// - `dot_theta = 0.0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
-        q[0] = k[4];
+        let k = &k[..35]; // one bounds check for all constant loads
+        let th0 = k[4];
+        q[0] = th0;
         qd[0] = 0.0;
     }
 
+    /// Each point's position over the state (`pos`), and its time derivative (`vel`).
+    ///
+    /// - `foot_x = 0`
+    /// - `foot_y = 0`
+    /// - `tip_x = ell*cos(theta)`
+    /// - `tip_y = ell*sin(theta)`
+    /// - `rod_centre_x = ell*cos(theta)/2`
+    /// - `rod_centre_y = ell*sin(theta)/2`
+    /// - `axis_x = R/sin(theta) + R*cos(theta)/sin(theta)`
+    /// - `axis_y = R`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
+        let ell = k[2];
+        let r = k[3];
+        let theta_dot = qd[0];
         pos[0] = [0.0, 0.0];
         vel[0] = [0.0, 0.0];
-        pos[1] = [k[2] * rc_c, k[2] * rc_s];
-        vel[1] = [-k[2] * qd[0] * rc_s, k[2] * qd[0] * rc_c];
+        pos[1] = [ell * rc_c, ell * rc_s];
+        vel[1] = [-ell * theta_dot * rc_s, ell * theta_dot * rc_c];
         pos[2] = [k[9] * rc_c, k[9] * rc_s];
-        vel[2] = [-k[9] * qd[0] * rc_s, k[9] * qd[0] * rc_c];
-        pos[3] = [(k[3] / rc_s) + (k[3] * rc_c / rc_s), k[3]];
+        vel[2] = [-k[9] * theta_dot * rc_s, k[9] * theta_dot * rc_c];
+        pos[3] = [(r / rc_s) + (r * rc_c / rc_s), r];
         vel[3] = [
-            -(k[3] * qd[0])
-                - (k[3] * qd[0] * rc_c / (rc_s * rc_s))
-                - (k[3] * qd[0] * (rc_c * rc_c) / (rc_s * rc_s)),
+            -(r * theta_dot)
+                - (r * theta_dot * rc_c / (rc_s * rc_s))
+                - (r * theta_dot * (rc_c * rc_c) / (rc_s * rc_s)),
             0.0,
         ];
     }
 
+    /// The total energy `E = T + V`.
+    ///
+    /// - `T`: 286 characters, written out in `generated/hinged_cylinder_closed.tex`
+    /// - `V = R*g*m2 + ell*g*m1*sin(theta)/2`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        let et0 = qd[0] * qd[0];
+        let theta_dot = qd[0];
+        let et0 = theta_dot * theta_dot;
         let et1 = rc_c * rc_c;
         ((k[10] * et0)
             + (k[11] * et0 * rc_c / (rc_s * rc_s))
             + (k[11] * et0 * et1 / (rc_s * rc_s))
             + (k[12] * et0 * et1 / rc_s.powi(4))
             + (k[11] * et0 * rc_c.powi(3) / rc_s.powi(4))
-            + (k[12] * et0 * rc_c.powi(4) / rc_s.powi(4))
-            + (k[13] * et0 * (rc_s * rc_s))
-            + (k[13] * et0 * et1))
-            + (k[14] + (k[15] * rc_s))
+            + (k[12] * et0 * rc_c.powi(4) / rc_s.powi(4)))
+            + (k[13] + (k[14] * rc_s))
     }
 
+    /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
+    ///
+    /// No cyclic coordinate.
     fn momenta(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
 
+    /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
+    ///
+    /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
+    /// - `L = T - V`: 322 characters, written out in `generated/hinged_cylinder_closed.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
+        let theta_dot = qd[0];
         let qt0 = rc_c * rc_c;
         let qt1 = rc_c.powi(3);
         let qt2 = rc_c.powi(4);
-        let qt3 = qd[0] * qd[0];
-        mass[0] = k[16]
-            + (k[17] * rc_c / (rc_s * rc_s))
-            + (k[17] * qt0 / (rc_s * rc_s))
+        let qt3 = theta_dot * theta_dot;
+        mass[0] = k[15]
+            + (k[16] * rc_c / (rc_s * rc_s))
+            + (k[16] * qt0 / (rc_s * rc_s))
             + (k[11] * qt0 / rc_s.powi(4))
-            + (k[17] * qt1 / rc_s.powi(4))
-            + (k[11] * qt2 / rc_s.powi(4))
-            + (k[18] * (rc_s * rc_s))
-            + (k[18] * qt0);
-        rhs[0] = -(k[15] * rc_c)
+            + (k[16] * qt1 / rc_s.powi(4))
+            + (k[11] * qt2 / rc_s.powi(4));
+        rhs[0] = -(k[14] * rc_c)
             + (k[11] * qt3 / rc_s)
-            + (k[17] * qt3 * rc_c / rc_s)
+            + (k[16] * qt3 * rc_c / rc_s)
             + (k[11] * qt3 * rc_c / rc_s.powi(3))
-            + (k[19] * qt3 * qt0 / rc_s.powi(3))
-            + (k[20] * qt3 * qt1 / rc_s.powi(3))
-            + (k[17] * qt3 * qt1 / rc_s.powi(5))
-            + (k[20] * qt3 * qt2 / rc_s.powi(5))
-            + (k[17] * qt3 * rc_c.powi(5) / rc_s.powi(5));
+            + (k[17] * qt3 * qt0 / rc_s.powi(3))
+            + (k[18] * qt3 * qt1 / rc_s.powi(3))
+            + (k[16] * qt3 * qt1 / rc_s.powi(5))
+            + (k[18] * qt3 * qt2 / rc_s.powi(5))
+            + (k[16] * qt3 * rc_c.powi(5) / rc_s.powi(5));
     }
 
+    /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
+    ///
+    /// - `contact_force`: 253 characters, written out in `generated/hinged_cylinder_closed.tex`
+    /// - `hinge_horizontal`: 270 characters, written out in `generated/hinged_cylinder_closed.tex`
+    /// - `hinge_vertical`: 315 characters, written out in `generated/hinged_cylinder_closed.tex`
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
+        let m2 = k[1];
+        let r = k[3];
+        let theta_dot = qd[0];
+        let theta_ddot = qdd[0];
         let ft0 = rc_s * rc_s;
         let ft1 = rc_c * rc_c;
-        let ft2 = qd[0] * qd[0];
-        let ft3 = rc_s.powi(3);
-        let ft4 = rc_c.powi(3);
-        let ft5 = k[22] * qdd[0] * rc_s * ft1;
-        let ft6 = rc_s.powi(4);
-        out[0] = k[1]
-            * (-(k[3] * qdd[0]) - (k[3] * qdd[0] * rc_c / ft0) - (k[3] * qdd[0] * ft1 / ft0)
-                + (k[3] * ft2 / rc_s)
-                + (k[21] * ft2 * rc_c / rc_s)
-                + (k[21] * ft2 * ft1 / ft3)
-                + (k[21] * ft2 * ft4 / ft3));
-        out[1] = -((k[22] * qdd[0] * rc_s * rc_c) + ft5 + (k[22] * qdd[0] * ft3)
-            - (k[22] * ft2 * ft0)
-            - (k[23] * ft2 * ft0 * rc_c)
-            - (k[23] * ft2 * ft1)
-            - (k[23] * ft2 * ft4)
-            + (k[24] * qdd[0] * ft6)
-            + (k[24] * ft2 * ft3 * rc_c))
+        let ft2 = theta_dot * theta_dot;
+        let ft3 = rc_c.powi(3);
+        let ft4 = k[20] * theta_ddot * rc_s * rc_c; // 2*R*m2*ddot_theta*rc_s*rc_c
+        let ft5 = rc_s.powi(4);
+        out[0] = m2
+            * (-(r * theta_ddot) - (r * theta_ddot * rc_c / ft0) - (r * theta_ddot * ft1 / ft0)
+                + (r * ft2 / rc_s)
+                + (k[19] * ft2 * rc_c / rc_s)
+                + (k[19] * ft2 * ft1 / rc_s.powi(3))
+                + (k[19] * ft2 * ft3 / rc_s.powi(3)));
+        out[1] = -(ft4 + (k[20] * theta_ddot * rc_s)
+            - (k[20] * ft2 * ft0)
+            - (k[21] * ft2 * rc_c)
+            - (k[21] * ft2 * ft1)
+            + (k[22] * theta_ddot * ft5)
+            + (k[22] * ft2 * rc_s.powi(3) * rc_c))
             / 2.0
-            / ft3;
-        out[2] = (ft5 + (k[22] * qdd[0] * rc_s * ft4) + (k[22] * qdd[0] * ft3 * rc_c)
-            - (k[22] * ft2 * ft0 * rc_c)
-            - (k[23] * ft2 * ft0 * ft1)
-            - (k[23] * ft2 * ft4)
-            - (k[23] * ft2 * rc_c.powi(4))
-            + (k[24] * qdd[0] * ft6 * rc_c)
-            + (k[25] * ft6)
-            - (k[24] * ft2 * rc_s.powi(5)))
+            / rc_s.powi(3);
+        out[2] = ((k[20] * theta_ddot * rc_s * ft1) + ft4
+            - (k[20] * ft2 * ft0 * rc_c)
+            - (k[21] * ft2 * ft1)
+            - (k[21] * ft2 * ft3)
+            + (k[22] * theta_ddot * ft5 * rc_c)
+            + (k[23] * ft5)
+            - (k[22] * ft2 * rc_s.powi(5)))
             / 2.0
-            / ft6;
+            / ft5;
     }
 
+    /// Each contact's gap `g(q)`, `>= 0` while apart (zero for a contact held closed).
+    ///
+    /// No open contact.
     fn gaps(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
         out[2] = 0.0;
     }
 
+    /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, _k: &[f64], _q: &[f64], _qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
         jac[0] = 0.0;
         jac[1] = 0.0;
@@ -368,16 +420,27 @@ impl Model for HingedCylinderClosed {
         bias[2] = 0.0;
     }
 
+    /// Each contact's edge margin, `>= 0` while the contact point is on the edge (infinite without one).
+    ///
+    /// - `contact_force = -R*sin(theta) - R*cos(theta)/sin(theta) - R*cos(theta)^2/sin(theta) + ell`
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        out[0] = k[2] - (k[3] * rc_s) - (k[3] * rc_c / rc_s) - (k[3] * (rc_c * rc_c) / rc_s);
+        let ell = k[2];
+        let r = k[3];
+        out[0] = ell - (r * rc_s) - (r * rc_c / rc_s) - (r * (rc_c * rc_c) / rc_s);
         out[1] = f64::INFINITY;
         out[2] = f64::INFINITY;
     }
 
+    /// Each friction's slip velocity `v = J(q) qd`: `jac` holds `J`, `bias` holds `dJ/dt qd`.
+    ///
+    /// No friction.
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
+    /// The monitors over the state and the contacts' forces `rc_f<i>`.
+    ///
+    /// No monitor.
     fn monitors_full(
         &self,
         _k: &[f64],
@@ -388,33 +451,49 @@ impl Model for HingedCylinderClosed {
     ) {
     }
 
+    /// The system's state (its general model's) that this phase's state stands for.
+    ///
+    /// - `x1 = 0`
+    /// - `dot_x1 = 0`
+    /// - `y1 = 0`
+    /// - `dot_y1 = 0`
+    /// - `theta = theta`
+    /// - `dot_theta = dot_theta`
+    /// - `xc = R/sin(theta) + R*cos(theta)/sin(theta)`
+    /// - `dot_xc = -R*dot_theta - R*dot_theta*cos(theta)/sin(theta)^2 - R*dot_theta*cos(theta)^2/sin(theta)^2`
     fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
+        let r = k[3];
+        let theta = q[0];
+        let theta_dot = qd[0];
         q_full[0] = 0.0;
         qd_full[0] = 0.0;
         q_full[1] = 0.0;
         qd_full[1] = 0.0;
-        q_full[2] = q[0];
-        qd_full[2] = qd[0];
-        q_full[3] = (k[3] / rc_s) + (k[3] * rc_c / rc_s);
-        qd_full[3] = -(k[3] * qd[0])
-            - (k[3] * qd[0] * rc_c / (rc_s * rc_s))
-            - (k[3] * qd[0] * (rc_c * rc_c) / (rc_s * rc_s));
+        q_full[2] = theta;
+        qd_full[2] = theta_dot;
+        q_full[3] = (r / rc_s) + (r * rc_c / rc_s);
+        qd_full[3] = -(r * theta_dot)
+            - (r * theta_dot * rc_c / (rc_s * rc_s))
+            - (r * theta_dot * (rc_c * rc_c) / (rc_s * rc_s));
     }
 
+    /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        poses[0] = [k[9] * rc_c, k[9] * rc_s, q[0]];
-        poses[1] = [(k[3] / rc_s) + (k[3] * rc_c / rc_s), k[3], 0.0];
+        let r = k[3];
+        let theta = q[0];
+        poses[0] = [k[9] * rc_c, k[9] * rc_s, theta];
+        poses[1] = [(r / rc_s) + (r * rc_c / rc_s), r, 0.0];
         sizes[0] = -k[9];
         sizes[1] = 0.0;
         sizes[2] = k[9];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
-        sizes[6] = k[3];
+        sizes[6] = r;
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -423,99 +502,116 @@ impl Model for HingedCylinderClosed {
 }
 
 impl Reduction for HingedCylinderClosed {
+    /// The reduced motion at `theta = theta_i - delta`: `theta_dot^2` from the energy integral, and `theta_ddot`.
+    ///
+    /// - `theta_dot^2 = -(3*(-ell*g*m1*sin(theta)^4*sin(th0) + ell*g*m1*sin(theta)^5)/(6*R^2*m2 + 6*R^2*m2*cos(theta) - 3*R^2*m2*sin(theta)^2 + ell^2*m1*sin(theta)^4))`
+    /// - `theta_ddot`: 666 characters, written out in `generated/hinged_cylinder_closed.tex`
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[4], k[7], k[8], delta);
         let rt0 = rc_s.powi(4);
-        let rt1 = k[27] + (k[27] * rc_c) - (k[28] * (rc_s * rc_s)) + (k[29] * rt0);
+        let rt1 = k[25] + (k[25] * rc_c) - (k[26] * (rc_s * rc_s)) + (k[27] * rt0); // 6*R^2*m2 + 6*R^2*m2*rc_c - 3*R^2*m2*rc_s^2 + ell^2*m1*rc_s^4
         let rt2 = rc_s.powi(3);
         let rt3 = rc_c * rc_c;
         let rt4 = rc_s.powi(5);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: k[26] * rt0 * rc_ds / rt1,
+            theta_dot_sq: k[24] * rt0 * rc_ds / rt1,
             theta_ddot: -3.0
-                * (-(k[30] * rt2 * rc_c * rc_ds) - (k[30] * rt2 * rt3 * rc_ds)
-                    + (k[31] * rt0 * rc_c)
-                    + (k[31] * rt0 * rt3)
-                    + (k[31] * rt4 * rc_c * rc_ds)
-                    - (k[31] * rt4 * rc_ds)
-                    - (k[32] * rc_s.powi(6) * rc_c)
-                    + (k[33] * rc_s.powi(8) * rc_c))
+                * (-(k[28] * rt2 * rc_c * rc_ds) - (k[28] * rt2 * rt3 * rc_ds)
+                    + (k[29] * rt0 * rc_c)
+                    + (k[29] * rt0 * rt3)
+                    + (k[29] * rt4 * rc_c * rc_ds)
+                    - (k[29] * rt4 * rc_ds)
+                    - (k[30] * rc_s.powi(6) * rc_c)
+                    + (k[31] * rc_s.powi(8) * rc_c))
                 / 2.0
                 / (rt1 * rt1),
         }
     }
 
+    /// `theta_dot^2` over `sin(theta)`, `cos(theta)` and their drops from the start (the per-point solver's integrand).
+    ///
+    /// - `theta_dot^2 = -(3*(-ell*g*m1*sin(theta)^4*sin(th0) + ell*g*m1*sin(theta)^5)/(6*R^2*m2 + 6*R^2*m2*cos(theta) - 3*R^2*m2*sin(theta)^2 + ell^2*m1*sin(theta)^4))`
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let rt0 = rc_s.powi(4);
-        k[26] * rt0 * rc_ds / (k[27] + (k[27] * rc_c) - (k[28] * (rc_s * rc_s)) + (k[29] * rt0))
+        k[24] * rt0 * rc_ds / (k[25] + (k[25] * rc_c) - (k[26] * (rc_s * rc_s)) + (k[27] * rt0))
     }
 
+    /// Each contact's force on the reduced motion (zero for a contact open in the phase).
+    ///
+    /// - `contact_force`: 730 characters, written out in `generated/hinged_cylinder_closed.tex`
+    /// - `hinge_horizontal`: 1208 characters, written out in `generated/hinged_cylinder_closed.tex`
+    /// - `hinge_vertical`: 1615 characters, written out in `generated/hinged_cylinder_closed.tex`
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[4], k[7], k[8], delta);
         let rt0 = rc_s.powi(4);
-        let rt1 = k[27] + (k[27] * rc_c) - (k[28] * (rc_s * rc_s)) + (k[29] * rt0);
+        let rt1 = k[25] + (k[25] * rc_c) - (k[26] * (rc_s * rc_s)) + (k[27] * rt0); // 6*R^2*m2 + 6*R^2*m2*rc_c - 3*R^2*m2*rc_s^2 + ell^2*m1*rc_s^4
         let rt2 = rc_s.powi(3);
         let rt3 = rc_c * rc_c;
         let rt4 = rc_s.powi(5);
-        let rc_w2 = k[26] * rt0 * rc_ds / rt1;
+        let rc_w2 = k[24] * rt0 * rc_ds / rt1;
         let rc_acc = -3.0
-            * (-(k[30] * rt2 * rc_c * rc_ds) - (k[30] * rt2 * rt3 * rc_ds)
-                + (k[31] * rt0 * rc_c)
-                + (k[31] * rt0 * rt3)
-                + (k[31] * rt4 * rc_c * rc_ds)
-                - (k[31] * rt4 * rc_ds)
-                - (k[32] * rc_s.powi(6) * rc_c)
-                + (k[33] * rc_s.powi(8) * rc_c))
+            * (-(k[28] * rt2 * rc_c * rc_ds) - (k[28] * rt2 * rt3 * rc_ds)
+                + (k[29] * rt0 * rc_c)
+                + (k[29] * rt0 * rt3)
+                + (k[29] * rt4 * rc_c * rc_ds)
+                - (k[29] * rt4 * rc_ds)
+                - (k[30] * rc_s.powi(6) * rc_c)
+                + (k[31] * rc_s.powi(8) * rc_c))
             / 2.0
             / (rt1 * rt1);
-        let ft0 = k[22] * rc_c * rc_w2 / rc_s;
-        let ft1 = k[34] * rc_w2 / rc_s;
+        let ft0 = k[20] * rc_c * rc_w2 / rc_s; // 2*R*m2*rc_c*rc_w2/rc_s
+        let ft1 = k[32] * rc_w2 / rc_s; // R*m2*rc_w2/rc_s
         let ft2 = rc_c * rc_c;
-        let ft3 = k[22] * ft2 * rc_w2 / rc_s.powi(3);
+        let ft3 = k[20] * ft2 * rc_w2 / rc_s.powi(3); // 2*R*m2*rc_c^2*rc_w2/rc_s^3
         let ft4 = rc_c.powi(3);
-        let ft5 = k[22] * ft4 * rc_w2 / rc_s.powi(3);
-        out[0] = -(k[34] * rc_acc) + ft0 + ft1
-            - (k[34] * rc_c * rc_acc / (rc_s * rc_s))
-            - (k[34] * ft2 * rc_acc / (rc_s * rc_s))
+        let ft5 = k[20] * ft4 * rc_w2 / rc_s.powi(3); // 2*R*m2*rc_c^3*rc_w2/rc_s^3
+        out[0] = -(k[32] * rc_acc) + ft0 + ft1
+            - (k[32] * rc_c * rc_acc / (rc_s * rc_s))
+            - (k[32] * ft2 * rc_acc / (rc_s * rc_s))
             + ft3
             + ft5;
-        out[1] = -(k[34] * rc_acc) + ft0 + ft1
-            - (k[34] * rc_c * rc_acc / (rc_s * rc_s))
-            - (k[34] * ft2 * rc_acc / (rc_s * rc_s))
+        out[1] = -(k[32] * rc_acc) + ft0 + ft1
+            - (k[32] * rc_c * rc_acc / (rc_s * rc_s))
+            - (k[32] * ft2 * rc_acc / (rc_s * rc_s))
             + ft3
             + ft5
-            - (k[35] * rc_s * rc_acc)
-            - (k[35] * rc_c * rc_w2);
-        out[2] = k[36] + (k[34] * rc_c * rc_acc / rc_s)
-            - (k[34] * rc_c * rc_w2 / (rc_s * rc_s))
-            - (k[22] * ft2 * rc_w2 / (rc_s * rc_s))
-            + (k[34] * ft2 * rc_acc / rc_s.powi(3))
-            + (k[34] * ft4 * rc_acc / rc_s.powi(3))
-            - (k[22] * ft4 * rc_w2 / rc_s.powi(4))
-            - (k[22] * rc_c.powi(4) * rc_w2 / rc_s.powi(4))
-            - (k[35] * rc_s * rc_w2)
-            + (k[35] * rc_c * rc_acc);
+            - (k[33] * rc_s * rc_acc)
+            - (k[33] * rc_c * rc_w2);
+        out[2] = k[34] + (k[32] * rc_c * rc_acc / rc_s)
+            - (k[32] * rc_c * rc_w2 / (rc_s * rc_s))
+            - (k[20] * ft2 * rc_w2 / (rc_s * rc_s))
+            + (k[32] * ft2 * rc_acc / rc_s.powi(3))
+            + (k[32] * ft4 * rc_acc / rc_s.powi(3))
+            - (k[20] * ft4 * rc_w2 / rc_s.powi(4))
+            - (k[20] * rc_c.powi(4) * rc_w2 / rc_s.powi(4))
+            - (k[33] * rc_s * rc_w2)
+            + (k[33] * rc_c * rc_acc);
     }
 
+    /// The coefficients, constant term first, of a contact's force zero as a polynomial in `sin(theta)`, where it is one.
     fn force_polynomial(&self, _k: &[f64], _contact: usize, _out: &mut [f64]) {}
 
+    /// The constants of `prepare` that the per-point solver reads, and only those.
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let th0 = p[4];
         k[..6].copy_from_slice(p);
         // k[6] = rc_wi = 0.0
         k[6] = 0.0;
         // k[7] = rc_si = sin(rc_thi)
-        k[7] = k[4].sin();
+        k[7] = th0.sin();
         // k[8] = rc_ci = cos(rc_thi)
-        k[8] = k[4].cos();
+        k[8] = th0.cos();
     }
 
+    /// The coefficients, constant term first, of the fall polynomial `P(s) = (sin(theta_i) - s) / theta_dot^2` in `s = sin(theta)`.
     fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
 
+    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
     fn full_state(
         &self,
         k: &[f64],
@@ -525,7 +621,7 @@ impl Reduction for HingedCylinderClosed {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         q[0] = k[4] - delta;
         qd[0] = theta_dot;
     }

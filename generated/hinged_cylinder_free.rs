@@ -89,7 +89,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 30,
+    n_constants: 27,
     coordinates: &["theta", "xc"],
     system_coordinates: &["x1", "y1", "theta", "xc"],
     reduced: 0,
@@ -197,157 +197,234 @@ impl Model for HingedCylinderFree {
         &INFO
     }
 
+    /// The requirements' margins over the parameters, each `>= 0` where it holds.
+    ///
+    /// - `leans_forward = cos(th0)`
+    /// - `touches_the_rod = ell - R*(1 + cos(th0))/sin(th0)`
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
-        let k = p;
-        let qt0 = k[4].cos();
+        let ell = p[2];
+        let r = p[3];
+        let th0 = p[4];
+        let qt0 = th0.cos();
         out[0] = qt0;
-        out[1] = k[2] - (k[3] * (1.0 + qt0) / k[4].sin());
+        out[1] = ell - (r * (1.0 + qt0) / th0.sin());
     }
 
+    /// Each contact's coefficient of restitution over the parameters.
+    ///
+    /// - `contact_force = 0`
+    /// - `hinge_horizontal = 0`
+    /// - `hinge_vertical = 0`
     fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
         out[2] = 0.0;
     }
 
+    /// The constants `k`: the parameters, then the constants derived from them.
+    ///
+    /// `k[..10]` holds the parameters `m1, m2, ell, R, th0, g, theta_0, xc_0, theta_dot_0, xc_dot_0`; each later slot's definition is the comment above the line that fills it.
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
+        let m1 = p[0];
+        let m2 = p[1];
+        let ell = p[2];
+        let r = p[3];
+        let g = p[5];
+        let theta_dot_0 = p[8];
+        let xc_dot_0 = p[9];
         k[..10].copy_from_slice(p);
         // k[6] also holds rc_thi = theta_0
         // k[8] also holds rc_wi = theta_dot_0
         // k[7] also holds rc_x0i = xc_0
         Reduction::prepare_lean(self, p, k);
         // k[12] = rc_p0 = m2*xc_dot_0
-        k[12] = k[1] * k[9];
+        k[12] = m2 * xc_dot_0;
         // k[13] = rc_ai = ell^2*m1/3
-        k[13] = (k[2] * k[2]) * k[0] / 3.0;
+        k[13] = (ell * ell) * m1 / 3.0;
         // k[14] = ell/2
-        k[14] = k[2] / 2.0;
-        // k[15] = ell^2*m1/24
-        k[15] = (k[2] * k[2]) * k[0] / 24.0;
-        // k[16] = ell^2*m1/8
-        k[16] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[17] = m2/2
-        k[17] = k[1] / 2.0;
-        // k[18] = R*g*m2
-        k[18] = k[3] * k[5] * k[1];
-        // k[19] = ell*g*m1/2
-        k[19] = k[2] * k[5] * k[0] / 2.0;
-        // k[20] = ell^2*m1/12
-        k[20] = (k[2] * k[2]) * k[0] / 12.0;
-        // k[21] = ell^2*m1/4
-        k[21] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[22] = ell*m1/2
-        k[22] = k[2] * k[0] / 2.0;
-        // k[23] = g*m1
-        k[23] = k[5] * k[0];
-        // k[24] = 2*R
-        k[24] = 2.0 * k[3];
-        // k[25] = 3/(ell^2*m1)
-        k[25] = 3.0 / (k[2] * k[2]) / k[0];
-        // k[26] = rc_wi^2*rc_ai
-        k[26] = (k[8] * k[8]) * k[13];
-        // k[27] = ell*g*m1
-        k[27] = k[2] * k[5] * k[0];
-        // k[28] = 3*g/(2*ell)
-        k[28] = 3.0 * k[5] / 2.0 / k[2];
-        // k[29] = rc_p0/m2
-        k[29] = k[12] / k[1];
+        k[14] = ell / 2.0;
+        // k[15] = ell^2*m1/6
+        k[15] = (ell * ell) * m1 / 6.0;
+        // k[16] = m2/2
+        k[16] = m2 / 2.0;
+        // k[17] = R*g*m2
+        k[17] = r * g * m2;
+        // k[18] = ell*g*m1/2
+        k[18] = ell * g * m1 / 2.0;
+        // k[19] = ell*m1/2
+        k[19] = ell * m1 / 2.0;
+        // k[20] = g*m1
+        k[20] = g * m1;
+        // k[21] = 2*R
+        k[21] = 2.0 * r;
+        // k[22] = 3/(ell^2*m1)
+        k[22] = 3.0 / (ell * ell) / m1;
+        // k[23] = rc_wi^2*rc_ai
+        k[23] = (theta_dot_0 * theta_dot_0) * k[13];
+        // k[24] = ell*g*m1
+        k[24] = ell * g * m1;
+        // k[25] = 3*g/(2*ell)
+        k[25] = 3.0 * g / 2.0 / ell;
+        // k[26] = rc_p0/m2
+        k[26] = k[12] / m2;
     }
 
+    /// The state at release, over the parameters.
+    ///
+    /// - `theta = theta_0`
+    /// - `dot_theta = theta_dot_0`
+    /// - `xc = xc_0`
+    /// - `dot_xc = xc_dot_0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
-        q[0] = k[6];
-        qd[0] = k[8];
-        q[1] = k[7];
-        qd[1] = k[9];
+        let k = &k[..27]; // one bounds check for all constant loads
+        let theta_0 = k[6];
+        let xc_0 = k[7];
+        let theta_dot_0 = k[8];
+        let xc_dot_0 = k[9];
+        q[0] = theta_0;
+        qd[0] = theta_dot_0;
+        q[1] = xc_0;
+        qd[1] = xc_dot_0;
     }
 
+    /// Each point's position over the state (`pos`), and its time derivative (`vel`).
+    ///
+    /// - `foot_x = 0`
+    /// - `foot_y = 0`
+    /// - `tip_x = ell*cos(theta)`
+    /// - `tip_y = ell*sin(theta)`
+    /// - `rod_centre_x = ell*cos(theta)/2`
+    /// - `rod_centre_y = ell*sin(theta)/2`
+    /// - `axis_x = xc`
+    /// - `axis_y = R`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
+        let ell = k[2];
+        let r = k[3];
+        let theta_dot = qd[0];
+        let xc = q[1];
+        let xc_dot = qd[1];
         pos[0] = [0.0, 0.0];
         vel[0] = [0.0, 0.0];
-        pos[1] = [k[2] * rc_c, k[2] * rc_s];
-        vel[1] = [-k[2] * qd[0] * rc_s, k[2] * qd[0] * rc_c];
+        pos[1] = [ell * rc_c, ell * rc_s];
+        vel[1] = [-ell * theta_dot * rc_s, ell * theta_dot * rc_c];
         pos[2] = [k[14] * rc_c, k[14] * rc_s];
-        vel[2] = [-k[14] * qd[0] * rc_s, k[14] * qd[0] * rc_c];
-        pos[3] = [q[1], k[3]];
-        vel[3] = [qd[1], 0.0];
+        vel[2] = [-k[14] * theta_dot * rc_s, k[14] * theta_dot * rc_c];
+        pos[3] = [xc, r];
+        vel[3] = [xc_dot, 0.0];
     }
 
+    /// The total energy `E = T + V`.
+    ///
+    /// - `T = dot_theta^2*ell^2*m1/6 + dot_xc^2*m2/2`
+    /// - `V = R*g*m2 + ell*g*m1*sin(theta)/2`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..30]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        let et0 = qd[0] * qd[0];
-        ((k[15] * et0)
-            + (k[16] * et0 * (rc_s * rc_s))
-            + (k[16] * et0 * (rc_c * rc_c))
-            + (k[17] * (qd[1] * qd[1])))
-            + (k[18] + (k[19] * rc_s))
+        let k = &k[..27]; // one bounds check for all constant loads
+        let rc_s = q[0].sin();
+        let theta_dot = qd[0];
+        let xc_dot = qd[1];
+        ((k[15] * (theta_dot * theta_dot)) + (k[16] * (xc_dot * xc_dot))) + (k[17] + (k[18] * rc_s))
     }
 
+    /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
+    ///
+    /// - `p_xc = dot_xc*m2`
     fn momenta(&self, k: &[f64], _q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
-        out[0] = k[1] * qd[1];
+        let k = &k[..27]; // one bounds check for all constant loads
+        let m2 = k[1];
+        let xc_dot = qd[1];
+        out[0] = m2 * xc_dot;
     }
 
+    /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
+    ///
+    /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
+    /// - `L = T - V = -(R*g*m2 + ell*g*m1*sin(theta)/2) + dot_theta^2*ell^2*m1/6 + dot_xc^2*m2/2`
     fn equations(&self, k: &[f64], q: &[f64], _qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        mass[0] = k[20] + (k[21] * (rc_s * rc_s)) + (k[21] * (rc_c * rc_c));
+        let k = &k[..27]; // one bounds check for all constant loads
+        let rc_c = q[0].cos();
+        let m2 = k[1];
+        mass[0] = k[13];
         mass[1] = 0.0;
         mass[2] = 0.0;
-        mass[3] = k[1];
-        rhs[0] = -k[19] * rc_c;
+        mass[3] = m2;
+        rhs[0] = -k[18] * rc_c;
         rhs[1] = 0.0;
     }
 
+    /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
+    ///
+    /// - `hinge_horizontal = -ddot_theta*ell*m1*sin(theta)/2 - dot_theta^2*ell*m1*cos(theta)/2`
+    /// - `hinge_vertical = ddot_theta*ell*m1*cos(theta)/2 + g*m1 - dot_theta^2*ell*m1*sin(theta)/2`
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        let ft0 = qd[0] * qd[0];
+        let theta_dot = qd[0];
+        let theta_ddot = qdd[0];
+        let ft0 = theta_dot * theta_dot;
         out[0] = 0.0;
-        out[1] = -(k[22] * qdd[0] * rc_s) - (k[22] * ft0 * rc_c);
-        out[2] = k[23] + (k[22] * qdd[0] * rc_c) - (k[22] * ft0 * rc_s);
+        out[1] = -(k[19] * theta_ddot * rc_s) - (k[19] * ft0 * rc_c);
+        out[2] = k[20] + (k[19] * theta_ddot * rc_c) - (k[19] * ft0 * rc_s);
     }
 
+    /// Each contact's gap `g(q)`, `>= 0` while apart (zero for a contact held closed).
+    ///
+    /// - `contact_force = -R/sin(theta) - R*cos(theta)/sin(theta) + xc`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        out[0] = -(k[3] / rc_s) - (k[3] * rc_c / rc_s) + q[1];
+        let r = k[3];
+        let xc = q[1];
+        out[0] = -(r / rc_s) - (r * rc_c / rc_s) + xc;
         out[1] = 0.0;
         out[2] = 0.0;
     }
 
+    /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
+        let r = k[3];
+        let theta_dot = qd[0];
         let jt0 = rc_c * rc_c;
-        let jt1 = qd[0] * qd[0];
-        jac[0] = k[3] + (k[3] * rc_c / (rc_s * rc_s)) + (k[3] * jt0 / (rc_s * rc_s));
+        let jt1 = theta_dot * theta_dot;
+        jac[0] = r + (r * rc_c / (rc_s * rc_s)) + (r * jt0 / (rc_s * rc_s));
         jac[1] = 1.0;
         jac[2] = 0.0;
         jac[3] = 0.0;
         jac[4] = 0.0;
         jac[5] = 0.0;
-        bias[0] = -(k[3] * jt1 / rc_s)
-            - (k[24] * jt1 * rc_c / rc_s)
-            - (k[24] * jt1 * jt0 / rc_s.powi(3))
-            - (k[24] * jt1 * rc_c.powi(3) / rc_s.powi(3));
+        bias[0] = -(r * jt1 / rc_s)
+            - (k[21] * jt1 * rc_c / rc_s)
+            - (k[21] * jt1 * jt0 / rc_s.powi(3))
+            - (k[21] * jt1 * rc_c.powi(3) / rc_s.powi(3));
         bias[1] = 0.0;
         bias[2] = 0.0;
     }
 
+    /// Each contact's edge margin, `>= 0` while the contact point is on the edge (infinite without one).
+    ///
+    /// - `contact_force = -R*sin(theta) + ell - xc*cos(theta)`
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        out[0] = k[2] - (k[3] * rc_s) - (q[1] * rc_c);
+        let ell = k[2];
+        let r = k[3];
+        let xc = q[1];
+        out[0] = ell - (r * rc_s) - (xc * rc_c);
         out[1] = f64::INFINITY;
         out[2] = f64::INFINITY;
     }
 
+    /// Each friction's slip velocity `v = J(q) qd`: `jac` holds `J`, `bias` holds `dJ/dt qd`.
+    ///
+    /// No friction.
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
+    /// The monitors over the state and the contacts' forces `rc_f<i>`.
+    ///
+    /// No monitor.
     fn monitors_full(
         &self,
         _k: &[f64],
@@ -358,29 +435,47 @@ impl Model for HingedCylinderFree {
     ) {
     }
 
+    /// The system's state (its general model's) that this phase's state stands for.
+    ///
+    /// - `x1 = 0`
+    /// - `dot_x1 = 0`
+    /// - `y1 = 0`
+    /// - `dot_y1 = 0`
+    /// - `theta = theta`
+    /// - `dot_theta = dot_theta`
+    /// - `xc = xc`
+    /// - `dot_xc = dot_xc`
     fn to_full(&self, _k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
+        let theta = q[0];
+        let theta_dot = qd[0];
+        let xc = q[1];
+        let xc_dot = qd[1];
         q_full[0] = 0.0;
         qd_full[0] = 0.0;
         q_full[1] = 0.0;
         qd_full[1] = 0.0;
-        q_full[2] = q[0];
-        qd_full[2] = qd[0];
-        q_full[3] = q[1];
-        qd_full[3] = qd[1];
+        q_full[2] = theta;
+        qd_full[2] = theta_dot;
+        q_full[3] = xc;
+        qd_full[3] = xc_dot;
     }
 
+    /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        poses[0] = [k[14] * rc_c, k[14] * rc_s, q[0]];
-        poses[1] = [q[1], k[3], 0.0];
+        let r = k[3];
+        let theta = q[0];
+        let xc = q[1];
+        poses[0] = [k[14] * rc_c, k[14] * rc_s, theta];
+        poses[1] = [xc, r, 0.0];
         sizes[0] = -k[14];
         sizes[1] = 0.0;
         sizes[2] = k[14];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
-        sizes[6] = k[3];
+        sizes[6] = r;
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -389,44 +484,60 @@ impl Model for HingedCylinderFree {
 }
 
 impl Reduction for HingedCylinderFree {
+    /// The reduced motion at `theta = theta_i - delta`: `theta_dot^2` from the energy integral, and `theta_ddot`.
+    ///
+    /// - `theta_dot^2 = (ell*theta_dot_0^2 - 3*g*sin(theta) + 3*g*sin(theta_0))/ell`
+    /// - `theta_ddot = -(3*g*cos(theta)/(2*ell))`
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[6], k[10], k[11], delta);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: k[25] * (k[26] + (k[27] * rc_ds)),
-            theta_ddot: -k[28] * rc_c,
+            theta_dot_sq: k[22] * (k[23] + (k[24] * rc_ds)),
+            theta_ddot: -k[25] * rc_c,
         }
     }
 
+    /// `theta_dot^2` over `sin(theta)`, `cos(theta)` and their drops from the start (the per-point solver's integrand).
+    ///
+    /// - `theta_dot^2 = (ell*theta_dot_0^2 - 3*g*sin(theta) + 3*g*sin(theta_0))/ell`
     fn theta_dot_sq_sc(&self, k: &[f64], _rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..30]; // one bounds check for all constant loads
-        k[25] * (k[26] + (k[27] * rc_ds))
+        let k = &k[..27]; // one bounds check for all constant loads
+        k[22] * (k[23] + (k[24] * rc_ds))
     }
 
+    /// Each contact's force on the reduced motion (zero for a contact open in the phase).
+    ///
+    /// - `hinge_horizontal = -((2*ell*m1*theta_dot_0^2*cos(theta) - 9*g*m1*sin(theta)*cos(theta) + 6*g*m1*cos(theta)*sin(theta_0))/4)`
+    /// - `hinge_vertical = -((2*ell*m1*theta_dot_0^2*sin(theta) - g*m1 + 6*g*m1*sin(theta)*sin(theta_0) - 9*g*m1*sin(theta)^2)/4)`
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[6], k[10], k[11], delta);
-        let rc_w2 = k[25] * (k[26] + (k[27] * rc_ds));
-        let rc_acc = -k[28] * rc_c;
+        let rc_w2 = k[22] * (k[23] + (k[24] * rc_ds));
+        let rc_acc = -k[25] * rc_c;
         out[0] = 0.0;
-        out[1] = -(k[22] * rc_s * rc_acc) - (k[22] * rc_c * rc_w2);
-        out[2] = k[23] - (k[22] * rc_s * rc_w2) + (k[22] * rc_c * rc_acc);
+        out[1] = -(k[19] * rc_s * rc_acc) - (k[19] * rc_c * rc_w2);
+        out[2] = k[20] - (k[19] * rc_s * rc_w2) + (k[19] * rc_c * rc_acc);
     }
 
+    /// The coefficients, constant term first, of a contact's force zero as a polynomial in `sin(theta)`, where it is one.
     fn force_polynomial(&self, _k: &[f64], _contact: usize, _out: &mut [f64]) {}
 
+    /// The constants of `prepare` that the per-point solver reads, and only those.
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let theta_0 = p[6];
         k[..10].copy_from_slice(p);
         // k[10] = rc_si = sin(rc_thi)
-        k[10] = k[6].sin();
+        k[10] = theta_0.sin();
         // k[11] = rc_ci = cos(rc_thi)
-        k[11] = k[6].cos();
+        k[11] = theta_0.cos();
     }
 
+    /// The coefficients, constant term first, of the fall polynomial `P(s) = (sin(theta_i) - s) / theta_dot^2` in `s = sin(theta)`.
     fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
 
+    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
     fn full_state(
         &self,
         k: &[f64],
@@ -436,11 +547,12 @@ impl Reduction for HingedCylinderFree {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
+        let xc_0 = k[7];
         let rc_t = t;
         q[0] = k[6] - delta;
         qd[0] = theta_dot;
-        q[1] = k[7] + (k[29] * rc_t);
-        qd[1] = k[29];
+        q[1] = xc_0 + (k[26] * rc_t);
+        qd[1] = k[26];
     }
 }

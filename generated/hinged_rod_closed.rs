@@ -53,7 +53,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 35,
+    n_constants: 32,
     coordinates: &["theta"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced: 0,
@@ -155,7 +155,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 8,
         force_degrees: &[3, 0, 0],
         fall_degree: Some(2),
-        lean_constants: &[6, 7, 8, 24, 31, 32, 33, 34],
+        lean_constants: &[6, 7, 8, 21, 28, 29, 30, 31],
     }),
     route_note: "",
 };
@@ -165,121 +165,171 @@ impl Model for HingedRodClosed {
         &INFO
     }
 
+    /// The requirements' margins over the parameters, each `>= 0` where it holds.
+    ///
+    /// - `rod_leans = ell - a`
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
-        let k = p;
-        out[0] = k[2] - k[3];
+        let ell = p[2];
+        let a = p[3];
+        out[0] = ell - a;
     }
 
+    /// Each contact's coefficient of restitution over the parameters.
+    ///
+    /// - `contact_force = 0`
+    /// - `hinge_horizontal = 0`
+    /// - `hinge_vertical = 0`
     fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
         out[2] = 0.0;
     }
 
+    /// The constants `k`: the parameters, then the constants derived from them.
+    ///
+    /// `k[..5]` holds the parameters `m1, m2, ell, a, g`; each later slot's definition is the comment above the line that fills it.
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
+        let m1 = p[0];
+        let m2 = p[1];
+        let ell = p[2];
+        let a = p[3];
+        let g = p[4];
         k[..5].copy_from_slice(p);
         Reduction::prepare_lean(self, p, k);
         // k[5] = rc_thi = asin(a/ell)
-        k[5] = (k[3] / k[2]).asin();
+        k[5] = (a / ell).asin();
         // k[9] = ell/2
-        k[9] = k[2] / 2.0;
-        // k[10] = ell^2*m1/24
-        k[10] = (k[2] * k[2]) * k[0] / 24.0;
-        // k[11] = ell^2*m1/8 + ell^2*m2/2
-        let h11_t0 = k[2] * k[2];
-        k[11] = (h11_t0 * k[0] / 8.0) + (h11_t0 * k[1] / 2.0);
-        // k[12] = ell^2*m1/8
-        k[12] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[13] = a*g*m2/2
-        k[13] = k[3] * k[4] * k[1] / 2.0;
-        // k[14] = ell*g*m1/2
-        k[14] = k[2] * k[4] * k[0] / 2.0;
-        // k[15] = ell^2*m1/12
-        k[15] = (k[2] * k[2]) * k[0] / 12.0;
-        // k[16] = ell^2*m1/4 + ell^2*m2
-        let h16_t0 = k[2] * k[2];
-        k[16] = (h16_t0 * k[0] / 4.0) + (h16_t0 * k[1]);
-        // k[17] = ell^2*m1/4
-        k[17] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[18] = ell^2*m2
-        k[18] = (k[2] * k[2]) * k[1];
-        // k[19] = ell*m1 + 2*ell*m2
-        k[19] = (k[2] * k[0]) + (2.0 * k[2] * k[1]);
-        // k[20] = g*m1
-        k[20] = k[4] * k[0];
-        // k[21] = ell*m1/2
-        k[21] = k[2] * k[0] / 2.0;
-        // k[22] = a/2
-        k[22] = k[3] / 2.0;
-        // k[23] = 3*g*m1/ell
-        k[23] = 3.0 * k[4] * k[0] / k[2];
-        // k[25] = 3/(2*ell)
-        k[25] = 3.0 / 2.0 / k[2];
-        // k[26] = 6*g*m1*m2
-        k[26] = 6.0 * k[4] * k[0] * k[1];
-        // k[27] = 3*g*m1*m2
-        k[27] = 3.0 * k[4] * k[0] * k[1];
-        // k[28] = g*m1^2
-        k[28] = k[4] * (k[0] * k[0]);
-        // k[29] = ell*m2
-        k[29] = k[2] * k[1];
-        // k[30] = (ell*m1 + 2*ell*m2)/2
-        k[30] = ((k[2] * k[0]) + (2.0 * k[2] * k[1])) / 2.0;
+        k[9] = ell / 2.0;
+        // k[10] = ell^2*m1/6
+        k[10] = (ell * ell) * m1 / 6.0;
+        // k[11] = ell^2*m2/2
+        k[11] = (ell * ell) * m2 / 2.0;
+        // k[12] = a*g*m2/2
+        k[12] = a * g * m2 / 2.0;
+        // k[13] = ell*g*m1/2
+        k[13] = ell * g * m1 / 2.0;
+        // k[14] = ell^2*m1/3
+        k[14] = (ell * ell) * m1 / 3.0;
+        // k[15] = ell^2*m2
+        k[15] = (ell * ell) * m2;
+        // k[16] = ell*m1 + 2*ell*m2
+        k[16] = (ell * m1) + (2.0 * ell * m2);
+        // k[17] = g*m1
+        k[17] = g * m1;
+        // k[18] = ell*m1/2
+        k[18] = ell * m1 / 2.0;
+        // k[19] = a/2
+        k[19] = a / 2.0;
+        // k[20] = 3*g*m1/ell
+        k[20] = 3.0 * g * m1 / ell;
+        // k[22] = 3/(2*ell)
+        k[22] = 3.0 / 2.0 / ell;
+        // k[23] = 6*g*m1*m2
+        k[23] = 6.0 * g * m1 * m2;
+        // k[24] = 3*g*m1*m2
+        k[24] = 3.0 * g * m1 * m2;
+        // k[25] = g*m1^2
+        k[25] = g * (m1 * m1);
+        // k[26] = ell*m2
+        k[26] = ell * m2;
+        // k[27] = (ell*m1 + 2*ell*m2)/2
+        k[27] = ((ell * m1) + (2.0 * ell * m2)) / 2.0;
     }
 
+    /// The state at release, over the parameters.
+    ///
+    /// - `theta = asin(a/ell)`
+    /// - `dot_theta = 0.0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         q[0] = k[5];
         qd[0] = 0.0;
     }
 
+    /// Each point's position over the state (`pos`), and its time derivative (`vel`).
+    ///
+    /// - `foot_x = 0`
+    /// - `foot_y = 0`
+    /// - `tip_x = ell*cos(theta)`
+    /// - `tip_y = ell*sin(theta)`
+    /// - `rod_centre_x = ell*cos(theta)/2`
+    /// - `rod_centre_y = ell*sin(theta)/2`
+    /// - `cube_x = ell*cos(theta)`
+    /// - `cube_y = 0`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        let pt0 = k[2] * rc_c;
-        let pt1 = -k[2] * qd[0] * rc_s;
+        let ell = k[2];
+        let theta_dot = qd[0];
+        let pt0 = ell * rc_c;
+        let pt1 = -ell * theta_dot * rc_s;
         pos[0] = [0.0, 0.0];
         vel[0] = [0.0, 0.0];
-        pos[1] = [pt0, k[2] * rc_s];
-        vel[1] = [pt1, k[2] * qd[0] * rc_c];
+        pos[1] = [pt0, ell * rc_s];
+        vel[1] = [pt1, ell * theta_dot * rc_c];
         pos[2] = [k[9] * rc_c, k[9] * rc_s];
-        vel[2] = [-k[9] * qd[0] * rc_s, k[9] * qd[0] * rc_c];
+        vel[2] = [-k[9] * theta_dot * rc_s, k[9] * theta_dot * rc_c];
         pos[3] = [pt0, 0.0];
         vel[3] = [pt1, 0.0];
     }
 
+    /// The total energy `E = T + V`.
+    ///
+    /// - `T = dot_theta^2*ell^2*m1/6 + dot_theta^2*ell^2*m2*sin(theta)^2/2`
+    /// - `V = a*g*m2/2 + ell*g*m1*sin(theta)/2`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..35]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        let et0 = qd[0] * qd[0];
-        ((k[10] * et0) + (k[11] * et0 * (rc_s * rc_s)) + (k[12] * et0 * (rc_c * rc_c)))
-            + (k[13] + (k[14] * rc_s))
+        let k = &k[..32]; // one bounds check for all constant loads
+        let rc_s = q[0].sin();
+        let theta_dot = qd[0];
+        let et0 = theta_dot * theta_dot;
+        ((k[10] * et0) + (k[11] * et0 * (rc_s * rc_s))) + (k[12] + (k[13] * rc_s))
     }
 
+    /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
+    ///
+    /// No cyclic coordinate.
     fn momenta(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
 
+    /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
+    ///
+    /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
+    /// - `L = T - V = -(a*g*m2/2 + ell*g*m1*sin(theta)/2) + dot_theta^2*ell^2*m1/6 + dot_theta^2*ell^2*m2*sin(theta)^2/2`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        mass[0] = k[15] + (k[16] * (rc_s * rc_s)) + (k[17] * (rc_c * rc_c));
-        rhs[0] = -(k[14] * rc_c) - (k[18] * (qd[0] * qd[0]) * rc_s * rc_c);
+        let theta_dot = qd[0];
+        mass[0] = k[14] + (k[15] * (rc_s * rc_s));
+        rhs[0] = -(k[13] * rc_c) - (k[15] * (theta_dot * theta_dot) * rc_s * rc_c);
     }
 
+    /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
+    ///
+    /// - `contact_force = m2*(-ddot_theta*ell*sin(theta) - dot_theta^2*ell*cos(theta))`
+    /// - `hinge_horizontal = -((ddot_theta*ell*m1*sin(theta) + 2*ddot_theta*ell*m2*sin(theta) + dot_theta^2*ell*m1*cos(theta) + 2*dot_theta^2*ell*m2*cos(theta))/2)`
+    /// - `hinge_vertical = ddot_theta*ell*m1*cos(theta)/2 + g*m1 - dot_theta^2*ell*m1*sin(theta)/2`
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        let ft0 = qd[0] * qd[0];
-        out[0] = k[1] * (-(k[2] * qdd[0] * rc_s) - (k[2] * ft0 * rc_c));
-        out[1] = -((k[19] * qdd[0] * rc_s) + (k[19] * ft0 * rc_c)) / 2.0;
-        out[2] = k[20] + (k[21] * qdd[0] * rc_c) - (k[21] * ft0 * rc_s);
+        let m2 = k[1];
+        let ell = k[2];
+        let theta_dot = qd[0];
+        let theta_ddot = qdd[0];
+        let ft0 = theta_dot * theta_dot;
+        out[0] = m2 * (-(ell * theta_ddot * rc_s) - (ell * ft0 * rc_c));
+        out[1] = -((k[16] * theta_ddot * rc_s) + (k[16] * ft0 * rc_c)) / 2.0;
+        out[2] = k[17] + (k[18] * theta_ddot * rc_c) - (k[18] * ft0 * rc_s);
     }
 
+    /// Each contact's gap `g(q)`, `>= 0` while apart (zero for a contact held closed).
+    ///
+    /// No open contact.
     fn gaps(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
         out[2] = 0.0;
     }
 
+    /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, _k: &[f64], _q: &[f64], _qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
         jac[0] = 0.0;
         jac[1] = 0.0;
@@ -289,46 +339,73 @@ impl Model for HingedRodClosed {
         bias[2] = 0.0;
     }
 
+    /// Each contact's edge margin, `>= 0` while the contact point is on the edge (infinite without one).
+    ///
+    /// No contact has an edge.
     fn edges(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
         out[0] = f64::INFINITY;
         out[1] = f64::INFINITY;
         out[2] = f64::INFINITY;
     }
 
+    /// Each friction's slip velocity `v = J(q) qd`: `jac` holds `J`, `bias` holds `dJ/dt qd`.
+    ///
+    /// No friction.
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
+    /// The monitors over the state and the contacts' forces `rc_f<i>`.
+    ///
+    /// - `cube_does_not_tip = a*g*m2/2 - rc_f0*(-a/2 + ell*sin(theta))`
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let rc_s = q[0].sin();
-        out[0] = k[13] - (forces[0] * (-k[22] + (k[2] * rc_s)));
+        let ell = k[2];
+        out[0] = k[12] - (forces[0] * (-k[19] + (ell * rc_s)));
     }
 
+    /// The system's state (its general model's) that this phase's state stands for.
+    ///
+    /// - `x1 = 0`
+    /// - `dot_x1 = 0`
+    /// - `y1 = 0`
+    /// - `dot_y1 = 0`
+    /// - `theta = theta`
+    /// - `dot_theta = dot_theta`
+    /// - `x2 = ell*cos(theta)`
+    /// - `dot_x2 = -(dot_theta*ell*sin(theta))`
     fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
+        let ell = k[2];
+        let theta = q[0];
+        let theta_dot = qd[0];
         q_full[0] = 0.0;
         qd_full[0] = 0.0;
         q_full[1] = 0.0;
         qd_full[1] = 0.0;
-        q_full[2] = q[0];
-        qd_full[2] = qd[0];
-        q_full[3] = k[2] * rc_c;
-        qd_full[3] = -k[2] * qd[0] * rc_s;
+        q_full[2] = theta;
+        qd_full[2] = theta_dot;
+        q_full[3] = ell * rc_c;
+        qd_full[3] = -ell * theta_dot * rc_s;
     }
 
+    /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        poses[0] = [k[9] * rc_c, k[9] * rc_s, q[0]];
-        poses[1] = [k[22] + (k[2] * rc_c), k[22], 0.0];
+        let ell = k[2];
+        let a = k[3];
+        let theta = q[0];
+        poses[0] = [k[9] * rc_c, k[9] * rc_s, theta];
+        poses[1] = [k[19] + (ell * rc_c), k[19], 0.0];
         sizes[0] = -k[9];
         sizes[1] = 0.0;
         sizes[2] = k[9];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
-        sizes[6] = k[3];
-        sizes[7] = k[3];
+        sizes[6] = a;
+        sizes[7] = a;
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -337,81 +414,107 @@ impl Model for HingedRodClosed {
 }
 
 impl Reduction for HingedRodClosed {
+    /// The reduced motion at `theta = theta_i - delta`: `theta_dot^2` from the energy integral, and `theta_ddot`.
+    ///
+    /// - `theta_dot^2 = -(3*(-a*g*m1 + ell*g*m1*sin(theta))/(ell^2*(m1 + 3*m2*sin(theta)^2)))`
+    /// - `theta_ddot = -(3*(6*a*g*m1*m2*sin(theta)*cos(theta) - 3*ell*g*m1*m2*sin(theta)^2*cos(theta) + ell*g*m1^2*cos(theta))/(2*ell^2*(m1 + 3*m2*sin(theta)^2)^2))`
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
+        let m1 = k[0];
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[7], k[8], delta);
         let rt0 = rc_s * rc_s;
-        let rt1 = k[0] + (k[24] * rt0);
+        let rt1 = m1 + (k[21] * rt0); // m1 + 3*m2*rc_s^2
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: k[23] * rc_ds / rt1,
-            theta_ddot: -k[25]
-                * ((k[26] * rc_s * rc_c * rc_ds) + (k[27] * rt0 * rc_c) + (k[28] * rc_c))
+            theta_dot_sq: k[20] * rc_ds / rt1,
+            theta_ddot: -k[22]
+                * ((k[23] * rc_s * rc_c * rc_ds) + (k[24] * rt0 * rc_c) + (k[25] * rc_c))
                 / (rt1 * rt1),
         }
     }
 
+    /// `theta_dot^2` over `sin(theta)`, `cos(theta)` and their drops from the start (the per-point solver's integrand).
+    ///
+    /// - `theta_dot^2 = -(3*(-a*g*m1 + ell*g*m1*sin(theta))/(ell^2*(m1 + 3*m2*sin(theta)^2)))`
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..35]; // one bounds check for all constant loads
-        k[23] * rc_ds / (k[0] + (k[24] * (rc_s * rc_s)))
+        let k = &k[..32]; // one bounds check for all constant loads
+        let m1 = k[0];
+        k[20] * rc_ds / (m1 + (k[21] * (rc_s * rc_s)))
     }
 
+    /// Each contact's force on the reduced motion (zero for a contact open in the phase).
+    ///
+    /// - `contact_force = 3*(-2*a*g*m1^2*m2*cos(theta) + 3*ell*g*m1*m2^2*sin(theta)^3*cos(theta) + 3*ell*g*m1^2*m2*sin(theta)*cos(theta))/(2*ell*(m1 + 3*m2*sin(theta)^2)^2)`
+    /// - `hinge_horizontal`: 249 characters, written out in `generated/hinged_rod_closed.tex`
+    /// - `hinge_vertical`: 223 characters, written out in `generated/hinged_rod_closed.tex`
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
+        let m1 = k[0];
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[7], k[8], delta);
         let rt0 = rc_s * rc_s;
-        let rt1 = k[0] + (k[24] * rt0);
-        let rc_w2 = k[23] * rc_ds / rt1;
-        let rc_acc = -k[25]
-            * ((k[26] * rc_s * rc_c * rc_ds) + (k[27] * rt0 * rc_c) + (k[28] * rc_c))
+        let rt1 = m1 + (k[21] * rt0); // m1 + 3*m2*rc_s^2
+        let rc_w2 = k[20] * rc_ds / rt1;
+        let rc_acc = -k[22]
+            * ((k[23] * rc_s * rc_c * rc_ds) + (k[24] * rt0 * rc_c) + (k[25] * rc_c))
             / (rt1 * rt1);
-        out[0] = -(k[29] * rc_s * rc_acc) - (k[29] * rc_c * rc_w2);
-        out[1] = -(k[30] * rc_s * rc_acc) - (k[30] * rc_c * rc_w2);
-        out[2] = k[20] - (k[21] * rc_s * rc_w2) + (k[21] * rc_c * rc_acc);
+        out[0] = -(k[26] * rc_s * rc_acc) - (k[26] * rc_c * rc_w2);
+        out[1] = -(k[27] * rc_s * rc_acc) - (k[27] * rc_c * rc_w2);
+        out[2] = k[17] - (k[18] * rc_s * rc_w2) + (k[18] * rc_c * rc_acc);
     }
 
+    /// The coefficients, constant term first, of a contact's force zero as a polynomial in `sin(theta)`, where it is one.
+    ///
+    /// - `separation condition (= 0) = (-2*a*m1 + 3*ell*m1*sin(theta) + 3*ell*m2*sin(theta)^3)/ell`
     fn force_polynomial(&self, k: &[f64], contact: usize, out: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         match contact {
             0 => {
-                out[0] = -k[31];
-                out[1] = k[32];
+                out[0] = -k[28];
+                out[1] = k[29];
                 out[2] = 0.0;
-                out[3] = k[24];
+                out[3] = k[21];
             }
             _ => {}
         }
     }
 
+    /// The constants of `prepare` that the per-point solver reads, and only those.
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let m1 = p[0];
+        let m2 = p[1];
+        let ell = p[2];
+        let a = p[3];
+        let g = p[4];
         k[..5].copy_from_slice(p);
         // k[6] = rc_wi = 0.0
         k[6] = 0.0;
         // k[7] = rc_si = a/ell
-        k[7] = k[3] / k[2];
+        k[7] = a / ell;
         // k[8] = rc_ci = ((1 - a/ell)*(1 + a/ell))^(1/2)
-        let c3_t0 = k[3] / k[2];
+        let c3_t0 = a / ell;
         k[8] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
-        // k[24] = 3*m2
-        k[24] = 3.0 * k[1];
-        // k[31] = 2*m1*rc_si
-        k[31] = 2.0 * k[0] * k[7];
-        // k[32] = 3*m1
-        k[32] = 3.0 * k[0];
-        // k[33] = ell/(3*g)
-        k[33] = k[2] / 3.0 / k[4];
-        // k[34] = ell*m2/(g*m1)
-        k[34] = k[2] * k[1] / k[4] / k[0];
+        // k[21] = 3*m2
+        k[21] = 3.0 * m2;
+        // k[28] = 2*m1*rc_si
+        k[28] = 2.0 * m1 * k[7];
+        // k[29] = 3*m1
+        k[29] = 3.0 * m1;
+        // k[30] = ell/(3*g)
+        k[30] = ell / 3.0 / g;
+        // k[31] = ell*m2/(g*m1)
+        k[31] = ell * m2 / g / m1;
     }
 
+    /// The coefficients, constant term first, of the fall polynomial `P(s) = (sin(theta_i) - s) / theta_dot^2` in `s = sin(theta)`.
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
-        out[0] = k[33];
+        let k = &k[..32]; // one bounds check for all constant loads
+        out[0] = k[30];
         out[1] = 0.0;
-        out[2] = k[34];
+        out[2] = k[31];
     }
 
+    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
     fn full_state(
         &self,
         k: &[f64],
@@ -421,7 +524,7 @@ impl Reduction for HingedRodClosed {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         q[0] = k[5] - delta;
         qd[0] = theta_dot;
     }

@@ -77,7 +77,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 29,
+    n_constants: 26,
     coordinates: &["theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced: 0,
@@ -189,178 +189,268 @@ impl Model for HingedRodFree {
         &INFO
     }
 
+    /// The requirements' margins over the parameters, each `>= 0` where it holds.
+    ///
+    /// - `rod_leans = ell - a`
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
-        let k = p;
-        out[0] = k[2] - k[3];
+        let ell = p[2];
+        let a = p[3];
+        out[0] = ell - a;
     }
 
+    /// Each contact's coefficient of restitution over the parameters.
+    ///
+    /// - `contact_force = 0`
+    /// - `hinge_horizontal = 0`
+    /// - `hinge_vertical = 0`
     fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
         out[2] = 0.0;
     }
 
+    /// The constants `k`: the parameters, then the constants derived from them.
+    ///
+    /// `k[..9]` holds the parameters `m1, m2, ell, a, g, theta_0, x2_0, theta_dot_0, x2_dot_0`; each later slot's definition is the comment above the line that fills it.
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
+        let m1 = p[0];
+        let m2 = p[1];
+        let ell = p[2];
+        let a = p[3];
+        let g = p[4];
+        let theta_dot_0 = p[7];
+        let x2_dot_0 = p[8];
         k[..9].copy_from_slice(p);
         // k[5] also holds rc_thi = theta_0
         // k[7] also holds rc_wi = theta_dot_0
         // k[6] also holds rc_x0i = x2_0
         Reduction::prepare_lean(self, p, k);
         // k[11] = rc_p0 = m2*x2_dot_0
-        k[11] = k[1] * k[8];
+        k[11] = m2 * x2_dot_0;
         // k[12] = rc_ai = ell^2*m1/3
-        k[12] = (k[2] * k[2]) * k[0] / 3.0;
+        k[12] = (ell * ell) * m1 / 3.0;
         // k[13] = ell/2
-        k[13] = k[2] / 2.0;
-        // k[14] = ell^2*m1/24
-        k[14] = (k[2] * k[2]) * k[0] / 24.0;
-        // k[15] = ell^2*m1/8
-        k[15] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[16] = m2/2
-        k[16] = k[1] / 2.0;
-        // k[17] = a*g*m2/2
-        k[17] = k[3] * k[4] * k[1] / 2.0;
-        // k[18] = ell*g*m1/2
-        k[18] = k[2] * k[4] * k[0] / 2.0;
-        // k[19] = ell^2*m1/12
-        k[19] = (k[2] * k[2]) * k[0] / 12.0;
-        // k[20] = ell^2*m1/4
-        k[20] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[21] = ell*m1/2
-        k[21] = k[2] * k[0] / 2.0;
-        // k[22] = g*m1
-        k[22] = k[4] * k[0];
-        // k[23] = a/2
-        k[23] = k[3] / 2.0;
-        // k[24] = 3/(ell^2*m1)
-        k[24] = 3.0 / (k[2] * k[2]) / k[0];
-        // k[25] = rc_wi^2*rc_ai
-        k[25] = (k[7] * k[7]) * k[12];
-        // k[26] = ell*g*m1
-        k[26] = k[2] * k[4] * k[0];
-        // k[27] = 3*g/(2*ell)
-        k[27] = 3.0 * k[4] / 2.0 / k[2];
-        // k[28] = rc_p0/m2
-        k[28] = k[11] / k[1];
+        k[13] = ell / 2.0;
+        // k[14] = ell^2*m1/6
+        k[14] = (ell * ell) * m1 / 6.0;
+        // k[15] = m2/2
+        k[15] = m2 / 2.0;
+        // k[16] = a*g*m2/2
+        k[16] = a * g * m2 / 2.0;
+        // k[17] = ell*g*m1/2
+        k[17] = ell * g * m1 / 2.0;
+        // k[18] = ell*m1/2
+        k[18] = ell * m1 / 2.0;
+        // k[19] = g*m1
+        k[19] = g * m1;
+        // k[20] = a/2
+        k[20] = a / 2.0;
+        // k[21] = 3/(ell^2*m1)
+        k[21] = 3.0 / (ell * ell) / m1;
+        // k[22] = rc_wi^2*rc_ai
+        k[22] = (theta_dot_0 * theta_dot_0) * k[12];
+        // k[23] = ell*g*m1
+        k[23] = ell * g * m1;
+        // k[24] = 3*g/(2*ell)
+        k[24] = 3.0 * g / 2.0 / ell;
+        // k[25] = rc_p0/m2
+        k[25] = k[11] / m2;
     }
 
+    /// The state at release, over the parameters.
+    ///
+    /// - `theta = theta_0`
+    /// - `dot_theta = theta_dot_0`
+    /// - `x2 = x2_0`
+    /// - `dot_x2 = x2_dot_0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
-        q[0] = k[5];
-        qd[0] = k[7];
-        q[1] = k[6];
-        qd[1] = k[8];
+        let k = &k[..26]; // one bounds check for all constant loads
+        let theta_0 = k[5];
+        let x2_0 = k[6];
+        let theta_dot_0 = k[7];
+        let x2_dot_0 = k[8];
+        q[0] = theta_0;
+        qd[0] = theta_dot_0;
+        q[1] = x2_0;
+        qd[1] = x2_dot_0;
     }
 
+    /// Each point's position over the state (`pos`), and its time derivative (`vel`).
+    ///
+    /// - `foot_x = 0`
+    /// - `foot_y = 0`
+    /// - `tip_x = ell*cos(theta)`
+    /// - `tip_y = ell*sin(theta)`
+    /// - `rod_centre_x = ell*cos(theta)/2`
+    /// - `rod_centre_y = ell*sin(theta)/2`
+    /// - `cube_x = x2`
+    /// - `cube_y = 0`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
+        let ell = k[2];
+        let theta_dot = qd[0];
+        let x2 = q[1];
+        let x2_dot = qd[1];
         pos[0] = [0.0, 0.0];
         vel[0] = [0.0, 0.0];
-        pos[1] = [k[2] * rc_c, k[2] * rc_s];
-        vel[1] = [-k[2] * qd[0] * rc_s, k[2] * qd[0] * rc_c];
+        pos[1] = [ell * rc_c, ell * rc_s];
+        vel[1] = [-ell * theta_dot * rc_s, ell * theta_dot * rc_c];
         pos[2] = [k[13] * rc_c, k[13] * rc_s];
-        vel[2] = [-k[13] * qd[0] * rc_s, k[13] * qd[0] * rc_c];
-        pos[3] = [q[1], 0.0];
-        vel[3] = [qd[1], 0.0];
+        vel[2] = [-k[13] * theta_dot * rc_s, k[13] * theta_dot * rc_c];
+        pos[3] = [x2, 0.0];
+        vel[3] = [x2_dot, 0.0];
     }
 
+    /// The total energy `E = T + V`.
+    ///
+    /// - `T = dot_theta^2*ell^2*m1/6 + dot_x2^2*m2/2`
+    /// - `V = a*g*m2/2 + ell*g*m1*sin(theta)/2`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..29]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        let et0 = qd[0] * qd[0];
-        ((k[14] * et0)
-            + (k[15] * et0 * (rc_s * rc_s))
-            + (k[15] * et0 * (rc_c * rc_c))
-            + (k[16] * (qd[1] * qd[1])))
-            + (k[17] + (k[18] * rc_s))
+        let k = &k[..26]; // one bounds check for all constant loads
+        let rc_s = q[0].sin();
+        let theta_dot = qd[0];
+        let x2_dot = qd[1];
+        ((k[14] * (theta_dot * theta_dot)) + (k[15] * (x2_dot * x2_dot))) + (k[16] + (k[17] * rc_s))
     }
 
+    /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
+    ///
+    /// - `p_x2 = dot_x2*m2`
     fn momenta(&self, k: &[f64], _q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
-        out[0] = k[1] * qd[1];
+        let k = &k[..26]; // one bounds check for all constant loads
+        let m2 = k[1];
+        let x2_dot = qd[1];
+        out[0] = m2 * x2_dot;
     }
 
+    /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
+    ///
+    /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
+    /// - `L = T - V = -(a*g*m2/2 + ell*g*m1*sin(theta)/2) + dot_theta^2*ell^2*m1/6 + dot_x2^2*m2/2`
     fn equations(&self, k: &[f64], q: &[f64], _qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        mass[0] = k[19] + (k[20] * (rc_s * rc_s)) + (k[20] * (rc_c * rc_c));
+        let k = &k[..26]; // one bounds check for all constant loads
+        let rc_c = q[0].cos();
+        let m2 = k[1];
+        mass[0] = k[12];
         mass[1] = 0.0;
         mass[2] = 0.0;
-        mass[3] = k[1];
-        rhs[0] = -k[18] * rc_c;
+        mass[3] = m2;
+        rhs[0] = -k[17] * rc_c;
         rhs[1] = 0.0;
     }
 
+    /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
+    ///
+    /// - `hinge_horizontal = -ddot_theta*ell*m1*sin(theta)/2 - dot_theta^2*ell*m1*cos(theta)/2`
+    /// - `hinge_vertical = ddot_theta*ell*m1*cos(theta)/2 + g*m1 - dot_theta^2*ell*m1*sin(theta)/2`
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        let ft0 = qd[0] * qd[0];
+        let theta_dot = qd[0];
+        let theta_ddot = qdd[0];
+        let ft0 = theta_dot * theta_dot;
         out[0] = 0.0;
-        out[1] = -(k[21] * qdd[0] * rc_s) - (k[21] * ft0 * rc_c);
-        out[2] = k[22] + (k[21] * qdd[0] * rc_c) - (k[21] * ft0 * rc_s);
+        out[1] = -(k[18] * theta_ddot * rc_s) - (k[18] * ft0 * rc_c);
+        out[2] = k[19] + (k[18] * theta_ddot * rc_c) - (k[18] * ft0 * rc_s);
     }
 
+    /// Each contact's gap `g(q)`, `>= 0` while apart (zero for a contact held closed).
+    ///
+    /// - `contact_force = -ell*cos(theta) + x2`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let rc_c = q[0].cos();
-        out[0] = -(k[2] * rc_c) + q[1];
+        let ell = k[2];
+        let x2 = q[1];
+        out[0] = -(ell * rc_c) + x2;
         out[1] = 0.0;
         out[2] = 0.0;
     }
 
+    /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        jac[0] = k[2] * rc_s;
+        let ell = k[2];
+        let theta_dot = qd[0];
+        jac[0] = ell * rc_s;
         jac[1] = 1.0;
         jac[2] = 0.0;
         jac[3] = 0.0;
         jac[4] = 0.0;
         jac[5] = 0.0;
-        bias[0] = k[2] * (qd[0] * qd[0]) * rc_c;
+        bias[0] = ell * (theta_dot * theta_dot) * rc_c;
         bias[1] = 0.0;
         bias[2] = 0.0;
     }
 
+    /// Each contact's edge margin, `>= 0` while the contact point is on the edge (infinite without one).
+    ///
+    /// No contact has an edge.
     fn edges(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
         out[0] = f64::INFINITY;
         out[1] = f64::INFINITY;
         out[2] = f64::INFINITY;
     }
 
+    /// Each friction's slip velocity `v = J(q) qd`: `jac` holds `J`, `bias` holds `dJ/dt qd`.
+    ///
+    /// No friction.
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
+    /// The monitors over the state and the contacts' forces `rc_f<i>`.
+    ///
+    /// - `cube_does_not_tip = a*g*m2/2 - rc_f0*(-a/2 + ell*sin(theta))`
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let rc_s = q[0].sin();
-        out[0] = k[17] - (forces[0] * (-k[23] + (k[2] * rc_s)));
+        let ell = k[2];
+        out[0] = k[16] - (forces[0] * (-k[20] + (ell * rc_s)));
     }
 
+    /// The system's state (its general model's) that this phase's state stands for.
+    ///
+    /// - `x1 = 0`
+    /// - `dot_x1 = 0`
+    /// - `y1 = 0`
+    /// - `dot_y1 = 0`
+    /// - `theta = theta`
+    /// - `dot_theta = dot_theta`
+    /// - `x2 = x2`
+    /// - `dot_x2 = dot_x2`
     fn to_full(&self, _k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
+        let theta = q[0];
+        let theta_dot = qd[0];
+        let x2 = q[1];
+        let x2_dot = qd[1];
         q_full[0] = 0.0;
         qd_full[0] = 0.0;
         q_full[1] = 0.0;
         qd_full[1] = 0.0;
-        q_full[2] = q[0];
-        qd_full[2] = qd[0];
-        q_full[3] = q[1];
-        qd_full[3] = qd[1];
+        q_full[2] = theta;
+        qd_full[2] = theta_dot;
+        q_full[3] = x2;
+        qd_full[3] = x2_dot;
     }
 
+    /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        poses[0] = [k[13] * rc_c, k[13] * rc_s, q[0]];
-        poses[1] = [k[23] + q[1], k[23], 0.0];
+        let a = k[3];
+        let theta = q[0];
+        let x2 = q[1];
+        poses[0] = [k[13] * rc_c, k[13] * rc_s, theta];
+        poses[1] = [k[20] + x2, k[20], 0.0];
         sizes[0] = -k[13];
         sizes[1] = 0.0;
         sizes[2] = k[13];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
-        sizes[6] = k[3];
-        sizes[7] = k[3];
+        sizes[6] = a;
+        sizes[7] = a;
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -369,44 +459,60 @@ impl Model for HingedRodFree {
 }
 
 impl Reduction for HingedRodFree {
+    /// The reduced motion at `theta = theta_i - delta`: `theta_dot^2` from the energy integral, and `theta_ddot`.
+    ///
+    /// - `theta_dot^2 = (ell*theta_dot_0^2 - 3*g*sin(theta) + 3*g*sin(theta_0))/ell`
+    /// - `theta_ddot = -(3*g*cos(theta)/(2*ell))`
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[9], k[10], delta);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: k[24] * (k[25] + (k[26] * rc_ds)),
-            theta_ddot: -k[27] * rc_c,
+            theta_dot_sq: k[21] * (k[22] + (k[23] * rc_ds)),
+            theta_ddot: -k[24] * rc_c,
         }
     }
 
+    /// `theta_dot^2` over `sin(theta)`, `cos(theta)` and their drops from the start (the per-point solver's integrand).
+    ///
+    /// - `theta_dot^2 = (ell*theta_dot_0^2 - 3*g*sin(theta) + 3*g*sin(theta_0))/ell`
     fn theta_dot_sq_sc(&self, k: &[f64], _rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..29]; // one bounds check for all constant loads
-        k[24] * (k[25] + (k[26] * rc_ds))
+        let k = &k[..26]; // one bounds check for all constant loads
+        k[21] * (k[22] + (k[23] * rc_ds))
     }
 
+    /// Each contact's force on the reduced motion (zero for a contact open in the phase).
+    ///
+    /// - `hinge_horizontal = -((2*ell*m1*theta_dot_0^2*cos(theta) - 9*g*m1*sin(theta)*cos(theta) + 6*g*m1*cos(theta)*sin(theta_0))/4)`
+    /// - `hinge_vertical = -((2*ell*m1*theta_dot_0^2*sin(theta) - g*m1 + 6*g*m1*sin(theta)*sin(theta_0) - 9*g*m1*sin(theta)^2)/4)`
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[9], k[10], delta);
-        let rc_w2 = k[24] * (k[25] + (k[26] * rc_ds));
-        let rc_acc = -k[27] * rc_c;
+        let rc_w2 = k[21] * (k[22] + (k[23] * rc_ds));
+        let rc_acc = -k[24] * rc_c;
         out[0] = 0.0;
-        out[1] = -(k[21] * rc_s * rc_acc) - (k[21] * rc_c * rc_w2);
-        out[2] = k[22] - (k[21] * rc_s * rc_w2) + (k[21] * rc_c * rc_acc);
+        out[1] = -(k[18] * rc_s * rc_acc) - (k[18] * rc_c * rc_w2);
+        out[2] = k[19] - (k[18] * rc_s * rc_w2) + (k[18] * rc_c * rc_acc);
     }
 
+    /// The coefficients, constant term first, of a contact's force zero as a polynomial in `sin(theta)`, where it is one.
     fn force_polynomial(&self, _k: &[f64], _contact: usize, _out: &mut [f64]) {}
 
+    /// The constants of `prepare` that the per-point solver reads, and only those.
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let theta_0 = p[5];
         k[..9].copy_from_slice(p);
         // k[9] = rc_si = sin(rc_thi)
-        k[9] = k[5].sin();
+        k[9] = theta_0.sin();
         // k[10] = rc_ci = cos(rc_thi)
-        k[10] = k[5].cos();
+        k[10] = theta_0.cos();
     }
 
+    /// The coefficients, constant term first, of the fall polynomial `P(s) = (sin(theta_i) - s) / theta_dot^2` in `s = sin(theta)`.
     fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
 
+    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
     fn full_state(
         &self,
         k: &[f64],
@@ -416,11 +522,12 @@ impl Reduction for HingedRodFree {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
+        let x2_0 = k[6];
         let rc_t = t;
         q[0] = k[5] - delta;
         qd[0] = theta_dot;
-        q[1] = k[6] + (k[28] * rc_t);
-        qd[1] = k[28];
+        q[1] = x2_0 + (k[25] * rc_t);
+        qd[1] = k[25];
     }
 }

@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 44,
+    n_constants: 41,
     coordinates: &["theta"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced: 0,
@@ -159,154 +159,210 @@ impl Model for HingedRodSpringClosed {
         &INFO
     }
 
+    /// The requirements' margins over the parameters, each `>= 0` where it holds.
+    ///
+    /// - `rod_leans = ell - a`
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
-        let k = p;
-        out[0] = k[2] - k[3];
+        let ell = p[2];
+        let a = p[3];
+        out[0] = ell - a;
     }
 
+    /// Each contact's coefficient of restitution over the parameters.
+    ///
+    /// - `contact_force = 0`
+    /// - `hinge_horizontal = 0`
+    /// - `hinge_vertical = 0`
     fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
         out[2] = 0.0;
     }
 
+    /// The constants `k`: the parameters, then the constants derived from them.
+    ///
+    /// `k[..6]` holds the parameters `m1, m2, ell, a, g, k`; each later slot's definition is the comment above the line that fills it.
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
+        let m1 = p[0];
+        let m2 = p[1];
+        let ell = p[2];
+        let a = p[3];
+        let g = p[4];
+        let k_param = p[5];
         k[..6].copy_from_slice(p);
         Reduction::prepare_lean(self, p, k);
         // k[6] = rc_thi = asin(a/ell)
-        k[6] = (k[3] / k[2]).asin();
+        k[6] = (a / ell).asin();
         // k[10] = ell/2
-        k[10] = k[2] / 2.0;
-        // k[11] = ell^2*m1/24
-        k[11] = (k[2] * k[2]) * k[0] / 24.0;
-        // k[12] = ell^2*m1/8 + ell^2*m2/2
-        let h12_t0 = k[2] * k[2];
-        k[12] = (h12_t0 * k[0] / 8.0) + (h12_t0 * k[1] / 2.0);
-        // k[13] = ell^2*m1/8
-        k[13] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[14] = a*g*m2/2
-        k[14] = k[3] * k[4] * k[1] / 2.0;
-        // k[15] = ell*g*m1/2
-        k[15] = k[2] * k[4] * k[0] / 2.0;
-        // k[16] = k/2
-        k[16] = k[5] / 2.0;
-        // k[17] = ell*cos(asin(a/ell))
-        k[17] = k[2] * (k[3] / k[2]).asin().cos();
-        // k[18] = ell^2*m1/12
-        k[18] = (k[2] * k[2]) * k[0] / 12.0;
-        // k[19] = ell^2*m1/4 + ell^2*m2
-        let h19_t0 = k[2] * k[2];
-        k[19] = (h19_t0 * k[0] / 4.0) + (h19_t0 * k[1]);
-        // k[20] = ell^2*m1/4
-        k[20] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[21] = ell*k
-        k[21] = k[2] * k[5];
-        // k[22] = ell^2*m2
-        k[22] = (k[2] * k[2]) * k[1];
-        // k[23] = 2*ell*k*cos(asin(a/ell))
-        k[23] = 2.0 * k[2] * k[5] * (k[3] / k[2]).asin().cos();
-        // k[24] = ell*m1 + 2*ell*m2
-        k[24] = (k[2] * k[0]) + (2.0 * k[2] * k[1]);
-        // k[25] = 2*ell*k
-        k[25] = 2.0 * k[2] * k[5];
-        // k[26] = g*m1
-        k[26] = k[4] * k[0];
-        // k[27] = ell*m1/2
-        k[27] = k[2] * k[0] / 2.0;
-        // k[28] = 3/ell
-        k[28] = 3.0 / k[2];
-        // k[29] = 3*m2
-        k[29] = 3.0 * k[1];
-        // k[30] = 2*ell*k*rc_ci - 2*ell*k*cos(asin(a/ell))
-        k[30] = (2.0 * k[2] * k[5] * k[9]) - (2.0 * k[2] * k[5] * (k[3] / k[2]).asin().cos());
-        // k[31] = 3/(2*ell)
-        k[31] = 3.0 / 2.0 / k[2];
-        // k[32] = 2*ell*k*m1
-        k[32] = 2.0 * k[2] * k[5] * k[0];
-        // k[33] = 2*ell*k*m1*rc_ci - 2*ell*k*m1*cos(asin(a/ell))
-        k[33] = (2.0 * k[2] * k[5] * k[0] * k[9])
-            - (2.0 * k[2] * k[5] * k[0] * (k[3] / k[2]).asin().cos());
-        // k[34] = 12*ell*k*m2*rc_ci - 12*ell*k*m2*cos(asin(a/ell))
-        k[34] = (12.0 * k[2] * k[5] * k[1] * k[9])
-            - (12.0 * k[2] * k[5] * k[1] * (k[3] / k[2]).asin().cos());
-        // k[35] = 6*ell*k*m2
-        k[35] = 6.0 * k[2] * k[5] * k[1];
-        // k[36] = 6*ell*k*m2*rc_ci - 6*ell*k*m2*cos(asin(a/ell))
-        k[36] = (6.0 * k[2] * k[5] * k[1] * k[9])
-            - (6.0 * k[2] * k[5] * k[1] * (k[3] / k[2]).asin().cos());
-        // k[37] = 6*g*m1*m2
-        k[37] = 6.0 * k[4] * k[0] * k[1];
-        // k[38] = 3*g*m1*m2
-        k[38] = 3.0 * k[4] * k[0] * k[1];
-        // k[39] = g*m1^2
-        k[39] = k[4] * (k[0] * k[0]);
-        // k[40] = ell*k*cos(asin(a/ell))
-        k[40] = k[2] * k[5] * (k[3] / k[2]).asin().cos();
-        // k[41] = ell*m2
-        k[41] = k[2] * k[1];
-        // k[42] = (ell*m1 + 2*ell*m2)/2
-        k[42] = ((k[2] * k[0]) + (2.0 * k[2] * k[1])) / 2.0;
-        // k[43] = a/2
-        k[43] = k[3] / 2.0;
+        k[10] = ell / 2.0;
+        // k[11] = ell^2*m1/6
+        k[11] = (ell * ell) * m1 / 6.0;
+        // k[12] = ell^2*m2/2
+        k[12] = (ell * ell) * m2 / 2.0;
+        // k[13] = a*g*m2/2
+        k[13] = a * g * m2 / 2.0;
+        // k[14] = ell*g*m1/2
+        k[14] = ell * g * m1 / 2.0;
+        // k[15] = k/2
+        k[15] = k_param / 2.0;
+        // k[16] = ell*cos(asin(a/ell))
+        k[16] = ell * (a / ell).asin().cos();
+        // k[17] = ell^2*m1/3
+        k[17] = (ell * ell) * m1 / 3.0;
+        // k[18] = ell^2*m2
+        k[18] = (ell * ell) * m2;
+        // k[19] = ell*k
+        k[19] = ell * k_param;
+        // k[20] = 2*ell*k*cos(asin(a/ell))
+        k[20] = 2.0 * ell * k_param * (a / ell).asin().cos();
+        // k[21] = ell*m1 + 2*ell*m2
+        k[21] = (ell * m1) + (2.0 * ell * m2);
+        // k[22] = 2*ell*k
+        k[22] = 2.0 * ell * k_param;
+        // k[23] = g*m1
+        k[23] = g * m1;
+        // k[24] = ell*m1/2
+        k[24] = ell * m1 / 2.0;
+        // k[25] = 3/ell
+        k[25] = 3.0 / ell;
+        // k[26] = 3*m2
+        k[26] = 3.0 * m2;
+        // k[27] = 2*ell*k*rc_ci - 2*ell*k*cos(asin(a/ell))
+        k[27] = (2.0 * ell * k_param * k[9]) - (2.0 * ell * k_param * (a / ell).asin().cos());
+        // k[28] = 3/(2*ell)
+        k[28] = 3.0 / 2.0 / ell;
+        // k[29] = 2*ell*k*m1
+        k[29] = 2.0 * ell * k_param * m1;
+        // k[30] = 2*ell*k*m1*rc_ci - 2*ell*k*m1*cos(asin(a/ell))
+        k[30] =
+            (2.0 * ell * k_param * m1 * k[9]) - (2.0 * ell * k_param * m1 * (a / ell).asin().cos());
+        // k[31] = 12*ell*k*m2*rc_ci - 12*ell*k*m2*cos(asin(a/ell))
+        k[31] = (12.0 * ell * k_param * m2 * k[9])
+            - (12.0 * ell * k_param * m2 * (a / ell).asin().cos());
+        // k[32] = 6*ell*k*m2
+        k[32] = 6.0 * ell * k_param * m2;
+        // k[33] = 6*ell*k*m2*rc_ci - 6*ell*k*m2*cos(asin(a/ell))
+        k[33] =
+            (6.0 * ell * k_param * m2 * k[9]) - (6.0 * ell * k_param * m2 * (a / ell).asin().cos());
+        // k[34] = 6*g*m1*m2
+        k[34] = 6.0 * g * m1 * m2;
+        // k[35] = 3*g*m1*m2
+        k[35] = 3.0 * g * m1 * m2;
+        // k[36] = g*m1^2
+        k[36] = g * (m1 * m1);
+        // k[37] = ell*k*cos(asin(a/ell))
+        k[37] = ell * k_param * (a / ell).asin().cos();
+        // k[38] = ell*m2
+        k[38] = ell * m2;
+        // k[39] = (ell*m1 + 2*ell*m2)/2
+        k[39] = ((ell * m1) + (2.0 * ell * m2)) / 2.0;
+        // k[40] = a/2
+        k[40] = a / 2.0;
     }
 
+    /// The state at release, over the parameters.
+    ///
+    /// - `theta = asin(a/ell)`
+    /// - `dot_theta = 0.0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         q[0] = k[6];
         qd[0] = 0.0;
     }
 
+    /// Each point's position over the state (`pos`), and its time derivative (`vel`).
+    ///
+    /// - `foot_x = 0`
+    /// - `foot_y = 0`
+    /// - `tip_x = ell*cos(theta)`
+    /// - `tip_y = ell*sin(theta)`
+    /// - `rod_centre_x = ell*cos(theta)/2`
+    /// - `rod_centre_y = ell*sin(theta)/2`
+    /// - `cube_x = ell*cos(theta)`
+    /// - `cube_y = 0`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        let pt0 = k[2] * rc_c;
-        let pt1 = -k[2] * qd[0] * rc_s;
+        let ell = k[2];
+        let theta_dot = qd[0];
+        let pt0 = ell * rc_c;
+        let pt1 = -ell * theta_dot * rc_s;
         pos[0] = [0.0, 0.0];
         vel[0] = [0.0, 0.0];
-        pos[1] = [pt0, k[2] * rc_s];
-        vel[1] = [pt1, k[2] * qd[0] * rc_c];
+        pos[1] = [pt0, ell * rc_s];
+        vel[1] = [pt1, ell * theta_dot * rc_c];
         pos[2] = [k[10] * rc_c, k[10] * rc_s];
-        vel[2] = [-k[10] * qd[0] * rc_s, k[10] * qd[0] * rc_c];
+        vel[2] = [-k[10] * theta_dot * rc_s, k[10] * theta_dot * rc_c];
         pos[3] = [pt0, 0.0];
         vel[3] = [pt1, 0.0];
     }
 
+    /// The total energy `E = T + V`.
+    ///
+    /// - `T = dot_theta^2*ell^2*m1/6 + dot_theta^2*ell^2*m2*sin(theta)^2/2`
+    /// - `V = a*g*m2/2 + ell*g*m1*sin(theta)/2 + k*(ell*cos(theta) - ell*cos(asin(a/ell)))^2/2`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        let et0 = qd[0] * qd[0];
-        ((k[11] * et0) + (k[12] * et0 * (rc_s * rc_s)) + (k[13] * et0 * (rc_c * rc_c)))
-            + (k[14]
-                + (k[15] * rc_s)
-                + (k[16] * ((-k[17] + (k[2] * rc_c)) * (-k[17] + (k[2] * rc_c)))))
+        let ell = k[2];
+        let theta_dot = qd[0];
+        let et0 = theta_dot * theta_dot;
+        ((k[11] * et0) + (k[12] * et0 * (rc_s * rc_s)))
+            + (k[13]
+                + (k[14] * rc_s)
+                + (k[15] * ((-k[16] + (ell * rc_c)) * (-k[16] + (ell * rc_c)))))
     }
 
+    /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
+    ///
+    /// No cyclic coordinate.
     fn momenta(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
 
+    /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
+    ///
+    /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
+    /// - `L = T - V = -(a*g*m2/2 + ell*g*m1*sin(theta)/2 + k*(ell*cos(theta) - ell*cos(asin(a/ell)))^2/2) + dot_theta^2*ell^2*m1/6 + dot_theta^2*ell^2*m2*sin(theta)^2/2`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        mass[0] = k[18] + (k[19] * (rc_s * rc_s)) + (k[20] * (rc_c * rc_c));
-        rhs[0] = -(k[15] * rc_c) + (k[21] * (-k[17] + (k[2] * rc_c)) * rc_s)
-            - (k[22] * (qd[0] * qd[0]) * rc_s * rc_c);
+        let ell = k[2];
+        let theta_dot = qd[0];
+        mass[0] = k[17] + (k[18] * (rc_s * rc_s));
+        rhs[0] = -(k[14] * rc_c) + (k[19] * (-k[16] + (ell * rc_c)) * rc_s)
+            - (k[18] * (theta_dot * theta_dot) * rc_s * rc_c);
     }
 
+    /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
+    ///
+    /// - `contact_force = k*(ell*cos(theta) - ell*cos(asin(a/ell))) + m2*(-ddot_theta*ell*sin(theta) - dot_theta^2*ell*cos(theta))`
+    /// - `hinge_horizontal`: 182 characters, written out in `generated/hinged_rod_spring_closed.tex`
+    /// - `hinge_vertical = ddot_theta*ell*m1*cos(theta)/2 + g*m1 - dot_theta^2*ell*m1*sin(theta)/2`
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        let ft0 = qd[0] * qd[0];
-        out[0] = (k[5] * (-k[17] + (k[2] * rc_c)))
-            + (k[1] * (-(k[2] * qdd[0] * rc_s) - (k[2] * ft0 * rc_c)));
-        out[1] = -(k[23] + (k[24] * qdd[0] * rc_s) - (k[25] * rc_c) + (k[24] * ft0 * rc_c)) / 2.0;
-        out[2] = k[26] + (k[27] * qdd[0] * rc_c) - (k[27] * ft0 * rc_s);
+        let m2 = k[1];
+        let ell = k[2];
+        let k_param = k[5];
+        let theta_dot = qd[0];
+        let theta_ddot = qdd[0];
+        let ft0 = theta_dot * theta_dot;
+        out[0] = (k_param * (-k[16] + (ell * rc_c)))
+            + (m2 * (-(ell * theta_ddot * rc_s) - (ell * ft0 * rc_c)));
+        out[1] =
+            -(k[20] + (k[21] * theta_ddot * rc_s) - (k[22] * rc_c) + (k[21] * ft0 * rc_c)) / 2.0;
+        out[2] = k[23] + (k[24] * theta_ddot * rc_c) - (k[24] * ft0 * rc_s);
     }
 
+    /// Each contact's gap `g(q)`, `>= 0` while apart (zero for a contact held closed).
+    ///
+    /// No open contact.
     fn gaps(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
         out[2] = 0.0;
     }
 
+    /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, _k: &[f64], _q: &[f64], _qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
         jac[0] = 0.0;
         jac[1] = 0.0;
@@ -316,14 +372,23 @@ impl Model for HingedRodSpringClosed {
         bias[2] = 0.0;
     }
 
+    /// Each contact's edge margin, `>= 0` while the contact point is on the edge (infinite without one).
+    ///
+    /// No contact has an edge.
     fn edges(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
         out[0] = f64::INFINITY;
         out[1] = f64::INFINITY;
         out[2] = f64::INFINITY;
     }
 
+    /// Each friction's slip velocity `v = J(q) qd`: `jac` holds `J`, `bias` holds `dJ/dt qd`.
+    ///
+    /// No friction.
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
+    /// The monitors over the state and the contacts' forces `rc_f<i>`.
+    ///
+    /// No monitor.
     fn monitors_full(
         &self,
         _k: &[f64],
@@ -334,32 +399,49 @@ impl Model for HingedRodSpringClosed {
     ) {
     }
 
+    /// The system's state (its general model's) that this phase's state stands for.
+    ///
+    /// - `x1 = 0`
+    /// - `dot_x1 = 0`
+    /// - `y1 = 0`
+    /// - `dot_y1 = 0`
+    /// - `theta = theta`
+    /// - `dot_theta = dot_theta`
+    /// - `x2 = ell*cos(theta)`
+    /// - `dot_x2 = -(dot_theta*ell*sin(theta))`
     fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
+        let ell = k[2];
+        let theta = q[0];
+        let theta_dot = qd[0];
         q_full[0] = 0.0;
         qd_full[0] = 0.0;
         q_full[1] = 0.0;
         qd_full[1] = 0.0;
-        q_full[2] = q[0];
-        qd_full[2] = qd[0];
-        q_full[3] = k[2] * rc_c;
-        qd_full[3] = -k[2] * qd[0] * rc_s;
+        q_full[2] = theta;
+        qd_full[2] = theta_dot;
+        q_full[3] = ell * rc_c;
+        qd_full[3] = -ell * theta_dot * rc_s;
     }
 
+    /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        poses[0] = [k[10] * rc_c, k[10] * rc_s, q[0]];
-        poses[1] = [k[43] + (k[2] * rc_c), k[43], 0.0];
+        let ell = k[2];
+        let a = k[3];
+        let theta = q[0];
+        poses[0] = [k[10] * rc_c, k[10] * rc_s, theta];
+        poses[1] = [k[40] + (ell * rc_c), k[40], 0.0];
         sizes[0] = -k[10];
         sizes[1] = 0.0;
         sizes[2] = k[10];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
-        sizes[6] = k[3];
-        sizes[7] = k[3];
+        sizes[6] = a;
+        sizes[7] = a;
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -368,73 +450,94 @@ impl Model for HingedRodSpringClosed {
 }
 
 impl Reduction for HingedRodSpringClosed {
+    /// The reduced motion at `theta = theta_i - delta`: `theta_dot^2` from the energy integral, and `theta_ddot`.
+    ///
+    /// - `theta_dot^2`: 187 characters, written out in `generated/hinged_rod_spring_closed.tex`
+    /// - `theta_ddot`: 420 characters, written out in `generated/hinged_rod_spring_closed.tex`
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
+        let m1 = k[0];
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let rt0 = rc_dc * rc_dc;
         let rt1 = rc_s * rc_s;
-        let rt2 = k[0] + (k[29] * rt1);
+        let rt2 = m1 + (k[26] * rt1); // m1 + 3*m2*rc_s^2
         let rt3 = rc_s.powi(3);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: -k[28] * (-(k[30] * rc_dc) + (k[21] * rt0) - (k[26] * rc_ds)) / rt2,
-            theta_ddot: -k[31]
-                * ((k[32] * rc_s * rc_dc) - (k[33] * rc_s) + (k[34] * rc_s * rc_c * rc_dc)
-                    - (k[35] * rc_s * rc_c * rt0)
-                    + (k[35] * rt3 * rc_dc)
-                    - (k[36] * rt3)
-                    + (k[37] * rc_s * rc_c * rc_ds)
-                    + (k[38] * rt1 * rc_c)
-                    + (k[39] * rc_c))
+            theta_dot_sq: -k[25] * (-(k[27] * rc_dc) + (k[19] * rt0) - (k[23] * rc_ds)) / rt2,
+            theta_ddot: -k[28]
+                * ((k[29] * rc_s * rc_dc) - (k[30] * rc_s) + (k[31] * rc_s * rc_c * rc_dc)
+                    - (k[32] * rc_s * rc_c * rt0)
+                    + (k[32] * rt3 * rc_dc)
+                    - (k[33] * rt3)
+                    + (k[34] * rc_s * rc_c * rc_ds)
+                    + (k[35] * rt1 * rc_c)
+                    + (k[36] * rc_c))
                 / (rt2 * rt2),
         }
     }
 
+    /// `theta_dot^2` over `sin(theta)`, `cos(theta)` and their drops from the start (the per-point solver's integrand).
+    ///
+    /// - `theta_dot^2`: 187 characters, written out in `generated/hinged_rod_spring_closed.tex`
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
-        let k = &k[..44]; // one bounds check for all constant loads
-        -k[28] * (-(k[30] * rc_dc) + (k[21] * (rc_dc * rc_dc)) - (k[26] * rc_ds))
-            / (k[0] + (k[29] * (rc_s * rc_s)))
+        let k = &k[..41]; // one bounds check for all constant loads
+        let m1 = k[0];
+        -k[25] * (-(k[27] * rc_dc) + (k[19] * (rc_dc * rc_dc)) - (k[23] * rc_ds))
+            / (m1 + (k[26] * (rc_s * rc_s)))
     }
 
+    /// Each contact's force on the reduced motion (zero for a contact open in the phase).
+    ///
+    /// - `contact_force`: 386 characters, written out in `generated/hinged_rod_spring_closed.tex`
+    /// - `hinge_horizontal`: 773 characters, written out in `generated/hinged_rod_spring_closed.tex`
+    /// - `hinge_vertical`: 682 characters, written out in `generated/hinged_rod_spring_closed.tex`
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
+        let m1 = k[0];
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let rt0 = rc_dc * rc_dc;
         let rt1 = rc_s * rc_s;
-        let rt2 = k[0] + (k[29] * rt1);
+        let rt2 = m1 + (k[26] * rt1); // m1 + 3*m2*rc_s^2
         let rt3 = rc_s.powi(3);
-        let rc_w2 = -k[28] * (-(k[30] * rc_dc) + (k[21] * rt0) - (k[26] * rc_ds)) / rt2;
-        let rc_acc = -k[31]
-            * ((k[32] * rc_s * rc_dc) - (k[33] * rc_s) + (k[34] * rc_s * rc_c * rc_dc)
-                - (k[35] * rc_s * rc_c * rt0)
-                + (k[35] * rt3 * rc_dc)
-                - (k[36] * rt3)
-                + (k[37] * rc_s * rc_c * rc_ds)
-                + (k[38] * rt1 * rc_c)
-                + (k[39] * rc_c))
+        let rc_w2 = -k[25] * (-(k[27] * rc_dc) + (k[19] * rt0) - (k[23] * rc_ds)) / rt2;
+        let rc_acc = -k[28]
+            * ((k[29] * rc_s * rc_dc) - (k[30] * rc_s) + (k[31] * rc_s * rc_c * rc_dc)
+                - (k[32] * rc_s * rc_c * rt0)
+                + (k[32] * rt3 * rc_dc)
+                - (k[33] * rt3)
+                + (k[34] * rc_s * rc_c * rc_ds)
+                + (k[35] * rt1 * rc_c)
+                + (k[36] * rc_c))
             / (rt2 * rt2);
-        let ft0 = k[21] * rc_c;
-        out[0] = -k[40] + ft0 - (k[41] * rc_s * rc_acc) - (k[41] * rc_c * rc_w2);
-        out[1] = -k[40] + ft0 - (k[42] * rc_s * rc_acc) - (k[42] * rc_c * rc_w2);
-        out[2] = k[26] - (k[27] * rc_s * rc_w2) + (k[27] * rc_c * rc_acc);
+        let ft0 = k[19] * rc_c; // ell*k*rc_c
+        out[0] = -k[37] + ft0 - (k[38] * rc_s * rc_acc) - (k[38] * rc_c * rc_w2);
+        out[1] = -k[37] + ft0 - (k[39] * rc_s * rc_acc) - (k[39] * rc_c * rc_w2);
+        out[2] = k[23] - (k[24] * rc_s * rc_w2) + (k[24] * rc_c * rc_acc);
     }
 
+    /// The coefficients, constant term first, of a contact's force zero as a polynomial in `sin(theta)`, where it is one.
     fn force_polynomial(&self, _k: &[f64], _contact: usize, _out: &mut [f64]) {}
 
+    /// The constants of `prepare` that the per-point solver reads, and only those.
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let ell = p[2];
+        let a = p[3];
         k[..6].copy_from_slice(p);
         // k[7] = rc_wi = 0.0
         k[7] = 0.0;
         // k[8] = rc_si = a/ell
-        k[8] = k[3] / k[2];
+        k[8] = a / ell;
         // k[9] = rc_ci = ((1 - a/ell)*(1 + a/ell))^(1/2)
-        let c3_t0 = k[3] / k[2];
+        let c3_t0 = a / ell;
         k[9] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
     }
 
+    /// The coefficients, constant term first, of the fall polynomial `P(s) = (sin(theta_i) - s) / theta_dot^2` in `s = sin(theta)`.
     fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
 
+    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
     fn full_state(
         &self,
         k: &[f64],
@@ -444,7 +547,7 @@ impl Reduction for HingedRodSpringClosed {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         q[0] = k[6] - delta;
         qd[0] = theta_dot;
     }

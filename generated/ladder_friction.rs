@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "ladder_leans",
         meaning: "the top must start below the ladder's length (a < ell)",
     }],
-    n_constants: 18,
+    n_constants: 16,
     coordinates: &["x1", "y1", "theta"],
     system_coordinates: &["x1", "y1", "theta"],
     reduced: 2,
@@ -144,46 +144,65 @@ impl Model for LadderFriction {
         &INFO
     }
 
+    /// The requirements' margins over the parameters, each `>= 0` where it holds.
+    ///
+    /// - `ladder_leans = ell - a`
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
-        let k = p;
-        out[0] = k[1] - k[2];
+        let ell = p[1];
+        let a = p[2];
+        out[0] = ell - a;
     }
 
+    /// Each contact's coefficient of restitution over the parameters.
+    ///
+    /// - `wall_push = 0`
+    /// - `floor_normal = 0`
     fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
     }
 
+    /// The constants `k`: the parameters, then the constants derived from them.
+    ///
+    /// `k[..6]` holds the parameters `m1, ell, a, g, mu_f, mu_w`; each later slot's definition is the comment above the line that fills it.
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
+        let m1 = p[0];
+        let ell = p[1];
+        let a = p[2];
+        let g = p[3];
         k[..6].copy_from_slice(p);
         // k[6] = sqrt((ell - a)*(ell + a))
-        k[6] = ((k[1] - k[2]) * (k[1] + k[2])).sqrt();
+        k[6] = ((ell - a) * (ell + a)).sqrt();
         // k[7] = asin(a/ell)
-        k[7] = (k[2] / k[1]).asin();
+        k[7] = (a / ell).asin();
         // k[8] = ell/2
-        k[8] = k[1] / 2.0;
+        k[8] = ell / 2.0;
         // k[9] = ell*m1/2
-        k[9] = k[1] * k[0] / 2.0;
-        // k[10] = ell^2*m1/24
-        k[10] = (k[1] * k[1]) * k[0] / 24.0;
-        // k[11] = ell^2*m1/8
-        k[11] = (k[1] * k[1]) * k[0] / 8.0;
-        // k[12] = m1/2
-        k[12] = k[0] / 2.0;
-        // k[13] = ell*g*m1/2
-        k[13] = k[1] * k[3] * k[0] / 2.0;
-        // k[14] = g*m1
-        k[14] = k[3] * k[0];
-        // k[15] = ell^2*m1/12
-        k[15] = (k[1] * k[1]) * k[0] / 12.0;
-        // k[16] = ell^2*m1/4
-        k[16] = (k[1] * k[1]) * k[0] / 4.0;
-        // k[17] = 0.0 + ell
-        k[17] = 0.0 + k[1];
+        k[9] = ell * m1 / 2.0;
+        // k[10] = ell^2*m1/6
+        k[10] = (ell * ell) * m1 / 6.0;
+        // k[11] = m1/2
+        k[11] = m1 / 2.0;
+        // k[12] = ell*g*m1/2
+        k[12] = ell * g * m1 / 2.0;
+        // k[13] = g*m1
+        k[13] = g * m1;
+        // k[14] = ell^2*m1/3
+        k[14] = (ell * ell) * m1 / 3.0;
+        // k[15] = 0.0 + ell
+        k[15] = 0.0 + ell;
     }
 
+    /// The state at release, over the parameters.
+    ///
+    /// - `x1 = -sqrt((ell - a)*(ell + a))`
+    /// - `dot_x1 = 0.0`
+    /// - `y1 = 0.0`
+    /// - `dot_y1 = 0.0`
+    /// - `theta = asin(a/ell)`
+    /// - `dot_theta = 0.0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..18]; // one bounds check for all constant loads
+        let k = &k[..16]; // one bounds check for all constant loads
         q[0] = -k[6];
         qd[0] = 0.0;
         q[1] = 0.0;
@@ -192,106 +211,162 @@ impl Model for LadderFriction {
         qd[2] = 0.0;
     }
 
+    /// Each point's position over the state (`pos`), and its time derivative (`vel`).
+    ///
+    /// - `foot_x = x1`
+    /// - `foot_y = y1`
+    /// - `tip_x = ell*cos(theta) + x1`
+    /// - `tip_y = ell*sin(theta) + y1`
+    /// - `rod_centre_x = ell*cos(theta)/2 + x1`
+    /// - `rod_centre_y = ell*sin(theta)/2 + y1`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..18]; // one bounds check for all constant loads
+        let k = &k[..16]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        pos[0] = [q[0], q[1]];
-        vel[0] = [qd[0], qd[1]];
-        pos[1] = [(k[1] * rc_c) + q[0], (k[1] * rc_s) + q[1]];
+        let ell = k[1];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let y1 = q[1];
+        let y1_dot = qd[1];
+        let theta_dot = qd[2];
+        pos[0] = [x1, y1];
+        vel[0] = [x1_dot, y1_dot];
+        pos[1] = [(ell * rc_c) + x1, (ell * rc_s) + y1];
         vel[1] = [
-            -(k[1] * qd[2] * rc_s) + qd[0],
-            (k[1] * qd[2] * rc_c) + qd[1],
+            -(ell * theta_dot * rc_s) + x1_dot,
+            (ell * theta_dot * rc_c) + y1_dot,
         ];
-        pos[2] = [(k[8] * rc_c) + q[0], (k[8] * rc_s) + q[1]];
+        pos[2] = [(k[8] * rc_c) + x1, (k[8] * rc_s) + y1];
         vel[2] = [
-            -(k[8] * qd[2] * rc_s) + qd[0],
-            (k[8] * qd[2] * rc_c) + qd[1],
+            -(k[8] * theta_dot * rc_s) + x1_dot,
+            (k[8] * theta_dot * rc_c) + y1_dot,
         ];
     }
 
+    /// The total energy `E = T + V`.
+    ///
+    /// - `T = -dot_theta*dot_x1*ell*m1*sin(theta)/2 + dot_theta*dot_y1*ell*m1*cos(theta)/2 + dot_theta^2*ell^2*m1/6 + dot_x1^2*m1/2 + dot_y1^2*m1/2`
+    /// - `V = ell*g*m1*sin(theta)/2 + g*m1*y1`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..18]; // one bounds check for all constant loads
+        let k = &k[..16]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let et0 = qd[2] * qd[2];
-        (-(k[9] * qd[2] * qd[0] * rc_s)
-            + (k[9] * qd[2] * qd[1] * rc_c)
-            + (k[10] * et0)
-            + (k[11] * et0 * (rc_s * rc_s))
-            + (k[11] * et0 * (rc_c * rc_c))
-            + (k[12] * (qd[0] * qd[0]))
-            + (k[12] * (qd[1] * qd[1])))
-            + ((k[13] * rc_s) + (k[14] * q[1]))
+        let x1_dot = qd[0];
+        let y1 = q[1];
+        let y1_dot = qd[1];
+        let theta_dot = qd[2];
+        (-(k[9] * theta_dot * x1_dot * rc_s)
+            + (k[9] * theta_dot * y1_dot * rc_c)
+            + (k[10] * (theta_dot * theta_dot))
+            + (k[11] * (x1_dot * x1_dot))
+            + (k[11] * (y1_dot * y1_dot)))
+            + ((k[12] * rc_s) + (k[13] * y1))
     }
 
+    /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
+    ///
+    /// - `p_x1 = -dot_theta*ell*m1*sin(theta)/2 + dot_x1*m1`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..18]; // one bounds check for all constant loads
+        let k = &k[..16]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
-        out[0] = -(k[9] * qd[2] * rc_s) + (k[0] * qd[0]);
+        let m1 = k[0];
+        let x1_dot = qd[0];
+        let theta_dot = qd[2];
+        out[0] = -(k[9] * theta_dot * rc_s) + (m1 * x1_dot);
     }
 
+    /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
+    ///
+    /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
+    /// - `L = T - V`: 169 characters, written out in `generated/ladder_friction.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..18]; // one bounds check for all constant loads
+        let k = &k[..16]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let qt0 = -k[9] * rc_s;
-        let qt1 = k[9] * rc_c;
-        let qt2 = qd[2] * qd[2];
-        mass[0] = k[0];
+        let m1 = k[0];
+        let theta_dot = qd[2];
+        let qt0 = -k[9] * rc_s; // -(ell*m1*rc_s/2)
+        let qt1 = k[9] * rc_c; // ell*m1*rc_c/2
+        let qt2 = theta_dot * theta_dot;
+        mass[0] = m1;
         mass[1] = 0.0;
         mass[2] = qt0;
         mass[3] = 0.0;
-        mass[4] = k[0];
+        mass[4] = m1;
         mass[5] = qt1;
         mass[6] = qt0;
         mass[7] = qt1;
-        mass[8] = k[15] + (k[16] * (rc_s * rc_s)) + (k[16] * (rc_c * rc_c));
+        mass[8] = k[14];
         rhs[0] = k[9] * qt2 * rc_c;
-        rhs[1] = -k[14] + (k[9] * qt2 * rc_s);
-        rhs[2] = -k[13] * rc_c;
+        rhs[1] = -k[13] + (k[9] * qt2 * rc_s);
+        rhs[2] = -k[12] * rc_c;
     }
 
+    /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
+    ///
+    /// No contact is closed in this phase.
     fn forces_full(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _qdd: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
     }
 
+    /// Each contact's gap `g(q)`, `>= 0` while apart (zero for a contact held closed).
+    ///
+    /// - `wall_push = -ell*cos(theta) - x1`
+    /// - `floor_normal = y1`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..18]; // one bounds check for all constant loads
+        let k = &k[..16]; // one bounds check for all constant loads
         let rc_c = q[2].cos();
-        out[0] = -(k[1] * rc_c) - q[0];
-        out[1] = q[1];
+        let ell = k[1];
+        let x1 = q[0];
+        let y1 = q[1];
+        out[0] = -(ell * rc_c) - x1;
+        out[1] = y1;
     }
 
+    /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..18]; // one bounds check for all constant loads
+        let k = &k[..16]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
+        let ell = k[1];
+        let theta_dot = qd[2];
         jac[0] = -1.0;
         jac[1] = 0.0;
-        jac[2] = k[1] * rc_s;
+        jac[2] = ell * rc_s;
         jac[3] = 0.0;
         jac[4] = 1.0;
         jac[5] = 0.0;
-        bias[0] = k[1] * (qd[2] * qd[2]) * rc_c;
+        bias[0] = ell * (theta_dot * theta_dot) * rc_c;
         bias[1] = 0.0;
     }
 
+    /// Each contact's edge margin, `>= 0` while the contact point is on the edge (infinite without one).
+    ///
+    /// No contact has an edge.
     fn edges(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
         out[0] = f64::INFINITY;
         out[1] = f64::INFINITY;
     }
 
+    /// Each friction's slip velocity `v = J(q) qd`: `jac` holds `J`, `bias` holds `dJ/dt qd`.
+    ///
+    /// - `v_floor_friction = dot_x1`
+    /// - `v_wall_friction = dot_theta*ell*cos(theta) + dot_y1`
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..18]; // one bounds check for all constant loads
+        let k = &k[..16]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
+        let ell = k[1];
+        let theta_dot = qd[2];
         jac[0] = 1.0;
         jac[1] = 0.0;
         jac[2] = 0.0;
         jac[3] = 0.0;
         jac[4] = 1.0;
-        jac[5] = k[1] * rc_c;
+        jac[5] = ell * rc_c;
         bias[0] = 0.0;
-        bias[1] = -k[1] * (qd[2] * qd[2]) * rc_s;
+        bias[1] = -ell * (theta_dot * theta_dot) * rc_s;
     }
 
+    /// The monitors over the state and the contacts' forces `rc_f<i>`.
+    ///
+    /// No monitor.
     fn monitors_full(
         &self,
         _k: &[f64],
@@ -302,20 +377,38 @@ impl Model for LadderFriction {
     ) {
     }
 
+    /// The system's state (its general model's) that this phase's state stands for.
+    ///
+    /// - `x1 = x1`
+    /// - `dot_x1 = dot_x1`
+    /// - `y1 = y1`
+    /// - `dot_y1 = dot_y1`
+    /// - `theta = theta`
+    /// - `dot_theta = dot_theta`
     fn to_full(&self, _k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        q_full[0] = q[0];
-        qd_full[0] = qd[0];
-        q_full[1] = q[1];
-        qd_full[1] = qd[1];
-        q_full[2] = q[2];
-        qd_full[2] = qd[2];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let y1 = q[1];
+        let y1_dot = qd[1];
+        let theta = q[2];
+        let theta_dot = qd[2];
+        q_full[0] = x1;
+        qd_full[0] = x1_dot;
+        q_full[1] = y1;
+        qd_full[1] = y1_dot;
+        q_full[2] = theta;
+        qd_full[2] = theta_dot;
     }
 
+    /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..18]; // one bounds check for all constant loads
+        let k = &k[..16]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
+        let x1 = q[0];
+        let y1 = q[1];
+        let theta = q[2];
         let dt0 = 0.0 + 0.0;
-        poses[0] = [(k[8] * rc_c) + q[0], (k[8] * rc_s) + q[1], q[2]];
+        poses[0] = [(k[8] * rc_c) + x1, (k[8] * rc_s) + y1, theta];
         sizes[0] = -k[8];
         sizes[1] = 0.0;
         sizes[2] = k[8];
@@ -323,7 +416,7 @@ impl Model for LadderFriction {
         sizes[4] = dt0;
         sizes[5] = dt0;
         sizes[6] = dt0;
-        sizes[7] = k[17];
+        sizes[7] = k[15];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {

@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 24,
+    n_constants: 22,
     coordinates: &["x1", "y1", "theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced: 2,
@@ -156,77 +156,102 @@ impl Model for LoadedRod {
         &INFO
     }
 
+    /// The requirements' margins over the parameters, each `>= 0` where it holds.
+    ///
+    /// - `rod_leans = ell - a`
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
-        let k = p;
-        out[0] = k[3] - k[4];
+        let ell = p[3];
+        let a = p[4];
+        out[0] = ell - a;
     }
 
+    /// Each contact's coefficient of restitution over the parameters.
+    ///
+    /// - `contact_force = 0`
+    /// - `floor_normal = 0`
     fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
     }
 
+    /// The constants `k`: the parameters, then the constants derived from them.
+    ///
+    /// `k[..6]` holds the parameters `m1, m2, m3, ell, a, g`; each later slot's definition is the comment above the line that fills it.
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
+        let m1 = p[0];
+        let m2 = p[1];
+        let m3 = p[2];
+        let ell = p[3];
+        let a = p[4];
+        let g = p[5];
         k[..6].copy_from_slice(p);
         // k[6] = asin(a/ell)
-        k[6] = (k[4] / k[3]).asin();
+        k[6] = (a / ell).asin();
         // k[7] = ell*((1 - a/ell)*(1 + a/ell))^(1/2)
-        let h7_t0 = k[4] / k[3];
-        k[7] = k[3] * ((1.0 - h7_t0) * (1.0 + h7_t0)).sqrt();
+        let h7_t0 = a / ell;
+        k[7] = ell * ((1.0 - h7_t0) * (1.0 + h7_t0)).sqrt();
         // k[8] = ell/2
-        k[8] = k[3] / 2.0;
+        k[8] = ell / 2.0;
         // k[9] = ell*m1/(2*(m1 + m3)) + ell*m3/(m1 + m3)
-        k[9] = (k[3] * k[0] / 2.0 / (k[0] + k[2])) + (k[3] * k[2] / (k[0] + k[2]));
+        k[9] = (ell * m1 / 2.0 / (m1 + m3)) + (ell * m3 / (m1 + m3));
         // k[10] = 3*ell*m1*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3)
-        k[10] = (3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
-            + (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
-            + (k[3] * (k[2] * k[2]) / (k[0] + k[2]));
-        // k[11] = ell^2*m1/24 + ell^2*m1*m3/(8*(m1 + m3))
-        let h11_t0 = k[3] * k[3];
-        k[11] = (h11_t0 * k[0] / 24.0) + (h11_t0 * k[0] * k[2] / 8.0 / (k[0] + k[2]));
-        // k[12] = ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*(2*m1*m3 + m1^2 + m3^2))
-        let h12_t0 = k[3] * k[3];
-        let h12_t1 = k[2] * k[2];
-        let h12_t2 = k[0] * k[0];
-        k[12] = (h12_t0 * k[0] * h12_t1 / ((2.0 * k[0] * k[2]) + h12_t2 + h12_t1))
-            + (5.0 * h12_t0 * h12_t2 * k[2] / 8.0 / ((2.0 * k[0] * k[2]) + h12_t2 + h12_t1))
-            + (h12_t0 * k[0].powi(3) / 8.0 / ((2.0 * k[0] * k[2]) + h12_t2 + h12_t1))
-            + (h12_t0 * k[2].powi(3) / 2.0 / ((2.0 * k[0] * k[2]) + h12_t2 + h12_t1));
-        // k[13] = m1/2 + m3/2
-        k[13] = (k[0] / 2.0) + (k[2] / 2.0);
-        // k[14] = m2/2
-        k[14] = k[1] / 2.0;
-        // k[15] = a*g*m2/2
-        k[15] = k[4] * k[5] * k[1] / 2.0;
-        // k[16] = 3*ell*g*m1*m3/(2*(m1 + m3)) + ell*g*m1^2/(2*(m1 + m3)) + ell*g*m3^2/(m1 + m3)
-        k[16] = (3.0 * k[3] * k[5] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
-            + (k[3] * k[5] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
-            + (k[3] * k[5] * (k[2] * k[2]) / (k[0] + k[2]));
-        // k[17] = g*m1 + g*m3
-        k[17] = (k[5] * k[0]) + (k[5] * k[2]);
-        // k[18] = m1 + m3
-        k[18] = k[0] + k[2];
-        // k[19] = ell^2*m1/12 + ell^2*m1*m3/(4*(m1 + m3))
-        let h19_t0 = k[3] * k[3];
-        k[19] = (h19_t0 * k[0] / 12.0) + (h19_t0 * k[0] * k[2] / 4.0 / (k[0] + k[2]));
-        // k[20] = 2*ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*m1*m3 + m1^2 + m3^2)
-        let h20_t0 = k[3] * k[3];
-        let h20_t1 = k[2] * k[2];
-        let h20_t2 = k[0] * k[0];
-        k[20] = (2.0 * h20_t0 * k[0] * h20_t1 / ((2.0 * k[0] * k[2]) + h20_t2 + h20_t1))
-            + (5.0 * h20_t0 * h20_t2 * k[2] / 4.0 / ((2.0 * k[0] * k[2]) + h20_t2 + h20_t1))
-            + (h20_t0 * k[0].powi(3) / 4.0 / ((2.0 * k[0] * k[2]) + h20_t2 + h20_t1))
-            + (h20_t0 * k[2].powi(3) / ((2.0 * k[0] * k[2]) + h20_t2 + h20_t1));
-        // k[21] = a/2
-        k[21] = k[4] / 2.0;
-        // k[22] = ell*(m1/2 + m3)/(m1 + m3)
-        k[22] = k[3] * ((k[0] / 2.0) + k[2]) / (k[0] + k[2]);
-        // k[23] = ell*m1/(2*(m1 + m3))
-        k[23] = k[3] * k[0] / (2.0 * (k[0] + k[2]));
+        k[10] = (3.0 * ell * m1 * m3 / 2.0 / (m1 + m3))
+            + (ell * (m1 * m1) / 2.0 / (m1 + m3))
+            + (ell * (m3 * m3) / (m1 + m3));
+        // k[11] = ell^2*m1/24 + ell^2*m1*m3/(8*(m1 + m3)) + ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*(2*m1*m3 + m1^2 + m3^2))
+        let h11_t0 = ell * ell;
+        let h11_t1 = m3 * m3;
+        let h11_t2 = m1 * m1;
+        k[11] = (h11_t0 * m1 / 24.0)
+            + (h11_t0 * m1 * m3 / 8.0 / (m1 + m3))
+            + (h11_t0 * m1 * h11_t1 / ((2.0 * m1 * m3) + h11_t2 + h11_t1))
+            + (5.0 * h11_t0 * h11_t2 * m3 / 8.0 / ((2.0 * m1 * m3) + h11_t2 + h11_t1))
+            + (h11_t0 * m1.powi(3) / 8.0 / ((2.0 * m1 * m3) + h11_t2 + h11_t1))
+            + (h11_t0 * m3.powi(3) / 2.0 / ((2.0 * m1 * m3) + h11_t2 + h11_t1));
+        // k[12] = m1/2 + m3/2
+        k[12] = (m1 / 2.0) + (m3 / 2.0);
+        // k[13] = m2/2
+        k[13] = m2 / 2.0;
+        // k[14] = a*g*m2/2
+        k[14] = a * g * m2 / 2.0;
+        // k[15] = 3*ell*g*m1*m3/(2*(m1 + m3)) + ell*g*m1^2/(2*(m1 + m3)) + ell*g*m3^2/(m1 + m3)
+        k[15] = (3.0 * ell * g * m1 * m3 / 2.0 / (m1 + m3))
+            + (ell * g * (m1 * m1) / 2.0 / (m1 + m3))
+            + (ell * g * (m3 * m3) / (m1 + m3));
+        // k[16] = g*m1 + g*m3
+        k[16] = (g * m1) + (g * m3);
+        // k[17] = m1 + m3
+        k[17] = m1 + m3;
+        // k[18] = ell^2*m1/12 + ell^2*m1*m3/(4*(m1 + m3)) + 2*ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*m1*m3 + m1^2 + m3^2)
+        let h18_t0 = ell * ell;
+        let h18_t1 = m3 * m3;
+        let h18_t2 = m1 * m1;
+        k[18] = (h18_t0 * m1 / 12.0)
+            + (h18_t0 * m1 * m3 / 4.0 / (m1 + m3))
+            + (2.0 * h18_t0 * m1 * h18_t1 / ((2.0 * m1 * m3) + h18_t2 + h18_t1))
+            + (5.0 * h18_t0 * h18_t2 * m3 / 4.0 / ((2.0 * m1 * m3) + h18_t2 + h18_t1))
+            + (h18_t0 * m1.powi(3) / 4.0 / ((2.0 * m1 * m3) + h18_t2 + h18_t1))
+            + (h18_t0 * m3.powi(3) / ((2.0 * m1 * m3) + h18_t2 + h18_t1));
+        // k[19] = a/2
+        k[19] = a / 2.0;
+        // k[20] = ell*(m1/2 + m3)/(m1 + m3)
+        k[20] = ell * ((m1 / 2.0) + m3) / (m1 + m3);
+        // k[21] = ell*m1/(2*(m1 + m3))
+        k[21] = ell * m1 / (2.0 * (m1 + m3));
     }
 
+    /// The state at release, over the parameters.
+    ///
+    /// - `x1 = 0.0`
+    /// - `dot_x1 = 0.0`
+    /// - `y1 = 0`
+    /// - `dot_y1 = 0`
+    /// - `theta = asin(a/ell)`
+    /// - `dot_theta = 0.0`
+    /// - `x2 = ell*((1 - a/ell)*(1 + a/ell))^(1/2)`
+    /// - `dot_x2 = 0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = 0.0;
@@ -237,144 +262,232 @@ impl Model for LoadedRod {
         qd[3] = 0.0;
     }
 
+    /// Each point's position over the state (`pos`), and its time derivative (`vel`).
+    ///
+    /// - `foot_x = x1`
+    /// - `foot_y = y1`
+    /// - `tip_x = ell*cos(theta) + x1`
+    /// - `tip_y = ell*sin(theta) + y1`
+    /// - `rod_centre_x = ell*cos(theta)/2 + x1`
+    /// - `rod_centre_y = ell*sin(theta)/2 + y1`
+    /// - `mass_centre_x = ell*m1*cos(theta)/(2*(m1 + m3)) + ell*m3*cos(theta)/(m1 + m3) + x1`
+    /// - `mass_centre_y = ell*m1*sin(theta)/(2*(m1 + m3)) + ell*m3*sin(theta)/(m1 + m3) + y1`
+    /// - `cube_x = x2`
+    /// - `cube_y = 0`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        pos[0] = [q[0], q[1]];
-        vel[0] = [qd[0], qd[1]];
-        pos[1] = [(k[3] * rc_c) + q[0], (k[3] * rc_s) + q[1]];
+        let ell = k[3];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let y1 = q[1];
+        let y1_dot = qd[1];
+        let theta_dot = qd[2];
+        let x2 = q[3];
+        let x2_dot = qd[3];
+        pos[0] = [x1, y1];
+        vel[0] = [x1_dot, y1_dot];
+        pos[1] = [(ell * rc_c) + x1, (ell * rc_s) + y1];
         vel[1] = [
-            -(k[3] * qd[2] * rc_s) + qd[0],
-            (k[3] * qd[2] * rc_c) + qd[1],
+            -(ell * theta_dot * rc_s) + x1_dot,
+            (ell * theta_dot * rc_c) + y1_dot,
         ];
-        pos[2] = [(k[8] * rc_c) + q[0], (k[8] * rc_s) + q[1]];
+        pos[2] = [(k[8] * rc_c) + x1, (k[8] * rc_s) + y1];
         vel[2] = [
-            -(k[8] * qd[2] * rc_s) + qd[0],
-            (k[8] * qd[2] * rc_c) + qd[1],
+            -(k[8] * theta_dot * rc_s) + x1_dot,
+            (k[8] * theta_dot * rc_c) + y1_dot,
         ];
-        pos[3] = [(k[9] * rc_c) + q[0], (k[9] * rc_s) + q[1]];
+        pos[3] = [(k[9] * rc_c) + x1, (k[9] * rc_s) + y1];
         vel[3] = [
-            -(k[9] * qd[2] * rc_s) + qd[0],
-            (k[9] * qd[2] * rc_c) + qd[1],
+            -(k[9] * theta_dot * rc_s) + x1_dot,
+            (k[9] * theta_dot * rc_c) + y1_dot,
         ];
-        pos[4] = [q[3], 0.0];
-        vel[4] = [qd[3], 0.0];
+        pos[4] = [x2, 0.0];
+        vel[4] = [x2_dot, 0.0];
     }
 
+    /// The total energy `E = T + V`.
+    ///
+    /// - `T`: 676 characters, written out in `generated/loaded_rod.tex`
+    /// - `V = a*g*m2/2 + 3*ell*g*m1*m3*sin(theta)/(2*(m1 + m3)) + ell*g*m1^2*sin(theta)/(2*(m1 + m3)) + ell*g*m3^2*sin(theta)/(m1 + m3) + g*m1*y1 + g*m3*y1`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let et0 = qd[2] * qd[2];
-        (-(k[10] * qd[2] * qd[0] * rc_s)
-            + (k[10] * qd[2] * qd[1] * rc_c)
-            + (k[11] * et0)
-            + (k[12] * et0 * (rc_s * rc_s))
-            + (k[12] * et0 * (rc_c * rc_c))
-            + (k[13] * (qd[0] * qd[0]))
-            + (k[14] * (qd[3] * qd[3]))
-            + (k[13] * (qd[1] * qd[1])))
-            + (k[15] + (k[16] * rc_s) + (k[17] * q[1]))
+        let x1_dot = qd[0];
+        let y1 = q[1];
+        let y1_dot = qd[1];
+        let theta_dot = qd[2];
+        let x2_dot = qd[3];
+        (-(k[10] * theta_dot * x1_dot * rc_s)
+            + (k[10] * theta_dot * y1_dot * rc_c)
+            + (k[11] * (theta_dot * theta_dot))
+            + (k[12] * (x1_dot * x1_dot))
+            + (k[13] * (x2_dot * x2_dot))
+            + (k[12] * (y1_dot * y1_dot)))
+            + (k[14] + (k[15] * rc_s) + (k[16] * y1))
     }
 
+    /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
+    ///
+    /// - `p_x1 = -3*dot_theta*ell*m1*m3*sin(theta)/(2*(m1 + m3)) - dot_theta*ell*m1^2*sin(theta)/(2*(m1 + m3)) - dot_theta*ell*m3^2*sin(theta)/(m1 + m3) + dot_x1*m1 + dot_x1*m3`
+    /// - `p_x2 = dot_x2*m2`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
-        out[0] = -(k[10] * qd[2] * rc_s) + (k[18] * qd[0]);
-        out[1] = k[1] * qd[3];
+        let m2 = k[1];
+        let x1_dot = qd[0];
+        let theta_dot = qd[2];
+        let x2_dot = qd[3];
+        out[0] = -(k[10] * theta_dot * rc_s) + (k[17] * x1_dot);
+        out[1] = m2 * x2_dot;
     }
 
+    /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
+    ///
+    /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
+    /// - `L = T - V`: 822 characters, written out in `generated/loaded_rod.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let qt0 = -k[10] * rc_s;
-        let qt1 = k[10] * rc_c;
-        let qt2 = qd[2] * qd[2];
-        mass[0] = k[18];
+        let m2 = k[1];
+        let theta_dot = qd[2];
+        let qt0 = -k[10] * rc_s; // -((3*ell*m1*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3))*rc_s)
+        let qt1 = k[10] * rc_c; // (3*ell*m1*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3))*rc_c
+        let qt2 = theta_dot * theta_dot;
+        mass[0] = k[17];
         mass[1] = 0.0;
         mass[2] = qt0;
         mass[3] = 0.0;
         mass[4] = 0.0;
-        mass[5] = k[18];
+        mass[5] = k[17];
         mass[6] = qt1;
         mass[7] = 0.0;
         mass[8] = qt0;
         mass[9] = qt1;
-        mass[10] = k[19] + (k[20] * (rc_s * rc_s)) + (k[20] * (rc_c * rc_c));
+        mass[10] = k[18];
         mass[11] = 0.0;
         mass[12] = 0.0;
         mass[13] = 0.0;
         mass[14] = 0.0;
-        mass[15] = k[1];
+        mass[15] = m2;
         rhs[0] = k[10] * qt2 * rc_c;
-        rhs[1] = -k[17] + (k[10] * qt2 * rc_s);
-        rhs[2] = -k[16] * rc_c;
+        rhs[1] = -k[16] + (k[10] * qt2 * rc_s);
+        rhs[2] = -k[15] * rc_c;
         rhs[3] = 0.0;
     }
 
+    /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
+    ///
+    /// No contact is closed in this phase.
     fn forces_full(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _qdd: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
     }
 
+    /// Each contact's gap `g(q)`, `>= 0` while apart (zero for a contact held closed).
+    ///
+    /// - `contact_force = -ell*cos(theta) - x1 + x2`
+    /// - `floor_normal = y1`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let rc_c = q[2].cos();
-        out[0] = -(k[3] * rc_c) - q[0] + q[3];
-        out[1] = q[1];
+        let ell = k[3];
+        let x1 = q[0];
+        let y1 = q[1];
+        let x2 = q[3];
+        out[0] = -(ell * rc_c) - x1 + x2;
+        out[1] = y1;
     }
 
+    /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
+        let ell = k[3];
+        let theta_dot = qd[2];
         jac[0] = -1.0;
         jac[1] = 0.0;
-        jac[2] = k[3] * rc_s;
+        jac[2] = ell * rc_s;
         jac[3] = 1.0;
         jac[4] = 0.0;
         jac[5] = 1.0;
         jac[6] = 0.0;
         jac[7] = 0.0;
-        bias[0] = k[3] * (qd[2] * qd[2]) * rc_c;
+        bias[0] = ell * (theta_dot * theta_dot) * rc_c;
         bias[1] = 0.0;
     }
 
+    /// Each contact's edge margin, `>= 0` while the contact point is on the edge (infinite without one).
+    ///
+    /// No contact has an edge.
     fn edges(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
         out[0] = f64::INFINITY;
         out[1] = f64::INFINITY;
     }
 
+    /// Each friction's slip velocity `v = J(q) qd`: `jac` holds `J`, `bias` holds `dJ/dt qd`.
+    ///
+    /// No friction.
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
+    /// The monitors over the state and the contacts' forces `rc_f<i>`.
+    ///
+    /// - `cube_does_not_tip = a*g*m2/2 - rc_f0*(-a/2 + ell*sin(theta))`
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
-        out[0] = k[15] - (forces[0] * (-k[21] + (k[3] * rc_s)));
+        let ell = k[3];
+        out[0] = k[14] - (forces[0] * (-k[19] + (ell * rc_s)));
     }
 
+    /// The system's state (its general model's) that this phase's state stands for.
+    ///
+    /// - `x1 = x1`
+    /// - `dot_x1 = dot_x1`
+    /// - `y1 = y1`
+    /// - `dot_y1 = dot_y1`
+    /// - `theta = theta`
+    /// - `dot_theta = dot_theta`
+    /// - `x2 = x2`
+    /// - `dot_x2 = dot_x2`
     fn to_full(&self, _k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        q_full[0] = q[0];
-        qd_full[0] = qd[0];
-        q_full[1] = q[1];
-        qd_full[1] = qd[1];
-        q_full[2] = q[2];
-        qd_full[2] = qd[2];
-        q_full[3] = q[3];
-        qd_full[3] = qd[3];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let y1 = q[1];
+        let y1_dot = qd[1];
+        let theta = q[2];
+        let theta_dot = qd[2];
+        let x2 = q[3];
+        let x2_dot = qd[3];
+        q_full[0] = x1;
+        qd_full[0] = x1_dot;
+        q_full[1] = y1;
+        qd_full[1] = y1_dot;
+        q_full[2] = theta;
+        qd_full[2] = theta_dot;
+        q_full[3] = x2;
+        qd_full[3] = x2_dot;
     }
 
+    /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        poses[0] = [(k[9] * rc_c) + q[0], (k[9] * rc_s) + q[1], q[2]];
-        poses[1] = [k[21] + q[3], k[21], 0.0];
-        sizes[0] = -k[22];
+        let a = k[4];
+        let x1 = q[0];
+        let y1 = q[1];
+        let theta = q[2];
+        let x2 = q[3];
+        poses[0] = [(k[9] * rc_c) + x1, (k[9] * rc_s) + y1, theta];
+        poses[1] = [k[19] + x2, k[19], 0.0];
+        sizes[0] = -k[20];
         sizes[1] = 0.0;
-        sizes[2] = k[23];
+        sizes[2] = k[21];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
-        sizes[6] = k[4];
-        sizes[7] = k[4];
+        sizes[6] = a;
+        sizes[7] = a;
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {

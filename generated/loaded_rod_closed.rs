@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 49,
+    n_constants: 46,
     coordinates: &["x1", "theta"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced: 1,
@@ -154,7 +154,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 9,
         force_degrees: &[3, 4],
         fall_degree: Some(2),
-        lean_constants: &[7, 8, 9, 31, 38, 39, 40, 41, 42, 43, 44, 45],
+        lean_constants: &[7, 8, 9, 28, 35, 36, 37, 38, 39, 40, 41, 42],
     }),
     route_note: "",
 };
@@ -164,241 +164,296 @@ impl Model for LoadedRodClosed {
         &INFO
     }
 
+    /// The requirements' margins over the parameters, each `>= 0` where it holds.
+    ///
+    /// - `rod_leans = ell - a`
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
-        let k = p;
-        out[0] = k[3] - k[4];
+        let ell = p[3];
+        let a = p[4];
+        out[0] = ell - a;
     }
 
+    /// Each contact's coefficient of restitution over the parameters.
+    ///
+    /// - `contact_force = 0`
+    /// - `floor_normal = 0`
     fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
     }
 
+    /// The constants `k`: the parameters, then the constants derived from them.
+    ///
+    /// `k[..6]` holds the parameters `m1, m2, m3, ell, a, g`; each later slot's definition is the comment above the line that fills it.
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
+        let m1 = p[0];
+        let m2 = p[1];
+        let m3 = p[2];
+        let ell = p[3];
+        let a = p[4];
+        let g = p[5];
         k[..6].copy_from_slice(p);
         Reduction::prepare_lean(self, p, k);
         // k[6] = rc_thi = asin(a/ell)
-        k[6] = (k[4] / k[3]).asin();
+        k[6] = (a / ell).asin();
         // k[10] = rc_x0i = 0.0
         k[10] = 0.0;
         // k[11] = ell/2
-        k[11] = k[3] / 2.0;
+        k[11] = ell / 2.0;
         // k[12] = ell*m1/(2*(m1 + m3)) + ell*m3/(m1 + m3)
-        k[12] = (k[3] * k[0] / 2.0 / (k[0] + k[2])) + (k[3] * k[2] / (k[0] + k[2]));
+        k[12] = (ell * m1 / 2.0 / (m1 + m3)) + (ell * m3 / (m1 + m3));
         // k[13] = 3*ell*m1*m3/(2*(m1 + m3)) + ell*m2 + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3)
-        k[13] = (3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
-            + (k[3] * k[1])
-            + (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
-            + (k[3] * (k[2] * k[2]) / (k[0] + k[2]));
-        // k[14] = ell^2*m1/24 + ell^2*m1*m3/(8*(m1 + m3))
-        let h14_t0 = k[3] * k[3];
-        k[14] = (h14_t0 * k[0] / 24.0) + (h14_t0 * k[0] * k[2] / 8.0 / (k[0] + k[2]));
-        // k[15] = ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + ell^2*m2/2 + 5*ell^2*m1^2*m3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*(2*m1*m3 + m1^2 + m3^2))
-        let h15_t0 = k[3] * k[3];
-        let h15_t1 = k[2] * k[2];
-        let h15_t2 = k[0] * k[0];
-        k[15] = (h15_t0 * k[0] * h15_t1 / ((2.0 * k[0] * k[2]) + h15_t2 + h15_t1))
-            + (h15_t0 * k[1] / 2.0)
-            + (5.0 * h15_t0 * h15_t2 * k[2] / 8.0 / ((2.0 * k[0] * k[2]) + h15_t2 + h15_t1))
-            + (h15_t0 * k[0].powi(3) / 8.0 / ((2.0 * k[0] * k[2]) + h15_t2 + h15_t1))
-            + (h15_t0 * k[2].powi(3) / 2.0 / ((2.0 * k[0] * k[2]) + h15_t2 + h15_t1));
-        // k[16] = ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*(2*m1*m3 + m1^2 + m3^2))
-        let h16_t0 = k[3] * k[3];
-        let h16_t1 = k[2] * k[2];
-        let h16_t2 = k[0] * k[0];
-        k[16] = (h16_t0 * k[0] * h16_t1 / ((2.0 * k[0] * k[2]) + h16_t2 + h16_t1))
-            + (5.0 * h16_t0 * h16_t2 * k[2] / 8.0 / ((2.0 * k[0] * k[2]) + h16_t2 + h16_t1))
-            + (h16_t0 * k[0].powi(3) / 8.0 / ((2.0 * k[0] * k[2]) + h16_t2 + h16_t1))
-            + (h16_t0 * k[2].powi(3) / 2.0 / ((2.0 * k[0] * k[2]) + h16_t2 + h16_t1));
-        // k[17] = m1/2 + m2/2 + m3/2
-        k[17] = (k[0] / 2.0) + (k[1] / 2.0) + (k[2] / 2.0);
-        // k[18] = a*g*m2/2
-        k[18] = k[4] * k[5] * k[1] / 2.0;
-        // k[19] = ell*g*m1/2 + ell*g*m3
-        k[19] = (k[3] * k[5] * k[0] / 2.0) + (k[3] * k[5] * k[2]);
-        // k[20] = m1 + m2 + m3
-        k[20] = k[0] + k[1] + k[2];
-        // k[21] = ell^2*m1/12 + ell^2*m1*m3/(4*(m1 + m3))
-        let h21_t0 = k[3] * k[3];
-        k[21] = (h21_t0 * k[0] / 12.0) + (h21_t0 * k[0] * k[2] / 4.0 / (k[0] + k[2]));
-        // k[22] = 2*ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + ell^2*m2 + 5*ell^2*m1^2*m3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*m1*m3 + m1^2 + m3^2)
-        let h22_t0 = k[3] * k[3];
-        let h22_t1 = k[2] * k[2];
-        let h22_t2 = k[0] * k[0];
-        k[22] = (2.0 * h22_t0 * k[0] * h22_t1 / ((2.0 * k[0] * k[2]) + h22_t2 + h22_t1))
-            + (h22_t0 * k[1])
-            + (5.0 * h22_t0 * h22_t2 * k[2] / 4.0 / ((2.0 * k[0] * k[2]) + h22_t2 + h22_t1))
-            + (h22_t0 * k[0].powi(3) / 4.0 / ((2.0 * k[0] * k[2]) + h22_t2 + h22_t1))
-            + (h22_t0 * k[2].powi(3) / ((2.0 * k[0] * k[2]) + h22_t2 + h22_t1));
-        // k[23] = 2*ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*m1*m3 + m1^2 + m3^2)
-        let h23_t0 = k[3] * k[3];
-        let h23_t1 = k[2] * k[2];
-        let h23_t2 = k[0] * k[0];
-        k[23] = (2.0 * h23_t0 * k[0] * h23_t1 / ((2.0 * k[0] * k[2]) + h23_t2 + h23_t1))
-            + (5.0 * h23_t0 * h23_t2 * k[2] / 4.0 / ((2.0 * k[0] * k[2]) + h23_t2 + h23_t1))
-            + (h23_t0 * k[0].powi(3) / 4.0 / ((2.0 * k[0] * k[2]) + h23_t2 + h23_t1))
-            + (h23_t0 * k[2].powi(3) / ((2.0 * k[0] * k[2]) + h23_t2 + h23_t1));
-        // k[24] = ell^2*m2
-        k[24] = (k[3] * k[3]) * k[1];
-        // k[25] = g*m1 + g*m3
-        k[25] = (k[5] * k[0]) + (k[5] * k[2]);
-        // k[26] = 3*ell*m1*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3)
-        k[26] = (3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
-            + (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
-            + (k[3] * (k[2] * k[2]) / (k[0] + k[2]));
-        // k[27] = a/2
-        k[27] = k[4] / 2.0;
-        // k[28] = 12/ell
-        k[28] = 12.0 / k[3];
-        // k[29] = g*m1*m2 + 3*g*m1*m3 + 2*g*m2*m3 + g*m1^2 + 2*g*m3^2
-        k[29] = (k[5] * k[0] * k[1])
-            + (3.0 * k[5] * k[0] * k[2])
-            + (2.0 * k[5] * k[1] * k[2])
-            + (k[5] * (k[0] * k[0]))
-            + (2.0 * k[5] * (k[2] * k[2]));
-        // k[30] = 4*m1*m2 + 16*m1*m3 + 12*m2*m3 + 4*m1^2 + 12*m3^2
-        k[30] = (4.0 * k[0] * k[1])
-            + (16.0 * k[0] * k[2])
-            + (12.0 * k[1] * k[2])
-            + (4.0 * (k[0] * k[0]))
-            + (12.0 * (k[2] * k[2]));
-        // k[32] = 6/ell
-        k[32] = 6.0 / k[3];
-        // k[33] = 144*g*m1*m2*m3^2 + 24*g*m1*m2^2*m3 + 120*g*m1*m3^3 + 96*g*m2*m3^3 + 60*g*m1^2*m2*m3 + 108*g*m1^2*m3^2 + 6*g*m1^3*m2 + 42*g*m1^3*m3 + 6*g*m1^4 + 48*g*m2^2*m3^2 + 48*g*m3^4
-        let h33_t0 = k[2] * k[2];
-        let h33_t1 = k[1] * k[1];
-        let h33_t2 = k[2].powi(3);
-        let h33_t3 = k[0] * k[0];
-        let h33_t4 = k[0].powi(3);
-        k[33] = (144.0 * k[5] * k[0] * k[1] * h33_t0)
-            + (24.0 * k[5] * k[0] * h33_t1 * k[2])
-            + (120.0 * k[5] * k[0] * h33_t2)
-            + (96.0 * k[5] * k[1] * h33_t2)
-            + (60.0 * k[5] * h33_t3 * k[1] * k[2])
-            + (108.0 * k[5] * h33_t3 * h33_t0)
-            + (6.0 * k[5] * h33_t4 * k[1])
-            + (42.0 * k[5] * h33_t4 * k[2])
-            + (6.0 * k[5] * k[0].powi(4))
-            + (48.0 * k[5] * h33_t1 * h33_t0)
-            + (48.0 * k[5] * k[2].powi(4));
-        // k[34] = 88*g*m1*m2*m3^2 + 20*g*m1*m2^2*m3 + 68*g*m1*m3^3 + 48*g*m2*m3^3 + 48*g*m1^2*m2*m3 + 4*g*m1^2*m2^2 + 68*g*m1^2*m3^2 + 8*g*m1^3*m2 + 28*g*m1^3*m3 + 4*g*m1^4 + 24*g*m2^2*m3^2 + 24*g*m3^4
-        let h34_t0 = k[2] * k[2];
-        let h34_t1 = k[1] * k[1];
-        let h34_t2 = k[2].powi(3);
-        let h34_t3 = k[0] * k[0];
-        let h34_t4 = k[0].powi(3);
-        k[34] = (88.0 * k[5] * k[0] * k[1] * h34_t0)
-            + (20.0 * k[5] * k[0] * h34_t1 * k[2])
-            + (68.0 * k[5] * k[0] * h34_t2)
-            + (48.0 * k[5] * k[1] * h34_t2)
-            + (48.0 * k[5] * h34_t3 * k[1] * k[2])
-            + (4.0 * k[5] * h34_t3 * h34_t1)
-            + (68.0 * k[5] * h34_t3 * h34_t0)
-            + (8.0 * k[5] * h34_t4 * k[1])
-            + (28.0 * k[5] * h34_t4 * k[2])
-            + (4.0 * k[5] * k[0].powi(4))
-            + (24.0 * k[5] * h34_t1 * h34_t0)
-            + (24.0 * k[5] * k[2].powi(4));
-        // k[35] = 72*g*m1*m2*m3^2 + 12*g*m1*m2^2*m3 + 60*g*m1*m3^3 + 48*g*m2*m3^3 + 30*g*m1^2*m2*m3 + 54*g*m1^2*m3^2 + 3*g*m1^3*m2 + 21*g*m1^3*m3 + 3*g*m1^4 + 24*g*m2^2*m3^2 + 24*g*m3^4
-        let h35_t0 = k[2] * k[2];
-        let h35_t1 = k[1] * k[1];
-        let h35_t2 = k[2].powi(3);
-        let h35_t3 = k[0] * k[0];
-        let h35_t4 = k[0].powi(3);
-        k[35] = (72.0 * k[5] * k[0] * k[1] * h35_t0)
-            + (12.0 * k[5] * k[0] * h35_t1 * k[2])
-            + (60.0 * k[5] * k[0] * h35_t2)
-            + (48.0 * k[5] * k[1] * h35_t2)
-            + (30.0 * k[5] * h35_t3 * k[1] * k[2])
-            + (54.0 * k[5] * h35_t3 * h35_t0)
-            + (3.0 * k[5] * h35_t4 * k[1])
-            + (21.0 * k[5] * h35_t4 * k[2])
-            + (3.0 * k[5] * k[0].powi(4))
-            + (24.0 * k[5] * h35_t1 * h35_t0)
-            + (24.0 * k[5] * k[2].powi(4));
-        // k[36] = ell*m1*m2/(2*(m1 + m2 + m3))
-        k[36] = k[3] * k[0] * k[1] / 2.0 / (k[0] + k[1] + k[2]);
-        // k[37] = (ell*m1 + 2*ell*m3)/2
-        k[37] = ((k[3] * k[0]) + (2.0 * k[3] * k[2])) / 2.0;
-        // k[46] = ell*m1/(2*(m1 + m2 + m3)) + ell*m2/(m1 + m2 + m3) + ell*m3/(m1 + m2 + m3)
-        k[46] = (k[3] * k[0] / 2.0 / (k[0] + k[1] + k[2]))
-            + (k[3] * k[1] / (k[0] + k[1] + k[2]))
-            + (k[3] * k[2] / (k[0] + k[1] + k[2]));
-        // k[47] = ell*(m1/2 + m3)/(m1 + m3)
-        k[47] = k[3] * ((k[0] / 2.0) + k[2]) / (k[0] + k[2]);
-        // k[48] = ell*m1/(2*(m1 + m3))
-        k[48] = k[3] * k[0] / (2.0 * (k[0] + k[2]));
+        k[13] = (3.0 * ell * m1 * m3 / 2.0 / (m1 + m3))
+            + (ell * m2)
+            + (ell * (m1 * m1) / 2.0 / (m1 + m3))
+            + (ell * (m3 * m3) / (m1 + m3));
+        // k[14] = ell^2*m1/24 + ell^2*m1*m3/(8*(m1 + m3)) + ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*(2*m1*m3 + m1^2 + m3^2))
+        let h14_t0 = ell * ell;
+        let h14_t1 = m3 * m3;
+        let h14_t2 = m1 * m1;
+        k[14] = (h14_t0 * m1 / 24.0)
+            + (h14_t0 * m1 * m3 / 8.0 / (m1 + m3))
+            + (h14_t0 * m1 * h14_t1 / ((2.0 * m1 * m3) + h14_t2 + h14_t1))
+            + (5.0 * h14_t0 * h14_t2 * m3 / 8.0 / ((2.0 * m1 * m3) + h14_t2 + h14_t1))
+            + (h14_t0 * m1.powi(3) / 8.0 / ((2.0 * m1 * m3) + h14_t2 + h14_t1))
+            + (h14_t0 * m3.powi(3) / 2.0 / ((2.0 * m1 * m3) + h14_t2 + h14_t1));
+        // k[15] = ell^2*m2/2
+        k[15] = (ell * ell) * m2 / 2.0;
+        // k[16] = m1/2 + m2/2 + m3/2
+        k[16] = (m1 / 2.0) + (m2 / 2.0) + (m3 / 2.0);
+        // k[17] = a*g*m2/2
+        k[17] = a * g * m2 / 2.0;
+        // k[18] = ell*g*m1/2 + ell*g*m3
+        k[18] = (ell * g * m1 / 2.0) + (ell * g * m3);
+        // k[19] = m1 + m2 + m3
+        k[19] = m1 + m2 + m3;
+        // k[20] = ell^2*m1/12 + ell^2*m1*m3/(4*(m1 + m3)) + 2*ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*m1*m3 + m1^2 + m3^2)
+        let h20_t0 = ell * ell;
+        let h20_t1 = m3 * m3;
+        let h20_t2 = m1 * m1;
+        k[20] = (h20_t0 * m1 / 12.0)
+            + (h20_t0 * m1 * m3 / 4.0 / (m1 + m3))
+            + (2.0 * h20_t0 * m1 * h20_t1 / ((2.0 * m1 * m3) + h20_t2 + h20_t1))
+            + (5.0 * h20_t0 * h20_t2 * m3 / 4.0 / ((2.0 * m1 * m3) + h20_t2 + h20_t1))
+            + (h20_t0 * m1.powi(3) / 4.0 / ((2.0 * m1 * m3) + h20_t2 + h20_t1))
+            + (h20_t0 * m3.powi(3) / ((2.0 * m1 * m3) + h20_t2 + h20_t1));
+        // k[21] = ell^2*m2
+        k[21] = (ell * ell) * m2;
+        // k[22] = g*m1 + g*m3
+        k[22] = (g * m1) + (g * m3);
+        // k[23] = 3*ell*m1*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3)
+        k[23] = (3.0 * ell * m1 * m3 / 2.0 / (m1 + m3))
+            + (ell * (m1 * m1) / 2.0 / (m1 + m3))
+            + (ell * (m3 * m3) / (m1 + m3));
+        // k[24] = a/2
+        k[24] = a / 2.0;
+        // k[25] = 12/ell
+        k[25] = 12.0 / ell;
+        // k[26] = g*m1*m2 + 3*g*m1*m3 + 2*g*m2*m3 + g*m1^2 + 2*g*m3^2
+        k[26] = (g * m1 * m2)
+            + (3.0 * g * m1 * m3)
+            + (2.0 * g * m2 * m3)
+            + (g * (m1 * m1))
+            + (2.0 * g * (m3 * m3));
+        // k[27] = 4*m1*m2 + 16*m1*m3 + 12*m2*m3 + 4*m1^2 + 12*m3^2
+        k[27] = (4.0 * m1 * m2)
+            + (16.0 * m1 * m3)
+            + (12.0 * m2 * m3)
+            + (4.0 * (m1 * m1))
+            + (12.0 * (m3 * m3));
+        // k[29] = 6/ell
+        k[29] = 6.0 / ell;
+        // k[30] = 144*g*m1*m2*m3^2 + 24*g*m1*m2^2*m3 + 120*g*m1*m3^3 + 96*g*m2*m3^3 + 60*g*m1^2*m2*m3 + 108*g*m1^2*m3^2 + 6*g*m1^3*m2 + 42*g*m1^3*m3 + 6*g*m1^4 + 48*g*m2^2*m3^2 + 48*g*m3^4
+        let h30_t0 = m3 * m3;
+        let h30_t1 = m2 * m2;
+        let h30_t2 = m3.powi(3);
+        let h30_t3 = m1 * m1;
+        let h30_t4 = m1.powi(3);
+        k[30] = (144.0 * g * m1 * m2 * h30_t0)
+            + (24.0 * g * m1 * h30_t1 * m3)
+            + (120.0 * g * m1 * h30_t2)
+            + (96.0 * g * m2 * h30_t2)
+            + (60.0 * g * h30_t3 * m2 * m3)
+            + (108.0 * g * h30_t3 * h30_t0)
+            + (6.0 * g * h30_t4 * m2)
+            + (42.0 * g * h30_t4 * m3)
+            + (6.0 * g * m1.powi(4))
+            + (48.0 * g * h30_t1 * h30_t0)
+            + (48.0 * g * m3.powi(4));
+        // k[31] = 88*g*m1*m2*m3^2 + 20*g*m1*m2^2*m3 + 68*g*m1*m3^3 + 48*g*m2*m3^3 + 48*g*m1^2*m2*m3 + 4*g*m1^2*m2^2 + 68*g*m1^2*m3^2 + 8*g*m1^3*m2 + 28*g*m1^3*m3 + 4*g*m1^4 + 24*g*m2^2*m3^2 + 24*g*m3^4
+        let h31_t0 = m3 * m3;
+        let h31_t1 = m2 * m2;
+        let h31_t2 = m3.powi(3);
+        let h31_t3 = m1 * m1;
+        let h31_t4 = m1.powi(3);
+        k[31] = (88.0 * g * m1 * m2 * h31_t0)
+            + (20.0 * g * m1 * h31_t1 * m3)
+            + (68.0 * g * m1 * h31_t2)
+            + (48.0 * g * m2 * h31_t2)
+            + (48.0 * g * h31_t3 * m2 * m3)
+            + (4.0 * g * h31_t3 * h31_t1)
+            + (68.0 * g * h31_t3 * h31_t0)
+            + (8.0 * g * h31_t4 * m2)
+            + (28.0 * g * h31_t4 * m3)
+            + (4.0 * g * m1.powi(4))
+            + (24.0 * g * h31_t1 * h31_t0)
+            + (24.0 * g * m3.powi(4));
+        // k[32] = 72*g*m1*m2*m3^2 + 12*g*m1*m2^2*m3 + 60*g*m1*m3^3 + 48*g*m2*m3^3 + 30*g*m1^2*m2*m3 + 54*g*m1^2*m3^2 + 3*g*m1^3*m2 + 21*g*m1^3*m3 + 3*g*m1^4 + 24*g*m2^2*m3^2 + 24*g*m3^4
+        let h32_t0 = m3 * m3;
+        let h32_t1 = m2 * m2;
+        let h32_t2 = m3.powi(3);
+        let h32_t3 = m1 * m1;
+        let h32_t4 = m1.powi(3);
+        k[32] = (72.0 * g * m1 * m2 * h32_t0)
+            + (12.0 * g * m1 * h32_t1 * m3)
+            + (60.0 * g * m1 * h32_t2)
+            + (48.0 * g * m2 * h32_t2)
+            + (30.0 * g * h32_t3 * m2 * m3)
+            + (54.0 * g * h32_t3 * h32_t0)
+            + (3.0 * g * h32_t4 * m2)
+            + (21.0 * g * h32_t4 * m3)
+            + (3.0 * g * m1.powi(4))
+            + (24.0 * g * h32_t1 * h32_t0)
+            + (24.0 * g * m3.powi(4));
+        // k[33] = ell*m1*m2/(2*(m1 + m2 + m3))
+        k[33] = ell * m1 * m2 / 2.0 / (m1 + m2 + m3);
+        // k[34] = (ell*m1 + 2*ell*m3)/2
+        k[34] = ((ell * m1) + (2.0 * ell * m3)) / 2.0;
+        // k[43] = ell*m1/(2*(m1 + m2 + m3)) + ell*m2/(m1 + m2 + m3) + ell*m3/(m1 + m2 + m3)
+        k[43] = (ell * m1 / 2.0 / (m1 + m2 + m3))
+            + (ell * m2 / (m1 + m2 + m3))
+            + (ell * m3 / (m1 + m2 + m3));
+        // k[44] = ell*(m1/2 + m3)/(m1 + m3)
+        k[44] = ell * ((m1 / 2.0) + m3) / (m1 + m3);
+        // k[45] = ell*m1/(2*(m1 + m3))
+        k[45] = ell * m1 / (2.0 * (m1 + m3));
     }
 
+    /// The state at release, over the parameters.
+    ///
+    /// - `x1 = 0.0`
+    /// - `dot_x1 = 0.0`
+    /// - `theta = asin(a/ell)`
+    /// - `dot_theta = 0.0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = k[6];
         qd[1] = 0.0;
     }
 
+    /// Each point's position over the state (`pos`), and its time derivative (`vel`).
+    ///
+    /// - `foot_x = x1`
+    /// - `foot_y = 0`
+    /// - `tip_x = ell*cos(theta) + x1`
+    /// - `tip_y = ell*sin(theta)`
+    /// - `rod_centre_x = ell*cos(theta)/2 + x1`
+    /// - `rod_centre_y = ell*sin(theta)/2`
+    /// - `mass_centre_x = ell*m1*cos(theta)/(2*(m1 + m3)) + ell*m3*cos(theta)/(m1 + m3) + x1`
+    /// - `mass_centre_y = ell*m1*sin(theta)/(2*(m1 + m3)) + ell*m3*sin(theta)/(m1 + m3)`
+    /// - `cube_x = ell*cos(theta) + x1`
+    /// - `cube_y = 0`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let pt0 = (k[3] * rc_c) + q[0];
-        let pt1 = -(k[3] * qd[1] * rc_s) + qd[0];
-        pos[0] = [q[0], 0.0];
-        vel[0] = [qd[0], 0.0];
-        pos[1] = [pt0, k[3] * rc_s];
-        vel[1] = [pt1, k[3] * qd[1] * rc_c];
-        pos[2] = [(k[11] * rc_c) + q[0], k[11] * rc_s];
-        vel[2] = [-(k[11] * qd[1] * rc_s) + qd[0], k[11] * qd[1] * rc_c];
-        pos[3] = [(k[12] * rc_c) + q[0], k[12] * rc_s];
-        vel[3] = [-(k[12] * qd[1] * rc_s) + qd[0], k[12] * qd[1] * rc_c];
+        let ell = k[3];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let theta_dot = qd[1];
+        let pt0 = (ell * rc_c) + x1;
+        let pt1 = -(ell * theta_dot * rc_s) + x1_dot;
+        pos[0] = [x1, 0.0];
+        vel[0] = [x1_dot, 0.0];
+        pos[1] = [pt0, ell * rc_s];
+        vel[1] = [pt1, ell * theta_dot * rc_c];
+        pos[2] = [(k[11] * rc_c) + x1, k[11] * rc_s];
+        vel[2] = [
+            -(k[11] * theta_dot * rc_s) + x1_dot,
+            k[11] * theta_dot * rc_c,
+        ];
+        pos[3] = [(k[12] * rc_c) + x1, k[12] * rc_s];
+        vel[3] = [
+            -(k[12] * theta_dot * rc_s) + x1_dot,
+            k[12] * theta_dot * rc_c,
+        ];
         pos[4] = [pt0, 0.0];
         vel[4] = [pt1, 0.0];
     }
 
+    /// The total energy `E = T + V`.
+    ///
+    /// - `T`: 561 characters, written out in `generated/loaded_rod_closed.tex`
+    /// - `V = a*g*m2/2 + ell*g*m1*sin(theta)/2 + ell*g*m3*sin(theta)`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..49]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let et0 = qd[1] * qd[1];
-        (-(k[13] * qd[1] * qd[0] * rc_s)
+        let k = &k[..46]; // one bounds check for all constant loads
+        let rc_s = q[1].sin();
+        let x1_dot = qd[0];
+        let theta_dot = qd[1];
+        let et0 = theta_dot * theta_dot;
+        (-(k[13] * theta_dot * x1_dot * rc_s)
             + (k[14] * et0)
             + (k[15] * et0 * (rc_s * rc_s))
-            + (k[16] * et0 * (rc_c * rc_c))
-            + (k[17] * (qd[0] * qd[0])))
-            + (k[18] + (k[19] * rc_s))
+            + (k[16] * (x1_dot * x1_dot)))
+            + (k[17] + (k[18] * rc_s))
     }
 
+    /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
+    ///
+    /// - `p_x1`: 201 characters, written out in `generated/loaded_rod_closed.tex`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
-        out[0] = -(k[13] * qd[1] * rc_s) + (k[20] * qd[0]);
+        let x1_dot = qd[0];
+        let theta_dot = qd[1];
+        out[0] = -(k[13] * theta_dot * rc_s) + (k[19] * x1_dot);
     }
 
+    /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
+    ///
+    /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
+    /// - `L = T - V`: 620 characters, written out in `generated/loaded_rod_closed.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let qt0 = -k[13] * rc_s;
-        let qt1 = qd[1] * qd[1];
-        mass[0] = k[20];
+        let theta_dot = qd[1];
+        let qt0 = -k[13] * rc_s; // -((3*ell*m1*m3/(2*(m1 + m3)) + ell*m2 + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3))*rc_s)
+        let qt1 = theta_dot * theta_dot;
+        mass[0] = k[19];
         mass[1] = qt0;
         mass[2] = qt0;
-        mass[3] = k[21] + (k[22] * (rc_s * rc_s)) + (k[23] * (rc_c * rc_c));
+        mass[3] = k[20] + (k[21] * (rc_s * rc_s));
         rhs[0] = k[13] * qt1 * rc_c;
-        rhs[1] = -(k[19] * rc_c) - (k[24] * qt1 * rc_s * rc_c);
+        rhs[1] = -(k[18] * rc_c) - (k[21] * qt1 * rc_s * rc_c);
     }
 
+    /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
+    ///
+    /// - `contact_force = m2*(-ddot_theta*ell*sin(theta) + ddot_x1 - dot_theta^2*ell*cos(theta))`
+    /// - `floor_normal`: 294 characters, written out in `generated/loaded_rod_closed.tex`
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let ft0 = qd[1] * qd[1];
-        out[0] = k[1] * (-(k[3] * qdd[1] * rc_s) + qdd[0] - (k[3] * ft0 * rc_c));
-        out[1] = k[25] + (k[26] * qdd[1] * rc_c) - (k[26] * ft0 * rc_s);
+        let m2 = k[1];
+        let ell = k[3];
+        let x1_ddot = qdd[0];
+        let theta_dot = qd[1];
+        let theta_ddot = qdd[1];
+        let ft0 = theta_dot * theta_dot;
+        out[0] = m2 * (-(ell * theta_ddot * rc_s) + x1_ddot - (ell * ft0 * rc_c));
+        out[1] = k[22] + (k[23] * theta_ddot * rc_c) - (k[23] * ft0 * rc_s);
     }
 
+    /// Each contact's gap `g(q)`, `>= 0` while apart (zero for a contact held closed).
+    ///
+    /// No open contact.
     fn gaps(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
     }
 
+    /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, _k: &[f64], _q: &[f64], _qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
         jac[0] = 0.0;
         jac[1] = 0.0;
@@ -408,45 +463,75 @@ impl Model for LoadedRodClosed {
         bias[1] = 0.0;
     }
 
+    /// Each contact's edge margin, `>= 0` while the contact point is on the edge (infinite without one).
+    ///
+    /// No contact has an edge.
     fn edges(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
         out[0] = f64::INFINITY;
         out[1] = f64::INFINITY;
     }
 
+    /// Each friction's slip velocity `v = J(q) qd`: `jac` holds `J`, `bias` holds `dJ/dt qd`.
+    ///
+    /// No friction.
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
+    /// The monitors over the state and the contacts' forces `rc_f<i>`.
+    ///
+    /// - `cube_does_not_tip = a*g*m2/2 - rc_f0*(-a/2 + ell*sin(theta))`
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
-        out[0] = k[18] - (forces[0] * (-k[27] + (k[3] * rc_s)));
+        let ell = k[3];
+        out[0] = k[17] - (forces[0] * (-k[24] + (ell * rc_s)));
     }
 
+    /// The system's state (its general model's) that this phase's state stands for.
+    ///
+    /// - `x1 = x1`
+    /// - `dot_x1 = dot_x1`
+    /// - `y1 = 0`
+    /// - `dot_y1 = 0`
+    /// - `theta = theta`
+    /// - `dot_theta = dot_theta`
+    /// - `x2 = ell*cos(theta) + x1`
+    /// - `dot_x2 = -dot_theta*ell*sin(theta) + dot_x1`
     fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        q_full[0] = q[0];
-        qd_full[0] = qd[0];
+        let ell = k[3];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let theta = q[1];
+        let theta_dot = qd[1];
+        q_full[0] = x1;
+        qd_full[0] = x1_dot;
         q_full[1] = 0.0;
         qd_full[1] = 0.0;
-        q_full[2] = q[1];
-        qd_full[2] = qd[1];
-        q_full[3] = (k[3] * rc_c) + q[0];
-        qd_full[3] = -(k[3] * qd[1] * rc_s) + qd[0];
+        q_full[2] = theta;
+        qd_full[2] = theta_dot;
+        q_full[3] = (ell * rc_c) + x1;
+        qd_full[3] = -(ell * theta_dot * rc_s) + x1_dot;
     }
 
+    /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        poses[0] = [(k[12] * rc_c) + q[0], k[12] * rc_s, q[1]];
-        poses[1] = [k[27] + (k[3] * rc_c) + q[0], k[27], 0.0];
-        sizes[0] = -k[47];
+        let ell = k[3];
+        let a = k[4];
+        let x1 = q[0];
+        let theta = q[1];
+        poses[0] = [(k[12] * rc_c) + x1, k[12] * rc_s, theta];
+        poses[1] = [k[24] + (ell * rc_c) + x1, k[24], 0.0];
+        sizes[0] = -k[44];
         sizes[1] = 0.0;
-        sizes[2] = k[48];
+        sizes[2] = k[45];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
-        sizes[6] = k[4];
-        sizes[7] = k[4];
+        sizes[6] = a;
+        sizes[7] = a;
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -455,164 +540,184 @@ impl Model for LoadedRodClosed {
 }
 
 impl Reduction for LoadedRodClosed {
+    /// The reduced motion at `theta = theta_i - delta`: `theta_dot^2` from the energy integral, and `theta_ddot`.
+    ///
+    /// - `theta_dot^2`: 349 characters, written out in `generated/loaded_rod_closed.tex`
+    /// - `theta_ddot`: 1441 characters, written out in `generated/loaded_rod_closed.tex`
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[6], k[8], k[9], delta);
         let rt0 = rc_s * rc_s;
-        let rt1 = -k[30] + (k[31] * rt0);
+        let rt1 = -k[27] + (k[28] * rt0); // -(4*m1*m2 + 16*m1*m3 + 12*m2*m3 + 4*m1^2 + 12*m3^2) + (12*m1*m3 + 12*m2*m3 + 3*m1^2 + 12*m3^2)*rc_s^2
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: -k[28] * (k[29] * rc_ds) / rt1,
-            theta_ddot: k[32]
-                * ((k[33] * rc_s * rc_c * rc_ds) - (k[34] * rc_c) + (k[35] * rt0 * rc_c))
+            theta_dot_sq: -k[25] * (k[26] * rc_ds) / rt1,
+            theta_ddot: k[29]
+                * ((k[30] * rc_s * rc_c * rc_ds) - (k[31] * rc_c) + (k[32] * rt0 * rc_c))
                 / (rt1 * rt1),
         }
     }
 
+    /// `theta_dot^2` over `sin(theta)`, `cos(theta)` and their drops from the start (the per-point solver's integrand).
+    ///
+    /// - `theta_dot^2`: 349 characters, written out in `generated/loaded_rod_closed.tex`
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..49]; // one bounds check for all constant loads
-        -k[28] * (k[29] * rc_ds) / (-k[30] + (k[31] * (rc_s * rc_s)))
+        let k = &k[..46]; // one bounds check for all constant loads
+        -k[25] * (k[26] * rc_ds) / (-k[27] + (k[28] * (rc_s * rc_s)))
     }
 
+    /// Each contact's force on the reduced motion (zero for a contact open in the phase).
+    ///
+    /// - `contact_force`: 963 characters, written out in `generated/loaded_rod_closed.tex`
+    /// - `floor_normal`: 1320 characters, written out in `generated/loaded_rod_closed.tex`
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[6], k[8], k[9], delta);
         let rt0 = rc_s * rc_s;
-        let rt1 = -k[30] + (k[31] * rt0);
-        let rc_w2 = -k[28] * (k[29] * rc_ds) / rt1;
-        let rc_acc = k[32]
-            * ((k[33] * rc_s * rc_c * rc_ds) - (k[34] * rc_c) + (k[35] * rt0 * rc_c))
+        let rt1 = -k[27] + (k[28] * rt0); // -(4*m1*m2 + 16*m1*m3 + 12*m2*m3 + 4*m1^2 + 12*m3^2) + (12*m1*m3 + 12*m2*m3 + 3*m1^2 + 12*m3^2)*rc_s^2
+        let rc_w2 = -k[25] * (k[26] * rc_ds) / rt1;
+        let rc_acc = k[29]
+            * ((k[30] * rc_s * rc_c * rc_ds) - (k[31] * rc_c) + (k[32] * rt0 * rc_c))
             / (rt1 * rt1);
-        out[0] = -(k[36] * rc_s * rc_acc) - (k[36] * rc_c * rc_w2);
-        out[1] = k[25] - (k[37] * rc_s * rc_w2) + (k[37] * rc_c * rc_acc);
+        out[0] = -(k[33] * rc_s * rc_acc) - (k[33] * rc_c * rc_w2);
+        out[1] = k[22] - (k[34] * rc_s * rc_w2) + (k[34] * rc_c * rc_acc);
     }
 
+    /// The coefficients, constant term first, of a contact's force zero as a polynomial in `sin(theta)`, where it is one.
+    ///
+    /// - `separation condition (= 0)`: 304 characters, written out in `generated/loaded_rod_closed.tex`
     fn force_polynomial(&self, k: &[f64], contact: usize, out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         match contact {
             0 => {
-                out[0] = -k[38];
-                out[1] = k[39];
+                out[0] = -k[35];
+                out[1] = k[36];
                 out[2] = 0.0;
-                out[3] = -k[31];
+                out[3] = -k[28];
             }
             1 => {
-                out[0] = k[40];
-                out[1] = -k[41];
-                out[2] = k[42];
+                out[0] = k[37];
+                out[1] = -k[38];
+                out[2] = k[39];
                 out[3] = 0.0;
-                out[4] = -k[43];
+                out[4] = -k[40];
             }
             _ => {}
         }
     }
 
+    /// The constants of `prepare` that the per-point solver reads, and only those.
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let m1 = p[0];
+        let m2 = p[1];
+        let m3 = p[2];
+        let ell = p[3];
+        let a = p[4];
+        let g = p[5];
         k[..6].copy_from_slice(p);
         // k[7] = rc_wi = 0.0
         k[7] = 0.0;
         // k[8] = rc_si = a/ell
-        k[8] = k[4] / k[3];
+        k[8] = a / ell;
         // k[9] = rc_ci = ((1 - a/ell)*(1 + a/ell))^(1/2)
-        let c3_t0 = k[4] / k[3];
+        let c3_t0 = a / ell;
         k[9] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
-        // k[31] = 12*m1*m3 + 12*m2*m3 + 3*m1^2 + 12*m3^2
-        k[31] = (12.0 * k[0] * k[2])
-            + (12.0 * k[1] * k[2])
-            + (3.0 * (k[0] * k[0]))
-            + (12.0 * (k[2] * k[2]));
-        // k[38] = 8*m1*m2*rc_si + 32*m1*m3*rc_si + 24*m2*m3*rc_si + 8*m1^2*rc_si + 24*m3^2*rc_si
-        k[38] = (8.0 * k[0] * k[1] * k[8])
-            + (32.0 * k[0] * k[2] * k[8])
-            + (24.0 * k[1] * k[2] * k[8])
-            + (8.0 * (k[0] * k[0]) * k[8])
-            + (24.0 * (k[2] * k[2]) * k[8]);
-        // k[39] = 12*m1*m2 + 48*m1*m3 + 36*m2*m3 + 12*m1^2 + 36*m3^2
-        k[39] = (12.0 * k[0] * k[1])
-            + (48.0 * k[0] * k[2])
-            + (36.0 * k[1] * k[2])
-            + (12.0 * (k[0] * k[0]))
-            + (36.0 * (k[2] * k[2]));
-        // k[40] = 152*m1*m2*m3^2 + 28*m1*m2^2*m3 + 124*m1*m3^3 + 96*m2*m3^3 + 64*m1^2*m2*m3 + 4*m1^2*m2^2 + 108*m1^2*m3^2 + 8*m1^3*m2 + 36*m1^3*m3 + 4*m1^4 + 48*m2^2*m3^2 + 48*m3^4
-        let h40_t0 = k[2] * k[2];
-        let h40_t1 = k[1] * k[1];
-        let h40_t2 = k[2].powi(3);
-        let h40_t3 = k[0] * k[0];
-        let h40_t4 = k[0].powi(3);
-        k[40] = (152.0 * k[0] * k[1] * h40_t0)
-            + (28.0 * k[0] * h40_t1 * k[2])
-            + (124.0 * k[0] * h40_t2)
-            + (96.0 * k[1] * h40_t2)
-            + (64.0 * h40_t3 * k[1] * k[2])
-            + (4.0 * h40_t3 * h40_t1)
-            + (108.0 * h40_t3 * h40_t0)
-            + (8.0 * h40_t4 * k[1])
-            + (36.0 * h40_t4 * k[2])
-            + (4.0 * k[0].powi(4))
-            + (48.0 * h40_t1 * h40_t0)
-            + (48.0 * k[2].powi(4));
-        // k[41] = 312*m1*m2*m3^2*rc_si + 96*m1*m2^2*m3*rc_si + 216*m1*m3^3*rc_si + 192*m2*m3^3*rc_si + 168*m1^2*m2*m3*rc_si + 24*m1^2*m2^2*rc_si + 168*m1^2*m3^2*rc_si + 30*m1^3*m2*rc_si + 54*m1^3*m3*rc_si + 6*m1^4*rc_si + 96*m2^2*m3^2*rc_si + 96*m3^4*rc_si
-        let h41_t0 = k[2] * k[2];
-        let h41_t1 = k[1] * k[1];
-        let h41_t2 = k[2].powi(3);
-        let h41_t3 = k[0] * k[0];
-        let h41_t4 = k[0].powi(3);
-        k[41] = (312.0 * k[0] * k[1] * h41_t0 * k[8])
-            + (96.0 * k[0] * h41_t1 * k[2] * k[8])
-            + (216.0 * k[0] * h41_t2 * k[8])
-            + (192.0 * k[1] * h41_t2 * k[8])
-            + (168.0 * h41_t3 * k[1] * k[2] * k[8])
-            + (24.0 * h41_t3 * h41_t1 * k[8])
-            + (168.0 * h41_t3 * h41_t0 * k[8])
-            + (30.0 * h41_t4 * k[1] * k[8])
-            + (54.0 * h41_t4 * k[2] * k[8])
-            + (6.0 * k[0].powi(4) * k[8])
-            + (96.0 * h41_t1 * h41_t0 * k[8])
-            + (96.0 * k[2].powi(4) * k[8]);
-        // k[42] = 228*m1*m2*m3^2 + 120*m1*m2^2*m3 + 108*m1*m3^3 + 96*m2*m3^3 + 180*m1^2*m2*m3 + 36*m1^2*m2^2 + 84*m1^2*m3^2 + 39*m1^3*m2 + 27*m1^3*m3 + 3*m1^4 + 48*m2^2*m3^2 + 48*m3^4
-        let h42_t0 = k[2] * k[2];
-        let h42_t1 = k[1] * k[1];
-        let h42_t2 = k[2].powi(3);
-        let h42_t3 = k[0] * k[0];
-        let h42_t4 = k[0].powi(3);
-        k[42] = (228.0 * k[0] * k[1] * h42_t0)
-            + (120.0 * k[0] * h42_t1 * k[2])
-            + (108.0 * k[0] * h42_t2)
-            + (96.0 * k[1] * h42_t2)
-            + (180.0 * h42_t3 * k[1] * k[2])
-            + (36.0 * h42_t3 * h42_t1)
-            + (84.0 * h42_t3 * h42_t0)
-            + (39.0 * h42_t4 * k[1])
-            + (27.0 * h42_t4 * k[2])
-            + (3.0 * k[0].powi(4))
-            + (48.0 * h42_t1 * h42_t0)
-            + (48.0 * k[2].powi(4));
-        // k[43] = 36*m1*m2*m3^2 + 36*m1*m2^2*m3 + 36*m1^2*m2*m3 + 9*m1^3*m2
-        k[43] = (36.0 * k[0] * k[1] * (k[2] * k[2]))
-            + (36.0 * k[0] * (k[1] * k[1]) * k[2])
-            + (36.0 * (k[0] * k[0]) * k[1] * k[2])
-            + (9.0 * k[0].powi(3) * k[1]);
-        // k[44] = (ell*m1 + 3*ell*m3)/(3*g*(m1 + 2*m3))
-        k[44] = ((k[3] * k[0]) + (3.0 * k[3] * k[2])) / 3.0 / k[5] / (k[0] + (2.0 * k[2]));
-        // k[45] = (4*ell*m1*m3 + 4*ell*m2*m3 + ell*m1^2 + 4*ell*m3^2)/(4*g*(m1 + 2*m3)*(m1 + m2 + m3))
-        k[45] = ((4.0 * k[3] * k[0] * k[2])
-            + (4.0 * k[3] * k[1] * k[2])
-            + (k[3] * (k[0] * k[0]))
-            + (4.0 * k[3] * (k[2] * k[2])))
+        // k[28] = 12*m1*m3 + 12*m2*m3 + 3*m1^2 + 12*m3^2
+        k[28] = (12.0 * m1 * m3) + (12.0 * m2 * m3) + (3.0 * (m1 * m1)) + (12.0 * (m3 * m3));
+        // k[35] = 8*m1*m2*rc_si + 32*m1*m3*rc_si + 24*m2*m3*rc_si + 8*m1^2*rc_si + 24*m3^2*rc_si
+        k[35] = (8.0 * m1 * m2 * k[8])
+            + (32.0 * m1 * m3 * k[8])
+            + (24.0 * m2 * m3 * k[8])
+            + (8.0 * (m1 * m1) * k[8])
+            + (24.0 * (m3 * m3) * k[8]);
+        // k[36] = 12*m1*m2 + 48*m1*m3 + 36*m2*m3 + 12*m1^2 + 36*m3^2
+        k[36] = (12.0 * m1 * m2)
+            + (48.0 * m1 * m3)
+            + (36.0 * m2 * m3)
+            + (12.0 * (m1 * m1))
+            + (36.0 * (m3 * m3));
+        // k[37] = 152*m1*m2*m3^2 + 28*m1*m2^2*m3 + 124*m1*m3^3 + 96*m2*m3^3 + 64*m1^2*m2*m3 + 4*m1^2*m2^2 + 108*m1^2*m3^2 + 8*m1^3*m2 + 36*m1^3*m3 + 4*m1^4 + 48*m2^2*m3^2 + 48*m3^4
+        let h37_t0 = m3 * m3;
+        let h37_t1 = m2 * m2;
+        let h37_t2 = m3.powi(3);
+        let h37_t3 = m1 * m1;
+        let h37_t4 = m1.powi(3);
+        k[37] = (152.0 * m1 * m2 * h37_t0)
+            + (28.0 * m1 * h37_t1 * m3)
+            + (124.0 * m1 * h37_t2)
+            + (96.0 * m2 * h37_t2)
+            + (64.0 * h37_t3 * m2 * m3)
+            + (4.0 * h37_t3 * h37_t1)
+            + (108.0 * h37_t3 * h37_t0)
+            + (8.0 * h37_t4 * m2)
+            + (36.0 * h37_t4 * m3)
+            + (4.0 * m1.powi(4))
+            + (48.0 * h37_t1 * h37_t0)
+            + (48.0 * m3.powi(4));
+        // k[38] = 312*m1*m2*m3^2*rc_si + 96*m1*m2^2*m3*rc_si + 216*m1*m3^3*rc_si + 192*m2*m3^3*rc_si + 168*m1^2*m2*m3*rc_si + 24*m1^2*m2^2*rc_si + 168*m1^2*m3^2*rc_si + 30*m1^3*m2*rc_si + 54*m1^3*m3*rc_si + 6*m1^4*rc_si + 96*m2^2*m3^2*rc_si + 96*m3^4*rc_si
+        let h38_t0 = m3 * m3;
+        let h38_t1 = m2 * m2;
+        let h38_t2 = m3.powi(3);
+        let h38_t3 = m1 * m1;
+        let h38_t4 = m1.powi(3);
+        k[38] = (312.0 * m1 * m2 * h38_t0 * k[8])
+            + (96.0 * m1 * h38_t1 * m3 * k[8])
+            + (216.0 * m1 * h38_t2 * k[8])
+            + (192.0 * m2 * h38_t2 * k[8])
+            + (168.0 * h38_t3 * m2 * m3 * k[8])
+            + (24.0 * h38_t3 * h38_t1 * k[8])
+            + (168.0 * h38_t3 * h38_t0 * k[8])
+            + (30.0 * h38_t4 * m2 * k[8])
+            + (54.0 * h38_t4 * m3 * k[8])
+            + (6.0 * m1.powi(4) * k[8])
+            + (96.0 * h38_t1 * h38_t0 * k[8])
+            + (96.0 * m3.powi(4) * k[8]);
+        // k[39] = 228*m1*m2*m3^2 + 120*m1*m2^2*m3 + 108*m1*m3^3 + 96*m2*m3^3 + 180*m1^2*m2*m3 + 36*m1^2*m2^2 + 84*m1^2*m3^2 + 39*m1^3*m2 + 27*m1^3*m3 + 3*m1^4 + 48*m2^2*m3^2 + 48*m3^4
+        let h39_t0 = m3 * m3;
+        let h39_t1 = m2 * m2;
+        let h39_t2 = m3.powi(3);
+        let h39_t3 = m1 * m1;
+        let h39_t4 = m1.powi(3);
+        k[39] = (228.0 * m1 * m2 * h39_t0)
+            + (120.0 * m1 * h39_t1 * m3)
+            + (108.0 * m1 * h39_t2)
+            + (96.0 * m2 * h39_t2)
+            + (180.0 * h39_t3 * m2 * m3)
+            + (36.0 * h39_t3 * h39_t1)
+            + (84.0 * h39_t3 * h39_t0)
+            + (39.0 * h39_t4 * m2)
+            + (27.0 * h39_t4 * m3)
+            + (3.0 * m1.powi(4))
+            + (48.0 * h39_t1 * h39_t0)
+            + (48.0 * m3.powi(4));
+        // k[40] = 36*m1*m2*m3^2 + 36*m1*m2^2*m3 + 36*m1^2*m2*m3 + 9*m1^3*m2
+        k[40] = (36.0 * m1 * m2 * (m3 * m3))
+            + (36.0 * m1 * (m2 * m2) * m3)
+            + (36.0 * (m1 * m1) * m2 * m3)
+            + (9.0 * m1.powi(3) * m2);
+        // k[41] = (ell*m1 + 3*ell*m3)/(3*g*(m1 + 2*m3))
+        k[41] = ((ell * m1) + (3.0 * ell * m3)) / 3.0 / g / (m1 + (2.0 * m3));
+        // k[42] = (4*ell*m1*m3 + 4*ell*m2*m3 + ell*m1^2 + 4*ell*m3^2)/(4*g*(m1 + 2*m3)*(m1 + m2 + m3))
+        k[42] = ((4.0 * ell * m1 * m3)
+            + (4.0 * ell * m2 * m3)
+            + (ell * (m1 * m1))
+            + (4.0 * ell * (m3 * m3)))
             / 4.0
-            / k[5]
-            / (k[0] + (2.0 * k[2]))
-            / (k[0] + k[1] + k[2]);
+            / g
+            / (m1 + (2.0 * m3))
+            / (m1 + m2 + m3);
     }
 
+    /// The coefficients, constant term first, of the fall polynomial `P(s) = (sin(theta_i) - s) / theta_dot^2` in `s = sin(theta)`.
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
-        out[0] = k[44];
+        let k = &k[..46]; // one bounds check for all constant loads
+        out[0] = k[41];
         out[1] = 0.0;
-        out[2] = -k[45];
+        out[2] = -k[42];
     }
 
+    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
     fn full_state(
         &self,
         k: &[f64],
@@ -622,12 +727,12 @@ impl Reduction for LoadedRodClosed {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..46]; // one bounds check for all constant loads
         let (rc_s, _, _, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let rc_w = theta_dot;
         q[1] = k[6] - delta;
         qd[1] = theta_dot;
-        q[0] = k[10] + (k[46] * rc_dc);
-        qd[0] = k[46] * rc_s * rc_w;
+        q[0] = k[10] + (k[43] * rc_dc);
+        qd[0] = k[43] * rc_s * rc_w;
     }
 }

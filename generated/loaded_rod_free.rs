@@ -95,7 +95,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 49,
+    n_constants: 47,
     coordinates: &["x1", "theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced: 1,
@@ -190,7 +190,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 13,
         force_degrees: &[0, 2],
         fall_degree: None,
-        lean_constants: &[12, 13, 16, 42, 43, 44],
+        lean_constants: &[12, 13, 16, 40, 41, 42],
     }),
     route_note: "",
 };
@@ -200,17 +200,37 @@ impl Model for LoadedRodFree {
         &INFO
     }
 
+    /// The requirements' margins over the parameters, each `>= 0` where it holds.
+    ///
+    /// - `rod_leans = ell - a`
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
-        let k = p;
-        out[0] = k[3] - k[4];
+        let ell = p[3];
+        let a = p[4];
+        out[0] = ell - a;
     }
 
+    /// Each contact's coefficient of restitution over the parameters.
+    ///
+    /// - `contact_force = 0`
+    /// - `floor_normal = 0`
     fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
     }
 
+    /// The constants `k`: the parameters, then the constants derived from them.
+    ///
+    /// `k[..12]` holds the parameters `m1, m2, m3, ell, a, g, x1_0, theta_0, x2_0, x1_dot_0, theta_dot_0, x2_dot_0`; each later slot's definition is the comment above the line that fills it.
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
+        let m1 = p[0];
+        let m2 = p[1];
+        let m3 = p[2];
+        let ell = p[3];
+        let a = p[4];
+        let g = p[5];
+        let x1_dot_0 = p[9];
+        let theta_dot_0 = p[10];
+        let x2_dot_0 = p[11];
         k[..12].copy_from_slice(p);
         // k[7] also holds rc_thi = theta_0
         // k[10] also holds rc_wi = theta_dot_0
@@ -218,235 +238,332 @@ impl Model for LoadedRodFree {
         // k[8] also holds rc_x1i = x2_0
         Reduction::prepare_lean(self, p, k);
         // k[14] = rc_p0 = -3*ell*m1*m3*rc_wi*rc_si/(2*(m1 + m3)) - ell*m1^2*rc_wi*rc_si/(2*(m1 + m3)) - ell*m3^2*rc_wi*rc_si/(m1 + m3) + m1*x1_dot_0 + m3*x1_dot_0
-        k[14] = -(3.0 * k[3] * k[0] * k[2] * k[10] * k[12] / 2.0 / (k[0] + k[2]))
-            - (k[3] * (k[0] * k[0]) * k[10] * k[12] / 2.0 / (k[0] + k[2]))
-            - (k[3] * (k[2] * k[2]) * k[10] * k[12] / (k[0] + k[2]))
-            + (k[0] * k[9])
-            + (k[2] * k[9]);
+        k[14] = -(3.0 * ell * m1 * m3 * theta_dot_0 * k[12] / 2.0 / (m1 + m3))
+            - (ell * (m1 * m1) * theta_dot_0 * k[12] / 2.0 / (m1 + m3))
+            - (ell * (m3 * m3) * theta_dot_0 * k[12] / (m1 + m3))
+            + (m1 * x1_dot_0)
+            + (m3 * x1_dot_0);
         // k[15] = rc_p1 = m2*x2_dot_0
-        k[15] = k[1] * k[11];
+        k[15] = m2 * x2_dot_0;
         // k[17] = ell/2
-        k[17] = k[3] / 2.0;
+        k[17] = ell / 2.0;
         // k[18] = ell*m1/(2*(m1 + m3)) + ell*m3/(m1 + m3)
-        k[18] = (k[3] * k[0] / 2.0 / (k[0] + k[2])) + (k[3] * k[2] / (k[0] + k[2]));
+        k[18] = (ell * m1 / 2.0 / (m1 + m3)) + (ell * m3 / (m1 + m3));
         // k[19] = 3*ell*m1*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3)
-        k[19] = (3.0 * k[3] * k[0] * k[2] / 2.0 / (k[0] + k[2]))
-            + (k[3] * (k[0] * k[0]) / 2.0 / (k[0] + k[2]))
-            + (k[3] * (k[2] * k[2]) / (k[0] + k[2]));
-        // k[20] = ell^2*m1/24 + ell^2*m1*m3/(8*(m1 + m3))
-        let h20_t0 = k[3] * k[3];
-        k[20] = (h20_t0 * k[0] / 24.0) + (h20_t0 * k[0] * k[2] / 8.0 / (k[0] + k[2]));
-        // k[21] = ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*(2*m1*m3 + m1^2 + m3^2))
-        let h21_t0 = k[3] * k[3];
-        let h21_t1 = k[2] * k[2];
-        let h21_t2 = k[0] * k[0];
-        k[21] = (h21_t0 * k[0] * h21_t1 / ((2.0 * k[0] * k[2]) + h21_t2 + h21_t1))
-            + (5.0 * h21_t0 * h21_t2 * k[2] / 8.0 / ((2.0 * k[0] * k[2]) + h21_t2 + h21_t1))
-            + (h21_t0 * k[0].powi(3) / 8.0 / ((2.0 * k[0] * k[2]) + h21_t2 + h21_t1))
-            + (h21_t0 * k[2].powi(3) / 2.0 / ((2.0 * k[0] * k[2]) + h21_t2 + h21_t1));
-        // k[22] = m1/2 + m3/2
-        k[22] = (k[0] / 2.0) + (k[2] / 2.0);
-        // k[23] = m2/2
-        k[23] = k[1] / 2.0;
-        // k[24] = a*g*m2/2
-        k[24] = k[4] * k[5] * k[1] / 2.0;
-        // k[25] = ell*g*m1/2 + ell*g*m3
-        k[25] = (k[3] * k[5] * k[0] / 2.0) + (k[3] * k[5] * k[2]);
-        // k[26] = m1 + m3
-        k[26] = k[0] + k[2];
-        // k[27] = ell^2*m1/12 + ell^2*m1*m3/(4*(m1 + m3))
-        let h27_t0 = k[3] * k[3];
-        k[27] = (h27_t0 * k[0] / 12.0) + (h27_t0 * k[0] * k[2] / 4.0 / (k[0] + k[2]));
-        // k[28] = 2*ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*m1*m3 + m1^2 + m3^2)
-        let h28_t0 = k[3] * k[3];
-        let h28_t1 = k[2] * k[2];
-        let h28_t2 = k[0] * k[0];
-        k[28] = (2.0 * h28_t0 * k[0] * h28_t1 / ((2.0 * k[0] * k[2]) + h28_t2 + h28_t1))
-            + (5.0 * h28_t0 * h28_t2 * k[2] / 4.0 / ((2.0 * k[0] * k[2]) + h28_t2 + h28_t1))
-            + (h28_t0 * k[0].powi(3) / 4.0 / ((2.0 * k[0] * k[2]) + h28_t2 + h28_t1))
-            + (h28_t0 * k[2].powi(3) / ((2.0 * k[0] * k[2]) + h28_t2 + h28_t1));
-        // k[29] = g*m1 + g*m3
-        k[29] = (k[5] * k[0]) + (k[5] * k[2]);
-        // k[30] = a/2
-        k[30] = k[4] / 2.0;
-        // k[31] = 12/ell^2
-        k[31] = 12.0 / (k[3] * k[3]);
-        // k[32] = m1*rc_wi^2*rc_ai + m3*rc_wi^2*rc_ai
-        let h32_t0 = k[10] * k[10];
-        k[32] = (k[0] * h32_t0 * k[16]) + (k[2] * h32_t0 * k[16]);
-        // k[33] = 3*ell*g*m1*m3 + ell*g*m1^2 + 2*ell*g*m3^2
-        k[33] = (3.0 * k[3] * k[5] * k[0] * k[2])
-            + (k[3] * k[5] * (k[0] * k[0]))
-            + (2.0 * k[3] * k[5] * (k[2] * k[2]));
-        // k[34] = 16*m1*m3 + 4*m1^2 + 12*m3^2
-        k[34] = (16.0 * k[0] * k[2]) + (4.0 * (k[0] * k[0])) + (12.0 * (k[2] * k[2]));
-        // k[35] = 12*m1*m3 + 3*m1^2 + 12*m3^2
-        k[35] = (12.0 * k[0] * k[2]) + (3.0 * (k[0] * k[0])) + (12.0 * (k[2] * k[2]));
-        // k[36] = 6/ell^2
-        k[36] = 6.0 / (k[3] * k[3]);
-        // k[37] = 120*ell*g*m1*m3^3 + 108*ell*g*m1^2*m3^2 + 42*ell*g*m1^3*m3 + 6*ell*g*m1^4 + 48*ell*g*m3^4
-        k[37] = (120.0 * k[3] * k[5] * k[0] * k[2].powi(3))
-            + (108.0 * k[3] * k[5] * (k[0] * k[0]) * (k[2] * k[2]))
-            + (42.0 * k[3] * k[5] * k[0].powi(3) * k[2])
-            + (6.0 * k[3] * k[5] * k[0].powi(4))
-            + (48.0 * k[3] * k[5] * k[2].powi(4));
-        // k[38] = 68*ell*g*m1*m3^3 + 68*ell*g*m1^2*m3^2 + 28*ell*g*m1^3*m3 + 4*ell*g*m1^4 + 24*ell*g*m3^4
-        k[38] = (68.0 * k[3] * k[5] * k[0] * k[2].powi(3))
-            + (68.0 * k[3] * k[5] * (k[0] * k[0]) * (k[2] * k[2]))
-            + (28.0 * k[3] * k[5] * k[0].powi(3) * k[2])
-            + (4.0 * k[3] * k[5] * k[0].powi(4))
-            + (24.0 * k[3] * k[5] * k[2].powi(4));
-        // k[39] = 60*ell*g*m1*m3^3 + 54*ell*g*m1^2*m3^2 + 21*ell*g*m1^3*m3 + 3*ell*g*m1^4 + 24*ell*g*m3^4
-        k[39] = (60.0 * k[3] * k[5] * k[0] * k[2].powi(3))
-            + (54.0 * k[3] * k[5] * (k[0] * k[0]) * (k[2] * k[2]))
-            + (21.0 * k[3] * k[5] * k[0].powi(3) * k[2])
-            + (3.0 * k[3] * k[5] * k[0].powi(4))
-            + (24.0 * k[3] * k[5] * k[2].powi(4));
-        // k[40] = 48*m1*m3^2*rc_wi^2*rc_ai + 30*m1^2*m3*rc_wi^2*rc_ai + 6*m1^3*rc_wi^2*rc_ai + 24*m3^3*rc_wi^2*rc_ai
-        let h40_t0 = k[10] * k[10];
-        k[40] = (48.0 * k[0] * (k[2] * k[2]) * h40_t0 * k[16])
-            + (30.0 * (k[0] * k[0]) * k[2] * h40_t0 * k[16])
-            + (6.0 * k[0].powi(3) * h40_t0 * k[16])
-            + (24.0 * k[2].powi(3) * h40_t0 * k[16]);
-        // k[41] = (ell*m1 + 2*ell*m3)/2
-        k[41] = ((k[3] * k[0]) + (2.0 * k[3] * k[2])) / 2.0;
-        // k[45] = rc_p0/(m1 + m3)
-        k[45] = k[14] / (k[0] + k[2]);
-        // k[46] = rc_p1/m2
-        k[46] = k[15] / k[1];
-        // k[47] = ell*(m1/2 + m3)/(m1 + m3)
-        k[47] = k[3] * ((k[0] / 2.0) + k[2]) / (k[0] + k[2]);
-        // k[48] = ell*m1/(2*(m1 + m3))
-        k[48] = k[3] * k[0] / (2.0 * (k[0] + k[2]));
+        k[19] = (3.0 * ell * m1 * m3 / 2.0 / (m1 + m3))
+            + (ell * (m1 * m1) / 2.0 / (m1 + m3))
+            + (ell * (m3 * m3) / (m1 + m3));
+        // k[20] = ell^2*m1/24 + ell^2*m1*m3/(8*(m1 + m3)) + ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*(2*m1*m3 + m1^2 + m3^2))
+        let h20_t0 = ell * ell;
+        let h20_t1 = m3 * m3;
+        let h20_t2 = m1 * m1;
+        k[20] = (h20_t0 * m1 / 24.0)
+            + (h20_t0 * m1 * m3 / 8.0 / (m1 + m3))
+            + (h20_t0 * m1 * h20_t1 / ((2.0 * m1 * m3) + h20_t2 + h20_t1))
+            + (5.0 * h20_t0 * h20_t2 * m3 / 8.0 / ((2.0 * m1 * m3) + h20_t2 + h20_t1))
+            + (h20_t0 * m1.powi(3) / 8.0 / ((2.0 * m1 * m3) + h20_t2 + h20_t1))
+            + (h20_t0 * m3.powi(3) / 2.0 / ((2.0 * m1 * m3) + h20_t2 + h20_t1));
+        // k[21] = m1/2 + m3/2
+        k[21] = (m1 / 2.0) + (m3 / 2.0);
+        // k[22] = m2/2
+        k[22] = m2 / 2.0;
+        // k[23] = a*g*m2/2
+        k[23] = a * g * m2 / 2.0;
+        // k[24] = ell*g*m1/2 + ell*g*m3
+        k[24] = (ell * g * m1 / 2.0) + (ell * g * m3);
+        // k[25] = m1 + m3
+        k[25] = m1 + m3;
+        // k[26] = ell^2*m1/12 + ell^2*m1*m3/(4*(m1 + m3)) + 2*ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*m1*m3 + m1^2 + m3^2)
+        let h26_t0 = ell * ell;
+        let h26_t1 = m3 * m3;
+        let h26_t2 = m1 * m1;
+        k[26] = (h26_t0 * m1 / 12.0)
+            + (h26_t0 * m1 * m3 / 4.0 / (m1 + m3))
+            + (2.0 * h26_t0 * m1 * h26_t1 / ((2.0 * m1 * m3) + h26_t2 + h26_t1))
+            + (5.0 * h26_t0 * h26_t2 * m3 / 4.0 / ((2.0 * m1 * m3) + h26_t2 + h26_t1))
+            + (h26_t0 * m1.powi(3) / 4.0 / ((2.0 * m1 * m3) + h26_t2 + h26_t1))
+            + (h26_t0 * m3.powi(3) / ((2.0 * m1 * m3) + h26_t2 + h26_t1));
+        // k[27] = g*m1 + g*m3
+        k[27] = (g * m1) + (g * m3);
+        // k[28] = a/2
+        k[28] = a / 2.0;
+        // k[29] = 12/ell^2
+        k[29] = 12.0 / (ell * ell);
+        // k[30] = m1*rc_wi^2*rc_ai + m3*rc_wi^2*rc_ai
+        let h30_t0 = theta_dot_0 * theta_dot_0;
+        k[30] = (m1 * h30_t0 * k[16]) + (m3 * h30_t0 * k[16]);
+        // k[31] = 3*ell*g*m1*m3 + ell*g*m1^2 + 2*ell*g*m3^2
+        k[31] = (3.0 * ell * g * m1 * m3) + (ell * g * (m1 * m1)) + (2.0 * ell * g * (m3 * m3));
+        // k[32] = 16*m1*m3 + 4*m1^2 + 12*m3^2
+        k[32] = (16.0 * m1 * m3) + (4.0 * (m1 * m1)) + (12.0 * (m3 * m3));
+        // k[33] = 12*m1*m3 + 3*m1^2 + 12*m3^2
+        k[33] = (12.0 * m1 * m3) + (3.0 * (m1 * m1)) + (12.0 * (m3 * m3));
+        // k[34] = 6/ell^2
+        k[34] = 6.0 / (ell * ell);
+        // k[35] = 120*ell*g*m1*m3^3 + 108*ell*g*m1^2*m3^2 + 42*ell*g*m1^3*m3 + 6*ell*g*m1^4 + 48*ell*g*m3^4
+        k[35] = (120.0 * ell * g * m1 * m3.powi(3))
+            + (108.0 * ell * g * (m1 * m1) * (m3 * m3))
+            + (42.0 * ell * g * m1.powi(3) * m3)
+            + (6.0 * ell * g * m1.powi(4))
+            + (48.0 * ell * g * m3.powi(4));
+        // k[36] = 68*ell*g*m1*m3^3 + 68*ell*g*m1^2*m3^2 + 28*ell*g*m1^3*m3 + 4*ell*g*m1^4 + 24*ell*g*m3^4
+        k[36] = (68.0 * ell * g * m1 * m3.powi(3))
+            + (68.0 * ell * g * (m1 * m1) * (m3 * m3))
+            + (28.0 * ell * g * m1.powi(3) * m3)
+            + (4.0 * ell * g * m1.powi(4))
+            + (24.0 * ell * g * m3.powi(4));
+        // k[37] = 60*ell*g*m1*m3^3 + 54*ell*g*m1^2*m3^2 + 21*ell*g*m1^3*m3 + 3*ell*g*m1^4 + 24*ell*g*m3^4
+        k[37] = (60.0 * ell * g * m1 * m3.powi(3))
+            + (54.0 * ell * g * (m1 * m1) * (m3 * m3))
+            + (21.0 * ell * g * m1.powi(3) * m3)
+            + (3.0 * ell * g * m1.powi(4))
+            + (24.0 * ell * g * m3.powi(4));
+        // k[38] = 48*m1*m3^2*rc_wi^2*rc_ai + 30*m1^2*m3*rc_wi^2*rc_ai + 6*m1^3*rc_wi^2*rc_ai + 24*m3^3*rc_wi^2*rc_ai
+        let h38_t0 = theta_dot_0 * theta_dot_0;
+        k[38] = (48.0 * m1 * (m3 * m3) * h38_t0 * k[16])
+            + (30.0 * (m1 * m1) * m3 * h38_t0 * k[16])
+            + (6.0 * m1.powi(3) * h38_t0 * k[16])
+            + (24.0 * m3.powi(3) * h38_t0 * k[16]);
+        // k[39] = (ell*m1 + 2*ell*m3)/2
+        k[39] = ((ell * m1) + (2.0 * ell * m3)) / 2.0;
+        // k[43] = rc_p0/(m1 + m3)
+        k[43] = k[14] / (m1 + m3);
+        // k[44] = rc_p1/m2
+        k[44] = k[15] / m2;
+        // k[45] = ell*(m1/2 + m3)/(m1 + m3)
+        k[45] = ell * ((m1 / 2.0) + m3) / (m1 + m3);
+        // k[46] = ell*m1/(2*(m1 + m3))
+        k[46] = ell * m1 / (2.0 * (m1 + m3));
     }
 
+    /// The state at release, over the parameters.
+    ///
+    /// - `x1 = x1_0`
+    /// - `dot_x1 = x1_dot_0`
+    /// - `theta = theta_0`
+    /// - `dot_theta = theta_dot_0`
+    /// - `x2 = x2_0`
+    /// - `dot_x2 = x2_dot_0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
-        q[0] = k[6];
-        qd[0] = k[9];
-        q[1] = k[7];
-        qd[1] = k[10];
-        q[2] = k[8];
-        qd[2] = k[11];
+        let k = &k[..47]; // one bounds check for all constant loads
+        let x1_0 = k[6];
+        let theta_0 = k[7];
+        let x2_0 = k[8];
+        let x1_dot_0 = k[9];
+        let theta_dot_0 = k[10];
+        let x2_dot_0 = k[11];
+        q[0] = x1_0;
+        qd[0] = x1_dot_0;
+        q[1] = theta_0;
+        qd[1] = theta_dot_0;
+        q[2] = x2_0;
+        qd[2] = x2_dot_0;
     }
 
+    /// Each point's position over the state (`pos`), and its time derivative (`vel`).
+    ///
+    /// - `foot_x = x1`
+    /// - `foot_y = 0`
+    /// - `tip_x = ell*cos(theta) + x1`
+    /// - `tip_y = ell*sin(theta)`
+    /// - `rod_centre_x = ell*cos(theta)/2 + x1`
+    /// - `rod_centre_y = ell*sin(theta)/2`
+    /// - `mass_centre_x = ell*m1*cos(theta)/(2*(m1 + m3)) + ell*m3*cos(theta)/(m1 + m3) + x1`
+    /// - `mass_centre_y = ell*m1*sin(theta)/(2*(m1 + m3)) + ell*m3*sin(theta)/(m1 + m3)`
+    /// - `cube_x = x2`
+    /// - `cube_y = 0`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        pos[0] = [q[0], 0.0];
-        vel[0] = [qd[0], 0.0];
-        pos[1] = [(k[3] * rc_c) + q[0], k[3] * rc_s];
-        vel[1] = [-(k[3] * qd[1] * rc_s) + qd[0], k[3] * qd[1] * rc_c];
-        pos[2] = [(k[17] * rc_c) + q[0], k[17] * rc_s];
-        vel[2] = [-(k[17] * qd[1] * rc_s) + qd[0], k[17] * qd[1] * rc_c];
-        pos[3] = [(k[18] * rc_c) + q[0], k[18] * rc_s];
-        vel[3] = [-(k[18] * qd[1] * rc_s) + qd[0], k[18] * qd[1] * rc_c];
-        pos[4] = [q[2], 0.0];
-        vel[4] = [qd[2], 0.0];
+        let ell = k[3];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let theta_dot = qd[1];
+        let x2 = q[2];
+        let x2_dot = qd[2];
+        pos[0] = [x1, 0.0];
+        vel[0] = [x1_dot, 0.0];
+        pos[1] = [(ell * rc_c) + x1, ell * rc_s];
+        vel[1] = [-(ell * theta_dot * rc_s) + x1_dot, ell * theta_dot * rc_c];
+        pos[2] = [(k[17] * rc_c) + x1, k[17] * rc_s];
+        vel[2] = [
+            -(k[17] * theta_dot * rc_s) + x1_dot,
+            k[17] * theta_dot * rc_c,
+        ];
+        pos[3] = [(k[18] * rc_c) + x1, k[18] * rc_s];
+        vel[3] = [
+            -(k[18] * theta_dot * rc_s) + x1_dot,
+            k[18] * theta_dot * rc_c,
+        ];
+        pos[4] = [x2, 0.0];
+        vel[4] = [x2_dot, 0.0];
     }
 
+    /// The total energy `E = T + V`.
+    ///
+    /// - `T`: 486 characters, written out in `generated/loaded_rod_free.tex`
+    /// - `V = a*g*m2/2 + ell*g*m1*sin(theta)/2 + ell*g*m3*sin(theta)`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..49]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let et0 = qd[1] * qd[1];
-        (-(k[19] * qd[1] * qd[0] * rc_s)
-            + (k[20] * et0)
-            + (k[21] * et0 * (rc_s * rc_s))
-            + (k[21] * et0 * (rc_c * rc_c))
-            + (k[22] * (qd[0] * qd[0]))
-            + (k[23] * (qd[2] * qd[2])))
-            + (k[24] + (k[25] * rc_s))
-    }
-
-    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
-        out[0] = -(k[19] * qd[1] * rc_s) + (k[26] * qd[0]);
-        out[1] = k[1] * qd[2];
+        let x1_dot = qd[0];
+        let theta_dot = qd[1];
+        let x2_dot = qd[2];
+        (-(k[19] * theta_dot * x1_dot * rc_s)
+            + (k[20] * (theta_dot * theta_dot))
+            + (k[21] * (x1_dot * x1_dot))
+            + (k[22] * (x2_dot * x2_dot)))
+            + (k[23] + (k[24] * rc_s))
     }
 
+    /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
+    ///
+    /// - `p_x1 = -3*dot_theta*ell*m1*m3*sin(theta)/(2*(m1 + m3)) - dot_theta*ell*m1^2*sin(theta)/(2*(m1 + m3)) - dot_theta*ell*m3^2*sin(theta)/(m1 + m3) + dot_x1*m1 + dot_x1*m3`
+    /// - `p_x2 = dot_x2*m2`
+    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let k = &k[..47]; // one bounds check for all constant loads
+        let rc_s = q[1].sin();
+        let m2 = k[1];
+        let x1_dot = qd[0];
+        let theta_dot = qd[1];
+        let x2_dot = qd[2];
+        out[0] = -(k[19] * theta_dot * rc_s) + (k[25] * x1_dot);
+        out[1] = m2 * x2_dot;
+    }
+
+    /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
+    ///
+    /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
+    /// - `L = T - V`: 545 characters, written out in `generated/loaded_rod_free.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let qt0 = -k[19] * rc_s;
-        mass[0] = k[26];
+        let m2 = k[1];
+        let theta_dot = qd[1];
+        let qt0 = -k[19] * rc_s; // -((3*ell*m1*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3))*rc_s)
+        mass[0] = k[25];
         mass[1] = qt0;
         mass[2] = 0.0;
         mass[3] = qt0;
-        mass[4] = k[27] + (k[28] * (rc_s * rc_s)) + (k[28] * (rc_c * rc_c));
+        mass[4] = k[26];
         mass[5] = 0.0;
         mass[6] = 0.0;
         mass[7] = 0.0;
-        mass[8] = k[1];
-        rhs[0] = k[19] * (qd[1] * qd[1]) * rc_c;
-        rhs[1] = -k[25] * rc_c;
+        mass[8] = m2;
+        rhs[0] = k[19] * (theta_dot * theta_dot) * rc_c;
+        rhs[1] = -k[24] * rc_c;
         rhs[2] = 0.0;
     }
 
+    /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
+    ///
+    /// - `floor_normal`: 294 characters, written out in `generated/loaded_rod_free.tex`
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
+        let theta_dot = qd[1];
+        let theta_ddot = qdd[1];
         out[0] = 0.0;
-        out[1] = k[29] + (k[19] * qdd[1] * rc_c) - (k[19] * (qd[1] * qd[1]) * rc_s);
+        out[1] = k[27] + (k[19] * theta_ddot * rc_c) - (k[19] * (theta_dot * theta_dot) * rc_s);
     }
 
+    /// Each contact's gap `g(q)`, `>= 0` while apart (zero for a contact held closed).
+    ///
+    /// - `contact_force = -ell*cos(theta) - x1 + x2`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         let rc_c = q[1].cos();
-        out[0] = -(k[3] * rc_c) - q[0] + q[2];
+        let ell = k[3];
+        let x1 = q[0];
+        let x2 = q[2];
+        out[0] = -(ell * rc_c) - x1 + x2;
         out[1] = 0.0;
     }
 
+    /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
+        let ell = k[3];
+        let theta_dot = qd[1];
         jac[0] = -1.0;
-        jac[1] = k[3] * rc_s;
+        jac[1] = ell * rc_s;
         jac[2] = 1.0;
         jac[3] = 0.0;
         jac[4] = 0.0;
         jac[5] = 0.0;
-        bias[0] = k[3] * (qd[1] * qd[1]) * rc_c;
+        bias[0] = ell * (theta_dot * theta_dot) * rc_c;
         bias[1] = 0.0;
     }
 
+    /// Each contact's edge margin, `>= 0` while the contact point is on the edge (infinite without one).
+    ///
+    /// No contact has an edge.
     fn edges(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
         out[0] = f64::INFINITY;
         out[1] = f64::INFINITY;
     }
 
+    /// Each friction's slip velocity `v = J(q) qd`: `jac` holds `J`, `bias` holds `dJ/dt qd`.
+    ///
+    /// No friction.
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
+    /// The monitors over the state and the contacts' forces `rc_f<i>`.
+    ///
+    /// - `cube_does_not_tip = a*g*m2/2 - rc_f0*(-a/2 + ell*sin(theta))`
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
-        out[0] = k[24] - (forces[0] * (-k[30] + (k[3] * rc_s)));
+        let ell = k[3];
+        out[0] = k[23] - (forces[0] * (-k[28] + (ell * rc_s)));
     }
 
+    /// The system's state (its general model's) that this phase's state stands for.
+    ///
+    /// - `x1 = x1`
+    /// - `dot_x1 = dot_x1`
+    /// - `y1 = 0`
+    /// - `dot_y1 = 0`
+    /// - `theta = theta`
+    /// - `dot_theta = dot_theta`
+    /// - `x2 = x2`
+    /// - `dot_x2 = dot_x2`
     fn to_full(&self, _k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        q_full[0] = q[0];
-        qd_full[0] = qd[0];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let theta = q[1];
+        let theta_dot = qd[1];
+        let x2 = q[2];
+        let x2_dot = qd[2];
+        q_full[0] = x1;
+        qd_full[0] = x1_dot;
         q_full[1] = 0.0;
         qd_full[1] = 0.0;
-        q_full[2] = q[1];
-        qd_full[2] = qd[1];
-        q_full[3] = q[2];
-        qd_full[3] = qd[2];
+        q_full[2] = theta;
+        qd_full[2] = theta_dot;
+        q_full[3] = x2;
+        qd_full[3] = x2_dot;
     }
 
+    /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        poses[0] = [(k[18] * rc_c) + q[0], k[18] * rc_s, q[1]];
-        poses[1] = [k[30] + q[2], k[30], 0.0];
-        sizes[0] = -k[47];
+        let a = k[4];
+        let x1 = q[0];
+        let theta = q[1];
+        let x2 = q[2];
+        poses[0] = [(k[18] * rc_c) + x1, k[18] * rc_s, theta];
+        poses[1] = [k[28] + x2, k[28], 0.0];
+        sizes[0] = -k[45];
         sizes[1] = 0.0;
-        sizes[2] = k[48];
+        sizes[2] = k[46];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
-        sizes[6] = k[4];
-        sizes[7] = k[4];
+        sizes[6] = a;
+        sizes[7] = a;
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -455,91 +572,108 @@ impl Model for LoadedRodFree {
 }
 
 impl Reduction for LoadedRodFree {
+    /// The reduced motion at `theta = theta_i - delta`: `theta_dot^2` from the energy integral, and `theta_ddot`.
+    ///
+    /// - `theta_dot^2`: 465 characters, written out in `generated/loaded_rod_free.tex`
+    /// - `theta_ddot`: 1276 characters, written out in `generated/loaded_rod_free.tex`
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[7], k[12], k[13], delta);
         let rt0 = rc_s * rc_s;
-        let rt1 = -k[34] + (k[35] * rt0);
+        let rt1 = -k[32] + (k[33] * rt0); // -(16*m1*m3 + 4*m1^2 + 12*m3^2) + (12*m1*m3 + 3*m1^2 + 12*m3^2)*rc_s^2
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: -k[31] * (k[32] + (k[33] * rc_ds)) / rt1,
-            theta_ddot: k[36]
-                * ((k[37] * rc_s * rc_c * rc_ds) - (k[38] * rc_c)
-                    + (k[39] * rt0 * rc_c)
-                    + (k[40] * rc_s * rc_c))
+            theta_dot_sq: -k[29] * (k[30] + (k[31] * rc_ds)) / rt1,
+            theta_ddot: k[34]
+                * ((k[35] * rc_s * rc_c * rc_ds) - (k[36] * rc_c)
+                    + (k[37] * rt0 * rc_c)
+                    + (k[38] * rc_s * rc_c))
                 / (rt1 * rt1),
         }
     }
 
+    /// `theta_dot^2` over `sin(theta)`, `cos(theta)` and their drops from the start (the per-point solver's integrand).
+    ///
+    /// - `theta_dot^2`: 465 characters, written out in `generated/loaded_rod_free.tex`
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..49]; // one bounds check for all constant loads
-        -k[31] * (k[32] + (k[33] * rc_ds)) / (-k[34] + (k[35] * (rc_s * rc_s)))
+        let k = &k[..47]; // one bounds check for all constant loads
+        -k[29] * (k[30] + (k[31] * rc_ds)) / (-k[32] + (k[33] * (rc_s * rc_s)))
     }
 
+    /// Each contact's force on the reduced motion (zero for a contact open in the phase).
+    ///
+    /// - `floor_normal`: 1024 characters, written out in `generated/loaded_rod_free.tex`
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[7], k[12], k[13], delta);
         let rt0 = rc_s * rc_s;
-        let rt1 = -k[34] + (k[35] * rt0);
-        let rc_w2 = -k[31] * (k[32] + (k[33] * rc_ds)) / rt1;
-        let rc_acc = k[36]
-            * ((k[37] * rc_s * rc_c * rc_ds) - (k[38] * rc_c)
-                + (k[39] * rt0 * rc_c)
-                + (k[40] * rc_s * rc_c))
+        let rt1 = -k[32] + (k[33] * rt0); // -(16*m1*m3 + 4*m1^2 + 12*m3^2) + (12*m1*m3 + 3*m1^2 + 12*m3^2)*rc_s^2
+        let rc_w2 = -k[29] * (k[30] + (k[31] * rc_ds)) / rt1;
+        let rc_acc = k[34]
+            * ((k[35] * rc_s * rc_c * rc_ds) - (k[36] * rc_c)
+                + (k[37] * rt0 * rc_c)
+                + (k[38] * rc_s * rc_c))
             / (rt1 * rt1);
         out[0] = 0.0;
-        out[1] = k[29] - (k[41] * rc_s * rc_w2) + (k[41] * rc_c * rc_acc);
+        out[1] = k[27] - (k[39] * rc_s * rc_w2) + (k[39] * rc_c * rc_acc);
     }
 
+    /// The coefficients, constant term first, of a contact's force zero as a polynomial in `sin(theta)`, where it is one.
     fn force_polynomial(&self, k: &[f64], contact: usize, out: &mut [f64]) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
         match contact {
             1 => {
-                out[0] = k[42];
-                out[1] = -k[43];
-                out[2] = k[44];
+                out[0] = k[40];
+                out[1] = -k[41];
+                out[2] = k[42];
             }
             _ => {}
         }
     }
 
+    /// The constants of `prepare` that the per-point solver reads, and only those.
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let m1 = p[0];
+        let m3 = p[2];
+        let ell = p[3];
+        let g = p[5];
+        let theta_0 = p[7];
+        let theta_dot_0 = p[10];
         k[..12].copy_from_slice(p);
         // k[12] = rc_si = sin(rc_thi)
-        k[12] = k[7].sin();
+        k[12] = theta_0.sin();
         // k[13] = rc_ci = cos(rc_thi)
-        k[13] = k[7].cos();
+        k[13] = theta_0.cos();
         // k[16] = rc_ai = -ell^2*m1*m3*rc_si^2/(m1 + m3) + 4*ell^2*m1*m3/(3*(m1 + m3)) - ell^2*m1^2*rc_si^2/(4*(m1 + m3)) + ell^2*m1^2/(3*(m1 + m3)) - ell^2*m3^2*rc_si^2/(m1 + m3) + ell^2*m3^2/(m1 + m3)
-        let c8_t0 = k[3] * k[3];
-        let c8_t1 = k[12] * k[12];
-        let c8_t2 = k[0] * k[0];
-        let c8_t3 = k[2] * k[2];
-        k[16] = -(c8_t0 * k[0] * k[2] * c8_t1 / (k[0] + k[2]))
-            + (4.0 * c8_t0 * k[0] * k[2] / 3.0 / (k[0] + k[2]))
-            - (c8_t0 * c8_t2 * c8_t1 / 4.0 / (k[0] + k[2]))
-            + (c8_t0 * c8_t2 / 3.0 / (k[0] + k[2]))
-            - (c8_t0 * c8_t3 * c8_t1 / (k[0] + k[2]))
-            + (c8_t0 * c8_t3 / (k[0] + k[2]));
-        // k[42] = 16*ell*g*m1*m3 + 4*ell*g*m1^2 + 12*ell*g*m3^2
-        k[42] = (16.0 * k[3] * k[5] * k[0] * k[2])
-            + (4.0 * k[3] * k[5] * (k[0] * k[0]))
-            + (12.0 * k[3] * k[5] * (k[2] * k[2]));
-        // k[43] = 24*ell*g*m1*m3*rc_si + 6*ell*g*m1^2*rc_si + 24*ell*g*m3^2*rc_si + 6*m1*rc_wi^2*rc_ai + 12*m3*rc_wi^2*rc_ai
-        let h43_t0 = k[10] * k[10];
-        k[43] = (24.0 * k[3] * k[5] * k[0] * k[2] * k[12])
-            + (6.0 * k[3] * k[5] * (k[0] * k[0]) * k[12])
-            + (24.0 * k[3] * k[5] * (k[2] * k[2]) * k[12])
-            + (6.0 * k[0] * h43_t0 * k[16])
-            + (12.0 * k[2] * h43_t0 * k[16]);
-        // k[44] = 12*ell*g*m1*m3 + 3*ell*g*m1^2 + 12*ell*g*m3^2
-        k[44] = (12.0 * k[3] * k[5] * k[0] * k[2])
-            + (3.0 * k[3] * k[5] * (k[0] * k[0]))
-            + (12.0 * k[3] * k[5] * (k[2] * k[2]));
+        let c8_t0 = ell * ell;
+        let c8_t1 = k[12] * k[12]; // rc_si^2
+        let c8_t2 = m1 * m1;
+        let c8_t3 = m3 * m3;
+        k[16] = -(c8_t0 * m1 * m3 * c8_t1 / (m1 + m3)) + (4.0 * c8_t0 * m1 * m3 / 3.0 / (m1 + m3))
+            - (c8_t0 * c8_t2 * c8_t1 / 4.0 / (m1 + m3))
+            + (c8_t0 * c8_t2 / 3.0 / (m1 + m3))
+            - (c8_t0 * c8_t3 * c8_t1 / (m1 + m3))
+            + (c8_t0 * c8_t3 / (m1 + m3));
+        // k[40] = 16*ell*g*m1*m3 + 4*ell*g*m1^2 + 12*ell*g*m3^2
+        k[40] =
+            (16.0 * ell * g * m1 * m3) + (4.0 * ell * g * (m1 * m1)) + (12.0 * ell * g * (m3 * m3));
+        // k[41] = 24*ell*g*m1*m3*rc_si + 6*ell*g*m1^2*rc_si + 24*ell*g*m3^2*rc_si + 6*m1*rc_wi^2*rc_ai + 12*m3*rc_wi^2*rc_ai
+        let h41_t0 = theta_dot_0 * theta_dot_0;
+        k[41] = (24.0 * ell * g * m1 * m3 * k[12])
+            + (6.0 * ell * g * (m1 * m1) * k[12])
+            + (24.0 * ell * g * (m3 * m3) * k[12])
+            + (6.0 * m1 * h41_t0 * k[16])
+            + (12.0 * m3 * h41_t0 * k[16]);
+        // k[42] = 12*ell*g*m1*m3 + 3*ell*g*m1^2 + 12*ell*g*m3^2
+        k[42] =
+            (12.0 * ell * g * m1 * m3) + (3.0 * ell * g * (m1 * m1)) + (12.0 * ell * g * (m3 * m3));
     }
 
+    /// The coefficients, constant term first, of the fall polynomial `P(s) = (sin(theta_i) - s) / theta_dot^2` in `s = sin(theta)`.
     fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
 
+    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
     fn full_state(
         &self,
         k: &[f64],
@@ -549,15 +683,17 @@ impl Reduction for LoadedRodFree {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..49]; // one bounds check for all constant loads
+        let k = &k[..47]; // one bounds check for all constant loads
+        let x1_0 = k[6];
+        let x2_0 = k[8];
         let (rc_s, _, _, rc_dc) = start_offsets(k[7], k[12], k[13], delta);
         let rc_t = t;
         let rc_w = theta_dot;
         q[1] = k[7] - delta;
         qd[1] = theta_dot;
-        q[0] = k[6] + (k[18] * rc_dc) + (k[45] * rc_t);
-        qd[0] = k[45] + (k[18] * rc_s * rc_w);
-        q[2] = k[8] + (k[46] * rc_t);
-        qd[2] = k[46];
+        q[0] = x1_0 + (k[18] * rc_dc) + (k[43] * rc_t);
+        qd[0] = k[43] + (k[18] * rc_s * rc_w);
+        q[2] = x2_0 + (k[44] * rc_t);
+        qd[2] = k[44];
     }
 }

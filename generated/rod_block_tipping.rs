@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the block must be lower than the rod is long (h < ell)",
     }],
-    n_constants: 24,
+    n_constants: 22,
     coordinates: &["x1", "y1", "theta", "xb", "yb", "phi"],
     system_coordinates: &["x1", "y1", "theta", "xb", "yb", "phi"],
     reduced: 2,
@@ -176,11 +176,22 @@ impl Model for RodBlockTipping {
         &INFO
     }
 
+    /// The requirements' margins over the parameters, each `>= 0` where it holds.
+    ///
+    /// - `rod_leans = ell - h`
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
-        let k = p;
-        out[0] = k[2] - k[4];
+        let ell = p[2];
+        let h = p[4];
+        out[0] = ell - h;
     }
 
+    /// Each contact's coefficient of restitution over the parameters.
+    ///
+    /// - `contact_force = 0`
+    /// - `block_near_edge = 0`
+    /// - `block_far_edge = 0`
+    /// - `floor_normal = 0`
+    /// - `tip_floor = 0`
     fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
@@ -189,48 +200,67 @@ impl Model for RodBlockTipping {
         out[4] = 0.0;
     }
 
+    /// The constants `k`: the parameters, then the constants derived from them.
+    ///
+    /// `k[..6]` holds the parameters `m1, m2, ell, w, h, g`; each later slot's definition is the comment above the line that fills it.
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
+        let m1 = p[0];
+        let m2 = p[1];
+        let ell = p[2];
+        let w = p[3];
+        let h = p[4];
+        let g = p[5];
         k[..6].copy_from_slice(p);
         // k[6] = asin(h/ell)
-        k[6] = (k[4] / k[2]).asin();
+        k[6] = (h / ell).asin();
         // k[7] = sqrt((ell - h)*(ell + h)) + w/2
-        k[7] = ((k[2] - k[4]) * (k[2] + k[4])).sqrt() + (k[3] / 2.0);
+        k[7] = ((ell - h) * (ell + h)).sqrt() + (w / 2.0);
         // k[8] = h/2
-        k[8] = k[4] / 2.0;
+        k[8] = h / 2.0;
         // k[9] = ell/2
-        k[9] = k[2] / 2.0;
+        k[9] = ell / 2.0;
         // k[10] = w/2
-        k[10] = k[3] / 2.0;
+        k[10] = w / 2.0;
         // k[11] = ell*m1/2
-        k[11] = k[2] * k[0] / 2.0;
+        k[11] = ell * m1 / 2.0;
         // k[12] = m2*w^2/24 + h^2*m2/24
-        k[12] = (k[1] * (k[3] * k[3]) / 24.0) + ((k[4] * k[4]) * k[1] / 24.0);
-        // k[13] = ell^2*m1/24
-        k[13] = (k[2] * k[2]) * k[0] / 24.0;
-        // k[14] = ell^2*m1/8
-        k[14] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[15] = m1/2
-        k[15] = k[0] / 2.0;
-        // k[16] = m2/2
-        k[16] = k[1] / 2.0;
-        // k[17] = ell*g*m1/2
-        k[17] = k[2] * k[5] * k[0] / 2.0;
-        // k[18] = g*m1
-        k[18] = k[5] * k[0];
-        // k[19] = g*m2
-        k[19] = k[5] * k[1];
-        // k[20] = m2*w^2/12 + h^2*m2/12
-        k[20] = (k[1] * (k[3] * k[3]) / 12.0) + ((k[4] * k[4]) * k[1] / 12.0);
-        // k[21] = ell^2*m1/12
-        k[21] = (k[2] * k[2]) * k[0] / 12.0;
-        // k[22] = ell^2*m1/4
-        k[22] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[23] = 2*ell
-        k[23] = 2.0 * k[2];
+        k[12] = (m2 * (w * w) / 24.0) + ((h * h) * m2 / 24.0);
+        // k[13] = ell^2*m1/6
+        k[13] = (ell * ell) * m1 / 6.0;
+        // k[14] = m1/2
+        k[14] = m1 / 2.0;
+        // k[15] = m2/2
+        k[15] = m2 / 2.0;
+        // k[16] = ell*g*m1/2
+        k[16] = ell * g * m1 / 2.0;
+        // k[17] = g*m1
+        k[17] = g * m1;
+        // k[18] = g*m2
+        k[18] = g * m2;
+        // k[19] = m2*w^2/12 + h^2*m2/12
+        k[19] = (m2 * (w * w) / 12.0) + ((h * h) * m2 / 12.0);
+        // k[20] = ell^2*m1/3
+        k[20] = (ell * ell) * m1 / 3.0;
+        // k[21] = 2*ell
+        k[21] = 2.0 * ell;
     }
 
+    /// The state at release, over the parameters.
+    ///
+    /// - `x1 = 0.0`
+    /// - `dot_x1 = 0.0`
+    /// - `y1 = 0.0`
+    /// - `dot_y1 = 0.0`
+    /// - `theta = asin(h/ell)`
+    /// - `dot_theta = 0.0`
+    /// - `xb = sqrt((ell - h)*(ell + h)) + w/2`
+    /// - `dot_xb = 0.0`
+    /// - `yb = h/2`
+    /// - `dot_yb = 0.0`
+    /// - `phi = 0.0`
+    /// - `dot_phi = 0.0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = 0.0;
@@ -245,121 +275,171 @@ impl Model for RodBlockTipping {
         qd[5] = 0.0;
     }
 
+    /// Each point's position over the state (`pos`), and its time derivative (`vel`).
+    ///
+    /// - `foot_x = x1`
+    /// - `foot_y = y1`
+    /// - `tip_x = ell*cos(theta) + x1`
+    /// - `tip_y = ell*sin(theta) + y1`
+    /// - `rod_centre_x = ell*cos(theta)/2 + x1`
+    /// - `rod_centre_y = ell*sin(theta)/2 + y1`
+    /// - `block_centre_x = xb`
+    /// - `block_centre_y = yb`
+    /// - `near_edge_x = h*sin(phi)/2 - w*cos(phi)/2 + xb`
+    /// - `near_edge_y = -h*cos(phi)/2 - w*sin(phi)/2 + yb`
+    /// - `far_edge_x = h*sin(phi)/2 + w*cos(phi)/2 + xb`
+    /// - `far_edge_y = -h*cos(phi)/2 + w*sin(phi)/2 + yb`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let pt0 = q[5].sin();
-        let pt1 = k[8] * pt0;
-        let pt2 = q[5].cos();
-        let pt3 = k[8] * qd[5] * pt2;
-        let pt4 = k[8] * qd[5] * pt0;
-        pos[0] = [q[0], q[1]];
-        vel[0] = [qd[0], qd[1]];
-        pos[1] = [(k[2] * rc_c) + q[0], (k[2] * rc_s) + q[1]];
+        let ell = k[2];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let y1 = q[1];
+        let y1_dot = qd[1];
+        let theta_dot = qd[2];
+        let xb = q[3];
+        let xb_dot = qd[3];
+        let yb = q[4];
+        let yb_dot = qd[4];
+        let phi = q[5];
+        let phi_dot = qd[5];
+        let pt0 = phi.sin();
+        let pt1 = k[8] * pt0; // h*sin(phi)/2
+        let pt2 = phi.cos();
+        let pt3 = k[8] * phi_dot * pt2; // h*dot_phi*cos(phi)/2
+        let pt4 = k[8] * phi_dot * pt0; // h*dot_phi*sin(phi)/2
+        pos[0] = [x1, y1];
+        vel[0] = [x1_dot, y1_dot];
+        pos[1] = [(ell * rc_c) + x1, (ell * rc_s) + y1];
         vel[1] = [
-            -(k[2] * qd[2] * rc_s) + qd[0],
-            (k[2] * qd[2] * rc_c) + qd[1],
+            -(ell * theta_dot * rc_s) + x1_dot,
+            (ell * theta_dot * rc_c) + y1_dot,
         ];
-        pos[2] = [(k[9] * rc_c) + q[0], (k[9] * rc_s) + q[1]];
+        pos[2] = [(k[9] * rc_c) + x1, (k[9] * rc_s) + y1];
         vel[2] = [
-            -(k[9] * qd[2] * rc_s) + qd[0],
-            (k[9] * qd[2] * rc_c) + qd[1],
+            -(k[9] * theta_dot * rc_s) + x1_dot,
+            (k[9] * theta_dot * rc_c) + y1_dot,
         ];
-        pos[3] = [q[3], q[4]];
-        vel[3] = [qd[3], qd[4]];
-        pos[4] = [
-            pt1 - (k[10] * pt2) + q[3],
-            -(k[8] * pt2) - (k[10] * pt0) + q[4],
-        ];
+        pos[3] = [xb, yb];
+        vel[3] = [xb_dot, yb_dot];
+        pos[4] = [pt1 - (k[10] * pt2) + xb, -(k[8] * pt2) - (k[10] * pt0) + yb];
         vel[4] = [
-            pt3 + (k[10] * qd[5] * pt0) + qd[3],
-            pt4 - (k[10] * qd[5] * pt2) + qd[4],
+            pt3 + (k[10] * phi_dot * pt0) + xb_dot,
+            pt4 - (k[10] * phi_dot * pt2) + yb_dot,
         ];
-        pos[5] = [
-            pt1 + (k[10] * pt2) + q[3],
-            -(k[8] * pt2) + (k[10] * pt0) + q[4],
-        ];
+        pos[5] = [pt1 + (k[10] * pt2) + xb, -(k[8] * pt2) + (k[10] * pt0) + yb];
         vel[5] = [
-            pt3 - (k[10] * qd[5] * pt0) + qd[3],
-            pt4 + (k[10] * qd[5] * pt2) + qd[4],
+            pt3 - (k[10] * phi_dot * pt0) + xb_dot,
+            pt4 + (k[10] * phi_dot * pt2) + yb_dot,
         ];
     }
 
+    /// The total energy `E = T + V`.
+    ///
+    /// - `T`: 209 characters, written out in `generated/rod_block_tipping.tex`
+    /// - `V = ell*g*m1*sin(theta)/2 + g*m1*y1 + g*m2*yb`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let et0 = qd[2] * qd[2];
-        (-(k[11] * qd[2] * qd[0] * rc_s)
-            + (k[11] * qd[2] * qd[1] * rc_c)
-            + (k[12] * (qd[5] * qd[5]))
-            + (k[13] * et0)
-            + (k[14] * et0 * (rc_s * rc_s))
-            + (k[14] * et0 * (rc_c * rc_c))
-            + (k[15] * (qd[0] * qd[0]))
-            + (k[16] * (qd[3] * qd[3]))
-            + (k[15] * (qd[1] * qd[1]))
-            + (k[16] * (qd[4] * qd[4])))
-            + ((k[17] * rc_s) + (k[18] * q[1]) + (k[19] * q[4]))
+        let x1_dot = qd[0];
+        let y1 = q[1];
+        let y1_dot = qd[1];
+        let theta_dot = qd[2];
+        let xb_dot = qd[3];
+        let yb = q[4];
+        let yb_dot = qd[4];
+        let phi_dot = qd[5];
+        (-(k[11] * theta_dot * x1_dot * rc_s)
+            + (k[11] * theta_dot * y1_dot * rc_c)
+            + (k[12] * (phi_dot * phi_dot))
+            + (k[13] * (theta_dot * theta_dot))
+            + (k[14] * (x1_dot * x1_dot))
+            + (k[15] * (xb_dot * xb_dot))
+            + (k[14] * (y1_dot * y1_dot))
+            + (k[15] * (yb_dot * yb_dot)))
+            + ((k[16] * rc_s) + (k[17] * y1) + (k[18] * yb))
     }
 
+    /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
+    ///
+    /// - `p_x1 = -dot_theta*ell*m1*sin(theta)/2 + dot_x1*m1`
+    /// - `p_xb = dot_xb*m2`
+    /// - `p_phi = dot_phi*m2*w^2/12 + dot_phi*h^2*m2/12`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
-        out[0] = -(k[11] * qd[2] * rc_s) + (k[0] * qd[0]);
-        out[1] = k[1] * qd[3];
-        out[2] = k[20] * qd[5];
+        let m1 = k[0];
+        let m2 = k[1];
+        let x1_dot = qd[0];
+        let theta_dot = qd[2];
+        let xb_dot = qd[3];
+        let phi_dot = qd[5];
+        out[0] = -(k[11] * theta_dot * rc_s) + (m1 * x1_dot);
+        out[1] = m2 * xb_dot;
+        out[2] = k[19] * phi_dot;
     }
 
+    /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
+    ///
+    /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
+    /// - `L = T - V`: 255 characters, written out in `generated/rod_block_tipping.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let qt0 = -k[11] * rc_s;
-        let qt1 = k[11] * rc_c;
-        let qt2 = qd[2] * qd[2];
-        mass[0] = k[0];
+        let m1 = k[0];
+        let m2 = k[1];
+        let theta_dot = qd[2];
+        let qt0 = -k[11] * rc_s; // -(ell*m1*rc_s/2)
+        let qt1 = k[11] * rc_c; // ell*m1*rc_c/2
+        let qt2 = theta_dot * theta_dot;
+        mass[0] = m1;
         mass[1] = 0.0;
         mass[2] = qt0;
         mass[3] = 0.0;
         mass[4] = 0.0;
         mass[5] = 0.0;
         mass[6] = 0.0;
-        mass[7] = k[0];
+        mass[7] = m1;
         mass[8] = qt1;
         mass[9] = 0.0;
         mass[10] = 0.0;
         mass[11] = 0.0;
         mass[12] = qt0;
         mass[13] = qt1;
-        mass[14] = k[21] + (k[22] * (rc_s * rc_s)) + (k[22] * (rc_c * rc_c));
+        mass[14] = k[20];
         mass[15] = 0.0;
         mass[16] = 0.0;
         mass[17] = 0.0;
         mass[18] = 0.0;
         mass[19] = 0.0;
         mass[20] = 0.0;
-        mass[21] = k[1];
+        mass[21] = m2;
         mass[22] = 0.0;
         mass[23] = 0.0;
         mass[24] = 0.0;
         mass[25] = 0.0;
         mass[26] = 0.0;
         mass[27] = 0.0;
-        mass[28] = k[1];
+        mass[28] = m2;
         mass[29] = 0.0;
         mass[30] = 0.0;
         mass[31] = 0.0;
         mass[32] = 0.0;
         mass[33] = 0.0;
         mass[34] = 0.0;
-        mass[35] = k[20];
+        mass[35] = k[19];
         rhs[0] = k[11] * qt2 * rc_c;
-        rhs[1] = -k[18] + (k[11] * qt2 * rc_s);
-        rhs[2] = -k[17] * rc_c;
+        rhs[1] = -k[17] + (k[11] * qt2 * rc_s);
+        rhs[2] = -k[16] * rc_c;
         rhs[3] = 0.0;
-        rhs[4] = -k[19];
+        rhs[4] = -k[18];
         rhs[5] = 0.0;
     }
 
+    /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
+    ///
+    /// No contact is closed in this phase.
     fn forces_full(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _qdd: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
@@ -368,37 +448,62 @@ impl Model for RodBlockTipping {
         out[4] = 0.0;
     }
 
+    /// Each contact's gap `g(q)`, `>= 0` while apart (zero for a contact held closed).
+    ///
+    /// - `contact_force = -ell*sin(phi)*sin(theta) - ell*cos(phi)*cos(theta) - w/2 - x1*cos(phi) + xb*cos(phi) - y1*sin(phi) + yb*sin(phi)`
+    /// - `block_near_edge = -h*cos(phi)/2 - w*sin(phi)/2 + yb`
+    /// - `block_far_edge = -h*cos(phi)/2 + w*sin(phi)/2 + yb`
+    /// - `floor_normal = y1`
+    /// - `tip_floor = ell*sin(theta) + y1`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let gt0 = q[5].sin();
-        let gt1 = q[5].cos();
-        out[0] = -k[10] - (k[2] * gt0 * rc_s) - (k[2] * gt1 * rc_c) - (q[0] * gt1) + (q[3] * gt1)
-            - (q[1] * gt0)
-            + (q[4] * gt0);
-        out[1] = -(k[8] * gt1) - (k[10] * gt0) + q[4];
-        out[2] = -(k[8] * gt1) + (k[10] * gt0) + q[4];
-        out[3] = q[1];
-        out[4] = (k[2] * rc_s) + q[1];
+        let ell = k[2];
+        let x1 = q[0];
+        let y1 = q[1];
+        let xb = q[3];
+        let yb = q[4];
+        let phi = q[5];
+        let gt0 = phi.sin();
+        let gt1 = phi.cos();
+        out[0] = -k[10] - (ell * gt0 * rc_s) - (ell * gt1 * rc_c) - (x1 * gt1) + (xb * gt1)
+            - (y1 * gt0)
+            + (yb * gt0);
+        out[1] = -(k[8] * gt1) - (k[10] * gt0) + yb;
+        out[2] = -(k[8] * gt1) + (k[10] * gt0) + yb;
+        out[3] = y1;
+        out[4] = (ell * rc_s) + y1;
     }
 
+    /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let jt0 = q[5].cos();
-        let jt1 = q[5].sin();
-        let jt2 = k[8] * jt1;
-        let jt3 = qd[5] * qd[5];
-        let jt4 = qd[2] * qd[2];
-        let jt5 = k[8] * jt3 * jt0;
+        let ell = k[2];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let y1 = q[1];
+        let y1_dot = qd[1];
+        let theta_dot = qd[2];
+        let xb = q[3];
+        let xb_dot = qd[3];
+        let yb = q[4];
+        let yb_dot = qd[4];
+        let phi = q[5];
+        let phi_dot = qd[5];
+        let jt0 = phi.cos();
+        let jt1 = phi.sin();
+        let jt2 = k[8] * jt1; // h*sin(phi)/2
+        let jt3 = phi_dot * phi_dot;
+        let jt4 = theta_dot * theta_dot;
+        let jt5 = k[8] * jt3 * jt0; // h*dot_phi^2*cos(phi)/2
         jac[0] = -jt0;
         jac[1] = -jt1;
-        jac[2] = -(k[2] * jt1 * rc_c) + (k[2] * rc_s * jt0);
+        jac[2] = -(ell * jt1 * rc_c) + (ell * rc_s * jt0);
         jac[3] = jt0;
         jac[4] = jt1;
-        jac[5] =
-            (k[2] * jt1 * rc_c) - (k[2] * rc_s * jt0) + (q[0] * jt1) - (q[3] * jt1) - (q[1] * jt0)
-                + (q[4] * jt0);
+        jac[5] = (ell * jt1 * rc_c) - (ell * rc_s * jt0) + (x1 * jt1) - (xb * jt1) - (y1 * jt0)
+            + (yb * jt0);
         jac[6] = 0.0;
         jac[7] = 0.0;
         jac[8] = 0.0;
@@ -419,46 +524,61 @@ impl Model for RodBlockTipping {
         jac[23] = 0.0;
         jac[24] = 0.0;
         jac[25] = 1.0;
-        jac[26] = k[2] * rc_c;
+        jac[26] = ell * rc_c;
         jac[27] = 0.0;
         jac[28] = 0.0;
         jac[29] = 0.0;
-        bias[0] = -(k[23] * qd[5] * qd[2] * jt1 * rc_s) - (k[23] * qd[5] * qd[2] * jt0 * rc_c)
-            + (2.0 * qd[5] * qd[0] * jt1)
-            - (2.0 * qd[5] * qd[3] * jt1)
-            - (2.0 * qd[5] * qd[1] * jt0)
-            + (2.0 * qd[5] * qd[4] * jt0)
-            + (k[2] * jt3 * jt1 * rc_s)
-            + (k[2] * jt3 * jt0 * rc_c)
-            + (jt3 * q[0] * jt0)
-            - (jt3 * q[3] * jt0)
-            + (jt3 * q[1] * jt1)
-            - (jt3 * q[4] * jt1)
-            + (k[2] * jt4 * jt1 * rc_s)
-            + (k[2] * jt4 * jt0 * rc_c);
+        bias[0] = -(k[21] * phi_dot * theta_dot * jt1 * rc_s)
+            - (k[21] * phi_dot * theta_dot * jt0 * rc_c)
+            + (2.0 * phi_dot * x1_dot * jt1)
+            - (2.0 * phi_dot * xb_dot * jt1)
+            - (2.0 * phi_dot * y1_dot * jt0)
+            + (2.0 * phi_dot * yb_dot * jt0)
+            + (ell * jt3 * jt1 * rc_s)
+            + (ell * jt3 * jt0 * rc_c)
+            + (jt3 * x1 * jt0)
+            - (jt3 * xb * jt0)
+            + (jt3 * y1 * jt1)
+            - (jt3 * yb * jt1)
+            + (ell * jt4 * jt1 * rc_s)
+            + (ell * jt4 * jt0 * rc_c);
         bias[1] = jt5 + (k[10] * jt3 * jt1);
         bias[2] = jt5 - (k[10] * jt3 * jt1);
         bias[3] = 0.0;
-        bias[4] = -k[2] * jt4 * rc_s;
+        bias[4] = -ell * jt4 * rc_s;
     }
 
+    /// Each contact's edge margin, `>= 0` while the contact point is on the edge (infinite without one).
+    ///
+    /// - `contact_force = ell*sin(phi)*cos(theta) - ell*sin(theta)*cos(phi) + h/2 + x1*sin(phi) - xb*sin(phi) - y1*cos(phi) + yb*cos(phi)`
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let et0 = q[5].sin();
-        let et1 = q[5].cos();
-        out[0] = k[8] + (k[2] * et0 * rc_c) - (k[2] * rc_s * et1) + (q[0] * et0)
-            - (q[3] * et0)
-            - (q[1] * et1)
-            + (q[4] * et1);
+        let ell = k[2];
+        let x1 = q[0];
+        let y1 = q[1];
+        let xb = q[3];
+        let yb = q[4];
+        let phi = q[5];
+        let et0 = phi.sin();
+        let et1 = phi.cos();
+        out[0] =
+            k[8] + (ell * et0 * rc_c) - (ell * rc_s * et1) + (x1 * et0) - (xb * et0) - (y1 * et1)
+                + (yb * et1);
         out[1] = f64::INFINITY;
         out[2] = f64::INFINITY;
         out[3] = f64::INFINITY;
         out[4] = f64::INFINITY;
     }
 
+    /// Each friction's slip velocity `v = J(q) qd`: `jac` holds `J`, `bias` holds `dJ/dt qd`.
+    ///
+    /// No friction.
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
+    /// The monitors over the state and the contacts' forces `rc_f<i>`.
+    ///
+    /// No monitor.
     fn monitors_full(
         &self,
         _k: &[f64],
@@ -469,34 +589,69 @@ impl Model for RodBlockTipping {
     ) {
     }
 
+    /// The system's state (its general model's) that this phase's state stands for.
+    ///
+    /// - `x1 = x1`
+    /// - `dot_x1 = dot_x1`
+    /// - `y1 = y1`
+    /// - `dot_y1 = dot_y1`
+    /// - `theta = theta`
+    /// - `dot_theta = dot_theta`
+    /// - `xb = xb`
+    /// - `dot_xb = dot_xb`
+    /// - `yb = yb`
+    /// - `dot_yb = dot_yb`
+    /// - `phi = phi`
+    /// - `dot_phi = dot_phi`
     fn to_full(&self, _k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        q_full[0] = q[0];
-        qd_full[0] = qd[0];
-        q_full[1] = q[1];
-        qd_full[1] = qd[1];
-        q_full[2] = q[2];
-        qd_full[2] = qd[2];
-        q_full[3] = q[3];
-        qd_full[3] = qd[3];
-        q_full[4] = q[4];
-        qd_full[4] = qd[4];
-        q_full[5] = q[5];
-        qd_full[5] = qd[5];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let y1 = q[1];
+        let y1_dot = qd[1];
+        let theta = q[2];
+        let theta_dot = qd[2];
+        let xb = q[3];
+        let xb_dot = qd[3];
+        let yb = q[4];
+        let yb_dot = qd[4];
+        let phi = q[5];
+        let phi_dot = qd[5];
+        q_full[0] = x1;
+        qd_full[0] = x1_dot;
+        q_full[1] = y1;
+        qd_full[1] = y1_dot;
+        q_full[2] = theta;
+        qd_full[2] = theta_dot;
+        q_full[3] = xb;
+        qd_full[3] = xb_dot;
+        q_full[4] = yb;
+        qd_full[4] = yb_dot;
+        q_full[5] = phi;
+        qd_full[5] = phi_dot;
     }
 
+    /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..24]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        poses[0] = [(k[9] * rc_c) + q[0], (k[9] * rc_s) + q[1], q[2]];
-        poses[1] = [q[3], q[4], q[5]];
+        let w = k[3];
+        let h = k[4];
+        let x1 = q[0];
+        let y1 = q[1];
+        let theta = q[2];
+        let xb = q[3];
+        let yb = q[4];
+        let phi = q[5];
+        poses[0] = [(k[9] * rc_c) + x1, (k[9] * rc_s) + y1, theta];
+        poses[1] = [xb, yb, phi];
         sizes[0] = -k[9];
         sizes[1] = 0.0;
         sizes[2] = k[9];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
-        sizes[6] = k[3];
-        sizes[7] = k[4];
+        sizes[6] = w;
+        sizes[7] = h;
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {

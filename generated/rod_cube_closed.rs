@@ -53,7 +53,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 44,
+    n_constants: 41,
     coordinates: &["x1", "theta"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced: 1,
@@ -144,7 +144,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 8,
         force_degrees: &[3, 4],
         fall_degree: Some(2),
-        lean_constants: &[6, 7, 8, 29, 35, 36, 37, 38, 39, 40, 41, 42],
+        lean_constants: &[6, 7, 8, 26, 32, 33, 34, 35, 36, 37, 38, 39],
     }),
     route_note: "",
 };
@@ -154,146 +154,203 @@ impl Model for RodCubeClosed {
         &INFO
     }
 
+    /// The requirements' margins over the parameters, each `>= 0` where it holds.
+    ///
+    /// - `rod_leans = ell - a`
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
-        let k = p;
-        out[0] = k[2] - k[3];
+        let ell = p[2];
+        let a = p[3];
+        out[0] = ell - a;
     }
 
+    /// Each contact's coefficient of restitution over the parameters.
+    ///
+    /// - `contact_force = 0`
+    /// - `floor_normal = 0`
     fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
     }
 
+    /// The constants `k`: the parameters, then the constants derived from them.
+    ///
+    /// `k[..5]` holds the parameters `m1, m2, ell, a, g`; each later slot's definition is the comment above the line that fills it.
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
+        let m1 = p[0];
+        let m2 = p[1];
+        let ell = p[2];
+        let a = p[3];
+        let g = p[4];
         k[..5].copy_from_slice(p);
         Reduction::prepare_lean(self, p, k);
         // k[5] = rc_thi = asin(a/ell)
-        k[5] = (k[3] / k[2]).asin();
+        k[5] = (a / ell).asin();
         // k[9] = rc_x0i = 0.0
         k[9] = 0.0;
         // k[10] = ell/2
-        k[10] = k[2] / 2.0;
+        k[10] = ell / 2.0;
         // k[11] = ell*m1/2 + ell*m2
-        k[11] = (k[2] * k[0] / 2.0) + (k[2] * k[1]);
-        // k[12] = ell^2*m1/24
-        k[12] = (k[2] * k[2]) * k[0] / 24.0;
-        // k[13] = ell^2*m1/8 + ell^2*m2/2
-        let h13_t0 = k[2] * k[2];
-        k[13] = (h13_t0 * k[0] / 8.0) + (h13_t0 * k[1] / 2.0);
-        // k[14] = ell^2*m1/8
-        k[14] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[15] = m1/2 + m2/2
-        k[15] = (k[0] / 2.0) + (k[1] / 2.0);
-        // k[16] = a*g*m2/2
-        k[16] = k[3] * k[4] * k[1] / 2.0;
-        // k[17] = ell*g*m1/2
-        k[17] = k[2] * k[4] * k[0] / 2.0;
-        // k[18] = m1 + m2
-        k[18] = k[0] + k[1];
-        // k[19] = ell^2*m1/12
-        k[19] = (k[2] * k[2]) * k[0] / 12.0;
-        // k[20] = ell^2*m1/4 + ell^2*m2
-        let h20_t0 = k[2] * k[2];
-        k[20] = (h20_t0 * k[0] / 4.0) + (h20_t0 * k[1]);
-        // k[21] = ell^2*m1/4
-        k[21] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[22] = ell^2*m2
-        k[22] = (k[2] * k[2]) * k[1];
-        // k[23] = g*m1
-        k[23] = k[4] * k[0];
-        // k[24] = ell*m1/2
-        k[24] = k[2] * k[0] / 2.0;
-        // k[25] = a/2
-        k[25] = k[3] / 2.0;
-        // k[26] = 12/ell
-        k[26] = 12.0 / k[2];
-        // k[27] = g*m1 + g*m2
-        k[27] = (k[4] * k[0]) + (k[4] * k[1]);
-        // k[28] = 4*m1 + 4*m2
-        k[28] = (4.0 * k[0]) + (4.0 * k[1]);
-        // k[30] = 6/ell
-        k[30] = 6.0 / k[2];
-        // k[31] = 6*g*m1*m2 + 6*g*m1^2
-        k[31] = (6.0 * k[4] * k[0] * k[1]) + (6.0 * k[4] * (k[0] * k[0]));
-        // k[32] = 8*g*m1*m2 + 4*g*m1^2 + 4*g*m2^2
-        k[32] = (8.0 * k[4] * k[0] * k[1])
-            + (4.0 * k[4] * (k[0] * k[0]))
-            + (4.0 * k[4] * (k[1] * k[1]));
-        // k[33] = 3*g*m1*m2 + 3*g*m1^2
-        k[33] = (3.0 * k[4] * k[0] * k[1]) + (3.0 * k[4] * (k[0] * k[0]));
-        // k[34] = ell*m1*m2/(2*(m1 + m2))
-        k[34] = k[2] * k[0] * k[1] / 2.0 / (k[0] + k[1]);
-        // k[43] = ell*m1/(2*(m1 + m2)) + ell*m2/(m1 + m2)
-        k[43] = (k[2] * k[0] / 2.0 / (k[0] + k[1])) + (k[2] * k[1] / (k[0] + k[1]));
+        k[11] = (ell * m1 / 2.0) + (ell * m2);
+        // k[12] = ell^2*m1/6
+        k[12] = (ell * ell) * m1 / 6.0;
+        // k[13] = ell^2*m2/2
+        k[13] = (ell * ell) * m2 / 2.0;
+        // k[14] = m1/2 + m2/2
+        k[14] = (m1 / 2.0) + (m2 / 2.0);
+        // k[15] = a*g*m2/2
+        k[15] = a * g * m2 / 2.0;
+        // k[16] = ell*g*m1/2
+        k[16] = ell * g * m1 / 2.0;
+        // k[17] = m1 + m2
+        k[17] = m1 + m2;
+        // k[18] = ell^2*m1/3
+        k[18] = (ell * ell) * m1 / 3.0;
+        // k[19] = ell^2*m2
+        k[19] = (ell * ell) * m2;
+        // k[20] = g*m1
+        k[20] = g * m1;
+        // k[21] = ell*m1/2
+        k[21] = ell * m1 / 2.0;
+        // k[22] = a/2
+        k[22] = a / 2.0;
+        // k[23] = 12/ell
+        k[23] = 12.0 / ell;
+        // k[24] = g*m1 + g*m2
+        k[24] = (g * m1) + (g * m2);
+        // k[25] = 4*m1 + 4*m2
+        k[25] = (4.0 * m1) + (4.0 * m2);
+        // k[27] = 6/ell
+        k[27] = 6.0 / ell;
+        // k[28] = 6*g*m1*m2 + 6*g*m1^2
+        k[28] = (6.0 * g * m1 * m2) + (6.0 * g * (m1 * m1));
+        // k[29] = 8*g*m1*m2 + 4*g*m1^2 + 4*g*m2^2
+        k[29] = (8.0 * g * m1 * m2) + (4.0 * g * (m1 * m1)) + (4.0 * g * (m2 * m2));
+        // k[30] = 3*g*m1*m2 + 3*g*m1^2
+        k[30] = (3.0 * g * m1 * m2) + (3.0 * g * (m1 * m1));
+        // k[31] = ell*m1*m2/(2*(m1 + m2))
+        k[31] = ell * m1 * m2 / 2.0 / (m1 + m2);
+        // k[40] = ell*m1/(2*(m1 + m2)) + ell*m2/(m1 + m2)
+        k[40] = (ell * m1 / 2.0 / (m1 + m2)) + (ell * m2 / (m1 + m2));
     }
 
+    /// The state at release, over the parameters.
+    ///
+    /// - `x1 = 0.0`
+    /// - `dot_x1 = 0.0`
+    /// - `theta = asin(a/ell)`
+    /// - `dot_theta = 0.0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = k[5];
         qd[1] = 0.0;
     }
 
+    /// Each point's position over the state (`pos`), and its time derivative (`vel`).
+    ///
+    /// - `foot_x = x1`
+    /// - `foot_y = 0`
+    /// - `tip_x = ell*cos(theta) + x1`
+    /// - `tip_y = ell*sin(theta)`
+    /// - `rod_centre_x = ell*cos(theta)/2 + x1`
+    /// - `rod_centre_y = ell*sin(theta)/2`
+    /// - `cube_x = ell*cos(theta) + x1`
+    /// - `cube_y = 0`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let pt0 = (k[2] * rc_c) + q[0];
-        let pt1 = -(k[2] * qd[1] * rc_s) + qd[0];
-        pos[0] = [q[0], 0.0];
-        vel[0] = [qd[0], 0.0];
-        pos[1] = [pt0, k[2] * rc_s];
-        vel[1] = [pt1, k[2] * qd[1] * rc_c];
-        pos[2] = [(k[10] * rc_c) + q[0], k[10] * rc_s];
-        vel[2] = [-(k[10] * qd[1] * rc_s) + qd[0], k[10] * qd[1] * rc_c];
+        let ell = k[2];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let theta_dot = qd[1];
+        let pt0 = (ell * rc_c) + x1;
+        let pt1 = -(ell * theta_dot * rc_s) + x1_dot;
+        pos[0] = [x1, 0.0];
+        vel[0] = [x1_dot, 0.0];
+        pos[1] = [pt0, ell * rc_s];
+        vel[1] = [pt1, ell * theta_dot * rc_c];
+        pos[2] = [(k[10] * rc_c) + x1, k[10] * rc_s];
+        vel[2] = [
+            -(k[10] * theta_dot * rc_s) + x1_dot,
+            k[10] * theta_dot * rc_c,
+        ];
         pos[3] = [pt0, 0.0];
         vel[3] = [pt1, 0.0];
     }
 
+    /// The total energy `E = T + V`.
+    ///
+    /// - `T`: 169 characters, written out in `generated/rod_cube_closed.tex`
+    /// - `V = a*g*m2/2 + ell*g*m1*sin(theta)/2`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..44]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let et0 = qd[1] * qd[1];
-        (-(k[11] * qd[1] * qd[0] * rc_s)
+        let k = &k[..41]; // one bounds check for all constant loads
+        let rc_s = q[1].sin();
+        let x1_dot = qd[0];
+        let theta_dot = qd[1];
+        let et0 = theta_dot * theta_dot;
+        (-(k[11] * theta_dot * x1_dot * rc_s)
             + (k[12] * et0)
             + (k[13] * et0 * (rc_s * rc_s))
-            + (k[14] * et0 * (rc_c * rc_c))
-            + (k[15] * (qd[0] * qd[0])))
-            + (k[16] + (k[17] * rc_s))
+            + (k[14] * (x1_dot * x1_dot)))
+            + (k[15] + (k[16] * rc_s))
     }
 
+    /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
+    ///
+    /// - `p_x1 = -dot_theta*ell*m1*sin(theta)/2 - dot_theta*ell*m2*sin(theta) + dot_x1*m1 + dot_x1*m2`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
-        out[0] = -(k[11] * qd[1] * rc_s) + (k[18] * qd[0]);
+        let x1_dot = qd[0];
+        let theta_dot = qd[1];
+        out[0] = -(k[11] * theta_dot * rc_s) + (k[17] * x1_dot);
     }
 
+    /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
+    ///
+    /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
+    /// - `L = T - V`: 206 characters, written out in `generated/rod_cube_closed.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let qt0 = -k[11] * rc_s;
-        let qt1 = qd[1] * qd[1];
-        mass[0] = k[18];
+        let theta_dot = qd[1];
+        let qt0 = -k[11] * rc_s; // -((ell*m1/2 + ell*m2)*rc_s)
+        let qt1 = theta_dot * theta_dot;
+        mass[0] = k[17];
         mass[1] = qt0;
         mass[2] = qt0;
-        mass[3] = k[19] + (k[20] * (rc_s * rc_s)) + (k[21] * (rc_c * rc_c));
+        mass[3] = k[18] + (k[19] * (rc_s * rc_s));
         rhs[0] = k[11] * qt1 * rc_c;
-        rhs[1] = -(k[17] * rc_c) - (k[22] * qt1 * rc_s * rc_c);
+        rhs[1] = -(k[16] * rc_c) - (k[19] * qt1 * rc_s * rc_c);
     }
 
+    /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
+    ///
+    /// - `contact_force = m2*(-ddot_theta*ell*sin(theta) + ddot_x1 - dot_theta^2*ell*cos(theta))`
+    /// - `floor_normal = ddot_theta*ell*m1*cos(theta)/2 + g*m1 - dot_theta^2*ell*m1*sin(theta)/2`
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let ft0 = qd[1] * qd[1];
-        out[0] = k[1] * (-(k[2] * qdd[1] * rc_s) + qdd[0] - (k[2] * ft0 * rc_c));
-        out[1] = k[23] + (k[24] * qdd[1] * rc_c) - (k[24] * ft0 * rc_s);
+        let m2 = k[1];
+        let ell = k[2];
+        let x1_ddot = qdd[0];
+        let theta_dot = qd[1];
+        let theta_ddot = qdd[1];
+        let ft0 = theta_dot * theta_dot;
+        out[0] = m2 * (-(ell * theta_ddot * rc_s) + x1_ddot - (ell * ft0 * rc_c));
+        out[1] = k[20] + (k[21] * theta_ddot * rc_c) - (k[21] * ft0 * rc_s);
     }
 
+    /// Each contact's gap `g(q)`, `>= 0` while apart (zero for a contact held closed).
+    ///
+    /// No open contact.
     fn gaps(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
     }
 
+    /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, _k: &[f64], _q: &[f64], _qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
         jac[0] = 0.0;
         jac[1] = 0.0;
@@ -303,45 +360,75 @@ impl Model for RodCubeClosed {
         bias[1] = 0.0;
     }
 
+    /// Each contact's edge margin, `>= 0` while the contact point is on the edge (infinite without one).
+    ///
+    /// No contact has an edge.
     fn edges(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
         out[0] = f64::INFINITY;
         out[1] = f64::INFINITY;
     }
 
+    /// Each friction's slip velocity `v = J(q) qd`: `jac` holds `J`, `bias` holds `dJ/dt qd`.
+    ///
+    /// No friction.
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
+    /// The monitors over the state and the contacts' forces `rc_f<i>`.
+    ///
+    /// - `cube_does_not_tip = a*g*m2/2 - rc_f0*(-a/2 + ell*sin(theta))`
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
-        out[0] = k[16] - (forces[0] * (-k[25] + (k[2] * rc_s)));
+        let ell = k[2];
+        out[0] = k[15] - (forces[0] * (-k[22] + (ell * rc_s)));
     }
 
+    /// The system's state (its general model's) that this phase's state stands for.
+    ///
+    /// - `x1 = x1`
+    /// - `dot_x1 = dot_x1`
+    /// - `y1 = 0`
+    /// - `dot_y1 = 0`
+    /// - `theta = theta`
+    /// - `dot_theta = dot_theta`
+    /// - `x2 = ell*cos(theta) + x1`
+    /// - `dot_x2 = -dot_theta*ell*sin(theta) + dot_x1`
     fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        q_full[0] = q[0];
-        qd_full[0] = qd[0];
+        let ell = k[2];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let theta = q[1];
+        let theta_dot = qd[1];
+        q_full[0] = x1;
+        qd_full[0] = x1_dot;
         q_full[1] = 0.0;
         qd_full[1] = 0.0;
-        q_full[2] = q[1];
-        qd_full[2] = qd[1];
-        q_full[3] = (k[2] * rc_c) + q[0];
-        qd_full[3] = -(k[2] * qd[1] * rc_s) + qd[0];
+        q_full[2] = theta;
+        qd_full[2] = theta_dot;
+        q_full[3] = (ell * rc_c) + x1;
+        qd_full[3] = -(ell * theta_dot * rc_s) + x1_dot;
     }
 
+    /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        poses[0] = [(k[10] * rc_c) + q[0], k[10] * rc_s, q[1]];
-        poses[1] = [k[25] + (k[2] * rc_c) + q[0], k[25], 0.0];
+        let ell = k[2];
+        let a = k[3];
+        let x1 = q[0];
+        let theta = q[1];
+        poses[0] = [(k[10] * rc_c) + x1, k[10] * rc_s, theta];
+        poses[1] = [k[22] + (ell * rc_c) + x1, k[22], 0.0];
         sizes[0] = -k[10];
         sizes[1] = 0.0;
         sizes[2] = k[10];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
-        sizes[6] = k[3];
-        sizes[7] = k[3];
+        sizes[6] = a;
+        sizes[7] = a;
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -350,97 +437,117 @@ impl Model for RodCubeClosed {
 }
 
 impl Reduction for RodCubeClosed {
+    /// The reduced motion at `theta = theta_i - delta`: `theta_dot^2` from the energy integral, and `theta_ddot`.
+    ///
+    /// - `theta_dot^2 = 12*(-a*g*m1 - a*g*m2 + ell*g*m1*sin(theta) + ell*g*m2*sin(theta))/(ell^2*(-4*m1 + 3*m1*sin(theta)^2 - 4*m2))`
+    /// - `theta_ddot`: 279 characters, written out in `generated/rod_cube_closed.tex`
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[7], k[8], delta);
         let rt0 = rc_s * rc_s;
-        let rt1 = -k[28] + (k[29] * rt0);
+        let rt1 = -k[25] + (k[26] * rt0); // -(4*m1 + 4*m2) + 3*m1*rc_s^2
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: -k[26] * (k[27] * rc_ds) / rt1,
-            theta_ddot: k[30]
-                * ((k[31] * rc_s * rc_c * rc_ds) - (k[32] * rc_c) + (k[33] * rt0 * rc_c))
+            theta_dot_sq: -k[23] * (k[24] * rc_ds) / rt1,
+            theta_ddot: k[27]
+                * ((k[28] * rc_s * rc_c * rc_ds) - (k[29] * rc_c) + (k[30] * rt0 * rc_c))
                 / (rt1 * rt1),
         }
     }
 
+    /// `theta_dot^2` over `sin(theta)`, `cos(theta)` and their drops from the start (the per-point solver's integrand).
+    ///
+    /// - `theta_dot^2 = 12*(-a*g*m1 - a*g*m2 + ell*g*m1*sin(theta) + ell*g*m2*sin(theta))/(ell^2*(-4*m1 + 3*m1*sin(theta)^2 - 4*m2))`
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..44]; // one bounds check for all constant loads
-        -k[26] * (k[27] * rc_ds) / (-k[28] + (k[29] * (rc_s * rc_s)))
+        let k = &k[..41]; // one bounds check for all constant loads
+        -k[23] * (k[24] * rc_ds) / (-k[25] + (k[26] * (rc_s * rc_s)))
     }
 
+    /// Each contact's force on the reduced motion (zero for a contact open in the phase).
+    ///
+    /// - `contact_force`: 225 characters, written out in `generated/rod_cube_closed.tex`
+    /// - `floor_normal`: 297 characters, written out in `generated/rod_cube_closed.tex`
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[5], k[7], k[8], delta);
         let rt0 = rc_s * rc_s;
-        let rt1 = -k[28] + (k[29] * rt0);
-        let rc_w2 = -k[26] * (k[27] * rc_ds) / rt1;
-        let rc_acc = k[30]
-            * ((k[31] * rc_s * rc_c * rc_ds) - (k[32] * rc_c) + (k[33] * rt0 * rc_c))
+        let rt1 = -k[25] + (k[26] * rt0); // -(4*m1 + 4*m2) + 3*m1*rc_s^2
+        let rc_w2 = -k[23] * (k[24] * rc_ds) / rt1;
+        let rc_acc = k[27]
+            * ((k[28] * rc_s * rc_c * rc_ds) - (k[29] * rc_c) + (k[30] * rt0 * rc_c))
             / (rt1 * rt1);
-        out[0] = -(k[34] * rc_s * rc_acc) - (k[34] * rc_c * rc_w2);
-        out[1] = k[23] - (k[24] * rc_s * rc_w2) + (k[24] * rc_c * rc_acc);
+        out[0] = -(k[31] * rc_s * rc_acc) - (k[31] * rc_c * rc_w2);
+        out[1] = k[20] - (k[21] * rc_s * rc_w2) + (k[21] * rc_c * rc_acc);
     }
 
+    /// The coefficients, constant term first, of a contact's force zero as a polynomial in `sin(theta)`, where it is one.
+    ///
+    /// - `separation condition (= 0) = -((8*a*m1 + 8*a*m2 - 12*ell*m1*sin(theta) + 3*ell*m1*sin(theta)^3 - 12*ell*m2*sin(theta))/ell)`
     fn force_polynomial(&self, k: &[f64], contact: usize, out: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         match contact {
             0 => {
-                out[0] = -k[35];
-                out[1] = k[36];
+                out[0] = -k[32];
+                out[1] = k[33];
                 out[2] = 0.0;
-                out[3] = -k[29];
+                out[3] = -k[26];
             }
             1 => {
-                out[0] = k[37];
-                out[1] = -k[38];
-                out[2] = k[39];
+                out[0] = k[34];
+                out[1] = -k[35];
+                out[2] = k[36];
                 out[3] = 0.0;
-                out[4] = -k[40];
+                out[4] = -k[37];
             }
             _ => {}
         }
     }
 
+    /// The constants of `prepare` that the per-point solver reads, and only those.
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let m1 = p[0];
+        let m2 = p[1];
+        let ell = p[2];
+        let a = p[3];
+        let g = p[4];
         k[..5].copy_from_slice(p);
         // k[6] = rc_wi = 0.0
         k[6] = 0.0;
         // k[7] = rc_si = a/ell
-        k[7] = k[3] / k[2];
+        k[7] = a / ell;
         // k[8] = rc_ci = ((1 - a/ell)*(1 + a/ell))^(1/2)
-        let c3_t0 = k[3] / k[2];
+        let c3_t0 = a / ell;
         k[8] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
-        // k[29] = 3*m1
-        k[29] = 3.0 * k[0];
-        // k[35] = 8*m1*rc_si + 8*m2*rc_si
-        k[35] = (8.0 * k[0] * k[7]) + (8.0 * k[1] * k[7]);
-        // k[36] = 12*m1 + 12*m2
-        k[36] = (12.0 * k[0]) + (12.0 * k[1]);
-        // k[37] = 8*m1*m2 + 4*m1^2 + 4*m2^2
-        k[37] = (8.0 * k[0] * k[1]) + (4.0 * (k[0] * k[0])) + (4.0 * (k[1] * k[1]));
-        // k[38] = 30*m1*m2*rc_si + 6*m1^2*rc_si + 24*m2^2*rc_si
-        k[38] = (30.0 * k[0] * k[1] * k[7])
-            + (6.0 * (k[0] * k[0]) * k[7])
-            + (24.0 * (k[1] * k[1]) * k[7]);
-        // k[39] = 39*m1*m2 + 3*m1^2 + 36*m2^2
-        k[39] = (39.0 * k[0] * k[1]) + (3.0 * (k[0] * k[0])) + (36.0 * (k[1] * k[1]));
-        // k[40] = 9*m1*m2
-        k[40] = 9.0 * k[0] * k[1];
-        // k[41] = ell/(3*g)
-        k[41] = k[2] / 3.0 / k[4];
-        // k[42] = ell*m1/(4*g*(m1 + m2))
-        k[42] = k[2] * k[0] / 4.0 / k[4] / (k[0] + k[1]);
+        // k[26] = 3*m1
+        k[26] = 3.0 * m1;
+        // k[32] = 8*m1*rc_si + 8*m2*rc_si
+        k[32] = (8.0 * m1 * k[7]) + (8.0 * m2 * k[7]);
+        // k[33] = 12*m1 + 12*m2
+        k[33] = (12.0 * m1) + (12.0 * m2);
+        // k[34] = 8*m1*m2 + 4*m1^2 + 4*m2^2
+        k[34] = (8.0 * m1 * m2) + (4.0 * (m1 * m1)) + (4.0 * (m2 * m2));
+        // k[35] = 30*m1*m2*rc_si + 6*m1^2*rc_si + 24*m2^2*rc_si
+        k[35] = (30.0 * m1 * m2 * k[7]) + (6.0 * (m1 * m1) * k[7]) + (24.0 * (m2 * m2) * k[7]);
+        // k[36] = 39*m1*m2 + 3*m1^2 + 36*m2^2
+        k[36] = (39.0 * m1 * m2) + (3.0 * (m1 * m1)) + (36.0 * (m2 * m2));
+        // k[37] = 9*m1*m2
+        k[37] = 9.0 * m1 * m2;
+        // k[38] = ell/(3*g)
+        k[38] = ell / 3.0 / g;
+        // k[39] = ell*m1/(4*g*(m1 + m2))
+        k[39] = ell * m1 / 4.0 / g / (m1 + m2);
     }
 
+    /// The coefficients, constant term first, of the fall polynomial `P(s) = (sin(theta_i) - s) / theta_dot^2` in `s = sin(theta)`.
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..44]; // one bounds check for all constant loads
-        out[0] = k[41];
+        let k = &k[..41]; // one bounds check for all constant loads
+        out[0] = k[38];
         out[1] = 0.0;
-        out[2] = -k[42];
+        out[2] = -k[39];
     }
 
+    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
     fn full_state(
         &self,
         k: &[f64],
@@ -450,12 +557,12 @@ impl Reduction for RodCubeClosed {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..44]; // one bounds check for all constant loads
+        let k = &k[..41]; // one bounds check for all constant loads
         let (rc_s, _, _, rc_dc) = start_offsets(k[5], k[7], k[8], delta);
         let rc_w = theta_dot;
         q[1] = k[5] - delta;
         qd[1] = theta_dot;
-        q[0] = k[9] + (k[43] * rc_dc);
-        qd[0] = k[43] * rc_s * rc_w;
+        q[0] = k[9] + (k[40] * rc_dc);
+        qd[0] = k[40] * rc_s * rc_w;
     }
 }

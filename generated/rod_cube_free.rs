@@ -89,7 +89,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 39,
+    n_constants: 37,
     coordinates: &["x1", "theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced: 1,
@@ -180,7 +180,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 12,
         force_degrees: &[0, 2],
         fall_degree: None,
-        lean_constants: &[11, 12, 15, 33, 34, 36],
+        lean_constants: &[11, 12, 15, 31, 32, 34],
     }),
     route_note: "",
 };
@@ -190,17 +190,36 @@ impl Model for RodCubeFree {
         &INFO
     }
 
+    /// The requirements' margins over the parameters, each `>= 0` where it holds.
+    ///
+    /// - `rod_leans = ell - a`
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
-        let k = p;
-        out[0] = k[2] - k[3];
+        let ell = p[2];
+        let a = p[3];
+        out[0] = ell - a;
     }
 
+    /// Each contact's coefficient of restitution over the parameters.
+    ///
+    /// - `contact_force = 0`
+    /// - `floor_normal = 0`
     fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
     }
 
+    /// The constants `k`: the parameters, then the constants derived from them.
+    ///
+    /// `k[..11]` holds the parameters `m1, m2, ell, a, g, x1_0, theta_0, x2_0, x1_dot_0, theta_dot_0, x2_dot_0`; each later slot's definition is the comment above the line that fills it.
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
+        let m1 = p[0];
+        let m2 = p[1];
+        let ell = p[2];
+        let a = p[3];
+        let g = p[4];
+        let x1_dot_0 = p[8];
+        let theta_dot_0 = p[9];
+        let x2_dot_0 = p[10];
         k[..11].copy_from_slice(p);
         // k[6] also holds rc_thi = theta_0
         // k[9] also holds rc_wi = theta_dot_0
@@ -208,176 +227,270 @@ impl Model for RodCubeFree {
         // k[7] also holds rc_x1i = x2_0
         Reduction::prepare_lean(self, p, k);
         // k[13] = rc_p0 = -ell*m1*rc_wi*rc_si/2 + m1*x1_dot_0
-        k[13] = -(k[2] * k[0] * k[9] * k[11] / 2.0) + (k[0] * k[8]);
+        k[13] = -(ell * m1 * theta_dot_0 * k[11] / 2.0) + (m1 * x1_dot_0);
         // k[14] = rc_p1 = m2*x2_dot_0
-        k[14] = k[1] * k[10];
+        k[14] = m2 * x2_dot_0;
         // k[16] = ell/2
-        k[16] = k[2] / 2.0;
+        k[16] = ell / 2.0;
         // k[17] = ell*m1/2
-        k[17] = k[2] * k[0] / 2.0;
-        // k[18] = ell^2*m1/24
-        k[18] = (k[2] * k[2]) * k[0] / 24.0;
-        // k[19] = ell^2*m1/8
-        k[19] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[20] = m1/2
-        k[20] = k[0] / 2.0;
-        // k[21] = m2/2
-        k[21] = k[1] / 2.0;
-        // k[22] = a*g*m2/2
-        k[22] = k[3] * k[4] * k[1] / 2.0;
-        // k[23] = ell*g*m1/2
-        k[23] = k[2] * k[4] * k[0] / 2.0;
-        // k[24] = ell^2*m1/12
-        k[24] = (k[2] * k[2]) * k[0] / 12.0;
-        // k[25] = ell^2*m1/4
-        k[25] = (k[2] * k[2]) * k[0] / 4.0;
-        // k[26] = g*m1
-        k[26] = k[4] * k[0];
-        // k[27] = a/2
-        k[27] = k[3] / 2.0;
-        // k[28] = 12/(ell^2*m1)
-        k[28] = 12.0 / (k[2] * k[2]) / k[0];
-        // k[29] = rc_wi^2*rc_ai
-        k[29] = (k[9] * k[9]) * k[15];
-        // k[30] = ell*g*m1
-        k[30] = k[2] * k[4] * k[0];
-        // k[31] = 6/(ell^2*m1)
-        k[31] = 6.0 / (k[2] * k[2]) / k[0];
-        // k[32] = 6*ell*g*m1
-        k[32] = 6.0 * k[2] * k[4] * k[0];
-        // k[35] = 6*rc_wi^2*rc_ai
-        k[35] = 6.0 * (k[9] * k[9]) * k[15];
-        // k[37] = rc_p0/m1
-        k[37] = k[13] / k[0];
-        // k[38] = rc_p1/m2
-        k[38] = k[14] / k[1];
+        k[17] = ell * m1 / 2.0;
+        // k[18] = ell^2*m1/6
+        k[18] = (ell * ell) * m1 / 6.0;
+        // k[19] = m1/2
+        k[19] = m1 / 2.0;
+        // k[20] = m2/2
+        k[20] = m2 / 2.0;
+        // k[21] = a*g*m2/2
+        k[21] = a * g * m2 / 2.0;
+        // k[22] = ell*g*m1/2
+        k[22] = ell * g * m1 / 2.0;
+        // k[23] = ell^2*m1/3
+        k[23] = (ell * ell) * m1 / 3.0;
+        // k[24] = g*m1
+        k[24] = g * m1;
+        // k[25] = a/2
+        k[25] = a / 2.0;
+        // k[26] = 12/(ell^2*m1)
+        k[26] = 12.0 / (ell * ell) / m1;
+        // k[27] = rc_wi^2*rc_ai
+        k[27] = (theta_dot_0 * theta_dot_0) * k[15];
+        // k[28] = ell*g*m1
+        k[28] = ell * g * m1;
+        // k[29] = 6/(ell^2*m1)
+        k[29] = 6.0 / (ell * ell) / m1;
+        // k[30] = 6*ell*g*m1
+        k[30] = 6.0 * ell * g * m1;
+        // k[33] = 6*rc_wi^2*rc_ai
+        k[33] = 6.0 * (theta_dot_0 * theta_dot_0) * k[15];
+        // k[35] = rc_p0/m1
+        k[35] = k[13] / m1;
+        // k[36] = rc_p1/m2
+        k[36] = k[14] / m2;
     }
 
+    /// The state at release, over the parameters.
+    ///
+    /// - `x1 = x1_0`
+    /// - `dot_x1 = x1_dot_0`
+    /// - `theta = theta_0`
+    /// - `dot_theta = theta_dot_0`
+    /// - `x2 = x2_0`
+    /// - `dot_x2 = x2_dot_0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
-        q[0] = k[5];
-        qd[0] = k[8];
-        q[1] = k[6];
-        qd[1] = k[9];
-        q[2] = k[7];
-        qd[2] = k[10];
+        let k = &k[..37]; // one bounds check for all constant loads
+        let x1_0 = k[5];
+        let theta_0 = k[6];
+        let x2_0 = k[7];
+        let x1_dot_0 = k[8];
+        let theta_dot_0 = k[9];
+        let x2_dot_0 = k[10];
+        q[0] = x1_0;
+        qd[0] = x1_dot_0;
+        q[1] = theta_0;
+        qd[1] = theta_dot_0;
+        q[2] = x2_0;
+        qd[2] = x2_dot_0;
     }
 
+    /// Each point's position over the state (`pos`), and its time derivative (`vel`).
+    ///
+    /// - `foot_x = x1`
+    /// - `foot_y = 0`
+    /// - `tip_x = ell*cos(theta) + x1`
+    /// - `tip_y = ell*sin(theta)`
+    /// - `rod_centre_x = ell*cos(theta)/2 + x1`
+    /// - `rod_centre_y = ell*sin(theta)/2`
+    /// - `cube_x = x2`
+    /// - `cube_y = 0`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        pos[0] = [q[0], 0.0];
-        vel[0] = [qd[0], 0.0];
-        pos[1] = [(k[2] * rc_c) + q[0], k[2] * rc_s];
-        vel[1] = [-(k[2] * qd[1] * rc_s) + qd[0], k[2] * qd[1] * rc_c];
-        pos[2] = [(k[16] * rc_c) + q[0], k[16] * rc_s];
-        vel[2] = [-(k[16] * qd[1] * rc_s) + qd[0], k[16] * qd[1] * rc_c];
-        pos[3] = [q[2], 0.0];
-        vel[3] = [qd[2], 0.0];
+        let ell = k[2];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let theta_dot = qd[1];
+        let x2 = q[2];
+        let x2_dot = qd[2];
+        pos[0] = [x1, 0.0];
+        vel[0] = [x1_dot, 0.0];
+        pos[1] = [(ell * rc_c) + x1, ell * rc_s];
+        vel[1] = [-(ell * theta_dot * rc_s) + x1_dot, ell * theta_dot * rc_c];
+        pos[2] = [(k[16] * rc_c) + x1, k[16] * rc_s];
+        vel[2] = [
+            -(k[16] * theta_dot * rc_s) + x1_dot,
+            k[16] * theta_dot * rc_c,
+        ];
+        pos[3] = [x2, 0.0];
+        vel[3] = [x2_dot, 0.0];
     }
 
+    /// The total energy `E = T + V`.
+    ///
+    /// - `T = -dot_theta*dot_x1*ell*m1*sin(theta)/2 + dot_theta^2*ell^2*m1/6 + dot_x1^2*m1/2 + dot_x2^2*m2/2`
+    /// - `V = a*g*m2/2 + ell*g*m1*sin(theta)/2`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..39]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[1].sin_cos();
-        let et0 = qd[1] * qd[1];
-        (-(k[17] * qd[1] * qd[0] * rc_s)
-            + (k[18] * et0)
-            + (k[19] * et0 * (rc_s * rc_s))
-            + (k[19] * et0 * (rc_c * rc_c))
-            + (k[20] * (qd[0] * qd[0]))
-            + (k[21] * (qd[2] * qd[2])))
-            + (k[22] + (k[23] * rc_s))
-    }
-
-    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
-        out[0] = -(k[17] * qd[1] * rc_s) + (k[0] * qd[0]);
-        out[1] = k[1] * qd[2];
+        let x1_dot = qd[0];
+        let theta_dot = qd[1];
+        let x2_dot = qd[2];
+        (-(k[17] * theta_dot * x1_dot * rc_s)
+            + (k[18] * (theta_dot * theta_dot))
+            + (k[19] * (x1_dot * x1_dot))
+            + (k[20] * (x2_dot * x2_dot)))
+            + (k[21] + (k[22] * rc_s))
     }
 
+    /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
+    ///
+    /// - `p_x1 = -dot_theta*ell*m1*sin(theta)/2 + dot_x1*m1`
+    /// - `p_x2 = dot_x2*m2`
+    fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let k = &k[..37]; // one bounds check for all constant loads
+        let rc_s = q[1].sin();
+        let m1 = k[0];
+        let m2 = k[1];
+        let x1_dot = qd[0];
+        let theta_dot = qd[1];
+        let x2_dot = qd[2];
+        out[0] = -(k[17] * theta_dot * rc_s) + (m1 * x1_dot);
+        out[1] = m2 * x2_dot;
+    }
+
+    /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
+    ///
+    /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
+    /// - `L = T - V = -dot_theta*dot_x1*ell*m1*sin(theta)/2 - (a*g*m2/2 + ell*g*m1*sin(theta)/2) + dot_theta^2*ell^2*m1/6 + dot_x1^2*m1/2 + dot_x2^2*m2/2`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        let qt0 = -k[17] * rc_s;
-        mass[0] = k[0];
+        let m1 = k[0];
+        let m2 = k[1];
+        let theta_dot = qd[1];
+        let qt0 = -k[17] * rc_s; // -(ell*m1*rc_s/2)
+        mass[0] = m1;
         mass[1] = qt0;
         mass[2] = 0.0;
         mass[3] = qt0;
-        mass[4] = k[24] + (k[25] * (rc_s * rc_s)) + (k[25] * (rc_c * rc_c));
+        mass[4] = k[23];
         mass[5] = 0.0;
         mass[6] = 0.0;
         mass[7] = 0.0;
-        mass[8] = k[1];
-        rhs[0] = k[17] * (qd[1] * qd[1]) * rc_c;
-        rhs[1] = -k[23] * rc_c;
+        mass[8] = m2;
+        rhs[0] = k[17] * (theta_dot * theta_dot) * rc_c;
+        rhs[1] = -k[22] * rc_c;
         rhs[2] = 0.0;
     }
 
+    /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
+    ///
+    /// - `floor_normal = ddot_theta*ell*m1*cos(theta)/2 + g*m1 - dot_theta^2*ell*m1*sin(theta)/2`
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
+        let theta_dot = qd[1];
+        let theta_ddot = qdd[1];
         out[0] = 0.0;
-        out[1] = k[26] + (k[17] * qdd[1] * rc_c) - (k[17] * (qd[1] * qd[1]) * rc_s);
+        out[1] = k[24] + (k[17] * theta_ddot * rc_c) - (k[17] * (theta_dot * theta_dot) * rc_s);
     }
 
+    /// Each contact's gap `g(q)`, `>= 0` while apart (zero for a contact held closed).
+    ///
+    /// - `contact_force = -ell*cos(theta) - x1 + x2`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let rc_c = q[1].cos();
-        out[0] = -(k[2] * rc_c) - q[0] + q[2];
+        let ell = k[2];
+        let x1 = q[0];
+        let x2 = q[2];
+        out[0] = -(ell * rc_c) - x1 + x2;
         out[1] = 0.0;
     }
 
+    /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
+        let ell = k[2];
+        let theta_dot = qd[1];
         jac[0] = -1.0;
-        jac[1] = k[2] * rc_s;
+        jac[1] = ell * rc_s;
         jac[2] = 1.0;
         jac[3] = 0.0;
         jac[4] = 0.0;
         jac[5] = 0.0;
-        bias[0] = k[2] * (qd[1] * qd[1]) * rc_c;
+        bias[0] = ell * (theta_dot * theta_dot) * rc_c;
         bias[1] = 0.0;
     }
 
+    /// Each contact's edge margin, `>= 0` while the contact point is on the edge (infinite without one).
+    ///
+    /// No contact has an edge.
     fn edges(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
         out[0] = f64::INFINITY;
         out[1] = f64::INFINITY;
     }
 
+    /// Each friction's slip velocity `v = J(q) qd`: `jac` holds `J`, `bias` holds `dJ/dt qd`.
+    ///
+    /// No friction.
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
+    /// The monitors over the state and the contacts' forces `rc_f<i>`.
+    ///
+    /// - `cube_does_not_tip = a*g*m2/2 - rc_f0*(-a/2 + ell*sin(theta))`
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let rc_s = q[1].sin();
-        out[0] = k[22] - (forces[0] * (-k[27] + (k[2] * rc_s)));
+        let ell = k[2];
+        out[0] = k[21] - (forces[0] * (-k[25] + (ell * rc_s)));
     }
 
+    /// The system's state (its general model's) that this phase's state stands for.
+    ///
+    /// - `x1 = x1`
+    /// - `dot_x1 = dot_x1`
+    /// - `y1 = 0`
+    /// - `dot_y1 = 0`
+    /// - `theta = theta`
+    /// - `dot_theta = dot_theta`
+    /// - `x2 = x2`
+    /// - `dot_x2 = dot_x2`
     fn to_full(&self, _k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        q_full[0] = q[0];
-        qd_full[0] = qd[0];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let theta = q[1];
+        let theta_dot = qd[1];
+        let x2 = q[2];
+        let x2_dot = qd[2];
+        q_full[0] = x1;
+        qd_full[0] = x1_dot;
         q_full[1] = 0.0;
         qd_full[1] = 0.0;
-        q_full[2] = q[1];
-        qd_full[2] = qd[1];
-        q_full[3] = q[2];
-        qd_full[3] = qd[2];
+        q_full[2] = theta;
+        qd_full[2] = theta_dot;
+        q_full[3] = x2;
+        qd_full[3] = x2_dot;
     }
 
+    /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[1].sin_cos();
-        poses[0] = [(k[16] * rc_c) + q[0], k[16] * rc_s, q[1]];
-        poses[1] = [k[27] + q[2], k[27], 0.0];
+        let a = k[3];
+        let x1 = q[0];
+        let theta = q[1];
+        let x2 = q[2];
+        poses[0] = [(k[16] * rc_c) + x1, k[16] * rc_s, theta];
+        poses[1] = [k[25] + x2, k[25], 0.0];
         sizes[0] = -k[16];
         sizes[1] = 0.0;
         sizes[2] = k[16];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
-        sizes[6] = k[3];
-        sizes[7] = k[3];
+        sizes[6] = a;
+        sizes[7] = a;
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -386,74 +499,93 @@ impl Model for RodCubeFree {
 }
 
 impl Reduction for RodCubeFree {
+    /// The reduced motion at `theta = theta_i - delta`: `theta_dot^2` from the energy integral, and `theta_ddot`.
+    ///
+    /// - `theta_dot^2 = (-4*ell*theta_dot_0^2 + 3*ell*theta_dot_0^2*sin(theta_0)^2 + 12*g*sin(theta) - 12*g*sin(theta_0))/(ell*(-4 + 3*sin(theta)^2))`
+    /// - `theta_ddot`: 227 characters, written out in `generated/rod_cube_free.tex`
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[6], k[11], k[12], delta);
         let rt0 = rc_s * rc_s;
         let rt1 = -4.0 + (3.0 * rt0);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: -k[28] * (k[29] + (k[30] * rc_ds)) / rt1,
-            theta_ddot: k[31]
-                * ((k[32] * rc_s * rc_c * rc_ds) - (k[33] * rc_c)
-                    + (k[34] * rt0 * rc_c)
-                    + (k[35] * rc_s * rc_c))
+            theta_dot_sq: -k[26] * (k[27] + (k[28] * rc_ds)) / rt1,
+            theta_ddot: k[29]
+                * ((k[30] * rc_s * rc_c * rc_ds) - (k[31] * rc_c)
+                    + (k[32] * rt0 * rc_c)
+                    + (k[33] * rc_s * rc_c))
                 / (rt1 * rt1),
         }
     }
 
+    /// `theta_dot^2` over `sin(theta)`, `cos(theta)` and their drops from the start (the per-point solver's integrand).
+    ///
+    /// - `theta_dot^2 = (-4*ell*theta_dot_0^2 + 3*ell*theta_dot_0^2*sin(theta_0)^2 + 12*g*sin(theta) - 12*g*sin(theta_0))/(ell*(-4 + 3*sin(theta)^2))`
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..39]; // one bounds check for all constant loads
-        -k[28] * (k[29] + (k[30] * rc_ds)) / (-4.0 + (3.0 * (rc_s * rc_s)))
+        let k = &k[..37]; // one bounds check for all constant loads
+        -k[26] * (k[27] + (k[28] * rc_ds)) / (-4.0 + (3.0 * (rc_s * rc_s)))
     }
 
+    /// Each contact's force on the reduced motion (zero for a contact open in the phase).
+    ///
+    /// - `floor_normal`: 180 characters, written out in `generated/rod_cube_free.tex`
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[6], k[11], k[12], delta);
         let rt0 = rc_s * rc_s;
         let rt1 = -4.0 + (3.0 * rt0);
-        let rc_w2 = -k[28] * (k[29] + (k[30] * rc_ds)) / rt1;
-        let rc_acc = k[31]
-            * ((k[32] * rc_s * rc_c * rc_ds) - (k[33] * rc_c)
-                + (k[34] * rt0 * rc_c)
-                + (k[35] * rc_s * rc_c))
+        let rc_w2 = -k[26] * (k[27] + (k[28] * rc_ds)) / rt1;
+        let rc_acc = k[29]
+            * ((k[30] * rc_s * rc_c * rc_ds) - (k[31] * rc_c)
+                + (k[32] * rt0 * rc_c)
+                + (k[33] * rc_s * rc_c))
             / (rt1 * rt1);
         out[0] = 0.0;
-        out[1] = k[26] - (k[17] * rc_s * rc_w2) + (k[17] * rc_c * rc_acc);
+        out[1] = k[24] - (k[17] * rc_s * rc_w2) + (k[17] * rc_c * rc_acc);
     }
 
+    /// The coefficients, constant term first, of a contact's force zero as a polynomial in `sin(theta)`, where it is one.
     fn force_polynomial(&self, k: &[f64], contact: usize, out: &mut [f64]) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
         match contact {
             1 => {
-                out[0] = k[33];
-                out[1] = -k[36];
-                out[2] = k[34];
+                out[0] = k[31];
+                out[1] = -k[34];
+                out[2] = k[32];
             }
             _ => {}
         }
     }
 
+    /// The constants of `prepare` that the per-point solver reads, and only those.
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let m1 = p[0];
+        let ell = p[2];
+        let g = p[4];
+        let theta_0 = p[6];
+        let theta_dot_0 = p[9];
         k[..11].copy_from_slice(p);
         // k[11] = rc_si = sin(rc_thi)
-        k[11] = k[6].sin();
+        k[11] = theta_0.sin();
         // k[12] = rc_ci = cos(rc_thi)
-        k[12] = k[6].cos();
+        k[12] = theta_0.cos();
         // k[15] = rc_ai = ell^2*m1/3 - ell^2*m1*rc_si^2/4
-        let c8_t0 = k[2] * k[2];
-        k[15] = (c8_t0 * k[0] / 3.0) - (c8_t0 * k[0] * (k[11] * k[11]) / 4.0);
-        // k[33] = 4*ell*g*m1
-        k[33] = 4.0 * k[2] * k[4] * k[0];
-        // k[34] = 3*ell*g*m1
-        k[34] = 3.0 * k[2] * k[4] * k[0];
-        // k[36] = 6*ell*g*m1*rc_si + 6*rc_wi^2*rc_ai
-        k[36] = (6.0 * k[2] * k[4] * k[0] * k[11]) + (6.0 * (k[9] * k[9]) * k[15]);
+        let c8_t0 = ell * ell;
+        k[15] = (c8_t0 * m1 / 3.0) - (c8_t0 * m1 * (k[11] * k[11]) / 4.0);
+        // k[31] = 4*ell*g*m1
+        k[31] = 4.0 * ell * g * m1;
+        // k[32] = 3*ell*g*m1
+        k[32] = 3.0 * ell * g * m1;
+        // k[34] = 6*ell*g*m1*rc_si + 6*rc_wi^2*rc_ai
+        k[34] = (6.0 * ell * g * m1 * k[11]) + (6.0 * (theta_dot_0 * theta_dot_0) * k[15]);
     }
 
+    /// The coefficients, constant term first, of the fall polynomial `P(s) = (sin(theta_i) - s) / theta_dot^2` in `s = sin(theta)`.
     fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
 
+    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
     fn full_state(
         &self,
         k: &[f64],
@@ -463,15 +595,17 @@ impl Reduction for RodCubeFree {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..39]; // one bounds check for all constant loads
+        let k = &k[..37]; // one bounds check for all constant loads
+        let x1_0 = k[5];
+        let x2_0 = k[7];
         let (rc_s, _, _, rc_dc) = start_offsets(k[6], k[11], k[12], delta);
         let rc_t = t;
         let rc_w = theta_dot;
         q[1] = k[6] - delta;
         qd[1] = theta_dot;
-        q[0] = k[5] + (k[16] * rc_dc) + (k[37] * rc_t);
-        qd[0] = k[37] + (k[16] * rc_s * rc_w);
-        q[2] = k[7] + (k[38] * rc_t);
-        qd[2] = k[38];
+        q[0] = x1_0 + (k[16] * rc_dc) + (k[35] * rc_t);
+        qd[0] = k[35] + (k[16] * rc_s * rc_w);
+        q[2] = x2_0 + (k[36] * rc_t);
+        qd[2] = k[36];
     }
 }

@@ -65,7 +65,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 19,
+    n_constants: 17,
     coordinates: &["x1", "y1", "theta", "xc"],
     system_coordinates: &["x1", "y1", "theta", "xc"],
     reduced: 2,
@@ -150,195 +150,297 @@ impl Model for RodCylinder {
         &INFO
     }
 
+    /// The requirements' margins over the parameters, each `>= 0` where it holds.
+    ///
+    /// - `leans_forward = cos(th0)`
+    /// - `touches_the_rod = ell - R*(1 + cos(th0))/sin(th0)`
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
-        let k = p;
-        let qt0 = k[4].cos();
+        let ell = p[2];
+        let r = p[3];
+        let th0 = p[4];
+        let qt0 = th0.cos();
         out[0] = qt0;
-        out[1] = k[2] - (k[3] * (1.0 + qt0) / k[4].sin());
+        out[1] = ell - (r * (1.0 + qt0) / th0.sin());
     }
 
+    /// Each contact's coefficient of restitution over the parameters.
+    ///
+    /// - `contact_force = 0`
+    /// - `floor_normal = 0`
     fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
     }
 
+    /// The constants `k`: the parameters, then the constants derived from them.
+    ///
+    /// `k[..6]` holds the parameters `m1, m2, ell, R, th0, g`; each later slot's definition is the comment above the line that fills it.
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
+        let m1 = p[0];
+        let m2 = p[1];
+        let ell = p[2];
+        let r = p[3];
+        let th0 = p[4];
+        let g = p[5];
         k[..6].copy_from_slice(p);
         // k[6] = R/sin(th0) + R*cos(th0)/sin(th0)
-        k[6] = (k[3] / k[4].sin()) + (k[3] * k[4].cos() / k[4].sin());
+        k[6] = (r / th0.sin()) + (r * th0.cos() / th0.sin());
         // k[7] = ell/2
-        k[7] = k[2] / 2.0;
+        k[7] = ell / 2.0;
         // k[8] = 2*R
-        k[8] = 2.0 * k[3];
+        k[8] = 2.0 * r;
         // k[9] = ell*m1/2
-        k[9] = k[2] * k[0] / 2.0;
-        // k[10] = ell^2*m1/24
-        k[10] = (k[2] * k[2]) * k[0] / 24.0;
-        // k[11] = ell^2*m1/8
-        k[11] = (k[2] * k[2]) * k[0] / 8.0;
-        // k[12] = m1/2
-        k[12] = k[0] / 2.0;
-        // k[13] = m2/2
-        k[13] = k[1] / 2.0;
-        // k[14] = R*g*m2
-        k[14] = k[3] * k[5] * k[1];
-        // k[15] = ell*g*m1/2
-        k[15] = k[2] * k[5] * k[0] / 2.0;
-        // k[16] = g*m1
-        k[16] = k[5] * k[0];
-        // k[17] = ell^2*m1/12
-        k[17] = (k[2] * k[2]) * k[0] / 12.0;
-        // k[18] = ell^2*m1/4
-        k[18] = (k[2] * k[2]) * k[0] / 4.0;
+        k[9] = ell * m1 / 2.0;
+        // k[10] = ell^2*m1/6
+        k[10] = (ell * ell) * m1 / 6.0;
+        // k[11] = m1/2
+        k[11] = m1 / 2.0;
+        // k[12] = m2/2
+        k[12] = m2 / 2.0;
+        // k[13] = R*g*m2
+        k[13] = r * g * m2;
+        // k[14] = ell*g*m1/2
+        k[14] = ell * g * m1 / 2.0;
+        // k[15] = g*m1
+        k[15] = g * m1;
+        // k[16] = ell^2*m1/3
+        k[16] = (ell * ell) * m1 / 3.0;
     }
 
+    /// The state at release, over the parameters.
+    ///
+    /// - `x1 = 0.0`
+    /// - `dot_x1 = 0.0`
+    /// - `y1 = 0`
+    /// - `dot_y1 = 0`
+    /// - `theta = th0`
+    /// - `dot_theta = 0.0`
+    /// - `xc = R/sin(th0) + R*cos(th0)/sin(th0)`
+    /// - `dot_xc = 0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..17]; // one bounds check for all constant loads
+        let th0 = k[4];
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = 0.0;
         qd[1] = 0.0;
-        q[2] = k[4];
+        q[2] = th0;
         qd[2] = 0.0;
         q[3] = k[6];
         qd[3] = 0.0;
     }
 
+    /// Each point's position over the state (`pos`), and its time derivative (`vel`).
+    ///
+    /// - `foot_x = x1`
+    /// - `foot_y = y1`
+    /// - `tip_x = ell*cos(theta) + x1`
+    /// - `tip_y = ell*sin(theta) + y1`
+    /// - `rod_centre_x = ell*cos(theta)/2 + x1`
+    /// - `rod_centre_y = ell*sin(theta)/2 + y1`
+    /// - `axis_x = xc`
+    /// - `axis_y = R`
+    /// - `touch_x = R*sin(theta)*cos(theta) + x1*sin(theta)^2 + xc*cos(theta)^2 - y1*sin(theta)*cos(theta)`
+    /// - `touch_y = R*sin(theta)^2 - x1*sin(theta)*cos(theta) + xc*sin(theta)*cos(theta) + y1*cos(theta)^2`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..17]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let pt0 = rc_c * rc_c;
-        let pt1 = rc_s * rc_s;
-        pos[0] = [q[0], q[1]];
-        vel[0] = [qd[0], qd[1]];
-        pos[1] = [(k[2] * rc_c) + q[0], (k[2] * rc_s) + q[1]];
+        let ell = k[2];
+        let r = k[3];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let y1 = q[1];
+        let y1_dot = qd[1];
+        let theta_dot = qd[2];
+        let xc = q[3];
+        let xc_dot = qd[3];
+        let pt0 = rc_s * rc_s;
+        let pt1 = rc_c * rc_c;
+        pos[0] = [x1, y1];
+        vel[0] = [x1_dot, y1_dot];
+        pos[1] = [(ell * rc_c) + x1, (ell * rc_s) + y1];
         vel[1] = [
-            -(k[2] * qd[2] * rc_s) + qd[0],
-            (k[2] * qd[2] * rc_c) + qd[1],
+            -(ell * theta_dot * rc_s) + x1_dot,
+            (ell * theta_dot * rc_c) + y1_dot,
         ];
-        pos[2] = [(k[7] * rc_c) + q[0], (k[7] * rc_s) + q[1]];
+        pos[2] = [(k[7] * rc_c) + x1, (k[7] * rc_s) + y1];
         vel[2] = [
-            -(k[7] * qd[2] * rc_s) + qd[0],
-            (k[7] * qd[2] * rc_c) + qd[1],
+            -(k[7] * theta_dot * rc_s) + x1_dot,
+            (k[7] * theta_dot * rc_c) + y1_dot,
         ];
-        pos[3] = [q[3], k[3]];
-        vel[3] = [qd[3], 0.0];
+        pos[3] = [xc, r];
+        vel[3] = [xc_dot, 0.0];
         pos[4] = [
-            (k[3] * rc_s * rc_c) + q[0] - (q[0] * pt0) + (q[3] * pt0) - (q[1] * rc_s * rc_c),
-            (k[3] * pt1) - (q[0] * rc_s * rc_c) + (q[3] * rc_s * rc_c) + q[1] - (q[1] * pt1),
+            (r * rc_s * rc_c) + (x1 * pt0) + (xc * pt1) - (y1 * rc_s * rc_c),
+            (r * pt0) - (x1 * rc_s * rc_c) + (xc * rc_s * rc_c) + (y1 * pt1),
         ];
         vel[4] = [
-            -(k[3] * qd[2] * pt1) + (k[3] * qd[2] * pt0) + (2.0 * qd[2] * q[0] * rc_s * rc_c)
-                - (2.0 * qd[2] * q[3] * rc_s * rc_c)
-                + (qd[2] * q[1] * pt1)
-                - (qd[2] * q[1] * pt0)
-                + qd[0]
-                - (qd[0] * pt0)
-                + (qd[3] * pt0)
-                - (qd[1] * rc_s * rc_c),
-            (k[8] * qd[2] * rc_s * rc_c) + (qd[2] * q[0] * pt1)
-                - (qd[2] * q[0] * pt0)
-                - (qd[2] * q[3] * pt1)
-                + (qd[2] * q[3] * pt0)
-                - (2.0 * qd[2] * q[1] * rc_s * rc_c)
-                - (qd[0] * rc_s * rc_c)
-                + (qd[3] * rc_s * rc_c)
-                + qd[1]
-                - (qd[1] * pt1),
+            -(r * theta_dot * pt0) + (r * theta_dot * pt1) + (2.0 * theta_dot * x1 * rc_s * rc_c)
+                - (2.0 * theta_dot * xc * rc_s * rc_c)
+                + (theta_dot * y1 * pt0)
+                - (theta_dot * y1 * pt1)
+                + (x1_dot * pt0)
+                + (xc_dot * pt1)
+                - (y1_dot * rc_s * rc_c),
+            (k[8] * theta_dot * rc_s * rc_c) + (theta_dot * x1 * pt0)
+                - (theta_dot * x1 * pt1)
+                - (theta_dot * xc * pt0)
+                + (theta_dot * xc * pt1)
+                - (2.0 * theta_dot * y1 * rc_s * rc_c)
+                - (x1_dot * rc_s * rc_c)
+                + (xc_dot * rc_s * rc_c)
+                + (y1_dot * pt1),
         ];
     }
 
+    /// The total energy `E = T + V`.
+    ///
+    /// - `T = -dot_theta*dot_x1*ell*m1*sin(theta)/2 + dot_theta*dot_y1*ell*m1*cos(theta)/2 + dot_theta^2*ell^2*m1/6 + dot_x1^2*m1/2 + dot_xc^2*m2/2 + dot_y1^2*m1/2`
+    /// - `V = R*g*m2 + ell*g*m1*sin(theta)/2 + g*m1*y1`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..17]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let et0 = qd[2] * qd[2];
-        (-(k[9] * qd[2] * qd[0] * rc_s)
-            + (k[9] * qd[2] * qd[1] * rc_c)
-            + (k[10] * et0)
-            + (k[11] * et0 * (rc_s * rc_s))
-            + (k[11] * et0 * (rc_c * rc_c))
-            + (k[12] * (qd[0] * qd[0]))
-            + (k[13] * (qd[3] * qd[3]))
-            + (k[12] * (qd[1] * qd[1])))
-            + (k[14] + (k[15] * rc_s) + (k[16] * q[1]))
+        let x1_dot = qd[0];
+        let y1 = q[1];
+        let y1_dot = qd[1];
+        let theta_dot = qd[2];
+        let xc_dot = qd[3];
+        (-(k[9] * theta_dot * x1_dot * rc_s)
+            + (k[9] * theta_dot * y1_dot * rc_c)
+            + (k[10] * (theta_dot * theta_dot))
+            + (k[11] * (x1_dot * x1_dot))
+            + (k[12] * (xc_dot * xc_dot))
+            + (k[11] * (y1_dot * y1_dot)))
+            + (k[13] + (k[14] * rc_s) + (k[15] * y1))
     }
 
+    /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
+    ///
+    /// - `p_x1 = -dot_theta*ell*m1*sin(theta)/2 + dot_x1*m1`
+    /// - `p_xc = dot_xc*m2`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..17]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
-        out[0] = -(k[9] * qd[2] * rc_s) + (k[0] * qd[0]);
-        out[1] = k[1] * qd[3];
+        let m1 = k[0];
+        let m2 = k[1];
+        let x1_dot = qd[0];
+        let theta_dot = qd[2];
+        let xc_dot = qd[3];
+        out[0] = -(k[9] * theta_dot * rc_s) + (m1 * x1_dot);
+        out[1] = m2 * xc_dot;
     }
 
+    /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
+    ///
+    /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
+    /// - `L = T - V`: 194 characters, written out in `generated/rod_cylinder.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..17]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let qt0 = -k[9] * rc_s;
-        let qt1 = k[9] * rc_c;
-        let qt2 = qd[2] * qd[2];
-        mass[0] = k[0];
+        let m1 = k[0];
+        let m2 = k[1];
+        let theta_dot = qd[2];
+        let qt0 = -k[9] * rc_s; // -(ell*m1*rc_s/2)
+        let qt1 = k[9] * rc_c; // ell*m1*rc_c/2
+        let qt2 = theta_dot * theta_dot;
+        mass[0] = m1;
         mass[1] = 0.0;
         mass[2] = qt0;
         mass[3] = 0.0;
         mass[4] = 0.0;
-        mass[5] = k[0];
+        mass[5] = m1;
         mass[6] = qt1;
         mass[7] = 0.0;
         mass[8] = qt0;
         mass[9] = qt1;
-        mass[10] = k[17] + (k[18] * (rc_s * rc_s)) + (k[18] * (rc_c * rc_c));
+        mass[10] = k[16];
         mass[11] = 0.0;
         mass[12] = 0.0;
         mass[13] = 0.0;
         mass[14] = 0.0;
-        mass[15] = k[1];
+        mass[15] = m2;
         rhs[0] = k[9] * qt2 * rc_c;
-        rhs[1] = -k[16] + (k[9] * qt2 * rc_s);
-        rhs[2] = -k[15] * rc_c;
+        rhs[1] = -k[15] + (k[9] * qt2 * rc_s);
+        rhs[2] = -k[14] * rc_c;
         rhs[3] = 0.0;
     }
 
+    /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
+    ///
+    /// No contact is closed in this phase.
     fn forces_full(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _qdd: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
     }
 
+    /// Each contact's gap `g(q)`, `>= 0` while apart (zero for a contact held closed).
+    ///
+    /// - `contact_force = -R - R*cos(theta) - x1*sin(theta) + xc*sin(theta) + y1*cos(theta)`
+    /// - `floor_normal = y1`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..17]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        out[0] = -k[3] - (k[3] * rc_c) - (q[0] * rc_s) + (q[3] * rc_s) + (q[1] * rc_c);
-        out[1] = q[1];
+        let r = k[3];
+        let x1 = q[0];
+        let y1 = q[1];
+        let xc = q[3];
+        out[0] = -r - (r * rc_c) - (x1 * rc_s) + (xc * rc_s) + (y1 * rc_c);
+        out[1] = y1;
     }
 
+    /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..17]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        let jt0 = qd[2] * qd[2];
+        let r = k[3];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let y1 = q[1];
+        let y1_dot = qd[1];
+        let theta_dot = qd[2];
+        let xc = q[3];
+        let xc_dot = qd[3];
+        let jt0 = theta_dot * theta_dot;
         jac[0] = -rc_s;
         jac[1] = rc_c;
-        jac[2] = (k[3] * rc_s) - (q[0] * rc_c) + (q[3] * rc_c) - (q[1] * rc_s);
+        jac[2] = (r * rc_s) - (x1 * rc_c) + (xc * rc_c) - (y1 * rc_s);
         jac[3] = rc_s;
         jac[4] = 0.0;
         jac[5] = 1.0;
         jac[6] = 0.0;
         jac[7] = 0.0;
-        bias[0] = (k[3] * jt0 * rc_c) - (2.0 * qd[2] * qd[0] * rc_c) + (2.0 * qd[2] * qd[3] * rc_c)
-            - (2.0 * qd[2] * qd[1] * rc_s)
-            + (jt0 * q[0] * rc_s)
-            - (jt0 * q[3] * rc_s)
-            - (jt0 * q[1] * rc_c);
+        bias[0] = (r * jt0 * rc_c) - (2.0 * theta_dot * x1_dot * rc_c)
+            + (2.0 * theta_dot * xc_dot * rc_c)
+            - (2.0 * theta_dot * y1_dot * rc_s)
+            + (jt0 * x1 * rc_s)
+            - (jt0 * xc * rc_s)
+            - (jt0 * y1 * rc_c);
         bias[1] = 0.0;
     }
 
+    /// Each contact's edge margin, `>= 0` while the contact point is on the edge (infinite without one).
+    ///
+    /// - `contact_force = -R*sin(theta) + ell + x1*cos(theta) - xc*cos(theta) + y1*sin(theta)`
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..17]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        out[0] = k[2] - (k[3] * rc_s) + (q[0] * rc_c) - (q[3] * rc_c) + (q[1] * rc_s);
+        let ell = k[2];
+        let r = k[3];
+        let x1 = q[0];
+        let y1 = q[1];
+        let xc = q[3];
+        out[0] = ell - (r * rc_s) + (x1 * rc_c) - (xc * rc_c) + (y1 * rc_s);
         out[1] = f64::INFINITY;
     }
 
+    /// Each friction's slip velocity `v = J(q) qd`: `jac` holds `J`, `bias` holds `dJ/dt qd`.
+    ///
+    /// No friction.
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
+    /// The monitors over the state and the contacts' forces `rc_f<i>`.
+    ///
+    /// No monitor.
     fn monitors_full(
         &self,
         _k: &[f64],
@@ -349,29 +451,53 @@ impl Model for RodCylinder {
     ) {
     }
 
+    /// The system's state (its general model's) that this phase's state stands for.
+    ///
+    /// - `x1 = x1`
+    /// - `dot_x1 = dot_x1`
+    /// - `y1 = y1`
+    /// - `dot_y1 = dot_y1`
+    /// - `theta = theta`
+    /// - `dot_theta = dot_theta`
+    /// - `xc = xc`
+    /// - `dot_xc = dot_xc`
     fn to_full(&self, _k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        q_full[0] = q[0];
-        qd_full[0] = qd[0];
-        q_full[1] = q[1];
-        qd_full[1] = qd[1];
-        q_full[2] = q[2];
-        qd_full[2] = qd[2];
-        q_full[3] = q[3];
-        qd_full[3] = qd[3];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let y1 = q[1];
+        let y1_dot = qd[1];
+        let theta = q[2];
+        let theta_dot = qd[2];
+        let xc = q[3];
+        let xc_dot = qd[3];
+        q_full[0] = x1;
+        qd_full[0] = x1_dot;
+        q_full[1] = y1;
+        qd_full[1] = y1_dot;
+        q_full[2] = theta;
+        qd_full[2] = theta_dot;
+        q_full[3] = xc;
+        qd_full[3] = xc_dot;
     }
 
+    /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..19]; // one bounds check for all constant loads
+        let k = &k[..17]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
-        poses[0] = [(k[7] * rc_c) + q[0], (k[7] * rc_s) + q[1], q[2]];
-        poses[1] = [q[3], k[3], 0.0];
+        let r = k[3];
+        let x1 = q[0];
+        let y1 = q[1];
+        let theta = q[2];
+        let xc = q[3];
+        poses[0] = [(k[7] * rc_c) + x1, (k[7] * rc_s) + y1, theta];
+        poses[1] = [xc, r, 0.0];
         sizes[0] = -k[7];
         sizes[1] = 0.0;
         sizes[2] = k[7];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
-        sizes[6] = k[3];
+        sizes[6] = r;
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {

@@ -47,7 +47,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "ladder_leans",
         meaning: "the top must start below the ladder's length (a < ell)",
     }],
-    n_constants: 22,
+    n_constants: 20,
     coordinates: &["theta"],
     system_coordinates: &["x1", "y1", "theta"],
     reduced: 0,
@@ -134,7 +134,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 7,
         force_degrees: &[1, 2],
         fall_degree: Some(0),
-        lean_constants: &[5, 6, 7, 18, 19, 20],
+        lean_constants: &[5, 6, 7, 16, 17, 18],
     }),
     route_note: "",
 };
@@ -144,96 +144,145 @@ impl Model for WallLadderClosed {
         &INFO
     }
 
+    /// The requirements' margins over the parameters, each `>= 0` where it holds.
+    ///
+    /// - `ladder_leans = ell - a`
     fn requirements(&self, p: &[f64], out: &mut [f64]) {
-        let k = p;
-        out[0] = k[1] - k[2];
+        let ell = p[1];
+        let a = p[2];
+        out[0] = ell - a;
     }
 
+    /// Each contact's coefficient of restitution over the parameters.
+    ///
+    /// - `contact_force = 0`
+    /// - `floor_normal = 0`
     fn restitutions(&self, _p: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
     }
 
+    /// The constants `k`: the parameters, then the constants derived from them.
+    ///
+    /// `k[..4]` holds the parameters `m1, ell, a, g`; each later slot's definition is the comment above the line that fills it.
     fn prepare(&self, p: &[f64], k: &mut [f64]) {
+        let m1 = p[0];
+        let ell = p[1];
+        let a = p[2];
+        let g = p[3];
         k[..4].copy_from_slice(p);
         Reduction::prepare_lean(self, p, k);
         // k[4] = rc_thi = asin(a/ell)
-        k[4] = (k[2] / k[1]).asin();
-        // k[8] = ell/2
-        k[8] = k[1] / 2.0;
-        // k[9] = ell^2*m1/24
-        k[9] = (k[1] * k[1]) * k[0] / 24.0;
-        // k[10] = ell^2*m1/8
-        k[10] = (k[1] * k[1]) * k[0] / 8.0;
+        k[4] = (a / ell).asin();
+        // k[8] = rc_ai = ell^2*m1/3
+        k[8] = (ell * ell) * m1 / 3.0;
+        // k[9] = ell/2
+        k[9] = ell / 2.0;
+        // k[10] = ell^2*m1/6
+        k[10] = (ell * ell) * m1 / 6.0;
         // k[11] = ell*g*m1/2
-        k[11] = k[1] * k[3] * k[0] / 2.0;
-        // k[12] = ell^2*m1/12
-        k[12] = (k[1] * k[1]) * k[0] / 12.0;
-        // k[13] = ell^2*m1/4
-        k[13] = (k[1] * k[1]) * k[0] / 4.0;
-        // k[14] = ell*m1/2
-        k[14] = k[1] * k[0] / 2.0;
-        // k[15] = g*m1
-        k[15] = k[3] * k[0];
-        // k[16] = 3*g/ell
-        k[16] = 3.0 * k[3] / k[1];
-        // k[17] = 3*g/(2*ell)
-        k[17] = 3.0 * k[3] / 2.0 / k[1];
-        // k[21] = 0.0 + ell
-        k[21] = 0.0 + k[1];
+        k[11] = ell * g * m1 / 2.0;
+        // k[12] = ell*m1/2
+        k[12] = ell * m1 / 2.0;
+        // k[13] = g*m1
+        k[13] = g * m1;
+        // k[14] = 3*g/ell
+        k[14] = 3.0 * g / ell;
+        // k[15] = 3*g/(2*ell)
+        k[15] = 3.0 * g / 2.0 / ell;
+        // k[19] = 0.0 + ell
+        k[19] = 0.0 + ell;
     }
 
+    /// The state at release, over the parameters.
+    ///
+    /// - `theta = asin(a/ell)`
+    /// - `dot_theta = 0.0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         q[0] = k[4];
         qd[0] = 0.0;
     }
 
+    /// Each point's position over the state (`pos`), and its time derivative (`vel`).
+    ///
+    /// - `foot_x = -(ell*cos(theta))`
+    /// - `foot_y = 0`
+    /// - `tip_x = 0`
+    /// - `tip_y = ell*sin(theta)`
+    /// - `rod_centre_x = -(ell*cos(theta)/2)`
+    /// - `rod_centre_y = ell*sin(theta)/2`
+    /// - `wall_x = 0`
+    /// - `wall_y = 0`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        pos[0] = [-k[1] * rc_c, 0.0];
-        vel[0] = [k[1] * qd[0] * rc_s, 0.0];
-        pos[1] = [0.0, k[1] * rc_s];
-        vel[1] = [0.0, k[1] * qd[0] * rc_c];
-        pos[2] = [-k[8] * rc_c, k[8] * rc_s];
-        vel[2] = [k[8] * qd[0] * rc_s, k[8] * qd[0] * rc_c];
+        let ell = k[1];
+        let theta_dot = qd[0];
+        pos[0] = [-ell * rc_c, 0.0];
+        vel[0] = [ell * theta_dot * rc_s, 0.0];
+        pos[1] = [0.0, ell * rc_s];
+        vel[1] = [0.0, ell * theta_dot * rc_c];
+        pos[2] = [-k[9] * rc_c, k[9] * rc_s];
+        vel[2] = [k[9] * theta_dot * rc_s, k[9] * theta_dot * rc_c];
         pos[3] = [0.0, 0.0];
         vel[3] = [0.0, 0.0];
     }
 
+    /// The total energy `E = T + V`.
+    ///
+    /// - `T = dot_theta^2*ell^2*m1/6`
+    /// - `V = ell*g*m1*sin(theta)/2`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..22]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        let et0 = qd[0] * qd[0];
-        ((k[9] * et0) + (k[10] * et0 * (rc_s * rc_s)) + (k[10] * et0 * (rc_c * rc_c)))
-            + (k[11] * rc_s)
+        let k = &k[..20]; // one bounds check for all constant loads
+        let rc_s = q[0].sin();
+        let theta_dot = qd[0];
+        (k[10] * (theta_dot * theta_dot)) + (k[11] * rc_s)
     }
 
+    /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
+    ///
+    /// No cyclic coordinate.
     fn momenta(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _out: &mut [f64]) {}
 
+    /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
+    ///
+    /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
+    /// - `L = T - V = -ell*g*m1*sin(theta)/2 + dot_theta^2*ell^2*m1/6`
     fn equations(&self, k: &[f64], q: &[f64], _qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
-        let (rc_s, rc_c) = q[0].sin_cos();
-        mass[0] = k[12] + (k[13] * (rc_s * rc_s)) + (k[13] * (rc_c * rc_c));
+        let k = &k[..20]; // one bounds check for all constant loads
+        let rc_c = q[0].cos();
+        mass[0] = k[8];
         rhs[0] = -k[11] * rc_c;
     }
 
+    /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
+    ///
+    /// - `contact_force = -(-ddot_theta*ell*m1*sin(theta)/2 + m1*(ddot_theta*ell*sin(theta) + dot_theta^2*ell*cos(theta)) - dot_theta^2*ell*m1*cos(theta)/2)`
+    /// - `floor_normal = ddot_theta*ell*m1*cos(theta)/2 + g*m1 - dot_theta^2*ell*m1*sin(theta)/2`
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        let ft0 = qd[0] * qd[0];
-        out[0] = -(-(k[14] * qdd[0] * rc_s)
-            + (k[0] * ((k[1] * qdd[0] * rc_s) + (k[1] * ft0 * rc_c)))
-            - (k[14] * ft0 * rc_c));
-        out[1] = k[15] + (k[14] * qdd[0] * rc_c) - (k[14] * ft0 * rc_s);
+        let m1 = k[0];
+        let ell = k[1];
+        let theta_dot = qd[0];
+        let theta_ddot = qdd[0];
+        let ft0 = theta_dot * theta_dot;
+        out[0] = -(-(k[12] * theta_ddot * rc_s)
+            + (m1 * ((ell * theta_ddot * rc_s) + (ell * ft0 * rc_c)))
+            - (k[12] * ft0 * rc_c));
+        out[1] = k[13] + (k[12] * theta_ddot * rc_c) - (k[12] * ft0 * rc_s);
     }
 
+    /// Each contact's gap `g(q)`, `>= 0` while apart (zero for a contact held closed).
+    ///
+    /// No open contact.
     fn gaps(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
         out[1] = 0.0;
     }
 
+    /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, _k: &[f64], _q: &[f64], _qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
         jac[0] = 0.0;
         jac[1] = 0.0;
@@ -241,13 +290,22 @@ impl Model for WallLadderClosed {
         bias[1] = 0.0;
     }
 
+    /// Each contact's edge margin, `>= 0` while the contact point is on the edge (infinite without one).
+    ///
+    /// No contact has an edge.
     fn edges(&self, _k: &[f64], _q: &[f64], out: &mut [f64]) {
         out[0] = f64::INFINITY;
         out[1] = f64::INFINITY;
     }
 
+    /// Each friction's slip velocity `v = J(q) qd`: `jac` holds `J`, `bias` holds `dJ/dt qd`.
+    ///
+    /// No friction.
     fn friction(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _jac: &mut [f64], _bias: &mut [f64]) {}
 
+    /// The monitors over the state and the contacts' forces `rc_f<i>`.
+    ///
+    /// No monitor.
     fn monitors_full(
         &self,
         _k: &[f64],
@@ -258,30 +316,43 @@ impl Model for WallLadderClosed {
     ) {
     }
 
+    /// The system's state (its general model's) that this phase's state stands for.
+    ///
+    /// - `x1 = -(ell*cos(theta))`
+    /// - `dot_x1 = dot_theta*ell*sin(theta)`
+    /// - `y1 = 0`
+    /// - `dot_y1 = 0`
+    /// - `theta = theta`
+    /// - `dot_theta = dot_theta`
     fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
-        q_full[0] = -k[1] * rc_c;
-        qd_full[0] = k[1] * qd[0] * rc_s;
+        let ell = k[1];
+        let theta = q[0];
+        let theta_dot = qd[0];
+        q_full[0] = -ell * rc_c;
+        qd_full[0] = ell * theta_dot * rc_s;
         q_full[1] = 0.0;
         qd_full[1] = 0.0;
-        q_full[2] = q[0];
-        qd_full[2] = qd[0];
+        q_full[2] = theta;
+        qd_full[2] = theta_dot;
     }
 
+    /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
+        let theta = q[0];
         let dt0 = 0.0 + 0.0;
-        poses[0] = [-k[8] * rc_c, k[8] * rc_s, q[0]];
-        sizes[0] = -k[8];
+        poses[0] = [-k[9] * rc_c, k[9] * rc_s, theta];
+        sizes[0] = -k[9];
         sizes[1] = 0.0;
-        sizes[2] = k[8];
+        sizes[2] = k[9];
         sizes[3] = 0.0;
         sizes[4] = dt0;
         sizes[5] = dt0;
         sizes[6] = dt0;
-        sizes[7] = k[21];
+        sizes[7] = k[19];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -290,69 +361,89 @@ impl Model for WallLadderClosed {
 }
 
 impl Reduction for WallLadderClosed {
+    /// The reduced motion at `theta = theta_i - delta`: `theta_dot^2` from the energy integral, and `theta_ddot`.
+    ///
+    /// - `theta_dot^2 = -(3*(-a*g + ell*g*sin(theta))/ell^2)`
+    /// - `theta_ddot = -(3*g*cos(theta)/(2*ell))`
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[4], k[6], k[7], delta);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: k[16] * rc_ds,
-            theta_ddot: -k[17] * rc_c,
+            theta_dot_sq: k[14] * rc_ds,
+            theta_ddot: -k[15] * rc_c,
         }
     }
 
+    /// `theta_dot^2` over `sin(theta)`, `cos(theta)` and their drops from the start (the per-point solver's integrand).
+    ///
+    /// - `theta_dot^2 = -(3*(-a*g + ell*g*sin(theta))/ell^2)`
     fn theta_dot_sq_sc(&self, k: &[f64], _rc_s: f64, _rc_c: f64, rc_ds: f64, _rc_dc: f64) -> f64 {
-        let k = &k[..22]; // one bounds check for all constant loads
-        k[16] * rc_ds
+        let k = &k[..20]; // one bounds check for all constant loads
+        k[14] * rc_ds
     }
 
+    /// Each contact's force on the reduced motion (zero for a contact open in the phase).
+    ///
+    /// - `contact_force = 3*(-2*a*g*m1*cos(theta) + 3*ell*g*m1*sin(theta)*cos(theta))/(4*ell)`
+    /// - `floor_normal = (-6*a*g*m1*sin(theta) + ell*g*m1 + 9*ell*g*m1*sin(theta)^2)/(4*ell)`
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         let (rc_s, rc_c, rc_ds, _) = start_offsets(k[4], k[6], k[7], delta);
-        let rc_w2 = k[16] * rc_ds;
-        let rc_acc = -k[17] * rc_c;
-        out[0] = -(k[14] * rc_s * rc_acc) - (k[14] * rc_c * rc_w2);
-        out[1] = k[15] - (k[14] * rc_s * rc_w2) + (k[14] * rc_c * rc_acc);
+        let rc_w2 = k[14] * rc_ds;
+        let rc_acc = -k[15] * rc_c;
+        out[0] = -(k[12] * rc_s * rc_acc) - (k[12] * rc_c * rc_w2);
+        out[1] = k[13] - (k[12] * rc_s * rc_w2) + (k[12] * rc_c * rc_acc);
     }
 
+    /// The coefficients, constant term first, of a contact's force zero as a polynomial in `sin(theta)`, where it is one.
+    ///
+    /// - `separation condition (= 0) = (-2*a + 3*ell*sin(theta))/ell`
     fn force_polynomial(&self, k: &[f64], contact: usize, out: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         match contact {
             0 => {
-                out[0] = -k[18];
+                out[0] = -k[16];
                 out[1] = 3.0;
             }
             1 => {
                 out[0] = 1.0;
-                out[1] = -k[19];
+                out[1] = -k[17];
                 out[2] = 9.0;
             }
             _ => {}
         }
     }
 
+    /// The constants of `prepare` that the per-point solver reads, and only those.
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let ell = p[1];
+        let a = p[2];
+        let g = p[3];
         k[..4].copy_from_slice(p);
         // k[5] = rc_wi = 0.0
         k[5] = 0.0;
         // k[6] = rc_si = a/ell
-        k[6] = k[2] / k[1];
+        k[6] = a / ell;
         // k[7] = rc_ci = ((1 - a/ell)*(1 + a/ell))^(1/2)
-        let c3_t0 = k[2] / k[1];
+        let c3_t0 = a / ell;
         k[7] = ((1.0 - c3_t0) * (1.0 + c3_t0)).sqrt();
-        // k[18] = 2*rc_si
-        k[18] = 2.0 * k[6];
-        // k[19] = 6*rc_si
-        k[19] = 6.0 * k[6];
-        // k[20] = ell/(3*g)
-        k[20] = k[1] / 3.0 / k[3];
+        // k[16] = 2*rc_si
+        k[16] = 2.0 * k[6];
+        // k[17] = 6*rc_si
+        k[17] = 6.0 * k[6];
+        // k[18] = ell/(3*g)
+        k[18] = ell / 3.0 / g;
     }
 
+    /// The coefficients, constant term first, of the fall polynomial `P(s) = (sin(theta_i) - s) / theta_dot^2` in `s = sin(theta)`.
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
-        out[0] = k[20];
+        let k = &k[..20]; // one bounds check for all constant loads
+        out[0] = k[18];
     }
 
+    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
     fn full_state(
         &self,
         k: &[f64],
@@ -362,7 +453,7 @@ impl Reduction for WallLadderClosed {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..20]; // one bounds check for all constant loads
         q[0] = k[4] - delta;
         qd[0] = theta_dot;
     }

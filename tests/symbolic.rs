@@ -134,7 +134,7 @@ fn positive_multiple(derived: &Expr, expected: &Expr, pos: &[&str]) -> Result<Ex
         (cas::expr(&q), mechanics::is_zero_trig(&dq))
     })
     .map_err(|e| e.to_string())?;
-    let ratio = ratio?;
+    let ratio = ratio.map_err(|e| e.to_string())?;
     let syms = ratio.symbols();
     if syms.contains("rc_s") || syms.contains("rc_c") || d_ratio != Ok(true) {
         return Err(format!("ratio depends on theta: {}", ratio.to_infix()));

@@ -5,8 +5,8 @@
 //! [`expr`](super::expr) and [`types`](super::types).
 
 use super::cas::{self, A};
-use super::expr::{Expr, product};
-use super::types::{Constant, DeriveError, at};
+use super::expr::{Expr, gcd, product, sum};
+use super::types::{Constant, DeriveError, StepError, at};
 
 /// A Symbolica atom as an expression, or the error of the step `what`.
 pub fn to_expr(a: &A, what: &str) -> Result<Expr, DeriveError> {
@@ -79,9 +79,174 @@ pub fn reduce_cos_sq(a: &A) -> A {
     cur
 }
 
+/// A term of a sum as `coefficient * rest * rc_s^sin * rc_c^cos`, for [`pythagoras`].
+#[derive(Debug, Clone)]
+struct Term {
+    /// The term as written, kept while no rule rewrote it.
+    written: Option<Expr>,
+    /// Its rational coefficient `(numerator, denominator)`, denominator positive.
+    coefficient: (i128, i128),
+    /// Its other factors, sorted by their infix text.
+    rest: Vec<Expr>,
+    sin: i128,
+    cos: i128,
+}
+
+impl Term {
+    fn of(t: &Expr) -> Term {
+        let factors = match t {
+            Expr::Mul(v) => v.clone(),
+            other => vec![other.clone()],
+        };
+        let mut term = Term {
+            written: Some(t.clone()),
+            coefficient: (1, 1),
+            rest: Vec::new(),
+            sin: 0,
+            cos: 0,
+        };
+        for f in factors {
+            let power = |name: &str| match &f {
+                Expr::Sym(s) if s == name => Some(1),
+                Expr::Pow(b, x) if **b == Expr::sym(name) => x.as_integer().filter(|&n| n > 0),
+                _ => None,
+            };
+            let (n, d) = term.coefficient;
+            match (&f, power("rc_s"), power("rc_c")) {
+                (_, Some(k), _) => term.sin += k,
+                (_, _, Some(k)) => term.cos += k,
+                (Expr::Rational(a, b), _, _) => match n.checked_mul(*a).zip(d.checked_mul(*b)) {
+                    Some(c) => term.coefficient = c,
+                    None => term.rest.push(f.clone()),
+                },
+                _ => term.rest.push(f.clone()),
+            }
+        }
+        term.rest.sort_by_key(Expr::to_infix);
+        term
+    }
+
+    /// Whether `self`'s coefficient is `sign` times `other`'s.
+    fn scales(&self, other: &Term, sign: i128) -> bool {
+        let ((a, b), (c, d)) = (self.coefficient, other.coefficient);
+        a.checked_mul(d) == c.checked_mul(b).and_then(|x| x.checked_mul(sign))
+    }
+
+    /// The one term that `self + other` is by `sin^2 + cos^2 = 1`, if it is one:
+    /// `X sin^2 + X cos^2 = X`, `X - X cos^2 = X sin^2`, `X - X sin^2 = X cos^2`.
+    fn combined(&self, other: &Term) -> Option<Term> {
+        if self.rest != other.rest {
+            return None;
+        }
+        if (self.sin, self.cos) == (other.sin, other.cos) {
+            // Like terms, which a join above can leave: their coefficients add.
+            let ((a, b), (c, d)) = (self.coefficient, other.coefficient);
+            let n = a.checked_mul(d)?.checked_add(c.checked_mul(b)?)?;
+            let d = b.checked_mul(d)?;
+            let g = gcd(n.abs(), d).max(1);
+            return Some(Term {
+                written: None,
+                coefficient: (n / g, d / g),
+                ..self.clone()
+            });
+        }
+        let (sin, cos) =
+            if self.scales(other, 1) && self.sin == other.sin + 2 && other.cos == self.cos + 2 {
+                (other.sin, self.cos)
+            } else if self.scales(other, -1) && other.sin == self.sin && other.cos == self.cos + 2 {
+                (self.sin + 2, self.cos)
+            } else if self.scales(other, -1) && other.cos == self.cos && other.sin == self.sin + 2 {
+                (self.sin, self.cos + 2)
+            } else {
+                return None;
+            };
+        Some(Term {
+            written: None,
+            coefficient: self.coefficient,
+            rest: self.rest.clone(),
+            sin,
+            cos,
+        })
+    }
+
+    fn expr(self) -> Expr {
+        if let Some(t) = self.written {
+            return t;
+        }
+        let (n, d) = self.coefficient;
+        let mut factors = vec![Expr::Rational(n, d)];
+        factors.extend(self.rest);
+        for (name, k) in [("rc_s", self.sin), ("rc_c", self.cos)] {
+            if k > 0 {
+                factors.push(Expr::Pow(Box::new(Expr::sym(name)), Box::new(Expr::int(k))));
+            }
+        }
+        Expr::Mul(factors).tidy()
+    }
+}
+
+/// `sin^2 + cos^2 = 1` applied to the terms of every sum in `e` (over `rc_s`, `rc_c`) where it
+/// joins two terms into one: `X sin^2 + X cos^2 = X`, `X - X cos^2 = X sin^2` and
+/// `X - X sin^2 = X cos^2`, `X` the same factors and coefficient in both (and like terms that
+/// a join leaves are added). Nothing is expanded,
+/// and no term is rewritten that no other joins, so no `1 - sin^2` cancels where `cos^2` was.
+pub fn pythagoras(e: &Expr) -> Expr {
+    let rec = |v: &Vec<Expr>| v.iter().map(pythagoras).collect::<Vec<_>>();
+    match e {
+        Expr::Add(v) => {
+            let mut terms: Vec<Term> = rec(v).iter().map(Term::of).collect();
+            'joined: loop {
+                for i in 0..terms.len() {
+                    for j in (0..terms.len()).filter(|&j| j != i) {
+                        if let Some(t) = terms[i].combined(&terms[j]) {
+                            terms[i] = t;
+                            terms.remove(j);
+                            terms.retain(|t| t.coefficient.0 != 0);
+                            continue 'joined;
+                        }
+                    }
+                }
+                break;
+            }
+            sum(terms.into_iter().map(Term::expr).collect())
+        }
+        Expr::Mul(v) => Expr::Mul(rec(v)),
+        Expr::Pow(b, x) => Expr::Pow(Box::new(pythagoras(b)), Box::new(pythagoras(x))),
+        Expr::Fun(f, v) => Expr::Fun(f.clone(), rec(v)),
+        _ => e.clone(),
+    }
+}
+
+/// `e` (over `sin(theta)`, `cos(theta)`) with [`pythagoras`] applied, checked by Symbolica to
+/// be equal to `e` (their difference zero modulo `sin^2 + cos^2 = 1`); an error naming `what`
+/// if it is not, or if the check could not be made.
+pub fn with_pythagoras(e: &Expr, theta: &str, what: &str) -> Result<Expr, DeriveError> {
+    let sc = to_sc_expr(e, theta);
+    let simpler = pythagoras(&sc);
+    if simpler == sc {
+        return Ok(e.clone());
+    }
+    let difference = Expr::Add(vec![
+        simpler.clone(),
+        Expr::Mul(vec![Expr::int(-1), sc.clone()]),
+    ]);
+    match is_zero_trig(&cas::atom(&difference)) {
+        Ok(true) => Ok(from_sc(&simpler, theta)),
+        Ok(false) => Err(at(
+            &[],
+            format!(
+                "{what}: sin^2 + cos^2 = 1 rewrote {} as {}, which Symbolica finds different",
+                sc.to_infix(),
+                simpler.to_infix()
+            ),
+        )),
+        Err(m) => Err(at(&[], format!("{what}: checking sin^2 + cos^2 = 1: {m}"))),
+    }
+}
+
 /// Whether a rational expression of `rc_s`, `rc_c` (and anything else) is zero modulo
 /// `sin^2 + cos^2 = 1`.
-pub fn is_zero_trig(a: &A) -> Result<bool, String> {
+pub fn is_zero_trig(a: &A) -> Result<bool, StepError> {
     let t = cas::together(a);
     let e = cas::expr(&t)?;
     let (num, _) = e.num_den();

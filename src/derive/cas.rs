@@ -7,6 +7,7 @@
 //! must run on the derivation thread started by [`super::on_cas_thread`].
 
 use super::expr::Expr;
+use super::types::StepError;
 use symbolica::atom::{Atom, AtomCore, AtomView, FunctionBuilder, Symbol};
 use symbolica::coefficient::CoefficientView;
 use symbolica::prelude::RealLike;
@@ -48,10 +49,13 @@ fn function(name: &str) -> Symbol {
 
 /// Converts a Symbolica expression back by walking its structure (its public atom views), so
 /// that no change in how Symbolica prints can change what the tool reads.
-pub fn expr(a: &A) -> Result<Expr, String> {
+pub fn expr(a: &A) -> Result<Expr, StepError> {
     view(a.as_view())
         .map(|e| e.tidy())
-        .map_err(|m| format!("cannot read back Symbolica's `{a}`: {m}"))
+        .map_err(|why| StepError::Unreadable {
+            atom: a.to_string(),
+            why,
+        })
 }
 
 fn view(v: AtomView) -> Result<Expr, String> {

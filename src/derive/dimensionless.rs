@@ -16,49 +16,7 @@ use super::expr::Expr;
 use super::present::{Presenter, Shape};
 use super::spec::{Spec, Text, solved_parameters};
 use super::types::{Derivation, DeriveError, FieldStep};
-
-/// A dimensionless group.
-#[derive(Debug, Clone)]
-pub struct Group {
-    /// Its symbol.
-    pub name: String,
-    /// Its definition over the parameters.
-    pub definition: Expr,
-    /// What it is.
-    pub meaning: String,
-    /// The parameter it is solved for.
-    pub solves: String,
-}
-
-/// A result without units.
-#[derive(Debug, Clone)]
-pub struct Scaled {
-    /// Key, as in the JSON record's `expressions` (`theta_dot_sq`, `contact_force`, ...).
-    pub key: String,
-    /// What it is, in words.
-    pub meaning: String,
-    /// The unit it is written in (`g/ell`, `m2*g`); none for a condition `= 0`.
-    pub unit: Option<Expr>,
-    /// The presentation form over the groups and `sin(theta)`, `cos(theta)`.
-    pub form: Expr,
-    /// Operations in the form (see [`super::present::RULE`]).
-    pub operations: usize,
-    /// The paper's equation number, where the spec gives one.
-    pub paper: Option<String>,
-}
-
-/// A phase's results without units.
-#[derive(Debug, Clone)]
-pub struct Dimensionless {
-    /// The groups, in the spec's order (a free phase's `omega_0` last).
-    pub groups: Vec<Group>,
-    /// The time scale.
-    pub time: Expr,
-    /// The force scale.
-    pub force: Expr,
-    /// The results (none on the integrated route, which has no closed forms).
-    pub results: Vec<Scaled>,
-}
+pub use super::types::{Dimensionless, Group, Scaled};
 
 /// The group of a free phase's start rate.
 pub const START_RATE_GROUP: &str = "omega_0";
@@ -235,7 +193,7 @@ pub fn derive(spec: &Spec, d: &Derivation) -> Result<Option<Dimensionless>, Deri
         if shape == Shape::Polynomial {
             value = condition(&value, &positive_symbols)?;
         }
-        let e = cas::expr(&value).map_err(at)?;
+        let e = cas::expr(&value).map_err(|m| at(m.to_string()))?;
         if let Some(s) = e.symbols().into_iter().find(|s| !allowed.contains(s)) {
             return Err(at(format!(
                 "`{key}` of model `{}` still depends on `{s}` when written in the groups ({}) \
@@ -271,7 +229,7 @@ pub fn derive(spec: &Spec, d: &Derivation) -> Result<Option<Dimensionless>, Deri
 /// A condition `value = 0` as a polynomial: its numerator with positive theta-free factors
 /// removed (the denominator must be positive).
 fn condition(value: &A, positive_symbols: &[String]) -> Result<A, DeriveError> {
-    let e = cas::expr(value).map_err(at)?;
+    let e = cas::expr(value).map_err(|m| at(m.to_string()))?;
     let (num, den) = e.num_den();
     let den = super::expr::product(den);
     if !positive(&den, positive_symbols) {

@@ -108,12 +108,10 @@ pub fn derive(checked: &Checked) -> Result<Vec<Derivation>, DeriveError> {
     let mut out = Vec::new();
     for plan in phase_plans(spec) {
         let general = plan.is_general();
-        let mut d = derive_phase(checked, &parsed, &plan)?;
+        let d = derive_phase(checked, &parsed, &plan)?;
         if !general && d.reduction.is_err() {
             continue;
         }
-        d.dimensionless = super::dimensionless::derive(spec, &d)?;
-        d.steps = Some(super::steps::derive(&d));
         out.push(d);
     }
     Ok(out)
@@ -423,7 +421,6 @@ fn derive_phase(
         Vec::new()
     };
     let frictions = phase_frictions(spec, &params, &slips)?;
-    let (monitor_names, monitors_full) = forces::monitors(spec, parsed, &st);
     let initial_list = phase_initial(spec, parsed, &st)?;
     let initial: BTreeMap<String, [Expr; 2]> = (st.coords.iter().cloned())
         .zip(initial_list.iter().cloned())
@@ -441,6 +438,7 @@ fn derive_phase(
         positive,
     };
     let reduction = reducer.reduce(&atoms)?;
+    let (monitor_names, monitors_full) = forces::monitors(spec, parsed, &st);
     let (point_pos, point_vel) = point_kinematics(parsed, &st)?;
     let list = |v: &[A], what: &str| -> Result<Vec<Expr>, DeriveError> {
         v.iter().map(|e| to_expr(e, what)).collect()

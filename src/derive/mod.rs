@@ -1,16 +1,20 @@
 //! The derivation tool (cargo feature `derive`): model specs in `derivations/*.yaml` are
 //! derived by Symbolica and rendered through `templates/` into `generated/`.
 //!
-//! Data flows one way, through modules that import only those before them:
+//! The modules form layers, bottom-up; each imports only the layers below it and, within the
+//! stages, only earlier stages (no module imports a later one, no two import each other):
 //!
-//! - below every stage: [`cas`] (the only module that calls Symbolica), [`types`] (what the
-//!   stages hand each other), [`algebra`] (trigonometric rewriting and polynomial helpers);
-//! - the stages of the derivation proper, each a file: [`read`] → [`setup`] → [`lagrangian`] →
-//!   [`equations`] → [`constraints`] → [`reduction`] → [`forces`], run in that order for each
-//!   phase by [`mechanics`];
-//! - presentation: [`present`] (forms checked equal), [`steps`], [`dimensionless`], [`latex`];
-//! - emission: [`lower`] (straight-line Rust), [`method`], [`emit`] (flat template contexts)
-//!   → tera → rustfmt → `generated/`.
+//! 1. shared by every stage, below them all: [`types`] (what the stages hand each other, the
+//!    presentation's results included, and the layer's errors: [`types::StepError`] of a step,
+//!    [`types::DeriveError`] placed at a spec field), [`cas`] (the only module that calls
+//!    Symbolica) and [`algebra`] (trigonometric rewriting and polynomial helpers);
+//! 2. the stages of the derivation proper, a file each: [`read`] (the spec's expressions) →
+//!    [`setup`] → [`lagrangian`] → [`equations`] → [`constraints`] → [`reduction`] →
+//!    [`forces`]; [`mechanics`] runs them in that order for each phase of a spec;
+//! 3. presentation: [`present`] (forms checked equal), then [`steps`] and [`dimensionless`];
+//! 4. emission: [`latex`], [`lower`] (straight-line Rust) and [`method`], then [`emit`] (flat
+//!    template contexts) → tera → rustfmt → `generated/`;
+//! 5. this module, which runs the derivation, the presentation and the emission of each spec.
 //!
 //! Every Symbolica call runs on one dedicated thread ([`on_cas_thread`]). In check mode
 //! nothing is written; stale files are reported.
@@ -23,10 +27,7 @@ pub mod emit;
 pub mod equations;
 pub mod forces;
 pub mod lagrangian;
-pub mod latex;
-pub mod lower;
 pub mod mechanics;
-pub mod method;
 pub mod present;
 pub mod read;
 pub mod reduction;
@@ -228,6 +229,20 @@ fn to_spec_error(checked: &Checked, err: mechanics::DeriveError) -> SpecError {
     }
 }
 
+/// One spec through every stage: the derivation proper ([`mechanics::derive`]: read → setup →
+/// Lagrangian → equations → constraints → reduction → forces, for each phase), then its
+/// presentation ([`dimensionless::derive`], [`steps::derive`], and `sin^2 + cos^2 = 1` applied
+/// to what the generated code and records print, [`present::with_identities`]).
+fn derive_and_present(c: &Checked) -> Result<Vec<Derivation>, mechanics::DeriveError> {
+    let mut phases = mechanics::derive(c)?;
+    for d in &mut phases {
+        d.dimensionless = dimensionless::derive(&c.spec, d)?;
+        d.steps = Some(steps::derive(d));
+        present::with_identities(d)?;
+    }
+    Ok(phases)
+}
+
 /// Derives checked specs on the Symbolica thread: each spec's phases, with the time it took.
 pub fn derive_all(checked: &[Checked]) -> Result<Vec<(Vec<Derivation>, Duration)>, Error> {
     let owned: Vec<Checked> = checked.to_vec();
@@ -236,7 +251,7 @@ pub fn derive_all(checked: &[Checked]) -> Result<Vec<(Vec<Derivation>, Duration)
             .iter()
             .map(|c| {
                 let start = Instant::now();
-                mechanics::derive(c)
+                derive_and_present(c)
                     .map(|d| (d, start.elapsed()))
                     .map_err(|e| to_spec_error(c, e))
             })
@@ -327,13 +342,13 @@ fn render_phase(
     phases: &[emit::PhaseEntry],
 ) -> Result<Vec<Rendered>, Error> {
     // A model the emitter cannot write is reported against its spec file.
-    let refused = |message: String| {
+    let refused = |error: mechanics::StepError| {
         Error::Spec(SpecError {
             file: c.file.clone(),
             line: 0,
             column: 0,
             field: String::new(),
-            message: format!("model `{}`: {message}", d.name),
+            message: format!("model `{}`: {error}", d.name),
             source_line: String::new(),
             width: 0,
         })

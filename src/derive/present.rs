@@ -18,10 +18,15 @@
 //! difference is zero as a rational function modulo `sin^2 + cos^2 = 1`); one that is not is
 //! a typed error, never printed. The others are not checked: they are never printed, and
 //! checking each cost most of the derivation's time.
+//!
+//! What the generated code and the JSON record print is the derivation with
+//! `sin^2 + cos^2 = 1` applied where it joins two terms into one ([`with_identities`]), each
+//! expression checked equal.
 
-use super::algebra::{is_zero_trig, reduce_cos_sq};
+use super::algebra::{is_zero_trig, reduce_cos_sq, with_pythagoras};
 use super::cas::{self, A};
 use super::expr::{Expr, product, sum};
+use super::types::{Derivation, DeriveError, StepError};
 
 /// A candidate form ranked: operations, characters, order made, the form, and the constant
 /// factor dropped from it.
@@ -124,7 +129,7 @@ struct Factored {
 }
 
 /// The factors of a product as Symbolica's `factor` prints them.
-fn factors_of(e: &Expr, sign: i128, out: &mut Factored) -> Result<(), String> {
+fn factors_of(e: &Expr, sign: i128, out: &mut Factored) -> Result<(), StepError> {
     let list = match e {
         Expr::Mul(v) => v.clone(),
         e => vec![e.clone()],
@@ -134,8 +139,8 @@ fn factors_of(e: &Expr, sign: i128, out: &mut Factored) -> Result<(), String> {
             Expr::Rational(n, d) => {
                 let (cn, cd) = out.coefficient;
                 let (n, d) = if sign > 0 { (n, d) } else { (d, n) };
-                let num = cn.checked_mul(n).ok_or("coefficient overflow")?;
-                let den = cd.checked_mul(d).ok_or("coefficient overflow")?;
+                let num = cn.checked_mul(n).ok_or(StepError::Overflow)?;
+                let den = cd.checked_mul(d).ok_or(StepError::Overflow)?;
                 out.coefficient = reduced(num, den);
             }
             Expr::Pow(b, k) => match k.as_integer() {
@@ -177,7 +182,7 @@ impl<'a> Presenter<'a> {
 
     /// The presentation form of `a` (over `rc_s`, `rc_c` and theta-free symbols), checked equal
     /// to it.
-    pub fn present(&self, a: &A, shape: Shape) -> Result<Form, String> {
+    pub fn present(&self, a: &A, shape: Shape) -> Result<Form, StepError> {
         let mut candidates = vec![self.factored(a, shape, shape)?];
         if shape == Shape::Fraction {
             // The numerator's sums also as polynomials (highest power first), which can spare
@@ -205,15 +210,18 @@ impl<'a> Presenter<'a> {
         ranked.sort_by_key(|r| (r.0, r.1, r.2));
         // The best form is printed only once Symbolica finds it equal to the result; a form
         // that is not is a bug in its maker, reported rather than skipped.
-        let (ops, _, _, expr, dropped) = ranked.into_iter().next().ok_or("no presentation form")?;
+        let (ops, _, _, expr, dropped) = ranked
+            .into_iter()
+            .next()
+            .ok_or_else(|| StepError::Presentation("no presentation form".into()))?;
         let factor = cas::atom(&Expr::Rational(dropped.0, dropped.1));
         let diff = cas::atom(&expr) * factor - a.clone();
         if !is_zero_trig(&diff)? {
-            return Err(format!(
+            return Err(StepError::Presentation(format!(
                 "the presentation form `{}` is not equal to the result `{}`",
                 expr.to_infix(),
                 cas::expr(a)?.to_infix()
-            ));
+            )));
         }
         Ok(Form {
             expr,
@@ -224,7 +232,7 @@ impl<'a> Presenter<'a> {
 
     /// Candidate (1): together, `sin^2 + cos^2 = 1`, factor, sums collected and signed, the
     /// denominator's as `shape` says, the numerator's as `top` says.
-    fn factored(&self, a: &A, shape: Shape, top: Shape) -> Result<Factored, String> {
+    fn factored(&self, a: &A, shape: Shape, top: Shape) -> Result<Factored, StepError> {
         let t = cas::expr(&cas::together(a))?;
         let (num, den) = t.num_den();
         let mut out = Factored {
@@ -252,7 +260,7 @@ impl<'a> Presenter<'a> {
     }
 
     /// Candidates (2): a theta-free factor of the numerator moved into the denominator's sum.
-    fn moved_into_denominator(&self, f: &Factored) -> Result<Vec<Factored>, String> {
+    fn moved_into_denominator(&self, f: &Factored) -> Result<Vec<Factored>, StepError> {
         let below: Vec<&Factor> = f.factors.iter().filter(|x| x.1 < 0).collect();
         let [(d_sum, d_pow)] = below.as_slice() else {
             return Ok(Vec::new());
@@ -322,7 +330,7 @@ impl<'a> Presenter<'a> {
     }
 
     /// A theta-free coefficient as ordered factors (number first).
-    fn arrange_coefficient(&self, c: &A) -> Result<Vec<Expr>, String> {
+    fn arrange_coefficient(&self, c: &A) -> Result<Vec<Expr>, StepError> {
         let mut f = Factored {
             coefficient: (1, 1),
             factors: Vec::new(),
@@ -392,7 +400,7 @@ impl<'a> Presenter<'a> {
 
     /// A sum collected in powers of sin and cos (each coefficient factored), in the order of
     /// `shape`, and whether its sign was flipped to make its first term positive.
-    fn arrange_sum(&self, e: &Expr, shape: Shape) -> Result<(bool, Expr), String> {
+    fn arrange_sum(&self, e: &Expr, shape: Shape) -> Result<(bool, Expr), StepError> {
         let Expr::Add(terms) = e else {
             return Ok((false, e.clone()));
         };
@@ -464,4 +472,50 @@ impl<'a> Presenter<'a> {
     fn assemble(&self, f: &Factored) -> Expr {
         product(self.ordered(f))
     }
+}
+
+/// `sin^2 + cos^2 = 1` applied to every expression of `d` over the full state, as the
+/// generated code and the JSON record print them (each checked equal by
+/// [`with_pythagoras`]): `k T sin^2 + k T cos^2` is `k T`. Run after the steps
+/// ([`super::steps`]), which show the expressions as derived.
+pub fn with_identities(d: &mut Derivation) -> Result<(), DeriveError> {
+    let theta = d.theta().to_string();
+    let one = |e: &mut Expr, what: &str| -> Result<(), DeriveError> {
+        *e = with_pythagoras(e, &theta, what)?;
+        Ok(())
+    };
+    let all = |v: &mut [Expr], what: &str| v.iter_mut().try_for_each(|e| one(e, what));
+    one(&mut d.kinetic, "kinetic energy")?;
+    one(&mut d.potential, "potential energy")?;
+    one(&mut d.lagrangian, "lagrangian")?;
+    all(&mut d.euler_lagrange, "equation")?;
+    for row in &mut d.mass {
+        all(row, "mass matrix")?;
+    }
+    all(&mut d.rhs, "forces")?;
+    all(&mut d.momenta, "momentum")?;
+    for p in d.point_pos.iter_mut().chain(&mut d.point_vel) {
+        all(p, "point")?;
+    }
+    for c in &mut d.contacts {
+        one(&mut c.gap, "gap")?;
+        all(&mut c.jacobian, "gap Jacobian")?;
+        one(&mut c.bias, "gap bias")?;
+        for e in c.edge.iter_mut().chain(&mut c.force) {
+            one(e, "contact")?;
+        }
+    }
+    all(&mut d.monitors_full, "monitor")?;
+    for pose in &mut d.body_pose {
+        all(pose, "body pose")?;
+    }
+    for f in &mut d.frictions {
+        one(&mut f.slip, "slip velocity")?;
+        all(&mut f.jacobian, "slip Jacobian")?;
+        one(&mut f.bias, "slip bias")?;
+    }
+    for state in &mut d.to_full {
+        all(state, "full state")?;
+    }
+    Ok(())
 }

@@ -311,7 +311,7 @@ impl Reducer<'_> {
         let inertia = reduce_cos_sq(&cas::expand(&cas::d(&cas::d(&e_red, "rc_w"), "rc_w")));
         let inertia = cas::expand(&cas::together(&inertia));
         let linear = cas::subs_var(&cas::d(&e_red, "rc_w"), "rc_w", &cas::num(0));
-        if !is_zero_trig(&linear).map_err(|m| at(&[], m))? {
+        if !is_zero_trig(&linear).map_err(|m| at(&[], m.to_string()))? {
             return Ok(Err(
                 "the reduced energy has a term linear in the angular velocity".into(),
             ));

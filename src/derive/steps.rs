@@ -18,36 +18,9 @@ use super::algebra::{is_zero_trig, to_sc_expr};
 use super::cas::{self, A};
 use super::expr::{Expr, product, sum};
 use super::present::{Presenter, Shape, operations};
-use super::types::Derivation;
+use super::types::{Derivation, StepError};
+pub use super::types::{Shown, Steps};
 use std::collections::BTreeMap;
-
-/// One step as shown, over `rc_s`, `rc_c` like the derivation.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Shown {
-    /// The expression shown.
-    pub expr: Expr,
-    /// The expression as derived (what `expr` equals).
-    pub derived: Expr,
-    /// Why it is shown as derived rather than in a grouped form, if it is.
-    pub as_derived: Option<String>,
-}
-
-/// Every step of a phase as shown.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Steps {
-    /// `T`.
-    pub kinetic: Shown,
-    /// `V`.
-    pub potential: Shown,
-    /// `L = T - V`.
-    pub lagrangian: Shown,
-    /// One Euler–Lagrange expression per coordinate (each `= 0`).
-    pub euler_lagrange: Vec<Shown>,
-    /// The conjugate momenta of the cyclic coordinates.
-    pub momenta: Vec<Shown>,
-    /// The reduced results by their key in `Reduction::plain`.
-    pub reduced: BTreeMap<String, Shown>,
-}
 
 /// The steps of `d` as shown.
 pub fn derive(d: &Derivation) -> Steps {
@@ -92,7 +65,7 @@ pub fn derive(d: &Derivation) -> Steps {
 /// `e` in the form `form` makes of it (a form checked by its maker) when that has no more
 /// operations, else as derived. A form that fails to be made leaves `e` as derived with the
 /// reason.
-fn show(e: &Expr, form: impl Fn(&A) -> Result<Expr, String>) -> Shown {
+fn show(e: &Expr, form: impl Fn(&A) -> Result<Expr, StepError>) -> Shown {
     let a = cas::atom(e);
     let raw = e.clone();
     let candidate = match form(&a) {
@@ -101,7 +74,7 @@ fn show(e: &Expr, form: impl Fn(&A) -> Result<Expr, String>) -> Shown {
             return Shown {
                 expr: raw.clone(),
                 derived: raw,
-                as_derived: Some(why),
+                as_derived: Some(why.to_string()),
             };
         }
     };
@@ -124,7 +97,7 @@ fn show(e: &Expr, form: impl Fn(&A) -> Result<Expr, String>) -> Shown {
 /// monomials, each coefficient in its presentation form: accelerations first, then velocity
 /// products, then the part without either; within each, in the order of `motion`, higher
 /// powers first.
-fn in_motion(presenter: &Presenter, a: &A, motion: &[String]) -> Result<Expr, String> {
+fn in_motion(presenter: &Presenter, a: &A, motion: &[String]) -> Result<Expr, StepError> {
     let expanded = cas::expr(&cas::expand(a))?;
     let terms = match expanded {
         Expr::Add(v) => v,
@@ -176,11 +149,11 @@ fn in_motion(presenter: &Presenter, a: &A, motion: &[String]) -> Result<Expr, St
     shown.extend(free);
     let grouped = sum(shown);
     if !is_zero_trig(&(cas::atom(&grouped) - a.clone()))? {
-        return Err(format!(
+        return Err(StepError::Presentation(format!(
             "the grouped form `{}` is not equal to `{}`",
             grouped.to_infix(),
             cas::expr(a)?.to_infix()
-        ));
+        )));
     }
     Ok(grouped)
 }

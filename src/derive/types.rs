@@ -1,5 +1,6 @@
 //! What the derivation produces, stage by stage: the typed values that every stage of
-//! `derive/` hands to the next (and the errors placed at a spec field), below all of them.
+//! `derive/` hands to the next, and the layer's errors (`StepError` of a step, `DeriveError`
+//! placed at a spec field), below all of them.
 //!
 //! A spec describes a *system*: its coordinates, bodies, potentials, obstacles and contacts.
 //! Each derived model is one *phase* of it, named by the contacts it holds closed by
@@ -9,7 +10,52 @@
 
 use super::expr::Expr;
 pub use crate::model::ShapeKind;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
+
+/// A derivation step that failed, before it is placed at a spec field ([`DeriveError`]) or
+/// reported by the tool as a refused model: the derive layer's error.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum StepError {
+    /// Symbolica gave back an atom that the derivation's expressions cannot hold.
+    #[error("cannot read back Symbolica's `{atom}`: {why}")]
+    Unreadable {
+        /// The atom, as Symbolica prints it.
+        atom: String,
+        /// What could not be held (a complex number, a rational beyond 128 bits).
+        why: String,
+    },
+    /// A coefficient outgrew 128 bits.
+    #[error("coefficient overflow")]
+    Overflow,
+    /// No presentation form could be made, or the one made is not equal to the result.
+    #[error("{0}")]
+    Presentation(String),
+    /// The derivation lacks what the emitter needs (a constant, a point, a parameter, the
+    /// presented steps).
+    #[error("{0}")]
+    Missing(String),
+    /// Expressions of a generated method read symbols the method does not have.
+    #[error("{what} {} besides {besides}", .symbols.join(", "))]
+    Unbound {
+        /// What depends on them (`the forces depend on`).
+        what: &'static str,
+        /// The symbols.
+        symbols: Vec<String>,
+        /// What the method has (`the state and the parameters`).
+        besides: &'static str,
+    },
+    /// Named constants that nothing reads even after dropping the unread ones.
+    #[error("constants still unread after dropping the unread ones: {0:?}")]
+    Unread(BTreeSet<String>),
+    /// Two symbols would be the same local in the generated code.
+    #[error("two symbols of `{model}` would both be the local `{local}` in the generated code")]
+    LocalClash {
+        /// The model.
+        model: String,
+        /// The local.
+        local: String,
+    },
+}
 
 /// Where a derivation error belongs in the spec: a dotted field path and a message.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -283,9 +329,9 @@ pub struct Derivation {
     /// The fast path, or why the phase is integrated instead.
     pub reduction: Result<Reduction, String>,
     /// The results without units, if the spec gives groups and scales.
-    pub dimensionless: Option<super::dimensionless::Dimensionless>,
+    pub dimensionless: Option<Dimensionless>,
     /// The steps as the LaTeX derivation shows them ([`super::steps`]), once presented.
-    pub steps: Option<super::steps::Steps>,
+    pub steps: Option<Steps>,
 }
 
 impl Derivation {
@@ -298,4 +344,77 @@ impl Derivation {
     pub fn is_general(&self) -> bool {
         self.plan.is_general()
     }
+}
+
+// What the presentation stages add to a phase ([`super::dimensionless`], [`super::steps`]).
+
+/// A dimensionless group.
+#[derive(Debug, Clone)]
+pub struct Group {
+    /// Its symbol.
+    pub name: String,
+    /// Its definition over the parameters.
+    pub definition: Expr,
+    /// What it is.
+    pub meaning: String,
+    /// The parameter it is solved for.
+    pub solves: String,
+}
+
+/// A result without units.
+#[derive(Debug, Clone)]
+pub struct Scaled {
+    /// Key, as in the JSON record's `expressions` (`theta_dot_sq`, `contact_force`, ...).
+    pub key: String,
+    /// What it is, in words.
+    pub meaning: String,
+    /// The unit it is written in (`g/ell`, `m2*g`); none for a condition `= 0`.
+    pub unit: Option<Expr>,
+    /// The presentation form over the groups and `sin(theta)`, `cos(theta)`.
+    pub form: Expr,
+    /// Operations in the form (see [`RULE`](super::present::RULE)).
+    pub operations: usize,
+    /// The paper's equation number, where the spec gives one.
+    pub paper: Option<String>,
+}
+
+/// A phase's results without units.
+#[derive(Debug, Clone)]
+pub struct Dimensionless {
+    /// The groups, in the spec's order (a free phase's `omega_0` last).
+    pub groups: Vec<Group>,
+    /// The time scale.
+    pub time: Expr,
+    /// The force scale.
+    pub force: Expr,
+    /// The results (none on the integrated route, which has no closed forms).
+    pub results: Vec<Scaled>,
+}
+
+/// One step as shown, over `rc_s`, `rc_c` like the derivation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Shown {
+    /// The expression shown.
+    pub expr: Expr,
+    /// The expression as derived (what `expr` equals).
+    pub derived: Expr,
+    /// Why it is shown as derived rather than in a grouped form, if it is.
+    pub as_derived: Option<String>,
+}
+
+/// Every step of a phase as shown.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Steps {
+    /// `T`.
+    pub kinetic: Shown,
+    /// `V`.
+    pub potential: Shown,
+    /// `L = T - V`.
+    pub lagrangian: Shown,
+    /// One Euler–Lagrange expression per coordinate (each `= 0`).
+    pub euler_lagrange: Vec<Shown>,
+    /// The conjugate momenta of the cyclic coordinates.
+    pub momenta: Vec<Shown>,
+    /// The reduced results by their key in `Reduction::plain`.
+    pub reduced: BTreeMap<String, Shown>,
 }

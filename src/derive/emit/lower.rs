@@ -1,7 +1,7 @@
 //! Lowers derived expressions to straight-line Rust: shared subexpressions become `let`s,
 //! parameter-only subexpressions are hoisted into the prepared constants `k`.
 
-use super::expr::{Expr, float_literal};
+use crate::derive::expr::{Expr, float_literal};
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 
 /// Names an expression's free symbols resolve to in generated code.
@@ -12,6 +12,9 @@ pub struct Scope {
     /// Symbols that are local variables (function arguments or earlier `let`s), with their
     /// Rust spelling.
     pub locals: BTreeMap<String, String>,
+    /// Slots of `k` read through a local of this name (the parameters, bound by the method's
+    /// preamble) rather than as `k[i]`.
+    pub named: BTreeMap<usize, String>,
 }
 
 /// Parameter-only subexpressions collected across all functions, to be computed once in
@@ -26,6 +29,8 @@ pub struct Hoisted {
     pub entries: Vec<(usize, Expr)>,
     /// Magnitude's key -> (its slot, whether the slot holds its negative).
     by_key: HashMap<String, (usize, bool)>,
+    /// Each slot a subexpression reads, with what it holds (for comments).
+    definitions: HashMap<usize, Expr>,
     next: usize,
 }
 
@@ -35,6 +40,7 @@ impl Hoisted {
         Hoisted {
             entries: Vec::new(),
             by_key: HashMap::new(),
+            definitions: HashMap::new(),
             next: first,
         }
     }
@@ -43,7 +49,24 @@ impl Hoisted {
     /// `k[idx]` instead of hoisting a copy (a start constant that an initial value repeats, say).
     pub fn known(&mut self, e: &Expr, idx: usize) {
         let (neg, magnitude) = signed(e);
+        self.definitions.entry(idx).or_insert_with(|| e.clone());
         self.by_key.entry(key(&magnitude)).or_insert((idx, neg));
+    }
+
+    /// `e` with every hoisted constant `rc_k<i>` it reads replaced by what that slot holds.
+    pub fn defined(&self, e: &Expr) -> Expr {
+        let rec = |v: &Vec<Expr>| v.iter().map(|x| self.defined(x)).collect();
+        match e {
+            Expr::Sym(s) => (s.strip_prefix("rc_k"))
+                .and_then(|i| i.parse::<usize>().ok())
+                .and_then(|i| self.definitions.get(&i))
+                .map_or_else(|| e.clone(), |d| self.defined(d)),
+            Expr::Add(v) => Expr::Add(rec(v)),
+            Expr::Mul(v) => Expr::Mul(rec(v)),
+            Expr::Pow(b, x) => Expr::Pow(Box::new(self.defined(b)), Box::new(self.defined(x))),
+            Expr::Fun(f, v) => Expr::Fun(f.clone(), rec(v)),
+            _ => e.clone(),
+        }
     }
 
     /// Total length of `k` after hoisting.
@@ -68,7 +91,8 @@ impl Hoisted {
         let (i, held_negated) = *self.by_key.entry(key(&magnitude)).or_insert_with(|| {
             let i = self.next;
             self.next += 1;
-            self.entries.push((i, magnitude));
+            self.entries.push((i, magnitude.clone()));
+            self.definitions.insert(i, magnitude);
             (i, false)
         });
         (neg != held_negated, Expr::Sym(format!("rc_k{i}")))
@@ -114,7 +138,7 @@ fn negated(e: &Expr) -> Expr {
                 Some(i) => v[i] = negated(&v[i]),
                 None => v.insert(0, Expr::int(-1)),
             }
-            super::expr::product(v)
+            crate::derive::expr::product(v)
         }
         _ => Expr::Mul(vec![Expr::int(-1), e.clone()]),
     }
@@ -139,12 +163,15 @@ fn with_sign(neg: bool, x: Expr) -> Expr {
 }
 
 /// A lowered function body: `let` lines and the final output expressions, all Rust text.
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct Body {
     /// `(name, rust expression)` pairs, in order.
     pub lets: Vec<(String, String)>,
     /// One Rust expression per requested output.
     pub outputs: Vec<String>,
+    /// What each `let` holds, over the spec's symbols (hoisted constants by their
+    /// definitions): the comment that explains its name.
+    pub holds: Vec<Expr>,
 }
 
 /// Lowers `outputs` (which may refer to each other's names only through `scope.locals`).
@@ -166,15 +193,20 @@ pub fn lower(outputs: &[Expr], scope: &Scope, hoist: Option<&mut Hoisted>, prefi
     for e in &outputs {
         count(e, &mut counts);
     }
-    let mut lets: Vec<(String, String)> = Vec::new();
+    let mut lets: Vec<(String, String, Expr)> = Vec::new();
     let mut named: HashMap<String, String> = HashMap::new();
     let mut lowered = Vec::new();
     for e in &outputs {
         let text = emit(e, scope, &counts, &mut named, &mut lets, prefix);
         lowered.push(bare(text));
     }
+    let defined = |e: &Expr| match hoist.as_deref() {
+        Some(h) => h.defined(e),
+        None => e.clone(),
+    };
     Body {
-        lets: lets.into_iter().map(|(n, v)| (n, bare(v))).collect(),
+        holds: lets.iter().map(|(_, _, e)| defined(e).tidy()).collect(),
+        lets: lets.into_iter().map(|(n, v, _)| (n, bare(v))).collect(),
         outputs: lowered,
     }
 }
@@ -247,19 +279,21 @@ fn hoist_constants(e: &Expr, scope: &Scope, h: &mut Hoisted) -> Expr {
             };
             let (coef, rest): (Vec<Expr>, Vec<Expr>) =
                 factors.into_iter().partition(|f| constant_only(f, scope));
-            let rest = super::expr::product(rest);
+            let rest = crate::derive::expr::product(rest);
             let key = rest.to_infix();
             match groups.iter_mut().find(|g| g.0 == key) {
-                Some(g) => g.2.push(super::expr::product(coef)),
-                None => groups.push((key, rest, vec![super::expr::product(coef)])),
+                Some(g) => g.2.push(crate::derive::expr::product(coef)),
+                None => groups.push((key, rest, vec![crate::derive::expr::product(coef)])),
             }
         }
         if groups.len() < v.len() {
             let terms = groups
                 .into_iter()
-                .map(|(_, rest, coefs)| Expr::Mul(vec![super::expr::sum(coefs), rest]).tidy())
+                .map(|(_, rest, coefs)| {
+                    Expr::Mul(vec![crate::derive::expr::sum(coefs), rest]).tidy()
+                })
                 .collect();
-            let grouped = super::expr::sum(terms);
+            let grouped = crate::derive::expr::sum(terms);
             // Only a sum the grouping shortened is taken apart again (tidying a grouped term
             // may spread it back into as many terms, which would recurse for ever).
             let shorter = match &grouped {
@@ -292,9 +326,9 @@ fn hoist_constants(e: &Expr, scope: &Scope, h: &mut Hoisted) -> Expr {
             let has_const = group.iter().any(|c| !c.symbols().is_empty());
             if has_const {
                 let g = if matches!(e, Expr::Mul(_)) {
-                    super::expr::product(group)
+                    crate::derive::expr::product(group)
                 } else {
-                    super::expr::sum(group)
+                    crate::derive::expr::sum(group)
                 };
                 let (neg, x) = h.constant(&g, scope);
                 if matches!(e, Expr::Mul(_)) {
@@ -310,9 +344,9 @@ fn hoist_constants(e: &Expr, scope: &Scope, h: &mut Hoisted) -> Expr {
             }
             out.extend(rest.into_iter().map(|c| hoist_constants(c, scope, h)));
             if matches!(e, Expr::Mul(_)) {
-                super::expr::product(out)
+                crate::derive::expr::product(out)
             } else {
-                super::expr::sum(out)
+                crate::derive::expr::sum(out)
             }
         }
         Expr::Pow(b, x) => Expr::Pow(
@@ -332,7 +366,7 @@ fn emit(
     scope: &Scope,
     counts: &HashMap<String, usize>,
     named: &mut HashMap<String, String>,
-    lets: &mut Vec<(String, String)>,
+    lets: &mut Vec<(String, String, Expr)>,
     prefix: &str,
 ) -> String {
     if !is_trivial(e) {
@@ -343,7 +377,7 @@ fn emit(
         if counts.get(&key).copied().unwrap_or(0) > 1 {
             let text = emit_node(e, scope, counts, named, lets, prefix);
             let name = format!("{prefix}t{}", lets.len());
-            lets.push((name.clone(), text));
+            lets.push((name.clone(), text, e.clone()));
             named.insert(key, name.clone());
             return name;
         }
@@ -356,7 +390,7 @@ fn emit_node(
     scope: &Scope,
     counts: &HashMap<String, usize>,
     named: &mut HashMap<String, String>,
-    lets: &mut Vec<(String, String)>,
+    lets: &mut Vec<(String, String, Expr)>,
     prefix: &str,
 ) -> String {
     let mut sub = |x: &Expr| emit(x, scope, counts, named, lets, prefix);
@@ -372,7 +406,10 @@ fn emit_node(
             if let Some(i) = s.strip_prefix("rc_k").and_then(|i| i.parse::<usize>().ok()) {
                 format!("k[{i}]")
             } else if let Some(i) = scope.constants.get(s) {
-                format!("k[{i}]")
+                match scope.named.get(i) {
+                    Some(name) => name.clone(),
+                    None => format!("k[{i}]"),
+                }
             } else if let Some(l) = scope.locals.get(s) {
                 l.clone()
             } else {
@@ -383,7 +420,7 @@ fn emit_node(
         }
         Expr::Add(v) => {
             let mut out = String::from("(");
-            super::expr::write_signed_sum(&mut out, v, |o, mag| o.push_str(&sub(mag)));
+            crate::derive::expr::write_signed_sum(&mut out, v, |o, mag| o.push_str(&sub(mag)));
             out.push(')');
             out
         }

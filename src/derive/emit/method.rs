@@ -1,7 +1,8 @@
 //! The head and preamble of one generated method: arguments its body never reads are spelled
 //! with a leading `_`, and a preamble line (the constant slice, the angle's sine and cosine, the
-//! start offsets, a renamed argument) is written only when the body reads what it defines, so
-//! the generated code compiles without `allow(unused_variables)`.
+//! start offsets, a renamed argument, the parameters and the state by name) is written only
+//! when the body reads what it defines, so the generated code compiles without
+//! `allow(unused_variables)`.
 
 /// A line a method's body may start with, kept only when the rest reads what it defines.
 #[derive(Debug, Clone, Copy)]
@@ -15,6 +16,11 @@ pub enum Preamble<'a> {
     Offsets([usize; 3]),
     /// `let name = value;`.
     Let(&'a str, &'a str),
+    /// `let name = slice[i];` for each `(i, name)`: the parameters by name, from `k` or `p`.
+    Names(&'a [String], &'a str),
+    /// `let c = q[i];`, `let c_dot = qd[i];`, `let c_ddot = qdd[i];`: the state by the
+    /// coordinates' names.
+    State(&'a [String]),
 }
 
 /// Whether `line` reads the identifier `word` (not as part of a longer identifier; comments
@@ -83,6 +89,26 @@ pub fn method(
                 })
             }
             Preamble::Let(name, value) => uses(name).then(|| format!("let {name} = {value};")),
+            Preamble::Names(names, slice) => {
+                let lets: Vec<String> = (names.iter().enumerate())
+                    .filter(|(_, name)| uses(name))
+                    .map(|(i, name)| format!("let {name} = {slice}[{i}];"))
+                    .collect();
+                head.extend(lets.into_iter().rev());
+                None
+            }
+            Preamble::State(coords) => {
+                let lets = (coords.iter().enumerate()).flat_map(|(i, c)| {
+                    [("", "q"), ("_dot", "qd"), ("_ddot", "qdd")]
+                        .map(|(suffix, slice)| (format!("{c}{suffix}"), format!("{slice}[{i}]")))
+                });
+                let lets: Vec<String> = lets
+                    .filter(|(name, _)| uses(name))
+                    .map(|(name, value)| format!("let {name} = {value};"))
+                    .collect();
+                head.extend(lets.into_iter().rev());
+                None
+            }
         };
         head.extend(line);
     }

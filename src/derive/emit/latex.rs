@@ -1,7 +1,7 @@
 //! The LaTeX printer of the derivation tool: an [`Expr`] as LaTeX, its printed width, and long
 //! displays broken into lines between the terms of a sum (the runtime crate prints no LaTeX).
 
-use super::expr::{Expr, wrap_in, write_signed_sum};
+use crate::derive::expr::{Expr, wrap_in, write_signed_sum};
 use std::fmt::Write as _;
 
 impl Expr {
