@@ -14,6 +14,7 @@ pub mod checks;
 pub mod contacts;
 pub mod impact;
 pub mod lean;
+pub mod linear;
 pub mod ode;
 pub mod phases;
 pub mod poly;
