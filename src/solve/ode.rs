@@ -1108,6 +1108,9 @@ fn locate<P: OdeProblem>(
     Ok(best)
 }
 
+/// A point and the function's value there.
+type Point = (f64, f64);
+
 /// How much [`bracket`]'s distance from its estimate grows at each look that finds no sign
 /// change.
 const BRACKET_GROWTH: f64 = 16.0;
@@ -1125,9 +1128,9 @@ fn bracket<E>(
     mut f: impl FnMut(f64) -> Result<f64, E>,
     estimate: f64,
     delta: f64,
-    (a, fa): (f64, f64),
-    (b, fb): (f64, f64),
-) -> Result<((f64, f64), (f64, f64)), E> {
+    (a, fa): Point,
+    (b, fb): Point,
+) -> Result<(Point, Point), E> {
     if !(estimate > a && estimate < b) {
         return Ok(((a, fa), (b, fb)));
     }
