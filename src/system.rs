@@ -258,6 +258,12 @@ fn finite(what: &'static str, values: &[f64]) -> Result<(), SystemError> {
     }
 }
 
+/// Sets `buffer` to `len` zeros, keeping its allocation.
+fn zeroed(buffer: &mut Vec<f64>, len: usize) {
+    buffer.clear();
+    buffer.resize(len, 0.0);
+}
+
 /// `Ok` when `value` is finite, else [`SystemError::NotFiniteInput`] naming it.
 fn finite_scalar(what: &'static str, value: f64) -> Result<(), SystemError> {
     finite(what, &[value])
@@ -277,6 +283,9 @@ pub struct Points {
 #[derive(Clone)]
 pub struct Bound<'m> {
     model: &'m dyn Model,
+    /// `model.info()`, read by every evaluation (kept to spare the call through the trait
+    /// object).
+    info: &'static ModelInfo,
     p: Vec<f64>,
     k: Vec<f64>,
     restitutions: Vec<f64>,
@@ -323,6 +332,7 @@ impl<'m> Bound<'m> {
         prepare_constants(model, p, &mut k)?;
         Ok(Bound {
             model,
+            info,
             p: p.to_vec(),
             k,
             restitutions,
@@ -342,7 +352,7 @@ impl<'m> Bound<'m> {
 
     /// The model's static description.
     pub fn info(&self) -> &'static ModelInfo {
-        self.model.info()
+        self.info
     }
 
     /// Model name.
@@ -476,13 +486,26 @@ impl<'m> Bound<'m> {
 
     /// The mass matrix (row-major) and right-hand side of `M(q) qdd = F(q, qd)`.
     pub fn equations(&self, state: &State) -> Result<(Vec<f64>, Vec<f64>), SystemError> {
+        let (mut mass, mut rhs) = (Vec::new(), Vec::new());
+        self.equations_into(state, &mut mass, &mut rhs)?;
+        Ok((mass, rhs))
+    }
+
+    /// [`Self::equations`] into buffers that keep their allocation from call to call (each
+    /// resized to its length): the integrator's right-hand sides allocate nothing.
+    pub fn equations_into(
+        &self,
+        state: &State,
+        mass: &mut Vec<f64>,
+        rhs: &mut Vec<f64>,
+    ) -> Result<(), SystemError> {
         self.check_state(state)?;
         let n = self.n_coordinates();
-        let mut mass = vec![0.0; n * n];
-        let mut rhs = vec![0.0; n];
+        zeroed(mass, n * n);
+        zeroed(rhs, n);
         self.model
-            .equations(&self.k, &state.q, &state.qd, &mut mass, &mut rhs);
-        Ok((mass, rhs))
+            .equations(&self.k, &state.q, &state.qd, mass, rhs);
+        Ok(())
     }
 
     /// Number of contacts of the system.
@@ -494,13 +517,25 @@ impl<'m> Bound<'m> {
     /// zero for the others) from a full state and its accelerations (one per coordinate, each
     /// finite).
     pub fn forces_full(&self, state: &State, qdd: &[f64]) -> Result<Vec<f64>, SystemError> {
+        let mut out = Vec::new();
+        self.forces_full_into(state, qdd, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`Self::forces_full`] into a buffer that keeps its allocation (resized to its length).
+    pub fn forces_full_into(
+        &self,
+        state: &State,
+        qdd: &[f64],
+        out: &mut Vec<f64>,
+    ) -> Result<(), SystemError> {
         self.check_state(state)?;
         self.check_length("qdd", self.n_coordinates(), qdd.len())?;
         finite("qdd", qdd)?;
-        let mut out = vec![0.0; self.n_contacts()];
+        zeroed(out, self.n_contacts());
         self.model
-            .forces_full(&self.k, &state.q, &state.qd, qdd, &mut out);
-        Ok(out)
+            .forces_full(&self.k, &state.q, &state.qd, qdd, out);
+        Ok(())
     }
 
     /// Every contact's gap (zero for those this model holds closed).
@@ -514,13 +549,26 @@ impl<'m> Bound<'m> {
     /// Every contact's constraint row `J = d gap / dq` (row-major, one row per contact) and
     /// bias `dJ/dt qd`: a contact's normal acceleration is `J qdd + bias`.
     pub fn constraints(&self, state: &State) -> Result<(Vec<f64>, Vec<f64>), SystemError> {
+        let (mut jac, mut bias) = (Vec::new(), Vec::new());
+        self.constraints_into(state, &mut jac, &mut bias)?;
+        Ok((jac, bias))
+    }
+
+    /// [`Self::constraints`] into buffers that keep their allocation (each resized to its
+    /// length).
+    pub fn constraints_into(
+        &self,
+        state: &State,
+        jac: &mut Vec<f64>,
+        bias: &mut Vec<f64>,
+    ) -> Result<(), SystemError> {
         self.check_state(state)?;
         let m = self.n_contacts();
-        let mut jac = vec![0.0; m * self.n_coordinates()];
-        let mut bias = vec![0.0; m];
+        zeroed(jac, m * self.n_coordinates());
+        zeroed(bias, m);
         self.model
-            .constraints(&self.k, &state.q, &state.qd, &mut jac, &mut bias);
-        Ok((jac, bias))
+            .constraints(&self.k, &state.q, &state.qd, jac, bias);
+        Ok(())
     }
 
     /// Every contact's edge margin (`+inf` for a contact without an edge).
@@ -543,20 +591,36 @@ impl<'m> Bound<'m> {
     /// The frictions' slip-velocity Jacobian `J` (row-major, one row per friction) and the
     /// part of the slip acceleration free of `qdd`: `v = J qd`, `dv/dt = J qdd + bias`.
     pub fn friction(&self, state: &State) -> Result<(Vec<f64>, Vec<f64>), SystemError> {
+        let (mut jac, mut bias) = (Vec::new(), Vec::new());
+        self.friction_into(state, &mut jac, &mut bias)?;
+        Ok((jac, bias))
+    }
+
+    /// [`Self::friction`] into buffers that keep their allocation (each resized to its length).
+    pub fn friction_into(
+        &self,
+        state: &State,
+        jac: &mut Vec<f64>,
+        bias: &mut Vec<f64>,
+    ) -> Result<(), SystemError> {
         self.check_state(state)?;
         let m = self.info().frictions.len();
-        let mut jac = vec![0.0; m * self.n_coordinates()];
-        let mut bias = vec![0.0; m];
-        self.model
-            .friction(&self.k, &state.q, &state.qd, &mut jac, &mut bias);
-        Ok((jac, bias))
+        zeroed(jac, m * self.n_coordinates());
+        zeroed(bias, m);
+        if m > 0 {
+            self.model.friction(&self.k, &state.q, &state.qd, jac, bias);
+        }
+        Ok(())
     }
 
     /// The friction coefficient of each friction.
     pub fn friction_coefficients(&self) -> Vec<f64> {
-        (self.info().frictions.iter())
-            .map(|f| self.p[f.coefficient])
-            .collect()
+        self.friction_coefficient_values().collect()
+    }
+
+    /// The friction coefficient of each friction, in order, without collecting them.
+    pub fn friction_coefficient_values(&self) -> impl Iterator<Item = f64> + '_ {
+        (self.info().frictions.iter()).map(|f| self.p[f.coefficient])
     }
 
     /// Monitor values (each must stay `>= 0`) at a state with the contacts' forces there (one

@@ -27,6 +27,7 @@
 use crate::model::ModelInfo;
 use crate::solve::SolveError;
 pub use crate::solve::active::{Active, DECIDE_TOLERANCE, Mode, check_active};
+use crate::solve::linear;
 use crate::solve::rest;
 use crate::system::{Bound, State};
 use nalgebra::{DMatrix, DVector};
@@ -43,7 +44,7 @@ pub const REST: f64 = 1e-9;
 pub const PAINLEVE_FLOOR: f64 = 1e-3;
 
 /// The accelerations, contact and friction forces at one state in one active set.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct Dynamics {
     /// `qdd`.
     pub qdd: Vec<f64>,
@@ -72,6 +73,7 @@ impl Dynamics {
 }
 
 /// The rows of one solve: the model's matrices at a state.
+#[derive(Debug, Clone, Default)]
 struct Rows {
     n: usize,
     mass: Vec<f64>,
@@ -84,18 +86,18 @@ struct Rows {
 
 impl Rows {
     fn at(sys: &Bound, state: &State) -> Result<Rows, SolveError> {
-        let (mass, rhs) = sys.equations(state)?;
-        let (jac, bias) = sys.constraints(state)?;
-        let (tjac, tbias) = sys.friction(state)?;
-        Ok(Rows {
-            n: sys.n_coordinates(),
-            mass,
-            rhs,
-            jac,
-            bias,
-            tjac,
-            tbias,
-        })
+        let mut rows = Rows::default();
+        rows.fill(sys, state)?;
+        Ok(rows)
+    }
+
+    /// The model's matrices at `state`, into the buffers already held.
+    fn fill(&mut self, sys: &Bound, state: &State) -> Result<(), SolveError> {
+        self.n = sys.n_coordinates();
+        sys.equations_into(state, &mut self.mass, &mut self.rhs)?;
+        sys.constraints_into(state, &mut self.jac, &mut self.bias)?;
+        sys.friction_into(state, &mut self.tjac, &mut self.tbias)?;
+        Ok(())
     }
 
     fn row<'a>(&self, m: &'a [f64], i: usize) -> &'a [f64] {
@@ -128,6 +130,38 @@ pub fn dynamics(
     active: &Active,
     t: f64,
 ) -> Result<Dynamics, SolveError> {
+    let mut work = DynamicsWork::default();
+    dynamics_into(sys, state, active, t, &mut work)?;
+    Ok(work.out)
+}
+
+/// The buffers of [`dynamics_into`] and its result ([`DynamicsWork::out`]), kept from call to
+/// call: an integration's right-hand sides then allocate nothing.
+#[derive(Debug, Clone, Default)]
+pub struct DynamicsWork {
+    rows: Rows,
+    /// Closed constraint rows (closed and not eliminated).
+    kkt: Vec<usize>,
+    /// Acting frictions.
+    acting: Vec<usize>,
+    mu: Vec<f64>,
+    /// The linear system (row-major) and its right-hand side, then its solution.
+    a: Vec<f64>,
+    x: Vec<f64>,
+    /// The system without the sliding frictions' coupling, for Painlevé's ratio.
+    a0: Vec<f64>,
+    /// The dynamics of the last call.
+    pub out: Dynamics,
+}
+
+/// [`dynamics`] into `work.out`, with `work`'s buffers.
+pub fn dynamics_into(
+    sys: &Bound,
+    state: &State,
+    active: &Active,
+    t: f64,
+    work: &mut DynamicsWork,
+) -> Result<(), SolveError> {
     let info = sys.info();
     let (n, m, nf) = (
         sys.n_coordinates(),
@@ -135,104 +169,115 @@ pub fn dynamics(
         info.frictions.len(),
     );
     check_active(info, active)?;
-    let rows = Rows::at(sys, state)?;
-    // Closed constraint rows (closed and not eliminated), then acting frictions.
-    let kkt: Vec<usize> = (0..m)
-        .filter(|&i| active.closed[i] && !info.contacts[i].closed)
-        .collect();
-    let acting: Vec<usize> = (0..nf).filter(|&j| active.friction_acts(info, j)).collect();
-    let dim = n + kkt.len() + acting.len();
-    let mu = sys.friction_coefficients();
-    let (a, b) = assemble(&rows, &mu, info, active, &kkt, &acting, dim);
+    work.rows.fill(sys, state)?;
+    work.kkt.clear();
+    work.kkt
+        .extend((0..m).filter(|&i| active.closed[i] && !info.contacts[i].closed));
+    work.acting.clear();
+    work.acting
+        .extend((0..nf).filter(|&j| active.friction_acts(info, j)));
+    let dim = n + work.kkt.len() + work.acting.len();
+    work.mu.clear();
+    work.mu.extend(sys.friction_coefficient_values());
+    assemble(work, info, active, dim);
+    let sliding = (work.acting.iter()).any(|&j| matches!(active.modes[j], Mode::Slide(_)));
+    if sliding {
+        work.a0.clone_from(&work.a);
+    }
     let singular = || SolveError::SingularContacts {
         model: info.name,
         t,
         closed: closed_list(info, &active.closed),
         q: state.q.clone(),
     };
-    let lu = a.clone().lu();
-    let x = lu.solve(&b).ok_or_else(singular)?;
-    if !x.iter().all(|v| v.is_finite()) {
+    let det = linear::solve_in_place(&mut work.a, dim, &mut work.x).map_err(|_| singular())?;
+    if !work.x.iter().all(|v| v.is_finite()) {
         return Err(singular());
     }
-    let sliding = acting
-        .iter()
-        .any(|&j| matches!(active.modes[j], Mode::Slide(_)));
     let painleve = if sliding {
         // The same system without the sliding frictions' coupling to their normal forces.
-        let mut a0 = a;
-        for (r, &j) in acting.iter().enumerate() {
+        let base = n + work.kkt.len();
+        for (r, &j) in work.acting.iter().enumerate() {
             if matches!(active.modes[j], Mode::Slide(_)) {
+                let row = base + r;
                 for c in 0..dim {
-                    a0[(n + kkt.len() + r, c)] = if c == n + kkt.len() + r { 1.0 } else { 0.0 };
+                    work.a0[row * dim + c] = if c == row { 1.0 } else { 0.0 };
                 }
             }
         }
-        lu.determinant() / a0.lu().determinant()
+        det / linear::determinant_in_place(&mut work.a0, dim)
     } else {
         1.0
     };
-    let qdd: Vec<f64> = x.iter().take(n).copied().collect();
-    let mut forces = sys.forces_full(state, &qdd)?;
-    for (r, &i) in kkt.iter().enumerate() {
-        forces[i] = x[n + r];
-    }
-    let mut fr = vec![0.0; nf];
-    for (r, &j) in acting.iter().enumerate() {
-        fr[j] = x[n + kkt.len() + r];
-    }
-    let normal_acc = (0..m)
-        .map(|i| Rows::dot(rows.row(&rows.jac, i), &qdd) + rows.bias[i])
-        .collect();
-
-    let slip = (0..nf)
-        .map(|j| Rows::dot(rows.row(&rows.tjac, j), &state.qd))
-        .collect();
-    let slip_acc = (0..nf)
-        .map(|j| Rows::dot(rows.row(&rows.tjac, j), &qdd) + rows.tbias[j])
-        .collect();
-    Ok(Dynamics {
-        qdd,
-        forces,
-        fr,
-        normal_acc,
-        slip,
-        slip_acc,
-        painleve,
-    })
+    results(sys, state, work, painleve)
 }
 
-/// The linear system of [`dynamics`]: the equations of motion, the closed rows and the
-/// frictions' laws.
-fn assemble(
-    rows: &Rows,
-    mu: &[f64],
-    info: &ModelInfo,
-    active: &Active,
-    kkt: &[usize],
-    acting: &[usize],
-    dim: usize,
-) -> (DMatrix<f64>, DVector<f64>) {
+/// Fills `work.out` from the solution `work.x` of the system.
+fn results(
+    sys: &Bound,
+    state: &State,
+    work: &mut DynamicsWork,
+    painleve: f64,
+) -> Result<(), SolveError> {
+    let (rows, out) = (&work.rows, &mut work.out);
     let n = rows.n;
-    let mut a = DMatrix::<f64>::zeros(dim, dim);
-    let mut b = DVector::<f64>::zeros(dim);
+    let (m, nf) = (rows.bias.len(), rows.tbias.len());
+    out.qdd.clear();
+    out.qdd.extend_from_slice(&work.x[..n]);
+    sys.forces_full_into(state, &out.qdd, &mut out.forces)?;
+    for (r, &i) in work.kkt.iter().enumerate() {
+        out.forces[i] = work.x[n + r];
+    }
+    out.fr.clear();
+    out.fr.resize(nf, 0.0);
+    let base = n + work.kkt.len();
+    for (r, &j) in work.acting.iter().enumerate() {
+        out.fr[j] = work.x[base + r];
+    }
+    out.normal_acc.clear();
+    out.normal_acc
+        .extend((0..m).map(|i| Rows::dot(rows.row(&rows.jac, i), &out.qdd) + rows.bias[i]));
+    out.slip.clear();
+    out.slip
+        .extend((0..nf).map(|j| Rows::dot(rows.row(&rows.tjac, j), &state.qd)));
+    out.slip_acc.clear();
+    out.slip_acc
+        .extend((0..nf).map(|j| Rows::dot(rows.row(&rows.tjac, j), &out.qdd) + rows.tbias[j]));
+    out.painleve = painleve;
+    Ok(())
+}
+
+/// The linear system of [`dynamics`] into `work.a` (row-major, `dim * dim`) and `work.x`: the
+/// equations of motion, the closed rows and the frictions' laws.
+fn assemble(work: &mut DynamicsWork, info: &ModelInfo, active: &Active, dim: usize) {
+    let DynamicsWork {
+        rows,
+        kkt,
+        acting,
+        mu,
+        a,
+        x: b,
+        ..
+    } = work;
+    let n = rows.n;
+    a.clear();
+    a.resize(dim * dim, 0.0);
+    b.clear();
+    b.resize(dim, 0.0);
     for r in 0..n {
-        for c in 0..n {
-            a[(r, c)] = rows.mass[r * n + c];
-        }
+        a[r * dim..r * dim + n].copy_from_slice(&rows.mass[r * n..(r + 1) * n]);
         b[r] = rows.rhs[r];
         for (k, &i) in kkt.iter().enumerate() {
-            a[(r, n + k)] = -rows.jac[i * n + r];
+            a[r * dim + n + k] = -rows.jac[i * n + r];
         }
         for (k, &j) in acting.iter().enumerate() {
-            a[(r, n + kkt.len() + k)] = -rows.tjac[j * n + r];
+            a[r * dim + n + kkt.len() + k] = -rows.tjac[j * n + r];
         }
     }
     for (k, &i) in kkt.iter().enumerate() {
-        for c in 0..n {
-            a[(n + k, c)] = rows.jac[i * n + c];
-        }
-        b[n + k] = -rows.bias[i];
+        let r = n + k;
+        a[r * dim..r * dim + n].copy_from_slice(&rows.jac[i * n..(i + 1) * n]);
+        b[r] = -rows.bias[i];
     }
     for (k, &j) in acting.iter().enumerate() {
         let r = n + kkt.len() + k;
@@ -240,20 +285,17 @@ fn assemble(
             Mode::Slide(sign) => {
                 // f + sign mu lambda = 0, lambda the force of the friction's contact (a row).
                 let contact = info.frictions[j].contact;
-                a[(r, r)] = 1.0;
+                a[r * dim + r] = 1.0;
                 if let Some(col) = kkt.iter().position(|&i| i == contact) {
-                    a[(r, n + col)] = sign * mu[j];
+                    a[r * dim + n + col] = sign * mu[j];
                 }
             }
             Mode::Stick => {
-                for c in 0..n {
-                    a[(r, c)] = rows.tjac[j * n + c];
-                }
+                a[r * dim..r * dim + n].copy_from_slice(&rows.tjac[j * n..(j + 1) * n]);
                 b[r] = -rows.tbias[j];
             }
         }
     }
-    (a, b)
 }
 
 /// What may happen to one contact at a decision.

@@ -13,6 +13,7 @@
 //! `-sum_i P_i (v-_i + v+_i) / 2`, which is zero for `e = 1` and for resting contacts.
 
 use crate::solve::SolveError;
+use crate::solve::linear;
 use crate::system::{Bound, State, SystemError, check_restitutions};
 use nalgebra::{DMatrix, DVector};
 
@@ -183,25 +184,28 @@ fn solve_set(
     target: &impl Fn(usize) -> f64,
 ) -> Option<(DVector<f64>, Vec<f64>)> {
     let n = qd.len();
-    let k = rows.len();
-    let mut a = DMatrix::zeros(n + k, n + k);
-    let mut b = DVector::zeros(n + k);
-    a.view_mut((0, 0), (n, n)).copy_from(mass);
-    b.rows_mut(0, n).copy_from(&(mass * qd));
+    let dim = n + rows.len();
+    // Row-major, for `linear::solve_in_place`.
+    let mut a = vec![0.0; dim * dim];
+    let mut x = vec![0.0; dim];
+    let momentum = mass * qd;
+    for r in 0..n {
+        for c in 0..n {
+            a[r * dim + c] = mass[(r, c)];
+        }
+        x[r] = momentum[r];
+    }
     for (r, &i) in rows.iter().enumerate() {
         let j = row(i);
         for c in 0..n {
-            a[(c, n + r)] = -j[c];
-            a[(n + r, c)] = j[c];
+            a[c * dim + n + r] = -j[c];
+            a[(n + r) * dim + c] = j[c];
         }
-        b[n + r] = target(i);
+        x[n + r] = target(i);
     }
-    let x = a.lu().solve(&b)?;
+    linear::solve_in_place(&mut a, dim, &mut x).ok()?;
     if !x.iter().all(|v| v.is_finite()) {
         return None;
     }
-    Some((
-        x.rows(0, n).into_owned(),
-        x.rows(n, k).iter().copied().collect(),
-    ))
+    Some((DVector::from_column_slice(&x[..n]), x[n..].to_vec()))
 }

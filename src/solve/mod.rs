@@ -18,6 +18,7 @@ pub mod contacts;
 pub mod impact;
 pub mod inversion;
 pub mod lean;
+pub mod linear;
 pub mod ode;
 pub mod phases;
 pub mod poly;

@@ -19,7 +19,7 @@
 //! state are therefore as accurate as any step, and the final step is truncated to the event.
 
 use crate::solve::SolveError;
-use crate::solve::roots::{changes_sign, illinois};
+use crate::solve::roots::{changes_sign, illinois, illinois_to};
 
 /// A first-order system `y' = f(t, y)` with optional event functions.
 pub trait OdeProblem {
@@ -31,7 +31,8 @@ pub trait OdeProblem {
     fn n_events(&self) -> usize {
         0
     }
-    /// Event values at a state and its derivative; a sign change is an event.
+    /// Event values at a state (of a step, or of a step's continuous extension) and its
+    /// derivative; a sign change is an event.
     fn events(
         &mut self,
         _t: f64,
@@ -667,11 +668,23 @@ mod dop853_coefficients {
 /// `out = y + h sum_j row_j k_j` (the products in stage order).
 ///
 /// Every buffer here has the problem's dimension `n`: the stages and `out` are allocated with
-/// it and the entry points check `y0.len() == n`, so `k_j[i]` is in bounds.
+/// it and the entry points check `y0.len() == n`. The sums run stage by stage over whole
+/// vectors (each component's terms still added in stage order, from `-0.0` as `Iterator::sum`
+/// does), which the compiler vectorises.
 fn combine(out: &mut [f64], y: &[f64], h: f64, row: &[f64], k: &[Vec<f64>]) {
-    for (i, (o, yi)) in out.iter_mut().zip(y).enumerate() {
-        let acc: f64 = row.iter().zip(k).map(|(a, kj)| a * kj[i]).sum();
-        *o = yi + h * acc;
+    weighted_sum(out, row, k);
+    for (o, yi) in out.iter_mut().zip(y) {
+        *o = yi + h * *o;
+    }
+}
+
+/// `out = sum_j w_j k_j`, stage by stage.
+fn weighted_sum(out: &mut [f64], w: &[f64], k: &[Vec<f64>]) {
+    out.fill(-0.0);
+    for (wj, kj) in w.iter().zip(k) {
+        for (o, v) in out.iter_mut().zip(kj) {
+            *o += wj * v;
+        }
     }
 }
 
@@ -686,7 +699,8 @@ struct Stages {
     /// The new point of the last step.
     y1: Vec<f64>,
     tmp: Vec<f64>,
-    /// End time of the last step.
+    /// Size and end time of the last step.
+    h: f64,
     t1: f64,
     /// Whether `k[solution]` holds the derivative at `(t1, y1)`.
     at_end: bool,
@@ -699,6 +713,7 @@ impl Stages {
             k: vec![vec![0.0; n]; tab.a.len()],
             y1: vec![0.0; n],
             tmp: vec![0.0; n],
+            h: 0.0,
             t1: 0.0,
             at_end: false,
         }
@@ -729,6 +744,7 @@ impl Stages {
             p.rhs(t + self.tab.c[s] * h, &self.tmp, &mut self.k[s])?;
         }
         combine(&mut self.y1, y, h, self.tab.a[sol], &self.k);
+        self.h = h;
         self.t1 = t + h;
         self.at_end = false;
         if self.tab.error_needs_end {
@@ -813,8 +829,11 @@ impl Stages {
             coeffs[0][i] = ydiff;
             coeffs[1][i] = bspl;
             coeffs[2][i] = ydiff - h * self.k[sol][i] - bspl;
-            for (c, d) in coeffs[3..].iter_mut().zip(self.tab.d) {
-                c[i] = h * d.iter().zip(&self.k).map(|(d, k)| d * k[i]).sum::<f64>();
+        }
+        for (c, d) in coeffs[3..].iter_mut().zip(self.tab.d) {
+            weighted_sum(c, d, &self.k);
+            for v in c.iter_mut() {
+                *v *= h;
             }
         }
         Ok(DenseStep {
@@ -988,12 +1007,24 @@ pub fn integrate<P: OdeProblem>(
         problem.events(t + h, &st.y1, st.end(), &mut g_new)?;
         check_finite("event function", t + h, &g_new)?;
         let crossed: Vec<usize> = (0..m).filter(|&i| changes_sign(g[i], g_new[i])).collect();
-        let located = locate(problem, &mut st, &mut sol, t, &y, h, &crossed, &g, &g_new)?;
+        let dense = st.dense(problem, t, &y, h)?;
+        let step = Trial {
+            t,
+            y: &y,
+            h,
+            rtol: opts.rtol,
+        };
+        let located = locate(
+            problem, &mut st, &mut sol, step, &dense, &crossed, &g, &g_new,
+        )?;
         if let Some((tau, index)) = located {
-            // Re-step exactly to the event for its state and the truncated dense step.
-            st.step(problem, t, &y, tau)?;
-            st.end_derivative(problem)?;
-            sol.event_trials += 1;
+            // The step exactly to the event for its state and the truncated dense step (the
+            // last trial's, when it was that step).
+            if st.h != tau {
+                st.step(problem, t, &y, tau)?;
+                st.end_derivative(problem)?;
+                sol.event_trials += 1;
+            }
             sol.steps.push(st.dense(problem, t, &y, tau)?);
             sol.event = Some(Event {
                 index,
@@ -1002,7 +1033,7 @@ pub fn integrate<P: OdeProblem>(
             });
             return Ok(sol);
         }
-        sol.steps.push(st.dense(problem, t, &y, h)?);
+        sol.steps.push(dense);
         t += h;
         y.copy_from_slice(&st.y1);
         st.fsal();
@@ -1015,25 +1046,45 @@ pub fn integrate<P: OdeProblem>(
     }
 }
 
-/// The earliest root among the crossed event functions (none crossed: `None`), by Illinois on
-/// re-steps from `(t, y)` (whose derivative is `st`'s first stage).
+/// A step from `(t, y)` of size `h` whose events are being located.
+#[derive(Clone, Copy)]
+struct Trial<'a> {
+    t: f64,
+    y: &'a [f64],
+    h: f64,
+    /// The relative tolerance it was taken at.
+    rtol: f64,
+}
+
+/// The earliest root among the crossed event functions (none crossed: `None`), to adjacent
+/// floats of genuine re-steps from the step's start (each trial a step to `t + x`, not the
+/// interpolant: the event's state is the integrator's own). The step's continuous extension
+/// `dense` gives each root's first estimate ([`bracket`] then closes in on it with few trials).
 #[allow(clippy::too_many_arguments)]
 fn locate<P: OdeProblem>(
     problem: &mut P,
     st: &mut Stages,
     sol: &mut OdeSolution,
-    t: f64,
-    y: &[f64],
-    h: f64,
+    step: Trial,
+    dense: &DenseStep,
     crossed: &[usize],
     g0: &[f64],
     g1: &[f64],
 ) -> Result<Option<(f64, usize)>, SolveError> {
+    let Trial { t, y, h, rtol } = step;
     let mut g = vec![0.0; g0.len()];
+    let mut dz = vec![0.0; y.len()];
     let mut best: Option<(f64, usize)> = None;
     for &idx in crossed {
-        // Each trial is a genuine step from `y` to `t + x`, not the interpolant.
-        let value_at = |x: f64| -> Result<f64, SolveError> {
+        let mut on_extension = |x: f64| -> Result<f64, SolveError> {
+            let z = dense.interpolate(t + x);
+            problem.rhs(t + x, &z, &mut dz)?;
+            problem.events(t + x, &z, &dz, &mut g)?;
+            check_finite("event function", t + x, &g)?;
+            Ok(g[idx])
+        };
+        let estimate = illinois(&mut on_extension, (0.0, g0[idx]), (h, g1[idx]))?;
+        let mut genuine = |x: f64| -> Result<f64, SolveError> {
             st.step(problem, t, y, x)?;
             st.end_derivative(problem)?;
             sol.event_trials += 1;
@@ -1041,12 +1092,75 @@ fn locate<P: OdeProblem>(
             check_finite("event function", t + x, &g)?;
             Ok(g[idx])
         };
-        let b = illinois(value_at, (0.0, g0[idx]), (h, g1[idx]))?;
-        if best.is_none_or(|(tb, ib)| b < tb || (b == tb && idx < ib)) {
-            best = Some((b, idx));
+        // Close in on the genuine root: around the extension's at the local error's distance,
+        // then around the secant root of that bracket at a few ulps.
+        let local = rtol.max(f64::EPSILON) * h;
+        let (a, b) = bracket(&mut genuine, estimate, local, (0.0, g0[idx]), (h, g1[idx]))?;
+        let secant = (a.0 * b.1 - b.0 * a.1) / (b.1 - a.1);
+        let ulps = 4.0 * f64::EPSILON * secant.abs();
+        let (a, b) = bracket(&mut genuine, secant, ulps, a, b)?;
+        // To two ulps of the event's time `t + x`, the most it can hold.
+        let root = illinois_to(genuine, a, b, 2.0 * f64::EPSILON * (t + h).abs())?;
+        if best.is_none_or(|(tb, ib)| root < tb || (root == tb && idx < ib)) {
+            best = Some((root, idx));
         }
     }
     Ok(best)
+}
+
+/// A point and the function's value there.
+type Point = (f64, f64);
+
+/// How much [`bracket`]'s distance from its estimate grows at each look that finds no sign
+/// change.
+const BRACKET_GROWTH: f64 = 16.0;
+
+/// Most looks of one [`bracket`]: from an ulp, sixteen-fold growth covers any interval of
+/// floats in 14.
+const BRACKET_LOOKS: usize = 16;
+
+/// A bracket `(a', b')` inside `(a, b)` of a root of `f` near `estimate` (`f(a')` of `fa`'s
+/// sign, `f(b')` across zero from it or zero), found by looking at distances from the estimate
+/// growing from `delta` (at least an ulp of it), on the side where the root lies. `a < b`, and
+/// `fa` and `fb` differ in sign; an estimate outside `(a, b)` (or not a number) leaves the
+/// bracket as it is.
+fn bracket<E>(
+    mut f: impl FnMut(f64) -> Result<f64, E>,
+    estimate: f64,
+    delta: f64,
+    (a, fa): Point,
+    (b, fb): Point,
+) -> Result<(Point, Point), E> {
+    if !(estimate > a && estimate < b) {
+        return Ok(((a, fa), (b, fb)));
+    }
+    let (mut x, mut fx) = (estimate, f(estimate)?);
+    let below = changes_sign(fa, fx);
+    let mut delta = delta
+        .max(f64::EPSILON * estimate.abs())
+        .max(f64::MIN_POSITIVE);
+    for _ in 0..BRACKET_LOOKS {
+        if fx == 0.0 {
+            break;
+        }
+        let next = if below { x - delta } else { x + delta };
+        if (below && next <= a) || (!below && next >= b) {
+            break;
+        }
+        let fn_ = f(next)?;
+        match (below, changes_sign(fa, fn_)) {
+            (true, false) => return Ok(((next, fn_), (x, fx))),
+            (false, true) => return Ok(((x, fx), (next, fn_))),
+            _ => (x, fx) = (next, fn_),
+        }
+        delta *= BRACKET_GROWTH;
+    }
+    // The root lies between the last point and the end on its side.
+    Ok(if below {
+        ((a, fa), (x, fx))
+    } else {
+        ((x, fx), (b, fb))
+    })
 }
 
 /// Hairer's starting step size for a method of order `order`.

@@ -7,13 +7,26 @@
 /// zero). Stops when the bracket is two ulps wide, `f` is exactly zero, or after 200 steps.
 /// Errors of `f` are passed through.
 pub fn illinois<E>(
+    f: impl FnMut(f64) -> Result<f64, E>,
+    a: (f64, f64),
+    b: (f64, f64),
+) -> Result<f64, E> {
+    illinois_to(f, a, b, 0.0)
+}
+
+/// [`illinois`], stopping also once the bracket is at most `width` wide: an offset from a
+/// later origin (an event's time within a step that starts at `t`) needs no more digits than
+/// the sum `t + x` can hold.
+pub fn illinois_to<E>(
     mut f: impl FnMut(f64) -> Result<f64, E>,
     (mut a, mut fa): (f64, f64),
     (mut b, mut fb): (f64, f64),
+    width: f64,
 ) -> Result<f64, E> {
     let mut side = 0i8;
     for _ in 0..200 {
-        if fb == 0.0 || (b - a).abs() <= 2.0 * f64::EPSILON * a.abs().max(b.abs()) {
+        let width = width.max(2.0 * f64::EPSILON * a.abs().max(b.abs()));
+        if fb == 0.0 || (b - a).abs() <= width {
             break;
         }
         let mut x = (a * fb - b * fa) / (fb - fa);

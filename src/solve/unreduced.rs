@@ -36,7 +36,8 @@
 use crate::results::Work;
 use crate::solve::SolveError;
 use crate::solve::contacts::{
-    self, Active, ContactOption, DECIDE_TOLERANCE, Dynamics, FrictionOption, Mode, Options,
+    self, Active, ContactOption, DECIDE_TOLERANCE, Dynamics, DynamicsWork, FrictionOption, Mode,
+    Options,
 };
 use crate::solve::ode::{
     Event, Method, OdeOptions, OdeProblem, OdeSolution, integrate as ode_integrate,
@@ -279,15 +280,25 @@ struct Problem<'a, 'm> {
     y0: Vec<f64>,
     y: Vec<f64>,
     state: State,
-    /// The dynamics of the last right-hand side and the `z` it was at: the integrator asks for
-    /// the events at the state it has just evaluated.
-    last: Option<(Vec<f64>, Dynamics)>,
+    /// The buffers of the contact solve and the dynamics of the last right-hand side
+    /// (`work.out`), at `last_z` while `last_valid`: the integrator asks for the events at the
+    /// state it has just evaluated.
+    work: DynamicsWork,
+    last_z: Vec<f64>,
+    last_valid: bool,
     with_work: bool,
     /// Right-hand sides evaluated.
     evaluations: u64,
 }
 
 impl Problem<'_, '_> {
+    /// Marks `work.out` as the dynamics at `z`.
+    fn remember(&mut self, z: &[f64]) {
+        self.last_z.clear();
+        self.last_z.extend_from_slice(z);
+        self.last_valid = true;
+    }
+
     /// Sets `y = y0 + z` and the state from it.
     fn load(&mut self, z: &[f64]) {
         for ((y, y0), z) in self.y.iter_mut().zip(&self.y0).zip(z) {
@@ -418,7 +429,7 @@ impl Problem<'_, '_> {
         };
         self.active = contacts::decide(self.sys, state, &options, t)?;
         self.slip_offset = slip_offsets(self.sys, state, &frictions)?;
-        self.last = None;
+        self.last_valid = false;
         Ok(())
     }
 }
@@ -449,13 +460,15 @@ impl OdeProblem for Problem<'_, '_> {
     fn rhs(&mut self, t: f64, z: &[f64], dz: &mut [f64]) -> Result<(), SolveError> {
         self.evaluations += 1;
         self.load(z);
-        let d = contacts::dynamics(self.sys, &self.state, &self.active, t)?;
+        self.last_valid = false;
+        contacts::dynamics_into(self.sys, &self.state, &self.active, t, &mut self.work)?;
+        let d = &self.work.out;
         dz[..self.n].copy_from_slice(&self.state.qd);
         dz[self.n..2 * self.n].copy_from_slice(&d.qdd);
         if self.with_work {
             dz[2 * self.n] = d.friction_power();
         }
-        self.last = Some((z.to_vec(), d));
+        self.remember(z);
         Ok(())
     }
 
@@ -465,11 +478,12 @@ impl OdeProblem for Problem<'_, '_> {
 
     fn events(&mut self, t: f64, z: &[f64], _dz: &[f64], g: &mut [f64]) -> Result<(), SolveError> {
         self.load(z);
-        let d = match self.last.take() {
-            Some((at, d)) if at == z => d,
-            _ => contacts::dynamics(self.sys, &self.state, &self.active, t)?,
-        };
-        self.values(&d, g)?;
+        if !(self.last_valid && self.last_z == z) {
+            self.last_valid = false;
+            contacts::dynamics_into(self.sys, &self.state, &self.active, t, &mut self.work)?;
+            self.remember(z);
+        }
+        self.values(&self.work.out, g)?;
         for (k, v) in g.iter_mut().enumerate() {
             if !self.armed[k] {
                 let watch = self.watches[k];
@@ -487,7 +501,6 @@ impl OdeProblem for Problem<'_, '_> {
                 }
             }
         }
-        self.last = Some((z.to_vec(), d));
         Ok(())
     }
 }
@@ -683,7 +696,9 @@ pub fn integrate_with(
         y0: y0.clone(),
         y: y0.clone(),
         state: start.state.clone(),
-        last: None,
+        work: DynamicsWork::default(),
+        last_z: Vec::new(),
+        last_valid: false,
         with_work,
         evaluations: 0,
     };
