@@ -62,7 +62,7 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 14,
     coordinates: &["x1", "y1", "theta"],
     system_coordinates: &["x1", "y1", "theta"],
-    reduced: 2,
+    reduced_index: 2,
     cyclic: &[0],
     end_angle: 0.0,
     contacts: &[
@@ -108,8 +108,8 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the point of the rod nearest the cylinder's axis (the contact point while they touch)",
         },
     ],
-    falling_point: 2,
-    gravity: 4,
+    falling_point_index: 2,
+    gravity_index: 4,
     monitors: &[],
     bodies: &["rod"],
     shapes: &[

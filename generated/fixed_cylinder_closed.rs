@@ -62,7 +62,7 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 37,
     coordinates: &["theta"],
     system_coordinates: &["x1", "y1", "theta"],
-    reduced: 0,
+    reduced_index: 0,
     cyclic: &[],
     end_angle: 0.0,
     contacts: &[
@@ -108,8 +108,8 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the point of the rod nearest the cylinder's axis (the contact point while they touch)",
         },
     ],
-    falling_point: 2,
-    gravity: 4,
+    falling_point_index: 2,
+    gravity_index: 4,
     monitors: &[],
     bodies: &["rod"],
     shapes: &[

@@ -86,7 +86,7 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 31,
     coordinates: &["x1", "theta"],
     system_coordinates: &["x1", "y1", "theta"],
-    reduced: 1,
+    reduced_index: 1,
     cyclic: &[0],
     end_angle: 0.0,
     contacts: &[
@@ -132,8 +132,8 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the point of the rod nearest the cylinder's axis (the contact point while they touch)",
         },
     ],
-    falling_point: 2,
-    gravity: 4,
+    falling_point_index: 2,
+    gravity_index: 4,
     monitors: &[],
     bodies: &["rod"],
     shapes: &[

@@ -92,7 +92,7 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 27,
     coordinates: &["theta", "xc"],
     system_coordinates: &["x1", "y1", "theta", "xc"],
-    reduced: 0,
+    reduced_index: 0,
     cyclic: &[1],
     end_angle: 0.0,
     contacts: &[
@@ -149,8 +149,8 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder's axis",
         },
     ],
-    falling_point: 2,
-    gravity: 5,
+    falling_point_index: 2,
+    gravity_index: 5,
     monitors: &[],
     bodies: &["rod", "cylinder"],
     shapes: &[

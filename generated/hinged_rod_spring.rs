@@ -62,7 +62,7 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 20,
     coordinates: &["x1", "y1", "theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
-    reduced: 2,
+    reduced_index: 2,
     cyclic: &[0],
     end_angle: 0.0,
     contacts: &[
@@ -119,8 +119,8 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cube's bottom corner on the rod's side",
         },
     ],
-    falling_point: 2,
-    gravity: 4,
+    falling_point_index: 2,
+    gravity_index: 4,
     monitors: &[],
     bodies: &["rod", "cube"],
     shapes: &[

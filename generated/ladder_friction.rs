@@ -62,7 +62,7 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 16,
     coordinates: &["x1", "y1", "theta"],
     system_coordinates: &["x1", "y1", "theta"],
-    reduced: 2,
+    reduced_index: 2,
     cyclic: &[0],
     end_angle: 0.0,
     contacts: &[
@@ -93,14 +93,14 @@ static INFO: ModelInfo = ModelInfo {
         FrictionInfo {
             name: "floor_friction",
             meaning: "the floor's friction on the ladder's foot, along +x (it opposes the foot's slip)",
-            coefficient: 4,
-            contact: 1,
+            coefficient_index: 4,
+            contact_index: 1,
         },
         FrictionInfo {
             name: "wall_friction",
             meaning: "the wall's friction on the ladder's top, along +y (it opposes the top's slip)",
-            coefficient: 5,
-            contact: 0,
+            coefficient_index: 5,
+            contact_index: 0,
         },
     ],
     points: &[
@@ -117,8 +117,8 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the ladder's centre of mass",
         },
     ],
-    falling_point: 2,
-    gravity: 3,
+    falling_point_index: 2,
+    gravity_index: 3,
     monitors: &[],
     bodies: &["rod"],
     shapes: &[

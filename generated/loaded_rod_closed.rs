@@ -62,7 +62,7 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 46,
     coordinates: &["x1", "theta"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
-    reduced: 1,
+    reduced_index: 1,
     cyclic: &[0],
     end_angle: 0.0,
     contacts: &[
@@ -112,8 +112,8 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cube's bottom corner on the rod's side",
         },
     ],
-    falling_point: 3,
-    gravity: 5,
+    falling_point_index: 3,
+    gravity_index: 5,
     monitors: &[MonitorInfo {
         name: "cube_does_not_tip",
         meaning: "the push's torque about the cube's far edge stays below gravity's",

@@ -98,7 +98,7 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 47,
     coordinates: &["x1", "theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
-    reduced: 1,
+    reduced_index: 1,
     cyclic: &[0, 2],
     end_angle: 0.0,
     contacts: &[
@@ -148,8 +148,8 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cube's bottom corner on the rod's side",
         },
     ],
-    falling_point: 3,
-    gravity: 5,
+    falling_point_index: 3,
+    gravity_index: 5,
     monitors: &[MonitorInfo {
         name: "cube_does_not_tip",
         meaning: "the push's torque about the cube's far edge stays below gravity's",

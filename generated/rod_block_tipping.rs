@@ -62,7 +62,7 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 22,
     coordinates: &["x1", "y1", "theta", "xb", "yb", "phi"],
     system_coordinates: &["x1", "y1", "theta", "xb", "yb", "phi"],
-    reduced: 2,
+    reduced_index: 2,
     cyclic: &[0, 3, 5],
     end_angle: -std::f64::consts::FRAC_PI_2,
     contacts: &[
@@ -149,8 +149,8 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the block's bottom edge away from the rod",
         },
     ],
-    falling_point: 2,
-    gravity: 5,
+    falling_point_index: 2,
+    gravity_index: 5,
     monitors: &[],
     bodies: &["rod", "block"],
     shapes: &[

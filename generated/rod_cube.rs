@@ -56,7 +56,7 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 17,
     coordinates: &["x1", "y1", "theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
-    reduced: 2,
+    reduced_index: 2,
     cyclic: &[0, 3],
     end_angle: 0.0,
     contacts: &[
@@ -102,8 +102,8 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cube's bottom corner on the rod's side",
         },
     ],
-    falling_point: 2,
-    gravity: 4,
+    falling_point_index: 2,
+    gravity_index: 4,
     monitors: &[MonitorInfo {
         name: "cube_does_not_tip",
         meaning: "the push's torque about the cube's far edge stays below gravity's",

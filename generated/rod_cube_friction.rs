@@ -62,7 +62,7 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 18,
     coordinates: &["x1", "y1", "theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
-    reduced: 2,
+    reduced_index: 2,
     cyclic: &[0, 3],
     end_angle: 0.0,
     contacts: &[
@@ -92,8 +92,8 @@ static INFO: ModelInfo = ModelInfo {
     frictions: &[FrictionInfo {
         name: "foot_friction",
         meaning: "the floor's friction on the rod's foot, along +x (it opposes the foot's slip)",
-        coefficient: 5,
-        contact: 1,
+        coefficient_index: 5,
+        contact_index: 1,
     }],
     points: &[
         NamedInfo {
@@ -113,8 +113,8 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cube's bottom corner on the rod's side",
         },
     ],
-    falling_point: 2,
-    gravity: 4,
+    falling_point_index: 2,
+    gravity_index: 4,
     monitors: &[MonitorInfo {
         name: "cube_does_not_tip",
         meaning: "the push's torque about the cube's far edge stays below gravity's",

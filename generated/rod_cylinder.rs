@@ -68,7 +68,7 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 17,
     coordinates: &["x1", "y1", "theta", "xc"],
     system_coordinates: &["x1", "y1", "theta", "xc"],
-    reduced: 2,
+    reduced_index: 2,
     cyclic: &[0, 3],
     end_angle: 0.0,
     contacts: &[
@@ -118,8 +118,8 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the point of the rod nearest the cylinder's axis (the contact point while they touch)",
         },
     ],
-    falling_point: 2,
-    gravity: 5,
+    falling_point_index: 2,
+    gravity_index: 5,
     monitors: &[],
     bodies: &["rod", "cylinder"],
     shapes: &[

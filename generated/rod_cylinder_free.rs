@@ -104,7 +104,7 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 38,
     coordinates: &["x1", "theta", "xc"],
     system_coordinates: &["x1", "y1", "theta", "xc"],
-    reduced: 1,
+    reduced_index: 1,
     cyclic: &[0, 2],
     end_angle: 0.0,
     contacts: &[
@@ -154,8 +154,8 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the point of the rod nearest the cylinder's axis (the contact point while they touch)",
         },
     ],
-    falling_point: 2,
-    gravity: 5,
+    falling_point_index: 2,
+    gravity_index: 5,
     monitors: &[],
     bodies: &["rod", "cylinder"],
     shapes: &[

@@ -50,7 +50,7 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 14,
     coordinates: &["x1", "y1", "theta"],
     system_coordinates: &["x1", "y1", "theta"],
-    reduced: 2,
+    reduced_index: 2,
     cyclic: &[0],
     end_angle: 0.0,
     contacts: &[
@@ -96,8 +96,8 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the foot of the wall",
         },
     ],
-    falling_point: 2,
-    gravity: 3,
+    falling_point_index: 2,
+    gravity_index: 3,
     monitors: &[],
     bodies: &["rod"],
     shapes: &[

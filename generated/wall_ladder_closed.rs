@@ -50,7 +50,7 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 20,
     coordinates: &["theta"],
     system_coordinates: &["x1", "y1", "theta"],
-    reduced: 0,
+    reduced_index: 0,
     cyclic: &[],
     end_angle: 0.0,
     contacts: &[
@@ -96,8 +96,8 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the foot of the wall",
         },
     ],
-    falling_point: 2,
-    gravity: 3,
+    falling_point_index: 2,
+    gravity_index: 3,
     monitors: &[],
     bodies: &["rod"],
     shapes: &[

@@ -74,7 +74,7 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 30,
     coordinates: &["x1", "theta"],
     system_coordinates: &["x1", "y1", "theta"],
-    reduced: 1,
+    reduced_index: 1,
     cyclic: &[0],
     end_angle: 0.0,
     contacts: &[
@@ -120,8 +120,8 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the foot of the wall",
         },
     ],
-    falling_point: 2,
-    gravity: 3,
+    falling_point_index: 2,
+    gravity_index: 3,
     monitors: &[],
     bodies: &["rod"],
     shapes: &[

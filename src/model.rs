@@ -128,8 +128,8 @@ pub struct ContactInfo {
 ///
 /// While the contact slides with slip velocity `v`, the friction force is
 /// `f = -mu N sign(v)`; while it sticks (`v = 0`), `f` is the force that keeps it stuck, which
-/// must stay within `|f| <= mu N`. `N` is the force of contact [`FrictionInfo::contact`] and
-/// `mu` the parameter [`FrictionInfo::coefficient`]. Its generalized force is `f J`, with `J`
+/// must stay within `|f| <= mu N`. `N` is the force of contact [`FrictionInfo::contact_index`] and
+/// `mu` the parameter [`FrictionInfo::coefficient_index`]. Its generalized force is `f J`, with `J`
 /// the row of [`Model::friction`]'s Jacobian (`v = J qd`). An open contact has no friction.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct FrictionInfo {
@@ -138,9 +138,9 @@ pub struct FrictionInfo {
     /// What it is, with its sign convention.
     pub meaning: &'static str,
     /// Index in [`ModelInfo::parameters`] of the friction coefficient `mu` (`>= 0`).
-    pub coefficient: usize,
+    pub coefficient_index: usize,
     /// Index in [`ModelInfo::contacts`] of the contact whose force is the normal force.
-    pub contact: usize,
+    pub contact_index: usize,
 }
 
 /// A fast phase of a system: the model that holds these contacts closed (and the others
@@ -218,7 +218,7 @@ pub struct ModelInfo {
     /// The system's coordinates (the general model's), which [`Model::to_full`] fills.
     pub system_coordinates: &'static [&'static str],
     /// Index in `coordinates` of the reduced coordinate (`theta`).
-    pub reduced: usize,
+    pub reduced_index: usize,
     /// Indices in `coordinates` of the cyclic coordinates (the Lagrangian does not depend on
     /// them); on the fast path their conserved momenta eliminate them.
     pub cyclic: &'static [usize],
@@ -231,9 +231,9 @@ pub struct ModelInfo {
     /// Named points whose trajectories can be asked for.
     pub points: &'static [NamedInfo],
     /// Index in `points` of the centre of mass whose free fall is the reference time.
-    pub falling_point: usize,
+    pub falling_point_index: usize,
     /// Index in `parameters` of the gravitational acceleration.
-    pub gravity: usize,
+    pub gravity_index: usize,
     /// Physical assumptions to monitor; each value must stay `>= 0` during the motion.
     pub monitors: &'static [MonitorInfo],
     /// The bodies, in the order of the poses [`Model::drawing`] writes.

@@ -396,7 +396,7 @@ impl<'m> Bound<'m> {
 
     /// Gravitational acceleration (m/s^2).
     pub fn gravity(&self) -> f64 {
-        self.p[self.info().gravity]
+        self.p[self.info().gravity_index]
     }
 
     /// The angle where the motion ends (rod on the floor).
@@ -620,7 +620,7 @@ impl<'m> Bound<'m> {
 
     /// The friction coefficient of each friction, in order, without collecting them.
     pub fn friction_coefficient_values(&self) -> impl Iterator<Item = f64> + '_ {
-        (self.info().frictions.iter()).map(|f| self.p[f.coefficient])
+        (self.info().frictions.iter()).map(|f| self.p[f.coefficient_index])
     }
 
     /// Monitor values (each must stay `>= 0`) at a state with the contacts' forces there (one
@@ -897,7 +897,7 @@ pub fn check_value(info: &'static ModelInfo, i: usize, value: f64) -> Result<(),
         return Err(SystemError::NotFinite { model, name, value });
     }
     if value < 0.0
-        && let Some(f) = info.frictions.iter().find(|f| f.coefficient == i)
+        && let Some(f) = info.frictions.iter().find(|f| f.coefficient_index == i)
     {
         return Err(SystemError::NegativeFriction {
             model,

@@ -195,7 +195,7 @@ fn ode_agrees_on_the_free_phase() {
         run.t_end,
         fr.duration()
     );
-    let theta_dot = run.state_end.qd()[GENERAL.info().reduced];
+    let theta_dot = run.state_end.qd()[GENERAL.info().reduced_index];
     assert!(((theta_dot - fr.theta_dot_end()) / fr.theta_dot_end()).abs() < 1e-9);
     // The walker's own integrated route gives the same phase.
     let integrated = Walker {

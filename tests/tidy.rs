@@ -239,15 +239,15 @@ fn no_function_in_src_passes_150_lines() {
                 continue;
             };
             let close = format!("{indent}}}");
-            if let Some(j) = (i + 1..lines.len()).find(|&j| lines[j] == close) {
-                if j - i + 1 > MAX_FUNCTION_LINES {
-                    long.push(format!(
-                        "{}:{} {name} ({} lines)",
-                        p.display(),
-                        i + 1,
-                        j - i + 1
-                    ));
-                }
+            if let Some(j) = (i + 1..lines.len()).find(|&j| lines[j] == close)
+                && j - i + 1 > MAX_FUNCTION_LINES
+            {
+                long.push(format!(
+                    "{}:{} {name} ({} lines)",
+                    p.display(),
+                    i + 1,
+                    j - i + 1
+                ));
             }
         }
     }

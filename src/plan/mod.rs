@@ -432,7 +432,7 @@ fn column(name: &str, unit: &'static str, values: Vec<f64>) -> Column {
 /// The reduced coordinate's name.
 fn angle_coordinate(info: &ModelInfo) -> &'static str {
     info.coordinates
-        .get(info.reduced)
+        .get(info.reduced_index)
         .copied()
         .unwrap_or("theta")
 }

@@ -49,7 +49,7 @@ pub(super) fn fate(motion: &Motion, general: &Bound, i: usize) -> Result<Option<
     };
     if motion.opened_at_release.contains(&i) {
         let bound = first.bound();
-        let theta = bound.to_full(&bound.initial_state())?.q[info.reduced];
+        let theta = bound.to_full(&bound.initial_state())?.q[info.reduced_index];
         return Ok(Some(Fate::Ended {
             t: 0.0,
             theta,
@@ -148,7 +148,7 @@ fn is_landing(general: &Bound, phase: &PhaseRun) -> Result<bool, SolveError> {
         End::Contact(_) => {
             let bound = general;
             let state = phase.full_end_state()?;
-            let height = bound.points(&state)?.pos[bound.info().falling_point][1];
+            let height = bound.points(&state)?.pos[bound.info().falling_point_index][1];
             Ok(height.abs() <= LANDING_TOLERANCE * bound.length_scale(&state)?)
         }
         _ => Ok(false),
@@ -393,10 +393,10 @@ impl Plan<'_> {
         let general = self.general();
         let info = general.info();
         let pts = general.points(&general.initial_state())?;
-        let h = pts.pos[info.falling_point][1];
+        let h = pts.pos[info.falling_point_index][1];
         let t = (2.0 * h.max(0.0) / general.gravity()).sqrt();
         let meaning = Meaning::PointMassFallTime {
-            point: info.points[info.falling_point].name.to_string(),
+            point: info.points[info.falling_point_index].name.to_string(),
             height: h,
         };
         scalar(
@@ -539,8 +539,8 @@ impl Plan<'_> {
                     ("theta".into(), "rad"),
                     (f.name.into(), "N"),
                     (
-                        info.contacts[f.contact].name.into(),
-                        info.contacts[f.contact].unit,
+                        info.contacts[f.contact_index].name.into(),
+                        info.contacts[f.contact_index].unit,
                     ),
                     ("slip_velocity".into(), "m/s"),
                 ]

@@ -53,7 +53,7 @@ impl Active {
 
     /// Whether friction `j` acts (its contact is closed).
     pub fn friction_acts(&self, info: &ModelInfo, j: usize) -> bool {
-        (info.frictions.get(j)).is_some_and(|f| self.closed.get(f.contact) == Some(&true))
+        (info.frictions.get(j)).is_some_and(|f| self.closed.get(f.contact_index) == Some(&true))
     }
 
     /// The names of the closed contacts.

@@ -284,7 +284,7 @@ fn assemble(work: &mut DynamicsWork, info: &ModelInfo, active: &Active, dim: usi
         match active.modes[j] {
             Mode::Slide(sign) => {
                 // f + sign mu lambda = 0, lambda the force of the friction's contact (a row).
-                let contact = info.frictions[j].contact;
+                let contact = info.frictions[j].contact_index;
                 a[r * dim + r] = 1.0;
                 if let Some(col) = kkt.iter().position(|&i| i == contact) {
                     a[r * dim + n + col] = sign * mu[j];
@@ -498,7 +498,7 @@ fn consistent(
         if !active.friction_acts(info, j) {
             continue;
         }
-        let normal = d.forces[info.frictions[j].contact];
+        let normal = d.forces[info.frictions[j].contact_index];
         let mode = active.modes[j];
         let ok = match (opt, mode) {
             (FrictionOption::Keep(_), _) => true,

@@ -362,7 +362,7 @@ impl<'m> PhaseRun<'m> {
     pub fn theta_end(&self) -> f64 {
         match self {
             PhaseRun::Reduced(r) => r.system.theta_initial() - r.mesh.delta_end,
-            PhaseRun::Integrated(r) => r.run.state_end.q[r.bound.info().reduced],
+            PhaseRun::Integrated(r) => r.run.state_end.q[r.bound.info().reduced_index],
         }
     }
 
@@ -370,7 +370,7 @@ impl<'m> PhaseRun<'m> {
     pub fn theta_dot_end(&self) -> f64 {
         match self {
             PhaseRun::Reduced(r) => r.theta_dot_end(),
-            PhaseRun::Integrated(r) => r.run.state_end.qd[r.bound.info().reduced],
+            PhaseRun::Integrated(r) => r.run.state_end.qd[r.bound.info().reduced_index],
         }
     }
 
@@ -445,7 +445,7 @@ impl<'m> PhaseRun<'m> {
 /// the time scale of the motion.
 pub fn fall_time_scale(bound: &Bound, state: &State) -> Result<f64, SolveError> {
     let info = bound.info();
-    let h = bound.points(state)?.pos[info.falling_point][1];
+    let h = bound.points(state)?.pos[info.falling_point_index][1];
     let length = bound.length_scale(state)?;
     let h = if h > LANDING_TOLERANCE * length {
         h
@@ -808,7 +808,7 @@ impl<'m> Walker<'m> {
     /// a landing.
     fn landed(&self, state: &State, t: f64) -> Result<(), SolveError> {
         let info = self.general.info();
-        let height = self.general.points(state)?.pos[info.falling_point][1];
+        let height = self.general.points(state)?.pos[info.falling_point_index][1];
         let length = self.general.length_scale(state)?;
         if height.abs() <= LANDING_TOLERANCE.max(self.tol) * length {
             return Ok(());
@@ -817,7 +817,7 @@ impl<'m> Walker<'m> {
             model: info.name,
             t,
             angle: info.end_angle,
-            point: info.points[info.falling_point].name,
+            point: info.points[info.falling_point_index].name,
             height,
         })
     }
@@ -936,13 +936,13 @@ impl<'m> Walker<'m> {
             .collect();
         let mu = general.friction_coefficients();
         if let Some(f) = (info.frictions.iter().enumerate())
-            .find(|(j, f)| parts[f.contact] != Part::None && mu[*j] != 0.0)
+            .find(|(j, f)| parts[f.contact_index] != Part::None && mu[*j] != 0.0)
             .map(|(_, f)| f)
         {
             return Err(SolveError::FrictionalImpact {
                 model: info.name,
                 t,
-                contact: info.contacts[f.contact].name,
+                contact: info.contacts[f.contact_index].name,
             });
         }
         let name = info.contacts[closing].name;

@@ -33,7 +33,7 @@ fn support_rows(info: &ModelInfo, active: &Active) -> Option<(Vec<usize>, Vec<us
     let all_stick = acting.iter().all(|&j| active.modes[j] == Mode::Stick);
     let rows_known = acting
         .iter()
-        .all(|&j| kkt.contains(&info.frictions[j].contact));
+        .all(|&j| kkt.contains(&info.frictions[j].contact_index));
     (all_stick && rows_known).then_some((kkt, acting))
 }
 
@@ -188,7 +188,10 @@ fn admissible(info: &ModelInfo, sys: &Bound, kkt: &[usize], acting: &[usize]) ->
         }
     }
     for (r, &j) in acting.iter().enumerate() {
-        let Some(normal) = kkt.iter().position(|&i| i == info.frictions[j].contact) else {
+        let Some(normal) = kkt
+            .iter()
+            .position(|&i| i == info.frictions[j].contact_index)
+        else {
             continue;
         };
         for sign in [1.0, -1.0] {

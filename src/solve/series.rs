@@ -147,7 +147,7 @@ pub fn sample_integrated_at(
 ) -> Result<PhaseSamples, SolveError> {
     let bound = &run.bound;
     let n = bound.n_coordinates();
-    let r = bound.info().reduced;
+    let r = bound.info().reduced_index;
     let duration = run.run.t_end;
     let mut out = PhaseSamples::default();
     for &t in times {
@@ -213,10 +213,8 @@ pub fn sample_friction(
                 let forces = r.system.forces(delta)?;
                 let normals = (info.frictions.iter())
                     .map(|f| {
-                        forces
-                            .get(f.contact)
-                            .copied()
-                            .ok_or_else(|| SolveError::PhaseMismatch {
+                        forces.get(f.contact_index).copied().ok_or_else(|| {
+                            SolveError::PhaseMismatch {
                                 system: info.name,
                                 name: r.system.name(),
                                 why: format!(
@@ -224,7 +222,8 @@ pub fn sample_friction(
                                     forces.len(),
                                     info.contacts.len()
                                 ),
-                            })
+                            }
+                        })
                     })
                     .collect::<Result<_, _>>()?;
                 Ok([vec![0.0; nf], normals, slip])
@@ -236,7 +235,11 @@ pub fn sample_friction(
             .zip(&s.t)
             .map(|(state, &t)| {
                 let d = r.run.dynamics_at(&r.bound, state, t)?;
-                let normals = info.frictions.iter().map(|f| d.forces[f.contact]).collect();
+                let normals = info
+                    .frictions
+                    .iter()
+                    .map(|f| d.forces[f.contact_index])
+                    .collect();
                 Ok([d.fr, normals, d.slip])
             })
             .collect(),

@@ -393,7 +393,9 @@ impl Problem<'_, '_> {
                         _ => v,
                     }
                 }
-                Watch::Stuck(j) => mu[j] * d.forces[info.frictions[j].contact] - d.fr[j].abs(),
+                Watch::Stuck(j) => {
+                    mu[j] * d.forces[info.frictions[j].contact_index] - d.fr[j].abs()
+                }
                 Watch::Painleve => d.painleve - contacts::PAINLEVE_FLOOR,
             };
         }
@@ -691,7 +693,7 @@ pub fn integrate_with(
         armed: Vec::new(),
         arm_at: DECIDE_TOLERANCE * sys.length_scale(&start.state)?,
         slip_offset: slip_offsets(sys, &start.state, &start.frictions)?,
-        reduced: info.reduced,
+        reduced: info.reduced_index,
         end_angle: info.end_angle,
         y0: y0.clone(),
         y: y0.clone(),

@@ -136,7 +136,7 @@ pub(super) fn static_info(
     let frictions_info = (d.frictions.iter())
         .map(|f| {
             format!(
-                "FrictionInfo {{ name: {:?}, meaning: {:?}, coefficient: {}, contact: {} }}",
+                "FrictionInfo {{ name: {:?}, meaning: {:?}, coefficient_index: {}, contact_index: {} }}",
                 f.named.name, f.named.meaning, f.coefficient, f.contact
             )
         })
