@@ -98,9 +98,21 @@ pub const FIXED: &[(&str, Quantity, &str)] = &[
     ),
 ];
 
+/// A `want` entry that names no quantity of the model.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown quantity `{name}` for model `{model}`; it offers: {}", offers.join(", "))]
+pub struct UnknownQuantity {
+    /// The entry.
+    pub name: String,
+    /// The model it was asked of.
+    pub model: &'static str,
+    /// Every quantity the model offers, in a stable order.
+    pub offers: Vec<String>,
+}
+
 impl Quantity {
     /// Resolves a `want` entry for a model; the error lists what the model offers.
-    pub fn parse(name: &str, info: &ModelInfo) -> Result<Quantity, String> {
+    pub fn parse(name: &str, info: &ModelInfo) -> Result<Quantity, UnknownQuantity> {
         if let Some((_, q, _)) = FIXED.iter().find(|(n, _, _)| *n == name) {
             return Ok(*q);
         }
@@ -119,11 +131,11 @@ impl Quantity {
         {
             return Ok(Quantity::Trajectory(i));
         }
-        Err(format!(
-            "unknown quantity `{name}` for model `{}`; it offers: {}",
-            info.name,
-            Quantity::names(info).join(", ")
-        ))
+        Err(UnknownQuantity {
+            name: name.to_string(),
+            model: info.name,
+            offers: Quantity::names(info),
+        })
     }
 
     /// The key of this quantity in scenes and results. An index the model does not have is

@@ -656,9 +656,12 @@ impl Ctx<'_> {
         for (i, name) in raw.want.iter().enumerate() {
             let field = format!("want[{i}]");
             match Quantity::parse(name, info) {
-                Err(message) => {
-                    out.push(self.diag(Kind::UnknownQuantity, &field, At::Value, message))
-                }
+                Err(unknown) => out.push(self.diag(
+                    Kind::UnknownQuantity,
+                    &field,
+                    At::Value,
+                    unknown.to_string(),
+                )),
                 Ok(q) if !q.available(info) => out.push(self.diag(
                     Kind::UnavailableQuantity,
                     &field,

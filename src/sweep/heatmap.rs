@@ -60,8 +60,40 @@ fn edges(axis: &Axis) -> (Vec<f64>, Vec<f64>) {
 
 /// The SVG heat map of `values` (`values[i * x.len() + j]` at `y[i]`, `x[j]`); NaN cells are
 /// left white.
-pub fn svg(title: &str, unit: &str, y: &Axis, x: &Axis, values: &[f64]) -> Result<String, String> {
-    draw(title, unit, y, x, values).map_err(|e| e.to_string())
+pub fn svg(
+    title: &str,
+    unit: &str,
+    y: &Axis,
+    x: &Axis,
+    values: &[f64],
+) -> Result<String, HeatmapError> {
+    let (nx, ny) = (x.values.len(), y.values.len());
+    if values.len() != nx * ny || nx == 0 || ny == 0 {
+        return Err(HeatmapError::Grid {
+            values: values.len(),
+            ny,
+            nx,
+        });
+    }
+    draw(title, unit, y, x, values).map_err(|e| HeatmapError::Draw(e.to_string()))
+}
+
+/// Why a heat map could not be drawn.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum HeatmapError {
+    /// The values do not fill the grid (or an axis is empty).
+    #[error("{values} values for a {ny} x {nx} grid")]
+    Grid {
+        /// How many values were given.
+        values: usize,
+        /// Rows (values of the y axis).
+        ny: usize,
+        /// Columns (values of the x axis).
+        nx: usize,
+    },
+    /// The plotting library failed, with its message.
+    #[error("{0}")]
+    Draw(String),
 }
 
 /// An axis's label: its name with `_over_` written as `/` (`a/ell`), `n` spelt out as the mass
@@ -78,6 +110,7 @@ fn label(axis: &Axis) -> String {
     }
 }
 
+/// [`svg`]'s drawing, once it has checked that the values fill the grid.
 fn draw(
     title: &str,
     unit: &str,
@@ -86,9 +119,6 @@ fn draw(
     values: &[f64],
 ) -> Result<String, Box<dyn std::error::Error>> {
     let (nx, ny) = (x.values.len(), y.values.len());
-    if values.len() != nx * ny || nx == 0 || ny == 0 {
-        return Err(format!("{} values for a {ny} x {nx} grid", values.len()).into());
-    }
     let (_, xe) = edges(x);
     let (_, ye) = edges(y);
     let finite: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();

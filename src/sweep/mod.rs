@@ -64,6 +64,9 @@ pub enum SweepError {
     /// A wanted quantity that is not a scalar or not offered.
     #[error("{0}")]
     Want(String),
+    /// A wanted name that is no quantity of the model.
+    #[error(transparent)]
+    UnknownQuantity(#[from] crate::quantity::UnknownQuantity),
     /// Neither a grid nor points, or both.
     #[error("{0}")]
     Layout(String),
@@ -327,7 +330,7 @@ pub fn parse_want(model: &dyn Model, names: &[String]) -> Result<Vec<Quantity>, 
     let info = model.info();
     let mut out = Vec::new();
     for name in names {
-        let q = Quantity::parse(name, info).map_err(SweepError::Want)?;
+        let q = Quantity::parse(name, info)?;
         match q {
             Quantity::SeparationAngle | Quantity::SeparationTime => {}
             Quantity::LinearisedSeparationAngle
@@ -549,6 +552,6 @@ pub fn heatmap_svg(
     y: &Axis,
     x: &Axis,
     values: &[f64],
-) -> Result<String, String> {
+) -> Result<String, heatmap::HeatmapError> {
     heatmap::svg(title, unit, y, x, values)
 }
