@@ -533,8 +533,11 @@ impl<'m> Bound<'m> {
         self.check_length("qdd", self.n_coordinates(), qdd.len())?;
         finite("qdd", qdd)?;
         zeroed(out, self.n_contacts());
-        self.model
-            .forces_full(&self.k, &state.q, &state.qd, qdd, out);
+        // A model that eliminates no contact has no force in closed form.
+        if self.info.contacts.iter().any(|c| c.closed) {
+            self.model
+                .forces_full(&self.k, &state.q, &state.qd, qdd, out);
+        }
         Ok(())
     }
 

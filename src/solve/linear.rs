@@ -10,13 +10,13 @@
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Singular;
 
-/// Eliminates below the diagonal of `a` (and applies the same row operations to `b`, when
-/// given), leaving the upper triangle. Returns the determinant of `a` (zero when singular,
+/// Eliminates below the diagonal of `a` and applies the same row operations to `b`, leaving
+/// the upper triangle. Returns the determinant of `a` (zero when singular,
 /// where it stops).
 ///
 /// The sizes of contact systems (a few coordinates and rows) each get their own compiled copy
 /// of [`eliminate_dim`], with the size a constant the loops are unrolled for.
-fn eliminate(a: &mut [f64], dim: usize, b: Option<&mut [f64]>) -> f64 {
+fn eliminate(a: &mut [f64], dim: usize, b: &mut [f64]) -> f64 {
     match dim {
         1 => eliminate_dim(a, 1, b),
         2 => eliminate_dim(a, 2, b),
@@ -32,7 +32,11 @@ fn eliminate(a: &mut [f64], dim: usize, b: Option<&mut [f64]>) -> f64 {
 
 /// [`eliminate`] for one size.
 #[inline(always)]
-fn eliminate_dim(a: &mut [f64], dim: usize, mut b: Option<&mut [f64]>) -> f64 {
+fn eliminate_dim(a: &mut [f64], dim: usize, b: &mut [f64]) -> f64 {
+    // Lengths the compiler knows for a constant `dim`, so that it can drop the index checks.
+    let (Some(a), Some(b)) = (a.get_mut(..dim * dim), b.get_mut(..dim)) else {
+        return 0.0;
+    };
     let mut det = 1.0;
     for k in 0..dim {
         let mut p = k;
@@ -46,12 +50,11 @@ fn eliminate_dim(a: &mut [f64], dim: usize, mut b: Option<&mut [f64]>) -> f64 {
             return 0.0;
         }
         if p != k {
-            for j in 0..dim {
-                a.swap(k * dim + j, p * dim + j);
-            }
-            if let Some(b) = b.as_deref_mut() {
-                b.swap(k, p);
-            }
+            // Only the columns from `k` on are read again (the upper triangle and the columns
+            // still to eliminate).
+            let (top, bottom) = a.split_at_mut(p * dim);
+            top[k * dim + k..(k + 1) * dim].swap_with_slice(&mut bottom[k..dim]);
+            b.swap(k, p);
             det = -det;
         }
         det *= pivot;
@@ -65,9 +68,7 @@ fn eliminate_dim(a: &mut [f64], dim: usize, mut b: Option<&mut [f64]>) -> f64 {
             for (x, p) in row[k + 1..].iter_mut().zip(pivot_row) {
                 *x -= factor * p;
             }
-            if let Some(b) = b.as_deref_mut() {
-                b[k + 1 + r] -= factor * b[k];
-            }
+            b[k + 1 + r] -= factor * b[k];
         }
     }
     det
@@ -81,7 +82,7 @@ pub fn solve_in_place(a: &mut [f64], dim: usize, b: &mut [f64]) -> Result<f64, S
     if a.len() != dim * dim || b.len() != dim {
         return Err(Singular);
     }
-    let det = eliminate(a, dim, Some(b));
+    let det = eliminate(a, dim, b);
     if det == 0.0 {
         return Err(Singular);
     }
@@ -102,7 +103,7 @@ pub fn determinant_in_place(a: &mut [f64], dim: usize) -> f64 {
     if a.len() != dim * dim {
         return 0.0;
     }
-    eliminate(a, dim, None)
+    eliminate(a, dim, &mut vec![0.0; dim])
 }
 
 #[cfg(test)]
