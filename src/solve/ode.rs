@@ -19,7 +19,7 @@
 //! state are therefore as accurate as any step, and the final step is truncated to the event.
 
 use crate::solve::SolveError;
-use crate::solve::roots::{changes_sign, illinois_to};
+use crate::solve::roots::{changes_sign, illinois, illinois_to};
 
 /// A first-order system `y' = f(t, y)` with optional event functions.
 pub trait OdeProblem {
@@ -1083,15 +1083,7 @@ fn locate<P: OdeProblem>(
             check_finite("event function", t + x, &g)?;
             Ok(g[idx])
         };
-        // The extension and a genuine step differ by about the local error: the estimate
-        // needs no more digits than that.
-        let local = rtol.max(f64::EPSILON) * h;
-        let estimate = illinois_to(
-            &mut on_extension,
-            (0.0, g0[idx]),
-            (h, g1[idx]),
-            local / 16.0,
-        )?;
+        let estimate = illinois(&mut on_extension, (0.0, g0[idx]), (h, g1[idx]))?;
         let mut genuine = |x: f64| -> Result<f64, SolveError> {
             st.step(problem, t, y, x)?;
             st.end_derivative(problem)?;
@@ -1102,6 +1094,7 @@ fn locate<P: OdeProblem>(
         };
         // Close in on the genuine root: around the extension's at the local error's distance,
         // then around the secant root of that bracket at a few ulps.
+        let local = rtol.max(f64::EPSILON) * h;
         let (a, b) = bracket(&mut genuine, estimate, local, (0.0, g0[idx]), (h, g1[idx]))?;
         let secant = (a.0 * b.1 - b.0 * a.1) / (b.1 - a.1);
         let ulps = 4.0 * f64::EPSILON * secant.abs();
