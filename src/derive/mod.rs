@@ -12,7 +12,7 @@
 //!    [`setup`] → [`lagrangian`] → [`equations`] → [`constraints`] → [`reduction`] →
 //!    [`forces`]; [`mechanics`] runs them in that order for each phase of a spec;
 //! 3. presentation: [`present`] (forms checked equal), then [`steps`] and [`dimensionless`];
-//! 4. emission: [`latex`], [`lower`] (straight-line Rust) and [`method`], then [`emit`] (flat
+//! 4. emission: [`emit`] (its `latex`, `lower` (straight-line Rust) and `method` beneath flat
 //!    template contexts) → tera → rustfmt → `generated/`;
 //! 5. this module, which runs the derivation, the presentation and the emission of each spec.
 //!
