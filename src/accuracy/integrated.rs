@@ -5,10 +5,9 @@
 //! method at 1e-15), with right-hand sides, steps, set-up and time per solve.
 
 use super::settings::pick;
-use super::{Budget, Measured, Measurement, Row, measure};
+use super::{AccuracyError, Budget, Measured, Measurement, Row, measure};
 use crate::model::Model;
 use crate::results::Work;
-use crate::solve::SolveError;
 use crate::solve::ode::Method;
 use crate::solve::phases::{End, PhaseRun, Route, Walker};
 use crate::system::Bound;
@@ -137,8 +136,8 @@ fn walker(
     model: &'static dyn Model,
     route: Route,
     rtol: f64,
-) -> Result<Walker<'static>, String> {
-    let general = Bound::new(model, m.parameters).map_err(|e| e.to_string())?;
+) -> Result<Walker<'static>, AccuracyError> {
+    let general = Bound::new(model, m.parameters)?;
     Ok(Walker {
         general,
         registry: crate::models::all(),
@@ -151,35 +150,34 @@ fn walker(
 
 /// The end of the first contact's phase from release by `method` (its time, the steps and
 /// right-hand sides it took); a phase that ends otherwise is an error saying how.
-pub fn contact_end(walker: &Walker, method: Option<Method>) -> Result<(f64, Work), String> {
-    let start = walker.release().map_err(|e| e.to_string())?.0;
+pub fn contact_end(walker: &Walker, method: Option<Method>) -> Result<(f64, Work), AccuracyError> {
+    let start = walker.release()?.0;
     let mut work = Work::default();
     let run = match method {
         Some(_) => walker.integrate_with(&start, method, &mut work),
         None => walker.solve(&start, &mut work),
-    }
-    .map_err(|e: SolveError| e.to_string())?;
+    }?;
     first_contact_ended(&run)?;
     Ok((run.t_end(), work))
 }
 
 /// Whether a phase ended with its first contact's end (its force at zero, or its point off an
 /// edge).
-fn first_contact_ended(run: &PhaseRun) -> Result<(), String> {
+fn first_contact_ended(run: &PhaseRun) -> Result<(), AccuracyError> {
     match run.end() {
         End::Force(0) | End::Edge(0) => Ok(()),
-        other => Err(format!(
-            "the phase ended by {other:?} before the first contact ended"
-        )),
+        end => Err(AccuracyError::EndedBefore { end }),
     }
 }
 
 /// The reference of `m`.
-pub fn reference(m: &IntegratedModel) -> Result<IntegratedReference, String> {
-    let model = crate::models::find(m.model).ok_or_else(|| format!("no model `{}`", m.model))?;
+pub fn reference(m: &IntegratedModel) -> Result<IntegratedReference, AccuracyError> {
+    let model = crate::models::find(m.model).ok_or_else(|| AccuracyError::NoModel {
+        name: m.model.into(),
+    })?;
     let fastest = walker(m, model, Route::Fastest, REFERENCE_RTOL)?;
-    let start = fastest.release().map_err(|e| e.to_string())?.0;
-    let fast = match fastest.fast_phase(&start).map_err(|e| e.to_string())? {
+    let start = fastest.release()?.0;
+    let fast = match fastest.fast_phase(&start)? {
         Some(_) => Some(contact_end(&fastest, None)?.0),
         None => None,
     };
@@ -219,10 +217,13 @@ pub fn measure_one(
         format!("rtol 1e-{k}"),
     );
     let Some(model) = crate::models::find(m.model) else {
-        row.note = format!("no model `{}`", m.model);
+        row.note = AccuracyError::NoModel {
+            name: m.model.into(),
+        }
+        .to_string();
         return row;
     };
-    let measured: Result<Measurement<(f64, u64)>, String> = measure(
+    let measured: Result<Measurement<(f64, u64)>, AccuracyError> = measure(
         || walker(m, model, Route::Integrated, rtol),
         |w| {
             let (t, work) = contact_end(w, Some(method))?;
@@ -241,7 +242,7 @@ pub fn measure_one(
             row.setup_seconds = done.setup_seconds;
             row.seconds = done.seconds;
         }
-        Err(note) => row.note = note,
+        Err(e) => row.note = e.to_string(),
     }
     row
 }

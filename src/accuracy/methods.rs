@@ -5,6 +5,7 @@
 //! with a set-up (a solver, a rule's nodes) has it in its own function, so that the report
 //! times the set-up once and the solve alone, as a user who solves many points pays for them.
 
+use super::AccuracyError;
 use crate::results::Work;
 use crate::solve::SolveError;
 use crate::solve::contacts::Active;
@@ -21,11 +22,7 @@ use std::collections::BinaryHeap;
 use std::num::NonZeroUsize;
 
 /// A method's answer and its cost in model evaluations.
-pub type Outcome<T> = Result<(T, u64), String>;
-
-fn err(e: SolveError) -> String {
-    e.to_string()
-}
+pub type Outcome<T> = Result<(T, u64), AccuracyError>;
 
 /// Coefficients of the separation polynomial and the open interval of the phase.
 fn polynomial(sys: &System) -> (Vec<f64>, f64, f64) {
@@ -43,22 +40,22 @@ fn polynomial(sys: &System) -> (Vec<f64>, f64, f64) {
 /// The project's default: derivative isolation and bracketed Newton on compensated Horner.
 pub fn angle_default(sys: &System) -> Outcome<f64> {
     let mut work = Work::default();
-    let s = separation(sys, &mut work).map_err(err)?;
-    let s = s.separation().ok_or("no separation")?;
+    let s = separation(sys, &mut work)?;
+    let s = s.separation().ok_or(AccuracyError::NoSeparation)?;
     Ok((s.theta, work.polynomial_evals))
 }
 
 /// The paper's linearised root (terms above degree 1 dropped).
 pub fn angle_linearised(sys: &System) -> Outcome<f64> {
-    let s = linearised_separation(sys).map_err(err)?;
-    Ok((s.separation().ok_or("no root")?.theta, 0))
+    let s = linearised_separation(sys)?;
+    Ok((s.separation().ok_or(AccuracyError::NoRoot)?.theta, 0))
 }
 
 /// The closed form of the cubic (Viete's trigonometric or hyperbolic form, Cardano for one
 /// real root) on the generated coefficients, in `f64`: the largest root in the interval.
 pub fn angle_closed_form(sys: &System) -> Outcome<f64> {
     let (c, lo, hi) = polynomial(sys);
-    let degree = c.iter().rposition(|&x| x != 0.0).ok_or("zero polynomial")?;
+    let degree = (c.iter().rposition(|&x| x != 0.0)).ok_or(AccuracyError::ZeroPolynomial)?;
     let roots: Vec<f64> = match degree {
         1 => vec![-c[0] / c[1]],
         2 => {
@@ -90,17 +87,20 @@ pub fn angle_closed_form(sys: &System) -> Outcome<f64> {
                 vec![(-q / 2.0 + sq).cbrt() + (-q / 2.0 - sq).cbrt() + shift]
             }
         }
-        _ => return Err(format!("no closed form for degree {degree}")),
+        _ => return Err(AccuracyError::NoClosedForm { degree }),
     };
     let s = roots
         .into_iter()
         .filter(|&s| s > lo && s < hi)
         .fold(f64::NAN, f64::max);
     if s.is_nan() {
-        return Err("no root in the interval".into());
+        return Err(AccuracyError::NoRootInInterval);
     }
     Ok((s.asin(), 1))
 }
+
+/// Most steps of plain Newton.
+const NEWTON_STEPS: usize = 200;
 
 /// Plain Newton on the generated polynomial from `sin(theta_i)` (no bracket, no compensation).
 pub fn angle_newton(sys: &System) -> Outcome<f64> {
@@ -108,18 +108,20 @@ pub fn angle_newton(sys: &System) -> Outcome<f64> {
     let d: Vec<f64> = (1..c.len()).map(|i| i as f64 * c[i]).collect();
     let mut x = hi;
     let mut evals = 0;
-    for _ in 0..200 {
+    for _ in 0..NEWTON_STEPS {
         let step = horner(&c, x) / horner(&d, x);
         evals += 2;
         x -= step;
         if !x.is_finite() {
-            return Err("Newton diverged".into());
+            return Err(AccuracyError::NewtonDiverged);
         }
         if step.abs() <= 2.0 * f64::EPSILON * x.abs() {
             return Ok((x.asin(), evals));
         }
     }
-    Err("Newton did not converge in 200 steps".into())
+    Err(AccuracyError::NewtonNoConvergence {
+        steps: NEWTON_STEPS,
+    })
 }
 
 /// Bisection on the generated polynomial over `(sin(end), sin(theta_i))` to adjacent floats.
@@ -128,7 +130,7 @@ pub fn angle_bisection(sys: &System) -> Outcome<f64> {
     let mut evals = 2;
     let flo = horner(&c, lo);
     if flo.signum() == horner(&c, hi).signum() {
-        return Err("no sign change over the interval".into());
+        return Err(AccuracyError::NoSignChange);
     }
     loop {
         let mid = 0.5 * (lo + hi);
@@ -149,12 +151,11 @@ pub fn angle_bisection(sys: &System) -> Outcome<f64> {
 // ----------------------------------------------------------------------------------------
 
 /// The end of the phase from the project's root.
-pub fn delta_sep(sys: &System) -> Result<f64, String> {
+pub fn delta_sep(sys: &System) -> Result<f64, AccuracyError> {
     let mut work = Work::default();
-    Ok(separation(sys, &mut work)
-        .map_err(err)?
+    Ok(separation(sys, &mut work)?
         .separation()
-        .ok_or("no separation")?
+        .ok_or(AccuracyError::NoSeparation)?
         .delta)
 }
 
@@ -162,15 +163,18 @@ pub fn delta_sep(sys: &System) -> Result<f64, String> {
 /// panel length after the `sin`/`sinh` substitution, at a relative tolerance.
 pub fn time_default(sys: &System, delta: f64, tol: f64) -> Outcome<f64> {
     let mut work = Work::default();
-    let mesh = TimeMesh::build(sys, delta, tol, &mut work).map_err(err)?;
+    let mesh = TimeMesh::build(sys, delta, tol, &mut work)?;
     Ok((mesh.duration, work.integrand_evals))
 }
 
 /// The set-up of the per-point route for a relative error `tol`: the sweeps' solver with its
 /// a-priori rule ([`prior`](crate::solve::prior): nodes chosen from where the integrand is
 /// singular, without an error estimate) made for `tol`.
-pub fn per_point_solver(sys: &System<'static>, tol: f64) -> Result<LeanSolver<'static>, String> {
-    LeanSolver::with_tolerance(sys.model(), tol).map_err(err)
+pub fn per_point_solver(
+    sys: &System<'static>,
+    tol: f64,
+) -> Result<LeanSolver<'static>, AccuracyError> {
+    Ok(LeanSolver::with_tolerance(sys.model(), tol)?)
 }
 
 /// The set-up of the per-point solver comparing fixed rules of `low` and `high` nodes on every
@@ -180,15 +184,15 @@ pub fn fixed_rules_solver(
     low: usize,
     high: usize,
     accept: f64,
-) -> Result<LeanSolver<'static>, String> {
-    LeanSolver::with_rules(sys.model(), low, high, accept).map_err(err)
+) -> Result<LeanSolver<'static>, AccuracyError> {
+    Ok(LeanSolver::with_rules(sys.model(), low, high, accept)?)
 }
 
 /// One point solved by a per-point solver from its parameters (root and time, as a sweep
 /// solves each point): the separation time and the evaluations it took.
 pub fn time_per_point(solver: &mut LeanSolver, sys: &System) -> Outcome<f64> {
     let before = solver.evals;
-    let out = solver.solve(sys.p()).map_err(err)?;
+    let out = solver.solve(sys.p())?;
     Ok((out.separation_time, solver.evals - before))
 }
 
@@ -206,7 +210,7 @@ pub fn time_gl_u2(sys: &System, delta: f64, nodes: usize) -> Outcome<f64> {
 
 /// `2u / |theta_dot|` at `delta = u^2` (the integrand after `delta = u^2`), with its limit at
 /// `u = 0` released from rest.
-fn u_integrand(sys: &System, u: f64) -> Result<f64, String> {
+fn u_integrand(sys: &System, u: f64) -> Result<f64, AccuracyError> {
     if u == 0.0 {
         let theta_ddot = sys.reduction().reduced(sys.k(), 0.0).theta_ddot;
         return if sys.starts_at_rest() && theta_ddot < 0.0 {
@@ -219,24 +223,24 @@ fn u_integrand(sys: &System, u: f64) -> Result<f64, String> {
 }
 
 /// `1 / |theta_dot|` at `delta` (the raw integrand, singular at 0).
-fn raw(sys: &System, delta: f64) -> Result<f64, String> {
-    let w2 = sys.reduced(delta).map_err(|e| e.to_string())?.theta_dot_sq;
+fn raw(sys: &System, delta: f64) -> Result<f64, AccuracyError> {
+    let w2 = sys.reduced(delta)?.theta_dot_sq;
     if w2 > 0.0 && w2.is_finite() {
         Ok(1.0 / w2.sqrt())
     } else {
-        Err(format!("theta_dot^2 = {w2} at delta = {delta:e}"))
+        Err(AccuracyError::ThetaDotSquared { value: w2, delta })
     }
 }
 
 /// The set-up of Gauss–Jacobi: the nodes and weights of `nodes` points for the weight
 /// `(1 + x)^(-1/2)` (by Golub–Welsch, which costs far more than the integral itself).
-pub fn jacobi_rule(nodes: usize) -> Result<Vec<(f64, f64)>, String> {
+pub fn jacobi_rule(nodes: usize) -> Result<Vec<(f64, f64)>, AccuracyError> {
     let (Some(n), Some(alpha), Some(beta)) = (
         NonZeroUsize::new(nodes),
         FiniteAboveNegOneF64::new(0.0),
         FiniteAboveNegOneF64::new(-0.5),
     ) else {
-        return Err("bad Gauss-Jacobi parameters".into());
+        return Err(AccuracyError::BadGaussJacobi);
     };
     Ok(GaussJacobi::new(n, alpha, beta)
         .as_node_weight_pairs()
@@ -304,11 +308,11 @@ const WG: [f64; 4] = [
 ];
 
 /// The 15-point Kronrod value and `|K15 - G7|` over `[a, b]`.
-pub fn kronrod15<F: FnMut(f64) -> Result<f64, String>>(
+pub fn kronrod15<F: FnMut(f64) -> Result<f64, AccuracyError>>(
     f: &mut F,
     a: f64,
     b: f64,
-) -> Result<(f64, f64), String> {
+) -> Result<(f64, f64), AccuracyError> {
     let (c, h) = (0.5 * (a + b), 0.5 * (b - a));
     let fc = f(c)?;
     let (mut k, mut g) = (WGK[7] * fc, WG[3] * fc);
@@ -363,9 +367,11 @@ pub fn time_gauss_kronrod(sys: &System, delta: f64, tol: f64) -> Outcome<f64> {
     let (mut total, mut error) = (v, e);
     while error > tol * total.abs() {
         if heap.len() >= GK_LIMIT {
-            return Err(format!(
-                "not converged after {GK_LIMIT} subintervals (estimate {total:.6e}, error {error:.1e})"
-            ));
+            return Err(AccuracyError::KronrodNotConverged {
+                limit: GK_LIMIT,
+                estimate: total,
+                error,
+            });
         }
         let Some(worst) = heap.pop() else { break };
         let m = 0.5 * (worst.a + worst.b);
@@ -432,7 +438,7 @@ fn reduced_ode(
     delta: f64,
     rtol: f64,
     t_max: f64,
-) -> Result<(crate::solve::ode::OdeSolution, u64), String> {
+) -> Result<(crate::solve::ode::OdeSolution, u64), AccuracyError> {
     let mut problem = Reduced {
         sys,
         end: delta,
@@ -444,14 +450,14 @@ fn reduced_ode(
         t_max,
         max_steps: 2_000_000,
     };
-    let sol = dopri5(&mut problem, 0.0, &[0.0, 0.0], &opts).map_err(err)?;
+    let sol = dopri5(&mut problem, 0.0, &[0.0, 0.0], &opts)?;
     Ok((sol, problem.calls))
 }
 
 /// The separation time from the reduced ODE's event.
 pub fn time_reduced_ode(sys: &System, delta: f64, rtol: f64, t_max: f64) -> Outcome<f64> {
     let (sol, calls) = reduced_ode(sys, delta, rtol, t_max)?;
-    let event = sol.event.ok_or("no event")?;
+    let event = sol.event.ok_or(AccuracyError::NoEvent)?;
     Ok((event.t, calls))
 }
 
@@ -473,10 +479,9 @@ pub fn time_unreduced(sys: &System, rtol: f64, t_max: f64) -> Outcome<f64> {
         None,
         t_max,
         &mut work,
-    )
-    .map_err(err)?;
+    )?;
     if run.end != unreduced::End::Force(0) {
-        return Err("the phase ended before the first contact's force vanished".into());
+        return Err(AccuracyError::ForceNotVanished);
     }
     Ok((run.t_end, work.ode_evaluations))
 }
@@ -491,8 +496,8 @@ pub type Samples = (Vec<f64>, Vec<f64>);
 /// The project's series: the quadrature `t(u)` inverted by Newton at uniform times.
 pub fn series_quadrature(sys: &System, delta: f64, tol: f64, samples: usize) -> Outcome<Samples> {
     let mut work = Work::default();
-    let mesh = TimeMesh::build(sys, delta, tol, &mut work).map_err(err)?;
-    let s = sample_phase(sys, &mesh, samples, &mut work).map_err(err)?;
+    let mesh = TimeMesh::build(sys, delta, tol, &mut work)?;
+    let s = sample_phase(sys, &mesh, samples, &mut work)?;
     Ok(((s.t, s.delta), work.integrand_evals))
 }
 
@@ -505,7 +510,7 @@ pub fn series_ode(
     samples: usize,
 ) -> Outcome<Samples> {
     let (sol, calls) = reduced_ode(sys, delta, rtol, t_max)?;
-    let end = sol.event.as_ref().ok_or("no event")?.t;
+    let end = sol.event.as_ref().ok_or(AccuracyError::NoEvent)?.t;
     let mut t = Vec::with_capacity(samples);
     let mut d = Vec::with_capacity(samples);
     for j in 0..samples {
@@ -514,7 +519,7 @@ pub fn series_ode(
         } else {
             end * j as f64 / (samples - 1) as f64
         };
-        let y = sol.interpolate(tj).ok_or("time outside the solution")?;
+        let y = (sol.interpolate(tj)).ok_or(AccuracyError::OutsideSolution { t: tj })?;
         t.push(tj);
         d.push(y[0].clamp(0.0, delta));
     }

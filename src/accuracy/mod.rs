@@ -8,11 +8,14 @@
 //! evaluations, set-up and time per solve, as a table, a CSV and log–log SVG plots of error
 //! against time with the Pareto front marked.
 
+pub mod error;
 pub mod integrated;
 pub mod methods;
 pub mod plot;
 pub mod settings;
 pub mod table;
+
+pub use error::AccuracyError;
 
 use crate::reference::{self, Family, Inputs, Reference, RootRoute, TimeRoute};
 use crate::solve::ode::Method;
@@ -217,11 +220,11 @@ pub struct Measurement<T> {
 /// answer, then (if `has_setup`) the set-up alone timed, then the solve alone timed on the
 /// first set-up's state. No set-up runs once the solve's timing has begun.
 pub fn measure<S, T>(
-    mut prepare: impl FnMut() -> Result<S, String>,
+    mut prepare: impl FnMut() -> Result<S, AccuracyError>,
     mut solve: impl FnMut(&mut S) -> methods::Outcome<T>,
     has_setup: bool,
     budget: &Budget,
-) -> Result<Measurement<T>, String> {
+) -> Result<Measurement<T>, AccuracyError> {
     let mut state = prepare()?;
     let (value, evals) = solve(&mut state)?;
     let setup_seconds = has_setup.then(|| time_per_call(budget, &mut prepare));
@@ -250,19 +253,15 @@ fn time_per_call<T>(budget: &Budget, mut f: impl FnMut() -> T) -> f64 {
 }
 
 /// The reference of one case.
-pub fn case_reference(family: Family, case: Case) -> Result<(Reference, CaseReference), String> {
-    let mut r = Reference::new(Inputs::dimensionless(family, case.n, case.a_over_ell))
-        .map_err(|e| e.to_string())?;
-    let a1 = r
-        .separation(RootRoute::ClosedForm)
-        .map_err(|e| e.to_string())?;
-    let a2 = r.separation(RootRoute::Newton).map_err(|e| e.to_string())?;
-    let t1 = r
-        .separation_time(TimeRoute::SinhGauss)
-        .map_err(|e| e.to_string())?;
-    let t2 = r
-        .separation_time(TimeRoute::TanhSinh)
-        .map_err(|e| e.to_string())?;
+pub fn case_reference(
+    family: Family,
+    case: Case,
+) -> Result<(Reference, CaseReference), AccuracyError> {
+    let mut r = Reference::new(Inputs::dimensionless(family, case.n, case.a_over_ell))?;
+    let a1 = r.separation(RootRoute::ClosedForm)?;
+    let a2 = r.separation(RootRoute::Newton)?;
+    let t1 = r.separation_time(TimeRoute::SinhGauss)?;
+    let t2 = r.separation_time(TimeRoute::TanhSinh)?;
     let info = CaseReference {
         case,
         angle_routes: reference::relative_difference(&a1.theta, &a2.theta),
@@ -297,58 +296,6 @@ pub struct Options {
 
 /// The models with a closed-form reference.
 pub const CLOSED_MODELS: [&str; 3] = ["rod_cube", "hinged_rod", "wall_ladder"];
-
-/// Why the report cannot be made.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum AccuracyError {
-    /// A model the report has no reference for.
-    #[error("no model `{name}` in the report; its models are: {known}")]
-    UnknownModel {
-        /// The name given.
-        name: String,
-        /// The models it has.
-        known: String,
-    },
-    /// A case none of the chosen models has.
-    #[error("no case `{name}` for the chosen models; their cases are: {known}")]
-    UnknownCase {
-        /// The key given.
-        name: String,
-        /// The keys the chosen models have.
-        known: String,
-    },
-    /// A method label the report does not have.
-    #[error("no method `{name}` in the report; its methods are: {known}")]
-    UnknownMethod {
-        /// The label given.
-        name: String,
-        /// The labels.
-        known: String,
-    },
-    /// The choices leave nothing to measure.
-    #[error("nothing to measure: {why}")]
-    Nothing {
-        /// Which choices exclude each other.
-        why: String,
-    },
-    /// A reference could not be computed.
-    #[error("{model}, case {case}: no reference: {message}")]
-    Reference {
-        /// The model.
-        model: String,
-        /// The case.
-        case: String,
-        /// Why.
-        message: String,
-    },
-}
-
-impl AccuracyError {
-    /// Whether the error is in the options (a usage error).
-    pub fn is_usage(&self) -> bool {
-        !matches!(self, AccuracyError::Reference { .. })
-    }
-}
 
 /// A report's rows and the references they were measured against.
 #[derive(Debug, Clone, Default)]
@@ -562,10 +509,10 @@ pub fn run(chosen: &Chosen, progress: &Progress) -> Result<Report, AccuracyError
     let tolerances = integrated::tolerances(chosen.quick);
     for m in &chosen.integrated {
         progress.case(m.model, m.case, integrators.len() * tolerances.len());
-        let reference = integrated::reference(m).map_err(|message| AccuracyError::Reference {
+        let reference = integrated::reference(m).map_err(|e| AccuracyError::Reference {
             model: m.model.into(),
             case: m.case.into(),
-            message,
+            source: Box::new(e),
         })?;
         for &method in &integrators {
             for &k in &tolerances {
@@ -589,19 +536,19 @@ fn run_case(
     budget: &Budget,
     progress: &Progress,
 ) -> Result<(Vec<Row>, CaseReference), AccuracyError> {
-    let failed = |message: String| AccuracyError::Reference {
+    let failed = |e: AccuracyError| AccuracyError::Reference {
         model: model.into(),
         case: case.key.into(),
-        message,
+        source: Box::new(e),
     };
     let (angle, time, series) = (chosen.angle(), chosen.time(), chosen.series());
     progress.case(model, case.key, angle.len() + time.len() + series.len());
     let (mut reference, cref) = case_reference(family, case).map_err(failed)?;
-    let m = crate::models::find(model).ok_or_else(|| failed(format!("no model `{model}`")))?;
+    let m = crate::models::find(model)
+        .ok_or_else(|| failed(AccuracyError::NoModel { name: model.into() }))?;
     // The phase the reference describes: the contact closed from release.
-    let m = crate::solve::lean::release_phase(m).map_err(|e| failed(e.to_string()))?;
-    let sys =
-        System::from_values(m, &parameters(family, case)).map_err(|e| failed(e.to_string()))?;
+    let m = crate::solve::lean::release_phase(m).map_err(|e| failed(e.into()))?;
+    let sys = System::from_values(m, &parameters(family, case)).map_err(|e| failed(e.into()))?;
     let delta = methods::delta_sep(&sys).map_err(failed)?;
     let point = Point {
         sys: &sys,
@@ -609,19 +556,20 @@ fn run_case(
         t_max: 100.0 * reference::to_f64(&cref.time),
     };
     let mut rows = Vec::new();
-    let row = |measured, s: &dyn Labelled, outcome: Result<(f64, Measurement<()>), String>| {
-        let mut r = Row::unmeasured(model, measured, case.key, s.label(), s.setting());
-        match outcome {
-            Ok((error, m)) => {
-                r.error = error;
-                r.evals = m.evals;
-                r.setup_seconds = m.setup_seconds;
-                r.seconds = m.seconds;
+    let row =
+        |measured, s: &dyn Labelled, outcome: Result<(f64, Measurement<()>), AccuracyError>| {
+            let mut r = Row::unmeasured(model, measured, case.key, s.label(), s.setting());
+            match outcome {
+                Ok((error, m)) => {
+                    r.error = error;
+                    r.evals = m.evals;
+                    r.setup_seconds = m.setup_seconds;
+                    r.seconds = m.seconds;
+                }
+                Err(e) => r.note = e.to_string(),
             }
-            Err(note) => r.note = note,
-        }
-        r
-    };
+            r
+        };
     for s in &angle {
         let outcome = s.measure(&point, budget).map(|m| {
             (
@@ -690,8 +638,8 @@ fn series_error(
     sys: &System,
     t: &[f64],
     d: &[f64],
-) -> Result<f64, String> {
-    let times = reference.times_at(d).map_err(|e| e.to_string())?;
+) -> Result<f64, AccuracyError> {
+    let times = reference.times_at(d)?;
     let theta_i = sys.theta_initial();
     let mut worst: f64 = 0.0;
     for j in 0..t.len() {
@@ -700,7 +648,7 @@ fn series_error(
         let theta = theta_i - d[j];
         let e = (dtheta / theta).abs();
         if !e.is_finite() {
-            return Err(format!("non-finite error at sample {j}"));
+            return Err(AccuracyError::NonFiniteSeriesError { sample: j });
         }
         worst = worst.max(e);
     }
@@ -709,9 +657,9 @@ fn series_error(
 
 /// The rows as CSV (`model,quantity,case,method,setting,relative_error,evaluations,steps,
 /// setup_seconds,seconds_per_solve,note`; an empty cell is a value the row has not).
-pub fn to_csv(rows: &[Row]) -> Result<String, String> {
+pub fn to_csv(rows: &[Row]) -> Result<String, AccuracyError> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    let fail = |e: csv::Error| e.to_string();
+    let fail = |e: csv::Error| csv_error(&e);
     w.write_record([
         "model",
         "quantity",
@@ -744,6 +692,13 @@ pub fn to_csv(rows: &[Row]) -> Result<String, String> {
         ])
         .map_err(fail)?;
     }
-    let bytes = w.into_inner().map_err(|e| e.to_string())?;
-    String::from_utf8(bytes).map_err(|e| e.to_string())
+    let bytes = w.into_inner().map_err(|e| csv_error(&e))?;
+    String::from_utf8(bytes).map_err(|e| csv_error(&e))
+}
+
+/// The CSV writer's failure, by its message.
+fn csv_error(e: &dyn std::fmt::Display) -> AccuracyError {
+    AccuracyError::Csv {
+        message: e.to_string(),
+    }
 }

@@ -3,7 +3,7 @@
 //! front (no other setting is both faster and more accurate) circled and joined by a dashed
 //! staircase. A last panel holds the legend.
 
-use super::{ERROR_FLOOR, Measured, Row};
+use super::{AccuracyError, ERROR_FLOOR, Measured, Row};
 use plotters::prelude::*;
 
 const FONT: &str = "sans-serif";
@@ -42,8 +42,10 @@ pub fn pareto(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
 }
 
 /// The SVG for one measured quantity over its cases, or `None` when nothing succeeded.
-pub fn svg(measured: Measured, model: &str, rows: &[Row]) -> Result<Option<String>, String> {
-    draw(measured, model, rows).map_err(|e| e.to_string())
+pub fn svg(measured: Measured, model: &str, rows: &[Row]) -> Result<Option<String>, AccuracyError> {
+    draw(measured, model, rows).map_err(|e| AccuracyError::Plot {
+        message: e.to_string(),
+    })
 }
 
 fn draw(

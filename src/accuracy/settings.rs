@@ -3,7 +3,7 @@
 //! and the values of its setting, with the set-up separated from the solve.
 
 use super::methods::{self, Outcome, Samples};
-use super::{Budget, Measurement, QUICK_SERIES_SAMPLES, SERIES_SAMPLES, measure};
+use super::{AccuracyError, Budget, Measurement, QUICK_SERIES_SAMPLES, SERIES_SAMPLES, measure};
 use crate::solve::lean::LeanSolver;
 use crate::solve::prior::PRIOR_TOL;
 use crate::system::System;
@@ -21,7 +21,7 @@ pub struct Point<'p> {
 }
 
 /// Measures a method at one setting on a point.
-type Run<T> = Box<dyn Fn(&Point<'_>, &Budget) -> Result<Measurement<T>, String>>;
+type Run<T> = Box<dyn Fn(&Point<'_>, &Budget) -> Result<Measurement<T>, AccuracyError>>;
 
 /// One method at one setting.
 pub struct Setting<T> {
@@ -35,7 +35,11 @@ pub struct Setting<T> {
 impl<T> Setting<T> {
     /// Solves `point` once for the value and its evaluations, then times the set-up (if any)
     /// and the solve apart.
-    pub fn measure(&self, point: &Point<'_>, budget: &Budget) -> Result<Measurement<T>, String> {
+    pub fn measure(
+        &self,
+        point: &Point<'_>,
+        budget: &Budget,
+    ) -> Result<Measurement<T>, AccuracyError> {
         (self.run)(point, budget)
     }
 }
@@ -66,7 +70,7 @@ fn plain<T: 'static>(
 fn prepared<S: 'static, T: 'static>(
     label: &'static str,
     setting: String,
-    prepare: impl Fn(&Point<'_>) -> Result<S, String> + 'static,
+    prepare: impl Fn(&Point<'_>) -> Result<S, AccuracyError> + 'static,
     solve: impl Fn(&mut S, &Point<'_>) -> Outcome<T> + 'static,
 ) -> Setting<T> {
     Setting {
