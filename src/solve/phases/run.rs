@@ -18,6 +18,22 @@ pub struct IntegratedRun<'m> {
     pub run: UnreducedRun,
 }
 
+impl IntegratedRun<'_> {
+    /// The refusal of a run that holds no segment, so no active set (the integrator ends every
+    /// run it returns with one; only a run built by hand can lack it):
+    /// [`SolveError::ActiveSize`], an active set of no contact and no friction.
+    pub fn no_active_set(&self) -> SolveError {
+        let info = self.bound.info();
+        SolveError::ActiveSize {
+            model: info.name,
+            contacts: info.contacts.len(),
+            frictions: info.frictions.len(),
+            closed: 0,
+            modes: 0,
+        }
+    }
+}
+
 /// One phase of the motion on either route.
 #[derive(Debug, Clone)]
 pub enum PhaseRun<'m> {
@@ -105,23 +121,25 @@ impl<'m> PhaseRun<'m> {
     }
 
     /// The contacts closed during the phase (at its start; a friction switch changes only the
-    /// modes).
-    pub fn closed(&self) -> Vec<bool> {
+    /// modes). An integrated run without a segment has no active set
+    /// ([`IntegratedRun::no_active_set`]).
+    pub fn closed(&self) -> Result<Vec<bool>, SolveError> {
         match self {
-            PhaseRun::Reduced(r) => r.system.info().contacts.iter().map(|c| c.closed).collect(),
+            PhaseRun::Reduced(r) => Ok(r.system.info().contacts.iter().map(|c| c.closed).collect()),
             PhaseRun::Integrated(r) => (r.run.segments.first())
                 .map(|s| s.active.closed.clone())
-                .unwrap_or_default(),
+                .ok_or_else(|| r.no_active_set()),
         }
     }
 
-    /// The contacts closed at the end of the phase (in the general model's order).
-    pub fn closed_at_end(&self) -> Vec<bool> {
+    /// The contacts closed at the end of the phase (in the general model's order). An
+    /// integrated run without a segment has no active set ([`IntegratedRun::no_active_set`]).
+    pub fn closed_at_end(&self) -> Result<Vec<bool>, SolveError> {
         match self {
-            PhaseRun::Reduced(r) => r.system.info().contacts.iter().map(|c| c.closed).collect(),
+            PhaseRun::Reduced(r) => Ok(r.system.info().contacts.iter().map(|c| c.closed).collect()),
             PhaseRun::Integrated(r) => (r.run.segments.last())
                 .map(|s| s.active.closed.clone())
-                .unwrap_or_default(),
+                .ok_or_else(|| r.no_active_set()),
         }
     }
 

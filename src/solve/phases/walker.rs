@@ -151,7 +151,7 @@ impl<'m> Walker<'m> {
     pub fn after(&self, run: &PhaseRun<'m>) -> Result<PhaseStart, SolveError> {
         let state = run.full_end_state()?;
         let t = run.t_end();
-        let held = run.closed_at_end();
+        let held = run.closed_at_end()?;
         let at = Moment::After {
             t,
             held: &held,
@@ -449,7 +449,7 @@ impl<'m> Walker<'m> {
         let info = general.info();
         let phase = motion.phases.len() - 1;
         let last = &motion.phases[phase];
-        let (state, t, held) = (last.full_end_state()?, last.t_end(), last.closed_at_end());
+        let (state, t, held) = (last.full_end_state()?, last.t_end(), last.closed_at_end()?);
         let approaching = approaching_touches(general, &state)?;
         let parts: Vec<Part> = (info.contacts.iter().enumerate())
             .map(|(c, contact)| {
