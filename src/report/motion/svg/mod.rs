@@ -109,12 +109,11 @@ fn description(anim: &Animation, factor: f64) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::clock::visibility;
     use super::markup::num_fixed;
     use super::*;
     use crate::model::ShapeKind;
     use crate::report::motion::animation::{
-        ContactEnd, Frame, ImpactMark, MAX_KEYFRAMES, PhaseSpan, Shape, place,
+        ContactEnd, Frame, ImpactMark, MAX_KEYFRAMES, PhaseSpan, Shape,
     };
 
     /// A rod turning about its foot and a square sliding, over `n` frames of one phase and `m`
