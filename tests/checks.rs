@@ -64,7 +64,14 @@ fn a_monitor_below_zero_fails_with_its_minimum_as_value() {
     assert!(untweaked[0].1.passed && least > 3.5, "{:?}", untweaked[0]);
     assert!((tip.value - (least - 4.0)).abs() < 1e-12, "{tip:?}");
     // The contacts' own checks are not monitors: they pass, the floor's push at least m1 g / 4.
-    let pushes = checks::contact_forces(bound, &samples, &forces, &phase.closed(), 1e-12, &ctx);
+    let pushes = checks::contact_forces(
+        bound,
+        &samples,
+        &forces,
+        &phase.closed().unwrap(),
+        1e-12,
+        &ctx,
+    );
     let keys: Vec<&str> = pushes.iter().map(|(k, _)| k.as_str()).collect();
     assert_eq!(
         keys,
@@ -173,7 +180,7 @@ fn a_contact_that_would_pull_fails_its_check() {
     let samples = sample(&phase, 50, &mut Work::default()).unwrap();
     let mut forces = sample_forces(&phase, &samples).unwrap();
     let ctx = checks::Context::new("rod_cube_closed");
-    let closed = phase.closed();
+    let closed = phase.closed().unwrap();
     let ok = checks::contact_forces(phase.bound(), &samples, &forces, &closed, 1e-12, &ctx);
     assert!(ok.iter().all(|(_, c)| c.passed), "{ok:?}");
     // The floor pulling the foot down by 1 N at one sample.

@@ -253,3 +253,35 @@ fn a_missing_phase_model_is_a_typed_error() {
         }
     );
 }
+
+#[test]
+fn an_integrated_run_without_a_segment_has_no_closed_set() {
+    // The integrator ends every run with a segment; one emptied by hand is refused, not read as
+    // "no contact closed".
+    let w = Walker {
+        route: Route::Integrated,
+        ..walker(MODELS)
+    };
+    let mut work = Work::default();
+    let (release, _) = w.release().unwrap();
+    let mut phase = w.solve(&release, &mut work).unwrap();
+    assert_eq!(phase.closed().unwrap(), vec![true, true]);
+    assert_eq!(phase.closed_at_end().unwrap(), vec![true, true]);
+    let rodcube::solve::phases::PhaseRun::Integrated(run) = &mut phase else {
+        panic!("the integrated route gave a fast phase");
+    };
+    run.run.segments.clear();
+    for got in [phase.closed(), phase.closed_at_end()] {
+        assert!(
+            matches!(
+                got,
+                Err(SolveError::ActiveSize {
+                    contacts: 2,
+                    closed: 0,
+                    ..
+                })
+            ),
+            "{got:?}"
+        );
+    }
+}

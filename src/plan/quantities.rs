@@ -62,15 +62,22 @@ pub(super) fn fate(motion: &Motion, general: &Bound, i: usize) -> Result<Option<
         (false, Some(last)) if matches!(last.end(), End::Contact(_)) => is_landing(general, last)?,
         _ => false,
     };
-    Ok(fate_along(motion, info, i, landed))
+    fate_along(motion, info, i, landed)
 }
 
 /// [`fate`] for a contact that did not open at release; `landed`: the motion ends at a landing
 /// where a contact closes.
-fn fate_along(motion: &Motion, info: &ModelInfo, i: usize, landed: bool) -> Option<Fate> {
-    let first = motion.phases.first()?;
-    if !first.closed().get(i).copied().unwrap_or(false) {
-        return Some(Fate::NeverClosed);
+fn fate_along(
+    motion: &Motion,
+    info: &ModelInfo,
+    i: usize,
+    landed: bool,
+) -> Result<Option<Fate>, SolveError> {
+    let Some(first) = motion.phases.first() else {
+        return Ok(None);
+    };
+    if !first.closed()?.get(i).copied().unwrap_or(false) {
+        return Ok(Some(Fate::NeverClosed));
     }
     let name = |j: usize| info.contacts.get(j).map_or("a contact", |c| c.name);
     for (k, phase) in motion.phases.iter().enumerate() {
@@ -80,63 +87,63 @@ fn fate_along(motion: &Motion, info: &ModelInfo, i: usize, landed: bool) -> Opti
             cause,
         };
         match phase.end() {
-            End::Force(j) if j == i => return Some(ended("force")),
-            End::Edge(j) if j == i => return Some(ended("edge")),
+            End::Force(j) if j == i => return Ok(Some(ended("force"))),
+            End::Edge(j) if j == i => return Ok(Some(ended("edge"))),
             End::Contact(j) if !motion.through_impacts && landed => {
-                return Some(Fate::Held {
+                return Ok(Some(Fate::Held {
                     until: Held::Lands {
                         contact: name(j).to_string(),
                         t: phase.t_end(),
                     },
-                });
+                }));
             }
-            End::Contact(_) if !motion.through_impacts => return Some(ended("contact")),
+            End::Contact(_) if !motion.through_impacts => return Ok(Some(ended("contact"))),
             End::Contact(_) => {
                 // An impact: it may have separated this contact.
                 let Some(next) = motion.phases.get(k + 1) else {
-                    return (motion.halted.as_ref()).map(|why| Fate::Held {
+                    return Ok((motion.halted.as_ref()).map(|why| Fate::Held {
                         until: Held::Halted(why.clone()),
-                    });
+                    }));
                 };
-                if !next.closed().get(i).copied().unwrap_or(false) {
-                    return Some(ended("impact"));
+                if !next.closed()?.get(i).copied().unwrap_or(false) {
+                    return Ok(Some(ended("impact")));
                 }
             }
             End::Until => {
-                return Some(Fate::Held {
+                return Ok(Some(Fate::Held {
                     until: Held::RunsEnd { t: phase.t_end() },
-                });
+                }));
             }
             End::Floor => {
-                return Some(Fate::Held {
+                return Ok(Some(Fate::Held {
                     until: Held::Floor {
                         angle: angle_coordinate(info).to_string(),
                         end_angle: info.end_angle,
                     },
-                });
+                }));
             }
             End::Edge(j) => {
-                return Some(Fate::Held {
+                return Ok(Some(Fate::Held {
                     until: Held::Edge {
                         contact: name(j).to_string(),
                         t: phase.t_end(),
                     },
-                });
+                }));
             }
             End::Force(_) => {
                 // Another contact opened; the decision there may have opened this one too.
                 let Some(next) = motion.phases.get(k + 1) else {
-                    return (motion.halted.as_ref()).map(|why| Fate::Held {
+                    return Ok((motion.halted.as_ref()).map(|why| Fate::Held {
                         until: Held::Halted(why.clone()),
-                    });
+                    }));
                 };
-                if !next.closed().get(i).copied().unwrap_or(false) {
-                    return Some(ended("force"));
+                if !next.closed()?.get(i).copied().unwrap_or(false) {
+                    return Ok(Some(ended("force")));
                 }
             }
         }
     }
-    None
+    Ok(None)
 }
 
 /// Whether `phase` (of the system whose general model is `general`) ends where the body lands: at the model's end angle, or where a contact

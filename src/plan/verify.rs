@@ -143,7 +143,7 @@ impl Plan<'_> {
                 bound,
                 samples,
                 &forces,
-                &run.closed(),
+                &run.closed()?,
                 tol,
                 &ctx,
             ));

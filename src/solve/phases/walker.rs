@@ -1,18 +1,11 @@
-//! Phases of the motion of a system: at release, and after every event, the contacts that stay
-//! closed are decided ([`contacts::decide`]); each stretch with one set of closed contacts is
-//! a phase, solved on the fast path where the system has a fast phase for that set, otherwise
-//! by integrating the general model with the closed contacts as constraints; the motion goes on
-//! from phase to phase until the rod reaches the floor, a contact runs off an edge, or an open
-//! contact closes (the bodies meet). Where the run is asked to go on to a time (`until`), a
-//! contact that closes is an impact ([`impact::resolve`]): the velocities jump by the impulses
-//! of Newton's law with complementarity, the contacts are decided again at the state after,
-//! and the motion goes on to that time; bounces whose times converge (Zeno) are caught.
-//!
-//! A fast phase that starts from a given state takes it as parameters (`<q>_0`,
-//! `<q>_dot_0`, bound from the system's state by coordinate name); the one that starts from
-//! the spec's release state serves only at release. A phase's clock restarts at zero; the
-//! absolute time of its start is kept in [`PhaseRun::t_start`].
+//! How a system's motion is solved ([`Walker`]): the contacts decided at release and after every
+//! event, each phase on its route, phase after phase until one ends for good, and through
+//! impacts (Zeno's bounces caught) where the run goes on to a time; with the limits that halt
+//! it and a fast phase's start parameters ([`phase_parameters`]).
 
+use super::motion::{ImpactAt, Motion};
+use super::reduced::{ReducedEnd, ReducedRun, phase_end};
+use super::run::{IntegratedRun, PhaseRun};
 use crate::model::{Model, ModelInfo};
 use crate::results::{Halt, Work, Zeno};
 use crate::solve::SolveError;
@@ -21,12 +14,10 @@ use crate::solve::contacts::{
     contact_options, friction_options,
 };
 use crate::solve::impact::{self, Impact, Part};
-use crate::solve::inversion::{delta_at_time, theta_dot_at};
+use crate::solve::inversion::delta_at_time;
 use crate::solve::ode::Method;
 use crate::solve::quadrature::TimeMesh;
-use crate::solve::roots::{self, changes_sign};
-use crate::solve::separation::{Separation, SeparationOutcome, edge, force_zero};
-use crate::solve::unreduced::{self, Start, UnreducedRun, motion_scales};
+use crate::solve::unreduced::{self, End, Start, motion_scales};
 use crate::system::{Bound, State, System};
 
 /// Most phases chained between two impacts (or from release to the first) before giving up:
@@ -56,11 +47,6 @@ pub const MAX_FALL_TIMES: f64 = 1e5;
 /// the reduced angle reaches its end angle, and still count as landed.
 pub const LANDING_TOLERANCE: f64 = 1e-9;
 
-/// Cells of the grid, uniform in the fast path's time variable, on which an open contact's gap
-/// is watched for closing (the first cell whose ends differ in sign; a touch without a crossing
-/// inside one cell is not seen).
-pub const GAP_CELLS: usize = 64;
-
 /// Which route solves a phase.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Route {
@@ -69,375 +55,6 @@ pub enum Route {
     Fastest,
     /// Integration of the general model for every phase (to compare the routes).
     Integrated,
-}
-
-pub use crate::solve::unreduced::End;
-
-/// Where a phase on the fast path ends.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ReducedEnd {
-    /// Why.
-    pub end: End,
-    /// The angle where a contact ends (`None` at the floor).
-    pub at: Option<Separation>,
-    /// The angle fallen at the end.
-    pub delta: f64,
-}
-
-/// Where a phase on the fast path ends, by its roots alone: the first of its closed contacts'
-/// force zeros and edges, else the floor. A closed contact whose force pulls at the start ends
-/// the phase there (`delta = 0`): it opens at once; a force that is not finite there is
-/// [`SolveError::NonFinite`].
-pub fn phase_end(sys: &System, work: &mut Work) -> Result<ReducedEnd, SolveError> {
-    let info = sys.info();
-    let at_start = sys.forces(0.0)?;
-    let mut found: Option<(End, Separation)> = None;
-    let mut consider = |end: End, outcome: SeparationOutcome| {
-        if let SeparationOutcome::Separates(s) = outcome
-            && found.is_none_or(|(_, f)| s.delta < f.delta)
-        {
-            found = Some((end, s));
-        }
-    };
-    for (i, c) in info.contacts.iter().enumerate() {
-        if !c.closed || c.bilateral {
-            continue;
-        }
-        if !at_start[i].is_finite() {
-            return Err(SolveError::NonFinite {
-                model: info.name,
-                what: "a closed contact's force at the phase's start",
-                delta: 0.0,
-                value: at_start[i],
-            });
-        }
-        if at_start[i] < 0.0 {
-            let theta = sys.theta_initial();
-            return Ok(ReducedEnd {
-                end: End::Force(i),
-                at: Some(Separation {
-                    sin_theta: theta.sin(),
-                    theta,
-                    delta: 0.0,
-                }),
-                delta: 0.0,
-            });
-        }
-        consider(End::Force(i), force_zero(sys, i, work)?);
-    }
-    for (i, c) in info.contacts.iter().enumerate() {
-        if c.closed && c.edge {
-            consider(End::Edge(i), edge(sys, i, work)?);
-        }
-    }
-    Ok(match found {
-        Some((end, at)) => ReducedEnd {
-            end,
-            at: Some(at),
-            delta: at.delta,
-        },
-        None => ReducedEnd {
-            end: End::Floor,
-            at: None,
-            delta: sys.delta_to_floor(),
-        },
-    })
-}
-
-/// A phase solved on the fast path.
-#[derive(Debug, Clone)]
-pub struct ReducedRun<'m> {
-    /// The model and its parameters for this phase.
-    pub system: System<'m>,
-    /// Absolute time of the phase start (s from release).
-    pub t_start: f64,
-    /// Where and why it ends.
-    pub end: ReducedEnd,
-    /// `t(delta)` over the phase.
-    pub mesh: TimeMesh,
-}
-
-impl<'m> ReducedRun<'m> {
-    /// Solves the phase when the end of its closed contacts is already known, then watches its
-    /// open contacts' gaps along it: one that closes first ends the phase there.
-    pub fn with_end(
-        sys: System<'m>,
-        t_start: f64,
-        end: ReducedEnd,
-        tol: f64,
-        work: &mut Work,
-    ) -> Result<Self, SolveError> {
-        if end.delta == 0.0 {
-            // A contact that opens at once: a phase of no length.
-            work.phases.push(sys.name().to_string());
-            return Ok(ReducedRun {
-                mesh: TimeMesh::empty(),
-                system: sys,
-                t_start,
-                end,
-            });
-        }
-        let mut mesh = TimeMesh::build(&sys, end.delta, tol, work)?;
-        let mut end = end;
-        if let Some((i, delta)) = first_gap_closing(&sys, &mesh, work)? {
-            mesh = TimeMesh::build(&sys, delta, tol, work)?;
-            let theta = sys.theta_initial() - delta;
-            end = ReducedEnd {
-                end: End::Contact(i),
-                at: Some(Separation {
-                    sin_theta: theta.sin(),
-                    theta,
-                    delta,
-                }),
-                delta,
-            };
-        }
-        work.phases.push(sys.name().to_string());
-        Ok(ReducedRun {
-            system: sys,
-            t_start,
-            end,
-            mesh,
-        })
-    }
-
-    /// The separation that ends it, if its first contact's force reached zero.
-    pub fn separation(&self) -> Option<Separation> {
-        match self.end.end {
-            End::Force(0) => self.end.at,
-            _ => None,
-        }
-    }
-
-    /// `theta_dot` at the end of the phase (rad/s).
-    pub fn theta_dot_end(&self) -> f64 {
-        theta_dot_at(&self.system, self.mesh.delta_end)
-    }
-
-    /// This run as a phase of the motion.
-    pub fn into_phase(self) -> PhaseRun<'m> {
-        PhaseRun::Reduced(self)
-    }
-
-    /// The full state at the end of the phase.
-    pub fn end_state(&self) -> Result<State, SolveError> {
-        Ok(self.system.full_state(
-            self.mesh.duration,
-            self.mesh.delta_end,
-            self.theta_dot_end(),
-        )?)
-    }
-}
-
-/// The first open contact whose gap closes along a fast phase, and the angle fallen where it
-/// does: each open contact's gap on [`GAP_CELLS`] cells uniform in the time variable `v`,
-/// bracketed and refined by [`roots::illinois`] in the angle fallen. A gap that starts at zero
-/// (a contact that has just opened) counts only once it has grown past rounding.
-fn first_gap_closing(
-    sys: &System,
-    mesh: &TimeMesh,
-    work: &mut Work,
-) -> Result<Option<(usize, f64)>, SolveError> {
-    let info = sys.info();
-    let open: Vec<usize> = (0..info.contacts.len())
-        .filter(|&i| !info.contacts[i].closed)
-        .collect();
-    if open.is_empty() {
-        return Ok(None);
-    }
-    let state_at = |delta: f64, work: &mut Work| -> Result<State, SolveError> {
-        let t = mesh.time_at_delta(sys, delta, work)?;
-        Ok(sys.full_state(t, delta, theta_dot_at(sys, delta))?)
-    };
-    let tol = DECIDE_TOLERANCE * sys.length_scale(&state_at(0.0, work)?)?;
-    let mut best: Option<(usize, f64)> = None;
-    for &i in &open {
-        let mut gap = |delta: f64| -> Result<f64, SolveError> {
-            let mut w = Work::default();
-            let g = sys.gaps(&state_at(delta, &mut w)?)?[i];
-            work.integrand_evals += w.integrand_evals;
-            Ok(g)
-        };
-        let mut armed = gap(0.0)? > tol;
-        let mut a = (0.0, 1.0);
-        for j in 1..=GAP_CELLS {
-            let v = mesh.v_end * j as f64 / GAP_CELLS as f64;
-            let delta = if j == GAP_CELLS {
-                mesh.delta_end
-            } else {
-                mesh.delta_at_v(sys, v)?
-            };
-            let g = gap(delta)?;
-            if !armed {
-                armed = g > tol;
-                a = (delta, 1.0);
-                continue;
-            }
-            if changes_sign(a.1, g) {
-                let root = roots::illinois(&mut gap, a, (delta, g))?;
-                if best.is_none_or(|(_, d)| root < d) {
-                    best = Some((i, root));
-                }
-                break;
-            }
-            a = (delta, g);
-        }
-    }
-    Ok(best)
-}
-
-/// A phase solved by integrating the general model's equations.
-#[derive(Debug, Clone)]
-pub struct IntegratedRun<'m> {
-    /// The general model and its parameters.
-    pub bound: Bound<'m>,
-    /// Absolute time of the phase start (s from release).
-    pub t_start: f64,
-    /// The integration, ended by its event.
-    pub run: UnreducedRun,
-}
-
-/// One phase of the motion on either route.
-#[derive(Debug, Clone)]
-pub enum PhaseRun<'m> {
-    /// On the fast path.
-    Reduced(ReducedRun<'m>),
-    /// Integrated.
-    Integrated(IntegratedRun<'m>),
-}
-
-impl<'m> PhaseRun<'m> {
-    /// The model and its parameters.
-    pub fn bound(&self) -> &Bound<'m> {
-        match self {
-            PhaseRun::Reduced(r) => r.system.bound(),
-            PhaseRun::Integrated(r) => &r.bound,
-        }
-    }
-
-    /// Absolute time of the phase start (s from release).
-    pub fn t_start(&self) -> f64 {
-        match self {
-            PhaseRun::Reduced(r) => r.t_start,
-            PhaseRun::Integrated(r) => r.t_start,
-        }
-    }
-
-    /// Phase duration (s).
-    pub fn duration(&self) -> f64 {
-        match self {
-            PhaseRun::Reduced(r) => r.mesh.duration,
-            PhaseRun::Integrated(r) => r.run.t_end,
-        }
-    }
-
-    /// Absolute end time (s from release).
-    pub fn t_end(&self) -> f64 {
-        self.t_start() + self.duration()
-    }
-
-    /// Why the phase ended.
-    pub fn end(&self) -> End {
-        match self {
-            PhaseRun::Reduced(r) => r.end.end,
-            PhaseRun::Integrated(r) => r.run.end,
-        }
-    }
-
-    /// The state at the end of the phase, in its model's coordinates.
-    pub fn end_state(&self) -> Result<State, SolveError> {
-        match self {
-            PhaseRun::Reduced(r) => r.end_state(),
-            PhaseRun::Integrated(r) => Ok(r.run.state_end.clone()),
-        }
-    }
-
-    /// The system's state at the end of the phase (the general model's coordinates).
-    pub fn full_end_state(&self) -> Result<State, SolveError> {
-        Ok(self.bound().to_full(&self.end_state()?)?)
-    }
-
-    /// The reduced angle at the end of the phase (rad): `theta_i - delta_end` on the fast path
-    /// (the reduced coordinate of [`ReducedRun::end_state`]), the end state's otherwise.
-    pub fn theta_end(&self) -> f64 {
-        match self {
-            PhaseRun::Reduced(r) => r.system.theta_initial() - r.mesh.delta_end,
-            PhaseRun::Integrated(r) => r.run.state_end.q[r.bound.info().reduced_index],
-        }
-    }
-
-    /// `theta_dot` at the end of the phase (rad/s).
-    pub fn theta_dot_end(&self) -> f64 {
-        match self {
-            PhaseRun::Reduced(r) => r.theta_dot_end(),
-            PhaseRun::Integrated(r) => r.run.state_end.qd[r.bound.info().reduced_index],
-        }
-    }
-
-    /// Work done by friction from release to the end of the phase (J, `<= 0`; zero without
-    /// friction).
-    pub fn friction_work(&self) -> f64 {
-        match self {
-            PhaseRun::Reduced(_) => 0.0,
-            PhaseRun::Integrated(r) => r.run.friction_work,
-        }
-    }
-
-    /// The contacts closed during the phase (at its start; a friction switch changes only the
-    /// modes).
-    pub fn closed(&self) -> Vec<bool> {
-        match self {
-            PhaseRun::Reduced(r) => r.system.info().contacts.iter().map(|c| c.closed).collect(),
-            PhaseRun::Integrated(r) => (r.run.segments.first())
-                .map(|s| s.active.closed.clone())
-                .unwrap_or_default(),
-        }
-    }
-
-    /// The contacts closed at the end of the phase (in the general model's order).
-    pub fn closed_at_end(&self) -> Vec<bool> {
-        match self {
-            PhaseRun::Reduced(r) => r.system.info().contacts.iter().map(|c| c.closed).collect(),
-            PhaseRun::Integrated(r) => (r.run.segments.last())
-                .map(|s| s.active.closed.clone())
-                .unwrap_or_default(),
-        }
-    }
-
-    /// The active sets over the phase: each stretch's start (s from release) and its closed
-    /// contacts and friction modes in words.
-    pub fn stretches(&self) -> Vec<(f64, String)> {
-        match self {
-            PhaseRun::Reduced(r) => {
-                let info = r.system.info();
-                vec![(r.t_start, Active::of_model(info).describe(info))]
-            }
-            PhaseRun::Integrated(r) => (r.run)
-                .switches(&r.bound)
-                .map(|(t, modes)| (r.t_start + t, modes))
-                .collect(),
-        }
-    }
-
-    /// The phase as `work.phases` names it: its model, and for an integrated phase the closed
-    /// contacts (and friction modes) of each stretch.
-    pub fn labels(&self) -> Vec<String> {
-        match self {
-            PhaseRun::Reduced(r) => vec![r.system.name().to_string()],
-            PhaseRun::Integrated(r) => (r.run)
-                .switches(&r.bound)
-                .map(|(_, modes)| format!("{} ({modes})", r.bound.name()))
-                .collect(),
-        }
-    }
-
-    /// The phase on the fast path, if it is on it.
-    pub fn reduced(&self) -> Option<&ReducedRun<'m>> {
-        match self {
-            PhaseRun::Reduced(r) => Some(r),
-            PhaseRun::Integrated(_) => None,
-        }
-    }
 }
 
 /// `sqrt(2 h / g)` for the height `h` of the falling point at `state` (the system's length
@@ -453,96 +70,6 @@ pub fn fall_time_scale(bound: &Bound, state: &State) -> Result<f64, SolveError> 
         length
     };
     Ok((2.0 * h / bound.gravity()).sqrt())
-}
-
-/// An impact between two phases of a motion.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ImpactAt {
-    /// Absolute time (s from release).
-    pub t: f64,
-    /// The phase that ended with it (an index into [`Motion::phases`]; the next one starts
-    /// from its state after).
-    pub phase: usize,
-    /// The contact whose gap closed.
-    pub closing: usize,
-    /// Each contact's part in it.
-    pub parts: Vec<Part>,
-    /// The impulses, the normal velocities and the state after.
-    pub impact: Impact,
-    /// Whether a converging (Zeno) sequence of bounces was closed by making this impact
-    /// plastic.
-    pub zeno: bool,
-}
-
-/// The whole motion, phase after phase.
-#[derive(Debug, Clone)]
-pub struct Motion<'m> {
-    /// The phases in order; the last one reaches the floor, an edge, a closing contact (where
-    /// the run does not go on through impacts) or the run's end.
-    pub phases: Vec<PhaseRun<'m>>,
-    /// The contacts that touched at release but opened at once (their force would have had to
-    /// pull).
-    pub opened_at_release: Vec<usize>,
-    /// The impacts between phases, in order.
-    pub impacts: Vec<ImpactAt>,
-    /// Whether a contact that closes is an impact the motion goes on through (the run has an
-    /// end time), or the end of the motion.
-    pub through_impacts: bool,
-    /// Why the motion stopped before its end, if it did (too many impacts).
-    pub halted: Option<Halt>,
-    /// What the reader should know about how the motion was followed: each converging (Zeno)
-    /// sequence of bounces closed.
-    pub notes: Vec<Zeno>,
-}
-
-impl<'m> Motion<'m> {
-    /// A motion of its first phase.
-    pub fn starting(first: PhaseRun<'m>, opened_at_release: Vec<usize>, through: bool) -> Self {
-        Motion {
-            phases: vec![first],
-            opened_at_release,
-            impacts: Vec::new(),
-            through_impacts: through,
-            halted: None,
-            notes: Vec::new(),
-        }
-    }
-
-    /// Absolute time the last phase ends (s).
-    pub fn end_time(&self) -> f64 {
-        self.phases.last().map_or(0.0, PhaseRun::t_end)
-    }
-
-    /// `theta_dot` at the end of the last phase (rad/s).
-    pub fn end_angular_velocity(&self) -> f64 {
-        self.phases.last().map_or(0.0, PhaseRun::theta_dot_end)
-    }
-
-    /// Why the last phase ended.
-    pub fn last_end(&self) -> Option<End> {
-        self.phases.last().map(PhaseRun::end)
-    }
-
-    /// Whether the motion goes on after a phase that ended by `end`: after a contact that
-    /// opens, and after one that closes where the run goes on through impacts.
-    pub fn goes_on_after(&self, end: End) -> bool {
-        match end {
-            End::Force(_) => true,
-            End::Contact(_) => self.through_impacts,
-            End::Edge(_) | End::Floor | End::Until => false,
-        }
-    }
-
-    /// Whether the motion is complete: its last phase ends for good (the floor, an edge, the
-    /// run's end, or a contact that closes where impacts end the run), or it was halted.
-    pub fn complete(&self) -> bool {
-        self.halted.is_some() || self.last_end().is_some_and(|e| !self.goes_on_after(e))
-    }
-
-    /// The impact that ended phase `k`, if one did.
-    pub fn impact_after(&self, k: usize) -> Option<&ImpactAt> {
-        self.impacts.iter().find(|i| i.phase == k)
-    }
 }
 
 /// How a system's motion is solved: its general model with parameters, where to find its
@@ -624,7 +151,7 @@ impl<'m> Walker<'m> {
     pub fn after(&self, run: &PhaseRun<'m>) -> Result<PhaseStart, SolveError> {
         let state = run.full_end_state()?;
         let t = run.t_end();
-        let held = run.closed_at_end();
+        let held = run.closed_at_end()?;
         let at = Moment::After {
             t,
             held: &held,
@@ -922,7 +449,7 @@ impl<'m> Walker<'m> {
         let info = general.info();
         let phase = motion.phases.len() - 1;
         let last = &motion.phases[phase];
-        let (state, t, held) = (last.full_end_state()?, last.t_end(), last.closed_at_end());
+        let (state, t, held) = (last.full_end_state()?, last.t_end(), last.closed_at_end()?);
         let approaching = approaching_touches(general, &state)?;
         let parts: Vec<Part> = (info.contacts.iter().enumerate())
             .map(|(c, contact)| {
