@@ -146,6 +146,7 @@ fn walker(
         rtol,
         route,
         until: None,
+        dense_output: true,
     })
 }
 
