@@ -47,6 +47,7 @@ fn solve(mu: f64) -> Result<Point, Box<dyn Error>> {
         rtol: 1e-13,
         route: Route::Fastest,
         until: None,
+        dense_output: true,
     };
     // The contact phase: the first phase from release (the foot's friction acts, so the general
     // model is integrated with both contacts closed), to its first event.

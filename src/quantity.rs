@@ -111,6 +111,29 @@ pub struct UnknownQuantity {
 }
 
 impl Quantity {
+    /// Whether the quantity samples the motion between the integrator's steps (series,
+    /// trajectories and the drawing made from them, the checks at the samples): the run then
+    /// keeps every integrated step's continuous extension, which DOP853 pays with three more
+    /// evaluations a step. Every variant is listed, so that a new one must say.
+    pub fn samples_motion(&self) -> bool {
+        match self {
+            Quantity::ThetaSeries
+            | Quantity::ForceSeries(_)
+            | Quantity::FrictionSeries(_)
+            | Quantity::Trajectory(_)
+            | Quantity::Checks => true,
+            Quantity::SeparationAngle
+            | Quantity::LinearisedSeparationAngle
+            | Quantity::SeparationTime
+            | Quantity::ContactEnd
+            | Quantity::ContactTimeToFloor
+            | Quantity::PointMassFallTime
+            | Quantity::FloorImpact
+            | Quantity::Impacts
+            | Quantity::CrossCheck => false,
+        }
+    }
+
     /// Resolves a `want` entry for a model; the error lists what the model offers.
     pub fn parse(name: &str, info: &ModelInfo) -> Result<Quantity, UnknownQuantity> {
         if let Some((_, q, _)) = FIXED.iter().find(|(n, _, _)| *n == name) {

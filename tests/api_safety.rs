@@ -756,6 +756,7 @@ fn the_solvers_refuse_a_state_of_another_length() {
             frictions: options.frictions.clone(),
             friction_work: 0.0,
             stop_at: None,
+            dense_output: true,
         };
         input(
             &unpanicked("integrate", || {
@@ -801,6 +802,7 @@ fn the_solvers_refuse_a_state_of_another_length() {
             rtol: 1e-12,
             route: Route::Fastest,
             until: None,
+            dense_output: true,
         };
         let start = PhaseStart {
             state: bad.clone(),

@@ -26,6 +26,7 @@ fn walker(registry: &'static [&'static dyn Model], route: Route) -> Walker<'stat
         rtol: 1e-12,
         route,
         until: None,
+        dense_output: true,
     }
 }
 
@@ -136,6 +137,7 @@ fn energy_drift_is_judged_against_the_motion_not_a_constant_potential() {
         rtol: 1e-12,
         route: Route::Fastest,
         until: None,
+        dense_output: true,
     };
     let (start, _) = w.release().unwrap();
     let phase = w.solve(&start, &mut Work::default()).unwrap();
@@ -349,6 +351,7 @@ fn a_cube_running_into_the_tip_ends_the_motion() {
         frictions: vec![],
         friction_work: 0.0,
         stop_at: None,
+        dense_output: true,
     };
     let ode = unreduced::integrate(&w.general, &start, 1e-12, None, 1.0, &mut work).unwrap();
     assert_eq!(ode.end, End::Contact(0));

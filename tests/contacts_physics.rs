@@ -120,6 +120,7 @@ fn walker(name: &str, params: &[(&str, f64)], route: Route) -> Walker<'static> {
         rtol: 1e-13,
         route,
         until: None,
+        dense_output: true,
     }
 }
 

@@ -93,6 +93,7 @@ fn walker(mu: f64, tol: f64, rtol: f64) -> Walker<'static> {
         rtol,
         route: Route::Fastest,
         until: None,
+        dense_output: true,
     }
 }
 

@@ -36,6 +36,7 @@ fn strike() -> (Bound<'static>, State, f64) {
         rtol: 1e-13,
         route: Route::Integrated,
         until: None,
+        dense_output: true,
     };
     let (start, opened) = w.release().unwrap();
     assert_eq!(opened, [0], "the cylinder opens at release");

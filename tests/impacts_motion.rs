@@ -39,6 +39,7 @@ fn liftoff_walker(e: f64, until: f64) -> Walker<'static> {
         rtol: 1e-13,
         route: Route::Fastest,
         until: Some(until),
+        dense_output: true,
     }
 }
 
@@ -207,6 +208,7 @@ fn the_rod_that_left_the_cylinder_strikes_it_again_and_goes_on() {
         rtol: 1e-13,
         route: Route::Fastest,
         until: Some(1.0),
+        dense_output: true,
     };
     let motion = walker.motion(&mut Work::default()).unwrap();
     assert_eq!(
@@ -312,6 +314,7 @@ fn a_block_that_tipped_comes_down_on_its_near_edge_by_the_hand_impulse() {
         rtol: 1e-13,
         route: Route::Fastest,
         until: Some(0.6),
+        dense_output: true,
     };
     let motion = walker.motion(&mut Work::default()).unwrap();
     let info = walker.general.info();

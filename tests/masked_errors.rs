@@ -53,6 +53,7 @@ fn a_mass_matrix_without_an_inverse_is_an_error_not_a_guess() {
         rtol: 1e-12,
         route: Route::Fastest,
         until: None,
+        dense_output: true,
     };
     match walker.release() {
         Err(SolveError::SingularMassMatrix { t, q }) => {

@@ -43,6 +43,7 @@ fn options() -> OdeOptions {
         atol: vec![1e-12],
         t_max: 2.0,
         max_steps: 1_000_000,
+        dense_output: true,
     }
 }
 

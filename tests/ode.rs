@@ -51,6 +51,7 @@ fn integrate_general(
         frictions: vec![],
         friction_work: 0.0,
         stop_at: None,
+        dense_output: true,
     };
     let d = contacts::dynamics(general, &start.state, &start.active, 0.0).unwrap();
     let scales = motion_scales(
@@ -139,6 +140,7 @@ fn the_contact_force_vanishes_at_the_event() {
         frictions: vec![],
         friction_work: 0.0,
         stop_at: None,
+        dense_output: true,
     };
     let run = integrate(bound, &start, 1e-12, None, 1.0, &mut Work::default()).unwrap();
     assert_eq!(run.end, End::Force(0));
@@ -301,6 +303,7 @@ fn both_integrators_find_the_separation() {
             atol: Vec::new(),
             t_max: 1.0,
             max_steps: 200_000,
+            dense_output: true,
         };
         let mut evals = [0; 2];
         for (e, method) in evals.iter_mut().zip([Method::Dopri5, Method::Dop853]) {

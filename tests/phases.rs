@@ -23,6 +23,7 @@ fn walker(registry: &'static [&'static dyn Model]) -> Walker<'static> {
         rtol: 1e-13,
         route: Route::Fastest,
         until: None,
+        dense_output: true,
     }
 }
 
@@ -186,6 +187,7 @@ fn ode_agrees_on_the_free_phase() {
         frictions: vec![],
         friction_work: 0.0,
         stop_at: None,
+        dense_output: true,
     };
     let run = integrate(&w.general, &start, 1e-12, None, 1.0, &mut Work::default()).unwrap();
     assert_eq!(run.end, End::Floor);
@@ -201,6 +203,7 @@ fn ode_agrees_on_the_free_phase() {
     let integrated = Walker {
         route: Route::Integrated,
         until: None,
+        dense_output: true,
         ..w.clone()
     };
     let next = integrated.after(&motion.phases[0]).unwrap();

@@ -77,6 +77,7 @@ fn series_agrees_with_the_ode_dense_output() {
             frictions: vec![],
             friction_work: 0.0,
             stop_at: None,
+            dense_output: true,
         };
         // Absolute tolerances from the motion's own scales (the foot's height, held at zero,
         // carries only rounding).
@@ -87,6 +88,7 @@ fn series_agrees_with_the_ode_dense_output() {
             rtol: 1e-13,
             route: Route::Integrated,
             until: None,
+            dense_output: true,
         };
         let scales = walker.scales(&start.state, &start.active).unwrap();
         let run = integrate(

@@ -145,6 +145,7 @@ fn walker(
         rtol,
         route,
         until: None,
+        dense_output: true,
     })
 }
 

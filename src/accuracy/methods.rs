@@ -452,6 +452,7 @@ fn reduced_ode(
         atol: Vec::new(),
         t_max,
         max_steps: 2_000_000,
+        dense_output: true,
     };
     let sol = dopri5(&mut problem, 0.0, &[0.0, 0.0], &opts)?;
     Ok((sol, problem.calls))
@@ -473,6 +474,7 @@ pub fn time_unreduced(sys: &System, rtol: f64, t_max: f64) -> Outcome<f64> {
         frictions: Vec::new(),
         friction_work: 0.0,
         stop_at: None,
+        dense_output: true,
     };
     let run = unreduced::integrate_with(
         sys,

@@ -342,6 +342,7 @@ pub fn run(request: &Request) -> Result<RunResults, PlanError> {
         rtol: (request.tolerance * ODE_RTOL_FACTOR).max(ODE_RTOL_FLOOR),
         route: request.route,
         until: request.until,
+        dense_output: want.iter().any(Quantity::samples_motion),
     };
     let mut plan = Plan::new(walker, request.samples);
     let mut out = RunResults {
@@ -662,6 +663,7 @@ impl<'m> Plan<'m> {
             frictions: start.frictions,
             friction_work: 0.0,
             stop_at: None,
+            dense_output: self.walker.dense_output,
         };
         let bound = self.general().clone();
         let t_max = 2.0 * duration.max(f64::MIN_POSITIVE);

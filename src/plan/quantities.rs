@@ -459,15 +459,26 @@ impl Plan<'_> {
         let motion = &*slot.insert(motion);
         let mut groups: Vec<(usize, Vec<f64>)> = Vec::new();
         for &t in &times {
-            // The phase that runs at `t`: the last one starting at or before it that lasts, or
-            // the one ending there (the phases cover the span, so there is one).
-            let k = (motion.phases.iter())
-                .rposition(|p| p.t_start() <= t && (t < p.t_end() || p.t_end() >= end))
-                .ok_or(SolveError::Inversion {
-                    target: t,
-                    duration: end,
-                    reason: "no solved phase runs at this time",
-                })?;
+            // The phase that runs at `t`: the last one starting at or before it that lasts; at
+            // the span's end the one ending there, never one that begins there, so that a
+            // series is the same however much of the motion other quantities solved (the
+            // phases cover the span, so there is one).
+            let runs = |p: &PhaseRun| p.t_start() <= t && t < p.t_end();
+            let ends = |p: &PhaseRun| p.t_start() < end && p.t_end() >= end;
+            let last = |p: &PhaseRun| p.t_start() <= t && p.t_end() >= end;
+            let phases = || motion.phases.iter();
+            let k = (if t < end {
+                phases().rposition(runs)
+            } else {
+                phases()
+                    .rposition(ends)
+                    .or_else(|| phases().rposition(last))
+            })
+            .ok_or(SolveError::Inversion {
+                target: t,
+                duration: end,
+                reason: "no solved phase runs at this time",
+            })?;
             match groups.last_mut() {
                 Some((g, ts)) if *g == k => ts.push(t),
                 _ => groups.push((k, vec![t])),

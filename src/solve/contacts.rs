@@ -162,14 +162,26 @@ pub fn dynamics_into(
     t: f64,
     work: &mut DynamicsWork,
 ) -> Result<(), SolveError> {
+    check_active(sys.info(), active)?;
+    work.rows.fill(sys, state)?;
+    solve_filled(sys, state, active, t, work)
+}
+
+/// [`dynamics_into`] with `work.rows` already filled at `state` (an active set checked): the
+/// sets [`decide`] tries at one state share the model's matrices.
+fn solve_filled(
+    sys: &Bound,
+    state: &State,
+    active: &Active,
+    t: f64,
+    work: &mut DynamicsWork,
+) -> Result<(), SolveError> {
     let info = sys.info();
     let (n, m, nf) = (
         sys.n_coordinates(),
         info.contacts.len(),
         info.frictions.len(),
     );
-    check_active(info, active)?;
-    work.rows.fill(sys, state)?;
     work.kkt.clear();
     work.kkt
         .extend((0..m).filter(|&i| active.closed[i] && !info.contacts[i].closed));
@@ -591,9 +603,15 @@ pub fn decide(sys: &Bound, state: &State, options: &Options, t: f64) -> Result<A
     }
     let mut found: Vec<(Active, Dynamics)> = Vec::new();
     let mut singular: Vec<String> = Vec::new();
+    // The model's matrices at the state, and its inverse mass matrix once one is needed, are
+    // shared by every set tried.
+    let mut work = DynamicsWork::default();
+    work.rows.fill(sys, state)?;
+    let mut inverse: Option<DMatrix<f64>> = None;
     for active in combinations(sys, options, t)? {
-        let d = match dynamics(sys, state, &active, t) {
-            Ok(d) => d,
+        check_active(info, &active)?;
+        match solve_filled(sys, state, &active, t, &mut work) {
+            Ok(()) => {}
             // Redundant supports that hold the system at rest (a ladder stuck at both ends):
             // its motion is none, whatever share of the load each support takes.
             Err(SolveError::SingularContacts { .. })
@@ -610,10 +628,15 @@ pub fn decide(sys: &Bound, state: &State, options: &Options, t: f64) -> Result<A
                 continue;
             }
             Err(e) => return Err(e),
+        }
+        let inverse = match &inverse {
+            Some(inv) => inv,
+            None => inverse.insert(inverse_mass(&work.rows, state, t)?),
         };
-        let scales = acc_scales(sys, state, &active, &d, t)?;
-        if consistent(sys, options, &active, &d, &scales) {
-            found.push((active, d));
+        let d = &work.out;
+        let scales = acc_scales(&work.rows, inverse, info, &active, d);
+        if consistent(sys, options, &active, d, &scales) {
+            found.push((active, d.clone()));
         }
     }
     let active = pick(info, options, found, &singular, t)?;
@@ -633,33 +656,34 @@ pub fn decide(sys: &Bound, state: &State, options: &Options, t: f64) -> Result<A
 /// block) is judged at its own scale, and one whose acceleration cancels to rounding noise
 /// (a foot just lifting) at the scale of the forces that cancel.
 ///
-/// A mass matrix that cannot be inverted (while the constrained system could be solved) gives
-/// no scale to judge a contact by: [`SolveError::SingularMassMatrix`], not a guess.
+/// `inverse` is the inverse of `rows`' mass matrix ([`inverse_mass`]).
 fn acc_scales(
-    sys: &Bound,
-    state: &State,
+    rows: &Rows,
+    inverse: &DMatrix<f64>,
+    info: &ModelInfo,
     active: &Active,
     d: &Dynamics,
-    t: f64,
-) -> Result<Vec<f64>, SolveError> {
-    let info = sys.info();
-    let rows = Rows::at(sys, state)?;
-    let n = rows.n;
-    let mass = DMatrix::from_row_slice(n, n, &rows.mass);
-    let Some(inverse) = mass.try_inverse() else {
-        return Err(SolveError::SingularMassMatrix {
-            t,
-            q: state.q.clone(),
-        });
-    };
-    let size = coordinate_scales(&rows, &inverse, info, active, d);
-    Ok((0..info.contacts.len())
+) -> Vec<f64> {
+    let size = coordinate_scales(rows, inverse, info, active, d);
+    (0..info.contacts.len())
         .map(|i| {
             let row = rows.row(&rows.jac, i);
             let terms: f64 = row.iter().zip(&size).map(|(j, s)| (j * s).abs()).sum();
             terms + rows.bias[i].abs()
         })
-        .collect())
+        .collect()
+}
+
+/// The inverse of the mass matrix of `rows` (at `state`, time `t` from release). One that
+/// cannot be inverted (while a constrained system could be solved) gives no scale to judge a
+/// contact by: [`SolveError::SingularMassMatrix`], not a guess.
+fn inverse_mass(rows: &Rows, state: &State, t: f64) -> Result<DMatrix<f64>, SolveError> {
+    let mass = DMatrix::from_row_slice(rows.n, rows.n, &rows.mass);
+    mass.try_inverse()
+        .ok_or_else(|| SolveError::SingularMassMatrix {
+            t,
+            q: state.q.clone(),
+        })
 }
 
 /// The size of each coordinate's acceleration in `d`, what its rounding is relative to: the

@@ -57,6 +57,11 @@ pub struct OdeOptions {
     pub t_max: f64,
     /// Most steps (accepted plus rejected) before [`SolveError::TooManySteps`].
     pub max_steps: u64,
+    /// Keep every step's continuous extension, so that the solution can be sampled between
+    /// steps ([`OdeSolution::interpolate`]). Without it only the steps whose events are located
+    /// compute one (DOP853 saves its three dense-output evaluations a step elsewhere) and the
+    /// solution holds the states at the steps' ends; the steps and events are the same.
+    pub dense_output: bool,
 }
 
 /// The Runge–Kutta method of an integration.
@@ -139,7 +144,8 @@ impl std::fmt::Display for Method {
     }
 }
 
-/// One accepted step with its dense-output coefficients.
+/// One accepted step with its dense-output coefficients (none when the integration did not keep
+/// them, [`OdeOptions::dense_output`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct DenseStep {
     /// Start time.
@@ -155,15 +161,35 @@ pub struct DenseStep {
     /// Continuous-extension coefficients `c_0..c_{m-1}` of
     /// `y0 + s (c_0 + (1 - s) (c_1 + s (c_2 + (1 - s) (c_3 + ...))))`, `s = (t - t0) / h`:
     /// `rcont2..rcont5` of Hairer's DOPRI5 (`m = 4`), `cont(2..8)` of DOP853's `contd8`
-    /// (`m = 7`), each of length `y0.len()`.
+    /// (`m = 7`), each of length `y0.len()`. Empty: the step kept only its ends.
     coeffs: Vec<Vec<f64>>,
 }
 
 impl DenseStep {
-    /// The interpolated state at `t` in `[t0, t0 + h]`. A component beyond a coefficient's
-    /// length (only if the public `y0` was lengthened after the step) takes that coefficient
-    /// as zero.
-    pub fn interpolate(&self, t: f64) -> Vec<f64> {
+    /// The interpolated state at `t` in `[t0, t0 + h]`; `None` when the step kept no
+    /// continuous extension ([`OdeOptions::dense_output`]) and `t` is not one of its ends.
+    pub fn interpolate(&self, t: f64) -> Option<Vec<f64>> {
+        if self.coeffs.is_empty() {
+            return if t == self.t0 {
+                Some(self.y0.clone())
+            } else if t == self.t1() {
+                Some(self.y1.clone())
+            } else {
+                None
+            };
+        }
+        Some(self.extension(t))
+    }
+
+    /// Whether the step kept its continuous extension.
+    pub fn has_extension(&self) -> bool {
+        !self.coeffs.is_empty()
+    }
+
+    /// The continuous extension at `t` (only for a step that has one). A component beyond a
+    /// coefficient's length (only if the public `y0` was lengthened after the step) takes
+    /// that coefficient as zero.
+    fn extension(&self, t: f64) -> Vec<f64> {
         let s = (t - self.t0) / self.h;
         let s1 = 1.0 - s;
         let m = self.coeffs.len();
@@ -225,7 +251,8 @@ impl OdeSolution {
         self.accepted + self.rejected + self.event_trials
     }
 
-    /// The state at `t` from dense output, if `t` lies in the integrated range.
+    /// The state at `t` from dense output, if `t` lies in the integrated range and its step
+    /// kept its continuous extension (or `t` is a step's end).
     pub fn interpolate(&self, t: f64) -> Option<Vec<f64>> {
         let first = self.steps.first()?;
         let last = self.steps.last()?;
@@ -240,7 +267,7 @@ impl OdeSolution {
         if t == step.t1() {
             return Some(step.y1.clone());
         }
-        Some(step.interpolate(t))
+        step.interpolate(t)
     }
 
     /// Time and state at the end of every accepted step, the initial state first.
@@ -845,6 +872,18 @@ impl Stages {
             coeffs,
         })
     }
+
+    /// The step just taken to `(t0 + h, y1)` with its ends only (no continuous extension).
+    fn ends(&self, t0: f64, y: &[f64], h: f64) -> DenseStep {
+        DenseStep {
+            t0,
+            h,
+            y0: y.to_vec(),
+            y1: self.y1.clone(),
+            method: self.tab.method,
+            coeffs: Vec::new(),
+        }
+    }
 }
 
 fn check_finite(what: &'static str, t: f64, v: &[f64]) -> Result<(), SolveError> {
@@ -1007,7 +1046,12 @@ pub fn integrate<P: OdeProblem>(
         problem.events(t + h, &st.y1, st.end(), &mut g_new)?;
         check_finite("event function", t + h, &g_new)?;
         let crossed: Vec<usize> = (0..m).filter(|&i| changes_sign(g[i], g_new[i])).collect();
-        let dense = st.dense(problem, t, &y, h)?;
+        // The extension estimates the events' roots: every step that crossed one needs it.
+        let dense = if opts.dense_output || !crossed.is_empty() {
+            st.dense(problem, t, &y, h)?
+        } else {
+            st.ends(t, &y, h)
+        };
         let step = Trial {
             t,
             y: &y,
@@ -1025,7 +1069,11 @@ pub fn integrate<P: OdeProblem>(
                 st.end_derivative(problem)?;
                 sol.event_trials += 1;
             }
-            sol.steps.push(st.dense(problem, t, &y, tau)?);
+            sol.steps.push(if opts.dense_output {
+                st.dense(problem, t, &y, tau)?
+            } else {
+                st.ends(t, &y, tau)
+            });
             sol.event = Some(Event {
                 index,
                 t: t + tau,
@@ -1077,7 +1125,7 @@ fn locate<P: OdeProblem>(
     let mut best: Option<(f64, usize)> = None;
     for &idx in crossed {
         let mut on_extension = |x: f64| -> Result<f64, SolveError> {
-            let z = dense.interpolate(t + x);
+            let z = dense.extension(t + x);
             problem.rhs(t + x, &z, &mut dz)?;
             problem.events(t + x, &z, &dz, &mut g)?;
             check_finite("event function", t + x, &g)?;
@@ -1239,6 +1287,7 @@ mod tests {
             atol: vec![1e-14; 2],
             t_max: 10.0,
             max_steps: 100_000,
+            dense_output: true,
         };
         let sol = dopri5(&mut Oscillator, 0.0, &[0.0, 1.0], &opts).unwrap();
         let ev = sol.event.clone().unwrap();
@@ -1265,6 +1314,7 @@ mod tests {
                 atol: vec![rtol; 2],
                 t_max: 1.0,
                 max_steps: 100_000,
+                dense_output: true,
             };
             struct Free;
             impl OdeProblem for Free {
@@ -1360,6 +1410,7 @@ mod tests {
             atol,
             t_max,
             max_steps: 100_000,
+            dense_output: true,
         }
     }
 
@@ -1386,6 +1437,41 @@ mod tests {
         }
         assert!(sol.interpolate(ev.t + 1e-9).is_none());
         assert!(sol.accepted > 3 && sol.rejected < sol.accepted);
+    }
+
+    /// Without dense output the steps, their ends and the event are the same to the bit; only
+    /// the steps' ends can then be read, and the steps that crossed the event kept their
+    /// extension to locate it (evaluations: DOP853's three a step fewer elsewhere).
+    #[test]
+    fn without_dense_output_the_steps_and_event_are_the_same() {
+        for method in METHODS {
+            let mut opts = options(1e-12, vec![1e-14; 2], 10.0);
+            let count = |opts: &OdeOptions| {
+                let mut p = Counted {
+                    inner: Oscillator,
+                    evals: 0,
+                };
+                let sol = integrate(method, &mut p, 0.0, &[0.0, 1.0], opts).unwrap();
+                (sol, p.evals)
+            };
+            let (with, evals_with) = count(&opts);
+            opts.dense_output = false;
+            let (without, evals_without) = count(&opts);
+            assert_eq!(with.event, without.event, "{method:?}");
+            assert_eq!(with.steps.len(), without.steps.len(), "{method:?}");
+            for (a, b) in with.steps.iter().zip(&without.steps) {
+                assert_eq!((a.t0, a.h, &a.y0, &a.y1), (b.t0, b.h, &b.y0, &b.y1));
+            }
+            let step = &without.steps[1];
+            assert!(!step.has_extension() && with.steps[1].has_extension());
+            assert_eq!(without.interpolate(step.t1()), Some(step.y1.clone()));
+            assert_eq!(without.interpolate(step.t0 + 0.5 * step.h), None);
+            // DOP853: three evaluations fewer on every accepted step but the one that crossed
+            // the event, and on the truncated step to it; DOPRI5's extension costs none.
+            let per_step = if method == Method::Dop853 { 3 } else { 0 };
+            let saved = evals_with - evals_without;
+            assert_eq!(saved, per_step * with.accepted, "{method:?}");
+        }
     }
 
     /// `y0' = -y0^2` (`y0 = 1 / (1 + t)`) and `y1' = cos(t) y1` (`y1 = exp(sin t)`): smooth,
@@ -1421,7 +1507,7 @@ mod tests {
             st.end_derivative(&mut Smooth).unwrap();
             let d = st.dense(&mut Smooth, t, &y, h).unwrap();
             let tm = t + h / 3.0;
-            for (a, b) in d.interpolate(tm).iter().zip(smooth_exact(tm)) {
+            for (a, b) in d.interpolate(tm).unwrap().iter().zip(smooth_exact(tm)) {
                 dense_err = dense_err.max((a - b).abs());
             }
             y.copy_from_slice(&st.y1);
@@ -1673,6 +1759,7 @@ mod tests {
         for method in METHODS {
             let opts = OdeOptions {
                 max_steps: 3,
+                dense_output: true,
                 ..options(1e-12, Vec::new(), 10.0)
             };
             let e = integrate(method, &mut Oscillator, 0.0, &[0.0, 1.0], &opts).unwrap_err();

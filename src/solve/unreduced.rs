@@ -589,6 +589,9 @@ pub struct Start {
     /// Where the run is asked to stop (s from this start) if no event comes first: it then
     /// ends there with [`End::Until`]. `None`: only an event ends it.
     pub stop_at: Option<f64>,
+    /// Keep every step's continuous extension, for sampling the run between its steps
+    /// ([`UnreducedRun::state_at`]; [`OdeOptions::dense_output`]).
+    pub dense_output: bool,
 }
 
 /// The integrator's absolute tolerances: `rtol` times each of `scales` (length `2 n`; none
@@ -713,6 +716,7 @@ pub fn integrate_with(
         atol,
         t_max: stop_at.unwrap_or(t_max),
         max_steps: MAX_STEPS,
+        dense_output: start.dense_output,
     };
     let mut segments = Vec::new();
     let mut t0 = 0.0;

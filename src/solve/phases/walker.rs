@@ -89,6 +89,11 @@ pub struct Walker<'m> {
     /// The time the run goes on to (s from release), through impacts: `None` ends it at the
     /// first event that ends the motion (the floor, an edge, or a contact that closes).
     pub until: Option<f64>,
+    /// Keep the continuous extension of every integrated step, so that the phases can be
+    /// sampled between steps (series, trajectories, checks;
+    /// [`crate::quantity::Quantity::samples_motion`]).
+    /// Without it a sample inside an integrated step is an error, never a guess.
+    pub dense_output: bool,
 }
 
 impl std::fmt::Debug for Walker<'_> {
@@ -309,6 +314,7 @@ impl<'m> Walker<'m> {
             frictions: start.frictions.clone(),
             friction_work: start.friction_work,
             stop_at: self.until.map(|u| u - start.t),
+            dense_output: self.dense_output,
         };
         // A run with an end time may go on to it however long its phases last.
         let t_max = (time * MAX_FALL_TIMES).max(from.stop_at.unwrap_or(0.0));
