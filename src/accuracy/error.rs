@@ -106,6 +106,9 @@ pub enum AccuracyError {
     /// Gauss–Jacobi's node count or exponents were refused.
     #[error("bad Gauss-Jacobi parameters")]
     BadGaussJacobi,
+    /// A Gauss–Legendre rule asked with no node.
+    #[error("a Gauss–Legendre rule needs at least one node")]
+    NoNodes,
     /// Adaptive Gauss–Kronrod ran out of subintervals.
     #[error(
         "not converged after {limit} subintervals (estimate {estimate:.6e}, error {error:.1e})"

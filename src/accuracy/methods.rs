@@ -199,7 +199,7 @@ pub fn time_per_point(solver: &mut LeanSolver, sys: &System) -> Outcome<f64> {
 /// One Gauss–Legendre panel of `nodes` after `delta = u^2`.
 pub fn time_gl_u2(sys: &System, delta: f64, nodes: usize) -> Outcome<f64> {
     let Some(order) = NonZeroUsize::new(nodes) else {
-        return Err("a Gauss–Legendre rule needs at least one node".to_string());
+        return Err(AccuracyError::NoNodes);
     };
     let rule = gauss_legendre_rule(order);
     let u_end = delta.sqrt();
