@@ -39,10 +39,22 @@ pub struct Checked {
 }
 
 impl Checked {
-    /// The gap unit and force unit of contact `j` (`("m", "N")`); empty strings for an index
-    /// out of range.
-    pub fn contact_units(&self, j: usize) -> (String, String) {
-        self.units.get(j).cloned().unwrap_or_default()
+    /// The gap unit and force unit of contact `j` (`("m", "N")`); an error at `contacts[j]`
+    /// for an index past the spec's contacts.
+    pub fn contact_units(&self, j: usize) -> Result<(String, String), SpecError> {
+        self.units.get(j).cloned().ok_or_else(|| SpecError {
+            file: self.file.clone(),
+            line: 0,
+            column: 0,
+            field: format!("contacts[{j}]"),
+            message: format!(
+                "no contact {j}: the spec has {} ({} with units)",
+                self.spec.contacts.len(),
+                self.units.len()
+            ),
+            source_line: String::new(),
+            width: 0,
+        })
     }
 }
 

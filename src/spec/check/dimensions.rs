@@ -108,17 +108,23 @@ impl Checker<'_> {
             })?;
             let force_unit = conjugate_force_unit(gap_unit)
                 .map_err(|err| self.err(&field.k("gap"), format!("contact `{}`: {err}", c.name)))?;
-            if let Some(edge) = &c.edge
-                && let Ok(e) = Expr::parse(&edge.text())
-                && let Err(err) = unit_of(&e, &lookup)
-            {
-                return Err(self.err(
-                    &field.k("edge"),
-                    format!(
-                        "the edge of contact `{}` has no consistent unit: {err}",
-                        c.name
-                    ),
-                ));
+            if let Some(edge) = &c.edge {
+                // The checker parsed it already; an error here would be its own, not skipped.
+                let e = Expr::parse(&edge.text()).map_err(|e| {
+                    self.err(
+                        &field.k("edge"),
+                        format!("cannot parse `{}`: {}", edge.text(), e.message),
+                    )
+                })?;
+                unit_of(&e, &lookup).map_err(|err| {
+                    self.err(
+                        &field.k("edge"),
+                        format!(
+                            "the edge of contact `{}` has no consistent unit: {err}",
+                            c.name
+                        ),
+                    )
+                })?;
             }
             if let Some(e) = &c.restitution {
                 expect(

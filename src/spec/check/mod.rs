@@ -71,34 +71,40 @@ pub(super) struct Checker<'a> {
 
 /// A field path as both YAML steps and a dotted name.
 #[derive(Clone)]
-struct Field(Vec<(Option<String>, Option<usize>)>);
+struct Field(Vec<Part>);
+
+/// One step of a [`Field`]: a mapping key or a sequence index.
+#[derive(Clone)]
+enum Part {
+    Key(String),
+    Index(usize),
+}
 
 impl Field {
     fn key(k: &str) -> Field {
-        Field(vec![(Some(k.to_string()), None)])
+        Field(vec![Part::Key(k.to_string())])
     }
     fn k(&self, k: &str) -> Field {
         let mut v = self.0.clone();
-        v.push((Some(k.to_string()), None));
+        v.push(Part::Key(k.to_string()));
         Field(v)
     }
     fn i(&self, i: usize) -> Field {
         let mut v = self.0.clone();
-        v.push((None, Some(i)));
+        v.push(Part::Index(i));
         Field(v)
     }
     fn dotted(&self) -> String {
         let mut s = String::new();
-        for (k, i) in &self.0 {
-            match (k, i) {
-                (Some(k), _) => {
+        for part in &self.0 {
+            match part {
+                Part::Key(k) => {
                     if !s.is_empty() {
                         s.push('.');
                     }
                     s.push_str(k);
                 }
-                (None, Some(i)) => s.push_str(&format!("[{i}]")),
-                _ => {}
+                Part::Index(i) => s.push_str(&format!("[{i}]")),
             }
         }
         s
@@ -110,10 +116,9 @@ impl Checker<'_> {
         let steps: Vec<Step<'_>> = field
             .0
             .iter()
-            .map(|(k, i)| match (k, i) {
-                (Some(k), _) => Step::Key(k.as_str()),
-                (None, Some(i)) => Step::Index(*i),
-                _ => Step::Index(0),
+            .map(|part| match part {
+                Part::Key(k) => Step::Key(k.as_str()),
+                Part::Index(i) => Step::Index(*i),
             })
             .collect();
         let mark = self.doc.locate_nearest(&steps, At::Key);
@@ -357,6 +362,7 @@ impl Checker<'_> {
                     ));
                 }
                 if let Some(j) = eliminated.insert(e, i) {
+                    // `j` is an earlier `i` of this loop over `s.contacts`: in range.
                     return Err(self.err(
                         &f,
                         format!(
@@ -497,6 +503,7 @@ impl Checker<'_> {
             }
         }
         if let Err(i) = solved_parameters(&dim.groups) {
+            // `i` is the index of one of `dim.groups` (see `solved_parameters`): in range.
             return Err(self.err(
                 &field.k("groups").i(i).k("expr"),
                 format!(

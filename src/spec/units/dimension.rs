@@ -545,12 +545,15 @@ fn function_list() -> String {
     names.join(", ")
 }
 
-fn base_unit_name(symbol: &str) -> &'static str {
+/// The name of an SI base unit besides kg, m and s; any other symbol (a [`UnitError`] built by
+/// hand) quoted as it is.
+fn base_unit_name(symbol: &str) -> String {
     match symbol {
-        "A" => "the ampere",
-        "K" => "the kelvin",
-        "mol" => "the mole",
-        _ => "the candela",
+        "A" => "the ampere".into(),
+        "K" => "the kelvin".into(),
+        "mol" => "the mole".into(),
+        "cd" => "the candela".into(),
+        other => format!("`{other}`"),
     }
 }
 

@@ -93,6 +93,17 @@ impl UnitParser<'_> {
         self.c.get(self.i).copied()
     }
 
+    /// The characters from here on while `keep` holds, passed over: a symbol, a number or the
+    /// digits of a power (collected as they are passed, so no range of `c` is looked up).
+    fn take_while(&mut self, keep: impl Fn(char) -> bool) -> String {
+        let mut taken = String::new();
+        while let Some(c) = self.peek().filter(|c| keep(*c)) {
+            taken.push(c);
+            self.i += 1;
+        }
+        taken
+    }
+
     /// Skips whitespace; whether there was any.
     fn ws(&mut self) -> bool {
         let start = self.i;
@@ -141,16 +152,14 @@ impl UnitParser<'_> {
         let start = self.i;
         let base = match self.peek() {
             Some(c) if c.is_alphabetic() => {
-                while self.peek().is_some_and(char::is_alphabetic) {
-                    self.i += 1;
-                }
-                let symbol: String = self.c.get(start..self.i).unwrap_or(&[]).iter().collect();
+                let symbol = self.take_while(char::is_alphabetic);
                 if let Some(c) = self.peek().filter(|c| c.is_ascii_digit()) {
                     return Err(self.syntax(format!("write powers with `^`: `{symbol}^{c}`")));
                 }
+                // Each superscript paired with its digit (or minus) by `zip`.
                 let superscript = self.peek().and_then(|c| {
-                    let i = "⁰¹²³⁴⁵⁶⁷⁸⁹⁻".chars().position(|x| x == c)?;
-                    "0123456789-".chars().nth(i)
+                    let mut pairs = "⁰¹²³⁴⁵⁶⁷⁸⁹⁻".chars().zip("0123456789-".chars());
+                    pairs.find(|(x, _)| *x == c).map(|(_, d)| d)
                 });
                 if let Some(c) = superscript {
                     return Err(self.syntax(format!("write powers with `^`: `{symbol}^{c}`")));
@@ -158,10 +167,7 @@ impl UnitParser<'_> {
                 self.symbol(&symbol, start)?
             }
             Some(c) if c.is_ascii_digit() => {
-                while self.peek().is_some_and(|c| c.is_ascii_digit() || c == '.') {
-                    self.i += 1;
-                }
-                let number: String = self.c.get(start..self.i).unwrap_or(&[]).iter().collect();
+                let number = self.take_while(|c| c.is_ascii_digit() || c == '.');
                 if number != "1" {
                     return Err(self.syntax_at(
                         start,
@@ -269,10 +275,8 @@ impl UnitParser<'_> {
     /// A non-negative integer that fits `i64` (so that its negation fits too).
     fn digits(&mut self) -> Result<i64, UnitError> {
         let start = self.i;
-        while self.peek().is_some_and(|c| c.is_ascii_digit()) {
-            self.i += 1;
-        }
-        if self.i == start {
+        let digits = self.take_while(|c| c.is_ascii_digit());
+        if digits.is_empty() {
             return Err(match self.peek() {
                 Some(c) => self.syntax(format!(
                     "expected a whole number for the power, found `{c}`"
@@ -280,7 +284,6 @@ impl UnitParser<'_> {
                 None => self.syntax("expected a whole number for the power at the end".into()),
             });
         }
-        let digits: String = self.c.get(start..self.i).unwrap_or(&[]).iter().collect();
         digits
             .parse::<i64>()
             .map_err(|_| self.syntax_at(start, format!("the power `{digits}` is too large")))
