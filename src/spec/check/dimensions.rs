@@ -52,13 +52,16 @@ impl Checker<'_> {
         let s = self.spec;
         let units = self.symbol_units()?;
         let lookup = |n: &str| units.get(n).copied();
-        let expect = |field: Field, text: &Text, unit: Unit, what: &str| {
-            let e = Expr::parse(&text.text()).map_err(|e| {
+        let parse = |field: &Field, text: &Text| {
+            Expr::parse(&text.text()).map_err(|e| {
                 self.err(
-                    &field,
+                    field,
                     format!("cannot parse `{}`: {}", text.text(), e.message),
                 )
-            })?;
+            })
+        };
+        let expect = |field: Field, text: &Text, unit: Unit, what: &str| {
+            let e = parse(&field, text)?;
             expect_unit(&e, &lookup, unit)
                 .map_err(|err| self.err(&field, format!("{what} must be in {unit}: {err}")))
         };
@@ -91,40 +94,24 @@ impl Checker<'_> {
         let mut out = Vec::new();
         for (i, c) in s.contacts.iter().enumerate() {
             let field = Field::key("contacts").i(i);
-            let gap = Expr::parse(&c.gap.text()).map_err(|e| {
-                self.err(
-                    &field.k("gap"),
-                    format!("cannot parse `{}`: {}", c.gap.text(), e.message),
-                )
-            })?;
-            let gap_unit = unit_of(&gap, &lookup).map_err(|err| {
-                self.err(
-                    &field.k("gap"),
-                    format!(
-                        "the gap of contact `{}` has no consistent unit: {err}",
-                        c.name
-                    ),
-                )
-            })?;
-            let force_unit = conjugate_force_unit(gap_unit)
-                .map_err(|err| self.err(&field.k("gap"), format!("contact `{}`: {err}", c.name)))?;
-            if let Some(edge) = &c.edge {
-                // The checker parsed it already; an error here would be its own, not skipped.
-                let e = Expr::parse(&edge.text()).map_err(|e| {
+            // The unit of the contact's `gap` or `edge`, which must have one.
+            let consistent = |key: &str, text: &Text| -> Result<Unit, SpecError> {
+                let f = field.k(key);
+                unit_of(&parse(&f, text)?, &lookup).map_err(|err| {
                     self.err(
-                        &field.k("edge"),
-                        format!("cannot parse `{}`: {}", edge.text(), e.message),
-                    )
-                })?;
-                unit_of(&e, &lookup).map_err(|err| {
-                    self.err(
-                        &field.k("edge"),
+                        &f,
                         format!(
-                            "the edge of contact `{}` has no consistent unit: {err}",
+                            "the {key} of contact `{}` has no consistent unit: {err}",
                             c.name
                         ),
                     )
-                })?;
+                })
+            };
+            let gap_unit = consistent("gap", &c.gap)?;
+            let force_unit = conjugate_force_unit(gap_unit)
+                .map_err(|err| self.err(&field.k("gap"), format!("contact `{}`: {err}", c.name)))?;
+            if let Some(edge) = &c.edge {
+                consistent("edge", edge)?;
             }
             if let Some(e) = &c.restitution {
                 expect(
