@@ -326,7 +326,9 @@ fn contact_rows(checked: &Checked, atoms: &[ContactAtoms]) -> Result<Vec<Contact
     let spec = &checked.spec;
     let mut out = Vec::new();
     for (j, (c, a)) in spec.contacts.iter().zip(atoms).enumerate() {
-        let (gap_unit, force_unit) = checked.contact_units(j);
+        let (gap_unit, force_unit) = checked
+            .contact_units(j)
+            .map_err(|e| at(&[key("contacts"), FieldStep::Index(j)], e.message))?;
         let opt = |x: &Option<A>, what: &str| -> Result<Option<Expr>, DeriveError> {
             x.as_ref().map(|e| to_expr(e, what)).transpose()
         };

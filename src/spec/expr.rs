@@ -410,20 +410,20 @@ pub fn write_signed_sum(
 }
 
 /// A product of factors, simplified for 0 and 1 factors.
-pub fn product(mut v: Vec<Expr>) -> Expr {
-    match v.len() {
-        0 => Expr::int(1),
-        1 => v.pop().unwrap_or(Expr::int(1)),
-        _ => Expr::Mul(v),
+pub fn product(v: Vec<Expr>) -> Expr {
+    match <[Expr; 1]>::try_from(v) {
+        Ok([only]) => only,
+        Err(v) if v.is_empty() => Expr::int(1),
+        Err(v) => Expr::Mul(v),
     }
 }
 
 /// A sum of terms, simplified for 0 and 1 terms.
-pub fn sum(mut v: Vec<Expr>) -> Expr {
-    match v.len() {
-        0 => Expr::int(0),
-        1 => v.pop().unwrap_or(Expr::int(0)),
-        _ => Expr::Add(v),
+pub fn sum(v: Vec<Expr>) -> Expr {
+    match <[Expr; 1]>::try_from(v) {
+        Ok([only]) => only,
+        Err(v) if v.is_empty() => Expr::int(0),
+        Err(v) => Expr::Add(v),
     }
 }
 
@@ -609,7 +609,12 @@ impl Parser<'_> {
                 break;
             }
         }
-        let text = std::str::from_utf8(&self.s[start..self.i]).unwrap_or("");
+        // In range: the loop moved `i` from `start` only over bytes that exist, and each is
+        // ASCII (a digit, `.`, `e`, `E` or a sign), so each byte is its own character.
+        let text: String = self.s[start..self.i]
+            .iter()
+            .map(|&b| char::from(b))
+            .collect();
         if float {
             text.parse::<f64>()
                 .map(Expr::Float)
