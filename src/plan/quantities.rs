@@ -7,8 +7,8 @@ use super::{Plan, angle_coordinate, column, phase_labels, scalar};
 use crate::model::ModelInfo;
 use crate::quantity::Quantity;
 use crate::results::{
-    ContactImpulse, Held, ImpactRecord, Label, Meaning, Note, RunResults, Series, Unlanded,
-    UntilNote, format_number,
+    ContactImpulse, Held, ImpactRecord, Label, LabelValue, Meaning, Note, RunResults, Series,
+    Stretch, Unlanded, UntilNote,
 };
 use crate::solve::SolveError;
 use crate::solve::impact::Part;
@@ -320,7 +320,7 @@ impl Plan<'_> {
                         out.labels.insert(
                             format!("{key}_cause"),
                             Label {
-                                value: cause,
+                                value: LabelValue::Word(cause),
                                 meaning: Meaning::ContactEndCause { contact },
                             },
                         );
@@ -362,13 +362,12 @@ impl Plan<'_> {
             Meaning::ContactEndFrictionWork,
         );
         let sequence = (phases.iter().flat_map(|p| p.stretches()))
-            .map(|(t, m)| format!("{m} from t = {} s", format_number(t, 6)))
-            .collect::<Vec<_>>()
-            .join("; ");
+            .map(|(from, modes)| Stretch { from, modes })
+            .collect();
         out.labels.insert(
             "contact_end_contact_modes".into(),
             Label {
-                value: sequence,
+                value: LabelValue::Stretches(sequence),
                 meaning: Meaning::ContactModes,
             },
         );

@@ -22,7 +22,7 @@
 //! A check carries what it tested as data (a [`CheckSubject`]: the quantity named, with the
 //! numbers that scale it); `report::prose::check_meaning` writes its sentence.
 
-use crate::results::{Check, CheckKind, CheckSubject};
+use crate::results::{Check, CheckKind, CheckPhase, CheckSubject};
 use crate::solve::SolveError;
 use crate::solve::impact::Impact;
 use crate::solve::series::PhaseSamples;
@@ -33,8 +33,8 @@ use nalgebra::DMatrix;
 /// absolute time its clock starts at (so monitor times read from release).
 #[derive(Debug, Clone)]
 pub struct Context {
-    /// `<model>` for a phase, `<model> (ODE cross-check)` for the cross-check's path.
-    pub phase: String,
+    /// The phase, an impact, or the cross-check's path.
+    pub phase: CheckPhase,
     /// Key prefix: `<model>`, or `<model>.ode`.
     pub key: String,
     /// Position of the group in the run (phases in the order they happen).
@@ -47,7 +47,7 @@ impl Context {
     /// A phase that starts at release and comes first, labelled and keyed `label`.
     pub fn new(label: &str) -> Context {
         Context {
-            phase: label.to_string(),
+            phase: CheckPhase::Phase(label.to_string()),
             key: label.to_string(),
             order: 0,
             t_start: 0.0,
