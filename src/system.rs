@@ -137,6 +137,17 @@ pub enum SystemError {
         /// Why, from the derivation.
         why: &'static str,
     },
+    /// A model whose `reduced_index` names none of its coordinates (a malformed generated
+    /// model).
+    #[error("model `{model}` names coordinate {index} as its reduced one but has {coordinates}")]
+    ReducedIndex {
+        /// Model name.
+        model: &'static str,
+        /// Its `reduced_index`.
+        index: usize,
+        /// How many coordinates it has.
+        coordinates: usize,
+    },
     /// A state's coordinates and velocities of different lengths ([`State::new`]).
     #[error("a state needs as many velocities as coordinates: q has {q} values, qd {qd}")]
     StateShape {
@@ -286,6 +297,9 @@ pub struct Bound<'m> {
     /// `model.info()`, read by every evaluation (kept to spare the call through the trait
     /// object).
     info: &'static ModelInfo,
+    /// `info.coordinates[info.reduced_index]`, looked up once when bound (a model whose
+    /// `reduced_index` names no coordinate is refused: [`SystemError::ReducedIndex`]).
+    reduced_coordinate: &'static str,
     p: Vec<f64>,
     k: Vec<f64>,
     restitutions: Vec<f64>,
@@ -325,6 +339,13 @@ impl<'m> Bound<'m> {
     /// [`check_parameters`] and prepared by [`prepare_constants`].
     pub fn from_values(model: &'m dyn Model, p: &[f64]) -> Result<Self, SystemError> {
         let info = model.info();
+        let reduced_coordinate = (info.coordinates.get(info.reduced_index).copied()).ok_or(
+            SystemError::ReducedIndex {
+                model: info.name,
+                index: info.reduced_index,
+                coordinates: info.coordinates.len(),
+            },
+        )?;
         let mut margins = vec![0.0; info.requirements.len()];
         check_parameters(model, p, &mut margins)?;
         let restitutions = restitutions(model, p)?;
@@ -333,6 +354,7 @@ impl<'m> Bound<'m> {
         Ok(Bound {
             model,
             info,
+            reduced_coordinate,
             p: p.to_vec(),
             k,
             restitutions,
@@ -343,6 +365,12 @@ impl<'m> Bound<'m> {
     /// order of [`ModelInfo::contacts`].
     pub fn restitutions(&self) -> &[f64] {
         &self.restitutions
+    }
+
+    /// The name of the reduced coordinate (`theta`), the model's
+    /// `coordinates[reduced_index]`.
+    pub fn reduced_coordinate(&self) -> &'static str {
+        self.reduced_coordinate
     }
 
     /// The model.

@@ -3,7 +3,7 @@
 //! the landing, each computing only what it needs of the motion.
 
 use super::drawing::{PhaseInput, record};
-use super::{Plan, angle_coordinate, column, phase_labels, scalar};
+use super::{Plan, column, phase_labels, scalar};
 use crate::model::ModelInfo;
 use crate::quantity::Quantity;
 use crate::results::{
@@ -62,12 +62,13 @@ pub(super) fn fate(motion: &Motion, general: &Bound, i: usize) -> Result<Option<
         (false, Some(last)) if matches!(last.end(), End::Contact(_)) => is_landing(general, last)?,
         _ => false,
     };
-    Ok(fate_along(motion, info, i, landed))
+    Ok(fate_along(motion, general, i, landed))
 }
 
 /// [`fate`] for a contact that did not open at release; `landed`: the motion ends at a landing
 /// where a contact closes.
-fn fate_along(motion: &Motion, info: &ModelInfo, i: usize, landed: bool) -> Option<Fate> {
+fn fate_along(motion: &Motion, general: &Bound, i: usize, landed: bool) -> Option<Fate> {
+    let info = general.info();
     let first = motion.phases.first()?;
     if !first.closed().get(i).copied().unwrap_or(false) {
         return Some(Fate::NeverClosed);
@@ -110,7 +111,7 @@ fn fate_along(motion: &Motion, info: &ModelInfo, i: usize, landed: bool) -> Opti
             End::Floor => {
                 return Some(Fate::Held {
                     until: Held::Floor {
-                        angle: angle_coordinate(info).to_string(),
+                        angle: general.reduced_coordinate().to_string(),
                         end_angle: info.end_angle,
                     },
                 });
@@ -222,7 +223,7 @@ impl Plan<'_> {
             && end.end == End::Force(0)
             && let Some(at) = end.at
         {
-            let angle = angle_coordinate(info).to_string();
+            let angle = self.general().reduced_coordinate().to_string();
             scalar(
                 out,
                 &key,
@@ -239,7 +240,7 @@ impl Plan<'_> {
                 cause: "force",
             } => {
                 if q == Quantity::SeparationAngle {
-                    let angle = angle_coordinate(info).to_string();
+                    let angle = self.general().reduced_coordinate().to_string();
                     scalar(out, &key, theta, "rad", Meaning::SeparationAngle { angle });
                 } else {
                     scalar(out, &key, t, "s", Meaning::SeparationTime);
@@ -312,7 +313,7 @@ impl Plan<'_> {
                         };
                         scalar(out, &format!("{key}_time"), *t, "s", meaning);
                         let meaning = Meaning::ContactEndAngle {
-                            angle: angle_coordinate(info).to_string(),
+                            angle: self.general().reduced_coordinate().to_string(),
                             contact: contact.clone(),
                             cause: cause.clone(),
                         };
@@ -380,7 +381,7 @@ impl Plan<'_> {
         let t = self.floor_mesh()?.duration;
         let key = Quantity::ContactTimeToFloor.name(info);
         let meaning = Meaning::ContactTimeToFloor {
-            angle: angle_coordinate(info).to_string(),
+            angle: self.general().reduced_coordinate().to_string(),
             end_angle: info.end_angle,
         };
         scalar(out, &key, t, "s", meaning);
@@ -576,7 +577,7 @@ impl Plan<'_> {
                 work,
                 "J",
                 Meaning::FloorImpactFrictionWork {
-                    angle: angle_coordinate(info).to_string(),
+                    angle: general.reduced_coordinate().to_string(),
                     end_angle: info.end_angle,
                 },
             );
@@ -608,7 +609,7 @@ impl Plan<'_> {
             return Ok(());
         };
         let (time, omega) = (landing.t_end(), landing.theta_dot_end());
-        let (angle, path) = (angle_coordinate(info).to_string(), phase_labels(motion));
+        let (angle, path) = (general.reduced_coordinate().to_string(), phase_labels(motion));
         let meaning = Meaning::FloorImpactTime {
             angle: angle.clone(),
             end_angle: info.end_angle,
