@@ -305,12 +305,18 @@ fn a_steep_rod_on_a_small_cylinder_leaves_it_at_release_and_meets_it_again() {
         &[Quantity::ContactEnd, Quantity::FloorImpact],
         Route::Fastest,
     );
-    assert_eq!(got.labels["contact_end_cause"].value.as_word(), Some("force"));
+    assert_eq!(
+        got.labels["contact_end_cause"].value.as_word(),
+        Some("force")
+    );
     assert_eq!(value(&got, "contact_end_time"), 0.0);
     assert_eq!(value(&got, "contact_end_angle"), th0);
     // Only the rod alone on the floor runs (on the fast path), until it meets the cylinder.
     assert_eq!(got.work.phases, vec!["rod_cylinder_free"]);
-    assert_eq!(got.labels["floor_normal_end_cause"].value.as_word(), Some("contact"));
+    assert_eq!(
+        got.labels["floor_normal_end_cause"].value.as_word(),
+        Some("contact")
+    );
     assert!(
         rodcube::report::prose::note(&got.notes["floor_impact"]).contains("the bodies meet"),
         "{:?}",
@@ -398,8 +404,14 @@ fn a_hinged_rod_on_a_cylinder_takes_the_fast_path_to_its_edge() {
         ];
         let fast = ask("hinged_cylinder", &params, &want, Route::Fastest);
         let slow = ask("hinged_cylinder", &params, &want, Route::Integrated);
-        assert_eq!(fast.labels["contact_end_cause"].value.as_word(), Some("edge"));
-        assert_eq!(slow.labels["contact_end_cause"].value.as_word(), Some("edge"));
+        assert_eq!(
+            fast.labels["contact_end_cause"].value.as_word(),
+            Some("edge")
+        );
+        assert_eq!(
+            slow.labels["contact_end_cause"].value.as_word(),
+            Some("edge")
+        );
         let edge = 2.0 * (r / 1.0f64).atan();
         let theta = value(&fast, "contact_end_angle");
         assert!(((theta - edge) / edge).abs() < 1e-14, "{theta} vs {edge}");

@@ -6,7 +6,8 @@
 use rodcube::io::OutDir;
 use rodcube::report::{self, csv, json, plot, table};
 use rodcube::results::{
-    Check, CheckKind, CheckPhase, CheckSubject, Column, Held, Meaning, Note, RunResults, Scalar, Series, Work,
+    Check, CheckKind, CheckPhase, CheckSubject, Column, Held, Meaning, Note, RunResults, Scalar,
+    Series, Work,
 };
 use std::collections::BTreeMap;
 use std::fs;

@@ -62,82 +62,116 @@ pub(super) fn fate(motion: &Motion, general: &Bound, i: usize) -> Result<Option<
         (false, Some(last)) if matches!(last.end(), End::Contact(_)) => is_landing(general, last)?,
         _ => false,
     };
-    Ok(fate_along(motion, general, i, landed))
+    fate_along(motion, general, i, landed)
+}
+
+/// Whether contact `i` of the system is closed in `phase`; a phase that does not list it is a
+/// [`SolveError::PhaseMismatch`] (every model of a system lists the system's contacts).
+fn closed_in(general: &Bound, phase: &PhaseRun, i: usize) -> Result<bool, SolveError> {
+    let closed = phase.closed();
+    closed.get(i).copied().ok_or_else(|| {
+        mismatch(
+            general,
+            phase,
+            format!("it lists {} contact(s), not contact {i}", closed.len()),
+        )
+    })
+}
+
+/// A phase of `general`'s system that does not fit it, with what does not.
+fn mismatch(general: &Bound, phase: &PhaseRun, why: String) -> SolveError {
+    SolveError::PhaseMismatch {
+        system: general.info().system,
+        name: phase.bound().info().name,
+        why,
+    }
 }
 
 /// [`fate`] for a contact that did not open at release; `landed`: the motion ends at a landing
 /// where a contact closes.
-fn fate_along(motion: &Motion, general: &Bound, i: usize, landed: bool) -> Option<Fate> {
+fn fate_along(
+    motion: &Motion,
+    general: &Bound,
+    i: usize,
+    landed: bool,
+) -> Result<Option<Fate>, SolveError> {
     let info = general.info();
-    let first = motion.phases.first()?;
-    if !first.closed().get(i).copied().unwrap_or(false) {
-        return Some(Fate::NeverClosed);
+    let Some(first) = motion.phases.first() else {
+        return Ok(None);
+    };
+    if !closed_in(general, first, i)? {
+        return Ok(Some(Fate::NeverClosed));
     }
-    let name = |j: usize| info.contacts.get(j).map_or("a contact", |c| c.name);
     for (k, phase) in motion.phases.iter().enumerate() {
+        let name = |j: usize| {
+            (info.contacts.get(j).map(|c| c.name.to_string())).ok_or_else(|| {
+                let why = format!("it ends at contact {j}, which the system does not have");
+                mismatch(general, phase, why)
+            })
+        };
         let ended = |cause| Fate::Ended {
             t: phase.t_end(),
             theta: phase.theta_end(),
             cause,
         };
         match phase.end() {
-            End::Force(j) if j == i => return Some(ended("force")),
-            End::Edge(j) if j == i => return Some(ended("edge")),
+            End::Force(j) if j == i => return Ok(Some(ended("force"))),
+            End::Edge(j) if j == i => return Ok(Some(ended("edge"))),
             End::Contact(j) if !motion.through_impacts && landed => {
-                return Some(Fate::Held {
+                return Ok(Some(Fate::Held {
                     until: Held::Lands {
-                        contact: name(j).to_string(),
+                        contact: name(j)?,
                         t: phase.t_end(),
                     },
-                });
+                }));
             }
-            End::Contact(_) if !motion.through_impacts => return Some(ended("contact")),
+            End::Contact(_) if !motion.through_impacts => return Ok(Some(ended("contact"))),
             End::Contact(_) => {
                 // An impact: it may have separated this contact.
                 let Some(next) = motion.phases.get(k + 1) else {
-                    return (motion.halted.as_ref()).map(|why| Fate::Held {
+                    return Ok((motion.halted.as_ref()).map(|why| Fate::Held {
                         until: Held::Halted(why.clone()),
-                    });
+                    }));
                 };
-                if !next.closed().get(i).copied().unwrap_or(false) {
-                    return Some(ended("impact"));
+                if !closed_in(general, next, i)? {
+                    return Ok(Some(ended("impact")));
                 }
             }
             End::Until => {
-                return Some(Fate::Held {
+                return Ok(Some(Fate::Held {
                     until: Held::RunsEnd { t: phase.t_end() },
-                });
+                }));
             }
             End::Floor => {
-                return Some(Fate::Held {
+                return Ok(Some(Fate::Held {
                     until: Held::Floor {
                         angle: general.reduced_coordinate().to_string(),
                         end_angle: info.end_angle,
                     },
-                });
+                }));
             }
             End::Edge(j) => {
-                return Some(Fate::Held {
+                return Ok(Some(Fate::Held {
                     until: Held::Edge {
-                        contact: name(j).to_string(),
+                        contact: name(j)?,
                         t: phase.t_end(),
                     },
-                });
+                }));
             }
             End::Force(_) => {
                 // Another contact opened; the decision there may have opened this one too.
                 let Some(next) = motion.phases.get(k + 1) else {
-                    return (motion.halted.as_ref()).map(|why| Fate::Held {
+                    return Ok((motion.halted.as_ref()).map(|why| Fate::Held {
                         until: Held::Halted(why.clone()),
-                    });
+                    }));
                 };
                 if !next.closed().get(i).copied().unwrap_or(false) {
-                    return Some(ended("force"));
+                    return Ok(Some(ended("force")));
                 }
             }
         }
     }
-    None
+    Ok(None)
 }
 
 /// Whether `phase` (of the system whose general model is `general`) ends where the body lands: at the model's end angle, or where a contact
@@ -501,13 +535,23 @@ impl Plan<'_> {
                 }
                 Quantity::ForceSeries(i) => {
                     for (j, f) in sample_forces(phase, s)?.iter().enumerate() {
-                        push(&[t[j], s.theta[j], f.get(i).copied().unwrap_or(f64::NAN)]);
+                        let force = f.get(i).copied().ok_or_else(|| {
+                            let why = format!("it gives {} force(s), not contact {i}'s", f.len());
+                            mismatch(&general, phase, why)
+                        })?;
+                        push(&[t[j], s.theta[j], force]);
                     }
                 }
                 Quantity::FrictionSeries(i) => {
                     for (j, [f, n, v]) in sample_friction(phase, &general, s)?.iter().enumerate() {
-                        let at = |x: &[f64]| x.get(i).copied().unwrap_or(f64::NAN);
-                        push(&[t[j], s.theta[j], at(f), at(n), at(v)]);
+                        let at = |x: &[f64]| {
+                            x.get(i).copied().ok_or_else(|| {
+                                let why =
+                                    format!("it gives {} friction(s), not friction {i}", x.len());
+                                mismatch(&general, phase, why)
+                            })
+                        };
+                        push(&[t[j], s.theta[j], at(f)?, at(n)?, at(v)?]);
                     }
                 }
                 Quantity::Trajectory(i) => {
@@ -609,7 +653,10 @@ impl Plan<'_> {
             return Ok(());
         };
         let (time, omega) = (landing.t_end(), landing.theta_dot_end());
-        let (angle, path) = (general.reduced_coordinate().to_string(), phase_labels(motion));
+        let (angle, path) = (
+            general.reduced_coordinate().to_string(),
+            phase_labels(motion),
+        );
         let meaning = Meaning::FloorImpactTime {
             angle: angle.clone(),
             end_angle: info.end_angle,

@@ -146,7 +146,7 @@ impl Plan<'_> {
                 &run.closed(),
                 tol,
                 &ctx,
-            ));
+            )?);
             found.extend(path_checks(run, samples, tol, &ctx)?);
             out.checks.extend(found);
         }
