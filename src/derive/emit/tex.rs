@@ -273,7 +273,7 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> Result<TexContext, Step
                             "Force \\texttt{{{}}}: {} (integrated route: {})",
                             tex_text(&c.name),
                             tex_text(&c.meaning),
-                            tex_text(why)
+                            tex_text(&why.to_string())
                         ),
                         "F = ".into(),
                         2,
