@@ -138,6 +138,11 @@
 #define RODCUBE_ERR_PARAM_RESTITUTION 114
 
 /**
+ * The model's reduced coordinate is none of its coordinates (a malformed model).
+ */
+#define RODCUBE_ERR_PARAM_REDUCED_INDEX 115
+
+/**
  * Group: the request was refused (codes 201 to 299).
  */
 #define RODCUBE_ERR_REQUEST 200

@@ -80,6 +80,8 @@ pub const RODCUBE_ERR_PARAM_LENGTH: c_int = 112;
 pub const RODCUBE_ERR_PARAM_NOT_FINITE_INPUT: c_int = 113;
 /// A contact's coefficient of restitution (from the parameters) outside [0, 1].
 pub const RODCUBE_ERR_PARAM_RESTITUTION: c_int = 114;
+/// The model's reduced coordinate is none of its coordinates (a malformed model).
+pub const RODCUBE_ERR_PARAM_REDUCED_INDEX: c_int = 115;
 
 /// Group: the request was refused (codes 201 to 299).
 pub const RODCUBE_ERR_REQUEST: c_int = 200;
@@ -247,6 +249,7 @@ static CODES: &[(c_int, &CStr)] = named![
     RODCUBE_ERR_PARAM_LENGTH,
     RODCUBE_ERR_PARAM_NOT_FINITE_INPUT,
     RODCUBE_ERR_PARAM_RESTITUTION,
+    RODCUBE_ERR_PARAM_REDUCED_INDEX,
     RODCUBE_ERR_REQUEST,
     RODCUBE_ERR_NOT_A_SYSTEM,
     RODCUBE_ERR_UNAVAILABLE,
@@ -327,6 +330,7 @@ fn system_code(e: &SystemError) -> c_int {
         SystemError::Length { .. } => RODCUBE_ERR_PARAM_LENGTH,
         SystemError::NotFiniteInput { .. } => RODCUBE_ERR_PARAM_NOT_FINITE_INPUT,
         SystemError::Restitution { .. } => RODCUBE_ERR_PARAM_RESTITUTION,
+        SystemError::ReducedIndex { .. } => RODCUBE_ERR_PARAM_REDUCED_INDEX,
     }
 }
 

@@ -11,12 +11,13 @@ use rodcube::model::Model;
 use rodcube::plan::{Request, run};
 use rodcube::quantity::Quantity;
 use rodcube::results::{CheckKind, Work};
+use rodcube::solve::SolveError;
 use rodcube::solve::checks::{self, Conserved};
 use rodcube::solve::contacts::Active;
 use rodcube::solve::phases::{End, PhaseRun, ReducedRun, Route, Walker, phase_end};
 use rodcube::solve::series::{sample, sample_forces};
 use rodcube::solve::unreduced::{self, Start};
-use rodcube::system::{Bound, State, System};
+use rodcube::system::{Bound, State, System, SystemError};
 
 fn walker(registry: &'static [&'static dyn Model], route: Route) -> Walker<'static> {
     Walker {
@@ -72,7 +73,8 @@ fn a_monitor_below_zero_fails_with_its_minimum_as_value() {
         &phase.closed().unwrap(),
         1e-12,
         &ctx,
-    );
+    )
+    .unwrap();
     let keys: Vec<&str> = pushes.iter().map(|(k, _)| k.as_str()).collect();
     assert_eq!(
         keys,
@@ -183,11 +185,13 @@ fn a_contact_that_would_pull_fails_its_check() {
     let mut forces = sample_forces(&phase, &samples).unwrap();
     let ctx = checks::Context::new("rod_cube_closed");
     let closed = phase.closed().unwrap();
-    let ok = checks::contact_forces(phase.bound(), &samples, &forces, &closed, 1e-12, &ctx);
+    let ok =
+        checks::contact_forces(phase.bound(), &samples, &forces, &closed, 1e-12, &ctx).unwrap();
     assert!(ok.iter().all(|(_, c)| c.passed), "{ok:?}");
     // The floor pulling the foot down by 1 N at one sample.
     forces[20][1] = -1.0;
-    let pulled = checks::contact_forces(phase.bound(), &samples, &forces, &closed, 1e-12, &ctx);
+    let pulled =
+        checks::contact_forces(phase.bound(), &samples, &forces, &closed, 1e-12, &ctx).unwrap();
     let floor = &pulled[1].1;
     assert_eq!(pulled[1].0, "rod_cube_closed.floor_normal_pushes");
     assert!(!floor.passed && floor.value == -1.0, "{floor:?}");
@@ -197,7 +201,8 @@ fn a_contact_that_would_pull_fails_its_check() {
     assert!(pulled[0].1.passed);
     // A NaN force fails too.
     forces[20][1] = f64::NAN;
-    let nan = checks::contact_forces(phase.bound(), &samples, &forces, &closed, 1e-12, &ctx);
+    let nan =
+        checks::contact_forces(phase.bound(), &samples, &forces, &closed, 1e-12, &ctx).unwrap();
     assert!(!nan[1].1.passed, "{:?}", nan[1]);
     // An open contact has no push to check.
     let none = checks::contact_forces(
@@ -207,8 +212,27 @@ fn a_contact_that_would_pull_fails_its_check() {
         &[false, false],
         1e-12,
         &ctx,
-    );
+    )
+    .unwrap();
     assert!(none.is_empty());
+    // A sample without the contact's force, or closed flags not one per contact, is an error,
+    // not a NaN that fails the check.
+    let mut short = forces.clone();
+    short[20].truncate(1);
+    for (what, forces, closed) in [
+        ("forces", &short, &closed[..]),
+        ("closed", &forces, &[true]),
+    ] {
+        match checks::contact_forces(phase.bound(), &samples, forces, closed, 1e-12, &ctx) {
+            Err(SolveError::Input(SystemError::Length {
+                what: w,
+                expected: 2,
+                got: 1,
+                ..
+            })) if w == what => {}
+            other => panic!("{what}: {other:?}"),
+        }
+    }
 }
 
 #[test]

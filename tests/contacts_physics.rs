@@ -75,10 +75,9 @@ fn value(r: &RunResults, key: &str) -> f64 {
 }
 
 fn label<'a>(r: &'a RunResults, key: &str) -> &'a str {
-    &r.labels
-        .get(key)
-        .unwrap_or_else(|| panic!("no label `{key}` in {:?}", r.labels))
-        .value
+    (r.labels.get(key))
+        .and_then(|l| l.value.as_word())
+        .unwrap_or_else(|| panic!("no word `{key}` in {:?}", r.labels))
 }
 
 /// `|a - b| <= tol |b|`, with a message.

@@ -354,3 +354,38 @@ fn a_frame_the_model_refuses_is_dropped_with_a_note() {
         animation.notes
     );
 }
+
+/// The general `rod_cube` whose `reduced_index` names no coordinate (a malformed generated
+/// model): the planner used to call its angle `theta` anyway.
+struct NoReducedCoordinate;
+
+impl Model for NoReducedCoordinate {
+    forward_model!(|_: &Self| &GENERAL; requirements, restitutions, prepare, initial_state, points, energy, momenta, equations, forces_full, gaps, constraints, edges, friction, monitors_full, to_full, drawing);
+
+    fn info(&self) -> &'static ModelInfo {
+        static INFO: OnceLock<&'static ModelInfo> = OnceLock::new();
+        INFO.get_or_init(|| {
+            Box::leak(Box::new(ModelInfo {
+                reduced_index: 4,
+                ..*GENERAL.info()
+            }))
+        })
+    }
+    fn reduction(&self) -> Option<&dyn Reduction> {
+        None
+    }
+}
+
+#[test]
+fn a_model_whose_reduced_index_names_no_coordinate_is_refused_when_bound() {
+    match Bound::new(&NoReducedCoordinate, &paper(9.81)) {
+        Err(SystemError::ReducedIndex {
+            model: "rod_cube",
+            index: 4,
+            coordinates: 4,
+        }) => {}
+        other => panic!("{other:?}"),
+    }
+    let plain = Bound::new(&GENERAL, &paper(9.81)).unwrap();
+    assert_eq!(plain.reduced_coordinate(), "theta");
+}

@@ -293,7 +293,7 @@ fn check_contact_end(model: &'static dyn Model, p: &[f64]) -> Result<(), TestCas
     match res.results.get("contact_end_time") {
         Some(t) => {
             let theta = res.results["contact_end_angle"].value;
-            let cause = &res.labels["contact_end_cause"].value;
+            let cause = rodcube::report::prose::label(&res.labels["contact_end_cause"].value);
             prop_assert!(t.value.is_finite() && t.value >= 0.0, "{p:?}: {}", t.value);
             prop_assert!(theta.is_finite() && theta > 0.0, "{p:?}: {theta}");
             prop_assert!(

@@ -6,7 +6,8 @@
 use rodcube::io::OutDir;
 use rodcube::report::{self, csv, json, plot, table};
 use rodcube::results::{
-    Check, CheckKind, CheckSubject, Column, Held, Meaning, Note, RunResults, Scalar, Series, Work,
+    Check, CheckKind, CheckPhase, CheckSubject, Column, Held, Meaning, Note, RunResults, Scalar,
+    Series, Work,
 };
 use std::collections::BTreeMap;
 use std::fs;
@@ -155,7 +156,7 @@ fn paper_results(m2: f64) -> RunResults {
         Check {
             passed: true,
             kind: CheckKind::Monitor,
-            phase: "rod_cube".into(),
+            phase: CheckPhase::Phase("rod_cube".into()),
             order: 0,
             value: 2.45,
             limit: 0.0,
@@ -175,7 +176,7 @@ fn paper_results(m2: f64) -> RunResults {
         Check {
             passed: false,
             kind: CheckKind::Drift,
-            phase: "rod_cube_free".into(),
+            phase: CheckPhase::Phase("rod_cube_free".into()),
             order: 2,
             value: 3e-9 + 1e-12,
             limit: 1e-12,

@@ -107,7 +107,7 @@ fn solve<'py>(
         out.set_item(key, scalar.value)?;
     }
     for (key, label) in &results.labels {
-        out.set_item(key, &label.value)?;
+        out.set_item(key, &rodcube::report::prose::label(&label.value))?;
     }
     for (key, series) in &results.series {
         let columns = PyDict::new(py);

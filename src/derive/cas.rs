@@ -7,7 +7,7 @@
 //! must run on the derivation thread started by [`super::on_cas_thread`].
 
 use super::expr::Expr;
-use super::types::StepError;
+use super::types::{StepError, Unheld};
 use symbolica::atom::{Atom, AtomCore, AtomView, FunctionBuilder, Symbol};
 use symbolica::coefficient::CoefficientView;
 use symbolica::prelude::RealLike;
@@ -58,8 +58,8 @@ pub fn expr(a: &A) -> Result<Expr, StepError> {
         })
 }
 
-fn view(v: AtomView) -> Result<Expr, String> {
-    let all = |items: &mut dyn Iterator<Item = AtomView>| -> Result<Vec<Expr>, String> {
+fn view(v: AtomView) -> Result<Expr, Unheld> {
+    let all = |items: &mut dyn Iterator<Item = AtomView>| -> Result<Vec<Expr>, Unheld> {
         items.map(view).collect()
     };
     Ok(match v {
@@ -80,8 +80,8 @@ fn view(v: AtomView) -> Result<Expr, String> {
 
 /// A real rational (or float) coefficient; anything else (complex, infinite, undefined, a
 /// finite-field element) has no place in a mechanics derivation and is an error.
-fn number(c: CoefficientView) -> Result<Expr, String> {
-    let too_large = |_| "a rational beyond 128 bits".to_string();
+fn number(c: CoefficientView) -> Result<Expr, Unheld> {
+    let too_large = |_| Unheld::TooLarge;
     match c {
         CoefficientView::Natural(n, d, 0, _) => Ok(Expr::Rational(n.into(), d.into())),
         CoefficientView::Large(re, im) if im.is_zero() => {
@@ -92,7 +92,7 @@ fn number(c: CoefficientView) -> Result<Expr, String> {
             ))
         }
         CoefficientView::Float(re, im) if im.is_zero() => Ok(Expr::Float(re.to_float().to_f64())),
-        _ => Err("a number that is not real and finite".into()),
+        _ => Err(Unheld::NotReal),
     }
 }
 

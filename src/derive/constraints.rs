@@ -186,9 +186,13 @@ fn multipliers(spec: &Spec, parsed: &Parsed, st: &Setup) -> Result<Vec<A>, Deriv
         lhs.push(row);
     }
     solve_linear(lhs, rhs).ok_or_else(|| {
-        let first = st.plan.closed.first().copied().unwrap_or(0);
+        // At the first closed contact's `eliminates`; at the contacts where none is closed.
+        let field = match st.plan.closed.first() {
+            Some(&first) => entry("contacts", first, "eliminates").to_vec(),
+            None => vec![key("contacts")],
+        };
         at(
-            &entry("contacts", first, "eliminates"),
+            &field,
             format!(
                 "phase `{}`: the closed contacts' forces cannot be solved from the coordinates \
                  they eliminate (their gaps' derivatives in those coordinates are singular)",

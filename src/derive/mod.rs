@@ -197,8 +197,18 @@ pub fn spec_files(root: &Path) -> Result<Vec<PathBuf>, Error> {
     Ok(out)
 }
 
-fn to_spec_error(checked: &Checked, err: mechanics::DeriveError) -> SpecError {
-    let text = std::fs::read_to_string(&checked.file).unwrap_or_default();
+/// A derivation's error placed in its spec file (read again for the position); an error
+/// reading the file is that error.
+fn to_spec_error(checked: &Checked, err: mechanics::DeriveError) -> Error {
+    let text = match std::fs::read_to_string(&checked.file) {
+        Ok(text) => text,
+        Err(source) => {
+            return Error::Io {
+                path: checked.file.clone(),
+                source,
+            };
+        }
+    };
     let steps: Vec<Step<'_>> = err
         .field
         .iter()
@@ -218,7 +228,7 @@ fn to_spec_error(checked: &Checked, err: mechanics::DeriveError) -> SpecError {
         .collect::<String>()
         .trim_start_matches('.')
         .to_string();
-    SpecError {
+    Error::Spec(SpecError {
         file: checked.file.clone(),
         line: mark.line,
         column: mark.column,
@@ -226,7 +236,7 @@ fn to_spec_error(checked: &Checked, err: mechanics::DeriveError) -> SpecError {
         message: err.message,
         source_line,
         width: mark.width,
-    }
+    })
 }
 
 /// One spec through every stage: the derivation proper ([`mechanics::derive`]: read → setup →
@@ -257,10 +267,7 @@ pub fn derive_all(checked: &[Checked]) -> Result<Vec<(Vec<Derivation>, Duration)
             })
             .collect::<Vec<_>>()
     })?;
-    results
-        .into_iter()
-        .map(|r| r.map_err(Error::from))
-        .collect()
+    results.into_iter().collect()
 }
 
 /// How long each spec took to derive, by model name.

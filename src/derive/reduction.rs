@@ -25,11 +25,8 @@ use super::expr::{Expr, product};
 use super::lagrangian::Lagrangian;
 use super::setup::Setup;
 use super::spec::Spec;
-use super::types::{Constant, DeriveError, Reduction, Separation, at, key};
+use super::types::{Constant, DeriveError, Reduction, Separation, Unreducible, at, key};
 use std::collections::BTreeMap;
-
-/// Why a phase has no fast path: not an error, the phase is integrated instead.
-pub type Unreducible = String;
 
 /// Stage 6, the reduction: the fast path of a phase, from its Lagrangian and equations.
 pub struct Reducer<'a> {
@@ -102,7 +99,12 @@ impl Reducer<'_> {
                 None => forces_reduced.push(cas::num(0)),
                 Some(f) => match self.reduced_force(f, &red.cyc_vel, &cyc_acc)? {
                     Ok(r) => forces_reduced.push(r),
-                    Err(why) => return Ok(Err(format!("force `{}`: {why}", c.name))),
+                    Err(why) => {
+                        return Ok(Err(Unreducible::Force {
+                            contact: c.name.clone(),
+                            why: Box::new(why),
+                        }));
+                    }
                 },
             }
         }
@@ -147,13 +149,11 @@ impl Reducer<'_> {
             if let (Some(_), Some(edge)) = (&row.force, &row.edge)
                 && !free_of(edge, &others)
             {
-                return Some(format!(
-                    "the edge of contact `{}` depends on {} besides `{}`, which only the \
-                     integrated path follows",
-                    c.name,
-                    others.join(", "),
-                    self.st.theta
-                ));
+                return Some(Unreducible::EdgeOffTheAngle {
+                    contact: c.name.clone(),
+                    others: others.join(", "),
+                    theta: self.st.theta.clone(),
+                });
             }
         }
         None
@@ -164,20 +164,18 @@ impl Reducer<'_> {
         let (st, eqs) = (self.st, self.eqs);
         for (i, c) in st.coords.iter().enumerate() {
             if i != st.reduced && !eqs.cyclic.contains(&i) {
-                return Some(format!(
-                    "coordinate `{c}` is not cyclic (the Lagrangian depends on it), so it cannot \
-                     be eliminated through a conserved momentum"
-                ));
+                return Some(Unreducible::NotCyclic {
+                    coordinate: c.clone(),
+                });
             }
         }
         for &i in &eqs.cyclic {
             for &j in &eqs.cyclic {
                 if !free_of(&eqs.mass[i][j], &[self.theta()]) {
-                    return Some(format!(
-                        "the inertia of cyclic coordinate `{}` depends on `{}`",
-                        st.coords[i],
-                        self.theta()
-                    ));
+                    return Some(Unreducible::InertiaOnTheAngle {
+                        coordinate: st.coords[i].clone(),
+                        theta: self.theta().to_string(),
+                    });
                 }
             }
         }
@@ -282,10 +280,7 @@ impl Reducer<'_> {
             .collect();
         Ok(match solve_linear(mat, vec_b) {
             Some(v) => Ok(v.iter().map(|x| cas::expand(&cas::together(x))).collect()),
-            None => Err(
-                "the cyclic velocities cannot be solved from their momenta (singular inertia)"
-                    .into(),
-            ),
+            None => Err(Unreducible::SingularCyclicInertia),
         })
     }
 
@@ -312,18 +307,15 @@ impl Reducer<'_> {
         let inertia = cas::expand(&cas::together(&inertia));
         let linear = cas::subs_var(&cas::d(&e_red, "rc_w"), "rc_w", &cas::num(0));
         if !is_zero_trig(&linear).map_err(|m| at(&[], m.to_string()))? {
-            return Ok(Err(
-                "the reduced energy has a term linear in the angular velocity".into(),
-            ));
+            return Ok(Err(Unreducible::LinearInRate));
         }
         let v_eff = cas::subs_var(&e_red, "rc_w", &cas::num(0));
         let mut motion: Vec<&str> = vec![theta];
         motion.extend(st.coords.iter().map(String::as_str));
         if !free_of(&v_eff, &motion) {
-            return Ok(Err(format!(
-                "the effective potential depends on {theta} otherwise than through sin({theta}) \
-                 and cos({theta})"
-            )));
+            return Ok(Err(Unreducible::PotentialOffTrig {
+                theta: theta.to_string(),
+            }));
         }
         let ai = cas::subs_var(
             &cas::subs_var(&inertia, "rc_s", &cas::var("rc_si")),
@@ -372,11 +364,10 @@ impl Reducer<'_> {
             let motion = ["rc_s", "rc_c", "rc_w"];
             let ok = [&a0, &bs, &bc, &b0].iter().all(|x| free_of(x, &motion));
             if !ok {
-                return Ok(Err(format!(
-                    "the velocity of `{}` is not affine in sin and cos of `{theta}`; its position \
-                     has no closed form",
-                    st.coords[eqs.cyclic[jj]]
-                )));
+                return Ok(Err(Unreducible::OpenPosition {
+                    coordinate: st.coords[eqs.cyclic[jj]].clone(),
+                    theta: theta.to_string(),
+                }));
             }
             let pos = cas::var(&format!("rc_x{jj}i"))
                 + a0 * cas::var("rc_t")
@@ -419,9 +410,7 @@ impl Reducer<'_> {
         let f2 = cas::expand(&(half * cas::d(&cas::d(&r, "rc_w"), "rc_w")));
         let f3 = cas::d(&f2, "rc_w");
         if !cas::is_zero(&f1) || !cas::is_zero(&f3) {
-            return Ok(Err(
-                "not of the form F0 + F2 theta_dot^2 on the reduced motion".into(),
-            ));
+            return Ok(Err(Unreducible::NotQuadraticInRate));
         }
         Ok(Ok(collect_over(
             &cas::expand(&(f0 + f2 * cas::var("rc_w2"))),
@@ -445,10 +434,7 @@ impl Reducer<'_> {
         // The polynomial keeps the force's sign only where its denominator is evidently
         // positive (a square, positive parameters); otherwise the zero is bracketed instead.
         if !positive(&product(den), &positive_symbols) {
-            return Ok(Err(
-                "the sign of the force's denominator is not evident, so its zero is bracketed"
-                    .into(),
-            ));
+            return Ok(Err(Unreducible::DenominatorSign));
         }
         let numer = reduce_cos_sq(&cas::atom(&product(num)));
         let p0 = cas::expand(&cas::subs_var(&numer, "rc_c", &cas::num(0)));
@@ -459,10 +445,7 @@ impl Reducer<'_> {
         ));
         let check = cas::expand(&(numer.clone() - p0.clone() - p1.clone() * cas::var("rc_c")));
         if !cas::is_zero(&check) {
-            return Ok(Err(
-                "the contact force's numerator is not linear in cos(theta) after sin^2 + cos^2 = 1"
-                    .into(),
-            ));
+            return Ok(Err(Unreducible::NumeratorNotLinearInCos));
         }
         // A factor cos(theta) is positive on the phase (0 < theta < pi/2).
         let poly = if cas::is_zero(&p1) {
@@ -470,10 +453,7 @@ impl Reducer<'_> {
         } else if cas::is_zero(&p0) {
             p1
         } else {
-            return Ok(Err(
-                "the separation condition mixes sin(theta) and cos(theta); it is not a polynomial in sin(theta)"
-                    .into(),
-            ));
+            return Ok(Err(Unreducible::MixedSinCos));
         };
         let (poly, negated) = strip_signed(&poly, &positive_symbols)?;
         let poly = if negated {
@@ -486,7 +466,7 @@ impl Reducer<'_> {
                 coefficients,
                 polynomial: to_expr(&poly, "separation polynomial")?,
             })),
-            None => Ok(Err("the separation polynomial has a degree above 16".into())),
+            None => Ok(Err(Unreducible::DegreeAbove16)),
         }
     }
 

@@ -1,6 +1,7 @@
 //! What the derivation produces, stage by stage: the typed values that every stage of
 //! `derive/` hands to the next, and the layer's errors (`StepError` of a step, `DeriveError`
-//! placed at a spec field), below all of them.
+//! placed at a spec field) and `Unreducible` (why a phase has no fast path), below all of
+//! them.
 //!
 //! A spec describes a *system*: its coordinates, bodies, potentials, obstacles and contacts.
 //! Each derived model is one *phase* of it, named by the contacts it holds closed by
@@ -22,7 +23,7 @@ pub enum StepError {
         /// The atom, as Symbolica prints it.
         atom: String,
         /// What could not be held (a complex number, a rational beyond 128 bits).
-        why: String,
+        why: Unheld,
     },
     /// A coefficient outgrew 128 bits.
     #[error("coefficient overflow")]
@@ -55,6 +56,104 @@ pub enum StepError {
         /// The local.
         local: String,
     },
+}
+
+/// What a number Symbolica gave back is that the derivation's expressions cannot hold.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum Unheld {
+    /// A rational whose numerator or denominator exceeds 128 bits.
+    #[error("a rational beyond 128 bits")]
+    TooLarge,
+    /// A complex, infinite or undefined number, or a finite-field element.
+    #[error("a number that is not real and finite")]
+    NotReal,
+}
+
+/// Why a phase has no fast path: not an error, the phase is integrated instead. Its text is the
+/// reason the LaTeX write-up, the JSON record and the model's `route_note` give.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum Unreducible {
+    /// A closed contact's edge depends on coordinates besides the angle.
+    #[error(
+        "the edge of contact `{contact}` depends on {others} besides `{theta}`, which only the \
+         integrated path follows"
+    )]
+    EdgeOffTheAngle {
+        /// The contact.
+        contact: String,
+        /// The other coordinates, comma-separated.
+        others: String,
+        /// The reduced coordinate.
+        theta: String,
+    },
+    /// A coordinate besides the angle on which the Lagrangian depends.
+    #[error(
+        "coordinate `{coordinate}` is not cyclic (the Lagrangian depends on it), so it cannot \
+         be eliminated through a conserved momentum"
+    )]
+    NotCyclic {
+        /// The coordinate.
+        coordinate: String,
+    },
+    /// A cyclic coordinate whose inertia depends on the angle.
+    #[error("the inertia of cyclic coordinate `{coordinate}` depends on `{theta}`")]
+    InertiaOnTheAngle {
+        /// The cyclic coordinate.
+        coordinate: String,
+        /// The reduced coordinate.
+        theta: String,
+    },
+    /// The cyclic velocities do not follow from their momenta.
+    #[error("the cyclic velocities cannot be solved from their momenta (singular inertia)")]
+    SingularCyclicInertia,
+    /// The reduced energy is not even in the angular velocity.
+    #[error("the reduced energy has a term linear in the angular velocity")]
+    LinearInRate,
+    /// The effective potential is no function of the angle's sine and cosine.
+    #[error(
+        "the effective potential depends on {theta} otherwise than through sin({theta}) \
+         and cos({theta})"
+    )]
+    PotentialOffTrig {
+        /// The reduced coordinate.
+        theta: String,
+    },
+    /// A cyclic velocity whose integral in time has no closed form.
+    #[error(
+        "the velocity of `{coordinate}` is not affine in sin and cos of `{theta}`; its position \
+         has no closed form"
+    )]
+    OpenPosition {
+        /// The cyclic coordinate.
+        coordinate: String,
+        /// The reduced coordinate.
+        theta: String,
+    },
+    /// A contact's force that does not reduce, and why.
+    #[error("force `{contact}`: {why}")]
+    Force {
+        /// The contact.
+        contact: String,
+        /// Why its force does not reduce.
+        why: Box<Unreducible>,
+    },
+    /// A force that is not `F0 + F2 theta_dot^2` on the reduced motion.
+    #[error("not of the form F0 + F2 theta_dot^2 on the reduced motion")]
+    NotQuadraticInRate,
+    /// A force whose denominator has no evident sign (its zero is then bracketed).
+    #[error("the sign of the force's denominator is not evident, so its zero is bracketed")]
+    DenominatorSign,
+    /// A force whose numerator is not linear in `cos(theta)`.
+    #[error("the contact force's numerator is not linear in cos(theta) after sin^2 + cos^2 = 1")]
+    NumeratorNotLinearInCos,
+    /// A separation condition that mixes the sine and the cosine.
+    #[error(
+        "the separation condition mixes sin(theta) and cos(theta); it is not a polynomial in sin(theta)"
+    )]
+    MixedSinCos,
+    /// A separation polynomial of degree above 16.
+    #[error("the separation polynomial has a degree above 16")]
+    DegreeAbove16,
 }
 
 /// Where a derivation error belongs in the spec: a dotted field path and a message.
@@ -327,7 +426,7 @@ pub struct Derivation {
     /// the general model this phase's state stands for.
     pub to_full: Vec<[Expr; 2]>,
     /// The fast path, or why the phase is integrated instead.
-    pub reduction: Result<Reduction, String>,
+    pub reduction: Result<Reduction, Unreducible>,
     /// The results without units, if the spec gives groups and scales.
     pub dimensionless: Option<Dimensionless>,
     /// The steps as the LaTeX derivation shows them ([`super::steps`]), once presented.

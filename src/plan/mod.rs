@@ -43,7 +43,7 @@ pub mod drawing;
 mod quantities;
 mod verify;
 
-use crate::model::{Model, ModelInfo};
+use crate::model::Model;
 use crate::quantity::Quantity;
 use crate::results::{Column, Meaning, RunResults, Scalar, Work};
 use crate::solve::SolveError;
@@ -428,14 +428,6 @@ fn column(name: &str, unit: &'static str, values: Vec<f64>) -> Column {
         unit,
         values,
     }
-}
-
-/// The reduced coordinate's name.
-fn angle_coordinate(info: &ModelInfo) -> &'static str {
-    info.coordinates
-        .get(info.reduced_index)
-        .copied()
-        .unwrap_or("theta")
 }
 
 impl<'m> Plan<'m> {

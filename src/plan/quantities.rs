@@ -3,12 +3,12 @@
 //! the landing, each computing only what it needs of the motion.
 
 use super::drawing::{PhaseInput, record};
-use super::{Plan, angle_coordinate, column, phase_labels, scalar};
+use super::{Plan, column, phase_labels, scalar};
 use crate::model::ModelInfo;
 use crate::quantity::Quantity;
 use crate::results::{
-    ContactImpulse, Held, ImpactRecord, Label, Meaning, Note, RunResults, Series, Unlanded,
-    UntilNote, format_number,
+    ContactImpulse, Held, ImpactRecord, Label, LabelValue, Meaning, Note, RunResults, Series,
+    Stretch, Unlanded, UntilNote,
 };
 use crate::solve::SolveError;
 use crate::solve::impact::Part;
@@ -62,25 +62,53 @@ pub(super) fn fate(motion: &Motion, general: &Bound, i: usize) -> Result<Option<
         (false, Some(last)) if matches!(last.end(), End::Contact(_)) => is_landing(general, last)?,
         _ => false,
     };
-    fate_along(motion, info, i, landed)
+    fate_along(motion, general, i, landed)
+}
+
+/// Whether contact `i` of the system is closed in `phase`; a phase that does not list it is a
+/// [`SolveError::PhaseMismatch`] (every model of a system lists the system's contacts).
+fn closed_in(general: &Bound, phase: &PhaseRun, i: usize) -> Result<bool, SolveError> {
+    let closed = phase.closed()?;
+    closed.get(i).copied().ok_or_else(|| {
+        mismatch(
+            general,
+            phase,
+            format!("it lists {} contact(s), not contact {i}", closed.len()),
+        )
+    })
+}
+
+/// A phase of `general`'s system that does not fit it, with what does not.
+fn mismatch(general: &Bound, phase: &PhaseRun, why: String) -> SolveError {
+    SolveError::PhaseMismatch {
+        system: general.info().system,
+        name: phase.bound().info().name,
+        why,
+    }
 }
 
 /// [`fate`] for a contact that did not open at release; `landed`: the motion ends at a landing
 /// where a contact closes.
 fn fate_along(
     motion: &Motion,
-    info: &ModelInfo,
+    general: &Bound,
     i: usize,
     landed: bool,
 ) -> Result<Option<Fate>, SolveError> {
+    let info = general.info();
     let Some(first) = motion.phases.first() else {
         return Ok(None);
     };
-    if !first.closed()?.get(i).copied().unwrap_or(false) {
+    if !closed_in(general, first, i)? {
         return Ok(Some(Fate::NeverClosed));
     }
-    let name = |j: usize| info.contacts.get(j).map_or("a contact", |c| c.name);
     for (k, phase) in motion.phases.iter().enumerate() {
+        let name = |j: usize| {
+            (info.contacts.get(j).map(|c| c.name.to_string())).ok_or_else(|| {
+                let why = format!("it ends at contact {j}, which the system does not have");
+                mismatch(general, phase, why)
+            })
+        };
         let ended = |cause| Fate::Ended {
             t: phase.t_end(),
             theta: phase.theta_end(),
@@ -92,7 +120,7 @@ fn fate_along(
             End::Contact(j) if !motion.through_impacts && landed => {
                 return Ok(Some(Fate::Held {
                     until: Held::Lands {
-                        contact: name(j).to_string(),
+                        contact: name(j)?,
                         t: phase.t_end(),
                     },
                 }));
@@ -105,7 +133,7 @@ fn fate_along(
                         until: Held::Halted(why.clone()),
                     }));
                 };
-                if !next.closed()?.get(i).copied().unwrap_or(false) {
+                if !closed_in(general, next, i)? {
                     return Ok(Some(ended("impact")));
                 }
             }
@@ -117,7 +145,7 @@ fn fate_along(
             End::Floor => {
                 return Ok(Some(Fate::Held {
                     until: Held::Floor {
-                        angle: angle_coordinate(info).to_string(),
+                        angle: general.reduced_coordinate().to_string(),
                         end_angle: info.end_angle,
                     },
                 }));
@@ -125,7 +153,7 @@ fn fate_along(
             End::Edge(j) => {
                 return Ok(Some(Fate::Held {
                     until: Held::Edge {
-                        contact: name(j).to_string(),
+                        contact: name(j)?,
                         t: phase.t_end(),
                     },
                 }));
@@ -137,7 +165,7 @@ fn fate_along(
                         until: Held::Halted(why.clone()),
                     }));
                 };
-                if !next.closed()?.get(i).copied().unwrap_or(false) {
+                if !closed_in(general, next, i)? {
                     return Ok(Some(ended("force")));
                 }
             }
@@ -229,7 +257,7 @@ impl Plan<'_> {
             && end.end == End::Force(0)
             && let Some(at) = end.at
         {
-            let angle = angle_coordinate(info).to_string();
+            let angle = self.general().reduced_coordinate().to_string();
             scalar(
                 out,
                 &key,
@@ -246,7 +274,7 @@ impl Plan<'_> {
                 cause: "force",
             } => {
                 if q == Quantity::SeparationAngle {
-                    let angle = angle_coordinate(info).to_string();
+                    let angle = self.general().reduced_coordinate().to_string();
                     scalar(out, &key, theta, "rad", Meaning::SeparationAngle { angle });
                 } else {
                     scalar(out, &key, t, "s", Meaning::SeparationTime);
@@ -319,7 +347,7 @@ impl Plan<'_> {
                         };
                         scalar(out, &format!("{key}_time"), *t, "s", meaning);
                         let meaning = Meaning::ContactEndAngle {
-                            angle: angle_coordinate(info).to_string(),
+                            angle: self.general().reduced_coordinate().to_string(),
                             contact: contact.clone(),
                             cause: cause.clone(),
                         };
@@ -327,7 +355,7 @@ impl Plan<'_> {
                         out.labels.insert(
                             format!("{key}_cause"),
                             Label {
-                                value: cause,
+                                value: LabelValue::Word(cause),
                                 meaning: Meaning::ContactEndCause { contact },
                             },
                         );
@@ -369,13 +397,12 @@ impl Plan<'_> {
             Meaning::ContactEndFrictionWork,
         );
         let sequence = (phases.iter().flat_map(|p| p.stretches()))
-            .map(|(t, m)| format!("{m} from t = {} s", format_number(t, 6)))
-            .collect::<Vec<_>>()
-            .join("; ");
+            .map(|(from, modes)| Stretch { from, modes })
+            .collect();
         out.labels.insert(
             "contact_end_contact_modes".into(),
             Label {
-                value: sequence,
+                value: LabelValue::Stretches(sequence),
                 meaning: Meaning::ContactModes,
             },
         );
@@ -388,7 +415,7 @@ impl Plan<'_> {
         let t = self.floor_mesh()?.duration;
         let key = Quantity::ContactTimeToFloor.name(info);
         let meaning = Meaning::ContactTimeToFloor {
-            angle: angle_coordinate(info).to_string(),
+            angle: self.general().reduced_coordinate().to_string(),
             end_angle: info.end_angle,
         };
         scalar(out, &key, t, "s", meaning);
@@ -519,13 +546,23 @@ impl Plan<'_> {
                 }
                 Quantity::ForceSeries(i) => {
                     for (j, f) in sample_forces(phase, s)?.iter().enumerate() {
-                        push(&[t[j], s.theta[j], f.get(i).copied().unwrap_or(f64::NAN)]);
+                        let force = f.get(i).copied().ok_or_else(|| {
+                            let why = format!("it gives {} force(s), not contact {i}'s", f.len());
+                            mismatch(&general, phase, why)
+                        })?;
+                        push(&[t[j], s.theta[j], force]);
                     }
                 }
                 Quantity::FrictionSeries(i) => {
                     for (j, [f, n, v]) in sample_friction(phase, &general, s)?.iter().enumerate() {
-                        let at = |x: &[f64]| x.get(i).copied().unwrap_or(f64::NAN);
-                        push(&[t[j], s.theta[j], at(f), at(n), at(v)]);
+                        let at = |x: &[f64]| {
+                            x.get(i).copied().ok_or_else(|| {
+                                let why =
+                                    format!("it gives {} friction(s), not friction {i}", x.len());
+                                mismatch(&general, phase, why)
+                            })
+                        };
+                        push(&[t[j], s.theta[j], at(f)?, at(n)?, at(v)?]);
                     }
                 }
                 Quantity::Trajectory(i) => {
@@ -595,7 +632,7 @@ impl Plan<'_> {
                 work,
                 "J",
                 Meaning::FloorImpactFrictionWork {
-                    angle: angle_coordinate(info).to_string(),
+                    angle: general.reduced_coordinate().to_string(),
                     end_angle: info.end_angle,
                 },
             );
@@ -627,7 +664,10 @@ impl Plan<'_> {
             return Ok(());
         };
         let (time, omega) = (landing.t_end(), landing.theta_dot_end());
-        let (angle, path) = (angle_coordinate(info).to_string(), phase_labels(motion));
+        let (angle, path) = (
+            general.reduced_coordinate().to_string(),
+            phase_labels(motion),
+        );
         let meaning = Meaning::FloorImpactTime {
             angle: angle.clone(),
             end_angle: info.end_angle,

@@ -2,7 +2,7 @@
 //! integrated with the same contacts closed, and the physical checks of every phase.
 
 use super::{Plan, scalar};
-use crate::results::{CheckKind, Meaning, Note, PhaseEnd, RunResults, Work, format_number};
+use crate::results::{CheckKind, CheckPhase, Meaning, Note, PhaseEnd, RunResults, Work};
 use crate::solve::SolveError;
 use crate::solve::checks::{self, Conserved, free_momenta};
 use crate::solve::phases::{End, PhaseRun};
@@ -128,7 +128,7 @@ impl Plan<'_> {
             let bound = run.bound();
             let label = run.labels().join(" then ");
             let ctx = checks::Context {
-                phase: label.clone(),
+                phase: CheckPhase::Phase(label),
                 key: if matches!(run, PhaseRun::Reduced(_)) {
                     bound.name().to_string()
                 } else {
@@ -146,7 +146,7 @@ impl Plan<'_> {
                 &run.closed()?,
                 tol,
                 &ctx,
-            ));
+            )?);
             found.extend(path_checks(run, samples, tol, &ctx)?);
             out.checks.extend(found);
         }
@@ -159,7 +159,10 @@ impl Plan<'_> {
                 })?
                 .full_end_state()?;
             let ctx = checks::Context {
-                phase: format!("impact {} at t = {} s", k + 1, format_number(at.t, 9)),
+                phase: CheckPhase::Impact {
+                    number: k + 1,
+                    t: at.t,
+                },
                 key: format!("impact_{}", k + 1),
                 order: 2 * at.phase + 1,
                 t_start: at.t,
@@ -173,7 +176,9 @@ impl Plan<'_> {
             let general = &walker.general;
             let ode_tol = tol.max(10.0 * ode.rtol);
             let ctx = checks::Context {
-                phase: format!("{} (ODE cross-check)", general.name()),
+                phase: CheckPhase::OdeCrossCheck {
+                    model: general.name().to_string(),
+                },
                 key: format!("{}.ode", general.name()),
                 order: 1,
                 t_start: 0.0,

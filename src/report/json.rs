@@ -9,7 +9,7 @@
 //! `{passed, margin, meaning}`) and `work` (counters and phases). Values are SI (angles in
 //! radians); a non-finite number is written as `null`, as JSON has no NaN.
 
-use super::prose::{check_meaning, meaning, note};
+use super::prose::{check_meaning, check_phase, label, meaning, note};
 use crate::results::RunResults;
 
 /// The meaning written beside `results.impacts`.
@@ -25,6 +25,7 @@ pub fn to_string(results: &RunResults) -> Result<String, serde_json::Error> {
         for (key, check) in &results.checks {
             if let Some(entry) = map.get_mut(key).and_then(|e| e.as_object_mut()) {
                 entry.insert("meaning".into(), check_meaning(check).into());
+                entry.insert("phase".into(), check_phase(&check.phase).into());
             }
         }
     }
@@ -42,11 +43,11 @@ pub fn to_string(results: &RunResults) -> Result<String, serde_json::Error> {
                 entry.insert("meaning".into(), meaning(&scalar.meaning).into());
             }
         }
-        for (key, label) in &results.labels {
-            let mut entry = serde_json::to_value(label)?;
-            if let Some(fields) = entry.as_object_mut() {
-                fields.insert("meaning".into(), meaning(&label.meaning).into());
-            }
+        for (key, word) in &results.labels {
+            let entry = serde_json::json!({
+                "value": label(&word.value),
+                "meaning": meaning(&word.meaning),
+            });
             map.insert(key.clone(), entry);
         }
         if let Some(impacts) = &results.impacts {

@@ -1,12 +1,37 @@
 //! The sentences for people about a run: what each check tested ([`check_meaning`], written
-//! as results.json's `meaning`, the table's legend and the Python binding's `meaning`) and
-//! why a quantity has no value ([`note`]). Results carry only names and numbers; the words
+//! as results.json's `meaning`, the table's legend and the Python binding's `meaning`), where
+//! it ran ([`check_phase`]), the word-valued results ([`label`]) and why a quantity has no
+//! value ([`note`]). Results carry only names and numbers; the words
 //! are all here.
 
 use crate::results::{
-    Check, CheckKind, CheckSubject, Halt, Held, Meaning, Note, PhaseEnd, Unlanded, UntilNote, Zeno,
-    format_number,
+    Check, CheckKind, CheckPhase, CheckSubject, Halt, Held, LabelValue, Meaning, Note, PhaseEnd,
+    Unlanded, UntilNote, Zeno, format_number,
 };
+
+/// Where a check ran, as the table's group heading and results.json's `phase` name it:
+/// `<labels>`, `impact <k> at t = <t> s`, `<model> (ODE cross-check)`.
+pub fn check_phase(phase: &CheckPhase) -> String {
+    match phase {
+        CheckPhase::Phase(labels) => labels.clone(),
+        CheckPhase::Impact { number, t } => {
+            format!("impact {number} at t = {} s", format_number(*t, 9))
+        }
+        CheckPhase::OdeCrossCheck { model } => format!("{model} (ODE cross-check)"),
+    }
+}
+
+/// A word-valued result as the table and results.json write it: the word, or each stretch as
+/// `<modes> from t = <t> s`, joined by `; `.
+pub fn label(value: &LabelValue) -> String {
+    match value {
+        LabelValue::Word(word) => word.clone(),
+        LabelValue::Stretches(stretches) => (stretches.iter())
+            .map(|s| format!("{} from t = {} s", s.modes, format_number(s.from, 6)))
+            .collect::<Vec<_>>()
+            .join("; "),
+    }
+}
 
 /// What a check tested and against what, in a sentence.
 pub fn check_meaning(check: &Check) -> String {

@@ -277,7 +277,7 @@ fn scalars(out: &mut String, results: &RunResults, layout: &Layout) {
     for (key, label) in &results.labels {
         let mut row = vec![
             key.clone(),
-            label.value.clone(),
+            super::prose::label(&label.value),
             String::new(),
             String::new(),
         ];
@@ -431,7 +431,11 @@ fn checks(out: &mut String, results: &RunResults, layout: &Layout) {
         align_right(&mut t, &[4]);
         section(
             out,
-            &wrap(&format!("{phase}:"), layout.width, 2),
+            &wrap(
+                &format!("{}:", super::prose::check_phase(phase)),
+                layout.width,
+                2,
+            ),
             &t,
             &legend,
             layout,

@@ -27,13 +27,41 @@ pub struct Scalar {
 }
 
 /// A result that is a word rather than a number (e.g. why a contact ended).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Label {
-    /// The word.
-    pub value: String,
+    /// The word, or the words and times it is made of (`report::prose::label` writes it).
+    pub value: LabelValue,
     /// What it is and which words it can be (`report::prose::meaning` says it in words).
-    #[serde(skip)]
     pub meaning: Meaning,
+}
+
+/// What a [`Label`] says.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LabelValue {
+    /// One word (why a contact ended: `force`, `edge`, ...).
+    Word(String),
+    /// The active sets over a span, in order: each stretch's start and its closed contacts
+    /// and friction modes in words.
+    Stretches(Vec<Stretch>),
+}
+
+impl LabelValue {
+    /// The word, if the label is one.
+    pub fn as_word(&self) -> Option<&str> {
+        match self {
+            LabelValue::Word(w) => Some(w),
+            LabelValue::Stretches(_) => None,
+        }
+    }
+}
+
+/// One stretch of a motion with one active set.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Stretch {
+    /// Its start (s from release).
+    pub from: f64,
+    /// Its closed contacts and friction modes, in words.
+    pub modes: String,
 }
 
 /// One column of a series.
@@ -79,9 +107,10 @@ pub struct Check {
     pub passed: bool,
     /// What is tested, and so how `value` and `limit` read.
     pub kind: CheckKind,
-    /// The phase (model name) the check ran on; `<model> (ODE cross-check)`
-    /// for the unreduced equations.
-    pub phase: String,
+    /// The phase the check ran on (`report::prose::check_phase` names it: results.json's
+    /// `phase`).
+    #[serde(skip)]
+    pub phase: CheckPhase,
     /// Position in the order the phases happen (the report sorts by it).
     pub order: usize,
     /// What was measured: a monitor's smallest value (in `unit`), or a relative drift.
@@ -103,6 +132,26 @@ pub struct Check {
     /// writes the sentence, results.json's `meaning`).
     #[serde(skip)]
     pub subject: CheckSubject,
+}
+
+/// Where a [`Check`] ran.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CheckPhase {
+    /// A phase of the motion, by its labels (`rod_cube`; for an integrated phase its model
+    /// and each stretch's closed contacts, joined by ` then `).
+    Phase(String),
+    /// An impact: its number in the run (from 1) and its time (s from release).
+    Impact {
+        /// Its number, from 1.
+        number: usize,
+        /// Its time (s from release).
+        t: f64,
+    },
+    /// The ODE cross-check: the system's general model integrated without reduction.
+    OdeCrossCheck {
+        /// The general model.
+        model: String,
+    },
 }
 
 /// What a [`Check`] is about: the quantity tested, named, with the numbers that scale it.

@@ -22,19 +22,19 @@
 //! A check carries what it tested as data (a [`CheckSubject`]: the quantity named, with the
 //! numbers that scale it); `report::prose::check_meaning` writes its sentence.
 
-use crate::results::{Check, CheckKind, CheckSubject};
+use crate::results::{Check, CheckKind, CheckPhase, CheckSubject};
 use crate::solve::SolveError;
 use crate::solve::impact::Impact;
 use crate::solve::series::PhaseSamples;
-use crate::system::{Bound, State};
+use crate::system::{Bound, State, SystemError};
 use nalgebra::DMatrix;
 
 /// Where a group of checks ran: the phase's label, its place in the order of the run, and the
 /// absolute time its clock starts at (so monitor times read from release).
 #[derive(Debug, Clone)]
 pub struct Context {
-    /// `<model>` for a phase, `<model> (ODE cross-check)` for the cross-check's path.
-    pub phase: String,
+    /// The phase, an impact, or the cross-check's path.
+    pub phase: CheckPhase,
     /// Key prefix: `<model>`, or `<model>.ode`.
     pub key: String,
     /// Position of the group in the run (phases in the order they happen).
@@ -47,7 +47,7 @@ impl Context {
     /// A phase that starts at release and comes first, labelled and keyed `label`.
     pub fn new(label: &str) -> Context {
         Context {
-            phase: label.to_string(),
+            phase: CheckPhase::Phase(label.to_string()),
             key: label.to_string(),
             order: 0,
             t_start: 0.0,
@@ -156,6 +156,8 @@ pub fn monitors(
 
 /// One check per unilateral contact closed in the phase (`closed`, per contact): its smallest
 /// force over the samples must be `>= 0` up to rounding. Keys are `<key>.<contact>_pushes`.
+/// `closed`, or a sample's forces, not one per contact of the model is
+/// [`SystemError::Length`].
 pub fn contact_forces(
     sys: &Bound,
     samples: &PhaseSamples,
@@ -163,16 +165,31 @@ pub fn contact_forces(
     closed: &[bool],
     tolerance: f64,
     ctx: &Context,
-) -> Vec<(String, Check)> {
+) -> Result<Vec<(String, Check)>, SolveError> {
     let info = sys.info();
+    let length = |what: &'static str, got: usize| SystemError::Length {
+        model: info.name,
+        what,
+        expected: info.contacts.len(),
+        got,
+    };
+    if closed.len() != info.contacts.len() {
+        return Err(length("closed", closed.len()).into());
+    }
     let mut out = Vec::new();
-    for (i, c) in info.contacts.iter().enumerate() {
-        if c.bilateral || closed.get(i) != Some(&true) {
+    for ((i, c), _) in (info.contacts.iter().enumerate())
+        .zip(closed)
+        .filter(|(_, on)| **on)
+    {
+        if c.bilateral {
             continue;
         }
         let mut low = Lowest::new();
         for (&t, f) in samples.t.iter().zip(forces) {
-            low.add(f.get(i).copied().unwrap_or(f64::NAN), t);
+            low.add(
+                f.get(i).copied().ok_or_else(|| length("forces", f.len()))?,
+                t,
+            );
         }
         let subject = CheckSubject::Pushes {
             model: info.name.to_string(),
@@ -181,7 +198,7 @@ pub fn contact_forces(
         let check = lowest_check(&low, tolerance, c.unit, samples.len(), ctx, subject);
         out.push((format!("{}.{}_pushes", ctx.key, c.name), check));
     }
-    out
+    Ok(out)
 }
 
 /// A drift check: `drift <= tolerance`.
@@ -437,12 +454,17 @@ pub fn drift(
         return Ok(Vec::new());
     };
     let n = sys.n_coordinates();
-    // A state without its work of friction counts as NaN, which fails the check.
+    // A state without its work of friction is an error (the work is one per state).
     let work_at = |i: usize| match conserved.friction_work {
-        Some(w) => w.get(i).copied().unwrap_or(f64::NAN),
-        None => 0.0,
+        Some(w) => w.get(i).copied().ok_or(SystemError::Length {
+            model: info.name,
+            what: "friction_work",
+            expected: states.len(),
+            got: w.len(),
+        }),
+        None => Ok(0.0),
     };
-    let e0 = sys.energy(first)? - work_at(0);
+    let e0 = sys.energy(first)? - work_at(0)?;
     let combine = |p: &[f64], w: &[f64]| -> f64 { p.iter().zip(w).map(|(a, b)| a * b).sum() };
     let p_first = sys.momenta(first)?;
     let p0: Vec<f64> = conserved
@@ -457,9 +479,10 @@ pub fn drift(
     for (i, s) in states.iter().enumerate() {
         let total = sys.energy(s)?;
         let ke = kinetic(sys, s)?;
-        e_dev = nan_max(e_dev, (total - work_at(i) - e0).abs());
+        let work = work_at(i)?;
+        e_dev = nan_max(e_dev, (total - work - e0).abs());
         kin_max = kin_max.max(ke.abs());
-        size_max = size_max.max(ke.abs() + (total - ke).abs() + work_at(i).abs());
+        size_max = size_max.max(ke.abs() + (total - ke).abs() + work.abs());
         v_min = v_min.min(total - ke);
         v_max = v_max.max(total - ke);
         let (mass, _) = sys.equations(s)?;

@@ -194,7 +194,7 @@ pub(super) fn static_info(
         bodies: d.bodies.iter().map(|b| lit(b)).collect(),
         route_note: match &d.reduction {
             Ok(_) => lit(""),
-            Err(why) => lit(&one_line(why)),
+            Err(why) => lit(&one_line(&why.to_string())),
         },
     })
 }

@@ -32,7 +32,7 @@ pub fn json_record(checked: &Checked, d: &Derivation) -> serde_json::Value {
             };
             ("reduced", how.to_string())
         }
-        Err(why) => ("integrated", why.clone()),
+        Err(why) => ("integrated", why.to_string()),
     };
     expressions.insert("lagrangian".into(), infix(&d.lagrangian));
     let contacts: Vec<serde_json::Value> = (d.contacts.iter().zip(&d.restitutions))

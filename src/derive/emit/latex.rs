@@ -190,7 +190,11 @@ impl Expr {
             return vec![self.to_latex(name)];
         }
         match self {
-            Expr::Add(terms) => break_sum(terms, String::new(), first, "", name, width).0,
+            Expr::Add(terms) => {
+                let (mut lines, last, _) = break_sum(terms, String::new(), first, "", name, width);
+                lines.push(last);
+                lines
+            }
             Expr::Mul(_) => {
                 let (neg, mag) = self.split_sign();
                 let (mut num, den) = mag.num_den();
@@ -244,17 +248,14 @@ impl Expr {
                 }
                 let mut lines = Vec::new();
                 if let Some(terms) = top {
-                    let (done, last) =
+                    (lines, line, used) =
                         break_sum(&terms, line + "\\Bigl(", used + 1, "\\Bigr)", name, width);
-                    lines = done;
-                    line = lines.pop().unwrap_or_default();
-                    used = last;
                 }
                 for f in &long {
                     let Some((terms, k)) = sum_power(f) else {
                         continue;
                     };
-                    let (done, last) = break_sum(
+                    let (done, last, last_used) = break_sum(
                         terms,
                         line + " \\Bigl(",
                         used + 1,
@@ -263,8 +264,7 @@ impl Expr {
                         width,
                     );
                     lines.extend(done);
-                    line = lines.pop().unwrap_or_default();
-                    used = last;
+                    (line, used) = (last, last_used);
                 }
                 lines.push(line);
                 lines
@@ -290,8 +290,8 @@ fn trig_factor(f: &Expr) -> bool {
 
 /// The terms of a sum on display lines of about `width` characters: the first line starts with
 /// `line` (`used` characters taken), the last ends with `close`; a continued line starts with
-/// `{}` so its leading sign is spaced as a binary operator. Also returns the width used on the
-/// last line.
+/// `{}` so its leading sign is spaced as a binary operator. Returns the lines before the
+/// last, the last (which a caller may go on) and the width used on it.
 fn break_sum(
     terms: &[Expr],
     mut line: String,
@@ -299,7 +299,7 @@ fn break_sum(
     close: &str,
     name: &dyn Fn(&str) -> String,
     width: usize,
-) -> (Vec<String>, usize) {
+) -> (Vec<String>, String, usize) {
     let mut lines = Vec::new();
     let mut in_line = 0;
     for (i, t) in terms.iter().enumerate() {
@@ -322,8 +322,7 @@ fn break_sum(
         in_line += 1;
     }
     line.push_str(close);
-    lines.push(line);
-    (lines, used + 2)
+    (lines, line, used + 2)
 }
 
 /// A sum or a sum raised to a positive integer power: its terms and the power.

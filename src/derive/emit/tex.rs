@@ -199,12 +199,11 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> Result<TexContext, Step
     };
     let sc = |e: &Expr| from_sc(e, &theta);
     let mut eqs = Vec::new();
-    for (c, row) in d.contacts.iter().filter(|c| c.closed).filter_map(|c| {
+    for (c, e, row) in d.contacts.iter().filter(|c| c.closed).filter_map(|c| {
         let e = c.eliminates.as_ref()?;
         let i = d.full_coords.iter().position(|q| q == e)?;
-        Some((c, d.to_full.get(i)?))
+        Some((c, e, d.to_full.get(i)?))
     }) {
-        let e = c.eliminates.as_deref().unwrap_or_default();
         eqs.push(display(
             &format!(
                 "Contact \\texttt{{{}}} is closed: its gap is zero, which ties ${}$",
@@ -274,7 +273,7 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> Result<TexContext, Step
                             "Force \\texttt{{{}}}: {} (integrated route: {})",
                             tex_text(&c.name),
                             tex_text(&c.meaning),
-                            tex_text(why)
+                            tex_text(&why.to_string())
                         ),
                         "F = ".into(),
                         2,
