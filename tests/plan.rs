@@ -486,7 +486,9 @@ fn each_quantity_alone_equals_itself_beside_every_other() {
         ("mu_f", 0.2),
         ("mu_w", 0.2),
     ];
-    let cases: [(&str, &[(&str, f64)], Option<f64>); 2] = [
+    /// A model, its parameters and how long the run goes on.
+    type Case<'a> = (&'a str, &'a [(&'a str, f64)], Option<f64>);
+    let cases: [Case; 2] = [
         ("rod_cube_liftoff", &bounce, Some(0.4)),
         ("ladder_friction", &ladder, None),
     ];
