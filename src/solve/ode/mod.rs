@@ -456,11 +456,7 @@ pub fn integrate<P: OdeProblem>(
         check_finite("event function", t + h, &g_new)?;
         let crossed: Vec<usize> = (0..m).filter(|&i| changes_sign(g[i], g_new[i])).collect();
         // The extension estimates the events' roots: every step that crossed one needs it.
-        let dense = if opts.dense_output || !crossed.is_empty() {
-            st.dense(problem, t, &y, h)?
-        } else {
-            st.ends(t, &y, h)
-        };
+        let dense = st.record(problem, t, &y, h, opts.dense_output || !crossed.is_empty())?;
         let step = Trial {
             t,
             y: &y,
@@ -478,11 +474,8 @@ pub fn integrate<P: OdeProblem>(
                 st.end_derivative(problem)?;
                 sol.event_trials += 1;
             }
-            sol.steps.push(if opts.dense_output {
-                st.dense(problem, t, &y, tau)?
-            } else {
-                st.ends(t, &y, tau)
-            });
+            sol.steps
+                .push(st.record(problem, t, &y, tau, opts.dense_output)?);
             sol.event = Some(Event {
                 index,
                 t: t + tau,

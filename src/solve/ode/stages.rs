@@ -178,17 +178,30 @@ impl Stages {
             }
         }
         Ok(DenseStep {
-            t0,
-            h,
-            y0: y.to_vec(),
-            y1: self.y1.clone(),
-            method: self.tab.method,
             coeffs,
+            ..self.ends(t0, y, h)
         })
     }
 
+    /// The step just taken to `(t0 + h, y1)` as the solution keeps it: with its continuous
+    /// extension ([`Stages::dense`]) when `extension`, else with its ends only.
+    pub(super) fn record<P: OdeProblem>(
+        &mut self,
+        p: &mut P,
+        t0: f64,
+        y: &[f64],
+        h: f64,
+        extension: bool,
+    ) -> Result<DenseStep, SolveError> {
+        if extension {
+            self.dense(p, t0, y, h)
+        } else {
+            Ok(self.ends(t0, y, h))
+        }
+    }
+
     /// The step just taken to `(t0 + h, y1)` with its ends only (no continuous extension).
-    pub(super) fn ends(&self, t0: f64, y: &[f64], h: f64) -> DenseStep {
+    fn ends(&self, t0: f64, y: &[f64], h: f64) -> DenseStep {
         DenseStep {
             t0,
             h,
