@@ -7,8 +7,7 @@ use rodcube::io::{OutDir, check_name};
 use rodcube::plan::{self, PlanError};
 use rodcube::report;
 use rodcube::results::RunResults;
-use rodcube::scene::{Kind, Scene, SceneError};
-use rodcube::system::SystemError;
+use rodcube::scene::{Scene, SceneError};
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -314,34 +313,12 @@ fn solve(scene: &Scene) -> Result<RunResults, Failure> {
     plan::run(&request).map_err(|e| planner_failure(scene, e))
 }
 
-/// A planner error as a failure. The scene was validated against the same rules, so these
-/// are rare; those about the scene's own values are placed at their field in the file.
+/// A planner error as a failure: those about the scene's own values placed at their field in
+/// the file ([`Scene::plan_error`]), the others a failed solve.
 fn planner_failure(scene: &Scene, error: PlanError) -> Failure {
-    let message = error.to_string();
-    let at = |field: String, kind| Failure::Scene(scene.error_at(&field, kind, message.clone()));
-    match &error {
-        PlanError::System(SystemError::Requirement { name, meaning, .. }) => {
-            Failure::Scene(scene.requirement_error(name, meaning, message))
-        }
-        PlanError::System(SystemError::NotFinite { name, .. }) => {
-            at(format!("parameters.{name}"), Kind::NotFinite)
-        }
-        PlanError::System(SystemError::NotPositive { name, .. }) => {
-            at(format!("parameters.{name}"), Kind::NotPositive)
-        }
-        PlanError::System(SystemError::MissingParameter { name, .. }) => {
-            at(format!("parameters.{name}"), Kind::MissingParameter)
-        }
-        PlanError::System(SystemError::UnknownParameter { name, .. }) => {
-            at(format!("parameters.{name}"), Kind::UnknownParameter)
-        }
-        PlanError::Unavailable { .. } => at("want".into(), Kind::UnavailableQuantity),
-        PlanError::BadTolerance { .. } => at("tolerance".into(), Kind::OutOfRange),
-        PlanError::BadUntil { .. } => at("until".into(), Kind::OutOfRange),
-        PlanError::TooFewSamples { .. } | PlanError::TooManySamples { .. } => {
-            at("samples".into(), Kind::OutOfRange)
-        }
-        _ => Failure::Solve(
+    match scene.plan_error(&error) {
+        Some(placed) => Failure::Scene(placed),
+        None => Failure::Solve(
             anyhow::Error::from(error).context(format!("solving {} failed", scene.file.display())),
         ),
     }

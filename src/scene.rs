@@ -24,6 +24,7 @@
 //! line and the token underlined.
 
 use crate::model::{Model, ModelInfo};
+use crate::plan::PlanError;
 use crate::quantity::Quantity;
 use crate::system::{SystemError, check_value, failed_requirements};
 use crate::yaml::{At, Document, Mark, Problem, ReadError, excerpt, parse_path};
@@ -388,6 +389,38 @@ impl Scene {
     ) -> SceneError {
         let involved = involved_parameters(name, meaning, self.info());
         self.error_at_parameters(&involved, Kind::Requirement, message)
+    }
+
+    /// A planner error about this scene's own values, placed at its field in the file
+    /// (parameters, wanted quantities, tolerance, end time, samples); `None` for the errors
+    /// of the solve itself. The scene was validated against the same rules, so these are rare.
+    pub fn plan_error(&self, error: &PlanError) -> Option<SceneError> {
+        let message = error.to_string();
+        let at = |field: String, kind| Some(self.error_at(&field, kind, message.clone()));
+        match error {
+            PlanError::System(SystemError::Requirement { name, meaning, .. }) => {
+                Some(self.requirement_error(name, meaning, message.clone()))
+            }
+            PlanError::System(SystemError::NotFinite { name, .. }) => {
+                at(format!("parameters.{name}"), Kind::NotFinite)
+            }
+            PlanError::System(SystemError::NotPositive { name, .. }) => {
+                at(format!("parameters.{name}"), Kind::NotPositive)
+            }
+            PlanError::System(SystemError::MissingParameter { name, .. }) => {
+                at(format!("parameters.{name}"), Kind::MissingParameter)
+            }
+            PlanError::System(SystemError::UnknownParameter { name, .. }) => {
+                at(format!("parameters.{name}"), Kind::UnknownParameter)
+            }
+            PlanError::Unavailable { .. } => at("want".into(), Kind::UnavailableQuantity),
+            PlanError::BadTolerance { .. } => at("tolerance".into(), Kind::OutOfRange),
+            PlanError::BadUntil { .. } => at("until".into(), Kind::OutOfRange),
+            PlanError::TooFewSamples { .. } | PlanError::TooManySamples { .. } => {
+                at("samples".into(), Kind::OutOfRange)
+            }
+            _ => None,
+        }
     }
 
     /// The scene's text, read again to place an error found after loading (errors are rare).
