@@ -1,14 +1,22 @@
-//! The Python package (`python/`): built by `pip install ./python` (maturin) in a fresh virtual
-//! environment under the test's temporary directory, then its pytest suite (`python/tests`,
-//! the README's Python example included) runs against it. Needs `python3` with `venv` and
-//! the Python package registry (for maturin, NumPy and pytest, at the versions pinned in
-//! `python/requirements-test.txt`); `.ci/run` installs them.
+//! The Python package (`python/`) as users get it: `maturin build --release` makes its abi3
+//! wheel, which is installed into a fresh virtual environment under the test's temporary
+//! directory with no Rust toolchain on the path (nor the package index: the wheel alone), then
+//! its pytest suite (`python/tests`: the README's Python example, the notebook helpers and the
+//! example notebook `examples/paper.ipynb` run by nbclient, whose numbers are checked against
+//! what this build's `rodcube run` prints) runs against it. Needs `python3` with `venv` and the
+//! Python package registry (for maturin, NumPy, pytest, pandas, matplotlib and the notebook
+//! tools, at the versions pinned in `python/requirements-test.txt`); `.ci/run` installs them.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
-fn run(program: &Path, args: &[&str], cwd: &Path, env: &[(&str, &Path)]) {
+/// Runs `program` in `cwd` with `env` added (or, with `clear`, as the whole environment) and
+/// fails the test, with its output, unless it succeeds.
+fn run(program: &Path, args: &[&str], cwd: &Path, env: &[(&str, &Path)], clear: bool) {
     let mut cmd = Command::new(program);
+    if clear {
+        cmd.env_clear();
+    }
     cmd.args(args)
         .current_dir(cwd)
         .env("PYTHONDONTWRITEBYTECODE", "1");
@@ -27,14 +35,54 @@ fn run(program: &Path, args: &[&str], cwd: &Path, env: &[(&str, &Path)]) {
     );
 }
 
+fn utf8(path: &Path) -> &str {
+    path.to_str().expect("UTF-8 path")
+}
+
+/// Builds the wheel into an emptied `dir` with maturin (from the virtual environment) and
+/// returns its path: the one `.whl` there.
+fn build_wheel(python: &Path, root: &Path, tmp: &Path, dir: &Path) -> PathBuf {
+    if dir.exists() {
+        std::fs::remove_dir_all(dir).expect("remove the old wheels");
+    }
+    // With its own target directory (not the test run's).
+    let target = tmp.join("target");
+    run(
+        python,
+        &["-m", "maturin", "build", "--release", "--out", utf8(dir)],
+        &root.join("python"),
+        &[("CARGO_TARGET_DIR", &target)],
+        false,
+    );
+    let wheels: Vec<PathBuf> = std::fs::read_dir(dir)
+        .expect("the wheel directory")
+        .map(|e| e.expect("a directory entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "whl"))
+        .collect();
+    assert_eq!(wheels.len(), 1, "one wheel expected: {wheels:?}");
+    let wheel = wheels[0].clone();
+    let name = wheel.file_name().and_then(|n| n.to_str()).unwrap_or("");
+    assert!(
+        name.starts_with("rodcube-") && name.contains("-cp39-abi3-"),
+        "an abi3 wheel for Python >= 3.9 expected, got {name}"
+    );
+    wheel
+}
+
 #[test]
-fn the_python_package_installs_and_passes_its_tests() {
+fn the_python_package_installs_from_its_wheel_and_passes_its_tests() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let tmp = Path::new(env!("CARGO_TARGET_TMPDIR")).join("python");
     let venv = tmp.join("venv");
     std::fs::create_dir_all(&tmp).expect("temporary directory");
     if !venv.join("bin/python").exists() {
-        run(Path::new("python3"), &["-m", "venv", "venv"], &tmp, &[]);
+        run(
+            Path::new("python3"),
+            &["-m", "venv", "venv"],
+            &tmp,
+            &[],
+            false,
+        );
     }
     let python = venv.join("bin/python");
     let quiet = [
@@ -46,25 +94,33 @@ fn the_python_package_installs_and_passes_its_tests() {
     ];
     // The exact versions `.ci/run` installs too.
     let requirements = root.join("python/requirements-test.txt");
-    let requirements = requirements.to_str().expect("UTF-8 path");
     let mut deps = quiet.to_vec();
-    deps.extend(["-r", requirements]);
-    run(&python, &deps, &tmp, &[]);
-    // Built in place from python/, with its own target directory (not the test run's).
-    let target = tmp.join("target");
+    deps.extend(["-r", utf8(&requirements)]);
+    run(&python, &deps, &tmp, &[], false);
+    let wheel = build_wheel(&python, root, &tmp, &tmp.join("wheels"));
+    // Installed from the wheel alone: no index, nothing to build, and no Rust toolchain on the
+    // path (the environment is cleared but for a PATH holding the virtual environment).
+    let bin = venv.join("bin");
+    assert!(!bin.join("cargo").exists() && !bin.join("rustc").exists());
     let mut install = quiet.to_vec();
-    let package = root.join("python");
-    let package = package.to_str().expect("UTF-8 path");
-    install.extend(["--force-reinstall", "--no-deps", package]);
-    run(&python, &install, &tmp, &[("CARGO_TARGET_DIR", &target)]);
+    install.extend([
+        "--force-reinstall",
+        "--no-deps",
+        "--no-index",
+        "--only-binary",
+        ":all:",
+        utf8(&wheel),
+    ]);
+    run(&python, &install, &tmp, &[("PATH", &bin)], true);
     let tests = root.join("python/tests");
-    let tests = tests.to_str().expect("UTF-8 path");
     // From the temporary directory, so that `import rodcube` finds the installed package and
     // pytest writes no cache into the repository.
+    let rodcube = Path::new(env!("CARGO_BIN_EXE_rodcube"));
     run(
         &python,
-        &["-m", "pytest", "-q", "-p", "no:cacheprovider", tests],
+        &["-m", "pytest", "-q", "-p", "no:cacheprovider", utf8(&tests)],
         &tmp,
-        &[],
+        &[("RODCUBE_BIN", rodcube)],
+        false,
     );
 }

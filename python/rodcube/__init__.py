@@ -11,6 +11,16 @@
   assumes none (not even g). A point that fails is NaN, ``False`` in the ``ok`` mask, and
   listed in ``errors`` with the reason.
 - ``models()`` and ``parameters(model)``: the registry, with each parameter's unit and meaning.
+- ``derivation(model)``: the model's derivation (carried by the package), which a notebook shows
+  as Markdown with LaTeX, every step numbered as in ``generated/<model>.tex``; its
+  ``expressions`` are the derived expressions as strings, ``steps`` the steps, ``latex`` the
+  write-up. ``derivation_models()`` names the models it knows.
+- ``run(scene)``: a scene (a path, YAML text or a dict) run as ``rodcube run`` runs it; the
+  ``RunResult`` holds ``results.json`` as Python values (``result["separation_angle"]``,
+  ``series`` as NumPy arrays, ``checks``, ``notes``) and ``motion_svg``, and a notebook shows it
+  as HTML: the tables fitted to the page, the checks and the motion, animated. Where pandas is
+  installed (it is optional) ``RunResult.to_frame()`` gives the results, or a series, as a
+  DataFrame; without pandas the method does not exist.
 
 Errors are ``RodcubeError`` (a ``ValueError``) with rodcube's own messages. Type stubs
 (``__init__.pyi``) describe every function for editors and type checkers.
@@ -24,8 +34,20 @@ import numpy as np
 
 from ._rodcube import RodcubeError, models, parameters, solve
 from ._rodcube import sweep_flat as _sweep_flat
+from ._notebook import Derivation, RunResult, derivation, derivation_models, run
 
-__all__ = ["RodcubeError", "models", "parameters", "solve", "sweep"]
+__all__ = [
+    "Derivation",
+    "RodcubeError",
+    "RunResult",
+    "derivation",
+    "derivation_models",
+    "models",
+    "parameters",
+    "run",
+    "solve",
+    "sweep",
+]
 
 
 def _numbers(what, value):

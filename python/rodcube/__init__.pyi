@@ -2,12 +2,24 @@
 its parameters and return types (`python/tests` checks them against the installed package)."""
 
 from collections.abc import Mapping, Sequence
-from typing import Any, Optional, TypedDict, Union
+from os import PathLike
+from typing import Any, NamedTuple, Optional, TypedDict, Union
 
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["RodcubeError", "models", "parameters", "solve", "sweep"]
+__all__ = [
+    "Derivation",
+    "RodcubeError",
+    "RunResult",
+    "derivation",
+    "derivation_models",
+    "models",
+    "parameters",
+    "run",
+    "solve",
+    "sweep",
+]
 
 class RodcubeError(ValueError):
     """A request rodcube refused or could not solve; the message says why."""
@@ -88,3 +100,69 @@ def sweep(
     """Separation angle and time over broadcast axes (`n` = m2/m1, `a_over_ell`, `axes`, and
     keyword parameters given as arrays); every parameter needs a value from an axis, a keyword
     or `defaults`, g included."""
+
+class Step(NamedTuple):
+    """One step of a derivation: a `\\subsection*` of the write-up, numbered in its order."""
+
+    number: int
+    section: str
+    title: str
+    latex: str
+
+class Derivation:
+    """A model's derivation as the derivation tool wrote it (`generated/<model>.tex` and
+    `.json`, carried by the package): a notebook shows it as Markdown with LaTeX, every step
+    numbered as in the `.tex`."""
+
+    model: str
+    latex: str
+    """The write-up, the text of `generated/<model>.tex`."""
+    record: dict[str, Any]
+    """The JSON record, `generated/<model>.json`."""
+    steps: list[Step]
+    def __init__(self, model: str) -> None: ...
+    @property
+    def expressions(self) -> dict[str, str]:
+        """The derived expressions by name, as strings."""
+    @property
+    def dimensionless(self) -> dict[str, str]:
+        """The results without units by name, in the dimensionless groups and the angle."""
+    def expression(self, name: str) -> str:
+        """One expression by name, from `expressions` or else `dimensionless`."""
+    def _repr_markdown_(self) -> str: ...
+
+class RunResult:
+    """What `run` returns: `results.json` of `rodcube run` as Python values, the series as
+    NumPy arrays and `motion.svg`; a notebook shows it as HTML (tables, checks, the motion)."""
+
+    json: str
+    """The text of `results.json`."""
+    record: dict[str, Any]
+    motion_svg: Optional[str]
+    """`motion.svg`, when the scene wanted a trajectory."""
+    model: str
+    parameters: dict[str, float]
+    results: dict[str, dict[str, Any]]
+    """Each result's `value`, `unit` and `meaning`."""
+    checks: dict[str, dict[str, Any]]
+    notes: dict[str, str]
+    series: dict[str, dict[str, npt.NDArray[np.float64]]]
+    def __init__(self, record_json: str, motion_svg: Optional[str]) -> None: ...
+    def __getitem__(self, key: str) -> Any:
+        """A result's value (a float, or a word) by name."""
+    def units(self, series: str) -> dict[str, str]:
+        """The unit of each column of a series."""
+    def to_frame(self, series: Optional[str] = None) -> Any:
+        """The results, or one series, as a pandas DataFrame. Only where pandas is installed:
+        without it the method does not exist."""
+    def _repr_html_(self) -> str: ...
+
+def derivation(model: str) -> Derivation:
+    """The derivation of `model` (any name of `derivation_models()`)."""
+
+def derivation_models() -> list[str]:
+    """The models whose derivations the package carries (every registered model)."""
+
+def run(scene: Union[str, PathLike[str], Mapping[str, Any]]) -> RunResult:
+    """Runs a scene as `rodcube run` does: a path, YAML text, or a dict with the scene's keys.
+    Errors are `RodcubeError` with rodcube's messages (file, line, column and field)."""

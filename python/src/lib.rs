@@ -3,7 +3,8 @@
 //! flat NumPy arrays in parallel with the GIL released (the package's `sweep`, in
 //! `rodcube/__init__.py`, broadcasts its arguments into them), `models` and `parameters` list
 //! the registry. Errors are `rodcube.RodcubeError` (a `ValueError`) with the library's own
-//! messages; a point that fails in a sweep keeps its error's message.
+//! messages; a point that fails in a sweep keeps its error's message. `notebook.rs` gives the
+//! notebook helpers (`derivation`, `run`) the embedded derivations and scene runs.
 
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::create_exception;
@@ -16,6 +17,8 @@ use rodcube::model::{Model, ModelInfo, ParamInfo};
 use rodcube::plan::{self, Parameters, Request};
 use rodcube::quantity::Quantity;
 use rodcube::solve::lean::LeanSolver;
+
+mod notebook;
 
 create_exception!(
     rodcube,
@@ -107,7 +110,7 @@ fn solve<'py>(
         out.set_item(key, scalar.value)?;
     }
     for (key, label) in &results.labels {
-        out.set_item(key, &rodcube::report::prose::label(&label.value))?;
+        out.set_item(key, rodcube::report::prose::label(&label.value))?;
     }
     for (key, series) in &results.series {
         let columns = PyDict::new(py);
@@ -373,6 +376,11 @@ fn _rodcube(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(parameters, m)?)?;
     m.add_function(wrap_pyfunction!(solve, m)?)?;
     m.add_function(wrap_pyfunction!(sweep_flat, m)?)?;
+    m.add_function(wrap_pyfunction!(notebook::derivation_models, m)?)?;
+    m.add_function(wrap_pyfunction!(notebook::derivation_sources, m)?)?;
+    m.add_function(wrap_pyfunction!(notebook::run_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(notebook::format_number, m)?)?;
+    m.add_function(wrap_pyfunction!(notebook::result_order, m)?)?;
     m.add("RodcubeError", m.py().get_type::<RodcubeError>())?;
     Ok(())
 }

@@ -349,8 +349,27 @@ def test_the_package_ships_its_type_stubs():
     assert "RodcubeError" in classes
     # Every public function is in the stub, with the runtime's parameters, kinds and
     # defaults, and a return type.
+    stubbed_classes = {c.name: c for c in stub.body if isinstance(c, ast.ClassDef)}
+    exported = [
+        ast.literal_eval(node.value)
+        for node in stub.body
+        if isinstance(node, ast.Assign) and [t.id for t in node.targets] == ["__all__"]
+    ]
+    assert exported == [rodcube.__all__]
     for name in rodcube.__all__:
         if name == "RodcubeError":
+            continue
+        runtime = getattr(rodcube, name)
+        if inspect.isclass(runtime):
+            # Every public attribute of the class (and its notebook hooks) is in the stub.
+            assert name in stubbed_classes, name
+            members = {
+                target.id if isinstance(target, ast.Name) else getattr(target, "name", None)
+                for node in stubbed_classes[name].body
+                for target in (node.target if isinstance(node, ast.AnnAssign) else node,)
+            }
+            public = {m for m in vars(runtime) if not m.startswith("_") or m.startswith("_repr_")}
+            assert public <= members, (name, public - members)
             continue
         assert name in functions, name
         f = functions[name]

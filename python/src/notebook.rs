@@ -1,0 +1,83 @@
+//! What the package's notebook helpers (`rodcube/_notebook.py`) need from Rust: a model's
+//! derivation as the derivation tool wrote it (embedded at build time by `build.rs`, so an
+//! installed wheel carries it), and a scene run as the `rodcube run` command runs it, returned
+//! as `results.json`'s text and `motion.svg`'s (when the run drew the motion), and the command
+//! line's number format.
+
+use pyo3::prelude::*;
+use rodcube::report::{self, motion};
+use rodcube::scene::Scene;
+use std::path::Path;
+
+use crate::error;
+
+include!(concat!(env!("OUT_DIR"), "/derivations.rs"));
+
+/// The names of the models whose derivations the package carries, sorted.
+#[pyfunction]
+pub fn derivation_models() -> Vec<&'static str> {
+    DERIVATIONS.iter().map(|(name, _, _)| *name).collect()
+}
+
+/// A model's derivation: `(LaTeX write-up, JSON record)`, the text of `generated/<model>.tex`
+/// and `generated/<model>.json`.
+#[pyfunction]
+pub fn derivation_sources(model: &str) -> PyResult<(&'static str, &'static str)> {
+    DERIVATIONS
+        .iter()
+        .find(|(name, _, _)| *name == model)
+        .map(|(_, tex, json)| (*tex, *json))
+        .ok_or_else(|| {
+            error(format!(
+                "no model `{model}`; there are: {}",
+                derivation_models().join(", ")
+            ))
+        })
+}
+
+/// A number as the command line's tables show it: `sig` significant digits, engineering
+/// notation outside `1e-3 ..= 1e6` ([`rodcube::results::format_number`]).
+#[pyfunction]
+pub fn format_number(value: f64, sig: usize) -> String {
+    rodcube::results::format_number(value, sig)
+}
+
+/// The quantities in the order of the vocabulary (the paper's order), which the command line's
+/// results table follows (the rest alphabetically after them).
+#[pyfunction]
+pub fn result_order() -> Vec<&'static str> {
+    rodcube::quantity::FIXED
+        .iter()
+        .map(|(name, _, _)| *name)
+        .collect()
+}
+
+/// Runs a scene: the file at `path`, or else `text` (a YAML scene, named `name` in messages).
+/// Returns `results.json`'s text and `motion.svg`'s (`None` unless the scene wants a
+/// trajectory). Errors are `RodcubeError` with the command line's messages: a scene's problems
+/// with file, line, column and field, a failed solve with the scene's file.
+#[pyfunction]
+#[pyo3(signature = (text, path, name))]
+pub fn run_scene(
+    py: Python<'_>,
+    text: Option<&str>,
+    path: Option<&str>,
+    name: &str,
+) -> PyResult<(String, Option<String>)> {
+    let scene = match (path, text) {
+        (Some(path), _) => Scene::load(Path::new(path)),
+        (None, Some(text)) => Scene::parse(text, Path::new(name), rodcube::models::all()),
+        (None, None) => return Err(error("give a scene: a path, YAML text or a dict")),
+    }
+    .map_err(error)?;
+    let request = scene.request();
+    let results =
+        py.detach(|| rodcube::plan::run(&request))
+            .map_err(|e| match scene.plan_error(&e) {
+                Some(placed) => error(placed),
+                None => error(format!("solving {} failed: {e}", scene.file.display())),
+            })?;
+    let json = report::json::to_string(&results).map_err(error)?;
+    let svg = (results.drawing.as_ref()).map(|d| motion::svg(&motion::Animation::build(d)));
+    Ok((json, svg))
+}
