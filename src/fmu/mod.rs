@@ -16,6 +16,7 @@ pub mod fmi2;
 mod zip;
 
 use crate::model::ModelInfo;
+use crate::report::motion::xml as escape;
 use crate::spec::units::Unit;
 use std::fmt::Write;
 
@@ -340,23 +341,6 @@ fn unit_definitions(x: &mut String, vars: &[Variable]) {
         );
     }
     let _ = writeln!(x, "  </UnitDefinitions>");
-}
-
-/// `text` with XML's special characters escaped for an attribute value.
-fn escape(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            '\n' => out.push_str("&#10;"),
-            c => out.push(c),
-        }
-    }
-    out
 }
 
 #[cfg(test)]

@@ -143,20 +143,37 @@ pub unsafe extern "C" fn fmi2SetupExperiment(
     }
 }
 
+/// Moves the instance from mode `from` to `to` (refusing the call `call` in any other mode),
+/// after `work` succeeds.
+///
+/// # Safety
+/// `c` is NULL or a live instance.
+unsafe fn transition(
+    c: *mut c_void,
+    call: &str,
+    (from, to): (Mode, Mode),
+    work: impl FnOnce(&mut Instance) -> Result<(), Refusal>,
+) -> c_int {
+    // SAFETY: as the caller promises.
+    unsafe {
+        with(c, |i| {
+            i.expect_mode(&[from], call)?;
+            work(i)?;
+            i.mode = to;
+            Ok(FMI2_OK)
+        })
+    }
+}
+
 /// `fmi2EnterInitializationMode`.
 ///
 /// # Safety
 /// `c` is NULL or a live instance.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2EnterInitializationMode(c: *mut c_void) -> c_int {
+    let modes = (Mode::Instantiated, Mode::Initialization);
     // SAFETY: as the caller promises.
-    unsafe {
-        with(c, |i| {
-            i.expect_mode(&[Mode::Instantiated], "fmi2EnterInitializationMode")?;
-            i.mode = Mode::Initialization;
-            Ok(FMI2_OK)
-        })
-    }
+    unsafe { transition(c, "fmi2EnterInitializationMode", modes, |_| Ok(())) }
 }
 
 /// `fmi2ExitInitializationMode`: binds the parameters (the model's requirements between them
@@ -166,15 +183,9 @@ pub unsafe extern "C" fn fmi2EnterInitializationMode(c: *mut c_void) -> c_int {
 /// `c` is NULL or a live instance.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2ExitInitializationMode(c: *mut c_void) -> c_int {
+    let modes = (Mode::Initialization, Mode::Stepping);
     // SAFETY: as the caller promises.
-    unsafe {
-        with(c, |i| {
-            i.expect_mode(&[Mode::Initialization], "fmi2ExitInitializationMode")?;
-            i.start()?;
-            i.mode = Mode::Stepping;
-            Ok(FMI2_OK)
-        })
-    }
+    unsafe { transition(c, "fmi2ExitInitializationMode", modes, Instance::start) }
 }
 
 /// `fmi2Terminate`.
@@ -183,14 +194,9 @@ pub unsafe extern "C" fn fmi2ExitInitializationMode(c: *mut c_void) -> c_int {
 /// `c` is NULL or a live instance.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2Terminate(c: *mut c_void) -> c_int {
+    let modes = (Mode::Stepping, Mode::Terminated);
     // SAFETY: as the caller promises.
-    unsafe {
-        with(c, |i| {
-            i.expect_mode(&[Mode::Stepping], "fmi2Terminate")?;
-            i.mode = Mode::Terminated;
-            Ok(FMI2_OK)
-        })
-    }
+    unsafe { transition(c, "fmi2Terminate", modes, |_| Ok(())) }
 }
 
 /// `fmi2Reset`: back to the start values and the state after `fmi2Instantiate`.
@@ -275,79 +281,32 @@ unsafe fn no_variables(c: *mut c_void, nvr: usize, what: &'static str) -> c_int 
     }
 }
 
-/// `fmi2GetBoolean`: there are none.
-///
-/// # Safety
-/// `c` is NULL or a live instance.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetBoolean(
-    c: *mut c_void,
-    _vr: *const c_uint,
-    nvr: usize,
-    _value: *mut c_int,
-) -> c_int {
-    // SAFETY: as the caller promises.
-    unsafe { no_variables(c, nvr, "Boolean") }
+macro_rules! no_variables {
+    ($($name:ident($value:ty, $what:literal);)*) => {$(
+        #[doc = concat!("`", stringify!($name), "`: the FMU has no ", $what, " variables ",
+                        "(`fmi2OK` for none, else `fmi2Error`).")]
+        ///
+        /// # Safety
+        /// `c` is NULL or a live instance.
+        #[unsafe(no_mangle)]
+        pub unsafe extern "C" fn $name(
+            c: *mut c_void,
+            _vr: *const c_uint,
+            nvr: usize,
+            _value: $value,
+        ) -> c_int {
+            // SAFETY: as the caller promises.
+            unsafe { no_variables(c, nvr, $what) }
+        }
+    )*};
 }
 
-/// `fmi2GetString`: there are none.
-///
-/// # Safety
-/// `c` is NULL or a live instance.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetString(
-    c: *mut c_void,
-    _vr: *const c_uint,
-    nvr: usize,
-    _value: *mut *const c_char,
-) -> c_int {
-    // SAFETY: as the caller promises.
-    unsafe { no_variables(c, nvr, "String") }
-}
-
-/// `fmi2SetInteger`: the only Integer, the phase, is an output.
-///
-/// # Safety
-/// `c` is NULL or a live instance.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetInteger(
-    c: *mut c_void,
-    _vr: *const c_uint,
-    nvr: usize,
-    _value: *const c_int,
-) -> c_int {
-    // SAFETY: as the caller promises.
-    unsafe { no_variables(c, nvr, "settable Integer") }
-}
-
-/// `fmi2SetBoolean`: there are none.
-///
-/// # Safety
-/// `c` is NULL or a live instance.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetBoolean(
-    c: *mut c_void,
-    _vr: *const c_uint,
-    nvr: usize,
-    _value: *const c_int,
-) -> c_int {
-    // SAFETY: as the caller promises.
-    unsafe { no_variables(c, nvr, "Boolean") }
-}
-
-/// `fmi2SetString`: there are none.
-///
-/// # Safety
-/// `c` is NULL or a live instance.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetString(
-    c: *mut c_void,
-    _vr: *const c_uint,
-    nvr: usize,
-    _value: *const *const c_char,
-) -> c_int {
-    // SAFETY: as the caller promises.
-    unsafe { no_variables(c, nvr, "String") }
+no_variables! {
+    fmi2GetBoolean(*mut c_int, "Boolean");
+    fmi2GetString(*mut *const c_char, "String");
+    fmi2SetInteger(*const c_int, "settable Integer");
+    fmi2SetBoolean(*const c_int, "Boolean");
+    fmi2SetString(*const *const c_char, "String");
 }
 
 /// A capability the model description says the FMU lacks: `fmi2Error`, logged.
