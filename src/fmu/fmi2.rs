@@ -234,39 +234,46 @@ impl Instance {
                 .map_err(|e| Refusal(FMI2_ERROR, format!("fmi2SetReal: {e}")))?;
             self.values[i] = value;
             self.outputs[vr as usize] = value;
+            // Outputs read in initialization mode were of the values before.
+            self.sim = None;
         }
         Ok(FMI2_OK)
     }
 
+    /// Makes the outputs available: in initialization mode (FMI's initial unknowns) by solving
+    /// the release with the parameters as they are, as `fmi2ExitInitializationMode` will.
+    fn outputs_ready(&mut self) -> Result<(), Refusal> {
+        match (&self.sim, self.mode) {
+            (Some(_), _) => Ok(()),
+            (None, Mode::Initialization) => self.start(),
+            (None, _) => refuse("the outputs are computed from fmi2EnterInitializationMode on"),
+        }
+    }
+
     /// `fmi2GetReal`.
-    fn get_real(&self, refs: &[c_uint], values: &mut [f64]) -> Result<c_int, Refusal> {
+    fn get_real(&mut self, refs: &[c_uint], values: &mut [f64]) -> Result<c_int, Refusal> {
         for (&vr, value) in refs.iter().zip(values.iter_mut()) {
             let var = self.variable(vr)?;
             *value = match var.role {
                 Role::Parameter(i) => self.values[i],
                 Role::Phase => return refuse(format!("{} is an Integer", var.name)),
-                _ if self.sim.is_none() => {
-                    return refuse(format!(
-                        "{} is computed at fmi2ExitInitializationMode",
-                        var.name
-                    ));
+                _ => {
+                    self.outputs_ready()?;
+                    self.outputs[vr as usize]
                 }
-                _ => self.outputs[vr as usize],
             };
         }
         Ok(FMI2_OK)
     }
 
     /// `fmi2GetInteger`: the phase index.
-    fn get_integer(&self, refs: &[c_uint], values: &mut [c_int]) -> Result<c_int, Refusal> {
+    fn get_integer(&mut self, refs: &[c_uint], values: &mut [c_int]) -> Result<c_int, Refusal> {
         for (&vr, value) in refs.iter().zip(values.iter_mut()) {
             let var = self.variable(vr)?;
             if var.role != Role::Phase {
                 return refuse(format!("{} is a Real", var.name));
             }
-            if self.sim.is_none() {
-                return refuse("the phase is computed at fmi2ExitInitializationMode");
-            }
+            self.outputs_ready()?;
             *value = self.phase;
         }
         Ok(FMI2_OK)

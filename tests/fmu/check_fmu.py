@@ -10,7 +10,9 @@ Usage: check_fmu.py FMU SERIES_JSON LANDING_JSON STOP_TIME
 - run to 0.3 s, the FMU stops at the rod's landing (fmi2Discard, fmi2Terminated), at the
   time `rodcube run` gives for it (LANDING_JSON's floor_impact_time);
 - fmi2SetReal of a parameter out of its domain is fmi2Error with a logged message, and so is
-  fmi2ExitInitializationMode with parameters that break a requirement (a < ell).
+  fmi2ExitInitializationMode with parameters that break a requirement (a < ell); after
+  fmi2Reset the start values hold again, and the release angle, asin(a/ell), can be read in
+  initialization mode.
 Prints one line per check; exits non-zero (an AssertionError) on the first that fails.
 """
 
@@ -94,8 +96,10 @@ def main(fmu, results, landing, stop):
     slave.reset()
     slave.setupExperiment()
     slave.enterInitializationMode()
+    initial = slave.getReal([vr["theta"]])[0]
     slave.exitInitializationMode()
-    assert slave.getReal([vr["theta"]])[0] == r["theta"][0]
+    assert initial == slave.getReal([vr["theta"]])[0] == r["theta"][0] == np.arcsin(0.25)
+    print("after fmi2Reset: theta at release", initial, "in and after initialization mode")
     slave.terminate()
     slave.freeInstance()
 

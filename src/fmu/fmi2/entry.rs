@@ -177,7 +177,8 @@ pub unsafe extern "C" fn fmi2EnterInitializationMode(c: *mut c_void) -> c_int {
 }
 
 /// `fmi2ExitInitializationMode`: binds the parameters (the model's requirements between them
-/// checked here) and solves the release.
+/// checked here) and solves the release (unless an output read in initialization mode did,
+/// with the same parameters).
 ///
 /// # Safety
 /// `c` is NULL or a live instance.
@@ -185,7 +186,14 @@ pub unsafe extern "C" fn fmi2EnterInitializationMode(c: *mut c_void) -> c_int {
 pub unsafe extern "C" fn fmi2ExitInitializationMode(c: *mut c_void) -> c_int {
     let modes = (Mode::Initialization, Mode::Stepping);
     // SAFETY: as the caller promises.
-    unsafe { transition(c, "fmi2ExitInitializationMode", modes, Instance::start) }
+    unsafe {
+        transition(
+            c,
+            "fmi2ExitInitializationMode",
+            modes,
+            Instance::outputs_ready,
+        )
+    }
 }
 
 /// `fmi2Terminate`.
@@ -214,7 +222,8 @@ pub unsafe extern "C" fn fmi2Reset(c: *mut c_void) -> c_int {
     }
 }
 
-/// `fmi2GetReal`: parameters at any time, outputs after `fmi2ExitInitializationMode`.
+/// `fmi2GetReal`: parameters at any time, outputs from `fmi2EnterInitializationMode` on (the
+/// release state until the first step).
 ///
 /// # Safety
 /// `c` is NULL or a live instance; `vr` and `value` point to `nvr` values.
