@@ -61,6 +61,8 @@ pub mod axes;
 pub mod derive;
 #[cfg(feature = "capi")]
 pub mod ffi;
+#[cfg(any(feature = "cli", feature = "fmi"))]
+pub mod fmu;
 #[doc(hidden)]
 pub mod fuzzing;
 pub mod io;

@@ -31,10 +31,23 @@ Examples:
   rodcube run scenes/paper.yaml --json > r.json
   rodcube run my_scene.yaml --out /tmp/mine  # choose the output directory
   rodcube models                             # models, their parameters and quantities
+  rodcube fmu rod_cube --out out/fmu         # an FMI 2.0 co-simulation FMU of a system
 
 Exit status: 0 success, 1 the computation failed, 2 bad command line,
 3 invalid scene or input file (the message names file:line:column and the field),
-4 an output could not be written.";
+4 an output could not be written (`rodcube fmu`: 2, and no partial .fmu is left).";
+
+const FMU_HELP: &str = "\
+The FMU's shared library is built from the C ABI with the FMI 2.0 entry points:
+  cargo rustc --release --lib --no-default-features --features fmi --crate-type cdylib
+which writes librodcube.so into the target directory's release/, beside the rodcube binary
+that `cargo build --release` writes, where `rodcube fmu` looks for it (or pass --binary).
+The parameters' start values are those of the first scene in scenes/ of the model (the
+paper's for rod_cube), or of --scene FILE.
+
+Examples:
+  rodcube fmu rod_cube --out out/fmu
+  rodcube fmu hinged_rod --out out/fmu --scene my_hinged.yaml";
 
 const RUN_HELP: &str = "\
 A scene is a YAML file:
@@ -75,6 +88,9 @@ enum Command {
     /// Sweep the separation angle and time over a grid of (n, a/ell) or a CSV of points
     #[command(after_help = numerics_cli::SWEEP_HELP)]
     Sweep(numerics_cli::SweepArgs),
+    /// Write DIR/MODEL.fmu, an FMI 2.0 co-simulation FMU of a system
+    #[command(after_help = FMU_HELP)]
+    Fmu(FmuArgs),
     /// Compare every method against a high-precision reference: error, evaluations, time
     #[command(after_help = numerics_cli::ACCURACY_HELP)]
     Accuracy(numerics_cli::AccuracyArgs),
@@ -112,6 +128,21 @@ struct RunArgs {
     out: Option<PathBuf>,
     #[command(flatten)]
     layout: LayoutArgs,
+}
+
+#[derive(Args)]
+struct FmuArgs {
+    /// The system (`rodcube models` lists them)
+    model: String,
+    /// Output directory: the FMU is DIR/MODEL.fmu
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+    /// Scene whose parameters are the start values [default: the model's scene in scenes/]
+    #[arg(long, value_name = "FILE")]
+    scene: Option<PathBuf>,
+    /// The shared library built with the feature `fmi` [default: librodcube.so beside rodcube]
+    #[arg(long, value_name = "FILE")]
+    binary: Option<PathBuf>,
 }
 
 /// How the printed tables are laid out.
@@ -207,6 +238,7 @@ fn main() -> ExitCode {
     let outcome = match cli.command.unwrap_or_else(default_command) {
         Command::Run(args) => run(args),
         Command::Models(args) => models(args),
+        Command::Fmu(args) => fmu(args),
         Command::Sweep(args) => numerics_cli::sweep(args),
         Command::Accuracy(args) => numerics_cli::accuracy(args),
         #[cfg(feature = "derive")]
@@ -322,6 +354,37 @@ fn planner_failure(scene: &Scene, error: PlanError) -> Failure {
             anyhow::Error::from(error).context(format!("solving {} failed", scene.file.display())),
         ),
     }
+}
+
+/// `rodcube fmu`: every refusal (an unknown model, a missing library, an output directory
+/// that cannot be written) exits 2, a refused scene 3; the archive is written atomically.
+fn fmu(args: FmuArgs) -> Result<(), Failure> {
+    use rodcube::fmu::export::{self, ExportError};
+    let usage = |e: ExportError| Failure::Usage(e.into());
+    let model = export::find_system(&args.model, rodcube::models::all()).map_err(usage)?;
+    let scene = match &args.scene {
+        Some(path) => Some(Scene::load(path).map_err(Failure::Scene)?),
+        None => None,
+    };
+    let defaults = export::defaults(model, scene.as_ref()).map_err(|e| match e {
+        ExportError::Scene(e) => Failure::Scene(e),
+        e => usage(e),
+    })?;
+    let binary = match args.binary {
+        Some(path) => path,
+        None => export::default_binary().ok_or_else(|| {
+            Failure::Usage(anyhow::anyhow!(
+                "cannot locate the rodcube executable to find {} beside it; pass --binary FILE",
+                export::LIBRARY_NAME
+            ))
+        })?,
+    };
+    let library = export::read_binary(&binary).map_err(usage)?;
+    // The message alone: it already ends with the system's reason.
+    let out = OutDir::create(&args.out).map_err(|e| Failure::Usage(anyhow::anyhow!("{e}")))?;
+    let path = export::write_fmu(model, &defaults, &library, &out).map_err(usage)?;
+    note(&format!("wrote {}", path.display()));
+    Ok(())
 }
 
 /// `rodcube models`.

@@ -268,7 +268,7 @@ const LAYERS: &[&[&str]] = &[
     &["solve", "report"],
     &["plan"],
     &["scene", "sweep"],
-    &["accuracy", "ffi", "fuzzing", "derive"],
+    &["accuracy", "ffi", "fmu", "fuzzing", "derive"],
 ];
 
 /// Every `src/` module (`a::b` for `src/a/b.rs` and `src/a/b/mod.rs`) with its text outside

@@ -37,4 +37,5 @@ pub use animation::{
     Animation, ContactEnd, Frame, ImpactMark, MAX_KEYFRAMES, PAUSE_SECONDS, PhaseSpan, Shape,
     TARGET_SECONDS, slow_motion,
 };
+pub(crate) use svg::xml;
 pub use svg::{MAX_IMPACT_MARKS, MAX_TIME_LABELS, svg};

@@ -23,8 +23,8 @@ pub(super) fn factor_words(f: f64) -> String {
     }
 }
 
-/// Text safe inside an XML element or attribute.
-pub(super) fn xml(text: &str) -> String {
+/// Text safe inside an XML element or attribute (also the FMU's `modelDescription.xml`).
+pub(crate) fn xml(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     for c in text.chars() {
         match c {

@@ -14,6 +14,7 @@ mod view;
 mod world;
 
 pub use layout::{MAX_IMPACT_MARKS, MAX_TIME_LABELS};
+pub(crate) use markup::xml;
 
 use crate::report::motion::animation::{
     Animation, PAUSE_SECONDS, drawable, keyframes, slow_motion,
@@ -21,7 +22,7 @@ use crate::report::motion::animation::{
 use clock::Clock;
 use labels::write_labels;
 use layout::WIDTH;
-use markup::{factor_words, num, xml};
+use markup::{factor_words, num};
 use std::fmt::Write;
 use view::View;
 use world::write_world;

@@ -1,0 +1,282 @@
+//! `rodcube fmu`: writes `<model>.fmu` (an FMI 2.0 co-simulation FMU) from a system, the start
+//! values of a scene and the shared library built with the feature `fmi`, which it checks for
+//! the FMI 2.0 entry points before zipping. The archive is made in memory and written
+//! atomically, so a failure leaves no partial `.fmu`.
+
+use super::zip::{self, TooLarge};
+use super::{
+    Defaults, DescriptionError, FMI2_FUNCTIONS, RESOURCES, Resources, guid, model_description,
+};
+use crate::io::{self, OutDir};
+use crate::model::Model;
+use crate::scene::{Scene, SceneError};
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+/// How to build the shared library an FMU needs (its name, `librodcube.so`, in the target
+/// directory's `release/`).
+pub const BUILD_LIBRARY: &str =
+    "cargo rustc --release --lib --no-default-features --features fmi --crate-type cdylib";
+
+/// The library's file name as cargo writes it.
+pub const LIBRARY_NAME: &str = "librodcube.so";
+
+/// The scenes of `scenes/`, built in: the start values of a model's FMU come from the first
+/// that names it (the paper's first), unless a scene is given.
+const SCENES: &[(&str, &str)] = &[
+    ("scenes/paper.yaml", include_str!("../../scenes/paper.yaml")),
+    (
+        "scenes/angle_only.yaml",
+        include_str!("../../scenes/angle_only.yaml"),
+    ),
+    (
+        "scenes/block_tipping.yaml",
+        include_str!("../../scenes/block_tipping.yaml"),
+    ),
+    (
+        "scenes/bounce.yaml",
+        include_str!("../../scenes/bounce.yaml"),
+    ),
+    (
+        "scenes/cylinder.yaml",
+        include_str!("../../scenes/cylinder.yaml"),
+    ),
+    (
+        "scenes/fixed_cylinder.yaml",
+        include_str!("../../scenes/fixed_cylinder.yaml"),
+    ),
+    (
+        "scenes/friction.yaml",
+        include_str!("../../scenes/friction.yaml"),
+    ),
+    (
+        "scenes/hinged.yaml",
+        include_str!("../../scenes/hinged.yaml"),
+    ),
+    (
+        "scenes/hinged_cylinder.yaml",
+        include_str!("../../scenes/hinged_cylinder.yaml"),
+    ),
+    (
+        "scenes/hinged_spring.yaml",
+        include_str!("../../scenes/hinged_spring.yaml"),
+    ),
+    (
+        "scenes/ladder.yaml",
+        include_str!("../../scenes/ladder.yaml"),
+    ),
+    (
+        "scenes/ladder_friction.yaml",
+        include_str!("../../scenes/ladder_friction.yaml"),
+    ),
+    (
+        "scenes/liftoff.yaml",
+        include_str!("../../scenes/liftoff.yaml"),
+    ),
+    (
+        "scenes/spring.yaml",
+        include_str!("../../scenes/spring.yaml"),
+    ),
+];
+
+/// Why an FMU was not written.
+#[derive(Debug, thiserror::Error)]
+pub enum ExportError {
+    /// No model of that name.
+    #[error("no model `{name}`; the systems are: {systems}")]
+    UnknownModel {
+        /// The name asked.
+        name: String,
+        /// The systems, comma-separated.
+        systems: String,
+    },
+    /// A fast phase was named: an FMU is of a system.
+    #[error("model `{name}` is a phase of the system `{system}`: export `{system}`")]
+    NotASystem {
+        /// The phase.
+        name: &'static str,
+        /// Its system.
+        system: &'static str,
+    },
+    /// The scene names another model.
+    #[error("the scene {} is of `{scene}`, not `{model}`", file.display())]
+    SceneModel {
+        /// The scene's file.
+        file: PathBuf,
+        /// Its model.
+        scene: &'static str,
+        /// The model exported.
+        model: &'static str,
+    },
+    /// No built-in scene names the model and none was given.
+    #[error("no scene in scenes/ is of `{model}`: give its start values with --scene FILE")]
+    NoScene {
+        /// The model.
+        model: &'static str,
+    },
+    /// A built-in scene was refused (a broken build).
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// The shared library could not be read.
+    #[error(
+        "cannot read the FMU's shared library {}: {error}; build it with `{BUILD_LIBRARY}` (it lands in the target directory's release/{LIBRARY_NAME}) or pass --binary FILE",
+        path.display()
+    )]
+    Binary {
+        /// Where it was looked for.
+        path: PathBuf,
+        /// The error.
+        error: std::io::Error,
+    },
+    /// The shared library lacks FMI 2.0 entry points (built without the feature `fmi`).
+    #[error(
+        "{} has no {missing}: it was built without the feature `fmi`; build it with `{BUILD_LIBRARY}`",
+        path.display()
+    )]
+    NotFmi {
+        /// The library.
+        path: PathBuf,
+        /// The first entry point missing.
+        missing: &'static str,
+    },
+    /// The model description could not be made.
+    #[error(transparent)]
+    Description(#[from] DescriptionError),
+    /// The resources could not be written as JSON.
+    #[error("cannot write the FMU's resources: {0}")]
+    Json(serde_json::Error),
+    /// The archive would be too large.
+    #[error("{0}")]
+    TooLarge(TooLarge),
+    /// The output directory or the file could not be written (nothing partial was left).
+    #[error(transparent)]
+    Output(#[from] io::Error),
+}
+
+/// The system named `name` in `registry`.
+pub fn find_system(
+    name: &str,
+    registry: &[&'static dyn Model],
+) -> Result<&'static dyn Model, ExportError> {
+    let model = registry.iter().copied().find(|m| m.info().name == name);
+    let Some(model) = model else {
+        let systems: Vec<&str> = (registry.iter().map(|m| m.info()))
+            .filter(|i| i.is_general())
+            .map(|i| i.name)
+            .collect();
+        return Err(ExportError::UnknownModel {
+            name: name.to_string(),
+            systems: systems.join(", "),
+        });
+    };
+    let info = model.info();
+    if !info.is_general() {
+        return Err(ExportError::NotASystem {
+            name: info.name,
+            system: info.system,
+        });
+    }
+    Ok(model)
+}
+
+/// The defaults of `model`'s FMU from `scene` (its parameters, tolerance and end time), or
+/// from the first built-in scene of the model when `scene` is `None`.
+pub fn defaults(model: &'static dyn Model, scene: Option<&Scene>) -> Result<Defaults, ExportError> {
+    let name = model.info().name;
+    let builtin;
+    let scene = match scene {
+        Some(s) => s,
+        None => {
+            let mut found = None;
+            for (file, text) in SCENES {
+                let s = Scene::parse(text, Path::new(file), crate::models::all())?;
+                if s.info().name == name {
+                    found = Some(s);
+                    break;
+                }
+            }
+            builtin = found.ok_or(ExportError::NoScene { model: name })?;
+            &builtin
+        }
+    };
+    if scene.info().name != name {
+        return Err(ExportError::SceneModel {
+            file: scene.file.clone(),
+            scene: scene.info().name,
+            model: name,
+        });
+    }
+    Ok(Defaults {
+        start: scene.parameters.clone(),
+        tolerance: scene.tolerance,
+        stop: scene.until,
+        source: format!("the parameters of {}", scene.file.display()),
+    })
+}
+
+/// Where `rodcube fmu` looks for the shared library when none is given: beside the running
+/// executable (cargo writes both into the target directory's `release/`).
+pub fn default_binary() -> Option<PathBuf> {
+    let exe = std::env::current_exe().ok()?;
+    Some(exe.parent()?.join(LIBRARY_NAME))
+}
+
+/// The shared library at `path`, checked to export every FMI 2.0 co-simulation function.
+pub fn read_binary(path: &Path) -> Result<Vec<u8>, ExportError> {
+    let bytes = std::fs::read(path).map_err(|error| ExportError::Binary {
+        path: path.to_path_buf(),
+        error,
+    })?;
+    let names = fmi2_names(&bytes);
+    if let Some(missing) = FMI2_FUNCTIONS
+        .iter()
+        .find(|f| !names.contains(f.as_bytes()))
+    {
+        return Err(ExportError::NotFmi {
+            path: path.to_path_buf(),
+            missing,
+        });
+    }
+    Ok(bytes)
+}
+
+/// Every NUL-terminated name starting `fmi2` in `bytes` (the dynamic symbol table's names
+/// among them).
+fn fmi2_names(bytes: &[u8]) -> BTreeSet<&[u8]> {
+    let mut out = BTreeSet::new();
+    let mut i = 0;
+    while let Some(at) = bytes[i..].windows(4).position(|w| w == b"fmi2") {
+        let start = i + at;
+        let len = bytes[start..].iter().position(|&b| b == 0);
+        let end = len.map_or(bytes.len(), |n| start + n);
+        out.insert(&bytes[start..end]);
+        i = start + 4;
+    }
+    out
+}
+
+/// Writes `<model>.fmu` into `out`: its model description with `defaults`, `binary` as
+/// `binaries/linux64/<model>.so` and the start values in `resources/rodcube.json`. Returns the file written.
+pub fn write_fmu(
+    model: &'static dyn Model,
+    defaults: &Defaults,
+    binary: &[u8],
+    out: &OutDir,
+) -> Result<PathBuf, ExportError> {
+    let info = model.info();
+    let description = model_description(info, defaults)?;
+    let library = format!("binaries/linux64/{}.so", info.name);
+    let resources = Resources {
+        model: info.name.to_string(),
+        guid: guid(info)?,
+        start: defaults.start.clone(),
+    };
+    let resources = serde_json::to_string_pretty(&resources).map_err(ExportError::Json)?;
+    let archive = zip::archive(&[
+        ("modelDescription.xml", description.as_bytes()),
+        (&library, binary),
+        (&format!("resources/{RESOURCES}"), resources.as_bytes()),
+    ])
+    .map_err(ExportError::TooLarge)?;
+    Ok(out.write(&format!("{}.fmu", info.name), &archive)?)
+}

@@ -1,0 +1,571 @@
+//! The FMI 2.0 co-simulation entry points of an exported FMU (feature `fmi`, in the shared
+//! library `rodcube fmu` zips): `fmi2Instantiate` reads the model and the parameters' start
+//! values from the FMU's `resources/rodcube.json`, `fmi2ExitInitializationMode` binds the
+//! parameters and solves the release, and `fmi2DoStep` walks the motion with the planner's
+//! [`Walker`] (the phases `rodcube run` solves), phase by phase as far as the step's end, and
+//! samples it there: a step that crosses an event (a contact opening or closing, an impact)
+//! gets the phase after it, solved to the tolerance of `fmi2SetupExperiment`.
+//!
+//! Architecture invariant: no panic crosses the boundary. Every entry point runs inside
+//! `catch_unwind`; a caught panic puts the instance in its error state and returns
+//! `fmi2Error`. Every refusal is logged through the host's logger callback.
+
+use super::{RESOURCES, Resources, Role, Variable, guid, variables};
+use crate::model::Model;
+use crate::plan::{DEFAULT_TOLERANCE, ODE_RTOL_FACTOR, ODE_RTOL_FLOOR};
+use crate::results::Work;
+use crate::solve::SolveError;
+use crate::solve::phases::{End, Motion, PhaseRun, Route, Walker};
+use crate::solve::series::{sample_at, sample_forces};
+use crate::system::{Bound, check_value};
+use std::ffi::{CStr, CString, c_char, c_int, c_uint, c_void};
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::PathBuf;
+
+/// `fmi2OK`.
+pub const FMI2_OK: c_int = 0;
+/// `fmi2Warning`.
+pub const FMI2_WARNING: c_int = 1;
+/// `fmi2Discard`: the step stopped early (the motion ended; see `fmi2Terminated`).
+pub const FMI2_DISCARD: c_int = 2;
+/// `fmi2Error`.
+pub const FMI2_ERROR: c_int = 3;
+/// `fmi2CoSimulation` (`fmi2Type`).
+pub const FMI2_CO_SIMULATION: c_int = 1;
+/// `fmi2DoStepStatus` (`fmi2StatusKind`).
+const DO_STEP_STATUS: c_int = 0;
+/// `fmi2LastSuccessfulTime` (`fmi2StatusKind`).
+const LAST_SUCCESSFUL_TIME: c_int = 2;
+/// `fmi2Terminated` (`fmi2StatusKind`).
+const TERMINATED: c_int = 3;
+
+/// Two communication times closer than this, relative to the larger (and to 1 s), are the
+/// same time: what a host's sum of steps rounds away.
+const TIME_SLACK: f64 = 1e-12;
+
+/// The host's logger (`fmi2CallbackLogger`; a C variadic function, called here with the
+/// message as its format, `%` doubled, and no further arguments).
+pub type Logger =
+    unsafe extern "C" fn(*mut c_void, *const c_char, c_int, *const c_char, *const c_char, ...);
+
+/// `fmi2CallbackFunctions`.
+#[repr(C)]
+pub struct CallbackFunctions {
+    /// `logger`.
+    pub logger: Option<Logger>,
+    /// `allocateMemory` (not used: the library allocates with Rust's allocator).
+    pub allocate_memory: Option<unsafe extern "C" fn(usize, usize) -> *mut c_void>,
+    /// `freeMemory` (not used).
+    pub free_memory: Option<unsafe extern "C" fn(*mut c_void)>,
+    /// `stepFinished` (not used: `fmi2DoStep` finishes before it returns).
+    pub step_finished: Option<unsafe extern "C" fn(*mut c_void, c_int)>,
+    /// `componentEnvironment`, handed back to the logger.
+    pub component_environment: *mut c_void,
+}
+
+/// Where an instance is in FMI's state machine.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Mode {
+    Instantiated,
+    Initialization,
+    Stepping,
+    Terminated,
+    Failed,
+}
+
+/// The motion being followed: the walker, the phases solved so far and the work done.
+struct Sim {
+    walker: Walker<'static>,
+    motion: Motion<'static>,
+    work: Work,
+}
+
+/// One FMU instance (an `fmi2Component`).
+struct Instance {
+    name: CString,
+    model: &'static dyn Model,
+    vars: Vec<Variable>,
+    logger: Option<Logger>,
+    env: *mut c_void,
+    start_values: Vec<f64>,
+    values: Vec<f64>,
+    tolerance: f64,
+    start_time: f64,
+    stop_time: Option<f64>,
+    mode: Mode,
+    sim: Option<Sim>,
+    /// The current communication point (s, the host's time).
+    time: f64,
+    /// Each variable's value at `time` (the parameters' included), by value reference.
+    outputs: Vec<f64>,
+    phase: c_int,
+    terminated: bool,
+}
+
+/// A refusal: its status and the message logged.
+struct Refusal(c_int, String);
+
+fn refuse<T>(message: impl Into<String>) -> Result<T, Refusal> {
+    Err(Refusal(FMI2_ERROR, message.into()))
+}
+
+impl Instance {
+    /// Logs `message` with `status` through the host's logger, if it gave one.
+    fn log(&self, status: c_int, message: &str) {
+        log(self.logger, self.env, &self.name, status, message);
+    }
+
+    fn expect_mode(&self, allowed: &[Mode], call: &str) -> Result<(), Refusal> {
+        if allowed.contains(&self.mode) {
+            return Ok(());
+        }
+        refuse(format!(
+            "{call} is not allowed now (the instance is {:?})",
+            self.mode
+        ))
+    }
+
+    /// Binds the parameters and solves the release: the motion's first phase.
+    fn start(&mut self) -> Result<(), Refusal> {
+        let general = Bound::from_values(self.model, &self.values)
+            .map_err(|e| Refusal(FMI2_ERROR, format!("the parameters were refused: {e}")))?;
+        let until = match self.stop_time {
+            Some(stop) if stop > self.start_time => Some(stop - self.start_time),
+            Some(stop) => {
+                return refuse(format!(
+                    "the stop time {stop} s is not after the start time {} s",
+                    self.start_time
+                ));
+            }
+            None => None,
+        };
+        let walker = Walker {
+            general,
+            registry: crate::models::all(),
+            tol: self.tolerance,
+            rtol: (self.tolerance * ODE_RTOL_FACTOR).max(ODE_RTOL_FLOOR),
+            route: Route::Fastest,
+            until,
+            dense_output: true,
+        };
+        let mut work = Work::default();
+        let first = walker.release().and_then(|(start, opened)| {
+            let run = walker.solve(&start, &mut work)?;
+            Ok(Motion::starting(run, opened, until.is_some()))
+        });
+        let motion = first.map_err(|e| Refusal(FMI2_ERROR, format!("at release: {e}")))?;
+        self.sim = Some(Sim {
+            walker,
+            motion,
+            work,
+        });
+        self.time = self.start_time;
+        self.terminated = false;
+        self.sample(0.0)
+    }
+
+    /// Sets the outputs to the motion at `t` (s from release).
+    fn sample(&mut self, t: f64) -> Result<(), Refusal> {
+        let Some(sim) = self.sim.as_mut() else {
+            return refuse("the motion has not started");
+        };
+        let failed = |e: SolveError| Refusal(FMI2_ERROR, format!("at t = {t} s: {e}"));
+        let phase = sim
+            .outputs(t, &self.vars, &mut self.outputs)
+            .map_err(failed)?;
+        self.phase =
+            c_int::try_from(phase).map_err(|_| Refusal(FMI2_ERROR, "too many phases".into()))?;
+        Ok(())
+    }
+
+    /// `fmi2DoStep`: follows the motion to `current + step`.
+    fn step(&mut self, current: f64, step: f64) -> Result<c_int, Refusal> {
+        self.expect_mode(&[Mode::Stepping], "fmi2DoStep")?;
+        if !(step >= 0.0 && step.is_finite() && current.is_finite()) {
+            return refuse(format!("a step of {step} s from {current} s"));
+        }
+        if !same_time(current, self.time) {
+            return refuse(format!(
+                "the step starts at {current} s, but the instance is at {} s",
+                self.time
+            ));
+        }
+        if self.terminated {
+            return Err(Refusal(FMI2_DISCARD, "the motion has ended".into()));
+        }
+        let target = current + step;
+        let t = target - self.start_time;
+        let Some(sim) = self.sim.as_mut() else {
+            return refuse("the motion has not started");
+        };
+        sim.reach(t).map_err(|e| {
+            Refusal(
+                FMI2_ERROR,
+                format!("following the motion to t = {t} s: {e}"),
+            )
+        })?;
+        let end = sim.motion.end_time();
+        if sim.motion.complete() && t > end && !same_time(t, end) {
+            self.sample(end)?;
+            self.time = self.start_time + end;
+            self.terminated = true;
+            let why = format!(
+                "the motion ended at t = {end} s ({}); the step to {target} s stopped there",
+                self.sim.as_ref().map_or_else(String::new, Sim::ending)
+            );
+            return Err(Refusal(FMI2_DISCARD, why));
+        }
+        self.sample(t.min(end))?;
+        self.time = target;
+        Ok(FMI2_OK)
+    }
+
+    /// `fmi2SetReal`: parameters only, before the motion starts; each value checked at once
+    /// (finite, positive where declared, a friction coefficient not negative), the
+    /// requirements between them at `fmi2ExitInitializationMode`.
+    fn set_real(&mut self, refs: &[c_uint], values: &[f64]) -> Result<c_int, Refusal> {
+        self.expect_mode(&[Mode::Instantiated, Mode::Initialization], "fmi2SetReal")?;
+        for (&vr, &value) in refs.iter().zip(values) {
+            let var = self.variable(vr)?;
+            let Role::Parameter(i) = var.role else {
+                return refuse(format!("{} is an output; it cannot be set", var.name));
+            };
+            check_value(self.model.info(), i, value)
+                .map_err(|e| Refusal(FMI2_ERROR, format!("fmi2SetReal: {e}")))?;
+            self.values[i] = value;
+            self.outputs[vr as usize] = value;
+            // Outputs read in initialization mode were of the values before.
+            self.sim = None;
+        }
+        Ok(FMI2_OK)
+    }
+
+    /// Makes the outputs available: in initialization mode (FMI's initial unknowns) by solving
+    /// the release with the parameters as they are, as `fmi2ExitInitializationMode` will.
+    fn outputs_ready(&mut self) -> Result<(), Refusal> {
+        match (&self.sim, self.mode) {
+            (Some(_), _) => Ok(()),
+            (None, Mode::Initialization) => self.start(),
+            (None, _) => refuse("the outputs are computed from fmi2EnterInitializationMode on"),
+        }
+    }
+
+    /// `fmi2GetReal`.
+    fn get_real(&mut self, refs: &[c_uint], values: &mut [f64]) -> Result<c_int, Refusal> {
+        for (&vr, value) in refs.iter().zip(values.iter_mut()) {
+            let var = self.variable(vr)?;
+            *value = match var.role {
+                Role::Parameter(i) => self.values[i],
+                Role::Phase => return refuse(format!("{} is an Integer", var.name)),
+                _ => {
+                    self.outputs_ready()?;
+                    self.outputs[vr as usize]
+                }
+            };
+        }
+        Ok(FMI2_OK)
+    }
+
+    /// `fmi2GetInteger`: the phase index.
+    fn get_integer(&mut self, refs: &[c_uint], values: &mut [c_int]) -> Result<c_int, Refusal> {
+        for (&vr, value) in refs.iter().zip(values.iter_mut()) {
+            let var = self.variable(vr)?;
+            if var.role != Role::Phase {
+                return refuse(format!("{} is a Real", var.name));
+            }
+            self.outputs_ready()?;
+            *value = self.phase;
+        }
+        Ok(FMI2_OK)
+    }
+
+    fn variable(&self, vr: c_uint) -> Result<&Variable, Refusal> {
+        match self.vars.get(vr as usize) {
+            Some(v) => Ok(v),
+            None => refuse(format!("no variable with value reference {vr}")),
+        }
+    }
+
+    /// `fmi2Reset`: back to the state after `fmi2Instantiate`.
+    fn reset(&mut self) {
+        self.values = self.start_values.clone();
+        self.outputs = vec![0.0; self.vars.len()];
+        for (i, v) in self.values.iter().enumerate() {
+            self.outputs[i] = *v;
+        }
+        self.tolerance = DEFAULT_TOLERANCE;
+        self.start_time = 0.0;
+        self.stop_time = None;
+        self.mode = Mode::Instantiated;
+        self.sim = None;
+        self.time = 0.0;
+        self.phase = 0;
+        self.terminated = false;
+    }
+}
+
+/// Logs `message` with `status` through `logger`, if there is one (the message is the format,
+/// its `%` doubled, and there are no further arguments).
+fn log(logger: Option<Logger>, env: *mut c_void, name: &CStr, status: c_int, message: &str) {
+    let Some(logger) = logger else { return };
+    let text = message.replace('%', "%%").replace('\0', " ");
+    let Ok(text) = CString::new(text) else { return };
+    let category: &CStr = if status == FMI2_OK {
+        c"logAll"
+    } else {
+        c"logStatusError"
+    };
+    // SAFETY: the host's logger, called with its environment, NUL-terminated strings that live
+    // across the call, and a format without conversions.
+    unsafe {
+        logger(env, name.as_ptr(), status, category.as_ptr(), text.as_ptr());
+    }
+}
+
+/// Whether two communication times are the same (within [`TIME_SLACK`]).
+fn same_time(a: f64, b: f64) -> bool {
+    (a - b).abs() <= TIME_SLACK * a.abs().max(b.abs()).max(1.0)
+}
+
+impl Sim {
+    /// How the motion ended, for a message.
+    fn ending(&self) -> String {
+        let info = self.walker.general.info();
+        let contact = |i: usize| info.contacts.get(i).map_or("a contact", |c| c.name);
+        if let Some(halt) = &self.motion.halted {
+            return format!("halted: {halt:?}");
+        }
+        match self.motion.last_end() {
+            Some(End::Floor) => "it reached the floor".into(),
+            Some(End::Until) => "the stop time".into(),
+            Some(End::Edge(i)) => format!("{} ran off its edge", contact(i)),
+            Some(End::Contact(i)) => format!("{} closed", contact(i)),
+            Some(End::Force(i)) => format!("{} opened", contact(i)),
+            None => "no phase".into(),
+        }
+    }
+
+    /// Solves phases until one runs past `t` (s from release) or the motion ends.
+    fn reach(&mut self, t: f64) -> Result<(), SolveError> {
+        while !self.motion.complete() && self.motion.end_time() <= t {
+            self.walker.step(&mut self.motion, &mut self.work)?;
+        }
+        Ok(())
+    }
+
+    /// The phase that runs at `t`, as `rodcube run`'s series choose it: the last one starting
+    /// at or before `t` that lasts past it; at the motion's end, the one ending there.
+    fn phase_at(&self, t: f64) -> Option<usize> {
+        let end = self.motion.end_time();
+        let phases = || self.motion.phases.iter();
+        if t < end {
+            phases().rposition(|p| p.t_start() <= t && t < p.t_end())
+        } else {
+            (phases().rposition(|p| p.t_start() < end && p.t_end() >= end))
+                .or_else(|| phases().rposition(|p| p.t_start() <= t && p.t_end() >= end))
+        }
+    }
+
+    /// Every variable's value at `t` (s from release, within the solved motion) into `out`
+    /// (the parameters' left as they are); returns the phase's index.
+    fn outputs(&mut self, t: f64, vars: &[Variable], out: &mut [f64]) -> Result<usize, SolveError> {
+        let k = self.phase_at(t).ok_or(SolveError::Inversion {
+            target: t,
+            duration: self.motion.end_time(),
+            reason: "no solved phase runs at this time",
+        })?;
+        let phase: &PhaseRun = &self.motion.phases[k];
+        let s = sample_at(phase, &[(t - phase.t_start()).max(0.0)], &mut self.work)?;
+        let forces = sample_forces(phase, &s)?;
+        let (Some(state), Some(forces)) = (s.states.first(), forces.first()) else {
+            return Err(SolveError::Inversion {
+                target: t,
+                duration: phase.duration(),
+                reason: "the phase gave no sample",
+            });
+        };
+        let points = phase.bound().points(state)?;
+        let missing = |what: &str, i: usize| SolveError::PhaseMismatch {
+            system: self.walker.general.info().name,
+            name: phase.bound().info().name,
+            why: format!("it has no {what} {i}"),
+        };
+        for (vr, v) in vars.iter().enumerate() {
+            out[vr] = match v.role {
+                Role::Parameter(_) | Role::Phase => continue,
+                Role::Angle => s.theta[0],
+                Role::Rate => s.theta_dot[0],
+                Role::Force(i) => *forces.get(i).ok_or_else(|| missing("contact", i))?,
+                Role::PointX(i) => points.pos.get(i).ok_or_else(|| missing("point", i))?[0],
+                Role::PointY(i) => points.pos.get(i).ok_or_else(|| missing("point", i))?[1],
+            };
+        }
+        Ok(k)
+    }
+}
+
+/// The path of a `file:` URI (`file:///a/b`, `file:/a/b`, `file://localhost/a/b`), its
+/// percent escapes decoded.
+fn uri_path(uri: &str) -> Option<PathBuf> {
+    let rest = uri.strip_prefix("file:")?;
+    let rest = match rest.strip_prefix("//") {
+        Some(r) => r.strip_prefix("localhost").unwrap_or(r),
+        None => rest,
+    };
+    if !rest.starts_with('/') {
+        return None;
+    }
+    let bytes = rest.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%' {
+            let hex = std::str::from_utf8(bytes.get(i + 1..i + 3)?).ok()?;
+            out.push(u8::from_str_radix(hex, 16).ok()?);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    Some(PathBuf::from(String::from_utf8(out).ok()?))
+}
+
+/// A new instance from `fmi2Instantiate`'s arguments, or why not.
+fn instantiate(
+    name: &str,
+    kind: c_int,
+    guid_given: &str,
+    resources: &str,
+    logger: Option<Logger>,
+    env: *mut c_void,
+) -> Result<Instance, String> {
+    if kind != FMI2_CO_SIMULATION {
+        return Err("this FMU is for co-simulation only (fmi2CoSimulation)".into());
+    }
+    let path = uri_path(resources)
+        .ok_or_else(|| format!("the resource location {resources:?} is not a file: URI"))?
+        .join(RESOURCES);
+    let text = std::fs::read_to_string(&path)
+        .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let res: Resources =
+        serde_json::from_str(&text).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let model = crate::models::find(&res.model)
+        .ok_or_else(|| format!("this library has no model `{}`", res.model))?;
+    let info = model.info();
+    let own = guid(info).map_err(|e| e.to_string())?;
+    if own != guid_given || own != res.guid {
+        return Err(format!(
+            "GUID {guid_given} is not this library's `{}` ({own}): the FMU was made by another rodcube",
+            info.name
+        ));
+    }
+    if res.start.len() != info.parameters.len() {
+        return Err(format!(
+            "{} gives {} start values for {} parameters",
+            path.display(),
+            res.start.len(),
+            info.parameters.len()
+        ));
+    }
+    let vars = variables(info).map_err(|e| e.to_string())?;
+    let mut instance = Instance {
+        name: CString::new(name).map_err(|e| e.to_string())?,
+        model,
+        outputs: vec![0.0; vars.len()],
+        vars,
+        logger,
+        env,
+        values: res.start.clone(),
+        start_values: res.start,
+        tolerance: DEFAULT_TOLERANCE,
+        start_time: 0.0,
+        stop_time: None,
+        mode: Mode::Instantiated,
+        sim: None,
+        time: 0.0,
+        phase: 0,
+        terminated: false,
+    };
+    instance.reset();
+    Ok(instance)
+}
+
+/// A C string argument, or why not (NULL, not UTF-8).
+///
+/// # Safety
+/// `s` is NULL or a NUL-terminated string.
+unsafe fn text<'a>(s: *const c_char, what: &str) -> Result<&'a str, String> {
+    if s.is_null() {
+        return Err(format!("{what} is NULL"));
+    }
+    // SAFETY: the caller gives a NUL-terminated string.
+    unsafe { CStr::from_ptr(s) }
+        .to_str()
+        .map_err(|e| format!("{what} is not UTF-8: {e}"))
+}
+
+/// Runs `body` on the instance behind `c`, logging a refusal and catching a panic (which
+/// leaves the instance failed).
+///
+/// # Safety
+/// `c` is NULL or a live instance from `fmi2Instantiate`.
+unsafe fn with(
+    c: *mut c_void,
+    body: impl FnOnce(&mut Instance) -> Result<c_int, Refusal>,
+) -> c_int {
+    // SAFETY: as the caller promises.
+    let Some(instance) = (unsafe { c.cast::<Instance>().as_mut() }) else {
+        return FMI2_ERROR;
+    };
+    let outcome = catch_unwind(AssertUnwindSafe(|| body(&mut *instance)));
+    match outcome {
+        Ok(Ok(status)) => status,
+        Ok(Err(Refusal(status, message))) => {
+            let _ = catch_unwind(AssertUnwindSafe(|| instance.log(status, &message)));
+            status
+        }
+        Err(_) => {
+            instance.mode = Mode::Failed;
+            let _ = catch_unwind(AssertUnwindSafe(|| {
+                instance.log(
+                    FMI2_ERROR,
+                    "internal error: rodcube panicked (please report it)",
+                )
+            }));
+            FMI2_ERROR
+        }
+    }
+}
+
+/// `n` values at `p` as a slice (empty for `n == 0`).
+///
+/// # Safety
+/// For `n > 0`, `p` is NULL or points to `n` readable values.
+unsafe fn slice<'a, T>(p: *const T, n: usize) -> Result<&'a [T], Refusal> {
+    if n == 0 {
+        return Ok(&[]);
+    }
+    if p.is_null() {
+        return refuse("an array argument is NULL");
+    }
+    // SAFETY: the caller gives `n` readable values.
+    Ok(unsafe { std::slice::from_raw_parts(p, n) })
+}
+
+/// `n` writable values at `p` as a slice (empty for `n == 0`).
+///
+/// # Safety
+/// For `n > 0`, `p` is NULL or points to `n` writable values.
+unsafe fn slice_mut<'a, T>(p: *mut T, n: usize) -> Result<&'a mut [T], Refusal> {
+    if n == 0 {
+        return Ok(&mut []);
+    }
+    if p.is_null() {
+        return refuse("an array argument is NULL");
+    }
+    // SAFETY: the caller gives `n` writable values.
+    Ok(unsafe { std::slice::from_raw_parts_mut(p, n) })
+}
+
+mod entry;

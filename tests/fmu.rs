@@ -1,0 +1,191 @@
+//! `rodcube fmu`: the FMU of the paper's model, its shared library built with the feature `fmi`
+//! (in its own target directory under the test's temporary directory), checked by FMPy, an FMI
+//! host independent of rodcube (`tests/fmu/check_fmu.py`, in a virtual environment with the
+//! versions pinned in `tests/fmu/requirements.txt`; `.ci/run` installs them): the model
+//! description validates; theta at a 1e-4 s output step equals `rodcube run`'s series at the
+//! same times within 1e-9; the contact force first vanishes within one step of the paper's
+//! separation; the FMU stops at the landing; a parameter out of its domain is `fmi2Error`
+//! with a logged message. And the command's refusals: exit status 2, no partial `.fmu`.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::OnceLock;
+
+fn tmp() -> PathBuf {
+    Path::new(env!("CARGO_TARGET_TMPDIR")).join("fmu")
+}
+
+fn run(cmd: &mut Command) -> Output {
+    let out = cmd
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run {cmd:?}: {e}"));
+    assert!(
+        out.status.success(),
+        "{cmd:?} failed ({:?}):\n{}\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// The shared library with the FMI entry points, built once for all the tests here.
+fn library() -> &'static Path {
+    static LIBRARY: OnceLock<PathBuf> = OnceLock::new();
+    LIBRARY.get_or_init(|| {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let target = tmp().join("target");
+        run(Command::new(env!("CARGO"))
+            .args([
+                "rustc",
+                "--quiet",
+                "--release",
+                "--lib",
+                "--no-default-features",
+            ])
+            .args([
+                "--features",
+                "fmi",
+                "--crate-type",
+                "cdylib",
+                "--manifest-path",
+            ])
+            .arg(root.join("Cargo.toml"))
+            .env("CARGO_TARGET_DIR", &target));
+        target.join("release/librodcube.so")
+    })
+}
+
+fn rodcube(args: &[&str]) -> Command {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_rodcube"));
+    cmd.args(args);
+    cmd
+}
+
+/// A fresh, empty directory under the test's temporary directory.
+fn fresh(name: &str) -> PathBuf {
+    let dir = tmp().join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temporary directory");
+    dir
+}
+
+/// The virtual environment with FMPy (made where missing), its Python.
+fn python() -> PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let venv = tmp().join("venv");
+    std::fs::create_dir_all(tmp()).expect("temporary directory");
+    if !venv.join("bin/python").exists() {
+        run(Command::new("python3").args(["-m", "venv"]).arg(&venv));
+    }
+    let python = venv.join("bin/python");
+    run(Command::new(&python)
+        .args([
+            "-m",
+            "pip",
+            "install",
+            "--quiet",
+            "--disable-pip-version-check",
+            "-r",
+        ])
+        .arg(root.join("tests/fmu/requirements.txt")));
+    python
+}
+
+const PAPER: &str = "model: rod_cube\nparameters: {m1: 1.0, m2: 3.0, ell: 1.0, a: 0.25, g: 9.81}\ntolerance: 1.0e-12\n";
+
+#[test]
+fn fmpy_validates_and_simulates_the_papers_fmu_as_rodcube_run() {
+    let dir = fresh("paper");
+    let lib = library().to_str().expect("UTF-8 path").to_string();
+    let out = dir.to_str().expect("UTF-8 path");
+    run(&mut rodcube(&[
+        "fmu", "rod_cube", "--out", out, "--binary", &lib,
+    ]));
+    let fmu = dir.join("rod_cube.fmu");
+    // `rodcube run`'s series on the FMU's 1e-4 s grid: 0.18 s (before the landing) in 1800
+    // steps; and the landing time of the whole motion.
+    let series = dir.join("series.yaml");
+    let want = "want: [theta_series]\nsamples: 1801\nuntil: 0.18\n";
+    std::fs::write(&series, format!("{PAPER}{want}")).expect("scene");
+    let landing = dir.join("landing.yaml");
+    std::fs::write(&landing, format!("{PAPER}want: [floor_impact]\n")).expect("scene");
+    for (scene, name) in [(&series, "series"), (&landing, "landing")] {
+        let json = run(rodcube(&["run", "--json", "--out"])
+            .arg(dir.join(name))
+            .arg(scene))
+        .stdout;
+        std::fs::write(dir.join(format!("{name}.json")), json).expect("results");
+    }
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = run(Command::new(python())
+        .arg(root.join("tests/fmu/check_fmu.py"))
+        .arg(&fmu)
+        .arg(dir.join("series.json"))
+        .arg(dir.join("landing.json"))
+        .arg("0.18")
+        .current_dir(&dir)
+        .env("PYTHONDONTWRITEBYTECODE", "1"));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("first zero contact force"), "{stdout}");
+}
+
+/// Runs `rodcube fmu` expecting exit status 2 with `message` on stderr.
+fn refused(args: &[&str], message: &str) {
+    let out = rodcube(args).output().expect("rodcube runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+    assert!(stderr.contains(message), "{args:?}: {stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
+/// The files in `dir`, by name.
+fn listing(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .expect("directory")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn refusals_exit_2_and_leave_no_partial_fmu() {
+    let dir = fresh("refusals");
+    let lib = library().to_str().expect("UTF-8 path").to_string();
+    let out = dir.to_str().expect("UTF-8 path").to_string();
+    refused(
+        &["fmu", "no_such_model", "--out", &out],
+        "no model `no_such_model`",
+    );
+    refused(
+        &["fmu", "rod_cube_closed", "--out", &out],
+        "export `rod_cube`",
+    );
+    let missing = dir.join("missing.so");
+    let missing = missing.to_str().expect("UTF-8 path");
+    refused(
+        &["fmu", "rod_cube", "--out", &out, "--binary", missing],
+        "--features fmi --crate-type cdylib",
+    );
+    let not_fmi = env!("CARGO_BIN_EXE_rodcube");
+    refused(
+        &["fmu", "rod_cube", "--out", &out, "--binary", not_fmi],
+        "built without the feature `fmi`",
+    );
+    assert!(listing(&dir).is_empty(), "{:?}", listing(&dir));
+    // An output directory that cannot be made (under a file: refused even to root).
+    std::fs::write(dir.join("file"), "").expect("file");
+    let under_file = dir.join("file/sub");
+    let under_file = under_file.to_str().expect("UTF-8 path");
+    let args = ["fmu", "rod_cube", "--out", under_file, "--binary", &lib];
+    refused(&args, "cannot create the output directory");
+    // A target that cannot be replaced (a directory in its place): the temporary file is gone.
+    std::fs::create_dir(dir.join("rod_cube.fmu")).expect("directory");
+    refused(
+        &["fmu", "rod_cube", "--out", &out, "--binary", &lib],
+        "cannot write",
+    );
+    assert_eq!(listing(&dir), ["file", "rod_cube.fmu"]);
+    assert!(dir.join("rod_cube.fmu").is_dir());
+}
