@@ -5,7 +5,11 @@
 //! description validates; theta at a 1e-4 s output step equals `rodcube run`'s series at the
 //! same times within 1e-9; the contact force first vanishes within one step of the paper's
 //! separation; the FMU stops at the landing; a parameter out of its domain is `fmi2Error`
-//! with a logged message. And the command's refusals: exit status 2, no partial `.fmu`.
+//! with a logged message; the tunable parameters (g, the masses) set between steps change the
+//! motion from then on (the same g again: theta within 1e-9 of the unchanged run; a new g:
+//! the energy with it conserved within 1e-8 until the contact ends, by the paper's energy
+//! integral written out in the script), a fixed one (ell) is refused. And the command's
+//! refusals: exit status 2, no partial `.fmu`.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

@@ -16,7 +16,7 @@ use crate::plan::{DEFAULT_TOLERANCE, ODE_RTOL_FACTOR, ODE_RTOL_FLOOR};
 use crate::results::Work;
 use crate::solve::SolveError;
 use crate::solve::phases::{End, Motion, PhaseRun, Route, Walker};
-use crate::solve::series::{sample_at, sample_forces};
+use crate::solve::series::{full_state_at, sample_at, sample_forces};
 use crate::system::{Bound, check_value};
 use std::ffi::{CStr, CString, c_char, c_int, c_uint, c_void};
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -78,6 +78,9 @@ struct Sim {
     walker: Walker<'static>,
     motion: Motion<'static>,
     work: Work,
+    /// The phase index of the motion's first phase: the phases before it, where the
+    /// parameters were changed during the motion (the motion taken up again mid-phase).
+    first_phase: usize,
 }
 
 /// One FMU instance (an `fmi2Component`).
@@ -158,6 +161,7 @@ impl Instance {
             walker,
             motion,
             work,
+            first_phase: 0,
         });
         self.time = self.start_time;
         self.terminated = false;
@@ -220,16 +224,17 @@ impl Instance {
         Ok(FMI2_OK)
     }
 
-    /// `fmi2SetReal`: parameters only, before the motion starts; each value checked at once
+    /// `fmi2SetReal`: parameters only; before the motion starts each value checked at once
     /// (finite, positive where declared, a friction coefficient not negative), the
-    /// requirements between them at `fmi2ExitInitializationMode`.
+    /// requirements between them at `fmi2ExitInitializationMode`; between steps the tunable
+    /// ones ([`Instance::tune`]).
     fn set_real(&mut self, refs: &[c_uint], values: &[f64]) -> Result<c_int, Refusal> {
+        if self.mode == Mode::Stepping {
+            return self.tune(refs, values);
+        }
         self.expect_mode(&[Mode::Instantiated, Mode::Initialization], "fmi2SetReal")?;
         for (&vr, &value) in refs.iter().zip(values) {
-            let var = self.variable(vr)?;
-            let Role::Parameter(i) = var.role else {
-                return refuse(format!("{} is an output; it cannot be set", var.name));
-            };
+            let i = self.parameter(vr)?;
             check_value(self.model.info(), i, value)
                 .map_err(|e| Refusal(FMI2_ERROR, format!("fmi2SetReal: {e}")))?;
             self.values[i] = value;
@@ -237,6 +242,66 @@ impl Instance {
             // Outputs read in initialization mode were of the values before.
             self.sim = None;
         }
+        Ok(FMI2_OK)
+    }
+
+    /// The parameter index of value reference `vr`, or why it cannot be set.
+    fn parameter(&self, vr: c_uint) -> Result<usize, Refusal> {
+        let var = self.variable(vr)?;
+        match var.role {
+            Role::Parameter { index, .. } => Ok(index),
+            _ => refuse(format!("{} is an output; it cannot be set", var.name)),
+        }
+    }
+
+    /// `fmi2SetReal` between steps: tunable parameters only (a fixed one is refused), each
+    /// value checked and the requirements between them too, then the motion taken up at the
+    /// current communication point with the new values: the system's positions and velocities
+    /// there kept, the contacts decided again as after an event, and the motion solved on from
+    /// there. A refusal leaves the parameters and the motion as they were.
+    fn tune(&mut self, refs: &[c_uint], values: &[f64]) -> Result<c_int, Refusal> {
+        let info = self.model.info();
+        let mut new = self.values.clone();
+        for (&vr, &value) in refs.iter().zip(values) {
+            let var = self.variable(vr)?;
+            let Role::Parameter { index, tunable } = var.role else {
+                return refuse(format!("{} is an output; it cannot be set", var.name));
+            };
+            if !tunable {
+                return refuse(format!(
+                    "{} ({}) is a fixed parameter, the geometry or the release state: it is \
+                     set before fmi2ExitInitializationMode (or after fmi2Reset), not between \
+                     steps",
+                    var.name, var.unit
+                ));
+            }
+            check_value(info, index, value)
+                .map_err(|e| Refusal(FMI2_ERROR, format!("fmi2SetReal: {e}")))?;
+            new[index] = value;
+        }
+        let general = Bound::from_values(self.model, &new)
+            .map_err(|e| Refusal(FMI2_ERROR, format!("the parameters were refused: {e}")))?;
+        let t = self.time - self.start_time;
+        let Some(sim) = self.sim.as_mut() else {
+            return refuse("the motion has not started");
+        };
+        if self.terminated || (sim.motion.complete() && t >= sim.motion.end_time()) {
+            return refuse(format!(
+                "the motion has ended (at t = {} s); there is no motion to change",
+                sim.motion.end_time()
+            ));
+        }
+        sim.restart(general, t).map_err(|e| {
+            Refusal(
+                FMI2_ERROR,
+                format!("taking the motion up at t = {t} s with the new parameters: {e}"),
+            )
+        })?;
+        for (&vr, &value) in refs.iter().zip(values) {
+            self.outputs[vr as usize] = value;
+        }
+        self.values = new;
+        self.sample(t)?;
         Ok(FMI2_OK)
     }
 
@@ -255,7 +320,7 @@ impl Instance {
         for (&vr, value) in refs.iter().zip(values.iter_mut()) {
             let var = self.variable(vr)?;
             *value = match var.role {
-                Role::Parameter(i) => self.values[i],
+                Role::Parameter { index, .. } => self.values[index],
                 Role::Phase => return refuse(format!("{} is an Integer", var.name)),
                 _ => {
                     self.outputs_ready()?;
@@ -366,6 +431,32 @@ impl Sim {
         }
     }
 
+    /// The motion taken up at `t` (s from release, within the solved motion) with the
+    /// parameters of `general`: the system's state there (positions and velocities; in a fast
+    /// phase too), the contacts decided as after an event ([`Walker::resume`]) and the next
+    /// phase solved from there. On an error the motion is left as it was.
+    fn restart(&mut self, general: Bound<'static>, t: f64) -> Result<(), SolveError> {
+        let k = self.phase_at(t).ok_or(SolveError::Inversion {
+            target: t,
+            duration: self.motion.end_time(),
+            reason: "no solved phase runs at this time",
+        })?;
+        let phase = &self.motion.phases[k];
+        let held = phase.closed()?;
+        let (state, friction_work) = full_state_at(phase, t - phase.t_start(), &mut self.work)?;
+        let walker = Walker {
+            general,
+            ..self.walker.clone()
+        };
+        let start = walker.resume(state, t, &held, friction_work)?;
+        let run = walker.solve(&start, &mut self.work)?;
+        let through = self.motion.through_impacts;
+        self.motion = Motion::starting(run, Vec::new(), through);
+        self.walker = walker;
+        self.first_phase += k;
+        Ok(())
+    }
+
     /// Every variable's value at `t` (s from release, within the solved motion) into `out`
     /// (the parameters' left as they are); returns the phase's index.
     fn outputs(&mut self, t: f64, vars: &[Variable], out: &mut [f64]) -> Result<usize, SolveError> {
@@ -392,7 +483,7 @@ impl Sim {
         };
         for (vr, v) in vars.iter().enumerate() {
             out[vr] = match v.role {
-                Role::Parameter(_) | Role::Phase => continue,
+                Role::Parameter { .. } | Role::Phase => continue,
                 Role::Angle => s.theta[0],
                 Role::Rate => s.theta_dot[0],
                 Role::Force(i) => *forces.get(i).ok_or_else(|| missing("contact", i))?,
@@ -400,7 +491,7 @@ impl Sim {
                 Role::PointY(i) => points.pos.get(i).ok_or_else(|| missing("point", i))?[1],
             };
         }
-        Ok(k)
+        Ok(self.first_phase + k)
     }
 }
 

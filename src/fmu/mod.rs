@@ -15,7 +15,7 @@ pub mod fmi2;
 #[cfg(feature = "cli")]
 mod zip;
 
-use crate::model::ModelInfo;
+use crate::model::{ModelInfo, ParamInfo};
 use crate::report::motion::xml as escape;
 use crate::spec::units::Unit;
 use std::fmt::Write;
@@ -77,8 +77,14 @@ pub struct Resources {
 /// What a variable of the FMU is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Role {
-    /// Parameter `i` (index of [`ModelInfo::parameters`]): a fixed parameter.
-    Parameter(usize),
+    /// A parameter: its index in [`ModelInfo::parameters`], and whether it is tunable (may be
+    /// set between steps; [`tunable`]) or fixed.
+    Parameter {
+        /// Its index in [`ModelInfo::parameters`].
+        index: usize,
+        /// Whether it is tunable.
+        tunable: bool,
+    },
     /// The reduced coordinate (an output).
     Angle,
     /// The reduced coordinate's rate (an output).
@@ -140,9 +146,16 @@ pub fn variables(info: &ModelInfo) -> Result<Vec<Variable>, DescriptionError> {
         description,
     };
     let mut out = Vec::new();
-    for (i, p) in info.parameters.iter().enumerate() {
-        let v = var(p.name.into(), Role::Parameter(i), p.unit, p.meaning.into());
-        out.push(v);
+    for (index, p) in info.parameters.iter().enumerate() {
+        let tunable = tunable(p);
+        let what = if tunable { TUNABLE } else { FIXED };
+        let role = Role::Parameter { index, tunable };
+        out.push(var(
+            p.name.into(),
+            role,
+            p.unit,
+            format!("{}; {what}", p.meaning),
+        ));
     }
     let angle = (info.coordinates.get(info.reduced_index).copied()).ok_or(
         DescriptionError::ReducedIndex {
@@ -167,6 +180,31 @@ pub fn variables(info: &ModelInfo) -> Result<Vec<Variable>, DescriptionError> {
                 opens or closes";
     out.push(var("phase".into(), Role::Phase, "", what.into()));
     Ok(out)
+}
+
+/// What a tunable parameter's description adds.
+const TUNABLE: &str = "tunable: set between steps, it changes the motion from that time on \
+                       (positions and velocities kept, contacts decided again)";
+
+/// What a fixed parameter's description adds.
+const FIXED: &str = "fixed: a length or an angle (the geometry or the release state), set \
+                     before fmi2ExitInitializationMode only";
+
+/// Whether parameter `p` is tunable: whether a change of it during the motion leaves the
+/// configuration admissible and still means something after release. Decided from its unit:
+/// a length (`m`), an angle (`rad`) or the rate of either (`m/s`, `rad/s`) is the geometry or
+/// the release state, fixed; every other parameter (a mass, gravity, a spring constant, a
+/// friction or restitution coefficient) only weighs the forces, tunable. A unit rodcube
+/// cannot read counts as fixed.
+pub fn tunable(p: &ParamInfo) -> bool {
+    let Ok(unit) = Unit::parse(p.unit) else {
+        return false;
+    };
+    let angle = p.unit.split([' ', '/', '^', '*']).any(|part| part == "rad");
+    let (length, speed) = (Unit::integers(0, 1, 0), Unit::integers(0, 1, -1));
+    let (pure, rate) = (Unit::DIMENSIONLESS, Unit::integers(0, 0, -1));
+    let geometric = unit == length || unit == speed || (angle && (unit == pure || unit == rate));
+    !geometric
 }
 
 /// The GUID of an FMU of `info`'s system: a hash of rodcube's version, the model's name and
@@ -251,7 +289,7 @@ pub fn model_description(
     }
     let _ = writeln!(x, "  </ModelVariables>\n  <ModelStructure>\n    <Outputs>");
     let outputs: Vec<usize> = (vars.iter().enumerate())
-        .filter(|(_, v)| !matches!(v.role, Role::Parameter(_)))
+        .filter(|(_, v)| !matches!(v.role, Role::Parameter { .. }))
         .map(|(i, _)| i + 1)
         .collect();
     for i in &outputs {
@@ -283,13 +321,17 @@ fn scalar_variable(x: &mut String, vr: usize, v: &Variable, defaults: &Defaults)
         String::new()
     };
     let _ = match v.role {
-        Role::Parameter(i) => {
+        Role::Parameter { index, tunable } => {
             // One start value per parameter: `model_description` checked the count.
-            let start = defaults.start.get(i).map(|s| format!(" start=\"{s:?}\""));
+            let start = defaults
+                .start
+                .get(index)
+                .map(|s| format!(" start=\"{s:?}\""));
+            let variability = if tunable { "tunable" } else { "fixed" };
             writeln!(
                 x,
                 "{}\n      <Real{unit}{}/>",
-                head("parameter", "fixed", r#" initial="exact""#),
+                head("parameter", variability, r#" initial="exact""#),
                 start.unwrap_or_default()
             )
         }
@@ -383,5 +425,34 @@ mod tests {
         assert!(xml.contains(r#"<Unit name="m/s^2"><BaseUnit m="1" s="-2"/></Unit>"#));
         assert!(xml.contains(r#"<Real unit="m/s^2" start="9.81"/>"#));
         assert!(xml.contains(r#"name="theta_dot""#));
+        assert!(xml.contains(r#"name="g" valueReference="4""#));
+        let tunable = xml
+            .matches(r#"causality="parameter" variability="tunable""#)
+            .count();
+        let fixed = xml
+            .matches(r#"causality="parameter" variability="fixed""#)
+            .count();
+        assert_eq!((tunable, fixed), (3, 2), "m1, m2, g tunable; ell, a fixed");
+    }
+
+    #[test]
+    fn lengths_angles_and_their_rates_are_fixed_the_rest_tunable() {
+        let param = |unit| ParamInfo {
+            name: "p",
+            meaning: "a parameter",
+            unit,
+            positive: true,
+        };
+        for unit in ["m", "rad", "m/s", "rad/s", "no such unit"] {
+            assert!(!tunable(&param(unit)), "{unit}");
+        }
+        for unit in ["kg", "m/s^2", "N/m", "1", "N m"] {
+            assert!(tunable(&param(unit)), "{unit}");
+        }
+        for m in crate::models::all() {
+            for p in m.info().parameters {
+                assert_eq!(tunable(p), !matches!(p.unit, "m" | "rad" | "m/s" | "rad/s"));
+            }
+        }
     }
 }

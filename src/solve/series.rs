@@ -133,6 +133,39 @@ pub fn sample_at(
     }
 }
 
+/// The system's state (the general model's coordinates, positions and velocities) at the
+/// phase time `t` of `run` (within it), and the work done by friction from release to then
+/// (J): what a motion taken up there starts from ([`crate::solve::phases::Walker::resume`]).
+pub fn full_state_at(run: &PhaseRun, t: f64, work: &mut Work) -> Result<(State, f64), SolveError> {
+    let samples = sample_at(run, &[t], work)?;
+    let state = samples.states.first().ok_or(SolveError::Inversion {
+        target: t,
+        duration: run.duration(),
+        reason: "the phase gave no sample",
+    })?;
+    let full = run.bound().to_full(state)?;
+    let friction_work = match run {
+        // No friction acts on the fast path.
+        PhaseRun::Reduced(_) => 0.0,
+        PhaseRun::Integrated(r) if t < r.run.t_end => {
+            let n = r.bound.n_coordinates();
+            let y = r.run.state_at(t).ok_or(SolveError::Inversion {
+                target: t,
+                duration: r.run.t_end,
+                reason: "time outside the integrated phase",
+            })?;
+            // The work is integrated (the last component) only where friction acts; without
+            // it the run's is zero.
+            match y.get(2 * n) {
+                Some(w) => *w,
+                None => r.run.friction_work,
+            }
+        }
+        PhaseRun::Integrated(r) => r.run.friction_work,
+    };
+    Ok((full, friction_work))
+}
+
 /// `samples` points uniform in time over an integrated phase, from its dense output (the last
 /// one is the event state itself).
 pub fn sample_integrated(run: &IntegratedRun, samples: usize) -> Result<PhaseSamples, SolveError> {

@@ -13,6 +13,17 @@ Usage: check_fmu.py FMU SERIES_JSON LANDING_JSON STOP_TIME
   fmi2ExitInitializationMode with parameters that break a requirement (a < ell); after
   fmi2Reset the start values hold again, and the release angle, asin(a/ell), can be read in
   initialization mode.
+- the masses, g (and any parameter not a length or an angle) are tunable, ell and a fixed;
+  stepping with fmi2DoStep at the 1e-4 s output step (FMPy's FMU2Slave):
+  a) fmi2SetReal of g to its own value at t = 0.05 s (the rod on the cube, a fast phase) or
+     0.15 s (the rod free) leaves theta within 1e-9 of the run without it at every output;
+  b) g set to G2 at t = 0.05 s: from then until the contact ends, the energy with the new g,
+     E = M(theta) theta_dot^2 / 2 + V_G2(theta), stays within 1e-8 (relative) of its value
+     at 0.05 s, M(theta) = 2 (V(theta0) - V(theta)) / theta_dot^2(theta) from the paper's
+     energy integral (eq. 9) by hand here; and the contact ends at another time than
+     0.108493254 s;
+  c) fmi2SetReal of ell (fixed) or of g = -1 between steps is fmi2Error with a logged
+     message, and theta goes on as without it.
 Prints one line per check; exits non-zero (an AssertionError) on the first that fails.
 """
 
@@ -102,6 +113,105 @@ def main(fmu, results, landing, stop):
     print("after fmi2Reset: theta at release", initial, "in and after initialization mode")
     slave.terminate()
     slave.freeInstance()
+
+    tunable(fmu, md)
+
+
+def stepping(fmu, md, steps, at=None, setting=None):
+    """Time, theta, theta_dot, contact force and phase at each STEP output to steps * STEP by
+    fmi2DoStep, with fmi2SetReal of `setting` ({name: value}) after `at` steps; also whether
+    that call was refused and what was logged then."""
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(fmu),
+                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName="tune")
+    slave.instantiate()
+    slave.setupExperiment(startTime=0.0)
+    slave.enterInitializationMode()
+    slave.exitInitializationMode()
+    names = ["theta", "theta_dot", "contact_force"]
+    rows, refused, log = [], None, io.StringIO()
+    for i in range(steps + 1):
+        if i == at:
+            with contextlib.redirect_stdout(log):
+                try:
+                    slave.setReal([vr[n] for n in setting], list(setting.values()))
+                    refused = False
+                except FMICallException as e:
+                    assert e.status == fmi2Error, e
+                    refused = True
+        t = i * STEP
+        rows.append([t, *slave.getReal([vr[n] for n in names]),
+                     slave.getInteger([vr["phase"]])[0]])
+        if i < steps:
+            slave.doStep(currentCommunicationPoint=t, communicationStepSize=(i + 1) * STEP - t)
+    slave.terminate()
+    slave.freeInstance()
+    return np.array(rows), refused, log.getvalue().strip()
+
+
+def tunable(fmu, md):
+    variability = {v.name: v.variability for v in md.modelVariables if v.causality == "parameter"}
+    assert variability == {"m1": "tunable", "m2": "tunable", "ell": "fixed", "a": "fixed",
+                           "g": "tunable"}, variability
+    print("tunable:", [n for n, v in variability.items() if v == "tunable"])
+    steps = 1800
+    plain, _, _ = stepping(fmu, md, steps)
+    for t1 in (0.05, 0.15):
+        at = round(t1 / STEP)
+        same, refused, log = stepping(fmu, md, steps, at, {"g": G})
+        assert refused is False, log
+        err = np.max(np.abs(same[at:, 1] - plain[at:, 1]))
+        assert err <= 1e-9, f"g set to itself at {t1} s: theta differs by {err}"
+        assert np.array_equal(same[:at, 1], plain[:at, 1])
+        assert np.array_equal(same[:, 4], plain[:, 4]), "the phase index changed"
+        print(f"g = {G} again at t = {t1} s: theta within {err:.3e} rad of the run without it")
+
+    at = round(0.05 / STEP)
+    # To 0.13 s: with the larger g the rod lands before 0.18 s.
+    run, refused, log = stepping(fmu, md, 1300, at, {"g": G2})
+    assert refused is False, log
+    t, theta, theta_dot, phase = run[:, 0], run[:, 1], run[:, 2], run[:, 4]
+    contact = np.flatnonzero((t >= t[at]) & (phase == 0))
+    end = contact[-1] + 1
+    assert end < len(t) and phase[end] == 1, phase
+    energy = mass(theta[contact]) * theta_dot[contact] ** 2 / 2 + potential(theta[contact], G2)
+    drift = np.max(np.abs(energy / energy[0] - 1))
+    assert drift <= 1e-8, f"the energy with g = {G2} drifts by {drift} (relative)"
+    # The check tells: with the old g in V the same outputs are far from conserving energy.
+    old = mass(theta[contact]) * theta_dot[contact] ** 2 / 2 + potential(theta[contact], G)
+    assert np.max(np.abs(old / old[0] - 1)) > 1e-3
+    assert abs(t[end] - SEPARATION) > 2 * STEP, f"the contact still ends at {t[end]} s"
+    assert np.array_equal(theta[:at], plain[:at, 1])
+    print(f"g = {G2} from t = 0.05 s: energy conserved within {drift:.3e} (relative) over "
+          f"{len(contact)} outputs; the contact ends by {t[end]} s instead of {SEPARATION} s")
+
+    for setting, word in (({"ell": 1.5}, "fixed"), ({"g": -1.0}, "-1")):
+        run, refused, log = stepping(fmu, md, steps, at, setting)
+        assert refused is True, f"{setting} between steps was accepted"
+        assert word in log, log
+        assert np.array_equal(run, plain), f"{setting}: the motion changed"
+        print(f"{setting} between steps: refused, motion unchanged;", log)
+
+
+# The paper's parameters (scenes/paper.yaml), and the new g of check b.
+M1, M2, ELL, A, G = 1.0, 3.0, 1.0, 0.25, 9.81
+G2 = 15.0
+
+
+def potential(theta, g):
+    """The rod's potential energy, m1 g (ell/2) sin(theta) (the cube's is constant)."""
+    return M1 * g * ELL / 2 * np.sin(theta)
+
+
+def mass(theta):
+    """The generalized mass M(theta) of the contact phase: the paper's eq. (9), theta_dot^2 =
+    4 (g/ell) (a/ell - sin(theta)) / (4/3 - sin(theta)^2 / (1 + m2/m1)) for the release from
+    rest at theta0 = asin(a/ell), is energy conservation 1/2 M theta_dot^2 = V(theta0) -
+    V(theta) (zero horizontal momentum, which a change of g keeps), so M = 2 (V(theta0) -
+    V(theta)) / theta_dot^2, the same for any g (here g = 1)."""
+    s = np.sin(theta)
+    theta_dot_sq = 4 / ELL * (A / ELL - s) / (4 / 3 - s**2 / (1 + M2 / M1))
+    return 2 * (potential(np.arcsin(A / ELL), 1.0) - potential(theta, 1.0)) / theta_dot_sq
 
 
 if __name__ == "__main__":

@@ -257,8 +257,11 @@ pub unsafe extern "C" fn fmi2GetInteger(
     }
 }
 
-/// `fmi2SetReal`: parameters, before `fmi2ExitInitializationMode`; a value out of the
-/// parameter's domain is `fmi2Error`, logged, and leaves the parameter as it was.
+/// `fmi2SetReal`: parameters, before `fmi2ExitInitializationMode`, and the tunable ones
+/// between steps too (the motion taken up at the current communication point with the new
+/// values); a value out of the parameter's domain, parameters that break a requirement, or a
+/// fixed parameter set between steps is `fmi2Error`, logged, and leaves the parameters (and
+/// the motion) as they were.
 ///
 /// # Safety
 /// `c` is NULL or a live instance; `vr` and `value` point to `nvr` values.

@@ -576,9 +576,42 @@ impl<'m> Walker<'m> {
         t: f64,
     ) -> Result<(Active, Vec<FrictionOption>), SolveError> {
         let held: Vec<bool> = parts.iter().map(|p| *p != Part::None).collect();
+        self.decide_held(state, &held, t)
+    }
+
+    /// Where the motion starts again from the system's `state` at `t` (s from release), as
+    /// after an event: the contacts and friction modes decided there, those `held` (closed
+    /// just before) closed where they touch within the run's drift; `friction_work` is the
+    /// work done by friction before (J). For a motion taken up mid-phase (the parameters
+    /// changed at a time the motion passes through, velocities kept).
+    pub fn resume(
+        &self,
+        state: State,
+        t: f64,
+        held: &[bool],
+        friction_work: f64,
+    ) -> Result<PhaseStart, SolveError> {
+        let (active, frictions) = self.decide_held(&state, held, t)?;
+        Ok(PhaseStart {
+            state,
+            active,
+            frictions,
+            t,
+            friction_work,
+        })
+    }
+
+    /// The contacts and friction modes at `state` at `t`, those `held` closed where they touch
+    /// within the run's drift, with the friction options they were decided from.
+    fn decide_held(
+        &self,
+        state: &State,
+        held: &[bool],
+        t: f64,
+    ) -> Result<(Active, Vec<FrictionOption>), SolveError> {
         let moment = Moment::After {
             t,
-            held: &held,
+            held,
             drift: self.tol,
         };
         let frictions = friction_options(&self.general, state)?;
