@@ -132,6 +132,7 @@ fn fmpy_validates_and_simulates_the_papers_fmu_as_rodcube_run() {
         .env("PYTHONDONTWRITEBYTECODE", "1"));
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("first zero contact force"), "{stdout}");
+    assert!(stdout.contains("energy conserved within"), "{stdout}");
 }
 
 /// Runs `rodcube fmu` expecting exit status 2 with `message` on stderr.
