@@ -35,6 +35,7 @@ use crate::solve::phases::{End, phase_end};
 use crate::solve::poly::horner;
 use crate::solve::poly::{self, MAX_DEGREE};
 use crate::solve::prior::{PRIOR_TOL, Prior, Singularities, integrate_prior, prior_panels};
+use crate::solve::sensitivity::{self, SensitivityWork, SeparationPoint, Unavailable};
 use crate::solve::quadrature::{
     self, ACCEPT, Control, Fall, FallIntegrand, HalfRule, PanelSum, RuleStep, SCHEDULE, v_at_drop,
 };
@@ -274,6 +275,59 @@ impl<'m> LeanSolver<'m> {
             }
         }
         self.checked(p)
+    }
+
+    /// The sensitivities of `point`, which this solver solved for the parameters `p`:
+    /// `d theta_sep/dp_i` into `angle` and `d t_sep/dp_i` into `time` (one entry per
+    /// parameter, in the model's order), by [`sensitivity::separation`], or why they do not
+    /// exist. Slices of another length are [`SystemError::Length`].
+    pub fn sensitivities(
+        &mut self,
+        p: &[f64],
+        point: &LeanPoint,
+        work: &mut SensitivityWork,
+        angle: &mut [f64],
+        time: &mut [f64],
+    ) -> Result<Result<(), Unavailable>, SolveError> {
+        let np = self.info.parameters.len();
+        for (what, len) in [("p", p.len()), ("angle", angle.len()), ("time", time.len())] {
+            if len != np {
+                return Err(SolveError::Input(SystemError::Length {
+                    model: self.info.name,
+                    what,
+                    expected: np,
+                    got: len,
+                }));
+            }
+        }
+        self.red.prepare_lean(p, &mut self.k);
+        if let Some(degree) = self.layout.fall_degree {
+            self.fall.resize(degree + 1, 0.0);
+            self.red.fall_polynomial(&self.k, &mut self.fall);
+        }
+        let [sin_initial, _, sin_sep, drop] = point.sines;
+        let at = SeparationPoint {
+            red: self.red,
+            k: &self.k,
+            parameters: np,
+            sin_initial,
+            fall: if self.layout.fall_degree.is_some() {
+                &self.fall
+            } else {
+                &[]
+            },
+            sin_sep,
+            drop,
+        };
+        let default_prior;
+        let prior = match &self.prior {
+            Some(prior) => prior,
+            None => {
+                default_prior = Prior::new(PRIOR_TOL);
+                &default_prior
+            }
+        };
+        sensitivity::separation(&at, prior, self.control.accept, work, angle, time)
     }
 
     /// Solves by the baseline instruction set even where the CPU has AVX2 (the results are
