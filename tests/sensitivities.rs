@@ -7,7 +7,8 @@ use astro_float::{BigFloat, RoundingMode};
 use rodcube::model::Model;
 use rodcube::reference::{Family, Inputs, PRECISION, Reference, RootRoute, TimeRoute, to_f64};
 use rodcube::solve::lean::{LeanPoint, LeanSolver};
-use rodcube::solve::sensitivity::{SensitivityWork, Unavailable};
+use rodcube::results::SensitivityGap;
+use rodcube::solve::sensitivity::SensitivityWork;
 
 const NS: [f64; 10] = [1e-12, 1e-8, 1e-4, 1e-2, 1.0, 3.0, 1e2, 1e4, 1e8, 1e12];
 const RS: [f64; 10] = [
@@ -33,7 +34,7 @@ fn model(name: &str) -> &'static dyn Model {
 fn solve(
     solver: &mut LeanSolver,
     p: &[f64],
-) -> (LeanPoint, Result<(Vec<f64>, Vec<f64>), Unavailable>) {
+) -> (LeanPoint, Result<(Vec<f64>, Vec<f64>), SensitivityGap>) {
     let point = solver.solve(p).expect("point");
     let mut work = SensitivityWork::default();
     let (mut angle, mut time) = (vec![0.0; p.len()], vec![0.0; p.len()]);

@@ -29,13 +29,13 @@
 
 use crate::model::PhaseInfo;
 use crate::model::{LeanStart, Model, ModelInfo, Reduction, ReductionInfo, positive_finite};
-use crate::results::Work;
+use crate::results::{SensitivityGap, Work};
 use crate::solve::SolveError;
 use crate::solve::phases::{End, phase_end};
 use crate::solve::poly::horner;
 use crate::solve::poly::{self, MAX_DEGREE};
 use crate::solve::prior::{PRIOR_TOL, Prior, Singularities, integrate_prior, prior_panels};
-use crate::solve::sensitivity::{self, SensitivityWork, SeparationPoint, Unavailable};
+use crate::solve::sensitivity::{self, SensitivityWork, SeparationPoint};
 use crate::solve::quadrature::{
     self, ACCEPT, Control, Fall, FallIntegrand, HalfRule, PanelSum, RuleStep, SCHEDULE, v_at_drop,
 };
@@ -288,7 +288,7 @@ impl<'m> LeanSolver<'m> {
         work: &mut SensitivityWork,
         angle: &mut [f64],
         time: &mut [f64],
-    ) -> Result<Result<(), Unavailable>, SolveError> {
+    ) -> Result<Result<(), SensitivityGap>, SolveError> {
         let np = self.info.parameters.len();
         for (what, len) in [("p", p.len()), ("angle", angle.len()), ("time", time.len())] {
             if len != np {

@@ -22,28 +22,11 @@
 //! `ds_sep/dp = cos(theta_sep) d theta_sep/dp`.
 
 use crate::model::Reduction;
+use crate::results::SensitivityGap;
 use crate::solve::SolveError;
 use crate::solve::poly::horner;
 use crate::solve::prior::{Prior, Singularities, prior_panels};
 use crate::solve::quadrature::{HalfRule, MAX_PANELS, half_rule, v_at_drop};
-
-/// Why a separation has no sensitivities (a note, no number).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Unavailable {
-    /// The model has no generated partial derivatives.
-    NoPartials,
-    /// The phase has no separation polynomial.
-    NoSeparationPolynomial,
-    /// The phase has no fall polynomial (it does not start from rest, or its potential or
-    /// inertia are not of that form): the time's sensitivities are not derived for it.
-    NoFallPolynomial,
-    /// The contact opens at release: the time is zero whatever the parameters and the angle
-    /// is the release angle's, not a separation's.
-    AtRelease,
-    /// The separation is a double root of its condition (`F_theta = 0`): the angle does not
-    /// move smoothly with the parameters.
-    DoubleRoot,
-}
 
 /// The separation of one fast phase from rest, as the solvers found it.
 #[derive(Clone, Copy)]
@@ -88,13 +71,13 @@ pub fn separation(
     work: &mut SensitivityWork,
     angle: &mut [f64],
     time: &mut [f64],
-) -> Result<Result<(), Unavailable>, SolveError> {
+) -> Result<Result<(), SensitivityGap>, SolveError> {
     let np = at.parameters;
     if !at.red.has_partials() {
-        return Ok(Err(Unavailable::NoPartials));
+        return Ok(Err(SensitivityGap::NoPartials));
     }
     if at.drop <= 0.0 {
-        return Ok(Err(Unavailable::AtRelease));
+        return Ok(Err(SensitivityGap::AtRelease));
     }
     work.partials.resize(np + 1, f64::NAN);
     let cos_sep = ((1.0 - at.sin_sep) * (1.0 + at.sin_sep)).sqrt();
@@ -102,16 +85,17 @@ pub fn separation(
         .separation_partials(at.k, at.sin_sep, cos_sep, &mut work.partials);
     let f_theta = work.partials[0];
     if f_theta.is_nan() {
-        return Ok(Err(Unavailable::NoSeparationPolynomial));
+        return Ok(Err(SensitivityGap::NoPartials));
     }
     if f_theta == 0.0 || !f_theta.is_finite() {
-        return Ok(Err(Unavailable::DoubleRoot));
+        return Ok(Err(SensitivityGap::DoubleRoot));
     }
     for (a, f_p) in angle.iter_mut().zip(&work.partials[1..]) {
-        *a = -f_p / f_theta;
+        // `+ 0.0` writes a parameter the angle does not depend on as 0, not -0.
+        *a = -f_p / f_theta + 0.0;
     }
     if at.fall.is_empty() {
-        return Ok(Err(Unavailable::NoFallPolynomial));
+        return Ok(Err(SensitivityGap::NoFallPolynomial));
     }
     let degree = at.fall.len();
     work.start.resize(np, 0.0);
