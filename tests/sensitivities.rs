@@ -183,3 +183,84 @@ fn rod_cube_d_theta_dn_matches_the_implicit_function_theorem_on_eq_14() {
         }
     }
 }
+
+/// Parameter values that most fast phases accept (a phase that refuses them is skipped, and
+/// the test asks that enough were checked).
+fn plausible(model: &dyn Model) -> Vec<f64> {
+    (model.info().parameters.iter())
+        .map(|p| match p.name {
+            "m2" => 3.0,
+            "a" => 0.25,
+            "g" => 9.81,
+            "theta_0" => 0.8,
+            "theta_dot_0" => -0.5,
+            "th0" => 1.2,
+            "R" | "r" => 0.2,
+            "e" => 0.5,
+            _ => 1.0,
+        })
+        .collect()
+}
+
+/// The generated partial derivatives of `theta_dot^2` at a fixed angle, of `sin(theta_i)` and
+/// of the fall polynomial's coefficients against central differences of the generated
+/// functions themselves (step `1e-5` relative: agreement to about `1e-8`), for every fast
+/// phase that takes the plausible parameters.
+#[test]
+fn generated_partials_match_differences_of_the_generated_functions() {
+    let mut checked = 0;
+    for &m in rodcube::models::all() {
+        let (Some(red), Some(layout)) = (m.reduction(), m.info().reduction.as_ref()) else {
+            continue;
+        };
+        assert!(red.has_partials(), "{}", m.info().name);
+        let p = plausible(m);
+        let Ok(sys) = rodcube::system::System::from_values(m, &p) else {
+            continue;
+        };
+        let n = m.info().n_constants;
+        let theta = 0.7 * sys.theta_initial();
+        let (s, c) = theta.sin_cos();
+        let degree = layout.fall_degree.map_or(0, |d| d + 1);
+        // theta_dot^2 at the fixed angle, sin(theta_i) and the fall coefficients at `q`.
+        let values = |q: &[f64]| -> Vec<f64> {
+            let mut k = vec![0.0; n];
+            m.prepare(q, &mut k);
+            let (si, ci) = (k[layout.k_sin_initial], k[layout.k_cos_initial]);
+            let mut out = vec![red.theta_dot_sq_sc(&k, s, c, si - s, ci - c), si];
+            let mut fall = vec![0.0; degree];
+            red.fall_polynomial(&k, &mut fall);
+            out.extend(fall);
+            out
+        };
+        let np = p.len();
+        let mut k = vec![0.0; n];
+        m.prepare(&p, &mut k);
+        let (mut w, mut si, mut fall) = (vec![0.0; np], vec![0.0; np], vec![0.0; np * degree]);
+        red.theta_dot_sq_partials(&k, s, c, &mut w);
+        red.start_partials(&k, &mut si);
+        red.fall_partials(&k, &mut fall);
+        let base = values(&p);
+        for i in 0..np {
+            let h = 1e-5 * p[i].abs().max(1e-3);
+            let (mut up, mut down) = (p.clone(), p.clone());
+            up[i] += h;
+            down[i] -= h;
+            let (vu, vd) = (values(&up), values(&down));
+            let mut exact = vec![w[i], si[i]];
+            exact.extend(&fall[i * degree..(i + 1) * degree]);
+            for (j, e) in exact.iter().enumerate() {
+                let diff = (vu[j] - vd[j]) / (2.0 * h);
+                let scale = base[j].abs() / p[i].abs().max(1e-3) + e.abs();
+                assert!(
+                    (diff - e).abs() <= 1e-7 * scale.max(1e-300),
+                    "{}: value {j} in {}: {e:e}, differences {diff:e}",
+                    m.info().name,
+                    m.info().parameters[i].name
+                );
+            }
+        }
+        checked += 1;
+    }
+    assert!(checked >= 10, "only {checked} fast phases took the parameters");
+}

@@ -129,7 +129,7 @@ impl Plan<'_> {
                 entry(d, per(target.unit, param.unit), false),
             );
             out.sensitivities.insert(
-                format!("elasticity({}, {})", target.key, param.name),
+                format!("elasticity({};{})", target.key, param.name),
                 entry(value / x * d, "1".into(), true),
             );
         }

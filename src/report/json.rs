@@ -8,7 +8,7 @@
 //! values}]}`), `checks` (name →
 //! `{passed, margin, meaning}`), `work` (counters and phases), `notes` (key → sentence) and,
 //! when sensitivities were wanted, `sensitivities` (`d(<result>)/d(<parameter>)` and
-//! `elasticity(<result>, <parameter>)` → `{value, unit, meaning}`). Values are SI (angles in
+//! `elasticity(<result>;<parameter>)` → `{value, unit, meaning}`). Values are SI (angles in
 //! radians); a non-finite number is written as `null`, as JSON has no NaN.
 
 use super::prose::{check_meaning, check_phase, label, meaning, note, sensitivity_meaning};

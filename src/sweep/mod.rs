@@ -505,7 +505,7 @@ pub fn sensitivity_columns(info: &ModelInfo) -> Vec<String> {
         out.extend((info.parameters.iter()).map(|p| format!("d({of})/d({})", p.name)));
     }
     for of in ["separation_angle", "separation_time"] {
-        out.extend((info.parameters.iter()).map(|p| format!("elasticity({of}, {})", p.name)));
+        out.extend((info.parameters.iter()).map(|p| format!("elasticity({of};{})", p.name)));
     }
     out
 }
