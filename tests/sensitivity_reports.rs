@@ -175,7 +175,9 @@ fn a_contact_that_opens_at_release_has_no_sensitivity() {
         k: &k,
         parameters: 5,
         sin_initial: si,
+        scale: 1.0 - si,
         fall: &[],
+        singularities: None,
         sin_sep: si,
         drop: 0.0,
     };

@@ -165,7 +165,9 @@ impl Plan<'_> {
             k,
             parameters: np,
             sin_initial: si,
+            scale: ci * ci / (1.0 + si),
             fall: sys.fall_coefficients(),
+            singularities: None,
             sin_sep: at.sin_theta,
             drop,
         };

@@ -71,6 +71,9 @@ pub struct LeanPoint {
     /// `sin(theta_i)`, `cos(theta_i)`, `sin(theta_sep)` and the drop `sin(theta_i) -
     /// sin(theta_sep)`, from which [`LeanPoint::delta`] is formed when asked.
     sines: [f64; 4],
+    /// The fall polynomial (padded with zeros to degree 2) where the a-priori route solved
+    /// the point, which the sensitivities reuse; `None` from the checked route.
+    fall: Option<[f64; 3]>,
 }
 
 impl LeanPoint {
@@ -300,22 +303,34 @@ impl<'m> LeanSolver<'m> {
                 }));
             }
         }
-        self.red.prepare_lean(p, &mut self.k);
-        if let Some(degree) = self.layout.fall_degree {
-            self.fall.resize(degree + 1, 0.0);
-            self.red.fall_polynomial(&self.k, &mut self.fall);
+        let [sin_initial, cos_initial, sin_sep, drop] = point.sines;
+        // The partial derivatives read the parameters alone; the fall polynomial comes from
+        // the a-priori route where it solved the point, else from the lean constants.
+        match &point.fall {
+            Some(fall) => {
+                self.k[..np].copy_from_slice(p);
+                let len = self.layout.fall_degree.map_or(0, |d| d + 1).min(3);
+                self.fall.clear();
+                self.fall.extend_from_slice(&fall[..len]);
+            }
+            None => {
+                self.red.prepare_lean(p, &mut self.k);
+                self.fall.clear();
+                if let Some(degree) = self.layout.fall_degree {
+                    self.fall.resize(degree + 1, 0.0);
+                    self.red.fall_polynomial(&self.k, &mut self.fall);
+                }
+            }
         }
-        let [sin_initial, _, sin_sep, drop] = point.sines;
         let at = SeparationPoint {
             red: self.red,
             k: &self.k,
             parameters: np,
             sin_initial,
-            fall: if self.layout.fall_degree.is_some() {
-                &self.fall
-            } else {
-                &[]
-            },
+            // 1 - sin(theta_i) without cancellation near upright, as the time's quadrature.
+            scale: cos_initial * cos_initial / (1.0 + sin_initial),
+            fall: &self.fall,
+            singularities: None,
             sin_sep,
             drop,
         };
@@ -387,6 +402,7 @@ impl<'m> LeanSolver<'m> {
                 separation_angle: si.asin(),
                 separation_time: 0.0,
                 sines: [si, self.k[self.layout.k_cos_initial], si, 0.0],
+                fall: None,
             });
         }
         let s = end.at.map_or(f64::NAN, |a| a.sin_theta);
@@ -420,6 +436,7 @@ impl<'m> LeanSolver<'m> {
             separation_angle: s.asin(),
             separation_time,
             sines: [si, ci, s, drop],
+            fall: None,
         };
         // The phase's end for messages, formed only for one.
         let delta_end = || point(f64::NAN).delta();
@@ -624,6 +641,7 @@ pub(crate) fn quick_route(
         separation_angle: s.asin(),
         separation_time: t,
         sines: [si, ci, s, drop],
+        fall: Some(start.fall),
     })
 }
 
@@ -673,6 +691,7 @@ mod tests {
             separation_angle: s.asin(),
             separation_time: 0.0,
             sines: [si, ((1.0 - si) * (1.0 + si)).sqrt(), s, si - s],
+            fall: None,
         }
     }
 

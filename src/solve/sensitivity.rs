@@ -40,6 +40,11 @@ pub struct SeparationPoint<'a> {
     pub parameters: usize,
     /// `sin(theta_i)`.
     pub sin_initial: f64,
+    /// `e = 1 - sin(theta_i)`, formed without cancellation near upright
+    /// (`cos^2 theta_i / (1 + sin theta_i)`), the scale of the substitution.
+    pub scale: f64,
+    /// The time integrand's singularities where the caller has them (else found here).
+    pub singularities: Option<Singularities>,
     /// The fall polynomial's coefficients, lowest degree first (empty without one).
     pub fall: &'a [f64],
     /// `sin(theta_sep)`.
@@ -47,6 +52,10 @@ pub struct SeparationPoint<'a> {
     /// `sin(theta_i) - sin(theta_sep) >= 0`, formed without cancellation by the solver.
     pub drop: f64,
 }
+
+/// Basis integrals the a-priori route keeps on the stack (a fall polynomial of degree 2 and the
+/// start's).
+const PRIOR_BASIS: usize = 4;
 
 /// Buffers of [`separation`], kept across points.
 #[derive(Debug, Clone, Default)]
@@ -102,10 +111,11 @@ pub fn separation(
     work.fall.resize(np * degree, 0.0);
     at.red.start_partials(at.k, &mut work.start);
     at.red.fall_partials(at.k, &mut work.fall);
-    let e = 1.0 - at.sin_initial;
+    let e = at.scale;
     let v_sep = v_at_drop(e, at.drop);
-    // The moving upper limit.
-    let (sh, ch) = (v_sep.sinh(), v_sep.cosh());
+    // The moving upper limit (`sinh^2 v_sep = drop / e` exactly, no transcendental call).
+    let sh2 = at.drop / e;
+    let (sh, ch) = (sh2.sqrt(), (1.0 + sh2).sqrt());
     let g_sep = 2.0 * (horner(at.fall, at.sin_sep) / (1.0 + at.sin_sep)).sqrt();
     let one_minus_sep = e + at.drop;
     for i in 0..np {
@@ -114,8 +124,12 @@ pub fn separation(
         time[i] = g_sep * dv;
     }
     integral(at, e, v_sep, prior, tol, work)?;
-    for (t, d) in time.iter_mut().zip(&work.panel) {
-        *t += d;
+    // Each parameter's integral from the basis integrals (`work.panel`).
+    let (basis, start) = (&work.panel, &work.start);
+    for (i, t) in time.iter_mut().enumerate() {
+        let fall = &work.fall[i * degree..(i + 1) * degree];
+        let from_fall: f64 = fall.iter().zip(basis).map(|(d, b)| d * b).sum();
+        *t += from_fall + start[i] * basis[degree];
     }
     Ok(Ok(()))
 }
@@ -140,7 +154,10 @@ struct Node {
 
 /// The node at `v` with weight `w`.
 fn node_at(at: &SeparationPoint, e: f64, v: f64, w: f64) -> Node {
-    let sh = v.sinh();
+    // `sinh v` from one exponential: its absolute error (an ulp of `cosh v`) moves `s` by an
+    // ulp of `e sinh v`, far below what the integrand notices.
+    let x = v.exp();
+    let sh = 0.5 * (x - 1.0 / x);
     let sh2 = sh * sh;
     let s = at.sin_initial - e * sh2;
     let one_plus = (1.0 + at.sin_initial) - e * sh2;
@@ -155,71 +172,81 @@ fn node_at(at: &SeparationPoint, e: f64, v: f64, w: f64) -> Node {
     }
 }
 
-/// `w dg/dp_i` for every parameter at one node, into `acc` (and `|.|` into `mag`).
-fn accumulate(
-    at: &SeparationPoint,
-    node: &Node,
-    (start, fall): (&[f64], &[f64]),
-    acc: &mut [f64],
-    mag: &mut [f64],
-) {
-    let degree = at.fall.len();
-    for (i, (x, m)) in acc.iter_mut().zip(mag.iter_mut()).enumerate() {
-        let ds = start[i] * node.ch2;
-        let p_i = horner(&fall[i * degree..(i + 1) * degree], node.s);
-        let value = node.weight * ((p_i + node.dp * ds) / node.p - ds / node.one_plus);
-        *x += value;
-        *m += value.abs();
+/// The basis integrands at one node, weighted, into `acc` (and `|.|` into `mag`): with
+/// `root = sqrt(P / (1 + s))`, `root s^j / P` for each power `j` of the fall polynomial and
+/// `root cosh^2 v (P'/P - 1/(1 + s))`. `dg/dp_i` is `sum_j (dP_j/dp_i) b_j + (ds_i/dp_i) b_last`:
+/// linear in the partial derivatives, so the nodes pay for the polynomial's degree, not for
+/// the number of parameters.
+fn accumulate(node: &Node, acc: &mut [f64], mag: Option<&mut [f64]>) {
+    let inv_p = 1.0 / node.p;
+    let last = acc.len() - 1;
+    let start = node.weight * node.ch2 * (node.dp * inv_p - 1.0 / node.one_plus);
+    let mut b = node.weight * inv_p;
+    match mag {
+        None => {
+            for x in &mut acc[..last] {
+                *x += b;
+                b *= node.s;
+            }
+        }
+        Some(mag) => {
+            for (x, m) in acc[..last].iter_mut().zip(mag[..last].iter_mut()) {
+                *x += b;
+                *m += b.abs();
+                b *= node.s;
+            }
+            mag[last] += start.abs();
+        }
     }
+    acc[last] += start;
 }
 
-/// `sum_nodes w dg/dp_i` on the panel `[a, b]` (symmetric about 0 where `a == 0`: the
-/// integrand is even in `v`), scaled by the panel's half-length, into `acc` and `mag`.
+/// `sum_nodes w b_j` of the basis integrands on the panel `[a, b]` (symmetric about 0 where
+/// `a == 0`: the integrand is even in `v`), scaled by the panel's half-length, added into
+/// `acc` (and their `|.|` into `mag` where given), both zero on entry.
 fn panel(
     at: &SeparationPoint,
     e: f64,
     rule: &HalfRule,
     (a, b): (f64, f64),
-    parts: (&[f64], &[f64]),
     acc: &mut [f64],
-    mag: &mut [f64],
+    mut mag: Option<&mut [f64]>,
 ) -> u64 {
-    acc.fill(0.0);
-    mag.fill(0.0);
     let mut evals = 0;
-    let mut node = |v: f64, w: f64, acc: &mut [f64], mag: &mut [f64]| {
-        accumulate(at, &node_at(at, e, v, w), parts, acc, mag);
+    let mut node = |v: f64, w: f64, acc: &mut [f64], mag: &mut Option<&mut [f64]>| {
+        accumulate(&node_at(at, e, v, w), acc, mag.as_deref_mut());
         evals += 1;
     };
     let scale = if a == 0.0 {
         if rule.centre != 0.0 {
-            node(0.0, 0.5 * rule.centre, acc, mag);
+            node(0.0, 0.5 * rule.centre, acc, &mut mag);
         }
         for &(x, w) in &rule.pairs {
-            node(b * x, w, acc, mag);
+            node(b * x, w, acc, &mut mag);
         }
         b
     } else {
         let (half, mid) = (0.5 * (b - a), 0.5 * (a + b));
         if rule.centre != 0.0 {
-            node(mid, rule.centre, acc, mag);
+            node(mid, rule.centre, acc, &mut mag);
         }
         for &(x, w) in &rule.pairs {
-            node(mid + half * x, w, acc, mag);
-            node(mid - half * x, w, acc, mag);
+            node(mid + half * x, w, acc, &mut mag);
+            node(mid - half * x, w, acc, &mut mag);
         }
         half
     };
-    for (x, m) in acc.iter_mut().zip(mag.iter_mut()) {
-        *x *= scale;
-        *m *= scale;
+    acc.iter_mut().for_each(|x| *x *= scale);
+    if let Some(m) = mag {
+        m.iter_mut().for_each(|x| *x *= scale);
     }
     evals
 }
 
-/// `integral_0^v_sep dg/dp_i dv` into `work.panel`: the a-priori rule's panels where it
-/// applies, else panels halved until a 16- and a 24-node rule agree to `tol` of the integral
-/// of `|dg/dp_i|` (so that a parameter the time barely depends on asks no impossible digits).
+/// The basis integrals of [`accumulate`] over `[0, v_sep]` into `work.panel`: the a-priori
+/// rule's panels where it applies, else panels halved until a 16- and a 24-node rule agree to
+/// `tol` of the integral of each basis integrand's `|.|` (so that one the time barely depends on
+/// asks no impossible digits).
 fn integral(
     at: &SeparationPoint,
     e: f64,
@@ -228,10 +255,9 @@ fn integral(
     tol: f64,
     work: &mut SensitivityWork,
 ) -> Result<(), SolveError> {
-    let np = at.parameters;
+    // The basis integrals: one per coefficient of the fall polynomial, one for the start.
+    let np = at.fall.len() + 1;
     let SensitivityWork {
-        start,
-        fall,
         panel: total,
         coarse,
         fine,
@@ -243,19 +269,26 @@ fn integral(
     total.resize(np, 0.0);
     coarse.resize(np, 0.0);
     magnitude.resize(np, 0.0);
-    let parts = (&start[..], &fall[..]);
-    if let Some(sing) = Singularities::of(at.sin_initial, e, at.fall) {
+    let sing = match at.singularities {
+        Some(sing) => Some(sing),
+        None => Singularities::of(at.sin_initial, e, at.fall),
+    };
+    // The a-priori rule takes fall polynomials of degree at most 2: at most four basis
+    // integrals, kept on the stack.
+    if let Some(sing) = sing.filter(|_| np <= PRIOR_BASIS) {
+        let mut sum = [0.0; PRIOR_BASIS];
         let done = prior_panels(&sing, v_sep, prior, |rule, a, b| {
-            let n = panel(at, e, rule, (a, b), parts, coarse, magnitude);
-            for (t, x) in total.iter_mut().zip(coarse.iter()) {
+            let mut acc = [0.0; PRIOR_BASIS];
+            let n = panel(at, e, rule, (a, b), &mut acc[..np], None);
+            for (t, x) in sum.iter_mut().zip(acc) {
                 *t += x;
             }
             Ok::<_, SolveError>((0.0, n))
         })?;
         if done.is_some() {
+            total.copy_from_slice(&sum[..np]);
             return Ok(());
         }
-        total.fill(0.0);
     }
     let (low, high) = (half_rule(16), half_rule(24));
     fine.resize(np, 0.0);
@@ -263,8 +296,11 @@ fn integral(
     stack.push((0.0, v_sep));
     let mut panels = 0;
     while let Some((a, b)) = stack.pop() {
-        panel(at, e, low, (a, b), parts, coarse, magnitude);
-        panel(at, e, high, (a, b), parts, fine, magnitude);
+        coarse.fill(0.0);
+        fine.fill(0.0);
+        magnitude.fill(0.0);
+        panel(at, e, low, (a, b), coarse, None);
+        panel(at, e, high, (a, b), fine, Some(magnitude));
         panels += 1;
         let agree = (fine.iter().zip(coarse.iter()).zip(magnitude.iter()))
             .all(|((f, c), m)| (f - c).abs() <= tol * m);
