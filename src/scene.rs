@@ -698,15 +698,17 @@ impl Ctx<'_> {
             return;
         }
         if let Some(i) = raw.want.iter().position(|w| w == "sensitivities") {
-            out.push(self.diag(
-                Kind::UnavailableQuantity,
-                &format!("want[{i}]"),
-                At::Value,
-                "`sensitivities` are of the separation angle and time and the contact ends, \
+            out.push(
+                self.diag(
+                    Kind::UnavailableQuantity,
+                    &format!("want[{i}]"),
+                    At::Value,
+                    "`sensitivities` are of the separation angle and time and the contact ends, \
                  and this scene wants none of them: add `separation_angle`, `separation_time` \
                  or `contact_end` to `want`"
-                    .into(),
-            ));
+                        .into(),
+                ),
+            );
         }
     }
 

@@ -6,23 +6,13 @@
 use astro_float::{BigFloat, RoundingMode};
 use rodcube::model::Model;
 use rodcube::reference::{Family, Inputs, PRECISION, Reference, RootRoute, TimeRoute, to_f64};
-use rodcube::solve::lean::{LeanPoint, LeanSolver};
 use rodcube::results::SensitivityGap;
+use rodcube::solve::lean::{LeanPoint, LeanSolver};
 use rodcube::solve::sensitivity::SensitivityWork;
 
-const NS: [f64; 10] = [1e-12, 1e-8, 1e-4, 1e-2, 1.0, 3.0, 1e2, 1e4, 1e8, 1e12];
-const RS: [f64; 10] = [
-    1e-10,
-    1e-7,
-    1e-4,
-    0.01,
-    0.25,
-    0.5,
-    0.9,
-    0.99,
-    1.0 - 1e-6,
-    1.0 - 1e-9,
-];
+#[path = "common/grid.rs"]
+mod grid;
+use grid::{NS, RS};
 
 const RM: RoundingMode = RoundingMode::ToEven;
 
@@ -30,11 +20,11 @@ fn model(name: &str) -> &'static dyn Model {
     rodcube::models::find(name).expect("generated model")
 }
 
-/// Solves a point and its sensitivities: `(point, d theta/dp, d t/dp)`.
-fn solve(
-    solver: &mut LeanSolver,
-    p: &[f64],
-) -> (LeanPoint, Result<(Vec<f64>, Vec<f64>), SensitivityGap>) {
+/// `(d theta/dp, d t/dp)`, or why there are none.
+type Sensitivities = Result<(Vec<f64>, Vec<f64>), SensitivityGap>;
+
+/// Solves a point and its sensitivities.
+fn solve(solver: &mut LeanSolver, p: &[f64]) -> (LeanPoint, Sensitivities) {
     let point = solver.solve(p).expect("point");
     let mut work = SensitivityWork::default();
     let (mut angle, mut time) = (vec![0.0; p.len()], vec![0.0; p.len()]);
@@ -120,7 +110,10 @@ fn check_family(family: Family, ns: &[f64]) {
             }
         }
     }
-    eprintln!("{family:?}: worst relative error {:e} ({})", worst.0, worst.1);
+    eprintln!(
+        "{family:?}: worst relative error {:e} ({})",
+        worst.0, worst.1
+    );
 }
 
 #[test]
@@ -262,5 +255,8 @@ fn generated_partials_match_differences_of_the_generated_functions() {
         }
         checked += 1;
     }
-    assert!(checked >= 10, "only {checked} fast phases took the parameters");
+    assert!(
+        checked >= 10,
+        "only {checked} fast phases took the parameters"
+    );
 }

@@ -60,9 +60,15 @@ fn results_json_carries_every_sensitivity_with_its_unit_and_the_elasticities() {
                  parameters: {m1: 1.0, m2: 3.0, ell: 1.0, a: 0.25, g: 9.81}\n\
                  want: [separation_angle, separation_time, contact_end, floor_impact, sensitivities]\n";
     let (out, dir) = run_scene("paper", scene);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let json = results_json(&dir);
-    let sens = json["sensitivities"].as_object().expect("a sensitivities block");
+    let sens = json["sensitivities"]
+        .as_object()
+        .expect("a sensitivities block");
     // The per-point solver's numbers, independently of the planner.
     let model = rodcube::models::find("rod_cube").unwrap();
     let p: Vec<f64> = PAPER.iter().map(|(_, v)| *v).collect();
@@ -79,11 +85,36 @@ fn results_json_carries_every_sensitivity_with_its_unit_and_the_elasticities() {
     let results = &json["results"];
     for (i, (name, value)) in PAPER.iter().enumerate() {
         for (of, unit, d, x) in [
-            ("separation_angle", units_angle[i], d_theta[i], point.separation_angle),
-            ("contact_end_angle", units_angle[i], d_theta[i], point.separation_angle),
-            ("separation_time", units_time[i], d_t[i], point.separation_time),
-            ("contact_end_time", units_time[i], d_t[i], point.separation_time),
-            ("contact_force_end_time", units_time[i], d_t[i], point.separation_time),
+            (
+                "separation_angle",
+                units_angle[i],
+                d_theta[i],
+                point.separation_angle,
+            ),
+            (
+                "contact_end_angle",
+                units_angle[i],
+                d_theta[i],
+                point.separation_angle,
+            ),
+            (
+                "separation_time",
+                units_time[i],
+                d_t[i],
+                point.separation_time,
+            ),
+            (
+                "contact_end_time",
+                units_time[i],
+                d_t[i],
+                point.separation_time,
+            ),
+            (
+                "contact_force_end_time",
+                units_time[i],
+                d_t[i],
+                point.separation_time,
+            ),
         ] {
             let entry = &sens[&format!("d({of})/d({name})")];
             assert_eq!(entry["unit"], unit, "{of} {name}");
@@ -100,15 +131,24 @@ fn results_json_carries_every_sensitivity_with_its_unit_and_the_elasticities() {
             assert!((x_reported - x).abs() <= 1e-9 * x, "{of}");
             let e = elasticity["value"].as_f64().unwrap();
             let want = value / x_reported * got;
-            assert!((e - want).abs() <= 1e-12 * want.abs().max(1e-12), "{of} {name}");
+            assert!(
+                (e - want).abs() <= 1e-12 * want.abs().max(1e-12),
+                "{of} {name}"
+            );
         }
     }
     // The angle does not depend on g at all: an exact zero.
     assert_eq!(sens["d(separation_angle)/d(g)"]["value"], 0.0);
     // What comes after the separation has a note, and no number.
     let notes = json["notes"].as_object().unwrap();
-    for key in ["sensitivities.floor_impact", "sensitivities.floor_normal_end"] {
-        assert!(notes[key].as_str().unwrap().contains("not available"), "{key}");
+    for key in [
+        "sensitivities.floor_impact",
+        "sensitivities.floor_normal_end",
+    ] {
+        assert!(
+            notes[key].as_str().unwrap().contains("not available"),
+            "{key}"
+        );
     }
     assert!(!sens.keys().any(|k| k.contains("floor")));
 }
@@ -122,7 +162,11 @@ fn sensitivities_of_nothing_wanted_are_a_scene_error_at_their_position() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(3), "{err}");
     assert!(out.stdout.is_empty());
-    for needle in ["scene.yaml:4:22", "want[1]", "`sensitivities` are of the separation"] {
+    for needle in [
+        "scene.yaml:4:22",
+        "want[1]",
+        "`sensitivities` are of the separation",
+    ] {
         assert!(err.contains(needle), "missing {needle:?} in:\n{err}");
     }
     assert!(!dir.join("out").exists(), "no output after a scene error");
@@ -150,7 +194,10 @@ fn an_integrated_run_gets_a_note_and_no_number() {
     let res = plan::run(&Request::new(model, p).with_want(&want)).unwrap();
     assert!(res.results.contains_key("separation_time"));
     assert!(res.sensitivities.is_empty());
-    for key in ["sensitivities.separation_angle", "sensitivities.separation_time"] {
+    for key in [
+        "sensitivities.separation_angle",
+        "sensitivities.separation_time",
+    ] {
         assert_eq!(
             res.notes.get(key),
             Some(&rodcube::results::Note::NoSensitivity(
@@ -213,7 +260,11 @@ fn sweep_sensitivities_add_columns_equal_to_the_per_point_solver() {
             "out",
         ],
     );
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = fs::read_to_string(dir.join("out").join("sweep.csv")).unwrap();
     let mut lines = text.lines().filter(|l| !l.starts_with('#'));
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
@@ -227,11 +278,20 @@ fn sweep_sensitivities_add_columns_equal_to_the_per_point_solver() {
     let point = solver.solve(&p).unwrap();
     let (mut d_theta, mut d_t) = (vec![0.0; 5], vec![0.0; 5]);
     solver
-        .sensitivities(&p, &point, &mut SensitivityWork::default(), &mut d_theta, &mut d_t)
+        .sensitivities(
+            &p,
+            &point,
+            &mut SensitivityWork::default(),
+            &mut d_theta,
+            &mut d_t,
+        )
         .unwrap()
         .unwrap();
     for (i, name) in ["m1", "m2", "ell", "a", "g"].iter().enumerate() {
-        assert_eq!(row[col(&format!("d(separation_angle)/d({name})"))], d_theta[i]);
+        assert_eq!(
+            row[col(&format!("d(separation_angle)/d({name})"))],
+            d_theta[i]
+        );
         assert_eq!(row[col(&format!("d(separation_time)/d({name})"))], d_t[i]);
         let e = row[col(&format!("elasticity(separation_time;{name})"))];
         assert_eq!(e, p[i] / point.separation_time * d_t[i]);

@@ -243,8 +243,8 @@ fn separation_sensitivities(
     presenter: &Presenter,
     d: &Derivation,
 ) -> Result<Vec<Scaled>, DeriveError> {
-    let f_theta = cas::d(condition, "rc_s") * cas::var("rc_c")
-        - cas::d(condition, "rc_c") * cas::var("rc_s");
+    let f_theta =
+        cas::d(condition, "rc_s") * cas::var("rc_c") - cas::d(condition, "rc_c") * cas::var("rc_s");
     let mut out = Vec::new();
     for g in groups {
         let f_g = cas::d(condition, &g.name);

@@ -70,7 +70,12 @@ fn separation_partials(coefficients: &[A], params: &[String]) -> Result<Vec<Expr
     };
     let dependence = |ratios: &[A]| -> usize {
         (params.iter())
-            .map(|p| ratios.iter().filter(|c| !cas::is_zero(&cas::d(c, p))).count())
+            .map(|p| {
+                ratios
+                    .iter()
+                    .filter(|c| !cas::is_zero(&cas::d(c, p)))
+                    .count()
+            })
             .sum()
     };
     let Some(k) = (0..coefficients.len())
@@ -84,13 +89,10 @@ fn separation_partials(coefficients: &[A], params: &[String]) -> Result<Vec<Expr
     };
     let ratios = ratios(k);
     let s = cas::var("rc_s");
-    let power = |j: usize| -> A {
-        (0..j).fold(cas::num(1), |acc, _| acc * s.clone())
-    };
-    let d_s = (ratios.iter().enumerate().skip(1))
-        .fold(cas::num(0), |acc, (j, c)| {
-            acc + c.clone() * cas::num(j as i64) * power(j - 1)
-        });
+    let power = |j: usize| -> A { (0..j).fold(cas::num(1), |acc, _| acc * s.clone()) };
+    let d_s = (ratios.iter().enumerate().skip(1)).fold(cas::num(0), |acc, (j, c)| {
+        acc + c.clone() * cas::num(j as i64) * power(j - 1)
+    });
     let mut out = vec![to_expr(&(d_s * cas::var("rc_c")), "dF/dtheta")?];
     for p in params {
         let d_p = (ratios.iter().enumerate())

@@ -25,9 +25,7 @@ use super::expr::{Expr, product};
 use super::lagrangian::Lagrangian;
 use super::setup::Setup;
 use super::spec::Spec;
-use super::types::{
-    Constant, DeriveError, Partials, Reduction, Separation, Unreducible, at, key,
-};
+use super::types::{Constant, DeriveError, Partials, Reduction, Separation, Unreducible, at, key};
 use std::collections::BTreeMap;
 
 /// Stage 6, the reduction: the fast path of a phase, from its Lagrangian and equations.

@@ -368,7 +368,10 @@ pub fn run(request: &Request) -> Result<RunResults, PlanError> {
 /// Refuses a result with a NaN or an infinity (a model function misbehaving), naming it.
 fn check_finite(out: &RunResults) -> Result<(), PlanError> {
     let sensitivities = (out.sensitivities.iter()).map(|(k, s)| (k, s.value));
-    for (key, value) in (out.results.iter()).map(|(k, s)| (k, s.value)).chain(sensitivities) {
+    for (key, value) in (out.results.iter())
+        .map(|(k, s)| (k, s.value))
+        .chain(sensitivities)
+    {
         if !value.is_finite() {
             return Err(PlanError::NonFinite {
                 key: key.clone(),

@@ -81,4 +81,3 @@ pub fn to_string(results: &RunResults) -> Result<String, serde_json::Error> {
     s.push('\n');
     Ok(s)
 }
-

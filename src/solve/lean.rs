@@ -35,10 +35,10 @@ use crate::solve::phases::{End, phase_end};
 use crate::solve::poly::horner;
 use crate::solve::poly::{self, MAX_DEGREE};
 use crate::solve::prior::{PRIOR_TOL, Prior, Singularities, integrate_prior, prior_panels};
-use crate::solve::sensitivity::{self, SensitivityWork, SeparationPoint};
 use crate::solve::quadrature::{
     self, ACCEPT, Control, Fall, FallIntegrand, HalfRule, PanelSum, RuleStep, SCHEDULE, v_at_drop,
 };
+use crate::solve::sensitivity::{self, SensitivityWork, SeparationPoint};
 use crate::system::{System, SystemError, check_parameters, ordered_values, prepare_constants};
 
 /// The fast phase a system starts in (its release phase), looked up in the registry; a model

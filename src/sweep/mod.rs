@@ -553,8 +553,13 @@ impl Row<'_> {
             .with_want(&want)
             .with_tolerance(self.tolerance);
         let res = plan::run(&request).map_err(|e| e.to_string())?;
-        values.extend((names.iter()).map(|k| res.sensitivities.get(k).map_or(f64::NAN, |s| s.value)));
-        match res.notes.iter().find(|(k, _)| k.starts_with("sensitivities.")) {
+        values
+            .extend((names.iter()).map(|k| res.sensitivities.get(k).map_or(f64::NAN, |s| s.value)));
+        match res
+            .notes
+            .iter()
+            .find(|(k, _)| k.starts_with("sensitivities."))
+        {
             Some((_, n)) => Err(prose::note(n)),
             None => Ok(()),
         }

@@ -272,10 +272,7 @@ pub(super) fn reduction_docs(d: &Derivation, r: &Reduction) -> Docs {
     );
     docs.insert(
         "start_partials",
-        doc(
-            "`d(sin theta_i)/dp` for each parameter.",
-            Vec::new(),
-        ),
+        doc("`d(sin theta_i)/dp` for each parameter.", Vec::new()),
     );
     docs.insert(
         "fall_partials",

@@ -3,8 +3,8 @@
 
 use super::common::{COMMAND, one_line, spec_path};
 use crate::derive::algebra::from_sc;
-use crate::derive::expr::Expr;
 use crate::derive::dimensionless::SEPARATION_SENSITIVITY;
+use crate::derive::expr::Expr;
 use crate::derive::present;
 use crate::derive::spec::Checked;
 use crate::derive::types::{
