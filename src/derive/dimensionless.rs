@@ -113,6 +113,7 @@ pub fn derive(spec: &Spec, d: &Derivation) -> Result<Option<Dimensionless>, Deri
             time,
             force,
             results,
+            sensitivities: Vec::new(),
         }));
     };
     let presenter = Presenter::new(&order);
@@ -220,14 +221,16 @@ pub fn derive(spec: &Spec, d: &Derivation) -> Result<Option<Dimensionless>, Deri
             operations: form.operations,
         });
     }
-    if let Some(condition) = &condition_value {
-        results.extend(separation_sensitivities(condition, &groups, &presenter, d)?);
-    }
+    let sensitivities = match &condition_value {
+        Some(condition) => separation_sensitivities(condition, &groups, &presenter, d)?,
+        None => Vec::new(),
+    };
     Ok(Some(Dimensionless {
         groups,
         time,
         force,
         results,
+        sensitivities,
     }))
 }
 

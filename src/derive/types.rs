@@ -506,6 +506,9 @@ pub struct Dimensionless {
     pub force: Expr,
     /// The results (none on the integrated route, which has no closed forms).
     pub results: Vec<Scaled>,
+    /// `d theta_sep / d <group>` for each group the separation condition depends on (keys
+    /// `dtheta_sep_d<group>`), at the separation angle, by the implicit-function theorem.
+    pub sensitivities: Vec<Scaled>,
 }
 
 /// One step as shown, over `rc_s`, `rc_c` like the derivation.

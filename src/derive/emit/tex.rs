@@ -483,7 +483,7 @@ fn tex_dimensionless(
         tex_text(present::RULE)
     );
     let mut results = Vec::new();
-    for (i, r) in dim.results.iter().enumerate() {
+    for (i, r) in dim.results.iter().chain(&dim.sensitivities).enumerate() {
         let form = from_sc(&r.form, theta);
         let quantity = match r.key.as_str() {
             "theta_dot_sq" => format!("{}^2", name(&format!("dot_{theta}"))),
