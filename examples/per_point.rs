@@ -7,27 +7,33 @@
 //! `a/ell_j = 0.01 + 0.98 j / 99` (`ell = g = m1 = 1`, `m2 = n`), row-major by `i`; point `k` is
 //! grid index `(7919 k) mod 10000`.
 //!
-//! Usage: `cargo run --release --example per_point -- [N] [--baseline]` (`--baseline`: the
-//! baseline instruction set even where the CPU has AVX2; the results are the same to the bit).
+//! Usage: `cargo run --release --example per_point -- [N] [--baseline] [--sensitivities]`
+//! (`--baseline`: the baseline instruction set even where the CPU has AVX2; the results are the
+//! same to the bit. `--sensitivities`: each point also with `d theta_sep/dp` and `d t_sep/dp` for
+//! every parameter, `LeanSolver::sensitivities`, their sum added to the printed one).
 
 use rodcube::models;
 use rodcube::solve::lean::LeanSolver;
+use rodcube::solve::sensitivity::SensitivityWork;
 use std::process::ExitCode;
 
 #[path = "common/per_point_set.rs"]
 mod set;
 
 fn main() -> ExitCode {
-    let (mut count, mut baseline) = (1000, false);
+    let (mut count, mut baseline, mut sensitivities) = (1000, false, false);
     for arg in std::env::args().skip(1) {
         if arg == "--baseline" {
             baseline = true;
+        } else if arg == "--sensitivities" {
+            sensitivities = true;
         } else {
             match arg.parse::<usize>() {
                 Ok(n) => count = n,
                 Err(_) => {
                     eprintln!(
-                        "per_point: expected N (a non-negative integer) or --baseline, got {arg:?}"
+                        "per_point: expected N (a non-negative integer), --baseline or \
+                         --sensitivities, got {arg:?}"
                     );
                     return ExitCode::from(2);
                 }
@@ -50,12 +56,29 @@ fn main() -> ExitCode {
         solver.baseline_only();
     }
     let mut sum = 0.0;
+    let np = model.info().parameters.len();
+    let (mut angle, mut time) = (vec![0.0; np], vec![0.0; np]);
+    let mut work = SensitivityWork::default();
     for (k, p) in points.iter().enumerate() {
-        match solver.solve(p) {
-            Ok(r) => sum += r.separation_angle + r.separation_time,
+        let r = match solver.solve(p) {
+            Ok(r) => r,
             Err(e) => {
                 eprintln!("per_point: point {k} ({p:?}): {e}");
                 return ExitCode::FAILURE;
+            }
+        };
+        sum += r.separation_angle + r.separation_time;
+        if sensitivities {
+            match solver.sensitivities(p, &r, &mut work, &mut angle, &mut time) {
+                Ok(Ok(())) => sum += angle.iter().chain(&time).sum::<f64>(),
+                Ok(Err(why)) => {
+                    eprintln!("per_point: point {k} ({p:?}): no sensitivities: {why:?}");
+                    return ExitCode::FAILURE;
+                }
+                Err(e) => {
+                    eprintln!("per_point: point {k} ({p:?}): {e}");
+                    return ExitCode::FAILURE;
+                }
             }
         }
     }

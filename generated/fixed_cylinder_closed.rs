@@ -619,6 +619,73 @@ impl Reduction for FixedCylinderClosed {
     /// The coefficients, constant term first, of the fall polynomial `P(s) = (sin(theta_i) - s) / theta_dot^2` in `s = sin(theta)`.
     fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
 
+    fn has_partials(&self) -> bool {
+        true
+    }
+
+    /// `[dF/dtheta, dF/dp_1, ...]` at `sin(theta)`, `cos(theta)`, of the separation condition `F = 0` divided by the coefficient that leaves the parameters in the fewest terms (the implicit-function theorem's `d theta_sep/dp = -F_p / F_theta` is the same for any factor).
+    fn separation_partials(&self, _k: &[f64], _rc_s: f64, _rc_c: f64, _out: &mut [f64]) {}
+
+    /// `d(theta_dot^2)/dp` for each parameter at a fixed angle given by `sin(theta)`, `cos(theta)`.
+    fn theta_dot_sq_partials(&self, k: &[f64], rc_s: f64, rc_c: f64, out: &mut [f64]) {
+        let k = &k[..37]; // one bounds check for all constant loads
+        let ell = k[1];
+        let r = k[2];
+        let th0 = k[3];
+        let g = k[4];
+        let dt0 = r * r;
+        let dt1 = rc_s.powi(4);
+        let dt2 = th0.sin();
+        let dt3 = rc_s.powi(5);
+        let dt4 = rc_s.powi(6);
+        let dt5 = rc_s.powi(7);
+        let dt6 = ell * ell;
+        let dt7 = rc_s.powi(8);
+        let dt8 = rc_s.powi(3);
+        let dt9 = -(3.0 * r * ell * dt8) - (3.0 * r * ell * dt8 * rc_c)
+            + (6.0 * dt0)
+            + (6.0 * dt0 * rc_c)
+            - (3.0 * dt0 * (rc_s * rc_s))
+            + (dt6 * dt1);
+        out[0] = 0.0;
+        out[1] = 3.0
+            * ((6.0 * dt0 * g * dt1 * rc_c * dt2) + (6.0 * dt0 * g * dt1 * dt2)
+                - (6.0 * dt0 * g * dt3)
+                - (6.0 * dt0 * g * dt3 * rc_c)
+                - (3.0 * dt0 * g * dt4 * dt2)
+                + (3.0 * dt0 * g * dt5)
+                - (dt6 * g * dt7 * dt2)
+                + (dt6 * g * rc_s.powi(9)))
+            / (dt9 * dt9);
+        out[2] = -9.0
+            * ((4.0 * r * ell * g * dt1 * rc_c * dt2) + (4.0 * r * ell * g * dt1 * dt2)
+                - (4.0 * r * ell * g * dt3)
+                - (4.0 * r * ell * g * dt3 * rc_c)
+                - (2.0 * r * ell * g * dt4 * dt2)
+                + (2.0 * r * ell * g * dt5)
+                - (dt6 * g * dt5 * rc_c * dt2)
+                - (dt6 * g * dt5 * dt2)
+                + (dt6 * g * dt7)
+                + (dt6 * g * dt7 * rc_c))
+            / (dt9 * dt9);
+        out[3] = 3.0 * ell * g * dt1 * th0.cos() / dt9;
+        out[4] = -3.0 * (-(ell * dt1 * dt2) + (ell * dt3)) / dt9;
+    }
+
+    /// `d(sin theta_i)/dp` for each parameter.
+    fn start_partials(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..37]; // one bounds check for all constant loads
+        let th0 = k[3];
+        out[0] = 0.0;
+        out[1] = 0.0;
+        out[2] = 0.0;
+        out[3] = th0.cos();
+        out[4] = 0.0;
+    }
+
+    /// `dP_j/dp` of the fall polynomial's coefficients, parameter by parameter (`j` fastest).
+    fn fall_partials(&self, _k: &[f64], _out: &mut [f64]) {}
+
     /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
     fn full_state(
         &self,

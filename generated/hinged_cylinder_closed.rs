@@ -611,6 +611,85 @@ impl Reduction for HingedCylinderClosed {
     /// The coefficients, constant term first, of the fall polynomial `P(s) = (sin(theta_i) - s) / theta_dot^2` in `s = sin(theta)`.
     fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
 
+    fn has_partials(&self) -> bool {
+        true
+    }
+
+    /// `[dF/dtheta, dF/dp_1, ...]` at `sin(theta)`, `cos(theta)`, of the separation condition `F = 0` divided by the coefficient that leaves the parameters in the fewest terms (the implicit-function theorem's `d theta_sep/dp = -F_p / F_theta` is the same for any factor).
+    fn separation_partials(&self, _k: &[f64], _rc_s: f64, _rc_c: f64, _out: &mut [f64]) {}
+
+    /// `d(theta_dot^2)/dp` for each parameter at a fixed angle given by `sin(theta)`, `cos(theta)`.
+    fn theta_dot_sq_partials(&self, k: &[f64], rc_s: f64, rc_c: f64, out: &mut [f64]) {
+        let k = &k[..35]; // one bounds check for all constant loads
+        let m1 = k[0];
+        let m2 = k[1];
+        let ell = k[2];
+        let r = k[3];
+        let th0 = k[4];
+        let g = k[5];
+        let dt0 = r * r;
+        let dt1 = rc_s.powi(4);
+        let dt2 = th0.sin();
+        let dt3 = rc_s.powi(5);
+        let dt4 = rc_s.powi(6);
+        let dt5 = rc_s.powi(7);
+        let dt6 = ell * ell;
+        let dt7 = (6.0 * dt0 * m2) + (6.0 * dt0 * m2 * rc_c) - (3.0 * dt0 * m2 * (rc_s * rc_s))
+            + (dt6 * m1 * dt1);
+        let dt8 = m1 * m1;
+        out[0] = 9.0
+            * ((2.0 * dt0 * ell * g * m2 * dt1 * rc_c * dt2)
+                + (2.0 * dt0 * ell * g * m2 * dt1 * dt2)
+                - (2.0 * dt0 * ell * g * m2 * dt3)
+                - (2.0 * dt0 * ell * g * m2 * dt3 * rc_c)
+                - (dt0 * ell * g * m2 * dt4 * dt2)
+                + (dt0 * ell * g * m2 * dt5))
+            / (dt7 * dt7);
+        out[1] = -9.0
+            * ((2.0 * dt0 * ell * g * m1 * dt1 * rc_c * dt2)
+                + (2.0 * dt0 * ell * g * m1 * dt1 * dt2)
+                - (2.0 * dt0 * ell * g * m1 * dt3)
+                - (2.0 * dt0 * ell * g * m1 * dt3 * rc_c)
+                - (dt0 * ell * g * m1 * dt4 * dt2)
+                + (dt0 * ell * g * m1 * dt5))
+            / (dt7 * dt7);
+        out[2] = 3.0
+            * ((6.0 * dt0 * g * m1 * m2 * dt1 * rc_c * dt2)
+                + (6.0 * dt0 * g * m1 * m2 * dt1 * dt2)
+                - (6.0 * dt0 * g * m1 * m2 * dt3)
+                - (6.0 * dt0 * g * m1 * m2 * dt3 * rc_c)
+                - (3.0 * dt0 * g * m1 * m2 * dt4 * dt2)
+                + (3.0 * dt0 * g * m1 * m2 * dt5)
+                - (dt6 * g * dt8 * rc_s.powi(8) * dt2)
+                + (dt6 * g * dt8 * rc_s.powi(9)))
+            / (dt7 * dt7);
+        out[3] = -18.0
+            * ((2.0 * r * ell * g * m1 * m2 * dt1 * rc_c * dt2)
+                + (2.0 * r * ell * g * m1 * m2 * dt1 * dt2)
+                - (2.0 * r * ell * g * m1 * m2 * dt3)
+                - (2.0 * r * ell * g * m1 * m2 * dt3 * rc_c)
+                - (r * ell * g * m1 * m2 * dt4 * dt2)
+                + (r * ell * g * m1 * m2 * dt5))
+            / (dt7 * dt7);
+        out[4] = 3.0 * ell * g * m1 * dt1 * th0.cos() / dt7;
+        out[5] = -3.0 * (-(ell * m1 * dt1 * dt2) + (ell * m1 * dt3)) / dt7;
+    }
+
+    /// `d(sin theta_i)/dp` for each parameter.
+    fn start_partials(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..35]; // one bounds check for all constant loads
+        let th0 = k[4];
+        out[0] = 0.0;
+        out[1] = 0.0;
+        out[2] = 0.0;
+        out[3] = 0.0;
+        out[4] = th0.cos();
+        out[5] = 0.0;
+    }
+
+    /// `dP_j/dp` of the fall polynomial's coefficients, parameter by parameter (`j` fastest).
+    fn fall_partials(&self, _k: &[f64], _out: &mut [f64]) {}
+
     /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
     fn full_state(
         &self,

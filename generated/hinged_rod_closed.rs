@@ -514,6 +514,80 @@ impl Reduction for HingedRodClosed {
         out[2] = k[31];
     }
 
+    fn has_partials(&self) -> bool {
+        true
+    }
+
+    /// `[dF/dtheta, dF/dp_1, ...]` at `sin(theta)`, `cos(theta)`, of the separation condition `F = 0` divided by the coefficient that leaves the parameters in the fewest terms (the implicit-function theorem's `d theta_sep/dp = -F_p / F_theta` is the same for any factor).
+    fn separation_partials(&self, k: &[f64], rc_s: f64, rc_c: f64, out: &mut [f64]) {
+        let k = &k[..32]; // one bounds check for all constant loads
+        let m1 = k[0];
+        let m2 = k[1];
+        let ell = k[2];
+        let a = k[3];
+        let dt0 = rc_s.powi(3);
+        out[0] = rc_c * (1.0 + (3.0 * m2 * (rc_s * rc_s) / m1));
+        out[1] = -m2 * dt0 / (m1 * m1);
+        out[2] = dt0 / m1;
+        out[3] = 2.0 * a / 3.0 / (ell * ell);
+        out[4] = -2.0 / 3.0 / ell;
+        out[5] = 0.0;
+    }
+
+    /// `d(theta_dot^2)/dp` for each parameter at a fixed angle given by `sin(theta)`, `cos(theta)`.
+    fn theta_dot_sq_partials(&self, k: &[f64], rc_s: f64, _rc_c: f64, out: &mut [f64]) {
+        let k = &k[..32]; // one bounds check for all constant loads
+        let m1 = k[0];
+        let m2 = k[1];
+        let ell = k[2];
+        let a = k[3];
+        let g = k[4];
+        let dt0 = rc_s * rc_s;
+        let dt1 = rc_s.powi(3);
+        let dt2 = m1 + (3.0 * m2 * dt0);
+        out[0] = -9.0 * (-(a * g * m2 * dt0) + (ell * g * m2 * dt1)) / (ell * ell) / (dt2 * dt2);
+        out[1] = 9.0 * (-(a * g * m1 * dt0) + (ell * g * m1 * dt1)) / (ell * ell) / (dt2 * dt2);
+        out[2] = 3.0 * (-(2.0 * a * g * m1) + (ell * g * m1 * rc_s)) / ell.powi(3) / dt2;
+        out[3] = 3.0 * g * m1 / (ell * ell) / dt2;
+        out[4] = -3.0 * (-(a * m1) + (ell * m1 * rc_s)) / (ell * ell) / dt2;
+    }
+
+    /// `d(sin theta_i)/dp` for each parameter.
+    fn start_partials(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..32]; // one bounds check for all constant loads
+        let ell = k[2];
+        let a = k[3];
+        out[0] = 0.0;
+        out[1] = 0.0;
+        out[2] = -a / (ell * ell);
+        out[3] = 1.0 / ell;
+        out[4] = 0.0;
+    }
+
+    /// `dP_j/dp` of the fall polynomial's coefficients, parameter by parameter (`j` fastest).
+    fn fall_partials(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..32]; // one bounds check for all constant loads
+        let m1 = k[0];
+        let m2 = k[1];
+        let ell = k[2];
+        let g = k[4];
+        out[0] = 0.0;
+        out[1] = 0.0;
+        out[2] = -ell * m2 / g / (m1 * m1);
+        out[3] = 0.0;
+        out[4] = 0.0;
+        out[5] = ell / g / m1;
+        out[6] = 1.0 / 3.0 / g;
+        out[7] = 0.0;
+        out[8] = m2 / g / m1;
+        out[9] = 0.0;
+        out[10] = 0.0;
+        out[11] = 0.0;
+        out[12] = -ell / 3.0 / (g * g);
+        out[13] = 0.0;
+        out[14] = -ell * m2 / (g * g) / m1;
+    }
+
     /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
     fn full_state(
         &self,

@@ -537,6 +537,97 @@ impl Reduction for HingedRodSpringClosed {
     /// The coefficients, constant term first, of the fall polynomial `P(s) = (sin(theta_i) - s) / theta_dot^2` in `s = sin(theta)`.
     fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
 
+    fn has_partials(&self) -> bool {
+        true
+    }
+
+    /// `[dF/dtheta, dF/dp_1, ...]` at `sin(theta)`, `cos(theta)`, of the separation condition `F = 0` divided by the coefficient that leaves the parameters in the fewest terms (the implicit-function theorem's `d theta_sep/dp = -F_p / F_theta` is the same for any factor).
+    fn separation_partials(&self, _k: &[f64], _rc_s: f64, _rc_c: f64, _out: &mut [f64]) {}
+
+    /// `d(theta_dot^2)/dp` for each parameter at a fixed angle given by `sin(theta)`, `cos(theta)`.
+    fn theta_dot_sq_partials(&self, k: &[f64], rc_s: f64, rc_c: f64, out: &mut [f64]) {
+        let k = &k[..41]; // one bounds check for all constant loads
+        let m1 = k[0];
+        let m2 = k[1];
+        let ell = k[2];
+        let a = k[3];
+        let g = k[4];
+        let k_param = k[5];
+        let dt0 = rc_s * rc_s;
+        let dt1 = rc_s.powi(3);
+        let dt2 = a * a;
+        let dt3 = ell * ell;
+        let dt4 = a / ell;
+        let dt5 = dt4.asin();
+        let dt6 = dt5.cos();
+        let dt7 = rc_c * rc_c;
+        let dt8 = 1.0 + dt4;
+        let dt9 = 1.0 - dt4;
+        let dt10 = dt8 * dt9;
+        let dt11 = dt10.sqrt();
+        let dt12 = m1 + (3.0 * m2 * dt0);
+        let dt13 = dt5.sin();
+        let dt14 = 1.0 - (dt2 / dt3);
+        let dt15 = dt14.sqrt();
+        out[0] = 3.0
+            * ((3.0 * a * g * m2 * dt0) - (3.0 * ell * g * m2 * dt1) + (dt2 * k_param)
+                - (dt3 * k_param)
+                - (2.0 * dt3 * k_param * rc_c * dt6)
+                + (dt3 * k_param * dt7)
+                + (2.0 * dt3 * k_param * dt11 * dt6))
+            / dt3
+            / (dt12 * dt12);
+        out[1] = 9.0
+            * (-(a * g * m1 * dt0) + (ell * g * m1 * dt1) + (dt2 * k_param * dt0)
+                - (dt3 * k_param * dt0)
+                - (2.0 * dt3 * k_param * dt0 * rc_c * dt6)
+                + (dt3 * k_param * dt0 * dt7)
+                + (2.0 * dt3 * k_param * dt0 * dt11 * dt6))
+            / dt3
+            / (dt12 * dt12);
+        out[2] = 3.0
+            * ((2.0 * a * ell * k_param * rc_c * dt11 * dt13)
+                - (2.0 * a * ell * k_param * dt8 * dt9 * dt13)
+                - (2.0 * a * g * m1 * dt11 * dt15)
+                + (ell * g * m1 * rc_s * dt11 * dt15)
+                + (2.0 * dt2 * k_param * dt11 * dt15)
+                - (2.0 * dt2 * k_param * dt15 * dt6))
+            / ell.powi(3)
+            / dt11
+            / dt15
+            / dt12;
+        out[3] = -3.0
+            * ((2.0 * a * k_param * dt11 * dt15) - (2.0 * a * k_param * dt15 * dt6)
+                + (2.0 * ell * k_param * rc_c * dt11 * dt13)
+                - (2.0 * ell * k_param * dt8 * dt9 * dt13)
+                - (g * m1 * dt11 * dt15))
+            / dt3
+            / dt11
+            / dt15
+            / dt12;
+        out[4] = -3.0 * (-(a * m1) + (ell * m1 * rc_s)) / dt3 / dt12;
+        out[5] = -3.0
+            * (dt2 - dt3 - (2.0 * dt3 * rc_c * dt6) + (dt3 * dt7) + (2.0 * dt3 * dt11 * dt6))
+            / dt3
+            / dt12;
+    }
+
+    /// `d(sin theta_i)/dp` for each parameter.
+    fn start_partials(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..41]; // one bounds check for all constant loads
+        let ell = k[2];
+        let a = k[3];
+        out[0] = 0.0;
+        out[1] = 0.0;
+        out[2] = -a / (ell * ell);
+        out[3] = 1.0 / ell;
+        out[4] = 0.0;
+        out[5] = 0.0;
+    }
+
+    /// `dP_j/dp` of the fall polynomial's coefficients, parameter by parameter (`j` fastest).
+    fn fall_partials(&self, _k: &[f64], _out: &mut [f64]) {}
+
     /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
     fn full_state(
         &self,

@@ -717,6 +717,236 @@ impl Reduction for LoadedRodClosed {
         out[2] = -k[42];
     }
 
+    fn has_partials(&self) -> bool {
+        true
+    }
+
+    /// `[dF/dtheta, dF/dp_1, ...]` at `sin(theta)`, `cos(theta)`, of the separation condition `F = 0` divided by the coefficient that leaves the parameters in the fewest terms (the implicit-function theorem's `d theta_sep/dp = -F_p / F_theta` is the same for any factor).
+    fn separation_partials(&self, k: &[f64], rc_s: f64, rc_c: f64, out: &mut [f64]) {
+        let k = &k[..46]; // one bounds check for all constant loads
+        let m1 = k[0];
+        let m2 = k[1];
+        let m3 = k[2];
+        let ell = k[3];
+        let a = k[4];
+        let dt0 = m1 * m1;
+        let dt1 = m3 * m3;
+        let dt2 = m1 + (3.0 * m3);
+        let dt3 = m1 + m2 + m3;
+        let dt4 = rc_s.powi(3);
+        let dt5 = m2 * m2;
+        out[0] = rc_c
+            * (1.0
+                - (3.0 * (rc_s * rc_s) * ((4.0 * m1 * m3) + (4.0 * m2 * m3) + dt0 + (4.0 * dt1))
+                    / 4.0
+                    / dt2
+                    / dt3));
+        out[1] = -(-(2.0 * m1 * m2 * m3 * dt4) - (2.0 * m1 * dt1 * dt4) - (8.0 * m2 * dt1 * dt4)
+            + (dt0 * m2 * dt4)
+            - (4.0 * dt5 * m3 * dt4)
+            - (4.0 * m3.powi(3) * dt4))
+            / 4.0
+            / (dt2 * dt2)
+            / (dt3 * dt3);
+        out[2] = dt0 * dt4 / 4.0 / dt2 / (dt3 * dt3);
+        out[3] = -((8.0 * m1 * m2 * m3 * dt4)
+            + (4.0 * m1 * dt5 * dt4)
+            + (4.0 * m1 * dt1 * dt4)
+            + (5.0 * dt0 * m2 * dt4)
+            + (2.0 * dt0 * m3 * dt4))
+            / 4.0
+            / (dt2 * dt2)
+            / (dt3 * dt3);
+        out[4] = 2.0 * a / 3.0 / (ell * ell);
+        out[5] = -2.0 / 3.0 / ell;
+        out[6] = 0.0;
+    }
+
+    /// `d(theta_dot^2)/dp` for each parameter at a fixed angle given by `sin(theta)`, `cos(theta)`.
+    fn theta_dot_sq_partials(&self, k: &[f64], rc_s: f64, _rc_c: f64, out: &mut [f64]) {
+        let k = &k[..46]; // one bounds check for all constant loads
+        let m1 = k[0];
+        let m2 = k[1];
+        let m3 = k[2];
+        let ell = k[3];
+        let a = k[4];
+        let g = k[5];
+        let dt0 = rc_s * rc_s;
+        let dt1 = m3 * m3;
+        let dt2 = m1 * m1;
+        let dt3 = m2 * m2;
+        let dt4 = m3.powi(3);
+        let dt5 = rc_s.powi(3);
+        let dt6 = -(4.0 * m1 * m2) - (16.0 * m1 * m3) + (12.0 * m1 * m3 * dt0) - (12.0 * m2 * m3)
+            + (12.0 * m2 * m3 * dt0)
+            - (4.0 * dt2)
+            + (3.0 * dt2 * dt0)
+            - (12.0 * dt1)
+            + (12.0 * dt1 * dt0);
+        let dt7 = m1.powi(3);
+        out[0] = -12.0
+            * (-(8.0 * a * g * m1 * m2 * m3) + (12.0 * a * g * m1 * m2 * m3 * dt0)
+                - (8.0 * a * g * m1 * dt1)
+                + (12.0 * a * g * m1 * dt1 * dt0)
+                - (8.0 * a * g * m2 * dt1)
+                + (24.0 * a * g * m2 * dt1 * dt0)
+                - (3.0 * a * g * dt2 * m2 * dt0)
+                - (4.0 * a * g * dt2 * m3)
+                + (3.0 * a * g * dt2 * m3 * dt0)
+                - (4.0 * a * g * dt3 * m3)
+                + (12.0 * a * g * dt3 * m3 * dt0)
+                - (4.0 * a * g * dt4)
+                + (12.0 * a * g * dt4 * dt0)
+                + (8.0 * ell * g * m1 * m2 * m3 * rc_s)
+                - (12.0 * ell * g * m1 * m2 * m3 * dt5)
+                + (8.0 * ell * g * m1 * dt1 * rc_s)
+                - (12.0 * ell * g * m1 * dt1 * dt5)
+                + (8.0 * ell * g * m2 * dt1 * rc_s)
+                - (24.0 * ell * g * m2 * dt1 * dt5)
+                + (3.0 * ell * g * dt2 * m2 * dt5)
+                + (4.0 * ell * g * dt2 * m3 * rc_s)
+                - (3.0 * ell * g * dt2 * m3 * dt5)
+                + (4.0 * ell * g * dt3 * m3 * rc_s)
+                - (12.0 * ell * g * dt3 * m3 * dt5)
+                + (4.0 * ell * g * dt4 * rc_s)
+                - (12.0 * ell * g * dt4 * dt5))
+            / (ell * ell)
+            / (dt6 * dt6);
+        out[1] = 36.0
+            * (-(2.0 * a * g * dt2 * m3 * dt0) - (a * g * dt7 * dt0)
+                + (2.0 * ell * g * dt2 * m3 * dt5)
+                + (ell * g * dt7 * dt5))
+            / (ell * ell)
+            / (dt6 * dt6);
+        out[2] = -12.0
+            * ((8.0 * a * g * m1 * m2 * m3) - (24.0 * a * g * m1 * m2 * m3 * dt0)
+                + (4.0 * a * g * m1 * dt3)
+                - (12.0 * a * g * m1 * dt3 * dt0)
+                + (4.0 * a * g * m1 * dt1)
+                - (12.0 * a * g * m1 * dt1 * dt0)
+                + (8.0 * a * g * dt2 * m2)
+                - (18.0 * a * g * dt2 * m2 * dt0)
+                + (8.0 * a * g * dt2 * m3)
+                - (12.0 * a * g * dt2 * m3 * dt0)
+                + (4.0 * a * g * dt7)
+                - (3.0 * a * g * dt7 * dt0)
+                - (8.0 * ell * g * m1 * m2 * m3 * rc_s)
+                + (24.0 * ell * g * m1 * m2 * m3 * dt5)
+                - (4.0 * ell * g * m1 * dt3 * rc_s)
+                + (12.0 * ell * g * m1 * dt3 * dt5)
+                - (4.0 * ell * g * m1 * dt1 * rc_s)
+                + (12.0 * ell * g * m1 * dt1 * dt5)
+                - (8.0 * ell * g * dt2 * m2 * rc_s)
+                + (18.0 * ell * g * dt2 * m2 * dt5)
+                - (8.0 * ell * g * dt2 * m3 * rc_s)
+                + (12.0 * ell * g * dt2 * m3 * dt5)
+                - (4.0 * ell * g * dt7 * rc_s)
+                + (3.0 * ell * g * dt7 * dt5))
+            / (ell * ell)
+            / (dt6 * dt6);
+        out[3] = -12.0
+            * (-(2.0 * a * g * m1 * m2)
+                - (6.0 * a * g * m1 * m3)
+                - (4.0 * a * g * m2 * m3)
+                - (2.0 * a * g * dt2)
+                - (4.0 * a * g * dt1)
+                + (ell * g * m1 * m2 * rc_s)
+                + (3.0 * ell * g * m1 * m3 * rc_s)
+                + (2.0 * ell * g * m2 * m3 * rc_s)
+                + (ell * g * dt2 * rc_s)
+                + (2.0 * ell * g * dt1 * rc_s))
+            / ell.powi(3)
+            / dt6;
+        out[4] = -12.0
+            * ((g * m1 * m2)
+                + (3.0 * g * m1 * m3)
+                + (2.0 * g * m2 * m3)
+                + (g * dt2)
+                + (2.0 * g * dt1))
+            / (ell * ell)
+            / dt6;
+        out[5] = 12.0
+            * (-(a * m1 * m2)
+                - (3.0 * a * m1 * m3)
+                - (2.0 * a * m2 * m3)
+                - (a * dt2)
+                - (2.0 * a * dt1)
+                + (ell * m1 * m2 * rc_s)
+                + (3.0 * ell * m1 * m3 * rc_s)
+                + (2.0 * ell * m2 * m3 * rc_s)
+                + (ell * dt2 * rc_s)
+                + (2.0 * ell * dt1 * rc_s))
+            / (ell * ell)
+            / dt6;
+    }
+
+    /// `d(sin theta_i)/dp` for each parameter.
+    fn start_partials(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..46]; // one bounds check for all constant loads
+        let ell = k[3];
+        let a = k[4];
+        out[0] = 0.0;
+        out[1] = 0.0;
+        out[2] = 0.0;
+        out[3] = -a / (ell * ell);
+        out[4] = 1.0 / ell;
+        out[5] = 0.0;
+    }
+
+    /// `dP_j/dp` of the fall polynomial's coefficients, parameter by parameter (`j` fastest).
+    fn fall_partials(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..46]; // one bounds check for all constant loads
+        let m1 = k[0];
+        let m2 = k[1];
+        let m3 = k[2];
+        let ell = k[3];
+        let g = k[5];
+        let dt0 = m1 + (2.0 * m3);
+        let dt1 = m3 * m3;
+        let dt2 = 4.0 * ell * m1 * dt1;
+        let dt3 = m1 * m1;
+        let dt4 = m2 * m2;
+        let dt5 = m1 + m2 + m3;
+        out[0] = -ell * m3 / 3.0 / g / (dt0 * dt0);
+        out[1] = 0.0;
+        out[2] = ((4.0 * ell * m1 * m2 * m3) + dt2 + (8.0 * ell * m2 * dt1) - (ell * dt3 * m2)
+            + (ell * dt3 * m3)
+            + (4.0 * ell * dt4 * m3)
+            + (4.0 * ell * m3.powi(3)))
+            / 4.0
+            / g
+            / (dt0 * dt0)
+            / (dt5 * dt5);
+        out[3] = 0.0;
+        out[4] = 0.0;
+        out[5] = ell * dt3 / 4.0 / g / dt0 / (dt5 * dt5);
+        out[6] = ell * m1 / 3.0 / g / (dt0 * dt0);
+        out[7] = 0.0;
+        out[8] = -((8.0 * ell * m1 * m2 * m3)
+            + (4.0 * ell * m1 * dt4)
+            + dt2
+            + (6.0 * ell * dt3 * m2)
+            + (4.0 * ell * dt3 * m3)
+            + (ell * m1.powi(3)))
+            / 4.0
+            / g
+            / (dt0 * dt0)
+            / (dt5 * dt5);
+        out[9] = (m1 + (3.0 * m3)) / 3.0 / g / dt0;
+        out[10] = 0.0;
+        out[11] = -((4.0 * m1 * m3) + (4.0 * m2 * m3) + dt3 + (4.0 * dt1)) / 4.0 / g / dt0 / dt5;
+        out[12] = 0.0;
+        out[13] = 0.0;
+        out[14] = 0.0;
+        out[15] = -((ell * m1) + (3.0 * ell * m3)) / 3.0 / (g * g) / dt0;
+        out[16] = 0.0;
+        out[17] = ((4.0 * ell * m1 * m3) + (4.0 * ell * m2 * m3) + (ell * dt3) + (4.0 * ell * dt1))
+            / 4.0
+            / (g * g)
+            / dt0
+            / dt5;
+    }
+
     /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
     fn full_state(
         &self,

@@ -673,6 +673,130 @@ impl Reduction for LoadedRodFree {
     /// The coefficients, constant term first, of the fall polynomial `P(s) = (sin(theta_i) - s) / theta_dot^2` in `s = sin(theta)`.
     fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
 
+    fn has_partials(&self) -> bool {
+        true
+    }
+
+    /// `[dF/dtheta, dF/dp_1, ...]` at `sin(theta)`, `cos(theta)`, of the separation condition `F = 0` divided by the coefficient that leaves the parameters in the fewest terms (the implicit-function theorem's `d theta_sep/dp = -F_p / F_theta` is the same for any factor).
+    fn separation_partials(&self, _k: &[f64], _rc_s: f64, _rc_c: f64, _out: &mut [f64]) {}
+
+    /// `d(theta_dot^2)/dp` for each parameter at a fixed angle given by `sin(theta)`, `cos(theta)`.
+    fn theta_dot_sq_partials(&self, k: &[f64], rc_s: f64, _rc_c: f64, out: &mut [f64]) {
+        let k = &k[..47]; // one bounds check for all constant loads
+        let m1 = k[0];
+        let m3 = k[2];
+        let ell = k[3];
+        let g = k[5];
+        let theta_0 = k[7];
+        let theta_dot_0 = k[10];
+        let dt0 = m3 * m3;
+        let dt1 = theta_dot_0 * theta_dot_0;
+        let dt2 = rc_s * rc_s;
+        let dt3 = theta_0.sin();
+        let dt4 = dt3 * dt3;
+        let dt5 = m3.powi(3);
+        let dt6 = 12.0 * g * m1 * dt0 * dt2 * dt3;
+        let dt7 = rc_s.powi(3);
+        let dt8 = m1 * m1;
+        let dt9 = -(16.0 * m1 * m3) + (12.0 * m1 * m3 * dt2) - (4.0 * dt8) + (3.0 * dt8 * dt2)
+            - (12.0 * dt0)
+            + (12.0 * dt0 * dt2);
+        let dt10 = m1.powi(3);
+        let dt11 = theta_0.cos();
+        out[0] = -12.0
+            * ((2.0 * ell * m1 * dt0 * dt1 * dt2) - (2.0 * ell * m1 * dt0 * dt1 * dt4)
+                + (4.0 * ell * dt5 * dt1 * dt2)
+                - (4.0 * ell * dt5 * dt1 * dt4)
+                + (8.0 * g * m1 * dt0 * rc_s)
+                - (8.0 * g * m1 * dt0 * dt3)
+                + dt6
+                - (12.0 * g * m1 * dt0 * dt7)
+                + (4.0 * g * dt8 * m3 * rc_s)
+                - (4.0 * g * dt8 * m3 * dt3)
+                + (3.0 * g * dt8 * m3 * dt2 * dt3)
+                - (3.0 * g * dt8 * m3 * dt7)
+                + (4.0 * g * dt5 * rc_s)
+                - (4.0 * g * dt5 * dt3)
+                + (12.0 * g * dt5 * dt2 * dt3)
+                - (12.0 * g * dt5 * dt7))
+            / ell
+            / (dt9 * dt9);
+        out[1] = 0.0;
+        out[2] = 12.0
+            * ((4.0 * ell * m1 * dt0 * dt1 * dt2) - (4.0 * ell * m1 * dt0 * dt1 * dt4)
+                + (2.0 * ell * dt8 * m3 * dt1 * dt2)
+                - (2.0 * ell * dt8 * m3 * dt1 * dt4)
+                + (4.0 * g * m1 * dt0 * rc_s)
+                - (4.0 * g * m1 * dt0 * dt3)
+                + dt6
+                - (12.0 * g * m1 * dt0 * dt7)
+                + (8.0 * g * dt8 * m3 * rc_s)
+                - (8.0 * g * dt8 * m3 * dt3)
+                + (12.0 * g * dt8 * m3 * dt2 * dt3)
+                - (12.0 * g * dt8 * m3 * dt7)
+                + (4.0 * g * dt10 * rc_s)
+                - (4.0 * g * dt10 * dt3)
+                + (3.0 * g * dt10 * dt2 * dt3)
+                - (3.0 * g * dt10 * dt7))
+            / ell
+            / (dt9 * dt9);
+        out[3] = -12.0
+            * ((3.0 * g * m1 * m3 * rc_s) - (3.0 * g * m1 * m3 * dt3) + (g * dt8 * rc_s)
+                - (g * dt8 * dt3)
+                + (2.0 * g * dt0 * rc_s)
+                - (2.0 * g * dt0 * dt3))
+            / (ell * ell)
+            / dt9;
+        out[4] = 0.0;
+        out[5] = 12.0
+            * ((3.0 * m1 * m3 * rc_s) - (3.0 * m1 * m3 * dt3) + (dt8 * rc_s) - (dt8 * dt3)
+                + (2.0 * dt0 * rc_s)
+                - (2.0 * dt0 * dt3))
+            / ell
+            / dt9;
+        out[6] = 0.0;
+        out[7] = 6.0
+            * ((4.0 * ell * m1 * m3 * dt1 * dt3 * dt11)
+                + (ell * dt8 * dt1 * dt3 * dt11)
+                + (4.0 * ell * dt0 * dt1 * dt3 * dt11)
+                - (6.0 * g * m1 * m3 * dt11)
+                - (2.0 * g * dt8 * dt11)
+                - (4.0 * g * dt0 * dt11))
+            / ell
+            / dt9;
+        out[8] = 0.0;
+        out[9] = 0.0;
+        out[10] = 2.0
+            * (-(16.0 * m1 * m3 * theta_dot_0) + (12.0 * m1 * m3 * theta_dot_0 * dt4)
+                - (4.0 * dt8 * theta_dot_0)
+                + (3.0 * dt8 * theta_dot_0 * dt4)
+                - (12.0 * dt0 * theta_dot_0)
+                + (12.0 * dt0 * theta_dot_0 * dt4))
+            / dt9;
+        out[11] = 0.0;
+    }
+
+    /// `d(sin theta_i)/dp` for each parameter.
+    fn start_partials(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..47]; // one bounds check for all constant loads
+        let theta_0 = k[7];
+        out[0] = 0.0;
+        out[1] = 0.0;
+        out[2] = 0.0;
+        out[3] = 0.0;
+        out[4] = 0.0;
+        out[5] = 0.0;
+        out[6] = 0.0;
+        out[7] = theta_0.cos();
+        out[8] = 0.0;
+        out[9] = 0.0;
+        out[10] = 0.0;
+        out[11] = 0.0;
+    }
+
+    /// `dP_j/dp` of the fall polynomial's coefficients, parameter by parameter (`j` fastest).
+    fn fall_partials(&self, _k: &[f64], _out: &mut [f64]) {}
+
     /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
     fn full_state(
         &self,

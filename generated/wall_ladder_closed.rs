@@ -443,6 +443,56 @@ impl Reduction for WallLadderClosed {
         out[0] = k[18];
     }
 
+    fn has_partials(&self) -> bool {
+        true
+    }
+
+    /// `[dF/dtheta, dF/dp_1, ...]` at `sin(theta)`, `cos(theta)`, of the separation condition `F = 0` divided by the coefficient that leaves the parameters in the fewest terms (the implicit-function theorem's `d theta_sep/dp = -F_p / F_theta` is the same for any factor).
+    fn separation_partials(&self, k: &[f64], rc_s: f64, rc_c: f64, out: &mut [f64]) {
+        let k = &k[..20]; // one bounds check for all constant loads
+        let ell = k[1];
+        let a = k[2];
+        out[0] = -3.0 * ell * rc_c / 2.0 / a;
+        out[1] = 0.0;
+        out[2] = -3.0 * rc_s / 2.0 / a;
+        out[3] = 3.0 * ell * rc_s / 2.0 / (a * a);
+        out[4] = 0.0;
+    }
+
+    /// `d(theta_dot^2)/dp` for each parameter at a fixed angle given by `sin(theta)`, `cos(theta)`.
+    fn theta_dot_sq_partials(&self, k: &[f64], rc_s: f64, _rc_c: f64, out: &mut [f64]) {
+        let k = &k[..20]; // one bounds check for all constant loads
+        let ell = k[1];
+        let a = k[2];
+        let g = k[3];
+        out[0] = 0.0;
+        out[1] = 3.0 * (-(2.0 * a * g) + (ell * g * rc_s)) / ell.powi(3);
+        out[2] = 3.0 * g / (ell * ell);
+        out[3] = -3.0 * (-a + (ell * rc_s)) / (ell * ell);
+    }
+
+    /// `d(sin theta_i)/dp` for each parameter.
+    fn start_partials(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..20]; // one bounds check for all constant loads
+        let ell = k[1];
+        let a = k[2];
+        out[0] = 0.0;
+        out[1] = -a / (ell * ell);
+        out[2] = 1.0 / ell;
+        out[3] = 0.0;
+    }
+
+    /// `dP_j/dp` of the fall polynomial's coefficients, parameter by parameter (`j` fastest).
+    fn fall_partials(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..20]; // one bounds check for all constant loads
+        let ell = k[1];
+        let g = k[3];
+        out[0] = 0.0;
+        out[1] = 1.0 / 3.0 / g;
+        out[2] = 0.0;
+        out[3] = -ell / 3.0 / (g * g);
+    }
+
     /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
     fn full_state(
         &self,

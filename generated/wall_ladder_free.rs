@@ -522,6 +522,52 @@ impl Reduction for WallLadderFree {
     /// The coefficients, constant term first, of the fall polynomial `P(s) = (sin(theta_i) - s) / theta_dot^2` in `s = sin(theta)`.
     fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
 
+    fn has_partials(&self) -> bool {
+        true
+    }
+
+    /// `[dF/dtheta, dF/dp_1, ...]` at `sin(theta)`, `cos(theta)`, of the separation condition `F = 0` divided by the coefficient that leaves the parameters in the fewest terms (the implicit-function theorem's `d theta_sep/dp = -F_p / F_theta` is the same for any factor).
+    fn separation_partials(&self, _k: &[f64], _rc_s: f64, _rc_c: f64, _out: &mut [f64]) {}
+
+    /// `d(theta_dot^2)/dp` for each parameter at a fixed angle given by `sin(theta)`, `cos(theta)`.
+    fn theta_dot_sq_partials(&self, k: &[f64], rc_s: f64, _rc_c: f64, out: &mut [f64]) {
+        let k = &k[..30]; // one bounds check for all constant loads
+        let ell = k[1];
+        let g = k[3];
+        let theta_0 = k[5];
+        let theta_dot_0 = k[7];
+        let dt0 = theta_0.sin();
+        let dt1 = theta_0.cos();
+        out[0] = 0.0;
+        out[1] = -12.0 * ((g * rc_s) - (g * dt0)) / (ell * ell) / (-4.0 + (3.0 * (rc_s * rc_s)));
+        out[2] = 0.0;
+        out[3] = 12.0 * (rc_s - dt0) / ell / (-4.0 + (3.0 * (rc_s * rc_s)));
+        out[4] = 0.0;
+        out[5] = 6.0 * ((ell * (theta_dot_0 * theta_dot_0) * dt0 * dt1) - (2.0 * g * dt1))
+            / ell
+            / (-4.0 + (3.0 * (rc_s * rc_s)));
+        out[6] = 0.0;
+        out[7] = 2.0 * (-(4.0 * theta_dot_0) + (3.0 * theta_dot_0 * (dt0 * dt0)))
+            / (-4.0 + (3.0 * (rc_s * rc_s)));
+    }
+
+    /// `d(sin theta_i)/dp` for each parameter.
+    fn start_partials(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..30]; // one bounds check for all constant loads
+        let theta_0 = k[5];
+        out[0] = 0.0;
+        out[1] = 0.0;
+        out[2] = 0.0;
+        out[3] = 0.0;
+        out[4] = 0.0;
+        out[5] = theta_0.cos();
+        out[6] = 0.0;
+        out[7] = 0.0;
+    }
+
+    /// `dP_j/dp` of the fall polynomial's coefficients, parameter by parameter (`j` fastest).
+    fn fall_partials(&self, _k: &[f64], _out: &mut [f64]) {}
+
     /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
     fn full_state(
         &self,

@@ -493,6 +493,29 @@ pub trait Reduction: Send + Sync {
     /// nothing for a phase without one.
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]);
 
+    /// Whether this fast path has the partial derivatives below (every generated one does; a
+    /// hand-written test phase may not, and then has no sensitivities).
+    fn has_partials(&self) -> bool {
+        false
+    }
+
+    /// `[dF/dtheta, dF/dp_1, ...]` (`out.len() == 1 + parameters`) at the angle of sine `s` and
+    /// cosine `c`, of the separation condition `F = 0` divided by a coefficient (any nonzero
+    /// factor gives the same `d theta_sep/dp = -F_p / F_theta` at the separation). Writes
+    /// nothing for a phase without a separation polynomial.
+    fn separation_partials(&self, _k: &[f64], _s: f64, _c: f64, _out: &mut [f64]) {}
+
+    /// `d(theta_dot^2)/dp` for every parameter (`out.len() == parameters`) at the fixed angle
+    /// of sine `s` and cosine `c`.
+    fn theta_dot_sq_partials(&self, _k: &[f64], _s: f64, _c: f64, _out: &mut [f64]) {}
+
+    /// `d(sin theta_i)/dp` for every parameter (`out.len() == parameters`).
+    fn start_partials(&self, _k: &[f64], _out: &mut [f64]) {}
+
+    /// `dP_j/dp_i` of the fall polynomial's coefficients, parameter by parameter with `j`
+    /// fastest (`out.len() == parameters * (fall_degree + 1)`). Writes nothing without one.
+    fn fall_partials(&self, _k: &[f64], _out: &mut [f64]) {}
+
     /// [`Model::prepare`] for the per-point solver: copies the parameters into `k` and computes
     /// only the constants of [`ReductionInfo::lean_constants`] (the start's sine, cosine and rate,
     /// and the force and fall polynomials), leaving the others as they were.

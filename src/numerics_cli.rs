@@ -74,6 +74,10 @@ pub struct SweepArgs {
     /// More quantities per point, comma-separated (through the planner; slower)
     #[arg(long, value_delimiter = ',', value_name = "QUANTITY")]
     want: Vec<String>,
+    /// Also write d(result)/d(parameter) and the elasticities of the separation angle and time
+    /// for every parameter (columns after the --want ones)
+    #[arg(long)]
+    sensitivities: bool,
     /// Relative tolerance of the --want quantities
     #[arg(long, default_value = rodcube::plan::DEFAULT_TOLERANCE_TEXT)]
     tolerance: f64,
@@ -146,7 +150,10 @@ pub fn sweep(args: SweepArgs) -> Result<(), Failure> {
     if info.contacts.first().is_none_or(|c| c.bilateral) {
         return Err(usage(sweep::SweepError::NoContact { model: info.name }));
     }
-    let extra = sweep::parse_want(model, &args.want).map_err(usage)?;
+    let mut extra = sweep::parse_want(model, &args.want).map_err(usage)?;
+    if args.sensitivities {
+        extra.push(rodcube::quantity::Quantity::Sensitivities);
+    }
     let fixed = parse_set(&args.set)?;
     let (points, grid) = match &args.points {
         Some(path) => {

@@ -37,6 +37,9 @@ pub enum Quantity {
     /// Integration of the general model's equations, the contacts as constraints, to the
     /// fast path's first event.
     CrossCheck,
+    /// `d(<result>)/d(<parameter>)` and the elasticities of the wanted separation angle and
+    /// time and contact ends, where the fast path gives them.
+    Sensitivities,
 }
 
 /// Quantity names that do not depend on the model, with their meaning.
@@ -96,6 +99,12 @@ pub const FIXED: &[(&str, Quantity, &str)] = &[
         Quantity::CrossCheck,
         "the general model's equations integrated to the fast path's first event",
     ),
+    (
+        "sensitivities",
+        Quantity::Sensitivities,
+        "d(result)/d(parameter) and elasticities of the wanted separation angle and time and \
+         contact ends, for every parameter (fast path)",
+    ),
 ];
 
 /// A `want` entry that names no quantity of the model.
@@ -130,7 +139,8 @@ impl Quantity {
             | Quantity::PointMassFallTime
             | Quantity::FloorImpact
             | Quantity::Impacts
-            | Quantity::CrossCheck => false,
+            | Quantity::CrossCheck
+            | Quantity::Sensitivities => false,
         }
     }
 
@@ -217,7 +227,9 @@ impl Quantity {
         let separates = info.contacts.first().is_some_and(|c| !c.bilateral);
         let release = info.phases.iter().find(|p| p.release);
         match self {
-            Quantity::SeparationAngle | Quantity::SeparationTime => separates,
+            Quantity::SeparationAngle | Quantity::SeparationTime | Quantity::Sensitivities => {
+                separates
+            }
             Quantity::ContactEnd => !info.contacts.is_empty(),
             Quantity::Impacts => (info.contacts.iter()).any(|c| !c.closed && !c.bilateral),
             Quantity::LinearisedSeparationAngle => {

@@ -346,6 +346,15 @@ impl Reference {
     /// Prepares a case: checks the inputs and forms `r`, `n`, `mu`, `theta_0` and `beta` in high
     /// precision.
     pub fn new(inputs: Inputs) -> Result<Reference, ReferenceError> {
+        let exact = [inputs.m1, inputs.m2, inputs.ell, inputs.a, inputs.g]
+            .map(|x| BigFloat::from_f64(x, PRECISION));
+        Reference::with_exact(inputs, exact)
+    }
+
+    /// A case whose parameters `[m1, m2, ell, a, g]` are given at [`PRECISION`] bits (so that a
+    /// difference can take a step far below an `f64` ulp); `inputs` holds them rounded to
+    /// `f64`, which are checked as [`Reference::new`] checks them.
+    pub fn with_exact(inputs: Inputs, exact: [BigFloat; 5]) -> Result<Reference, ReferenceError> {
         for (name, value) in [
             ("m1", inputs.m1),
             ("m2", inputs.m2),
@@ -362,16 +371,25 @@ impl Reference {
                 r: inputs.a / inputs.ell,
             });
         }
-        let mut hp = Hp::new(PRECISION);
-        let r = hp.div(&hp.c(inputs.a), &hp.c(inputs.ell));
-        let n = hp.div(&hp.c(inputs.m2), &hp.c(inputs.m1));
+        Reference::build(Hp::new(PRECISION), inputs, exact)
+    }
+
+    /// Forms `r`, `n`, `mu`, `theta_0` and `beta` from the exact parameters.
+    fn build(
+        mut hp: Hp,
+        inputs: Inputs,
+        exact: [BigFloat; 5],
+    ) -> Result<Reference, ReferenceError> {
+        let [m1, m2, ell, a, g] = exact;
+        let r = hp.div(&a, &ell);
+        let n = hp.div(&m2, &m1);
         let one = hp.c(1.0);
         let mu = match inputs.family {
             Family::RodCube => hp.div(&hp.c(-3.0), &hp.mul(&hp.c(4.0), &hp.add(&one, &n))),
             Family::HingedRod => hp.mul(&hp.c(3.0), &n),
             Family::WallLadder => hp.c(0.0),
         };
-        let kappa = hp.div(&hp.c(3.0 * inputs.g), &hp.c(inputs.ell));
+        let kappa = hp.div(&hp.mul(&hp.c(3.0), &g), &ell);
         let pi = hp.pi();
         let half_pi = hp.div(&pi, &hp.c(2.0));
         // Far from upright asin(r) is well conditioned; near upright beta = asin(cos theta_0)

@@ -715,8 +715,34 @@ impl Ctx<'_> {
                 Ok(q) => want.push(q),
             }
         }
-
+        self.sensitivities_of_something(raw, &want, out);
         want
+    }
+
+    /// `sensitivities` are of the separation angle and time and the contact ends: wanted
+    /// without any of them, they would be of nothing the scene computes.
+    fn sensitivities_of_something(&self, raw: &Raw, want: &[Quantity], out: &mut Vec<Diagnostic>) {
+        let of = [
+            Quantity::SeparationAngle,
+            Quantity::SeparationTime,
+            Quantity::ContactEnd,
+        ];
+        if !want.contains(&Quantity::Sensitivities) || want.iter().any(|q| of.contains(q)) {
+            return;
+        }
+        if let Some(i) = raw.want.iter().position(|w| w == "sensitivities") {
+            out.push(
+                self.diag(
+                    Kind::UnavailableQuantity,
+                    &format!("want[{i}]"),
+                    At::Value,
+                    "`sensitivities` are of the separation angle and time and the contact ends, \
+                 and this scene wants none of them: add `separation_angle`, `separation_time` \
+                 or `contact_end` to `want`"
+                        .into(),
+                ),
+            );
+        }
     }
 
     /// The parameter values in the model's order, each checked by [`check_value`]; `None`

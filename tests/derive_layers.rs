@@ -21,6 +21,7 @@ const DERIVE: &[&str] = &[
     "equations",
     "constraints",
     "reduction",
+    "partials",
     "forces",
     "mechanics",
     "present",

@@ -11,19 +11,9 @@ use rodcube::reference::{Family, Inputs, Reference, RootRoute, TimeRoute, relati
 use rodcube::solve::lean::LeanSolver;
 use rodcube::system::SystemError;
 
-const NS: [f64; 10] = [1e-12, 1e-8, 1e-4, 1e-2, 1.0, 3.0, 1e2, 1e4, 1e8, 1e12];
-const RS: [f64; 10] = [
-    1e-10,
-    1e-7,
-    1e-4,
-    0.01,
-    0.25,
-    0.5,
-    0.9,
-    0.99,
-    1.0 - 1e-6,
-    1.0 - 1e-9,
-];
+#[path = "common/grid.rs"]
+mod grid;
+use grid::{NS, RS};
 
 fn model(name: &str) -> &'static dyn Model {
     rodcube::models::find(name).expect("generated model")

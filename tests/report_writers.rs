@@ -218,6 +218,7 @@ fn paper_results(m2: f64) -> RunResults {
         notes: BTreeMap::new(),
         impacts: None,
         drawing: None,
+        sensitivities: BTreeMap::new(),
     }
 }
 

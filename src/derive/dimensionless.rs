@@ -113,6 +113,7 @@ pub fn derive(spec: &Spec, d: &Derivation) -> Result<Option<Dimensionless>, Deri
             time,
             force,
             results,
+            sensitivities: Vec::new(),
         }));
     };
     let presenter = Presenter::new(&order);
@@ -184,6 +185,7 @@ pub fn derive(spec: &Spec, d: &Derivation) -> Result<Option<Dimensionless>, Deri
         None,
         Shape::Polynomial,
     ));
+    let mut condition_value = None;
     for (key, meaning, scale, unit, shape) in wanted {
         let Some(plain) = r.plain.get(&key) else {
             continue;
@@ -192,6 +194,7 @@ pub fn derive(spec: &Spec, d: &Derivation) -> Result<Option<Dimensionless>, Deri
         let mut value = substitute(&(raw * scale));
         if shape == Shape::Polynomial {
             value = condition(&value, &positive_symbols)?;
+            condition_value = Some(value.clone());
         }
         let e = cas::expr(&value).map_err(|m| at(m.to_string()))?;
         if let Some(s) = e.symbols().into_iter().find(|s| !allowed.contains(s)) {
@@ -218,12 +221,58 @@ pub fn derive(spec: &Spec, d: &Derivation) -> Result<Option<Dimensionless>, Deri
             operations: form.operations,
         });
     }
+    let sensitivities = match &condition_value {
+        Some(condition) => separation_sensitivities(condition, &groups, &presenter, d)?,
+        None => Vec::new(),
+    };
     Ok(Some(Dimensionless {
         groups,
         time,
         force,
         results,
+        sensitivities,
     }))
+}
+
+/// The prefix of the keys of `d theta_sep / d <group>`.
+pub const SEPARATION_SENSITIVITY: &str = "dtheta_sep_d";
+
+/// `d theta_sep / d g` for every group `g` the separation condition `F(sin, cos; groups) = 0`
+/// depends on, by the implicit-function theorem: `-F_g / F_theta` with
+/// `F_theta = cos F_sin - sin F_cos`, over the groups and the separation angle's sine and cosine.
+fn separation_sensitivities(
+    condition: &A,
+    groups: &[Group],
+    presenter: &Presenter,
+    d: &Derivation,
+) -> Result<Vec<Scaled>, DeriveError> {
+    let f_theta =
+        cas::d(condition, "rc_s") * cas::var("rc_c") - cas::d(condition, "rc_c") * cas::var("rc_s");
+    let mut out = Vec::new();
+    for g in groups {
+        let f_g = cas::d(condition, &g.name);
+        if cas::is_zero(&f_g) {
+            continue;
+        }
+        let value = cas::together(&(cas::num(-1) * f_g / f_theta.clone()));
+        let key = format!("{SEPARATION_SENSITIVITY}{}", g.name);
+        let form = presenter
+            .present(&value, Shape::Fraction)
+            .map_err(|m| at(format!("`{key}` of model `{}`: {m}", d.name)))?;
+        out.push(Scaled {
+            key,
+            meaning: format!(
+                "how the separation angle moves with {}, at the separation angle (the \
+                 implicit-function theorem on the separation condition)",
+                g.name
+            ),
+            unit: None,
+            form: form.expr,
+            operations: form.operations,
+            paper: None,
+        });
+    }
+    Ok(out)
 }
 
 /// A condition `value = 0` as a polynomial: its numerator with positive theta-free factors

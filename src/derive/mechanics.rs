@@ -32,6 +32,7 @@ use super::equations::equations;
 use super::expr::Expr;
 use super::forces;
 use super::lagrangian::{Lagrangian, lagrangian};
+use super::partials;
 use super::read::{Parsed, read};
 use super::reduction::Reducer;
 use super::setup::{Setup, setup, ties};
@@ -439,7 +440,11 @@ fn derive_phase(
         initial: &initial,
         positive,
     };
-    let reduction = reducer.reduce(&atoms)?;
+    let mut reduction = reducer.reduce(&atoms)?;
+    if let Ok(r) = &mut reduction {
+        let names: Vec<String> = params.iter().map(|p| p.name.clone()).collect();
+        r.partials = partials::derive(r, &names)?;
+    }
     let (monitor_names, monitors_full) = forces::monitors(spec, parsed, &st);
     let (point_pos, point_vel) = point_kinematics(parsed, &st)?;
     let list = |v: &[A], what: &str| -> Result<Vec<Expr>, DeriveError> {

@@ -28,6 +28,7 @@ pub mod equations;
 pub mod forces;
 pub mod lagrangian;
 pub mod mechanics;
+pub mod partials;
 pub mod present;
 pub mod read;
 pub mod reduction;

@@ -25,7 +25,7 @@ use super::expr::{Expr, product};
 use super::lagrangian::Lagrangian;
 use super::setup::Setup;
 use super::spec::Spec;
-use super::types::{Constant, DeriveError, Reduction, Separation, Unreducible, at, key};
+use super::types::{Constant, DeriveError, Partials, Reduction, Separation, Unreducible, at, key};
 use std::collections::BTreeMap;
 
 /// Stage 6, the reduction: the fast path of a phase, from its Lagrangian and equations.
@@ -135,6 +135,7 @@ impl Reducer<'_> {
             force_polynomials,
             fall,
             plain,
+            partials: Partials::default(),
         }))
     }
 
@@ -485,20 +486,9 @@ impl Reducer<'_> {
         force_polynomials: &[Option<Separation>],
     ) -> Result<BTreeMap<String, Expr>, DeriveError> {
         let theta = self.theta();
-        let mut const_plain: Vec<(String, A)> = Vec::new();
-        for c in &red.constants {
-            let mut v = cas::atom(&simplify_inverse_trig(&c.value));
-            for (s, val) in &const_plain {
-                v = cas::subs_var(&v, s, val);
-            }
-            let v = cas::atom(&simplify_inverse_trig(&to_expr(&v, "constant")?));
-            const_plain.push((c.symbol.clone(), v));
-        }
+        let const_plain = plain_constants(&red.constants)?;
         let plainify = |a: &A| -> Result<Expr, DeriveError> {
-            let mut v = gap_vars(a);
-            for (s, val) in const_plain.iter().rev() {
-                v = cas::subs_var(&v, s, val);
-            }
+            let v = over_parameters(a, &const_plain);
             let v = to_expr(&cas::together(&v), "plain form")?;
             let (num, den) = v.num_den();
             let num = reduce_cos_sq(&cas::atom(&product(num)));
@@ -523,6 +513,31 @@ impl Reducer<'_> {
         }
         Ok(plain)
     }
+}
+
+/// Each reduction constant's value over the parameters alone, in the constants' order (the
+/// earlier ones substituted into the later ones, inverse trigonometric pairs simplified).
+pub fn plain_constants(constants: &[Constant]) -> Result<Vec<(String, A)>, DeriveError> {
+    let mut const_plain: Vec<(String, A)> = Vec::new();
+    for c in constants {
+        let mut v = cas::atom(&simplify_inverse_trig(&c.value));
+        for (s, val) in &const_plain {
+            v = cas::subs_var(&v, s, val);
+        }
+        let v = cas::atom(&simplify_inverse_trig(&to_expr(&v, "constant")?));
+        const_plain.push((c.symbol.clone(), v));
+    }
+    Ok(const_plain)
+}
+
+/// A reduced expression over the parameters, `rc_s` and `rc_c`: the drops written out and
+/// every constant replaced by its value from [`plain_constants`].
+pub fn over_parameters(a: &A, const_plain: &[(String, A)]) -> A {
+    let mut v = gap_vars(a);
+    for (s, val) in const_plain.iter().rev() {
+        v = cas::subs_var(&v, s, val);
+    }
+    v
 }
 
 /// `V(theta_i) - V(theta)` in the drops `rc_ds`, `rc_dc` for an effective potential over

@@ -352,6 +352,24 @@ pub struct Reduction {
     pub fall: Option<Vec<Expr>>,
     /// Fully substituted forms over parameters and `theta` for people and other tools.
     pub plain: BTreeMap<String, Expr>,
+    /// The partial derivatives behind the sensitivities (filled in by `partials.rs`).
+    pub partials: Partials,
+}
+
+/// The partial derivatives of a fast path in every parameter (in the phase's parameter order),
+/// over the parameters, `rc_s` and `rc_c`.
+#[derive(Debug, Clone, Default)]
+pub struct Partials {
+    /// `[dF/dtheta, dF/dp_1, ...]` of the separation condition `F = 0` divided by one of its
+    /// coefficients; empty without a separation polynomial.
+    pub separation: Vec<Expr>,
+    /// `d(theta_dot^2)/dp_i` at a fixed angle.
+    pub theta_dot_sq: Vec<Expr>,
+    /// `d(sin theta_i)/dp_i`.
+    pub start_sine: Vec<Expr>,
+    /// `dP_j/dp_i` of the fall polynomial's coefficients, parameter by parameter (`j` fastest);
+    /// empty without a fall polynomial.
+    pub fall: Vec<Expr>,
 }
 
 impl Reduction {
@@ -488,6 +506,9 @@ pub struct Dimensionless {
     pub force: Expr,
     /// The results (none on the integrated route, which has no closed forms).
     pub results: Vec<Scaled>,
+    /// `d theta_sep / d <group>` for each group the separation condition depends on (keys
+    /// `dtheta_sep_d<group>`), at the separation angle, by the implicit-function theorem.
+    pub sensitivities: Vec<Scaled>,
 }
 
 /// One step as shown, over `rc_s`, `rc_c` like the derivation.

@@ -41,6 +41,7 @@
 
 pub mod drawing;
 mod quantities;
+mod sensitivities;
 mod verify;
 
 use crate::model::Model;
@@ -366,12 +367,16 @@ pub fn run(request: &Request) -> Result<RunResults, PlanError> {
 
 /// Refuses a result with a NaN or an infinity (a model function misbehaving), naming it.
 fn check_finite(out: &RunResults) -> Result<(), PlanError> {
-    for (key, s) in &out.results {
-        if !s.value.is_finite() {
+    let sensitivities = (out.sensitivities.iter()).map(|(k, s)| (k, s.value));
+    for (key, value) in (out.results.iter())
+        .map(|(k, s)| (k, s.value))
+        .chain(sensitivities)
+    {
+        if !value.is_finite() {
             return Err(PlanError::NonFinite {
                 key: key.clone(),
                 index: 0,
-                value: s.value,
+                value,
             });
         }
     }
@@ -693,6 +698,7 @@ impl<'m> Plan<'m> {
             Quantity::Impacts => self.impacts(out),
             Quantity::CrossCheck => self.cross_check(out),
             Quantity::Checks => self.checks(want.contains(&Quantity::CrossCheck), out),
+            Quantity::Sensitivities => self.sensitivities(want, out),
         }
     }
 }

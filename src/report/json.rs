@@ -6,10 +6,12 @@
 //! [{contact, normal_velocity_before, normal_velocity_after, impulse, velocity_unit,
 //! impulse_unit}], energy_lost, zeno_limit}`), `series` (name → `{columns: [{name, unit,
 //! values}]}`), `checks` (name →
-//! `{passed, margin, meaning}`) and `work` (counters and phases). Values are SI (angles in
+//! `{passed, margin, meaning}`), `work` (counters and phases), `notes` (key → sentence) and,
+//! when sensitivities were wanted, `sensitivities` (`d(<result>)/d(<parameter>)` and
+//! `elasticity(<result>;<parameter>)` → `{value, unit, meaning}`). Values are SI (angles in
 //! radians); a non-finite number is written as `null`, as JSON has no NaN.
 
-use super::prose::{check_meaning, check_phase, label, meaning, note};
+use super::prose::{check_meaning, check_phase, label, meaning, note, sensitivity_meaning};
 use crate::results::RunResults;
 
 /// The meaning written beside `results.impacts`.
@@ -36,6 +38,21 @@ pub fn to_string(results: &RunResults) -> Result<String, serde_json::Error> {
             .map(|(key, n)| (key.clone(), note(n).into()))
             .collect();
         map.insert("notes".into(), notes.into());
+    }
+    if !results.sensitivities.is_empty()
+        && let Some(map) = value.as_object_mut()
+    {
+        let entries: serde_json::Map<String, serde_json::Value> = (results.sensitivities.iter())
+            .map(|(key, s)| {
+                let entry = serde_json::json!({
+                    "value": s.value,
+                    "unit": s.unit,
+                    "meaning": sensitivity_meaning(s),
+                });
+                (key.clone(), entry)
+            })
+            .collect();
+        map.insert("sensitivities".into(), entries.into());
     }
     if let Some(map) = value.get_mut("results").and_then(|r| r.as_object_mut()) {
         for (key, scalar) in &results.results {

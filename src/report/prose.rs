@@ -6,7 +6,7 @@
 
 use crate::results::{
     Check, CheckKind, CheckPhase, CheckSubject, Halt, Held, LabelValue, Meaning, Note, PhaseEnd,
-    Unlanded, UntilNote, Zeno, format_number,
+    Sensitivity, SensitivityGap, Unlanded, UntilNote, Zeno, format_number,
 };
 
 /// Where a check ran, as the table's group heading and results.json's `phase` name it:
@@ -118,6 +118,7 @@ fn conserved(check: &Check, what: &str, model: &str) -> String {
 pub fn note(note: &Note) -> String {
     match note {
         Note::Refused(why) => why.clone(),
+        Note::NoSensitivity(gap) => sensitivity_gap(*gap).into(),
         Note::NoSeparationEnded { contact, cause } => format!(
             "no separation: contact `{contact}` ended before its force vanished ({}; \
              `contact_end` says when)",
@@ -390,5 +391,54 @@ pub fn meaning(meaning: &Meaning) -> String {
             "largest difference between the integrated and the reduced states over {nodes} \
              steps, relative to the largest coordinate (or velocity) on the path"
         ),
+    }
+}
+
+/// Why a result has no sensitivities, in words.
+fn sensitivity_gap(gap: SensitivityGap) -> &'static str {
+    match gap {
+        SensitivityGap::AtRelease => {
+            "no sensitivity: the contact opens at release, so there is no separation to \
+             differentiate (the time is zero whatever the parameters)"
+        }
+        SensitivityGap::NoSeparation => {
+            "no sensitivity: the first contact does not separate on the fast phase the motion \
+             starts on"
+        }
+        SensitivityGap::Integrated => {
+            "sensitivities are not available on integrated (unreduced) phases: only the fast \
+             path's separation has them"
+        }
+        SensitivityGap::NotBuilt => {
+            "sensitivities are not available here: they are built only for the first contact's \
+             separation on the fast phase the motion starts on, not for other contacts' ends, \
+             later or integrated phases, or impacts"
+        }
+        SensitivityGap::NoPartials => "no sensitivity: the model has no partial derivatives",
+        SensitivityGap::NoFallPolynomial => {
+            "no sensitivity of the time: the fast phase has no fall polynomial (it is not \
+             from rest, or its potential or inertia are not of that form)"
+        }
+        SensitivityGap::DoubleRoot => {
+            "no sensitivity: the separation is a double root of its condition, where the angle \
+             does not move smoothly with the parameters"
+        }
+    }
+}
+
+/// What a sensitivity is, in words (results.json's `meaning`).
+pub fn sensitivity_meaning(s: &Sensitivity) -> String {
+    if s.elasticity {
+        format!(
+            "elasticity of {} in {}: ({}/{}) d({})/d({}), the relative change of the result \
+             per relative change of the parameter",
+            s.of, s.parameter, s.parameter, s.of, s.of, s.parameter
+        )
+    } else {
+        format!(
+            "how {} changes with {}: the exact derivative d({})/d({}) from the derivation's \
+             partial derivatives",
+            s.of, s.parameter, s.of, s.parameter
+        )
     }
 }

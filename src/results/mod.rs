@@ -12,7 +12,7 @@ mod notes;
 
 pub use drawing::{Drawing, DrawnPhase, DrawnSample, PhaseEnd, Pose};
 pub use meanings::Meaning;
-pub use notes::{Halt, Held, Note, Unlanded, UntilNote, Zeno};
+pub use notes::{Halt, Held, Note, SensitivityGap, Unlanded, UntilNote, Zeno};
 
 /// A scalar result with its unit.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -296,6 +296,30 @@ pub struct RunResults {
     /// results.json.
     #[serde(skip)]
     pub drawing: Option<Drawing>,
+    /// The sensitivities `d(<result>)/d(<parameter>)` and elasticities
+    /// `(p/x) dx/dp` of the wanted results, by key, when `sensitivities` was wanted (written
+    /// in JSON as `sensitivities: {key: {value, unit, meaning}}`).
+    #[serde(skip)]
+    pub sensitivities: BTreeMap<String, Sensitivity>,
+}
+
+/// How a result moves with a parameter: `d(of)/d(parameter)`, or the elasticity
+/// `(parameter/of) d(of)/d(parameter)`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Sensitivity {
+    /// The value, in `unit`.
+    pub value: f64,
+    /// The result's unit over the parameter's (`rad/kg`, `s^3/m`); `1` for an elasticity.
+    pub unit: String,
+    /// The result's key (`separation_angle`).
+    #[serde(skip)]
+    pub of: String,
+    /// The parameter.
+    #[serde(skip)]
+    pub parameter: String,
+    /// Whether this is the elasticity rather than the derivative.
+    #[serde(skip)]
+    pub elasticity: bool,
 }
 
 impl RunResults {

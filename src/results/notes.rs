@@ -208,4 +208,28 @@ pub enum Note {
     Until(UntilNote),
     /// The converging sequences of bounces closed, in order.
     Zeno(Vec<Zeno>),
+    /// A wanted sensitivity that has no number, and why.
+    NoSensitivity(SensitivityGap),
+}
+
+/// Why a result has no sensitivities.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SensitivityGap {
+    /// The contact opens at release: the time is zero and the angle the release angle's
+    /// whatever the parameters; there is no separation to differentiate.
+    AtRelease,
+    /// The first contact does not separate on the fast phase the motion starts on.
+    NoSeparation,
+    /// The result comes from an integrated (unreduced) phase, whose forward sensitivities are
+    /// not built.
+    Integrated,
+    /// The result is not the first contact's separation on the fast phase the motion starts
+    /// on (another contact's end, a later phase, an impact), whose sensitivities are not built.
+    NotBuilt,
+    /// The model has no generated partial derivatives.
+    NoPartials,
+    /// The fast phase has no fall polynomial, which the time's sensitivities need.
+    NoFallPolynomial,
+    /// The separation is a double root of its condition.
+    DoubleRoot,
 }

@@ -29,7 +29,7 @@
 
 use crate::model::PhaseInfo;
 use crate::model::{LeanStart, Model, ModelInfo, Reduction, ReductionInfo, positive_finite};
-use crate::results::Work;
+use crate::results::{SensitivityGap, Work};
 use crate::solve::SolveError;
 use crate::solve::phases::{End, phase_end};
 use crate::solve::poly::horner;
@@ -38,6 +38,7 @@ use crate::solve::prior::{PRIOR_TOL, Prior, Singularities, integrate_prior, prio
 use crate::solve::quadrature::{
     self, ACCEPT, Control, Fall, FallIntegrand, HalfRule, PanelSum, RuleStep, SCHEDULE, v_at_drop,
 };
+use crate::solve::sensitivity::{self, SensitivityWork, SeparationPoint};
 use crate::system::{System, SystemError, check_parameters, ordered_values, prepare_constants};
 
 /// The fast phase a system starts in (its release phase), looked up in the registry; a model
@@ -70,6 +71,9 @@ pub struct LeanPoint {
     /// `sin(theta_i)`, `cos(theta_i)`, `sin(theta_sep)` and the drop `sin(theta_i) -
     /// sin(theta_sep)`, from which [`LeanPoint::delta`] is formed when asked.
     sines: [f64; 4],
+    /// The fall polynomial (padded with zeros to degree 2) where the a-priori route solved
+    /// the point, which the sensitivities reuse; `None` from the checked route.
+    fall: Option<[f64; 3]>,
 }
 
 impl LeanPoint {
@@ -276,6 +280,71 @@ impl<'m> LeanSolver<'m> {
         self.checked(p)
     }
 
+    /// The sensitivities of `point`, which this solver solved for the parameters `p`:
+    /// `d theta_sep/dp_i` into `angle` and `d t_sep/dp_i` into `time` (one entry per
+    /// parameter, in the model's order), by [`sensitivity::separation`], or why they do not
+    /// exist. Slices of another length are [`SystemError::Length`].
+    pub fn sensitivities(
+        &mut self,
+        p: &[f64],
+        point: &LeanPoint,
+        work: &mut SensitivityWork,
+        angle: &mut [f64],
+        time: &mut [f64],
+    ) -> Result<Result<(), SensitivityGap>, SolveError> {
+        let np = self.info.parameters.len();
+        for (what, len) in [("p", p.len()), ("angle", angle.len()), ("time", time.len())] {
+            if len != np {
+                return Err(SolveError::Input(SystemError::Length {
+                    model: self.info.name,
+                    what,
+                    expected: np,
+                    got: len,
+                }));
+            }
+        }
+        let [sin_initial, cos_initial, sin_sep, drop] = point.sines;
+        // The partial derivatives read the parameters alone; the fall polynomial comes from
+        // the a-priori route where it solved the point, else from the lean constants.
+        match &point.fall {
+            Some(fall) => {
+                self.k[..np].copy_from_slice(p);
+                let len = self.layout.fall_degree.map_or(0, |d| d + 1).min(3);
+                self.fall.clear();
+                self.fall.extend_from_slice(&fall[..len]);
+            }
+            None => {
+                self.red.prepare_lean(p, &mut self.k);
+                self.fall.clear();
+                if let Some(degree) = self.layout.fall_degree {
+                    self.fall.resize(degree + 1, 0.0);
+                    self.red.fall_polynomial(&self.k, &mut self.fall);
+                }
+            }
+        }
+        let at = SeparationPoint {
+            red: self.red,
+            k: &self.k,
+            parameters: np,
+            sin_initial,
+            // 1 - sin(theta_i) without cancellation near upright, as the time's quadrature.
+            scale: cos_initial * cos_initial / (1.0 + sin_initial),
+            fall: &self.fall,
+            singularities: None,
+            sin_sep,
+            drop,
+        };
+        let default_prior;
+        let prior = match &self.prior {
+            Some(prior) => prior,
+            None => {
+                default_prior = Prior::new(PRIOR_TOL);
+                &default_prior
+            }
+        };
+        sensitivity::separation(&at, prior, self.control.accept, work, angle, time)
+    }
+
     /// Solves by the baseline instruction set even where the CPU has AVX2 (the results are
     /// the same to the bit, which `tests/prior.rs` checks; the two can be timed side by side,
     /// as `examples/per_point.rs --baseline` does).
@@ -333,6 +402,7 @@ impl<'m> LeanSolver<'m> {
                 separation_angle: si.asin(),
                 separation_time: 0.0,
                 sines: [si, self.k[self.layout.k_cos_initial], si, 0.0],
+                fall: None,
             });
         }
         let s = end.at.map_or(f64::NAN, |a| a.sin_theta);
@@ -366,6 +436,7 @@ impl<'m> LeanSolver<'m> {
             separation_angle: s.asin(),
             separation_time,
             sines: [si, ci, s, drop],
+            fall: None,
         };
         // The phase's end for messages, formed only for one.
         let delta_end = || point(f64::NAN).delta();
@@ -570,6 +641,7 @@ pub(crate) fn quick_route(
         separation_angle: s.asin(),
         separation_time: t,
         sines: [si, ci, s, drop],
+        fall: Some(start.fall),
     })
 }
 
@@ -619,6 +691,7 @@ mod tests {
             separation_angle: s.asin(),
             separation_time: 0.0,
             sines: [si, ((1.0 - si) * (1.0 + si)).sqrt(), s, si - s],
+            fall: None,
         }
     }
 

@@ -26,6 +26,7 @@ pub mod prior;
 pub mod quadrature;
 pub mod rest;
 pub mod roots;
+pub mod sensitivity;
 pub mod separation;
 pub mod series;
 pub mod unreduced;

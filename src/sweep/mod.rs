@@ -12,7 +12,10 @@ use crate::axes::{AxisError, Mapping};
 use crate::model::{Model, ModelInfo};
 use crate::plan::{self, Request};
 use crate::quantity::Quantity;
-use crate::solve::lean::LeanSolver;
+use crate::report::prose;
+use crate::results::Note;
+use crate::solve::lean::{LeanPoint, LeanSolver};
+use crate::solve::sensitivity::SensitivityWork;
 use crate::system::check_parameters;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -348,6 +351,12 @@ pub fn parse_want(model: &dyn Model, names: &[String]) -> Result<Vec<Quantity>, 
                     out.push(q);
                 }
             }
+            Quantity::Sensitivities => {
+                return Err(SweepError::Want(
+                    "`sensitivities` are columns of their own in a sweep: pass `--sensitivities`"
+                        .into(),
+                ));
+            }
             _ => {
                 return Err(SweepError::Want(format!(
                     "`{name}` is a series or a set of checks, not a number per point; a sweep takes scalar quantities (linearised_separation_angle, contact_time_to_floor, point_mass_fall_time, floor_impact, cross_check)"
@@ -373,6 +382,12 @@ pub fn run(
     let start = std::time::Instant::now();
     let np = model.info().parameters.len();
     let dims = points.names.len().max(1);
+    // `sensitivities` are columns of their own, after the planner's.
+    let sens = extra.contains(&Quantity::Sensitivities);
+    let extra: Vec<Quantity> = (extra.iter().copied())
+        .filter(|q| *q != Quantity::Sensitivities)
+        .collect();
+    let extra = &extra[..];
     // The extra columns' names, from the first point the planner solves.
     let mut extra_names: Vec<String> = Vec::new();
     if !extra.is_empty() {
@@ -389,6 +404,12 @@ pub fn run(
         }
     }
     let ne = extra_names.len();
+    let sens_names = if sens {
+        sensitivity_columns(model.info())
+    } else {
+        Vec::new()
+    };
+    let ns = sens_names.len();
     let chunks: Vec<ChunkResult> = points
         .values
         .par_chunks(CHUNK * dims)
@@ -400,21 +421,22 @@ pub fn run(
                 Vec::with_capacity(chunk.len() / dims),
                 Vec::with_capacity(chunk.len() / dims),
             );
-            let mut values = Vec::with_capacity(chunk.len() / dims * ne);
+            let mut values = Vec::with_capacity(chunk.len() / dims * (ne + ns));
             let mut errors = Vec::new();
+            let mut work = SensitivityWork::default();
             for (i, point) in chunk.chunks(dims).enumerate() {
                 let index = c * CHUNK + i;
                 mapping.fill(point, &mut p);
-                let (a, t) = match solver.as_mut() {
+                let (a, t, lean) = match solver.as_mut() {
                     Some(s) => s
                         .solve(&p)
-                        .map(|r| (r.separation_angle, r.separation_time))
+                        .map(|r| (r.separation_angle, r.separation_time, Some(r)))
                         .map_err(|e| e.to_string()),
-                    None => separation_by_planner(model, &p, tolerance),
+                    None => separation_by_planner(model, &p, tolerance).map(|(a, t)| (a, t, None)),
                 }
                 .unwrap_or_else(|e| {
                     errors.push((index, e));
-                    (f64::NAN, f64::NAN)
+                    (f64::NAN, f64::NAN, None)
                 });
                 angle.push(a);
                 time.push(t);
@@ -434,11 +456,31 @@ pub fn run(
                         }
                     }
                 }
+                if sens {
+                    let row = Row {
+                        model,
+                        p: &p,
+                        tolerance,
+                    };
+                    let before = values.len();
+                    let outcome = match (solver.as_mut(), &lean) {
+                        (Some(s), Some(point)) => row.lean(s, point, &mut work, &mut values),
+                        (Some(_), None) => Err(String::new()),
+                        (None, _) => row.planned(&sens_names, &mut values),
+                    };
+                    values.resize(before + ns, f64::NAN);
+                    if let Err(e) = outcome.map_err(|e| e.to_string())
+                        && !e.is_empty()
+                    {
+                        errors.push((index, e));
+                    }
+                }
             }
             progress.inc((chunk.len() / dims) as u64);
             (angle, time, values, errors)
         })
         .collect();
+    extra_names.extend(sens_names);
     let mut out = SweepResults {
         extra_names,
         ..SweepResults::default()
@@ -453,6 +495,75 @@ pub fn run(
     out.errors.dedup_by_key(|e| e.0);
     out.seconds = start.elapsed().as_secs_f64();
     out
+}
+
+/// The columns of `--sensitivities`: `d(<result>)/d(<p>)` of the separation angle and time,
+/// then their elasticities, for every parameter in the model's order.
+pub fn sensitivity_columns(info: &ModelInfo) -> Vec<String> {
+    let mut out = Vec::new();
+    for of in ["separation_angle", "separation_time"] {
+        out.extend((info.parameters.iter()).map(|p| format!("d({of})/d({})", p.name)));
+    }
+    for of in ["separation_angle", "separation_time"] {
+        out.extend((info.parameters.iter()).map(|p| format!("elasticity({of};{})", p.name)));
+    }
+    out
+}
+
+/// One point's sensitivities for the sweep.
+struct Row<'a> {
+    model: &'static dyn Model,
+    p: &'a [f64],
+    tolerance: f64,
+}
+
+impl Row<'_> {
+    /// The columns of [`sensitivity_columns`] from the per-point solver's point: appended to
+    /// `values` (none where there are no sensitivities, and the message why).
+    fn lean(
+        &self,
+        solver: &mut LeanSolver,
+        point: &LeanPoint,
+        work: &mut SensitivityWork,
+        values: &mut Vec<f64>,
+    ) -> Result<(), String> {
+        let np = self.p.len();
+        let (mut angle, mut time) = (vec![0.0; np], vec![0.0; np]);
+        match solver.sensitivities(self.p, point, work, &mut angle, &mut time) {
+            Ok(Ok(())) => {}
+            Ok(Err(gap)) => return Err(prose::note(&Note::NoSensitivity(gap))),
+            Err(e) => return Err(e.to_string()),
+        }
+        let (theta, t) = (point.separation_angle, point.separation_time);
+        values.extend(angle.iter().chain(&time));
+        values.extend(self.p.iter().zip(&angle).map(|(x, d)| x / theta * d));
+        values.extend(self.p.iter().zip(&time).map(|(x, d)| x / t * d));
+        Ok(())
+    }
+
+    /// The columns of [`sensitivity_columns`] (`names`) through the planner, for a model the
+    /// per-point solver does not take.
+    fn planned(&self, names: &[String], values: &mut Vec<f64>) -> Result<(), String> {
+        let want = [
+            Quantity::SeparationAngle,
+            Quantity::SeparationTime,
+            Quantity::Sensitivities,
+        ];
+        let request = Request::new(self.model, self.p.to_vec())
+            .with_want(&want)
+            .with_tolerance(self.tolerance);
+        let res = plan::run(&request).map_err(|e| e.to_string())?;
+        values
+            .extend((names.iter()).map(|k| res.sensitivities.get(k).map_or(f64::NAN, |s| s.value)));
+        match res
+            .notes
+            .iter()
+            .find(|(k, _)| k.starts_with("sensitivities."))
+        {
+            Some((_, n)) => Err(prose::note(n)),
+            None => Ok(()),
+        }
+    }
 }
 
 /// The separation angle and time through the planner, for a model the per-point solver does
@@ -474,7 +585,7 @@ fn separation_by_planner(
             .notes
             .values()
             .next()
-            .map(crate::report::prose::note)
+            .map(prose::note)
             .unwrap_or_else(|| "no separation".into())),
     }
 }

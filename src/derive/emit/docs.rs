@@ -257,6 +257,31 @@ pub(super) fn reduction_docs(d: &Derivation, r: &Reduction) -> Docs {
         ),
     );
     docs.insert(
+        "separation_partials",
+        doc(
+            "`[dF/dtheta, dF/dp_1, ...]` at `sin(theta)`, `cos(theta)`, of the separation condition `F = 0` divided by the coefficient that leaves the parameters in the fewest terms (the implicit-function theorem's `d theta_sep/dp = -F_p / F_theta` is the same for any factor).",
+            Vec::new(),
+        ),
+    );
+    docs.insert(
+        "theta_dot_sq_partials",
+        doc(
+            "`d(theta_dot^2)/dp` for each parameter at a fixed angle given by `sin(theta)`, `cos(theta)`.",
+            Vec::new(),
+        ),
+    );
+    docs.insert(
+        "start_partials",
+        doc("`d(sin theta_i)/dp` for each parameter.", Vec::new()),
+    );
+    docs.insert(
+        "fall_partials",
+        doc(
+            "`dP_j/dp` of the fall polynomial's coefficients, parameter by parameter (`j` fastest).",
+            Vec::new(),
+        ),
+    );
+    docs.insert(
         "full_state",
         doc(
             "The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.",

@@ -5,6 +5,7 @@
 use super::code::{Code, DELTA, K, Locals, OUT, out_lines};
 use super::lower::{Hoisted, Scope, lower, unbound};
 use super::method::Preamble;
+use crate::derive::expr::Expr;
 use crate::derive::types::{Derivation, Reduction, StepError};
 
 /// The error of a reduction constant that the emitter needs and the derivation lacks.
@@ -32,11 +33,17 @@ pub struct ReducedCode {
     /// The constants the per-point solver reads, and the code computing only them.
     pub(super) prepare_lean: Code,
     pub(super) lean_constants: Vec<usize>,
+    /// `Reduction::separation_partials`, `theta_dot_sq_partials`, `start_partials` and
+    /// `fall_partials`: the partial derivatives behind the sensitivities.
+    pub(super) separation_partials: Code,
+    pub(super) theta_dot_sq_partials: Code,
+    pub(super) start_partials: Code,
+    pub(super) fall_partials: Code,
 }
 
 impl ReducedCode {
     /// Every method's code.
-    pub(super) fn codes(&self) -> [&Code; 7] {
+    pub(super) fn codes(&self) -> [&Code; 11] {
         [
             &self.reduced_code,
             &self.theta_dot_sq_code,
@@ -45,6 +52,10 @@ impl ReducedCode {
             &self.fall,
             &self.full_state,
             &self.prepare_lean,
+            &self.separation_partials,
+            &self.theta_dot_sq_partials,
+            &self.start_partials,
+            &self.fall_partials,
         ]
     }
 
@@ -73,6 +84,16 @@ impl ReducedCode {
             .finish(&[K, ("contact", "usize"), OUT], &[slice, params]);
         self.fall.outputs = out_lines(&self.fall.outputs);
         self.fall.finish(&[K, OUT], &[slice, params]);
+        let at_angle = [K, sc[0], sc[1], OUT];
+        for (code, args) in [
+            (&mut self.separation_partials, &at_angle[..]),
+            (&mut self.theta_dot_sq_partials, &at_angle[..]),
+            (&mut self.start_partials, &[K, OUT][..]),
+            (&mut self.fall_partials, &[K, OUT][..]),
+        ] {
+            code.outputs = out_lines(&code.outputs);
+            code.finish(args, &[slice, params]);
+        }
         self.prepare_lean
             .stmts
             .insert(0, format!("k[..{np}].copy_from_slice(p);"));
@@ -241,7 +262,25 @@ pub(super) fn reduced_code(
             ]
         })
         .collect();
+    // The partial derivatives: over the parameters (read by name, nothing hoisted, so that
+    // `prepare` does no work for them), `rc_s` and `rc_c`.
+    let mut sc_only = scope.clone();
+    for s in ["rc_s", "rc_c"] {
+        sc_only.locals.insert(s.into(), s.into());
+    }
+    let partial = |exprs: &[Expr]| -> Code {
+        let mut code = Code::default();
+        if !exprs.is_empty() {
+            code.outputs = code.push_body(lower(exprs, &sc_only, None, "d"));
+        }
+        code
+    };
+    let pd = &r.partials;
     Ok(ReducedCode {
+        separation_partials: partial(&pd.separation),
+        theta_dot_sq_partials: partial(&pd.theta_dot_sq),
+        start_partials: partial(&pd.start_sine),
+        fall_partials: partial(&pd.fall),
         k_theta_initial: idx("rc_thi")?,
         k_sin_initial: idx("rc_si")?,
         k_cos_initial: idx("rc_ci")?,

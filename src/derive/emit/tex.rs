@@ -3,6 +3,7 @@
 
 use super::common::{COMMAND, one_line, spec_path};
 use crate::derive::algebra::from_sc;
+use crate::derive::dimensionless::SEPARATION_SENSITIVITY;
 use crate::derive::expr::Expr;
 use crate::derive::present;
 use crate::derive::spec::Checked;
@@ -482,20 +483,30 @@ fn tex_dimensionless(
         tex_text(present::RULE)
     );
     let mut results = Vec::new();
-    for (i, r) in dim.results.iter().enumerate() {
+    for (i, r) in dim.results.iter().chain(&dim.sensitivities).enumerate() {
         let form = from_sc(&r.form, theta);
         let quantity = match r.key.as_str() {
             "theta_dot_sq" => format!("{}^2", name(&format!("dot_{theta}"))),
             "theta_ddot" => name(&format!("ddot_{theta}")),
             key => format!("F_{{\\mathrm{{{}}}}}", tex_text(key)),
         };
-        let (lhs, width, rhs) = match &r.unit {
-            Some(u) => (
+        let derivative = r.key.strip_prefix(SEPARATION_SENSITIVITY);
+        let (lhs, width, rhs) = match (&r.unit, derivative) {
+            (_, Some(group)) => (
+                format!(
+                    "\\frac{{\\mathrm{{d}}{}_{{\\mathrm{{sep}}}}}}{{\\mathrm{{d}}{}}} = ",
+                    name(theta),
+                    name(group)
+                ),
+                6,
+                None,
+            ),
+            (Some(u), None) => (
                 format!("\\frac{{{quantity}}}{{{}}} = ", inline_unit(u, name)),
                 6,
                 None,
             ),
-            None => (String::new(), 0, Some(Expr::int(0))),
+            (None, None) => (String::new(), 0, Some(Expr::int(0))),
         };
         let unit = match &r.unit {
             Some(u) => format!(", in units of ${}$", inline_unit(u, name)),
