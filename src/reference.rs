@@ -94,6 +94,12 @@ pub enum ReferenceError {
         /// Its last relative change.
         change: f64,
     },
+    /// A parameter index past `[m1, m2, ell, a, g]`.
+    #[error("reference: no parameter {index} (there are five: m1, m2, ell, a, g)")]
+    NoParameter {
+        /// The index asked.
+        index: usize,
+    },
     /// The asked angle lies outside the phase.
     #[error("reference: delta = {delta:e} is outside [0, {end:e}]")]
     Outside {
@@ -319,6 +325,46 @@ pub fn relative_error(x: f64, reference: &BigFloat) -> f64 {
 pub fn relative_difference(a: &BigFloat, b: &BigFloat) -> f64 {
     let p = PRECISION;
     to_f64(&a.sub(b, p, RM).div(b, p, RM)).abs()
+}
+
+/// The parameters' names in the order of [`Reference::with_exact`]'s `[m1, m2, ell, a, g]`.
+pub const PARAMETERS: [&str; 5] = ["m1", "m2", "ell", "a", "g"];
+
+/// The relative step of [`derivatives`]: `2^-70`, so that at [`PRECISION`] bits the central
+/// difference's truncation is near `1e-42` and its rounding near `1e-56`.
+pub const DIFFERENCE_STEP: f64 = 1.0 / (1u128 << 70) as f64;
+
+/// `(d theta_sep/dp, d t_sep/dp)` of a case in its parameter `j` (of [`PARAMETERS`]): central
+/// differences of the reference (the closed-form root, the sinh route's time) with the step
+/// [`DIFFERENCE_STEP`] relative, taken at [`PRECISION`] bits, so that the difference is exact
+/// to far below an `f64` ulp. An independent check of the generated partial derivatives.
+pub fn derivatives(inputs: Inputs, j: usize) -> Result<(f64, f64), ReferenceError> {
+    let p = PRECISION;
+    let values = [inputs.m1, inputs.m2, inputs.ell, inputs.a, inputs.g];
+    let x = values
+        .get(j)
+        .map(|&v| BigFloat::from_f64(v, p))
+        .ok_or(ReferenceError::NoParameter { index: j })?;
+    let h = x.mul(&BigFloat::from_f64(DIFFERENCE_STEP, p), p, RM);
+    let at = |sign: f64| -> Result<(BigFloat, BigFloat), ReferenceError> {
+        let mut exact = values.map(|v| BigFloat::from_f64(v, p));
+        exact[j] = x.add(&h.mul(&BigFloat::from_f64(sign, p), p, RM), p, RM);
+        let mut r = Reference::with_exact(inputs, exact)?;
+        let theta = r.separation(RootRoute::ClosedForm)?.theta;
+        Ok((theta, r.separation_time(TimeRoute::SinhGauss)?))
+    };
+    let (theta_plus, t_plus) = at(1.0)?;
+    let (theta_minus, t_minus) = at(-1.0)?;
+    let two_h = h.mul(&BigFloat::from_f64(2.0, p), p, RM);
+    let d = |a: &BigFloat, b: &BigFloat| to_f64(&a.sub(b, p, RM).div(&two_h, p, RM));
+    Ok((d(&theta_plus, &theta_minus), d(&t_plus, &t_minus)))
+}
+
+/// The error of a derivative `x` against its `reference`, relative to `|reference|`; a
+/// derivative that is (nearly) zero is compared at `1e-3` of `scale`, the size of its
+/// quantity per its parameter (`theta_sep / p`), rather than at its own size.
+pub fn derivative_error(x: f64, reference: f64, scale: f64) -> f64 {
+    (x - reference).abs() / reference.abs().max(1e-3 * scale.abs())
 }
 
 /// The reference solver for one case.

@@ -336,3 +336,43 @@ fn the_command_measures_each_chosen_model_and_writes_its_files() {
         assert!(dir.join(svg).exists(), "{svg}");
     }
 }
+
+/// The sensitivities' rows: the exact ones (the generated partial derivatives) agree with the
+/// 256-bit reference's differences to a few ulps on the paper's case and near upright; central
+/// differences of the same solver lose about half the digits at their best step (the
+/// truncation `h^2` against the rounding `eps/h`) and more at the others; and near upright a
+/// difference in `ell` cannot straddle `a < ell`, so it fails with the model's requirement.
+#[test]
+fn exact_sensitivities_keep_the_digits_that_differences_lose() {
+    let chosen = accuracy::Options {
+        models: vec!["rod_cube".into()],
+        cases: vec!["paper".into(), "near_upright".into()],
+        methods: vec!["exact".into(), "differences".into()],
+        quick: true,
+    }
+    .choose()
+    .unwrap();
+    let report = accuracy::run(&chosen, &accuracy::Progress::hidden()).unwrap();
+    let rows = |case: &str, label: &str| -> Vec<Row> {
+        (report.rows.iter())
+            .filter(|r| r.case == case && r.label == label)
+            .cloned()
+            .collect()
+    };
+    for case in ["paper", "near_upright"] {
+        let exact = rows(case, "exact");
+        assert_eq!(exact.len(), 1);
+        assert_eq!(exact[0].measured, Measured::Sensitivities);
+        assert!(exact[0].error < 1e-13, "{case}: {:?}", exact[0]);
+    }
+    let differences = rows("paper", "differences");
+    assert_eq!(differences.len(), 3, "{differences:?}");
+    let best = differences
+        .iter()
+        .map(|r| r.error)
+        .fold(f64::INFINITY, f64::min);
+    assert!(best > 1e-11 && best < 1e-7, "{differences:?}");
+    for r in rows("near_upright", "differences") {
+        assert!(r.error.is_nan() && r.note.contains("a < ell"), "{r:?}");
+    }
+}

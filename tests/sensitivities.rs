@@ -3,9 +3,8 @@
 //! and against central differences of the 256-bit reference (the step taken in high
 //! precision) over the hard-case grid, for every model the reference covers.
 
-use astro_float::{BigFloat, RoundingMode};
 use rodcube::model::Model;
-use rodcube::reference::{Family, Inputs, PRECISION, Reference, RootRoute, TimeRoute, to_f64};
+use rodcube::reference::{self, Family, Inputs};
 use rodcube::results::SensitivityGap;
 use rodcube::solve::lean::{LeanPoint, LeanSolver};
 use rodcube::solve::sensitivity::SensitivityWork;
@@ -13,8 +12,6 @@ use rodcube::solve::sensitivity::SensitivityWork;
 #[path = "common/grid.rs"]
 mod grid;
 use grid::{NS, RS};
-
-const RM: RoundingMode = RoundingMode::ToEven;
 
 fn model(name: &str) -> &'static dyn Model {
     rodcube::models::find(name).expect("generated model")
@@ -36,44 +33,15 @@ fn solve(solver: &mut LeanSolver, p: &[f64]) -> (LeanPoint, Sensitivities) {
 
 /// The reference's index (`[m1, m2, ell, a, g]`) of a model's parameter.
 fn reference_index(name: &str) -> usize {
-    ["m1", "m2", "ell", "a", "g"]
-        .iter()
+    (reference::PARAMETERS.iter())
         .position(|n| *n == name)
         .expect("a parameter of the reference's family")
-}
-
-/// `(theta_sep, t_sep)` of the reference at exact parameters.
-fn reference_at(inputs: Inputs, exact: [BigFloat; 5]) -> (BigFloat, BigFloat) {
-    let mut r = Reference::with_exact(inputs, exact).expect("reference");
-    let sep = r.separation(RootRoute::ClosedForm).expect("separation");
-    let t = r.separation_time(TimeRoute::SinhGauss).expect("time");
-    (sep.theta, t)
-}
-
-/// Central differences of the reference in parameter `j` (of `[m1, m2, ell, a, g]`) with the
-/// relative step `2^-70`, at 256 bits: truncation near `1e-42`, rounding near `1e-56`.
-fn reference_derivatives(inputs: Inputs, j: usize) -> (f64, f64) {
-    let p = PRECISION;
-    let values = [inputs.m1, inputs.m2, inputs.ell, inputs.a, inputs.g];
-    let x = BigFloat::from_f64(values[j], p);
-    let h = x.mul(&BigFloat::from_f64(2f64.powi(-70), p), p, RM);
-    let at = |sign: f64| {
-        let mut exact = values.map(|v| BigFloat::from_f64(v, p));
-        let step = h.mul(&BigFloat::from_f64(sign, p), p, RM);
-        exact[j] = x.add(&step, p, RM);
-        reference_at(inputs, exact)
-    };
-    let (th_plus, t_plus) = at(1.0);
-    let (th_minus, t_minus) = at(-1.0);
-    let two_h = h.mul(&BigFloat::from_f64(2.0, p), p, RM);
-    let d = |a: &BigFloat, b: &BigFloat| to_f64(&a.sub(b, p, RM).div(&two_h, p, RM));
-    (d(&th_plus, &th_minus), d(&t_plus, &t_minus))
 }
 
 /// `|x - reference|` within `bound` of `|reference|` (an exact zero must be matched by a
 /// value within `bound` of the scale `x` is compared at).
 fn close(x: f64, reference: f64, bound: f64, scale: f64) -> bool {
-    (x - reference).abs() <= bound * reference.abs().max(1e-3 * scale)
+    reference::derivative_error(x, reference, scale) <= bound
 }
 
 fn check_family(family: Family, ns: &[f64]) {
@@ -90,7 +58,8 @@ fn check_family(family: Family, ns: &[f64]) {
             let (point, outcome) = solve(&mut solver, &p);
             let (angle, time) = outcome.unwrap_or_else(|why| panic!("n={n} r={r}: {why:?}"));
             for (i, name) in names.iter().enumerate() {
-                let (d_theta, d_t) = reference_derivatives(inputs, reference_index(name));
+                let (d_theta, d_t) =
+                    reference::derivatives(inputs, reference_index(name)).expect("reference");
                 // Each derivative is compared at the scale of its quantity per its parameter.
                 let scale_theta = point.separation_angle / p[i];
                 let scale_t = point.separation_time / p[i];
@@ -98,7 +67,7 @@ fn check_family(family: Family, ns: &[f64]) {
                     ("d theta_sep", angle[i], d_theta, scale_theta),
                     ("d t_sep", time[i], d_t, scale_t),
                 ] {
-                    let error = (x - reference).abs() / reference.abs().max(1e-3 * scale);
+                    let error = reference::derivative_error(x, reference, scale);
                     if error > worst.0 {
                         worst = (error, format!("{what}/d {name} at n={n:e} r={r}"));
                     }

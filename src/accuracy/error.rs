@@ -3,6 +3,7 @@
 //! numbers. A failed setting's message becomes its row's note in the report.
 
 use crate::reference::ReferenceError;
+use crate::results::SensitivityGap;
 use crate::solve::SolveError;
 use crate::solve::phases::End;
 use crate::system::SystemError;
@@ -106,6 +107,18 @@ pub enum AccuracyError {
     /// Gauss–Jacobi's node count or exponents were refused.
     #[error("bad Gauss-Jacobi parameters")]
     BadGaussJacobi,
+    /// A point without sensitivities.
+    #[error("{}", crate::report::prose::sensitivity_gap(*.gap))]
+    NoSensitivity {
+        /// Why there are none.
+        gap: SensitivityGap,
+    },
+    /// A model's parameter that the reference does not have.
+    #[error("the reference has no parameter `{name}` (it has m1, m2, ell, a, g)")]
+    NoReferenceParameter {
+        /// The parameter.
+        name: &'static str,
+    },
     /// A Gauss–Legendre rule asked with no node.
     #[error("a Gauss–Legendre rule needs at least one node")]
     NoNodes,

@@ -13,6 +13,7 @@ use crate::solve::lean::LeanSolver;
 use crate::solve::ode::{Method, OdeOptions, OdeProblem, dopri5};
 use crate::solve::poly::horner;
 use crate::solve::quadrature::{TimeMesh, gauss_legendre_rule};
+use crate::solve::sensitivity::SensitivityWork;
 use crate::solve::separation::{linearised_separation, separation};
 use crate::solve::series::sample_phase;
 use crate::solve::unreduced;
@@ -194,6 +195,54 @@ pub fn time_per_point(solver: &mut LeanSolver, sys: &System) -> Outcome<f64> {
     let before = solver.evals;
     let out = solver.solve(sys.p())?;
     Ok((out.separation_time, solver.evals - before))
+}
+
+/// One point and its sensitivities by the per-point solver (the generated partial
+/// derivatives: the implicit-function theorem for the angle, the differentiated quadrature for
+/// the time): `d theta_sep/dp` then `d t_sep/dp` for every parameter in the model's order, and
+/// the evaluations the point took.
+pub fn sensitivities_exact(
+    solver: &mut LeanSolver,
+    work: &mut SensitivityWork,
+    sys: &System,
+) -> Outcome<Vec<f64>> {
+    let before = solver.evals;
+    let p = sys.p();
+    let point = solver.solve(p)?;
+    let (mut angle, mut time) = (vec![0.0; p.len()], vec![0.0; p.len()]);
+    solver
+        .sensitivities(p, &point, work, &mut angle, &mut time)?
+        .map_err(|gap| AccuracyError::NoSensitivity { gap })?;
+    angle.extend(time);
+    Ok((angle, solver.evals - before))
+}
+
+/// The same derivatives by central differences of the per-point solver, each parameter moved by
+/// `step` relative (two solves a parameter), as a user without exact derivatives would take
+/// them.
+pub fn sensitivities_differences(
+    solver: &mut LeanSolver,
+    sys: &System,
+    step: f64,
+) -> Outcome<Vec<f64>> {
+    let before = solver.evals;
+    let p = sys.p();
+    let (mut angle, mut time) = (Vec::with_capacity(p.len()), Vec::with_capacity(p.len()));
+    let mut moved = p.to_vec();
+    for i in 0..p.len() {
+        let h = step * p[i].abs();
+        moved[i] = p[i] + h;
+        let plus = solver.solve(&moved)?;
+        moved[i] = p[i] - h;
+        let minus = solver.solve(&moved)?;
+        moved[i] = p[i];
+        // The step actually taken, as the floats hold it.
+        let taken = (p[i] + h) - (p[i] - h);
+        angle.push((plus.separation_angle - minus.separation_angle) / taken);
+        time.push((plus.separation_time - minus.separation_time) / taken);
+    }
+    angle.extend(time);
+    Ok((angle, solver.evals - before))
 }
 
 /// One Gauss–Legendre panel of `nodes` after `delta = u^2`.

@@ -67,6 +67,8 @@ pub enum Measured {
     Series,
     /// The time the first contact ends, on the integrated route.
     ContactEnd,
+    /// The separation angle's and time's derivatives in every parameter.
+    Sensitivities,
 }
 
 impl Measured {
@@ -77,6 +79,7 @@ impl Measured {
             Measured::Time => "separation_time",
             Measured::Series => "theta_series",
             Measured::ContactEnd => "contact_end_time",
+            Measured::Sensitivities => "sensitivities",
         }
     }
 }
@@ -382,6 +385,12 @@ impl Chosen {
         s
     }
 
+    fn sensitivities(&self) -> Vec<Setting<Vec<f64>>> {
+        let mut s = settings::sensitivities(self.quick);
+        s.retain(|x| self.wants(x.label));
+        s
+    }
+
     fn integrators(&self) -> Vec<Method> {
         [Method::Dopri5, Method::Dop853]
             .into_iter()
@@ -391,7 +400,10 @@ impl Chosen {
 
     /// How many settings [`run`] measures (for a progress bar).
     pub fn settings(&self) -> usize {
-        let per_case = self.angle().len() + self.time().len() + self.series().len();
+        let per_case = self.angle().len()
+            + self.time().len()
+            + self.series().len()
+            + self.sensitivities().len();
         let closed: usize = self.closed.iter().map(|(_, _, c)| c.len() * per_case).sum();
         let integrated = self.integrated.len()
             * self.integrators().len()
@@ -485,8 +497,8 @@ impl Options {
         if chosen.settings() == 0 {
             return Err(AccuracyError::Nothing {
                 why: "no chosen method applies to a chosen model and case (the closed-form models \
-                      rod_cube, hinged_rod and wall_ladder have the root, quadrature and series \
-                      methods; the integrated models have dopri5 and dop853)"
+                      rod_cube, hinged_rod and wall_ladder have the root, quadrature, series and \
+                      sensitivity methods; the integrated models have dopri5 and dop853)"
                     .into(),
             });
         }
@@ -542,7 +554,9 @@ fn run_case(
         source: Box::new(e),
     };
     let (angle, time, series) = (chosen.angle(), chosen.time(), chosen.series());
-    progress.case(model, case.key, angle.len() + time.len() + series.len());
+    let sensitivities = chosen.sensitivities();
+    let settings = angle.len() + time.len() + series.len() + sensitivities.len();
+    progress.case(model, case.key, settings);
     let (mut reference, cref) = case_reference(family, case).map_err(failed)?;
     let m = crate::models::find(model)
         .ok_or_else(|| failed(AccuracyError::NoModel { name: model.into() }))?;
@@ -599,7 +613,50 @@ fn run_case(
         rows.push(row(Measured::Series, s, outcome));
         progress.step(format!("{model} {}: {} {}", case.key, s.label, s.setting));
     }
+    if !sensitivities.is_empty() {
+        let exact = reference_sensitivities(family, case, &sys, &cref).map_err(failed)?;
+        for s in &sensitivities {
+            let outcome = s.measure(&point, budget).map(|m| {
+                let worst = (m.value.iter().zip(&exact))
+                    .map(|(x, (reference, scale))| {
+                        reference::derivative_error(*x, *reference, *scale)
+                    })
+                    .fold(0.0, f64::max);
+                (worst, m.without_value())
+            });
+            rows.push(row(Measured::Sensitivities, s, outcome));
+            progress.step(format!("{model} {}: {} {}", case.key, s.label, s.setting));
+        }
+    }
     Ok((rows, cref))
+}
+
+/// The reference's derivatives of a case, `d theta_sep/dp` then `d t_sep/dp` in the order of
+/// the system's parameters, each with the scale it is compared at (its quantity over its
+/// parameter: [`reference::derivative_error`]): 256-bit central differences
+/// ([`reference::derivatives`]).
+fn reference_sensitivities(
+    family: Family,
+    case: Case,
+    sys: &System,
+    cref: &CaseReference,
+) -> Result<Vec<(f64, f64)>, AccuracyError> {
+    let inputs = Inputs::dimensionless(family, case.n, case.a_over_ell);
+    let (angle, time) = (
+        reference::to_f64(&cref.angle),
+        reference::to_f64(&cref.time),
+    );
+    let (mut d_angle, mut d_time) = (Vec::new(), Vec::new());
+    for (spec, &value) in sys.model().info().parameters.iter().zip(sys.p()) {
+        let j = (reference::PARAMETERS.iter())
+            .position(|n| *n == spec.name)
+            .ok_or(AccuracyError::NoReferenceParameter { name: spec.name })?;
+        let (dt, dtime) = reference::derivatives(inputs, j)?;
+        d_angle.push((dt, angle / value));
+        d_time.push((dtime, time / value));
+    }
+    d_angle.extend(d_time);
+    Ok(d_angle)
 }
 
 /// A setting's label and setting, whatever it computes.

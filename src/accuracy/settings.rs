@@ -6,6 +6,7 @@ use super::methods::{self, Outcome, Samples};
 use super::{AccuracyError, Budget, Measurement, QUICK_SERIES_SAMPLES, SERIES_SAMPLES, measure};
 use crate::solve::lean::LeanSolver;
 use crate::solve::prior::PRIOR_TOL;
+use crate::solve::sensitivity::SensitivityWork;
 use crate::system::System;
 
 /// One case as a method sees it: the validated system, the end of its phase (`delta_sep`, from
@@ -122,6 +123,14 @@ pub const LABELS: &[(&str, &str)] = &[
     (
         "series",
         "default series: the quadrature t(v) inverted by Newton",
+    ),
+    (
+        "exact",
+        "sensitivities from the generated partial derivatives (implicit-function theorem, differentiated quadrature); set-up: the per-point solver",
+    ),
+    (
+        "differences",
+        "sensitivities by central differences of the per-point solver (two solves a parameter); set-up: the solver",
     ),
     ("rk-dense", "DOPRI5 on theta'' with dense output"),
     (
@@ -257,6 +266,36 @@ pub fn series(quick: bool) -> Vec<Setting<Samples>> {
         out.push(plain("rk-dense", rtol_label(k), move |p| {
             methods::series_ode(p.sys, p.delta, rtol, p.t_max, samples)
         }));
+    }
+    out
+}
+
+/// The sensitivities' methods (`d theta_sep/dp` and `d t_sep/dp` for every parameter): the
+/// exact ones and central differences at relative steps around the best one for `f64`
+/// (`eps^(1/3)`, about `6e-6`), on the per-point solver at its default tolerance.
+pub fn sensitivities(quick: bool) -> Vec<Setting<Vec<f64>>> {
+    let mut out = vec![prepared(
+        "exact",
+        format!("tol {PRIOR_TOL:.0e}"),
+        |p| {
+            Ok((
+                methods::per_point_solver(p.sys, PRIOR_TOL)?,
+                SensitivityWork::default(),
+            ))
+        },
+        |(solver, work): &mut (LeanSolver<'static>, SensitivityWork), p| {
+            methods::sensitivities_exact(solver, work, p.sys)
+        },
+    )];
+    for step in pick(&[1e-3, 1e-4, 1e-5, 6e-6, 1e-6, 1e-7, 1e-8], quick) {
+        out.push(prepared(
+            "differences",
+            format!("step {step:.0e}"),
+            |p| methods::per_point_solver(p.sys, PRIOR_TOL),
+            move |solver: &mut LeanSolver<'static>, p| {
+                methods::sensitivities_differences(solver, p.sys, step)
+            },
+        ));
     }
     out
 }

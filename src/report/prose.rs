@@ -395,7 +395,7 @@ pub fn meaning(meaning: &Meaning) -> String {
 }
 
 /// Why a result has no sensitivities, in words.
-fn sensitivity_gap(gap: SensitivityGap) -> &'static str {
+pub fn sensitivity_gap(gap: SensitivityGap) -> &'static str {
     match gap {
         SensitivityGap::AtRelease => {
             "no sensitivity: the contact opens at release, so there is no separation to \
