@@ -270,9 +270,12 @@ type Flat<'py> = (
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<bool>>,
-    Vec<(usize, String)>,
+    Failures,
     Vec<(String, Bound<'py, PyArray1<f64>>)>,
 );
+
+/// Failed points: `(flat index, message)`.
+type Failures = Vec<(usize, String)>;
 
 /// The sweep over flat arrays, one per axis and all of one length (the Python `sweep`
 /// broadcasts and reshapes): separation angle and time by the per-point solver, in parallel
@@ -326,7 +329,7 @@ fn sweep_flat<'py>(
     } else {
         0
     };
-    let chunks: Vec<(Vec<(usize, String)>, Vec<f64>)> = py.detach(|| {
+    let chunks: Vec<(Failures, Vec<f64>)> = py.detach(|| {
         (
             points.par_chunks(CHUNK * dims),
             angle.par_chunks_mut(CHUNK),
@@ -415,7 +418,7 @@ struct Chunk<'a> {
     angles: &'a mut [f64],
     times: &'a mut [f64],
     oks: &'a mut [bool],
-    errors: Vec<(usize, String)>,
+    errors: Failures,
     /// Per point, `d theta_sep/dp` then `d t_sep/dp` (NaN where there are none).
     sens: Vec<f64>,
 }
