@@ -557,19 +557,25 @@ unsafe fn text<'a>(s: *const c_char, what: &str) -> Result<&'a str, Failure> {
         .map_err(|e| failure(RODCUBE_ERR_UTF8, format!("{what} is not UTF-8: {e}")))
 }
 
+/// A NULL pointer with a count above zero is refused by name.
+fn counted<T>(p: *const T, n: usize, what: &str) -> Result<(), Failure> {
+    if n > 0 && p.is_null() {
+        return Err(failure(
+            RODCUBE_ERR_ARGUMENT,
+            format!("{what} is NULL with a count of {n}"),
+        ));
+    }
+    Ok(())
+}
+
 /// `n` values at `p` as a slice (empty for `n == 0`, whatever `p`).
 ///
 /// # Safety
 /// For `n > 0`, `p` points to `n` readable values of `T`.
 unsafe fn slice<'a, T>(p: *const T, n: usize, what: &str) -> Result<&'a [T], Failure> {
+    counted(p, n, what)?;
     if n == 0 {
         return Ok(&[]);
-    }
-    if p.is_null() {
-        return Err(failure(
-            RODCUBE_ERR_ARGUMENT,
-            format!("{what} is NULL with a count of {n}"),
-        ));
     }
     // SAFETY: the caller gives `n` readable values.
     Ok(unsafe { std::slice::from_raw_parts(p, n) })
@@ -580,14 +586,9 @@ unsafe fn slice<'a, T>(p: *const T, n: usize, what: &str) -> Result<&'a [T], Fai
 /// # Safety
 /// For `n > 0`, `p` points to `n` writable values of `T`, not aliased by other arguments.
 unsafe fn slice_mut<'a, T>(p: *mut T, n: usize, what: &str) -> Result<&'a mut [T], Failure> {
+    counted(p.cast_const(), n, what)?;
     if n == 0 {
         return Ok(&mut []);
-    }
-    if p.is_null() {
-        return Err(failure(
-            RODCUBE_ERR_ARGUMENT,
-            format!("{what} is NULL with a count of {n}"),
-        ));
     }
     // SAFETY: the caller gives `n` writable values.
     Ok(unsafe { std::slice::from_raw_parts_mut(p, n) })
