@@ -373,6 +373,13 @@
 #define RODCUBE_ERR_FRICTIONAL_IMPACT 337
 
 /**
+ * Solver: the point solved, but its sensitivities do not exist there (the message says why:
+ * the contact opens at release, the separation is a double root of its condition, the model
+ * has no partial derivatives, ...); `rodcube_sensitivities` writes no number.
+ */
+#define RODCUBE_ERR_NO_SENSITIVITY 338
+
+/**
  * Group: the scene was refused (codes 401 to 499). A scene's message lists every problem
  * found; the code is the kind of the first, in file order. Returned alone only for a scene
  * error without a problem, which scene parsing never makes.
@@ -579,6 +586,32 @@ int rodcube_solve_named(struct rodcube_solver *solver,
                         struct rodcube_point *out,
                         char *err,
                         size_t err_len);
+
+/**
+ * Solves one point as `rodcube_solve` does (`params`: `n_params` values in the model's
+ * order; `*out`, when `out` is not NULL, gets the point) and writes its exact sensitivities:
+ * `d_angle[i]` = d(separation_angle)/d(parameter i) (rad over the parameter's unit) and
+ * `d_time[i]` = d(separation_time)/d(parameter i) (s over the parameter's unit), each array
+ * `n_out` values long, `n_out` the model's parameter count (`rodcube_parameter_count`). They
+ * are the numbers of a scene's `want: [sensitivities]` and of `rodcube sweep
+ * --sensitivities`. Where the point solves but its sensitivities do not exist (the contact
+ * opens at release, a double root, ...) it fails with `RODCUBE_ERR_NO_SENSITIVITY`, `*out`
+ * written and the arrays left as they were; `n_out` other than the parameter count fails with
+ * `RODCUBE_ERR_PARAM_LENGTH`; other failures are `rodcube_solve`'s.
+ *
+ * # Safety
+ * As `rodcube_solve`, with `out` NULL or pointing to one writable `rodcube_point`, and
+ * `d_angle` and `d_time` each pointing to `n_out` writable values.
+ */
+int rodcube_sensitivities(struct rodcube_solver *solver,
+                          const double *params,
+                          size_t n_params,
+                          struct rodcube_point *out,
+                          double *d_angle,
+                          double *d_time,
+                          size_t n_out,
+                          char *err,
+                          size_t err_len);
 
 /**
  * Runs a scene given as YAML text (the format of the files in `scenes/`) once, and makes its

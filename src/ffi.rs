@@ -23,9 +23,11 @@
 
 use crate::model::Model;
 use crate::plan::{self, PlanError};
+use crate::results::{Note, SensitivityGap};
 use crate::scene::{Kind, Scene, SceneError};
 use crate::solve::SolveError;
 use crate::solve::lean::{LeanPoint, LeanSolver};
+use crate::solve::sensitivity::SensitivityWork;
 use crate::system::{SystemError, ordered_values};
 use std::ffi::{CStr, CString, c_char, c_int};
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -179,6 +181,10 @@ pub const RODCUBE_ERR_RESULT_NOT_FINITE: c_int = 335;
 pub const RODCUBE_ERR_NO_SUCH_PHASE: c_int = 336;
 /// An impact at a contact with friction (tangential impulses are not modelled).
 pub const RODCUBE_ERR_FRICTIONAL_IMPACT: c_int = 337;
+/// Solver: the point solved, but its sensitivities do not exist there (the message says why:
+/// the contact opens at release, the separation is a double root of its condition, the model
+/// has no partial derivatives, ...); `rodcube_sensitivities` writes no number.
+pub const RODCUBE_ERR_NO_SENSITIVITY: c_int = 338;
 
 /// Group: the scene was refused (codes 401 to 499). A scene's message lists every problem
 /// found; the code is the kind of the first, in file order. Returned alone only for a scene
@@ -295,6 +301,7 @@ static CODES: &[(c_int, &CStr)] = named![
     RODCUBE_ERR_RESULT_NOT_FINITE,
     RODCUBE_ERR_NO_SUCH_PHASE,
     RODCUBE_ERR_FRICTIONAL_IMPACT,
+    RODCUBE_ERR_NO_SENSITIVITY,
     RODCUBE_ERR_SCENE,
     RODCUBE_ERR_SCENE_READ,
     RODCUBE_ERR_SCENE_SYNTAX,
@@ -433,6 +440,10 @@ pub struct RodcubeSolver {
     solver: LeanSolver<'static>,
     /// Scratch for parameters given by name.
     values: Vec<f64>,
+    /// Scratch of `rodcube_sensitivities`, kept across points: the sensitivities before they
+    /// are known to exist, then the integrals' buffers.
+    sens: Vec<f64>,
+    work: SensitivityWork,
 }
 
 /// A scene's results (opaque): the text of its `results.json`, made once by
@@ -464,6 +475,13 @@ impl From<SolveError> for Failure {
 impl From<PlanError> for Failure {
     fn from(e: PlanError) -> Self {
         Failure(plan_code(&e), e.to_string())
+    }
+}
+
+impl From<SensitivityGap> for Failure {
+    fn from(gap: SensitivityGap) -> Self {
+        let message = crate::report::prose::note(&Note::NoSensitivity(gap));
+        Failure(RODCUBE_ERR_NO_SENSITIVITY, message)
     }
 }
 
@@ -539,22 +557,41 @@ unsafe fn text<'a>(s: *const c_char, what: &str) -> Result<&'a str, Failure> {
         .map_err(|e| failure(RODCUBE_ERR_UTF8, format!("{what} is not UTF-8: {e}")))
 }
 
-/// `n` values at `p` as a slice (empty for `n == 0`, whatever `p`).
-///
-/// # Safety
-/// For `n > 0`, `p` points to `n` readable values of `T`.
-unsafe fn slice<'a, T>(p: *const T, n: usize, what: &str) -> Result<&'a [T], Failure> {
-    if n == 0 {
-        return Ok(&[]);
-    }
-    if p.is_null() {
+/// A NULL pointer with a count above zero is refused by name.
+fn counted<T>(p: *const T, n: usize, what: &str) -> Result<(), Failure> {
+    if n > 0 && p.is_null() {
         return Err(failure(
             RODCUBE_ERR_ARGUMENT,
             format!("{what} is NULL with a count of {n}"),
         ));
     }
+    Ok(())
+}
+
+/// `n` values at `p` as a slice (empty for `n == 0`, whatever `p`).
+///
+/// # Safety
+/// For `n > 0`, `p` points to `n` readable values of `T`.
+unsafe fn slice<'a, T>(p: *const T, n: usize, what: &str) -> Result<&'a [T], Failure> {
+    counted(p, n, what)?;
+    if n == 0 {
+        return Ok(&[]);
+    }
     // SAFETY: the caller gives `n` readable values.
     Ok(unsafe { std::slice::from_raw_parts(p, n) })
+}
+
+/// `n` writable values at `p` as a slice (empty for `n == 0`, whatever `p`).
+///
+/// # Safety
+/// For `n > 0`, `p` points to `n` writable values of `T`, not aliased by other arguments.
+unsafe fn slice_mut<'a, T>(p: *mut T, n: usize, what: &str) -> Result<&'a mut [T], Failure> {
+    counted(p.cast_const(), n, what)?;
+    if n == 0 {
+        return Ok(&mut []);
+    }
+    // SAFETY: the caller gives `n` writable values.
+    Ok(unsafe { std::slice::from_raw_parts_mut(p, n) })
 }
 
 /// The place behind an out pointer, set to NULL (what a failure leaves there).
@@ -711,6 +748,8 @@ pub unsafe extern "C" fn rodcube_solver_new(
             *slot = Box::into_raw(Box::new(RodcubeSolver {
                 solver: lean,
                 values: vec![0.0; m.info().parameters.len()],
+                sens: Vec::new(),
+                work: SensitivityWork::default(),
             }));
             Ok(())
         })
@@ -786,6 +825,55 @@ pub unsafe extern "C" fn rodcube_solve_named(
             ordered_values(s.solver.model().info(), &pairs, &mut s.values)?;
             let out = output(out)?;
             *out = s.solver.solve(&s.values)?.into();
+            Ok(())
+        })
+    }
+}
+
+/// Solves one point as `rodcube_solve` does (`params`: `n_params` values in the model's
+/// order; `*out`, when `out` is not NULL, gets the point) and writes its exact sensitivities:
+/// `d_angle[i]` = d(separation_angle)/d(parameter i) (rad over the parameter's unit) and
+/// `d_time[i]` = d(separation_time)/d(parameter i) (s over the parameter's unit), each array
+/// `n_out` values long, `n_out` the model's parameter count (`rodcube_parameter_count`). They
+/// are the numbers of a scene's `want: [sensitivities]` and of `rodcube sweep
+/// --sensitivities`. Where the point solves but its sensitivities do not exist (the contact
+/// opens at release, a double root, ...) it fails with `RODCUBE_ERR_NO_SENSITIVITY`, `*out`
+/// written and the arrays left as they were; `n_out` other than the parameter count fails with
+/// `RODCUBE_ERR_PARAM_LENGTH`; other failures are `rodcube_solve`'s.
+///
+/// # Safety
+/// As `rodcube_solve`, with `out` NULL or pointing to one writable `rodcube_point`, and
+/// `d_angle` and `d_time` each pointing to `n_out` writable values.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn rodcube_sensitivities(
+    solver: *mut RodcubeSolver,
+    params: *const f64,
+    n_params: usize,
+    out: *mut RodcubePoint,
+    d_angle: *mut f64,
+    d_time: *mut f64,
+    n_out: usize,
+    err: *mut c_char,
+    err_len: usize,
+) -> c_int {
+    // SAFETY: forwarded from the caller.
+    unsafe {
+        guarded(err, err_len, || {
+            let s = solver_mut(solver)?;
+            let p = slice(params, n_params, "the parameters")?;
+            let angle = slice_mut(d_angle, n_out, "d_angle")?;
+            let time = slice_mut(d_time, n_out, "d_time")?;
+            let point = s.solver.solve(p)?;
+            if let Some(out) = out.as_mut() {
+                *out = point.into();
+            }
+            // Into scratch first: a gap leaves the caller's arrays as they were.
+            s.sens.resize(2 * n_out, 0.0);
+            let (a, t) = s.sens.split_at_mut(n_out);
+            s.solver.sensitivities(p, &point, &mut s.work, a, t)??;
+            angle.copy_from_slice(a);
+            time.copy_from_slice(t);
             Ok(())
         })
     }
@@ -898,5 +986,36 @@ pub unsafe extern "C" fn rodcube_results_free(results: *mut RodcubeResults) {
     if !results.is_null() {
         // SAFETY: made by `Box::into_raw` in `rodcube_run_scene`, released once.
         let _ = catch_unwind(AssertUnwindSafe(|| drop(unsafe { Box::from_raw(results) })));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every reason a sensitivity does not exist is `RODCUBE_ERR_NO_SENSITIVITY`, with the
+    /// words of results.json's note (no concrete point the per-point solver takes reaches one,
+    /// so `tests/capi.rs` cannot call for it).
+    #[test]
+    fn every_sensitivity_gap_is_no_sensitivity_with_its_note() {
+        for gap in [
+            SensitivityGap::AtRelease,
+            SensitivityGap::NoSeparation,
+            SensitivityGap::Integrated,
+            SensitivityGap::NotBuilt,
+            SensitivityGap::NoPartials,
+            SensitivityGap::NoFallPolynomial,
+            SensitivityGap::DoubleRoot,
+        ] {
+            let Failure(code, message) = gap.into();
+            assert_eq!(code, RODCUBE_ERR_NO_SENSITIVITY, "{gap:?}");
+            let note = crate::report::prose::note(&Note::NoSensitivity(gap));
+            assert_eq!(message, note);
+            assert!(message.contains("sensitivit"), "{gap:?}: {message}");
+        }
+        assert_eq!(
+            rodcube_error_group(RODCUBE_ERR_NO_SENSITIVITY),
+            RODCUBE_ERR_SOLVE
+        );
     }
 }

@@ -1,10 +1,10 @@
 //! The C ABI: `examples/c/run.sh` builds the library and `examples/c/paper.c` with the system C
 //! compiler (which also checks `include/rodcube.h`) and prints the paper's separation angle
-//! and time, equal to the bit to the Rust per-point solver's; the header's constants and
-//! struct layout, as a C compiler reads them, are the library's; every function answers bad
-//! arguments and failures with the code of their kind (each reachable code from a concrete
-//! input) and a message, never a crash; and a scene is solved once, its results read from
-//! the handle as often as wanted.
+//! and time and their sensitivities to every parameter, equal to the bit to the Rust
+//! per-point solver's; the header's constants and struct layout, as a C compiler reads them,
+//! are the library's; every function answers bad arguments and failures with the code of
+//! their kind (each reachable code from a concrete input) and a message, never a crash; and a
+//! scene is solved once, its results read from the handle as often as wanted.
 
 use rodcube::solve::lean::LeanSolver;
 use std::path::Path;
@@ -49,6 +49,27 @@ fn the_c_example_prints_the_rust_solvers_numbers() {
         value("separation_time").to_bits(),
         rust.separation_time.to_bits()
     );
+    // The second line: the point's sensitivities, the Rust per-point solver's to the bit.
+    let second = stdout.lines().nth(1).unwrap_or("");
+    let mut solver = LeanSolver::new(model).unwrap();
+    let point = solver.solve(&PAPER).unwrap();
+    let (mut d_angle, mut d_time) = ([0.0; 5], [0.0; 5]);
+    let mut work = rodcube::solve::sensitivity::SensitivityWork::default();
+    (solver.sensitivities(&PAPER, &point, &mut work, &mut d_angle, &mut d_time))
+        .unwrap()
+        .unwrap();
+    for (i, p) in model.info().parameters.iter().enumerate() {
+        for (of, want) in [
+            ("separation_angle", d_angle[i]),
+            ("separation_time", d_time[i]),
+        ] {
+            let key = format!("d({of})/d({})=", p.name);
+            let got: f64 = (second.split_whitespace())
+                .find_map(|kv| kv.strip_prefix(&key)?.parse().ok())
+                .unwrap_or_else(|| panic!("no {key} in {second:?}"));
+            assert_eq!(got.to_bits(), want.to_bits(), "{key}");
+        }
+    }
 
     // The README's C example, inside a `main`, against the library run.sh built: it prints the
     // same line.
@@ -311,7 +332,7 @@ mod calls {
             99,
             116,
             299,
-            338,
+            339,
             416,
             500,
             c_int::MAX,
@@ -329,6 +350,7 @@ mod calls {
             (RODCUBE_ERR_TOO_MANY_SAMPLES, RODCUBE_ERR_REQUEST),
             (RODCUBE_ERR_NO_SEPARATION, RODCUBE_ERR_SOLVE),
             (RODCUBE_ERR_RESULT_NOT_FINITE, RODCUBE_ERR_SOLVE),
+            (RODCUBE_ERR_NO_SENSITIVITY, RODCUBE_ERR_SOLVE),
             (RODCUBE_ERR_SCENE_SYNTAX, RODCUBE_ERR_SCENE),
         ] {
             assert_eq!(rodcube_error_group(code), group, "{code}");
@@ -419,8 +441,10 @@ mod calls {
     /// Every code a concrete input reaches, with the words its message must hold: each kind
     /// gets its own code. (Not reached from C: `RODCUBE_ERR_PANIC`, which no input causes;
     /// `RODCUBE_ERR_JSON`; the request group, which a scene's own validation catches first;
-    /// and the solver failures that only faulty models give, `tests/lean.rs` and
-    /// `tests/numerical_faults.rs` reach them in Rust.)
+    /// the solver failures that only faulty models give, `tests/lean.rs` and
+    /// `tests/numerical_faults.rs` reach them in Rust; and `RODCUBE_ERR_NO_SENSITIVITY`,
+    /// which no point the per-point solver takes reaches (its separations all have
+    /// sensitivities: the unit test `ffi::tests` maps every `SensitivityGap` to it).)
     #[test]
     fn every_reachable_code_comes_from_a_concrete_input() {
         let s = solver("rod_cube").unwrap();
@@ -627,6 +651,124 @@ mod calls {
         assert_eq!(rodcube_error_group(code), RODCUBE_ERR_SOLVE);
         // The solver is still usable after every failure.
         assert_eq!(solve(s, &PAPER), (RODCUBE_OK, String::new()));
+        // SAFETY: made by rodcube_solver_new, released once.
+        unsafe { rodcube_solver_free(s) };
+    }
+
+    /// `rodcube_sensitivities(solver, params, n, out, d_angle, d_time, n_out)`.
+    fn sensitivities(
+        s: *mut RodcubeSolver,
+        params: &[f64],
+        out: Option<&mut RodcubePoint>,
+        d_angle: &mut [f64],
+        d_time: &mut [f64],
+    ) -> Outcome {
+        let mut err = [0 as c_char; 512];
+        let out = out.map_or(null_mut(), |o| o as *mut RodcubePoint);
+        // SAFETY: a live solver, valid slices (`n_out` is the shorter) and buffers.
+        let code = unsafe {
+            rodcube_sensitivities(
+                s,
+                params.as_ptr(),
+                params.len(),
+                out,
+                d_angle.as_mut_ptr(),
+                d_time.as_mut_ptr(),
+                d_angle.len().min(d_time.len()),
+                err.as_mut_ptr(),
+                512,
+            )
+        };
+        (code, message(&err))
+    }
+
+    /// The C call gives the per-point solver's sensitivities to the bit (the numbers of a
+    /// scene's `want: [sensitivities]` and of `rodcube sweep --sensitivities`), with the point
+    /// as `rodcube_solve` gives it; wrong lengths, NULL arrays and refused points get their
+    /// codes and leave the arrays as they were.
+    #[test]
+    fn sensitivities_are_the_per_point_solvers() {
+        use rodcube::solve::lean::LeanSolver;
+        use rodcube::solve::sensitivity::SensitivityWork;
+        let model = rodcube::models::find("rod_cube").unwrap();
+        let mut rust = LeanSolver::new(model).unwrap();
+        let s = solver("rod_cube").unwrap();
+        for p in [
+            PAPER,
+            [1.0, 0.05, 1.0, 0.8, 9.81],
+            [2.0, 40.0, 1.5, 0.1, 1.0],
+        ] {
+            let point = rust.solve(&p).unwrap();
+            let (mut want_a, mut want_t) = ([0.0; 5], [0.0; 5]);
+            rust.sensitivities(
+                &p,
+                &point,
+                &mut SensitivityWork::default(),
+                &mut want_a,
+                &mut want_t,
+            )
+            .unwrap()
+            .unwrap();
+            let (mut a, mut t) = ([f64::NAN; 5], [f64::NAN; 5]);
+            let mut out = RodcubePoint::default();
+            assert_eq!(
+                sensitivities(s, &p, Some(&mut out), &mut a, &mut t),
+                (RODCUBE_OK, String::new())
+            );
+            assert_eq!(a.map(f64::to_bits), want_a.map(f64::to_bits), "{p:?}");
+            assert_eq!(t.map(f64::to_bits), want_t.map(f64::to_bits), "{p:?}");
+            assert_eq!(
+                out.separation_angle.to_bits(),
+                point.separation_angle.to_bits()
+            );
+            assert_eq!(
+                out.separation_time.to_bits(),
+                point.separation_time.to_bits()
+            );
+            // `out` may be NULL.
+            let (mut a2, mut t2) = ([0.0; 5], [0.0; 5]);
+            assert_eq!(sensitivities(s, &p, None, &mut a2, &mut t2).0, RODCUBE_OK);
+            assert_eq!((a2, t2), (a, t));
+        }
+        let (mut a, mut t) = ([7.0; 5], [7.0; 5]);
+        let (code, text) = sensitivities(s, &PAPER, None, &mut a[..4], &mut t[..4]);
+        assert_eq!(code, RODCUBE_ERR_PARAM_LENGTH, "{text}");
+        let refused = [1.0, 3.0, 1.0, 1.0, 9.81];
+        let (code, text) = sensitivities(s, &refused, None, &mut a, &mut t);
+        assert_eq!(code, RODCUBE_ERR_PARAM_REQUIREMENT, "{text}");
+        assert_eq!((a, t), ([7.0; 5], [7.0; 5]), "a failure writes no number");
+        let mut err = [0 as c_char; 512];
+        // SAFETY: NULL arrays with a count: refused before anything is read or written.
+        let code = unsafe {
+            rodcube_sensitivities(
+                s,
+                PAPER.as_ptr(),
+                5,
+                null_mut(),
+                null_mut(),
+                t.as_mut_ptr(),
+                5,
+                err.as_mut_ptr(),
+                512,
+            )
+        };
+        assert_eq!(code, RODCUBE_ERR_ARGUMENT);
+        assert!(message(&err).contains("d_angle is NULL"));
+        // SAFETY: NULL solver.
+        let code = unsafe {
+            rodcube_sensitivities(
+                null_mut(),
+                PAPER.as_ptr(),
+                5,
+                null_mut(),
+                a.as_mut_ptr(),
+                t.as_mut_ptr(),
+                5,
+                null_mut(),
+                0,
+            )
+        };
+        assert_eq!(code, RODCUBE_ERR_ARGUMENT);
         // SAFETY: made by rodcube_solver_new, released once.
         unsafe { rodcube_solver_free(s) };
     }

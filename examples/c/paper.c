@@ -1,6 +1,8 @@
 /* paper.c: the paper's case (n = 3, a/ell = 1/4, g = 9.81) through rodcube's C interface.
  *
- * Prints `separation_angle=<rad> separation_time=<s>` to full double precision. It also
+ * Prints `separation_angle=<rad> separation_time=<s>` to full double precision, then a line
+ * of its exact sensitivities to every parameter, `d(separation_angle)/d(<p>)=...` and
+ * `d(separation_time)/d(<p>)=...` (rodcube_sensitivities). It also
  * solves the point with its parameters in the model's order (the two must agree), shows a
  * refused point's code and message, and runs a scene once to its JSON results, read in place
  * and copied, so every function of rodcube.h is called. Build and run: examples/c/run.sh
@@ -68,6 +70,18 @@ int main(void) {
         return fail("comparing", -1, "by name and in order differ");
     }
 
+    /* The point's sensitivities to every parameter, in the model's order. */
+    double d_angle[5];
+    double d_time[5];
+    rodcube_point again;
+    code = rodcube_sensitivities(solver, ordered, 5, &again, d_angle, d_time, 5, err, sizeof err);
+    if (code != RODCUBE_OK) {
+        return fail("rodcube_sensitivities", code, err);
+    }
+    if (memcmp(&again, &point, sizeof point) != 0) {
+        return fail("comparing", -1, "rodcube_sensitivities' point differs from rodcube_solve's");
+    }
+
     /* A refused point: the cube as high as the rod is long, a requirement of the model, in
      * the group of refused parameters. */
     const double upright[] = {1.0, 3.0, 1.0, 1.0, 9.81};
@@ -109,5 +123,11 @@ int main(void) {
 
     printf("separation_angle=%.17g separation_time=%.17g\n", point.separation_angle,
            point.separation_time);
+    for (size_t i = 0; i < 5; i++) {
+        const char *p = rodcube_parameter_name((size_t)model, i);
+        printf("%sd(separation_angle)/d(%s)=%.17g d(separation_time)/d(%s)=%.17g", i ? " " : "", p,
+               d_angle[i], p, d_time[i]);
+    }
+    printf("\n");
     return 0;
 }

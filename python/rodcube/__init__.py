@@ -2,14 +2,16 @@
 
 - ``solve(model, want=[...], **parameters)``: one parameter point through rodcube's planner;
   returns a dict of floats (scalars), strings (words such as ``contact_end_cause``) and dicts
-  of NumPy arrays (series, by column).
+  of NumPy arrays (series, by column); ``"sensitivities"`` in ``want`` adds the dicts
+  ``sensitivities`` and ``sensitivity_units``, keyed as in results.json.
 - ``sweep(n, a_over_ell, *, model="rod_cube", axes={...}, defaults={...}, **parameters)``:
   separation angle and time over arrays, in parallel with the GIL released. Axes are
   ``n = m2/m1``, ``a_over_ell``, the entries of ``axes`` (any parameter or ratio ``p_over_q``
   of two parameters) and every keyword parameter given as an array; scalars and array-likes
   broadcast against each other as NumPy broadcasts. Every parameter needs a value: rodcube
   assumes none (not even g). A point that fails is NaN, ``False`` in the ``ok`` mask, and
-  listed in ``errors`` with the reason.
+  listed in ``errors`` with the reason. ``sensitivities=True`` adds the exact
+  ``d(separation_angle)/d(<p>)`` and ``d(separation_time)/d(<p>)`` for every parameter.
 - ``models()`` and ``parameters(model)``: the registry, with each parameter's unit and meaning.
 - ``derivation(model)``: the model's derivation (carried by the package), which a notebook shows
   as Markdown with LaTeX, every step numbered as in ``generated/<model>.tex``; its
@@ -60,7 +62,9 @@ def _numbers(what, value):
         ) from None
 
 
-def sweep(n=None, a_over_ell=None, *, model="rod_cube", axes=None, defaults=None, **parameters):
+def sweep(
+    n=None, a_over_ell=None, *, model="rod_cube", axes=None, defaults=None, sensitivities=False, **parameters
+):
     """Separation angle and time of ``model`` over arrays of parameter values.
 
     The axes are ``n`` (= m2/m1), ``a_over_ell``, the entries of ``axes`` (a dict from a
@@ -83,6 +87,14 @@ def sweep(n=None, a_over_ell=None, *, model="rod_cube", axes=None, defaults=None
     - ``errors``: ``(index, message)`` for every failed point in C order (the order of
       ``np.argwhere(~ok)``); ``index`` is a tuple indexing the result arrays, ``message`` is
       rodcube's reason.
+
+    With ``sensitivities=True`` it also holds, for every parameter ``p`` of the model, the exact
+    sensitivities ``d(separation_angle)/d(<p>)`` (rad per unit of ``p``) and
+    ``d(separation_time)/d(<p>)`` (s per unit of ``p``) as float arrays of the same shape: the
+    numbers of ``solve(..., want=[..., "sensitivities"])``, of results.json and of
+    ``rodcube sweep --sensitivities``. Where a point's sensitivities do not exist (the contact
+    opens at release, say) they are NaN, the point is ``False`` in ``ok`` (its angle and time
+    kept) and ``errors`` says why.
 
     Raises ``RodcubeError`` for an unknown model, axis or parameter, a parameter without a
     value (the message lists each with its unit and meaning), a parameter set twice, a value
@@ -126,8 +138,8 @@ def sweep(n=None, a_over_ell=None, *, model="rod_cube", axes=None, defaults=None
         raise RodcubeError(f"the axes' shapes do not broadcast together: {shapes}") from None
     shape = broadcast[0].shape
     columns = [np.ascontiguousarray(b).reshape(-1) for b in broadcast]
-    angle, time, ok, failures = _sweep_flat(
-        model, [name for name, _ in named], columns, fixed, given
+    angle, time, ok, failures, derivatives = _sweep_flat(
+        model, [name for name, _ in named], columns, fixed, given, bool(sensitivities)
     )
     if failures and shape:
         flat = np.fromiter((i for i, _ in failures), dtype=np.intp, count=len(failures))
@@ -136,9 +148,11 @@ def sweep(n=None, a_over_ell=None, *, model="rod_cube", axes=None, defaults=None
     else:
         # A 0-d result: its one point's index is ().
         errors = [((), message) for _, message in failures]
-    return {
+    out = {
         "separation_angle": angle.reshape(shape),
         "separation_time": time.reshape(shape),
         "ok": ok.reshape(shape),
         "errors": errors,
     }
+    out.update((name, values.reshape(shape)) for name, values in derivatives)
+    return out

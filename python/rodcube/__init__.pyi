@@ -66,6 +66,12 @@ class SweepResult(TypedDict):
     errors: list[tuple[tuple[int, ...], str]]
     """(index into the arrays, rodcube's message) for every failed point, in C order."""
 
+# With `sweep(..., sensitivities=True)` the result also holds, for every parameter `p`, the
+# float arrays `"d(separation_angle)/d(<p>)"` (rad per unit of p) and
+# `"d(separation_time)/d(<p>)"` (s per unit of p), NaN where the point failed or its
+# sensitivities do not exist (then `ok` is False and `errors` says why); those keys are no
+# identifiers, so `SweepResult` does not list them.
+
 def models() -> list[str]:
     """The names of the registered models."""
 
@@ -85,7 +91,11 @@ def solve(
     `checks` as `dict[str, Check]`, `impacts` as `list[Impact]`, and `notes: dict[str, str]`
     (why a wanted quantity has no value, how the motion ended) when there are any. `until`
     (s from release) carries the motion on through impacts to that time; without it the run
-    ends where the bodies first meet.
+    ends where the bodies first meet. With `"sensitivities"` in `want`,
+    `sensitivities: dict[str, float]` holds `d(<result>)/d(<parameter>)` and
+    `elasticity(<result>;<parameter>)` keyed as in results.json and `sensitivity_units:
+    dict[str, str]` their units; a sensitivity that does not exist is absent and `notes` says
+    why.
     """
 
 def sweep(
@@ -95,11 +105,13 @@ def sweep(
     model: str = "rod_cube",
     axes: Optional[Mapping[str, npt.ArrayLike]] = None,
     defaults: Optional[Mapping[str, float]] = None,
+    sensitivities: bool = False,
     **parameters: Union[float, npt.ArrayLike],
 ) -> SweepResult:
     """Separation angle and time over broadcast axes (`n` = m2/m1, `a_over_ell`, `axes`, and
     keyword parameters given as arrays); every parameter needs a value from an axis, a keyword
-    or `defaults`, g included."""
+    or `defaults`, g included. `sensitivities=True` adds `d(separation_angle)/d(<p>)` and
+    `d(separation_time)/d(<p>)` for every parameter (see above)."""
 
 class Step(NamedTuple):
     """One step of a derivation: a `\\subsection*` of the write-up, numbered in its order."""

@@ -1,6 +1,7 @@
 //! Python bindings of rodcube (PyO3, abi3, NumPy), the compiled module `rodcube._rodcube`:
 //! `solve` runs the planner for one parameter point, `sweep_flat` the per-point solver over
-//! flat NumPy arrays in parallel with the GIL released (the package's `sweep`, in
+//! flat NumPy arrays (with each point's exact sensitivities if asked) in parallel with the GIL
+//! released (the package's `sweep`, in
 //! `rodcube/__init__.py`, broadcasts its arguments into them), `models` and `parameters` list
 //! the registry. Errors are `rodcube.RodcubeError` (a `ValueError`) with the library's own
 //! messages; a point that fails in a sweep keeps its error's message. `notebook.rs` gives the
@@ -16,7 +17,10 @@ use rodcube::axes::{Mapping, Target, resolve};
 use rodcube::model::{Model, ModelInfo, ParamInfo};
 use rodcube::plan::{self, Parameters, Request};
 use rodcube::quantity::Quantity;
+use rodcube::report::prose;
+use rodcube::results::Note;
 use rodcube::solve::lean::LeanSolver;
+use rodcube::solve::sensitivity::SensitivityWork;
 
 mod notebook;
 
@@ -68,6 +72,10 @@ fn parameters(model: &str) -> PyResult<Vec<(&'static str, &'static str, &'static
 /// strings, series as dicts of NumPy arrays by column, `checks` as dicts, `impacts` as a list
 /// of dicts, and `notes` (why a wanted quantity has no value, how the motion ended) when there
 /// are any. `until` (s from release) carries the motion on through impacts to that time.
+/// With `sensitivities` wanted, `sensitivities` maps `d(<result>)/d(<parameter>)` and
+/// `elasticity(<result>;<parameter>)` (the keys of results.json) to their values and
+/// `sensitivity_units` the same keys to their units; a sensitivity that does not exist is
+/// absent, and `notes` says why.
 #[pyfunction]
 #[pyo3(signature = (model, want=None, tolerance=None, samples=None, until=None, **parameters))]
 fn solve<'py>(
@@ -154,6 +162,15 @@ fn solve<'py>(
             list.append(entry)?;
         }
         out.set_item("impacts", list)?;
+    }
+    if !results.sensitivities.is_empty() {
+        let (values, units) = (PyDict::new(py), PyDict::new(py));
+        for (key, sensitivity) in &results.sensitivities {
+            values.set_item(key, sensitivity.value)?;
+            units.set_item(key, &sensitivity.unit)?;
+        }
+        out.set_item("sensitivities", values)?;
+        out.set_item("sensitivity_units", units)?;
     }
     if !results.notes.is_empty() {
         let notes: std::collections::BTreeMap<&str, String> = (results.notes.iter())
@@ -246,21 +263,30 @@ fn missing_message(
 }
 
 /// What [`sweep_flat`] returns: separation angle and time (NaN where a point failed), whether
-/// each point succeeded, and every failure as `(flat index, message)` in index order.
+/// each point succeeded, every failure as `(flat index, message)` in index order, and, when
+/// sensitivities were asked for, `(name, values)` for `d(separation_angle)/d(<p>)` then
+/// `d(separation_time)/d(<p>)` for every parameter `p` in the model's order.
 type Flat<'py> = (
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<bool>>,
-    Vec<(usize, String)>,
+    Failures,
+    Vec<(String, Bound<'py, PyArray1<f64>>)>,
 );
+
+/// Failed points: `(flat index, message)`.
+type Failures = Vec<(usize, String)>;
 
 /// The sweep over flat arrays, one per axis and all of one length (the Python `sweep`
 /// broadcasts and reshapes): separation angle and time by the per-point solver, in parallel
 /// with the GIL released. `fixed` are keyword values; `defaults` give parameters that neither
 /// an axis nor `fixed` sets. A parameter that nothing sets is an error naming it: no value is
 /// ever assumed. A point that fails is NaN, `False` in the mask, and its error's message.
+/// With `sensitivities`, each point's exact sensitivities by `LeanSolver::sensitivities` too:
+/// where they do not exist the point is `False` in the mask (its angle and time kept), its
+/// sensitivities NaN, and the message says why.
 #[pyfunction]
-#[pyo3(signature = (model, axes, columns, fixed, defaults))]
+#[pyo3(signature = (model, axes, columns, fixed, defaults, sensitivities=false))]
 fn sweep_flat<'py>(
     py: Python<'py>,
     model: &str,
@@ -268,6 +294,7 @@ fn sweep_flat<'py>(
     columns: Vec<PyReadonlyArray1<'py, f64>>,
     fixed: Vec<(String, f64)>,
     defaults: Vec<(String, f64)>,
+    sensitivities: bool,
 ) -> PyResult<Flat<'py>> {
     let m = find(model)?;
     let info = m.info();
@@ -289,35 +316,7 @@ fn sweep_flat<'py>(
         )));
     }
     let axis_names: Vec<&str> = axes.iter().map(String::as_str).collect();
-    let mut values: Vec<(&str, f64)> = fixed.iter().map(|(n, v)| (n.as_str(), *v)).collect();
-    // Refused axes or keyword values first, by name, before anything is said to be missing.
-    Mapping::new(info, &axis_names, &values).map_err(error)?;
-    let targets = axis_names
-        .iter()
-        .map(|name| resolve(name, info).map_err(error))
-        .collect::<PyResult<Vec<_>>>()?;
-    let unset = unset(info, &targets, &values, &defaults)?;
-    let missing: Vec<&ParamInfo> = unset
-        .iter()
-        .filter(|(_, d)| d.is_none())
-        .map(|(p, _)| *p)
-        .collect();
-    if !missing.is_empty() {
-        return Err(error(missing_message(
-            info,
-            &axis_names,
-            &targets,
-            &missing,
-        )));
-    }
-    values.extend(
-        unset
-            .iter()
-            .flat_map(|(_, d)| d.map(|(n, v)| (n.as_str(), *v))),
-    );
-    // Every parameter is now an axis or a value given: `Mapping`'s 1 for the others never
-    // applies.
-    let mapping = Mapping::new(info, &axis_names, &values).map_err(error)?;
+    let mapping = full_mapping(info, &axis_names, &fixed, &defaults)?;
     let dims = columns.len();
     let points: Vec<f64> = (0..len)
         .flat_map(|k| columns.iter().map(move |c| c[k]))
@@ -325,7 +324,12 @@ fn sweep_flat<'py>(
     let mut angle = vec![f64::NAN; len];
     let mut time = vec![f64::NAN; len];
     let mut ok = vec![false; len];
-    let errors: Vec<(usize, String)> = py.detach(|| {
+    let width = if sensitivities {
+        2 * info.parameters.len()
+    } else {
+        0
+    };
+    let chunks: Vec<(Failures, Vec<f64>)> = py.detach(|| {
         (
             points.par_chunks(CHUNK * dims),
             angle.par_chunks_mut(CHUNK),
@@ -334,39 +338,141 @@ fn sweep_flat<'py>(
         )
             .into_par_iter()
             .enumerate()
-            .flat_map_iter(|(c, (chunk, angles, times, oks))| {
-                let first = c * CHUNK;
-                let mut errors = Vec::new();
-                let mut solver = match LeanSolver::new(m) {
-                    Ok(solver) => solver,
-                    Err(e) => {
-                        let message = e.to_string();
-                        errors.extend((0..oks.len()).map(|k| (first + k, message.clone())));
-                        return errors.into_iter();
-                    }
+            .map(|(c, (chunk, angles, times, oks))| {
+                let mut out = Chunk {
+                    first: c * CHUNK,
+                    angles,
+                    times,
+                    oks,
+                    errors: Vec::new(),
+                    sens: vec![f64::NAN; width * (chunk.len() / dims)],
                 };
-                let mut p = vec![0.0; info.parameters.len()];
-                for (k, point) in chunk.chunks(dims).enumerate() {
-                    mapping.fill(point, &mut p);
-                    match solver.solve(&p) {
-                        Ok(out) => {
-                            angles[k] = out.separation_angle;
-                            times[k] = out.separation_time;
-                            oks[k] = true;
-                        }
-                        Err(e) => errors.push((first + k, e.to_string())),
-                    }
-                }
-                errors.into_iter()
+                out.solve(m, &mapping, chunk, dims, width > 0);
+                (out.errors, out.sens)
             })
             .collect()
     });
+    let mut errors = Vec::new();
+    let mut sens = Vec::with_capacity(width * len);
+    for (e, s) in chunks {
+        errors.extend(e);
+        sens.extend(s);
+    }
+    let names = (["separation_angle", "separation_time"].iter())
+        .flat_map(|of| (info.parameters.iter()).map(move |p| format!("d({of})/d({})", p.name)));
+    let sens_columns = names
+        .take(width)
+        .enumerate()
+        .map(|(j, name)| {
+            let column: Vec<f64> = (0..len).map(|k| sens[k * width + j]).collect();
+            (name, column.into_pyarray(py))
+        })
+        .collect();
     Ok((
         angle.into_pyarray(py),
         time.into_pyarray(py),
         ok.into_pyarray(py),
         errors,
+        sens_columns,
     ))
+}
+
+/// The mapping from axes to parameters once every parameter has a value: an axis, a keyword
+/// value (`fixed`) or `defaults`. A parameter that nothing sets is an error naming it.
+fn full_mapping(
+    info: &'static ModelInfo,
+    axis_names: &[&str],
+    fixed: &[(String, f64)],
+    defaults: &[(String, f64)],
+) -> PyResult<Mapping> {
+    let mut values: Vec<(&str, f64)> = fixed.iter().map(|(n, v)| (n.as_str(), *v)).collect();
+    // Refused axes or keyword values first, by name, before anything is said to be missing.
+    Mapping::new(info, axis_names, &values).map_err(error)?;
+    let targets = axis_names
+        .iter()
+        .map(|name| resolve(name, info).map_err(error))
+        .collect::<PyResult<Vec<_>>>()?;
+    let unset = unset(info, &targets, &values, defaults)?;
+    let missing: Vec<&ParamInfo> = unset
+        .iter()
+        .filter(|(_, d)| d.is_none())
+        .map(|(p, _)| *p)
+        .collect();
+    if !missing.is_empty() {
+        return Err(error(missing_message(info, axis_names, &targets, &missing)));
+    }
+    values.extend(
+        unset
+            .iter()
+            .flat_map(|(_, d)| d.map(|(n, v)| (n.as_str(), *v))),
+    );
+    // Every parameter is now an axis or a value given: `Mapping`'s 1 for the others never
+    // applies.
+    Mapping::new(info, axis_names, &values).map_err(error)
+}
+
+/// One parallel task's share of the sweep's outputs.
+struct Chunk<'a> {
+    /// The flat index of its first point.
+    first: usize,
+    angles: &'a mut [f64],
+    times: &'a mut [f64],
+    oks: &'a mut [bool],
+    errors: Failures,
+    /// Per point, `d theta_sep/dp` then `d t_sep/dp` (NaN where there are none).
+    sens: Vec<f64>,
+}
+
+impl Chunk<'_> {
+    /// Solves the chunk's points (`dims` values each), with their sensitivities if `sens`.
+    fn solve(
+        &mut self,
+        m: &'static dyn Model,
+        mapping: &Mapping,
+        chunk: &[f64],
+        dims: usize,
+        sens: bool,
+    ) {
+        let mut solver = match LeanSolver::new(m) {
+            Ok(solver) => solver,
+            Err(e) => {
+                let message = e.to_string();
+                let first = self.first;
+                (self.errors).extend((0..self.oks.len()).map(|k| (first + k, message.clone())));
+                return;
+            }
+        };
+        let np = m.info().parameters.len();
+        let mut p = vec![0.0; np];
+        let mut work = SensitivityWork::default();
+        for (k, point) in chunk.chunks(dims).enumerate() {
+            mapping.fill(point, &mut p);
+            let out = match solver.solve(&p) {
+                Ok(out) => out,
+                Err(e) => {
+                    self.errors.push((self.first + k, e.to_string()));
+                    continue;
+                }
+            };
+            self.angles[k] = out.separation_angle;
+            self.times[k] = out.separation_time;
+            self.oks[k] = true;
+            if !sens {
+                continue;
+            }
+            let (a, t) = self.sens[2 * np * k..2 * np * (k + 1)].split_at_mut(np);
+            let missing = match solver.sensitivities(&p, &out, &mut work, a, t) {
+                Ok(Ok(())) => continue,
+                Ok(Err(gap)) => prose::note(&Note::NoSensitivity(gap)),
+                Err(e) => e.to_string(),
+            };
+            // Whatever part was written before the gap is no number.
+            a.fill(f64::NAN);
+            t.fill(f64::NAN);
+            self.oks[k] = false;
+            self.errors.push((self.first + k, missing));
+        }
+    }
 }
 
 /// The compiled half of the `rodcube` package.
