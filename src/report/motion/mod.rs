@@ -37,5 +37,7 @@ pub use animation::{
     Animation, ContactEnd, Frame, ImpactMark, MAX_KEYFRAMES, PAUSE_SECONDS, PhaseSpan, Shape,
     TARGET_SECONDS, slow_motion,
 };
+// The FMU's model description escapes its text with it.
+#[cfg(any(feature = "cli", feature = "fmi"))]
 pub(crate) use svg::xml;
 pub use svg::{MAX_IMPACT_MARKS, MAX_TIME_LABELS, svg};
