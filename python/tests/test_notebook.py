@@ -16,6 +16,7 @@ import pathlib
 import re
 import subprocess
 import sys
+import sysconfig
 from importlib import metadata
 
 import pytest
@@ -255,5 +256,8 @@ def test_the_package_is_installed_from_an_abi3_wheel():
     wheel = dist.read_text("WHEEL") or ""
     assert re.search(r"^Tag: cp39-abi3-", wheel, re.M), wheel
     assert dist.metadata["Requires-Python"] == ">=3.9"
-    # Not the source tree: the package lives in the environment.
-    assert ROOT not in pathlib.Path(rodcube.__file__).resolve().parents
+    # Not the source tree: the package lives in the environment's site-packages (which may
+    # itself lie under the checkout, as the test's virtual environment does in target/).
+    installed = pathlib.Path(rodcube.__file__).resolve().parents
+    assert ROOT / "python" not in installed
+    assert pathlib.Path(sysconfig.get_paths()["purelib"]).resolve() in installed
