@@ -451,6 +451,47 @@ pub trait Model: Send + Sync {
     /// `poses.len()` is the number of bodies, `sizes.len()` [`ModelInfo::drawing_sizes`].
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]);
 
+    /// Whether the model has [`Model::tangents`] and [`Model::initial_tangents`] (every
+    /// generated general model does: the integrated phases' forward sensitivities need them; a
+    /// fast phase or a hand-written test model has none).
+    fn has_tangents(&self) -> bool {
+        false
+    }
+
+    /// Partial derivatives over `x = [q, qd, p]` (`2 n + np` columns, `np` the parameters of
+    /// [`ModelInfo::parameters`] in order; row-major) of these rows, at a state with
+    /// accelerations `qdd`, every contact's force `forces` (one per contact, zero where open)
+    /// and every friction's force `fr` (one per friction), each of `qdd`, `forces` and `fr`
+    /// held fixed:
+    ///
+    /// 1. `n` rows: the equations of motion's residual `M qdd - F - J^T forces - T^T fr`
+    ///    ([`Model::equations`], [`Model::constraints`], [`Model::friction`]);
+    /// 2. one row per contact: its normal acceleration `J qdd + bias`;
+    /// 3. one row per friction: its slip acceleration `T qdd + c`;
+    /// 4. one row per contact: its gap ([`Model::gaps`]; a zero row where it is zero);
+    /// 5. one row per contact: its edge margin ([`Model::edges`]; a zero row without an edge);
+    /// 6. one row per friction: its slip velocity `T qd`.
+    ///
+    /// `out.len()` is `(n + 3 m + 2 nf) (2 n + np)` with `m` contacts and `nf` frictions.
+    /// Writes nothing where [`Model::has_tangents`] is false.
+    #[allow(clippy::too_many_arguments)]
+    fn tangents(
+        &self,
+        _k: &[f64],
+        _q: &[f64],
+        _qd: &[f64],
+        _qdd: &[f64],
+        _forces: &[f64],
+        _fr: &[f64],
+        _out: &mut [f64],
+    ) {
+    }
+
+    /// `d(initial state)/dp`: `2 n` rows (`q`, then `qd`, as [`Model::initial_state`] gives
+    /// them) over the parameters (`np` columns, row-major). Writes nothing where
+    /// [`Model::has_tangents`] is false.
+    fn initial_tangents(&self, _k: &[f64], _out: &mut [f64]) {}
+
     /// The fast path, if the model has one ([`ModelInfo::reduction`] describes it).
     fn reduction(&self) -> Option<&dyn Reduction>;
 }
