@@ -39,6 +39,7 @@ impl OdeProblem for NotANumber {
 
 fn options() -> OdeOptions {
     OdeOptions {
+        controlled: None,
         rtol: 1e-10,
         atol: vec![1e-12],
         t_max: 2.0,

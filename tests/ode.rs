@@ -299,6 +299,7 @@ fn both_integrators_find_the_separation() {
         1e-6, 1e-8, 1e-9, 1e-10, 5e-11, 3e-11, 2e-11, 1e-11, 1e-12, 1e-13,
     ] {
         let opts = OdeOptions {
+            controlled: None,
             rtol,
             atol: Vec::new(),
             t_max: 1.0,

@@ -497,6 +497,7 @@ fn reduced_ode(
         calls: 0,
     };
     let opts = OdeOptions {
+        controlled: None,
         rtol,
         atol: Vec::new(),
         t_max,

@@ -712,6 +712,7 @@ pub fn integrate_with(
     let atol = absolute_tolerances(sys, start, scales, rtol, with_work)?;
     let stop_at = start.stop_at.filter(|s| *s <= t_max);
     let opts = OdeOptions {
+        controlled: None,
         rtol,
         atol,
         t_max: stop_at.unwrap_or(t_max),

@@ -364,6 +364,53 @@ impl<'m> Bound<'m> {
         Ok(())
     }
 
+    /// The number of rows of [`Self::tangents_into`]: `n + 3 m + 2 nf`.
+    pub fn tangent_rows(&self) -> usize {
+        let info = self.info();
+        self.n_coordinates() + 3 * info.contacts.len() + 2 * info.frictions.len()
+    }
+
+    /// The partial derivatives of the dynamics' rows over `[q, qd, p]` at a state with its
+    /// accelerations, contact forces and friction forces held fixed
+    /// ([`Model::tangents`](crate::model::Model::tangents) gives the rows), row-major with
+    /// `2 n + np` columns, into `out` (resized).
+    pub fn tangents_into(
+        &self,
+        state: &State,
+        qdd: &[f64],
+        forces: &[f64],
+        fr: &[f64],
+        out: &mut Vec<f64>,
+    ) -> Result<(), SystemError> {
+        self.check_state(state)?;
+        let info = self.info();
+        if !self.model.has_tangents() {
+            return Err(SystemError::NoTangents { model: info.name });
+        }
+        self.check_length("qdd", self.n_coordinates(), qdd.len())?;
+        self.check_length("forces", info.contacts.len(), forces.len())?;
+        self.check_length("fr", info.frictions.len(), fr.len())?;
+        finite("qdd", qdd)?;
+        finite("forces", forces)?;
+        finite("fr", fr)?;
+        let cols = 2 * self.n_coordinates() + info.parameters.len();
+        zeroed(out, self.tangent_rows() * cols);
+        self.model
+            .tangents(&self.k, &state.q, &state.qd, qdd, forces, fr, out);
+        Ok(())
+    }
+
+    /// `d(initial state)/dp`: `2 n` rows (`q`, then `qd`) over the parameters, row-major.
+    pub fn initial_tangents(&self) -> Result<Vec<f64>, SystemError> {
+        let info = self.info();
+        if !self.model.has_tangents() {
+            return Err(SystemError::NoTangents { model: info.name });
+        }
+        let mut out = vec![0.0; 2 * self.n_coordinates() * info.parameters.len()];
+        self.model.initial_tangents(&self.k, &mut out);
+        Ok(out)
+    }
+
     /// The friction coefficient of each friction.
     pub fn friction_coefficients(&self) -> Vec<f64> {
         self.friction_coefficient_values().collect()

@@ -153,6 +153,13 @@ pub enum SystemError {
         /// Why, from the derivation.
         why: &'static str,
     },
+    /// The model has no partial derivatives of its dynamics ([`crate::model::Model::tangents`]):
+    /// a fast phase, or a hand-written model.
+    #[error("model `{model}` has no partial derivatives of its dynamics (tangents)")]
+    NoTangents {
+        /// Model name.
+        model: &'static str,
+    },
     /// A model whose `reduced_index` names none of its coordinates (a malformed generated
     /// model).
     #[error("model `{model}` names coordinate {index} as its reduced one but has {coordinates}")]

@@ -71,6 +71,11 @@ pub struct OdeOptions {
     /// compute one (DOP853 saves its three dense-output evaluations a step elsewhere) and the
     /// solution holds the states at the steps' ends; the steps and events are the same.
     pub dense_output: bool,
+    /// How many leading components of `y` the step-size control holds to the tolerances
+    /// (`None`: all of them). The others ride along on the same steps without steering them
+    /// (forward sensitivities: their state's steps, events and values are then those of the
+    /// integration without them, bit for bit). `atol`'s length is compared with this count.
+    pub controlled: Option<usize>,
 }
 
 /// The Runge–Kutta method of an integration.
@@ -311,6 +316,8 @@ fn check_finite(what: &'static str, t: f64, v: &[f64]) -> Result<(), SolveError>
 /// of another length than `dim`, `rtol` times the component's running peak (floored at `1e-8`
 /// of the largest peak).
 struct Tolerance {
+    /// How many leading components are controlled.
+    n: usize,
     rtol: f64,
     atol: Vec<f64>,
     relative_only: bool,
@@ -319,9 +326,11 @@ struct Tolerance {
 
 impl Tolerance {
     fn new(opts: &OdeOptions, y0: &[f64]) -> Self {
-        let n = y0.len();
+        let n = opts.controlled.map_or(y0.len(), |c| c.min(y0.len()));
+        let y0 = &y0[..n];
         let relative_only = opts.atol.len() != n;
         Tolerance {
+            n,
             rtol: opts.rtol,
             atol: if relative_only {
                 vec![0.0; n]
@@ -507,11 +516,12 @@ fn initial_step<P: OdeProblem>(
     order: u32,
 ) -> Result<f64, SolveError> {
     let n = y.len();
-    let sc: Vec<f64> = (0..n)
+    let controlled = tol.n;
+    let sc: Vec<f64> = (0..controlled)
         .map(|i| tol.atol[i] + tol.rtol * y[i].abs())
         .collect();
     let norm = |v: &[f64]| {
-        (v.iter().zip(&sc).map(|(x, s)| (x / s).powi(2)).sum::<f64>() / n as f64).sqrt()
+        (v.iter().zip(&sc).map(|(x, s)| (x / s).powi(2)).sum::<f64>() / controlled as f64).sqrt()
     };
     let d0 = norm(y);
     let d1 = norm(f0);

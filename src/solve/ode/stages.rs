@@ -118,7 +118,7 @@ impl Stages {
 
     /// The step's error norm relative to the tolerances (accept when at most 1).
     pub(super) fn error(&self, y: &[f64], h: f64, tol: &Tolerance) -> f64 {
-        let n = y.len();
+        let n = tol.n.min(y.len());
         let scale = |i: usize| tol.atol[i] + tol.rtol * y[i].abs().max(self.y1[i].abs());
         let weighted =
             |w: &[f64], i: usize| -> f64 { w.iter().zip(&self.k).map(|(e, k)| e * k[i]).sum() };

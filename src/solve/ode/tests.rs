@@ -27,6 +27,7 @@ impl OdeProblem for Oscillator {
 #[test]
 fn oscillator_event_and_dense_output() {
     let opts = OdeOptions {
+        controlled: None,
         rtol: 1e-12,
         atol: vec![1e-14; 2],
         t_max: 10.0,
@@ -54,6 +55,7 @@ fn tighter_tolerance_is_more_accurate() {
     // Without events: a tighter tolerance takes more steps and lands closer to sin(1).
     let run = |rtol: f64| {
         let opts = OdeOptions {
+            controlled: None,
             rtol,
             atol: vec![rtol; 2],
             t_max: 1.0,
@@ -138,6 +140,7 @@ impl<P: OdeProblem> OdeProblem for Counted<P> {
 
 fn options(rtol: f64, atol: Vec<f64>, t_max: f64) -> OdeOptions {
     OdeOptions {
+        controlled: None,
         rtol,
         atol,
         t_max,
@@ -484,6 +487,7 @@ fn non_finite_derivatives_are_the_same_typed_error() {
 fn step_limits_are_the_same_typed_errors() {
     for method in METHODS {
         let opts = OdeOptions {
+            controlled: None,
             max_steps: 3,
             dense_output: true,
             ..options(1e-12, Vec::new(), 10.0)
@@ -542,4 +546,83 @@ fn dop853_tableau_is_consistent() {
     let e5: f64 = dop853_coefficients::E5.iter().sum();
     let e3: f64 = dop853_coefficients::E3.iter().sum();
     assert!(e5.abs() < 1e-14 && e3.abs() < 1e-14, "{e5:e} {e3:e}");
+}
+
+/// `y'' = -w^2 y` from `y = 1`, `y' = 0` with its forward sensitivity `s = dy/dw` riding along
+/// (`s'' = -w^2 s - 2 w y`, exactly `-t sin(w t)`), and the event `y' = -w/2`.
+struct Sensitive {
+    w: f64,
+    riders: bool,
+}
+
+impl OdeProblem for Sensitive {
+    fn dim(&self) -> usize {
+        if self.riders { 4 } else { 2 }
+    }
+    fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SolveError> {
+        let w2 = self.w * self.w;
+        dy[0] = y[1];
+        dy[1] = -w2 * y[0];
+        if self.riders {
+            dy[2] = y[3];
+            dy[3] = -w2 * y[2] - 2.0 * self.w * y[0];
+        }
+        Ok(())
+    }
+    fn n_events(&self) -> usize {
+        1
+    }
+    fn events(&mut self, _t: f64, y: &[f64], _dy: &[f64], g: &mut [f64]) -> Result<(), SolveError> {
+        g[0] = y[1] + 0.5 * self.w;
+        Ok(())
+    }
+}
+
+#[test]
+fn riders_follow_the_steps_without_steering_them() {
+    for method in [Method::Dopri5, Method::Dop853] {
+        let w = 1.3;
+        let plain = integrate(
+            method,
+            &mut Sensitive { w, riders: false },
+            0.0,
+            &[1.0, 0.0],
+            &options(1e-11, vec![1e-13; 2], 10.0),
+        )
+        .unwrap();
+        let opts = OdeOptions {
+            controlled: Some(2),
+            ..options(1e-11, vec![1e-13; 2], 10.0)
+        };
+        let with = integrate(
+            method,
+            &mut Sensitive { w, riders: true },
+            0.0,
+            &[1.0, 0.0, 0.0, 0.0],
+            &opts,
+        )
+        .unwrap();
+        assert_eq!(plain.accepted, with.accepted, "{method}");
+        assert_eq!(plain.rejected, with.rejected, "{method}");
+        let (a, b) = (plain.event.clone().unwrap(), with.event.clone().unwrap());
+        assert_eq!(a.t.to_bits(), b.t.to_bits(), "{method}");
+        assert_eq!(a.y[..], b.y[..2], "{method}");
+        // The event at w t = pi/6 + ...: y' = -w sin(w t) = -w/2, so w t = pi/6.
+        let t = std::f64::consts::FRAC_PI_6 / w;
+        assert!((b.t - t).abs() < 1e-12, "{method}: {} vs {t}", b.t);
+        let exact = -t * (w * t).sin();
+        assert!(
+            (b.y[2] - exact).abs() < 1e-10,
+            "{method}: {} vs {exact}",
+            b.y[2]
+        );
+        for t in [0.1, 0.2, 0.3] {
+            let s = with.interpolate(t).unwrap()[2];
+            assert!(
+                (s + t * (w * t).sin()).abs() < 1e-9,
+                "{method} at {t}: {s} off by {}",
+                s + t * (w * t).sin()
+            );
+        }
+    }
 }
