@@ -1001,8 +1001,11 @@ mod tests {
         for gap in [
             SensitivityGap::AtRelease,
             SensitivityGap::NoSeparation,
-            SensitivityGap::Integrated,
             SensitivityGap::NotBuilt,
+            SensitivityGap::PastImpact,
+            SensitivityGap::Grazing,
+            SensitivityGap::RoutesDisagree,
+            SensitivityGap::IntegrationFailed,
             SensitivityGap::NoPartials,
             SensitivityGap::NoFallPolynomial,
             SensitivityGap::DoubleRoot,

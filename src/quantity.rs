@@ -102,8 +102,8 @@ pub const FIXED: &[(&str, Quantity, &str)] = &[
     (
         "sensitivities",
         Quantity::Sensitivities,
-        "d(result)/d(parameter) and elasticities of the wanted separation angle and time and \
-         contact ends, for every parameter (fast path)",
+        "d(result)/d(parameter) and elasticities of the wanted separation angle and time, \
+         contact ends and floor impact, for every parameter",
     ),
 ];
 
@@ -227,9 +227,7 @@ impl Quantity {
         let separates = info.contacts.first().is_some_and(|c| !c.bilateral);
         let release = info.phases.iter().find(|p| p.release);
         match self {
-            Quantity::SeparationAngle | Quantity::SeparationTime | Quantity::Sensitivities => {
-                separates
-            }
+            Quantity::SeparationAngle | Quantity::SeparationTime => separates,
             Quantity::ContactEnd => !info.contacts.is_empty(),
             Quantity::Impacts => (info.contacts.iter()).any(|c| !c.closed && !c.bilateral),
             Quantity::LinearisedSeparationAngle => {
@@ -240,6 +238,7 @@ impl Quantity {
             Quantity::FrictionSeries(i) => *i < info.frictions.len(),
             Quantity::Trajectory(i) => *i < info.points.len(),
             Quantity::FloorImpact
+            | Quantity::Sensitivities
             | Quantity::ThetaSeries
             | Quantity::Checks
             | Quantity::PointMassFallTime => true,

@@ -757,6 +757,7 @@ fn the_solvers_refuse_a_state_of_another_length() {
             friction_work: 0.0,
             stop_at: None,
             dense_output: true,
+            sensitivity: None,
         };
         input(
             &unpanicked("integrate", || {

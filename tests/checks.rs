@@ -376,6 +376,7 @@ fn a_cube_running_into_the_tip_ends_the_motion() {
         friction_work: 0.0,
         stop_at: None,
         dense_output: true,
+        sensitivity: None,
     };
     let ode = unreduced::integrate(&w.general, &start, 1e-12, None, 1.0, &mut work).unwrap();
     assert_eq!(ode.end, End::Contact(0));

@@ -52,6 +52,7 @@ fn integrate_general(
         friction_work: 0.0,
         stop_at: None,
         dense_output: true,
+        sensitivity: None,
     };
     let d = contacts::dynamics(general, &start.state, &start.active, 0.0).unwrap();
     let scales = motion_scales(
@@ -141,6 +142,7 @@ fn the_contact_force_vanishes_at_the_event() {
         friction_work: 0.0,
         stop_at: None,
         dense_output: true,
+        sensitivity: None,
     };
     let run = integrate(bound, &start, 1e-12, None, 1.0, &mut Work::default()).unwrap();
     assert_eq!(run.end, End::Force(0));

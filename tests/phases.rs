@@ -188,6 +188,7 @@ fn ode_agrees_on_the_free_phase() {
         friction_work: 0.0,
         stop_at: None,
         dense_output: true,
+        sensitivity: None,
     };
     let run = integrate(&w.general, &start, 1e-12, None, 1.0, &mut Work::default()).unwrap();
     assert_eq!(run.end, End::Floor);

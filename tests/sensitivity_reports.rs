@@ -139,18 +139,18 @@ fn results_json_carries_every_sensitivity_with_its_unit_and_the_elasticities() {
     }
     // The angle does not depend on g at all: an exact zero.
     assert_eq!(sens["d(separation_angle)/d(g)"]["value"], 0.0);
-    // What comes after the separation has a note, and no number.
+    // The landing comes from the motion integrated with its forward sensitivities, with the
+    // landing's units; the floor's contact holds to the landing: no number, and no note of
+    // its own beside the one that says it holds.
+    assert_eq!(sens["d(floor_impact_time)/d(ell)"]["unit"], "s/m");
+    assert_eq!(sens["d(impact_angular_velocity)/d(g)"]["unit"], "s/m");
     let notes = json["notes"].as_object().unwrap();
-    for key in [
-        "sensitivities.floor_impact",
-        "sensitivities.floor_normal_end",
-    ] {
-        assert!(
-            notes[key].as_str().unwrap().contains("not available"),
-            "{key}"
-        );
-    }
-    assert!(!sens.keys().any(|k| k.contains("floor")));
+    assert!(notes.contains_key("floor_normal_end"), "{notes:?}");
+    assert!(
+        !notes.keys().any(|k| k.starts_with("sensitivities.")),
+        "{notes:?}"
+    );
+    assert!(!sens.keys().any(|k| k.contains("floor_normal")));
 }
 
 #[test]
@@ -173,8 +173,10 @@ fn sensitivities_of_nothing_wanted_are_a_scene_error_at_their_position() {
 }
 
 #[test]
-fn an_integrated_run_gets_a_note_and_no_number() {
-    // The friction model has no fast phase: its separation is integrated.
+fn an_integrated_run_has_sensitivities_with_their_units() {
+    // The friction model has no fast phase: its separation is integrated, with its forward
+    // sensitivities (their values are checked against differences in
+    // tests/forward_sensitivities.rs).
     let model = rodcube::models::find("rod_cube_friction").unwrap();
     let names: Vec<&str> = model.info().parameters.iter().map(|p| p.name).collect();
     let p: Vec<f64> = (names.iter())
@@ -182,7 +184,7 @@ fn an_integrated_run_gets_a_note_and_no_number() {
             "m2" => 3.0,
             "a" => 0.25,
             "g" => 9.81,
-            "mu" | "mu_floor" | "mu_cube" => 0.0,
+            "mu" => 1.45,
             _ => 1.0,
         })
         .collect();
@@ -193,19 +195,19 @@ fn an_integrated_run_gets_a_note_and_no_number() {
     ];
     let res = plan::run(&Request::new(model, p).with_want(&want)).unwrap();
     assert!(res.results.contains_key("separation_time"));
-    assert!(res.sensitivities.is_empty());
-    for key in [
-        "sensitivities.separation_angle",
-        "sensitivities.separation_time",
-    ] {
-        assert_eq!(
-            res.notes.get(key),
-            Some(&rodcube::results::Note::NoSensitivity(
-                SensitivityGap::Integrated
-            )),
-            "{key}: {:?}",
-            res.notes
-        );
+    assert!(
+        !res.notes.keys().any(|k| k.starts_with("sensitivities.")),
+        "{:?}",
+        res.notes
+    );
+    for name in names {
+        for (of, unit) in [("separation_time", "s"), ("separation_angle", "rad")] {
+            let s = &res.sensitivities[&format!("d({of})/d({name})")];
+            assert!(s.value.is_finite(), "{of} {name}");
+            if name == "mu" {
+                assert_eq!(s.unit, unit, "{of} {name}");
+            }
+        }
     }
 }
 

@@ -78,6 +78,7 @@ fn series_agrees_with_the_ode_dense_output() {
             friction_work: 0.0,
             stop_at: None,
             dense_output: true,
+            sensitivity: None,
         };
         // Absolute tolerances from the motion's own scales (the foot's height, held at zero,
         // carries only rounding).

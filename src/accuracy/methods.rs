@@ -525,6 +525,7 @@ pub fn time_unreduced(sys: &System, rtol: f64, t_max: f64) -> Outcome<f64> {
         friction_work: 0.0,
         stop_at: None,
         dense_output: true,
+        sensitivity: None,
     };
     let run = unreduced::integrate_with(
         sys,

@@ -46,10 +46,11 @@ mod verify;
 
 use crate::model::Model;
 use crate::quantity::Quantity;
-use crate::results::{Column, Meaning, RunResults, Scalar, Work};
+use crate::results::{Column, Meaning, RunResults, Scalar, SensitivityGap, Work};
 use crate::solve::SolveError;
 use crate::solve::phases::{
-    End, Motion, PhaseRun, PhaseStart, ReducedEnd, ReducedRun, Route, Walker, phase_end,
+    End, Motion, PhaseRun, PhaseStart, ReducedEnd, ReducedRun, Route, SensitiveMotion, Walker,
+    phase_end,
 };
 use crate::solve::quadrature::TimeMesh;
 use crate::solve::series::PhaseSamples;
@@ -351,8 +352,13 @@ pub fn run(request: &Request) -> Result<RunResults, PlanError> {
         parameters: plan.walker.general.parameter_map(),
         ..RunResults::default()
     };
-    // The cross-check first, so that `checks` can include its path when both are wanted.
-    want.sort_by_key(|q| matches!(q, Quantity::Checks));
+    // The cross-check first, so that `checks` can include its path when both are wanted; the
+    // sensitivities last, of the results computed before them.
+    want.sort_by_key(|q| match q {
+        Quantity::Checks => 1,
+        Quantity::Sensitivities => 2,
+        _ => 0,
+    });
     for q in &want {
         plan.quantity(*q, &want, &mut out)?;
     }
@@ -414,6 +420,8 @@ struct Plan<'m> {
     span: Option<Vec<(usize, PhaseSamples, Vec<f64>)>>,
     /// The cross-check's integration.
     ode: Option<UnreducedRun>,
+    /// The motion integrated with its forward sensitivities, or why there is none.
+    sensitive: Option<Result<SensitiveMotion<'m>, SensitivityGap>>,
 }
 
 fn scalar(out: &mut RunResults, key: &str, value: f64, unit: &'static str, meaning: Meaning) {
@@ -449,6 +457,7 @@ impl<'m> Plan<'m> {
             phase_samples: Vec::new(),
             span: None,
             ode: None,
+            sensitive: None,
         }
     }
 
@@ -661,6 +670,7 @@ impl<'m> Plan<'m> {
             friction_work: 0.0,
             stop_at: None,
             dense_output: self.walker.dense_output,
+            sensitivity: None,
         };
         let bound = self.general().clone();
         let t_max = 2.0 * duration.max(f64::MIN_POSITIVE);

@@ -190,6 +190,17 @@ fn is_landing(general: &Bound, phase: &PhaseRun) -> Result<bool, SolveError> {
     }
 }
 
+/// The index of the phase of `motion` (of the system whose general model is `general`) that
+/// ends where the body lands ([`is_landing`]), if one does.
+pub(super) fn landing(motion: &Motion, general: &Bound) -> Result<Option<usize>, SolveError> {
+    for (k, phase) in motion.phases.iter().enumerate() {
+        if is_landing(general, phase)? {
+            return Ok(Some(k));
+        }
+    }
+    Ok(None)
+}
+
 /// An impact as results hold it: names, normal velocities and impulses of the contacts that
 /// took part, with their units.
 fn impact_record(info: &ModelInfo, at: &ImpactAt) -> ImpactRecord {
@@ -638,14 +649,7 @@ impl Plan<'_> {
             );
         }
         let name = |j: usize| info.contacts.get(j).map_or("a contact", |c| c.name);
-        let mut landing = None;
-        for phase in &motion.phases {
-            if is_landing(&general, phase)? {
-                landing = Some(phase);
-                break;
-            }
-        }
-        let Some(landing) = landing else {
+        let Some(landing) = landing(motion, &general)?.map(|k| &motion.phases[k]) else {
             let end = match motion.last_end() {
                 Some(End::Edge(j)) => Unlanded::Edge(name(j).to_string()),
                 Some(End::Contact(j)) => Unlanded::Contact(name(j).to_string()),

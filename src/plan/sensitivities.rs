@@ -1,21 +1,25 @@
 //! The quantity `sensitivities`: `d(<result>)/d(<parameter>)` and the elasticities
-//! `(p/x) dx/dp` of the wanted separation angle and time and of the first contact's end where
-//! it is that separation, for every parameter, from the fast path's generated partial
-//! derivatives (`solve::sensitivity`). Anything else wanted that sensitivities could be asked
-//! of (the other contacts' ends, the floor impact, the impacts) gets a note saying they are not
-//! available there, never a number.
+//! `(p/x) dx/dp` of every wanted result that has them, for every parameter: the separation
+//! angle and time, every contact's end (time and angle), the floor impact (time and angular
+//! velocity). The first contact's separation on the fast phase the motion starts on has them
+//! from the fast path's generated partial derivatives (`solve::sensitivity`); every other
+//! from the motion integrated with its forward sensitivities (`Walker::sensitive_motion`),
+//! whose event is held to the run's: the same contact ending by the same cause, at a time
+//! within [`ROUTES_AGREE`]. Where a result has none (after an impact, at a grazing event, an
+//! impact's own numbers), a note says why, never a number.
 
 use super::Plan;
-use super::quantities::Fate;
+use super::quantities::{Fate, fate, landing};
 use crate::model::start_offsets;
 use crate::quantity::Quantity;
 use crate::results::{Note, RunResults, Sensitivity, SensitivityGap};
 use crate::solve::SolveError;
-use crate::solve::phases::End;
+use crate::solve::phases::{End, SensitiveMotion};
 use crate::solve::prior::{PRIOR_TOL, Prior};
 use crate::solve::quadrature::ACCEPT;
 use crate::solve::sensitivity::{self, SensitivityWork, SeparationPoint};
 use crate::spec::units::Unit;
+use crate::system::SystemError;
 
 /// A result the sensitivities are of: its key, unit and whether it is an angle.
 struct Target {
@@ -51,7 +55,25 @@ pub fn per(result: &str, parameter: &str) -> String {
     }
 }
 
-impl Plan<'_> {
+/// The relative difference of an event's time on the integrated route that carries the
+/// sensitivities from the run's own, past which the two are not the same event.
+pub const ROUTES_AGREE: f64 = 1e-6;
+
+/// Where a target's derivatives come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Source {
+    /// The first contact's separation (fast path where it has one).
+    Separation,
+    /// Contact `i`'s end (the first contact's from the fast path where it has one).
+    End(usize),
+    /// The landing.
+    Floor,
+}
+
+/// The derivatives of one result, or why there are none.
+type Derivatives = Result<Vec<f64>, SensitivityGap>;
+
+impl<'m> Plan<'m> {
     /// The sensitivities of every wanted result that has them, and notes for the others.
     pub(super) fn sensitivities(
         &mut self,
@@ -59,57 +81,151 @@ impl Plan<'_> {
         out: &mut RunResults,
     ) -> Result<(), SolveError> {
         let info = self.general().info();
-        let first = info.contacts.first().map_or("contact", |c| c.name);
-        let mut targets = Vec::new();
+        let mut targets: Vec<(Target, Source)> = Vec::new();
+        let target = |key: String, unit: &'static str, angle: bool| Target { key, unit, angle };
         for q in want {
             match q {
-                Quantity::SeparationAngle => targets.push(("separation_angle".into(), true)),
-                Quantity::SeparationTime => targets.push(("separation_time".into(), false)),
+                Quantity::SeparationAngle => targets.push((
+                    target("separation_angle".into(), "rad", true),
+                    Source::Separation,
+                )),
+                Quantity::SeparationTime => targets.push((
+                    target("separation_time".into(), "s", false),
+                    Source::Separation,
+                )),
                 Quantity::ContactEnd => {
-                    for key in ["contact_end".to_string(), format!("{first}_end")] {
-                        targets.push((format!("{key}_time"), false));
-                        targets.push((format!("{key}_angle"), true));
-                    }
-                    for c in info.contacts.iter().skip(1) {
-                        let gap = Note::NoSensitivity(SensitivityGap::NotBuilt);
-                        out.notes.insert(note_key(&format!("{}_end", c.name)), gap);
+                    for (i, c) in info.contacts.iter().enumerate() {
+                        let mut keys = vec![format!("{}_end", c.name)];
+                        if i == 0 {
+                            keys.insert(0, "contact_end".into());
+                        }
+                        for key in keys {
+                            let time = target(format!("{key}_time"), "s", false);
+                            targets.push((time, Source::End(i)));
+                            let angle = target(format!("{key}_angle"), "rad", true);
+                            targets.push((angle, Source::End(i)));
+                        }
                     }
                 }
-                Quantity::FloorImpact | Quantity::Impacts => {
+                Quantity::FloorImpact => {
+                    targets.push((
+                        target("floor_impact_time".into(), "s", false),
+                        Source::Floor,
+                    ));
+                    let rate = target("impact_angular_velocity".into(), "rad/s", false);
+                    targets.push((rate, Source::Floor));
+                }
+                Quantity::Impacts => {
                     let gap = Note::NoSensitivity(SensitivityGap::NotBuilt);
                     out.notes.insert(note_key(&q.name(info)), gap);
                 }
                 _ => {}
             }
         }
-        let targets: Vec<Target> = (targets.into_iter())
-            .map(|(key, angle)| Target {
-                key,
-                unit: if angle { "rad" } else { "s" },
-                angle,
-            })
-            .collect();
-        match self.separation_sensitivities()? {
-            Ok(found) => {
-                for target in &targets {
-                    match (target.angle, &found.d_t) {
-                        (true, _) => self.record(target, found.theta, &found.d_theta, out),
-                        (false, Ok(d_t)) => self.record(target, found.t, d_t, out),
-                        (false, Err(gap)) => {
-                            let note = Note::NoSensitivity(*gap);
-                            out.notes.insert(note_key(&target.key), note);
-                        }
-                    }
-                }
-            }
-            Err(gap) => {
-                for target in &targets {
+        let fast = self.separation_sensitivities()?;
+        for (target, source) in &targets {
+            let Some(x) = out.results.get(&target.key).map(|r| r.value) else {
+                // The run has no such number (a contact that holds or never closes): its
+                // own note says why.
+                continue;
+            };
+            let first = matches!(source, Source::Separation | Source::End(0));
+            let found = match (&fast, first) {
+                (Some(Ok(found)), true) => match (target.angle, &found.d_t) {
+                    (true, _) => Ok(found.d_theta.clone()),
+                    (false, Ok(d_t)) => Ok(d_t.clone()),
+                    (false, Err(gap)) => Err(*gap),
+                },
+                (Some(Err(gap)), true) => Err(*gap),
+                _ => self.integrated_derivatives(target, *source)?,
+            };
+            match found {
+                Ok(d) => self.record(target, x, &d, out),
+                Err(gap) => {
                     out.notes
                         .insert(note_key(&target.key), Note::NoSensitivity(gap));
                 }
             }
         }
         Ok(())
+    }
+
+    /// The derivatives of `target` from the motion integrated with its forward
+    /// sensitivities, its event held to the run's.
+    fn integrated_derivatives(
+        &mut self,
+        target: &Target,
+        source: Source,
+    ) -> Result<Derivatives, SolveError> {
+        let general = self.general().clone();
+        let contact = match source {
+            Source::Separation => 0,
+            Source::End(i) => i,
+            Source::Floor => usize::MAX,
+        };
+        // The run's own event: a contact's end, or the landing.
+        let run_event = if source == Source::Floor {
+            let motion = self.complete()?;
+            landing(motion, &general)?.map(|k| (motion.phases[k].t_end(), "floor"))
+        } else {
+            match self.fate(contact)? {
+                Fate::Ended { t, .. } if t == 0.0 => return Ok(Err(SensitivityGap::AtRelease)),
+                Fate::Ended { t, cause, .. } => Some((t, cause)),
+                _ => None,
+            }
+        };
+        let Some((t_run, cause_run)) = run_event else {
+            return Ok(Err(SensitivityGap::NoSeparation));
+        };
+        let sensitive = match self.sensitive() {
+            Ok(s) => s,
+            Err(gap) => return Ok(Err(gap)),
+        };
+        let event = if source == Source::Floor {
+            landing(&sensitive.motion, &general)?.map(|k| (k, "floor"))
+        } else {
+            match fate(&sensitive.motion, &general, contact)? {
+                Some(Fate::Ended { t, cause, .. }) => (sensitive.motion.phases.iter())
+                    .position(|p| p.t_end() == t)
+                    .map(|k| (k, cause)),
+                _ => None,
+            }
+        };
+        let Some((k, cause)) = event else {
+            let gap = if sensitive.stopped_at_impact {
+                SensitivityGap::PastImpact
+            } else {
+                SensitivityGap::RoutesDisagree
+            };
+            return Ok(Err(gap));
+        };
+        let t = sensitive.motion.phases[k].t_end();
+        if cause != cause_run || (t - t_run).abs() > ROUTES_AGREE * t_run.abs() {
+            return Ok(Err(SensitivityGap::RoutesDisagree));
+        }
+        Ok(match &sensitive.ends[k] {
+            Err(_) => Err(SensitivityGap::Grazing),
+            Ok(d) if target.key == "impact_angular_velocity" => Ok(d.theta_dot.clone()),
+            Ok(d) if target.angle => Ok(d.theta.clone()),
+            Ok(d) => Ok(d.t.clone()),
+        })
+    }
+
+    /// The motion integrated with its forward sensitivities (solved once), or why there is
+    /// none.
+    fn sensitive(&mut self) -> Result<&SensitiveMotion<'m>, SensitivityGap> {
+        if self.sensitive.is_none() {
+            let solved = self.walker.sensitive_motion(&mut self.work);
+            self.sensitive = Some(solved.map_err(|e| match e {
+                SolveError::System(SystemError::NoTangents { .. }) => SensitivityGap::NoPartials,
+                _ => SensitivityGap::IntegrationFailed,
+            }));
+        }
+        match &self.sensitive {
+            Some(Ok(s)) => Ok(s),
+            Some(Err(gap)) => Err(*gap),
+            None => Err(SensitivityGap::IntegrationFailed),
+        }
     }
 
     /// `d(target)/dp` and its elasticity for every parameter, from `x` and its derivatives.
@@ -135,25 +251,28 @@ impl Plan<'_> {
         }
     }
 
-    /// The separation on the fast phase the motion starts on with its sensitivities, or why
-    /// there are none.
-    fn separation_sensitivities(&mut self) -> Result<Result<Found, SensitivityGap>, SolveError> {
+    /// The first contact's separation on the fast phase the motion starts on with its
+    /// sensitivities, or why there are none; `None` where it does not separate there (it
+    /// ends otherwise, or on an integrated phase).
+    fn separation_sensitivities(
+        &mut self,
+    ) -> Result<Option<Result<Found, SensitivityGap>>, SolveError> {
         let Fate::Ended {
             t, cause: "force", ..
         } = self.fate(0)?
         else {
-            return Ok(Err(SensitivityGap::NoSeparation));
+            return Ok(None);
         };
         if t == 0.0 {
-            return Ok(Err(SensitivityGap::AtRelease));
+            return Ok(Some(Err(SensitivityGap::AtRelease)));
         }
         let Some(sys) = self.fast()? else {
-            return Ok(Err(SensitivityGap::Integrated));
+            return Ok(None);
         };
         let end = self.end()?;
         let (End::Force(0), Some(at)) = (end.end, end.at) else {
             // The first contact separates on a later phase, which is integrated.
-            return Ok(Err(SensitivityGap::Integrated));
+            return Ok(None);
         };
         let layout = sys.layout();
         let k = sys.k();
@@ -181,21 +300,14 @@ impl Plan<'_> {
             Ok(()) => Ok(d_t),
             // The angle's are there; the time's need the fall polynomial.
             Err(SensitivityGap::NoFallPolynomial) => Err(SensitivityGap::NoFallPolynomial),
-            Err(why) => return Ok(Err(why)),
+            Err(why) => return Ok(Some(Err(why))),
         };
-        Ok(Ok(Found {
-            theta: at.theta,
-            t,
-            d_theta,
-            d_t,
-        }))
+        Ok(Some(Ok(Found { d_theta, d_t })))
     }
 }
 
 /// A separation with its sensitivities.
 struct Found {
-    theta: f64,
-    t: f64,
     d_theta: Vec<f64>,
     /// The time's, or why there are none.
     d_t: Result<Vec<f64>, SensitivityGap>,

@@ -405,14 +405,25 @@ pub fn sensitivity_gap(gap: SensitivityGap) -> &'static str {
             "no sensitivity: the first contact does not separate on the fast phase the motion \
              starts on"
         }
-        SensitivityGap::Integrated => {
-            "sensitivities are not available on integrated (unreduced) phases: only the fast \
-             path's separation has them"
-        }
         SensitivityGap::NotBuilt => {
-            "sensitivities are not available here: they are built only for the first contact's \
-             separation on the fast phase the motion starts on, not for other contacts' ends, \
-             later or integrated phases, or impacts"
+            "sensitivities are not available for impacts: the derivatives of the impact map \
+             are not built"
+        }
+        SensitivityGap::PastImpact => {
+            "no sensitivity: the result comes after an impact, and the derivatives of the \
+             impact map are not built"
+        }
+        SensitivityGap::Grazing => {
+            "no sensitivity: an event on the way is grazing (its function's rate is zero \
+             there), where the time does not move smoothly with the parameters"
+        }
+        SensitivityGap::RoutesDisagree => {
+            "no sensitivity: the integrated route that carries the sensitivities ends this \
+             contact otherwise than the run's route (another event, or another time)"
+        }
+        SensitivityGap::IntegrationFailed => {
+            "no sensitivity: the integrated route that carries the sensitivities failed where \
+             the run's route did not"
         }
         SensitivityGap::NoPartials => "no sensitivity: the model has no partial derivatives",
         SensitivityGap::NoFallPolynomial => {

@@ -220,12 +220,22 @@ pub enum SensitivityGap {
     AtRelease,
     /// The first contact does not separate on the fast phase the motion starts on.
     NoSeparation,
-    /// The result comes from an integrated (unreduced) phase, whose forward sensitivities are
-    /// not built.
-    Integrated,
-    /// The result is not the first contact's separation on the fast phase the motion starts
-    /// on (another contact's end, a later phase, an impact), whose sensitivities are not built.
+    /// The result is of an impact (its impulses, velocities, energy lost), whose map's
+    /// derivatives are not built.
     NotBuilt,
+    /// The result comes after an impact the motion went through, whose map's derivatives are
+    /// not built.
+    PastImpact,
+    /// An event on the way to the result is grazing (its function's rate is zero there), where
+    /// the time does not move smoothly with the parameters.
+    Grazing,
+    /// The integrated route that carries the sensitivities ends the result's contact otherwise
+    /// (by another event, or at a time that differs from the run's by more than the tolerance
+    /// the two routes are held to) than the route the run took.
+    RoutesDisagree,
+    /// The integrated route that carries the sensitivities failed where the run's route did
+    /// not.
+    IntegrationFailed,
     /// The model has no generated partial derivatives.
     NoPartials,
     /// The fast phase has no fall polynomial, which the time's sensitivities need.

@@ -152,6 +152,126 @@ pub struct DynamicsWork {
     a0: Vec<f64>,
     /// The dynamics of the last call.
     pub out: Dynamics,
+    /// The system of the last call, assembled again for [`tangent_into`].
+    tangent_a: Vec<f64>,
+}
+
+/// Derivatives of the dynamics along directions `xi = (dq, dqd, dp)`, one set per direction
+/// ([`tangent_into`]), each flat with the direction slowest.
+#[derive(Debug, Clone, Default)]
+pub struct Tangent {
+    /// `d qdd` (`n` per direction).
+    pub qdd: Vec<f64>,
+    /// `d lambda`: every contact's force (`m` per direction; zero where open).
+    pub forces: Vec<f64>,
+    /// `d f`: every friction's force (`nf` per direction; zero where it does not act).
+    pub fr: Vec<f64>,
+    /// The rows of [`Bound::tangents_into`] along the direction, with `qdd` and the forces
+    /// held (`n + 3 m + 2 nf` per direction): their residuals, normal and slip accelerations,
+    /// gaps, edge margins and slip velocities.
+    pub rows: Vec<f64>,
+}
+
+/// Where [`tangent_into`] differentiates: the state and time of the last [`dynamics_into`],
+/// its active set and the partial derivatives of the dynamics' rows there.
+#[derive(Debug, Clone, Copy)]
+pub struct TangentAt<'a> {
+    /// The state.
+    pub state: &'a State,
+    /// Its time (from release; labels errors).
+    pub t: f64,
+    /// The closed contacts and friction modes.
+    pub active: &'a Active,
+    /// [`Bound::tangents_into`] at the state.
+    pub tan: &'a [f64],
+}
+
+/// The derivatives of the accelerations and of the contacts' and frictions' forces along each
+/// of the directions `xi` (`2 n + np` values each: `dq`, `dqd`, `dp`), from the partial
+/// derivatives `tan` of the dynamics' rows ([`Bound::tangents_into`], at the state and
+/// dynamics of the last [`dynamics_into`] with `work`, in the active set `active`): the contact
+/// system of [`dynamics`] differentiated, `A dx = -(dA x - db)`, the same matrix with the rows'
+/// derivatives as right-hand sides. A sliding friction's law `f + s mu lambda = 0` gives
+/// `df + s mu dlambda = -s lambda dmu`.
+pub fn tangent_into(
+    sys: &Bound,
+    at: TangentAt,
+    work: &mut DynamicsWork,
+    xi: &[f64],
+    out: &mut Tangent,
+) -> Result<(), SolveError> {
+    let TangentAt {
+        state,
+        t,
+        active,
+        tan,
+    } = at;
+    let info = sys.info();
+    let (n, m, nf, np) = (
+        sys.n_coordinates(),
+        info.contacts.len(),
+        info.frictions.len(),
+        info.parameters.len(),
+    );
+    let (cols, rows) = (2 * n + np, n + 3 * m + 2 * nf);
+    let directions = xi.len() / cols;
+    if tan.len() != rows * cols || xi.len() != directions * cols {
+        return Err(crate::system::SystemError::Length {
+            model: info.name,
+            what: "tangent directions",
+            expected: rows * cols,
+            got: tan.len(),
+        }
+        .into());
+    }
+    let dim = n + work.kkt.len() + work.acting.len();
+    assemble(work, info, active, dim);
+    work.tangent_a.clone_from(&work.a);
+    let resize = |v: &mut Vec<f64>, per: usize| {
+        v.clear();
+        v.resize(directions * per, 0.0);
+    };
+    resize(&mut out.qdd, n);
+    resize(&mut out.forces, m);
+    resize(&mut out.fr, nf);
+    resize(&mut out.rows, rows);
+    for (d, x) in xi.chunks_exact(cols).enumerate() {
+        let r = &mut out.rows[d * rows..(d + 1) * rows];
+        for (ri, row) in r.iter_mut().zip(tan.chunks_exact(cols)) {
+            *ri = row.iter().zip(x).map(|(a, b)| a * b).sum();
+        }
+        let b = &mut work.x;
+        b.clear();
+        b.extend(r[..n].iter().map(|v| -v));
+        b.extend(work.kkt.iter().map(|&i| -r[n + i]));
+        for &j in &work.acting {
+            b.push(match active.modes[j] {
+                Mode::Stick => -r[n + m + j],
+                Mode::Slide(sign) => {
+                    let lambda = work.out.forces[info.frictions[j].contact_index];
+                    -sign * lambda * x[2 * n + info.frictions[j].coefficient_index]
+                }
+            });
+        }
+        work.a.clone_from(&work.tangent_a);
+        linear::solve_in_place(&mut work.a, dim, &mut work.x).map_err(|_| {
+            SolveError::SingularContacts {
+                model: info.name,
+                t,
+                closed: closed_list(info, &active.closed),
+                q: state.q.clone(),
+            }
+        })?;
+        out.qdd[d * n..(d + 1) * n].copy_from_slice(&work.x[..n]);
+        for (k, &i) in work.kkt.iter().enumerate() {
+            out.forces[d * m + i] = work.x[n + k];
+        }
+        let base = n + work.kkt.len();
+        for (k, &j) in work.acting.iter().enumerate() {
+            out.fr[d * nf + j] = work.x[base + k];
+        }
+    }
+    Ok(())
 }
 
 /// [`dynamics`] into `work.out`, with `work`'s buffers.

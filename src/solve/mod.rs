@@ -15,6 +15,7 @@
 pub mod active;
 pub mod checks;
 pub mod contacts;
+pub mod forward;
 pub mod impact;
 pub mod inversion;
 pub mod lean;

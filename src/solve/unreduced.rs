@@ -39,6 +39,7 @@ use crate::solve::contacts::{
     self, Active, ContactOption, DECIDE_TOLERANCE, Dynamics, DynamicsWork, FrictionOption, Mode,
     Options,
 };
+use crate::solve::forward::{self, Forward, Grazing, Measured};
 use crate::solve::ode::{
     Event, Method, OdeOptions, OdeProblem, OdeSolution, integrate as ode_integrate,
 };
@@ -173,6 +174,25 @@ pub struct UnreducedRun {
     pub state_end: State,
     /// Work done by friction up to the end (J, `<= 0`; zero without friction).
     pub friction_work: f64,
+    /// The forward sensitivities at the end, where the start had them
+    /// ([`Start::sensitivity`]).
+    pub sensitivity: Option<EndSensitivity>,
+}
+
+/// The forward sensitivities at the end of an integration ([`forward`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct EndSensitivity {
+    /// `S = dy/dp` at the end, before any jump there: `2 n` values per parameter (`S_q`, then
+    /// `S_qd`).
+    pub s: Vec<f64>,
+    /// `dt_end/dp` (absolute: the start's own dependence is in its `S`), or the grazing event
+    /// (this one or a switch before it) whose time has none.
+    pub dt: Result<Vec<f64>, Grazing>,
+    /// The accelerations at the end in the last active set.
+    pub qdd: Vec<f64>,
+    /// `dt/dp` of each switch of the friction modes inside the run (the start of each segment
+    /// after the first, in order), or the grazing switch whose time has none.
+    pub switches: Vec<Result<Vec<f64>, Grazing>>,
 }
 
 impl UnreducedRun {
@@ -289,6 +309,9 @@ struct Problem<'a, 'm> {
     with_work: bool,
     /// Right-hand sides evaluated.
     evaluations: u64,
+    /// The forward sensitivities riding along after the state's `base` components.
+    riders: Option<Riders>,
+    base: usize,
 }
 
 impl Problem<'_, '_> {
@@ -436,6 +459,82 @@ impl Problem<'_, '_> {
     }
 }
 
+/// What watch `w` measures, for its time's derivatives (`reduced`: the reduced coordinate's
+/// index).
+fn measured(w: Watch, reduced: usize) -> Measured {
+    match w {
+        Watch::Force(i) => Measured::Force(i),
+        Watch::Gap(i) => Measured::Gap(i),
+        Watch::Edge(i) => Measured::Edge(i),
+        Watch::Floor => Measured::Coordinate(reduced),
+        Watch::Slip(j) => Measured::Slip(j),
+        Watch::Stuck(j) => Measured::Stuck(j),
+        // Painlevé's watch ends the run with an error; its time is never differentiated.
+        Watch::Painleve => Measured::Clock,
+    }
+}
+
+/// The forward sensitivities of an integration ([`forward`]).
+struct Riders {
+    fw: Forward,
+    /// `S` at the last event (or the start).
+    s: Vec<f64>,
+    /// A switch whose time had no derivative: `S` after it is not defined.
+    grazed: Option<Grazing>,
+    /// `dt/dp` of each switch so far.
+    switches: Vec<Result<Vec<f64>, Grazing>>,
+}
+
+impl Riders {
+    /// The sensitivities at the run's end, an event measuring `what` at `at` (its state, time
+    /// and the active set before it).
+    fn at_end(
+        mut self,
+        sys: &Bound,
+        work: &mut DynamicsWork,
+        at: (&State, f64, &Active),
+        what: Measured,
+    ) -> Result<EndSensitivity, SolveError> {
+        let (dt, qdd) = self.fw.event_times(sys, at, work, &self.s, what)?;
+        let dt = match self.grazed {
+            Some(g) => Err(g),
+            None => dt,
+        };
+        Ok(EndSensitivity {
+            s: self.s,
+            dt,
+            qdd,
+            switches: self.switches,
+        })
+    }
+
+    /// `S` across a switch of the friction modes to `after`, an event measuring `what` at `at`
+    /// (its state, time and the active set before it).
+    fn across(
+        &mut self,
+        sys: &Bound,
+        work: &mut DynamicsWork,
+        at: (&State, f64, &Active),
+        after: &Active,
+        what: Measured,
+    ) -> Result<(), SolveError> {
+        let (dt, before) = self.fw.event_times(sys, at, work, &self.s, what)?;
+        let dt = match self.grazed {
+            Some(g) => Err(g),
+            None => dt,
+        };
+        match &dt {
+            Ok(dt) => {
+                let after = contacts::dynamics(sys, at.0, after, at.1)?;
+                forward::jump(&mut self.s, &before, &after.qdd, dt);
+            }
+            Err(g) => self.grazed = Some(*g),
+        }
+        self.switches.push(dt);
+        Ok(())
+    }
+}
+
 /// The slip velocity each friction's event measures from at a segment's start: its own slip
 /// for a contact that may have switched there, zero for one that keeps its mode.
 fn slip_offsets(
@@ -456,7 +555,7 @@ fn slip_offsets(
 
 impl OdeProblem for Problem<'_, '_> {
     fn dim(&self) -> usize {
-        2 * self.n + usize::from(self.with_work)
+        self.base + self.riders.as_ref().map_or(0, |r| r.fw.len())
     }
 
     fn rhs(&mut self, t: f64, z: &[f64], dz: &mut [f64]) -> Result<(), SolveError> {
@@ -469,6 +568,11 @@ impl OdeProblem for Problem<'_, '_> {
         dz[self.n..2 * self.n].copy_from_slice(&d.qdd);
         if self.with_work {
             dz[2 * self.n] = d.friction_power();
+        }
+        if let Some(r) = self.riders.as_mut() {
+            let at = (&self.state, t, &self.active);
+            let (s, ds) = (&z[self.base..], &mut dz[self.base..]);
+            r.fw.rhs(self.sys, at, &mut self.work, s, ds)?;
         }
         self.remember(z);
         Ok(())
@@ -592,6 +696,11 @@ pub struct Start {
     /// Keep every step's continuous extension, for sampling the run between its steps
     /// ([`UnreducedRun::state_at`]; [`OdeOptions::dense_output`]).
     pub dense_output: bool,
+    /// The forward sensitivities `S = dy/dp` at the start (`2 n` values per parameter: `S_q`,
+    /// then `S_qd`; [`forward`]), to integrate with the motion: the run's end then has them
+    /// ([`UnreducedRun::sensitivity`]). The model must have
+    /// [`Model::tangents`](crate::model::Model::tangents). `None`: no sensitivities.
+    pub sensitivity: Option<Vec<f64>>,
 }
 
 /// The integrator's absolute tolerances: `rtol` times each of `scales` (length `2 n`; none
@@ -706,13 +815,37 @@ pub fn integrate_with(
         last_valid: false,
         with_work,
         evaluations: 0,
+        riders: None,
+        base: y0.len(),
+    };
+    // The sensitivities ride after the state; `S` is integrated as itself, not as a deviation.
+    problem.riders = match &start.sensitivity {
+        Some(s0) => {
+            let fw = Forward::new(sys)?;
+            if s0.len() != fw.len() {
+                return Err(crate::system::SystemError::Length {
+                    model: info.name,
+                    what: "sensitivity",
+                    expected: fw.len(),
+                    got: s0.len(),
+                }
+                .into());
+            }
+            Some(Riders {
+                fw,
+                s: s0.clone(),
+                grazed: None,
+                switches: Vec::new(),
+            })
+        }
+        None => None,
     };
     let d = contacts::dynamics(sys, &start.state, &problem.active, 0.0)?;
     problem.watch(&d)?;
     let atol = absolute_tolerances(sys, start, scales, rtol, with_work)?;
     let stop_at = start.stop_at.filter(|s| *s <= t_max);
     let opts = OdeOptions {
-        controlled: None,
+        controlled: Some(y0.len()),
         rtol,
         atol,
         t_max: stop_at.unwrap_or(t_max),
@@ -722,7 +855,11 @@ pub fn integrate_with(
     let mut segments = Vec::new();
     let mut t0 = 0.0;
     loop {
-        let solution = ode_integrate(method, &mut problem, t0, &vec![0.0; y0.len()], &opts);
+        let mut z0 = vec![0.0; y0.len()];
+        if let Some(r) = &problem.riders {
+            z0.extend_from_slice(&r.s);
+        }
+        let solution = ode_integrate(method, &mut problem, t0, &z0, &opts);
         work.ode_evaluations += std::mem::take(&mut problem.evaluations);
         let solution = solution?;
         work.ode_steps += solution.total_steps();
@@ -734,6 +871,9 @@ pub fn integrate_with(
             return Err(SolveError::NoEvent { t_max });
         };
         let y: Vec<f64> = (event.y.iter().zip(&y0)).map(|(z, y0)| y0 + z).collect();
+        if let Some(r) = problem.riders.as_mut() {
+            r.s.copy_from_slice(&event.y[y0.len()..]);
+        }
         segments.push(Segment {
             t_start: t0,
             active: problem.active.clone(),
@@ -766,7 +906,17 @@ pub fn integrate_with(
             };
         let watch = match next {
             Ok(end) => {
+                let measured = match end {
+                    End::Until => Measured::Clock,
+                    _ => measured(problem.watches[event.index], info.reduced_index),
+                };
+                let at = (&state, event.t, &problem.active);
+                let sensitivity = match problem.riders.take() {
+                    Some(r) => Some(r.at_end(problem.sys, &mut problem.work, at, measured)?),
+                    None => None,
+                };
                 return Ok(UnreducedRun {
+                    sensitivity,
                     segments,
                     rtol,
                     method,
@@ -786,7 +936,13 @@ pub fn integrate_with(
                 t: event.t,
             });
         }
+        let before = problem.active.clone();
         problem.switch(watch, &state, event.t)?;
+        if let Some(r) = problem.riders.as_mut() {
+            let at = (&state, event.t, &before);
+            let (work, after) = (&mut problem.work, &problem.active);
+            r.across(sys, work, at, after, measured(watch, info.reduced_index))?;
+        }
         problem.state = state;
         y0 = y;
         problem.y0 = y0.clone();

@@ -15,7 +15,8 @@
 //!
 //! `reduced.rs` holds a phase on the fast path ([`ReducedRun`], [`phase_end`]); `run.rs` a
 //! phase on either route ([`PhaseRun`]); `motion.rs` the [`Motion`] with its [`ImpactAt`]s;
-//! `walker.rs` the [`Walker`] that solves it.
+//! `walker.rs` the [`Walker`] that solves it; `sensitive.rs` the motion with the forward
+//! sensitivities of its phases' ends ([`SensitiveMotion`]).
 //!
 //! [`contacts::decide`]: crate::solve::contacts::decide
 //! [`impact::resolve`]: crate::solve::impact::resolve
@@ -23,11 +24,13 @@
 mod motion;
 mod reduced;
 mod run;
+mod sensitive;
 mod walker;
 
 pub use motion::{ImpactAt, Motion};
 pub use reduced::{GAP_CELLS, ReducedEnd, ReducedRun, phase_end};
 pub use run::{IntegratedRun, PhaseRun};
+pub use sensitive::{EndDerivatives, SensitiveMotion};
 pub use walker::{
     LANDING_TOLERANCE, MAX_FALL_TIMES, MAX_IMPACTS, MAX_PHASES, PhaseStart, Route, Walker,
     ZENO_RATIO_SPREAD, ZENO_RATIOS, fall_time_scale, phase_parameters,

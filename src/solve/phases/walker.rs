@@ -17,8 +17,8 @@ use crate::solve::impact::{self, Impact, Part};
 use crate::solve::inversion::delta_at_time;
 use crate::solve::ode::Method;
 use crate::solve::quadrature::TimeMesh;
-use crate::solve::unreduced::{self, End, Start, motion_scales};
-use crate::system::{Bound, State, System};
+use crate::solve::unreduced::{self, End, EndSensitivity, Start, motion_scales};
+use crate::system::{Bound, State, System, SystemError};
 
 /// Most phases chained between two impacts (or from release to the first) before giving up:
 /// contacts that keep opening and closing without an impact are chatter, not a motion.
@@ -305,6 +305,36 @@ impl<'m> Walker<'m> {
         method: Option<Method>,
         work: &mut Work,
     ) -> Result<PhaseRun<'m>, SolveError> {
+        self.integrate_from(start, method, None, work)
+    }
+
+    /// [`Walker::integrate`] with the forward sensitivities `s` at the start
+    /// ([`Start::sensitivity`]), and those at its end.
+    pub fn integrate_sensitive(
+        &self,
+        start: &PhaseStart,
+        s: Vec<f64>,
+        work: &mut Work,
+    ) -> Result<(PhaseRun<'m>, EndSensitivity), SolveError> {
+        let mut run = self.integrate_from(start, None, Some(s), work)?;
+        let sens = match &mut run {
+            PhaseRun::Integrated(r) => r.run.sensitivity.take(),
+            PhaseRun::Reduced(_) => None,
+        };
+        // The integration returns them whenever it starts with them.
+        let model = self.general.info().name;
+        let sens = sens.ok_or(SystemError::NoTangents { model })?;
+        Ok((run, sens))
+    }
+
+    /// [`Walker::integrate_with`] with the sensitivities at the start, if any.
+    fn integrate_from(
+        &self,
+        start: &PhaseStart,
+        method: Option<Method>,
+        sensitivity: Option<Vec<f64>>,
+        work: &mut Work,
+    ) -> Result<PhaseRun<'m>, SolveError> {
         let bound = self.general.clone();
         let time = fall_time_scale(&bound, &start.state)?;
         let scales = self.scales(&start.state, &start.active)?;
@@ -315,6 +345,7 @@ impl<'m> Walker<'m> {
             friction_work: start.friction_work,
             stop_at: self.until.map(|u| u - start.t),
             dense_output: self.dense_output,
+            sensitivity,
         };
         // A run with an end time may go on to it however long its phases last.
         let t_max = (time * MAX_FALL_TIMES).max(from.stop_at.unwrap_or(0.0));
