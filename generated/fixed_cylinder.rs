@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 14,
+    n_constants: 22,
     coordinates: &["x1", "y1", "theta"],
     system_coordinates: &["x1", "y1", "theta"],
     reduced_index: 2,
@@ -198,6 +198,26 @@ impl Model for FixedCylinder {
         k[12] = g * m1;
         // k[13] = ell^2*m1/3
         k[13] = (ell * ell) * m1 / 3.0;
+        // k[14] = ell*m1
+        k[14] = ell * m1;
+        // k[15] = ell^2/12
+        k[15] = (ell * ell) / 12.0;
+        // k[16] = ell^2/4
+        k[16] = (ell * ell) / 4.0;
+        // k[17] = ell*g/2
+        k[17] = ell * g / 2.0;
+        // k[18] = ell*m1/6
+        k[18] = ell * m1 / 6.0;
+        // k[19] = g*m1/2
+        k[19] = g * m1 / 2.0;
+        // k[20] = 1/sin(th0) + cos(th0)/sin(th0)
+        let h20_t0 = 1.0 / th0.sin();
+        k[20] = h20_t0 + (th0.cos() / th0.sin());
+        // k[21] = R + R*cos(th0)/sin(th0)^2 + R*cos(th0)^2/sin(th0)^2
+        let h21_t0 = th0.cos();
+        k[21] = r
+            + (r * h21_t0 / (th0.sin() * th0.sin()))
+            + (r * (h21_t0 * h21_t0) / (th0.sin() * th0.sin()));
     }
 
     /// The state at release, over the parameters.
@@ -209,7 +229,7 @@ impl Model for FixedCylinder {
     /// - `theta = th0`
     /// - `dot_theta = 0.0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..14]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let th0 = k[3];
         q[0] = -k[5];
         qd[0] = 0.0;
@@ -230,7 +250,7 @@ impl Model for FixedCylinder {
     /// - `touch_x = R*sin(theta)*cos(theta) + x1*sin(theta)^2 - y1*sin(theta)*cos(theta)`
     /// - `touch_y = R*sin(theta)^2 - x1*sin(theta)*cos(theta) + y1*cos(theta)^2`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..14]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[1];
         let r = k[2];
@@ -278,7 +298,7 @@ impl Model for FixedCylinder {
     /// - `T = -dot_theta*dot_x1*ell*m1*sin(theta)/2 + dot_theta*dot_y1*ell*m1*cos(theta)/2 + dot_theta^2*ell^2*m1/6 + dot_x1^2*m1/2 + dot_y1^2*m1/2`
     /// - `V = ell*g*m1*sin(theta)/2 + g*m1*y1`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..14]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let x1_dot = qd[0];
         let y1 = q[1];
@@ -296,7 +316,7 @@ impl Model for FixedCylinder {
     ///
     /// - `p_x1 = -dot_theta*ell*m1*sin(theta)/2 + dot_x1*m1`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..14]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let m1 = k[0];
         let x1_dot = qd[0];
@@ -309,7 +329,7 @@ impl Model for FixedCylinder {
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
     /// - `L = T - V`: 169 characters, written out in `generated/fixed_cylinder.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..14]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let theta_dot = qd[2];
@@ -343,7 +363,7 @@ impl Model for FixedCylinder {
     /// - `cylinder_push = -R - R*cos(theta) - x1*sin(theta) + y1*cos(theta)`
     /// - `floor_normal = y1`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..14]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let r = k[2];
         let x1 = q[0];
@@ -354,7 +374,7 @@ impl Model for FixedCylinder {
 
     /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..14]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let r = k[2];
         let x1 = q[0];
@@ -381,7 +401,7 @@ impl Model for FixedCylinder {
     ///
     /// - `cylinder_push = -R*sin(theta) + ell + x1*cos(theta) + y1*sin(theta)`
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..14]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[1];
         let r = k[2];
@@ -434,7 +454,7 @@ impl Model for FixedCylinder {
 
     /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..14]; // one bounds check for all constant loads
+        let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let r = k[2];
         let x1 = q[0];
@@ -448,6 +468,101 @@ impl Model for FixedCylinder {
         sizes[4] = 0.0;
         sizes[5] = r;
         sizes[6] = r;
+    }
+
+    fn has_tangents(&self) -> bool {
+        true
+    }
+
+    /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities (`qdd`, `forces`, `fr` held fixed), row-major.
+    ///
+    /// 9 rows (3 + 3 x 2 + 2 x 0) by 11 columns (2 x 3 + 5), differentiated symbolically; see `generated/fixed_cylinder.tex` for the rows.
+    #[allow(clippy::too_many_arguments)]
+    fn tangents(
+        &self,
+        k: &[f64],
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        forces: &[f64],
+        _fr: &[f64],
+        out: &mut [f64],
+    ) {
+        let k = &k[..22]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        let m1 = k[0];
+        let r = k[2];
+        let g = k[4];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let x1_ddot = qdd[0];
+        let y1 = q[1];
+        let y1_dot = qd[1];
+        let y1_ddot = qdd[1];
+        let theta_dot = qd[2];
+        let theta_ddot = qdd[2];
+        let xt0 = forces[0] * rc_c;
+        let xt1 = theta_dot * theta_dot;
+        let xt2 = forces[0] * rc_s;
+        let xt3 = (r * rc_c) + (x1 * rc_s) - (y1 * rc_c);
+        let xt4 = rc_s * rc_s;
+        let xt5 = rc_c * rc_c;
+        let xt6 = -rc_s;
+        out.fill(0.0);
+        out[2] = -(k[8] * theta_ddot * rc_c) + xt0 + (k[8] * xt1 * rc_s);
+        out[5] = -k[14] * theta_dot * rc_c;
+        out[6] = -(k[6] * theta_ddot * rc_s) + x1_ddot - (k[6] * xt1 * rc_c);
+        out[7] = -(k[10] * theta_ddot * rc_s) - (k[10] * xt1 * rc_c);
+        out[13] = -(k[8] * theta_ddot * rc_s) + xt2 - (k[8] * xt1 * rc_c);
+        out[16] = -k[14] * theta_dot * rc_s;
+        out[17] = (k[6] * theta_ddot * rc_c) + y1_ddot - (-g + (k[6] * xt1 * rc_s));
+        out[18] = (k[10] * theta_ddot * rc_c) - (k[10] * xt1 * rc_s);
+        out[21] = m1;
+        out[22] = xt0;
+        out[23] = xt2;
+        out[24] =
+            -(k[8] * x1_ddot * rc_c) - (k[8] * y1_ddot * rc_s) - (k[11] * rc_s) - (forces[0] * xt3);
+        out[28] = (theta_ddot * (k[15] + (k[16] * xt4) + (k[16] * xt5))) - (k[6] * x1_ddot * rc_s)
+            + (k[6] * y1_ddot * rc_c)
+            + (k[17] * rc_c);
+        out[29] = (theta_ddot * (k[18] + (k[8] * xt4) + (k[8] * xt5))) - (k[10] * x1_ddot * rc_s)
+            + (k[10] * y1_ddot * rc_c)
+            + (k[19] * rc_c);
+        out[30] = -forces[0] * rc_s;
+        out[32] = k[8] * rc_c;
+        out[33] = -(theta_ddot * rc_c) + (xt1 * rc_s);
+        out[34] = -(theta_ddot * rc_s) - (xt1 * rc_c);
+        out[35] = -(r * xt1 * rc_s) + (theta_ddot * xt3) - (x1_ddot * rc_c) - (y1_ddot * rc_s)
+            + (2.0 * theta_dot * x1_dot * rc_s)
+            - (2.0 * theta_dot * y1_dot * rc_c)
+            + (xt1 * x1 * rc_c)
+            + (xt1 * y1 * rc_s);
+        out[36] = -2.0 * theta_dot * rc_c;
+        out[37] = -2.0 * theta_dot * rc_s;
+        out[38] = (k[7] * theta_dot * rc_c) + (2.0 * theta_dot * x1 * rc_s)
+            - (2.0 * theta_dot * y1 * rc_c)
+            - (2.0 * x1_dot * rc_c)
+            - (2.0 * y1_dot * rc_s);
+        out[41] = (theta_ddot * rc_s) + (xt1 * rc_c);
+        out[55] = xt6;
+        out[56] = rc_c;
+        out[57] = (r * rc_s) - (x1 * rc_c) - (y1 * rc_s);
+        out[63] = -1.0 - rc_c;
+        out[67] = 1.0;
+        out[77] = rc_c;
+        out[78] = rc_s;
+        out[79] = -(r * rc_c) - (x1 * rc_s) + (y1 * rc_c);
+        out[84] = 1.0;
+        out[85] = xt6;
+    }
+
+    /// `d(initial state)/dp`: the rows `d q_0/dp`, then `d qd_0/dp`, by the parameters.
+    fn initial_tangents(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..22]; // one bounds check for all constant loads
+        out.fill(0.0);
+        out[2] = -k[20];
+        out[3] = k[21];
+        out[13] = 1.0;
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {

@@ -65,7 +65,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 17,
+    n_constants: 29,
     coordinates: &["x1", "y1", "theta", "xc"],
     system_coordinates: &["x1", "y1", "theta", "xc"],
     reduced_index: 2,
@@ -222,6 +222,34 @@ impl Model for HingedCylinder {
         k[15] = (ell * ell) * m1 / 3.0;
         // k[16] = 2*R
         k[16] = 2.0 * r;
+        // k[17] = ell*m1
+        k[17] = ell * m1;
+        // k[18] = ell^2/12
+        k[18] = (ell * ell) / 12.0;
+        // k[19] = ell^2/4
+        k[19] = (ell * ell) / 4.0;
+        // k[20] = ell*g/2
+        k[20] = ell * g / 2.0;
+        // k[21] = ell*m1/6
+        k[21] = ell * m1 / 6.0;
+        // k[22] = g*m1/2
+        k[22] = g * m1 / 2.0;
+        // k[23] = 5*R
+        k[23] = 5.0 * r;
+        // k[24] = 8*R
+        k[24] = 8.0 * r;
+        // k[25] = 6*R
+        k[25] = 6.0 * r;
+        // k[26] = 4*R
+        k[26] = 4.0 * r;
+        // k[27] = 1/sin(th0) + cos(th0)/sin(th0)
+        let h27_t0 = 1.0 / th0.sin();
+        k[27] = h27_t0 + (th0.cos() / th0.sin());
+        // k[28] = R + R*cos(th0)/sin(th0)^2 + R*cos(th0)^2/sin(th0)^2
+        let h28_t0 = th0.cos();
+        k[28] = r
+            + (r * h28_t0 / (th0.sin() * th0.sin()))
+            + (r * (h28_t0 * h28_t0) / (th0.sin() * th0.sin()));
     }
 
     /// The state at release, over the parameters.
@@ -235,7 +263,7 @@ impl Model for HingedCylinder {
     /// - `xc = R/sin(th0) + R*cos(th0)/sin(th0)`
     /// - `dot_xc = 0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..29]; // one bounds check for all constant loads
         let th0 = k[4];
         q[0] = 0.0;
         qd[0] = 0.0;
@@ -258,7 +286,7 @@ impl Model for HingedCylinder {
     /// - `axis_x = xc`
     /// - `axis_y = R`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..29]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let r = k[3];
@@ -290,7 +318,7 @@ impl Model for HingedCylinder {
     /// - `T = -dot_theta*dot_x1*ell*m1*sin(theta)/2 + dot_theta*dot_y1*ell*m1*cos(theta)/2 + dot_theta^2*ell^2*m1/6 + dot_x1^2*m1/2 + dot_xc^2*m2/2 + dot_y1^2*m1/2`
     /// - `V = R*g*m2 + ell*g*m1*sin(theta)/2 + g*m1*y1`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..29]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let x1_dot = qd[0];
         let y1 = q[1];
@@ -311,7 +339,7 @@ impl Model for HingedCylinder {
     /// - `p_x1 = -dot_theta*ell*m1*sin(theta)/2 + dot_x1*m1`
     /// - `p_xc = dot_xc*m2`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..29]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let m1 = k[0];
         let m2 = k[1];
@@ -327,7 +355,7 @@ impl Model for HingedCylinder {
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
     /// - `L = T - V`: 194 characters, written out in `generated/hinged_cylinder.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..29]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let m2 = k[1];
@@ -372,7 +400,7 @@ impl Model for HingedCylinder {
     /// - `hinge_horizontal = x1`
     /// - `hinge_vertical = y1`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..29]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let r = k[3];
         let x1 = q[0];
@@ -385,7 +413,7 @@ impl Model for HingedCylinder {
 
     /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..29]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let r = k[3];
         let y1 = q[1];
@@ -424,7 +452,7 @@ impl Model for HingedCylinder {
     ///
     /// - `contact_force = -R*sin(theta) + ell + x1*cos(theta) - xc*cos(theta) + y1*sin(theta)`
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..29]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let r = k[3];
@@ -485,7 +513,7 @@ impl Model for HingedCylinder {
 
     /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..29]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let r = k[3];
         let x1 = q[0];
@@ -501,6 +529,127 @@ impl Model for HingedCylinder {
         sizes[4] = 0.0;
         sizes[5] = 0.0;
         sizes[6] = r;
+    }
+
+    fn has_tangents(&self) -> bool {
+        true
+    }
+
+    /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities (`qdd`, `forces`, `fr` held fixed), row-major.
+    ///
+    /// 13 rows (4 + 3 x 3 + 2 x 0) by 14 columns (2 x 4 + 6), differentiated symbolically; see `generated/hinged_cylinder.tex` for the rows.
+    #[allow(clippy::too_many_arguments)]
+    fn tangents(
+        &self,
+        k: &[f64],
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        forces: &[f64],
+        _fr: &[f64],
+        out: &mut [f64],
+    ) {
+        let k = &k[..29]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        let m1 = k[0];
+        let r = k[3];
+        let g = k[5];
+        let x1 = q[0];
+        let x1_ddot = qdd[0];
+        let y1 = q[1];
+        let y1_dot = qd[1];
+        let y1_ddot = qdd[1];
+        let theta_dot = qd[2];
+        let theta_ddot = qdd[2];
+        let xc = q[3];
+        let xc_ddot = qdd[3];
+        let xt0 = theta_dot * theta_dot;
+        let xt1 = rc_c * rc_c;
+        let xt2 = rc_s * rc_s;
+        let xt3 = -1.0 - (xt1 / xt2);
+        let xt4 = rc_c.powi(3);
+        let xt5 = -(r / rc_s)
+            - (k[16] * rc_c / rc_s)
+            - (k[16] * xt1 / rc_s.powi(3))
+            - (k[16] * xt4 / rc_s.powi(3))
+            + (2.0 * y1 * rc_c / rc_s)
+            + (2.0 * y1 * xt4 / rc_s.powi(3)); // -R/rc_s - 2*R*rc_c/rc_s - 2*R*rc_c^2/rc_s^3 - 2*R*rc_c^3/rc_s^3 + 2*y1*rc_c/rc_s + 2*y1*rc_c^3/rc_s^3
+        let xt6 = 1.0 + (rc_c / xt2) + (xt1 / xt2);
+        let xt7 = rc_c.powi(4);
+        out.fill(0.0);
+        out[2] = -(k[8] * theta_ddot * rc_c) + (k[8] * xt0 * rc_s);
+        out[6] = -k[17] * theta_dot * rc_c;
+        out[8] = -(k[7] * theta_ddot * rc_s) + x1_ddot - (k[7] * xt0 * rc_c);
+        out[10] = -(k[10] * theta_ddot * rc_s) - (k[10] * xt0 * rc_c);
+        out[16] = -(k[8] * theta_ddot * rc_s)
+            - (-forces[0] - (forces[0] * xt1 / xt2))
+            - (k[8] * xt0 * rc_c);
+        out[20] = -k[17] * theta_dot * rc_s;
+        out[22] = (k[7] * theta_ddot * rc_c) + y1_ddot - (-g + (k[7] * xt0 * rc_s));
+        out[24] = (k[10] * theta_ddot * rc_c) - (k[10] * xt0 * rc_s);
+        out[27] = m1;
+        out[29] = -forces[0] * xt3;
+        out[30] =
+            -(k[8] * x1_ddot * rc_c) - (k[8] * y1_ddot * rc_s) - (k[13] * rc_s) - (forces[0] * xt5);
+        out[36] = (theta_ddot * (k[18] + (k[19] * xt2) + (k[19] * xt1))) - (k[7] * x1_ddot * rc_s)
+            + (k[7] * y1_ddot * rc_c)
+            + (k[20] * rc_c);
+        out[38] = (theta_ddot * (k[21] + (k[8] * xt2) + (k[8] * xt1))) - (k[10] * x1_ddot * rc_s)
+            + (k[10] * y1_ddot * rc_c)
+            + (k[22] * rc_c);
+        out[39] = -forces[0] * xt6;
+        out[41] = k[8] * rc_c;
+        out[51] = xc_ddot;
+        out[57] = (theta_ddot * xt3) + (2.0 * xt0 * rc_c / rc_s) + (2.0 * xt0 * xt4 / rc_s.powi(3));
+        out[58] = (k[16] * xt0)
+            + (k[23] * xt0 * rc_c / xt2)
+            + (k[24] * xt0 * xt1 / xt2)
+            + (k[25] * xt0 * xt4 / rc_s.powi(4))
+            + (k[25] * xt0 * xt7 / rc_s.powi(4))
+            + (theta_ddot * xt5)
+            - y1_ddot
+            - (y1_ddot * xt1 / xt2)
+            + (4.0 * theta_dot * y1_dot * rc_c / rc_s)
+            + (4.0 * theta_dot * y1_dot * xt4 / rc_s.powi(3))
+            - (2.0 * xt0 * y1)
+            - (8.0 * xt0 * y1 * xt1 / xt2)
+            - (6.0 * xt0 * y1 * xt7 / rc_s.powi(4));
+        out[61] = -(2.0 * theta_dot) - (2.0 * theta_dot * xt1 / xt2);
+        out[62] = -(k[16] * theta_dot / rc_s)
+            - (k[26] * theta_dot * rc_c / rc_s)
+            - (k[26] * theta_dot * xt1 / rc_s.powi(3))
+            - (k[26] * theta_dot * xt4 / rc_s.powi(3))
+            + (4.0 * theta_dot * y1 * rc_c / rc_s)
+            + (4.0 * theta_dot * y1 * xt4 / rc_s.powi(3))
+            - (2.0 * y1_dot)
+            - (2.0 * y1_dot * xt1 / xt2);
+        out[67] = (theta_ddot * xt6)
+            - (xt0 / rc_s)
+            - (2.0 * xt0 * rc_c / rc_s)
+            - (2.0 * xt0 * xt1 / rc_s.powi(3))
+            - (2.0 * xt0 * xt4 / rc_s.powi(3));
+        out[98] = -1.0;
+        out[99] = rc_c / rc_s;
+        out[100] = r + (r * rc_c / xt2) + (r * xt1 / xt2) - y1 - (y1 * xt1 / xt2);
+        out[101] = 1.0;
+        out[109] = -(1.0 / rc_s) - (rc_c / rc_s);
+        out[112] = 1.0;
+        out[127] = 1.0;
+        out[140] = rc_c;
+        out[141] = rc_s;
+        out[142] = -(r * rc_c) - (x1 * rc_s) + (xc * rc_s) + (y1 * rc_c);
+        out[143] = -rc_c;
+        out[150] = 1.0;
+        out[151] = -rc_s;
+    }
+
+    /// `d(initial state)/dp`: the rows `d q_0/dp`, then `d qd_0/dp`, by the parameters.
+    fn initial_tangents(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..29]; // one bounds check for all constant loads
+        out.fill(0.0);
+        out[16] = 1.0;
+        out[21] = k[27];
+        out[22] = -k[28];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {

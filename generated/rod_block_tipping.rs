@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the block must be lower than the rod is long (h < ell)",
     }],
-    n_constants: 22,
+    n_constants: 35,
     coordinates: &["x1", "y1", "theta", "xb", "yb", "phi"],
     system_coordinates: &["x1", "y1", "theta", "xb", "yb", "phi"],
     reduced_index: 2,
@@ -243,6 +243,33 @@ impl Model for RodBlockTipping {
         k[20] = (ell * ell) * m1 / 3.0;
         // k[21] = 2*ell
         k[21] = 2.0 * ell;
+        // k[22] = ell*m1
+        k[22] = ell * m1;
+        // k[23] = ell^2/12
+        k[23] = (ell * ell) / 12.0;
+        // k[24] = ell^2/4
+        k[24] = (ell * ell) / 4.0;
+        // k[25] = ell*g/2
+        k[25] = ell * g / 2.0;
+        // k[26] = ell*m1/6
+        k[26] = ell * m1 / 6.0;
+        // k[27] = g*m1/2
+        k[27] = g * m1 / 2.0;
+        // k[28] = h^2/12 + w^2/12
+        k[28] = ((h * h) / 12.0) + ((w * w) / 12.0);
+        // k[29] = m2*w/6
+        k[29] = m2 * w / 6.0;
+        // k[30] = h*m2/6
+        k[30] = h * m2 / 6.0;
+        // k[31] = h/(ell^2*(1 - h^2/ell^2)^(1/2))
+        k[31] = h / (ell * ell) / (1.0 - ((h * h) / (ell * ell))).sqrt();
+        // k[32] = 1/(ell*(1 - h^2/ell^2)^(1/2))
+        k[32] = 1.0 / ell / (1.0 - ((h * h) / (ell * ell))).sqrt();
+        // k[33] = ell/((ell + h)*(ell - h))^(1/2)
+        k[33] = ell / ((ell + h) * (ell - h)).sqrt();
+        // k[34] = (ell - h - (ell + h))/(2*((ell + h)*(ell - h))^(1/2))
+        let h34_t0 = ell + h;
+        k[34] = (ell - h - h34_t0) / 2.0 / (h34_t0 * (ell - h)).sqrt();
     }
 
     /// The state at release, over the parameters.
@@ -260,7 +287,7 @@ impl Model for RodBlockTipping {
     /// - `phi = 0.0`
     /// - `dot_phi = 0.0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = 0.0;
@@ -290,7 +317,7 @@ impl Model for RodBlockTipping {
     /// - `far_edge_x = h*sin(phi)/2 + w*cos(phi)/2 + xb`
     /// - `far_edge_y = -h*cos(phi)/2 + w*sin(phi)/2 + yb`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let x1 = q[0];
@@ -340,7 +367,7 @@ impl Model for RodBlockTipping {
     /// - `T`: 209 characters, written out in `generated/rod_block_tipping.tex`
     /// - `V = ell*g*m1*sin(theta)/2 + g*m1*y1 + g*m2*yb`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let x1_dot = qd[0];
         let y1 = q[1];
@@ -367,7 +394,7 @@ impl Model for RodBlockTipping {
     /// - `p_xb = dot_xb*m2`
     /// - `p_phi = dot_phi*m2*w^2/12 + dot_phi*h^2*m2/12`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let m1 = k[0];
         let m2 = k[1];
@@ -385,7 +412,7 @@ impl Model for RodBlockTipping {
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
     /// - `L = T - V`: 255 characters, written out in `generated/rod_block_tipping.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let m2 = k[1];
@@ -456,7 +483,7 @@ impl Model for RodBlockTipping {
     /// - `floor_normal = y1`
     /// - `tip_floor = ell*sin(theta) + y1`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let x1 = q[0];
@@ -477,7 +504,7 @@ impl Model for RodBlockTipping {
 
     /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let x1 = q[0];
@@ -552,7 +579,7 @@ impl Model for RodBlockTipping {
     ///
     /// - `contact_force = ell*sin(phi)*cos(theta) - ell*sin(theta)*cos(phi) + h/2 + x1*sin(phi) - xb*sin(phi) - y1*cos(phi) + yb*cos(phi)`
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let x1 = q[0];
@@ -632,7 +659,7 @@ impl Model for RodBlockTipping {
 
     /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let w = k[3];
         let h = k[4];
@@ -652,6 +679,227 @@ impl Model for RodBlockTipping {
         sizes[5] = 0.0;
         sizes[6] = w;
         sizes[7] = h;
+    }
+
+    fn has_tangents(&self) -> bool {
+        true
+    }
+
+    /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities (`qdd`, `forces`, `fr` held fixed), row-major.
+    ///
+    /// 21 rows (6 + 3 x 5 + 2 x 0) by 18 columns (2 x 6 + 6), differentiated symbolically; see `generated/rod_block_tipping.tex` for the rows.
+    #[allow(clippy::too_many_arguments)]
+    fn tangents(
+        &self,
+        k: &[f64],
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        forces: &[f64],
+        _fr: &[f64],
+        out: &mut [f64],
+    ) {
+        let k = &k[..35]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        let m1 = k[0];
+        let m2 = k[1];
+        let ell = k[2];
+        let w = k[3];
+        let h = k[4];
+        let g = k[5];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let x1_ddot = qdd[0];
+        let y1 = q[1];
+        let y1_dot = qd[1];
+        let y1_ddot = qdd[1];
+        let theta_dot = qd[2];
+        let theta_ddot = qdd[2];
+        let xb = q[3];
+        let xb_dot = qd[3];
+        let xb_ddot = qdd[3];
+        let yb = q[4];
+        let yb_dot = qd[4];
+        let yb_ddot = qdd[4];
+        let phi = q[5];
+        let phi_dot = qd[5];
+        let phi_ddot = qdd[5];
+        let xt0 = theta_dot * theta_dot;
+        let xt1 = phi.sin();
+        let xt2 = -forces[0] * xt1;
+        let xt3 = phi.cos();
+        let xt4 = forces[0] * xt3;
+        let xt5 = ell * xt1 * rc_s;
+        let xt6 = ell * xt3 * rc_c;
+        let xt7 = xt5 + xt6;
+        let xt8 = -xt5 - xt6;
+        let xt9 = -forces[0] * xt8;
+        let xt10 = rc_s * rc_s;
+        let xt11 = rc_c * rc_c;
+        let xt12 = -(xt1 * rc_c) + (rc_s * xt3);
+        let xt13 = forces[0] * xt1;
+        let xt14 = -forces[0] * xt3;
+        let xt15 = xt5 + xt6 + (x1 * xt3) - (xb * xt3) + (y1 * xt1) - (yb * xt1);
+        let xt16 = k[8] * xt3; // h*cos(phi)/2
+        let xt17 = xt16 + (k[10] * xt1); // h*cos(phi)/2 + w*sin(phi)/2
+        let xt18 = xt16 - (k[10] * xt1); // h*cos(phi)/2 - w*sin(phi)/2
+        let xt19 = (xt1 * rc_c) - (rc_s * xt3);
+        let xt20 = phi_dot * phi_dot;
+        let xt21 = h * phi_dot * xt3;
+        let xt22 = (phi_ddot * xt1 / 2.0) + (xt20 * xt3 / 2.0);
+        let xt23 = -xt3;
+        let xt24 = -xt1;
+        let xt25 = k[8] * xt1; // h*sin(phi)/2
+        let xt26 = -xt3 / 2.0;
+        out.fill(0.0);
+        out[2] = -(k[11] * theta_ddot * rc_c) + (k[11] * xt0 * rc_s);
+        out[5] = xt2;
+        out[8] = -k[22] * theta_dot * rc_c;
+        out[12] = -(k[9] * theta_ddot * rc_s) + x1_ddot - (k[9] * xt0 * rc_c);
+        out[14] = -(k[14] * theta_ddot * rc_s) - (k[14] * xt0 * rc_c);
+        out[20] = -(k[11] * theta_ddot * rc_s) - (k[11] * xt0 * rc_c);
+        out[23] = xt4;
+        out[26] = -k[22] * theta_dot * rc_s;
+        out[30] = (k[9] * theta_ddot * rc_c) + y1_ddot - (-g + (k[9] * xt0 * rc_s));
+        out[32] = (k[14] * theta_ddot * rc_c) - (k[14] * xt0 * rc_s);
+        out[35] = m1;
+        out[38] = -(k[11] * x1_ddot * rc_c)
+            - (k[11] * y1_ddot * rc_s)
+            - (k[16] * rc_s)
+            - (-(ell * forces[4] * rc_s) + (forces[0] * xt7));
+        out[41] = xt9;
+        out[48] = (theta_ddot * (k[23] + (k[24] * xt10) + (k[24] * xt11)))
+            - (k[9] * x1_ddot * rc_s)
+            + (k[9] * y1_ddot * rc_c)
+            + (k[25] * rc_c);
+        out[50] = (theta_ddot * (k[26] + (k[11] * xt10) + (k[11] * xt11)))
+            - (k[14] * x1_ddot * rc_s)
+            + (k[14] * y1_ddot * rc_c)
+            + (k[27] * rc_c)
+            - ((forces[0] * xt12) + (forces[4] * rc_c));
+        out[53] = k[11] * rc_c;
+        out[59] = xt13;
+        out[67] = xb_ddot;
+        out[77] = xt14;
+        out[85] = g + yb_ddot;
+        out[89] = m2;
+        out[90] = xt2;
+        out[91] = xt4;
+        out[92] = xt9;
+        out[93] = xt13;
+        out[94] = xt14;
+        out[95] = -((forces[0] * xt15) + (forces[1] * xt17) + (forces[2] * xt18));
+        out[103] = k[28] * phi_ddot;
+        out[104] = -forces[0] * xt19;
+        out[105] = (k[29] * phi_ddot) - (-(forces[1] * xt3 / 2.0) + (forces[2] * xt3 / 2.0));
+        out[106] = (k[30] * phi_ddot) - ((forces[1] * xt1 / 2.0) + (forces[2] * xt1 / 2.0));
+        out[108] = (phi_ddot * xt1) + (xt20 * xt3);
+        out[109] = -(phi_ddot * xt3) + (xt20 * xt1);
+        out[110] = (phi_ddot * xt8) + (theta_ddot * xt7)
+            - (k[21] * phi_dot * theta_dot * xt1 * rc_c)
+            + (k[21] * phi_dot * theta_dot * rc_s * xt3)
+            + (ell * xt20 * xt1 * rc_c)
+            - (ell * xt20 * rc_s * xt3)
+            + (ell * xt0 * xt1 * rc_c)
+            - (ell * xt0 * rc_s * xt3);
+        out[111] = -(phi_ddot * xt1) - (xt20 * xt3);
+        out[112] = (phi_ddot * xt3) - (xt20 * xt1);
+        out[113] = (phi_ddot * xt15) + (theta_ddot * xt8) + (x1_ddot * xt1)
+            - (xb_ddot * xt1)
+            - (y1_ddot * xt3)
+            + (yb_ddot * xt3)
+            + (k[21] * phi_dot * theta_dot * xt1 * rc_c)
+            - (k[21] * phi_dot * theta_dot * rc_s * xt3)
+            + (2.0 * phi_dot * x1_dot * xt3)
+            - (2.0 * phi_dot * xb_dot * xt3)
+            + (2.0 * phi_dot * y1_dot * xt1)
+            - (2.0 * phi_dot * yb_dot * xt1)
+            - (ell * xt20 * xt1 * rc_c)
+            + (ell * xt20 * rc_s * xt3)
+            - (xt20 * x1 * xt1)
+            + (xt20 * xb * xt1)
+            + (xt20 * y1 * xt3)
+            - (xt20 * yb * xt3)
+            - (ell * xt0 * xt1 * rc_c)
+            + (ell * xt0 * rc_s * xt3);
+        out[114] = 2.0 * phi_dot * xt1;
+        out[115] = -2.0 * phi_dot * xt3;
+        out[116] = -(k[21] * phi_dot * xt1 * rc_s) - (k[21] * phi_dot * xt3 * rc_c)
+            + (k[21] * theta_dot * xt1 * rc_s)
+            + (k[21] * theta_dot * xt3 * rc_c);
+        out[117] = -2.0 * phi_dot * xt1;
+        out[118] = 2.0 * phi_dot * xt3;
+        out[119] = (k[21] * phi_dot * xt1 * rc_s)
+            + (k[21] * phi_dot * xt3 * rc_c)
+            + (2.0 * phi_dot * x1 * xt3)
+            - (2.0 * phi_dot * xb * xt3)
+            + (2.0 * phi_dot * y1 * xt1)
+            - (2.0 * phi_dot * yb * xt1)
+            - (k[21] * theta_dot * xt1 * rc_s)
+            - (k[21] * theta_dot * xt3 * rc_c)
+            + (2.0 * x1_dot * xt1)
+            - (2.0 * xb_dot * xt1)
+            - (2.0 * y1_dot * xt3)
+            + (2.0 * yb_dot * xt3);
+        out[122] = (phi_ddot * xt19) + (theta_ddot * xt12)
+            - (2.0 * phi_dot * theta_dot * xt1 * rc_s)
+            - (2.0 * phi_dot * theta_dot * xt3 * rc_c)
+            + (xt20 * xt1 * rc_s)
+            + (xt20 * xt3 * rc_c)
+            + (xt0 * xt1 * rc_s)
+            + (xt0 * xt3 * rc_c);
+        out[131] = (phi_ddot * xt17) - (k[8] * xt20 * xt1) + (k[10] * xt20 * xt3);
+        out[137] = xt21 + (w * phi_dot * xt1);
+        out[141] = -(phi_ddot * xt3 / 2.0) + (xt20 * xt1 / 2.0);
+        out[142] = xt22;
+        out[149] = (phi_ddot * xt18) - (k[8] * xt20 * xt1) - (k[10] * xt20 * xt3);
+        out[155] = xt21 - (w * phi_dot * xt1);
+        out[159] = (phi_ddot * xt3 / 2.0) - (xt20 * xt1 / 2.0);
+        out[160] = xt22;
+        out[182] = -(ell * theta_ddot * rc_s) - (ell * xt0 * rc_c);
+        out[188] = -k[21] * theta_dot * rc_s;
+        out[194] = (theta_ddot * rc_c) - (xt0 * rc_s);
+        out[198] = xt23;
+        out[199] = xt24;
+        out[200] = -(ell * xt1 * rc_c) + (ell * rc_s * xt3);
+        out[201] = xt3;
+        out[202] = xt1;
+        out[203] = (ell * xt1 * rc_c) - (ell * rc_s * xt3) + (x1 * xt1) - (xb * xt1) - (y1 * xt3)
+            + (yb * xt3);
+        out[212] = -(xt1 * rc_s) - (xt3 * rc_c);
+        out[213] = -1.0 / 2.0;
+        out[220] = 1.0;
+        out[221] = xt25 - (k[10] * xt3);
+        out[231] = -xt1 / 2.0;
+        out[232] = xt26;
+        out[238] = 1.0;
+        out[239] = xt25 + (k[10] * xt3);
+        out[249] = xt1 / 2.0;
+        out[250] = xt26;
+        out[253] = 1.0;
+        out[271] = 1.0;
+        out[272] = ell * rc_c;
+        out[284] = rc_s;
+        out[288] = xt1;
+        out[289] = xt23;
+        out[290] = xt8;
+        out[291] = xt24;
+        out[292] = xt3;
+        out[293] = xt15;
+        out[302] = xt19;
+        out[304] = 1.0 / 2.0;
+    }
+
+    /// `d(initial state)/dp`: the rows `d q_0/dp`, then `d qd_0/dp`, by the parameters.
+    fn initial_tangents(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..35]; // one bounds check for all constant loads
+        out.fill(0.0);
+        out[14] = -k[31];
+        out[16] = k[32];
+        out[20] = k[33];
+        out[21] = 1.0 / 2.0;
+        out[22] = k[34];
+        out[28] = 1.0 / 2.0;
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {

@@ -53,7 +53,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 17,
+    n_constants: 28,
     coordinates: &["x1", "y1", "theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced_index: 2,
@@ -199,6 +199,35 @@ impl Model for RodCube {
         k[15] = (ell * ell) * m1 / 3.0;
         // k[16] = a/2
         k[16] = a / 2.0;
+        // k[17] = ell*m1
+        k[17] = ell * m1;
+        // k[18] = ell^2/12
+        k[18] = (ell * ell) / 12.0;
+        // k[19] = ell^2/4
+        k[19] = (ell * ell) / 4.0;
+        // k[20] = ell*g/2
+        k[20] = ell * g / 2.0;
+        // k[21] = ell*m1/6
+        k[21] = ell * m1 / 6.0;
+        // k[22] = g*m1/2
+        k[22] = g * m1 / 2.0;
+        // k[23] = 2*ell
+        k[23] = 2.0 * ell;
+        // k[24] = a/(ell^2*(1 - a^2/ell^2)^(1/2))
+        k[24] = a / (ell * ell) / (1.0 - ((a * a) / (ell * ell))).sqrt();
+        // k[25] = 1/(ell*(1 - a^2/ell^2)^(1/2))
+        k[25] = 1.0 / ell / (1.0 - ((a * a) / (ell * ell))).sqrt();
+        // k[26] = ell*(a*(1 + a/ell)/ell^2 - a*(1 - a/ell)/ell^2)/(2*((1 + a/ell)*(1 - a/ell))^(1/2)) + ((1 + a/ell)*(1 - a/ell))^(1/2)
+        let h26_t0 = 1.0 + (a / ell);
+        let h26_t1 = 1.0 - (a / ell);
+        let h26_t2 = h26_t0 * h26_t1;
+        k[26] =
+            (ell * ((a * h26_t0 / (ell * ell)) - (a * h26_t1 / (ell * ell))) / 2.0 / h26_t2.sqrt())
+                + h26_t2.sqrt();
+        // k[27] = ell*(-(1 + a/ell)/ell + (1 - a/ell)/ell)/(2*((1 + a/ell)*(1 - a/ell))^(1/2))
+        let h27_t0 = 1.0 + (a / ell);
+        let h27_t1 = 1.0 - (a / ell);
+        k[27] = ell * (-(h27_t0 / ell) + (h27_t1 / ell)) / 2.0 / (h27_t0 * h27_t1).sqrt();
     }
 
     /// The state at release, over the parameters.
@@ -212,7 +241,7 @@ impl Model for RodCube {
     /// - `x2 = ell*((1 - a/ell)*(1 + a/ell))^(1/2)`
     /// - `dot_x2 = 0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = 0.0;
@@ -234,7 +263,7 @@ impl Model for RodCube {
     /// - `cube_x = x2`
     /// - `cube_y = 0`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let x1 = q[0];
@@ -265,7 +294,7 @@ impl Model for RodCube {
     /// - `T = -dot_theta*dot_x1*ell*m1*sin(theta)/2 + dot_theta*dot_y1*ell*m1*cos(theta)/2 + dot_theta^2*ell^2*m1/6 + dot_x1^2*m1/2 + dot_x2^2*m2/2 + dot_y1^2*m1/2`
     /// - `V = a*g*m2/2 + ell*g*m1*sin(theta)/2 + g*m1*y1`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let x1_dot = qd[0];
         let y1 = q[1];
@@ -286,7 +315,7 @@ impl Model for RodCube {
     /// - `p_x1 = -dot_theta*ell*m1*sin(theta)/2 + dot_x1*m1`
     /// - `p_x2 = dot_x2*m2`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let m1 = k[0];
         let m2 = k[1];
@@ -302,7 +331,7 @@ impl Model for RodCube {
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
     /// - `L = T - V`: 196 characters, written out in `generated/rod_cube.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let m2 = k[1];
@@ -345,7 +374,7 @@ impl Model for RodCube {
     /// - `contact_force = -ell*cos(theta) - x1 + x2`
     /// - `floor_normal = y1`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         let rc_c = q[2].cos();
         let ell = k[2];
         let x1 = q[0];
@@ -357,7 +386,7 @@ impl Model for RodCube {
 
     /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let theta_dot = qd[2];
@@ -390,7 +419,7 @@ impl Model for RodCube {
     ///
     /// - `cube_does_not_tip = a*g*m2/2 - rc_f0*(-a/2 + ell*sin(theta))`
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let ell = k[2];
         out[0] = k[12] - (forces[0] * (-k[16] + (ell * rc_s)));
@@ -427,7 +456,7 @@ impl Model for RodCube {
 
     /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..28]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let a = k[3];
         let x1 = q[0];
@@ -444,6 +473,80 @@ impl Model for RodCube {
         sizes[5] = 0.0;
         sizes[6] = a;
         sizes[7] = a;
+    }
+
+    fn has_tangents(&self) -> bool {
+        true
+    }
+
+    /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities (`qdd`, `forces`, `fr` held fixed), row-major.
+    ///
+    /// 10 rows (4 + 3 x 2 + 2 x 0) by 13 columns (2 x 4 + 5), differentiated symbolically; see `generated/rod_cube.tex` for the rows.
+    #[allow(clippy::too_many_arguments)]
+    fn tangents(
+        &self,
+        k: &[f64],
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        forces: &[f64],
+        _fr: &[f64],
+        out: &mut [f64],
+    ) {
+        let k = &k[..28]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        let m1 = k[0];
+        let ell = k[2];
+        let g = k[4];
+        let x1_ddot = qdd[0];
+        let y1_ddot = qdd[1];
+        let theta_dot = qd[2];
+        let theta_ddot = qdd[2];
+        let x2_ddot = qdd[3];
+        let xt0 = theta_dot * theta_dot;
+        let xt1 = rc_s * rc_s;
+        let xt2 = rc_c * rc_c;
+        out.fill(0.0);
+        out[2] = -(k[8] * theta_ddot * rc_c) + (k[8] * xt0 * rc_s);
+        out[6] = -k[17] * theta_dot * rc_c;
+        out[8] = -(k[7] * theta_ddot * rc_s) + x1_ddot - (k[7] * xt0 * rc_c);
+        out[10] = -(k[10] * theta_ddot * rc_s) - (k[10] * xt0 * rc_c);
+        out[15] = -(k[8] * theta_ddot * rc_s) - (k[8] * xt0 * rc_c);
+        out[19] = -k[17] * theta_dot * rc_s;
+        out[21] = (k[7] * theta_ddot * rc_c) + y1_ddot - (-g + (k[7] * xt0 * rc_s));
+        out[23] = (k[10] * theta_ddot * rc_c) - (k[10] * xt0 * rc_s);
+        out[25] = m1;
+        out[28] = -(k[8] * x1_ddot * rc_c)
+            - (k[8] * y1_ddot * rc_s)
+            - (k[13] * rc_s)
+            - (ell * forces[0] * rc_c);
+        out[34] = (theta_ddot * (k[18] + (k[19] * xt1) + (k[19] * xt2))) - (k[7] * x1_ddot * rc_s)
+            + (k[7] * y1_ddot * rc_c)
+            + (k[20] * rc_c);
+        out[36] = (theta_ddot * (k[21] + (k[8] * xt1) + (k[8] * xt2))) - (k[10] * x1_ddot * rc_s)
+            + (k[10] * y1_ddot * rc_c)
+            + (k[22] * rc_c)
+            - (forces[0] * rc_s);
+        out[38] = k[8] * rc_c;
+        out[48] = x2_ddot;
+        out[54] = (ell * theta_ddot * rc_c) - (ell * xt0 * rc_s);
+        out[58] = k[23] * theta_dot * rc_c;
+        out[62] = (theta_ddot * rc_s) + (xt0 * rc_c);
+        out[78] = -1.0;
+        out[80] = ell * rc_s;
+        out[81] = 1.0;
+        out[88] = -rc_c;
+        out[92] = 1.0;
+    }
+
+    /// `d(initial state)/dp`: the rows `d q_0/dp`, then `d qd_0/dp`, by the parameters.
+    fn initial_tangents(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..28]; // one bounds check for all constant loads
+        out.fill(0.0);
+        out[12] = -k[24];
+        out[13] = k[25];
+        out[17] = k[26];
+        out[18] = k[27];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {

@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 20,
+    n_constants: 33,
     coordinates: &["x1", "y1", "theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced_index: 2,
@@ -193,6 +193,39 @@ impl Model for RodCubeSpring {
         k[18] = (ell * ell) * m1 / 3.0;
         // k[19] = a/2
         k[19] = a / 2.0;
+        // k[20] = ell*m1
+        k[20] = ell * m1;
+        // k[21] = ell^2/12
+        k[21] = (ell * ell) / 12.0;
+        // k[22] = ell^2/4
+        k[22] = (ell * ell) / 4.0;
+        // k[23] = ell*g/2
+        k[23] = ell * g / 2.0;
+        // k[24] = ell*m1/6
+        k[24] = ell * m1 / 6.0;
+        // k[25] = g*m1/2
+        k[25] = g * m1 / 2.0;
+        // k[26] = ell*k/(-a^2 + ell^2)^(1/2)
+        k[26] = ell * k_param / (-(a * a) + (ell * ell)).sqrt();
+        // k[27] = a*k/(-a^2 + ell^2)^(1/2)
+        k[27] = a * k_param / (-(a * a) + (ell * ell)).sqrt();
+        // k[28] = 2*ell
+        k[28] = 2.0 * ell;
+        // k[29] = a/(ell^2*(1 - a^2/ell^2)^(1/2))
+        k[29] = a / (ell * ell) / (1.0 - ((a * a) / (ell * ell))).sqrt();
+        // k[30] = 1/(ell*(1 - a^2/ell^2)^(1/2))
+        k[30] = 1.0 / ell / (1.0 - ((a * a) / (ell * ell))).sqrt();
+        // k[31] = ell*(a*(1 + a/ell)/ell^2 - a*(1 - a/ell)/ell^2)/(2*((1 + a/ell)*(1 - a/ell))^(1/2)) + ((1 + a/ell)*(1 - a/ell))^(1/2)
+        let h31_t0 = 1.0 + (a / ell);
+        let h31_t1 = 1.0 - (a / ell);
+        let h31_t2 = h31_t0 * h31_t1;
+        k[31] =
+            (ell * ((a * h31_t0 / (ell * ell)) - (a * h31_t1 / (ell * ell))) / 2.0 / h31_t2.sqrt())
+                + h31_t2.sqrt();
+        // k[32] = ell*(-(1 + a/ell)/ell + (1 - a/ell)/ell)/(2*((1 + a/ell)*(1 - a/ell))^(1/2))
+        let h32_t0 = 1.0 + (a / ell);
+        let h32_t1 = 1.0 - (a / ell);
+        k[32] = ell * (-(h32_t0 / ell) + (h32_t1 / ell)) / 2.0 / (h32_t0 * h32_t1).sqrt();
     }
 
     /// The state at release, over the parameters.
@@ -206,7 +239,7 @@ impl Model for RodCubeSpring {
     /// - `x2 = ell*((1 - a/ell)*(1 + a/ell))^(1/2)`
     /// - `dot_x2 = 0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..20]; // one bounds check for all constant loads
+        let k = &k[..33]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = 0.0;
@@ -228,7 +261,7 @@ impl Model for RodCubeSpring {
     /// - `cube_x = x2`
     /// - `cube_y = 0`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..20]; // one bounds check for all constant loads
+        let k = &k[..33]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let x1 = q[0];
@@ -259,7 +292,7 @@ impl Model for RodCubeSpring {
     /// - `T = -dot_theta*dot_x1*ell*m1*sin(theta)/2 + dot_theta*dot_y1*ell*m1*cos(theta)/2 + dot_theta^2*ell^2*m1/6 + dot_x1^2*m1/2 + dot_x2^2*m2/2 + dot_y1^2*m1/2`
     /// - `V = a*g*m2/2 + ell*g*m1*sin(theta)/2 + g*m1*y1 + k*(x2 - (-a^2 + ell^2)^(1/2))^2/2`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..20]; // one bounds check for all constant loads
+        let k = &k[..33]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let x1_dot = qd[0];
         let y1 = q[1];
@@ -280,7 +313,7 @@ impl Model for RodCubeSpring {
     ///
     /// - `p_x1 = -dot_theta*ell*m1*sin(theta)/2 + dot_x1*m1`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..20]; // one bounds check for all constant loads
+        let k = &k[..33]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let m1 = k[0];
         let x1_dot = qd[0];
@@ -293,7 +326,7 @@ impl Model for RodCubeSpring {
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
     /// - `L = T - V`: 232 characters, written out in `generated/rod_cube_spring.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..20]; // one bounds check for all constant loads
+        let k = &k[..33]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let m2 = k[1];
@@ -338,7 +371,7 @@ impl Model for RodCubeSpring {
     /// - `contact_force = -ell*cos(theta) - x1 + x2`
     /// - `floor_normal = y1`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..20]; // one bounds check for all constant loads
+        let k = &k[..33]; // one bounds check for all constant loads
         let rc_c = q[2].cos();
         let ell = k[2];
         let x1 = q[0];
@@ -350,7 +383,7 @@ impl Model for RodCubeSpring {
 
     /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..20]; // one bounds check for all constant loads
+        let k = &k[..33]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let theta_dot = qd[2];
@@ -423,7 +456,7 @@ impl Model for RodCubeSpring {
 
     /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..20]; // one bounds check for all constant loads
+        let k = &k[..33]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let a = k[3];
         let x1 = q[0];
@@ -440,6 +473,86 @@ impl Model for RodCubeSpring {
         sizes[5] = 0.0;
         sizes[6] = a;
         sizes[7] = a;
+    }
+
+    fn has_tangents(&self) -> bool {
+        true
+    }
+
+    /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities (`qdd`, `forces`, `fr` held fixed), row-major.
+    ///
+    /// 10 rows (4 + 3 x 2 + 2 x 0) by 14 columns (2 x 4 + 6), differentiated symbolically; see `generated/rod_cube_spring.tex` for the rows.
+    #[allow(clippy::too_many_arguments)]
+    fn tangents(
+        &self,
+        k: &[f64],
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        forces: &[f64],
+        _fr: &[f64],
+        out: &mut [f64],
+    ) {
+        let k = &k[..33]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        let m1 = k[0];
+        let ell = k[2];
+        let g = k[4];
+        let k_param = k[5];
+        let x1_ddot = qdd[0];
+        let y1_ddot = qdd[1];
+        let theta_dot = qd[2];
+        let theta_ddot = qdd[2];
+        let x2 = q[3];
+        let x2_ddot = qdd[3];
+        let xt0 = theta_dot * theta_dot;
+        let xt1 = rc_s * rc_s;
+        let xt2 = rc_c * rc_c;
+        out.fill(0.0);
+        out[2] = -(k[9] * theta_ddot * rc_c) + (k[9] * xt0 * rc_s);
+        out[6] = -k[20] * theta_dot * rc_c;
+        out[8] = -(k[8] * theta_ddot * rc_s) + x1_ddot - (k[8] * xt0 * rc_c);
+        out[10] = -(k[11] * theta_ddot * rc_s) - (k[11] * xt0 * rc_c);
+        out[16] = -(k[9] * theta_ddot * rc_s) - (k[9] * xt0 * rc_c);
+        out[20] = -k[20] * theta_dot * rc_s;
+        out[22] = (k[8] * theta_ddot * rc_c) + y1_ddot - (-g + (k[8] * xt0 * rc_s));
+        out[24] = (k[11] * theta_ddot * rc_c) - (k[11] * xt0 * rc_s);
+        out[26] = m1;
+        out[30] = -(k[9] * x1_ddot * rc_c)
+            - (k[9] * y1_ddot * rc_s)
+            - (k[14] * rc_s)
+            - (ell * forces[0] * rc_c);
+        out[36] = (theta_ddot * (k[21] + (k[22] * xt1) + (k[22] * xt2))) - (k[8] * x1_ddot * rc_s)
+            + (k[8] * y1_ddot * rc_c)
+            + (k[23] * rc_c);
+        out[38] = (theta_ddot * (k[24] + (k[9] * xt1) + (k[9] * xt2))) - (k[11] * x1_ddot * rc_s)
+            + (k[11] * y1_ddot * rc_c)
+            + (k[25] * rc_c)
+            - (forces[0] * rc_s);
+        out[40] = k[9] * rc_c;
+        out[45] = k_param;
+        out[51] = x2_ddot;
+        out[52] = -k[26];
+        out[53] = k[27];
+        out[55] = -k[17] + x2;
+        out[58] = (ell * theta_ddot * rc_c) - (ell * xt0 * rc_s);
+        out[62] = k[28] * theta_dot * rc_c;
+        out[66] = (theta_ddot * rc_s) + (xt0 * rc_c);
+        out[84] = -1.0;
+        out[86] = ell * rc_s;
+        out[87] = 1.0;
+        out[94] = -rc_c;
+        out[99] = 1.0;
+    }
+
+    /// `d(initial state)/dp`: the rows `d q_0/dp`, then `d qd_0/dp`, by the parameters.
+    fn initial_tangents(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..33]; // one bounds check for all constant loads
+        out.fill(0.0);
+        out[14] = -k[29];
+        out[15] = k[30];
+        out[20] = k[31];
+        out[21] = k[32];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {

@@ -65,7 +65,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
         },
     ],
-    n_constants: 17,
+    n_constants: 25,
     coordinates: &["x1", "y1", "theta", "xc"],
     system_coordinates: &["x1", "y1", "theta", "xc"],
     reduced_index: 2,
@@ -205,6 +205,26 @@ impl Model for RodCylinder {
         k[15] = g * m1;
         // k[16] = ell^2*m1/3
         k[16] = (ell * ell) * m1 / 3.0;
+        // k[17] = ell*m1
+        k[17] = ell * m1;
+        // k[18] = ell^2/12
+        k[18] = (ell * ell) / 12.0;
+        // k[19] = ell^2/4
+        k[19] = (ell * ell) / 4.0;
+        // k[20] = ell*g/2
+        k[20] = ell * g / 2.0;
+        // k[21] = ell*m1/6
+        k[21] = ell * m1 / 6.0;
+        // k[22] = g*m1/2
+        k[22] = g * m1 / 2.0;
+        // k[23] = 1/sin(th0) + cos(th0)/sin(th0)
+        let h23_t0 = 1.0 / th0.sin();
+        k[23] = h23_t0 + (th0.cos() / th0.sin());
+        // k[24] = R + R*cos(th0)/sin(th0)^2 + R*cos(th0)^2/sin(th0)^2
+        let h24_t0 = th0.cos();
+        k[24] = r
+            + (r * h24_t0 / (th0.sin() * th0.sin()))
+            + (r * (h24_t0 * h24_t0) / (th0.sin() * th0.sin()));
     }
 
     /// The state at release, over the parameters.
@@ -218,7 +238,7 @@ impl Model for RodCylinder {
     /// - `xc = R/sin(th0) + R*cos(th0)/sin(th0)`
     /// - `dot_xc = 0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..25]; // one bounds check for all constant loads
         let th0 = k[4];
         q[0] = 0.0;
         qd[0] = 0.0;
@@ -243,7 +263,7 @@ impl Model for RodCylinder {
     /// - `touch_x = R*sin(theta)*cos(theta) + x1*sin(theta)^2 + xc*cos(theta)^2 - y1*sin(theta)*cos(theta)`
     /// - `touch_y = R*sin(theta)^2 - x1*sin(theta)*cos(theta) + xc*sin(theta)*cos(theta) + y1*cos(theta)^2`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let r = k[3];
@@ -298,7 +318,7 @@ impl Model for RodCylinder {
     /// - `T = -dot_theta*dot_x1*ell*m1*sin(theta)/2 + dot_theta*dot_y1*ell*m1*cos(theta)/2 + dot_theta^2*ell^2*m1/6 + dot_x1^2*m1/2 + dot_xc^2*m2/2 + dot_y1^2*m1/2`
     /// - `V = R*g*m2 + ell*g*m1*sin(theta)/2 + g*m1*y1`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let x1_dot = qd[0];
         let y1 = q[1];
@@ -319,7 +339,7 @@ impl Model for RodCylinder {
     /// - `p_x1 = -dot_theta*ell*m1*sin(theta)/2 + dot_x1*m1`
     /// - `p_xc = dot_xc*m2`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..25]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let m1 = k[0];
         let m2 = k[1];
@@ -335,7 +355,7 @@ impl Model for RodCylinder {
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
     /// - `L = T - V`: 194 characters, written out in `generated/rod_cylinder.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let m2 = k[1];
@@ -378,7 +398,7 @@ impl Model for RodCylinder {
     /// - `contact_force = -R - R*cos(theta) - x1*sin(theta) + xc*sin(theta) + y1*cos(theta)`
     /// - `floor_normal = y1`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let r = k[3];
         let x1 = q[0];
@@ -390,7 +410,7 @@ impl Model for RodCylinder {
 
     /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let r = k[3];
         let x1 = q[0];
@@ -422,7 +442,7 @@ impl Model for RodCylinder {
     ///
     /// - `contact_force = -R*sin(theta) + ell + x1*cos(theta) - xc*cos(theta) + y1*sin(theta)`
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let r = k[3];
@@ -482,7 +502,7 @@ impl Model for RodCylinder {
 
     /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..17]; // one bounds check for all constant loads
+        let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let r = k[3];
         let x1 = q[0];
@@ -498,6 +518,118 @@ impl Model for RodCylinder {
         sizes[4] = 0.0;
         sizes[5] = 0.0;
         sizes[6] = r;
+    }
+
+    fn has_tangents(&self) -> bool {
+        true
+    }
+
+    /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities (`qdd`, `forces`, `fr` held fixed), row-major.
+    ///
+    /// 10 rows (4 + 3 x 2 + 2 x 0) by 14 columns (2 x 4 + 6), differentiated symbolically; see `generated/rod_cylinder.tex` for the rows.
+    #[allow(clippy::too_many_arguments)]
+    fn tangents(
+        &self,
+        k: &[f64],
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        forces: &[f64],
+        _fr: &[f64],
+        out: &mut [f64],
+    ) {
+        let k = &k[..25]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        let m1 = k[0];
+        let r = k[3];
+        let g = k[5];
+        let x1 = q[0];
+        let x1_dot = qd[0];
+        let x1_ddot = qdd[0];
+        let y1 = q[1];
+        let y1_dot = qd[1];
+        let y1_ddot = qdd[1];
+        let theta_dot = qd[2];
+        let theta_ddot = qdd[2];
+        let xc = q[3];
+        let xc_dot = qd[3];
+        let xc_ddot = qdd[3];
+        let xt0 = forces[0] * rc_c;
+        let xt1 = theta_dot * theta_dot;
+        let xt2 = forces[0] * rc_s;
+        let xt3 = (r * rc_c) + (x1 * rc_s) - (xc * rc_s) - (y1 * rc_c);
+        let xt4 = -forces[0] * rc_c;
+        let xt5 = rc_s * rc_s;
+        let xt6 = rc_c * rc_c;
+        let xt7 = -rc_s;
+        let xt8 = -rc_c;
+        out.fill(0.0);
+        out[2] = -(k[9] * theta_ddot * rc_c) + xt0 + (k[9] * xt1 * rc_s);
+        out[6] = -k[17] * theta_dot * rc_c;
+        out[8] = -(k[7] * theta_ddot * rc_s) + x1_ddot - (k[7] * xt1 * rc_c);
+        out[10] = -(k[11] * theta_ddot * rc_s) - (k[11] * xt1 * rc_c);
+        out[16] = -(k[9] * theta_ddot * rc_s) + xt2 - (k[9] * xt1 * rc_c);
+        out[20] = -k[17] * theta_dot * rc_s;
+        out[22] = (k[7] * theta_ddot * rc_c) + y1_ddot - (-g + (k[7] * xt1 * rc_s));
+        out[24] = (k[11] * theta_ddot * rc_c) - (k[11] * xt1 * rc_s);
+        out[27] = m1;
+        out[28] = xt0;
+        out[29] = xt2;
+        out[30] =
+            -(k[9] * x1_ddot * rc_c) - (k[9] * y1_ddot * rc_s) - (k[14] * rc_s) - (forces[0] * xt3);
+        out[31] = xt4;
+        out[36] = (theta_ddot * (k[18] + (k[19] * xt5) + (k[19] * xt6))) - (k[7] * x1_ddot * rc_s)
+            + (k[7] * y1_ddot * rc_c)
+            + (k[20] * rc_c);
+        out[38] = (theta_ddot * (k[21] + (k[9] * xt5) + (k[9] * xt6))) - (k[11] * x1_ddot * rc_s)
+            + (k[11] * y1_ddot * rc_c)
+            + (k[22] * rc_c);
+        out[39] = -forces[0] * rc_s;
+        out[41] = k[9] * rc_c;
+        out[44] = xt4;
+        out[51] = xc_ddot;
+        out[56] = -(theta_ddot * rc_c) + (xt1 * rc_s);
+        out[57] = -(theta_ddot * rc_s) - (xt1 * rc_c);
+        out[58] = -(r * xt1 * rc_s) + (theta_ddot * xt3) - (x1_ddot * rc_c) + (xc_ddot * rc_c)
+            - (y1_ddot * rc_s)
+            + (2.0 * theta_dot * x1_dot * rc_s)
+            - (2.0 * theta_dot * xc_dot * rc_s)
+            - (2.0 * theta_dot * y1_dot * rc_c)
+            + (xt1 * x1 * rc_c)
+            - (xt1 * xc * rc_c)
+            + (xt1 * y1 * rc_s);
+        out[59] = (theta_ddot * rc_c) - (xt1 * rc_s);
+        out[60] = -2.0 * theta_dot * rc_c;
+        out[61] = -2.0 * theta_dot * rc_s;
+        out[62] = (k[8] * theta_dot * rc_c) + (2.0 * theta_dot * x1 * rc_s)
+            - (2.0 * theta_dot * xc * rc_s)
+            - (2.0 * theta_dot * y1 * rc_c)
+            - (2.0 * x1_dot * rc_c)
+            + (2.0 * xc_dot * rc_c)
+            - (2.0 * y1_dot * rc_s);
+        out[63] = 2.0 * theta_dot * rc_c;
+        out[67] = (theta_ddot * rc_s) + (xt1 * rc_c);
+        out[84] = xt7;
+        out[85] = rc_c;
+        out[86] = (r * rc_s) - (x1 * rc_c) + (xc * rc_c) - (y1 * rc_s);
+        out[87] = rc_s;
+        out[95] = -1.0 - rc_c;
+        out[99] = 1.0;
+        out[112] = rc_c;
+        out[113] = rc_s;
+        out[114] = -(r * rc_c) - (x1 * rc_s) + (xc * rc_s) + (y1 * rc_c);
+        out[115] = xt8;
+        out[122] = 1.0;
+        out[123] = xt7;
+    }
+
+    /// `d(initial state)/dp`: the rows `d q_0/dp`, then `d qd_0/dp`, by the parameters.
+    fn initial_tangents(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..25]; // one bounds check for all constant loads
+        out.fill(0.0);
+        out[16] = 1.0;
+        out[21] = k[23];
+        out[22] = -k[24];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {

@@ -47,7 +47,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "ladder_leans",
         meaning: "the top must start below the ladder's length (a < ell)",
     }],
-    n_constants: 14,
+    n_constants: 25,
     coordinates: &["x1", "y1", "theta"],
     system_coordinates: &["x1", "y1", "theta"],
     reduced_index: 2,
@@ -184,6 +184,35 @@ impl Model for WallLadder {
         k[12] = (ell * ell) * m1 / 3.0;
         // k[13] = 0.0 + ell
         k[13] = 0.0 + ell;
+        // k[14] = ell*m1
+        k[14] = ell * m1;
+        // k[15] = ell^2/12
+        k[15] = (ell * ell) / 12.0;
+        // k[16] = ell^2/4
+        k[16] = (ell * ell) / 4.0;
+        // k[17] = ell*g/2
+        k[17] = ell * g / 2.0;
+        // k[18] = ell*m1/6
+        k[18] = ell * m1 / 6.0;
+        // k[19] = g*m1/2
+        k[19] = g * m1 / 2.0;
+        // k[20] = 2*ell
+        k[20] = 2.0 * ell;
+        // k[21] = ell*(a*(1 + a/ell)/ell^2 - a*(1 - a/ell)/ell^2)/(2*((1 + a/ell)*(1 - a/ell))^(1/2)) + ((1 + a/ell)*(1 - a/ell))^(1/2)
+        let h21_t0 = 1.0 + (a / ell);
+        let h21_t1 = 1.0 - (a / ell);
+        let h21_t2 = h21_t0 * h21_t1;
+        k[21] =
+            (ell * ((a * h21_t0 / (ell * ell)) - (a * h21_t1 / (ell * ell))) / 2.0 / h21_t2.sqrt())
+                + h21_t2.sqrt();
+        // k[22] = ell*(-(1 + a/ell)/ell + (1 - a/ell)/ell)/(2*((1 + a/ell)*(1 - a/ell))^(1/2))
+        let h22_t0 = 1.0 + (a / ell);
+        let h22_t1 = 1.0 - (a / ell);
+        k[22] = ell * (-(h22_t0 / ell) + (h22_t1 / ell)) / 2.0 / (h22_t0 * h22_t1).sqrt();
+        // k[23] = a/(ell^2*(1 - a^2/ell^2)^(1/2))
+        k[23] = a / (ell * ell) / (1.0 - ((a * a) / (ell * ell))).sqrt();
+        // k[24] = 1/(ell*(1 - a^2/ell^2)^(1/2))
+        k[24] = 1.0 / ell / (1.0 - ((a * a) / (ell * ell))).sqrt();
     }
 
     /// The state at release, over the parameters.
@@ -195,7 +224,7 @@ impl Model for WallLadder {
     /// - `theta = asin(a/ell)`
     /// - `dot_theta = 0.0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..14]; // one bounds check for all constant loads
+        let k = &k[..25]; // one bounds check for all constant loads
         q[0] = -k[4];
         qd[0] = 0.0;
         q[1] = 0.0;
@@ -215,7 +244,7 @@ impl Model for WallLadder {
     /// - `wall_x = 0`
     /// - `wall_y = 0`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..14]; // one bounds check for all constant loads
+        let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[1];
         let x1 = q[0];
@@ -244,7 +273,7 @@ impl Model for WallLadder {
     /// - `T = -dot_theta*dot_x1*ell*m1*sin(theta)/2 + dot_theta*dot_y1*ell*m1*cos(theta)/2 + dot_theta^2*ell^2*m1/6 + dot_x1^2*m1/2 + dot_y1^2*m1/2`
     /// - `V = ell*g*m1*sin(theta)/2 + g*m1*y1`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..14]; // one bounds check for all constant loads
+        let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let x1_dot = qd[0];
         let y1 = q[1];
@@ -262,7 +291,7 @@ impl Model for WallLadder {
     ///
     /// - `p_x1 = -dot_theta*ell*m1*sin(theta)/2 + dot_x1*m1`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..14]; // one bounds check for all constant loads
+        let k = &k[..25]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let m1 = k[0];
         let x1_dot = qd[0];
@@ -275,7 +304,7 @@ impl Model for WallLadder {
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
     /// - `L = T - V`: 169 characters, written out in `generated/wall_ladder.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..14]; // one bounds check for all constant loads
+        let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let theta_dot = qd[2];
@@ -309,7 +338,7 @@ impl Model for WallLadder {
     /// - `contact_force = -ell*cos(theta) - x1`
     /// - `floor_normal = y1`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..14]; // one bounds check for all constant loads
+        let k = &k[..25]; // one bounds check for all constant loads
         let rc_c = q[2].cos();
         let ell = k[1];
         let x1 = q[0];
@@ -320,7 +349,7 @@ impl Model for WallLadder {
 
     /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..14]; // one bounds check for all constant loads
+        let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[1];
         let theta_dot = qd[2];
@@ -385,7 +414,7 @@ impl Model for WallLadder {
 
     /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..14]; // one bounds check for all constant loads
+        let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let x1 = q[0];
         let y1 = q[1];
@@ -400,6 +429,77 @@ impl Model for WallLadder {
         sizes[5] = dt0;
         sizes[6] = dt0;
         sizes[7] = k[13];
+    }
+
+    fn has_tangents(&self) -> bool {
+        true
+    }
+
+    /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities (`qdd`, `forces`, `fr` held fixed), row-major.
+    ///
+    /// 9 rows (3 + 3 x 2 + 2 x 0) by 10 columns (2 x 3 + 4), differentiated symbolically; see `generated/wall_ladder.tex` for the rows.
+    #[allow(clippy::too_many_arguments)]
+    fn tangents(
+        &self,
+        k: &[f64],
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        forces: &[f64],
+        _fr: &[f64],
+        out: &mut [f64],
+    ) {
+        let k = &k[..25]; // one bounds check for all constant loads
+        let (rc_s, rc_c) = q[2].sin_cos();
+        let m1 = k[0];
+        let ell = k[1];
+        let g = k[3];
+        let x1_ddot = qdd[0];
+        let y1_ddot = qdd[1];
+        let theta_dot = qd[2];
+        let theta_ddot = qdd[2];
+        let xt0 = theta_dot * theta_dot;
+        let xt1 = rc_s * rc_s;
+        let xt2 = rc_c * rc_c;
+        out.fill(0.0);
+        out[2] = -(k[7] * theta_ddot * rc_c) + (k[7] * xt0 * rc_s);
+        out[5] = -k[14] * theta_dot * rc_c;
+        out[6] = -(k[6] * theta_ddot * rc_s) + x1_ddot - (k[6] * xt0 * rc_c);
+        out[7] = -(k[9] * theta_ddot * rc_s) - (k[9] * xt0 * rc_c);
+        out[12] = -(k[7] * theta_ddot * rc_s) - (k[7] * xt0 * rc_c);
+        out[15] = -k[14] * theta_dot * rc_s;
+        out[16] = (k[6] * theta_ddot * rc_c) + y1_ddot - (-g + (k[6] * xt0 * rc_s));
+        out[17] = (k[9] * theta_ddot * rc_c) - (k[9] * xt0 * rc_s);
+        out[19] = m1;
+        out[22] = -(k[7] * x1_ddot * rc_c)
+            - (k[7] * y1_ddot * rc_s)
+            - (k[10] * rc_s)
+            - (ell * forces[0] * rc_c);
+        out[26] = (theta_ddot * (k[15] + (k[16] * xt1) + (k[16] * xt2))) - (k[6] * x1_ddot * rc_s)
+            + (k[6] * y1_ddot * rc_c)
+            + (k[17] * rc_c);
+        out[27] = (theta_ddot * (k[18] + (k[7] * xt1) + (k[7] * xt2))) - (k[9] * x1_ddot * rc_s)
+            + (k[9] * y1_ddot * rc_c)
+            + (k[19] * rc_c)
+            - (forces[0] * rc_s);
+        out[29] = k[7] * rc_c;
+        out[32] = (ell * theta_ddot * rc_c) - (ell * xt0 * rc_s);
+        out[35] = k[20] * theta_dot * rc_c;
+        out[37] = (theta_ddot * rc_s) + (xt0 * rc_c);
+        out[50] = -1.0;
+        out[52] = ell * rc_s;
+        out[57] = -rc_c;
+        out[61] = 1.0;
+    }
+
+    /// `d(initial state)/dp`: the rows `d q_0/dp`, then `d qd_0/dp`, by the parameters.
+    fn initial_tangents(&self, k: &[f64], out: &mut [f64]) {
+        let k = &k[..25]; // one bounds check for all constant loads
+        out.fill(0.0);
+        out[1] = -k[21];
+        out[2] = -k[22];
+        out[9] = -k[23];
+        out[10] = k[24];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {

@@ -4,7 +4,8 @@
 //! (`M(q) qdd = F(q, qd)`, cyclic coordinates, momenta) → [`constraints`]
 //! (each contact's gap, Jacobian and bias, or its force in closed form where the phase holds it
 //! closed; the frictions' slips) → [`reduction`](super::reduction) (the fast path) →
-//! [`forces`] (monitors). This module only runs them, in that order, for every
+//! [`forces`] (monitors) → [`tangents`] (the general model's partial derivatives for the
+//! forward sensitivities). This module only runs them, in that order, for every
 //! phase of a spec; it is the top of the derivation proper.
 //!
 //! A spec gives its **general model** (named as the spec): every coordinate, every contact a
@@ -37,6 +38,7 @@ use super::read::{Parsed, read};
 use super::reduction::Reducer;
 use super::setup::{Setup, setup, ties};
 use super::spec::{Checked, Spec};
+use super::tangents;
 use std::collections::BTreeMap;
 
 /// The phases a spec derives: its general model first, then every set of eliminable contacts
@@ -450,7 +452,7 @@ fn derive_phase(
     let list = |v: &[A], what: &str| -> Result<Vec<Expr>, DeriveError> {
         v.iter().map(|e| to_expr(e, what)).collect()
     };
-    Ok(Derivation {
+    let mut d = Derivation {
         name: plan.name.clone(),
         system: spec.name.clone(),
         plan: plan.clone(),
@@ -483,7 +485,12 @@ fn derive_phase(
         frictions,
         to_full: to_full(spec, &st)?,
         reduction,
+        tangents: None,
         dimensionless: None,
         steps: None,
-    })
+    };
+    if plan.is_general() {
+        d.tangents = Some(tangents::derive(&d)?);
+    }
+    Ok(d)
 }

@@ -34,6 +34,7 @@ pub mod read;
 pub mod reduction;
 pub mod setup;
 pub mod steps;
+pub mod tangents;
 pub mod types;
 
 // Spec parsing and expressions need no Symbolica: they live in the runtime crate.

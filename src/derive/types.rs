@@ -372,6 +372,20 @@ pub struct Partials {
     pub fall: Vec<Expr>,
 }
 
+/// The partial derivatives of the general model's rows over `x = [q, qd, p]` (the layout of
+/// `Model::tangents`), each row-major.
+#[derive(Debug, Clone, Default)]
+pub struct Tangents {
+    /// `(n + 3 m + 2 nf) (2 n + np)` entries over the state, the accelerations `ddot_<q>`, the
+    /// contacts' forces `rc_f<i>`, the frictions' forces `rc_fr<j>` and the parameters: the
+    /// residual `M qdd - F - J^T f - T^T fr`, the contacts' normal accelerations, the
+    /// frictions' slip accelerations, the gaps, the edge margins and the slip velocities.
+    pub rows: Vec<Expr>,
+    /// `2 n np` entries over the parameters: the `n` rows `d q_0/dp`, then the `n` rows
+    /// `d qd_0/dp` of the initial state (`Model::initial_tangents`).
+    pub initial: Vec<Expr>,
+}
+
 impl Reduction {
     /// The separation polynomial: that of the spec's first contact, where it is closed in the
     /// phase and its zero is a polynomial root.
@@ -445,6 +459,9 @@ pub struct Derivation {
     pub to_full: Vec<[Expr; 2]>,
     /// The fast path, or why the phase is integrated instead.
     pub reduction: Result<Reduction, Unreducible>,
+    /// The partial derivatives behind the integrated route's forward sensitivities (the
+    /// general model's only; filled in by `tangents.rs`).
+    pub tangents: Option<Tangents>,
     /// The results without units, if the spec gives groups and scales.
     pub dimensionless: Option<Dimensionless>,
     /// The steps as the LaTeX derivation shows them ([`super::steps`]), once presented.

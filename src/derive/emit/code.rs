@@ -80,6 +80,7 @@ const TAKEN: &[&str] = &[
     "jac",
     "bias",
     "forces",
+    "fr",
     "pos",
     "vel",
     "poses",

@@ -290,3 +290,30 @@ pub(super) fn reduction_docs(d: &Derivation, r: &Reduction) -> Docs {
     );
     docs
 }
+
+/// The doc comments of the general model `d`'s `Model::tangents` and `Model::initial_tangents`.
+pub(super) fn tangents_docs(d: &Derivation) -> Docs {
+    let (n, np) = (d.coords.len(), d.params.len());
+    let (m, nf) = (d.contacts.len(), d.frictions.len());
+    let mut docs = Docs::new();
+    docs.insert(
+        "tangents",
+        doc(
+            "The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities (`qdd`, `forces`, `fr` held fixed), row-major.",
+            vec![format!(
+                "{} rows ({n} + 3 x {m} + 2 x {nf}) by {} columns (2 x {n} + {np}), differentiated symbolically; see `generated/{}.tex` for the rows.",
+                n + 3 * m + 2 * nf,
+                2 * n + np,
+                d.name
+            )],
+        ),
+    );
+    docs.insert(
+        "initial_tangents",
+        doc(
+            "`d(initial state)/dp`: the rows `d q_0/dp`, then `d qd_0/dp`, by the parameters.",
+            Vec::new(),
+        ),
+    );
+    docs
+}

@@ -425,7 +425,16 @@ fn emit_node(
             out
         }
         Expr::Mul(_) => {
-            let (neg, mag) = e.split_sign();
+            let (mut neg, mut mag) = e.split_sign();
+            // A product left with one factor that is itself a signed product (`-(-x y)` after
+            // hoisting) gives up that sign too, so that no sign follows a sign (`--x`).
+            loop {
+                let (inner, rest) = mag.split_sign();
+                if !inner {
+                    break;
+                }
+                (neg, mag) = (!neg, rest);
+            }
             let (num, den) = mag.num_den();
             let mut out = String::from("(");
             if neg {
@@ -489,6 +498,17 @@ pub fn unbound(exprs: &[Expr], scope: &Scope) -> BTreeSet<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_sign_never_follows_a_sign() {
+        let x = || Expr::sym("x");
+        let inner = Expr::Mul(vec![Expr::int(-1), x(), x()]);
+        let e = Expr::Mul(vec![Expr::int(-1), Expr::Mul(vec![inner])]);
+        let mut scope = Scope::default();
+        scope.locals.insert("x".into(), "x".into());
+        let body = lower(&[e], &scope, None, "q");
+        assert_eq!(body.outputs, ["x * x"]);
+    }
 
     #[test]
     fn shares_repeated_subexpressions_and_hoists_constants() {

@@ -19,6 +19,7 @@ pub mod method;
 pub mod reduced;
 pub mod rust;
 pub mod state;
+pub mod tangents;
 pub mod tex;
 
 pub use common::{COMMAND, one_line, spec_path};

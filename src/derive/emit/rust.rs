@@ -4,12 +4,13 @@
 
 use super::code::{Code, K, Locals, OUT, Q, out_lines, parameter_local};
 use super::constants::{constant_layout, prepare_code, unread_constants};
-use super::docs::{Docs, model_docs, reduction_docs};
+use super::docs::{Docs, model_docs, reduction_docs, tangents_docs};
 use super::info::{PhaseEntry, StaticInfo, static_info};
 use super::lower::{Hoisted, Scope, lower};
 use super::method::Preamble;
 use super::reduced::{ReducedCode, reduced_code, reduction_info};
 use super::state::{FullStateCode, drawing_code, full_state_code};
+use super::tangents::{TangentsCode, tangents_code};
 use crate::derive::expr::Expr;
 use crate::derive::spec::Checked;
 use crate::derive::types::{Derivation, StepError};
@@ -34,6 +35,8 @@ pub struct RustContext {
     #[serde(flatten)]
     general: FullStateCode,
     reduction: Option<ReducedCode>,
+    /// The general model's `Model::tangents` and `Model::initial_tangents`.
+    tangents: Option<TangentsCode>,
     /// Each method's doc comment, by the method's name.
     docs: Docs,
     /// The reduction's named constants that nothing reads (see [`rust_context`]).
@@ -83,6 +86,10 @@ fn context_without(
         Err(_) => None,
     };
     let (mut drawing, shapes_info) = drawing_code(d, &scope, &mut hoisted);
+    // Last, so that the other methods' constants keep their slots.
+    let mut tangents = (d.tangents.as_ref())
+        .map(|t| tangents_code(d, t, &scope, &mut hoisted))
+        .transpose()?;
     let mut requirements = parameters_code(&d.requirements, d);
     let mut restitutions = parameters_code(&d.restitutions, d);
     let n_constants = hoisted.len();
@@ -107,6 +114,9 @@ fn context_without(
     if let Some(code) = reduction.as_mut() {
         code.finish(n_constants, np, d.reduced, &locals);
     }
+    if let Some(code) = tangents.as_mut() {
+        code.finish(n_constants, d.reduced, &locals);
+    }
     let poses = ("poses", "&mut [[f64; 3]]");
     let sizes = ("sizes", "&mut [f64]");
     drawing.finish(
@@ -121,10 +131,14 @@ fn context_without(
     let mut codes: Vec<&Code> = vec![&requirements, &restitutions, &prepare, &drawing];
     codes.extend(general.codes());
     codes.extend(reduction.iter().flat_map(ReducedCode::codes));
+    codes.extend(tangents.iter().flat_map(TangentsCode::codes));
     let unread = unread_constants(d, &own, &codes);
     let mut docs = model_docs(checked, d);
     if let Ok(r) = &d.reduction {
         docs.extend(reduction_docs(d, r));
+    }
+    if tangents.is_some() {
+        docs.extend(tangents_docs(d));
     }
     Ok(RustContext {
         info: static_info(checked, d, phases)?,
@@ -138,6 +152,7 @@ fn context_without(
         prepare,
         general,
         reduction,
+        tangents,
         unread,
     })
 }

@@ -82,7 +82,7 @@ impl FullStateCode {
 /// The scope of the full-state functions: the constants, `rc_s`, `rc_c` (the template's
 /// preamble) and the state by the coordinates' names (bound to `q`, `qd`, `qdd` by the
 /// preamble, [`Preamble::State`]).
-fn state_scope(d: &Derivation, scope: &Scope) -> Scope {
+pub(super) fn state_scope(d: &Derivation, scope: &Scope) -> Scope {
     let mut full_scope = scope.clone();
     full_scope.locals.insert("rc_s".into(), "rc_s".into());
     full_scope.locals.insert("rc_c".into(), "rc_c".into());
