@@ -9,14 +9,29 @@ use rodcube::plan::{self, Request};
 use rodcube::quantity::Quantity;
 use rodcube::results::{RunResults, Work};
 use rodcube::scene::Scene;
-use rodcube::solve::phases::{PhaseRun, Route, Walker};
+use rodcube::solve::phases::{PhaseRun, Route, Stop, Walker};
 use rodcube::system::Bound;
 use std::collections::BTreeMap;
 use std::path::Path;
 
 /// The tolerance of every run here: the integrator's error then stays near `1e-12` of the
-/// motion, so that a difference with a step of `1e-3` keeps about nine digits.
+/// motion, so that a difference with a step of [`STEP`] keeps about nine digits.
 const TOL: f64 = 1e-12;
+
+/// The differences' relative step. Their truncation error goes as its fourth power and is
+/// large for the friction model, near the `mu` where the foot would no longer stick: the first
+/// switch's `dt/dmu` by differences with steps of `1e-3`, `3e-4`, `1e-4`, `3e-5` is
+/// -0.880596005, -0.8805992618, -0.8805992879, -0.88059928822 (the forward sensitivity:
+/// -0.88059928822). At `1e-4` truncation leaves about `4e-10` of the derivative, and the
+/// runs' rounding (about `1e-13` of a time) about `1e-9`. A system near a singular geometry
+/// needs a step relative to its distance from it ([`NEAR_SINGULAR_STEP`]).
+const STEP: f64 = 1e-4;
+
+/// The step for the tipping block, whose height `h = 0.99` is one hundredth of the rod's
+/// length from `ell`: the block's end time's `d/d(ell)` (about -19, an elasticity of -130)
+/// by differences with steps `1e-3` to `1e-5` is -19.0383, -19.04405, -19.0440949, -19.04409540,
+/// -19.044095409 (forward: -19.044095409).
+const NEAR_SINGULAR_STEP: f64 = 1e-5;
 
 /// The scene's model and parameters.
 fn scene(name: &str) -> (&'static dyn rodcube::model::Model, BTreeMap<String, f64>) {
@@ -39,21 +54,16 @@ fn run(
     plan::run(&request).unwrap_or_else(|e| panic!("{}: {e}", model.info().name))
 }
 
-/// `d(key)/d(param)` by the fourth-order central difference of the run's `key` with a
-/// relative step `step` (an absolute one for a parameter that is zero).
+/// `d(key)/d(param)` by the fourth-order central difference of the run's `key` with the
+/// relative step `step` (`param` not zero).
 fn difference(
     model: &'static dyn rodcube::model::Model,
     p: &BTreeMap<String, f64>,
-    want: &[Quantity],
-    key: &str,
+    (want, key): (&[Quantity], &str),
     param: &str,
     step: f64,
 ) -> f64 {
-    let h = if p[param] == 0.0 {
-        step
-    } else {
-        step * p[param].abs()
-    };
+    let h = step * p[param].abs();
     let at = |k: f64| {
         let mut q = p.clone();
         *q.get_mut(param).unwrap() += k * h;
@@ -67,9 +77,15 @@ fn difference(
 }
 
 /// Every `d(key)/d(p)` the run reports, against differences: held to `bound` relative to
-/// the result's own scale `|x / p|` (the derivative an elasticity of one would have; `|x|`
-/// for a parameter that is zero). Returns the worst such error.
-fn against_differences(scene_name: &str, want: &[Quantity], keys: &[&str], bound: f64) -> f64 {
+/// the result's own scale `|x / p|` (the derivative an elasticity of one would have). A
+/// parameter at zero (a restitution or friction coefficient at its bound) has a one-sided
+/// derivative only: it must be finite. Returns the worst error.
+fn against_differences(
+    scene_name: &str,
+    want: &[Quantity],
+    keys: &[&str],
+    (bound, step): (f64, f64),
+) -> f64 {
     let (model, p) = scene(scene_name);
     let mut with = want.to_vec();
     with.push(Quantity::Sensitivities);
@@ -86,12 +102,12 @@ fn against_differences(scene_name: &str, want: &[Quantity], keys: &[&str], bound
             let got = (res.sensitivities.get(&name))
                 .unwrap_or_else(|| panic!("{scene_name}: {name} missing; notes {:?}", res.notes))
                 .value;
-            let want_value = difference(model, &p, want, key, param, 1e-3);
-            let scale = if p[param] == 0.0 {
-                x.abs()
-            } else {
-                (x / p[param]).abs()
-            };
+            if p[param] == 0.0 {
+                assert!(got.is_finite(), "{scene_name} {name}: {got}");
+                continue;
+            }
+            let want_value = difference(model, &p, (want, key), param, step);
+            let scale = (x / p[param]).abs();
             let err = (got - want_value).abs() / scale;
             worst = worst.max(err);
             assert!(
@@ -110,7 +126,8 @@ fn integrated_sensitivities_equal_the_fast_paths_exact_ones() {
         Quantity::SeparationTime,
         Quantity::Sensitivities,
     ];
-    for name in ["paper", "hinged", "ladder", "cylinder", "fixed_cylinder"] {
+    let mut worst: f64 = 0.0;
+    for name in ["paper", "hinged", "ladder"] {
         let (model, p) = scene(name);
         let fast = run(model, &p, &want, Route::Fastest);
         let integrated = run(model, &p, &want, Route::Integrated);
@@ -121,14 +138,17 @@ fn integrated_sensitivities_equal_the_fast_paths_exact_ones() {
             }
             let other = (integrated.sensitivities.get(key))
                 .unwrap_or_else(|| panic!("{name}: {key} missing: {:?}", integrated.notes));
+            let err = (other.value - s.value).abs();
+            worst = worst.max(err);
             assert!(
-                (other.value - s.value).abs() <= 1e-8,
+                err <= 1e-8,
                 "{name} {key}: integrated {} vs exact {}",
                 other.value,
                 s.value
             );
         }
     }
+    eprintln!("elasticities, integrated against exact: worst {worst:.1e}");
 }
 
 #[test]
@@ -144,16 +164,58 @@ fn friction_and_its_stick_slip_switch_agree_with_differences() {
         "floor_impact_time",
         "impact_angular_velocity",
     ];
-    let worst = against_differences("friction", &want, &keys, 1e-8);
+    let worst = against_differences("friction", &want, &keys, (1e-8, STEP));
     eprintln!("friction: worst {worst:.1e}");
 }
 
 #[test]
-fn springs_and_lift_off_agree_with_differences() {
-    let want = [Quantity::SeparationAngle, Quantity::SeparationTime];
-    let keys = ["separation_angle", "separation_time"];
-    for name in ["spring", "liftoff", "ladder_friction"] {
-        let worst = against_differences(name, &want, &keys, 1e-8);
+fn springs_lift_off_edges_and_later_contacts_agree_with_differences() {
+    use Quantity::{ContactEnd, FloorImpact, SeparationAngle, SeparationTime};
+    let cases: [(&str, &[Quantity], &[&str]); 6] = [
+        // A spring: integrated from release.
+        (
+            "spring",
+            &[SeparationAngle, SeparationTime],
+            &["separation_angle", "separation_time"],
+        ),
+        // A hinge with a spring: its fast phase has no partial derivatives of the separation.
+        (
+            "hinged_spring",
+            &[SeparationAngle, SeparationTime],
+            &["separation_angle", "separation_time"],
+        ),
+        // The foot may lift: the landing after the free phases.
+        (
+            "liftoff",
+            &[SeparationTime, FloorImpact],
+            &["separation_time", "floor_impact_time"],
+        ),
+        // Friction at two contacts with switches, to the landing.
+        (
+            "ladder_friction",
+            &[SeparationTime, FloorImpact],
+            &["separation_time", "floor_impact_time"],
+        ),
+        // A second contact's end (the block's edge contact), after the first's.
+        (
+            "block_tipping",
+            &[ContactEnd],
+            &["block_near_edge_end_time", "block_near_edge_end_angle"],
+        ),
+        // A contact that ends at an edge.
+        (
+            "cylinder",
+            &[ContactEnd],
+            &["contact_end_time", "contact_end_angle"],
+        ),
+    ];
+    for (name, want, keys) in cases {
+        let step = if name == "block_tipping" {
+            NEAR_SINGULAR_STEP
+        } else {
+            STEP
+        };
+        let worst = against_differences(name, want, keys, (1e-8, step));
         eprintln!("{name}: worst {worst:.1e}");
     }
 }
@@ -163,7 +225,7 @@ fn a_contacts_end_after_the_first_phase_agrees_with_differences() {
     // The paper's rod: the cube's push ends on the fast path; the floor's ends later (or holds
     // to the landing), on the free slide: the landing's time comes from the integrated route.
     let want = [Quantity::ContactEnd, Quantity::FloorImpact];
-    let worst = against_differences("paper", &want, &["floor_impact_time"], 1e-8);
+    let worst = against_differences("paper", &want, &["floor_impact_time"], (1e-8, STEP));
     eprintln!("paper landing: worst {worst:.1e}");
 }
 
@@ -208,7 +270,7 @@ fn a_stick_slip_switch_time_moves_as_differences_across_it_say() {
     assert_eq!(switches.len(), times.len());
     let names: Vec<&str> = model.info().parameters.iter().map(|q| q.name).collect();
     for (j, name) in names.iter().enumerate() {
-        let h = 1e-3 * p[*name].abs();
+        let h = STEP * p[*name].abs();
         let at = |k: f64| {
             let mut q = p.clone();
             *q.get_mut(*name).unwrap() += k * h;
@@ -217,7 +279,7 @@ fn a_stick_slip_switch_time_moves_as_differences_across_it_say() {
         let (a, b, c, d) = (at(1.0), at(-1.0), at(2.0), at(-2.0));
         for (s, sw) in switches.iter().enumerate() {
             let diff = (8.0 * (a[s] - b[s]) - (c[s] - d[s])) / (12.0 * h);
-            let scale = times[s] / p[*name].abs();
+            let scale = (times[s] / p[*name]).abs().max(diff.abs());
             assert!(
                 (sw[j] - diff).abs() <= 1e-8 * scale,
                 "switch {s}, d t/d {name}: {} vs differences {diff}",
@@ -225,4 +287,47 @@ fn a_stick_slip_switch_time_moves_as_differences_across_it_say() {
             );
         }
     }
+}
+
+#[test]
+fn the_sensitive_motion_stops_at_the_first_impact_it_would_go_through() {
+    // The bouncing rod goes on through its impacts to 0.6 s; the impact map's derivatives
+    // are not built, so the motion with sensitivities stops at the first.
+    let (model, p) = scene("bounce");
+    let mut w = walker(model, &p);
+    w.until = Some(0.6);
+    let sensitive = w.sensitive_motion(&mut Work::default()).expect("solves");
+    assert_eq!(sensitive.stop, Some(Stop::Impact));
+    assert_eq!(sensitive.ends.len(), sensitive.motion.phases.len());
+    assert!(matches!(
+        sensitive.motion.last_end(),
+        Some(rodcube::solve::phases::End::Contact(_))
+    ));
+    let full = w.motion(&mut Work::default()).expect("solves");
+    assert!(full.phases.len() > sensitive.motion.phases.len());
+    assert!(!full.impacts.is_empty() && sensitive.motion.impacts.is_empty());
+    // Every phase up to the impact has its end's derivatives.
+    assert!(sensitive.ends.iter().all(Result::is_ok));
+}
+
+#[test]
+fn results_past_an_impact_get_a_note_and_no_number() {
+    // The same run's impacts: their numbers have no sensitivities, and say so.
+    let (model, p) = scene("bounce");
+    let want = [
+        Quantity::ContactEnd,
+        Quantity::Impacts,
+        Quantity::Sensitivities,
+    ];
+    let request = Request::new(model, &p)
+        .with_want(&want)
+        .with_until(Some(0.6));
+    let res = plan::run(&request).expect("runs");
+    assert_eq!(
+        res.notes.get("sensitivities.impacts"),
+        Some(&rodcube::results::Note::NoSensitivity(
+            rodcube::results::SensitivityGap::NotBuilt
+        ))
+    );
+    assert!(!res.sensitivities.keys().any(|k| k.contains("impacts")));
 }

@@ -6,18 +6,19 @@
 //! times the set-up once and the solve alone, as a user who solves many points pays for them.
 
 use super::AccuracyError;
-use crate::results::Work;
+use crate::results::{SensitivityGap, Work};
 use crate::solve::SolveError;
 use crate::solve::contacts::Active;
 use crate::solve::lean::LeanSolver;
 use crate::solve::ode::{Method, OdeOptions, OdeProblem, dopri5};
+use crate::solve::phases::{End, Route, Walker};
 use crate::solve::poly::horner;
 use crate::solve::quadrature::{TimeMesh, gauss_legendre_rule};
 use crate::solve::sensitivity::SensitivityWork;
 use crate::solve::separation::{linearised_separation, separation};
 use crate::solve::series::sample_phase;
 use crate::solve::unreduced;
-use crate::system::System;
+use crate::system::{Bound, System};
 use gauss_quad::{FiniteAboveNegOneF64, GaussJacobi};
 use std::collections::BinaryHeap;
 use std::num::NonZeroUsize;
@@ -215,6 +216,40 @@ pub fn sensitivities_exact(
         .map_err(|gap| AccuracyError::NoSensitivity { gap })?;
     angle.extend(time);
     Ok((angle, solver.evals - before))
+}
+
+/// The same derivatives from the system's general model's motion integrated with its forward
+/// sensitivities (`Walker::sensitive_motion` at the integrator's tolerance `rtol`, every phase
+/// as a run takes them), read at the first contact's separation, and the right-hand sides it
+/// evaluated.
+pub fn sensitivities_forward(sys: &System, rtol: f64) -> Outcome<Vec<f64>> {
+    let info = sys.info();
+    let model = crate::models::find(info.system).ok_or(SolveError::UnknownPhaseModel {
+        system: info.system,
+        name: info.system,
+    })?;
+    let walker = Walker {
+        general: Bound::from_values(model, sys.p())?,
+        registry: crate::models::all(),
+        tol: rtol,
+        rtol,
+        route: Route::Integrated,
+        until: None,
+        dense_output: false,
+    };
+    let mut work = Work::default();
+    let motion = walker.sensitive_motion(&mut work)?;
+    let k = (motion.motion.phases.iter())
+        .position(|p| p.end() == End::Force(0))
+        .ok_or(AccuracyError::ForceNotVanished)?;
+    let ends = motion.ends[k]
+        .as_ref()
+        .map_err(|_| AccuracyError::NoSensitivity {
+            gap: SensitivityGap::Grazing,
+        })?;
+    let mut out = ends.theta.clone();
+    out.extend_from_slice(&ends.t);
+    Ok((out, work.ode_evaluations))
 }
 
 /// The same derivatives by central differences of the per-point solver, each parameter moved by
@@ -536,7 +571,7 @@ pub fn time_unreduced(sys: &System, rtol: f64, t_max: f64) -> Outcome<f64> {
         t_max,
         &mut work,
     )?;
-    if run.end != unreduced::End::Force(0) {
+    if run.end != End::Force(0) {
         return Err(AccuracyError::ForceNotVanished);
     }
     Ok((run.t_end, work.ode_evaluations))

@@ -129,6 +129,10 @@ pub const LABELS: &[(&str, &str)] = &[
         "sensitivities from the generated partial derivatives (implicit-function theorem, differentiated quadrature); set-up: the per-point solver",
     ),
     (
+        "forward",
+        "sensitivities from the general model's motion integrated on every phase with its forward sensitivities (the generated tangents), read at the separation",
+    ),
+    (
         "differences",
         "sensitivities by central differences of the per-point solver (two solves a parameter); set-up: the solver",
     ),
@@ -287,6 +291,11 @@ pub fn sensitivities(quick: bool) -> Vec<Setting<Vec<f64>>> {
             methods::sensitivities_exact(solver, work, p.sys)
         },
     )];
+    for rtol in pick(&[1e-8, 1e-10, 1e-12], quick) {
+        out.push(plain("forward", format!("rtol {rtol:.0e}"), move |p| {
+            methods::sensitivities_forward(p.sys, rtol)
+        }));
+    }
     for step in pick(&[1e-3, 1e-4, 1e-5, 6e-6, 1e-6, 1e-7, 1e-8], quick) {
         out.push(prepared(
             "differences",

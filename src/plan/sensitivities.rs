@@ -14,7 +14,7 @@ use crate::model::start_offsets;
 use crate::quantity::Quantity;
 use crate::results::{Note, RunResults, Sensitivity, SensitivityGap};
 use crate::solve::SolveError;
-use crate::solve::phases::{End, SensitiveMotion};
+use crate::solve::phases::{End, SensitiveMotion, Stop};
 use crate::solve::prior::{PRIOR_TOL, Prior};
 use crate::solve::quadrature::ACCEPT;
 use crate::solve::sensitivity::{self, SensitivityWork, SeparationPoint};
@@ -130,17 +130,25 @@ impl<'m> Plan<'m> {
                 continue;
             };
             let first = matches!(source, Source::Separation | Source::End(0));
-            let found = match (&fast, first) {
+            // The fast path's where it has them; where it lacks the partial derivatives (or
+            // the time's fall polynomial), the integrated route's.
+            let exact = match (&fast, first) {
                 (Some(Ok(found)), true) => match (target.angle, &found.d_t) {
-                    (true, _) => Ok(found.d_theta.clone()),
-                    (false, Ok(d_t)) => Ok(d_t.clone()),
-                    (false, Err(gap)) => Err(*gap),
+                    (true, _) => Some(Ok(found.d_theta.clone())),
+                    (false, Ok(d_t)) => Some(Ok(d_t.clone())),
+                    (false, Err(SensitivityGap::NoFallPolynomial)) => None,
+                    (false, Err(gap)) => Some(Err(*gap)),
                 },
-                (Some(Err(gap)), true) => Err(*gap),
-                _ => self.integrated_derivatives(target, *source)?,
+                (Some(Err(SensitivityGap::NoPartials)), true) => None,
+                (Some(Err(gap)), true) => Some(Err(*gap)),
+                _ => None,
+            };
+            let (found, integrated) = match exact {
+                Some(found) => (found, false),
+                None => (self.integrated_derivatives(target, *source)?, true),
             };
             match found {
-                Ok(d) => self.record(target, x, &d, out),
+                Ok(d) => self.record(target, (x, &d), integrated, out),
                 Err(gap) => {
                     out.notes
                         .insert(note_key(&target.key), Note::NoSensitivity(gap));
@@ -192,10 +200,11 @@ impl<'m> Plan<'m> {
             }
         };
         let Some((k, cause)) = event else {
-            let gap = if sensitive.stopped_at_impact {
-                SensitivityGap::PastImpact
-            } else {
-                SensitivityGap::RoutesDisagree
+            let gap = match sensitive.stop {
+                Some(Stop::Impact) => SensitivityGap::PastImpact,
+                Some(Stop::Grazing) => SensitivityGap::Grazing,
+                Some(Stop::Failed(_)) => SensitivityGap::IntegrationFailed,
+                None => SensitivityGap::RoutesDisagree,
             };
             return Ok(Err(gap));
         };
@@ -228,8 +237,10 @@ impl<'m> Plan<'m> {
         }
     }
 
-    /// `d(target)/dp` and its elasticity for every parameter, from `x` and its derivatives.
-    fn record(&self, target: &Target, x: f64, dx: &[f64], out: &mut RunResults) {
+    /// `d(target)/dp` and its elasticity for every parameter, from `x` and its derivatives
+    /// (`integrated`: by the integrated route).
+    fn record(&self, target: &Target, x: (f64, &[f64]), integrated: bool, out: &mut RunResults) {
+        let (x, dx) = x;
         let info = self.general().info();
         let p = self.general().p();
         for ((param, &value), &d) in info.parameters.iter().zip(p).zip(dx) {
@@ -239,6 +250,7 @@ impl<'m> Plan<'m> {
                 of: target.key.clone(),
                 parameter: param.name.to_string(),
                 elasticity,
+                integrated,
             };
             out.sensitivities.insert(
                 format!("d({})/d({})", target.key, param.name),

@@ -445,6 +445,12 @@ pub fn sensitivity_meaning(s: &Sensitivity) -> String {
              per relative change of the parameter",
             s.of, s.parameter, s.parameter, s.of, s.of, s.parameter
         )
+    } else if s.integrated {
+        format!(
+            "how {} changes with {}: the derivative d({})/d({}) from the motion integrated with \
+             its forward sensitivities (the derivation's partial derivatives of the dynamics)",
+            s.of, s.parameter, s.of, s.parameter
+        )
     } else {
         format!(
             "how {} changes with {}: the exact derivative d({})/d({}) from the derivation's \

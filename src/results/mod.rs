@@ -320,6 +320,11 @@ pub struct Sensitivity {
     /// Whether this is the elasticity rather than the derivative.
     #[serde(skip)]
     pub elasticity: bool,
+    /// Whether it comes from the motion integrated with its forward sensitivities (its
+    /// integration's tolerance bounds its error) rather than from the fast path's closed-form
+    /// partial derivatives.
+    #[serde(skip)]
+    pub integrated: bool,
 }
 
 impl RunResults {

@@ -30,7 +30,7 @@ mod walker;
 pub use motion::{ImpactAt, Motion};
 pub use reduced::{GAP_CELLS, ReducedEnd, ReducedRun, phase_end};
 pub use run::{IntegratedRun, PhaseRun};
-pub use sensitive::{EndDerivatives, SensitiveMotion};
+pub use sensitive::{EndDerivatives, SensitiveMotion, Stop};
 pub use walker::{
     LANDING_TOLERANCE, MAX_FALL_TIMES, MAX_IMPACTS, MAX_PHASES, PhaseStart, Route, Walker,
     ZENO_RATIO_SPREAD, ZENO_RATIOS, fall_time_scale, phase_parameters,

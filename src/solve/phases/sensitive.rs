@@ -4,7 +4,7 @@
 //! differentiated in every parameter. The derivatives of an impact's map are not built: the
 //! motion stops at its first impact, and the phases after it have none.
 
-use super::{MAX_PHASES, Motion, Route, Walker};
+use super::{MAX_PHASES, Motion, PhaseStart, Route, Walker};
 use crate::results::Work;
 use crate::solve::SolveError;
 use crate::solve::contacts;
@@ -33,9 +33,20 @@ pub struct SensitiveMotion<'m> {
     /// Per phase of [`SensitiveMotion::motion`], its end's derivatives, or the grazing event
     /// (its own or one before it) whose time has none.
     pub ends: Vec<Result<EndDerivatives, Grazing>>,
-    /// Whether the motion stopped at an impact it would have gone on through: the phases after
-    /// it are not solved.
-    pub stopped_at_impact: bool,
+    /// Why the motion stopped before its end, if it did: the phases after are not solved.
+    pub stop: Option<Stop>,
+}
+
+/// Why the motion with sensitivities stopped before its end.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Stop {
+    /// At an impact it would have gone on through (the impact map's derivatives are not
+    /// built).
+    Impact,
+    /// At a grazing event, past which `S` is not defined.
+    Grazing,
+    /// A later phase failed (the first phase's error is the motion's).
+    Failed(SolveError),
 }
 
 /// The derivatives of a phase's end from its sensitivities (`reduced`: the reduced
@@ -64,13 +75,21 @@ fn derivatives(
     })
 }
 
+/// What follows a phase of the motion with sensitivities.
+enum Next {
+    /// The next phase's start, with `S` there.
+    Go(PhaseStart, Vec<f64>),
+    /// The motion ends here, complete or for the reason given.
+    Stop(Option<Stop>),
+}
+
 impl<'m> Walker<'m> {
     /// The motion from release on the integrated route, with the derivatives of every phase's
     /// end in every parameter (a model without
     /// [`Model::tangents`](crate::model::Model::tangents) is
-    /// [`SystemError::NoTangents`](crate::system::SystemError::NoTangents)). It stops at the
-    /// first impact it would go on through, and at a grazing event (the phases after that have
-    /// no sensitivities).
+    /// [`SystemError::NoTangents`](crate::system::SystemError::NoTangents), as is any error
+    /// of the first phase). It stops early ([`SensitiveMotion::stop`]) at the first impact it
+    /// would go on through, at a grazing event, or where a later phase fails.
     pub fn sensitive_motion(&self, work: &mut Work) -> Result<SensitiveMotion<'m>, SolveError> {
         let walker = Walker {
             route: Route::Integrated,
@@ -78,58 +97,70 @@ impl<'m> Walker<'m> {
             ..self.clone()
         };
         let general = &walker.general;
-        let reduced = general.info().reduced_index;
         let (mut start, opened) = walker.release()?;
         let mut s = Forward::new(general)?.initial(general)?;
-        let mut motion: Option<Motion<'m>> = None;
+        let (run, mut sens) = walker.integrate_sensitive(&start, s, work)?;
         let mut ends = Vec::new();
+        let mut motion = Motion::starting(run, opened, walker.until.is_some());
         loop {
-            let (run, sens) = walker.integrate_sensitive(&start, s, work)?;
-            let end_state = run.full_end_state()?;
-            let end = derivatives(&sens, reduced, &end_state.qd);
-            let dt = end.as_ref().ok().map(|e| e.t.clone());
-            ends.push(end);
-            let motion = match motion.as_mut() {
-                Some(m) => {
-                    m.phases.push(run);
-                    m
-                }
-                None => motion.insert(Motion::starting(
-                    run,
-                    opened.clone(),
-                    walker.until.is_some(),
-                )),
-            };
-            let last = motion.phases.last();
-            let closes = matches!(motion.last_end(), Some(End::Contact(_)));
-            let next = match (dt, last) {
-                (Some(dt), Some(last)) if !motion.complete() && !closes => {
-                    if motion.phases.len() >= MAX_PHASES {
-                        return Err(SolveError::TooManyPhases { limit: MAX_PHASES });
-                    }
-                    match walker.after(last) {
-                        Ok(next) => Some((next, dt)),
-                        // Another contact closes as this one opens: an impact.
-                        Err(SolveError::ImpactAtRelease { .. }) => None,
-                        Err(e) => return Err(e),
+            let next = walker.next_sensitive(&motion, &mut ends, sens);
+            let stop = match next {
+                Ok(Next::Go(next, s_next)) => {
+                    (start, s) = (next, s_next);
+                    match walker.integrate_sensitive(&start, s, work) {
+                        Ok((run, sens_next)) => {
+                            motion.phases.push(run);
+                            sens = sens_next;
+                            continue;
+                        }
+                        Err(e) => Some(Stop::Failed(e)),
                     }
                 }
-                _ => None,
+                Ok(Next::Stop(stop)) => stop,
+                Err(e) => Some(Stop::Failed(e)),
             };
-            let Some((next, dt)) = next else {
-                let stopped_at_impact =
-                    !motion.complete() && ends.last().is_some_and(Result::is_ok);
-                return Ok(SensitiveMotion {
-                    motion: motion.clone(),
-                    ends,
-                    stopped_at_impact,
-                });
-            };
-            // `S` across the boundary: the accelerations jump to the next active set's.
-            let after = contacts::dynamics(general, &next.state, &next.active, next.t)?;
-            s = sens.s;
-            forward::jump(&mut s, &sens.qdd, &after.qdd, &dt);
-            start = next;
+            return Ok(SensitiveMotion { motion, ends, stop });
         }
+    }
+
+    /// The derivatives of the end of `motion`'s last phase (into `ends`) from its
+    /// sensitivities `sens`, and what follows it.
+    fn next_sensitive(
+        &self,
+        motion: &Motion<'m>,
+        ends: &mut Vec<Result<EndDerivatives, Grazing>>,
+        sens: EndSensitivity,
+    ) -> Result<Next, SolveError> {
+        let general = &self.general;
+        let Some(last) = motion.phases.last() else {
+            return Ok(Next::Stop(None));
+        };
+        let end_state = last.full_end_state()?;
+        let end = derivatives(&sens, general.info().reduced_index, &end_state.qd);
+        let dt = end.as_ref().ok().map(|e| e.t.clone());
+        ends.push(end);
+        if motion.complete() {
+            return Ok(Next::Stop(None));
+        }
+        let Some(dt) = dt else {
+            return Ok(Next::Stop(Some(Stop::Grazing)));
+        };
+        if matches!(motion.last_end(), Some(End::Contact(_))) {
+            return Ok(Next::Stop(Some(Stop::Impact)));
+        }
+        if motion.phases.len() >= MAX_PHASES {
+            return Err(SolveError::TooManyPhases { limit: MAX_PHASES });
+        }
+        let next = match self.after(last) {
+            Ok(next) => next,
+            // Another contact closes as this one opens: an impact.
+            Err(SolveError::ImpactAtRelease { .. }) => return Ok(Next::Stop(Some(Stop::Impact))),
+            Err(e) => return Err(e),
+        };
+        // `S` across the boundary: the accelerations jump to the next active set's.
+        let after = contacts::dynamics(general, &next.state, &next.active, next.t)?;
+        let mut s = sens.s;
+        forward::jump(&mut s, &sens.qdd, &after.qdd, &dt);
+        Ok(Next::Go(next, s))
     }
 }
