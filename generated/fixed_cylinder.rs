@@ -476,7 +476,7 @@ impl Model for FixedCylinder {
 
     /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities (`qdd`, `forces`, `fr` held fixed), row-major.
     ///
-    /// 9 rows (3 + 3 x 2 + 2 x 0) by 11 columns (2 x 3 + 5), differentiated symbolically; see `generated/fixed_cylinder.tex` for the rows.
+    /// 9 rows (3 + 3 x 2 + 2 x 0) by 11 columns (2 x 3 + 5), differentiated symbolically from the expressions of `equations`, `constraints`, `friction`, `gaps` and `edges`.
     #[allow(clippy::too_many_arguments)]
     fn tangents(
         &self,

@@ -448,7 +448,7 @@ impl Model for LadderFriction {
 
     /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities (`qdd`, `forces`, `fr` held fixed), row-major.
     ///
-    /// 13 rows (3 + 3 x 2 + 2 x 2) by 12 columns (2 x 3 + 6), differentiated symbolically; see `generated/ladder_friction.tex` for the rows.
+    /// 13 rows (3 + 3 x 2 + 2 x 2) by 12 columns (2 x 3 + 6), differentiated symbolically from the expressions of `equations`, `constraints`, `friction`, `gaps` and `edges`.
     #[allow(clippy::too_many_arguments)]
     fn tangents(
         &self,

@@ -687,7 +687,7 @@ impl Model for RodBlockTipping {
 
     /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities (`qdd`, `forces`, `fr` held fixed), row-major.
     ///
-    /// 21 rows (6 + 3 x 5 + 2 x 0) by 18 columns (2 x 6 + 6), differentiated symbolically; see `generated/rod_block_tipping.tex` for the rows.
+    /// 21 rows (6 + 3 x 5 + 2 x 0) by 18 columns (2 x 6 + 6), differentiated symbolically from the expressions of `equations`, `constraints`, `friction`, `gaps` and `edges`.
     #[allow(clippy::too_many_arguments)]
     fn tangents(
         &self,

@@ -526,7 +526,7 @@ impl Model for RodCylinder {
 
     /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities (`qdd`, `forces`, `fr` held fixed), row-major.
     ///
-    /// 10 rows (4 + 3 x 2 + 2 x 0) by 14 columns (2 x 4 + 6), differentiated symbolically; see `generated/rod_cylinder.tex` for the rows.
+    /// 10 rows (4 + 3 x 2 + 2 x 0) by 14 columns (2 x 4 + 6), differentiated symbolically from the expressions of `equations`, `constraints`, `friction`, `gaps` and `edges`.
     #[allow(clippy::too_many_arguments)]
     fn tangents(
         &self,

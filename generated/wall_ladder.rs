@@ -437,7 +437,7 @@ impl Model for WallLadder {
 
     /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities (`qdd`, `forces`, `fr` held fixed), row-major.
     ///
-    /// 9 rows (3 + 3 x 2 + 2 x 0) by 10 columns (2 x 3 + 4), differentiated symbolically; see `generated/wall_ladder.tex` for the rows.
+    /// 9 rows (3 + 3 x 2 + 2 x 0) by 10 columns (2 x 3 + 4), differentiated symbolically from the expressions of `equations`, `constraints`, `friction`, `gaps` and `edges`.
     #[allow(clippy::too_many_arguments)]
     fn tangents(
         &self,

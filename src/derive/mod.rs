@@ -10,7 +10,8 @@
 //!    Symbolica) and [`algebra`] (trigonometric rewriting and polynomial helpers);
 //! 2. the stages of the derivation proper, a file each: [`read`] (the spec's expressions) →
 //!    [`setup`] → [`lagrangian`] → [`equations`] → [`constraints`] → [`reduction`] →
-//!    [`forces`]; [`mechanics`] runs them in that order for each phase of a spec;
+//!    [`partials`] → [`forces`] → [`tangents`] (the general model's, for the forward
+//!    sensitivities); [`mechanics`] runs them in that order for each phase of a spec;
 //! 3. presentation: [`present`] (forms checked equal), then [`steps`] and [`dimensionless`];
 //! 4. emission: [`emit`] (its `latex`, `lower` (straight-line Rust) and `method` beneath flat
 //!    template contexts) → tera → rustfmt → `generated/`;

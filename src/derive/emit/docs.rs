@@ -301,10 +301,9 @@ pub(super) fn tangents_docs(d: &Derivation) -> Docs {
         doc(
             "The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities (`qdd`, `forces`, `fr` held fixed), row-major.",
             vec![format!(
-                "{} rows ({n} + 3 x {m} + 2 x {nf}) by {} columns (2 x {n} + {np}), differentiated symbolically; see `generated/{}.tex` for the rows.",
+                "{} rows ({n} + 3 x {m} + 2 x {nf}) by {} columns (2 x {n} + {np}), differentiated symbolically from the expressions of `equations`, `constraints`, `friction`, `gaps` and `edges`.",
                 n + 3 * m + 2 * nf,
                 2 * n + np,
-                d.name
             )],
         ),
     );

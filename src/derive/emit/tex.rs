@@ -182,6 +182,8 @@ pub struct TexContext {
     scales: String,
     /// The results without units, numbered.
     results: Vec<Equation>,
+    /// Whether the model carries its tangents (`Model::tangents`), which are not printed.
+    tangents: bool,
 }
 
 /// Builds the LaTeX context: the derivation's steps as displayed equations.
@@ -324,6 +326,7 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> Result<TexContext, Step
         groups: dim_groups,
         scales: dim_scales,
         results: dim_results,
+        tangents: d.tangents.is_some(),
     })
 }
 
