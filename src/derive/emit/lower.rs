@@ -503,7 +503,7 @@ mod tests {
     fn a_sign_never_follows_a_sign() {
         let x = || Expr::sym("x");
         let inner = Expr::Mul(vec![Expr::int(-1), x(), x()]);
-        let e = Expr::Mul(vec![Expr::int(-1), Expr::Mul(vec![inner])]);
+        let e = Expr::Mul(vec![Expr::int(-1), inner]);
         let mut scope = Scope::default();
         scope.locals.insert("x".into(), "x".into());
         let body = lower(&[e], &scope, None, "q");
