@@ -143,6 +143,11 @@
 #define RODCUBE_ERR_PARAM_REDUCED_INDEX 115
 
 /**
+ * The model has no partial derivatives of its dynamics (forward sensitivities need them).
+ */
+#define RODCUBE_ERR_PARAM_NO_TANGENTS 116
+
+/**
  * Group: the request was refused (codes 201 to 299).
  */
 #define RODCUBE_ERR_REQUEST 200

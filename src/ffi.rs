@@ -84,6 +84,8 @@ pub const RODCUBE_ERR_PARAM_NOT_FINITE_INPUT: c_int = 113;
 pub const RODCUBE_ERR_PARAM_RESTITUTION: c_int = 114;
 /// The model's reduced coordinate is none of its coordinates (a malformed model).
 pub const RODCUBE_ERR_PARAM_REDUCED_INDEX: c_int = 115;
+/// The model has no partial derivatives of its dynamics (forward sensitivities need them).
+pub const RODCUBE_ERR_PARAM_NO_TANGENTS: c_int = 116;
 
 /// Group: the request was refused (codes 201 to 299).
 pub const RODCUBE_ERR_REQUEST: c_int = 200;
@@ -256,6 +258,7 @@ static CODES: &[(c_int, &CStr)] = named![
     RODCUBE_ERR_PARAM_NOT_FINITE_INPUT,
     RODCUBE_ERR_PARAM_RESTITUTION,
     RODCUBE_ERR_PARAM_REDUCED_INDEX,
+    RODCUBE_ERR_PARAM_NO_TANGENTS,
     RODCUBE_ERR_REQUEST,
     RODCUBE_ERR_NOT_A_SYSTEM,
     RODCUBE_ERR_UNAVAILABLE,
@@ -338,6 +341,7 @@ fn system_code(e: &SystemError) -> c_int {
         SystemError::NotFiniteInput { .. } => RODCUBE_ERR_PARAM_NOT_FINITE_INPUT,
         SystemError::Restitution { .. } => RODCUBE_ERR_PARAM_RESTITUTION,
         SystemError::ReducedIndex { .. } => RODCUBE_ERR_PARAM_REDUCED_INDEX,
+        SystemError::NoTangents { .. } => RODCUBE_ERR_PARAM_NO_TANGENTS,
     }
 }
 

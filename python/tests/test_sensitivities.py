@@ -4,8 +4,9 @@ sensitivities=True)` those of `rodcube sweep --sensitivities` (to the bit) and o
 angle's to the bit; the time's, which the planner and the per-point solver integrate from
 differently rounded fall coefficients, within 1e-15 relative, or of the natural scale t/p
 where cancellation makes the sensitivity small), and all of them
-agree with central differences of the sweep's own angle and time. A sensitivity that does not
-exist is no number, and the note says why.
+agree with central differences of the sweep's own angle and time. An integrated separation
+has its forward sensitivities; a sensitivity that does not exist (an impact's) is no number,
+and the note says why.
 
 `tests/python.rs` sets RODCUBE_BIN to the `rodcube` binary of the same build."""
 
@@ -106,13 +107,17 @@ def test_sweeps_sensitivities_are_its_own_central_differences(point):
 
 
 def test_a_sensitivity_that_does_not_exist_is_a_note_and_no_number():
-    # The friction model's separation is integrated: no sensitivity, and a note why.
+    # The friction model's separation is integrated, with its forward sensitivities; an
+    # impact's numbers have none (the impact map's derivatives are not built), and a note why.
     names = [p for p, _, _ in rodcube.parameters("rod_cube_friction")]
     point = {p: PAPER.get(p, 0.2) for p in names}
-    one = rodcube.solve("rod_cube_friction", want=WANT, **point)
+    one = rodcube.solve("rod_cube_friction", want=WANT + ["impacts"], **point)
     assert math.isfinite(one["separation_angle"])
-    assert "sensitivities" not in one
-    assert "integrated" in one["notes"]["sensitivities.separation_angle"]
+    for p in names:
+        assert math.isfinite(one["sensitivities"][f"d(separation_angle)/d({p})"]), p
+    assert one["sensitivity_units"]["d(separation_time)/d(mu)"] == "s"
+    assert "impact map" in one["notes"]["sensitivities.impacts"]
+    assert not any("impacts" in k for k in one["sensitivities"])
     # A point that fails has NaN sensitivities and one error.
     s = rodcube.sweep(n=3.0, a_over_ell=[0.25, 1.5], m1=1.0, ell=1.0, g=9.81, sensitivities=True)
     assert s["ok"].tolist() == [True, False] and [i for i, _ in s["errors"]] == [(1,)]

@@ -425,6 +425,34 @@ impl Problem<'_, '_> {
         Ok(())
     }
 
+    /// What an event ends: the run (at `until`, the run's end time, or at a contact's event) or
+    /// only the segment, at the friction watch whose switch goes on with it. `y` is the state
+    /// there (for the error of an event no watch has).
+    fn ending(
+        &self,
+        until: bool,
+        event: &Event,
+        y: &[f64],
+    ) -> Result<Result<End, Watch>, SolveError> {
+        if until {
+            return Ok(Ok(End::Until));
+        }
+        Ok(match self.watches.get(event.index).copied() {
+            Some(Watch::Force(i)) => Ok(End::Force(i)),
+            Some(Watch::Gap(i)) => Ok(End::Contact(i)),
+            Some(Watch::Edge(i)) => Ok(End::Edge(i)),
+            Some(Watch::Floor) => Ok(End::Floor),
+            Some(watch) => Err(watch),
+            None => {
+                return Err(SolveError::OdeNonFinite {
+                    what: "event index outside the watched events",
+                    t: event.t,
+                    y: y.to_vec(),
+                });
+            }
+        })
+    }
+
     /// At friction watch `w` (a contact's slip stopped or its stuck friction reached `mu N`),
     /// the next modes: the one consistent choice, the contacts kept as they are.
     fn switch(&mut self, w: Watch, state: &State, t: f64) -> Result<(), SolveError> {
@@ -459,6 +487,33 @@ impl Problem<'_, '_> {
     }
 }
 
+/// The checks of an integration's start (its active set's size, the mass matrix's
+/// conditioning) and the tolerance it is run at, raised to the conditioning floor, with the
+/// condition number.
+fn checked_start(sys: &Bound, start: &Start, rtol: f64) -> Result<(f64, f64), SolveError> {
+    let info = sys.info();
+    contacts::check_active(info, &start.active)?;
+    if start.frictions.len() != info.frictions.len() {
+        return Err(SolveError::ActiveSize {
+            model: info.name,
+            contacts: info.contacts.len(),
+            frictions: info.frictions.len(),
+            closed: start.active.closed.len(),
+            modes: start.frictions.len(),
+        });
+    }
+    let condition = mass_condition(sys, &start.state)?;
+    let rtol = rtol.max(CONDITION_SAFETY * f64::EPSILON * condition);
+    if rtol.is_nan() || rtol > MAX_RTOL {
+        return Err(SolveError::IllConditioned {
+            model: info.name,
+            condition,
+            rtol,
+        });
+    }
+    Ok((rtol, condition))
+}
+
 /// What watch `w` measures, for its time's derivatives (`reduced`: the reduced coordinate's
 /// index).
 fn measured(w: Watch, reduced: usize) -> Measured {
@@ -486,6 +541,30 @@ struct Riders {
 }
 
 impl Riders {
+    /// The sensitivities `s0` at a start (none without them), for `sys`'s model, which must
+    /// have its tangents.
+    fn new(sys: &Bound, s0: Option<&[f64]>) -> Result<Option<Riders>, SolveError> {
+        let Some(s0) = s0 else {
+            return Ok(None);
+        };
+        let fw = Forward::new(sys)?;
+        if s0.len() != fw.len() {
+            return Err(crate::system::SystemError::Length {
+                model: sys.info().name,
+                what: "sensitivity",
+                expected: fw.len(),
+                got: s0.len(),
+            }
+            .into());
+        }
+        Ok(Some(Riders {
+            fw,
+            s: s0.to_vec(),
+            grazed: None,
+            switches: Vec::new(),
+        }))
+    }
+
     /// The sensitivities at the run's end, an event measuring `what` at `at` (its state, time
     /// and the active set before it).
     fn at_end(
@@ -772,25 +851,7 @@ pub fn integrate_with(
     let info = sys.info();
     let n = sys.n_coordinates();
     let with_work = !info.frictions.is_empty();
-    contacts::check_active(info, &start.active)?;
-    if start.frictions.len() != info.frictions.len() {
-        return Err(SolveError::ActiveSize {
-            model: info.name,
-            contacts: info.contacts.len(),
-            frictions: info.frictions.len(),
-            closed: start.active.closed.len(),
-            modes: start.frictions.len(),
-        });
-    }
-    let condition = mass_condition(sys, &start.state)?;
-    let rtol = rtol.max(CONDITION_SAFETY * f64::EPSILON * condition);
-    if rtol.is_nan() || rtol > MAX_RTOL {
-        return Err(SolveError::IllConditioned {
-            model: info.name,
-            condition,
-            rtol,
-        });
-    }
+    let (rtol, condition) = checked_start(sys, start, rtol)?;
     let method = method.unwrap_or_else(|| Method::for_rtol(rtol));
     let mut y0 = start.state.q.clone();
     y0.extend_from_slice(&start.state.qd);
@@ -819,27 +880,7 @@ pub fn integrate_with(
         base: y0.len(),
     };
     // The sensitivities ride after the state; `S` is integrated as itself, not as a deviation.
-    problem.riders = match &start.sensitivity {
-        Some(s0) => {
-            let fw = Forward::new(sys)?;
-            if s0.len() != fw.len() {
-                return Err(crate::system::SystemError::Length {
-                    model: info.name,
-                    what: "sensitivity",
-                    expected: fw.len(),
-                    got: s0.len(),
-                }
-                .into());
-            }
-            Some(Riders {
-                fw,
-                s: s0.clone(),
-                grazed: None,
-                switches: Vec::new(),
-            })
-        }
-        None => None,
-    };
+    problem.riders = Riders::new(sys, start.sensitivity.as_deref())?;
     let d = contacts::dynamics(sys, &start.state, &problem.active, 0.0)?;
     problem.watch(&d)?;
     let atol = absolute_tolerances(sys, start, scales, rtol, with_work)?;
@@ -885,30 +926,15 @@ pub fn integrate_with(
             qd: y[n..2 * n].to_vec(),
         };
         // The run's end, or the watch whose switch goes on with it.
-        let next: Result<End, Watch> =
-            if segments.last().is_some_and(|g| g.solution.event.is_none()) {
-                Ok(End::Until)
-            } else {
-                match problem.watches.get(event.index).copied() {
-                    Some(Watch::Force(i)) => Ok(End::Force(i)),
-                    Some(Watch::Gap(i)) => Ok(End::Contact(i)),
-                    Some(Watch::Edge(i)) => Ok(End::Edge(i)),
-                    Some(Watch::Floor) => Ok(End::Floor),
-                    Some(watch) => Err(watch),
-                    None => {
-                        return Err(SolveError::OdeNonFinite {
-                            what: "event index outside the watched events",
-                            t: event.t,
-                            y,
-                        });
-                    }
-                }
-            };
-        let watch = match next {
+        let until = segments.last().is_some_and(|g| g.solution.event.is_none());
+        let watch = match problem.ending(until, &event, &y)? {
             Ok(end) => {
                 let measured = match end {
+                    End::Force(i) => Measured::Force(i),
+                    End::Contact(i) => Measured::Gap(i),
+                    End::Edge(i) => Measured::Edge(i),
+                    End::Floor => Measured::Coordinate(info.reduced_index),
                     End::Until => Measured::Clock,
-                    _ => measured(problem.watches[event.index], info.reduced_index),
                 };
                 let at = (&state, event.t, &problem.active);
                 let sensitivity = match problem.riders.take() {
