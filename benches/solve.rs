@@ -4,7 +4,9 @@
 //! the fixed set of 1,000 points of `examples/per_point.rs` on both compiled copies of the
 //! per-point route, and the paper's whole scene
 //! (`scenes/paper.yaml`, every quantity, 1000 samples per series) without writing files, and a
-//! run through ten impacts (`rod_cube_liftoff` bouncing at restitution 1/2).
+//! run through ten impacts (`rod_cube_liftoff` bouncing at restitution 1/2), and the forward
+//! sensitivities of integrated runs against the same runs without them (`rod_cube_friction`'s
+//! scene to the landing, `rod_cube_spring` to the separation).
 //!
 //! Run: `cargo bench --bench solve -- --warm-up-time 1 --measurement-time 3`.
 
@@ -229,5 +231,58 @@ fn impacts(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, per_point, integrated, paper_scene, impacts);
+/// The forward sensitivities' cost: a run's integrated results, then the same run with
+/// `sensitivities` (every result's derivatives in every parameter, from the motion integrated
+/// again with `S = dy/dp` riding along), side by side: the friction scene (sliding, sticking,
+/// the free slide, the landing) and the spring's separation, at a tolerance of 1e-10.
+fn forward_sensitivities(c: &mut Criterion) {
+    let mut g = c.benchmark_group("forward_sensitivities");
+    let cases = [
+        (
+            "rod_cube_friction_to_the_landing",
+            "rod_cube_friction",
+            vec![("mu", 1.45)],
+            vec![
+                Quantity::SeparationTime,
+                Quantity::ContactEnd,
+                Quantity::FloorImpact,
+            ],
+        ),
+        (
+            "rod_cube_spring_separation",
+            "rod_cube_spring",
+            vec![("k", 50.0)],
+            vec![Quantity::SeparationAngle, Quantity::SeparationTime],
+        ),
+    ];
+    for (label, name, extra, want) in cases {
+        let model = rodcube::models::find(name).expect("the model is generated");
+        let mut p = PAPER.to_vec();
+        p.extend(extra);
+        let plain = Request::new(model, &p[..])
+            .with_want(&want)
+            .with_tolerance(1e-10);
+        let mut with = want.clone();
+        with.push(Quantity::Sensitivities);
+        let sensitive = plain.clone().with_want(&with);
+        let run = plan::run(&sensitive).expect("the point solves");
+        assert!(!run.sensitivities.is_empty(), "{label}: {:?}", run.notes);
+        g.bench_function(format!("{label}/plain"), |b| {
+            b.iter(|| plan::run(black_box(&plain)).expect("the point solves"))
+        });
+        g.bench_function(format!("{label}/with_sensitivities"), |b| {
+            b.iter(|| plan::run(black_box(&sensitive)).expect("the point solves"))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(
+    benches,
+    per_point,
+    integrated,
+    paper_scene,
+    impacts,
+    forward_sensitivities
+);
 criterion_main!(benches);

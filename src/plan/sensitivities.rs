@@ -177,7 +177,7 @@ impl<'m> Plan<'m> {
             landing(motion, &general)?.map(|k| (motion.phases[k].t_end(), "floor"))
         } else {
             match self.fate(contact)? {
-                Fate::Ended { t, .. } if t == 0.0 => return Ok(Err(SensitivityGap::AtRelease)),
+                Fate::Ended { t: 0.0, .. } => return Ok(Err(SensitivityGap::AtRelease)),
                 Fate::Ended { t, cause, .. } => Some((t, cause)),
                 _ => None,
             }

@@ -50,6 +50,9 @@ pub struct Grazing {
     pub rate: f64,
 }
 
+/// `dt_e/dp` of an event for every parameter, or the grazing that leaves it none.
+pub type EventTimes = Result<Vec<f64>, Grazing>;
+
 /// The forward sensitivities of one model: sizes and buffers.
 #[derive(Debug, Clone)]
 pub struct Forward {
@@ -159,7 +162,7 @@ impl Forward {
         work: &mut DynamicsWork,
         s: &[f64],
         what: Measured,
-    ) -> Result<(Result<Vec<f64>, Grazing>, Vec<f64>), SolveError> {
+    ) -> Result<(EventTimes, Vec<f64>), SolveError> {
         let (state, t, active) = at;
         contacts::dynamics_into(sys, state, active, t, work)?;
         let qdd = work.out.qdd.clone();
