@@ -331,3 +331,39 @@ fn results_past_an_impact_get_a_note_and_no_number() {
     );
     assert!(!res.sensitivities.keys().any(|k| k.contains("impacts")));
 }
+
+#[test]
+fn a_loose_tolerance_still_finds_the_same_events() {
+    // At a tolerance of 1e-4 the fast path's separation may be off by about that much: the
+    // integrated route's events are still taken as the run's, and their derivatives agree with
+    // the tight run's to about the tolerance.
+    let (model, p) = scene("paper");
+    let want = [
+        Quantity::ContactEnd,
+        Quantity::FloorImpact,
+        Quantity::Sensitivities,
+    ];
+    let loose = plan::run(
+        &Request::new(model, &p)
+            .with_want(&want)
+            .with_tolerance(1e-4),
+    )
+    .expect("runs");
+    let tight = run(model, &p, &want, Route::Fastest);
+    assert!(
+        !loose.notes.keys().any(|k| k.starts_with("sensitivities.")),
+        "{:?}",
+        loose.notes
+    );
+    for (key, s) in &tight.sensitivities {
+        let other = &loose.sensitivities[key];
+        if s.elasticity {
+            assert!(
+                (other.value - s.value).abs() <= 1e-3,
+                "{key}: {} vs {}",
+                other.value,
+                s.value
+            );
+        }
+    }
+}

@@ -8,8 +8,8 @@
 //! within [`ROUTES_AGREE`]. Where a result has none (after an impact, at a grazing event, an
 //! impact's own numbers), a note says why, never a number.
 
-use super::Plan;
 use super::quantities::{Fate, fate, landing};
+use super::{DEFAULT_TOLERANCE, ODE_RTOL_FACTOR, Plan};
 use crate::model::start_offsets;
 use crate::quantity::Quantity;
 use crate::results::{Note, RunResults, Sensitivity, SensitivityGap};
@@ -56,8 +56,13 @@ pub fn per(result: &str, parameter: &str) -> String {
 }
 
 /// The relative difference of an event's time on the integrated route that carries the
-/// sensitivities from the run's own, past which the two are not the same event.
+/// sensitivities from the run's own, past which the two are not the same event: this, or
+/// [`ROUTES_AGREE_PER_TOLERANCE`] times the run's tolerance where that is larger (a loose
+/// tolerance's fast path may be off by about the tolerance).
 pub const ROUTES_AGREE: f64 = 1e-6;
+
+/// See [`ROUTES_AGREE`].
+pub const ROUTES_AGREE_PER_TOLERANCE: f64 = 100.0;
 
 /// Where a target's derivatives come from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -185,6 +190,7 @@ impl<'m> Plan<'m> {
         let Some((t_run, cause_run)) = run_event else {
             return Ok(Err(SensitivityGap::NoSeparation));
         };
+        let agree = ROUTES_AGREE.max(ROUTES_AGREE_PER_TOLERANCE * self.walker.tol);
         let sensitive = match self.sensitive() {
             Ok(s) => s,
             Err(gap) => return Ok(Err(gap)),
@@ -209,7 +215,7 @@ impl<'m> Plan<'m> {
             return Ok(Err(gap));
         };
         let t = sensitive.motion.phases[k].t_end();
-        if cause != cause_run || (t - t_run).abs() > ROUTES_AGREE * t_run.abs() {
+        if cause != cause_run || (t - t_run).abs() > agree * t_run.abs() {
             return Ok(Err(SensitivityGap::RoutesDisagree));
         }
         Ok(match &sensitive.ends[k] {
@@ -220,11 +226,17 @@ impl<'m> Plan<'m> {
         })
     }
 
-    /// The motion integrated with its forward sensitivities (solved once), or why there is
-    /// none.
+    /// The motion integrated with its forward sensitivities (solved once, at the run's
+    /// tolerance or the default one where that is tighter), or why there is none.
     fn sensitive(&mut self) -> Result<&SensitiveMotion<'m>, SensitivityGap> {
         if self.sensitive.is_none() {
-            let solved = self.walker.sensitive_motion(&mut self.work);
+            // Never looser than the default run's: at a loose tolerance the integrated route
+            // may meet events the run does not have (a contact that just opened touching
+            // again within the integration's error).
+            let mut walker = self.walker.clone();
+            walker.tol = walker.tol.min(DEFAULT_TOLERANCE);
+            walker.rtol = walker.rtol.min(DEFAULT_TOLERANCE * ODE_RTOL_FACTOR);
+            let solved = walker.sensitive_motion(&mut self.work);
             self.sensitive = Some(solved.map_err(|e| match e {
                 SolveError::System(SystemError::NoTangents { .. }) => SensitivityGap::NoPartials,
                 _ => SensitivityGap::IntegrationFailed,
