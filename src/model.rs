@@ -473,7 +473,11 @@ pub trait Model: Send + Sync {
     /// 6. one row per friction: its slip velocity `T qd`.
     ///
     /// `out.len()` is `(n + 3 m + 2 nf) (2 n + np)` with `m` contacts and `nf` frictions.
-    /// Writes nothing where [`Model::has_tangents`] is false.
+    /// The parameters' columns are total derivatives through `k` (which must be
+    /// [`Model::prepare`]'s for the same parameters). A friction coefficient's column is zero
+    /// (the friction forces are held): it acts through a sliding friction's law
+    /// `f = -s mu lambda`, which the caller differentiates. Writes nothing where
+    /// [`Model::has_tangents`] is false.
     #[allow(clippy::too_many_arguments)]
     fn tangents(
         &self,
@@ -487,8 +491,9 @@ pub trait Model: Send + Sync {
     ) {
     }
 
-    /// `d(initial state)/dp`: `2 n` rows (`q`, then `qd`, as [`Model::initial_state`] gives
-    /// them) over the parameters (`np` columns, row-major). Writes nothing where
+    /// `d(initial state)/dp`: `2 n` rows over the parameters (`np` columns, row-major), rows
+    /// `0..n` the coordinates' `dq_i/dp`, rows `n..2 n` the velocities' `dqd_i/dp` (grouped, not
+    /// interleaved as [`Model::initial_state`] assigns them). Writes nothing where
     /// [`Model::has_tangents`] is false.
     fn initial_tangents(&self, _k: &[f64], _out: &mut [f64]) {}
 
