@@ -103,20 +103,24 @@ impl Forward {
         Ok(s)
     }
 
-    /// The directions `(S_q, S_qd, e_j)` of every parameter, and with `rate` the motion's own
-    /// `(qd, qdd, 0)` last.
-    fn directions(&mut self, state: &State, qdd: &[f64], s: &[f64], rate: bool) {
+    /// The directions `(S_q, S_qd, e_j)` of every parameter, and with `rate` (the state and
+    /// its accelerations) the motion's own `(qd, qdd, 0)` last.
+    fn directions(&mut self, s: &[f64], rate: Option<(&State, &[f64])>) {
         let (n, np) = (self.n, self.np);
         let cols = 2 * n + np;
         self.xi.clear();
-        self.xi.resize((np + usize::from(rate)) * cols, 0.0);
+        self.xi
+            .resize((np + usize::from(rate.is_some())) * cols, 0.0);
         for (j, x) in self.xi.chunks_exact_mut(cols).enumerate() {
-            if j < np {
-                x[..2 * n].copy_from_slice(&s[j * 2 * n..(j + 1) * 2 * n]);
-                x[2 * n + j] = 1.0;
-            } else {
-                x[..n].copy_from_slice(&state.qd);
-                x[n..2 * n].copy_from_slice(qdd);
+            match rate {
+                Some((state, qdd)) if j == np => {
+                    x[..n].copy_from_slice(&state.qd);
+                    x[n..2 * n].copy_from_slice(qdd);
+                }
+                _ => {
+                    x[..2 * n].copy_from_slice(&s[j * 2 * n..(j + 1) * 2 * n]);
+                    x[2 * n + j] = 1.0;
+                }
             }
         }
     }
@@ -134,8 +138,7 @@ impl Forward {
         let (state, t, active) = at;
         let d = &work.out;
         sys.tangents_into(state, &d.qdd, &d.forces, &d.fr, &mut self.tan)?;
-        let qdd = d.qdd.clone();
-        self.directions(state, &qdd, s, false);
+        self.directions(s, None);
         let at = TangentAt {
             state,
             t,
@@ -172,7 +175,7 @@ impl Forward {
         let d = &work.out;
         sys.tangents_into(state, &d.qdd, &d.forces, &d.fr, &mut self.tan)?;
         let (forces, fr) = (d.forces.clone(), d.fr.clone());
-        self.directions(state, &qdd, s, true);
+        self.directions(s, Some((state, &qdd)));
         let at = TangentAt {
             state,
             t,
