@@ -143,7 +143,11 @@ fn results_json_carries_every_sensitivity_with_its_unit_and_the_elasticities() {
     // landing's units; the floor's contact holds to the landing: no number, and no note of
     // its own beside the one that says it holds.
     assert_eq!(sens["d(floor_impact_time)/d(ell)"]["unit"], "s/m");
-    assert_eq!(sens["d(impact_angular_velocity)/d(g)"]["unit"], "s/m");
+    assert_eq!(sens["d(impact_angular_velocity)/d(g)"]["unit"], "rad s/m");
+    assert_eq!(
+        sens["d(impact_angular_velocity)/d(m1)"]["unit"],
+        "rad kg^-1 s^-1"
+    );
     let notes = json["notes"].as_object().unwrap();
     assert!(notes.contains_key("floor_normal_end"), "{notes:?}");
     assert!(

@@ -33,12 +33,16 @@ fn note_key(key: &str) -> String {
     format!("sensitivities.{key}")
 }
 
-/// `result` over `parameter` as a unit: `rad/kg`, `s^3/m`, `rad s^2/m`.
+/// `result` over `parameter` as a unit: `rad/kg`, `s^3/m`, `rad s^2/m`, `rad s/m` (an angular
+/// rate over an acceleration).
 pub fn per(result: &str, parameter: &str) -> String {
     let parsed = |u: &str| Unit::parse(u).ok();
-    let (angle, result_unit) = match result {
-        "rad" => (true, parsed("1")),
-        other => (false, parsed(other)),
+    // An angle (`rad`) or an angular rate (`rad/s`) keeps its `rad`, which the unit algebra
+    // drops as dimensionless.
+    let (angle, result_unit) = match result.strip_prefix("rad") {
+        Some("") => (true, parsed("1")),
+        Some(rate) if rate.starts_with('/') => (true, parsed(&format!("1{rate}"))),
+        _ => (false, parsed(result)),
     };
     let quotient = result_unit
         .zip(parsed(parameter))
