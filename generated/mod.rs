@@ -59,3 +59,77 @@ pub static MODELS: &[&dyn crate::model::Model] = &[
     &wall_ladder_closed::WallLadderClosed,
     &wall_ladder_free::WallLadderFree,
 ];
+
+/// Every generated model's tape (`<model>.tape.json`, the same program as its Rust), by name:
+/// what `rodcube run --interpreted` runs, and what a tape found on disk is compared with.
+pub static TAPES: &[(&str, &str)] = &[
+    ("fixed_cylinder", include_str!("fixed_cylinder.tape.json")),
+    (
+        "fixed_cylinder_closed",
+        include_str!("fixed_cylinder_closed.tape.json"),
+    ),
+    (
+        "fixed_cylinder_free",
+        include_str!("fixed_cylinder_free.tape.json"),
+    ),
+    ("hinged_cylinder", include_str!("hinged_cylinder.tape.json")),
+    (
+        "hinged_cylinder_closed",
+        include_str!("hinged_cylinder_closed.tape.json"),
+    ),
+    (
+        "hinged_cylinder_free",
+        include_str!("hinged_cylinder_free.tape.json"),
+    ),
+    ("hinged_rod", include_str!("hinged_rod.tape.json")),
+    (
+        "hinged_rod_closed",
+        include_str!("hinged_rod_closed.tape.json"),
+    ),
+    ("hinged_rod_free", include_str!("hinged_rod_free.tape.json")),
+    (
+        "hinged_rod_spring",
+        include_str!("hinged_rod_spring.tape.json"),
+    ),
+    (
+        "hinged_rod_spring_closed",
+        include_str!("hinged_rod_spring_closed.tape.json"),
+    ),
+    ("ladder_friction", include_str!("ladder_friction.tape.json")),
+    ("loaded_rod", include_str!("loaded_rod.tape.json")),
+    (
+        "loaded_rod_closed",
+        include_str!("loaded_rod_closed.tape.json"),
+    ),
+    ("loaded_rod_free", include_str!("loaded_rod_free.tape.json")),
+    (
+        "rod_block_tipping",
+        include_str!("rod_block_tipping.tape.json"),
+    ),
+    ("rod_cube", include_str!("rod_cube.tape.json")),
+    ("rod_cube_closed", include_str!("rod_cube_closed.tape.json")),
+    ("rod_cube_free", include_str!("rod_cube_free.tape.json")),
+    (
+        "rod_cube_friction",
+        include_str!("rod_cube_friction.tape.json"),
+    ),
+    (
+        "rod_cube_liftoff",
+        include_str!("rod_cube_liftoff.tape.json"),
+    ),
+    ("rod_cube_spring", include_str!("rod_cube_spring.tape.json")),
+    ("rod_cylinder", include_str!("rod_cylinder.tape.json")),
+    (
+        "rod_cylinder_free",
+        include_str!("rod_cylinder_free.tape.json"),
+    ),
+    ("wall_ladder", include_str!("wall_ladder.tape.json")),
+    (
+        "wall_ladder_closed",
+        include_str!("wall_ladder_closed.tape.json"),
+    ),
+    (
+        "wall_ladder_free",
+        include_str!("wall_ladder_free.tape.json"),
+    ),
+];

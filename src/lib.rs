@@ -80,6 +80,7 @@ pub mod spec;
 #[cfg(feature = "cli")]
 pub mod sweep;
 pub mod system;
+pub mod tape;
 pub mod yaml;
 
 /// The README's Rust examples, compiled and run as doctests.

@@ -76,6 +76,14 @@ struct Cli {
     #[command(subcommand)]
     /// What to do (default: `run`, the paper's scene)
     command: Option<Command>,
+    /// Also look for models' tapes (`<model>.tape.json`) in DIR, before `generated/` under the
+    /// current directory: a model derived there runs with no build
+    #[arg(long, value_name = "DIR", global = true)]
+    models: Option<PathBuf>,
+    /// Run every compiled-in model from its tape instead (the same program, evaluated; every
+    /// result equal to the bit)
+    #[arg(long, global = true)]
+    interpreted: bool,
 }
 
 #[derive(Subcommand)]
@@ -114,6 +122,10 @@ struct DeriveArgs {
     /// Overwrite generated files even where they were edited by hand
     #[arg(long)]
     force: bool,
+    /// Write only the tapes of SPECS, into DIR, and nothing into generated/ (what `run --spec`
+    /// does before it runs the scene)
+    #[arg(long, value_name = "DIR", requires = "specs")]
+    tapes_into: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -126,6 +138,11 @@ struct RunArgs {
     /// Output directory [default: out/<scene stem>/]
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
+    /// Derive this model spec now (in memory: nothing is written to generated/) and run the
+    /// scene on it, with no build
+    #[cfg(feature = "derive")]
+    #[arg(long, value_name = "SPEC")]
+    spec: Option<PathBuf>,
     #[command(flatten)]
     layout: LayoutArgs,
 }
@@ -168,6 +185,8 @@ fn default_command() -> Command {
         scene: None,
         json: false,
         out: None,
+        #[cfg(feature = "derive")]
+        spec: None,
         layout: LayoutArgs::default(),
     })
 }
@@ -235,7 +254,16 @@ impl Failure {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let outcome = match cli.command.unwrap_or_else(default_command) {
+    let command = cli.command.unwrap_or_else(default_command);
+    #[cfg(feature = "derive")]
+    let deriving = matches!(command, Command::Derive(_));
+    #[cfg(not(feature = "derive"))]
+    let deriving = false;
+    // `derive` writes the tapes; every other command may run them.
+    if !deriving && let Err(f) = load_models(cli.models.as_deref(), cli.interpreted) {
+        return f.report();
+    }
+    let outcome = match command {
         Command::Run(args) => run(args),
         Command::Models(args) => models(args),
         Command::Fmu(args) => fmu(args),
@@ -250,10 +278,32 @@ fn main() -> ExitCode {
     }
 }
 
+/// Puts the models of the tapes found (`--models DIR`, then `generated/` here) into the
+/// registry, and with `--interpreted` every compiled model's own tape in place of its code. A
+/// tape the loader refuses is an invalid input file (exit 3, naming it).
+fn load_models(dir: Option<&std::path::Path>, interpreted: bool) -> Result<(), Failure> {
+    if let Some(d) = dir
+        && !d.is_dir()
+    {
+        return Err(Failure::Usage(anyhow::anyhow!(
+            "--models {}: not a directory",
+            d.display()
+        )));
+    }
+    let invalid = |e: rodcube::tape::TapeError| Failure::Invalid(e.into());
+    if interpreted {
+        rodcube::models::interpret_compiled().map_err(invalid)?;
+    }
+    rodcube::models::load_search_path(dir).map_err(invalid)
+}
+
 /// `rodcube derive`: regenerate `generated/` (or check that it is fresh).
 #[cfg(feature = "derive")]
 fn derive(args: DeriveArgs) -> Result<(), Failure> {
     use rodcube::derive::{Error, Options, run};
+    if let Some(dir) = &args.tapes_into {
+        return write_tapes(&args.specs, dir);
+    }
     let opts = Options {
         root: PathBuf::from("."),
         specs: args.specs,
@@ -294,8 +344,68 @@ fn derive(args: DeriveArgs) -> Result<(), Failure> {
     }
 }
 
+/// `rodcube derive --tapes-into DIR SPECS`: the specs' tapes, written together (or none).
+#[cfg(feature = "derive")]
+fn write_tapes(specs: &[PathBuf], dir: &std::path::Path) -> Result<(), Failure> {
+    use rodcube::derive::Error;
+    let mut files = Vec::new();
+    for spec in specs {
+        match rodcube::derive::tapes(spec) {
+            Ok(tapes) => files.extend(tapes.into_iter().map(|t| (dir.join(&t.path), t.text))),
+            Err(Error::Spec(e)) => return Err(Failure::Invalid(anyhow::anyhow!("{e}"))),
+            Err(e) => return Err(Failure::Solve(anyhow::anyhow!("{e}"))),
+        }
+    }
+    OutDir::create(dir).map_err(|e| Failure::Output(e.into()))?;
+    rodcube::io::write_all_atomic(&files).map_err(|e| Failure::Output(e.into()))?;
+    for (path, _) in &files {
+        note(&format!("wrote {}", path.display()));
+    }
+    Ok(())
+}
+
+/// `rodcube run --spec SPEC`: derives the spec's models in a child process of this program
+/// (Symbolica prints its licence banner on stdout, which goes to this program's stderr there,
+/// so `--json` keeps stdout exactly results.json), into a temporary directory, and loads their
+/// tapes into the registry. Nothing is written to generated/.
+#[cfg(feature = "derive")]
+fn derive_spec(spec: &std::path::Path) -> Result<(), Failure> {
+    let failed = |what: &str, e: &dyn std::fmt::Display| {
+        Failure::Solve(anyhow::anyhow!("--spec {}: {what}: {e}", spec.display()))
+    };
+    let dir = std::env::temp_dir().join(format!("rodcube-spec-{}", std::process::id()));
+    let exe = std::env::current_exe().map_err(|e| failed("cannot find this program", &e))?;
+    let status = std::process::Command::new(exe)
+        .arg("derive")
+        .arg("--tapes-into")
+        .arg(&dir)
+        .arg(spec)
+        .stdin(std::process::Stdio::null())
+        .stdout(std::io::stderr())
+        .status()
+        .map_err(|e| failed("cannot start the derivation", &e))?;
+    let loaded = if status.success() {
+        rodcube::models::load_derived(&dir, spec).map_err(|e| Failure::Invalid(e.into()))
+    } else {
+        // The child has said why on stderr; its status says what kind of failure it was.
+        Err(match status.code() {
+            Some(code) if code == i32::from(EXIT_SCENE) => Failure::Invalid(anyhow::anyhow!(
+                "--spec {}: the spec is invalid",
+                spec.display()
+            )),
+            _ => failed("the derivation failed", &status),
+        })
+    };
+    let _ = std::fs::remove_dir_all(&dir);
+    loaded.map(|_| ())
+}
+
 /// `rodcube run`.
 fn run(args: RunArgs) -> Result<(), Failure> {
+    #[cfg(feature = "derive")]
+    if let Some(spec) = &args.spec {
+        derive_spec(spec)?;
+    }
     let scene = load_scene(args.scene.as_ref())?;
     let out_dir = match args.out {
         Some(dir) => dir,

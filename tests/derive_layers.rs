@@ -49,6 +49,7 @@ const EMIT: &[&str] = &[
     "rust",
     "tex",
     "json",
+    "tape",
     "mod",
 ];
 

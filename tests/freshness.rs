@@ -30,8 +30,8 @@ fn generated_files_are_up_to_date() {
         outcome.written
     );
     // Every model of every spec (its general model and the fast phases that reduce, as the
-    // compiled registry lists them) gives .rs, .tex and .json, plus the registry and the
-    // digest manifest; every spec gives its general model.
+    // compiled registry lists them) gives .rs, .tex, .json and .tape.json, plus the registry
+    // and the digest manifest; every spec gives its general model.
     let specs = rodcube::derive::spec_files(&root()).unwrap();
     let models = rodcube::models::all();
     for spec in &specs {
@@ -45,7 +45,7 @@ fn generated_files_are_up_to_date() {
         );
     }
     let phases = models.len();
-    assert_eq!(outcome.unchanged.len(), 3 * phases + 2);
+    assert_eq!(outcome.unchanged.len(), 4 * phases + 2);
     assert!(
         outcome
             .unchanged

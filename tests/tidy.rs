@@ -263,6 +263,7 @@ fn no_function_in_src_passes_150_lines() {
 const LAYERS: &[&[&str]] = &[
     &["io", "yaml", "reference"],
     &["model", "spec"],
+    &["tape"],
     &["models", "system", "quantity", "axes"],
     &["results"],
     &["solve", "report"],

@@ -291,13 +291,25 @@ fn render(root: &Path, template: &str, context: &impl serde::Serialize) -> Resul
         path: path.clone(),
         source,
     })?;
+    render_source(template, &source, context)
+}
+
+/// The model template as this program was built with it: what [`tapes`] renders, so that a
+/// spec derives in any directory.
+const MODEL_TEMPLATE: &str = include_str!("../../templates/model.rs.tera");
+
+fn render_source(
+    template: &str,
+    source: &str,
+    context: &impl serde::Serialize,
+) -> Result<String, Error> {
     let mut tera = tera::Tera::default();
     tera.autoescape_on(Vec::<&str>::new());
     let terr = |e: tera::Error| Error::Template {
         template: template.into(),
         message: format!("{e:?}"),
     };
-    tera.add_raw_template(template, &source).map_err(terr)?;
+    tera.add_raw_template(template, source).map_err(terr)?;
     let ctx = tera::Context::from_serialize(context).map_err(terr)?;
     tera.render(template, &ctx).map_err(terr)
 }
@@ -344,28 +356,51 @@ fn fast_phases(phases: &[Derivation]) -> Vec<emit::PhaseEntry> {
         .collect()
 }
 
-/// The Rust, LaTeX and JSON files of one derived phase.
+/// An emitter's refusal of a model, reported against its spec file.
+fn refused(c: &Checked, model: &str, error: mechanics::StepError) -> Error {
+    Error::Spec(SpecError {
+        file: c.file.clone(),
+        line: 0,
+        column: 0,
+        field: String::new(),
+        message: format!("model `{model}`: {error}"),
+        source_line: String::new(),
+        width: 0,
+    })
+}
+
+/// The Rust of one derived phase as the template renders it (before rustfmt), and its tape,
+/// compiled from that Rust (formatting changes no operation).
+fn rust_and_tape(
+    template: &str,
+    c: &Checked,
+    d: &Derivation,
+    phases: &[emit::PhaseEntry],
+) -> Result<(String, crate::tape::format::TapeFile), Error> {
+    let ctx = emit::rust_context(c, d, phases).map_err(|e| refused(c, &d.name, e))?;
+    let raw = render_source("model.rs.tera", template, &ctx)?;
+    let origin = emit::tape::Origin {
+        model: &d.name,
+        spec: &emit::spec_path(c),
+        spec_text: &c.text,
+    };
+    let tape = emit::tape::compile(&raw, &origin)
+        .map_err(|m| refused(c, &d.name, mechanics::StepError::Tape(m)))?;
+    Ok((raw, tape))
+}
+
+/// The Rust, LaTeX, JSON and tape files of one derived phase.
 fn render_phase(
     root: &Path,
     c: &Checked,
     d: &Derivation,
     phases: &[emit::PhaseEntry],
 ) -> Result<Vec<Rendered>, Error> {
-    // A model the emitter cannot write is reported against its spec file.
-    let refused = |error: mechanics::StepError| {
-        Error::Spec(SpecError {
-            file: c.file.clone(),
-            line: 0,
-            column: 0,
-            field: String::new(),
-            message: format!("model `{}`: {error}", d.name),
-            source_line: String::new(),
-            width: 0,
-        })
-    };
-    let ctx = emit::rust_context(c, d, phases).map_err(refused)?;
-    let rust = rustfmt(&d.name, &render(root, "model.rs.tera", &ctx)?)?;
-    let tex_ctx = emit::tex_context(c, d).map_err(refused)?;
+    let path = root.join("templates").join("model.rs.tera");
+    let template = std::fs::read_to_string(&path).map_err(|source| Error::Io { path, source })?;
+    let (raw, tape) = rust_and_tape(&template, c, d, phases)?;
+    let rust = rustfmt(&d.name, &raw)?;
+    let tex_ctx = emit::tex_context(c, d).map_err(|e| refused(c, &d.name, e))?;
     let tex = render(root, "model.tex.tera", &tex_ctx)?;
     let json =
         serde_json::to_string_pretty(&emit::json_record(c, d)).map_err(|e| Error::Template {
@@ -385,7 +420,48 @@ fn render_phase(
             path: PathBuf::from(format!("generated/{}.json", d.name)),
             text: json,
         },
+        Rendered {
+            path: PathBuf::from(format!("generated/{}.tape.json", d.name)),
+            text: crate::tape::format::render(&tape),
+        },
     ])
+}
+
+/// The tapes of one spec's models (`<model>.tape.json`, text), derived in memory with the
+/// template built into this program: no file is read but the spec (and the specs beside it,
+/// whose symbols are declared first in the same order as `cargo derive` declares them, so the
+/// programs are the ones it would write) and none is written. What `rodcube run --spec` runs.
+pub fn tapes(spec_path: &Path) -> Result<Vec<Rendered>, Error> {
+    let c = spec::load(spec_path)?;
+    let mut siblings: Vec<Checked> = Vec::new();
+    if let Some(dir) = spec_path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .or(Some(Path::new(".")))
+    {
+        let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+            .map(|e| e.filter_map(|e| e.ok().map(|e| e.path())).collect())
+            .unwrap_or_default();
+        files.retain(|p| p.extension().is_some_and(|x| x == "yaml" || x == "yml"));
+        files.sort();
+        // A sibling that is not a valid spec (a scene, say) declares nothing.
+        siblings.extend(files.iter().filter_map(|p| spec::load(p).ok()));
+    }
+    let specs: Vec<&spec::Spec> = siblings.iter().chain([&c]).map(|c| &c.spec).collect();
+    let symbols = mechanics::canonical_symbols(&specs);
+    on_cas_thread(move || cas::declare(&symbols))?;
+    let mut out = Vec::new();
+    for (phases, _) in derive_all(std::slice::from_ref(&c))? {
+        let fast = fast_phases(&phases);
+        for d in &phases {
+            let (_, tape) = rust_and_tape(MODEL_TEMPLATE, &c, d, &fast)?;
+            out.push(Rendered {
+                path: PathBuf::from(format!("{}.tape.json", d.name)),
+                text: crate::tape::format::render(&tape),
+            });
+        }
+    }
+    Ok(out)
 }
 
 /// Derives and renders every output file for the selected specs plus the registry.

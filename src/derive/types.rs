@@ -28,6 +28,9 @@ pub enum StepError {
     /// A coefficient outgrew 128 bits.
     #[error("coefficient overflow")]
     Overflow,
+    /// The generated Rust could not be compiled into a tape (`emit::tape`).
+    #[error("cannot write the tape: {0}")]
+    Tape(String),
     /// No presentation form could be made, or the one made is not equal to the result.
     #[error("{0}")]
     Presentation(String),

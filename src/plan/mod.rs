@@ -366,9 +366,36 @@ pub fn run(request: &Request) -> Result<RunResults, PlanError> {
         plan.drawing(&want, &mut out)?;
     }
     plan.motion_notes(&mut out);
+    provenance_notes(info.name, &mut out);
     out.work = plan.work;
     check_finite(&out)?;
     Ok(out)
+}
+
+/// Where the model came from, when a reader should know: run from a tape, or derived from a
+/// spec that has changed since.
+fn provenance_notes(model: &str, out: &mut RunResults) {
+    use crate::models::{Provenance, TapeRoute};
+    use crate::results::{Note, TapeReason};
+    let Some(entry) = crate::models::entry(model) else {
+        return;
+    };
+    if let Provenance::Tape { file, why } = entry.provenance {
+        let why = match why {
+            TapeRoute::Asked => TapeReason::Asked,
+            TapeRoute::NotCompiled => TapeReason::NotCompiled,
+            TapeRoute::DiffersFromCompiled => TapeReason::DiffersFromCompiled,
+            TapeRoute::DerivedNow => TapeReason::DerivedNow,
+        };
+        let model = model.to_string();
+        out.notes
+            .insert("model".into(), Note::FromTape { model, file, why });
+    }
+    if let Some(spec) = entry.stale_spec {
+        let (model, spec) = (model.to_string(), spec.display().to_string());
+        out.notes
+            .insert("spec".into(), Note::SpecChanged { model, spec });
+    }
 }
 
 /// Refuses a result with a NaN or an infinity (a model function misbehaving), naming it.

@@ -6,7 +6,7 @@
 
 use crate::results::{
     Check, CheckKind, CheckPhase, CheckSubject, Halt, Held, LabelValue, Meaning, Note, PhaseEnd,
-    Sensitivity, SensitivityGap, Unlanded, UntilNote, Zeno, format_number,
+    Sensitivity, SensitivityGap, TapeReason, Unlanded, UntilNote, Zeno, format_number,
 };
 
 /// Where a check ran, as the table's group heading and results.json's `phase` name it:
@@ -119,6 +119,28 @@ pub fn note(note: &Note) -> String {
     match note {
         Note::Refused(why) => why.clone(),
         Note::NoSensitivity(gap) => sensitivity_gap(*gap).into(),
+        Note::FromTape { model, file, why } => match why {
+            TapeReason::Asked => format!(
+                "model `{model}` ran from its tape {file} (--interpreted): the same program as \
+                 the compiled code, evaluated"
+            ),
+            TapeReason::NotCompiled => format!(
+                "model `{model}` is not compiled into this program; it ran from its tape {file}"
+            ),
+            TapeReason::DerivedNow => format!(
+                "model `{model}` was derived from {file} for this run and ran from its tape"
+            ),
+            TapeReason::DiffersFromCompiled => format!(
+                "model `{model}` ran from its tape {file}, which is another program than the \
+                 compiled-in model of that name (its spec was derived again since this program \
+                 was built)"
+            ),
+        },
+        Note::SpecChanged { model, spec } => format!(
+            "the spec {spec} has changed since model `{model}` was derived from it: these are \
+             the results of the model as last derived; run `cargo derive` (or `rodcube derive`) \
+             to derive it again"
+        ),
         Note::NoSeparationEnded { contact, cause } => format!(
             "no separation: contact `{contact}` ended before its force vanished ({}; \
              `contact_end` says when)",

@@ -12,7 +12,7 @@ mod notes;
 
 pub use drawing::{Drawing, DrawnPhase, DrawnSample, PhaseEnd, Pose};
 pub use meanings::Meaning;
-pub use notes::{Halt, Held, Note, SensitivityGap, Unlanded, UntilNote, Zeno};
+pub use notes::{Halt, Held, Note, SensitivityGap, TapeReason, Unlanded, UntilNote, Zeno};
 
 /// A scalar result with its unit.
 #[derive(Debug, Clone, PartialEq, Serialize)]

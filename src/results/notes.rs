@@ -210,6 +210,36 @@ pub enum Note {
     Zeno(Vec<Zeno>),
     /// A wanted sensitivity that has no number, and why.
     NoSensitivity(SensitivityGap),
+    /// The model ran from its tape (`generated/<model>.tape.json`) rather than compiled code.
+    FromTape {
+        /// The model.
+        model: String,
+        /// The tape's file.
+        file: String,
+        /// Why.
+        why: TapeReason,
+    },
+    /// The spec the model was derived from has changed since: the results are of the model as
+    /// last derived.
+    SpecChanged {
+        /// The model.
+        model: String,
+        /// The spec's file.
+        spec: String,
+    },
+}
+
+/// Why a model ran from its tape.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TapeReason {
+    /// Asked for (`--interpreted`).
+    Asked,
+    /// No model of its name is compiled in.
+    NotCompiled,
+    /// The compiled model of its name is another program (derived again since).
+    DiffersFromCompiled,
+    /// Derived from its spec (the note's file) for this run.
+    DerivedNow,
 }
 
 /// Why a result has no sensitivities.

@@ -36,6 +36,8 @@ pub struct Checked {
     /// Each contact's gap unit and its force's unit (conjugate to the gap), in the spec's
     /// order.
     pub units: Vec<(String, String)>,
+    /// The spec's text as read (its digest is recorded in the model's tape).
+    pub text: String,
 }
 
 impl Checked {
@@ -91,5 +93,6 @@ pub fn parse(path: &Path, text: &str) -> Result<Checked, SpecError> {
         spec,
         file: path.to_path_buf(),
         units,
+        text: text.to_string(),
     })
 }

@@ -20,6 +20,7 @@ pub mod reduced;
 pub mod rust;
 pub mod state;
 pub mod tangents;
+pub mod tape;
 pub mod tex;
 
 pub use common::{COMMAND, one_line, spec_path};

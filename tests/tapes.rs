@@ -1,0 +1,609 @@
+//! Tapes (`generated/<model>.tape.json`): every compiled model's tape, evaluated, equals its
+//! compiled code to the bit in every method at random inputs, and describes the same
+//! `ModelInfo`; the loader refuses broken tapes with typed errors naming the file.
+
+mod common;
+
+use common::hand::Gauss;
+use rodcube::model::{Model, Reduction};
+use rodcube::models;
+use rodcube::tape::{self, TapeError};
+
+/// A small deterministic generator (xorshift), so failures reproduce.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    fn vec(&mut self, n: usize, lo: f64, hi: f64) -> Vec<f64> {
+        (0..n).map(|_| lo + (hi - lo) * self.next()).collect()
+    }
+}
+
+fn same(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|(x, y)| x.to_bits() == y.to_bits() || x.is_nan() && y.is_nan())
+}
+
+/// Calls `f` on the compiled model and on the tape with outputs of `len` numbers each, both
+/// starting from the same values, and asserts they wrote the same bits.
+fn both(name: &str, what: &str, len: usize, mut f: impl FnMut(bool, &mut [f64])) {
+    let mut a = vec![7.25; len];
+    let mut b = vec![7.25; len];
+    f(false, &mut a);
+    f(true, &mut b);
+    assert!(same(&a, &b), "{name}.{what}: compiled {a:?}\n tape {b:?}");
+}
+
+fn check_model(compiled: &dyn Model, taped: &dyn Model, rng: &mut Rng) {
+    let info = compiled.info();
+    let name = info.name;
+    assert_eq!(
+        format!("{info:?}"),
+        format!("{:?}", taped.info()),
+        "{name}: info"
+    );
+    let (n, np, m) = (
+        info.coordinates.len(),
+        info.parameters.len(),
+        info.contacts.len(),
+    );
+    let nf = info.frictions.len();
+    let pick = |tape: bool| if tape { taped } else { compiled };
+    for _ in 0..5 {
+        let p = rng.vec(np, 0.2, 2.0);
+        let mut k = vec![0.0; info.n_constants];
+        compiled.prepare(&p, &mut k);
+        both(name, "prepare", info.n_constants, |t, out| {
+            pick(t).prepare(&p, out)
+        });
+        let (q, qd, qdd) = (
+            rng.vec(n, -1.0, 1.5),
+            rng.vec(n, -2.0, 2.0),
+            rng.vec(n, -3.0, 3.0),
+        );
+        let forces = rng.vec(m, -2.0, 5.0);
+        let fr = rng.vec(nf, -1.0, 1.0);
+        both(name, "requirements", info.requirements.len(), |t, o| {
+            pick(t).requirements(&p, o)
+        });
+        both(name, "restitutions", m, |t, o| pick(t).restitutions(&p, o));
+        both(name, "initial_state", 2 * n, |t, o| {
+            let (a, b) = o.split_at_mut(n);
+            pick(t).initial_state(&k, a, b)
+        });
+        both(name, "points", 4 * info.points.len(), |t, o| {
+            let (a, b) = o.split_at_mut(2 * info.points.len());
+            let (a, b) = (a.as_chunks_mut::<2>().0, b.as_chunks_mut::<2>().0);
+            pick(t).points(&k, &q, &qd, a, b)
+        });
+        both(name, "energy", 1, |t, o| o[0] = pick(t).energy(&k, &q, &qd));
+        both(name, "momenta", info.cyclic.len(), |t, o| {
+            pick(t).momenta(&k, &q, &qd, o)
+        });
+        both(name, "equations", n * n + n, |t, o| {
+            let (a, b) = o.split_at_mut(n * n);
+            pick(t).equations(&k, &q, &qd, a, b)
+        });
+        both(name, "forces_full", m, |t, o| {
+            pick(t).forces_full(&k, &q, &qd, &qdd, o)
+        });
+        both(name, "gaps", m, |t, o| pick(t).gaps(&k, &q, o));
+        both(name, "constraints", m * n + m, |t, o| {
+            let (a, b) = o.split_at_mut(m * n);
+            pick(t).constraints(&k, &q, &qd, a, b)
+        });
+        both(name, "edges", m, |t, o| pick(t).edges(&k, &q, o));
+        both(name, "friction", nf * n + nf, |t, o| {
+            let (a, b) = o.split_at_mut(nf * n);
+            pick(t).friction(&k, &q, &qd, a, b)
+        });
+        both(name, "monitors_full", info.monitors.len(), |t, o| {
+            pick(t).monitors_full(&k, &q, &qd, &forces, o)
+        });
+        let ns = info.system_coordinates.len();
+        both(name, "to_full", 2 * ns, |t, o| {
+            let (a, b) = o.split_at_mut(ns);
+            pick(t).to_full(&k, &q, &qd, a, b)
+        });
+        let nb = info.bodies.len();
+        both(name, "drawing", 3 * nb + info.drawing_sizes(), |t, o| {
+            let (a, b) = o.split_at_mut(3 * nb);
+            pick(t).drawing(&k, &q, a.as_chunks_mut::<3>().0, b)
+        });
+        assert_eq!(
+            compiled.has_tangents(),
+            taped.has_tangents(),
+            "{name}: has_tangents"
+        );
+        let rows = n + 3 * m + 2 * nf;
+        both(name, "tangents", rows * (2 * n + np), |t, o| {
+            pick(t).tangents(&k, &q, &qd, &qdd, &forces, &fr, o)
+        });
+        both(name, "initial_tangents", 2 * n * np, |t, o| {
+            pick(t).initial_tangents(&k, o)
+        });
+        assert_eq!(
+            compiled.reduction().is_some(),
+            taped.reduction().is_some(),
+            "{name}"
+        );
+        if let (Some(a), Some(b)) = (compiled.reduction(), taped.reduction()) {
+            check_reduction(name, a, b, &p, &k, rng, info);
+        }
+        assert_eq!(
+            compiled.lean_start(&p).map(|s| format!("{s:?}")),
+            taped.lean_start(&p).map(|s| format!("{s:?}")),
+            "{name}: lean_start"
+        );
+    }
+}
+
+fn check_reduction(
+    name: &str,
+    compiled: &dyn Reduction,
+    taped: &dyn Reduction,
+    p: &[f64],
+    k: &[f64],
+    rng: &mut Rng,
+    info: &rodcube::model::ModelInfo,
+) {
+    let pick = |tape: bool| if tape { taped } else { compiled };
+    let layout = info.reduction.expect("a fast path's layout");
+    let np = info.parameters.len();
+    let delta = rng.next() * 0.3;
+    let (s, c, ds, dc) = (rng.next(), rng.next(), rng.next() * 0.1, rng.next() * 0.1);
+    both(name, "reduced", 4, |t, o| {
+        let r = pick(t).reduced(k, delta);
+        o.copy_from_slice(&[r.sin, r.cos, r.theta_dot_sq, r.theta_ddot]);
+    });
+    both(name, "theta_dot_sq_sc", 1, |t, o| {
+        o[0] = pick(t).theta_dot_sq_sc(k, s, c, ds, dc)
+    });
+    both(name, "forces", info.contacts.len(), |t, o| {
+        pick(t).forces(k, delta, o)
+    });
+    for (contact, degree) in layout.force_degrees.iter().enumerate() {
+        both(name, "force_polynomial", degree + 1, |t, o| {
+            pick(t).force_polynomial(k, contact, o)
+        });
+    }
+    let fall = layout.fall_degree.map_or(0, |d| d + 1);
+    both(name, "fall_polynomial", fall, |t, o| {
+        pick(t).fall_polynomial(k, o)
+    });
+    both(name, "prepare_lean", info.n_constants, |t, o| {
+        pick(t).prepare_lean(p, o)
+    });
+    assert_eq!(
+        compiled.has_partials(),
+        taped.has_partials(),
+        "{name}: has_partials"
+    );
+    both(name, "separation_partials", np + 1, |t, o| {
+        pick(t).separation_partials(k, s, c, o)
+    });
+    both(name, "theta_dot_sq_partials", np, |t, o| {
+        pick(t).theta_dot_sq_partials(k, s, c, o)
+    });
+    both(name, "start_partials", np, |t, o| {
+        pick(t).start_partials(k, o)
+    });
+    both(name, "fall_partials", fall * np, |t, o| {
+        pick(t).fall_partials(k, o)
+    });
+    let n = info.coordinates.len();
+    let (time, rate) = (rng.next(), -rng.next());
+    both(name, "full_state", 2 * n, |t, o| {
+        let (a, b) = o.split_at_mut(n);
+        pick(t).full_state(k, time, delta, rate, a, b)
+    });
+}
+
+#[test]
+fn every_compiled_model_and_its_tape_agree_to_the_bit_in_every_method() {
+    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    let mut checked = 0;
+    for &compiled in models::compiled() {
+        let name = compiled.info().name;
+        let text = models::embedded_tape(name).expect("every compiled model embeds its tape");
+        let taped = tape::parse(text, name).unwrap_or_else(|e| panic!("{e}"));
+        check_model(compiled, &taped, &mut rng);
+        checked += 1;
+    }
+    assert_eq!(checked, 27);
+}
+
+fn paper_tape() -> String {
+    models::embedded_tape("rod_cube")
+        .expect("embedded")
+        .to_string()
+}
+
+/// A tape whose body is edited, with its digest brought up to date (so the check under test is
+/// the one reached, not the digest's).
+fn edited(edit: impl FnOnce(&mut serde_json::Value)) -> String {
+    let mut v: serde_json::Value = serde_json::from_str(&paper_tape()).expect("json");
+    edit(&mut v["body"]);
+    let body: tape::format::Body = serde_json::from_value(v["body"].clone()).expect("body");
+    v["body_digest"] = body.digest().into();
+    serde_json::to_string(&v).expect("json")
+}
+
+fn refusal(text: &str) -> TapeError {
+    match tape::parse(text, "t.tape.json") {
+        Ok(_) => panic!("accepted a broken tape"),
+        Err(e) => e,
+    }
+}
+
+#[test]
+fn a_truncated_or_hand_edited_tape_is_refused_by_its_digest() {
+    let text = paper_tape();
+    let cut = &text[..text.len() / 2];
+    let e = refusal(cut);
+    assert!(matches!(e, TapeError::Syntax { .. }), "{e}");
+    assert!(e.to_string().starts_with("t.tape.json:"), "{e}");
+    let changed = text.replacen("[\"const\",", "[\"const\",1", 1);
+    let e = refusal(&changed);
+    assert!(matches!(e, TapeError::Digest { .. }), "{e}");
+    assert!(e.to_string().contains("cargo derive"), "{e}");
+}
+
+#[test]
+fn another_format_version_is_answered_with_the_command_that_regenerates_it() {
+    let text = paper_tape().replacen("\"version\": 1,", "\"version\": 0,", 1);
+    let e = refusal(&text);
+    assert!(matches!(e, TapeError::Version { found: 0, .. }), "{e}");
+    assert!(e.to_string().contains("cargo derive"), "{e}");
+    let text = paper_tape().replacen("rodcube-tape", "something-else", 1);
+    assert!(matches!(refusal(&text), TapeError::Format { .. }));
+}
+
+fn method_refusal(method: &str, edit: impl FnOnce(&mut Vec<serde_json::Value>)) -> String {
+    let text = edited(|body| {
+        let functions = body["functions"].as_array_mut().expect("functions");
+        let f = (functions.iter_mut())
+            .find(|f| f["name"] == method)
+            .expect("method");
+        edit(f["code"].as_array_mut().expect("code"));
+    });
+    let e = refusal(&text);
+    assert!(
+        matches!(&e, TapeError::Method { method: m, .. } if m == method),
+        "{e}"
+    );
+    e.to_string()
+}
+
+#[test]
+fn programs_that_could_misbehave_are_refused_naming_the_method_and_instruction() {
+    use serde_json::json;
+    // An index past the mass matrix's 16 numbers.
+    let e = method_refusal("equations", |c| c.push(json!(["st", "mass", 16, 0])));
+    assert!(e.contains("past `mass`'s 16 numbers"), "{e}");
+    // A register read before anything writes it.
+    let e = method_refusal("equations", |c| c.insert(0, json!(["add", 0, 5000, 1])));
+    assert!(e.contains("before anything writes it"), "{e}");
+    // An argument the method does not have.
+    let e = method_refusal("gaps", |c| c.insert(0, json!(["ld", 0, "qdd", 0])));
+    assert!(e.contains("`qdd` is not"), "{e}");
+    // A register beyond the bound on a tape's registers.
+    let e = method_refusal("gaps", |c| {
+        c.insert(0, json!(["const", 4_000_000_000u32, 1.0]))
+    });
+    assert!(e.contains("a tape may use"), "{e}");
+    // Methods missing or unknown.
+    let text = edited(|b| {
+        let f = b["functions"].as_array_mut().expect("functions");
+        f.retain(|f| f["name"] != "equations");
+    });
+    assert!(refusal(&text).to_string().contains("`equations`: missing"));
+    let text = edited(|b| b["functions"][0]["name"] = "format_disk".into());
+    assert!(refusal(&text).to_string().contains("no such method"));
+}
+
+#[test]
+fn unknown_operations_and_wrong_arities_are_refused_at_their_line() {
+    for (bad, what) in [
+        (r#"["jump",0,1]"#, "unknown operation `jump`"),
+        (r#"["add",0,1]"#, "takes 3 operands, not 2"),
+        (r#"["ld",0,"disk",0]"#, "is not an argument"),
+        (r#"["powi",0,1,2.5]"#, "not a 32-bit integer"),
+    ] {
+        let text = paper_tape().replacen(r#"["ld",0,"p",2]"#, bad, 1);
+        assert_ne!(text, paper_tape(), "the paper's tape starts with that load");
+        let e = refusal(&text);
+        let TapeError::Syntax { line, .. } = &e else {
+            panic!("{e}");
+        };
+        assert!(*line > 1 && e.to_string().contains(what), "{e}");
+    }
+}
+
+#[test]
+fn inconsistent_info_is_refused() {
+    let text = edited(|b| b["info"]["reduced_index"] = 9.into());
+    let e = refusal(&text);
+    assert!(matches!(e, TapeError::Info { .. }), "{e}");
+    assert!(e.to_string().contains("reduced_index"), "{e}");
+    let text = edited(|b| b["info"]["n_constants"] = 1u64.into());
+    assert!(matches!(refusal(&text), TapeError::Info { .. }));
+}
+
+/// The results.json a scene writes, with `--interpreted` or without, and the run's stderr.
+fn scene_results(
+    scene: &std::path::Path,
+    interpreted: bool,
+    out: &std::path::Path,
+) -> serde_json::Value {
+    let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_rodcube"));
+    cmd.arg("run")
+        .arg(scene)
+        .arg("--out")
+        .arg(out)
+        .arg("--json");
+    if interpreted {
+        cmd.arg("--interpreted");
+    }
+    let run = cmd.output().expect("rodcube runs");
+    assert!(
+        run.status.success(),
+        "{}: {}",
+        scene.display(),
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let text = std::fs::read_to_string(out.join("results.json")).expect("results.json");
+    serde_json::from_str(&text).expect("results.json is JSON")
+}
+
+#[test]
+fn every_shipped_scene_gives_the_same_results_json_from_the_tapes_to_the_bit() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let tmp = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("tapes_scenes");
+    let mut scenes: Vec<_> = std::fs::read_dir(root.join("scenes"))
+        .expect("scenes/")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| p.extension().is_some_and(|x| x == "yaml"))
+        .collect();
+    scenes.sort();
+    assert!(scenes.len() >= 14, "{scenes:?}");
+    for scene in &scenes {
+        let stem = scene.file_stem().and_then(|s| s.to_str()).expect("stem");
+        let compiled = scene_results(scene, false, &tmp.join(format!("{stem}-compiled")));
+        let mut taped = scene_results(scene, true, &tmp.join(format!("{stem}-tape")));
+        // The one difference: the tape's run says where its model came from.
+        let note = taped["notes"]
+            .as_object_mut()
+            .and_then(|n| n.remove("model"))
+            .unwrap_or_else(|| panic!("{stem}: no note of the tape"));
+        assert!(
+            note.as_str().is_some_and(|s| s.contains("--interpreted")),
+            "{note}"
+        );
+        if taped["notes"].as_object().is_some_and(|n| n.is_empty()) {
+            taped.as_object_mut().expect("object").remove("notes");
+        }
+        // Serialised by the same writer, equal values print to the same shortest digits: the
+        // texts are compared, so a difference in the last bit of any number fails.
+        assert_eq!(
+            serde_json::to_string_pretty(&compiled).expect("json"),
+            serde_json::to_string_pretty(&taped).expect("json"),
+            "{stem}: results.json differs between the compiled model and its tape"
+        );
+    }
+}
+
+/// A spec a user writes from README's "Adding a model": the paper's rod (`mr`, `L`) leaning on
+/// a block (`mb`, side `h`) with names of their own, four coordinates and four contacts (the
+/// rod's tip on the block, the floor under the foot and under the tip, and a wall far behind the
+/// block), nothing eliminated: every phase is integrated.
+const SLED_SPEC: &str = r#"
+name: sled
+description: A rod leaning on a sliding block, with a wall behind the block.
+parameters:
+  - {name: mr, meaning: mass of the rod, unit: kg}
+  - {name: mb, meaning: mass of the block, unit: kg}
+  - {name: L, meaning: length of the rod, unit: m}
+  - {name: h, meaning: side of the block, unit: m}
+  - {name: W, meaning: distance from the foot to the wall, unit: m}
+  - {name: g, meaning: gravitational acceleration, unit: m/s^2}
+requirements:
+  - {name: leans, expr: L - h, meaning: the block is lower than the rod is long}
+  - {name: room, expr: W - L - h, meaning: the wall is behind the block}
+gravity: g
+coordinates:
+  - {name: xf, meaning: position of the rod's foot, unit: m}
+  - {name: yf, meaning: height of the rod's foot, unit: m}
+  - {name: th, meaning: angle of the rod to the floor, unit: rad}
+  - {name: xb, meaning: position of the block's face on the rod's side, unit: m}
+reduced: th
+end_angle: -1.5707963267948966
+bodies:
+  - {name: rod, mass: mr, inertia: mr*L^2/12, position: [xf + L/2*cos(th), yf + L/2*sin(th)], angle: th, shape: {segment: [[-L/2, 0], [L/2, 0]]}}
+  - {name: block, mass: mb, inertia: mb*h^2/6, position: [xb + h/2, h/2], angle: 0, shape: {rectangle: [h, h]}}
+points:
+  - {name: tip, position: [xf + L*cos(th), yf + L*sin(th)], meaning: the rod's upper end}
+  - {name: centre, position: [xf + L/2*cos(th), yf + L/2*sin(th)], meaning: the rod's centre}
+falling_point: centre
+contacts:
+  - {name: push, meaning: "the rod's tip on the block, positive while they touch", gap: xb - xf - L*cos(th)}
+  - {name: foot, meaning: "the floor under the rod's foot, positive while they touch", gap: yf}
+  - {name: tip_floor, meaning: "the floor under the rod's tip, positive while they touch", gap: yf + L*sin(th)}
+  - {name: wall, meaning: "the wall behind the block, positive while they touch", gap: W - xb - h}
+initial:
+  xf: {position: 0, velocity: 0}
+  yf: {position: 0, velocity: 0}
+  th: {position: asin(h/L), velocity: 0}
+  xb: {position: sqrt((L - h)*(L + h)), velocity: 0}
+"#;
+
+const SLED_SCENE: &str = "\
+model: sled
+parameters: {mr: 1.0, mb: 3.0, L: 1.0, h: 0.25, W: 5.0, g: 9.81}
+want: [separation_angle, separation_time, push_series]
+tolerance: 1.0e-12
+samples: 50
+";
+
+/// The paper's closed forms for the rod on a free block (`PHYSICS.md`, re-derived by hand):
+/// the separation's sine, the root of eq. (14) `3 s^3 - 12 (1+n) s + 8 r (1+n) = 0` in
+/// `(0, r)`; its time, `int dtheta / sqrt(theta_dot^2)` of eq. (9) with the substitution
+/// `theta = theta_0 - u^2` that removes the endpoint's `1/sqrt`; and the push at release,
+/// eq. (16).
+fn paper_closed_forms(n: f64, r: f64, ell: f64, g: f64, m2: f64) -> (f64, f64, f64) {
+    let f = |s: f64| 3.0 * s.powi(3) - 12.0 * (1.0 + n) * s + 8.0 * r * (1.0 + n);
+    let (mut lo, mut hi) = (0.0, r);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if f(mid) > 0.0 { lo = mid } else { hi = mid }
+    }
+    let theta_sep = (0.5 * (lo + hi)).asin();
+    let theta0 = r.asin();
+    let rate_sq = |theta: f64| {
+        let s = theta.sin();
+        let d = 4.0 / 3.0 - s * s / (1.0 + n);
+        4.0 * (g / ell) * (r - s) / d
+    };
+    let u_end = (theta0 - theta_sep).sqrt();
+    let t_sep =
+        Gauss::new(30).integrate(|u| 2.0 * u / rate_sq(theta0 - u * u).sqrt(), 0.0, u_end, 8);
+    let (s, c) = (r, theta0.cos());
+    let push = m2
+        * (-3.0 * g * c * (8.0 * r * (1.0 + n) - 12.0 * (1.0 + n) * s + 3.0 * s.powi(3))
+            / (4.0 * (1.0 + n) - 3.0 * s * s).powi(2));
+    (theta_sep, t_sep, push)
+}
+
+fn run_in(dir: &std::path::Path, args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_rodcube"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("rodcube runs")
+}
+
+fn check_sled(results: &serde_json::Value, what: &str) {
+    let value = |k: &str| {
+        results["results"][k]["value"]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{what}: {k}"))
+    };
+    let (theta_sep, t_sep, push0) = paper_closed_forms(3.0, 0.25, 1.0, 9.81, 3.0);
+    let angle = value("separation_angle");
+    let time = value("separation_time");
+    assert!(
+        (angle - theta_sep).abs() < 1e-9,
+        "{what}: angle {angle} vs {theta_sep}"
+    );
+    assert!(
+        (time - t_sep).abs() < 1e-9 * t_sep,
+        "{what}: time {time} vs {t_sep}"
+    );
+    let push = &results["series"]["push_series"]["columns"];
+    let force = (push.as_array().into_iter().flatten())
+        .find(|c| c["name"] == "push")
+        .unwrap_or_else(|| panic!("{what}: push_series {push}"));
+    let first = force["values"][0].as_f64().expect("a number");
+    assert!(
+        (first - push0).abs() < 1e-9 * push0.abs(),
+        "{what}: push {first} vs {push0}"
+    );
+}
+
+#[test]
+fn a_new_spec_runs_at_once_through_spec_and_through_its_tapes_and_matches_the_closed_forms() {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("tapes_sled");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temporary directory");
+    std::fs::write(dir.join("sled.yaml"), SLED_SPEC).expect("spec");
+    std::fs::write(dir.join("scene.yaml"), SLED_SCENE).expect("scene");
+    // 1. `--spec`: derived in memory, run at once; stdout is exactly results.json (Symbolica's
+    //    banner goes to stderr) and nothing is written but the outputs.
+    let run = run_in(
+        &dir,
+        &[
+            "run",
+            "scene.yaml",
+            "--spec",
+            "sled.yaml",
+            "--json",
+            "--out",
+            "out",
+        ],
+    );
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let derived: serde_json::Value =
+        serde_json::from_slice(&run.stdout).expect("stdout is results.json alone");
+    check_sled(&derived, "--spec");
+    let note = derived["notes"]["model"].as_str().unwrap_or_default();
+    assert!(note.contains("derived from sled.yaml"), "{note}");
+    assert!(!dir.join("generated").exists());
+    // 2. The tapes written by `derive --tapes-into` and found by `--models`: the same numbers
+    //    to the bit.
+    let tapes = run_in(&dir, &["derive", "--tapes-into", "models", "sled.yaml"]);
+    assert!(
+        tapes.status.success(),
+        "{}",
+        String::from_utf8_lossy(&tapes.stderr)
+    );
+    assert!(dir.join("models/sled.tape.json").is_file());
+    let run = run_in(
+        &dir,
+        &[
+            "run",
+            "scene.yaml",
+            "--models",
+            "models",
+            "--json",
+            "--out",
+            "out2",
+        ],
+    );
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let loaded: serde_json::Value = serde_json::from_slice(&run.stdout).expect("results.json");
+    check_sled(&loaded, "--models");
+    for key in ["separation_angle", "separation_time"] {
+        assert_eq!(
+            derived["results"][key]["value"].as_f64().map(f64::to_bits),
+            loaded["results"][key]["value"].as_f64().map(f64::to_bits),
+            "{key}"
+        );
+    }
+    let note = loaded["notes"]["model"].as_str().unwrap_or_default();
+    assert!(note.contains("not compiled into this program"), "{note}");
+    // 3. A spec with an error is refused with its file, line and field, exit 3, no output.
+    std::fs::write(
+        dir.join("bad.yaml"),
+        SLED_SPEC.replace("inertia: mr*L^2/12", "inertia: mr*L^2/12 +"),
+    )
+    .expect("spec");
+    let run = run_in(
+        &dir,
+        &["run", "scene.yaml", "--spec", "bad.yaml", "--out", "out3"],
+    );
+    assert_eq!(
+        run.status.code(),
+        Some(3),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(err.contains("bad.yaml:"), "{err}");
+    assert!(!dir.join("out3/results.json").exists());
+}
