@@ -348,11 +348,14 @@ pub fn excerpt(
 // ---------------------------------------------------------------------------------------------
 
 /// The deserializer's options: NaN and infinities pass as numbers (scenes and specs refuse them
-/// with a message of their own), no snippet in errors (the caller renders its own).
+/// with a message of their own), no snippet in errors (the caller renders its own), and only
+/// YAML 1.2's `true` and `false` are booleans: `y`, `n`, `yes`, `no`, `on` and `off` are names
+/// (a coordinate `y`, a mass ratio `n`), which YAML 1.1 would have read as booleans.
 fn options() -> serde_saphyr::Options {
     serde_saphyr::options! {
         non_finite_float_policy: serde_saphyr::NonFiniteFloatPolicy::PassThrough,
         with_snippet: false,
+        strict_booleans: true,
     }
 }
 

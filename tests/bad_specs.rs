@@ -816,3 +816,33 @@ fn a_restitution_outside_zero_to_one_of_a_coordinate_or_with_a_unit_is_refused()
         &["bilateral contact", "no restitution"],
     );
 }
+
+#[test]
+fn a_value_that_is_not_an_expression_says_what_an_expression_is() {
+    // Not "did not match any variant of untagged enum Text": what is expected, with examples.
+    let text = edit("    mass: m1\n", "    mass: [m1]\n");
+    refused(
+        "not_an_expression",
+        &text,
+        ("mass:", "mass"),
+        "bodies[0].mass",
+        &["expected an expression, e.g. `x + 1`"],
+    );
+    // `true` is YAML's boolean; a bare `y`, `n`, `on` or `no` is a name.
+    let text = edit("    angle: theta\n", "    angle: true\n");
+    refused(
+        "a_boolean",
+        &text,
+        ("angle: true", "angle"),
+        "bodies[0].angle",
+        &["boolean", "expected an expression"],
+    );
+    let text = edit("    angle: theta\n", "    angle: on\n");
+    refused(
+        "on_is_a_name",
+        &text,
+        ("angle: on", "angle"),
+        "bodies[0].angle",
+        &["`on`"],
+    );
+}

@@ -714,3 +714,54 @@ fn rodcube_derive_then_rodcube_run_runs_the_edited_spec_with_no_build() {
         angle(&taped).map(f64::to_bits)
     );
 }
+
+#[test]
+fn a_spec_with_coordinates_x_and_y_and_a_parameter_n_written_bare_derives_and_runs() {
+    // YAML 1.1 would read a bare `y` or `n` as a boolean; rodcube reads them as the names they
+    // are. The paper's rod on a cube with every support a contact, renamed: coordinates `x`,
+    // `y` for the foot, and the restitution `n`.
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let spec =
+        std::fs::read_to_string(root.join("derivations/rod_cube_liftoff.yaml")).expect("spec");
+    let spec = spec
+        .replace("name: rod_cube_liftoff", "name: renamed")
+        .replace("x1", "x")
+        .replace("y1", "y")
+        .replace("{name: e,", "{name: n,")
+        .replace("restitution: e", "restitution: n")
+        .replace(
+            "- {name: n, expr: m2/m1",
+            "- {name: mass_ratio, expr: m2/m1",
+        );
+    assert!(spec.contains("position: [x, y]") && spec.contains("restitution: n"));
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("tapes_renamed");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("directory");
+    std::fs::write(dir.join("renamed.yaml"), &spec).expect("spec");
+    let scene = "model: renamed\nparameters: {m1: 1.0, m2: 3.0, ell: 1.0, a: 0.25, g: 9.81, n: 0}\n\
+                 want: [separation_time]\ntolerance: 1.0e-12\n";
+    std::fs::write(dir.join("scene.yaml"), scene).expect("scene");
+    let run = run_in(
+        &dir,
+        &[
+            "run",
+            "scene.yaml",
+            "--spec",
+            "renamed.yaml",
+            "--json",
+            "--out",
+            "o",
+        ],
+    );
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let results: serde_json::Value = serde_json::from_slice(&run.stdout).expect("json");
+    let time = results["results"]["separation_time"]["value"]
+        .as_f64()
+        .expect("a time");
+    let (_, t_sep, _) = paper_closed_forms(3.0, 0.25, 1.0, 9.81, 3.0);
+    assert!((time - t_sep).abs() < 1e-9 * t_sep, "{time} vs {t_sep}");
+}

@@ -5,9 +5,10 @@ use super::expr;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 
-/// An expression field: YAML may write it as a string or a bare number.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(untagged)]
+/// An expression field: YAML may write it as a string or a bare number. Any plain scalar that
+/// is not a number is its source text (the YAML reader takes only `true` and `false` as
+/// booleans, so `y`, `n`, `on` and `no` are names here, as a physicist writes them).
+#[derive(Debug, Clone)]
 pub enum Text {
     /// `"ell/2*sin(theta)"`
     Str(String),
@@ -22,6 +23,39 @@ impl Text {
             Text::Str(s) => s.clone(),
             Text::Num(x) => expr::float_literal(*x),
         }
+    }
+
+    /// The number it is, where it is written as one.
+    pub fn number(&self) -> Option<f64> {
+        match self {
+            Text::Num(x) => Some(*x),
+            Text::Str(_) => None,
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Text {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Text, D::Error> {
+        struct Visitor;
+        impl serde::de::Visitor<'_> for Visitor {
+            type Value = Text;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("an expression, e.g. `x + 1`, `ell/2*sin(theta)` or `0.5`")
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Text, E> {
+                Ok(Text::Str(v.to_string()))
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Text, E> {
+                Ok(Text::Num(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Text, E> {
+                Ok(Text::Num(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Text, E> {
+                Ok(Text::Num(v as f64))
+            }
+        }
+        d.deserialize_any(Visitor)
     }
 }
 

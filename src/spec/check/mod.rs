@@ -610,8 +610,8 @@ impl Checker<'_> {
             let d = field.k("direction");
             self.expr(&d.i(0), &f.direction[0], &names.kinematic)?;
             self.expr(&d.i(1), &f.direction[1], &names.kinematic)?;
-            if let (Text::Num(x), Text::Num(y)) = (&f.direction[0], &f.direction[1]) {
-                self.unit(&d, [*x, *y])?;
+            if let (Some(x), Some(y)) = (f.direction[0].number(), f.direction[1].number()) {
+                self.unit(&d, [x, y])?;
             }
         }
         Ok(())
