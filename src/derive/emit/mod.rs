@@ -34,7 +34,25 @@ use crate::derive::types::Derivation;
 
 #[cfg(test)]
 mod tests {
-    use super::{one_line, tex_text};
+    use super::{latex_name, one_line, tex_text};
+
+    #[test]
+    fn names_as_people_write_them_print_with_subscripts() {
+        let t = "theta";
+        assert_eq!(latex_name("m1", t), "m_{\\mathrm{1}}");
+        assert_eq!(latex_name("mA", t), "m_{\\mathrm{A}}");
+        assert_eq!(latex_name("yB", t), "y_{\\mathrm{B}}");
+        assert_eq!(latex_name("theta0", t), "\\theta_{\\mathrm{0}}");
+        assert_eq!(latex_name("dot_xA", t), "\\dot{x}_{\\mathrm{A}}");
+        assert_eq!(latex_name("ddot_x1", t), "\\ddot{x}_{\\mathrm{1}}");
+        assert_eq!(latex_name("dot_theta", t), "\\dot{\\theta}");
+        assert_eq!(latex_name("x_rest", t), "x_{\\mathrm{rest}}");
+        // A capital alone, or a word, has no subscript to take.
+        assert_eq!(latex_name("R", t), "R");
+        assert_eq!(latex_name("W", t), "W");
+        assert_eq!(latex_name("ell", t), "\\ell");
+        assert_eq!(latex_name("mass", t), "\\mathrm{mass}");
+    }
 
     #[test]
     fn spec_text_cannot_leave_a_comment_or_run_as_tex() {

@@ -33,7 +33,28 @@ pub fn tex_text(text: &str) -> String {
     out
 }
 
-/// LaTeX spelling of a symbol: `m1` -> `m_{1}`, `ell` -> `\ell`, `dot_theta` -> `\dot{\theta}`.
+/// A name as its base and subscript: after an underscore (`x_rest`), trailing digits (`m1`,
+/// `theta0`) or trailing capitals after a lower-case base (`mA`, `yB`); otherwise no subscript.
+fn base_and_subscript(s: &str) -> (&str, Option<&str>) {
+    if let Some((base, sub)) = s.split_once('_') {
+        return (base, Some(sub));
+    }
+    let trailing = |pred: fn(char) -> bool| s.len() - s.trim_end_matches(pred).len();
+    let digits = trailing(|c| c.is_ascii_digit());
+    if digits > 0 && digits < s.len() {
+        return (&s[..s.len() - digits], Some(&s[s.len() - digits..]));
+    }
+    let capitals = trailing(|c| c.is_ascii_uppercase());
+    let base = &s[..s.len() - capitals];
+    if capitals > 0 && base.chars().all(|c| c.is_ascii_lowercase()) && !base.is_empty() {
+        return (base, Some(&s[base.len()..]));
+    }
+    (s, None)
+}
+
+/// LaTeX spelling of a symbol: `m1` -> `m_{1}`, `mA` -> `m_{A}`, `ell` -> `\ell`,
+/// `theta0` -> `\theta_{0}`, `dot_theta` -> `\dot{\theta}`, `dot_xA` -> `\dot{x}_{A}` (the dot
+/// over the letter, the subscript after it).
 pub fn latex_name(s: &str, theta: &str) -> String {
     match s {
         "rc_s" => return format!("\\sin {}", latex_name(theta, theta)),
@@ -44,40 +65,33 @@ pub fn latex_name(s: &str, theta: &str) -> String {
         "rc_ci" => return format!("\\cos {}_{{\\mathrm{{i}}}}", latex_name(theta, theta)),
         _ => {}
     }
-    if let Some(rest) = s.strip_prefix("ddot_") {
-        return format!("\\ddot{{{}}}", latex_name(rest, theta));
+    for (prefix, accent) in [("ddot_", "ddot"), ("dot_", "dot")] {
+        if let Some(rest) = s.strip_prefix(prefix) {
+            let (base, sub) = base_and_subscript(rest);
+            return with_subscript(format!("\\{accent}{{{}}}", letters(base)), sub);
+        }
     }
-    if let Some(rest) = s.strip_prefix("dot_") {
-        return format!("\\dot{{{}}}", latex_name(rest, theta));
-    }
+    let (base, sub) = base_and_subscript(s);
+    with_subscript(letters(base), sub)
+}
+
+/// A name's letters: a Greek letter's command (and `\ell`), a single letter as it is, a longer
+/// word upright.
+fn letters(base: &str) -> String {
     const GREEK: &[&str] = &[
         "alpha", "beta", "gamma", "delta", "epsilon", "theta", "kappa", "lambda", "mu", "nu", "xi",
         "pi", "rho", "sigma", "tau", "phi", "chi", "psi", "omega", "ell",
     ];
-    let (base, sub) = match s.split_once('_') {
-        Some((b, sub)) => (b.to_string(), Some(sub.to_string())),
-        None => {
-            let digits = s.trim_start_matches(|c: char| !c.is_ascii_digit());
-            if !digits.is_empty()
-                && digits.len() < s.len()
-                && digits.chars().all(|c| c.is_ascii_digit())
-            {
-                (
-                    s[..s.len() - digits.len()].to_string(),
-                    Some(digits.to_string()),
-                )
-            } else {
-                (s.to_string(), None)
-            }
-        }
-    };
-    let base = if GREEK.contains(&base.as_str()) {
+    if GREEK.contains(&base) {
         format!("\\{base}")
-    } else if base.len() > 1 {
+    } else if base.chars().count() > 1 {
         format!("\\mathrm{{{base}}}")
     } else {
-        base
-    };
+        base.to_string()
+    }
+}
+
+fn with_subscript(base: String, sub: Option<&str>) -> String {
     match sub {
         Some(sub) => format!("{base}_{{\\mathrm{{{}}}}}", sub.replace('_', ",")),
         None => base,
