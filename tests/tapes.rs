@@ -765,3 +765,61 @@ fn a_spec_with_coordinates_x_and_y_and_a_parameter_n_written_bare_derives_and_ru
     let (_, t_sep, _) = paper_closed_forms(3.0, 0.25, 1.0, 9.81, 3.0);
     assert!((time - t_sep).abs() < 1e-9 * t_sep, "{time} vs {t_sep}");
 }
+
+#[test]
+fn pi_is_a_constant_in_expressions() {
+    // The sled again with its rod's angle written through `pi`: `cos(th) = -cos(pi - th)`,
+    // `sin(th) = sin(pi - th)`, an angle `th + 2*pi` (the same orientation) and a release at
+    // `pi/2 - acos(h/L)`: the same motion, the paper's closed forms again.
+    let spec = SLED_SPEC
+        .replace("name: sled", "name: sled_pi")
+        .replace(
+            "position: [xf + L/2*cos(th), yf + L/2*sin(th)], angle: th,",
+            "position: [xf - L/2*cos(pi - th), yf + L/2*sin(pi - th)], angle: th + 2*pi,",
+        )
+        .replace("gap: xb - xf - L*cos(th)", "gap: xb - xf + L*cos(pi - th)")
+        .replace(
+            "th: {position: asin(h/L)",
+            "th: {position: pi/2 - acos(h/L)",
+        );
+    assert_eq!(spec.matches("(pi - th)").count(), 3, "{spec}");
+    assert!(spec.contains("th + 2*pi") && spec.contains("pi/2 - acos"), "{spec}");
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("tapes_pi");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("directory");
+    std::fs::write(dir.join("sled_pi.yaml"), &spec).expect("spec");
+    std::fs::write(
+        dir.join("scene.yaml"),
+        SLED_SCENE.replace("model: sled", "model: sled_pi"),
+    )
+    .expect("scene");
+    let run = run_in(
+        &dir,
+        &[
+            "run",
+            "scene.yaml",
+            "--spec",
+            "sled_pi.yaml",
+            "--json",
+            "--out",
+            "o",
+        ],
+    );
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let results: serde_json::Value = serde_json::from_slice(&run.stdout).expect("json");
+    check_sled(&results, "pi");
+    // `pi` is no name to declare.
+    let taken = spec.replace("{name: W, meaning", "{name: pi, meaning");
+    std::fs::write(dir.join("taken.yaml"), taken).expect("spec");
+    let run = run_in(
+        &dir,
+        &["run", "scene.yaml", "--spec", "taken.yaml", "--out", "o2"],
+    );
+    assert_eq!(run.status.code(), Some(3));
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(err.contains("`pi` is the constant"), "{err}");
+}

@@ -64,7 +64,11 @@ fn view(v: AtomView) -> Result<Expr, Unheld> {
     };
     Ok(match v {
         AtomView::Num(n) => number(n.get_coeff_view())?,
-        AtomView::Var(x) => Expr::Sym(x.get_symbol().get_stripped_name().to_string()),
+        AtomView::Var(x) => match x.get_symbol().get_stripped_name() {
+            // Symbolica's own constant: a spec's `pi` comes back as it.
+            "𝜋" => Expr::Sym(crate::derive::expr::PI.to_string()),
+            name => Expr::Sym(name.to_string()),
+        },
         AtomView::Fun(f) => Expr::Fun(
             f.get_symbol().get_stripped_name().to_string(),
             all(&mut f.iter())?,

@@ -36,6 +36,11 @@ pub const FUNCTIONS: &[(&str, usize)] = &[
     ("log", 1),
 ];
 
+/// The name of the constant `pi` in spec expressions: not a free symbol ([`Expr::symbols`]
+/// leaves it out), dimensionless, `std::f64::consts::PI` in the generated code and `\pi` in the
+/// LaTeX; no parameter or coordinate may take the name.
+pub const PI: &str = "pi";
+
 /// A parse error with the byte offset where it was found.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ParseError {
@@ -168,7 +173,9 @@ impl Expr {
     pub fn symbols(&self) -> BTreeSet<String> {
         let mut out = BTreeSet::new();
         self.visit(&mut |e| {
-            if let Expr::Sym(s) = e {
+            if let Expr::Sym(s) = e
+                && s != PI
+            {
                 out.insert(s.clone());
             }
         });
@@ -203,6 +210,7 @@ impl Expr {
         match self {
             Expr::Rational(n, d) => *n as f64 / *d as f64,
             Expr::Float(x) => *x,
+            Expr::Sym(s) if s == PI => std::f64::consts::PI,
             Expr::Sym(s) => lookup(s).unwrap_or(f64::NAN),
             Expr::Add(v) => v.iter().map(|e| e.eval(lookup)).sum(),
             Expr::Mul(v) => v.iter().map(|e| e.eval(lookup)).product(),

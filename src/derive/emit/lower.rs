@@ -402,6 +402,7 @@ fn emit_node(
             float_literal(*d as f64)
         ),
         Expr::Float(x) => float_literal(*x),
+        Expr::Sym(s) if s == crate::derive::expr::PI => "std::f64::consts::PI".to_string(),
         Expr::Sym(s) => {
             if let Some(i) = s.strip_prefix("rc_k").and_then(|i| i.parse::<usize>().ok()) {
                 format!("k[{i}]")

@@ -699,8 +699,11 @@ impl Checker<'_> {
                 format!("`{name}`: names starting with `{p}` are reserved"),
             ));
         }
-        if FUNCTIONS.iter().any(|(f, _)| *f == name) || name == "pi" {
+        if FUNCTIONS.iter().any(|(f, _)| *f == name) {
             return Err(self.err(field, format!("`{name}` is the name of a function")));
+        }
+        if name == super::expr::PI {
+            return Err(self.err(field, format!("`{name}` is the constant 3.14159...")));
         }
         if !seen.insert(name.to_string()) {
             return Err(self.err(field, format!("`{name}` is declared twice")));

@@ -62,6 +62,7 @@ fn infer(
     }
     match e {
         Expr::Rational(..) | Expr::Float(_) => Ok(Unit::DIMENSIONLESS),
+        Expr::Sym(name) if name == crate::spec::expr::PI => Ok(Unit::DIMENSIONLESS),
         Expr::Sym(name) => {
             symbols(name).ok_or_else(|| UnitError::UnknownSymbol { name: name.clone() })
         }
