@@ -43,11 +43,14 @@ The FMU's shared library is built from the C ABI with the FMI 2.0 entry points:
 which writes librodcube.so into the target directory's release/, beside the rodcube binary
 that `cargo build --release` writes, where `rodcube fmu` looks for it (or pass --binary).
 The parameters' start values are those of the first scene in scenes/ of the model (the
-paper's for rod_cube), or of --scene FILE.
+paper's for rod_cube), or of --scene FILE. The FMU carries the model as data (the tapes of
+the system and its fast phases, in resources/), so the library is the same for every model:
+one only derived (`rodcube derive --tapes-into DIR SPEC`) exports with --models DIR.
 
 Examples:
   rodcube fmu rod_cube --out out/fmu
-  rodcube fmu hinged_rod --out out/fmu --scene my_hinged.yaml";
+  rodcube fmu hinged_rod --out out/fmu --scene my_hinged.yaml
+  rodcube fmu sled --models models --scene sled_scene.yaml --out out/fmu";
 
 const RUN_HELP: &str = "\
 A scene is a YAML file:
@@ -489,10 +492,11 @@ fn fmu(args: FmuArgs) -> Result<(), Failure> {
             ))
         })?,
     };
+    let tapes = export::tapes(model).map_err(usage)?;
     let library = export::read_binary(&binary).map_err(usage)?;
     // The message alone: it already ends with the system's reason.
     let out = OutDir::create(&args.out).map_err(|e| Failure::Usage(anyhow::anyhow!("{e}")))?;
-    let path = export::write_fmu(model, &defaults, &library, &out).map_err(usage)?;
+    let path = export::write_fmu(model, &defaults, &tapes, &library, &out).map_err(usage)?;
     note(&format!("wrote {}", path.display()));
     Ok(())
 }

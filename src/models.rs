@@ -14,7 +14,7 @@ pub mod generated;
 use crate::model::Model;
 use crate::tape::{self, TapeError, TapeModel};
 use std::path::{Path, PathBuf};
-use std::sync::RwLock;
+use std::sync::{Arc, RwLock};
 
 /// Where a model of the registry comes from.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -54,6 +54,9 @@ pub struct Entry {
     /// The spec it was derived from, where that file has changed since (its tape records the
     /// spec's digest): the path it was found at.
     pub stale_spec: Option<PathBuf>,
+    /// The text of the tape it runs from, as it was read (`None` where it runs compiled code,
+    /// whose tape is [`embedded_tape`]).
+    pub tape: Option<Arc<str>>,
 }
 
 struct Registry {
@@ -92,7 +95,16 @@ pub fn entry(name: &str) -> Option<Entry> {
         model,
         provenance: Provenance::Compiled,
         stale_spec: None,
+        tape: None,
     })
+}
+
+/// The tape of a model of the registry, the model as data (what an FMU carries): the text it
+/// was loaded from where it runs from a tape, the tape built into the program where it runs
+/// compiled code (the same program); `None` for a name that is not a model.
+pub fn tape_text(name: &str) -> Option<Arc<str>> {
+    let e = entry(name)?;
+    e.tape.or_else(|| embedded_tape(name).map(Arc::from))
 }
 
 /// The tape of a compiled model, as the program embeds it.
@@ -139,6 +151,7 @@ pub fn interpret_compiled() -> Result<(), TapeError> {
                 why: TapeRoute::Asked,
             },
             stale_spec: None,
+            tape: Some(Arc::from(*text)),
         });
     }
     install(entries);
@@ -206,6 +219,7 @@ fn load_from(dir: &Path, derived_from: Option<&Path>) -> Result<Loaded, TapeErro
                 let current = entry(&head.model);
                 entries.push(Entry {
                     model: current.as_ref().map_or(model, |e| e.model),
+                    tape: current.as_ref().and_then(|e| e.tape.clone()),
                     provenance: current.map_or(Provenance::Compiled, |e| e.provenance),
                     stale_spec,
                 });
@@ -224,6 +238,7 @@ fn load_from(dir: &Path, derived_from: Option<&Path>) -> Result<Loaded, TapeErro
             model,
             provenance: Provenance::Tape { file, why },
             stale_spec,
+            tape: Some(Arc::from(text)),
         });
     }
     install(entries);

@@ -401,49 +401,8 @@ fn every_shipped_scene_gives_the_same_results_json_from_the_tapes_to_the_bit() {
     }
 }
 
-/// A spec a user writes from README's "Adding a model": the paper's rod (`mr`, `L`) leaning on
-/// a block (`mb`, side `h`) with names of their own, four coordinates and four contacts (the
-/// rod's tip on the block, the floor under the foot and under the tip, and a wall far behind the
-/// block), nothing eliminated: every phase is integrated.
-const SLED_SPEC: &str = r#"
-name: sled
-description: A rod leaning on a sliding block, with a wall behind the block.
-parameters:
-  - {name: mr, meaning: mass of the rod, unit: kg}
-  - {name: mb, meaning: mass of the block, unit: kg}
-  - {name: L, meaning: length of the rod, unit: m}
-  - {name: h, meaning: side of the block, unit: m}
-  - {name: W, meaning: distance from the foot to the wall, unit: m}
-  - {name: g, meaning: gravitational acceleration, unit: m/s^2}
-requirements:
-  - {name: leans, expr: L - h, meaning: the block is lower than the rod is long}
-  - {name: room, expr: W - L - h, meaning: the wall is behind the block}
-gravity: g
-coordinates:
-  - {name: xf, meaning: position of the rod's foot, unit: m}
-  - {name: yf, meaning: height of the rod's foot, unit: m}
-  - {name: th, meaning: angle of the rod to the floor, unit: rad}
-  - {name: xb, meaning: position of the block's face on the rod's side, unit: m}
-reduced: th
-end_angle: -1.5707963267948966
-bodies:
-  - {name: rod, mass: mr, inertia: mr*L^2/12, position: [xf + L/2*cos(th), yf + L/2*sin(th)], angle: th, shape: {segment: [[-L/2, 0], [L/2, 0]]}}
-  - {name: block, mass: mb, inertia: mb*h^2/6, position: [xb + h/2, h/2], angle: 0, shape: {rectangle: [h, h]}}
-points:
-  - {name: tip, position: [xf + L*cos(th), yf + L*sin(th)], meaning: the rod's upper end}
-  - {name: centre, position: [xf + L/2*cos(th), yf + L/2*sin(th)], meaning: the rod's centre}
-falling_point: centre
-contacts:
-  - {name: push, meaning: "the rod's tip on the block, positive while they touch", gap: xb - xf - L*cos(th)}
-  - {name: foot, meaning: "the floor under the rod's foot, positive while they touch", gap: yf}
-  - {name: tip_floor, meaning: "the floor under the rod's tip, positive while they touch", gap: yf + L*sin(th)}
-  - {name: wall, meaning: "the wall behind the block, positive while they touch", gap: W - xb - h}
-initial:
-  xf: {position: 0, velocity: 0}
-  yf: {position: 0, velocity: 0}
-  th: {position: asin(h/L), velocity: 0}
-  xb: {position: sqrt((L - h)*(L + h)), velocity: 0}
-"#;
+/// A spec a user writes, with a model not compiled in (its comments say what it is).
+const SLED_SPEC: &str = include_str!("specs/sled.yaml");
 
 const SLED_SCENE: &str = "\
 model: sled

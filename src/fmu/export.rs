@@ -1,6 +1,8 @@
 //! `rodcube fmu`: writes `<model>.fmu` (an FMI 2.0 co-simulation FMU) from a system, the start
 //! values of a scene and the shared library built with the feature `fmi`, which it checks for
-//! the FMI 2.0 entry points before zipping. The archive is made in memory and written
+//! the FMI 2.0 entry points before zipping. The model travels as data: the tapes of the system
+//! and of its fast phases go into the FMU's `resources/`, so the library is the same for every
+//! model, one derived a minute ago included. The archive is made in memory and written
 //! atomically, so a failure leaves no partial `.fmu`.
 
 use super::zip::{self, TooLarge};
@@ -12,6 +14,7 @@ use crate::model::Model;
 use crate::scene::{Scene, SceneError};
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// How to build the shared library an FMU needs (its name, `librodcube.so`, in the target
 /// directory's `release/`).
@@ -139,6 +142,26 @@ pub enum ExportError {
         /// The first entry point missing.
         missing: &'static str,
     },
+    /// A fast phase of the system is not in the registry, so its tape cannot go into the FMU.
+    #[error(
+        "the system `{system}` has the fast phase `{phase}`, which is not loaded: put its tape \
+         ({phase}.tape.json, derived with the system's) in the --models directory"
+    )]
+    NoTape {
+        /// The system.
+        system: &'static str,
+        /// The phase.
+        phase: &'static str,
+    },
+    /// A model's name cannot name files and a C identifier (a tape written by hand).
+    #[error(
+        "the model `{name}` is not named by an identifier (letters, digits and `_`, not first a \
+         digit): it cannot name the FMU's model identifier and files"
+    )]
+    ModelName {
+        /// The name.
+        name: &'static str,
+    },
     /// The model description could not be made.
     #[error(transparent)]
     Description(#[from] DescriptionError),
@@ -255,11 +278,56 @@ fn fmi2_names(bytes: &[u8]) -> BTreeSet<&[u8]> {
     out
 }
 
+/// One model's tape, as the FMU carries it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelTape {
+    /// The model.
+    pub model: &'static str,
+    /// The tape's text.
+    pub text: Arc<str>,
+}
+
+impl ModelTape {
+    /// Its file in the FMU: `resources/<model>.tape.json`.
+    pub fn entry(&self) -> String {
+        format!("resources/{}.tape.json", self.model)
+    }
+}
+
+/// The tapes an FMU of `model`'s system carries: the system's, then each fast phase's
+/// ([`crate::model::ModelInfo::phases`]), each as [`crate::models::tape_text`] gives it (the
+/// tape a model was loaded from, or a compiled model's own), so the library needs none of them
+/// compiled in.
+pub fn tapes(model: &'static dyn Model) -> Result<Vec<ModelTape>, ExportError> {
+    let info = model.info();
+    let mut names = vec![info.name];
+    for p in info.phases {
+        if !names.contains(&p.model) {
+            names.push(p.model);
+        }
+    }
+    let mut out = Vec::with_capacity(names.len());
+    for name in names {
+        if !crate::spec::is_identifier(name) {
+            return Err(ExportError::ModelName { name });
+        }
+        let text = crate::models::tape_text(name).ok_or(ExportError::NoTape {
+            system: info.name,
+            phase: name,
+        })?;
+        out.push(ModelTape { model: name, text });
+    }
+    Ok(out)
+}
+
 /// Writes `<model>.fmu` into `out`: its model description with `defaults`, `binary` as
-/// `binaries/linux64/<model>.so` and the start values in `resources/rodcube.json`. Returns the file written.
+/// `binaries/linux64/<model>.so`, the start values in `resources/rodcube.json` and the models'
+/// `tapes` as `resources/<model>.tape.json` (which the library loads at `fmi2Instantiate`).
+/// Returns the file written.
 pub fn write_fmu(
     model: &'static dyn Model,
     defaults: &Defaults,
+    tapes: &[ModelTape],
     binary: &[u8],
     out: &OutDir,
 ) -> Result<PathBuf, ExportError> {
@@ -272,11 +340,16 @@ pub fn write_fmu(
         start: defaults.start.clone(),
     };
     let resources = serde_json::to_string_pretty(&resources).map_err(ExportError::Json)?;
-    let archive = zip::archive(&[
+    let resources_entry = format!("resources/{RESOURCES}");
+    let tape_entries: Vec<String> = tapes.iter().map(ModelTape::entry).collect();
+    let mut entries: Vec<(&str, &[u8])> = vec![
         ("modelDescription.xml", description.as_bytes()),
         (&library, binary),
-        (&format!("resources/{RESOURCES}"), resources.as_bytes()),
-    ])
-    .map_err(ExportError::TooLarge)?;
+        (&resources_entry, resources.as_bytes()),
+    ];
+    for (name, t) in tape_entries.iter().zip(tapes) {
+        entries.push((name, t.text.as_bytes()));
+    }
+    let archive = zip::archive(&entries).map_err(ExportError::TooLarge)?;
     Ok(out.write(&format!("{}.fmu", info.name), &archive)?)
 }

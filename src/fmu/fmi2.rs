@@ -1,6 +1,9 @@
 //! The FMI 2.0 co-simulation entry points of an exported FMU (feature `fmi`, in the shared
-//! library `rodcube fmu` zips): `fmi2Instantiate` reads the model and the parameters' start
-//! values from the FMU's `resources/rodcube.json`, `fmi2ExitInitializationMode` binds the
+//! library `rodcube fmu` zips, the same for every model): `fmi2Instantiate` loads the tapes in
+//! the FMU's `resources/` (`<model>.tape.json`: the system and its fast phases) into the
+//! registry, a model compiled into the library with the same program keeping its compiled
+//! code, and reads the model and the parameters' start values from
+//! `resources/rodcube.json`; `fmi2ExitInitializationMode` binds the
 //! parameters and solves the release, and `fmi2DoStep` walks the motion with the planner's
 //! [`Walker`] (the phases `rodcube run` solves), phase by phase as far as the step's end, and
 //! samples it there: a step that crosses an event (a contact opening or closing, an impact)
@@ -20,7 +23,8 @@ use crate::solve::series::{full_state_at, sample_at, sample_forces};
 use crate::system::{Bound, check_value};
 use std::ffi::{CStr, CString, c_char, c_int, c_uint, c_void};
 use std::panic::{AssertUnwindSafe, catch_unwind};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 /// `fmi2OK`.
 pub const FMI2_OK: c_int = 0;
@@ -87,6 +91,9 @@ struct Sim {
 struct Instance {
     name: CString,
     model: &'static dyn Model,
+    /// The models the motion may use (the system's fast phases among them), as the registry
+    /// held them once this instance's tapes were loaded.
+    registry: &'static [&'static dyn Model],
     vars: Vec<Variable>,
     logger: Option<Logger>,
     env: *mut c_void,
@@ -144,7 +151,7 @@ impl Instance {
         };
         let walker = Walker {
             general,
-            registry: crate::models::all(),
+            registry: self.registry,
             tol: self.tolerance,
             rtol: (self.tolerance * ODE_RTOL_FACTOR).max(ODE_RTOL_FLOOR),
             route: Route::Fastest,
@@ -498,31 +505,102 @@ impl Sim {
     }
 }
 
-/// The path of a `file:` URI (`file:///a/b`, `file:/a/b`, `file://localhost/a/b`), its
-/// percent escapes decoded.
-fn uri_path(uri: &str) -> Option<PathBuf> {
-    let rest = uri.strip_prefix("file:")?;
+/// The path of the directory a `file:` URI names (`file:///a/b`, `file:/a/b`,
+/// `file://localhost/a/b`; the scheme in any case), its percent escapes decoded, or why it
+/// names none: empty, another scheme, another host, a bad escape, not UTF-8.
+fn uri_path(uri: &str) -> Result<PathBuf, String> {
+    let bad = |why: &str| {
+        Err(format!(
+            "the resource location {uri:?} is not the file: URI of a local directory: {why}"
+        ))
+    };
+    if uri.is_empty() {
+        return Err(
+            "the host gave no resource location (the file: URI of the unzipped FMU's \
+                    resources/ directory, where its model's tapes are)"
+                .into(),
+        );
+    }
+    let Some(rest) = (uri.get(..5))
+        .filter(|scheme| scheme.eq_ignore_ascii_case("file:"))
+        .and_then(|_| uri.get(5..))
+    else {
+        return bad("it does not start with `file:`");
+    };
     let rest = match rest.strip_prefix("//") {
-        Some(r) => r.strip_prefix("localhost").unwrap_or(r),
+        Some(r) if r.starts_with('/') => r,
+        Some(r) => match r.get(..9) {
+            Some(host) if host.eq_ignore_ascii_case("localhost") => &r[9..],
+            _ => return bad("it names another host"),
+        },
         None => rest,
     };
     if !rest.starts_with('/') {
-        return None;
+        return bad("its path is not absolute");
     }
     let bytes = rest.as_bytes();
     let mut out = Vec::with_capacity(bytes.len());
     let mut i = 0;
     while i < bytes.len() {
         if bytes[i] == b'%' {
-            let hex = std::str::from_utf8(bytes.get(i + 1..i + 3)?).ok()?;
-            out.push(u8::from_str_radix(hex, 16).ok()?);
+            let hex = |j: usize| bytes.get(j).and_then(|&b| (b as char).to_digit(16));
+            let (Some(hi), Some(lo)) = (hex(i + 1), hex(i + 2)) else {
+                return bad("a `%` not followed by two hexadecimal digits");
+            };
+            // Two hexadecimal digits: at most 255.
+            out.push(u8::try_from(hi * 16 + lo).unwrap_or(u8::MAX));
             i += 3;
         } else {
             out.push(bytes[i]);
             i += 1;
         }
     }
-    Some(PathBuf::from(String::from_utf8(out).ok()?))
+    match String::from_utf8(out) {
+        Ok(path) => Ok(PathBuf::from(path)),
+        Err(_) => bad("its decoded path is not UTF-8"),
+    }
+}
+
+/// The FMU's resources directory from its location: the directory itself, or (as some hosts
+/// give) the unzipped FMU's root with `resources/` in it.
+fn resources_dir(location: &str) -> Result<PathBuf, String> {
+    let dir = uri_path(location)?;
+    if dir.join(RESOURCES).is_file() {
+        return Ok(dir);
+    }
+    let inner = dir.join("resources");
+    if inner.join(RESOURCES).is_file() {
+        return Ok(inner);
+    }
+    Err(format!(
+        "the resource location {location:?} ({}) holds no {RESOURCES}: it is not the resources/ \
+         directory of an FMU that `rodcube fmu` wrote, or the FMU was not unzipped whole",
+        dir.display()
+    ))
+}
+
+/// Loads the tapes in `dir` (the FMU's `resources/`) into the registry and finds the system
+/// `name` there: the model and the registry as it stands (its fast phases in it). One loading
+/// at a time, so an instance made on another thread at once sees its own models.
+fn models_in(
+    dir: &Path,
+    name: &str,
+) -> Result<(&'static dyn Model, &'static [&'static dyn Model]), String> {
+    static LOADING: Mutex<()> = Mutex::new(());
+    let _one = LOADING.lock().unwrap_or_else(|e| e.into_inner());
+    crate::models::load(dir).map_err(|e| format!("the FMU's model was refused: {e}"))?;
+    let registry = crate::models::all();
+    let model = (registry.iter().copied())
+        .find(|m| m.info().name == name)
+        .ok_or_else(|| {
+            format!(
+                "no model `{name}`: {} has no {name}.tape.json and this library does not \
+                 compile it in; export the FMU again with `rodcube fmu {name}` (and \
+                 --models DIR where its tape is)",
+                dir.display()
+            )
+        })?;
+    Ok((model, registry))
 }
 
 /// A new instance from `fmi2Instantiate`'s arguments, or why not.
@@ -537,20 +615,19 @@ fn instantiate(
     if kind != FMI2_CO_SIMULATION {
         return Err("this FMU is for co-simulation only (fmi2CoSimulation)".into());
     }
-    let path = uri_path(resources)
-        .ok_or_else(|| format!("the resource location {resources:?} is not a file: URI"))?
-        .join(RESOURCES);
+    let dir = resources_dir(resources)?;
+    let path = dir.join(RESOURCES);
     let text = std::fs::read_to_string(&path)
         .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
     let res: Resources =
         serde_json::from_str(&text).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
-    let model = crate::models::find(&res.model)
-        .ok_or_else(|| format!("this library has no model `{}`", res.model))?;
+    let (model, registry) = models_in(&dir, &res.model)?;
     let info = model.info();
     let own = guid(info).map_err(|e| e.to_string())?;
     if own != guid_given || own != res.guid {
         return Err(format!(
-            "GUID {guid_given} is not this library's `{}` ({own}): the FMU was made by another rodcube",
+            "GUID {guid_given} is not that of the model `{}` ({own}) this FMU's tapes hold: \
+             the FMU was made by another rodcube, or its files were changed",
             info.name
         ));
     }
@@ -566,6 +643,7 @@ fn instantiate(
     let mut instance = Instance {
         name: CString::new(name).map_err(|e| e.to_string())?,
         model,
+        registry,
         outputs: vec![0.0; vars.len()],
         vars,
         logger,
@@ -663,3 +741,48 @@ unsafe fn slice_mut<'a, T>(p: *mut T, n: usize) -> Result<&'a mut [T], Refusal> 
 }
 
 mod entry;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn resource_locations_are_file_uris_percent_decoded() {
+        let ok = |uri: &str| uri_path(uri).unwrap_or_else(|e| panic!("{uri}: {e}"));
+        assert_eq!(ok("file:///tmp/a/resources"), Path::new("/tmp/a/resources"));
+        assert_eq!(ok("file:/tmp/a"), Path::new("/tmp/a"));
+        assert_eq!(ok("FILE://LocalHost/tmp/a"), Path::new("/tmp/a"));
+        assert_eq!(
+            ok("file:///tmp/un%20zipped%25/r%C3%A9sources/"),
+            Path::new("/tmp/un zipped%/résources/")
+        );
+        let refused = |uri: &str, why: &str| {
+            let e = uri_path(uri)
+                .err()
+                .unwrap_or_else(|| panic!("{uri} accepted"));
+            assert!(e.contains(why), "{uri}: {e}");
+        };
+        refused("", "no resource location");
+        refused("http://example.com/r", "does not start with `file:`");
+        refused("/tmp/a", "does not start with `file:`");
+        refused("file://server/share/r", "another host");
+        refused("file:relative/r", "not absolute");
+        refused("file:///tmp/a%2", "two hexadecimal digits");
+        refused("file:///tmp/a%+1b", "two hexadecimal digits");
+        refused("file:///tmp/%ff%fe", "not UTF-8");
+    }
+
+    #[test]
+    fn the_resources_directory_is_the_location_or_its_resources() {
+        let root = std::env::temp_dir().join(format!("rodcube-fmi2-{}", std::process::id()));
+        let resources = root.join("resources");
+        std::fs::create_dir_all(&resources).expect("temporary directory");
+        let uri = |p: &Path| format!("file://{}", p.display());
+        let none = resources_dir(&uri(&resources)).err().unwrap_or_default();
+        assert!(none.contains("holds no rodcube.json"), "{none}");
+        std::fs::write(resources.join(RESOURCES), "{}").expect("file");
+        assert_eq!(resources_dir(&uri(&resources)), Ok(resources.clone()));
+        assert_eq!(resources_dir(&uri(&root)), Ok(resources.clone()));
+        let _ = std::fs::remove_dir_all(&root);
+    }
+}

@@ -1,8 +1,9 @@
 //! FMI 2.0 co-simulation export of a system: the variables an FMU of it has (its parameters,
 //! and as outputs the reduced angle, its rate, every contact's force, the points' positions
 //! and the phase index), its `modelDescription.xml` and the GUID that ties the description to
-//! the model; `export` (feature `cli`) zips them with the shared library into `<model>.fmu`,
-//! and `fmi2` (feature `fmi`) is that library's FMI 2.0 entry points.
+//! the model; `export` (feature `cli`) zips them with the shared library and the model's tapes
+//! (the system's and its fast phases', in `resources/`) into `<model>.fmu`, and `fmi2`
+//! (feature `fmi`) is that library's FMI 2.0 entry points, the same library for every model.
 //!
 //! Architecture invariant: the description and the library agree through [`variables`] alone:
 //! the value reference of a variable is its index in that list, and [`guid`] hashes the list,

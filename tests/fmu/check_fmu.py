@@ -1,7 +1,11 @@
-"""FMPy's view of an FMU that `rodcube fmu rod_cube` wrote (run by tests/fmu.rs).
+"""FMPy's view of the FMUs that `rodcube fmu` writes (run by tests/fmu.rs).
 
-Usage: check_fmu.py FMU SERIES_JSON LANDING_JSON STOP_TIME
-- FMPy validates the model description without a problem;
+Usage: check_fmu.py paper FMU SERIES_JSON LANDING_JSON STOP_TIME
+       check_fmu.py tape FMU RUN_JSON TAPES_DIR STOP_TIME
+
+`paper`: the FMU of `rod_cube`, compiled into the library too:
+- FMPy validates the model description without a problem; the FMU carries the tapes of the
+  system and its two fast phases in resources/, those of generated/;
 - `simulate_fmu` at a 1e-4 s output step to STOP_TIME gives theta within 1e-9 of the
   theta_series of SERIES_JSON (`rodcube run` of the same parameters with `until: STOP_TIME`
   and samples on the same 1e-4 s grid), at the same times;
@@ -24,13 +28,29 @@ Usage: check_fmu.py FMU SERIES_JSON LANDING_JSON STOP_TIME
      0.108493254 s;
   c) fmi2SetReal of ell (fixed) or of g = -1 between steps is fmi2Error with a logged
      message, and theta goes on as without it.
+
+`tape`: the FMU of a model that is only a tape (derived into TAPES_DIR by the test, compiled
+into no library), RUN_JSON being `rodcube run --models TAPES_DIR` of the FMU's scene (to
+STOP_TIME, samples on the 1e-4 s grid, every output's series):
+- FMPy validates it; its resources/ hold rodcube.json and the model's tape, byte for byte
+  the file of TAPES_DIR;
+- unzipped into a directory whose name needs percent-encoding in the resource location
+  (a space, `%`, a non-ASCII letter), `simulate_fmu` at a 1e-4 s output step to STOP_TIME
+  gives every output (the angle, its rate, every contact's force, every point) within 1e-9
+  (relative to the value, or absolute under 1) of the run's series at the same times, and the
+  phase index of the run's phases (the push's end, the landing's impact) at every output;
+- without its tape in resources/ fmi2Instantiate fails, logging that there is no such model;
+  with the tape's body edited, logging the tape's digest.
 Prints one line per check; exits non-zero (an AssertionError) on the first that fails.
 """
 
 import contextlib
 import io
 import json
+import pathlib
+import shutil
 import sys
+import zipfile
 
 import numpy as np
 from fmpy import extract, read_model_description, simulate_fmu
@@ -42,13 +62,33 @@ STEP = 1e-4
 SEPARATION = 0.108493254
 
 
-def main(fmu, results, landing, stop):
+def validated(fmu):
+    """The model description, after FMPy's validation found no problem."""
     problems = validate_fmu(fmu)
     assert problems == [], f"FMPy's validation: {problems}"
     md = read_model_description(fmu, validate=True, validate_variable_names=True,
                                 validate_model_structure=True)
-    names = [v.name for v in md.modelVariables]
-    print("validated:", len(names), "variables")
+    print("validated:", len(md.modelVariables), "variables")
+    return md
+
+
+def resources(fmu):
+    """The files in the FMU's resources/, by name, with their contents."""
+    with zipfile.ZipFile(fmu) as z:
+        return {n[len("resources/"):]: z.read(n) for n in z.namelist()
+                if n.startswith("resources/")}
+
+
+def paper(fmu, results, landing, stop):
+    md = validated(fmu)
+    generated = pathlib.Path(__file__).resolve().parents[2] / "generated"
+    models = ["rod_cube", "rod_cube_closed", "rod_cube_free"]
+    carried = resources(fmu)
+    assert sorted(carried) == sorted(["rodcube.json"] + [f"{m}.tape.json" for m in models]), \
+        sorted(carried)
+    for m in models:
+        assert carried[f"{m}.tape.json"] == (generated / f"{m}.tape.json").read_bytes(), m
+    print("resources/ carries the tapes of", ", ".join(models), "as generated/ holds them")
 
     columns = json.load(open(results))["series"]["theta_series"]["columns"]
     t_run = np.array(columns[0]["values"])
@@ -214,5 +254,103 @@ def mass(theta):
     return 2 * (potential(np.arcsin(A / ELL), 1.0) - potential(theta, 1.0)) / theta_dot_sq
 
 
+def tape(fmu, run, tapes, stop):
+    md = validated(fmu)
+    model = md.modelName
+    carried = resources(fmu)
+    assert sorted(carried) == ["rodcube.json", f"{model}.tape.json"], sorted(carried)
+    own = (pathlib.Path(tapes) / f"{model}.tape.json").read_bytes()
+    assert carried[f"{model}.tape.json"] == own, "the tape differs from the one derived"
+    print(f"resources/ carries {model}.tape.json as derived")
+
+    # Unzipped where the resource location needs percent-encoding: FMPy's is
+    # pathlib.Path(...).as_uri().
+    where = pathlib.Path("un zipped %41 é").resolve()
+    shutil.rmtree(where, ignore_errors=True)
+    unzipped = pathlib.Path(extract(fmu, unzipdir=str(where)))
+    location = (unzipped / "resources").as_uri()
+    assert "%20" in location and "%25" in location, location
+    r = simulate_fmu(str(unzipped), stop_time=stop, output_interval=STEP)
+
+    data = json.load(open(run))
+    series = {}
+    for s in data["series"].values():
+        columns = {c["name"]: np.array(c["values"]) for c in s["columns"]}
+        t = columns.pop("t")
+        assert len(r) == len(t), f"{len(r)} FMU samples, {len(t)} in the run's series"
+        dt = np.max(np.abs(r["time"] - t))
+        assert dt < 1e-15, f"the series' times differ from the FMU's by {dt}"
+        series.update(columns)
+    # In value-reference order: the angle, its rate, the contacts' forces, the points.
+    outputs = [v.name for v in md.modelVariables
+               if v.causality == "output" and v.type == "Real"]
+    # The run's name of each output: the angle and its rate are theta and theta_dot in
+    # theta_series, a point's x and y are in its trajectory, a force has its own name.
+    pairs = {outputs[0]: "theta", outputs[1]: "theta_dot"}
+    worst = 0.0
+    for name in outputs:
+        ours = pairs.get(name, name)
+        want = trajectory(data, ours) if "." in ours else series.get(ours)
+        assert want is not None, f"the run has no series of {name}"
+        err = np.max(np.abs(r[name] - want) / np.maximum(1.0, np.abs(want)))
+        assert err <= 1e-9, f"{name} differs from rodcube run's by {err} (relative)"
+        worst = max(worst, err)
+    print(f"{len(outputs)} outputs ({', '.join(outputs)}) within {worst:.3e} of rodcube run's "
+          f"series over {len(r)} samples, unzipped in {where.name!r} ({location})")
+
+    results = data["results"]
+    ends = sorted(v["value"] for k, v in results.items() if k.endswith("_end_time")
+                  and k != "contact_end_time")
+    ends += [i["time"] for i in results["impacts"]["value"]]
+    want = np.array([sum(t >= e for e in ends) for t in r["time"]])
+    assert np.array_equal(r["phase"], want), (r["phase"], ends)
+    print(f"phase index as the run's phases, ending at {ends} s: 0 to {r['phase'][-1]}")
+
+    refused(md, unzipped, lambda d: (d / f"{model}.tape.json").unlink(),
+            f"no model `{model}`", "without its tape")
+
+    def edit(d):
+        text = (d / f"{model}.tape.json").read_text()
+        at = text.index('"body"')
+        (d / f"{model}.tape.json").write_text(text[:at] + text[at:].replace("0", "1", 1))
+    refused(md, unzipped, edit, "digest", "with its body edited")
+
+
+def trajectory(data, name):
+    """A point's x or y from the run's `<point>_trajectory` series (`name` is
+    `<point>.<axis>`, the FMU's)."""
+    point, axis = name.split(".")
+    s = data["series"].get(f"{point}_trajectory")
+    if s is None:
+        return None
+    return np.array(next(c["values"] for c in s["columns"] if c["name"] == axis))
+
+
+def refused(md, unzipped, change, message, what):
+    """fmi2Instantiate of a copy of the unzipped FMU with `change` made to its resources/
+    fails, logging `message`."""
+    copy = unzipped.parent / (unzipped.name + " changed")
+    shutil.rmtree(copy, ignore_errors=True)
+    shutil.copytree(unzipped, copy)
+    change(copy / "resources")
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=str(copy),
+                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName="changed")
+    log = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(log):
+            slave.instantiate()
+    except Exception:  # FMPy raises where fmi2Instantiate returns NULL.
+        pass
+    else:
+        raise AssertionError(f"fmi2Instantiate {what} succeeded")
+    assert message in log.getvalue(), log.getvalue()
+    print(f"{what}: fmi2Instantiate fails:", log.getvalue().strip())
+
+
 if __name__ == "__main__":
-    main(sys.argv[1], sys.argv[2], sys.argv[3], float(sys.argv[4]))
+    if sys.argv[1] == "paper":
+        paper(sys.argv[2], sys.argv[3], sys.argv[4], float(sys.argv[5]))
+    elif sys.argv[1] == "tape":
+        tape(sys.argv[2], sys.argv[3], sys.argv[4], float(sys.argv[5]))
+    else:
+        sys.exit(f"unknown check {sys.argv[1]!r}: paper or tape")
