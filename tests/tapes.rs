@@ -742,7 +742,10 @@ fn pi_is_a_constant_in_expressions() {
             "th: {position: pi/2 - acos(h/L)",
         );
     assert_eq!(spec.matches("(pi - th)").count(), 3, "{spec}");
-    assert!(spec.contains("th + 2*pi") && spec.contains("pi/2 - acos"), "{spec}");
+    assert!(
+        spec.contains("th + 2*pi") && spec.contains("pi/2 - acos"),
+        "{spec}"
+    );
     let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("tapes_pi");
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("directory");
