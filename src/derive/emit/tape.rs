@@ -265,11 +265,9 @@ impl Compiler<'_> {
             ));
         }
         let bound: Vec<Binding> = (args)
-            .map(|a| match a {
-                Expr::Path(p) => (p.path.get_ident())
-                    .and_then(|i| self.names.get(&i.to_string()).copied())
-                    .ok_or_else(|| "an argument that is not in scope".to_string()),
-                _ => Err("an argument that is not a name".to_string()),
+            .map(|a| {
+                let name = name_of(a).ok_or("an argument that is not a name")?;
+                (self.names.get(&name).copied()).ok_or_else(|| format!("`{name}` is not in scope"))
             })
             .collect::<Result<_, _>>()?;
         let saved = std::mem::take(&mut self.names);
@@ -404,14 +402,7 @@ impl Compiler<'_> {
     }
 
     fn slice_of(&self, e: &Expr) -> Result<Arg, String> {
-        let Expr::Path(p) = e else {
-            return Err("an index into something other than an argument".into());
-        };
-        let name = p
-            .path
-            .get_ident()
-            .map(|i| i.to_string())
-            .unwrap_or_default();
+        let name = name_of(e).ok_or("an index into something other than an argument")?;
         match self.names.get(&name) {
             Some(Binding::Slice(a)) => Ok(*a),
             _ => Err(format!("`{name}` indexed, but it is not a slice argument")),
@@ -485,14 +476,7 @@ impl Compiler<'_> {
 
     /// `match contact { 0 => { .. } .. _ => {} }`: one case per contact.
     fn cases(&mut self, m: &syn::ExprMatch, cases: &mut Vec<Case>) -> Result<(), String> {
-        let Expr::Path(p) = &*m.expr else {
-            return Err("a match on something other than the contact".into());
-        };
-        let name = p
-            .path
-            .get_ident()
-            .map(|i| i.to_string())
-            .unwrap_or_default();
+        let name = name_of(&m.expr).unwrap_or_default();
         if !matches!(self.names.get(&name), Some(Binding::Contact)) {
             return Err("a match on something other than the contact".into());
         }
@@ -540,11 +524,7 @@ impl Compiler<'_> {
                 if let Some(value) = constant(&p.path) {
                     return Ok(self.emit(|dst| Instr::Const { dst, value }));
                 }
-                let name = p
-                    .path
-                    .get_ident()
-                    .map(|i| i.to_string())
-                    .unwrap_or_default();
+                let name = name_of(e).unwrap_or_default();
                 match self.names.get(&name) {
                     Some(Binding::Reg(r)) => Ok(*r),
                     Some(Binding::Scalar(arg)) => {
@@ -610,6 +590,14 @@ impl Compiler<'_> {
             }
             (name, _) => Err(format!("a call of `{name}` with arguments")),
         }
+    }
+}
+
+/// The name an expression is, where it is a bare name (`k`, `delta`, `contact`).
+fn name_of(e: &Expr) -> Option<String> {
+    match e {
+        Expr::Path(p) => p.path.get_ident().map(|i| i.to_string()),
+        _ => None,
     }
 }
 
