@@ -17,8 +17,9 @@
  *
  * Status codes below 100 concern the call itself (3, 4 and 5 are no longer used: they were
  * catch-all codes); 101-199 are refused parameters, 201-299 a refused request, 301-399 a
- * solver's failure and 401-499 a refused scene, each group's own code (RODCUBE_ERR_PARAMETERS
- * = 100, ...) being what rodcube_error_group returns for its members.
+ * solver's failure, 401-499 a refused scene and 501-599 a refused tape (rodcube_models_load),
+ * each group's own code (RODCUBE_ERR_PARAMETERS = 100, ...) being what rodcube_error_group
+ * returns for its members.
  */
 
 #ifndef RODCUBE_H
@@ -53,7 +54,7 @@
 #define RODCUBE_ERR_PANIC 7
 
 /**
- * A text argument (a model, parameter name or scene) is not UTF-8.
+ * A text argument (a model, parameter name, scene or directory) is not UTF-8.
  */
 #define RODCUBE_ERR_UTF8 8
 
@@ -467,6 +468,51 @@
 #define RODCUBE_ERR_SCENE_REQUIREMENT 415
 
 /**
+ * Group: a tape was refused by `rodcube_models_load` (codes 501 to 599). The message names
+ * the file (and, for text that is not a tape, its line and column); nothing of the directory
+ * is loaded then.
+ */
+#define RODCUBE_ERR_TAPE 500
+
+/**
+ * Tape: the directory or a tape in it could not be read.
+ */
+#define RODCUBE_ERR_TAPE_READ 501
+
+/**
+ * Tape: not JSON of a tape's shape (a truncated file, an unknown operation, a wrong number of
+ * operands, ...).
+ */
+#define RODCUBE_ERR_TAPE_SYNTAX 502
+
+/**
+ * Tape: its `format` is not `rodcube-tape`.
+ */
+#define RODCUBE_ERR_TAPE_FORMAT 503
+
+/**
+ * Tape: written in another version of the format; derive it again from its spec.
+ */
+#define RODCUBE_ERR_TAPE_VERSION 504
+
+/**
+ * Tape: its body does not match the digest it records (edited by hand).
+ */
+#define RODCUBE_ERR_TAPE_DIGEST 505
+
+/**
+ * Tape: the model's description (`body.info`) is inconsistent (a name that is not an
+ * identifier, a parameter named twice, an index past its list).
+ */
+#define RODCUBE_ERR_TAPE_INFO 506
+
+/**
+ * Tape: a method's program is refused (unknown, missing, given twice, or one that could read
+ * out of bounds or a register not yet written).
+ */
+#define RODCUBE_ERR_TAPE_METHOD 507
+
+/**
  * A scene's results (opaque): the text of its `results.json`, made once by
  * `rodcube_run_scene`, read by `rodcube_results_json`, `rodcube_results_len` and
  * `rodcube_results_copy` (which never solve again), released by `rodcube_results_free`.
@@ -509,14 +555,17 @@ const char *rodcube_error_name(int code);
 
 /**
  * The group of status code `code`: `RODCUBE_ERR_PARAMETERS`, `RODCUBE_ERR_REQUEST`,
- * `RODCUBE_ERR_SOLVE` or `RODCUBE_ERR_SCENE` for the codes of a group (the group's own code
- * included), the code itself for the others below 100 (`RODCUBE_OK` included), -1 for a
- * number that is no code.
+ * `RODCUBE_ERR_SOLVE`, `RODCUBE_ERR_SCENE` or `RODCUBE_ERR_TAPE` for the codes of a group
+ * (the group's own code included), the code itself for the others below 100 (`RODCUBE_OK`
+ * included), -1 for a number that is no code.
  */
 int rodcube_error_group(int code);
 
 /**
- * How many models are registered.
+ * How many models are registered: those compiled into the library and those
+ * `rodcube_models_load` added. Indices of the functions below run from 0 to this count
+ * minus 1 and stay valid: a load appends the models it adds, and a model a tape replaces
+ * keeps its index.
  */
 size_t rodcube_model_count(void);
 
@@ -536,6 +585,29 @@ size_t rodcube_parameter_count(size_t model);
  * order `rodcube_solve` takes the values, or NULL past the end.
  */
 const char *rodcube_parameter_name(size_t model, size_t parameter);
+
+/**
+ * Loads every tape of the directory `dir` (its `*.tape.json` files, as `rodcube derive
+ * --tapes-into DIR SPEC` or `cargo derive` writes them) into the registry, so that the models
+ * they hold run at once, with no compiler: after it `rodcube_model_count` and
+ * `rodcube_model_name` list them, `rodcube_solver_new` makes their per-point solvers and
+ * `rodcube_run_scene` runs scenes that name them (the results' notes say the model ran from
+ * its tape). A model not compiled into the library is added after the others; a tape of a
+ * compiled model whose program differs (its spec was changed and derived again) takes its
+ * place; a tape that holds a compiled model's own program is checked and the compiled code
+ * kept. `*n_models`, when `n_models` is not NULL, gets the number of models the directory's
+ * tapes hold (0 on failure). Loading the same directory again changes nothing.
+ *
+ * Every tape is checked before anything runs: a tape refused fails the whole load with a
+ * `RODCUBE_ERR_TAPE_*` code (a directory or file that cannot be read, text that is not a
+ * tape, another format version, a body that does not match its digest, ...) and a message
+ * naming the file, and nothing of the directory is loaded.
+ *
+ * # Safety
+ * `dir` is a NUL-terminated string (a path); `n_models` is NULL or points to a writable
+ * `size_t`; `err` is NULL or points to `err_len` writable bytes.
+ */
+int rodcube_models_load(const char *dir, size_t *n_models, char *err, size_t err_len);
 
 /**
  * Makes a per-point solver for the model named `model` into `*solver` (NULL on failure).

@@ -1,9 +1,11 @@
 //! The C ABI (cargo feature `capi`): the per-point solver of any registered model, by handle,
-//! with parameters in the model's order or by name, and a whole scene run once to a handle on
-//! its JSON results. `include/rodcube.h` is generated from this file by cbindgen
-//! (`cbindgen.toml`; `cargo run --example c_header` writes it, `tests/capi_header.rs` fails when
-//! it is stale), so the doc comments here are the header's documentation: they are written for
-//! a C reader and name C functions and constants plainly.
+//! with parameters in the model's order or by name, a whole scene run once to a handle on its
+//! JSON results, and the registry itself, which `rodcube_models_load` extends with the models
+//! of a directory of tapes (derived models that need no compiler). `include/rodcube.h` is
+//! generated from this file by cbindgen (`cbindgen.toml`; `cargo run --example c_header`
+//! writes it, `tests/capi_header.rs` fails when it is stale), so the doc comments here are the
+//! header's documentation: they are written for a C reader and name C functions and constants
+//! plainly.
 //!
 //! Conventions, for every function:
 //! - a function that can fail returns a status code (`RODCUBE_OK` = 0, else one of the
@@ -18,10 +20,10 @@
 //! - no panic crosses the boundary: one would be caught and reported as `RODCUBE_ERR_PANIC`.
 //!
 //! Architecture invariant: every error of the layers below (`SystemError`, `SolveError`,
-//! `PlanError`, the scene's `Kind`) maps to its code by an exhaustive `match`, so a new
-//! variant does not compile until it has a code here (and thereby in the header).
+//! `PlanError`, the scene's `Kind`, `TapeError`) maps to its code by an exhaustive `match`, so
+//! a new variant does not compile until it has a code here (and thereby in the header).
 
-use crate::model::Model;
+use crate::model::{Model, ModelInfo};
 use crate::plan::{self, PlanError};
 use crate::results::{Note, SensitivityGap};
 use crate::scene::{Kind, Scene, SceneError};
@@ -29,10 +31,11 @@ use crate::solve::SolveError;
 use crate::solve::lean::{LeanPoint, LeanSolver};
 use crate::solve::sensitivity::SensitivityWork;
 use crate::system::{SystemError, ordered_values};
+use crate::tape::TapeError;
 use std::ffi::{CStr, CString, c_char, c_int};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
-use std::sync::OnceLock;
+use std::sync::Mutex;
 
 // Status codes: their numbering is described in the header's opening comment (`cbindgen.toml`).
 
@@ -47,7 +50,7 @@ pub const RODCUBE_ERR_MODEL: c_int = 2;
 pub const RODCUBE_ERR_BUFFER: c_int = 6;
 /// An internal error: a panic, caught at the boundary (please report it).
 pub const RODCUBE_ERR_PANIC: c_int = 7;
-/// A text argument (a model, parameter name or scene) is not UTF-8.
+/// A text argument (a model, parameter name, scene or directory) is not UTF-8.
 pub const RODCUBE_ERR_UTF8: c_int = 8;
 /// The results could not be written as JSON.
 pub const RODCUBE_ERR_JSON: c_int = 9;
@@ -223,6 +226,28 @@ pub const RODCUBE_ERR_SCENE_OUT_OF_RANGE: c_int = 414;
 /// Scene: a requirement of the model on its parameters (e.g. `a < ell`) fails.
 pub const RODCUBE_ERR_SCENE_REQUIREMENT: c_int = 415;
 
+/// Group: a tape was refused by `rodcube_models_load` (codes 501 to 599). The message names
+/// the file (and, for text that is not a tape, its line and column); nothing of the directory
+/// is loaded then.
+pub const RODCUBE_ERR_TAPE: c_int = 500;
+/// Tape: the directory or a tape in it could not be read.
+pub const RODCUBE_ERR_TAPE_READ: c_int = 501;
+/// Tape: not JSON of a tape's shape (a truncated file, an unknown operation, a wrong number of
+/// operands, ...).
+pub const RODCUBE_ERR_TAPE_SYNTAX: c_int = 502;
+/// Tape: its `format` is not `rodcube-tape`.
+pub const RODCUBE_ERR_TAPE_FORMAT: c_int = 503;
+/// Tape: written in another version of the format; derive it again from its spec.
+pub const RODCUBE_ERR_TAPE_VERSION: c_int = 504;
+/// Tape: its body does not match the digest it records (edited by hand).
+pub const RODCUBE_ERR_TAPE_DIGEST: c_int = 505;
+/// Tape: the model's description (`body.info`) is inconsistent (a name that is not an
+/// identifier, a parameter named twice, an index past its list).
+pub const RODCUBE_ERR_TAPE_INFO: c_int = 506;
+/// Tape: a method's program is refused (unknown, missing, given twice, or one that could read
+/// out of bounds or a register not yet written).
+pub const RODCUBE_ERR_TAPE_METHOD: c_int = 507;
+
 /// Every status code with its name, for `rodcube_error_name` and `rodcube_error_group`.
 macro_rules! named {
     ($($code:ident),* $(,)?) => {
@@ -321,6 +346,14 @@ static CODES: &[(c_int, &CStr)] = named![
     RODCUBE_ERR_SCENE_NOT_FINITE,
     RODCUBE_ERR_SCENE_OUT_OF_RANGE,
     RODCUBE_ERR_SCENE_REQUIREMENT,
+    RODCUBE_ERR_TAPE,
+    RODCUBE_ERR_TAPE_READ,
+    RODCUBE_ERR_TAPE_SYNTAX,
+    RODCUBE_ERR_TAPE_FORMAT,
+    RODCUBE_ERR_TAPE_VERSION,
+    RODCUBE_ERR_TAPE_DIGEST,
+    RODCUBE_ERR_TAPE_INFO,
+    RODCUBE_ERR_TAPE_METHOD,
 ];
 
 /// The code of a refused parameter set.
@@ -426,6 +459,19 @@ fn scene_kind_code(kind: Kind) -> c_int {
     }
 }
 
+/// The code of a refused tape.
+fn tape_code(e: &TapeError) -> c_int {
+    match e {
+        TapeError::Io { .. } => RODCUBE_ERR_TAPE_READ,
+        TapeError::Syntax { .. } => RODCUBE_ERR_TAPE_SYNTAX,
+        TapeError::Format { .. } => RODCUBE_ERR_TAPE_FORMAT,
+        TapeError::Version { .. } => RODCUBE_ERR_TAPE_VERSION,
+        TapeError::Digest { .. } => RODCUBE_ERR_TAPE_DIGEST,
+        TapeError::Info { .. } => RODCUBE_ERR_TAPE_INFO,
+        TapeError::Method { .. } => RODCUBE_ERR_TAPE_METHOD,
+    }
+}
+
 /// One point's separation, as the per-point solver returns it.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -479,6 +525,12 @@ impl From<SolveError> for Failure {
 impl From<PlanError> for Failure {
     fn from(e: PlanError) -> Self {
         Failure(plan_code(&e), e.to_string())
+    }
+}
+
+impl From<TapeError> for Failure {
+    fn from(e: TapeError) -> Self {
+        Failure(tape_code(&e), e.to_string())
     }
 }
 
@@ -648,22 +700,42 @@ fn find_model(name: &str) -> Result<&'static dyn Model, Failure> {
     })
 }
 
-/// The registered models' names and their parameters' names as C strings, made once.
-fn names() -> &'static [(CString, Vec<CString>)] {
-    static NAMES: OnceLock<Vec<(CString, Vec<CString>)>> = OnceLock::new();
-    NAMES.get_or_init(|| {
+/// A model's name and its parameters' names as C strings.
+struct CNames {
+    name: CString,
+    parameters: Vec<CString>,
+}
+
+impl CNames {
+    fn of(info: &ModelInfo) -> CNames {
         let c = |s: &str| CString::new(s).unwrap_or_default();
-        crate::models::all()
-            .iter()
-            .map(|m| {
-                let info = m.info();
-                (
-                    c(info.name),
-                    info.parameters.iter().map(|p| c(p.name)).collect(),
-                )
-            })
-            .collect()
-    })
+        CNames {
+            name: c(info.name),
+            parameters: info.parameters.iter().map(|p| c(p.name)).collect(),
+        }
+    }
+
+    fn names(&self, info: &ModelInfo) -> bool {
+        self.name.as_bytes() == info.name.as_bytes()
+            && self.parameters.len() == info.parameters.len()
+            && (self.parameters.iter().zip(info.parameters))
+                .all(|(c, p)| c.as_bytes() == p.name.as_bytes())
+    }
+}
+
+/// The names of the model at index `model` of the registry as it is now, made once per
+/// distinct list of names and kept for the program's life: a pointer handed out stays valid
+/// when `rodcube_models_load` later adds models or puts a tape in a model's place.
+fn names(model: usize) -> Option<&'static CNames> {
+    static MADE: Mutex<Vec<&'static CNames>> = Mutex::new(Vec::new());
+    let info = crate::models::all().get(model)?.info();
+    let mut made = MADE.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(n) = made.iter().find(|n| n.names(info)) {
+        return Some(n);
+    }
+    let leaked: &'static CNames = Box::leak(Box::new(CNames::of(info)));
+    made.push(leaked);
+    Some(leaked)
 }
 
 /// The name of status code `code` as the header spells it (`"RODCUBE_ERR_AT_REST"`, static
@@ -677,9 +749,9 @@ pub extern "C" fn rodcube_error_name(code: c_int) -> *const c_char {
 }
 
 /// The group of status code `code`: `RODCUBE_ERR_PARAMETERS`, `RODCUBE_ERR_REQUEST`,
-/// `RODCUBE_ERR_SOLVE` or `RODCUBE_ERR_SCENE` for the codes of a group (the group's own code
-/// included), the code itself for the others below 100 (`RODCUBE_OK` included), -1 for a
-/// number that is no code.
+/// `RODCUBE_ERR_SOLVE`, `RODCUBE_ERR_SCENE` or `RODCUBE_ERR_TAPE` for the codes of a group
+/// (the group's own code included), the code itself for the others below 100 (`RODCUBE_OK`
+/// included), -1 for a number that is no code.
 #[unsafe(no_mangle)]
 pub extern "C" fn rodcube_error_group(code: c_int) -> c_int {
     if rodcube_error_name(code).is_null() {
@@ -691,28 +763,27 @@ pub extern "C" fn rodcube_error_group(code: c_int) -> c_int {
     }
 }
 
-/// How many models are registered.
+/// How many models are registered: those compiled into the library and those
+/// `rodcube_models_load` added. Indices of the functions below run from 0 to this count
+/// minus 1 and stay valid: a load appends the models it adds, and a model a tape replaces
+/// keeps its index.
 #[unsafe(no_mangle)]
 pub extern "C" fn rodcube_model_count() -> usize {
-    catch_unwind(|| names().len()).unwrap_or(0)
+    catch_unwind(|| crate::models::all().len()).unwrap_or(0)
 }
 
 /// The name of model `model` (an index below `rodcube_model_count()`; static storage), or
 /// NULL past the end.
 #[unsafe(no_mangle)]
 pub extern "C" fn rodcube_model_name(model: usize) -> *const c_char {
-    catch_unwind(|| {
-        names()
-            .get(model)
-            .map_or(std::ptr::null(), |(n, _)| n.as_ptr())
-    })
-    .unwrap_or(std::ptr::null())
+    catch_unwind(|| names(model).map_or(std::ptr::null(), |n| n.name.as_ptr()))
+        .unwrap_or(std::ptr::null())
 }
 
 /// How many parameters model `model` (an index) takes; 0 past the end.
 #[unsafe(no_mangle)]
 pub extern "C" fn rodcube_parameter_count(model: usize) -> usize {
-    catch_unwind(|| names().get(model).map_or(0, |(_, p)| p.len())).unwrap_or(0)
+    catch_unwind(|| names(model).map_or(0, |n| n.parameters.len())).unwrap_or(0)
 }
 
 /// The name of parameter `parameter` of model `model` (indices; static storage), in the
@@ -720,12 +791,53 @@ pub extern "C" fn rodcube_parameter_count(model: usize) -> usize {
 #[unsafe(no_mangle)]
 pub extern "C" fn rodcube_parameter_name(model: usize, parameter: usize) -> *const c_char {
     catch_unwind(|| {
-        names()
-            .get(model)
-            .and_then(|(_, p)| p.get(parameter))
-            .map_or(std::ptr::null(), |n| n.as_ptr())
+        names(model)
+            .and_then(|n| n.parameters.get(parameter))
+            .map_or(std::ptr::null(), |p| p.as_ptr())
     })
     .unwrap_or(std::ptr::null())
+}
+
+/// Loads every tape of the directory `dir` (its `*.tape.json` files, as `rodcube derive
+/// --tapes-into DIR SPEC` or `cargo derive` writes them) into the registry, so that the models
+/// they hold run at once, with no compiler: after it `rodcube_model_count` and
+/// `rodcube_model_name` list them, `rodcube_solver_new` makes their per-point solvers and
+/// `rodcube_run_scene` runs scenes that name them (the results' notes say the model ran from
+/// its tape). A model not compiled into the library is added after the others; a tape of a
+/// compiled model whose program differs (its spec was changed and derived again) takes its
+/// place; a tape that holds a compiled model's own program is checked and the compiled code
+/// kept. `*n_models`, when `n_models` is not NULL, gets the number of models the directory's
+/// tapes hold (0 on failure). Loading the same directory again changes nothing.
+///
+/// Every tape is checked before anything runs: a tape refused fails the whole load with a
+/// `RODCUBE_ERR_TAPE_*` code (a directory or file that cannot be read, text that is not a
+/// tape, another format version, a body that does not match its digest, ...) and a message
+/// naming the file, and nothing of the directory is loaded.
+///
+/// # Safety
+/// `dir` is a NUL-terminated string (a path); `n_models` is NULL or points to a writable
+/// `size_t`; `err` is NULL or points to `err_len` writable bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn rodcube_models_load(
+    dir: *const c_char,
+    n_models: *mut usize,
+    err: *mut c_char,
+    err_len: usize,
+) -> c_int {
+    // SAFETY: forwarded from the caller.
+    unsafe {
+        guarded(err, err_len, || {
+            if let Some(n) = n_models.as_mut() {
+                *n = 0;
+            }
+            let dir = text(dir, "the directory")?;
+            let loaded = crate::models::load(Path::new(dir))?;
+            if let Some(n) = n_models.as_mut() {
+                *n = loaded.models.len() + loaded.same_as_compiled.len();
+            }
+            Ok(())
+        })
+    }
 }
 
 /// Makes a per-point solver for the model named `model` into `*solver` (NULL on failure).

@@ -3,8 +3,11 @@
 //! and time and their sensitivities to every parameter, equal to the bit to the Rust
 //! per-point solver's; the header's constants and struct layout, as a C compiler reads them,
 //! are the library's; every function answers bad arguments and failures with the code of
-//! their kind (each reachable code from a concrete input) and a message, never a crash; and a
-//! scene is solved once, its results read from the handle as often as wanted.
+//! their kind (each reachable code from a concrete input) and a message, never a crash; a
+//! scene is solved once, its results read from the handle as often as wanted; and a model
+//! derived by the test from a spec of its own, not compiled in, is loaded from its tapes by
+//! `rodcube_models_load` and solved and run from C (`examples/c/tapes.c` too) to the paper's
+//! closed forms, while a corrupted tape is refused with its code and a message naming it.
 
 use rodcube::solve::lean::LeanSolver;
 use std::path::Path;
@@ -124,9 +127,18 @@ mod calls {
     use std::path::Path;
     use std::process::Command;
     use std::ptr::{null, null_mut};
+    use std::sync::{Mutex, MutexGuard};
 
     /// A call's status code and message.
     type Outcome = (c_int, String);
+
+    /// The registry is the process's: a test that reads it whole, or loads tapes into it, holds
+    /// this while it does.
+    static REGISTRY: Mutex<()> = Mutex::new(());
+
+    fn registry() -> MutexGuard<'static, ()> {
+        REGISTRY.lock().unwrap_or_else(|e| e.into_inner())
+    }
 
     fn message(err: &[c_char]) -> String {
         // SAFETY: the functions always NUL-terminate a non-empty buffer.
@@ -228,6 +240,7 @@ mod calls {
 
     #[test]
     fn models_and_parameters_are_listed() {
+        let _registry = registry();
         let n = rodcube_model_count();
         assert_eq!(n, rodcube::models::all().len());
         let names: Vec<String> = (0..n)
@@ -334,7 +347,8 @@ mod calls {
             299,
             339,
             416,
-            500,
+            508,
+            600,
             c_int::MAX,
             c_int::MIN,
         ] {
@@ -352,6 +366,8 @@ mod calls {
             (RODCUBE_ERR_RESULT_NOT_FINITE, RODCUBE_ERR_SOLVE),
             (RODCUBE_ERR_NO_SENSITIVITY, RODCUBE_ERR_SOLVE),
             (RODCUBE_ERR_SCENE_SYNTAX, RODCUBE_ERR_SCENE),
+            (RODCUBE_ERR_TAPE, RODCUBE_ERR_TAPE),
+            (RODCUBE_ERR_TAPE_DIGEST, RODCUBE_ERR_TAPE),
         ] {
             assert_eq!(rodcube_error_group(code), group, "{code}");
         }
@@ -836,5 +852,379 @@ mod calls {
             assert!((t - 0.1085).abs() < 5e-4);
             rodcube_results_free(results);
         }
+    }
+
+    /// `rodcube_models_load(dir, &n_models, err, err_len)`: its code, message and count.
+    fn load(dir: &Path) -> (c_int, String, usize) {
+        let dir = CString::new(dir.to_str().expect("UTF-8 path")).unwrap();
+        let mut err = [0 as c_char; 2048];
+        let mut n = usize::MAX;
+        // SAFETY: valid string, out pointer and buffer.
+        let code = unsafe { rodcube_models_load(dir.as_ptr(), &mut n, err.as_mut_ptr(), 2048) };
+        (code, message(&err), n)
+    }
+
+    /// The names the registry lists, through the C calls.
+    fn listed() -> Vec<String> {
+        (0..rodcube_model_count())
+            // SAFETY: static NUL-terminated strings below the count.
+            .map(|i| unsafe { CStr::from_ptr(rodcube_model_name(i)) })
+            .map(|s| s.to_string_lossy().into_owned())
+            .collect()
+    }
+
+    /// A refused tape fails the whole load with the code of its kind and a message naming the
+    /// file, writes 0 models and installs nothing; each kind of refusal is reached from a copy
+    /// of the paper's tape cut short or edited (edits inside the body with its digest brought
+    /// up to date, so that the check under test is the one reached).
+    #[test]
+    fn a_corrupted_tape_is_refused_with_its_code_and_file() {
+        let root = Path::new(env!("CARGO_TARGET_TMPDIR")).join("capi-tape-refusals");
+        let _ = std::fs::remove_dir_all(&root);
+        let paper = rodcube::models::embedded_tape("rod_cube").expect("embedded");
+        let rebodied = |edit: &dyn Fn(&mut serde_json::Value)| {
+            let mut v: serde_json::Value = serde_json::from_str(paper).unwrap();
+            edit(&mut v["body"]);
+            let body: rodcube::tape::format::Body =
+                serde_json::from_value(v["body"].clone()).unwrap();
+            v["body_digest"] = body.digest().into();
+            serde_json::to_string(&v).unwrap()
+        };
+        let cases: Vec<(&str, String, c_int, &str)> = vec![
+            (
+                "cut short",
+                paper[..paper.len() / 2].to_string(),
+                RODCUBE_ERR_TAPE_SYNTAX,
+                "not a rodcube tape",
+            ),
+            (
+                "another format",
+                paper.replacen("rodcube-tape", "something-else", 1),
+                RODCUBE_ERR_TAPE_FORMAT,
+                "something-else",
+            ),
+            (
+                "another version",
+                paper.replacen("\"version\": 1,", "\"version\": 0,", 1),
+                RODCUBE_ERR_TAPE_VERSION,
+                "cargo derive",
+            ),
+            (
+                "a number edited",
+                paper.replacen("[\"const\",", "[\"const\",1", 1),
+                RODCUBE_ERR_TAPE_DIGEST,
+                "truncated or edited by hand",
+            ),
+            (
+                "another name in its info",
+                rebodied(&|body| body["info"]["name"] = "rod_cubes".into()),
+                RODCUBE_ERR_TAPE_INFO,
+                "rod_cubes",
+            ),
+            (
+                "a method twice",
+                rebodied(&|body| {
+                    let functions = body["functions"].as_array_mut().unwrap();
+                    functions.push(functions[0].clone());
+                }),
+                RODCUBE_ERR_TAPE_METHOD,
+                "given twice",
+            ),
+        ];
+        let before = {
+            let _registry = registry();
+            listed()
+        };
+        for (i, (what, text, expected, needle)) in cases.iter().enumerate() {
+            let dir = root.join(format!("case{i}"));
+            std::fs::create_dir_all(&dir).unwrap();
+            let file = dir.join("rod_cube.tape.json");
+            std::fs::write(&file, text).unwrap();
+            let (code, text, n) = load(&dir);
+            assert_eq!(
+                (code, name_of(code)),
+                (*expected, name_of(*expected)),
+                "{what}: {text}"
+            );
+            assert_eq!(rodcube_error_group(code), RODCUBE_ERR_TAPE, "{what}");
+            assert!(
+                text.starts_with(&file.display().to_string()),
+                "{what}: {text}"
+            );
+            assert!(text.contains(needle), "{what}: no {needle:?} in {text}");
+            assert_eq!(n, 0, "{what}");
+        }
+        // A directory that is not there, named; NULL and text that is not UTF-8.
+        let (code, text, n) = load(&root.join("nowhere"));
+        assert_eq!(code, RODCUBE_ERR_TAPE_READ, "{text}");
+        assert!(text.contains("nowhere"), "{text}");
+        assert_eq!(n, 0);
+        let mut err = [0 as c_char; 256];
+        // SAFETY: NULL and non-UTF-8 directories, a NULL count, a valid buffer.
+        unsafe {
+            let code = rodcube_models_load(null(), null_mut(), err.as_mut_ptr(), 256);
+            assert_eq!(code, RODCUBE_ERR_ARGUMENT, "{}", message(&err));
+            assert!(message(&err).contains("the directory is NULL"));
+            let code = rodcube_models_load(c"dir\xff".as_ptr(), null_mut(), err.as_mut_ptr(), 256);
+            assert_eq!(code, RODCUBE_ERR_UTF8, "{}", message(&err));
+        }
+        // Nothing was installed: the registry is as it was.
+        let _registry = registry();
+        assert_eq!(listed(), before);
+    }
+
+    /// A model of the test's own (a plank on a crate, the paper's system under other names),
+    /// with its fast phases, derived by `rodcube derive --tapes-into`: nothing of it is compiled
+    /// into the library.
+    #[cfg(feature = "derive")]
+    const CRATE_SPEC: &str = r#"
+name: plank_on_crate
+description: A plank leaning on a crate that slides on a frictionless floor.
+parameters:
+  - {name: mp, meaning: mass of the plank, unit: kg}
+  - {name: mc, meaning: mass of the crate, unit: kg}
+  - {name: L, meaning: length of the plank, unit: m}
+  - {name: h, meaning: height of the crate, unit: m}
+  - {name: g, meaning: gravitational acceleration, unit: m/s^2}
+requirements:
+  - {name: leans, expr: L - h, meaning: the crate is lower than the plank is long}
+gravity: g
+coordinates:
+  - {name: xf, meaning: position of the plank's foot, unit: m}
+  - {name: yf, meaning: height of the plank's foot, unit: m}
+  - {name: th, meaning: angle of the plank to the floor, unit: rad}
+  - {name: xc, meaning: position of the crate's face on the plank's side, unit: m}
+reduced: th
+end_angle: 0
+bodies:
+  - {name: plank, mass: mp, inertia: mp*L^2/12, position: [xf + L/2*cos(th), yf + L/2*sin(th)], angle: th, shape: {segment: [[-L/2, 0], [L/2, 0]]}}
+  - {name: crate, mass: mc, inertia: mc*h^2/6, position: [xc + h/2, h/2], angle: 0, shape: {rectangle: [h, h]}}
+points:
+  - {name: middle, position: [xf + L/2*cos(th), yf + L/2*sin(th)], meaning: the plank's centre}
+falling_point: middle
+contacts:
+  - {name: push, meaning: "the plank's top on the crate, positive while they touch", gap: xc - xf - L*cos(th), eliminates: xc}
+  - {name: floor, meaning: "the floor under the plank's foot, positive while they touch", gap: yf, eliminates: yf}
+initial:
+  xf: {position: 0, velocity: 0}
+  th: {position: asin(h/L), velocity: 0}
+"#;
+
+    /// The paper's closed forms for a rod on a free block (`PHYSICS.md`), independent of
+    /// rodcube: `s = sin(theta_sep)` is the root in `(0, r)` of eq. (14),
+    /// `3 s^3 - 12 (1+n) s + 8 r (1+n) = 0` (bisection), and the time is
+    /// `int dtheta / sqrt(theta_dot^2)` with eq. (9)'s
+    /// `theta_dot^2 = 4 (g/ell) (r - sin theta) / (4/3 - sin^2 theta / (1+n))`, after
+    /// `theta = theta_0 - u^2` removes the endpoint's `1/sqrt` and
+    /// `r - sin(theta) = 2 cos(theta_0 - u^2/2) sin(u^2/2)` its cancellation (Gauss–Legendre
+    /// panels).
+    #[cfg(feature = "derive")]
+    fn closed_forms(n: f64, r: f64, ell: f64, g: f64) -> (f64, f64) {
+        let f = |s: f64| 3.0 * s.powi(3) - 12.0 * (1.0 + n) * s + 8.0 * r * (1.0 + n);
+        let (mut lo, mut hi) = (0.0, r);
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if f(mid) > 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let theta_sep = (0.5 * (lo + hi)).asin();
+        let theta0 = r.asin();
+        let integrand = |u: f64| {
+            let s = (theta0 - u * u).sin();
+            // r - s without cancellation: sin(theta_0) - sin(theta_0 - u^2).
+            let drop = 2.0 * (theta0 - 0.5 * u * u).cos() * (0.5 * u * u).sin();
+            let rate_sq = 4.0 * (g / ell) * drop / (4.0 / 3.0 - s * s / (1.0 + n));
+            2.0 * u / rate_sq.sqrt()
+        };
+        let rule = gauss_quad::GaussLegendre::new(std::num::NonZeroUsize::new(30).unwrap());
+        let (panels, end) = (8, (theta0 - theta_sep).sqrt());
+        let width = end / f64::from(panels);
+        let mut t_sep = 0.0;
+        for p in 0..panels {
+            let mid = width * (f64::from(p) + 0.5);
+            for &(x, w) in rule.as_node_weight_pairs() {
+                t_sep += 0.5 * width * w * integrand(mid + 0.5 * width * x);
+            }
+        }
+        (theta_sep, t_sep)
+    }
+
+    /// The whole route from C: a spec derived into a directory of tapes, loaded by
+    /// `rodcube_models_load` (refused whole while a corrupted tape is among them), listed,
+    /// solved by its per-point solver and run as a scene, by `examples/c/tapes.c` too, each to
+    /// the paper's closed forms.
+    #[test]
+    #[cfg(feature = "derive")]
+    fn a_model_derived_into_tapes_is_loaded_solved_and_run_from_c() {
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("capi-tapes");
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("plank_on_crate.yaml"), CRATE_SPEC).unwrap();
+        let derived = Command::new(env!("CARGO_BIN_EXE_rodcube"))
+            .args(["derive", "--tapes-into", "tapes", "plank_on_crate.yaml"])
+            .current_dir(&dir)
+            .output()
+            .expect("rodcube runs");
+        assert!(
+            derived.status.success(),
+            "{}",
+            String::from_utf8_lossy(&derived.stderr)
+        );
+        let tapes = dir.join("tapes");
+        let models = [
+            "plank_on_crate",
+            "plank_on_crate_closed",
+            "plank_on_crate_free",
+        ];
+        for m in models {
+            assert!(tapes.join(format!("{m}.tape.json")).is_file(), "{m}");
+            assert!(
+                rodcube::models::compiled()
+                    .iter()
+                    .all(|c| c.info().name != m)
+            );
+        }
+        let _registry = registry();
+        // Not there before: the name is unknown.
+        assert_eq!(solver("plank_on_crate").unwrap_err().0, RODCUBE_ERR_MODEL);
+        let before = listed();
+
+        // With one of them corrupted, nothing of the directory is loaded.
+        let broken = dir.join("broken");
+        std::fs::create_dir_all(&broken).unwrap();
+        for m in models {
+            let file = format!("{m}.tape.json");
+            std::fs::copy(tapes.join(&file), broken.join(&file)).unwrap();
+        }
+        let free = broken.join("plank_on_crate_free.tape.json");
+        let text = std::fs::read_to_string(&free).unwrap();
+        std::fs::write(&free, text.replacen("[\"ld\",", "[\"ld\",1", 1)).unwrap();
+        let (code, text, n) = load(&broken);
+        assert_eq!(code, RODCUBE_ERR_TAPE_DIGEST, "{text}");
+        assert!(
+            text.starts_with(&free.display().to_string()),
+            "the message names the file: {text}"
+        );
+        assert_eq!((n, listed()), (0, before.clone()));
+        assert_eq!(solver("plank_on_crate").unwrap_err().0, RODCUBE_ERR_MODEL);
+
+        // Loaded: listed after the compiled models, with their parameters.
+        assert_eq!(load(&tapes), (RODCUBE_OK, String::new(), 3));
+        let now = listed();
+        assert_eq!(now[..before.len()], before[..]);
+        assert_eq!(now[before.len()..], models.map(String::from));
+        let i = before.len();
+        let parameters: Vec<String> = (0..rodcube_parameter_count(i))
+            // SAFETY: static NUL-terminated strings below the count.
+            .map(|j| unsafe { CStr::from_ptr(rodcube_parameter_name(i, j)) })
+            .map(|s| s.to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(parameters, ["mp", "mc", "L", "h", "g"]);
+        // Loading again changes nothing.
+        assert_eq!(load(&tapes), (RODCUBE_OK, String::new(), 3));
+        assert_eq!(listed(), now);
+
+        // Solved by its per-point solver, by name, against the closed forms; two points.
+        let s = solver("plank_on_crate").unwrap();
+        let names = ["g", "h", "L", "mc", "mp"];
+        for (mp, mc, ell, h) in [(1.0, 3.0, 1.0, 0.25), (2.0, 0.5, 1.5, 0.9)] {
+            let (theta_sep, t_sep) = closed_forms(mc / mp, h / ell, ell, 9.81);
+            let names: Vec<CString> = names.iter().map(|n| CString::new(*n).unwrap()).collect();
+            let p: Vec<*const c_char> = names.iter().map(|c| c.as_ptr()).collect();
+            let values = [9.81, h, ell, mc, mp];
+            let mut out = RodcubePoint::default();
+            let mut err = [0 as c_char; 512];
+            // SAFETY: a live solver, five names and values, valid buffers.
+            let code = unsafe {
+                rodcube_solve_named(
+                    s,
+                    p.as_ptr(),
+                    values.as_ptr(),
+                    5,
+                    &mut out,
+                    err.as_mut_ptr(),
+                    512,
+                )
+            };
+            assert_eq!((code, message(&err)), (RODCUBE_OK, String::new()));
+            assert!(
+                (out.separation_angle - theta_sep).abs() < 1e-13,
+                "{} vs {theta_sep}",
+                out.separation_angle
+            );
+            assert!(
+                (out.separation_time - t_sep).abs() < 1e-12 * t_sep,
+                "{} vs {t_sep}",
+                out.separation_time
+            );
+        }
+        // SAFETY: made by rodcube_solver_new, released once.
+        unsafe { rodcube_solver_free(s) };
+
+        // Run as a scene: the same numbers, and the note says where the model came from.
+        let results = run_scene(
+            "model: plank_on_crate\nparameters: {mp: 1, mc: 3, L: 1, h: 0.25, g: 9.81}\nwant: [separation_angle, separation_time]\ntolerance: 1.0e-12\n",
+        )
+        .unwrap();
+        // SAFETY: a live handle, released once.
+        let json = unsafe {
+            let json = CStr::from_ptr(rodcube_results_json(results))
+                .to_string_lossy()
+                .into_owned();
+            rodcube_results_free(results);
+            json
+        };
+        let value: serde_json::Value = serde_json::from_str(&json).unwrap();
+        let result = |k: &str| value["results"][k]["value"].as_f64().unwrap();
+        let (theta_sep, t_sep) = closed_forms(3.0, 0.25, 1.0, 9.81);
+        assert!((result("separation_angle") - theta_sep).abs() < 1e-12);
+        assert!((result("separation_time") - t_sep).abs() < 1e-11 * t_sep);
+        let note = value["notes"]["model"].as_str().unwrap_or_default();
+        assert!(note.contains("not compiled into this program"), "{note}");
+        assert!(note.contains("plank_on_crate.tape.json"), "{note}");
+
+        // A C program does the same (examples/c/tapes.c, built by run.sh against the header).
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let out = Command::new(root.join("examples/c/run.sh"))
+            .arg("tapes")
+            .arg(&tapes)
+            .args(["plank_on_crate", "mp=1", "mc=3", "L=1", "h=0.25", "g=9.81"])
+            .env(
+                "CARGO_TARGET_DIR",
+                Path::new(env!("CARGO_TARGET_TMPDIR")).join("capi"),
+            )
+            .env("CARGO", env!("CARGO"))
+            .env_remove("LD_LIBRARY_PATH")
+            .output()
+            .expect("run.sh runs");
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "tapes.c failed:\n{stdout}\n{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let value = |key: &str| -> f64 {
+            stdout
+                .split_whitespace()
+                .find_map(|kv| kv.strip_prefix(key)?.strip_prefix('='))
+                .and_then(|v| v.parse().ok())
+                .unwrap_or_else(|| panic!("no {key} in {stdout}"))
+        };
+        assert_eq!(value("loaded"), 3.0);
+        assert!(
+            (value("separation_angle") - theta_sep).abs() < 1e-13,
+            "{stdout}"
+        );
+        assert!(
+            (value("separation_time") - t_sep).abs() < 1e-12 * t_sep,
+            "{stdout}"
+        );
+        assert!(
+            stdout.contains("not compiled into this program"),
+            "{stdout}"
+        );
     }
 }

@@ -330,12 +330,32 @@ fn unknown_operations_and_wrong_arities_are_refused_at_their_line() {
 
 #[test]
 fn inconsistent_info_is_refused() {
+    use serde_json::json;
     let text = edited(|b| b["info"]["reduced_index"] = 9.into());
     let e = refusal(&text);
     assert!(matches!(e, TapeError::Info { .. }), "{e}");
     assert!(e.to_string().contains("reduced_index"), "{e}");
     let text = edited(|b| b["info"]["n_constants"] = 1u64.into());
     assert!(matches!(refusal(&text), TapeError::Info { .. }));
+    // Names that programs look models and parameters up by, and that C gets as C strings.
+    for (edit, needle) in [
+        (json!(["name", "rod\u{0}cube"]), "`name`"),
+        (json!(["system", "rod cube"]), "`system`"),
+    ] {
+        let text = edited(|b| b["info"][edit[0].as_str().unwrap()] = edit[1].clone());
+        let e = refusal(&text);
+        assert!(matches!(e, TapeError::Info { .. }), "{e}");
+        assert!(e.to_string().contains(needle), "{e}");
+    }
+    let text = edited(|b| b["info"]["parameters"][1]["name"] = "m1".into());
+    let e = refusal(&text);
+    assert!(
+        e.to_string().contains("parameter `m1` is named twice"),
+        "{e}"
+    );
+    let text = edited(|b| b["info"]["parameters"][0]["name"] = "".into());
+    let e = refusal(&text);
+    assert!(e.to_string().contains("not an identifier"), "{e}");
 }
 
 /// The results.json a scene writes, with `--interpreted` or without, and the run's stderr.

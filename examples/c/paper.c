@@ -5,7 +5,8 @@
  * `d(separation_time)/d(<p>)=...` (rodcube_sensitivities). It also
  * solves the point with its parameters in the model's order (the two must agree), shows a
  * refused point's code and message, and runs a scene once to its JSON results, read in place
- * and copied, so every function of rodcube.h is called. Build and run: examples/c/run.sh
+ * and copied, so every function of rodcube.h is called but rodcube_models_load (tapes.c calls
+ * it). Build and run: examples/c/run.sh
  */
 #include <stdio.h>
 #include <stdlib.h>

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds rodcube's C library (cdylib, feature `capi`) and the C programs of examples/c/ with the
 # system C compiler (`cc`, or $CC), then runs one: `run.sh` runs paper, `run.sh per_point [N]`
-# the per-point cost probe. Honours CARGO_TARGET_DIR.
+# the per-point cost probe, `run.sh tapes DIR MODEL NAME=VALUE...` a model loaded from a
+# directory of tapes. Honours CARGO_TARGET_DIR.
 set -euo pipefail
 
 root="$(cd "$(dirname "$0")/../.." && pwd)"
@@ -12,7 +13,7 @@ shift || true
 cargo rustc --quiet --manifest-path "$root/Cargo.toml" --release --lib \
     --no-default-features --features capi --crate-type cdylib
 mkdir -p "$target/c-example"
-for name in paper per_point; do
+for name in paper per_point tapes; do
     "${CC:-cc}" -std=c11 -O2 -Wall -Wextra -Werror -pedantic -I"$root/include" \
         "$root/examples/c/$name.c" -L"$target/release" -lrodcube -lm \
         -Wl,-rpath,"$target/release" -o "$target/c-example/$name"

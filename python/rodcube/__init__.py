@@ -13,7 +13,13 @@
   listed in ``errors`` with the reason. ``sensitivities=True`` adds the exact
   ``d(separation_angle)/d(<p>)`` and ``d(separation_time)/d(<p>)`` for every parameter.
 - ``models()`` and ``parameters(model)``: the registry, with each parameter's unit and meaning.
-- ``derivation(model)``: the model's derivation (carried by the package), which a notebook shows
+- ``load_models(path)``: adds to the registry the models of a directory of tapes (as
+  ``rodcube derive --tapes-into DIR SPEC`` writes them: a model derived a minute ago, run with
+  no compiler) and returns their names; ``solve``, ``sweep``, ``run`` and ``parameters`` then
+  take them by name. A tape refused (cut short, edited, another format version) raises
+  ``RodcubeError`` naming the file, and nothing of the directory is loaded.
+- ``derivation(model)``: the model's derivation (carried by the package for every model compiled
+  into it; a tape holds no derivation), which a notebook shows
   as Markdown with LaTeX, every step numbered as in ``generated/<model>.tex``; its
   ``expressions`` are the derived expressions as strings, ``steps`` the steps, ``latex`` the
   write-up. ``derivation_models()`` names the models it knows.
@@ -34,7 +40,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ._rodcube import RodcubeError, models, parameters, solve
+from ._rodcube import RodcubeError, load_models, models, parameters, solve
 from ._rodcube import sweep_flat as _sweep_flat
 from ._notebook import Derivation, RunResult, derivation, derivation_models, run
 
@@ -44,6 +50,7 @@ __all__ = [
     "RunResult",
     "derivation",
     "derivation_models",
+    "load_models",
     "models",
     "parameters",
     "run",

@@ -14,6 +14,7 @@ __all__ = [
     "RunResult",
     "derivation",
     "derivation_models",
+    "load_models",
     "models",
     "parameters",
     "run",
@@ -73,7 +74,20 @@ class SweepResult(TypedDict):
 # identifiers, so `SweepResult` does not list them.
 
 def models() -> list[str]:
-    """The names of the registered models."""
+    """The names of the registered models: those compiled into the package, then those
+    `load_models` added."""
+
+def load_models(path: Union[str, PathLike[str]]) -> list[str]:
+    """Loads every tape (`*.tape.json`, as `rodcube derive --tapes-into DIR SPEC` or `cargo
+    derive` writes them) of the directory `path` into the registry and returns the names of
+    the models they hold, sorted; `solve`, `sweep`, `run` and `parameters` then take them by
+    name, run from their tapes with no compiler (`solve`'s and `run`'s `notes["model"]` says
+    so). A model not compiled into the package is added; a tape of a compiled model whose
+    program differs (its spec was derived again) takes its place; a tape that holds a compiled
+    model's own program is checked and the compiled code kept. Loading a directory again
+    changes nothing. A tape refused (cut short, edited by hand, another format version, a
+    program that could read out of bounds) raises `RodcubeError` with the loader's message,
+    which names the file; nothing of the directory is loaded then."""
 
 def parameters(model: str) -> list[tuple[str, str, str]]:
     """The parameters of a model, in order: `(name, unit, meaning)`."""
@@ -170,10 +184,11 @@ class RunResult:
     def _repr_html_(self) -> str: ...
 
 def derivation(model: str) -> Derivation:
-    """The derivation of `model` (any name of `derivation_models()`)."""
+    """The derivation of `model` (any name of `derivation_models()`). A model `load_models`
+    loaded from a tape has none (`RodcubeError` naming its tape)."""
 
 def derivation_models() -> list[str]:
-    """The models whose derivations the package carries (every registered model)."""
+    """The models whose derivations the package carries: every model compiled into it."""
 
 def run(scene: Union[str, PathLike[str], Mapping[str, Any]]) -> RunResult:
     """Runs a scene as `rodcube run` does: a path, YAML text, or a dict with the scene's keys.

@@ -225,7 +225,8 @@ class Derivation:
 
 
 def derivation(model: str) -> Derivation:
-    """The derivation of ``model`` (any name of ``derivation_models()``)."""
+    """The derivation of ``model`` (any name of ``derivation_models()``). A model that
+    ``load_models`` loaded from a tape has none: ``RodcubeError`` names its tape."""
     return Derivation(model)
 
 

@@ -3,8 +3,10 @@
 //! flat NumPy arrays (with each point's exact sensitivities if asked) in parallel with the GIL
 //! released (the package's `sweep`, in
 //! `rodcube/__init__.py`, broadcasts its arguments into them), `models` and `parameters` list
-//! the registry. Errors are `rodcube.RodcubeError` (a `ValueError`) with the library's own
-//! messages; a point that fails in a sweep keeps its error's message. `notebook.rs` gives the
+//! the registry, and `load_models` adds to it the models of a directory of tapes (derived
+//! models run with no compiler), which every function then finds by name. Errors are
+//! `rodcube.RodcubeError` (a `ValueError`) with the library's own messages; a point that fails
+//! in a sweep keeps its error's message. `notebook.rs` gives the
 //! notebook helpers (`derivation`, `run`) the embedded derivations and scene runs.
 
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
@@ -55,6 +57,25 @@ fn models() -> Vec<&'static str> {
         .iter()
         .map(|m| m.info().name)
         .collect()
+}
+
+/// Loads every tape (`*.tape.json`, as `rodcube derive --tapes-into DIR SPEC` or `cargo derive`
+/// writes them) of the directory `path` into the registry, so that `solve`, `sweep`, `run` and
+/// `parameters` find its models by name, and returns their names, sorted: a model not compiled
+/// into the package is added; a tape of a compiled model whose program differs (its spec
+/// derived again) takes its place; a tape that holds a compiled model's own program is checked
+/// and the compiled code kept. Each tape is checked before anything runs: one refused raises
+/// `RodcubeError` with the loader's message, which names the file, and nothing of the
+/// directory is loaded then.
+#[pyfunction]
+fn load_models(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Vec<String>> {
+    let loaded = py.detach(|| rodcube::models::load(&path)).map_err(error)?;
+    let mut names: Vec<String> = (loaded.models.iter())
+        .map(|m| m.info().name.to_string())
+        .chain(loaded.same_as_compiled)
+        .collect();
+    names.sort();
+    Ok(names)
 }
 
 /// The parameters of a model, in order: `(name, unit, meaning)`.
@@ -479,6 +500,7 @@ impl Chunk<'_> {
 #[pymodule]
 fn _rodcube(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(models, m)?)?;
+    m.add_function(wrap_pyfunction!(load_models, m)?)?;
     m.add_function(wrap_pyfunction!(parameters, m)?)?;
     m.add_function(wrap_pyfunction!(solve, m)?)?;
     m.add_function(wrap_pyfunction!(sweep_flat, m)?)?;

@@ -2,9 +2,10 @@
 //! derivation as the derivation tool wrote it (embedded at build time by `build.rs`, so an
 //! installed wheel carries it), and a scene run as the `rodcube run` command runs it, returned
 //! as `results.json`'s text and `motion.svg`'s (when the run drew the motion), and the command
-//! line's number format.
+//! line's number format. Scenes find the models `load_models` loaded from tapes too.
 
 use pyo3::prelude::*;
+use rodcube::models::{Entry, Provenance, TapeRoute};
 use rodcube::report::{self, motion};
 use rodcube::scene::Scene;
 use std::path::Path;
@@ -20,9 +21,24 @@ pub fn derivation_models() -> Vec<&'static str> {
 }
 
 /// A model's derivation: `(LaTeX write-up, JSON record)`, the text of `generated/<model>.tex`
-/// and `generated/<model>.json`.
+/// and `generated/<model>.json`. A model that runs from a tape `load_models` loaded has none
+/// here (a tape holds the program, not the write-up; the one the package carries of a compiled
+/// model of that name is of another program): an error naming its tape says so.
 #[pyfunction]
 pub fn derivation_sources(model: &str) -> PyResult<(&'static str, &'static str)> {
+    if let Some(Entry {
+        provenance: Provenance::Tape { file, why },
+        ..
+    }) = rodcube::models::entry(model)
+        && why != TapeRoute::Asked
+    {
+        return Err(error(format!(
+            "model `{model}` runs from its tape {file}, which holds its program but not its \
+             derivation; the package carries the derivations of the models compiled into it \
+             (`derivation_models()`); `cargo derive` writes a spec's derivation into \
+             generated/<model>.tex"
+        )));
+    }
     DERIVATIONS
         .iter()
         .find(|(name, _, _)| *name == model)

@@ -6,6 +6,7 @@ use crate::model::{
     ContactInfo, FrictionInfo, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo,
     ReductionInfo, ShapeInfo, ShapeKind,
 };
+use crate::spec::is_identifier;
 use serde::{Deserialize, Serialize};
 
 /// The most prepared constants a tape's model may have (a bound on what a caller allocates).
@@ -135,8 +136,27 @@ pub struct Reduction {
 }
 
 impl Info {
-    /// What is inconsistent in it, if anything: an index past the list it points into.
+    /// What is inconsistent in it, if anything: a model, system or parameter name that is not an
+    /// identifier (programs find models and bind parameters by these names, and the C interface
+    /// hands them out as C strings), a parameter named twice, or an index past the list it
+    /// points into.
     pub fn check(&self) -> Result<(), String> {
+        for (what, name) in [("name", &self.name), ("system", &self.system)] {
+            if !is_identifier(name) {
+                return Err(format!("`{what}` is {name:?}, not an identifier"));
+            }
+        }
+        for (i, p) in self.parameters.iter().enumerate() {
+            if !is_identifier(&p.name) {
+                return Err(format!(
+                    "parameter {i} is named {:?}, not an identifier",
+                    p.name
+                ));
+            }
+            if self.parameters[..i].iter().any(|q| q.name == p.name) {
+                return Err(format!("parameter `{}` is named twice", p.name));
+            }
+        }
         let n = self.coordinates.len();
         let within = |what: &str, i: usize, len: usize| {
             if i < len {
