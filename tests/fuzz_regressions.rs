@@ -51,6 +51,35 @@ fn expr_regressions() {
     replay("expr", rodcube::fuzzing::expr);
 }
 
+#[test]
+fn tape_regressions() {
+    use rodcube::fuzzing::{TapeOutcome, tape};
+    let n = replay("tape", |data| {
+        tape(data);
+    });
+    assert!(n >= 3);
+    // The first finding: a shape's `first` (the drawing's `sizes`) past what a caller could
+    // allocate, which the loader now refuses; the seeds load.
+    for path in inputs("tape") {
+        let name = path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or_default();
+        let outcome = tape(&fs::read(&path).unwrap());
+        if name.starts_with("crash-shape-first") {
+            let TapeOutcome::Refused(e) = &outcome else {
+                panic!("{name}: {outcome:?}");
+            };
+            assert!(e.to_string().contains("`sizes`"), "{name}: {e}");
+        } else if name.starts_with("seed-rod") || name.starts_with("seed-ladder") {
+            assert!(
+                matches!(outcome, TapeOutcome::Accepted),
+                "{name}: {outcome:?}"
+            );
+        }
+    }
+}
+
 /// The harnesses are not vacuous: each one panics on the kind of failure it exists to catch.
 #[test]
 fn harnesses_catch_failures() {

@@ -328,6 +328,16 @@ fn unknown_operations_and_wrong_arities_are_refused_at_their_line() {
     }
 }
 
+/// A fast path's layout for the paper's two contacts, with these degrees of the second
+/// contact's force polynomial and of the fall polynomial.
+fn fast_path(force_degree: u64, fall_degree: u64) -> serde_json::Value {
+    serde_json::json!({
+        "k_theta_initial": 0, "k_theta_dot_initial": 0, "k_sin_initial": 0,
+        "k_cos_initial": 0, "force_degrees": [3, force_degree], "fall_degree": fall_degree,
+        "lean_constants": []
+    })
+}
+
 #[test]
 fn inconsistent_info_is_refused() {
     use serde_json::json;
@@ -356,6 +366,23 @@ fn inconsistent_info_is_refused() {
     let text = edited(|b| b["info"]["parameters"][0]["name"] = "".into());
     let e = refusal(&text);
     assert!(e.to_string().contains("not an identifier"), "{e}");
+    // Lengths a caller sizes from the info and could not allocate (the fuzz harness's first
+    // finding: a shape's `first` of 2^64 - 1 made the drawing's `sizes` unallocatable, and
+    // overflowed where it is summed), or whose sum overflows.
+    for edit in [
+        (|b: &mut serde_json::Value| b["info"]["shapes"][0]["first"] = u64::MAX.into())
+            as fn(&mut serde_json::Value),
+        |b| b["info"]["shapes"][0]["first"] = (1u64 << 20).into(),
+        |b| b["info"]["reduction"] = fast_path(u64::MAX, 2),
+        |b| b["info"]["reduction"] = fast_path(3, 1 << 40),
+    ] {
+        let e = refusal(&edited(edit));
+        assert!(matches!(e, TapeError::Info { .. }), "{e}");
+        assert!(
+            e.to_string().contains("numbers a method's output may have"),
+            "{e}"
+        );
+    }
 }
 
 /// The results.json a scene writes, with `--interpreted` or without, and the run's stderr.
@@ -804,4 +831,81 @@ fn pi_is_a_constant_in_expressions() {
     assert_eq!(run.status.code(), Some(3));
     let err = String::from_utf8_lossy(&run.stderr);
     assert!(err.contains("`pi` is the constant"), "{err}");
+}
+
+/// The fuzz target's harness (`rodcube::fuzzing::tape`, `fuzz/fuzz_targets/tape.rs`) on edits
+/// drawn from a seeded generator: the paper's tape edited 4,000 ways and every other compiled
+/// model's 40 (operands replaced or moved by one, operations renamed, instructions deleted,
+/// duplicated or swapped, methods dropped or renamed, numbers and lists of the info changed,
+/// digits of the text replaced; the digest brought up to date unless an edit says not to).
+/// Each must be refused with a `TapeError` naming the file, or accepted with every method of
+/// every trait running on it; the edits reach every check (each kind of refusal is seen) and
+/// some are accepted.
+#[test]
+fn edited_tapes_are_refused_or_run_every_method_without_a_panic() {
+    use rodcube::fuzzing::{TapeOutcome, tape as harness};
+    let compiled = models::compiled();
+    let paper = (compiled.iter())
+        .position(|m| m.info().name == "rod_cube")
+        .expect("rod_cube is compiled") as u8;
+    let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+    let mut byte = move || (rng.next() * 256.0) as u8;
+    let mut inputs = Vec::new();
+    for (model, count) in std::iter::once((
+        paper,
+        std::env::var("N").map_or(4000, |v| v.parse().unwrap()),
+    ))
+    .chain(
+        (0..compiled.len() as u8)
+            .filter(|&i| i != paper)
+            .map(|i| (i, 40)),
+    ) {
+        for _ in 0..count {
+            let len = 1 + (byte() % 24) as usize;
+            let mut data = vec![model];
+            data.extend((0..len).map(|_| byte()));
+            inputs.push(data);
+        }
+    }
+    let mut seen = std::collections::BTreeMap::<&str, usize>::new();
+    let mut panics = Vec::new();
+    for data in &inputs {
+        let kind = match std::panic::catch_unwind(|| harness(data)) {
+            Err(_) => {
+                panics.push(data.iter().map(|b| format!("{b:02x}")).collect::<String>());
+                continue;
+            }
+            Ok(TapeOutcome::Accepted) => "accepted",
+            Ok(TapeOutcome::Skipped) => "skipped",
+            Ok(TapeOutcome::Refused(e)) => match e {
+                TapeError::Syntax { .. } => "syntax",
+                TapeError::Format { .. } | TapeError::Version { .. } => "format",
+                TapeError::Digest { .. } => "digest",
+                TapeError::Info { .. } => "info",
+                TapeError::Method { .. } => "method",
+                TapeError::Io { .. } => "io",
+            },
+        };
+        *seen.entry(kind).or_default() += 1;
+    }
+    assert!(
+        panics.is_empty(),
+        "{} of {} inputs panic (hex, as the fuzz target reads them): {panics:#?}",
+        panics.len(),
+        inputs.len()
+    );
+    for kind in ["accepted", "syntax", "format", "digest", "info", "method"] {
+        assert!(
+            seen.get(kind).copied().unwrap_or(0) >= 10,
+            "{kind}: {seen:?}"
+        );
+    }
+    // The unedited tapes are accepted, and so is a whole tape given as text.
+    for i in 0..compiled.len() as u8 {
+        assert!(matches!(harness(&[i]), TapeOutcome::Accepted));
+    }
+    assert!(matches!(
+        harness(paper_tape().as_bytes()),
+        TapeOutcome::Accepted
+    ));
 }

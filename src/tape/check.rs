@@ -351,20 +351,47 @@ pub const PARTIALS: &[Method] = &[
     Method::FallPartials,
 ];
 
-fn length(len: Len, info: &Info) -> usize {
+/// Every kind of length, for [`lengths`].
+const LENS: &[Len] = &[
+    L::One,
+    L::Params,
+    L::ParamsPlusOne,
+    L::Constants,
+    L::Coords,
+    L::SystemCoords,
+    L::Contacts,
+    L::Frictions,
+    L::Requirements,
+    L::Cyclic,
+    L::Monitors,
+    L::PointPairs,
+    L::BodyTriples,
+    L::Sizes,
+    L::CoordsSquared,
+    L::ContactRows,
+    L::FrictionRows,
+    L::TangentTable,
+    L::InitialTangentTable,
+    L::Reduced,
+    L::Fall,
+    L::FallPartials,
+];
+
+/// How many numbers an argument or output of this kind has, from the info; `None` where that
+/// overflows (an info [`lengths`] refuses).
+fn length(len: Len, info: &Info) -> Option<usize> {
     let n = info.coordinates.len();
     let np = info.parameters.len();
     let m = info.contacts.len();
     let nf = info.frictions.len();
-    let fall = info
-        .reduction
-        .as_ref()
-        .and_then(|r| r.fall_degree)
-        .map_or(0, |d| d + 1);
-    match len {
+    let fall = match info.reduction.as_ref().and_then(|r| r.fall_degree) {
+        Some(d) => d.checked_add(1)?,
+        None => 0,
+    };
+    Some(match len {
         L::One => 1,
         L::Params => np,
-        L::ParamsPlusOne => np + 1,
+        L::ParamsPlusOne => np.checked_add(1)?,
         L::Constants => info.n_constants,
         L::Coords => n,
         L::SystemCoords => info.system_coordinates.len(),
@@ -373,28 +400,85 @@ fn length(len: Len, info: &Info) -> usize {
         L::Requirements => info.requirements.len(),
         L::Cyclic => info.cyclic.len(),
         L::Monitors => info.monitors.len(),
-        L::PointPairs => 2 * info.points.len(),
-        L::BodyTriples => 3 * info.bodies.len(),
-        L::Sizes => (info.shapes.iter())
-            .map(|s| {
-                s.first
-                    + match s.kind {
-                        super::info::Kind::Circle => 3,
-                        _ => 4,
-                    }
-            })
-            .max()
-            .unwrap_or(0),
-        L::CoordsSquared => n * n,
-        L::ContactRows => m * n,
-        L::FrictionRows => nf * n,
-        L::TangentTable => (n + 3 * m + 2 * nf) * (2 * n + np),
-        L::InitialTangentTable => 2 * n * np,
+        L::PointPairs => info.points.len().checked_mul(2)?,
+        L::BodyTriples => info.bodies.len().checked_mul(3)?,
+        L::Sizes => (info.shapes.iter()).try_fold(0, |most: usize, s| {
+            let numbers = match s.kind {
+                super::info::Kind::Circle => 3,
+                _ => 4,
+            };
+            Some(most.max(s.first.checked_add(numbers)?))
+        })?,
+        L::CoordsSquared => n.checked_mul(n)?,
+        L::ContactRows => m.checked_mul(n)?,
+        L::FrictionRows => nf.checked_mul(n)?,
+        L::TangentTable => {
+            let rows = n
+                .checked_add(m.checked_mul(3)?)?
+                .checked_add(nf.checked_mul(2)?)?;
+            rows.checked_mul(n.checked_mul(2)?.checked_add(np)?)?
+        }
+        L::InitialTangentTable => n.checked_mul(2)?.checked_mul(np)?,
         L::Reduced => 4,
         L::Fall => fall,
-        L::FallPartials => fall * np,
+        L::FallPartials => fall.checked_mul(np)?,
+    })
+}
+
+/// What has a length of this kind, for messages.
+fn describe(len: Len) -> &'static str {
+    match len {
+        L::One | L::Reduced => "a scalar",
+        L::Params => "`p`",
+        L::ParamsPlusOne => "`separation_partials`' output",
+        L::Constants => "`k`",
+        L::Coords => "`q`",
+        L::SystemCoords => "`q_full`",
+        L::Contacts => "`forces`",
+        L::Frictions => "`fr`",
+        L::Requirements => "`requirements`' output",
+        L::Cyclic => "`momenta`' output",
+        L::Monitors => "`monitors_full`' output",
+        L::PointPairs => "`pos`",
+        L::BodyTriples => "`poses`",
+        L::Sizes => "the drawing's `sizes` (a shape's `first` and its numbers)",
+        L::CoordsSquared => "`mass`",
+        L::ContactRows => "`constraints`' `jac`",
+        L::FrictionRows => "`friction`'s `jac`",
+        L::TangentTable => "`tangents`' output",
+        L::InitialTangentTable => "`initial_tangents`' output",
+        L::Fall => "`fall_polynomial`'s output",
+        L::FallPartials => "`fall_partials`' output",
     }
 }
+
+/// What is wrong with the lengths the info gives the methods' arguments and outputs: one
+/// past [`MAX_LENGTH`] (a caller sizes them from the info: a tape may not make it allocate
+/// without bound), the drawing's sizes and each contact's force polynomial included.
+pub fn lengths(info: &Info) -> Result<(), String> {
+    let too_long = |what: &str| {
+        format!("{what} would have more than the {MAX_LENGTH} numbers a method's output may have")
+    };
+    for &len in LENS {
+        if length(len, info).is_none_or(|l| l > MAX_LENGTH) {
+            return Err(too_long(describe(len)));
+        }
+    }
+    if let Some(r) = &info.reduction {
+        for (contact, &degree) in r.force_degrees.iter().enumerate() {
+            if degree >= MAX_LENGTH {
+                return Err(too_long(&format!(
+                    "the force polynomial of contact {contact} (degree {degree})"
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The most numbers an argument or output of a tape's method may have (every length a caller
+/// sizes from the model's info: a tape whose info asks for more is refused).
+pub const MAX_LENGTH: usize = 1 << 20;
 
 /// The most registers one method may use (a bound on what a load allocates).
 pub const MAX_REGISTERS: usize = 1 << 20;
@@ -486,7 +570,7 @@ pub fn program(f: &Function, s: &Signature, info: &Info) -> Result<Program, Stri
             &case.code,
             s,
             info,
-            Some(degree + 1),
+            Some(degree.saturating_add(1)),
             &mut written,
             &mut registers,
         )?;
@@ -512,7 +596,7 @@ fn block(
             .ok_or_else(|| format!("`{}` is not {what} of `{}`", arg.name(), s.name))?;
         let len = match (out_len, arg) {
             (Some(n), Arg::Out) => n,
-            _ => length(list[i].1, info),
+            _ => length(list[i].1, info).ok_or("a length that overflows")?,
         };
         Ok::<_, String>((i as u8, len))
     };

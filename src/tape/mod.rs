@@ -1,18 +1,20 @@
 //! Models run from their tapes, with no compiler: `generated/<model>.tape.json` holds the same
 //! straight-line program as `generated/<model>.rs`, and [`TapeModel`] evaluates it.
 //!
-//! A tape is data, never code. [`parse`] refuses, with a [`TapeError`] naming the file and
-//! what is wrong, a tape that is not one, is of another format version, whose body does not
-//! match its digest (truncated or edited by hand), whose info is inconsistent, or whose
-//! programs name an unknown operation, a register not yet written, an argument the method
-//! does not have or an index past the length the info gives it. A tape that passes cannot
-//! make the evaluator index out of bounds. The format is described in `docs/tape.md`.
+//! A tape is data, never code. [`parse`] refuses, with a [`TapeError`] naming the file and what
+//! is wrong, a tape that is not one, is of another format version, whose body does not match
+//! its digest (truncated or edited by hand), whose info is inconsistent or gives an output more
+//! than [`MAX_LENGTH`] numbers, or whose programs name an unknown operation, a register not yet
+//! written, an argument the method does not have or an index past the length the info gives it.
+//! A tape that passes cannot make the evaluator index out of bounds. The format is described in
+//! `docs/tape.md`.
 
 mod check;
 mod eval;
 pub mod format;
 pub mod info;
 
+pub use check::MAX_LENGTH;
 pub use eval::TapeModel;
 pub use format::{FORMAT, VERSION};
 
@@ -107,6 +109,11 @@ pub fn signature(method: &str) -> Option<(Vec<format::Arg>, Vec<format::Arg>)> {
     Some((s.inputs().collect(), s.outputs().collect()))
 }
 
+/// The name of every method a tape may hold, in the trait's order.
+pub fn method_names() -> impl Iterator<Item = &'static str> {
+    METHODS.iter().map(|s| s.name)
+}
+
 /// Reads, checks and prepares a tape from its text; `file` names it in errors.
 pub fn parse(text: &str, file: &str) -> Result<TapeModel, TapeError> {
     let f = || file.to_string();
@@ -139,6 +146,7 @@ pub fn parse(text: &str, file: &str) -> Result<TapeModel, TapeError> {
     let info_error = |message: String| TapeError::Info { file: f(), message };
     let info = &tape.body.info;
     info.check().map_err(info_error)?;
+    check::lengths(info).map_err(info_error)?;
     if info.name != tape.model {
         return Err(info_error(format!(
             "names the model `{}`, the tape `{}`",
