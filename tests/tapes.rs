@@ -496,6 +496,18 @@ fn run_in(dir: &std::path::Path, args: &[&str]) -> std::process::Output {
         .expect("rodcube runs")
 }
 
+/// `rodcube ARGS` in `dir`, which must succeed, and its stdout read as JSON (results.json alone
+/// with `--json`).
+fn run_json(dir: &std::path::Path, args: &[&str]) -> serde_json::Value {
+    let run = run_in(dir, args);
+    assert!(
+        run.status.success(),
+        "rodcube {args:?}: {}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    serde_json::from_slice(&run.stdout).expect("stdout is JSON alone")
+}
+
 fn check_sled(results: &serde_json::Value, what: &str) {
     let value = |k: &str| {
         results["results"][k]["value"]
@@ -533,7 +545,7 @@ fn a_new_spec_runs_at_once_through_spec_and_through_its_tapes_and_matches_the_cl
     std::fs::write(dir.join("scene.yaml"), SLED_SCENE).expect("scene");
     // 1. `--spec`: derived in memory, run at once; stdout is exactly results.json (Symbolica's
     //    banner goes to stderr) and nothing is written but the outputs.
-    let run = run_in(
+    let derived = run_json(
         &dir,
         &[
             "run",
@@ -545,13 +557,6 @@ fn a_new_spec_runs_at_once_through_spec_and_through_its_tapes_and_matches_the_cl
             "out",
         ],
     );
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
-    let derived: serde_json::Value =
-        serde_json::from_slice(&run.stdout).expect("stdout is results.json alone");
     check_sled(&derived, "--spec");
     let note = derived["notes"]["model"].as_str().unwrap_or_default();
     assert!(note.contains("derived from sled.yaml"), "{note}");
@@ -565,7 +570,7 @@ fn a_new_spec_runs_at_once_through_spec_and_through_its_tapes_and_matches_the_cl
         String::from_utf8_lossy(&tapes.stderr)
     );
     assert!(dir.join("models/sled.tape.json").is_file());
-    let run = run_in(
+    let loaded = run_json(
         &dir,
         &[
             "run",
@@ -577,12 +582,6 @@ fn a_new_spec_runs_at_once_through_spec_and_through_its_tapes_and_matches_the_cl
             "out2",
         ],
     );
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
-    let loaded: serde_json::Value = serde_json::from_slice(&run.stdout).expect("results.json");
     check_sled(&loaded, "--models");
     for key in ["separation_angle", "separation_time"] {
         assert_eq!(
@@ -632,13 +631,7 @@ fn rodcube_derive_then_rodcube_run_runs_the_edited_spec_with_no_build() {
     for sub in ["derivations", "templates", "generated", "scenes"] {
         copy_dir(&root.join(sub), &dir.join(sub));
     }
-    let compiled = run_in(&dir, &["run", "scenes/paper.yaml", "--json", "--out", "o0"]);
-    assert!(
-        compiled.status.success(),
-        "{}",
-        String::from_utf8_lossy(&compiled.stderr)
-    );
-    let compiled: serde_json::Value = serde_json::from_slice(&compiled.stdout).expect("json");
+    let compiled = run_json(&dir, &["run", "scenes/paper.yaml", "--json", "--out", "o0"]);
     assert!(
         compiled["notes"]["model"].is_null(),
         "the project's own tapes are the compiled ones"
@@ -656,13 +649,7 @@ fn rodcube_derive_then_rodcube_run_runs_the_edited_spec_with_no_build() {
         "{}",
         String::from_utf8_lossy(&derive.stderr)
     );
-    let run = run_in(&dir, &["run", "scenes/paper.yaml", "--json", "--out", "o1"]);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
-    let taped: serde_json::Value = serde_json::from_slice(&run.stdout).expect("json");
+    let taped = run_json(&dir, &["run", "scenes/paper.yaml", "--json", "--out", "o1"]);
     let note = taped["notes"]["model"].as_str().unwrap_or_default();
     assert!(
         note.contains("another program than the compiled-in model"),
@@ -675,7 +662,7 @@ fn rodcube_derive_then_rodcube_run_runs_the_edited_spec_with_no_build() {
         "the edit changes the motion"
     );
     // The same edited spec through `--spec` (derived in memory) gives the same bits.
-    let fresh = run_in(
+    let fresh = run_json(
         &dir,
         &[
             "run",
@@ -687,12 +674,6 @@ fn rodcube_derive_then_rodcube_run_runs_the_edited_spec_with_no_build() {
             "o2",
         ],
     );
-    assert!(
-        fresh.status.success(),
-        "{}",
-        String::from_utf8_lossy(&fresh.stderr)
-    );
-    let fresh: serde_json::Value = serde_json::from_slice(&fresh.stdout).expect("json");
     assert_eq!(
         angle(&fresh).map(f64::to_bits),
         angle(&taped).map(f64::to_bits)
@@ -703,13 +684,7 @@ fn rodcube_derive_then_rodcube_run_runs_the_edited_spec_with_no_build() {
         edited.replacen("inertia: m1*ell^2/6", "inertia: m1*ell^2/4", 1),
     )
     .expect("spec");
-    let run = run_in(&dir, &["run", "scenes/paper.yaml", "--json", "--out", "o3"]);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
-    let stale: serde_json::Value = serde_json::from_slice(&run.stdout).expect("json");
+    let stale = run_json(&dir, &["run", "scenes/paper.yaml", "--json", "--out", "o3"]);
     let note = stale["notes"]["spec"].as_str().unwrap_or_default();
     assert!(
         note.contains("has changed since") && note.contains("cargo derive"),
@@ -747,7 +722,7 @@ fn a_spec_with_coordinates_x_and_y_and_a_parameter_n_written_bare_derives_and_ru
     let scene = "model: renamed\nparameters: {m1: 1.0, m2: 3.0, ell: 1.0, a: 0.25, g: 9.81, n: 0}\n\
                  want: [separation_time]\ntolerance: 1.0e-12\n";
     std::fs::write(dir.join("scene.yaml"), scene).expect("scene");
-    let run = run_in(
+    let results = run_json(
         &dir,
         &[
             "run",
@@ -759,12 +734,6 @@ fn a_spec_with_coordinates_x_and_y_and_a_parameter_n_written_bare_derives_and_ru
             "o",
         ],
     );
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
-    let results: serde_json::Value = serde_json::from_slice(&run.stdout).expect("json");
     let time = results["results"]["separation_time"]["value"]
         .as_f64()
         .expect("a time");
@@ -802,7 +771,7 @@ fn pi_is_a_constant_in_expressions() {
         SLED_SCENE.replace("model: sled", "model: sled_pi"),
     )
     .expect("scene");
-    let run = run_in(
+    let results = run_json(
         &dir,
         &[
             "run",
@@ -814,12 +783,6 @@ fn pi_is_a_constant_in_expressions() {
             "o",
         ],
     );
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
-    let results: serde_json::Value = serde_json::from_slice(&run.stdout).expect("json");
     check_sled(&results, "pi");
     // `pi` is no name to declare.
     let taken = spec.replace("{name: W, meaning", "{name: pi, meaning");
