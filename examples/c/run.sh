@@ -13,9 +13,13 @@ shift || true
 cargo rustc --quiet --manifest-path "$root/Cargo.toml" --release --lib \
     --no-default-features --features capi --crate-type cdylib
 mkdir -p "$target/c-example"
+# Each program is linked to a file of this run's own and renamed into place, so that a run
+# started beside this one (the tests run several) never executes a file still being written
+# ("Text file busy").
 for name in paper per_point tapes; do
     "${CC:-cc}" -std=c11 -O2 -Wall -Wextra -Werror -pedantic -I"$root/include" \
         "$root/examples/c/$name.c" -L"$target/release" -lrodcube -lm \
-        -Wl,-rpath,"$target/release" -o "$target/c-example/$name"
+        -Wl,-rpath,"$target/release" -o "$target/c-example/$name.$$"
+    mv -f "$target/c-example/$name.$$" "$target/c-example/$name"
 done
 exec "$target/c-example/$program" "$@"
