@@ -977,38 +977,7 @@ mod calls {
     /// with its fast phases, derived by `rodcube derive --tapes-into`: nothing of it is compiled
     /// into the library.
     #[cfg(feature = "derive")]
-    const CRATE_SPEC: &str = r#"
-name: plank_on_crate
-description: A plank leaning on a crate that slides on a frictionless floor.
-parameters:
-  - {name: mp, meaning: mass of the plank, unit: kg}
-  - {name: mc, meaning: mass of the crate, unit: kg}
-  - {name: L, meaning: length of the plank, unit: m}
-  - {name: h, meaning: height of the crate, unit: m}
-  - {name: g, meaning: gravitational acceleration, unit: m/s^2}
-requirements:
-  - {name: leans, expr: L - h, meaning: the crate is lower than the plank is long}
-gravity: g
-coordinates:
-  - {name: xf, meaning: position of the plank's foot, unit: m}
-  - {name: yf, meaning: height of the plank's foot, unit: m}
-  - {name: th, meaning: angle of the plank to the floor, unit: rad}
-  - {name: xc, meaning: position of the crate's face on the plank's side, unit: m}
-reduced: th
-end_angle: 0
-bodies:
-  - {name: plank, mass: mp, inertia: mp*L^2/12, position: [xf + L/2*cos(th), yf + L/2*sin(th)], angle: th, shape: {segment: [[-L/2, 0], [L/2, 0]]}}
-  - {name: crate, mass: mc, inertia: mc*h^2/6, position: [xc + h/2, h/2], angle: 0, shape: {rectangle: [h, h]}}
-points:
-  - {name: middle, position: [xf + L/2*cos(th), yf + L/2*sin(th)], meaning: the plank's centre}
-falling_point: middle
-contacts:
-  - {name: push, meaning: "the plank's top on the crate, positive while they touch", gap: xc - xf - L*cos(th), eliminates: xc}
-  - {name: floor, meaning: "the floor under the plank's foot, positive while they touch", gap: yf, eliminates: yf}
-initial:
-  xf: {position: 0, velocity: 0}
-  th: {position: asin(h/L), velocity: 0}
-"#;
+    const CRATE_SPEC: &str = include_str!("specs/plank.yaml");
 
     /// The paper's closed forms for a rod on a free block (`PHYSICS.md`), independent of
     /// rodcube: `s = sin(theta_sep)` is the root in `(0, r)` of eq. (14),
@@ -1062,9 +1031,9 @@ initial:
         let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("capi-tapes");
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
-        std::fs::write(dir.join("plank_on_crate.yaml"), CRATE_SPEC).unwrap();
+        std::fs::write(dir.join("plank.yaml"), CRATE_SPEC).unwrap();
         let derived = Command::new(env!("CARGO_BIN_EXE_rodcube"))
-            .args(["derive", "--tapes-into", "tapes", "plank_on_crate.yaml"])
+            .args(["derive", "--tapes-into", "tapes", "plank.yaml"])
             .current_dir(&dir)
             .output()
             .expect("rodcube runs");
@@ -1074,11 +1043,7 @@ initial:
             String::from_utf8_lossy(&derived.stderr)
         );
         let tapes = dir.join("tapes");
-        let models = [
-            "plank_on_crate",
-            "plank_on_crate_closed",
-            "plank_on_crate_free",
-        ];
+        let models = ["plank", "plank_closed", "plank_free"];
         for m in models {
             assert!(tapes.join(format!("{m}.tape.json")).is_file(), "{m}");
             assert!(
@@ -1089,7 +1054,7 @@ initial:
         }
         let _registry = registry();
         // Not there before: the name is unknown.
-        assert_eq!(solver("plank_on_crate").unwrap_err().0, RODCUBE_ERR_MODEL);
+        assert_eq!(solver("plank").unwrap_err().0, RODCUBE_ERR_MODEL);
         let before = listed();
 
         // With one of them corrupted, nothing of the directory is loaded.
@@ -1099,7 +1064,7 @@ initial:
             let file = format!("{m}.tape.json");
             std::fs::copy(tapes.join(&file), broken.join(&file)).unwrap();
         }
-        let free = broken.join("plank_on_crate_free.tape.json");
+        let free = broken.join("plank_free.tape.json");
         let text = std::fs::read_to_string(&free).unwrap();
         std::fs::write(&free, text.replacen("[\"ld\",", "[\"ld\",1", 1)).unwrap();
         let (code, text, n) = load(&broken);
@@ -1109,7 +1074,7 @@ initial:
             "the message names the file: {text}"
         );
         assert_eq!((n, listed()), (0, before.clone()));
-        assert_eq!(solver("plank_on_crate").unwrap_err().0, RODCUBE_ERR_MODEL);
+        assert_eq!(solver("plank").unwrap_err().0, RODCUBE_ERR_MODEL);
 
         // Loaded: listed after the compiled models, with their parameters.
         assert_eq!(load(&tapes), (RODCUBE_OK, String::new(), 3));
@@ -1128,7 +1093,7 @@ initial:
         assert_eq!(listed(), now);
 
         // Solved by its per-point solver, by name, against the closed forms; two points.
-        let s = solver("plank_on_crate").unwrap();
+        let s = solver("plank").unwrap();
         let names = ["g", "h", "L", "mc", "mp"];
         for (mp, mc, ell, h) in [(1.0, 3.0, 1.0, 0.25), (2.0, 0.5, 1.5, 0.9)] {
             let (theta_sep, t_sep) = closed_forms(mc / mp, h / ell, ell, 9.81);
@@ -1166,7 +1131,7 @@ initial:
 
         // Run as a scene: the same numbers, and the note says where the model came from.
         let results = run_scene(
-            "model: plank_on_crate\nparameters: {mp: 1, mc: 3, L: 1, h: 0.25, g: 9.81}\nwant: [separation_angle, separation_time]\ntolerance: 1.0e-12\n",
+            "model: plank\nparameters: {mp: 1, mc: 3, L: 1, h: 0.25, g: 9.81}\nwant: [separation_angle, separation_time]\ntolerance: 1.0e-12\n",
         )
         .unwrap();
         // SAFETY: a live handle, released once.
@@ -1184,14 +1149,14 @@ initial:
         assert!((result("separation_time") - t_sep).abs() < 1e-11 * t_sep);
         let note = value["notes"]["model"].as_str().unwrap_or_default();
         assert!(note.contains("not compiled into this program"), "{note}");
-        assert!(note.contains("plank_on_crate.tape.json"), "{note}");
+        assert!(note.contains("plank.tape.json"), "{note}");
 
         // A C program does the same (examples/c/tapes.c, built by run.sh against the header).
         let root = Path::new(env!("CARGO_MANIFEST_DIR"));
         let out = Command::new(root.join("examples/c/run.sh"))
             .arg("tapes")
             .arg(&tapes)
-            .args(["plank_on_crate", "mp=1", "mc=3", "L=1", "h=0.25", "g=9.81"])
+            .args(["plank", "mp=1", "mc=3", "L=1", "h=0.25", "g=9.81"])
             .env(
                 "CARGO_TARGET_DIR",
                 Path::new(env!("CARGO_TARGET_TMPDIR")).join("capi"),

@@ -74,38 +74,7 @@ fn build_wheel(python: &Path, root: &Path, tmp: &Path, dir: &Path) -> PathBuf {
 /// A model no build compiles in: the paper's rod on a free block as a plank on a crate, under
 /// names of its own, with its fast phases (`plank_closed`, `plank_free`), which
 /// `python/tests/test_tapes.py` checks against the paper's closed forms.
-const PLANK_SPEC: &str = r#"
-name: plank
-description: A plank leaning on a crate that slides on a frictionless floor, released from rest.
-parameters:
-  - {name: mp, meaning: mass of the plank, unit: kg}
-  - {name: mc, meaning: mass of the crate, unit: kg}
-  - {name: L, meaning: length of the plank, unit: m}
-  - {name: h, meaning: height of the crate, unit: m}
-  - {name: g, meaning: gravitational acceleration, unit: m/s^2}
-requirements:
-  - {name: leans, expr: L - h, meaning: the crate is lower than the plank is long}
-gravity: g
-coordinates:
-  - {name: xf, meaning: position of the plank's foot, unit: m}
-  - {name: yf, meaning: height of the plank's foot, unit: m}
-  - {name: th, meaning: angle of the plank to the floor, unit: rad}
-  - {name: xc, meaning: position of the crate's face on the plank's side, unit: m}
-reduced: th
-end_angle: 0
-bodies:
-  - {name: plank, mass: mp, inertia: mp*L^2/12, position: [xf + L/2*cos(th), yf + L/2*sin(th)], angle: th, shape: {segment: [[-L/2, 0], [L/2, 0]]}}
-  - {name: crate, mass: mc, inertia: mc*h^2/6, position: [xc + h/2, h/2], angle: 0, shape: {rectangle: [h, h]}}
-points:
-  - {name: middle, position: [xf + L/2*cos(th), yf + L/2*sin(th)], meaning: the plank's centre}
-falling_point: middle
-contacts:
-  - {name: push, meaning: "the plank's top on the crate, positive while they touch", gap: xc - xf - L*cos(th), eliminates: xc}
-  - {name: floor, meaning: "the floor under the plank's foot, positive while they touch", gap: yf, eliminates: yf}
-initial:
-  xf: {position: 0, velocity: 0}
-  th: {position: asin(h/L), velocity: 0}
-"#;
+const PLANK_SPEC: &str = include_str!("specs/plank.yaml");
 
 /// Derives [`PLANK_SPEC`]'s tapes into an emptied `tmp/tapes` with this build's `rodcube
 /// derive --tapes-into` and returns that directory.
