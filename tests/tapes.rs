@@ -488,6 +488,14 @@ fn paper_closed_forms(n: f64, r: f64, ell: f64, g: f64, m2: f64) -> (f64, f64, f
     (theta_sep, t_sep, push)
 }
 
+/// An empty directory of this name under the tests' temporary directory.
+fn scratch(name: &str) -> std::path::PathBuf {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("a temporary directory");
+    dir
+}
+
 fn run_in(dir: &std::path::Path, args: &[&str]) -> std::process::Output {
     std::process::Command::new(env!("CARGO_BIN_EXE_rodcube"))
         .args(args)
@@ -538,9 +546,7 @@ fn check_sled(results: &serde_json::Value, what: &str) {
 
 #[test]
 fn a_new_spec_runs_at_once_through_spec_and_through_its_tapes_and_matches_the_closed_forms() {
-    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("tapes_sled");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("temporary directory");
+    let dir = scratch("tapes_sled");
     std::fs::write(dir.join("sled.yaml"), SLED_SPEC).expect("spec");
     std::fs::write(dir.join("scene.yaml"), SLED_SCENE).expect("scene");
     // 1. `--spec`: derived in memory, run at once; stdout is exactly results.json (Symbolica's
@@ -626,8 +632,7 @@ fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
 #[test]
 fn rodcube_derive_then_rodcube_run_runs_the_edited_spec_with_no_build() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("tapes_project");
-    let _ = std::fs::remove_dir_all(&dir);
+    let dir = scratch("tapes_project");
     for sub in ["derivations", "templates", "generated", "scenes"] {
         copy_dir(&root.join(sub), &dir.join(sub));
     }
@@ -715,9 +720,7 @@ fn a_spec_with_coordinates_x_and_y_and_a_parameter_n_written_bare_derives_and_ru
             "- {name: mass_ratio, expr: m2/m1",
         );
     assert!(spec.contains("position: [x, y]") && spec.contains("restitution: n"));
-    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("tapes_renamed");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("directory");
+    let dir = scratch("tapes_renamed");
     std::fs::write(dir.join("renamed.yaml"), &spec).expect("spec");
     let scene = "model: renamed\nparameters: {m1: 1.0, m2: 3.0, ell: 1.0, a: 0.25, g: 9.81, n: 0}\n\
                  want: [separation_time]\ntolerance: 1.0e-12\n";
@@ -762,9 +765,7 @@ fn pi_is_a_constant_in_expressions() {
         spec.contains("th + 2*pi") && spec.contains("pi/2 - acos"),
         "{spec}"
     );
-    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("tapes_pi");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("directory");
+    let dir = scratch("tapes_pi");
     std::fs::write(dir.join("sled_pi.yaml"), &spec).expect("spec");
     std::fs::write(
         dir.join("scene.yaml"),

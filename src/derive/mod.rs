@@ -531,15 +531,9 @@ pub fn render_all(root: &Path, specs: &[PathBuf]) -> Result<(Vec<Rendered>, Timi
 /// The manifest of digests of the generated files, as the tool last wrote them.
 pub const MANIFEST: &str = "generated/manifest.txt";
 
-/// FNV-1a 64-bit digest of a text (stable across platforms and Rust versions).
-pub fn digest(text: &str) -> String {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in text.bytes() {
-        h ^= u64::from(b);
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    format!("{h:016x}")
-}
+/// FNV-1a 64-bit digest of a text (stable across platforms and Rust versions): the one a tape
+/// records of its spec and body, here of each generated file.
+pub use crate::tape::format::digest;
 
 /// The manifest of `files` as about to be written, keeping the rows of `kept` (other files
 /// already generated) except where `files` gives a new digest; sorted by path.
