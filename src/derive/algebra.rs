@@ -53,30 +53,40 @@ pub fn simplify_inverse_trig(e: &Expr) -> Expr {
 /// Replaces `cos^k` by `cos^(k mod 2) (1 - sin^2)^(k div 2)` in an expanded polynomial of
 /// `rc_s`, `rc_c`, so that results are unique modulo `sin^2 + cos^2 = 1`.
 pub fn reduce_cos_sq(a: &A) -> A {
-    let mut cur = cas::expand(a);
-    for _ in 0..16 {
-        let mut next = cur.clone();
-        let pow =
-            |base: &str, n: i128| Expr::Pow(Box::new(Expr::sym(base)), Box::new(Expr::int(n)));
-        for k in (2..=12).rev() {
-            let pat = cas::atom(&pow("rc_c", k));
-            let one_minus_s2 = Expr::Add(vec![
-                Expr::int(1),
-                Expr::Mul(vec![Expr::int(-1), pow("rc_s", 2)]),
-            ]);
-            let rep = cas::atom(&Expr::Mul(vec![
-                pow("rc_c", k % 2),
-                Expr::Pow(Box::new(one_minus_s2), Box::new(Expr::int(k / 2))),
-            ]));
-            next = cas::subs(&next, &pat, &rep);
-        }
-        next = cas::expand(&next);
-        if next == cur {
-            break;
-        }
-        cur = next;
+    thread_local! {
+        /// The rules `rc_c^k -> rc_c^(k mod 2) (1 - rc_s^2)^(k div 2)`, highest `k` first, made
+        /// once per thread (only the Symbolica thread calls this).
+        static RULES: Vec<(A, A)> = (2..=12).rev().map(cos_power_rule).collect();
     }
-    cur
+    RULES.with(|rules| {
+        let mut cur = cas::expand(a);
+        for _ in 0..16 {
+            let mut next = cur.clone();
+            for (pat, rep) in rules {
+                next = cas::subs(&next, pat, rep);
+            }
+            next = cas::expand(&next);
+            if next == cur {
+                break;
+            }
+            cur = next;
+        }
+        cur
+    })
+}
+
+/// The pattern `rc_c^k` and its replacement `rc_c^(k mod 2) (1 - rc_s^2)^(k div 2)`.
+fn cos_power_rule(k: i128) -> (A, A) {
+    let pow = |base: &str, n: i128| Expr::Pow(Box::new(Expr::sym(base)), Box::new(Expr::int(n)));
+    let one_minus_s2 = Expr::Add(vec![
+        Expr::int(1),
+        Expr::Mul(vec![Expr::int(-1), pow("rc_s", 2)]),
+    ]);
+    let rep = Expr::Mul(vec![
+        pow("rc_c", k % 2),
+        Expr::Pow(Box::new(one_minus_s2), Box::new(Expr::int(k / 2))),
+    ]);
+    (cas::atom(&pow("rc_c", k)), cas::atom(&rep))
 }
 
 /// A term of a sum as `coefficient * rest * rc_s^sin * rc_c^cos`, for [`pythagoras`].

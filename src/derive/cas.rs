@@ -22,8 +22,8 @@ pub fn atom(e: &Expr) -> A {
         Expr::Rational(n, d) => Atom::num((*n, *d)),
         Expr::Float(x) => Atom::num(*x),
         Expr::Sym(s) => var(s),
-        Expr::Add(v) => v.iter().fold(num(0), |sum, t| sum + atom(t)),
-        Expr::Mul(v) => v.iter().fold(num(1), |product, f| product * atom(f)),
+        Expr::Add(v) => balanced(v, &|a, b| a + b).unwrap_or_else(|| num(0)),
+        Expr::Mul(v) => balanced(v, &|a, b| a * b).unwrap_or_else(|| num(1)),
         Expr::Pow(b, x) => atom(b).pow(atom(x)),
         Expr::Fun(f, args) => args
             .iter()
@@ -31,6 +31,20 @@ pub fn atom(e: &Expr) -> A {
                 call.add_arg(atom(a))
             })
             .finish(),
+    }
+}
+
+/// The terms (or factors) `v` combined pairwise as a balanced tree (`None` when there are
+/// none): each operation normalises its result, so a left fold over `n` terms would normalise
+/// sums of 1, 2, ..., n terms, a balanced tree sums of `n` terms `log2 n` times.
+fn balanced(v: &[Expr], op: &impl Fn(A, A) -> A) -> Option<A> {
+    match v {
+        [] => None,
+        [one] => Some(atom(one)),
+        _ => {
+            let (left, right) = v.split_at(v.len() / 2);
+            Some(op(balanced(left, op)?, balanced(right, op)?))
+        }
     }
 }
 

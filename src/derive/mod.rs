@@ -258,19 +258,55 @@ fn derive_and_present(c: &Checked) -> Result<Vec<Derivation>, mechanics::DeriveE
 
 /// Derives checked specs on the Symbolica thread: each spec's phases, with the time it took.
 pub fn derive_all(checked: &[Checked]) -> Result<Vec<(Vec<Derivation>, Duration)>, Error> {
-    let owned: Vec<Checked> = checked.to_vec();
-    let results = on_cas_thread(move || {
-        owned
-            .iter()
-            .map(|c| {
-                let start = Instant::now();
-                derive_and_present(c)
-                    .map(|d| (d, start.elapsed()))
-                    .map_err(|e| to_spec_error(c, e))
-            })
-            .collect::<Vec<_>>()
+    let mut out = Vec::with_capacity(checked.len());
+    derive_each(checked, |_, phases, took| {
+        out.push((phases, took));
+        Ok(())
     })?;
-    results.into_iter().collect()
+    Ok(out)
+}
+
+/// Derives checked specs on the Symbolica thread and hands each spec's phases (with the time
+/// it took) to `each`, on this thread and in order, as soon as that spec is derived: what
+/// `each` does (lowering, templates, rustfmt) overlaps the next spec's derivation. The first
+/// error, of a derivation or of `each`, stops both.
+pub fn derive_each(
+    checked: &[Checked],
+    mut each: impl FnMut(usize, Vec<Derivation>, Duration) -> Result<(), Error>,
+) -> Result<(), Error> {
+    let owned: Vec<Checked> = checked.to_vec();
+    let (tx, rx) = channel();
+    std::thread::scope(|scope| {
+        // Waits on the Symbolica thread's whole job, which sends each spec's result as it goes.
+        let waiter = scope.spawn(move || {
+            on_cas_thread(move || {
+                for c in &owned {
+                    let start = Instant::now();
+                    let result = derive_and_present(c)
+                        .map(|d| (d, start.elapsed()))
+                        .map_err(|e| to_spec_error(c, e));
+                    let failed = result.is_err();
+                    // The receiver gone (`each` failed) or this spec failed: nothing more to do.
+                    if tx.send(result).is_err() || failed {
+                        break;
+                    }
+                }
+            })
+        });
+        let mut outcome = Ok(());
+        for (i, result) in rx.iter().enumerate() {
+            if let Err(e) = result.and_then(|(phases, took)| each(i, phases, took)) {
+                outcome = Err(e);
+                break;
+            }
+        }
+        drop(rx);
+        let finished = waiter
+            .join()
+            .map_err(|_| Error::Worker("the derivation's waiting thread panicked".into()))
+            .and_then(|r| r);
+        outcome.and(finished)
+    })
 }
 
 /// How long each spec took to derive, by model name.
@@ -340,6 +376,65 @@ fn rustfmt(model: &str, text: &str) -> Result<String, Error> {
     String::from_utf8(out.stdout).map_err(|e| err(e.to_string()))
 }
 
+/// Formats the Rust files among `files` (their text as rendered) in one run of rustfmt over a
+/// directory of their own, in place: one process start for every model rather than one each
+/// (rustfmt's start costs more than its formatting of a model). The files are formatted as
+/// the same text through `--emit stdout` would be (no configuration file in that directory).
+fn rustfmt_rust_files(files: &mut [Rendered]) -> Result<(), Error> {
+    use std::process::{Command, Stdio};
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    static RUN: AtomicUsize = AtomicUsize::new(0);
+    let rust: Vec<usize> = (0..files.len())
+        .filter(|&i| files[i].path.extension().is_some_and(|x| x == "rs"))
+        .collect();
+    if rust.is_empty() {
+        return Ok(());
+    }
+    let models = (rust.iter())
+        .filter_map(|&i| files[i].path.file_stem())
+        .map(|s| s.to_string_lossy().into_owned())
+        .collect::<Vec<_>>()
+        .join(", ");
+    let err = |message: String| Error::Rustfmt {
+        model: models.clone(),
+        message,
+    };
+    let dir = std::env::temp_dir().join(format!(
+        "rodcube-rustfmt-{}-{}",
+        std::process::id(),
+        RUN.fetch_add(1, Ordering::Relaxed)
+    ));
+    let io = |path: &Path, source: std::io::Error| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    std::fs::create_dir_all(&dir).map_err(|e| io(&dir, e))?;
+    let result = (|| {
+        let mut paths = Vec::with_capacity(rust.len());
+        for (k, &i) in rust.iter().enumerate() {
+            let path = dir.join(format!("{k}.rs"));
+            std::fs::write(&path, &files[i].text).map_err(|e| io(&path, e))?;
+            paths.push(path);
+        }
+        let out = Command::new("rustfmt")
+            .args(["--edition", "2024", "--quiet"])
+            .args(&paths)
+            .stdin(Stdio::null())
+            .output()
+            .map_err(|e| err(format!("cannot start rustfmt: {e}")))?;
+        if !out.status.success() {
+            return Err(err(String::from_utf8_lossy(&out.stderr).into_owned()));
+        }
+        for (path, &i) in paths.iter().zip(&rust) {
+            files[i].text = std::fs::read_to_string(path).map_err(|e| io(path, e))?;
+        }
+        Ok(())
+    })();
+    // The directory is this run's own; failing to remove it loses nothing but space.
+    let _ = std::fs::remove_dir_all(&dir);
+    result
+}
+
 /// The fast phases of a system (its derived phases that have a fast path), as every model of
 /// the system lists them.
 fn fast_phases(phases: &[Derivation]) -> Vec<emit::PhaseEntry> {
@@ -389,7 +484,7 @@ fn rust_and_tape(
     Ok((raw, tape))
 }
 
-/// The Rust, LaTeX, JSON and tape files of one derived phase.
+/// The Rust (not yet formatted), LaTeX, JSON and tape files of one derived phase.
 fn render_phase(
     root: &Path,
     c: &Checked,
@@ -398,8 +493,8 @@ fn render_phase(
 ) -> Result<Vec<Rendered>, Error> {
     let path = root.join("templates").join("model.rs.tera");
     let template = std::fs::read_to_string(&path).map_err(|source| Error::Io { path, source })?;
-    let (raw, tape) = rust_and_tape(&template, c, d, phases)?;
-    let rust = rustfmt(&d.name, &raw)?;
+    // Formatted with the other models' Rust ([`rustfmt_rust_files`]).
+    let (rust, tape) = rust_and_tape(&template, c, d, phases)?;
     let tex_ctx = emit::tex_context(c, d).map_err(|e| refused(c, &d.name, e))?;
     let tex = render(root, "model.tex.tera", &tex_ctx)?;
     let json =
@@ -484,16 +579,19 @@ pub fn render_all(root: &Path, specs: &[PathBuf]) -> Result<(Vec<Rendered>, Timi
     let specs: Vec<&spec::Spec> = all.iter().chain(&selected).map(|c| &c.spec).collect();
     let symbols = mechanics::canonical_symbols(&specs);
     on_cas_thread(move || cas::declare(&symbols))?;
-    let derived = derive_all(&selected)?;
     let mut out = Vec::new();
     let mut timings = Vec::new();
-    for (c, (phases, took)) in selected.iter().zip(derived) {
+    derive_each(&selected, |i, phases, took| {
+        let c =
+            (selected.get(i)).ok_or_else(|| Error::Worker(format!("no spec {i} was asked for")))?;
         timings.push((c.spec.name.clone(), took));
         let fast = fast_phases(&phases);
         for d in &phases {
             out.extend(render_phase(root, c, d, &fast)?);
         }
-    }
+        Ok(())
+    })?;
+    rustfmt_rust_files(&mut out)?;
     // The registry lists only models whose Rust file exists once this run has written: those
     // rendered now and, when only some specs were given, those generated before (recorded in
     // the manifest). A spec that has not derived is never named, so the crate still builds.
