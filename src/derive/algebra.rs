@@ -132,7 +132,7 @@ impl Term {
                 _ => term.rest.push(f.clone()),
             }
         }
-        term.rest.sort_by_key(Expr::to_infix);
+        term.rest.sort_by_cached_key(Expr::to_infix);
         term
     }
 
@@ -336,7 +336,7 @@ pub fn collect_over(a: &A, motion: &[&str]) -> Result<A, DeriveError> {
         let (mut moving, coefficient): (Vec<Expr>, Vec<Expr>) = factors
             .into_iter()
             .partition(|f| f.symbols().iter().any(|s| motion.contains(&s.as_str())));
-        moving.sort_by_key(|f| f.to_infix());
+        moving.sort_by_cached_key(|f| f.to_infix());
         let key = moving
             .iter()
             .map(|f| f.to_infix())

@@ -126,7 +126,21 @@ pub fn declare(names: &[String]) {
 
 /// A symbol.
 pub fn var(name: &str) -> A {
-    Atom::var(symbol!(name))
+    thread_local! {
+        /// The variables made so far (only the Symbolica thread makes any): a symbol's lookup
+        /// by name costs more than a copy of its atom.
+        static VARS: std::cell::RefCell<std::collections::HashMap<String, A>> =
+            Default::default();
+    }
+    VARS.with(|vars| {
+        let mut vars = vars.borrow_mut();
+        if let Some(a) = vars.get(name) {
+            return a.clone();
+        }
+        let a = Atom::var(symbol!(name));
+        vars.insert(name.to_string(), a.clone());
+        a
+    })
 }
 
 /// An integer.

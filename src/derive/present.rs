@@ -351,7 +351,7 @@ impl<'a> Presenter<'a> {
     /// The factors of a product in order (the number first), powers written as powers.
     fn ordered(&self, f: &Factored) -> Vec<Expr> {
         let mut factors = f.factors.clone();
-        factors.sort_by_key(|(b, _)| self.factor_key(b));
+        factors.sort_by_cached_key(|(b, _)| self.factor_key(b));
         let (n, d) = f.coefficient;
         let mut out = Vec::new();
         if (n, d) != (1, 1) {
@@ -387,7 +387,7 @@ impl<'a> Presenter<'a> {
         let (mut numbers, mut rest): (Vec<Expr>, Vec<Expr>) = v
             .into_iter()
             .partition(|x| matches!(x, Expr::Rational(..) | Expr::Float(_)));
-        rest.sort_by_key(|b| {
+        rest.sort_by_cached_key(|b| {
             let base = match b {
                 Expr::Pow(base, _) => base,
                 b => b,
@@ -412,7 +412,7 @@ impl<'a> Presenter<'a> {
                 t if has_theta(t) => (vec![t.clone()], Vec::new()),
                 t => (Vec::new(), vec![t.clone()]),
             };
-            theta.sort_by_key(|x| self.factor_key(x));
+            theta.sort_by_cached_key(|x| self.factor_key(x));
             let degree = theta_degree(&product(theta.clone()));
             match groups.iter_mut().find(|g| g.0 == theta) {
                 Some(g) => g.2.push(product(coefficient)),
@@ -428,7 +428,7 @@ impl<'a> Presenter<'a> {
                 .iter()
                 .map(|t| self.arrange_product(t))
                 .collect();
-            v.sort_by_key(|t| {
+            v.sort_by_cached_key(|t| {
                 let syms = t.symbols().len();
                 (syms, self.order.rank(t))
             });
