@@ -433,7 +433,7 @@ fn want_takes_any_scalar_quantity_of_an_integrated_model() {
     // paper's separation (t_sep = 0.108493254170856 s at g = 9.81, held to the 256-bit
     // reference by tests/hard_cases.rs).
     let dir = temp_dir("friction-want");
-    let out = rodcube(&[
+    succeeds(&[
         "sweep",
         "--model",
         "rod_cube_friction",
@@ -448,11 +448,6 @@ fn want_takes_any_scalar_quantity_of_an_integrated_model() {
         "--out",
         dir.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let (_, header, rows) = read_csv(&dir.join("sweep.csv"));
     let col = |name: &str| {
         (header.iter().position(|h| h == name)).unwrap_or_else(|| panic!("{name}: {header:?}"))
@@ -481,4 +476,15 @@ fn want_takes_any_scalar_quantity_of_an_integrated_model() {
             .all(|r| r[col("floor_normal_end_time")].is_nan())
     );
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Runs rodcube, failing the test with its error output unless it succeeds.
+fn succeeds(args: &[&str]) -> Output {
+    let out = rodcube(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
 }
