@@ -235,10 +235,9 @@ impl Quantity {
 
     /// The scalar results the planner gives for this quantity of a model, whatever the
     /// parameters, the quantity's own first: where one has no value at a point, its `note`
-    /// explains why. Empty for the
-    /// quantities that are no numbers (series, checks, impacts, sensitivities). The planner
-    /// writes these keys (`plan::quantities`); `plan`'s tests hold the two together on every
-    /// shipped scene.
+    /// explains why. Empty for the quantities that are no numbers (series, checks, impacts,
+    /// sensitivities). The planner writes these keys (`plan::quantities`); the tests of
+    /// `sweep::planned` hold the two together on every shipped scene.
     pub fn scalar_keys(&self, info: &ModelInfo) -> Vec<ScalarKey> {
         let key = |key: String, unit: &'static str, note: &str| ScalarKey {
             key,
