@@ -77,7 +77,7 @@ pub mod results;
 pub mod scene;
 pub mod solve;
 pub mod spec;
-#[cfg(feature = "cli")]
+#[cfg(feature = "sweep")]
 pub mod sweep;
 pub mod system;
 pub mod tape;

@@ -71,7 +71,9 @@ pub struct SweepArgs {
     /// CSV of points whose header names the axes (instead of a grid)
     #[arg(long, value_name = "FILE", conflicts_with_all = ["axis", "n", "a_over_ell", "heatmap"])]
     points: Option<PathBuf>,
-    /// More quantities per point, comma-separated (through the planner; slower)
+    /// More quantities per point, comma-separated: any with a number per point (contact_end,
+    /// floor_impact, cross_check, ...), each giving its result keys as columns (through the
+    /// planner; slower)
     #[arg(long, value_delimiter = ',', value_name = "QUANTITY")]
     want: Vec<String>,
     /// Also write d(result)/d(parameter) and the elasticities of the separation angle and time

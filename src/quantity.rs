@@ -107,6 +107,22 @@ pub const FIXED: &[(&str, Quantity, &str)] = &[
     ),
 ];
 
+/// A scalar result a quantity gives (in `RunResults::results`): its key, its unit, and the key
+/// of the note that says why it has no value where it has none.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ScalarKey {
+    /// The result's key (`contact_end_time`), as in results.json and the sweep's CSV.
+    pub key: String,
+    /// Its SI unit (`s`, `rad`, `J`, `1`).
+    pub unit: &'static str,
+    /// The key under `RunResults::notes` that explains its absence (`contact_end`).
+    pub note: String,
+    /// Whether it is one contact's detail (`<contact>_end_time`) rather than the quantity's
+    /// own result: where it has none (a floor contact that holds to the end) the quantity
+    /// still has its value.
+    pub per_contact: bool,
+}
+
 /// A `want` entry that names no quantity of the model.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("unknown quantity `{name}` for model `{model}`; it offers: {}", offers.join(", "))]
@@ -215,6 +231,77 @@ impl Quantity {
         out.extend((0..info.frictions.len()).map(Quantity::FrictionSeries));
         out.extend((0..info.points.len()).map(Quantity::Trajectory));
         out
+    }
+
+    /// The scalar results the planner gives for this quantity of a model, whatever the
+    /// parameters, the quantity's own first: where one has no value at a point, its `note`
+    /// explains why. Empty for the quantities that are no numbers (series, checks, impacts,
+    /// sensitivities). The planner writes these keys (`plan::quantities`); the tests of
+    /// `sweep::planned` hold the two together on every shipped scene.
+    pub fn scalar_keys(&self, info: &ModelInfo) -> Vec<ScalarKey> {
+        let key = |key: String, unit: &'static str, note: &str| ScalarKey {
+            key,
+            unit,
+            note: note.to_string(),
+            per_contact: false,
+        };
+        let own = |unit| vec![key(self.name(info), unit, &self.name(info))];
+        let friction = !info.frictions.is_empty();
+        match self {
+            Quantity::SeparationAngle | Quantity::LinearisedSeparationAngle => own("rad"),
+            Quantity::SeparationTime
+            | Quantity::ContactTimeToFloor
+            | Quantity::PointMassFallTime => own("s"),
+            Quantity::ContactEnd => {
+                let names = std::iter::once(("contact_end".to_string(), false))
+                    .chain((info.contacts.iter()).map(|c| (format!("{}_end", c.name), true)));
+                let mut out: Vec<ScalarKey> = names
+                    .flat_map(|(n, per_contact)| {
+                        [(format!("{n}_time"), "s"), (format!("{n}_angle"), "rad")].map(
+                            |(k, unit)| ScalarKey {
+                                per_contact,
+                                ..key(k, unit, &n)
+                            },
+                        )
+                    })
+                    .collect();
+                if friction {
+                    out.push(key("contact_end_friction_work".into(), "J", "contact_end"));
+                }
+                out
+            }
+            Quantity::FloorImpact => {
+                let mut out = vec![
+                    key("floor_impact_time".into(), "s", "floor_impact"),
+                    key("impact_angular_velocity".into(), "rad/s", "floor_impact"),
+                ];
+                if friction {
+                    out.push(key(
+                        "floor_impact_friction_work".into(),
+                        "J",
+                        "floor_impact",
+                    ));
+                }
+                out
+            }
+            Quantity::CrossCheck => [
+                ("cross_check_time", "s"),
+                ("cross_check_relative_difference", "1"),
+                ("cross_check_rtol", "1"),
+                ("cross_check_time_deviation", "s"),
+                ("cross_check_state_deviation", "1"),
+            ]
+            .into_iter()
+            .map(|(k, unit)| key(k.into(), unit, "cross_check"))
+            .collect(),
+            Quantity::ThetaSeries
+            | Quantity::ForceSeries(_)
+            | Quantity::FrictionSeries(_)
+            | Quantity::Trajectory(_)
+            | Quantity::Impacts
+            | Quantity::Checks
+            | Quantity::Sensitivities => Vec::new(),
+        }
     }
 
     /// Whether a model can provide this quantity: the separation needs a unilateral first

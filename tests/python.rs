@@ -5,9 +5,12 @@
 //! example notebook `examples/paper.ipynb` run by nbclient, whose numbers are checked against
 //! what this build's `rodcube run` prints, and a model derived here from a spec of the test's own
 //! into a directory of tapes, which `python/tests/test_tapes.py` loads with `load_models` and
-//! runs by name) runs against it. Needs `python3` with `venv` and the
-//! Python package registry (for maturin, NumPy, pytest, pandas, matplotlib and the notebook
-//! tools, at the versions pinned in `python/requirements-test.txt`); `.ci/run` installs them.
+//! runs by name, and `python/examples/dask_sweep.py`, run on a `dask.distributed` LocalCluster
+//! of two workers and on a cluster given by its scheduler's address, whose result
+//! `python/tests/test_dask_sweep.py` checks against the local sweep to the bit) runs against
+//! it. Needs `python3` with `venv` and the Python package registry (for maturin, NumPy, pytest,
+//! pandas, matplotlib, the notebook tools, dask and distributed, at the versions pinned in
+//! `python/requirements-test.txt`); `.ci/run` installs them.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -425,3 +425,66 @@ fn the_tolerance_shown_in_help_is_the_planners_default() {
     let help = String::from_utf8_lossy(&rodcube(&["sweep", "--help"]).stdout).into_owned();
     assert!(help.contains("[default: 1e-10]"), "{help}");
 }
+
+#[test]
+fn want_takes_any_scalar_quantity_of_an_integrated_model() {
+    // The friction model (integrated, no per-point solver) with `contact_end` and
+    // `floor_impact`: their columns whatever the points, the contact's end at mu = 0 the
+    // paper's separation (t_sep = 0.108493254170856 s at g = 9.81, held to the 256-bit
+    // reference by tests/hard_cases.rs).
+    let dir = temp_dir("friction-want");
+    succeeds(&[
+        "sweep",
+        "--model",
+        "rod_cube_friction",
+        "--axis",
+        "mu=0,0.5",
+        "--set",
+        "m1=1,m2=3,ell=1,a=0.25,g=9.81",
+        "--want",
+        "contact_end,floor_impact",
+        "--tolerance",
+        "1e-12",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let (_, header, rows) = read_csv(&dir.join("sweep.csv"));
+    let col = |name: &str| {
+        (header.iter().position(|h| h == name)).unwrap_or_else(|| panic!("{name}: {header:?}"))
+    };
+    for name in [
+        "contact_end_angle",
+        "floor_normal_end_time",
+        "impact_angular_velocity",
+    ] {
+        col(name);
+    }
+    let (end, separation) = (col("contact_end_time"), col("separation_time"));
+    assert!(
+        (rows[0][end] - 0.108493254170856).abs() < 1e-11,
+        "{}",
+        rows[0][end]
+    );
+    // The separation is the first contact's end by its force: one number, two columns.
+    for row in &rows {
+        assert_eq!(row[end].to_bits(), row[separation].to_bits());
+        assert!(row[end] < row[col("floor_impact_time")]);
+    }
+    // The floor holds the foot throughout: no end of its own, an empty cell.
+    assert!(
+        rows.iter()
+            .all(|r| r[col("floor_normal_end_time")].is_nan())
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Runs rodcube, failing the test with its error output unless it succeeds.
+fn succeeds(args: &[&str]) -> Output {
+    let out = rodcube(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}

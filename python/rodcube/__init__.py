@@ -12,6 +12,10 @@
   assumes none (not even g). A point that fails is NaN, ``False`` in the ``ok`` mask, and
   listed in ``errors`` with the reason. ``sensitivities=True`` adds the exact
   ``d(separation_angle)/d(<p>)`` and ``d(separation_time)/d(<p>)`` for every parameter.
+  With ``want=[...]`` (quantity names) it sweeps any model through the planner instead and
+  returns an array per scalar result of the wanted quantities (``contact_end_time``,
+  ``floor_impact_time``, ...); ``sweep_results(model, want)`` lists them with their units.
+  ``python/examples/dask_sweep.py`` runs such a sweep on a ``dask.distributed`` cluster.
 - ``models()`` and ``parameters(model)``: the registry, with each parameter's unit and meaning.
 - ``load_models(path)``: adds to the registry the models of a directory of tapes (as
   ``rodcube derive --tapes-into DIR SPEC`` writes them: a model derived a minute ago, run with
@@ -42,6 +46,8 @@ import numpy as np
 
 from ._rodcube import RodcubeError, load_models, models, parameters, solve
 from ._rodcube import sweep_flat as _sweep_flat
+from ._rodcube import sweep_planned as _sweep_planned
+from ._rodcube import sweep_results
 from ._notebook import Derivation, RunResult, derivation, derivation_models, run
 
 __all__ = [
@@ -56,6 +62,7 @@ __all__ = [
     "run",
     "solve",
     "sweep",
+    "sweep_results",
 ]
 
 
@@ -70,9 +77,20 @@ def _numbers(what, value):
 
 
 def sweep(
-    n=None, a_over_ell=None, *, model="rod_cube", axes=None, defaults=None, sensitivities=False, **parameters
+    n=None,
+    a_over_ell=None,
+    *,
+    model="rod_cube",
+    want=None,
+    tolerance=None,
+    until=None,
+    axes=None,
+    defaults=None,
+    sensitivities=False,
+    **parameters,
 ):
-    """Separation angle and time of ``model`` over arrays of parameter values.
+    """Separation angle and time of ``model`` over arrays of parameter values, or with
+    ``want`` any of its scalar results.
 
     The axes are ``n`` (= m2/m1), ``a_over_ell``, the entries of ``axes`` (a dict from a
     parameter name, or a ratio ``p_over_q`` of two parameters of one unit, to values) and
@@ -95,6 +113,22 @@ def sweep(
       ``np.argwhere(~ok)``); ``index`` is a tuple indexing the result arrays, ``message`` is
       rodcube's reason.
 
+    With ``want`` (a list of quantity names, as ``solve`` takes: ``separation_time``,
+    ``contact_end``, ``floor_impact``, ``cross_check``, ...) every point runs through rodcube's
+    planner instead, any model (integrated, friction, impacts, tapes) and any quantity with a
+    number per point: the dict holds one float array per scalar result of the wanted quantities
+    (``contact_end_time``, ``contact_end_angle``, ``<contact>_end_time``,
+    ``floor_impact_time``, ``impact_angular_velocity``, ...: the keys of results.json, whose
+    units ``sweep_results(model, want)`` lists) beside ``ok`` and ``errors``. A point is
+    ``False`` in ``ok`` where the model refuses it or the planner fails (every value NaN), or
+    where a wanted quantity has no value there (NaN, the others kept; ``errors`` gives its
+    note); a contact of its own that holds to the end is NaN in its ``<contact>_end_*`` only.
+    ``tolerance`` (relative, default 1e-10) and ``until`` (s from release: the motion goes on
+    through impacts to that time) are ``solve``'s. The columns depend on the model and ``want``
+    alone, so a sweep cut into blocks (``python/examples/dask_sweep.py`` runs one on a
+    ``dask.distributed`` cluster) has the same keys in every block, and each point's numbers
+    are the same wherever it runs.
+
     With ``sensitivities=True`` it also holds, for every parameter ``p`` of the model, the exact
     sensitivities ``d(separation_angle)/d(<p>)`` (rad per unit of ``p``) and
     ``d(separation_time)/d(<p>)`` (s per unit of ``p``) as float arrays of the same shape: the
@@ -103,7 +137,8 @@ def sweep(
     opens at release, say) they are NaN, the point is ``False`` in ``ok`` (its angle and time
     kept) and ``errors`` says why.
 
-    Raises ``RodcubeError`` for an unknown model, axis or parameter, a parameter without a
+    Raises ``RodcubeError`` for an unknown model, axis, parameter or quantity, a quantity
+    that is no number per point, a parameter without a
     value (the message lists each with its unit and meaning), a parameter set twice, a value
     that is not a number, or axes whose shapes do not broadcast together.
     """
@@ -145,9 +180,34 @@ def sweep(
         raise RodcubeError(f"the axes' shapes do not broadcast together: {shapes}") from None
     shape = broadcast[0].shape
     columns = [np.ascontiguousarray(b).reshape(-1) for b in broadcast]
-    angle, time, ok, failures, derivatives = _sweep_flat(
-        model, [name for name, _ in named], columns, fixed, given, bool(sensitivities)
-    )
+    names = [name for name, _ in named]
+    if want is None:
+        if tolerance is not None or until is not None:
+            raise RodcubeError(
+                "tolerance and until are the planner's: give them with want=[...]; the separation "
+                "sweep without want solves each point exactly"
+            )
+        angle, time, ok, failures, derivatives = _sweep_flat(
+            model, names, columns, fixed, given, bool(sensitivities)
+        )
+        results = [("separation_angle", angle), ("separation_time", time)] + derivatives
+    else:
+        if sensitivities:
+            raise RodcubeError(
+                "sensitivities=True is the separation sweep's (without want); with want, solve "
+                "wants \"sensitivities\" point by point"
+            )
+        if isinstance(want, str) or not all(isinstance(w, str) for w in want):
+            raise RodcubeError(f"want must be a list of quantity names, not {want!r}")
+        results, ok, failures = _sweep_planned(
+            model, list(want), names, columns, fixed, given, tolerance, until
+        )
+    return _shaped(shape, results, ok, failures)
+
+
+def _shaped(shape, results, ok, failures):
+    """The sweep's dict: each flat result and the mask in ``shape``, the failures' flat indices
+    as index tuples into it."""
     if failures and shape:
         flat = np.fromiter((i for i, _ in failures), dtype=np.intp, count=len(failures))
         where = zip(*(k.tolist() for k in np.unravel_index(flat, shape)))
@@ -155,11 +215,7 @@ def sweep(
     else:
         # A 0-d result: its one point's index is ().
         errors = [((), message) for _, message in failures]
-    out = {
-        "separation_angle": angle.reshape(shape),
-        "separation_time": time.reshape(shape),
-        "ok": ok.reshape(shape),
-        "errors": errors,
-    }
-    out.update((name, values.reshape(shape)) for name, values in derivatives)
+    out = {name: values.reshape(shape) for name, values in results}
+    out["ok"] = ok.reshape(shape)
+    out["errors"] = errors
     return out

@@ -3,7 +3,7 @@ its parameters and return types (`python/tests` checks them against the installe
 
 from collections.abc import Mapping, Sequence
 from os import PathLike
-from typing import Any, NamedTuple, Optional, TypedDict, Union
+from typing import Any, NamedTuple, Optional, TypedDict, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -20,6 +20,7 @@ __all__ = [
     "run",
     "solve",
     "sweep",
+    "sweep_results",
 ]
 
 class RodcubeError(ValueError):
@@ -112,11 +113,37 @@ def solve(
     why.
     """
 
+@overload
 def sweep(
     n: Optional[npt.ArrayLike] = None,
     a_over_ell: Optional[npt.ArrayLike] = None,
     *,
     model: str = "rod_cube",
+    want: Sequence[str],
+    tolerance: Optional[float] = None,
+    until: Optional[float] = None,
+    axes: Optional[Mapping[str, npt.ArrayLike]] = None,
+    defaults: Optional[Mapping[str, float]] = None,
+    sensitivities: bool = False,
+    **parameters: Union[float, npt.ArrayLike],
+) -> dict[str, Any]:
+    """Any model's scalar results through the planner over broadcast axes: a float array per
+    scalar result of the wanted quantities (`contact_end`, `floor_impact`, ...), keyed as in
+    results.json (`contact_end_time`, ...: `sweep_results(model, want)` lists them) and NaN
+    where a point has none; `ok` (`NDArray[bool_]`, True where the point has a value of every
+    wanted quantity) and `errors` (`list[tuple[tuple[int, ...], str]]`: index and rodcube's
+    message, or the note why a quantity has no value, for every point not ok, in C order).
+    `tolerance` and `until` are `solve`'s; `sensitivities=True` is refused here."""
+
+@overload
+def sweep(
+    n: Optional[npt.ArrayLike] = None,
+    a_over_ell: Optional[npt.ArrayLike] = None,
+    *,
+    model: str = "rod_cube",
+    want: None = None,
+    tolerance: None = None,
+    until: None = None,
     axes: Optional[Mapping[str, npt.ArrayLike]] = None,
     defaults: Optional[Mapping[str, float]] = None,
     sensitivities: bool = False,
@@ -126,6 +153,10 @@ def sweep(
     keyword parameters given as arrays); every parameter needs a value from an axis, a keyword
     or `defaults`, g included. `sensitivities=True` adds `d(separation_angle)/d(<p>)` and
     `d(separation_time)/d(<p>)` for every parameter (see above)."""
+
+def sweep_results(model: str, want: Sequence[str]) -> list[tuple[str, str]]:
+    """The scalar results `sweep(model=model, want=want, ...)` returns, `(key, unit)` in order:
+    they follow from the model and `want` alone, whatever the points."""
 
 class Step(NamedTuple):
     """One step of a derivation: a `\\subsection*` of the write-up, numbered in its order."""

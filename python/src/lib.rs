@@ -23,6 +23,7 @@ use rodcube::report::prose;
 use rodcube::results::Note;
 use rodcube::solve::lean::LeanSolver;
 use rodcube::solve::sensitivity::SensitivityWork;
+use rodcube::sweep::{Points, planned};
 
 mod notebook;
 
@@ -320,28 +321,11 @@ fn sweep_flat<'py>(
     let m = find(model)?;
     let info = m.info();
     LeanSolver::new(m).map_err(error)?;
-    if axes.is_empty() || axes.len() != columns.len() {
-        return Err(error(format!(
-            "give one column per axis and at least one axis: {} axes, {} columns",
-            axes.len(),
-            columns.len()
-        )));
-    }
-    let columns: Vec<Vec<f64>> = columns.iter().map(|c| c.as_array().to_vec()).collect();
-    let len = columns[0].len();
-    if let Some((name, c)) = axes.iter().zip(&columns).find(|(_, c)| c.len() != len) {
-        return Err(error(format!(
-            "axis `{}` has {len} values and `{name}` {}; they must have as many",
-            axes[0],
-            c.len()
-        )));
-    }
-    let axis_names: Vec<&str> = axes.iter().map(String::as_str).collect();
+    let points = flat_points(axes, &columns)?;
+    let axis_names: Vec<&str> = points.names.iter().map(String::as_str).collect();
     let mapping = full_mapping(info, &axis_names, &fixed, &defaults)?;
-    let dims = columns.len();
-    let points: Vec<f64> = (0..len)
-        .flat_map(|k| columns.iter().map(move |c| c[k]))
-        .collect();
+    let (dims, len) = (points.names.len(), points.len());
+    let points = points.values;
     let mut angle = vec![f64::NAN; len];
     let mut time = vec![f64::NAN; len];
     let mut ok = vec![false; len];
@@ -396,6 +380,99 @@ fn sweep_flat<'py>(
         errors,
         sens_columns,
     ))
+}
+
+/// The points of flat columns, one per axis and all of one length (the Python `sweep`
+/// broadcasts and reshapes), point after point.
+fn flat_points(axes: Vec<String>, columns: &[PyReadonlyArray1<'_, f64>]) -> PyResult<Points> {
+    if axes.is_empty() || axes.len() != columns.len() {
+        return Err(error(format!(
+            "give one column per axis and at least one axis: {} axes, {} columns",
+            axes.len(),
+            columns.len()
+        )));
+    }
+    let columns: Vec<Vec<f64>> = columns.iter().map(|c| c.as_array().to_vec()).collect();
+    let len = columns[0].len();
+    if let Some((name, c)) = axes.iter().zip(&columns).find(|(_, c)| c.len() != len) {
+        return Err(error(format!(
+            "axis `{}` has {len} values and `{name}` {}; they must have as many",
+            axes[0],
+            c.len()
+        )));
+    }
+    Ok(Points {
+        names: axes,
+        values: (0..len)
+            .flat_map(|k| columns.iter().map(move |c| c[k]))
+            .collect(),
+        lines: Vec::new(),
+    })
+}
+
+/// The wanted quantities of a sweep through the planner and their scalar results.
+fn sweep_wanted(model: &'static dyn Model, want: &[String]) -> PyResult<planned::Wanted> {
+    planned::wanted(model, want).map_err(error)
+}
+
+/// The scalar results `sweep(model=model, want=want, ...)` returns: `(key, unit)` in order,
+/// whatever the points.
+#[pyfunction]
+fn sweep_results(model: &str, want: Vec<String>) -> PyResult<Vec<(String, &'static str)>> {
+    let wanted = sweep_wanted(find(model)?, &want)?;
+    Ok((wanted.columns.into_iter())
+        .map(|c| (c.key, c.unit))
+        .collect())
+}
+
+/// What [`sweep_planned`] returns: `(key, values)` per scalar result (NaN where a point has
+/// none), whether each point has a value of every wanted quantity, and `(flat index,
+/// message)` for every point that has not, in index order.
+type PlannedFlat<'py> = (
+    Vec<(String, Bound<'py, PyArray1<f64>>)>,
+    Bound<'py, PyArray1<bool>>,
+    Failures,
+);
+
+/// The sweep of any model's wanted scalar results over flat arrays through the planner
+/// (`rodcube::sweep::planned`), in parallel with the GIL released. Every parameter needs a
+/// value, as in [`sweep_flat`]. A point the model refuses or cannot solve is NaN, `False`
+/// and its message; one where a wanted quantity has no value keeps the others, `False` and
+/// the note why.
+#[pyfunction]
+#[pyo3(signature = (model, want, axes, columns, fixed, defaults, tolerance=None, until=None))]
+#[allow(clippy::too_many_arguments)]
+fn sweep_planned<'py>(
+    py: Python<'py>,
+    model: &str,
+    want: Vec<String>,
+    axes: Vec<String>,
+    columns: Vec<PyReadonlyArray1<'py, f64>>,
+    fixed: Vec<(String, f64)>,
+    defaults: Vec<(String, f64)>,
+    tolerance: Option<f64>,
+    until: Option<f64>,
+) -> PyResult<PlannedFlat<'py>> {
+    let m = find(model)?;
+    let wanted = sweep_wanted(m, &want)?;
+    let points = flat_points(axes, &columns)?;
+    let axis_names: Vec<&str> = points.names.iter().map(String::as_str).collect();
+    let mapping = full_mapping(m.info(), &axis_names, &fixed, &defaults)?;
+    let settings = planned::Settings {
+        tolerance: tolerance.unwrap_or(plan::DEFAULT_TOLERANCE),
+        until,
+    };
+    let out = py
+        .detach(|| planned::run(m, &mapping, &points, &wanted, settings))
+        .map_err(error)?;
+    let (width, len) = (wanted.columns.len(), points.len());
+    let results = (wanted.columns.into_iter().enumerate())
+        .map(|(j, c)| {
+            let column: Vec<f64> = (0..len).map(|k| out.values[k * width + j]).collect();
+            (c.key, column.into_pyarray(py))
+        })
+        .collect();
+    Ok((results, out.ok.into_pyarray(py), out.errors))
 }
 
 /// The mapping from axes to parameters once every parameter has a value: an axis, a keyword
@@ -504,6 +581,8 @@ fn _rodcube(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(parameters, m)?)?;
     m.add_function(wrap_pyfunction!(solve, m)?)?;
     m.add_function(wrap_pyfunction!(sweep_flat, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep_planned, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep_results, m)?)?;
     m.add_function(wrap_pyfunction!(notebook::derivation_models, m)?)?;
     m.add_function(wrap_pyfunction!(notebook::derivation_sources, m)?)?;
     m.add_function(wrap_pyfunction!(notebook::run_scene, m)?)?;

@@ -147,6 +147,24 @@ def test_sweep_takes_the_loaded_model_by_name_in_parallel(loaded):
     assert s["separation_time"][5, 7] == pytest.approx(one["separation_time"], rel=2e-15, abs=0)
 
 
+def test_sweep_with_want_runs_the_loaded_model_through_the_planner(loaded):
+    # The plank's contact end over a 6 x 5 grid: the closed forms' angle and time (the first
+    # contact lets go by its force: the separation), each point the planner's own.
+    n = np.logspace(-1, 1, 6)[:, None]
+    r = np.linspace(0.1, 0.8, 5)
+    s = rodcube.sweep(
+        model="plank", want=["contact_end"], axes={"mc_over_mp": n, "h_over_L": r}, mp=1.0, L=1.0, g=9.81
+    )
+    assert s["ok"].all() and s["errors"] == []
+    assert [key for key, _ in rodcube.sweep_results("plank", ["contact_end"])] == [
+        k for k in s if k not in ("ok", "errors")
+    ]
+    for i, j in np.ndindex(6, 5):
+        nn, rr = float(n[i, 0]), float(r[j])
+        assert s["contact_end_angle"][i, j] == pytest.approx(separation_angle(nn, rr), rel=1e-12, abs=0)
+        assert s["contact_end_time"][i, j] == pytest.approx(separation_time(nn, rr, 1.0, 9.81), rel=1e-10, abs=0)
+
+
 def test_a_truncated_tape_is_refused_naming_the_file(tmp_path):
     before = rodcube.models()
     broken = tmp_path / "broken"

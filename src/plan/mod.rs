@@ -201,6 +201,15 @@ impl<'m> Request<'m> {
     }
 }
 
+impl Request<'_> {
+    /// Checks what does not depend on the parameters (the model is a system that offers every
+    /// wanted quantity, the tolerance, `until`, the samples) without solving anything: a sweep
+    /// refuses a request once rather than at every point.
+    pub fn check(&self) -> Result<(), PlanError> {
+        wanted(self).map(|_| ())
+    }
+}
+
 /// Why a request could not be run.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum PlanError {

@@ -1,26 +1,34 @@
 //! `rodcube sweep`: separation angle and time over a grid or a list of points, on every core,
-//! with the lean per-point solver ([`LeanSolver`]); more quantities per point through the
-//! planner; CSV out, and heat maps of a two-axis grid.
+//! with the lean per-point solver ([`crate::solve::lean::LeanSolver`]); more quantities per
+//! point through the planner ([`planned`], which also sweeps any model's scalar results
+//! alone: the Python package's engine); CSV out, and heat maps of a two-axis grid. Without
+//! the feature `cli` (the feature `sweep` alone) the module holds the points, their axes and
+//! [`planned`].
 //!
 //! Axes are named by the model's own parameters or by ratios of two of them
 //! ([`crate::axes`]: `a_over_ell`, and `n` for `m2_over_m1`); every other parameter is fixed
 //! (`--set`, default 1). The CSV's first line says how each parameter was set.
 
+#[cfg(feature = "cli")]
 pub mod heatmap;
+pub mod planned;
 
 use crate::axes::{AxisError, Mapping};
 use crate::model::{Model, ModelInfo};
-use crate::plan::{self, Request};
 use crate::quantity::Quantity;
-use crate::report::prose;
-use crate::results::Note;
-use crate::solve::lean::{LeanPoint, LeanSolver};
-use crate::solve::sensitivity::SensitivityWork;
 use crate::system::check_parameters;
-use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use std::fmt::Write as _;
-use std::path::Path;
+#[cfg(feature = "cli")]
+use {
+    crate::plan::{self, Request},
+    crate::report::prose,
+    crate::results::Note,
+    crate::solve::lean::{LeanPoint, LeanSolver},
+    crate::solve::sensitivity::SensitivityWork,
+    indicatif::{ProgressBar, ProgressStyle},
+    std::path::Path,
+};
 
 /// Points handed to one worker at a time (also the progress bar's step).
 pub const CHUNK: usize = 2048;
@@ -229,6 +237,7 @@ impl Points {
 /// Reads a CSV whose header names the axes: every column that is a parameter of the model or a
 /// ratio of two ([`crate::axes::resolve`]) is one; other columns are ignored. Lines starting
 /// with `#` are comments.
+#[cfg(feature = "cli")]
 pub fn read_points(path: &Path, info: &'static ModelInfo) -> Result<Points, SweepError> {
     let fail = |reason: String| SweepError::Points {
         path: path.display().to_string(),
@@ -327,40 +336,25 @@ pub struct SweepResults {
     pub seconds: f64,
 }
 
-/// Resolves `--want` names to quantities computed through the planner (scalars only; the
-/// separation angle and time are always there).
+/// Resolves `--want` names to quantities computed through the planner, as
+/// [`planned::wanted`] does (scalars only); the separation angle and time are always there.
 pub fn parse_want(model: &dyn Model, names: &[String]) -> Result<Vec<Quantity>, SweepError> {
     let info = model.info();
     let mut out = Vec::new();
     for name in names {
-        let q = Quantity::parse(name, info)?;
-        match q {
-            Quantity::SeparationAngle | Quantity::SeparationTime => {}
-            Quantity::LinearisedSeparationAngle
-            | Quantity::ContactTimeToFloor
-            | Quantity::PointMassFallTime
-            | Quantity::FloorImpact
-            | Quantity::CrossCheck => {
-                if !q.available(info) {
-                    return Err(SweepError::Want(format!(
-                        "model `{}` cannot provide `{name}`",
-                        info.name
-                    )));
-                }
-                if !out.contains(&q) {
-                    out.push(q);
-                }
-            }
-            Quantity::Sensitivities => {
+        match Quantity::parse(name, info) {
+            Ok(Quantity::SeparationAngle | Quantity::SeparationTime) => continue,
+            Ok(Quantity::Sensitivities) => {
                 return Err(SweepError::Want(
                     "`sensitivities` are columns of their own in a sweep: pass `--sensitivities`"
                         .into(),
                 ));
             }
-            _ => {
-                return Err(SweepError::Want(format!(
-                    "`{name}` is a series or a set of checks, not a number per point; a sweep takes scalar quantities (linearised_separation_angle, contact_time_to_floor, point_mass_fall_time, floor_impact, cross_check)"
-                )));
+            _ => {}
+        }
+        for q in planned::wanted(model, std::slice::from_ref(name))?.quantities {
+            if !out.contains(&q) {
+                out.push(q);
             }
         }
     }
@@ -368,9 +362,11 @@ pub fn parse_want(model: &dyn Model, names: &[String]) -> Result<Vec<Quantity>, 
 }
 
 /// One chunk's angles, times, extra values and failures.
+#[cfg(feature = "cli")]
 type ChunkResult = (Vec<f64>, Vec<f64>, Vec<f64>, Vec<(usize, String)>);
 
 /// Solves every point in parallel (rayon), advancing `progress` per chunk.
+#[cfg(feature = "cli")]
 pub fn run(
     model: &'static dyn Model,
     mapping: &Mapping,
@@ -387,22 +383,13 @@ pub fn run(
     let extra: Vec<Quantity> = (extra.iter().copied())
         .filter(|q| *q != Quantity::Sensitivities)
         .collect();
-    let extra = &extra[..];
-    // The extra columns' names, from the first point the planner solves.
-    let mut extra_names: Vec<String> = Vec::new();
-    if !extra.is_empty() {
-        let mut p = vec![0.0; np];
-        for point in points.values.chunks(dims).take(16) {
-            mapping.fill(point, &mut p);
-            let request = Request::new(model, p.clone())
-                .with_want(extra)
-                .with_tolerance(tolerance);
-            if let Ok(res) = plan::run(&request) {
-                extra_names = res.results.keys().cloned().collect();
-                break;
-            }
-        }
-    }
+    // The extra columns: the quantities' scalar results, whatever the points.
+    let want = planned::Wanted::of(model.info(), &extra);
+    let settings = planned::Settings {
+        tolerance,
+        until: None,
+    };
+    let mut extra_names: Vec<String> = want.columns.iter().map(|c| c.key.clone()).collect();
     let ne = extra_names.len();
     let sens_names = if sens {
         sensitivity_columns(model.info())
@@ -441,19 +428,11 @@ pub fn run(
                 angle.push(a);
                 time.push(t);
                 if ne > 0 {
-                    let request = Request::new(model, p.clone())
-                        .with_want(extra)
-                        .with_tolerance(tolerance);
-                    match plan::run(&request) {
-                        Ok(res) => values.extend(
-                            extra_names
-                                .iter()
-                                .map(|k| res.results.get(k).map_or(f64::NAN, |s| s.value)),
-                        ),
-                        Err(e) => {
-                            values.extend(std::iter::repeat_n(f64::NAN, ne));
-                            errors.push((index, e.to_string()));
-                        }
+                    let before = values.len();
+                    values.resize(before + ne, f64::NAN);
+                    let row = &mut values[before..];
+                    if let Err(e) = planned::solve_point(model, &p, &want, settings, row) {
+                        errors.push((index, e));
                     }
                 }
                 if sens {
@@ -511,12 +490,14 @@ pub fn sensitivity_columns(info: &ModelInfo) -> Vec<String> {
 }
 
 /// One point's sensitivities for the sweep.
+#[cfg(feature = "cli")]
 struct Row<'a> {
     model: &'static dyn Model,
     p: &'a [f64],
     tolerance: f64,
 }
 
+#[cfg(feature = "cli")]
 impl Row<'_> {
     /// The columns of [`sensitivity_columns`] from the per-point solver's point: appended to
     /// `values` (none where there are no sensitivities, and the message why).
@@ -569,6 +550,7 @@ impl Row<'_> {
 /// The separation angle and time through the planner, for a model the per-point solver does
 /// not take (no polynomial separation condition, several coordinates): slower, but any model
 /// with a contact. A point without a separation is an error saying why.
+#[cfg(feature = "cli")]
 fn separation_by_planner(
     model: &'static dyn Model,
     p: &[f64],
@@ -591,6 +573,7 @@ fn separation_by_planner(
 }
 
 /// A progress bar on stderr for `len` points (drawn only when stderr is a terminal).
+#[cfg(feature = "cli")]
 pub fn progress_bar(len: usize) -> ProgressBar {
     let bar = ProgressBar::new(len as u64);
     if let Ok(style) = ProgressStyle::with_template(
@@ -657,6 +640,7 @@ fn cell(s: &mut String, v: f64) {
 
 /// A heat map SVG of `values` over a two-axis grid (`values[i * x.len() + j]` at `y[i]`,
 /// `x[j]`).
+#[cfg(feature = "cli")]
 pub fn heatmap_svg(
     title: &str,
     unit: &str,
