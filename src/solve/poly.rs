@@ -681,6 +681,25 @@ mod tests {
         assert!(evals > 0);
     }
 
+    /// A polynomial of `degree` with a random leading coefficient (either sign, 1e-4 to 1e4)
+    /// and roots in `[-1, 2]`, and an interval inside `[-0.2, 1.2]` near and across them.
+    fn random_from_roots(next: &mut impl FnMut() -> f64, degree: usize) -> (Vec<f64>, f64, f64) {
+        let lead = if next() < 0.5 { -1.0 } else { 1.0 } * 10f64.powf(next() * 8.0 - 4.0);
+        let mut c = vec![lead];
+        for _ in 0..degree {
+            // Multiply by (x - r).
+            let r = next() * 3.0 - 1.0;
+            let mut m = vec![0.0; c.len() + 1];
+            for (i, ci) in c.iter().enumerate() {
+                m[i + 1] += ci;
+                m[i] -= r * ci;
+            }
+            c = m;
+        }
+        let lo = next() * 1.4 - 0.2;
+        (c, lo, lo + next() * (1.2 - lo))
+    }
+
     /// The least of `c` on `[lo, hi]` as the root isolator sees it: the compensated values at
     /// the ends, at every critical point (the derivative's sign-changing roots) and at every
     /// sign change of `c` itself (a value of about zero there).
@@ -712,20 +731,7 @@ mod tests {
         let (mut said_yes, mut hard_yes, mut hard) = (0, 0, 0);
         for case in 0..40_000 {
             let (c, lo, hi) = if case % 2 == 0 {
-                let degree = (case / 2) % 8;
-                let lead = if next() < 0.5 { -1.0 } else { 1.0 } * 10f64.powf(next() * 8.0 - 4.0);
-                let mut c = vec![lead];
-                for _ in 0..degree {
-                    let r = next() * 3.0 - 1.0;
-                    let mut m = vec![0.0; c.len() + 1];
-                    for (i, ci) in c.iter().enumerate() {
-                        m[i + 1] += ci;
-                        m[i] -= r * ci;
-                    }
-                    c = m;
-                }
-                let lo = next() * 1.4 - 0.2;
-                (c, lo, lo + next() * (1.2 - lo))
+                random_from_roots(&mut next, (case / 2) % 8)
             } else {
                 let scale = 10f64.powf(next() * 12.0 - 6.0);
                 let mut c = vec![
@@ -775,21 +781,7 @@ mod tests {
         let mut next = uniform(0x0bad_5eed_1234_5678);
         let mut said_yes = 0;
         for case in 0..20_000 {
-            let degree = case % 7;
-            let lead = if next() < 0.5 { -1.0 } else { 1.0 } * 10f64.powf(next() * 8.0 - 4.0);
-            let mut c = vec![lead];
-            for _ in 0..degree {
-                // Multiply by (x - r), r in [-1, 2]; interval below is inside [-0.2, 1.2].
-                let r = next() * 3.0 - 1.0;
-                let mut m = vec![0.0; c.len() + 1];
-                for (i, ci) in c.iter().enumerate() {
-                    m[i + 1] += ci;
-                    m[i] -= r * ci;
-                }
-                c = m;
-            }
-            let lo = next() * 1.4 - 0.2;
-            let hi = lo + next() * (1.2 - lo);
+            let (c, lo, hi) = random_from_roots(&mut next, case % 7);
             let mut fixed = [0.0; 7];
             fixed[..c.len()].copy_from_slice(&c);
             if !positive_on(&fixed, lo, hi) {

@@ -658,7 +658,7 @@ fn events_on_the_extension_agree_with_the_genuine_root_in_at_most_two_trials() {
             let genuine_root = last.t0 + a;
             let (to_exact, to_genuine) = ((ev.t - exact).abs(), (ev.t - genuine_root).abs());
             assert!(
-                to_genuine <= 2.0 * super::events::EXTENSION_SHARE * rtol * exact,
+                to_genuine <= 2.0 * events::EXTENSION_SHARE * rtol * exact,
                 "{method:?} {rtol:e}: {to_genuine:e}"
             );
             assert!(
