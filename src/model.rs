@@ -339,6 +339,16 @@ pub trait Model: Send + Sync {
     /// (no constant vector in memory, no virtual call).
     #[inline(always)]
     fn lean_start(&self, p: &[f64]) -> Option<LeanStart> {
+        self.lean_start_in(p, &mut [0.0; LEAN_MAX_CONSTANTS])
+    }
+
+    /// [`Model::lean_start`] with the scratch of the constants `k` supplied by the caller
+    /// (`None` where it is shorter than [`ModelInfo::n_constants`]), so that a solver of many
+    /// points zeroes none: what `k` holds on entry is never read, as
+    /// [`Reduction::prepare_lean`] writes every constant the route reads (tests/lean.rs checks
+    /// it, for every model, against a `k` of NaNs).
+    #[inline(always)]
+    fn lean_start_in(&self, p: &[f64], k: &mut [f64]) -> Option<LeanStart> {
         let info = self.info();
         let layout = info.reduction.as_ref()?;
         let sep_len = layout.separation_degree() + 1;
@@ -349,7 +359,6 @@ pub trait Model: Send + Sync {
             return None;
         }
         let red = self.reduction()?;
-        let mut k = [0.0; LEAN_MAX_CONSTANTS];
         let k = k.get_mut(..info.n_constants)?;
         red.prepare_lean(p, k);
         let (mut separation, mut fall) = ([0.0; 4], [0.0; 3]);

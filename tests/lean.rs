@@ -376,6 +376,22 @@ fn the_lean_start_is_the_prepared_start_or_nothing() {
                 assert_eq!(row[..poly.len()], poly[..], "{} contact {i}", info.name);
                 assert!(row[poly.len()..].iter().all(|&c| c == 0.0));
             }
+            // The same from a scratch of NaNs (a solver's, left by other points): what it
+            // holds on entry is never read.
+            let mut scratch = vec![f64::NAN; info.n_constants];
+            let again = model.lean_start_in(&p, &mut scratch);
+            assert_eq!(
+                format!("{again:?}"),
+                format!("{:?}", Some(start)),
+                "{}",
+                info.name
+            );
+            assert_eq!(
+                model.lean_start_in(&p, &mut scratch[1..]),
+                None,
+                "{}",
+                info.name
+            );
             served += 1;
             // What the quick test cannot pass: a value not positive and finite, a wrong count.
             for bad in [f64::NAN, f64::INFINITY, 0.0, -1.0] {

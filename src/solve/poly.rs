@@ -407,19 +407,66 @@ fn quadratic_roots(c: &[f64], lo: f64, hi: f64, out: &mut [f64; MAX_DEGREE]) -> 
 }
 
 /// Whether `coeffs` (lowest degree first, degree below `N`) is certainly positive on
-/// `[lo, hi]`, by the shifted polynomial `p(lo + h u) = sum a_j u^j` (`h = hi - lo`, `u` in
-/// `[0, 1]`): first the cheap bound `a_0 + sum_j min(a_j, 0) > margin`, else every coefficient
-/// of its Bernstein form of degree `N - 1` above the margin (the Bernstein form's convex hull
-/// holds the graph). The margin is [`BERNSTEIN_MARGIN`] times the same shift done on
-/// `|coeffs|` and `|lo|`, which bounds the shift's rounding. A sufficient test, cheap next to
-/// isolating roots (`O(N^2)` flops, no branch on the data): `false` says nothing, and the
+/// `[lo, hi]`. A sufficient test, cheap next to isolating roots: `false` says nothing, and the
 /// caller then looks for roots. `false` too past [`MAX_DEGREE`] or for a value that is not
-/// finite.
+/// finite. Two stages: first Taylor's formula at `hi` with a bound of the curvature
+/// ([`positive_by_curvature`], `O(N)` flops), which decides every floor push of the per-point
+/// route; where it cannot, the Bernstein form ([`positive_by_bernstein`], `O(N^2)`).
 #[inline]
 pub fn positive_on<const N: usize>(coeffs: &[f64; N], lo: f64, hi: f64) -> bool {
     if N == 0 || N > MAX_DEGREE || lo.partial_cmp(&hi).is_none_or(|o| o.is_gt()) {
         return false;
     }
+    positive_by_curvature(coeffs, lo, hi) || positive_by_bernstein(coeffs, lo, hi)
+}
+
+/// The first stage of [`positive_on`] (`lo <= hi`, `coeffs` not empty): with `t = hi - x` in
+/// `[0, h]`, Taylor's formula with Lagrange's remainder gives
+/// `p(x) >= p(hi) - p'(hi) t + C t^2 / 2`, `C` a lower bound of `p''` on `[lo, hi]` taken term
+/// by term (`j (j - 1) c_j x^(j-2)` is smallest at an end of the interval, or at 0 where the
+/// interval holds it). The minimum of that parabola over `[0, h]` (an end, or its vertex when
+/// `C > 0` puts it inside) must exceed `d^2` [`BERNSTEIN_MARGIN`] times
+/// `S = sum |c_j| M^j`, `M = max(|lo|, |hi|)`, `d` the degree: the rounding of the value, the
+/// slope times `h <= 2 M` and the curvature times `h^2 / 2 <= 2 M^2` is below
+/// `(2d + 1)(1 + 2d + 2d^2) eps S`, far below that floor for every degree up to [`MAX_DEGREE`].
+#[inline]
+fn positive_by_curvature(c: &[f64], lo: f64, hi: f64) -> bool {
+    let m = lo.abs().max(hi.abs());
+    let (mut v, mut d1, mut size) = (0.0, 0.0, 0.0);
+    for &a in c.iter().rev() {
+        d1 = d1 * hi + v;
+        v = v * hi + a;
+        size = size * m + a.abs();
+    }
+    let straddles = (lo < 0.0) & (hi > 0.0);
+    let (mut low_power, mut high_power, mut curvature) = (1.0, 1.0, 0.0);
+    for (j, &a) in c.iter().enumerate().skip(2) {
+        let w = (j * (j - 1)) as f64 * a;
+        let least = (w * low_power).min(w * high_power);
+        curvature += if straddles { least.min(0.0) } else { least };
+        low_power *= lo;
+        high_power *= hi;
+    }
+    let (h, slope) = (hi - lo, -d1);
+    let end = v + slope * h + 0.5 * curvature * h * h;
+    let least = if (curvature > 0.0) & (slope < 0.0) & (-slope < curvature * h) {
+        v - slope * slope / (2.0 * curvature)
+    } else {
+        v.min(end)
+    };
+    let d = (c.len() - 1) as f64;
+    // A value that is not finite (a NaN is skipped by `min`) fails the sum's test.
+    (v + d1 + curvature + end + size).is_finite() && least > BERNSTEIN_MARGIN * d * d * size
+}
+
+/// The second stage of [`positive_on`] (`lo <= hi`), by the shifted polynomial
+/// `p(lo + h u) = sum a_j u^j` (`h = hi - lo`, `u` in `[0, 1]`): first the bound
+/// `a_0 + sum_j min(a_j, 0) > margin`, else every coefficient of its Bernstein form of degree
+/// `N - 1` above the margin (the Bernstein form's convex hull holds the graph). The margin is
+/// [`BERNSTEIN_MARGIN`] times the same shift done on `|coeffs|` and `|lo|`, which bounds the
+/// shift's rounding. Out of line: the per-point route rarely needs it.
+#[inline(never)]
+fn positive_by_bernstein<const N: usize>(coeffs: &[f64; N], lo: f64, hi: f64) -> bool {
     let d = N - 1;
     // The Taylor shift to `lo` (repeated synthetic division), and its bound on `|coeffs|`.
     let (mut a, mut m) = (*coeffs, coeffs.map(f64::abs));
@@ -634,6 +681,98 @@ mod tests {
         assert!(evals > 0);
     }
 
+    /// A polynomial of `degree` with a random leading coefficient (either sign, 1e-4 to 1e4)
+    /// and roots in `[-1, 2]`, and an interval inside `[-0.2, 1.2]` near and across them.
+    fn random_from_roots(next: &mut impl FnMut() -> f64, degree: usize) -> (Vec<f64>, f64, f64) {
+        let lead = if next() < 0.5 { -1.0 } else { 1.0 } * 10f64.powf(next() * 8.0 - 4.0);
+        let mut c = vec![lead];
+        for _ in 0..degree {
+            // Multiply by (x - r).
+            let r = next() * 3.0 - 1.0;
+            let mut m = vec![0.0; c.len() + 1];
+            for (i, ci) in c.iter().enumerate() {
+                m[i + 1] += ci;
+                m[i] -= r * ci;
+            }
+            c = m;
+        }
+        let lo = next() * 1.4 - 0.2;
+        (c, lo, lo + next() * (1.2 - lo))
+    }
+
+    /// The least of `c` on `[lo, hi]` as the root isolator sees it: the compensated values at
+    /// the ends, at every critical point (the derivative's sign-changing roots) and at every
+    /// sign change of `c` itself (a value of about zero there).
+    fn least_on(c: &[f64], lo: f64, hi: f64) -> f64 {
+        let mut evals = 0;
+        let derivative: Vec<f64> = (1..c.len()).map(|j| j as f64 * c[j]).collect();
+        let critical = real_roots(&derivative, lo, hi, &mut evals).expect("degree <= 16");
+        let roots = real_roots(c, lo, hi, &mut evals).expect("degree <= 16");
+        let at = |x: f64| horner_compensated(c, x);
+        let least = critical
+            .iter()
+            .fold(at(lo).min(at(hi)), |m, &x| m.min(at(x)));
+        if roots.is_empty() {
+            least
+        } else {
+            least.min(0.0)
+        }
+    }
+
+    #[test]
+    fn the_curvature_bound_never_certifies_a_polynomial_that_reaches_zero() {
+        // Property: random polynomials of degree 0..=7 built from their roots, and the floor
+        // push's shape `c0 - c1 x + c2 x^2 - c4 x^4` (positive coefficients) shifted down so
+        // that its least on the interval is within 1e-3 .. 1e-13 of zero, of either sign
+        // (touching and just crossing): whenever the first stage says yes, the least value
+        // the root isolation finds is positive. It must also say yes often (cheap bound
+        // useful), and never where the shift put the least at or below zero.
+        let mut next = uniform(0x5eed_c0de_0042_1234);
+        let (mut said_yes, mut hard_yes, mut hard) = (0, 0, 0);
+        for case in 0..40_000 {
+            let (c, lo, hi) = if case % 2 == 0 {
+                random_from_roots(&mut next, (case / 2) % 8)
+            } else {
+                let scale = 10f64.powf(next() * 12.0 - 6.0);
+                let mut c = vec![
+                    next() * scale,
+                    -next() * 4.0 * scale,
+                    next() * 8.0 * scale,
+                    0.0,
+                    -next() * 4.0 * scale,
+                ];
+                let lo = next() * 0.9;
+                let hi = lo + next() * (1.0 - lo);
+                // Put the least within `gap` of zero, below or above it.
+                let gap = 10f64.powf(-3.0 - next() * 10.0) * scale;
+                let sign = if next() < 0.5 { -1.0 } else { 1.0 };
+                c[0] += sign * gap - least_on(&c, lo, hi);
+                hard += 1;
+                (c, lo, hi)
+            };
+            let mut fixed = [0.0; 8];
+            fixed[..c.len()].copy_from_slice(&c);
+            if !(lo <= hi && positive_by_curvature(&fixed, lo, hi)) {
+                continue;
+            }
+            said_yes += 1;
+            hard_yes += case % 2;
+            let least = least_on(&c, lo, hi);
+            assert!(least > 0.0, "{c:?} on [{lo}, {hi}]: least {least}");
+        }
+        assert!(said_yes > 5_000, "{said_yes}");
+        assert!(hard_yes > 100 && hard_yes < hard, "{hard_yes} of {hard}");
+        // A double root far from zero (x - 10)^2, and a touching quartic (x^2 - 1/4)^2 + 0.
+        assert!(!positive_by_curvature(&[100.0, -20.0, 1.0], 9.0, 11.0));
+        assert!(!positive_by_curvature(
+            &[0.0625, 0.0, -0.5, 0.0, 1.0],
+            0.0,
+            1.0
+        ));
+        assert!(!positive_by_curvature(&[1.0, f64::NAN], 0.0, 1.0));
+        assert!(!positive_by_curvature(&[1.0, 0.0, 0.0, 1e300], 0.0, 1e300));
+    }
+
     #[test]
     fn a_bernstein_certificate_never_contradicts_the_roots() {
         // Random polynomials of degree 0..=6, with roots placed near and inside the interval:
@@ -642,21 +781,7 @@ mod tests {
         let mut next = uniform(0x0bad_5eed_1234_5678);
         let mut said_yes = 0;
         for case in 0..20_000 {
-            let degree = case % 7;
-            let lead = if next() < 0.5 { -1.0 } else { 1.0 } * 10f64.powf(next() * 8.0 - 4.0);
-            let mut c = vec![lead];
-            for _ in 0..degree {
-                // Multiply by (x - r), r in [-1, 2]; interval below is inside [-0.2, 1.2].
-                let r = next() * 3.0 - 1.0;
-                let mut m = vec![0.0; c.len() + 1];
-                for (i, ci) in c.iter().enumerate() {
-                    m[i + 1] += ci;
-                    m[i] -= r * ci;
-                }
-                c = m;
-            }
-            let lo = next() * 1.4 - 0.2;
-            let hi = lo + next() * (1.2 - lo);
+            let (c, lo, hi) = random_from_roots(&mut next, case % 7);
             let mut fixed = [0.0; 7];
             fixed[..c.len()].copy_from_slice(&c);
             if !positive_on(&fixed, lo, hi) {
