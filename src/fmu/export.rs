@@ -1,5 +1,6 @@
 //! `rodcube fmu`: writes `<model>.fmu` (an FMI 2.0 co-simulation FMU) from a system, the start
-//! values of a scene and the shared library built with the feature `fmi`, which it checks for
+//! values of a scene and the shared library with the feature `fmi` (`librodcube.so`, which the
+//! plain `cargo build --release` writes beside the `rodcube` binary), which it checks for
 //! the FMI 2.0 entry points before zipping. The model travels as data: the tapes of the system
 //! and of its fast phases go into the FMU's `resources/`, so the library is the same for every
 //! model, one derived a minute ago included. The archive is made in memory and written
@@ -17,9 +18,9 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// How to build the shared library an FMU needs (its name, `librodcube.so`, in the target
-/// directory's `release/`).
-pub const BUILD_LIBRARY: &str =
-    "cargo rustc --release --lib --no-default-features --features fmi --crate-type cdylib";
+/// directory's `release/`): the main build, whose default features include `fmi` and whose
+/// library is also a `cdylib` (Cargo.toml's `[lib]`).
+pub const BUILD_LIBRARY: &str = "cargo build --release";
 
 /// The library's file name as cargo writes it.
 pub const LIBRARY_NAME: &str = "librodcube.so";
