@@ -168,7 +168,8 @@ struct FmuArgs {
 /// How the printed tables are laid out.
 #[derive(Args, Clone, Copy, Default)]
 struct LayoutArgs {
-    /// Follow each table with the meaning of every row
+    /// Follow each table with the meaning of every row, and list everything a long run
+    /// summarises (every phase's checks, every impact, every phase in the work)
     #[arg(long, short)]
     verbose: bool,
     /// Do not wrap lines (by default they fit $COLUMNS, the terminal, or 100 columns)
