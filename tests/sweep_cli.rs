@@ -411,19 +411,11 @@ fn every_parameter_needs_a_value_and_each_missing_one_is_named_with_its_unit() {
     assert!(!err.contains("m2 [") && !err.contains("  a ["), "{err}");
     assert!(!dir.exists(), "{err}");
     // One left out of --set is still missing: no value is ever assumed.
-    let out = rodcube(&[
-        "sweep",
-        "--model",
-        "rod_cube_friction",
-        "--n",
-        "3",
-        "--a-over-ell",
-        "0.25",
-        "--set",
-        "m1=1,ell=1,g=9.81",
-        "--out",
-        d,
-    ]);
+    let friction =
+        "sweep --model rod_cube_friction --n 3 --a-over-ell 0.25 --set m1=1,ell=1,g=9.81";
+    let mut args: Vec<&str> = friction.split(' ').collect();
+    args.extend(["--out", d]);
+    let out = rodcube(&args);
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
