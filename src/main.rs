@@ -39,9 +39,9 @@ Exit status: 0 success, 1 the computation failed, 2 bad command line,
 
 const FMU_HELP: &str = "\
 The FMU's shared library is rodcube's C library with the FMI 2.0 entry points,
-librodcube.so, which `cargo build --release` (and `cargo run --release`) writes into the
-target directory's release/ beside the rodcube binary, where `rodcube fmu` looks for it
-(or pass --binary).
+librodcube.so, which the build of rodcube leaves in the target directory: beside the rodcube
+binary (`cargo build --release`) or in deps/ there (`cargo run --release`), where
+`rodcube fmu` looks for it, the newer of the two (or pass --binary).
 The parameters' start values are those of the first scene in scenes/ of the model (the
 paper's for rod_cube), or of --scene FILE. The FMU carries the model as data (the tapes of
 the system and its fast phases, in resources/), so the library is the same for every model:
@@ -160,7 +160,8 @@ struct FmuArgs {
     /// Scene whose parameters are the start values [default: the model's scene in scenes/]
     #[arg(long, value_name = "FILE")]
     scene: Option<PathBuf>,
-    /// The shared library with the FMI entry points [default: librodcube.so beside rodcube]
+    /// The shared library with the FMI entry points [default: librodcube.so beside rodcube,
+    /// or in deps/ there]
     #[arg(long, value_name = "FILE")]
     binary: Option<PathBuf>,
 }

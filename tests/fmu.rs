@@ -1,6 +1,7 @@
-//! `rodcube fmu`: the FMU of the paper's model, its shared library the one the main build writes
-//! beside the `rodcube` binary (`librodcube.so`, the `cdylib` of Cargo.toml's `[lib]`; no second
-//! cargo command), which `rodcube fmu` finds there by itself, checked by FMPy, an FMI
+//! `rodcube fmu`: the FMU of the paper's model, its shared library the one cargo's own build of
+//! the crate left (`librodcube.so`, the `cdylib` of Cargo.toml's `[lib]`, in `deps/` beside the
+//! `rodcube` binary when the library was built only for it, as by `cargo test` or `cargo run`;
+//! no second cargo command), which `rodcube fmu` finds by itself, checked by FMPy, an FMI
 //! host independent of rodcube (`tests/fmu/check_fmu.py`, in a virtual environment with the
 //! versions pinned in `tests/fmu/requirements.txt`; `.ci/run` installs them): the model
 //! description validates; the FMU carries the tapes of the system and its fast phases;
@@ -38,12 +39,13 @@ fn run(cmd: &mut Command) -> Output {
     out
 }
 
-/// The shared library with the FMI entry points: the one cargo wrote beside this test's
-/// `rodcube` when it built the crate (Cargo.toml's `[lib]` is also a `cdylib`, and the default
-/// features include `fmi`), where `rodcube fmu` looks for it.
+/// The shared library with the FMI entry points: the one cargo wrote into `deps/` beside this
+/// test's `rodcube` when it built the crate for it (Cargo.toml's `[lib]` is also a `cdylib`,
+/// and the default features include `fmi`; cargo copies up beside the binary only what was
+/// asked for, as `cargo build` asks for the library), where `rodcube fmu` looks for it too.
 fn library() -> PathBuf {
     let exe = Path::new(env!("CARGO_BIN_EXE_rodcube"));
-    exe.with_file_name("librodcube.so")
+    exe.with_file_name("deps").join("librodcube.so")
 }
 
 fn rodcube(args: &[&str]) -> Command {
@@ -88,7 +90,7 @@ const PAPER: &str = "model: rod_cube\nparameters: {m1: 1.0, m2: 3.0, ell: 1.0, a
 fn fmpy_validates_and_simulates_the_papers_fmu_as_rodcube_run() {
     let dir = fresh("paper");
     let out = dir.to_str().expect("UTF-8 path");
-    // No --binary: the library the build left beside `rodcube`.
+    // No --binary: the library the build left (as `cargo run` leaves it).
     assert!(
         library().is_file(),
         "the build wrote no {}",
