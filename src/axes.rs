@@ -1,9 +1,10 @@
 //! Sweep axes for any model: how the coordinates of a sweep's points, named by the model's own
 //! parameters (`m2`, `R`) or by ratios of two of them (`a_over_ell`, and `n` for `m2_over_m1`),
 //! become its parameter vector. The command line's `rodcube sweep` and the Python package's
-//! `sweep` both use it.
+//! `sweep` both use it. Every parameter takes its value from an axis or from a value given:
+//! none is assumed, a parameter that nothing sets is [`AxisError::Missing`].
 
-use crate::model::ModelInfo;
+use crate::model::{ModelInfo, ParamInfo};
 
 /// What one axis sets.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -93,13 +94,52 @@ pub enum AxisError {
         /// The value.
         value: f64,
     },
+    /// Parameters that neither an axis nor a value sets (no value is ever assumed).
+    #[error("{}", missing_text(model, unset))]
+    Missing {
+        /// Model name.
+        model: &'static str,
+        /// Each parameter without a value, in the model's order.
+        unset: Vec<Unset>,
+    },
+}
+
+/// A parameter that neither an axis nor a value sets.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Unset {
+    /// The parameter (its name, unit and meaning).
+    pub parameter: ParamInfo,
+    /// The ratio axes measured against it (`a_over_ell` against `ell`).
+    pub against: Vec<String>,
+}
+
+/// `model `rod_cube`: no value for 2 parameters (rodcube assumes none):`, then one line per
+/// parameter with its unit, its meaning and the ratio axes measured against it.
+fn missing_text(model: &str, unset: &[Unset]) -> String {
+    let mut text = format!(
+        "model `{model}`: no value for {} parameter{} (rodcube assumes none):",
+        unset.len(),
+        if unset.len() == 1 { "" } else { "s" }
+    );
+    for u in unset {
+        let p = &u.parameter;
+        text.push_str(&format!("\n  {} [{}]: {}", p.name, p.unit, p.meaning));
+        if !u.against.is_empty() {
+            let axes: Vec<String> = u.against.iter().map(|a| format!("`{a}`")).collect();
+            text.push_str(&format!(
+                "; the axis {} is measured against it",
+                axes.join(", ")
+            ));
+        }
+    }
+    text
 }
 
 /// Where each parameter's value comes from.
 #[derive(Debug, Clone, PartialEq)]
 enum Source {
-    /// Given (or the default, 1).
-    Fixed { value: f64, given: bool },
+    /// A value given.
+    Fixed(f64),
     /// Axis `k`.
     Axis(usize),
 }
@@ -166,7 +206,8 @@ fn parameter_list(info: &ModelInfo) -> String {
 
 impl Mapping {
     /// Axes by name (in the order of a point's coordinates) and fixed values by parameter
-    /// name; every other parameter is 1.
+    /// name. Every parameter needs one or the other: the others are [`AxisError::Missing`],
+    /// checked after everything else, so its list is complete when nothing else is wrong.
     pub fn new(
         info: &'static ModelInfo,
         axes: &[&str],
@@ -185,13 +226,7 @@ impl Mapping {
                 Ok(())
             }
         };
-        let mut sources = vec![
-            Source::Fixed {
-                value: 1.0,
-                given: false
-            };
-            np
-        ];
+        let mut sources: Vec<Option<Source>> = vec![None; np];
         let mut targets = Vec::with_capacity(axes.len());
         for (k, name) in axes.iter().enumerate() {
             let target = resolve(name, info)?;
@@ -199,7 +234,7 @@ impl Mapping {
                 Target::Parameter(i) | Target::Ratio { numerator: i, .. } => i,
             };
             claim(set, format!("the axis `{name}`"))?;
-            sources[set] = Source::Axis(k);
+            sources[set] = Some(Source::Axis(k));
             targets.push(target);
         }
         for &(name, value) in fixed {
@@ -217,11 +252,11 @@ impl Mapping {
                 });
             }
             claim(i, format!("the value `{name} = {value}`"))?;
-            sources[i] = Source::Fixed { value, given: true };
+            sources[i] = Some(Source::Fixed(value));
         }
         for (k, target) in targets.iter().enumerate() {
             if let Target::Ratio { denominator, .. } = *target
-                && let Source::Axis(j) = sources[denominator]
+                && let Some(Source::Axis(j)) = sources[denominator]
                 && matches!(targets[j], Target::Ratio { .. })
             {
                 return Err(AxisError::Chained {
@@ -231,10 +266,11 @@ impl Mapping {
                 });
             }
         }
+        let sources = complete(info, axes, &targets, sources)?;
         let base = sources
             .iter()
             .map(|s| match s {
-                Source::Fixed { value, .. } => *value,
+                Source::Fixed(value) => *value,
                 Source::Axis(_) => f64::NAN,
             })
             .collect();
@@ -278,19 +314,15 @@ impl Mapping {
     }
 
     /// One line saying how every parameter is set: `m1 = 1, m2 = n * m1, ell = 1,
-    /// a = a_over_ell * ell, g = 1`, with the defaults marked.
+    /// a = a_over_ell * ell, g = 9.81`.
     pub fn describe(&self) -> String {
-        let mut defaulted = false;
         let parts: Vec<String> = self
             .info
             .parameters
             .iter()
             .zip(&self.sources)
             .map(|(p, s)| match s {
-                Source::Fixed { value, given } => {
-                    defaulted |= !given;
-                    format!("{} = {value}{}", p.name, if *given { "" } else { "*" })
-                }
+                Source::Fixed(value) => format!("{} = {value}", p.name),
                 Source::Axis(k) => match self.targets[*k] {
                     Target::Parameter(_) => format!("{} = {}", p.name, self.names[*k]),
                     Target::Ratio { denominator, .. } => format!(
@@ -300,10 +332,34 @@ impl Mapping {
                 },
             })
             .collect();
-        let mut line = parts.join(", ");
-        if defaulted {
-            line.push_str(" (* not given: 1)");
-        }
-        line
+        parts.join(", ")
     }
+}
+
+/// Every parameter's source, or [`AxisError::Missing`] naming those without one.
+fn complete(
+    info: &'static ModelInfo,
+    axes: &[&str],
+    targets: &[Target],
+    sources: Vec<Option<Source>>,
+) -> Result<Vec<Source>, AxisError> {
+    let unset: Vec<Unset> = (info.parameters.iter().enumerate())
+        .filter(|&(i, _)| sources[i].is_none())
+        .map(|(i, p)| Unset {
+            parameter: *p,
+            against: (axes.iter().zip(targets))
+                .filter(
+                    |(_, t)| matches!(t, Target::Ratio { denominator, .. } if *denominator == i),
+                )
+                .map(|(name, _)| name.to_string())
+                .collect(),
+        })
+        .collect();
+    if !unset.is_empty() {
+        return Err(AxisError::Missing {
+            model: info.name,
+            unset,
+        });
+    }
+    Ok(sources.into_iter().flatten().collect())
 }

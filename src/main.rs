@@ -38,10 +38,10 @@ Exit status: 0 success, 1 the computation failed, 2 bad command line,
 4 an output could not be written (`rodcube fmu`: 2, and no partial .fmu is left).";
 
 const FMU_HELP: &str = "\
-The FMU's shared library is built from the C ABI with the FMI 2.0 entry points:
-  cargo rustc --release --lib --no-default-features --features fmi --crate-type cdylib
-which writes librodcube.so into the target directory's release/, beside the rodcube binary
-that `cargo build --release` writes, where `rodcube fmu` looks for it (or pass --binary).
+The FMU's shared library is rodcube's C library with the FMI 2.0 entry points,
+librodcube.so, which the build of rodcube leaves in the target directory: beside the rodcube
+binary (`cargo build --release`) or in deps/ there (`cargo run --release`), where
+`rodcube fmu` looks for it, the newer of the two (or pass --binary).
 The parameters' start values are those of the first scene in scenes/ of the model (the
 paper's for rod_cube), or of --scene FILE. The FMU carries the model as data (the tapes of
 the system and its fast phases, in resources/), so the library is the same for every model:
@@ -160,7 +160,8 @@ struct FmuArgs {
     /// Scene whose parameters are the start values [default: the model's scene in scenes/]
     #[arg(long, value_name = "FILE")]
     scene: Option<PathBuf>,
-    /// The shared library built with the feature `fmi` [default: librodcube.so beside rodcube]
+    /// The shared library with the FMI entry points [default: librodcube.so beside rodcube,
+    /// or in deps/ there]
     #[arg(long, value_name = "FILE")]
     binary: Option<PathBuf>,
 }
@@ -168,7 +169,8 @@ struct FmuArgs {
 /// How the printed tables are laid out.
 #[derive(Args, Clone, Copy, Default)]
 struct LayoutArgs {
-    /// Follow each table with the meaning of every row
+    /// Follow each table with the meaning of every row, and list everything a long run
+    /// summarises (every phase's checks, every impact, every phase in the work)
     #[arg(long, short)]
     verbose: bool,
     /// Do not wrap lines (by default they fit $COLUMNS, the terminal, or 100 columns)

@@ -15,17 +15,18 @@ An axis is named by a parameter of the model (m2, R, ...) or by a ratio of two p
 the same unit, written p_over_q (a_over_ell sets a = value * ell); n stands for m2_over_m1.
 Its values are START:STOP:lin|log:COUNT, a single value, or values separated by commas. A grid
 takes every combination, the first axis varying slowest. Parameters on no axis are fixed with
---set (default 1), so with the paper's model m1 = ell = g = 1 and the results read in units of
-sqrt(ell/g). The CSV's first line says how each parameter was set; its columns are the axes,
+--set: each needs a value (none is assumed; a missing one is named with its unit). With
+--set m1=1,ell=1,g=1 the results read in units of sqrt(ell/g). The CSV's first line says
+how each parameter was set; its columns are the axes,
 separation_angle, separation_time, then the result keys of each --want quantity (computed by
 the planner, much slower). --heatmap draws a two-axis grid.
 
 Examples:
-  rodcube sweep --n 1e-3:1e3:log:200 --a-over-ell 0.01:0.99:lin:200 --heatmap
-  rodcube sweep --model hinged_rod --n 0.1,1,10 --a-over-ell 0.05:0.95:lin:19
-  rodcube sweep --model rod_cylinder --axis m2_over_m1=0.5:8:log:20 --axis R=0.05:0.3:lin:20 --heatmap
-  rodcube sweep --model wall_ladder --a-over-ell 0.1:0.9:lin:9 --set ell=5,g=9.81
-  rodcube sweep --points points.csv --want point_mass_fall_time --set ell=1,g=9.81";
+  rodcube sweep --n 1e-3:1e3:log:200 --a-over-ell 0.01:0.99:lin:200 --set m1=1,ell=1,g=1 --heatmap
+  rodcube sweep --model hinged_rod --n 0.1,1,10 --a-over-ell 0.05:0.95:lin:19 --set m1=1,ell=1,g=9.81
+  rodcube sweep --model rod_cylinder --axis m2_over_m1=0.5:8:log:20 --axis R=0.05:0.3:lin:20 --set m1=1,ell=1,th0=0.9,g=9.81 --heatmap
+  rodcube sweep --model wall_ladder --a-over-ell 0.1:0.9:lin:9 --set m1=1,ell=5,g=9.81
+  rodcube sweep --points points.csv --want point_mass_fall_time --set m1=1,ell=1,g=9.81";
 
 pub const ACCURACY_HELP: &str = "\
 Runs every method on the paper's case (n = 3, a/ell = 1/4) and the hard cases (near upright,
@@ -60,7 +61,7 @@ pub struct SweepArgs {
     /// The axis a/ell (same as --axis a_over_ell=SPEC)
     #[arg(long = "a-over-ell", value_name = "SPEC", allow_hyphen_values = true)]
     a_over_ell: Option<String>,
-    /// Parameters on no axis: NAME=VALUE, comma-separated or repeated (default 1 each)
+    /// Parameters on no axis: NAME=VALUE, comma-separated or repeated (each needs a value)
     #[arg(
         long,
         value_delimiter = ',',
@@ -171,7 +172,16 @@ pub fn sweep(args: SweepArgs) -> Result<(), Failure> {
     };
     let names: Vec<&str> = points.names.iter().map(String::as_str).collect();
     let fixed_ref: Vec<(&str, f64)> = fixed.iter().map(|(n, v)| (n.as_str(), *v)).collect();
-    let mapping = rodcube::axes::Mapping::new(info, &names, &fixed_ref).map_err(usage)?;
+    let mapping = rodcube::axes::Mapping::new(info, &names, &fixed_ref).map_err(|e| match e {
+        rodcube::axes::AxisError::Missing { ref unset, .. } => {
+            let first = unset.first().map_or("g", |u| u.parameter.name);
+            let column = if args.points.is_some() { ", as a column of the points file" } else { "" };
+            usage(format!(
+                "{e}\ngive each with --set NAME=VALUE (--set {first}=...), on an axis (--axis {first}=SPEC){column}"
+            ))
+        }
+        e => usage(e),
+    })?;
     sweep::check(&mapping, model, &points).map_err(usage)?;
     let heat_axes = grid.as_ref().filter(|a| a.len() == 2);
     if args.heatmap && heat_axes.is_none() {

@@ -1,5 +1,7 @@
-//! `rodcube fmu`: the FMU of the paper's model, its shared library built with the feature `fmi`
-//! (in its own target directory under the test's temporary directory), checked by FMPy, an FMI
+//! `rodcube fmu`: the FMU of the paper's model, its shared library the one cargo's own build of
+//! the crate left (`librodcube.so`, the `cdylib` of Cargo.toml's `[lib]`, in `deps/` beside the
+//! `rodcube` binary when the library was built only for it, as by `cargo test` or `cargo run`;
+//! no second cargo command), which `rodcube fmu` finds by itself, checked by FMPy, an FMI
 //! host independent of rodcube (`tests/fmu/check_fmu.py`, in a virtual environment with the
 //! versions pinned in `tests/fmu/requirements.txt`; `.ci/run` installs them): the model
 //! description validates; the FMU carries the tapes of the system and its fast phases;
@@ -18,7 +20,6 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use std::sync::OnceLock;
 
 fn tmp() -> PathBuf {
     Path::new(env!("CARGO_TARGET_TMPDIR")).join("fmu")
@@ -38,31 +39,13 @@ fn run(cmd: &mut Command) -> Output {
     out
 }
 
-/// The shared library with the FMI entry points, built once for all the tests here.
-fn library() -> &'static Path {
-    static LIBRARY: OnceLock<PathBuf> = OnceLock::new();
-    LIBRARY.get_or_init(|| {
-        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-        let target = tmp().join("target");
-        run(Command::new(env!("CARGO"))
-            .args([
-                "rustc",
-                "--quiet",
-                "--release",
-                "--lib",
-                "--no-default-features",
-            ])
-            .args([
-                "--features",
-                "fmi",
-                "--crate-type",
-                "cdylib",
-                "--manifest-path",
-            ])
-            .arg(root.join("Cargo.toml"))
-            .env("CARGO_TARGET_DIR", &target));
-        target.join("release/librodcube.so")
-    })
+/// The shared library with the FMI entry points: the one cargo wrote into `deps/` beside this
+/// test's `rodcube` when it built the crate for it (Cargo.toml's `[lib]` is also a `cdylib`,
+/// and the default features include `fmi`; cargo copies up beside the binary only what was
+/// asked for, as `cargo build` asks for the library), where `rodcube fmu` looks for it too.
+fn library() -> PathBuf {
+    let exe = Path::new(env!("CARGO_BIN_EXE_rodcube"));
+    exe.with_file_name("deps").join("librodcube.so")
 }
 
 fn rodcube(args: &[&str]) -> Command {
@@ -106,11 +89,14 @@ const PAPER: &str = "model: rod_cube\nparameters: {m1: 1.0, m2: 3.0, ell: 1.0, a
 #[test]
 fn fmpy_validates_and_simulates_the_papers_fmu_as_rodcube_run() {
     let dir = fresh("paper");
-    let lib = library().to_str().expect("UTF-8 path").to_string();
     let out = dir.to_str().expect("UTF-8 path");
-    run(&mut rodcube(&[
-        "fmu", "rod_cube", "--out", out, "--binary", &lib,
-    ]));
+    // No --binary: the library the build left (as `cargo run` leaves it).
+    assert!(
+        library().is_file(),
+        "the build wrote no {}",
+        library().display()
+    );
+    run(&mut rodcube(&["fmu", "rod_cube", "--out", out]));
     let fmu = dir.join("rod_cube.fmu");
     // `rodcube run`'s series on the FMU's 1e-4 s grid: 0.18 s (before the landing) in 1800
     // steps; and the landing time of the whole motion.
@@ -254,9 +240,12 @@ fn refusals_exit_2_and_leave_no_partial_fmu() {
     let missing = missing.to_str().expect("UTF-8 path");
     refused(
         &["fmu", "rod_cube", "--out", &out, "--binary", missing],
-        "--features fmi --crate-type cdylib",
+        "build it with `cargo build --release`",
     );
-    let not_fmi = env!("CARGO_BIN_EXE_rodcube");
+    // A library with only the first two entry points (as the C library without `fmi` has none).
+    let not_fmi = fresh("not_fmi").join("librodcube.so");
+    std::fs::write(&not_fmi, b"\x7fELF\0fmi2GetTypesPlatform\0fmi2GetVersion\0").expect("file");
+    let not_fmi = not_fmi.to_str().expect("UTF-8 path");
     refused(
         &["fmu", "rod_cube", "--out", &out, "--binary", not_fmi],
         "built without the feature `fmi`",

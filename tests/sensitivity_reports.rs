@@ -260,7 +260,7 @@ fn sweep_sensitivities_add_columns_equal_to_the_per_point_solver() {
             "--a-over-ell",
             "0.25",
             "--set",
-            "ell=1,g=9.81",
+            "m1=1,ell=1,g=9.81",
             "--sensitivities",
             "--out",
             "out",

@@ -1,7 +1,8 @@
 //! `rodcube sweep` end to end: the CSV's first line says how every parameter was set, its rows
 //! match the planner point by point, axes are any model's parameters or their ratios (a model
 //! off the per-point solver goes through the planner), points files and heat maps work, and
-//! bad input (an upright rod, `n` for a model without `m2`, an unknown model) is a clear error.
+//! bad input (an upright rod, `n` for a model without `m2`, an unknown model, a parameter that
+//! nothing sets) is a clear error.
 
 use rodcube::plan::{self, Request};
 use rodcube::quantity::Quantity;
@@ -72,6 +73,8 @@ fn a_grid_sweep_matches_the_planner_and_says_it_is_dimensionless() {
         "1e-3:1e3:log:4",
         "--a-over-ell",
         "0.01:0.99:lin:3",
+        "--set",
+        "m1=1,ell=1,g=1",
         "--heatmap",
         "--out",
         dir.to_str().unwrap(),
@@ -86,8 +89,9 @@ fn a_grid_sweep_matches_the_planner_and_says_it_is_dimensionless() {
     let (comment, header, rows) = read_csv(&dir.join("sweep.csv"));
     assert!(
         comment.starts_with('#')
-            && comment.contains("m1 = 1*, m2 = n * m1, ell = 1*, a = a_over_ell * ell, g = 1*")
-            && comment.contains("not given: 1"),
+            && comment.contains("m1 = 1, m2 = n * m1, ell = 1, a = a_over_ell * ell, g = 1")
+            && !comment.contains("1*")
+            && !comment.contains("not given"),
         "{comment}"
     );
     assert_eq!(
@@ -129,7 +133,7 @@ fn set_fixes_parameters_and_extra_quantities_come_from_the_planner() {
         "--a-over-ell",
         "0.25",
         "--set",
-        "ell=1,g=9.81",
+        "m1=1,ell=1,g=9.81",
         "--want",
         "point_mass_fall_time,linearised_separation_angle",
         "--out",
@@ -176,6 +180,8 @@ fn a_points_file_is_swept_in_its_order() {
         "hinged_rod",
         "--points",
         file.to_str().unwrap(),
+        "--set",
+        "m1=1,ell=1,g=1",
         "--out",
         out_dir.to_str().unwrap(),
     ]);
@@ -211,6 +217,8 @@ fn the_wall_ladder_sweeps_a_over_ell_alone_and_refuses_n() {
         "wall_ladder",
         "--a-over-ell",
         "0.3,0.6,0.9",
+        "--set",
+        "m1=1,ell=1,g=1",
         "--out",
         dir.to_str().unwrap(),
     ]);
@@ -254,13 +262,25 @@ fn bad_sweeps_fail_with_a_clear_message() {
                 "3",
                 "--a-over-ell",
                 "0.5:1:lin:3",
+                "--set",
+                "m1=1,ell=1,g=1",
                 "--out",
                 d,
             ],
             "a < ell",
         ),
         (
-            vec!["sweep", "--n", "3", "--a-over-ell", "1.5", "--out", d],
+            vec![
+                "sweep",
+                "--n",
+                "3",
+                "--a-over-ell",
+                "1.5",
+                "--set",
+                "m1=1,ell=1,g=1",
+                "--out",
+                d,
+            ],
             "point 1 (n = 3, a_over_ell = 1.5)",
         ),
         (
@@ -372,6 +392,40 @@ fn bad_sweeps_fail_with_a_clear_message() {
 }
 
 #[test]
+fn every_parameter_needs_a_value_and_each_missing_one_is_named_with_its_unit() {
+    let dir = temp_dir("missing");
+    let d = dir.to_str().unwrap();
+    let out = rodcube(&["sweep", "--n", "3", "--a-over-ell", "0.25", "--out", d]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("no value for 3 parameters"), "{err}");
+    for line in [
+        "m1 [kg]: mass of the rod; the axis `n` is measured against it",
+        "ell [m]: length of the rod; the axis `a_over_ell` is measured against it",
+        "g [m/s^2]: gravitational acceleration",
+        "--set m1=...",
+    ] {
+        assert!(err.contains(line), "{line}: {err}");
+    }
+    // Only those: m2 and a are set by the ratios, and nothing was written.
+    assert!(!err.contains("m2 [") && !err.contains("  a ["), "{err}");
+    assert!(!dir.exists(), "{err}");
+    // One left out of --set is still missing: no value is ever assumed.
+    let friction =
+        "sweep --model rod_cube_friction --n 3 --a-over-ell 0.25 --set m1=1,ell=1,g=9.81";
+    let mut args: Vec<&str> = friction.split(' ').collect();
+    args.extend(["--out", d]);
+    let out = rodcube(&args);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("no value for 1 parameter (") && err.contains("mu [1]"),
+        "{err}"
+    );
+    assert!(!dir.exists(), "{err}");
+}
+
+#[test]
 fn any_model_sweeps_over_its_own_parameters_and_ratios() {
     // rod_cylinder has no per-point solver (its separation condition is not polynomial): the
     // sweep goes through the planner, and its axes are its own parameters.
@@ -385,7 +439,7 @@ fn any_model_sweeps_over_its_own_parameters_and_ratios() {
         "--axis",
         "R=0.05,0.1",
         "--set",
-        "th0=0.9,g=9.81",
+        "m1=1,ell=1,th0=0.9,g=9.81",
         "--heatmap",
         "--out",
         dir.to_str().unwrap(),

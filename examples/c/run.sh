@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Builds rodcube's C library (cdylib, feature `capi`) and the C programs of examples/c/ with the
-# system C compiler (`cc`, or $CC), then runs one: `run.sh` runs paper, `run.sh per_point [N]`
+# Builds rodcube's C library (the cdylib of Cargo.toml's [lib], without the command line: the
+# feature `fmi` and the `capi` it implies, so it is also the library `rodcube fmu` packs) and the
+# C programs of examples/c/ with the system C compiler (`cc`, or $CC), then runs one: `run.sh` runs paper, `run.sh per_point [N]`
 # the per-point cost probe, `run.sh tapes DIR MODEL NAME=VALUE...` a model loaded from a
 # directory of tapes. Honours CARGO_TARGET_DIR.
 set -euo pipefail
@@ -10,8 +11,8 @@ target="${CARGO_TARGET_DIR:-$root/target}"
 program="${1:-paper}"
 shift || true
 
-cargo rustc --quiet --manifest-path "$root/Cargo.toml" --release --lib \
-    --no-default-features --features capi --crate-type cdylib
+cargo build --quiet --manifest-path "$root/Cargo.toml" --release --lib \
+    --no-default-features --features fmi
 mkdir -p "$target/c-example"
 # Each program is linked to a file of this run's own and renamed into place, so that a run
 # started beside this one (the tests run several) never executes a file still being written

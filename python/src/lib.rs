@@ -15,8 +15,8 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
-use rodcube::axes::{Mapping, Target, resolve};
-use rodcube::model::{Model, ModelInfo, ParamInfo};
+use rodcube::axes::{AxisError, Mapping};
+use rodcube::model::{Model, ModelInfo};
 use rodcube::plan::{self, Parameters, Request};
 use rodcube::quantity::Quantity;
 use rodcube::report::prose;
@@ -206,18 +206,8 @@ fn solve<'py>(
 /// Points per parallel task.
 const CHUNK: usize = 4096;
 
-/// A parameter that neither an axis nor a keyword sets, with its entry in `defaults` if any.
-type Unset<'a> = (&'static ParamInfo, Option<&'a (String, f64)>);
-
-/// The parameters set by neither an axis (`targets`, resolved) nor a keyword value, each with
-/// what `defaults` gives it (`None`: nothing, so the sweep cannot run). Keyword values that
-/// are no parameter are left to [`Mapping::new`], which refuses them by name.
-fn unset<'a>(
-    info: &'static ModelInfo,
-    targets: &[Target],
-    fixed: &[(&str, f64)],
-    defaults: &'a [(String, f64)],
-) -> PyResult<Vec<Unset<'a>>> {
+/// Refuses `defaults` that name no parameter of the model.
+fn check_defaults(info: &'static ModelInfo, defaults: &[(String, f64)]) -> PyResult<()> {
     if let Some((name, _)) = defaults
         .iter()
         .find(|(name, _)| !info.parameters.iter().any(|p| p.name == *name))
@@ -229,59 +219,7 @@ fn unset<'a>(
             names.join(", ")
         )));
     }
-    Ok(info
-        .parameters
-        .iter()
-        .enumerate()
-        .filter(|&(i, p)| {
-            let on_axis = targets.iter().any(|t| match *t {
-                Target::Parameter(j) | Target::Ratio { numerator: j, .. } => j == i,
-            });
-            !on_axis && !fixed.iter().any(|(name, _)| *name == p.name)
-        })
-        .map(|(_, p)| (p, defaults.iter().find(|(d, _)| d == p.name)))
-        .collect())
-}
-
-/// The message for parameters that nothing sets: each with its unit and meaning, and the
-/// ratio axes measured against it.
-fn missing_message(
-    info: &'static ModelInfo,
-    axes: &[&str],
-    targets: &[Target],
-    missing: &[&ParamInfo],
-) -> String {
-    let lines: Vec<String> = missing
-        .iter()
-        .map(|p| {
-            let against: Vec<String> = axes
-                .iter()
-                .zip(targets)
-                .filter(|(_, t)| match **t {
-                    Target::Ratio { denominator, .. } => {
-                        info.parameters.get(denominator).map(|d| d.name) == Some(p.name)
-                    }
-                    Target::Parameter(_) => false,
-                })
-                .map(|(name, _)| format!("`{name}`"))
-                .collect();
-            let ratio = if against.is_empty() {
-                String::new()
-            } else {
-                format!("; the axis {} is measured against it", against.join(", "))
-            };
-            format!("  {} [{}]: {}{ratio}", p.name, p.unit, p.meaning)
-        })
-        .collect();
-    let first = missing.first().map_or("g", |p| p.name);
-    format!(
-        "model `{}`: no value for {} parameter{} (rodcube assumes none):\n{}\n\
-         give each as a keyword ({first}=...), on an axis, or in defaults={{\"{first}\": ...}}",
-        info.name,
-        missing.len(),
-        if missing.len() == 1 { "" } else { "s" },
-        lines.join("\n")
-    )
+    Ok(())
 }
 
 /// What [`sweep_flat`] returns: separation angle and time (NaN where a point failed), whether
@@ -476,37 +414,35 @@ fn sweep_planned<'py>(
 }
 
 /// The mapping from axes to parameters once every parameter has a value: an axis, a keyword
-/// value (`fixed`) or `defaults`. A parameter that nothing sets is an error naming it.
+/// value (`fixed`) or `defaults`. A parameter that nothing sets is an error naming it (the
+/// library's [`AxisError::Missing`], with how to give it from Python).
 fn full_mapping(
     info: &'static ModelInfo,
     axis_names: &[&str],
     fixed: &[(String, f64)],
     defaults: &[(String, f64)],
 ) -> PyResult<Mapping> {
+    check_defaults(info, defaults)?;
     let mut values: Vec<(&str, f64)> = fixed.iter().map(|(n, v)| (n.as_str(), *v)).collect();
-    // Refused axes or keyword values first, by name, before anything is said to be missing.
-    Mapping::new(info, axis_names, &values).map_err(error)?;
-    let targets = axis_names
-        .iter()
-        .map(|name| resolve(name, info).map_err(error))
-        .collect::<PyResult<Vec<_>>>()?;
-    let unset = unset(info, &targets, &values, defaults)?;
-    let missing: Vec<&ParamInfo> = unset
-        .iter()
-        .filter(|(_, d)| d.is_none())
-        .map(|(p, _)| *p)
-        .collect();
-    if !missing.is_empty() {
-        return Err(error(missing_message(info, axis_names, &targets, &missing)));
-    }
-    values.extend(
-        unset
-            .iter()
-            .flat_map(|(_, d)| d.map(|(n, v)| (n.as_str(), *v))),
-    );
-    // Every parameter is now an axis or a value given: `Mapping`'s 1 for the others never
-    // applies.
-    Mapping::new(info, axis_names, &values).map_err(error)
+    // Refused axes or keyword values first, by name; then `defaults` give what nothing set.
+    let unset = match Mapping::new(info, axis_names, &values) {
+        Err(AxisError::Missing { unset, .. }) => unset,
+        other => return other.map_err(error),
+    };
+    values.extend(unset.iter().filter_map(|u| {
+        (defaults.iter())
+            .find(|(name, _)| name == u.parameter.name)
+            .map(|(name, v)| (name.as_str(), *v))
+    }));
+    Mapping::new(info, axis_names, &values).map_err(|e| match &e {
+        AxisError::Missing { unset, .. } => {
+            let first = unset.first().map_or("g", |u| u.parameter.name);
+            error(format!(
+                "{e}\ngive each as a keyword ({first}=...), on an axis, or in defaults={{\"{first}\": ...}}"
+            ))
+        }
+        _ => error(e),
+    })
 }
 
 /// One parallel task's share of the sweep's outputs.

@@ -1,5 +1,6 @@
 //! `rodcube fmu`: writes `<model>.fmu` (an FMI 2.0 co-simulation FMU) from a system, the start
-//! values of a scene and the shared library built with the feature `fmi`, which it checks for
+//! values of a scene and the shared library with the feature `fmi` (`librodcube.so`, which the
+//! build of `rodcube` leaves beside it or in `deps/` there: [`default_binary`]), which it checks for
 //! the FMI 2.0 entry points before zipping. The model travels as data: the tapes of the system
 //! and of its fast phases go into the FMU's `resources/`, so the library is the same for every
 //! model, one derived a minute ago included. The archive is made in memory and written
@@ -17,9 +18,9 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// How to build the shared library an FMU needs (its name, `librodcube.so`, in the target
-/// directory's `release/`).
-pub const BUILD_LIBRARY: &str =
-    "cargo rustc --release --lib --no-default-features --features fmi --crate-type cdylib";
+/// directory's `release/`): the main build, whose default features include `fmi` and whose
+/// library is also a `cdylib` (Cargo.toml's `[lib]`).
+pub const BUILD_LIBRARY: &str = "cargo build --release";
 
 /// The library's file name as cargo writes it.
 pub const LIBRARY_NAME: &str = "librodcube.so";
@@ -238,10 +239,21 @@ pub fn defaults(model: &'static dyn Model, scene: Option<&Scene>) -> Result<Defa
 }
 
 /// Where `rodcube fmu` looks for the shared library when none is given: beside the running
-/// executable (cargo writes both into the target directory's `release/`).
+/// executable, where `cargo build` writes both, and in `deps/` there, where cargo leaves the
+/// library when it built it only for the binary (`cargo run`, `cargo test`: it copies up
+/// only what was asked for); the newer of the two that exist (the other may be left from an
+/// older build), else the first, which the error names.
 pub fn default_binary() -> Option<PathBuf> {
     let exe = std::env::current_exe().ok()?;
-    Some(exe.parent()?.join(LIBRARY_NAME))
+    let dir = exe.parent()?;
+    let candidates = [dir.join(LIBRARY_NAME), dir.join("deps").join(LIBRARY_NAME)];
+    let modified = |p: &PathBuf| std::fs::metadata(p).and_then(|m| m.modified()).ok();
+    let newest = (candidates.iter())
+        .filter_map(|p| Some((modified(p)?, p)))
+        .max_by_key(|(t, _)| *t)
+        .map(|(_, p)| p.clone());
+    let [first, _] = candidates;
+    Some(newest.unwrap_or(first))
 }
 
 /// The shared library at `path`, checked to export every FMI 2.0 co-simulation function.

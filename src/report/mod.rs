@@ -14,12 +14,18 @@
 //! the impact that closed a converging sequence of bounces).
 
 #[cfg(feature = "cli")]
+mod checks;
+#[cfg(feature = "cli")]
 pub mod csv;
 pub mod json;
+#[cfg(feature = "cli")]
+mod layout;
 pub mod motion;
 #[cfg(feature = "cli")]
 pub mod plot;
 pub mod prose;
+#[cfg(feature = "cli")]
+mod sequence;
 #[cfg(feature = "cli")]
 pub mod table;
 mod touch;

@@ -2,11 +2,14 @@
 //! paper's figures beside ours when the scene is the paper's), impacts, notes on quantities
 //! without a value, checks, series and work; and the `rodcube models` listing.
 
+pub use super::layout::Layout;
+pub(crate) use super::layout::{align_right, new_table, no_wrap, wrap};
+use super::layout::{section, with_unit};
 use crate::model::ModelInfo;
 use crate::quantity::{FIXED, Quantity};
 pub use crate::results::format_number;
-use crate::results::{Check, CheckKind, ImpactRecord, RunResults};
-use comfy_table::{CellAlignment, ColumnConstraint, ContentArrangement, Table, Width, presets};
+use crate::results::{ImpactRecord, LabelValue, RunResults};
+use comfy_table::{Cell, CellAlignment, ColumnConstraint, Width};
 
 /// The paper's published figures (Section 3, three digits), by result key.
 pub const PAPER_FIGURES: &[(&str, &str)] = &[
@@ -35,86 +38,6 @@ pub fn is_paper_case(results: &RunResults) -> bool {
         && (9.8 - 1e-9..=9.81 + 1e-9).contains(&g)
 }
 
-/// How wide the report may be, and how much it says.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Layout {
-    /// Largest line length in characters; `None` for no limit (`--wide`).
-    pub width: Option<usize>,
-    /// Whether each table is followed by a legend with the meaning of every row.
-    pub verbose: bool,
-}
-
-impl Layout {
-    /// The width of piped output (and of a terminal whose width cannot be read).
-    pub const PIPE_WIDTH: usize = 100;
-
-    /// The layout of stdout: `COLUMNS` when set to a number, else the terminal's width, else
-    /// [`Layout::PIPE_WIDTH`]; no limit with `wide`.
-    pub fn detect(wide: bool, verbose: bool) -> Layout {
-        let width = if wide {
-            None
-        } else {
-            let columns = std::env::var("COLUMNS")
-                .ok()
-                .and_then(|c| c.trim().parse::<usize>().ok())
-                .filter(|&c| c > 0);
-            let terminal = || {
-                use std::io::IsTerminal;
-                std::io::stdout()
-                    .is_terminal()
-                    .then(|| Table::new().width().map(usize::from))
-                    .flatten()
-            };
-            Some(columns.or_else(terminal).unwrap_or(Self::PIPE_WIDTH))
-        };
-        Layout { width, verbose }
-    }
-}
-
-impl Default for Layout {
-    /// [`Layout::PIPE_WIDTH`] columns, no legends.
-    fn default() -> Self {
-        Layout {
-            width: Some(Self::PIPE_WIDTH),
-            verbose: false,
-        }
-    }
-}
-
-/// `v` and its unit (`0.1085 s`; a pure number without one).
-fn with_unit(v: f64, sig: usize, unit: &str) -> String {
-    match unit {
-        "" | "1" => format_number(v, sig),
-        _ => format!("{} {unit}", format_number(v, sig)),
-    }
-}
-
-pub(crate) fn new_table(header: &[&str], layout: &Layout) -> Table {
-    let mut t = Table::new();
-    t.load_style(presets::UTF8_FULL_CONDENSED)
-        .set_header(header.to_vec());
-    match layout.width {
-        // Wraps the free-text columns (at spaces) so that no line is longer than `width`.
-        Some(w) => {
-            t.set_content_arrangement(ContentArrangement::Dynamic)
-                .set_width(u16::try_from(w).unwrap_or(u16::MAX));
-        }
-        None => {
-            t.set_content_arrangement(ContentArrangement::Disabled);
-        }
-    }
-    t
-}
-
-/// Keeps these columns at their content's width (identifiers and numbers must not wrap).
-pub(crate) fn no_wrap(t: &mut Table, columns: &[usize]) {
-    for &c in columns {
-        if let Some(col) = t.column_mut(c) {
-            col.set_constraint(ColumnConstraint::ContentWidth);
-        }
-    }
-}
-
 /// Result keys in the order of the quantity vocabulary (the paper's order), then the rest
 /// alphabetically.
 fn result_order(key: &str) -> (usize, &str) {
@@ -125,57 +48,6 @@ fn result_order(key: &str) -> (usize, &str) {
             .unwrap_or(FIXED.len()),
         key,
     )
-}
-
-pub(crate) fn align_right(t: &mut Table, columns: &[usize]) {
-    for &c in columns {
-        if let Some(col) = t.column_mut(c) {
-            col.set_cell_alignment(CellAlignment::Right);
-        }
-    }
-}
-
-/// `text` broken at spaces into lines of at most `width` characters (a longer word stays
-/// whole), each line after the first indented by `indent` spaces.
-pub(crate) fn wrap(text: &str, width: Option<usize>, indent: usize) -> String {
-    let Some(width) = width else {
-        return text.to_string();
-    };
-    let mut out = String::new();
-    let mut line_len = 0;
-    for word in text.split_whitespace() {
-        let len = word.chars().count();
-        if line_len > indent && line_len + 1 + len > width {
-            out.push('\n');
-            out.push_str(&" ".repeat(indent));
-            line_len = indent;
-        } else if !out.is_empty() {
-            out.push(' ');
-            line_len += 1;
-        }
-        out.push_str(word);
-        line_len += len;
-    }
-    out
-}
-
-/// A section: its title, the table, and with `verbose` a legend of what each row means.
-fn section(
-    out: &mut String,
-    title: &str,
-    table: &Table,
-    legend: &[(String, String)],
-    layout: &Layout,
-) {
-    out.push_str(&format!("\n{title}\n{table}\n"));
-    if layout.verbose && legend.iter().any(|(_, m)| !m.is_empty()) {
-        let mut t = new_table(&["", "meaning"], layout);
-        for (name, meaning) in legend.iter().filter(|(_, m)| !m.is_empty()) {
-            t.add_row(vec![name.clone(), meaning.clone()]);
-        }
-        no_wrap(&mut t, &[0]);
-        out.push_str(&format!("{t}\n"));
-    }
 }
 
 /// The full report of a run. `info` supplies parameter units and meanings when known.
@@ -207,7 +79,7 @@ pub fn render(results: &RunResults, info: Option<&ModelInfo>, layout: &Layout) -
         out.push_str(&format!("\nNotes\n{t}\n"));
     }
     if !results.checks.is_empty() {
-        checks(&mut out, results, layout);
+        super::checks::checks(&mut out, results, layout);
     }
     series(&mut out, results, layout);
     work(&mut out, results, layout);
@@ -241,6 +113,29 @@ fn parameters(out: &mut String, results: &RunResults, info: Option<&ModelInfo>, 
     align_right(&mut t, &[1]);
     no_wrap(&mut t, &[0, 1, 2]);
     out.push_str(&format!("\nParameters\n{t}\n"));
+}
+
+/// Most stretches of a label listed one by one without `--verbose`.
+pub const MAX_STRETCHES_LISTED: usize = 4;
+
+/// A label's cell: its value ([`super::prose::label`]); without `verbose`, a sequence of more
+/// than [`MAX_STRETCHES_LISTED`] stretches as its modes with repeats counted, within three
+/// lines of the cell.
+fn label_cell(value: &LabelValue, layout: &Layout) -> String {
+    match value {
+        LabelValue::Stretches(stretches)
+            if !layout.verbose && stretches.len() > MAX_STRETCHES_LISTED =>
+        {
+            let modes: Vec<&str> = stretches.iter().map(|s| s.modes.as_str()).collect();
+            let budget = layout.width.map(|w| 3 * w.saturating_sub(40).max(20));
+            format!(
+                "{} ({} stretches; --verbose: when each began)",
+                super::sequence::summarise(&modes, " -> ", budget),
+                stretches.len()
+            )
+        }
+        other => super::prose::label(other),
+    }
 }
 
 fn scalars(out: &mut String, results: &RunResults, layout: &Layout) {
@@ -277,7 +172,7 @@ fn scalars(out: &mut String, results: &RunResults, layout: &Layout) {
     for (key, label) in &results.labels {
         let mut row = vec![
             key.clone(),
-            super::prose::label(&label.value),
+            label_cell(&label.value, layout),
             String::new(),
             String::new(),
         ];
@@ -302,13 +197,55 @@ fn scalars(out: &mut String, results: &RunResults, layout: &Layout) {
     }
 }
 
+/// Most impacts listed without `--verbose`: more are shown as the first and the last
+/// [`IMPACTS_AT_EACH_END`], with how many are left out between them.
+pub const MAX_IMPACTS_LISTED: usize = 12;
+
+/// Impacts shown at each end of a long list.
+pub const IMPACTS_AT_EACH_END: usize = 5;
+
 /// The impacts: one row per contact taking part in each impact, the closing one marked `*`;
 /// the impact's time and energy lost on its first row, `(Zeno)` beside the energy of an impact
-/// that closed a converging sequence of bounces. A line of legend says what the marks mean
-/// (another for the Zeno mark, when there is one); with `verbose`, what the table is.
+/// that closed a converging sequence of bounces. A unit that every row shares is in the header,
+/// else in each cell. Without `verbose`, a list longer than [`MAX_IMPACTS_LISTED`] shows its
+/// ends. A line of legend says what the marks mean (another for the Zeno mark, when there is
+/// one); with `verbose`, what the table is.
 fn impacts(out: &mut String, list: &[ImpactRecord], layout: &Layout) {
+    let contacts = || list.iter().flat_map(|r| &r.per_contact);
+    let shared = |unit: fn(&crate::results::ContactImpulse) -> &str| {
+        let first = contacts().next().map(unit);
+        first.filter(|u| contacts().all(|c| unit(c) == *u))
+    };
+    let velocity_unit = shared(|c| c.velocity_unit);
+    let impulse_unit = shared(|c| c.impulse_unit);
+    let in_cell = |v: f64, unit: &str, shared: Option<&str>| match shared {
+        Some(_) => format_number(v, 6),
+        None => with_unit(v, 6, unit),
+    };
+    let shown: Vec<Option<&ImpactRecord>> = if layout.verbose || list.len() <= MAX_IMPACTS_LISTED {
+        list.iter().map(Some).collect()
+    } else {
+        let end = IMPACTS_AT_EACH_END;
+        let head = list[..end].iter().map(Some);
+        head.chain([None])
+            .chain(list[list.len() - end..].iter().map(Some))
+            .collect()
+    };
     let mut rows: Vec<[String; 6]> = Vec::new();
-    for r in list {
+    for r in shown {
+        let Some(r) = r else {
+            let left = list.len() - 2 * IMPACTS_AT_EACH_END;
+            let gap = format!("… {left} more (--verbose, impacts.csv)");
+            rows.push([
+                "…".into(),
+                gap,
+                String::new(),
+                String::new(),
+                String::new(),
+                "…".into(),
+            ]);
+            continue;
+        };
         let mut time = format_number(r.time, 6);
         let mut energy = format_number(r.energy_lost, 6);
         if r.zeno_limit {
@@ -330,26 +267,34 @@ fn impacts(out: &mut String, list: &[ImpactRecord], layout: &Layout) {
             rows.push([
                 std::mem::take(&mut time),
                 mark(&c.contact),
-                with_unit(c.normal_velocity_before, 6, c.velocity_unit),
-                with_unit(c.normal_velocity_after, 6, c.velocity_unit),
-                with_unit(c.impulse, 6, c.impulse_unit),
+                in_cell(c.normal_velocity_before, c.velocity_unit, velocity_unit),
+                in_cell(c.normal_velocity_after, c.velocity_unit, velocity_unit),
+                in_cell(c.impulse, c.impulse_unit, impulse_unit),
                 std::mem::take(&mut energy),
             ]);
         }
     }
+    let titled = |title: &str, unit: Option<&str>| match unit {
+        Some(u) => format!("{title} ({u})"),
+        None => title.to_string(),
+    };
     let header = [
-        "t (s)",
-        "contact",
-        "v before",
-        "v after",
-        "impulse",
-        "energy lost (J)",
+        "t (s)".to_string(),
+        "contact".to_string(),
+        titled("v before", velocity_unit),
+        titled("v after", velocity_unit),
+        titled("impulse", impulse_unit),
+        "energy lost (J)".to_string(),
     ];
+    let header: Vec<&str> = header.iter().map(String::as_str).collect();
     let mut t = new_table(&header, layout);
     let mut widths = [0usize; 6];
     for row in rows {
-        for (w, cell) in widths.iter_mut().zip(&row) {
-            *w = (*w).max(cell.chars().count());
+        // The gap's words may wrap; the names and numbers never do.
+        if row[0] != "…" {
+            for (w, cell) in widths.iter_mut().zip(&row) {
+                *w = (*w).max(cell.chars().count());
+            }
         }
         t.add_row(row.to_vec());
     }
@@ -378,93 +323,6 @@ fn impacts(out: &mut String, list: &[ImpactRecord], layout: &Layout) {
         out.push_str(&wrap(super::json::IMPACTS_MEANING, layout.width, 2));
         out.push('\n');
     }
-}
-
-/// Checks grouped by phase, in the order the phases happen (each group its own table, all with
-/// the same column widths); each with what it measured, in its own unit, the bound it is held
-/// to and, for a monitor, when it came closest.
-fn checks(out: &mut String, results: &RunResults, layout: &Layout) {
-    let mut rows: Vec<(&String, &Check)> = results.checks.iter().collect();
-    rows.sort_by_key(|(key, c)| (c.order, c.kind != CheckKind::Monitor, key.as_str()));
-    let cells: Vec<(&Check, [String; 5])> = rows
-        .iter()
-        .map(|(key, c)| (*c, check_cells(key, c)))
-        .collect();
-    let header = ["check", "status", "measured", "held to", "at t"];
-    let mut widths: Vec<usize> = header.iter().map(|h| h.chars().count()).collect();
-    for (_, row) in &cells {
-        for (w, cell) in widths.iter_mut().zip(row) {
-            *w = (*w).max(cell.chars().count());
-        }
-    }
-    let failed = results.checks.values().filter(|c| !c.passed).count();
-    out.push_str(&format!(
-        "\nChecks ({} passed, {failed} failed), phase by phase\n",
-        results.checks.len() - failed
-    ));
-    let mut legend = Vec::new();
-    let mut group = 0;
-    while group < cells.len() {
-        let phase = &cells[group].0.phase;
-        let end = cells[group..]
-            .iter()
-            .position(|(c, _)| &c.phase != phase)
-            .map_or(cells.len(), |n| group + n);
-        let mut t = new_table(&header, layout);
-        for (c, row) in &cells[group..end] {
-            t.add_row(row.to_vec());
-            legend.push((row[0].clone(), super::prose::check_meaning(c)));
-        }
-        // The same widths in every group, where they fit the line; else each group wraps.
-        let total: usize = widths.iter().map(|w| w + 3).sum::<usize>() + 1;
-        let fixed = if layout.width.is_some_and(|w| total > w) {
-            &[][..]
-        } else {
-            &widths[..]
-        };
-        for (i, w) in fixed.iter().enumerate() {
-            if let Some(col) = t.column_mut(i) {
-                let w = u16::try_from(*w + 2).unwrap_or(u16::MAX);
-                col.set_constraint(ColumnConstraint::LowerBoundary(Width::Fixed(w)));
-            }
-        }
-        align_right(&mut t, &[4]);
-        section(
-            out,
-            &wrap(
-                &format!("{}:", super::prose::check_phase(phase)),
-                layout.width,
-                2,
-            ),
-            &t,
-            &legend,
-            layout,
-        );
-        legend.clear();
-        group = end;
-    }
-}
-
-/// A check's row: name, status, what was measured, the bound, and when.
-fn check_cells(key: &str, c: &Check) -> [String; 5] {
-    let name = key.rsplit('.').next().unwrap_or(key).to_string();
-    let status = if c.passed { "pass" } else { "FAIL" }.to_string();
-    let (measured, held_to) = match c.kind {
-        CheckKind::Monitor => (
-            format!("min {}", with_unit(c.value, 5, &c.unit)),
-            format!(">= {}", with_unit(c.limit, 3, &c.unit)),
-        ),
-        CheckKind::Drift => (
-            format!("drift {}", format_number(c.value, 3)),
-            format!("<= {}", format_number(c.limit, 3)),
-        ),
-        CheckKind::Identity => (
-            format!("drift {}", format_number(c.value, 3)),
-            format!("<= {} (built in)", format_number(c.limit, 3)),
-        ),
-    };
-    let at = c.at_time.map_or(String::new(), |t| with_unit(t, 4, "s"));
-    [name, status, measured, held_to, at]
 }
 
 fn series(out: &mut String, results: &RunResults, layout: &Layout) {
@@ -502,15 +360,22 @@ fn work(out: &mut String, results: &RunResults, layout: &Layout) {
         "ODE right-hand sides".to_string(),
         w.ode_evaluations.to_string(),
     ]);
-    t.add_row(vec![
-        "phases".to_string(),
-        if w.phases.is_empty() {
-            "-".to_string()
-        } else {
-            w.phases.join(" -> ")
-        },
-    ]);
+    let phases: Vec<&str> = w.phases.iter().map(String::as_str).collect();
+    let phases = if phases.is_empty() {
+        "-".to_string()
+    } else if layout.verbose {
+        phases.join(" -> ")
+    } else {
+        // Three lines of the cell at most (its column: the width less `ODE right-hand sides`
+        // and the borders).
+        let budget = layout.width.map(|w| 3 * w.saturating_sub(28).max(20));
+        super::sequence::summarise(&phases, " -> ", budget)
+    };
     align_right(&mut t, &[1]);
+    t.add_row(vec![
+        Cell::new("phases"),
+        Cell::new(phases).set_alignment(CellAlignment::Left),
+    ]);
     out.push_str(&format!("\nWork\n{t}\n"));
 }
 
