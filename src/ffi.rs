@@ -1119,6 +1119,7 @@ mod tests {
             SensitivityGap::NoSeparation,
             SensitivityGap::NotBuilt,
             SensitivityGap::PastImpact,
+            SensitivityGap::PastZeno,
             SensitivityGap::Grazing,
             SensitivityGap::RoutesDisagree,
             SensitivityGap::IntegrationFailed,

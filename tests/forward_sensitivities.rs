@@ -289,30 +289,64 @@ fn a_stick_slip_switch_time_moves_as_differences_across_it_say() {
     }
 }
 
+/// The times of `walker`'s impacts that close no Zeno sequence, in order.
+fn impact_times(walker: &Walker) -> Vec<f64> {
+    let motion = walker.motion(&mut Work::default()).expect("solves");
+    (motion.impacts.iter())
+        .filter(|i| i.zeno.is_none())
+        .map(|i| i.t)
+        .collect()
+}
+
 #[test]
-fn the_sensitive_motion_stops_at_the_first_impact_it_would_go_through() {
-    // The bouncing rod goes on through its impacts to 0.6 s; the impact map's derivatives
-    // are not built, so the motion with sensitivities stops at the first.
+fn the_sensitive_motion_goes_through_every_impact_and_its_times_move_as_differences_say() {
+    // The bouncing rod goes on through its impacts to 0.6 s: `S` crosses each by its saltation
+    // matrix, up to the limit of the converging (Zeno) sequence, which is extrapolated.
     let (model, p) = scene("bounce");
     let mut w = walker(model, &p);
     w.until = Some(0.6);
     let sensitive = w.sensitive_motion(&mut Work::default()).expect("solves");
-    assert_eq!(sensitive.stop, Some(Stop::Impact));
+    assert_eq!(sensitive.stop, Some(Stop::Zeno));
     assert_eq!(sensitive.ends.len(), sensitive.motion.phases.len());
-    assert!(matches!(
-        sensitive.motion.last_end(),
-        Some(rodcube::solve::phases::End::Contact(_))
-    ));
     let full = w.motion(&mut Work::default()).expect("solves");
-    assert!(full.phases.len() > sensitive.motion.phases.len());
-    assert!(!full.impacts.is_empty() && sensitive.motion.impacts.is_empty());
-    // Every phase up to the impact has its end's derivatives.
-    assert!(sensitive.ends.iter().all(Result::is_ok));
+    assert_eq!(sensitive.motion.impacts.len(), full.impacts.len());
+    let crossed = &sensitive.motion.impacts[..sensitive.motion.impacts.len() - 1];
+    assert!(crossed.len() >= 4, "{} impacts", crossed.len());
+    // The first four impacts' times against fourth-order central differences of the run.
+    for name in ["e", "a", "ell", "g", "m2"] {
+        let j = model
+            .info()
+            .parameters
+            .iter()
+            .position(|q| q.name == name)
+            .unwrap();
+        let h = STEP * p[name].abs();
+        let at = |k: f64| {
+            let mut q = p.clone();
+            *q.get_mut(name).unwrap() += k * h;
+            let mut w = walker(model, &q);
+            w.until = Some(0.6);
+            impact_times(&w)
+        };
+        let (a, b, c, d) = (at(1.0), at(-1.0), at(2.0), at(-2.0));
+        for (k, impact) in crossed.iter().take(4).enumerate() {
+            let dt = sensitive.ends[impact.phase]
+                .as_ref()
+                .expect("not grazing")
+                .t[j];
+            let diff = (8.0 * (a[k] - b[k]) - (c[k] - d[k])) / (12.0 * h);
+            let scale = (impact.t / p[name]).abs().max(diff.abs());
+            assert!(
+                (dt - diff).abs() <= 1e-7 * scale,
+                "impact {}, d t/d {name}: {dt} vs differences {diff}",
+                k + 1
+            );
+        }
+    }
 }
 
 #[test]
-fn results_past_an_impact_get_a_note_and_no_number() {
-    // The same run's impacts: their numbers have no sensitivities, and say so.
+fn every_impact_time_has_its_sensitivities_and_the_zeno_limit_a_note() {
     let (model, p) = scene("bounce");
     let want = [
         Quantity::ContactEnd,
@@ -323,13 +357,34 @@ fn results_past_an_impact_get_a_note_and_no_number() {
         .with_want(&want)
         .with_until(Some(0.6));
     let res = plan::run(&request).expect("runs");
+    let impacts = res.impacts.as_ref().expect("impacts");
+    let last = impacts.len();
+    assert!(impacts[last - 1].zeno_limit && last >= 5);
+    for i in 1..last {
+        for q in ["m1", "m2", "ell", "a", "g", "e"] {
+            let key = format!("d(impact_{i}_time)/d({q})");
+            let s = res
+                .sensitivities
+                .get(&key)
+                .unwrap_or_else(|| panic!("{key}"));
+            assert!(s.value.is_finite() && s.integrated, "{key}: {s:?}");
+        }
+    }
+    assert_eq!(res.sensitivities["d(impact_1_time)/d(m1)"].unit, "s/kg");
+    assert_eq!(res.sensitivities["d(impact_2_time)/d(e)"].unit, "s");
+    assert_eq!(
+        res.notes.get(&format!("sensitivities.impact_{last}_time")),
+        Some(&rodcube::results::Note::NoSensitivity(
+            rodcube::results::SensitivityGap::PastZeno
+        ))
+    );
+    // The impulses have none, and say so.
     assert_eq!(
         res.notes.get("sensitivities.impacts"),
         Some(&rodcube::results::Note::NoSensitivity(
             rodcube::results::SensitivityGap::NotBuilt
         ))
     );
-    assert!(!res.sensitivities.keys().any(|k| k.contains("impacts")));
 }
 
 #[test]

@@ -194,7 +194,9 @@ fn the_table_has_a_row_per_contact_in_each_impact() {
     }
     assert!(text.contains("* the contact whose gap closed"));
     assert!(
-        text.contains("(Zeno): the impact that closed a converging sequence"),
+        text.contains(
+            "(Zeno): the limit of a converging sequence of bounces, at its accumulation time"
+        ),
         "{text}"
     );
     assert!(text.lines().all(|l| l.chars().count() <= 100), "{text}");

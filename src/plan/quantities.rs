@@ -227,12 +227,12 @@ fn impact_record(info: &ModelInfo, at: &ImpactAt) -> ImpactRecord {
         })
         .collect();
     ImpactRecord {
-        time: at.t,
+        time: at.zeno.unwrap_or(at.t),
         closing: name(at.closing),
         contacts: taking.iter().map(|&i| name(i)).collect(),
         per_contact,
         energy_lost: at.impact.energy_lost,
-        zeno_limit: at.zeno,
+        zeno_limit: at.zeno.is_some(),
     }
 }
 

@@ -368,7 +368,7 @@ fn impacts(out: &mut String, list: &[ImpactRecord], layout: &Layout) {
     ];
     if list.iter().any(|r| r.zeno_limit) {
         legend
-            .push("(Zeno): the impact that closed a converging sequence of bounces, made plastic");
+            .push("(Zeno): the limit of a converging sequence of bounces, at its accumulation time: the last bounce resolved made plastic");
     }
     for line in legend {
         out.push_str(&wrap(line, layout.width, 2));

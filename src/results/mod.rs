@@ -249,7 +249,8 @@ pub struct ContactImpulse {
 /// that took part and the kinetic energy they took out.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ImpactRecord {
-    /// Time from release (s).
+    /// Time from release (s); for the impact that closed a converging (Zeno) sequence of
+    /// bounces, the sequence's accumulation time.
     pub time: f64,
     /// The contact whose gap closed.
     pub closing: String,
@@ -259,7 +260,9 @@ pub struct ImpactRecord {
     pub per_contact: Vec<ContactImpulse>,
     /// Kinetic energy lost (J), from the impulses: `-sum P (v- + v+) / 2`.
     pub energy_lost: f64,
-    /// Whether this impact closed a converging (Zeno) sequence of bounces, made plastic.
+    /// Whether this impact closed a converging (Zeno) sequence of bounces, made plastic and
+    /// listed at the sequence's accumulation time (its impulses and energy are those of the
+    /// last bounce resolved, made plastic: the whole sequence's energy lost).
     pub zeno_limit: bool,
 }
 

@@ -27,6 +27,7 @@ pub mod prior;
 pub mod quadrature;
 pub mod rest;
 pub mod roots;
+pub mod saltation;
 pub mod sensitivity;
 pub mod separation;
 pub mod series;
