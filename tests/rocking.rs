@@ -119,8 +119,17 @@ fn every_strike_keeps_housners_ratio_at_the_energy_integrals_times() {
     let hand = hand_strikes(count);
     for (k, at) in motion.impacts.iter().enumerate() {
         let (before, after) = around(&motion, k);
-        assert!(before.q()[2].abs() < 1e-9, "upright at the strike: {}", before.q()[2]);
-        close(after.qd()[2] / before.qd()[2], housner(), 1e-12, "omega+/omega-");
+        assert!(
+            before.q()[2].abs() < 1e-9,
+            "upright at the strike: {}",
+            before.q()[2]
+        );
+        close(
+            after.qd()[2] / before.qd()[2],
+            housner(),
+            1e-12,
+            "omega+/omega-",
+        );
         close(at.t, hand[k], 1e-10, &format!("strike {k}'s time"));
         // The new corner strikes and sticks, the old one lifts.
         let (new, old) = if k % 2 == 0 { (1, 0) } else { (0, 1) };
@@ -133,9 +142,19 @@ fn every_strike_keeps_housners_ratio_at_the_energy_integrals_times() {
         let b = &w.general;
         let lost = b.energy(&before).unwrap() - b.energy(&after).unwrap();
         close(at.impact.energy_lost, lost, 1e-12, "energy lost");
-        close(at.impact.friction_energy_lost, 0.0, 1e-12, "friction's part");
+        close(
+            at.impact.friction_energy_lost,
+            0.0,
+            1e-12,
+            "friction's part",
+        );
         let kinetic = 0.5 * (M * (W * W + H * H) / 3.0) * before.qd()[2].powi(2);
-        close(lost, kinetic * (1.0 - housner().powi(2)), 1e-11, "lost by hand");
+        close(
+            lost,
+            kinetic * (1.0 - housner().powi(2)),
+            1e-11,
+            "lost by hand",
+        );
     }
 }
 
@@ -145,9 +164,7 @@ fn friction_holds_at_the_pivot_and_at_the_strike() {
     // At the strike the stuck corner's impulses are in the ratio h (1 - r) / (w (1 + r)).
     let by_hand = H * (1.0 - ratio) / (W * (1.0 + ratio));
     assert!(by_hand <= mu, "{by_hand}");
-    let motion = walker(mu, 0.0, 1.5)
-        .motion(&mut Work::default())
-        .unwrap();
+    let motion = walker(mu, 0.0, 1.5).motion(&mut Work::default()).unwrap();
     assert!(motion.impacts.len() >= 3);
     for at in &motion.impacts {
         let c = at.closing;
@@ -162,19 +179,19 @@ fn friction_holds_at_the_pivot_and_at_the_strike() {
     // Along the rocking: the pivot's |F| / N, and at release Newton–Euler about the corner:
     // phi'' = -m g R sin(alpha - phi0) / I_O, the centre's acceleration phi'' z x r (r from the
     // pivot to the centre), F = m a_x, N = m (g + a_y).
-    let request = Request::new(find("rocking_block").unwrap(), &[
-        ("m", M),
-        ("w", W),
-        ("h", H),
-        ("phi0", PHI0),
-        ("g", G),
-        ("mu", mu),
-        ("e", 0.0),
-    ][..])
-    .with_want(&[
-        Quantity::FrictionSeries(0),
-        Quantity::FrictionSeries(1),
-    ])
+    let request = Request::new(
+        find("rocking_block").unwrap(),
+        &[
+            ("m", M),
+            ("w", W),
+            ("h", H),
+            ("phi0", PHI0),
+            ("g", G),
+            ("mu", mu),
+            ("e", 0.0),
+        ][..],
+    )
+    .with_want(&[Quantity::FrictionSeries(0), Quantity::FrictionSeries(1)])
     .with_tolerance(1e-10)
     .with_samples(400)
     .with_until(Some(1.5));
@@ -185,17 +202,26 @@ fn friction_holds_at_the_pivot_and_at_the_strike() {
     let to_centre = [0.5 * W * c - 0.5 * H * s, 0.5 * W * s + 0.5 * H * c];
     let (fx, n) = (-M * phi_dd * to_centre[1], M * (G + phi_dd * to_centre[0]));
     let mut checked = 0;
-    for (corner, friction) in [("left_corner", "left_friction"), ("right_corner", "right_friction")] {
+    for (corner, friction) in [
+        ("left_corner", "left_friction"),
+        ("right_corner", "right_friction"),
+    ] {
         let name = format!("{friction}_series");
         let series = &run.series[&name];
         let col = |label: &str| {
             let found = series.columns.iter().find(|c| c.name == label);
-            &found.unwrap_or_else(|| panic!("{name}: no column {label}")).values
+            &found
+                .unwrap_or_else(|| panic!("{name}: no column {label}"))
+                .values
         };
         let (t, f, normal) = (col("t"), col(friction), col(corner));
         for i in 0..t.len() {
             if normal[i] > 1e-9 {
-                assert!(f[i].abs() <= mu * normal[i] * (1.0 + 1e-9), "{name} at {}", t[i]);
+                assert!(
+                    f[i].abs() <= mu * normal[i] * (1.0 + 1e-9),
+                    "{name} at {}",
+                    t[i]
+                );
                 checked += 1;
             }
         }
@@ -259,7 +285,12 @@ fn with_little_friction_the_strike_slides_as_the_hand_balance_says() {
     assert_eq!(impact.friction_laws[1], FrictionLaw::Slide(sign));
     assert_eq!(impact.laws, [ContactLaw::Open, ContactLaw::Restitution]);
     // The slide takes energy: its part is -P_t (s- + s+) / 2 with s- = 0.
-    close(impact.friction_energy_lost, -0.5 * pt * slip, 1e-12, "friction's part");
+    close(
+        impact.friction_energy_lost,
+        -0.5 * pt * slip,
+        1e-12,
+        "friction's part",
+    );
     assert!(impact.friction_energy_lost > 0.0);
     // In the motion, every strike slides.
     let motion = walker(mu, 0.0, 1.0).motion(&mut Work::default()).unwrap();

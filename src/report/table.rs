@@ -308,7 +308,10 @@ fn impulse_cell(c: &ContactImpulse) -> String {
     if c.tangential_impulse == 0.0 {
         normal
     } else {
-        format!("{normal}, {}", with_unit(c.tangential_impulse, 6, c.impulse_unit))
+        format!(
+            "{normal}, {}",
+            with_unit(c.tangential_impulse, 6, c.impulse_unit)
+        )
     }
 }
 
@@ -383,7 +386,10 @@ fn impacts(out: &mut String, list: &[ImpactRecord], layout: &Layout) {
     let mut legend = vec![
         "* the contact whose gap closed; v: a contact's normal velocity (negative: approaching)",
     ];
-    if list.iter().any(|r| r.per_contact.iter().any(|c| c.tangential_impulse != 0.0)) {
+    if list
+        .iter()
+        .any(|r| r.per_contact.iter().any(|c| c.tangential_impulse != 0.0))
+    {
         legend.push(
             "impulse a, b: the normal impulse a and its friction's tangential impulse b; energy \
              lost (normal, friction): what the normal and the tangential impulses took",

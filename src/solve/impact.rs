@@ -182,7 +182,9 @@ pub fn resolve_with(
 ) -> Result<Impact, SolveError> {
     let problem = Problem::at(sys, state, parts, restitution)?;
     let info = problem.info;
-    let taking: Vec<usize> = (0..parts.len()).filter(|&i| parts[i] != Part::None).collect();
+    let taking: Vec<usize> = (0..parts.len())
+        .filter(|&i| parts[i] != Part::None)
+        .collect();
     let indeterminate = |why: String| SolveError::Indeterminate {
         model: info.name,
         t,
@@ -205,9 +207,11 @@ pub fn resolve_with(
     }
     // Of the combinations that hold, one that sticks the most frictions (at the cone's edge a
     // slide that ends at zero slip is the same impact as a stick).
-    let stuck = |s: &Solution| (s.active.modes.iter().enumerate())
-        .filter(|(j, m)| problem.acts(&s.active, *j) && **m == Mode::Stick)
-        .count();
+    let stuck = |s: &Solution| {
+        (s.active.modes.iter().enumerate())
+            .filter(|(j, m)| problem.acts(&s.active, *j) && **m == Mode::Stick)
+            .count()
+    };
     let Some(best) = (0..found.len()).max_by_key(|&k| (stuck(&found[k]), usize::MAX - k)) else {
         return Err(indeterminate(
             "no set of impulses satisfies Newton's law and Coulomb's friction cone with the contacts pushing".into(),
@@ -215,8 +219,9 @@ pub fn resolve_with(
     };
     let chosen = found.swap_remove(best);
     let scale = chosen.qd.iter().fold(problem.speed, |a, v| a.max(v.abs()));
-    let differ = |s: &Solution| (s.qd.iter().zip(chosen.qd.iter()))
-        .any(|(a, b)| (a - b).abs() > IMPACT_TOLERANCE * scale);
+    let differ = |s: &Solution| {
+        (s.qd.iter().zip(chosen.qd.iter())).any(|(a, b)| (a - b).abs() > IMPACT_TOLERANCE * scale)
+    };
     if found.iter().any(differ) {
         return Err(indeterminate(format!(
             "{} sets of impulses satisfy Newton's law and Coulomb's friction cone with different velocities after",
@@ -273,10 +278,16 @@ impl<'a> Problem<'a> {
         let slip_before: Vec<f64> = (0..nf).map(|j| dot(&tjac[j * n..(j + 1) * n])).collect();
         // The target of a contact whose law holds with equality: v+ = -e v- (approaching), 0
         // (resting or separating; a separating contact that takes part can only stay so).
-        let target = (0..m).map(|i| -restitution[i] * before[i].min(0.0)).collect();
+        let target = (0..m)
+            .map(|i| -restitution[i] * before[i].min(0.0))
+            .collect();
         let taking = |i: usize| parts[i] != Part::None;
         let speed = ((0..m).filter(|&i| taking(i)).map(|i| before[i].abs()))
-            .chain((0..nf).filter(|&j| taking(info.frictions[j].contact_index)).map(|j| slip_before[j].abs()))
+            .chain(
+                (0..nf)
+                    .filter(|&j| taking(info.frictions[j].contact_index))
+                    .map(|j| slip_before[j].abs()),
+            )
             .fold(f64::EPSILON, f64::max);
         Ok(Problem {
             info,
@@ -337,8 +348,12 @@ impl<'a> Problem<'a> {
     /// same impact).
     fn solve(&self, active: Active) -> Option<Solution> {
         let n = self.n;
-        let rows: Vec<usize> = (0..self.parts.len()).filter(|&i| active.closed[i]).collect();
-        let fr: Vec<usize> = (0..self.mu.len()).filter(|&j| self.acts(&active, j)).collect();
+        let rows: Vec<usize> = (0..self.parts.len())
+            .filter(|&i| active.closed[i])
+            .collect();
+        let fr: Vec<usize> = (0..self.mu.len())
+            .filter(|&j| self.acts(&active, j))
+            .collect();
         let dim = n + rows.len() + fr.len();
         // Row-major, for `linear::solve_in_place`.
         let mut a = vec![0.0; dim * dim];
@@ -408,15 +423,16 @@ impl<'a> Problem<'a> {
                 true => s.impulse[i] >= -zero_impulse,
                 false => dot(self.row(i)) - self.target[i] >= -zero_speed,
             });
-        let frictions_hold = (0..self.mu.len())
-            .filter(|&j| self.acts(&s.active, j))
-            .all(|j| match s.active.modes[j] {
-                Mode::Stick => {
-                    let normal = s.impulse[self.info.frictions[j].contact_index];
-                    s.friction_impulse[j].abs() <= self.mu[j] * normal.max(0.0) + zero_impulse
-                }
-                Mode::Slide(sign) => sign * dot(self.trow(j)) >= -zero_speed,
-            });
+        let frictions_hold =
+            (0..self.mu.len())
+                .filter(|&j| self.acts(&s.active, j))
+                .all(|j| match s.active.modes[j] {
+                    Mode::Stick => {
+                        let normal = s.impulse[self.info.frictions[j].contact_index];
+                        s.friction_impulse[j].abs() <= self.mu[j] * normal.max(0.0) + zero_impulse
+                    }
+                    Mode::Slide(sign) => sign * dot(self.trow(j)) >= -zero_speed,
+                });
         contacts_hold && frictions_hold
     }
 
@@ -454,8 +470,7 @@ impl<'a> Problem<'a> {
                 .sum::<f64>()
         };
         let normal_energy_lost = half_work(&s.impulse, &self.before, &after);
-        let friction_energy_lost =
-            half_work(&s.friction_impulse, &self.slip_before, &slip_after);
+        let friction_energy_lost = half_work(&s.friction_impulse, &self.slip_before, &slip_after);
         let energy_lost = normal_energy_lost + friction_energy_lost;
         let kinetic = 0.5 * self.qd.dot(&(&self.mass * &self.qd));
         if energy_lost < -IMPACT_TOLERANCE * kinetic {
