@@ -5,7 +5,7 @@
 use crate::model::ModelInfo;
 use crate::quantity::{FIXED, Quantity};
 pub use crate::results::format_number;
-use crate::results::{Check, CheckKind, ImpactRecord, RunResults};
+use crate::results::{Check, CheckKind, ContactImpulse, ImpactRecord, RunResults};
 use comfy_table::{CellAlignment, ColumnConstraint, ContentArrangement, Table, Width, presets};
 
 /// The paper's published figures (Section 3, three digits), by result key.
@@ -302,6 +302,19 @@ fn scalars(out: &mut String, results: &RunResults, layout: &Layout) {
     }
 }
 
+/// A contact's impulse in the impacts table, its friction's beside it where it has one.
+fn impulse_cell(c: &ContactImpulse) -> String {
+    let normal = with_unit(c.impulse, 6, c.impulse_unit);
+    if c.tangential_impulse == 0.0 {
+        normal
+    } else {
+        format!(
+            "{normal}, {}",
+            with_unit(c.tangential_impulse, 6, c.impulse_unit)
+        )
+    }
+}
+
 /// The impacts: one row per contact taking part in each impact, the closing one marked `*`;
 /// the impact's time and energy lost on its first row, `(Zeno)` beside the energy of an impact
 /// that closed a converging sequence of bounces. A line of legend says what the marks mean
@@ -311,6 +324,13 @@ fn impacts(out: &mut String, list: &[ImpactRecord], layout: &Layout) {
     for r in list {
         let mut time = format_number(r.time, 6);
         let mut energy = format_number(r.energy_lost, 6);
+        if r.friction_energy_lost != 0.0 {
+            energy.push_str(&format!(
+                " (normal {}, friction {})",
+                format_number(r.normal_energy_lost, 6),
+                format_number(r.friction_energy_lost, 6)
+            ));
+        }
         if r.zeno_limit {
             energy.push_str(" (Zeno)");
         }
@@ -332,7 +352,7 @@ fn impacts(out: &mut String, list: &[ImpactRecord], layout: &Layout) {
                 mark(&c.contact),
                 with_unit(c.normal_velocity_before, 6, c.velocity_unit),
                 with_unit(c.normal_velocity_after, 6, c.velocity_unit),
-                with_unit(c.impulse, 6, c.impulse_unit),
+                impulse_cell(c),
                 std::mem::take(&mut energy),
             ]);
         }
@@ -366,6 +386,15 @@ fn impacts(out: &mut String, list: &[ImpactRecord], layout: &Layout) {
     let mut legend = vec![
         "* the contact whose gap closed; v: a contact's normal velocity (negative: approaching)",
     ];
+    if list
+        .iter()
+        .any(|r| r.per_contact.iter().any(|c| c.tangential_impulse != 0.0))
+    {
+        legend.push(
+            "impulse a, b: the normal impulse a and its friction's tangential impulse b; energy \
+             lost (normal, friction): what the normal and the tangential impulses took",
+        );
+    }
     if list.iter().any(|r| r.zeno_limit) {
         legend
             .push("(Zeno): the limit of a converging sequence of bounces, at its accumulation time: the last bounce resolved made plastic");

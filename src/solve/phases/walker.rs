@@ -483,7 +483,7 @@ impl<'m> Walker<'m> {
 
     /// The impact that ends the motion's last phase, where contact `closing` closed: every
     /// contact closed then, `closing` and any other open one that touches while approaching take
-    /// part; a contact with friction taking part is [`SolveError::FrictionalImpact`]. Bounces
+    /// part, with their frictions (`impact::resolve_with`). Bounces
     /// converging as Zeno's (`zeno_limit`) are closed by a plastic impact, with a note.
     pub fn impact(&self, motion: &mut Motion<'m>, closing: usize) -> Result<ImpactAt, SolveError> {
         let general = &self.general;
@@ -502,17 +502,6 @@ impl<'m> Walker<'m> {
                 }
             })
             .collect();
-        let mu = general.friction_coefficients();
-        if let Some(f) = (info.frictions.iter().enumerate())
-            .find(|(j, f)| parts[f.contact_index] != Part::None && mu[*j] != 0.0)
-            .map(|(_, f)| f)
-        {
-            return Err(SolveError::FrictionalImpact {
-                model: info.name,
-                t,
-                contact: info.contacts[f.contact_index].name,
-            });
-        }
         let name = info.contacts[closing].name;
         let mut restitution = general.restitutions().to_vec();
         let limit = zeno_limit(&motion.impacts, closing, t, self.tol);
