@@ -345,6 +345,75 @@ fn the_sensitive_motion_goes_through_every_impact_and_its_times_move_as_differen
     }
 }
 
+/// The rocking block (scenes/rocking.yaml) with friction `mu`, to `until`: the first
+/// `count` strikes' times differentiated through the earlier strikes' saltation matrices, with
+/// their frictions' laws (`stick`: sticking at every strike, else sliding at some), against
+/// fourth-order central differences of the run.
+fn rocking_strikes_agree(mu: f64, until: f64, count: usize, stick: bool) {
+    use rodcube::solve::impact::FrictionLaw;
+    let (model, mut p) = scene("rocking");
+    *p.get_mut("mu").expect("mu") = mu;
+    let mut w = walker(model, &p);
+    w.until = Some(until);
+    let sensitive = w.sensitive_motion(&mut Work::default()).expect("solves");
+    assert!(
+        matches!(sensitive.stop, None | Some(Stop::Zeno)),
+        "{:?}",
+        sensitive.stop
+    );
+    let all = &sensitive.motion.impacts;
+    let strikes = &all[..all.iter().take_while(|i| i.zeno.is_none()).count()];
+    assert!(strikes.len() >= count, "{} strikes", strikes.len());
+    let laws = |i: usize| &strikes[i].impact.friction_laws;
+    let slides =
+        (0..strikes.len()).any(|i| laws(i).iter().any(|l| matches!(l, FrictionLaw::Slide(_))));
+    assert_eq!(slides, !stick);
+    assert!((0..strikes.len()).all(|i| laws(i).iter().any(|l| *l != FrictionLaw::Out)));
+    for name in ["w", "h", "phi0", "g", "mu"] {
+        let j = model
+            .info()
+            .parameters
+            .iter()
+            .position(|q| q.name == name)
+            .unwrap();
+        let h = STEP * p[name].abs();
+        let at = |k: f64| {
+            let mut q = p.clone();
+            *q.get_mut(name).unwrap() += k * h;
+            let mut w = walker(model, &q);
+            w.until = Some(until);
+            impact_times(&w)
+        };
+        let (a, b, c, d) = (at(1.0), at(-1.0), at(2.0), at(-2.0));
+        for (k, strike) in strikes.iter().take(count).enumerate() {
+            let dt = sensitive.ends[strike.phase]
+                .as_ref()
+                .expect("not grazing")
+                .t[j];
+            let diff = (8.0 * (a[k] - b[k]) - (c[k] - d[k])) / (12.0 * h);
+            let scale = (strike.t / p[name]).abs().max(diff.abs());
+            assert!(
+                (dt - diff).abs() <= 1e-7 * scale,
+                "mu {mu}, strike {}, d t/d {name}: {dt} vs differences {diff}",
+                k + 1
+            );
+        }
+    }
+}
+
+#[test]
+fn rocking_strikes_that_stick_move_as_differences_say() {
+    // mu = 0.7: every strike sticks (Housner's); the strike times do not move with mu.
+    rocking_strikes_agree(0.7, 1.5, 4, true);
+}
+
+#[test]
+fn rocking_strikes_that_slide_move_as_differences_say() {
+    // mu = 0.1: the strike slides, its impulse on the cone's edge, whose derivative in mu
+    // moves every later strike.
+    rocking_strikes_agree(0.1, 1.0, 2, false);
+}
+
 #[test]
 fn every_impact_time_has_its_sensitivities_and_the_zeno_limit_a_note() {
     let (model, p) = scene("bounce");

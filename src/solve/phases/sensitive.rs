@@ -10,7 +10,7 @@ use crate::results::Work;
 use crate::solve::SolveError;
 use crate::solve::contacts;
 use crate::solve::forward::{self, Forward, Grazing};
-use crate::solve::saltation::{self, Crossing, SaltationGap, frictionless_laws};
+use crate::solve::saltation::{self, Crossing, SaltationGap};
 use crate::solve::unreduced::{End, EndSensitivity};
 
 /// How one phase's end moves with the parameters (one value per parameter each).
@@ -199,7 +199,7 @@ impl<'m> Walker<'m> {
             return Ok(Next::Stop(Some(Stop::Zeno)));
         }
         let after = contacts::dynamics(&self.general, &start.state, &start.active, start.t)?;
-        let laws = frictionless_laws(&at.parts, &at.impact);
+        let laws = saltation::laws(&at.impact);
         let crossing = Crossing {
             before: &state,
             impact: &at.impact,

@@ -550,7 +550,8 @@ impl<'m> Walker<'m> {
     /// open), and for how long (s): its normal velocity after squared over twice its normal
     /// acceleration pulling it back, and twice the velocity over that acceleration, with it
     /// open and the other contacts decided at the state after. `None` for a contact that stays
-    /// closed, is not pulled back, or rises clear.
+    /// closed (its velocity after within [`impact::IMPACT_TOLERANCE`] of its approach speed),
+    /// is not pulled back, or rises clear.
     fn unresolved_bounce(
         &self,
         impact: &Impact,
@@ -559,7 +560,10 @@ impl<'m> Walker<'m> {
         t: f64,
     ) -> Result<Option<(f64, f64)>, SolveError> {
         let u = impact.normal_velocity_after[closing];
-        if u <= 0.0 {
+        // A plastic contact's velocity after is zero but for rounding: no bounce to sum (its
+        // flight, `2 u / pull`, would be rounding over rounding).
+        let rounding = impact::IMPACT_TOLERANCE * impact.normal_velocity_before[closing].abs();
+        if u <= rounding {
             return Ok(None);
         }
         let state = &impact.after;
