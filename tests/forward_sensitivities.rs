@@ -313,36 +313,8 @@ fn the_sensitive_motion_goes_through_every_impact_and_its_times_move_as_differen
     let crossed = &sensitive.motion.impacts[..sensitive.motion.impacts.len() - 1];
     assert!(crossed.len() >= 4, "{} impacts", crossed.len());
     // The first four impacts' times against fourth-order central differences of the run.
-    for name in ["e", "a", "ell", "g", "m2"] {
-        let j = model
-            .info()
-            .parameters
-            .iter()
-            .position(|q| q.name == name)
-            .unwrap();
-        let h = STEP * p[name].abs();
-        let at = |k: f64| {
-            let mut q = p.clone();
-            *q.get_mut(name).unwrap() += k * h;
-            let mut w = walker(model, &q);
-            w.until = Some(0.6);
-            impact_times(&w)
-        };
-        let (a, b, c, d) = (at(1.0), at(-1.0), at(2.0), at(-2.0));
-        for (k, impact) in crossed.iter().take(4).enumerate() {
-            let dt = sensitive.ends[impact.phase]
-                .as_ref()
-                .expect("not grazing")
-                .t[j];
-            let diff = (8.0 * (a[k] - b[k]) - (c[k] - d[k])) / (12.0 * h);
-            let scale = (impact.t / p[name]).abs().max(diff.abs());
-            assert!(
-                (dt - diff).abs() <= 1e-7 * scale,
-                "impact {}, d t/d {name}: {dt} vs differences {diff}",
-                k + 1
-            );
-        }
-    }
+    let names = ["e", "a", "ell", "g", "m2"];
+    impact_times_agree((model, &p, 0.6), &sensitive.ends, &crossed[..4], &names);
 }
 
 /// The rocking block (scenes/rocking.yaml) with friction `mu`, to `until`: the first
@@ -369,32 +341,51 @@ fn rocking_strikes_agree(mu: f64, until: f64, count: usize, stick: bool) {
         (0..strikes.len()).any(|i| laws(i).iter().any(|l| matches!(l, FrictionLaw::Slide(_))));
     assert_eq!(slides, !stick);
     assert!((0..strikes.len()).all(|i| laws(i).iter().any(|l| *l != FrictionLaw::Out)));
-    for name in ["w", "h", "phi0", "g", "mu"] {
-        let j = model
-            .info()
-            .parameters
-            .iter()
-            .position(|q| q.name == name)
-            .unwrap();
-        let h = STEP * p[name].abs();
+    let names = ["w", "h", "phi0", "g", "mu"];
+    impact_times_agree(
+        (model, &p, until),
+        &sensitive.ends,
+        &strikes[..count],
+        &names,
+    );
+}
+
+/// The times of `impacts` (the first of a motion of `model` with parameters `p` to `until`,
+/// none closing a Zeno sequence), differentiated in each parameter of `names` by the
+/// sensitivities' `ends`, against fourth-order central differences of the run, within `1e-7`
+/// of the result's own scale `|t / p|`.
+fn impact_times_agree(
+    run: (
+        &'static dyn rodcube::model::Model,
+        &BTreeMap<String, f64>,
+        f64,
+    ),
+    ends: &[Result<rodcube::solve::phases::EndDerivatives, rodcube::solve::forward::Grazing>],
+    impacts: &[rodcube::solve::phases::ImpactAt],
+    names: &[&str],
+) {
+    let (model, p, until) = run;
+    for name in names {
+        let j = (model.info().parameters.iter())
+            .position(|q| q.name == *name)
+            .expect("a parameter");
+        let h = STEP * p[*name].abs();
         let at = |k: f64| {
             let mut q = p.clone();
-            *q.get_mut(name).unwrap() += k * h;
+            *q.get_mut(*name).expect("a parameter") += k * h;
             let mut w = walker(model, &q);
             w.until = Some(until);
             impact_times(&w)
         };
         let (a, b, c, d) = (at(1.0), at(-1.0), at(2.0), at(-2.0));
-        for (k, strike) in strikes.iter().take(count).enumerate() {
-            let dt = sensitive.ends[strike.phase]
-                .as_ref()
-                .expect("not grazing")
-                .t[j];
+        for (k, impact) in impacts.iter().enumerate() {
+            let dt = ends[impact.phase].as_ref().expect("not grazing").t[j];
             let diff = (8.0 * (a[k] - b[k]) - (c[k] - d[k])) / (12.0 * h);
-            let scale = (strike.t / p[name]).abs().max(diff.abs());
+            let scale = (impact.t / p[*name]).abs().max(diff.abs());
             assert!(
                 (dt - diff).abs() <= 1e-7 * scale,
-                "mu {mu}, strike {}, d t/d {name}: {dt} vs differences {diff}",
+                "{}, impact {}, d t/d {name}: {dt} vs differences {diff}",
+                model.info().name,
                 k + 1
             );
         }
