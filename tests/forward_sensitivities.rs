@@ -438,6 +438,19 @@ fn every_impact_time_has_its_sensitivities_and_the_zeno_limit_a_note() {
             rodcube::results::SensitivityGap::PastZeno
         ))
     );
+    // Without `until` the run ends at its first impact, the landing: its time's derivatives
+    // are the landing's.
+    let request = Request::new(model, &p).with_want(&[
+        Quantity::FloorImpact,
+        Quantity::Impacts,
+        Quantity::Sensitivities,
+    ]);
+    let first = plan::run(&request).expect("runs");
+    assert_eq!(first.impacts.as_ref().map(Vec::len), Some(1));
+    for q in ["m1", "m2", "ell", "a", "g", "e"] {
+        let d = |key: &str| first.sensitivities[&format!("d({key})/d({q})")].value;
+        assert_eq!(d("impact_1_time"), d("floor_impact_time"), "{q}");
+    }
     // The impulses have none, and say so.
     assert_eq!(
         res.notes.get("sensitivities.impacts"),

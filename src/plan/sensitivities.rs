@@ -16,7 +16,7 @@ use crate::model::start_offsets;
 use crate::quantity::Quantity;
 use crate::results::{Note, RunResults, Sensitivity, SensitivityGap};
 use crate::solve::SolveError;
-use crate::solve::phases::{End, SensitiveMotion, Stop};
+use crate::solve::phases::{End, Motion, SensitiveMotion, Stop};
 use crate::solve::prior::{PRIOR_TOL, Prior};
 use crate::solve::quadrature::ACCEPT;
 use crate::solve::sensitivity::{self, SensitivityWork, SeparationPoint};
@@ -231,18 +231,18 @@ impl<'m> Plan<'m> {
     /// integrated with its forward sensitivities, each impact held to the run's: the same
     /// closing contact, at a time within [`ROUTES_AGREE`]. An impact with none has a note.
     fn impact_sensitivities(&mut self, out: &mut RunResults) -> Result<(), SolveError> {
-        let run: Vec<(f64, usize, bool)> = (self.complete()?.impacts.iter())
-            .map(|i| (i.zeno.unwrap_or(i.t), i.closing, i.zeno.is_some()))
-            .collect();
+        let run = impact_events(self.complete()?);
         let agree = ROUTES_AGREE.max(ROUTES_AGREE_PER_TOLERANCE * self.walker.tol);
-        for (k, (t_run, closing, zeno)) in run.into_iter().enumerate() {
+        for (k, ran) in run.into_iter().enumerate() {
             let key = format!("impact_{}_time", k + 1);
             let found = match self.sensitive() {
                 Err(gap) => Err(gap),
-                Ok(_) if zeno => Err(SensitivityGap::PastZeno),
-                Ok(sensitive) => match sensitive.motion.impacts.get(k) {
-                    Some(at) if at.zeno.is_some() => Err(SensitivityGap::PastZeno),
-                    Some(at) if at.closing != closing || (at.t - t_run).abs() > agree * t_run => {
+                Ok(_) if ran.zeno => Err(SensitivityGap::PastZeno),
+                Ok(sensitive) => match impact_events(&sensitive.motion).get(k) {
+                    Some(at) if at.zeno => Err(SensitivityGap::PastZeno),
+                    Some(at)
+                        if at.closing != ran.closing || (at.t - ran.t).abs() > agree * ran.t =>
+                    {
                         Err(SensitivityGap::RoutesDisagree)
                     }
                     Some(at) => match sensitive.ends.get(at.phase) {
@@ -252,6 +252,7 @@ impl<'m> Plan<'m> {
                     None => Err(stop_gap(&sensitive.stop)),
                 },
             };
+            let t_run = ran.t;
             match found {
                 Ok(d) => {
                     let target = Target {
@@ -371,6 +372,39 @@ impl<'m> Plan<'m> {
         };
         Ok(Some(Ok(Found { d_theta, d_t })))
     }
+}
+
+/// An impact of a motion, as its time's sensitivities are matched.
+struct ImpactEvent {
+    /// Its time as listed (a Zeno limit's accumulation time).
+    t: f64,
+    closing: usize,
+    /// Whether it closes a Zeno sequence.
+    zeno: bool,
+    /// The phase that ended with it.
+    phase: usize,
+}
+
+/// The impacts of `motion` in order, with the one that ends it where it does not go on
+/// through impacts (a contact that closes ends a run without `until`).
+fn impact_events(motion: &Motion) -> Vec<ImpactEvent> {
+    let mut events: Vec<ImpactEvent> = (motion.impacts.iter())
+        .map(|i| ImpactEvent {
+            t: i.zeno.unwrap_or(i.t),
+            closing: i.closing,
+            zeno: i.zeno.is_some(),
+            phase: i.phase,
+        })
+        .collect();
+    if let (false, Some(End::Contact(closing))) = (motion.through_impacts, motion.last_end()) {
+        events.push(ImpactEvent {
+            t: motion.end_time(),
+            closing,
+            zeno: false,
+            phase: motion.phases.len() - 1,
+        });
+    }
+    events
 }
 
 /// Why a result the motion with sensitivities did not reach has none: why it stopped.
