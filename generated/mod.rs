@@ -16,6 +16,7 @@ pub mod ladder_friction;
 pub mod loaded_rod;
 pub mod loaded_rod_closed;
 pub mod loaded_rod_free;
+pub mod rocking_block;
 pub mod rod_block_tipping;
 pub mod rod_cube;
 pub mod rod_cube_closed;
@@ -46,6 +47,7 @@ pub static MODELS: &[&dyn crate::model::Model] = &[
     &loaded_rod::LoadedRod,
     &loaded_rod_closed::LoadedRodClosed,
     &loaded_rod_free::LoadedRodFree,
+    &rocking_block::RockingBlock,
     &rod_block_tipping::RodBlockTipping,
     &rod_cube::RodCube,
     &rod_cube_closed::RodCubeClosed,
@@ -102,6 +104,7 @@ pub static TAPES: &[(&str, &str)] = &[
         include_str!("loaded_rod_closed.tape.json"),
     ),
     ("loaded_rod_free", include_str!("loaded_rod_free.tape.json")),
+    ("rocking_block", include_str!("rocking_block.tape.json")),
     (
         "rod_block_tipping",
         include_str!("rod_block_tipping.tape.json"),

@@ -376,9 +376,10 @@
 #define RODCUBE_ERR_NO_SUCH_PHASE 336
 
 /**
- * An impact at a contact with friction (tangential impulses are not modelled).
+ * An impact whose impulses (Newton's law of restitution with Coulomb friction) would create
+ * kinetic energy.
  */
-#define RODCUBE_ERR_FRICTIONAL_IMPACT 337
+#define RODCUBE_ERR_IMPACT_GAINS_ENERGY 337
 
 /**
  * Solver: the point solved, but its sensitivities do not exist there (the message says why:

@@ -184,8 +184,9 @@ pub const RODCUBE_ERR_NEXT_PHASE: c_int = 334;
 pub const RODCUBE_ERR_RESULT_NOT_FINITE: c_int = 335;
 /// A phase index past the phases of the run (a planner inconsistency).
 pub const RODCUBE_ERR_NO_SUCH_PHASE: c_int = 336;
-/// An impact at a contact with friction (tangential impulses are not modelled).
-pub const RODCUBE_ERR_FRICTIONAL_IMPACT: c_int = 337;
+/// An impact whose impulses (Newton's law of restitution with Coulomb friction) would create
+/// kinetic energy.
+pub const RODCUBE_ERR_IMPACT_GAINS_ENERGY: c_int = 337;
 /// Solver: the point solved, but its sensitivities do not exist there (the message says why:
 /// the contact opens at release, the separation is a double root of its condition, the model
 /// has no partial derivatives, ...); `rodcube_sensitivities` writes no number.
@@ -328,7 +329,7 @@ static CODES: &[(c_int, &CStr)] = named![
     RODCUBE_ERR_NEXT_PHASE,
     RODCUBE_ERR_RESULT_NOT_FINITE,
     RODCUBE_ERR_NO_SUCH_PHASE,
-    RODCUBE_ERR_FRICTIONAL_IMPACT,
+    RODCUBE_ERR_IMPACT_GAINS_ENERGY,
     RODCUBE_ERR_NO_SENSITIVITY,
     RODCUBE_ERR_SCENE,
     RODCUBE_ERR_SCENE_READ,
@@ -403,7 +404,7 @@ fn solve_code(e: &SolveError) -> c_int {
         SolveError::AtRest { .. } => RODCUBE_ERR_AT_REST,
         SolveError::Overlap { .. } => RODCUBE_ERR_OVERLAP,
         SolveError::ImpactAtRelease { .. } => RODCUBE_ERR_IMPACT_AT_RELEASE,
-        SolveError::FrictionalImpact { .. } => RODCUBE_ERR_FRICTIONAL_IMPACT,
+        SolveError::ImpactGainsEnergy { .. } => RODCUBE_ERR_IMPACT_GAINS_ENERGY,
         SolveError::NotThisPhase { .. } => RODCUBE_ERR_NOT_THIS_PHASE,
         SolveError::SingularContacts { .. } => RODCUBE_ERR_SINGULAR_CONTACTS,
         SolveError::TooManySwitches { .. } => RODCUBE_ERR_TOO_MANY_SWITCHES,
@@ -1119,6 +1120,7 @@ mod tests {
             SensitivityGap::NoSeparation,
             SensitivityGap::NotBuilt,
             SensitivityGap::PastImpact,
+            SensitivityGap::PastZeno,
             SensitivityGap::Grazing,
             SensitivityGap::RoutesDisagree,
             SensitivityGap::IntegrationFailed,

@@ -719,14 +719,16 @@ impl Ctx<'_> {
         want
     }
 
-    /// `sensitivities` are of the separation angle and time, the contact ends and the floor
-    /// impact: wanted without any of them, they would be of nothing the scene computes.
+    /// `sensitivities` are of the separation angle and time, the contact ends, the floor
+    /// impact and the impacts' times: wanted without any of them, they would be of nothing the
+    /// scene computes.
     fn sensitivities_of_something(&self, raw: &Raw, want: &[Quantity], out: &mut Vec<Diagnostic>) {
         let of = [
             Quantity::SeparationAngle,
             Quantity::SeparationTime,
             Quantity::ContactEnd,
             Quantity::FloorImpact,
+            Quantity::Impacts,
         ];
         if !want.contains(&Quantity::Sensitivities) || want.iter().any(|q| of.contains(q)) {
             return;
@@ -737,9 +739,10 @@ impl Ctx<'_> {
                     Kind::UnavailableQuantity,
                     &format!("want[{i}]"),
                     At::Value,
-                    "`sensitivities` are of the separation angle and time, the contact ends and \
-                 the floor impact, and this scene wants none of them: add `separation_angle`, \
-                 `separation_time`, `contact_end` or `floor_impact` to `want`"
+                    "`sensitivities` are of the separation angle and time, the contact ends, \
+                 the floor impact and the impacts' times, and this scene wants none of them: add \
+                 `separation_angle`, `separation_time`, `contact_end`, `floor_impact` or \
+                 `impacts` to `want`"
                         .into(),
                 ),
             );

@@ -289,30 +289,124 @@ fn a_stick_slip_switch_time_moves_as_differences_across_it_say() {
     }
 }
 
+/// The times of `walker`'s impacts that close no Zeno sequence, in order.
+fn impact_times(walker: &Walker) -> Vec<f64> {
+    let motion = walker.motion(&mut Work::default()).expect("solves");
+    (motion.impacts.iter())
+        .filter(|i| i.zeno.is_none())
+        .map(|i| i.t)
+        .collect()
+}
+
 #[test]
-fn the_sensitive_motion_stops_at_the_first_impact_it_would_go_through() {
-    // The bouncing rod goes on through its impacts to 0.6 s; the impact map's derivatives
-    // are not built, so the motion with sensitivities stops at the first.
+fn the_sensitive_motion_goes_through_every_impact_and_its_times_move_as_differences_say() {
+    // The bouncing rod goes on through its impacts to 0.6 s: `S` crosses each by its saltation
+    // matrix, up to the limit of the converging (Zeno) sequence, which is extrapolated.
     let (model, p) = scene("bounce");
     let mut w = walker(model, &p);
     w.until = Some(0.6);
     let sensitive = w.sensitive_motion(&mut Work::default()).expect("solves");
-    assert_eq!(sensitive.stop, Some(Stop::Impact));
+    assert_eq!(sensitive.stop, Some(Stop::Zeno));
     assert_eq!(sensitive.ends.len(), sensitive.motion.phases.len());
-    assert!(matches!(
-        sensitive.motion.last_end(),
-        Some(rodcube::solve::phases::End::Contact(_))
-    ));
     let full = w.motion(&mut Work::default()).expect("solves");
-    assert!(full.phases.len() > sensitive.motion.phases.len());
-    assert!(!full.impacts.is_empty() && sensitive.motion.impacts.is_empty());
-    // Every phase up to the impact has its end's derivatives.
-    assert!(sensitive.ends.iter().all(Result::is_ok));
+    assert_eq!(sensitive.motion.impacts.len(), full.impacts.len());
+    let crossed = &sensitive.motion.impacts[..sensitive.motion.impacts.len() - 1];
+    assert!(crossed.len() >= 4, "{} impacts", crossed.len());
+    // The first four impacts' times against fourth-order central differences of the run.
+    let names = ["e", "a", "ell", "g", "m2"];
+    impact_times_agree((model, &p, 0.6), &sensitive.ends, &crossed[..4], &names);
+}
+
+/// The rocking block (scenes/rocking.yaml) with friction `mu`, to `until`: the first
+/// `count` strikes' times differentiated through the earlier strikes' saltation matrices, with
+/// their frictions' laws (`stick`: sticking at every strike, else sliding at some), against
+/// fourth-order central differences of the run.
+fn rocking_strikes_agree(mu: f64, until: f64, count: usize, stick: bool) {
+    use rodcube::solve::impact::FrictionLaw;
+    let (model, mut p) = scene("rocking");
+    *p.get_mut("mu").expect("mu") = mu;
+    let mut w = walker(model, &p);
+    w.until = Some(until);
+    let sensitive = w.sensitive_motion(&mut Work::default()).expect("solves");
+    assert!(
+        matches!(sensitive.stop, None | Some(Stop::Zeno)),
+        "{:?}",
+        sensitive.stop
+    );
+    let all = &sensitive.motion.impacts;
+    let strikes = &all[..all.iter().take_while(|i| i.zeno.is_none()).count()];
+    assert!(strikes.len() >= count, "{} strikes", strikes.len());
+    let laws = |i: usize| &strikes[i].impact.friction_laws;
+    let slides =
+        (0..strikes.len()).any(|i| laws(i).iter().any(|l| matches!(l, FrictionLaw::Slide(_))));
+    assert_eq!(slides, !stick);
+    assert!((0..strikes.len()).all(|i| laws(i).iter().any(|l| *l != FrictionLaw::Out)));
+    let names = ["w", "h", "phi0", "g", "mu"];
+    impact_times_agree(
+        (model, &p, until),
+        &sensitive.ends,
+        &strikes[..count],
+        &names,
+    );
+}
+
+/// The times of `impacts` (the first of a motion of `model` with parameters `p` to `until`,
+/// none closing a Zeno sequence), differentiated in each parameter of `names` by the
+/// sensitivities' `ends`, against fourth-order central differences of the run, within `1e-7`
+/// of the result's own scale `|t / p|`.
+fn impact_times_agree(
+    run: (
+        &'static dyn rodcube::model::Model,
+        &BTreeMap<String, f64>,
+        f64,
+    ),
+    ends: &[Result<rodcube::solve::phases::EndDerivatives, rodcube::solve::forward::Grazing>],
+    impacts: &[rodcube::solve::phases::ImpactAt],
+    names: &[&str],
+) {
+    let (model, p, until) = run;
+    for name in names {
+        let j = (model.info().parameters.iter())
+            .position(|q| q.name == *name)
+            .expect("a parameter");
+        let h = STEP * p[*name].abs();
+        let at = |k: f64| {
+            let mut q = p.clone();
+            *q.get_mut(*name).expect("a parameter") += k * h;
+            let mut w = walker(model, &q);
+            w.until = Some(until);
+            impact_times(&w)
+        };
+        let (a, b, c, d) = (at(1.0), at(-1.0), at(2.0), at(-2.0));
+        for (k, impact) in impacts.iter().enumerate() {
+            let dt = ends[impact.phase].as_ref().expect("not grazing").t[j];
+            let diff = (8.0 * (a[k] - b[k]) - (c[k] - d[k])) / (12.0 * h);
+            let scale = (impact.t / p[*name]).abs().max(diff.abs());
+            assert!(
+                (dt - diff).abs() <= 1e-7 * scale,
+                "{}, impact {}, d t/d {name}: {dt} vs differences {diff}",
+                model.info().name,
+                k + 1
+            );
+        }
+    }
 }
 
 #[test]
-fn results_past_an_impact_get_a_note_and_no_number() {
-    // The same run's impacts: their numbers have no sensitivities, and say so.
+fn rocking_strikes_that_stick_move_as_differences_say() {
+    // mu = 0.7: every strike sticks (Housner's); the strike times do not move with mu.
+    rocking_strikes_agree(0.7, 1.5, 4, true);
+}
+
+#[test]
+fn rocking_strikes_that_slide_move_as_differences_say() {
+    // mu = 0.1: the strike slides, its impulse on the cone's edge, whose derivative in mu
+    // moves every later strike.
+    rocking_strikes_agree(0.1, 1.0, 2, false);
+}
+
+#[test]
+fn every_impact_time_has_its_sensitivities_and_the_zeno_limit_a_note() {
     let (model, p) = scene("bounce");
     let want = [
         Quantity::ContactEnd,
@@ -323,13 +417,47 @@ fn results_past_an_impact_get_a_note_and_no_number() {
         .with_want(&want)
         .with_until(Some(0.6));
     let res = plan::run(&request).expect("runs");
+    let impacts = res.impacts.as_ref().expect("impacts");
+    let last = impacts.len();
+    assert!(impacts[last - 1].zeno_limit && last >= 5);
+    for i in 1..last {
+        for q in ["m1", "m2", "ell", "a", "g", "e"] {
+            let key = format!("d(impact_{i}_time)/d({q})");
+            let s = res
+                .sensitivities
+                .get(&key)
+                .unwrap_or_else(|| panic!("{key}"));
+            assert!(s.value.is_finite() && s.integrated, "{key}: {s:?}");
+        }
+    }
+    assert_eq!(res.sensitivities["d(impact_1_time)/d(m1)"].unit, "s/kg");
+    assert_eq!(res.sensitivities["d(impact_2_time)/d(e)"].unit, "s");
+    assert_eq!(
+        res.notes.get(&format!("sensitivities.impact_{last}_time")),
+        Some(&rodcube::results::Note::NoSensitivity(
+            rodcube::results::SensitivityGap::PastZeno
+        ))
+    );
+    // Without `until` the run ends at its first impact, the landing: its time's derivatives
+    // are the landing's.
+    let request = Request::new(model, &p).with_want(&[
+        Quantity::FloorImpact,
+        Quantity::Impacts,
+        Quantity::Sensitivities,
+    ]);
+    let first = plan::run(&request).expect("runs");
+    assert_eq!(first.impacts.as_ref().map(Vec::len), Some(1));
+    for q in ["m1", "m2", "ell", "a", "g", "e"] {
+        let d = |key: &str| first.sensitivities[&format!("d({key})/d({q})")].value;
+        assert_eq!(d("impact_1_time"), d("floor_impact_time"), "{q}");
+    }
+    // The impulses have none, and say so.
     assert_eq!(
         res.notes.get("sensitivities.impacts"),
         Some(&rodcube::results::Note::NoSensitivity(
             rodcube::results::SensitivityGap::NotBuilt
         ))
     );
-    assert!(!res.sensitivities.keys().any(|k| k.contains("impacts")));
 }
 
 #[test]

@@ -12,7 +12,8 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 const HEADER: &str = "time [s],contact,closing,normal_velocity_before,normal_velocity_after,\
-                      velocity_unit,impulse,impulse_unit,energy_lost [J],zeno_limit";
+                      velocity_unit,impulse,impulse_unit,tangential_impulse,energy_lost [J],\
+                      normal_energy_lost [J],friction_energy_lost [J],zeno_limit";
 
 fn part(
     contact: &str,
@@ -26,6 +27,7 @@ fn part(
         normal_velocity_before: before,
         normal_velocity_after: after,
         impulse,
+        tangential_impulse: 0.0,
         velocity_unit: units.0,
         impulse_unit: units.1,
     }
@@ -51,6 +53,8 @@ fn fixture() -> Vec<ImpactRecord> {
                 part("floor_normal", 0.0, 0.4039804004205225, 0.0, ("m/s", "N s")),
             ],
             energy_lost: 0.10637305993657369,
+            normal_energy_lost: 0.10637305993657369,
+            friction_energy_lost: 0.0,
             zeno_limit: false,
         },
         ImpactRecord {
@@ -65,6 +69,8 @@ fn fixture() -> Vec<ImpactRecord> {
                 ("rad/s", "N m s"),
             )],
             energy_lost: 1e-20,
+            normal_energy_lost: 1e-20,
+            friction_energy_lost: 0.0,
             zeno_limit: true,
         },
     ]
@@ -79,7 +85,7 @@ fn impacts_csv_has_its_header_and_reads_back_exactly() {
     assert_eq!(csv::IMPACTS_HEADER.join(","), HEADER);
     assert_eq!(
         lines[3],
-        "0.6180339887498949,hinge_angle,true,-3.5e-7,1.75e-7,rad/s,2.5e-8,N m s,1e-20,true"
+        "0.6180339887498949,hinge_angle,true,-3.5e-7,1.75e-7,rad/s,2.5e-8,N m s,0,1e-20,1e-20,0,true"
     );
     assert!(text.ends_with('\n'));
     // Every number back to its bits, every word as it was.
@@ -128,7 +134,7 @@ fn impacts_csv_has_its_header_and_reads_back_exactly() {
     ];
     let bits = |s: &str| s.parse::<f64>().unwrap().to_bits();
     for (row, (t, contact, closing, v, units, energy, zeno)) in rows.iter().zip(expected) {
-        assert_eq!(row.len(), 10, "{row:?}");
+        assert_eq!(row.len(), 13, "{row:?}");
         assert_eq!(bits(row[0]), t.to_bits());
         assert_eq!((row[1], row[2]), (contact, closing));
         assert_eq!(bits(row[3]), v[0].to_bits());
@@ -136,8 +142,11 @@ fn impacts_csv_has_its_header_and_reads_back_exactly() {
         assert_eq!(row[5], units.0);
         assert_eq!(bits(row[6]), v[2].to_bits());
         assert_eq!(row[7], units.1);
-        assert_eq!(bits(row[8]), energy.to_bits());
-        assert_eq!(row[9], zeno);
+        assert_eq!(bits(row[8]), 0f64.to_bits());
+        assert_eq!(bits(row[9]), energy.to_bits());
+        assert_eq!(bits(row[10]), energy.to_bits());
+        assert_eq!(bits(row[11]), 0f64.to_bits());
+        assert_eq!(row[12], zeno);
     }
     // No impacts: the header alone.
     assert_eq!(csv::impacts(&[]).unwrap(), format!("{HEADER}\n"));
@@ -151,7 +160,9 @@ fn an_impact_without_its_contacts_still_has_a_row() {
     let text = csv::impacts(&bare).unwrap();
     assert_eq!(
         text.lines().nth(1),
-        Some("0.2173103556284601,cylinder_push,true,,,,,,0.10637305993657369,false")
+        Some(
+            "0.2173103556284601,cylinder_push,true,,,,,,,0.10637305993657369,0.10637305993657369,0,false"
+        )
     );
 }
 
@@ -194,7 +205,9 @@ fn the_table_has_a_row_per_contact_in_each_impact() {
     }
     assert!(text.contains("* the contact whose gap closed"));
     assert!(
-        text.contains("(Zeno): the impact that closed a converging sequence"),
+        text.contains(
+            "(Zeno): the limit of a converging sequence of bounces, at its accumulation time"
+        ),
         "{text}"
     );
     assert!(text.lines().all(|l| l.chars().count() <= 100), "{text}");

@@ -37,6 +37,8 @@ fn parameters(model: &dyn Model, u: &[f64], spread: u8) -> Vec<f64> {
             "g" => log(u[i], -1.0, 2.0),
             "theta_0" => lin(u[i], 0.01, 1.56),
             "theta_dot_0" => -lin(u[i], 0.0, 3.0),
+            // The rocking block's tilt, below its slenderness angle atan(w/h) (set below).
+            "phi0" => u[i],
             // Friction from none to below Painlevé's 4/3 for a free rod sliding on its foot
             // (above it the sliding equations can turn singular: tests/friction.rs).
             "mu" | "mu_f" | "mu_w" => lin(u[i], 0.0, 1.3),
@@ -112,6 +114,10 @@ fn parameters(model: &dyn Model, u: &[f64], spread: u8) -> Vec<f64> {
         for x in ["x1_0", "x2_0"].into_iter().filter_map(idx) {
             p[x] = lin(u[x], -1.0, 1.0) * p[ell];
         }
+    }
+    // A rocking block tilted by a fraction of its slenderness angle atan(w/h).
+    if let (Some(w), Some(h), Some(phi0)) = (idx("w"), idx("h"), idx("phi0")) {
+        p[phi0] = (p[w] / p[h]).atan() * lin(u[phi0], 0.05, 0.95);
     }
     // A rod on a cylinder: the tangent point R cot(th0/2) must lie on the rod, th0 < pi/2.
     if let (Some(ell), Some(r), Some(th0)) = (idx("ell"), idx("R"), idx("th0")) {

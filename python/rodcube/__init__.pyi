@@ -41,11 +41,13 @@ class ContactImpulse(TypedDict):
     """Negative: approaching."""
     normal_velocity_after: float
     impulse: float
+    tangential_impulse: float
+    """Its friction's impulse (0 without friction), in the unit of `impulse`."""
     velocity_unit: str
     impulse_unit: str
 
 class Impact(TypedDict):
-    """An impact: where a contact closed, the impulses by Newton's law with complementarity."""
+    """An impact: where a contact closed, the impulses by Newton's law with complementarity and Coulomb's cone."""
 
     time: float
     """s from release."""
@@ -53,7 +55,11 @@ class Impact(TypedDict):
     contacts: list[str]
     per_contact: list[ContactImpulse]
     energy_lost: float
-    """J, from the impulses."""
+    """J, from the impulses: normal_energy_lost + friction_energy_lost."""
+    normal_energy_lost: float
+    """J, the normal impulses' part."""
+    friction_energy_lost: float
+    """J, the friction impulses' part."""
     zeno_limit: bool
 
 class SweepResult(TypedDict):

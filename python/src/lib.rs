@@ -168,6 +168,8 @@ fn solve<'py>(
             entry.set_item("closing", &record.closing)?;
             entry.set_item("contacts", record.contacts.clone())?;
             entry.set_item("energy_lost", record.energy_lost)?;
+            entry.set_item("normal_energy_lost", record.normal_energy_lost)?;
+            entry.set_item("friction_energy_lost", record.friction_energy_lost)?;
             entry.set_item("zeno_limit", record.zeno_limit)?;
             let per_contact = PyList::empty(py);
             for c in &record.per_contact {
@@ -176,6 +178,7 @@ fn solve<'py>(
                 d.set_item("normal_velocity_before", c.normal_velocity_before)?;
                 d.set_item("normal_velocity_after", c.normal_velocity_after)?;
                 d.set_item("impulse", c.impulse)?;
+                d.set_item("tangential_impulse", c.tangential_impulse)?;
                 d.set_item("velocity_unit", c.velocity_unit)?;
                 d.set_item("impulse_unit", c.impulse_unit)?;
                 per_contact.append(d)?;

@@ -108,7 +108,7 @@ def test_sweeps_sensitivities_are_its_own_central_differences(point):
 
 def test_a_sensitivity_that_does_not_exist_is_a_note_and_no_number():
     # The friction model's separation is integrated, with its forward sensitivities; an
-    # impact's numbers have none (the impact map's derivatives are not built), and a note why.
+    # impact's impulses and energy have none (only its time is differentiated), and a note why.
     names = [p for p, _, _ in rodcube.parameters("rod_cube_friction")]
     point = {p: PAPER.get(p, 0.2) for p in names}
     one = rodcube.solve("rod_cube_friction", want=WANT + ["impacts"], **point)
@@ -116,7 +116,7 @@ def test_a_sensitivity_that_does_not_exist_is_a_note_and_no_number():
     for p in names:
         assert math.isfinite(one["sensitivities"][f"d(separation_angle)/d({p})"]), p
     assert one["sensitivity_units"]["d(separation_time)/d(mu)"] == "s"
-    assert "impact map" in one["notes"]["sensitivities.impacts"]
+    assert "times only" in one["notes"]["sensitivities.impacts"]
     assert not any("impacts" in k for k in one["sensitivities"])
     # A point that fails has NaN sensitivities and one error.
     s = rodcube.sweep(n=3.0, a_over_ell=[0.25, 1.5], m1=1.0, ell=1.0, g=9.81, sensitivities=True)

@@ -221,18 +221,24 @@ fn impact_record(info: &ModelInfo, at: &ImpactAt) -> ImpactRecord {
                 normal_velocity_before: at.impact.normal_velocity_before[i],
                 normal_velocity_after: at.impact.normal_velocity_after[i],
                 impulse: at.impact.impulse[i],
+                tangential_impulse: (info.frictions.iter().enumerate())
+                    .filter(|(_, f)| f.contact_index == i)
+                    .filter_map(|(j, _)| at.impact.friction_impulse.get(j))
+                    .sum(),
                 velocity_unit: if angular { "rad/s" } else { "m/s" },
                 impulse_unit: if angular { "N m s" } else { "N s" },
             }
         })
         .collect();
     ImpactRecord {
-        time: at.t,
+        time: at.zeno.unwrap_or(at.t),
         closing: name(at.closing),
         contacts: taking.iter().map(|&i| name(i)).collect(),
         per_contact,
         energy_lost: at.impact.energy_lost,
-        zeno_limit: at.zeno,
+        normal_energy_lost: at.impact.normal_energy_lost,
+        friction_energy_lost: at.impact.friction_energy_lost,
+        zeno_limit: at.zeno.is_some(),
     }
 }
 
@@ -700,7 +706,7 @@ impl Plan<'_> {
         if let (false, Some(End::Contact(i))) = (motion.through_impacts, motion.last_end()) {
             match walker.impact(motion, i) {
                 Ok(at) => list.push(at),
-                Err(e @ SolveError::FrictionalImpact { .. }) => {
+                Err(e @ SolveError::ImpactGainsEnergy { .. }) => {
                     out.notes
                         .insert("impacts".into(), Note::Refused(e.to_string()));
                 }

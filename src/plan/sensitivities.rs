@@ -5,8 +5,10 @@
 //! from the fast path's generated partial derivatives (`solve::sensitivity`); every other
 //! from the motion integrated with its forward sensitivities (`Walker::sensitive_motion`),
 //! whose event is held to the run's: the same contact ending by the same cause, at a time
-//! within [`ROUTES_AGREE`]. Where a result has none (after an impact, at a grazing event, an
-//! impact's own numbers), a note says why, never a number.
+//! within [`ROUTES_AGREE`]; every impact's time (`impact_<i>_time`, `i` from 1) from the same
+//! motion, carried through every impact by its saltation matrix. Where a result has none (past
+//! a converging Zeno sequence's limit, at a grazing event, an impact's impulses and energy), a
+//! note says why, never a number.
 
 use super::quantities::{Fate, fate, landing};
 use super::{DEFAULT_TOLERANCE, ODE_RTOL_FACTOR, Plan};
@@ -14,7 +16,7 @@ use crate::model::start_offsets;
 use crate::quantity::Quantity;
 use crate::results::{Note, RunResults, Sensitivity, SensitivityGap};
 use crate::solve::SolveError;
-use crate::solve::phases::{End, SensitiveMotion, Stop};
+use crate::solve::phases::{End, Motion, SensitiveMotion, Stop};
 use crate::solve::prior::{PRIOR_TOL, Prior};
 use crate::solve::quadrature::ACCEPT;
 use crate::solve::sensitivity::{self, SensitivityWork, SeparationPoint};
@@ -125,6 +127,7 @@ impl<'m> Plan<'m> {
                     targets.push((rate, Source::Floor));
                 }
                 Quantity::Impacts => {
+                    self.impact_sensitivities(out)?;
                     let gap = Note::NoSensitivity(SensitivityGap::NotBuilt);
                     out.notes.insert(note_key(&q.name(info)), gap);
                 }
@@ -210,13 +213,7 @@ impl<'m> Plan<'m> {
             }
         };
         let Some((k, cause)) = event else {
-            let gap = match sensitive.stop {
-                Some(Stop::Impact) => SensitivityGap::PastImpact,
-                Some(Stop::Grazing) => SensitivityGap::Grazing,
-                Some(Stop::Failed(_)) => SensitivityGap::IntegrationFailed,
-                None => SensitivityGap::RoutesDisagree,
-            };
-            return Ok(Err(gap));
+            return Ok(Err(stop_gap(&sensitive.stop)));
         };
         let t = sensitive.motion.phases[k].t_end();
         if cause != cause_run || (t - t_run).abs() > agree * t_run.abs() {
@@ -228,6 +225,49 @@ impl<'m> Plan<'m> {
             Ok(d) if target.angle => Ok(d.theta.clone()),
             Ok(d) => Ok(d.t.clone()),
         })
+    }
+
+    /// `d(impact_<i>_time)/dp` (`i` from 1) of every impact of the run, from the motion
+    /// integrated with its forward sensitivities, each impact held to the run's: the same
+    /// closing contact, at a time within [`ROUTES_AGREE`]. An impact with none has a note.
+    fn impact_sensitivities(&mut self, out: &mut RunResults) -> Result<(), SolveError> {
+        let run = impact_events(self.complete()?);
+        let agree = ROUTES_AGREE.max(ROUTES_AGREE_PER_TOLERANCE * self.walker.tol);
+        for (k, ran) in run.into_iter().enumerate() {
+            let key = format!("impact_{}_time", k + 1);
+            let found = match self.sensitive() {
+                Err(gap) => Err(gap),
+                Ok(_) if ran.zeno => Err(SensitivityGap::PastZeno),
+                Ok(sensitive) => match impact_events(&sensitive.motion).get(k) {
+                    Some(at) if at.zeno => Err(SensitivityGap::PastZeno),
+                    Some(at)
+                        if at.closing != ran.closing || (at.t - ran.t).abs() > agree * ran.t =>
+                    {
+                        Err(SensitivityGap::RoutesDisagree)
+                    }
+                    Some(at) => match sensitive.ends.get(at.phase) {
+                        Some(Ok(d)) => Ok(d.t.clone()),
+                        _ => Err(SensitivityGap::Grazing),
+                    },
+                    None => Err(stop_gap(&sensitive.stop)),
+                },
+            };
+            let t_run = ran.t;
+            match found {
+                Ok(d) => {
+                    let target = Target {
+                        key,
+                        unit: "s",
+                        angle: false,
+                    };
+                    self.record(&target, (t_run, &d), true, out);
+                }
+                Err(gap) => {
+                    out.notes.insert(note_key(&key), Note::NoSensitivity(gap));
+                }
+            }
+        }
+        Ok(())
     }
 
     /// The motion integrated with its forward sensitivities (solved once, at the run's
@@ -331,6 +371,50 @@ impl<'m> Plan<'m> {
             Err(why) => return Ok(Some(Err(why))),
         };
         Ok(Some(Ok(Found { d_theta, d_t })))
+    }
+}
+
+/// An impact of a motion, as its time's sensitivities are matched.
+struct ImpactEvent {
+    /// Its time as listed (a Zeno limit's accumulation time).
+    t: f64,
+    closing: usize,
+    /// Whether it closes a Zeno sequence.
+    zeno: bool,
+    /// The phase that ended with it.
+    phase: usize,
+}
+
+/// The impacts of `motion` in order, with the one that ends it where it does not go on
+/// through impacts (a contact that closes ends a run without `until`).
+fn impact_events(motion: &Motion) -> Vec<ImpactEvent> {
+    let mut events: Vec<ImpactEvent> = (motion.impacts.iter())
+        .map(|i| ImpactEvent {
+            t: i.zeno.unwrap_or(i.t),
+            closing: i.closing,
+            zeno: i.zeno.is_some(),
+            phase: i.phase,
+        })
+        .collect();
+    if let (false, Some(End::Contact(closing))) = (motion.through_impacts, motion.last_end()) {
+        events.push(ImpactEvent {
+            t: motion.end_time(),
+            closing,
+            zeno: false,
+            phase: motion.phases.len() - 1,
+        });
+    }
+    events
+}
+
+/// Why a result the motion with sensitivities did not reach has none: why it stopped.
+fn stop_gap(stop: &Option<Stop>) -> SensitivityGap {
+    match stop {
+        Some(Stop::Impact(_)) => SensitivityGap::PastImpact,
+        Some(Stop::Zeno) => SensitivityGap::PastZeno,
+        Some(Stop::Grazing) => SensitivityGap::Grazing,
+        Some(Stop::Failed(_)) => SensitivityGap::IntegrationFailed,
+        None => SensitivityGap::RoutesDisagree,
     }
 }
 

@@ -10,7 +10,7 @@ use crate::results::{ImpactRecord, Series};
 /// The header of `impacts.csv`. The normal velocities and the impulse have their units in
 /// their own columns, as they may differ from contact to contact (`m/s` and `N s` for a
 /// distance gap, `rad/s` and `N m s` for an angular one).
-pub const IMPACTS_HEADER: [&str; 10] = [
+pub const IMPACTS_HEADER: [&str; 13] = [
     "time [s]",
     "contact",
     "closing",
@@ -19,7 +19,10 @@ pub const IMPACTS_HEADER: [&str; 10] = [
     "velocity_unit",
     "impulse",
     "impulse_unit",
+    "tangential_impulse",
     "energy_lost [J]",
+    "normal_energy_lost [J]",
+    "friction_energy_lost [J]",
     "zeno_limit",
 ];
 
@@ -63,7 +66,9 @@ pub fn to_string(name: &str, series: &Series) -> Result<String, Error> {
 
 /// The text of `impacts.csv`: [`IMPACTS_HEADER`], then one row per contact that took part in
 /// each impact, impacts in order and contacts in each impact's order. `time`, `energy_lost`
-/// (the impact's, repeated on each of its rows) and `zeno_limit` are the impact's; `closing` is
+/// and its split into the normal and the friction impulses' parts (the impact's, repeated on
+/// each of its rows) and `zeno_limit` are the impact's; `tangential_impulse` is the contact's
+/// friction impulse (in the unit of `impulse`); `closing` is
 /// `true` on the row of the contact whose gap closed. An impact that names no contact taking
 /// part still has a row: its closing contact, with the velocity and impulse cells empty.
 pub fn impacts(records: &[ImpactRecord]) -> Result<String, Error> {
@@ -74,8 +79,8 @@ pub fn impacts(records: &[ImpactRecord]) -> Result<String, Error> {
     let mut w = ::csv::Writer::from_writer(Vec::new());
     w.write_record(IMPACTS_HEADER).map_err(|e| csv_error(&e))?;
     for r in records {
-        let impact = |contact: &str, cells: [String; 5]| {
-            let [before, after, v_unit, impulse, p_unit] = cells;
+        let impact = |contact: &str, cells: [String; 6]| {
+            let [before, after, v_unit, impulse, p_unit, tangential] = cells;
             [
                 number(r.time),
                 contact.to_string(),
@@ -85,7 +90,10 @@ pub fn impacts(records: &[ImpactRecord]) -> Result<String, Error> {
                 v_unit,
                 impulse,
                 p_unit,
+                tangential,
                 number(r.energy_lost),
+                number(r.normal_energy_lost),
+                number(r.friction_energy_lost),
                 r.zeno_limit.to_string(),
             ]
         };
@@ -100,6 +108,7 @@ pub fn impacts(records: &[ImpactRecord]) -> Result<String, Error> {
                 c.velocity_unit.to_string(),
                 number(c.impulse),
                 c.impulse_unit.to_string(),
+                number(c.tangential_impulse),
             ];
             w.write_record(impact(&c.contact, cells))
                 .map_err(|e| csv_error(&e))?;

@@ -17,8 +17,9 @@ use crate::results::RunResults;
 /// The meaning written beside `results.impacts`.
 pub const IMPACTS_MEANING: &str = "every impact of the motion in order: its time (s from release), the \
      contact that closed, the contacts that took part with their normal velocities before and \
-     after (negative: approaching) and impulses by Newton's law of restitution with \
-     complementarity, and the kinetic energy lost (J)";
+     after (negative: approaching) and impulses (normal, and tangential where a friction acts) by \
+     Newton's law of restitution with complementarity and Coulomb's friction cone, and the \
+     kinetic energy lost (J), split into what the normal and the friction impulses took";
 
 /// Pretty-printed JSON of the results, ending with a newline.
 pub fn to_string(results: &RunResults) -> Result<String, serde_json::Error> {

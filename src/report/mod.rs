@@ -10,8 +10,9 @@
 //! `time [s]`, `contact`, `closing` (`true` for the contact whose gap closed),
 //! `normal_velocity_before`, `normal_velocity_after`, `velocity_unit`, `impulse`,
 //! `impulse_unit` (the units in their own columns, as they may differ from contact to
-//! contact), `energy_lost [J]` (the impact's, on each of its rows) and `zeno_limit` (`true` for
-//! the impact that closed a converging sequence of bounces).
+//! contact), `tangential_impulse` (its friction's, in the impulse's unit), `energy_lost [J]`,
+//! `normal_energy_lost [J]` and `friction_energy_lost [J]` (the impact's, on each of its rows)
+//! and `zeno_limit` (`true` for the impact that closed a converging sequence of bounces).
 
 #[cfg(feature = "cli")]
 mod checks;

@@ -307,20 +307,24 @@ fn zeno_words(zeno: &Zeno) -> String {
             t,
         } => format!(
             "contact `{contact}` bounced {bounces} times with intervals shrinking by a steady \
-             ratio {ratio:.4} (Zeno): their limit is t = {t_limit:.12} s, within the run's \
-             tolerance of the bounce at t = {t:.12} s, which was made plastic for the rest"
+             ratio {ratio:.4} (Zeno): the rest, summed as a geometric series, accumulate at \
+             t = {t_limit:.12} s, where the impact that closes the sequence is listed (the \
+             bounce at t = {t:.12} s made plastic); the contact is held closed from that bounce"
         ),
         Zeno::Unresolved {
             contact,
             t,
             rise,
             open_gap,
-            left,
+            bounces,
+            t_limit,
         } => format!(
-            "contact `{contact}` would bounce at t = {t:.12} s by {rise:.3e} of the length \
-             scale, below the {open_gap:e} at which a gap counts as open: the bounces from there \
-             (a converging Zeno sequence, about {left:.3e} s in all) are taken as one plastic \
-             impact, so the motion after it runs early by about that much"
+            "contact `{contact}` bounced {bounces} times, the last at t = {t:.12} s by \
+             {rise:.3e} of the length scale, below the {open_gap:e} at which a gap counts as \
+             open: the bounces from there (a converging Zeno sequence) are summed as a \
+             geometric series in its restitution, which accumulates at t = {t_limit:.12} s, \
+             where the impact that closes the sequence is listed (that bounce made plastic); \
+             the contact is held closed from that bounce"
         ),
     }
 }
@@ -428,12 +432,17 @@ pub fn sensitivity_gap(gap: SensitivityGap) -> &'static str {
              starts on"
         }
         SensitivityGap::NotBuilt => {
-            "sensitivities are not available for impacts: the derivatives of the impact map \
-             are not built"
+            "sensitivities of impacts are given for their times only \
+             (d(impact_<i>_time)/d(<parameter>)): their impulses, normal velocities and \
+             energies lost are not differentiated"
         }
         SensitivityGap::PastImpact => {
-            "no sensitivity: the result comes after an impact, and the derivatives of the \
-             impact map are not built"
+            "no sensitivity: the result comes after an impact whose map has no derivatives (a \
+             restitution given by an expression of the parameters, or redundant contacts)"
+        }
+        SensitivityGap::PastZeno => {
+            "no sensitivity: the result is, or comes after, the limit of a converging (Zeno) \
+             sequence of bounces, whose accumulation time is extrapolated, not differentiated"
         }
         SensitivityGap::Grazing => {
             "no sensitivity: an event on the way is grazing (its function's rate is zero \

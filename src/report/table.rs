@@ -8,7 +8,7 @@ use super::layout::{section, with_unit};
 use crate::model::ModelInfo;
 use crate::quantity::{FIXED, Quantity};
 pub use crate::results::format_number;
-use crate::results::{ImpactRecord, LabelValue, RunResults};
+use crate::results::{ContactImpulse, ImpactRecord, LabelValue, RunResults};
 use comfy_table::{Cell, CellAlignment, ColumnConstraint, Width};
 
 /// The paper's published figures (Section 3, three digits), by result key.
@@ -204,6 +204,20 @@ pub const MAX_IMPACTS_LISTED: usize = 12;
 /// Impacts shown at each end of a long list.
 pub const IMPACTS_AT_EACH_END: usize = 5;
 
+/// A contact's impulse in the impacts table (its unit in the cell unless the header holds it:
+/// `shared`), its friction's beside it where it has one.
+fn impulse_cell(c: &ContactImpulse, shared: Option<&str>) -> String {
+    let cell = |v: f64| match shared {
+        Some(_) => format_number(v, 6),
+        None => with_unit(v, 6, c.impulse_unit),
+    };
+    if c.tangential_impulse == 0.0 {
+        cell(c.impulse)
+    } else {
+        format!("{}, {}", cell(c.impulse), cell(c.tangential_impulse))
+    }
+}
+
 /// The impacts: one row per contact taking part in each impact, the closing one marked `*`;
 /// the impact's time and energy lost on its first row, `(Zeno)` beside the energy of an impact
 /// that closed a converging sequence of bounces. A unit that every row shares is in the header,
@@ -212,7 +226,7 @@ pub const IMPACTS_AT_EACH_END: usize = 5;
 /// one); with `verbose`, what the table is.
 fn impacts(out: &mut String, list: &[ImpactRecord], layout: &Layout) {
     let contacts = || list.iter().flat_map(|r| &r.per_contact);
-    let shared = |unit: fn(&crate::results::ContactImpulse) -> &str| {
+    let shared = |unit: fn(&ContactImpulse) -> &str| {
         let first = contacts().next().map(unit);
         first.filter(|u| contacts().all(|c| unit(c) == *u))
     };
@@ -248,6 +262,13 @@ fn impacts(out: &mut String, list: &[ImpactRecord], layout: &Layout) {
         };
         let mut time = format_number(r.time, 6);
         let mut energy = format_number(r.energy_lost, 6);
+        if r.friction_energy_lost != 0.0 {
+            energy.push_str(&format!(
+                " (normal {}, friction {})",
+                format_number(r.normal_energy_lost, 6),
+                format_number(r.friction_energy_lost, 6)
+            ));
+        }
         if r.zeno_limit {
             energy.push_str(" (Zeno)");
         }
@@ -269,7 +290,7 @@ fn impacts(out: &mut String, list: &[ImpactRecord], layout: &Layout) {
                 mark(&c.contact),
                 in_cell(c.normal_velocity_before, c.velocity_unit, velocity_unit),
                 in_cell(c.normal_velocity_after, c.velocity_unit, velocity_unit),
-                in_cell(c.impulse, c.impulse_unit, impulse_unit),
+                impulse_cell(c, impulse_unit),
                 std::mem::take(&mut energy),
             ]);
         }
@@ -311,9 +332,18 @@ fn impacts(out: &mut String, list: &[ImpactRecord], layout: &Layout) {
     let mut legend = vec![
         "* the contact whose gap closed; v: a contact's normal velocity (negative: approaching)",
     ];
+    if list
+        .iter()
+        .any(|r| r.per_contact.iter().any(|c| c.tangential_impulse != 0.0))
+    {
+        legend.push(
+            "impulse a, b: the normal impulse a and its friction's tangential impulse b; energy \
+             lost (normal, friction): what the normal and the tangential impulses took",
+        );
+    }
     if list.iter().any(|r| r.zeno_limit) {
         legend
-            .push("(Zeno): the impact that closed a converging sequence of bounces, made plastic");
+            .push("(Zeno): the limit of a converging sequence of bounces, at its accumulation time: the last bounce resolved made plastic");
     }
     for line in legend {
         out.push_str(&wrap(line, layout.width, 2));

@@ -239,6 +239,9 @@ pub struct ContactImpulse {
     pub normal_velocity_after: f64,
     /// The impulse it took (`>= 0` for a unilateral contact).
     pub impulse: f64,
+    /// The tangential impulse of its friction (zero without one, or where it does not act),
+    /// positive along its slip direction.
+    pub tangential_impulse: f64,
     /// The unit of the normal velocities (`m/s`, or `rad/s` for an angular gap).
     pub velocity_unit: &'static str,
     /// The unit of the impulse (`N s`, or `N m s`).
@@ -249,7 +252,8 @@ pub struct ContactImpulse {
 /// that took part and the kinetic energy they took out.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ImpactRecord {
-    /// Time from release (s).
+    /// Time from release (s); for the impact that closed a converging (Zeno) sequence of
+    /// bounces, the sequence's accumulation time.
     pub time: f64,
     /// The contact whose gap closed.
     pub closing: String,
@@ -257,9 +261,16 @@ pub struct ImpactRecord {
     pub contacts: Vec<String>,
     /// Per contact that took part, in the order of `contacts`.
     pub per_contact: Vec<ContactImpulse>,
-    /// Kinetic energy lost (J), from the impulses: `-sum P (v- + v+) / 2`.
+    /// Kinetic energy lost (J), from the impulses: `normal_energy_lost + friction_energy_lost`.
     pub energy_lost: f64,
-    /// Whether this impact closed a converging (Zeno) sequence of bounces, made plastic.
+    /// The normal impulses' part of it (J): `-sum P (v- + v+) / 2`.
+    pub normal_energy_lost: f64,
+    /// The tangential (friction) impulses' part of it (J): `-sum P_t (s- + s+) / 2`, `s` the
+    /// slip velocities.
+    pub friction_energy_lost: f64,
+    /// Whether this impact closed a converging (Zeno) sequence of bounces, made plastic and
+    /// listed at the sequence's accumulation time (its impulses and energy are those of the
+    /// last bounce resolved, made plastic: the whole sequence's energy lost).
     pub zeno_limit: bool,
 }
 

@@ -48,8 +48,9 @@ pub enum Zeno {
         /// The bounce made plastic (s from release).
         t: f64,
     },
-    /// A bounce too small to open the gap: the rest of the sequence taken as one plastic
-    /// impact.
+    /// A bounce too small to open the gap: the rest of the sequence summed as a geometric
+    /// series (each flight `e` times the one before) and taken as one plastic impact at its
+    /// limit.
     Unresolved {
         /// The contact that would bounce.
         contact: String,
@@ -59,8 +60,10 @@ pub enum Zeno {
         rise: f64,
         /// The relative gap at which a contact counts as open.
         open_gap: f64,
-        /// About how long the bounces left would last in all (s).
-        left: f64,
+        /// How many impacts of the sequence were resolved one by one (this one among them).
+        bounces: usize,
+        /// The limit of the bounces' times, the accumulation time (s from release).
+        t_limit: f64,
     },
 }
 
@@ -250,12 +253,15 @@ pub enum SensitivityGap {
     AtRelease,
     /// The first contact does not separate on the fast phase the motion starts on.
     NoSeparation,
-    /// The result is of an impact (its impulses, velocities, energy lost), whose map's
-    /// derivatives are not built.
+    /// The result is of an impact's impulses, velocities or energy lost, which are not
+    /// differentiated (its time is).
     NotBuilt,
-    /// The result comes after an impact the motion went through, whose map's derivatives are
-    /// not built.
+    /// The result comes after an impact whose map has no derivatives (a restitution given by
+    /// an expression of the parameters, or redundant contacts taking part).
     PastImpact,
+    /// The result is, or comes after, the limit of a converging (Zeno) sequence of bounces,
+    /// whose accumulation time is extrapolated, not differentiated.
+    PastZeno,
     /// An event on the way to the result is grazing (its function's rate is zero there), where
     /// the time does not move smoothly with the parameters.
     Grazing,

@@ -646,8 +646,10 @@ fn consistent(
 }
 
 /// Every combination the options allow (contacts first, then the modes of the frictions whose
-/// contacts are closed in it); an error past [`MAX_COMBINATIONS`].
-fn combinations(sys: &Bound, options: &Options, t: f64) -> Result<Vec<Active>, SolveError> {
+/// contacts are closed in it); an error past [`MAX_COMBINATIONS`]. The one enumeration of
+/// contact states and friction modes: [`decide`]'s at the acceleration level, and the
+/// impacts' at the velocity level (`solve::impact`).
+pub fn combinations(sys: &Bound, options: &Options, t: f64) -> Result<Vec<Active>, SolveError> {
     let info = sys.info();
     let contact_lists: Vec<Vec<bool>> = (options.contacts.iter())
         .map(|o| match o {

@@ -27,6 +27,7 @@ pub mod prior;
 pub mod quadrature;
 pub mod rest;
 pub mod roots;
+pub mod saltation;
 pub mod sensitivity;
 pub mod separation;
 pub mod series;
@@ -297,18 +298,22 @@ pub enum SolveError {
         /// Its normal velocity (negative: closing).
         velocity: f64,
     },
-    /// An impact at a contact with friction: its tangential impulse (sticking or sliding
-    /// through the impact) is not modelled, so the motion after it is refused.
+    /// An impact whose impulses would create kinetic energy (Newton's law of restitution
+    /// with friction can, for some geometries): the law does not describe it.
     #[error(
-        "model `{model}` at t = {t:e} s: contact `{contact}` has friction and takes part in an impact; impulses with friction are not modelled, so the motion cannot go on past it (set its friction coefficient to 0, or end the run before it)"
+        "model `{model}` at t = {t:e} s ({contacts}): the impulses of Newton's law of restitution with Coulomb friction would create {gained:e} J of kinetic energy (of {kinetic:e} J before the impact), so this law does not describe the impact; rodcube stops rather than continue with it"
     )]
-    FrictionalImpact {
+    ImpactGainsEnergy {
         /// Model name.
         model: &'static str,
         /// Time from release (s).
         t: f64,
-        /// The contact with friction.
-        contact: &'static str,
+        /// The contacts taking part, comma-separated.
+        contacts: String,
+        /// The kinetic energy the impulses would create (J).
+        gained: f64,
+        /// The kinetic energy before the impact (J).
+        kinetic: f64,
     },
     /// The phase the per-point solver solves is not the one the system starts in.
     #[error(

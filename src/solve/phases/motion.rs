@@ -20,9 +20,12 @@ pub struct ImpactAt {
     pub parts: Vec<Part>,
     /// The impulses, the normal velocities and the state after.
     pub impact: Impact,
-    /// Whether a converging (Zeno) sequence of bounces was closed by making this impact
-    /// plastic.
-    pub zeno: bool,
+    /// Where this impact closed a converging (Zeno) sequence of bounces, made plastic: the
+    /// sequence's accumulation time (s from release), extrapolated from its bounces. The
+    /// impact is listed there; the motion after it starts at `t` with the contact closed (the
+    /// closed contact's motion is what the ever smaller bounces tend to), and a system the
+    /// impact leaves at rest comes to rest at the accumulation time.
+    pub zeno: Option<f64>,
 }
 
 /// The whole motion, phase after phase.

@@ -1,14 +1,16 @@
 //! The motion with the forward sensitivities of every phase's end ([`Walker::sensitive_motion`]):
 //! every phase integrated with `S = dy/dp` riding along ([`forward`]), `S` carried across each
-//! phase boundary by the jump of the accelerations there, and each end's time, angle and rate
-//! differentiated in every parameter. The derivatives of an impact's map are not built: the
-//! motion stops at its first impact, and the phases after it have none.
+//! phase boundary by the jump of the accelerations there and across each impact by its
+//! saltation matrix ([`saltation`]), and each end's time, angle and rate differentiated in every
+//! parameter. The accumulation time of a converging (Zeno) sequence is extrapolated, not
+//! differentiated: the motion with sensitivities stops there.
 
 use super::{MAX_PHASES, Motion, PhaseStart, Route, Walker};
 use crate::results::Work;
 use crate::solve::SolveError;
 use crate::solve::contacts;
 use crate::solve::forward::{self, Forward, Grazing};
+use crate::solve::saltation::{self, Crossing, SaltationGap};
 use crate::solve::unreduced::{End, EndSensitivity};
 
 /// How one phase's end moves with the parameters (one value per parameter each).
@@ -28,7 +30,7 @@ pub struct EndDerivatives {
 /// The motion on the integrated route with the derivatives of its phases' ends.
 #[derive(Debug, Clone)]
 pub struct SensitiveMotion<'m> {
-    /// The motion, to its end or to its first impact.
+    /// The motion, to its end or to where it stopped ([`SensitiveMotion::stop`]).
     pub motion: Motion<'m>,
     /// Per phase of [`SensitiveMotion::motion`], its end's derivatives, or the grazing event
     /// (its own or one before it) whose time has none.
@@ -40,9 +42,11 @@ pub struct SensitiveMotion<'m> {
 /// Why the motion with sensitivities stopped before its end.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Stop {
-    /// At an impact it would have gone on through (the impact map's derivatives are not
-    /// built).
-    Impact,
+    /// At an impact whose map has no derivatives (why: the gap).
+    Impact(SaltationGap),
+    /// At the impact that closes a converging (Zeno) sequence of bounces (its accumulation
+    /// time is extrapolated, not differentiated).
+    Zeno,
     /// At a grazing event, past which `S` is not defined.
     Grazing,
     /// A later phase failed (the first phase's error is the motion's).
@@ -88,8 +92,9 @@ impl<'m> Walker<'m> {
     /// end in every parameter (a model without
     /// [`Model::tangents`](crate::model::Model::tangents) is
     /// [`SystemError::NoTangents`](crate::system::SystemError::NoTangents), as is any error
-    /// of the first phase). It stops early ([`SensitiveMotion::stop`]) at the first impact it
-    /// would go on through, at a grazing event, or where a later phase fails.
+    /// of the first phase). It goes on through impacts as the run does, and stops early
+    /// ([`SensitiveMotion::stop`]) at an impact whose map has no derivatives, at the limit of a
+    /// converging (Zeno) sequence, at a grazing event, or where a later phase fails.
     pub fn sensitive_motion(&self, work: &mut Work) -> Result<SensitiveMotion<'m>, SolveError> {
         let walker = Walker {
             route: Route::Integrated,
@@ -103,7 +108,7 @@ impl<'m> Walker<'m> {
         let mut ends = Vec::new();
         let mut motion = Motion::starting(run, opened, walker.until.is_some());
         loop {
-            let next = walker.next_sensitive(&motion, &mut ends, sens);
+            let next = walker.next_sensitive(&mut motion, &mut ends, sens);
             let stop = match next {
                 Ok(Next::Go(next, s_next)) => {
                     (start, s) = (next, s_next);
@@ -124,10 +129,11 @@ impl<'m> Walker<'m> {
     }
 
     /// The derivatives of the end of `motion`'s last phase (into `ends`) from its
-    /// sensitivities `sens`, and what follows it.
+    /// sensitivities `sens`, and what follows it (an impact there is resolved and added to
+    /// `motion`, `S` carried across it).
     fn next_sensitive(
         &self,
-        motion: &Motion<'m>,
+        motion: &mut Motion<'m>,
         ends: &mut Vec<Result<EndDerivatives, Grazing>>,
         sens: EndSensitivity,
     ) -> Result<Next, SolveError> {
@@ -145,16 +151,23 @@ impl<'m> Walker<'m> {
         let Some(dt) = dt else {
             return Ok(Next::Stop(Some(Stop::Grazing)));
         };
-        if matches!(motion.last_end(), Some(End::Contact(_))) {
-            return Ok(Next::Stop(Some(Stop::Impact)));
-        }
-        if motion.phases.len() >= MAX_PHASES {
+        let since = motion.phases.len() - motion.impacts.last().map_or(0, |i| i.phase + 1);
+        if since >= MAX_PHASES {
             return Err(SolveError::TooManyPhases { limit: MAX_PHASES });
+        }
+        if let Some(End::Contact(i)) = motion.last_end() {
+            return self.sensitive_impact(motion, i, (end_state, sens, dt));
         }
         let next = match self.after(last) {
             Ok(next) => next,
             // Another contact closes as this one opens: an impact.
-            Err(SolveError::ImpactAtRelease { .. }) => return Ok(Next::Stop(Some(Stop::Impact))),
+            Err(e @ SolveError::ImpactAtRelease { contact, .. }) => {
+                let info = general.info();
+                let Some(j) = info.contacts.iter().position(|c| c.name == contact) else {
+                    return Err(e);
+                };
+                return self.sensitive_impact(motion, j, (end_state, sens, dt));
+            }
             Err(e) => return Err(e),
         };
         // `S` across the boundary: the accelerations jump to the next active set's.
@@ -162,5 +175,43 @@ impl<'m> Walker<'m> {
         let mut s = sens.s;
         forward::jump(&mut s, &sens.qdd, &after.qdd, &dt);
         Ok(Next::Go(next, s))
+    }
+
+    /// The impact where contact `closing` closes at the end of `motion`'s last phase (its
+    /// state there, its sensitivities and `dt/dp` of its end in `before`), resolved as the run
+    /// resolves it and added to `motion`, and `S` carried across it by its saltation matrix.
+    fn sensitive_impact(
+        &self,
+        motion: &mut Motion<'m>,
+        closing: usize,
+        before: (crate::system::State, EndSensitivity, Vec<f64>),
+    ) -> Result<Next, SolveError> {
+        let (state, sens, dt) = before;
+        let friction_work = motion.phases.last().map_or(0.0, |p| p.friction_work());
+        let Some(start) = self.through_impact(motion, closing, friction_work)? else {
+            // Halted: too many impacts, or at rest after it.
+            return Ok(Next::Stop(None));
+        };
+        let Some(at) = motion.impacts.last() else {
+            return Ok(Next::Stop(None));
+        };
+        if at.zeno.is_some() {
+            return Ok(Next::Stop(Some(Stop::Zeno)));
+        }
+        let after = contacts::dynamics(&self.general, &start.state, &start.active, start.t)?;
+        let laws = saltation::laws(&at.impact);
+        let crossing = Crossing {
+            before: &state,
+            impact: &at.impact,
+            laws: &laws,
+            qdd_before: &sens.qdd,
+            qdd_after: &after.qdd,
+            dt: &dt,
+        };
+        let mut s = sens.s;
+        Ok(match saltation::cross(&self.general, &crossing, &mut s)? {
+            Ok(()) => Next::Go(start, s),
+            Err(gap) => Next::Stop(Some(Stop::Impact(gap))),
+        })
     }
 }

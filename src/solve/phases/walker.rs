@@ -1,7 +1,8 @@
 //! How a system's motion is solved ([`Walker`]): the contacts decided at release and after every
 //! event, each phase on its route, phase after phase until one ends for good, and through
 //! impacts (Zeno's bounces caught) where the run goes on to a time; with the limits that halt
-//! it and a fast phase's start parameters ([`phase_parameters`]).
+//! it and a fast phase's start parameters ([`phase_parameters`]); a converging sequence is
+//! closed at its accumulation time.
 
 use super::motion::{ImpactAt, Motion};
 use super::reduced::{ReducedEnd, ReducedRun, phase_end};
@@ -31,7 +32,8 @@ pub const MAX_IMPACTS: usize = 1000;
 /// Bounces at one contact whose intervals shrink by a steady ratio (the last
 /// [`ZENO_RATIOS`] ratios below one and within this fraction of each other) converge: once the
 /// time left to their limit, `dt r / (1 - r)`, is within the run's tolerance of the time from
-/// release, the rest of them is taken as one plastic impact.
+/// release, the rest of them is summed as a geometric series: one plastic impact, listed at
+/// their limit.
 pub const ZENO_RATIO_SPREAD: f64 = 0.1;
 
 /// How many successive interval ratios must agree before bounces count as converging.
@@ -450,7 +452,7 @@ impl<'m> Walker<'m> {
     /// The impact at the end of the motion's last phase where contact `closing` closes, and
     /// where the motion starts again after it; `None` (with the motion halted and why) past
     /// [`MAX_IMPACTS`], or where the impact leaves the system at rest.
-    fn through_impact(
+    pub(super) fn through_impact(
         &self,
         motion: &mut Motion<'m>,
         closing: usize,
@@ -469,7 +471,9 @@ impl<'m> Walker<'m> {
         match start {
             Ok(start) => Ok(Some(start)),
             // An impact that leaves the system at rest ends its motion.
+            // At the accumulation time where the impact closed a converging sequence.
             Err(SolveError::AtRest { t, how, .. }) => {
+                let t = (motion.impacts.last()).map_or(t, |i| i.zeno.unwrap_or(t));
                 motion.halted = Some(Halt::AtRest { t, how });
                 Ok(None)
             }
@@ -479,7 +483,7 @@ impl<'m> Walker<'m> {
 
     /// The impact that ends the motion's last phase, where contact `closing` closed: every
     /// contact closed then, `closing` and any other open one that touches while approaching take
-    /// part; a contact with friction taking part is [`SolveError::FrictionalImpact`]. Bounces
+    /// part, with their frictions (`impact::resolve_with`). Bounces
     /// converging as Zeno's (`zeno_limit`) are closed by a plastic impact, with a note.
     pub fn impact(&self, motion: &mut Motion<'m>, closing: usize) -> Result<ImpactAt, SolveError> {
         let general = &self.general;
@@ -498,17 +502,6 @@ impl<'m> Walker<'m> {
                 }
             })
             .collect();
-        let mu = general.friction_coefficients();
-        if let Some(f) = (info.frictions.iter().enumerate())
-            .find(|(j, f)| parts[f.contact_index] != Part::None && mu[*j] != 0.0)
-            .map(|(_, f)| f)
-        {
-            return Err(SolveError::FrictionalImpact {
-                model: info.name,
-                t,
-                contact: info.contacts[f.contact_index].name,
-            });
-        }
         let name = info.contacts[closing].name;
         let mut restitution = general.restitutions().to_vec();
         let limit = zeno_limit(&motion.impacts, closing, t, self.tol);
@@ -516,8 +509,9 @@ impl<'m> Walker<'m> {
             restitution[closing] = 0.0;
         }
         let mut impact = impact::resolve_with(general, &state, &parts, &restitution, t)?;
-        let mut plastic = limit.is_some();
+        let mut accumulation = None;
         if let Some((ratio, t_limit, bounces)) = limit {
+            accumulation = Some(t_limit);
             motion.notes.push(Zeno::Limit {
                 contact: name.to_string(),
                 bounces,
@@ -526,18 +520,19 @@ impl<'m> Walker<'m> {
                 t,
             });
         } else if let Some((rise, flight)) = self.unresolved_bounce(&impact, &parts, closing, t)? {
-            // The bounces left, each `e` times the one before: their flights sum to about
-            // `flight / (1 - e)`.
+            // The bounces left, each `e` times the one before (the pull back constant over
+            // them, as under gravity): their flights sum to `flight / (1 - e)`.
             let left = flight / (1.0 - restitution[closing]).max(f64::EPSILON);
             restitution[closing] = 0.0;
             impact = impact::resolve_with(general, &state, &parts, &restitution, t)?;
-            plastic = true;
+            accumulation = Some(t + left);
             motion.notes.push(Zeno::Unresolved {
                 contact: name.to_string(),
                 t,
                 rise,
                 open_gap: DECIDE_TOLERANCE,
-                left,
+                bounces: sequence_times(&motion.impacts, closing, t).len(),
+                t_limit: t + left,
             });
         }
         Ok(ImpactAt {
@@ -546,7 +541,7 @@ impl<'m> Walker<'m> {
             closing,
             parts,
             impact,
-            zeno: plastic,
+            zeno: accumulation,
         })
     }
 
@@ -555,7 +550,8 @@ impl<'m> Walker<'m> {
     /// open), and for how long (s): its normal velocity after squared over twice its normal
     /// acceleration pulling it back, and twice the velocity over that acceleration, with it
     /// open and the other contacts decided at the state after. `None` for a contact that stays
-    /// closed, is not pulled back, or rises clear.
+    /// closed (its velocity after within [`impact::IMPACT_TOLERANCE`] of its approach speed),
+    /// is not pulled back, or rises clear.
     fn unresolved_bounce(
         &self,
         impact: &Impact,
@@ -564,7 +560,10 @@ impl<'m> Walker<'m> {
         t: f64,
     ) -> Result<Option<(f64, f64)>, SolveError> {
         let u = impact.normal_velocity_after[closing];
-        if u <= 0.0 {
+        // A plastic contact's velocity after is zero but for rounding: no bounce to sum (its
+        // flight, `2 u / pull`, would be rounding over rounding).
+        let rounding = impact::IMPACT_TOLERANCE * impact.normal_velocity_before[closing].abs();
+        if u <= rounding {
             return Ok(None);
         }
         let state = &impact.after;
@@ -689,14 +688,7 @@ fn approaching_touches(sys: &Bound, state: &State) -> Result<Vec<bool>, SolveErr
 /// below one and agree within [`ZENO_RATIO_SPREAD`], and the time left to their limit is within
 /// `tol` of `t`. Returns the ratio, the limit's time and the bounces counted.
 fn zeno_limit(impacts: &[ImpactAt], closing: usize, t: f64, tol: f64) -> Option<(f64, f64, usize)> {
-    let times: Vec<f64> = (impacts.iter().rev())
-        .take_while(|i| i.closing == closing)
-        .map(|i| i.t)
-        .collect::<Vec<_>>()
-        .into_iter()
-        .rev()
-        .chain([t])
-        .collect();
+    let times = sequence_times(impacts, closing, t);
     if times.len() < ZENO_RATIOS + 2 {
         return None;
     }
@@ -709,6 +701,18 @@ fn zeno_limit(impacts: &[ImpactAt], closing: usize, t: f64, tol: f64) -> Option<
         .all(|q| *q > 0.0 && *q < 1.0 && (q - r).abs() <= ZENO_RATIO_SPREAD * r);
     let left = dt[dt.len() - 1] * r / (1.0 - r);
     (steady && left <= tol * t).then_some((r, t + left, times.len()))
+}
+
+/// The times of the impacts at contact `closing` that end `impacts` (one after another, no
+/// other contact's between), and `t`'s: the bounces of a sequence so far.
+fn sequence_times(impacts: &[ImpactAt], closing: usize, t: f64) -> Vec<f64> {
+    let mut times: Vec<f64> = (impacts.iter().rev())
+        .take_while(|i| i.closing == closing)
+        .map(|i| i.t)
+        .collect();
+    times.reverse();
+    times.push(t);
+    times
 }
 
 /// A phase's error with the phase's start time added to the time it names (the integrator
