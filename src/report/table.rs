@@ -204,6 +204,13 @@ pub const MAX_IMPACTS_LISTED: usize = 12;
 /// Impacts shown at each end of a long list.
 pub const IMPACTS_AT_EACH_END: usize = 5;
 
+/// Whether the impacts table shows the part of an impact's energy loss its friction took: where
+/// it is more than rounding (1e-9 of the whole loss; `impacts.csv` and the JSON always hold it).
+fn friction_shown(r: &ImpactRecord) -> bool {
+    let f = r.friction_energy_lost;
+    f.abs() > 1e-9 * r.energy_lost.abs()
+}
+
 /// A contact's impulse in the impacts table (its unit in the cell unless the header holds it:
 /// `shared`), its friction's beside it where it has one.
 fn impulse_cell(c: &ContactImpulse, shared: Option<&str>) -> String {
@@ -262,10 +269,9 @@ fn impacts(out: &mut String, list: &[ImpactRecord], layout: &Layout) {
         };
         let mut time = format_number(r.time, 6);
         let mut energy = format_number(r.energy_lost, 6);
-        if r.friction_energy_lost != 0.0 {
+        if friction_shown(r) {
             energy.push_str(&format!(
-                " (normal {}, friction {})",
-                format_number(r.normal_energy_lost, 6),
+                " (friction {})",
                 format_number(r.friction_energy_lost, 6)
             ));
         }
@@ -336,9 +342,12 @@ fn impacts(out: &mut String, list: &[ImpactRecord], layout: &Layout) {
         .iter()
         .any(|r| r.per_contact.iter().any(|c| c.tangential_impulse != 0.0))
     {
+        legend.push("impulse a, b: the normal impulse a and its friction's tangential impulse b");
+    }
+    if list.iter().any(friction_shown) {
         legend.push(
-            "impulse a, b: the normal impulse a and its friction's tangential impulse b; energy \
-             lost (normal, friction): what the normal and the tangential impulses took",
+            "energy lost (friction f): f of it taken by the tangential impulses, the rest by the \
+             normal ones (shown where above 1e-9 of the whole; impacts.csv: always)",
         );
     }
     if list.iter().any(|r| r.zeno_limit) {
