@@ -605,8 +605,11 @@ impl Reduction for FixedCylinderClosed {
     fn force_polynomial(&self, _k: &[f64], _contact: usize, _out: &mut [f64]) {}
 
     /// The constants of `prepare` that the per-point solver reads, and only those.
+    #[inline]
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let p = &p[..5];
         let th0 = p[3];
+        let k = &mut k[..37]; // one bounds check for all constant stores
         k[..5].copy_from_slice(p);
         // k[5] = rc_wi = 0.0
         k[5] = 0.0;

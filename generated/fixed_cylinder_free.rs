@@ -535,12 +535,15 @@ impl Reduction for FixedCylinderFree {
     }
 
     /// The constants of `prepare` that the per-point solver reads, and only those.
+    #[inline]
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let p = &p[..9];
         let m1 = p[0];
         let ell = p[1];
         let g = p[4];
         let theta_0 = p[6];
         let theta_dot_0 = p[8];
+        let k = &mut k[..31]; // one bounds check for all constant stores
         k[..9].copy_from_slice(p);
         // k[9] = rc_si = sin(rc_thi)
         k[9] = theta_0.sin();

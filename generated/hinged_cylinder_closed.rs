@@ -597,8 +597,11 @@ impl Reduction for HingedCylinderClosed {
     fn force_polynomial(&self, _k: &[f64], _contact: usize, _out: &mut [f64]) {}
 
     /// The constants of `prepare` that the per-point solver reads, and only those.
+    #[inline]
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let p = &p[..6];
         let th0 = p[4];
+        let k = &mut k[..35]; // one bounds check for all constant stores
         k[..6].copy_from_slice(p);
         // k[6] = rc_wi = 0.0
         k[6] = 0.0;

@@ -525,8 +525,11 @@ impl Reduction for HingedCylinderFree {
     fn force_polynomial(&self, _k: &[f64], _contact: usize, _out: &mut [f64]) {}
 
     /// The constants of `prepare` that the per-point solver reads, and only those.
+    #[inline]
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let p = &p[..10];
         let theta_0 = p[6];
+        let k = &mut k[..27]; // one bounds check for all constant stores
         k[..10].copy_from_slice(p);
         // k[10] = rc_si = sin(rc_thi)
         k[10] = theta_0.sin();

@@ -500,8 +500,11 @@ impl Reduction for HingedRodFree {
     fn force_polynomial(&self, _k: &[f64], _contact: usize, _out: &mut [f64]) {}
 
     /// The constants of `prepare` that the per-point solver reads, and only those.
+    #[inline]
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let p = &p[..9];
         let theta_0 = p[5];
+        let k = &mut k[..26]; // one bounds check for all constant stores
         k[..9].copy_from_slice(p);
         // k[9] = rc_si = sin(rc_thi)
         k[9] = theta_0.sin();

@@ -521,9 +521,12 @@ impl Reduction for HingedRodSpringClosed {
     fn force_polynomial(&self, _k: &[f64], _contact: usize, _out: &mut [f64]) {}
 
     /// The constants of `prepare` that the per-point solver reads, and only those.
+    #[inline]
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let p = &p[..6];
         let ell = p[2];
         let a = p[3];
+        let k = &mut k[..41]; // one bounds check for all constant stores
         k[..6].copy_from_slice(p);
         // k[7] = rc_wi = 0.0
         k[7] = 0.0;

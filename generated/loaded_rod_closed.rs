@@ -608,13 +608,16 @@ impl Reduction for LoadedRodClosed {
     }
 
     /// The constants of `prepare` that the per-point solver reads, and only those.
+    #[inline]
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let p = &p[..6];
         let m1 = p[0];
         let m2 = p[1];
         let m3 = p[2];
         let ell = p[3];
         let a = p[4];
         let g = p[5];
+        let k = &mut k[..46]; // one bounds check for all constant stores
         k[..6].copy_from_slice(p);
         // k[7] = rc_wi = 0.0
         k[7] = 0.0;

@@ -633,13 +633,16 @@ impl Reduction for LoadedRodFree {
     }
 
     /// The constants of `prepare` that the per-point solver reads, and only those.
+    #[inline]
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let p = &p[..12];
         let m1 = p[0];
         let m3 = p[2];
         let ell = p[3];
         let g = p[5];
         let theta_0 = p[7];
         let theta_dot_0 = p[10];
+        let k = &mut k[..47]; // one bounds check for all constant stores
         k[..12].copy_from_slice(p);
         // k[12] = rc_si = sin(rc_thi)
         k[12] = theta_0.sin();

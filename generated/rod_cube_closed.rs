@@ -505,12 +505,15 @@ impl Reduction for RodCubeClosed {
     }
 
     /// The constants of `prepare` that the per-point solver reads, and only those.
+    #[inline]
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let p = &p[..5];
         let m1 = p[0];
         let m2 = p[1];
         let ell = p[2];
         let a = p[3];
         let g = p[4];
+        let k = &mut k[..41]; // one bounds check for all constant stores
         k[..5].copy_from_slice(p);
         // k[6] = rc_wi = 0.0
         k[6] = 0.0;

@@ -560,12 +560,15 @@ impl Reduction for RodCubeFree {
     }
 
     /// The constants of `prepare` that the per-point solver reads, and only those.
+    #[inline]
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let p = &p[..11];
         let m1 = p[0];
         let ell = p[2];
         let g = p[4];
         let theta_0 = p[6];
         let theta_dot_0 = p[9];
+        let k = &mut k[..37]; // one bounds check for all constant stores
         k[..11].copy_from_slice(p);
         // k[11] = rc_si = sin(rc_thi)
         k[11] = theta_0.sin();

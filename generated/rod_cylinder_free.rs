@@ -605,12 +605,15 @@ impl Reduction for RodCylinderFree {
     }
 
     /// The constants of `prepare` that the per-point solver reads, and only those.
+    #[inline]
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let p = &p[..12];
         let m1 = p[0];
         let ell = p[2];
         let g = p[5];
         let theta_0 = p[7];
         let theta_dot_0 = p[10];
+        let k = &mut k[..38]; // one bounds check for all constant stores
         k[..12].copy_from_slice(p);
         // k[12] = rc_si = sin(rc_thi)
         k[12] = theta_0.sin();

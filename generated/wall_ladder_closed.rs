@@ -417,10 +417,13 @@ impl Reduction for WallLadderClosed {
     }
 
     /// The constants of `prepare` that the per-point solver reads, and only those.
+    #[inline]
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let p = &p[..4];
         let ell = p[1];
         let a = p[2];
         let g = p[3];
+        let k = &mut k[..20]; // one bounds check for all constant stores
         k[..4].copy_from_slice(p);
         // k[5] = rc_wi = 0.0
         k[5] = 0.0;

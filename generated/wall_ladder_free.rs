@@ -497,12 +497,15 @@ impl Reduction for WallLadderFree {
     }
 
     /// The constants of `prepare` that the per-point solver reads, and only those.
+    #[inline]
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        let p = &p[..8];
         let m1 = p[0];
         let ell = p[1];
         let g = p[3];
         let theta_0 = p[5];
         let theta_dot_0 = p[7];
+        let k = &mut k[..30]; // one bounds check for all constant stores
         k[..8].copy_from_slice(p);
         // k[8] = rc_si = sin(rc_thi)
         k[8] = theta_0.sin();

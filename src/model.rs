@@ -305,8 +305,11 @@ pub const LEAN_MAX_REQUIREMENTS: usize = 8;
 /// Most closed unilateral contacts besides the first that [`Model::lean_start`] serves.
 pub const LEAN_MAX_OTHERS: usize = 2;
 
-/// Most coefficients of such a contact's force polynomial that [`Model::lean_start`] serves.
-pub const LEAN_OTHER_COEFFICIENTS: usize = 8;
+/// Most coefficients of such a contact's force polynomial that [`Model::lean_start`] serves
+/// (a quartic: the floor's push of every generated model is one at most; a higher degree takes
+/// the checked route, and every spare coefficient would cost the route's bound of the push a
+/// Horner step and a curvature term on every point).
+pub const LEAN_OTHER_COEFFICIENTS: usize = 5;
 
 /// Evaluation functions of one generated model over its full state. All are allocation-free
 /// and evaluate each shared subexpression once per call.

@@ -114,8 +114,9 @@ impl Prior {
 
     /// The rule for a panel whose nearest singularity has Bernstein parameter `rho`, if one of
     /// at most [`PRIOR_MAX_NODES`] nodes suffices: the fewest nodes whose threshold `rho`
-    /// reaches, by a scan from the table's start for `rho`'s cell.
-    #[inline]
+    /// reaches, by a scan from the table's start for `rho`'s cell. Always inlined, as
+    /// [`prior_panels`] is.
+    #[inline(always)]
     fn rule_for(&self, rho: f64) -> Option<&'static HalfRule> {
         // The cell from the float's bits above 1.0's; rho below 1, NaN, or beyond the table
         // (its bits wrap or run past it) scans from the fewest nodes, which is exact too.
@@ -393,7 +394,8 @@ pub fn integrate_prior(
 /// `sing`: one panel when a rule of at most [`PRIOR_MAX_NODES`] nodes suffices, else halves,
 /// depth first, each integrated by `panel(rule, a, b)` (the first one from rest symmetric).
 /// `Ok(None)` past [`PRIOR_MAX_PANELS`] panels; the integral and the evaluations otherwise.
-#[inline]
+/// Always inlined: the per-point route's copies otherwise call it out of line.
+#[inline(always)]
 pub fn prior_panels<E>(
     sing: &Singularities,
     v_end: f64,

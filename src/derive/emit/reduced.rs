@@ -94,12 +94,22 @@ impl ReducedCode {
             code.outputs = out_lines(&code.outputs);
             code.finish(args, &[slice, params]);
         }
-        self.prepare_lean
-            .stmts
-            .insert(0, format!("k[..{np}].copy_from_slice(p);"));
+        // One bounds check for each slice, not one for each parameter read and each slot
+        // written (this runs once per point on the per-point route).
+        self.prepare_lean.stmts.splice(
+            0..0,
+            [
+                format!("let k = &mut k[..{n}]; // one bounds check for all constant stores"),
+                format!("k[..{np}].copy_from_slice(p);"),
+            ],
+        );
+        let p_slice = format!("&p[..{np}]");
         self.prepare_lean.finish(
             &[("p", "&[f64]"), ("k", "&mut [f64]")],
-            &[Preamble::Names(&locals.params, "p")],
+            &[
+                Preamble::Let("p", &p_slice),
+                Preamble::Names(&locals.params, "p"),
+            ],
         );
         let head = [
             format!("q[{reduced}] = k[{}] - delta;", self.k_theta_initial),
