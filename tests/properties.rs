@@ -367,7 +367,7 @@ fn check_theta_dot_sq_sc(model: &'static dyn Model, u: &[f64], spread: u8, frac:
     );
     assert!((sin_i - theta_i.sin()).abs() <= 1e-15 * sin_i.abs().max(1e-300));
     assert!((cos_i - theta_i.cos()).abs() <= 1e-15);
-    let delta = frac * (theta_i - info.end_angle);
+    let delta = frac * (theta_i - info.end_angle.unwrap());
     let (s, c, ds, dc) = rodcube::model::start_offsets(theta_i, sin_i, cos_i, delta);
     let sc = model.reduction().unwrap().theta_dot_sq_sc(k, s, c, ds, dc);
     let full = model.reduction().unwrap().reduced(k, delta).theta_dot_sq;

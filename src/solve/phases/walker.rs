@@ -58,12 +58,14 @@ pub enum Route {
 }
 
 /// `sqrt(2 h / g)` for the height `h` of the falling point at `state` (the system's length
-/// scale in place of a height within [`LANDING_TOLERANCE`] of it: a body lying on the floor):
-/// the time scale of the motion.
+/// scale in place of a height within [`LANDING_TOLERANCE`] of it, a body lying on the floor,
+/// or where the system names no falling point): the time scale of the motion.
 pub fn fall_time_scale(bound: &Bound, state: &State) -> Result<f64, SolveError> {
-    let info = bound.info();
-    let h = bound.points(state)?.pos[info.falling_point_index][1];
     let length = bound.length_scale(state)?;
+    let h = match bound.info().falling_point_index {
+        Some(i) => bound.points(state)?.pos[i][1],
+        None => length,
+    };
     let h = if h > LANDING_TOLERANCE * length {
         h
     } else {
@@ -372,7 +374,8 @@ impl<'m> Walker<'m> {
     /// a landing.
     fn landed(&self, state: &State, t: f64) -> Result<(), SolveError> {
         let info = self.general.info();
-        let height = self.general.points(state)?.pos[info.falling_point_index][1];
+        let falling = self.general.falling_point()?;
+        let height = self.general.points(state)?.pos[falling][1];
         let length = self.general.length_scale(state)?;
         if height.abs() <= LANDING_TOLERANCE.max(self.tol) * length {
             return Ok(());
@@ -380,8 +383,8 @@ impl<'m> Walker<'m> {
         Err(SolveError::AboveFloor {
             model: info.name,
             t,
-            angle: info.end_angle,
-            point: info.points[info.falling_point_index].name,
+            angle: self.general.end_angle()?,
+            point: info.points[falling].name,
             height,
         })
     }
