@@ -450,6 +450,11 @@ impl Problem<'_, '_> {
             Some(Watch::Gap(i)) => Ok(End::Contact(i)),
             Some(Watch::Edge(i)) => Ok(End::Edge(i)),
             Some(Watch::Floor { .. }) => Ok(End::Floor),
+            // A friction's switch located where the reduced angle is already at or past the
+            // end angle: the two roots coincide to the located time's ulps (a ladder lying flat
+            // against the wall's foot stops its foot's slip, `ell sin(theta) theta'`, exactly at
+            // the floor), and the run ends at the floor, past which the model describes nothing.
+            Some(_) if self.floor_reached(y) => Ok(End::Floor),
             Some(watch) => Err(watch),
             None => {
                 return Err(SolveError::OdeNonFinite {
@@ -458,6 +463,15 @@ impl Problem<'_, '_> {
                     y: y.to_vec(),
                 });
             }
+        })
+    }
+
+    /// Whether the state `y` has the reduced angle at or past the end angle (where the system
+    /// has one, and only where its floor is watched).
+    fn floor_reached(&self, y: &[f64]) -> bool {
+        (self.watches.iter()).any(|w| match *w {
+            Watch::Floor { coordinate, angle } => y[coordinate] - angle <= 0.0,
+            _ => false,
         })
     }
 

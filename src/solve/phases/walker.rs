@@ -159,10 +159,17 @@ impl<'m> Walker<'m> {
         let state = run.full_end_state()?;
         let t = run.t_end();
         let held = run.closed_at_end()?;
+        // The held contacts' gaps drift like the phase's error: the run's tolerance, or the
+        // integrator's where the mass matrix's conditioning raised it (a light block under a
+        // rod, condition 1e9: rtol 2e-6, gaps 1e-9 of the system's size).
+        let drift = match run {
+            PhaseRun::Integrated(r) => self.tol.max(r.run.rtol),
+            PhaseRun::Reduced(_) => self.tol,
+        };
         let at = Moment::After {
             t,
             held: &held,
-            drift: self.tol,
+            drift,
         };
         let mut contacts = contact_options(&self.general, &state, at)?;
         if let End::Force(i) = run.end()
