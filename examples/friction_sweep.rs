@@ -74,7 +74,10 @@ fn solve(mu: f64) -> Result<Point, Box<dyn Error>> {
     Ok(Point {
         mu,
         regime,
-        separation: (end == End::Force(0)).then(|| (run.t_end(), run.theta_end().to_degrees())),
+        separation: match end == End::Force(0) {
+            true => Some((run.t_end(), run.theta_end()?.to_degrees())),
+            false => None,
+        },
         first_switch: modes.get(1).map(|(t, _)| *t),
     })
 }

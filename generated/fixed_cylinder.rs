@@ -62,9 +62,9 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 22,
     coordinates: &["x1", "y1", "theta"],
     system_coordinates: &["x1", "y1", "theta"],
-    reduced_index: 2,
+    reduced_index: Some(2),
     cyclic: &[0],
-    end_angle: 0.0,
+    end_angle: Some(0.0),
     contacts: &[
         ContactInfo {
             name: "cylinder_push",
@@ -108,7 +108,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the point of the rod nearest the cylinder's axis (the contact point while they touch)",
         },
     ],
-    falling_point_index: 2,
+    falling_point_index: Some(2),
     gravity_index: 4,
     monitors: &[],
     bodies: &["rod"],

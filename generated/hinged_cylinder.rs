@@ -68,9 +68,9 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 29,
     coordinates: &["x1", "y1", "theta", "xc"],
     system_coordinates: &["x1", "y1", "theta", "xc"],
-    reduced_index: 2,
+    reduced_index: Some(2),
     cyclic: &[0, 3],
-    end_angle: 0.0,
+    end_angle: Some(0.0),
     contacts: &[
         ContactInfo {
             name: "contact_force",
@@ -125,7 +125,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cylinder's axis",
         },
     ],
-    falling_point_index: 2,
+    falling_point_index: Some(2),
     gravity_index: 5,
     monitors: &[],
     bodies: &["rod", "cylinder"],

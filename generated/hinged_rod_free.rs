@@ -80,9 +80,9 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 26,
     coordinates: &["theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
-    reduced_index: 0,
+    reduced_index: Some(0),
     cyclic: &[1],
-    end_angle: 0.0,
+    end_angle: Some(0.0),
     contacts: &[
         ContactInfo {
             name: "contact_force",
@@ -137,7 +137,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cube's bottom corner on the rod's side",
         },
     ],
-    falling_point_index: 2,
+    falling_point_index: Some(2),
     gravity_index: 4,
     monitors: &[MonitorInfo {
         name: "cube_does_not_tip",

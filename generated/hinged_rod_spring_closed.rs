@@ -62,9 +62,9 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 41,
     coordinates: &["theta"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
-    reduced_index: 0,
+    reduced_index: Some(0),
     cyclic: &[],
-    end_angle: 0.0,
+    end_angle: Some(0.0),
     contacts: &[
         ContactInfo {
             name: "contact_force",
@@ -119,7 +119,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cube's bottom corner on the rod's side",
         },
     ],
-    falling_point_index: 2,
+    falling_point_index: Some(2),
     gravity_index: 4,
     monitors: &[],
     bodies: &["rod", "cube"],

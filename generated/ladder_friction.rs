@@ -62,9 +62,9 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 27,
     coordinates: &["x1", "y1", "theta"],
     system_coordinates: &["x1", "y1", "theta"],
-    reduced_index: 2,
+    reduced_index: Some(2),
     cyclic: &[0],
-    end_angle: 0.0,
+    end_angle: Some(0.0),
     contacts: &[
         ContactInfo {
             name: "wall_push",
@@ -117,7 +117,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the ladder's centre of mass",
         },
     ],
-    falling_point_index: 2,
+    falling_point_index: Some(2),
     gravity_index: 3,
     monitors: &[],
     bodies: &["rod"],

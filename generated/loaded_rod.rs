@@ -62,9 +62,9 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 41,
     coordinates: &["x1", "y1", "theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
-    reduced_index: 2,
+    reduced_index: Some(2),
     cyclic: &[0, 3],
-    end_angle: 0.0,
+    end_angle: Some(0.0),
     contacts: &[
         ContactInfo {
             name: "contact_force",
@@ -112,7 +112,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cube's bottom corner on the rod's side",
         },
     ],
-    falling_point_index: 3,
+    falling_point_index: Some(3),
     gravity_index: 5,
     monitors: &[MonitorInfo {
         name: "cube_does_not_tip",

@@ -68,9 +68,9 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 22,
     coordinates: &["x", "y", "phi"],
     system_coordinates: &["x", "y", "phi"],
-    reduced_index: 2,
+    reduced_index: Some(2),
     cyclic: &[0],
-    end_angle: -std::f64::consts::FRAC_PI_2,
+    end_angle: None,
     contacts: &[
         ContactInfo {
             name: "left_corner",
@@ -123,7 +123,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the block's right bottom corner",
         },
     ],
-    falling_point_index: 0,
+    falling_point_index: None,
     gravity_index: 4,
     monitors: &[],
     bodies: &["block"],

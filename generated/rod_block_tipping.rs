@@ -62,9 +62,9 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 35,
     coordinates: &["x1", "y1", "theta", "xb", "yb", "phi"],
     system_coordinates: &["x1", "y1", "theta", "xb", "yb", "phi"],
-    reduced_index: 2,
+    reduced_index: Some(2),
     cyclic: &[0, 3, 5],
-    end_angle: -std::f64::consts::FRAC_PI_2,
+    end_angle: Some(-std::f64::consts::FRAC_PI_2),
     contacts: &[
         ContactInfo {
             name: "contact_force",
@@ -149,7 +149,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the block's bottom edge away from the rod",
         },
     ],
-    falling_point_index: 2,
+    falling_point_index: Some(2),
     gravity_index: 5,
     monitors: &[],
     bodies: &["rod", "block"],

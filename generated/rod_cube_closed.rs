@@ -56,9 +56,9 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 41,
     coordinates: &["x1", "theta"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
-    reduced_index: 1,
+    reduced_index: Some(1),
     cyclic: &[0],
-    end_angle: 0.0,
+    end_angle: Some(0.0),
     contacts: &[
         ContactInfo {
             name: "contact_force",
@@ -102,7 +102,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cube's bottom corner on the rod's side",
         },
     ],
-    falling_point_index: 2,
+    falling_point_index: Some(2),
     gravity_index: 4,
     monitors: &[MonitorInfo {
         name: "cube_does_not_tip",

@@ -62,9 +62,9 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 29,
     coordinates: &["x1", "y1", "theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
-    reduced_index: 2,
+    reduced_index: Some(2),
     cyclic: &[0, 3],
-    end_angle: -std::f64::consts::FRAC_PI_2,
+    end_angle: Some(-std::f64::consts::FRAC_PI_2),
     contacts: &[
         ContactInfo {
             name: "contact_force",
@@ -119,7 +119,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the cube's bottom corner on the rod's side",
         },
     ],
-    falling_point_index: 2,
+    falling_point_index: Some(2),
     gravity_index: 4,
     monitors: &[MonitorInfo {
         name: "cube_does_not_tip",

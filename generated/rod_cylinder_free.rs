@@ -104,9 +104,9 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 38,
     coordinates: &["x1", "theta", "xc"],
     system_coordinates: &["x1", "y1", "theta", "xc"],
-    reduced_index: 1,
+    reduced_index: Some(1),
     cyclic: &[0, 2],
-    end_angle: 0.0,
+    end_angle: Some(0.0),
     contacts: &[
         ContactInfo {
             name: "contact_force",
@@ -154,7 +154,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the point of the rod nearest the cylinder's axis (the contact point while they touch)",
         },
     ],
-    falling_point_index: 2,
+    falling_point_index: Some(2),
     gravity_index: 5,
     monitors: &[],
     bodies: &["rod", "cylinder"],

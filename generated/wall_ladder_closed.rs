@@ -50,9 +50,9 @@ static INFO: ModelInfo = ModelInfo {
     n_constants: 20,
     coordinates: &["theta"],
     system_coordinates: &["x1", "y1", "theta"],
-    reduced_index: 0,
+    reduced_index: Some(0),
     cyclic: &[],
-    end_angle: 0.0,
+    end_angle: Some(0.0),
     contacts: &[
         ContactInfo {
             name: "contact_force",
@@ -96,7 +96,7 @@ static INFO: ModelInfo = ModelInfo {
             meaning: "the foot of the wall",
         },
     ],
-    falling_point_index: 2,
+    falling_point_index: Some(2),
     gravity_index: 3,
     monitors: &[],
     bodies: &["rod"],

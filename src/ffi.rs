@@ -376,6 +376,9 @@ fn system_code(e: &SystemError) -> c_int {
         SystemError::Restitution { .. } => RODCUBE_ERR_PARAM_RESTITUTION,
         SystemError::ReducedIndex { .. } => RODCUBE_ERR_PARAM_REDUCED_INDEX,
         SystemError::NoTangents { .. } => RODCUBE_ERR_PARAM_NO_TANGENTS,
+        SystemError::NoReducedCoordinate { .. }
+        | SystemError::NoEndAngle { .. }
+        | SystemError::NoFallingPoint { .. } => RODCUBE_ERR_PARAM_NO_REDUCTION,
     }
 }
 

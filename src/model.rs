@@ -217,21 +217,26 @@ pub struct ModelInfo {
     pub coordinates: &'static [&'static str],
     /// The system's coordinates (the general model's), which [`Model::to_full`] fills.
     pub system_coordinates: &'static [&'static str],
-    /// Index in `coordinates` of the reduced coordinate (`theta`).
-    pub reduced_index: usize,
+    /// Index in `coordinates` of the reduced coordinate (`theta`), the angle the motion is
+    /// reported in; none for a system whose spec names none (it has no fast phase and no
+    /// angle among its results).
+    pub reduced_index: Option<usize>,
     /// Indices in `coordinates` of the cyclic coordinates (the Lagrangian does not depend on
     /// them); on the fast path their conserved momenta eliminate them.
     pub cyclic: &'static [usize],
-    /// The angle at which the motion ends (the rod lies on the floor), in radians.
-    pub end_angle: f64,
+    /// The value of the reduced coordinate at which the motion ends (the rod lies on the
+    /// floor), in radians; none for a motion with no end of its own, which runs to its end
+    /// time (a scene's `until`).
+    pub end_angle: Option<f64>,
     /// Every contact of the system, in the spec's order.
     pub contacts: &'static [ContactInfo],
     /// Coulomb frictions (at contacts; only the general model has them).
     pub frictions: &'static [FrictionInfo],
     /// Named points whose trajectories can be asked for.
     pub points: &'static [NamedInfo],
-    /// Index in `points` of the centre of mass whose free fall is the reference time.
-    pub falling_point_index: usize,
+    /// Index in `points` of the centre of mass whose free fall is the reference time (none:
+    /// no such reference).
+    pub falling_point_index: Option<usize>,
     /// Index in `parameters` of the gravitational acceleration.
     pub gravity_index: usize,
     /// Physical assumptions to monitor; each value must stay `>= 0` during the motion.

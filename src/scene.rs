@@ -521,6 +521,7 @@ impl Ctx<'_> {
         let Some(model) = self.model(&raw, registry, &mut out) else {
             return Err(finish(out));
         };
+        self.needs_until(&raw, model.info(), &mut out);
         let want = self.wanted(&raw, model.info(), &mut out);
         let values = self.parameter_values(&raw, model.info(), &mut out);
         if let Some(values) = &values {
@@ -670,6 +671,24 @@ impl Ctx<'_> {
         Some(model)
     }
 
+    /// A system with no end angle has no end of its own: its scene must give `until` (the
+    /// diagnostic names `until` at the `model` line, as the key is absent).
+    fn needs_until(&self, raw: &Raw, info: &ModelInfo, out: &mut Vec<Diagnostic>) {
+        if info.end_angle.is_none() && raw.until.is_none() {
+            let mark = self.doc.locate_nearest(&parse_path("model"), At::Value);
+            out.push(self.at(
+                Kind::Structure,
+                mark,
+                "until",
+                format!(
+                    "model `{}` has no end angle, so its motion has no end of its own: give \
+                     `until: <seconds>`, the time to run it to",
+                    info.name
+                ),
+            ));
+        }
+    }
+
     /// The quantities of `want`, each known, available from the model and named once.
     fn wanted(&self, raw: &Raw, info: &ModelInfo, out: &mut Vec<Diagnostic>) -> Vec<Quantity> {
         let mut want = Vec::new();
@@ -702,7 +721,7 @@ impl Ctx<'_> {
                     format!(
                         "model `{}` cannot provide `{name}`: {}; it offers: {}",
                         info.name,
-                        unavailable_reason(q),
+                        unavailable_reason(q, info),
                         Quantity::names(info).join(", ")
                     ),
                 )),
@@ -913,8 +932,19 @@ fn finish(mut out: Vec<Diagnostic>) -> SceneError {
 }
 
 /// Why a model cannot provide a quantity it knows by name.
-fn unavailable_reason(q: Quantity) -> &'static str {
+fn unavailable_reason(q: Quantity, info: &ModelInfo) -> &'static str {
     match q {
+        Quantity::FloorImpact => "it has no end angle (its spec names none)",
+        Quantity::PointMassFallTime => "it has no falling point (its spec names none)",
+        Quantity::ThetaSeries
+        | Quantity::Sensitivities
+        | Quantity::ContactEnd
+        | Quantity::SeparationAngle
+        | Quantity::SeparationTime
+            if info.reduced_index.is_none() =>
+        {
+            "it has no reduced coordinate (its spec names none) to measure it in"
+        }
         Quantity::LinearisedSeparationAngle => {
             "it has no fast phase at release whose separation is a polynomial root"
         }

@@ -507,6 +507,71 @@ fn ladder_friction_separation_matches_newton_euler_and_the_two_thirds_law() {
     }
 }
 
+/// A ladder released nearly flat (a/ell = 1e-10) on a frictionless floor leaves the wall where
+/// its foot's slip is at rest to the decision's tolerance (the foot moves as `ell sin(theta)
+/// theta'`) and its slip acceleration vanishes (at the wall's release `x_cm'' = 0`): the stuck
+/// foot's friction there is zero to rounding, and with `mu_f = 0` Coulomb's cone is that zero.
+/// The case of `tests/properties.rs` that was refused as inconsistent; the wall's release is at
+/// `sin(theta) = (2/3) a/ell` (with friction at the wall as well: its force, `mu_w` times a wall
+/// push of order `theta`, shifts the angle by a relative `1e-10`), and the ladder goes on to
+/// the floor.
+#[test]
+fn a_nearly_flat_ladder_on_a_frictionless_floor_leaves_the_wall_at_two_thirds() {
+    for mu_w in [0.0, 0.727_982_137_594_939_2] {
+        let (a, ell) = (9.99999999e-13, 0.01);
+        let p = [
+            ("m1", 0.001),
+            ("ell", ell),
+            ("a", a),
+            ("g", 0.1),
+            ("mu_f", 0.0),
+            ("mu_w", mu_w),
+        ];
+        let want = [Quantity::ContactEnd, Quantity::FloorImpact];
+        let r = ask("ladder_friction", &p, &want, 1e-10, Route::Fastest);
+        let what = format!("mu_w = {mu_w}");
+        close(
+            value(&r, "wall_push_end_angle").sin(),
+            2.0 * a / (3.0 * ell),
+            1e-9,
+            &what,
+        );
+        if mu_w == 0.0 {
+            let (_, t_sep) = ladder_frictionless_separation(ell, a, 0.1);
+            close(value(&r, "wall_push_end_time"), t_sep, 1e-9, &what);
+        }
+        assert!(value(&r, "floor_impact_time") > value(&r, "wall_push_end_time"));
+    }
+}
+
+/// A nearly flat rod hinged at its foot (a/ell = 4.6e-7) beside a cube of 1e-9 kg leaves the
+/// cube at release: with the contact open the rod's top accelerates away from the cube (the
+/// open set's normal acceleration, 3e-7 m/s^2, is 0.6 of its own scale, no rounding), so the
+/// closed set's force is a pull of `m2` times about that (3e-16 N). Judged at the scale of the
+/// hinge's force (2.5e-5 N) that pull was taken for zero, both sets were consistent, and the
+/// release was refused as indeterminate (the case of `tests/properties.rs`); judged at the
+/// contact's own size (its acceleration scale times its effective mass) it is a pull.
+#[test]
+fn a_light_cube_leaves_a_nearly_flat_hinged_rod_at_release() {
+    let p = [
+        ("m1", 0.001),
+        ("m2", 1e-9),
+        ("ell", 0.01),
+        ("a", 4.620_203_653_972_913_5e-9),
+        ("g", 0.1),
+        ("k", 216.440_675_540_344_8),
+    ];
+    let r = ask(
+        "hinged_rod_spring",
+        &p,
+        &[Quantity::ContactEnd],
+        1e-10,
+        Route::Fastest,
+    );
+    assert_eq!(value(&r, "contact_force_end_time"), 0.0);
+    assert_eq!(label(&r, "contact_force_end_cause"), "force");
+}
+
 /// A ladder that static friction holds (hand `Ladder::slides()` false) is the typed outcome
 /// `SolveError::AtRest` from the planner and the walker; one just below the static limit, and
 /// one well below it, slide and separate where the hand run does.

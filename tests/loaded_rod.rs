@@ -204,7 +204,10 @@ fn it_is_registered_with_its_phases() {
     assert_eq!(info.coordinates, ["x1", "theta"]);
     assert_eq!(info.cyclic, [0]);
     assert_eq!(info.reduction.unwrap().separation_degree(), 3);
-    assert_eq!(info.points[info.falling_point_index].name, "mass_centre");
+    assert_eq!(
+        info.points[info.falling_point_index.unwrap()].name,
+        "mass_centre"
+    );
     assert!(info.contacts.iter().all(|c| c.closed));
     // The free phase: the tip open, starting from the state it is handed.
     let free = find("loaded_rod_free").info();

@@ -366,7 +366,7 @@ impl Model for NoReducedCoordinate {
         static INFO: OnceLock<&'static ModelInfo> = OnceLock::new();
         INFO.get_or_init(|| {
             Box::leak(Box::new(ModelInfo {
-                reduced_index: 4,
+                reduced_index: Some(4),
                 ..*GENERAL.info()
             }))
         })
@@ -387,5 +387,5 @@ fn a_model_whose_reduced_index_names_no_coordinate_is_refused_when_bound() {
         other => panic!("{other:?}"),
     }
     let plain = Bound::new(&GENERAL, &paper(9.81)).unwrap();
-    assert_eq!(plain.reduced_coordinate(), "theta");
+    assert_eq!(plain.reduced_coordinate(), Some("theta"));
 }

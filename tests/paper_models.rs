@@ -27,7 +27,7 @@ fn check_consistency(sys: &System, delta_end: f64) {
         let qdd = contacts::dynamics(sys.bound(), &state, &active, 0.0)
             .unwrap()
             .qdd;
-        let theta = sys.info().reduced_index;
+        let theta = sys.info().reduced_index.unwrap();
         assert!(
             close(qdd[theta], red.theta_ddot, 1e-12),
             "theta'' {} vs {}",
@@ -142,7 +142,7 @@ fn check_general(sys: &System, closed: [bool; 2], delta_end: f64) {
         }
         // The constrained equations give the reduced motion and its forces.
         let d = contacts::dynamics(&general, &full, &active, 0.0).unwrap();
-        let theta = general.info().reduced_index;
+        let theta = general.info().reduced_index.unwrap();
         assert!(
             close(d.qdd[theta], red.theta_ddot, 1e-11),
             "theta'' {} vs {}",

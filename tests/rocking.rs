@@ -356,3 +356,53 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn series_are_named_by_the_blocks_own_angle_phi() {
+    // The block's reduced coordinate is `phi`: its series and the angle column beside each
+    // force and friction carry that name, with the rate and acceleration named after it, and
+    // the angle column holds the coordinate itself (the release tilt first).
+    let request = Request::new(
+        find("rocking_block").unwrap(),
+        &[
+            ("m", M),
+            ("w", W),
+            ("h", H),
+            ("phi0", PHI0),
+            ("g", G),
+            ("mu", 0.7),
+            ("e", 0.0),
+        ][..],
+    )
+    .with_want(&[
+        Quantity::ThetaSeries,
+        Quantity::ForceSeries(0),
+        Quantity::FrictionSeries(1),
+    ])
+    .with_tolerance(1e-10)
+    .with_samples(50)
+    .with_until(Some(0.5));
+    let run = plan::run(&request).unwrap();
+    let names = |key: &str| -> Vec<String> {
+        (run.series[key].columns.iter())
+            .map(|c| c.name.clone())
+            .collect()
+    };
+    assert_eq!(names("theta_series"), ["t", "phi", "phi_dot", "phi_ddot"]);
+    assert_eq!(names("left_corner_series"), ["t", "phi", "left_corner"]);
+    assert_eq!(
+        names("right_friction_series"),
+        [
+            "t",
+            "phi",
+            "right_friction",
+            "right_corner",
+            "slip_velocity"
+        ]
+    );
+    let phi = &run.series["theta_series"].columns[1];
+    assert_eq!((phi.unit, phi.values[0]), ("rad", PHI0));
+    // No end angle: the block rocks on to the run's end, 0.5 s.
+    let t = &run.series["theta_series"].columns[0].values;
+    close(*t.last().unwrap(), 0.5, 1e-15, "the last sample's time");
+}

@@ -102,7 +102,7 @@ fn series_agrees_with_the_ode_dense_output() {
         )
         .unwrap();
         assert_eq!(run.end, End::Force(0), "n = {n}, r = {r}");
-        let theta = GENERAL.info().reduced_index;
+        let theta = GENERAL.info().reduced_index.unwrap();
         let mut worst = 0.0f64;
         for j in 0..101 {
             let t = s.t[j].min(run.t_end);

@@ -882,3 +882,109 @@ fn edited_tapes_are_refused_or_run_every_method_without_a_panic() {
         TapeOutcome::Accepted
     ));
 }
+
+const BALL_SPEC: &str = include_str!("specs/ball.yaml");
+
+/// The ball of `tests/specs/ball.yaml` (no reduced coordinate, no end angle, no falling point)
+/// dropped from `H = 1.1 m` with `R = 0.1 m`, `e = 0.5`, run to `until` (the line is the
+/// scene's last).
+const BALL_SCENE: &str = "model: ball\n\
+    parameters: {m: 1.0, R: 0.1, H: 1.1, v0: 0.5, g: 9.81, e: 0.5}\n\
+    want: [impacts, floor_series, centre_trajectory]\n\
+    tolerance: 1.0e-12\n\
+    until: 1.2\n";
+
+/// The ball's results: its impacts at the closed form of a body bouncing under gravity,
+/// `t_n = t_1 + 2 t_1 sum_{k=1}^{n-1} e^k` with `t_1 = sqrt(2 (H - R) / g)` (the third at
+/// 1.129 s, the fourth past `until`), the run to `until` with the horizontal motion uniform,
+/// and the floor's series with no angle column (the system has none).
+fn check_ball(results: &serde_json::Value, what: &str) {
+    let t1 = (2.0 * 1.0 / 9.81_f64).sqrt();
+    let impacts = results["results"]["impacts"]["value"]
+        .as_array()
+        .unwrap_or_else(|| panic!("{what}: impacts {}", results["results"]));
+    let times: Vec<f64> = (impacts.iter())
+        .map(|i| i["time"].as_f64().expect("a time"))
+        .collect();
+    let want = [t1, 2.0 * t1, 2.5 * t1];
+    assert_eq!(times.len(), want.len(), "{what}: impacts at {times:?}");
+    for (t, w) in times.iter().zip(want) {
+        assert!((t - w).abs() < 1e-9 * w, "{what}: impact at {t} vs {w}");
+    }
+    let columns = |key: &str| -> Vec<(String, Vec<f64>)> {
+        let cols = results["series"][key]["columns"].as_array();
+        (cols.into_iter().flatten())
+            .map(|c| {
+                let values = (c["values"].as_array().into_iter().flatten())
+                    .map(|v| v.as_f64().expect("a number"))
+                    .collect();
+                (c["name"].as_str().expect("a name").to_string(), values)
+            })
+            .collect()
+    };
+    let floor = columns("floor_series");
+    let names: Vec<&str> = floor.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(names, ["t", "floor"], "{what}");
+    let centre = columns("centre_trajectory");
+    let (t, x) = (&centre[0].1, &centre[1].1);
+    let (end, x_end) = (t[t.len() - 1], x[x.len() - 1]);
+    assert_eq!(end, 1.2, "{what}: the run ends at until");
+    assert!((x_end - 0.5 * 1.2).abs() < 1e-12, "{what}: x = {x_end}");
+    let notes = results["notes"].to_string();
+    assert!(notes.contains("until"), "{what}: {notes}");
+}
+
+#[test]
+fn a_spec_without_an_angle_an_end_or_a_falling_point_runs_to_its_scenes_until() {
+    let dir = scratch("tapes_ball");
+    std::fs::write(dir.join("ball.yaml"), BALL_SPEC).expect("spec");
+    std::fs::write(dir.join("scene.yaml"), BALL_SCENE).expect("scene");
+    let json = ["--json", "--out"];
+    let spec = ["run", "scene.yaml", "--spec", "ball.yaml"];
+    let derived = run_json(&dir, &[&spec[..], &json[..], &["o1"]].concat());
+    check_ball(&derived, "--spec");
+    let tapes = run_in(&dir, &["derive", "--tapes-into", "models", "ball.yaml"]);
+    assert!(tapes.status.success(), "{tapes:?}");
+    let taped = run_json(
+        &dir,
+        &[
+            "run",
+            "scene.yaml",
+            "--models",
+            "models",
+            "--json",
+            "--out",
+            "o2",
+        ],
+    );
+    check_ball(&taped, "tapes");
+    // Without `until` the motion has no end: the scene is refused at `model`'s line, naming
+    // `until`, with exit status 3 and nothing written.
+    let endless = BALL_SCENE.replace("until: 1.2\n", "");
+    std::fs::write(dir.join("endless.yaml"), endless).expect("scene");
+    let refused = run_in(
+        &dir,
+        &["run", "endless.yaml", "--spec", "ball.yaml", "--out", "o3"],
+    );
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(3), "{stderr}");
+    assert!(stderr.contains("endless.yaml:1:"), "{stderr}");
+    assert!(
+        stderr.contains("error[structure]: until: ") && stderr.contains("no end angle"),
+        "{stderr}"
+    );
+    assert!(!dir.join("o3").exists());
+    // And what is measured in an angle the system does not have is refused by name.
+    let angled = BALL_SCENE.replace("want: [impacts,", "want: [theta_series, impacts,");
+    std::fs::write(dir.join("angled.yaml"), angled).expect("scene");
+    let refused = run_in(
+        &dir,
+        &["run", "angled.yaml", "--spec", "ball.yaml", "--out", "o4"],
+    );
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(3), "{stderr}");
+    assert!(
+        stderr.contains("want[0]") && stderr.contains("no reduced coordinate"),
+        "{stderr}"
+    );
+}

@@ -230,7 +230,10 @@ pub fn pythagoras(e: &Expr) -> Expr {
 /// `e` (over `sin(theta)`, `cos(theta)`) with [`pythagoras`] applied, checked by Symbolica to
 /// be equal to `e` (their difference zero modulo `sin^2 + cos^2 = 1`); an error naming `what`
 /// if it is not, or if the check could not be made.
-pub fn with_pythagoras(e: &Expr, theta: &str, what: &str) -> Result<Expr, DeriveError> {
+pub fn with_pythagoras(e: &Expr, theta: Option<&str>, what: &str) -> Result<Expr, DeriveError> {
+    let Some(theta) = theta else {
+        return Ok(e.clone());
+    };
     let sc = to_sc_expr(e, theta);
     let simpler = pythagoras(&sc);
     if simpler == sc {
@@ -276,6 +279,17 @@ pub fn to_sc(a: &A, theta: &str) -> A {
         &cas::atom(&Expr::Fun("cos".into(), vec![Expr::sym(theta)])),
         &cas::var("rc_c"),
     )
+}
+
+/// [`to_sc_expr`] over a phase's reduced coordinate where it has one; without one no
+/// expression is written over `rc_s`, `rc_c`, and `e` is returned as it is.
+pub fn to_sc_over(e: &Expr, theta: Option<&str>) -> Expr {
+    theta.map_or_else(|| e.clone(), |t| to_sc_expr(e, t))
+}
+
+/// [`from_sc`] over a phase's reduced coordinate where it has one (see [`to_sc_over`]).
+pub fn from_sc_over(e: &Expr, theta: Option<&str>) -> Expr {
+    theta.map_or_else(|| e.clone(), |t| from_sc(e, t))
 }
 
 /// Replaces `rc_s`, `rc_c` by `sin(theta)`, `cos(theta)` in a plain expression.

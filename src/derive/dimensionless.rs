@@ -60,8 +60,11 @@ fn groups(
             solves: p,
         });
     }
-    let rate = format!("{}_dot_0", d.theta());
-    if d.plan.start_params && d.params.iter().any(|p| p.name == rate) {
+    let rate = d.theta().map(|theta| format!("{theta}_dot_0"));
+    if let Some(rate) = rate
+        && d.plan.start_params
+        && d.params.iter().any(|p| p.name == rate)
+    {
         let taken = out.iter().any(|g| g.name == START_RATE_GROUP)
             || d.params.iter().any(|p| p.name == START_RATE_GROUP);
         if taken {
@@ -144,7 +147,9 @@ pub fn derive(spec: &Spec, d: &Derivation) -> Result<Option<Dimensionless>, Deri
         )
         .map_err(|m| at(format!("the unit of rates: {m}")))?
         .expr;
-    let theta = d.theta().to_string();
+    let theta = (d.theta())
+        .ok_or_else(|| at("the fast path has no reduced coordinate".into()))?
+        .to_string();
     let paper = |key: &str| dim.paper.get(key).cloned();
     // (key, meaning, scale factor, unit, shape)
     let mut wanted: Vec<(String, String, A, Option<Expr>, Shape)> = Vec::new();

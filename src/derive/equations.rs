@@ -39,7 +39,7 @@ pub fn equations(st: &Setup, lag: &Lagrangian, frictions: &[Vec<A>]) -> Equation
         el.push(e);
     }
     let cyclic: Vec<usize> = (0..st.coords.len())
-        .filter(|&i| i != st.reduced && cas::is_zero(&cas::d(&lag.lag, &st.coords[i])))
+        .filter(|&i| Some(i) != st.reduced && cas::is_zero(&cas::d(&lag.lag, &st.coords[i])))
         .filter(|&i| {
             frictions
                 .iter()

@@ -434,15 +434,21 @@ fn derive_phase(
         .filter(|p| p.positive)
         .map(|p| p.name.clone())
         .collect();
-    let reducer = Reducer {
-        spec,
-        st: &st,
-        lag: &lag,
-        eqs: &eqs,
-        initial: &initial,
-        positive,
+    let mut reduction = match (st.reduced, st.theta.as_deref()) {
+        (Some(i), Some(theta)) => {
+            let reducer = Reducer {
+                spec,
+                st: &st,
+                reduced: (i, theta),
+                lag: &lag,
+                eqs: &eqs,
+                initial: &initial,
+                positive,
+            };
+            reducer.reduce(&atoms)?
+        }
+        _ => Err(Unreducible::NoReducedCoordinate),
     };
-    let mut reduction = reducer.reduce(&atoms)?;
     if let Ok(r) = &mut reduction {
         let names: Vec<String> = params.iter().map(|p| p.name.clone()).collect();
         r.partials = partials::derive(r, &names)?;

@@ -479,9 +479,9 @@ impl<'a> Presenter<'a> {
 /// [`with_pythagoras`]): `k T sin^2 + k T cos^2` is `k T`. Run after the steps
 /// ([`super::steps`]), which show the expressions as derived.
 pub fn with_identities(d: &mut Derivation) -> Result<(), DeriveError> {
-    let theta = d.theta().to_string();
+    let theta = d.theta().map(str::to_string);
     let one = |e: &mut Expr, what: &str| -> Result<(), DeriveError> {
-        *e = with_pythagoras(e, &theta, what)?;
+        *e = with_pythagoras(e, theta.as_deref(), what)?;
         Ok(())
     };
     let all = |v: &mut [Expr], what: &str| v.iter_mut().try_for_each(|e| one(e, what));

@@ -34,6 +34,8 @@ pub struct Reducer<'a> {
     pub spec: &'a Spec,
     /// The phase.
     pub st: &'a Setup,
+    /// Its reduced coordinate's index and name.
+    pub reduced: (usize, &'a str),
     /// Its Lagrangian.
     pub lag: &'a Lagrangian,
     /// Its equations.
@@ -57,7 +59,7 @@ struct Reduced {
 impl Reducer<'_> {
     /// The reduced coordinate.
     fn theta(&self) -> &str {
-        &self.st.theta
+        self.reduced.1
     }
 
     fn init(&self, c: &str, what: usize) -> Result<Expr, DeriveError> {
@@ -143,7 +145,7 @@ impl Reducer<'_> {
     /// depend on `theta` and the parameters only.
     fn edges_off_the_angle(&self, contacts: &[ContactAtoms]) -> Option<Unreducible> {
         let others: Vec<&str> = (self.st.coords.iter())
-            .filter(|c| **c != self.st.theta)
+            .filter(|c| *c != self.theta())
             .map(String::as_str)
             .collect();
         for (c, row) in self.spec.contacts.iter().zip(contacts) {
@@ -153,7 +155,7 @@ impl Reducer<'_> {
                 return Some(Unreducible::EdgeOffTheAngle {
                     contact: c.name.clone(),
                     others: others.join(", "),
-                    theta: self.st.theta.clone(),
+                    theta: self.theta().to_string(),
                 });
             }
         }
@@ -164,7 +166,7 @@ impl Reducer<'_> {
     fn unreducible_coordinates(&self) -> Option<Unreducible> {
         let (st, eqs) = (self.st, self.eqs);
         for (i, c) in st.coords.iter().enumerate() {
-            if i != st.reduced && !eqs.cyclic.contains(&i) {
+            if i != self.reduced.0 && !eqs.cyclic.contains(&i) {
                 return Some(Unreducible::NotCyclic {
                     coordinate: c.clone(),
                 });
@@ -260,7 +262,7 @@ impl Reducer<'_> {
         &self,
         constants: &mut [Constant],
     ) -> Result<Result<Vec<A>, Unreducible>, DeriveError> {
-        let (st, eqs, theta) = (self.st, self.eqs, self.theta());
+        let (eqs, theta) = (self.eqs, self.theta());
         let w = cas::var("rc_w");
         let k = eqs.cyclic.len();
         let momentum: Vec<A> = (0..k)
@@ -276,7 +278,7 @@ impl Reducer<'_> {
             .collect();
         let vec_b: Vec<A> = (eqs.cyclic.iter().enumerate())
             .map(|(jj, &i)| {
-                momentum[jj].clone() - to_sc(&eqs.mass[i][st.reduced], theta) * w.clone()
+                momentum[jj].clone() - to_sc(&eqs.mass[i][self.reduced.0], theta) * w.clone()
             })
             .collect();
         Ok(match solve_linear(mat, vec_b) {

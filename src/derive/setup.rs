@@ -36,10 +36,10 @@ pub struct Setup {
     pub plan: PhasePlan,
     /// Its coordinates: the spec's without the eliminated ones.
     pub coords: Vec<String>,
-    /// Index of the reduced coordinate among them.
-    pub reduced: usize,
+    /// Index of the reduced coordinate among them (none where the spec names none).
+    pub reduced: Option<usize>,
     /// The reduced coordinate's name.
-    pub theta: String,
+    pub theta: Option<String>,
     /// Each eliminated coordinate with its value over the phase's coordinates.
     pub ties: Vec<(String, A)>,
     /// The time derivative along the phase's state.
@@ -123,18 +123,18 @@ pub fn setup(spec: &Spec, parsed: &Parsed, plan: &PhasePlan) -> Result<Setup, De
         .map(|c| c.name.clone())
         .filter(|c| ties.iter().all(|(e, _)| e != c))
         .collect();
-    let reduced = coords
-        .iter()
-        .position(|c| *c == spec.reduced)
-        .ok_or_else(|| {
+    let reduced = match &spec.reduced {
+        Some(name) => Some(coords.iter().position(|c| c == name).ok_or_else(|| {
             at(
                 &[key("reduced")],
-                format!("`{}` is not a coordinate of the phase", spec.reduced),
+                format!("`{name}` is not a coordinate of the phase"),
             )
-        })?;
+        })?),
+        None => None,
+    };
     Ok(Setup {
         plan: plan.clone(),
-        theta: coords[reduced].clone(),
+        theta: reduced.map(|i| coords[i].clone()),
         kin: Kin {
             coords: coords.clone(),
         },

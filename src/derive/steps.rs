@@ -14,7 +14,7 @@
 //! `sin^2 + cos^2 = 1`; a condition `= 0` up to its constant factor) before it can be shown; one
 //! that is not is not shown, and the step is shown as derived with the reason.
 
-use super::algebra::{is_zero_trig, to_sc_expr};
+use super::algebra::{is_zero_trig, to_sc_over};
 use super::cas::{self, A};
 use super::expr::{Expr, product, sum};
 use super::present::{Presenter, Shape, operations};
@@ -32,12 +32,8 @@ pub fn derive(d: &Derivation) -> Steps {
         .collect();
     // The presenter works over `rc_s`, `rc_c` (so that it can apply sin^2 + cos^2 = 1); the
     // full-state expressions hold `sin(theta)`, `cos(theta)`.
-    let theta = d.theta().to_string();
-    let grouped = |e: &Expr| {
-        show(&to_sc_expr(e, &theta), |a| {
-            in_motion(&presenter, a, &motion)
-        })
-    };
+    let theta = d.theta();
+    let grouped = |e: &Expr| show(&to_sc_over(e, theta), |a| in_motion(&presenter, a, &motion));
     let mut steps = Steps {
         kinetic: grouped(&d.kinetic),
         potential: grouped(&d.potential),
@@ -53,7 +49,7 @@ pub fn derive(d: &Derivation) -> Steps {
             } else {
                 Shape::Fraction
             };
-            let form = show(&to_sc_expr(e, &theta), |a| {
+            let form = show(&to_sc_over(e, theta), |a| {
                 presenter.present(a, shape).map(|f| f.expr)
             });
             steps.reduced.insert(key.clone(), form);

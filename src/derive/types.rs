@@ -76,6 +76,9 @@ pub enum Unheld {
 /// reason the LaTeX write-up, the JSON record and the model's `route_note` give.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum Unreducible {
+    /// The spec names no reduced coordinate for a fast phase to keep.
+    #[error("the spec names no `reduced` coordinate")]
+    NoReducedCoordinate,
     /// A closed contact's edge depends on coordinates besides the angle.
     #[error(
         "the edge of contact `{contact}` depends on {others} besides `{theta}`, which only the \
@@ -414,8 +417,8 @@ pub struct Derivation {
     pub coords: Vec<String>,
     /// The spec's coordinates (the general model's), in order.
     pub full_coords: Vec<String>,
-    /// Index of the reduced coordinate.
-    pub reduced: usize,
+    /// Index of the reduced coordinate (none where the spec names none).
+    pub reduced: Option<usize>,
     /// Indices of the cyclic coordinates (whose momenta are conserved).
     pub cyclic: Vec<usize>,
     /// Kinetic energy (full state).
@@ -472,9 +475,9 @@ pub struct Derivation {
 }
 
 impl Derivation {
-    /// The reduced coordinate's name.
-    pub fn theta(&self) -> &str {
-        &self.coords[self.reduced]
+    /// The reduced coordinate's name (none where the spec names none).
+    pub fn theta(&self) -> Option<&str> {
+        self.reduced.map(|i| self.coords[i].as_str())
     }
 
     /// Whether this is the general model of its system.

@@ -494,8 +494,11 @@ impl Sim {
         for (vr, v) in vars.iter().enumerate() {
             out[vr] = match v.role {
                 Role::Parameter { .. } | Role::Phase => continue,
-                Role::Angle => s.theta[0],
-                Role::Rate => s.theta_dot[0],
+                Role::Angle => *s.theta.first().ok_or_else(|| missing("angle sample", 0))?,
+                Role::Rate => *s
+                    .theta_dot
+                    .first()
+                    .ok_or_else(|| missing("rate sample", 0))?,
                 Role::Force(i) => *forces.get(i).ok_or_else(|| missing("contact", i))?,
                 Role::PointX(i) => points.pos.get(i).ok_or_else(|| missing("point", i))?[0],
                 Role::PointY(i) => points.pos.get(i).ok_or_else(|| missing("point", i))?[1],

@@ -158,16 +158,18 @@ pub fn variables(info: &ModelInfo) -> Result<Vec<Variable>, DescriptionError> {
             format!("{}; {what}", p.meaning),
         ));
     }
-    let angle = (info.coordinates.get(info.reduced_index).copied()).ok_or(
-        DescriptionError::ReducedIndex {
-            model: info.name,
-            index: info.reduced_index,
-        },
-    )?;
-    let what = format!("the reduced coordinate {angle}");
-    out.push(var(angle.into(), Role::Angle, "rad", what));
-    let what = format!("the rate of {angle}");
-    out.push(var(format!("{angle}_dot"), Role::Rate, "rad/s", what));
+    // The reduced coordinate and its rate, where the system has one.
+    if let Some(index) = info.reduced_index {
+        let angle =
+            (info.coordinates.get(index).copied()).ok_or(DescriptionError::ReducedIndex {
+                model: info.name,
+                index,
+            })?;
+        let what = format!("the reduced coordinate {angle}");
+        out.push(var(angle.into(), Role::Angle, "rad", what));
+        let what = format!("the rate of {angle}");
+        out.push(var(format!("{angle}_dot"), Role::Rate, "rad/s", what));
+    }
     for (i, c) in info.contacts.iter().enumerate() {
         let v = var(c.name.into(), Role::Force(i), c.unit, c.meaning.into());
         out.push(v);

@@ -43,13 +43,12 @@ pub(super) enum Fate {
 /// Contact `i`'s fate on `motion` as far as it is solved; `None` when the phases solved so
 /// far do not tell yet.
 pub(super) fn fate(motion: &Motion, general: &Bound, i: usize) -> Result<Option<Fate>, SolveError> {
-    let info = general.info();
     let Some(first) = motion.phases.first() else {
         return Ok(None);
     };
     if motion.opened_at_release.contains(&i) {
         let bound = first.bound();
-        let theta = bound.to_full(&bound.initial_state())?.q[info.reduced_index];
+        let theta = bound.to_full(&bound.initial_state())?.q[general.reduced()?.0];
         return Ok(Some(Fate::Ended {
             t: 0.0,
             theta,
@@ -109,14 +108,16 @@ fn fate_along(
                 mismatch(general, phase, why)
             })
         };
-        let ended = |cause| Fate::Ended {
-            t: phase.t_end(),
-            theta: phase.theta_end(),
-            cause,
+        let ended = |cause| -> Result<Fate, SolveError> {
+            Ok(Fate::Ended {
+                t: phase.t_end(),
+                theta: phase.theta_end()?,
+                cause,
+            })
         };
         match phase.end() {
-            End::Force(j) if j == i => return Ok(Some(ended("force"))),
-            End::Edge(j) if j == i => return Ok(Some(ended("edge"))),
+            End::Force(j) if j == i => return Ok(Some(ended("force")?)),
+            End::Edge(j) if j == i => return Ok(Some(ended("edge")?)),
             End::Contact(j) if !motion.through_impacts && landed => {
                 return Ok(Some(Fate::Held {
                     until: Held::Lands {
@@ -125,7 +126,7 @@ fn fate_along(
                     },
                 }));
             }
-            End::Contact(_) if !motion.through_impacts => return Ok(Some(ended("contact"))),
+            End::Contact(_) if !motion.through_impacts => return Ok(Some(ended("contact")?)),
             End::Contact(_) => {
                 // An impact: it may have separated this contact.
                 let Some(next) = motion.phases.get(k + 1) else {
@@ -134,7 +135,7 @@ fn fate_along(
                     }));
                 };
                 if !closed_in(general, next, i)? {
-                    return Ok(Some(ended("impact")));
+                    return Ok(Some(ended("impact")?));
                 }
             }
             End::Until => {
@@ -145,8 +146,8 @@ fn fate_along(
             End::Floor => {
                 return Ok(Some(Fate::Held {
                     until: Held::Floor {
-                        angle: general.reduced_coordinate().to_string(),
-                        end_angle: info.end_angle,
+                        angle: general.reduced()?.1.to_string(),
+                        end_angle: general.end_angle()?,
                     },
                 }));
             }
@@ -166,7 +167,7 @@ fn fate_along(
                     }));
                 };
                 if !closed_in(general, next, i)? {
-                    return Ok(Some(ended("force")));
+                    return Ok(Some(ended("force")?));
                 }
             }
         }
@@ -180,12 +181,16 @@ fn fate_along(
 fn is_landing(general: &Bound, phase: &PhaseRun) -> Result<bool, SolveError> {
     match phase.end() {
         End::Floor => Ok(true),
-        End::Contact(_) => {
-            let bound = general;
-            let state = phase.full_end_state()?;
-            let height = bound.points(&state)?.pos[bound.info().falling_point_index][1];
-            Ok(height.abs() <= LANDING_TOLERANCE * bound.length_scale(&state)?)
-        }
+        // Without a falling point the system names no body that lands: a contact that closes
+        // is an impact.
+        End::Contact(_) => match general.info().falling_point_index {
+            Some(falling) => {
+                let state = phase.full_end_state()?;
+                let height = general.points(&state)?.pos[falling][1];
+                Ok(height.abs() <= LANDING_TOLERANCE * general.length_scale(&state)?)
+            }
+            None => Ok(false),
+        },
         _ => Ok(false),
     }
 }
@@ -274,7 +279,7 @@ impl Plan<'_> {
             && end.end == End::Force(0)
             && let Some(at) = end.at
         {
-            let angle = self.general().reduced_coordinate().to_string();
+            let angle = self.general().reduced()?.1.to_string();
             scalar(
                 out,
                 &key,
@@ -291,7 +296,7 @@ impl Plan<'_> {
                 cause: "force",
             } => {
                 if q == Quantity::SeparationAngle {
-                    let angle = self.general().reduced_coordinate().to_string();
+                    let angle = self.general().reduced()?.1.to_string();
                     scalar(out, &key, theta, "rad", Meaning::SeparationAngle { angle });
                 } else {
                     scalar(out, &key, t, "s", Meaning::SeparationTime);
@@ -364,7 +369,7 @@ impl Plan<'_> {
                         };
                         scalar(out, &format!("{key}_time"), *t, "s", meaning);
                         let meaning = Meaning::ContactEndAngle {
-                            angle: self.general().reduced_coordinate().to_string(),
+                            angle: self.general().reduced()?.1.to_string(),
                             contact: contact.clone(),
                             cause: cause.clone(),
                         };
@@ -432,8 +437,8 @@ impl Plan<'_> {
         let t = self.floor_mesh()?.duration;
         let key = Quantity::ContactTimeToFloor.name(info);
         let meaning = Meaning::ContactTimeToFloor {
-            angle: self.general().reduced_coordinate().to_string(),
-            end_angle: info.end_angle,
+            angle: self.general().reduced()?.1.to_string(),
+            end_angle: self.general().end_angle()?,
         };
         scalar(out, &key, t, "s", meaning);
         Ok(())
@@ -444,10 +449,11 @@ impl Plan<'_> {
         let general = self.general();
         let info = general.info();
         let pts = general.points(&general.initial_state())?;
-        let h = pts.pos[info.falling_point_index][1];
+        let falling = general.falling_point()?;
+        let h = pts.pos[falling][1];
         let t = (2.0 * h.max(0.0) / general.gravity()).sqrt();
         let meaning = Meaning::PointMassFallTime {
-            point: info.points[info.falling_point_index].name.to_string(),
+            point: info.points[falling].name.to_string(),
             height: h,
         };
         scalar(
@@ -540,17 +546,27 @@ impl Plan<'_> {
     }
 
     /// A series over the first contact's span: the angle, a contact's force, a friction, or a
-    /// point's path.
+    /// point's path. Columns are named by the reduced coordinate's own name (`theta`, `phi`);
+    /// a system without one has no angle column beside its forces.
     pub(super) fn series(&mut self, q: Quantity, out: &mut RunResults) -> Result<(), SolveError> {
         let info = self.general().info();
         let groups = self.span_samples()?;
         let general = self.general().clone();
+        let angle = general.reduced_coordinate();
         let motion = &*self.motion()?;
         let mut cols: Vec<Vec<f64>> = Vec::new();
         let mut push = |row: &[f64]| {
             cols.resize(row.len(), Vec::new());
             for (c, v) in cols.iter_mut().zip(row) {
                 c.push(*v);
+            }
+        };
+        // The time and, where the system has a reduced coordinate, the angle: a force's row
+        // starts with them.
+        let lead = |s: &PhaseSamples, t: f64, j: usize| -> Vec<f64> {
+            match (angle, s.theta.get(j)) {
+                (Some(_), Some(&theta)) => vec![t, theta],
+                _ => vec![t],
             }
         };
         for (k, s, t) in &groups {
@@ -567,7 +583,9 @@ impl Plan<'_> {
                             let why = format!("it gives {} force(s), not contact {i}'s", f.len());
                             mismatch(&general, phase, why)
                         })?;
-                        push(&[t[j], s.theta[j], force]);
+                        let mut row = lead(s, t[j], j);
+                        row.push(force);
+                        push(&row);
                     }
                 }
                 Quantity::FrictionSeries(i) => {
@@ -579,7 +597,9 @@ impl Plan<'_> {
                                 mismatch(&general, phase, why)
                             })
                         };
-                        push(&[t[j], s.theta[j], at(f)?, at(n)?, at(v)?]);
+                        let mut row = lead(s, t[j], j);
+                        row.extend([at(f)?, at(n)?, at(v)?]);
+                        push(&row);
                     }
                 }
                 Quantity::Trajectory(i) => {
@@ -592,39 +612,38 @@ impl Plan<'_> {
                 _ => {}
             }
         }
-        let names: Vec<(String, &'static str)> = match q {
-            Quantity::ThetaSeries => vec![
-                ("t".into(), "s"),
-                ("theta".into(), "rad"),
-                ("theta_dot".into(), "rad/s"),
-                ("theta_ddot".into(), "rad/s^2"),
-            ],
-            Quantity::ForceSeries(i) => vec![
-                ("t".into(), "s"),
-                ("theta".into(), "rad"),
-                (info.contacts[i].name.into(), info.contacts[i].unit),
-            ],
+        let mut names: Vec<(String, &'static str)> = vec![("t".into(), "s")];
+        if let Some(a) = angle
+            && matches!(
+                q,
+                Quantity::ThetaSeries | Quantity::ForceSeries(_) | Quantity::FrictionSeries(_)
+            )
+        {
+            names.push((a.into(), "rad"));
+        }
+        match q {
+            Quantity::ThetaSeries => {
+                let a = general.reduced()?.1;
+                names.push((format!("{a}_dot"), "rad/s"));
+                names.push((format!("{a}_ddot"), "rad/s^2"));
+            }
+            Quantity::ForceSeries(i) => {
+                names.push((info.contacts[i].name.into(), info.contacts[i].unit));
+            }
             Quantity::FrictionSeries(i) => {
                 let f = &info.frictions[i];
-                vec![
-                    ("t".into(), "s"),
-                    ("theta".into(), "rad"),
-                    (f.name.into(), "N"),
-                    (
-                        info.contacts[f.contact_index].name.into(),
-                        info.contacts[f.contact_index].unit,
-                    ),
-                    ("slip_velocity".into(), "m/s"),
-                ]
+                names.push((f.name.into(), "N"));
+                let c = &info.contacts[f.contact_index];
+                names.push((c.name.into(), c.unit));
+                names.push(("slip_velocity".into(), "m/s"));
             }
-            _ => vec![
-                ("t".into(), "s"),
+            _ => names.extend([
                 ("x".into(), "m"),
                 ("y".into(), "m"),
                 ("vx".into(), "m/s"),
                 ("vy".into(), "m/s"),
-            ],
-        };
+            ]),
+        }
         cols.resize(names.len(), Vec::new());
         let series = Series {
             columns: (names.into_iter().zip(cols))
@@ -649,8 +668,8 @@ impl Plan<'_> {
                 work,
                 "J",
                 Meaning::FloorImpactFrictionWork {
-                    angle: general.reduced_coordinate().to_string(),
-                    end_angle: info.end_angle,
+                    angle: general.reduced()?.1.to_string(),
+                    end_angle: general.end_angle()?,
                 },
             );
         }
@@ -673,14 +692,11 @@ impl Plan<'_> {
             out.notes.insert("floor_impact".into(), note);
             return Ok(());
         };
-        let (time, omega) = (landing.t_end(), landing.theta_dot_end());
-        let (angle, path) = (
-            general.reduced_coordinate().to_string(),
-            phase_labels(motion),
-        );
+        let (time, omega) = (landing.t_end(), landing.theta_dot_end()?);
+        let (angle, path) = (general.reduced()?.1.to_string(), phase_labels(motion));
         let meaning = Meaning::FloorImpactTime {
             angle: angle.clone(),
-            end_angle: info.end_angle,
+            end_angle: general.end_angle()?,
             path: path.clone(),
         };
         scalar(out, "floor_impact_time", time, "s", meaning);

@@ -74,7 +74,8 @@ impl Plan<'_> {
         } else {
             (ode.t_end - t_quad).abs()
         };
-        let (dt_max, dy_max, nodes) = path_deviation(first, ode, info.reduced_index, work)?;
+        let (dt_max, dy_max, nodes) =
+            path_deviation(first, ode, first.system.bound().reduced()?.0, work)?;
         let steps = ode.steps();
         let event = ended_at(ode, info);
         let meaning = Meaning::CrossCheckTime {

@@ -43,6 +43,12 @@ pub const REST: f64 = 1e-9;
 /// sliding frictions over the one without them ([`Dynamics::painleve`]) has fallen to this.
 pub const PAINLEVE_FLOOR: f64 = 1e-3;
 
+/// The rounding a stuck friction may pass Coulomb's cone by and still stick: relative to
+/// `mu N`, and to the largest force of the set (what a friction that must be zero, `mu = 0`,
+/// comes out as when the slip's free acceleration vanishes). Far below [`DECIDE_TOLERANCE`],
+/// so a friction `1e-9` short of what sticking needs still slides.
+pub const STICK_ROUNDING: f64 = 1e-12;
+
 /// The accelerations, contact and friction forces at one state in one active set.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Dynamics {
@@ -597,7 +603,8 @@ pub fn normal_velocity(row: &[f64], state: &State) -> f64 {
 }
 
 /// Whether a candidate combination is consistent: closed candidates push (within
-/// [`DECIDE_TOLERANCE`] of the largest force), open candidates accelerate apart (within
+/// [`DECIDE_TOLERANCE`] of the largest force, or of their own force's size where that is
+/// smaller, [`force_scales`]), open candidates accelerate apart (within
 /// [`DECIDE_TOLERANCE`] of the size of their own normal acceleration's terms), frictions obey Coulomb's law in
 /// their modes, and sliding is clear of Painlevé's singularity.
 fn consistent(
@@ -606,6 +613,7 @@ fn consistent(
     active: &Active,
     d: &Dynamics,
     acc_scale: &[f64],
+    own_force: &[f64],
 ) -> bool {
     let info = sys.info();
     let force_scale = (d.forces.iter())
@@ -615,7 +623,8 @@ fn consistent(
     for (i, opt) in options.contacts.iter().enumerate() {
         let ok = match (opt, active.closed[i]) {
             (ContactOption::Candidate, true) => {
-                info.contacts[i].bilateral || d.forces[i] >= -DECIDE_TOLERANCE * force_scale
+                info.contacts[i].bilateral
+                    || d.forces[i] >= -DECIDE_TOLERANCE * force_scale.min(own_force[i])
             }
             (ContactOption::Candidate | ContactOption::Opens, false) => {
                 d.normal_acc[i] >= -DECIDE_TOLERANCE * acc_scale[i]
@@ -634,7 +643,15 @@ fn consistent(
         let mode = active.modes[j];
         let ok = match (opt, mode) {
             (FrictionOption::Keep(_), _) => true,
-            (_, Mode::Stick) => d.fr[j].abs() <= mu[j] * normal.max(0.0) * (1.0 + 1e-12),
+            // Within the cone to rounding: relative to `mu N`, and to the largest force, since
+            // with `mu = 0` the friction a stick needs is zero only to rounding (a nearly flat
+            // ladder's foot at rest where its slip's acceleration vanishes, at the wall's
+            // release).
+            (_, Mode::Stick) => {
+                d.fr[j].abs()
+                    <= mu[j] * normal.max(0.0) * (1.0 + STICK_ROUNDING)
+                        + STICK_ROUNDING * force_scale
+            }
             (FrictionOption::Breaks(_), Mode::Slide(_)) => true,
             (_, Mode::Slide(s)) => s * d.slip_acc[j] > 0.0,
         };
@@ -757,7 +774,8 @@ pub fn decide(sys: &Bound, state: &State, options: &Options, t: f64) -> Result<A
         };
         let d = &work.out;
         let scales = acc_scales(&work.rows, inverse, info, &active, d);
-        if consistent(sys, options, &active, d, &scales) {
+        let forces = force_scales(&work.rows, inverse, &scales);
+        if consistent(sys, options, &active, d, &scales, &forces) {
             found.push((active, d.clone()));
         }
     }
@@ -792,6 +810,25 @@ fn acc_scales(
             let row = rows.row(&rows.jac, i);
             let terms: f64 = row.iter().zip(&size).map(|(j, s)| (j * s).abs()).sum();
             terms + rows.bias[i].abs()
+        })
+        .collect()
+}
+
+/// The size of each contact's force that its acceleration scale (`acc_scale`, [`acc_scales`])
+/// stands for: that scale times the contact's effective mass `1 / (J M^-1 J^T)`. So the force
+/// of a contact that pushes a light body (a cube of 1e-9 kg beside a rod of 1e-3 kg) is judged
+/// at its own size, not at the size of the largest force of the system, which would take a
+/// pull that opens it for rounding. Infinite for a row that moves nothing.
+fn force_scales(rows: &Rows, inverse: &DMatrix<f64>, acc_scale: &[f64]) -> Vec<f64> {
+    (acc_scale.iter().enumerate())
+        .map(|(i, a)| {
+            let row = DVector::from_column_slice(rows.row(&rows.jac, i));
+            let effective = row.dot(&(inverse * &row));
+            if effective > 0.0 {
+                a / effective
+            } else {
+                f64::INFINITY
+            }
         })
         .collect()
 }

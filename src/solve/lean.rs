@@ -193,6 +193,10 @@ impl<'m> LeanSolver<'m> {
                 why: info.route_note,
             }));
         };
+        let end_angle =
+            (info.end_angle).ok_or(SolveError::Parameters(SystemError::NoEndAngle {
+                model: info.name,
+            }))?;
         let why = if !info
             .contacts
             .first()
@@ -230,7 +234,7 @@ impl<'m> LeanSolver<'m> {
             info,
             red,
             layout,
-            sin_end: info.end_angle.sin(),
+            sin_end: end_angle.sin(),
             k: vec![0.0; info.n_constants],
             margins: vec![0.0; info.requirements.len()],
             fall: vec![0.0; layout.fall_degree.map_or(0, |d| d + 1)],
@@ -662,7 +666,10 @@ mod tests {
         // give the same bits, the same refusals and the same evaluation counts.
         let prior = Prior::new(PRIOR_TOL);
         let dynamic: &dyn Model = &RodCubeClosed;
-        let sin_end = dynamic.info().end_angle.sin();
+        let Some(end_angle) = dynamic.info().end_angle else {
+            panic!("rod_cube_closed has an end angle");
+        };
+        let sin_end = end_angle.sin();
         let mut served = 0;
         for (m2, a) in [
             (3.0, 0.25),

@@ -180,6 +180,7 @@ pub fn sample_integrated_at(
 ) -> Result<PhaseSamples, SolveError> {
     let bound = &run.bound;
     let n = bound.n_coordinates();
+    // The reduced coordinate's samples, where the system has one (empty otherwise).
     let r = bound.info().reduced_index;
     let duration = run.run.t_end;
     let mut out = PhaseSamples::default();
@@ -200,9 +201,11 @@ pub fn sample_integrated_at(
         let t = t.min(duration);
         let qdd = run.run.dynamics_at(bound, &state, t)?.qdd;
         out.t.push(t);
-        out.theta.push(state.q[r]);
-        out.theta_dot.push(state.qd[r]);
-        out.theta_ddot.push(qdd[r]);
+        if let Some(r) = r {
+            out.theta.push(state.q[r]);
+            out.theta_dot.push(state.qd[r]);
+            out.theta_ddot.push(qdd[r]);
+        }
         out.states.push(state);
     }
     Ok(out)

@@ -125,8 +125,14 @@ enum Watch {
     Gap(usize),
     /// A closed contact's edge margin.
     Edge(usize),
-    /// The reduced angle above the end angle.
-    Floor,
+    /// The reduced angle (the coordinate at this index) above the end angle (a system with
+    /// no end angle has no such watch).
+    Floor {
+        /// The reduced coordinate's index.
+        coordinate: usize,
+        /// The end angle.
+        angle: f64,
+    },
     /// A sliding friction's slip velocity (from its offset at the segment's start).
     Slip(usize),
     /// A stuck friction's margin `mu N - |f|`.
@@ -295,8 +301,8 @@ struct Problem<'a, 'm> {
     /// start of a contact that just switched (so that it does not count as a crossing), zero
     /// for one that keeps sliding.
     slip_offset: Vec<f64>,
-    reduced: usize,
-    end_angle: f64,
+    /// The reduced coordinate's index and the end angle, where the system has one.
+    floor: Option<(usize, f64)>,
     y0: Vec<f64>,
     y: Vec<f64>,
     state: State,
@@ -348,7 +354,9 @@ impl Problem<'_, '_> {
                 watches.push(Watch::Edge(i));
             }
         }
-        watches.push(Watch::Floor);
+        if let Some((coordinate, angle)) = self.floor {
+            watches.push(Watch::Floor { coordinate, angle });
+        }
         let mut sliding = false;
         for j in 0..info.frictions.len() {
             if self.active.friction_acts(info, j) {
@@ -405,7 +413,7 @@ impl Problem<'_, '_> {
                 Watch::Force(i) => d.forces[i],
                 Watch::Gap(i) => gaps[i],
                 Watch::Edge(i) => edges[i],
-                Watch::Floor => self.state.q[self.reduced] - self.end_angle,
+                Watch::Floor { coordinate, angle } => self.state.q[coordinate] - angle,
                 Watch::Slip(j) => {
                     let v = d.slip[j] - self.slip_offset[j];
                     // A slide that starts from zero slip (from rest, or just switched) has its
@@ -441,7 +449,12 @@ impl Problem<'_, '_> {
             Some(Watch::Force(i)) => Ok(End::Force(i)),
             Some(Watch::Gap(i)) => Ok(End::Contact(i)),
             Some(Watch::Edge(i)) => Ok(End::Edge(i)),
-            Some(Watch::Floor) => Ok(End::Floor),
+            Some(Watch::Floor { .. }) => Ok(End::Floor),
+            // A friction's switch located where the reduced angle is already at or past the
+            // end angle: the two roots coincide to the located time's ulps (a ladder lying flat
+            // against the wall's foot stops its foot's slip, `ell sin(theta) theta'`, exactly at
+            // the floor), and the run ends at the floor, past which the model describes nothing.
+            Some(_) if self.floor_reached(y) => Ok(End::Floor),
             Some(watch) => Err(watch),
             None => {
                 return Err(SolveError::OdeNonFinite {
@@ -450,6 +463,15 @@ impl Problem<'_, '_> {
                     y: y.to_vec(),
                 });
             }
+        })
+    }
+
+    /// Whether the state `y` has the reduced angle at or past the end angle (where the system
+    /// has one, and only where its floor is watched).
+    fn floor_reached(&self, y: &[f64]) -> bool {
+        (self.watches.iter()).any(|w| match *w {
+            Watch::Floor { coordinate, angle } => y[coordinate] - angle <= 0.0,
+            _ => false,
         })
     }
 
@@ -514,14 +536,13 @@ fn checked_start(sys: &Bound, start: &Start, rtol: f64) -> Result<(f64, f64), So
     Ok((rtol, condition))
 }
 
-/// What watch `w` measures, for its time's derivatives (`reduced`: the reduced coordinate's
-/// index).
-fn measured(w: Watch, reduced: usize) -> Measured {
+/// What watch `w` measures, for its time's derivatives.
+fn measured(w: Watch) -> Measured {
     match w {
         Watch::Force(i) => Measured::Force(i),
         Watch::Gap(i) => Measured::Gap(i),
         Watch::Edge(i) => Measured::Edge(i),
-        Watch::Floor => Measured::Coordinate(reduced),
+        Watch::Floor { coordinate, .. } => Measured::Coordinate(coordinate),
         Watch::Slip(j) => Measured::Slip(j),
         Watch::Stuck(j) => Measured::Stuck(j),
         // Painlevé's watch ends the run with an error; its time is never differentiated.
@@ -866,8 +887,7 @@ pub fn integrate_with(
         armed: Vec::new(),
         arm_at: DECIDE_TOLERANCE * sys.length_scale(&start.state)?,
         slip_offset: slip_offsets(sys, &start.state, &start.frictions)?,
-        reduced: info.reduced_index,
-        end_angle: info.end_angle,
+        floor: (info.reduced_index).zip(info.end_angle),
         y0: y0.clone(),
         y: y0.clone(),
         state: start.state.clone(),
@@ -933,7 +953,10 @@ pub fn integrate_with(
                     End::Force(i) => Measured::Force(i),
                     End::Contact(i) => Measured::Gap(i),
                     End::Edge(i) => Measured::Edge(i),
-                    End::Floor => Measured::Coordinate(info.reduced_index),
+                    End::Floor => match problem.floor {
+                        Some((coordinate, _)) => Measured::Coordinate(coordinate),
+                        None => Measured::Clock,
+                    },
                     End::Until => Measured::Clock,
                 };
                 let at = (&state, event.t, &problem.active);
@@ -967,7 +990,7 @@ pub fn integrate_with(
         if let Some(r) = problem.riders.as_mut() {
             let at = (&state, event.t, &before);
             let (work, after) = (&mut problem.work, &problem.active);
-            r.across(sys, work, at, after, measured(watch, info.reduced_index))?;
+            r.across(sys, work, at, after, measured(watch))?;
         }
         problem.state = state;
         y0 = y;

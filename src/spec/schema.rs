@@ -345,17 +345,24 @@ pub struct Spec {
     /// Generalized coordinates.
     pub coordinates: Vec<CoordSpec>,
     /// The coordinate reported as the angle of the motion (`theta`): the one kept when the
-    /// others are cyclic and eliminated, and the one whose `end_angle` ends the motion.
-    pub reduced: String,
-    /// Value of the reduced coordinate where the motion ends (the floor).
-    pub end_angle: f64,
+    /// others are cyclic and eliminated, and the one whose `end_angle` ends the motion. None:
+    /// the system has no such angle (no fast phase, no angle in its results); it runs to its
+    /// scene's `until`.
+    #[serde(default)]
+    pub reduced: Option<String>,
+    /// Value of the reduced coordinate where the motion ends (the floor). None: the motion has
+    /// no end of its own and runs to its scene's `until`.
+    #[serde(default)]
+    pub end_angle: Option<f64>,
     /// Bodies.
     pub bodies: Vec<BodySpec>,
     /// Named points.
     #[serde(default)]
     pub points: Vec<PointSpec>,
-    /// Point whose initial height gives the reference free-fall time.
-    pub falling_point: String,
+    /// Point whose initial height gives the reference free-fall time, and whose height tells a
+    /// landing at `end_angle` from a support holding the body up. None: no such reference.
+    #[serde(default)]
+    pub falling_point: Option<String>,
     /// Potential energy besides gravity.
     #[serde(default)]
     pub potentials: Vec<PotentialSpec>,

@@ -17,9 +17,10 @@ pub struct Bound<'m> {
     /// `model.info()`, read by every evaluation (kept to spare the call through the trait
     /// object).
     info: &'static ModelInfo,
-    /// `info.coordinates[info.reduced_index]`, looked up once when bound (a model whose
-    /// `reduced_index` names no coordinate is refused: [`SystemError::ReducedIndex`]).
-    reduced_coordinate: &'static str,
+    /// `info.reduced_index` with the coordinate it names, looked up once when bound (a model
+    /// whose `reduced_index` names no coordinate is refused: [`SystemError::ReducedIndex`]);
+    /// none for a system without a reduced coordinate.
+    reduced: Option<(usize, &'static str)>,
     p: Vec<f64>,
     k: Vec<f64>,
     restitutions: Vec<f64>,
@@ -59,13 +60,17 @@ impl<'m> Bound<'m> {
     /// [`check_parameters`] and prepared by [`prepare_constants`].
     pub fn from_values(model: &'m dyn Model, p: &[f64]) -> Result<Self, SystemError> {
         let info = model.info();
-        let reduced_coordinate = (info.coordinates.get(info.reduced_index).copied()).ok_or(
-            SystemError::ReducedIndex {
-                model: info.name,
-                index: info.reduced_index,
-                coordinates: info.coordinates.len(),
-            },
-        )?;
+        let reduced = match info.reduced_index {
+            Some(index) => Some((
+                index,
+                (info.coordinates.get(index).copied()).ok_or(SystemError::ReducedIndex {
+                    model: info.name,
+                    index,
+                    coordinates: info.coordinates.len(),
+                })?,
+            )),
+            None => None,
+        };
         let mut margins = vec![0.0; info.requirements.len()];
         check_parameters(model, p, &mut margins)?;
         let restitutions = restitutions(model, p)?;
@@ -74,7 +79,7 @@ impl<'m> Bound<'m> {
         Ok(Bound {
             model,
             info,
-            reduced_coordinate,
+            reduced,
             p: p.to_vec(),
             k,
             restitutions,
@@ -88,9 +93,17 @@ impl<'m> Bound<'m> {
     }
 
     /// The name of the reduced coordinate (`theta`), the model's
-    /// `coordinates[reduced_index]`.
-    pub fn reduced_coordinate(&self) -> &'static str {
-        self.reduced_coordinate
+    /// `coordinates[reduced_index]`; none for a system without one.
+    pub fn reduced_coordinate(&self) -> Option<&'static str> {
+        self.reduced.map(|(_, name)| name)
+    }
+
+    /// The index and name of the reduced coordinate, for what is measured in it (an angle's
+    /// series or result, the fast path): [`SystemError::NoReducedCoordinate`] for a system
+    /// without one.
+    pub fn reduced(&self) -> Result<(usize, &'static str), SystemError> {
+        self.reduced
+            .ok_or(SystemError::NoReducedCoordinate { model: self.name() })
     }
 
     /// The model.
@@ -147,9 +160,16 @@ impl<'m> Bound<'m> {
         self.p[self.info().gravity_index]
     }
 
-    /// The angle where the motion ends (rod on the floor).
-    pub fn end_angle(&self) -> f64 {
-        self.info().end_angle
+    /// The angle where the motion ends (rod on the floor): [`SystemError::NoEndAngle`] for a
+    /// motion with no end of its own (it runs to a given end time).
+    pub fn end_angle(&self) -> Result<f64, SystemError> {
+        (self.info().end_angle).ok_or(SystemError::NoEndAngle { model: self.name() })
+    }
+
+    /// The index in [`ModelInfo::points`] of the point whose fall is the reference and whose
+    /// height tells a landing: [`SystemError::NoFallingPoint`] for a system that names none.
+    pub fn falling_point(&self) -> Result<usize, SystemError> {
+        (self.info().falling_point_index).ok_or(SystemError::NoFallingPoint { model: self.name() })
     }
 
     /// Number of unreduced coordinates.

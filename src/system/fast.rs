@@ -12,6 +12,8 @@ pub struct System<'m> {
     bound: Bound<'m>,
     reduction: &'m dyn Reduction,
     layout: &'static ReductionInfo,
+    /// The angle where the fall ends (the spec's `end_angle`, which a fast path has).
+    end_angle: f64,
     /// The fall polynomial's coefficients (empty without one).
     fall: Vec<f64>,
 }
@@ -51,11 +53,17 @@ impl<'m> System<'m> {
         Self::reduce(Bound::from_values(model, p)?)
     }
 
-    /// The fast path of a bound model, or [`SystemError::NoReduction`].
+    /// The fast path of a bound model, or [`SystemError::NoReduction`] (also for a model
+    /// whose info lists a fast path without the reduced coordinate and end angle it falls in).
     pub fn reduce(bound: Bound<'m>) -> Result<Self, SystemError> {
         let info = bound.info();
-        match (bound.model().reduction(), &info.reduction) {
-            (Some(reduction), Some(layout)) => {
+        let ends = (info.reduced_index).and(info.end_angle);
+        match (bound.model().reduction(), &info.reduction, ends) {
+            (Some(_), Some(_), None) => Err(SystemError::NoReduction {
+                model: info.name,
+                why: "its info gives no reduced coordinate and end angle for the fast path",
+            }),
+            (Some(reduction), Some(layout), Some(end_angle)) => {
                 let mut fall = vec![0.0; layout.fall_degree.map_or(0, |d| d + 1)];
                 if !fall.is_empty() {
                     reduction.fall_polynomial(bound.k(), &mut fall);
@@ -64,6 +72,7 @@ impl<'m> System<'m> {
                     bound,
                     reduction,
                     layout,
+                    end_angle,
                     fall,
                 })
             }
@@ -102,6 +111,11 @@ impl<'m> System<'m> {
     /// Whether the motion starts from rest (`theta_dot_i == 0`).
     pub fn starts_at_rest(&self) -> bool {
         self.theta_dot_initial() == 0.0
+    }
+
+    /// The angle where the fall ends (rod on the floor).
+    pub fn end_angle(&self) -> f64 {
+        self.end_angle
     }
 
     /// `theta_i - end_angle`: the angle fallen when the rod reaches the floor.

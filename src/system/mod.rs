@@ -171,6 +171,27 @@ pub enum SystemError {
         /// How many coordinates it has.
         coordinates: usize,
     },
+    /// A model without a reduced coordinate asked for something measured in it (an angle, the
+    /// fast path).
+    #[error("model `{model}` has no reduced coordinate (its spec names none)")]
+    NoReducedCoordinate {
+        /// Model name.
+        model: &'static str,
+    },
+    /// A model without an end angle asked where its motion ends.
+    #[error(
+        "model `{model}` has no end angle (its spec names none): its motion ends at a given time"
+    )]
+    NoEndAngle {
+        /// Model name.
+        model: &'static str,
+    },
+    /// A model without a falling point asked for it.
+    #[error("model `{model}` has no falling point (its spec names none)")]
+    NoFallingPoint {
+        /// Model name.
+        model: &'static str,
+    },
     /// A state's coordinates and velocities of different lengths ([`State::new`]).
     #[error("a state needs as many velocities as coordinates: q has {q} values, qd {qd}")]
     StateShape {

@@ -26,13 +26,13 @@ pub struct Info {
     pub n_constants: usize,
     pub coordinates: Vec<String>,
     pub system_coordinates: Vec<String>,
-    pub reduced_index: usize,
+    pub reduced_index: Option<usize>,
     pub cyclic: Vec<usize>,
-    pub end_angle: f64,
+    pub end_angle: Option<f64>,
     pub contacts: Vec<Contact>,
     pub frictions: Vec<Friction>,
     pub points: Vec<Named>,
-    pub falling_point_index: usize,
+    pub falling_point_index: Option<usize>,
     pub gravity_index: usize,
     pub monitors: Vec<Monitor>,
     pub bodies: Vec<String>,
@@ -168,17 +168,18 @@ impl Info {
         if n == 0 {
             return Err("`coordinates` is empty".into());
         }
-        within("reduced_index", self.reduced_index, n)?;
+        if let Some(r) = self.reduced_index {
+            within("reduced_index", r, n)?;
+        }
         for &c in &self.cyclic {
             within("cyclic", c, n)?;
         }
         within("gravity_index", self.gravity_index, self.parameters.len())?;
-        if !self.points.is_empty() {
-            within(
-                "falling_point_index",
-                self.falling_point_index,
-                self.points.len(),
-            )?;
+        if let Some(p) = self.falling_point_index {
+            within("falling_point_index", p, self.points.len())?;
+        }
+        if self.end_angle.is_some() && self.reduced_index.is_none() {
+            return Err("`end_angle` is given without a `reduced_index` it is a value of".into());
         }
         for f in &self.frictions {
             within(

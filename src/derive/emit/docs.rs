@@ -2,7 +2,7 @@
 //! derivation, in the spec's symbols (an expression too long for a comment is left to the
 //! model's LaTeX write-up, `generated/<model>.tex`).
 
-use crate::derive::algebra::from_sc;
+use crate::derive::algebra::from_sc_over;
 use crate::derive::expr::Expr;
 use crate::derive::spec::Checked;
 use crate::derive::types::{Derivation, Reduction};
@@ -22,7 +22,7 @@ struct Printer<'a> {
 impl Printer<'_> {
     /// `name = e` in backticks as a list item, or a pointer to the LaTeX write-up when `e` is too long.
     fn eq(&self, name: &str, e: &Expr) -> String {
-        let text = from_sc(e, self.d.theta()).to_infix();
+        let text = from_sc_over(e, self.d.theta()).to_infix();
         match text.len() <= LONGEST {
             true => format!("- `{name} = {text}`"),
             false => format!(

@@ -55,8 +55,10 @@ pub(super) struct StaticInfo {
     n_params: usize,
     coordinates: Vec<String>,
     n_coordinates: usize,
-    reduced: usize,
+    /// `Some(i)` or `None`, as Rust.
+    reduced: String,
     cyclic: Vec<usize>,
+    /// `Some(angle)` or `None`, as Rust.
     end_angle: String,
     /// The system: the spec's name (its general model) and coordinates.
     system: String,
@@ -70,7 +72,8 @@ pub(super) struct StaticInfo {
     /// `FrictionInfo { .. }` literals.
     frictions_info: Vec<String>,
     points_info: Vec<Named>,
-    falling_point: usize,
+    /// `Some(i)` or `None`, as Rust.
+    falling_point: String,
     gravity: usize,
     monitors_info: Vec<Monitor>,
     /// The bodies' names, as Rust string literals.
@@ -166,9 +169,9 @@ pub(super) fn static_info(
         n_params: np,
         coordinates: d.coords.clone(),
         n_coordinates: d.coords.len(),
-        reduced: d.reduced,
+        reduced: option(d.reduced),
         cyclic: d.cyclic.clone(),
-        end_angle: angle_literal(spec.end_angle),
+        end_angle: option(spec.end_angle.map(angle_literal)),
         system: d.system.clone(),
         system_coordinates: d.full_coords.clone(),
         contacts_info,
@@ -181,7 +184,7 @@ pub(super) fn static_info(
                 meaning: lit(&p.meaning),
             })
             .collect(),
-        falling_point: point_index(&spec.falling_point)?,
+        falling_point: option(spec.falling_point.as_deref().map(point_index).transpose()?),
         gravity: (d.params.iter().position(|p| p.name == spec.gravity))
             .ok_or_else(|| StepError::Missing(format!("`{}` is not a parameter", spec.gravity)))?,
         monitors_info: (d.monitors.iter())
@@ -197,6 +200,11 @@ pub(super) fn static_info(
             Err(why) => lit(&one_line(&why.to_string())),
         },
     })
+}
+
+/// An optional value as Rust source.
+fn option<T: std::fmt::Display>(x: Option<T>) -> String {
+    x.map_or_else(|| "None".to_string(), |x| format!("Some({x})"))
 }
 
 /// An angle as Rust source: `std::f64::consts::FRAC_PI_2` and the like (with their sign) where

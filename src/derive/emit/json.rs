@@ -1,7 +1,7 @@
 //! The JSON writer: the machine-readable record of a model (`generated/<model>.json`).
 
 use super::common::{COMMAND, spec_path};
-use crate::derive::algebra::from_sc;
+use crate::derive::algebra::from_sc_over;
 use crate::derive::expr::Expr;
 use crate::derive::present;
 use crate::derive::spec::Checked;
@@ -10,8 +10,8 @@ use std::collections::BTreeMap;
 
 /// The machine-readable record (`generated/<model>.json`).
 pub fn json_record(checked: &Checked, d: &Derivation) -> serde_json::Value {
-    let theta = d.theta().to_string();
-    let infix = |e: &Expr| from_sc(e, &theta).to_infix();
+    let theta = d.theta();
+    let infix = |e: &Expr| from_sc_over(e, theta).to_infix();
     let mut expressions = BTreeMap::new();
     let (route, reason) = match &d.reduction {
         Ok(r) => {
@@ -19,7 +19,7 @@ pub fn json_record(checked: &Checked, d: &Derivation) -> serde_json::Value {
                 if k == "reduced_inertia" {
                     continue;
                 }
-                expressions.insert(k.to_string(), from_sc(v, &theta).to_infix());
+                expressions.insert(k.to_string(), from_sc_over(v, theta).to_infix());
             }
             let how = match (d.contacts.first(), r.separation()) {
                 (Some(c), Some(_)) if c.closed => {
@@ -89,7 +89,7 @@ pub fn json_record(checked: &Checked, d: &Derivation) -> serde_json::Value {
         "expressions": expressions,
     });
     if let Some(dim) = &d.dimensionless {
-        record["dimensionless"] = dimensionless_record(dim, &theta);
+        record["dimensionless"] = dimensionless_record(dim, theta);
     }
     if !d.frictions.is_empty() {
         record["frictions"] = d
@@ -113,7 +113,7 @@ pub fn json_record(checked: &Checked, d: &Derivation) -> serde_json::Value {
 
 /// The JSON record's `dimensionless` block: groups, scales, and each result's form, unit and
 /// (where the spec gives one) the paper's equation number.
-fn dimensionless_record(dim: &Dimensionless, theta: &str) -> serde_json::Value {
+fn dimensionless_record(dim: &Dimensionless, theta: Option<&str>) -> serde_json::Value {
     let groups: Vec<serde_json::Value> = (dim.groups.iter())
         .map(|g| {
             serde_json::json!({
@@ -128,7 +128,7 @@ fn dimensionless_record(dim: &Dimensionless, theta: &str) -> serde_json::Value {
     let mut units = serde_json::Map::new();
     let mut paper = serde_json::Map::new();
     for r in &dim.results {
-        let form = from_sc(&r.form, theta).to_infix();
+        let form = from_sc_over(&r.form, theta).to_infix();
         expressions.insert(r.key.clone(), form.into());
         let unit = match &r.unit {
             Some(u) => u.to_infix(),

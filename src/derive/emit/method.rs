@@ -9,8 +9,9 @@
 pub enum Preamble<'a> {
     /// `let k = &k[..n];`: one bounds check for all constant loads.
     Slice(usize),
-    /// `rc_s`, `rc_c`: the sine and cosine of the coordinate `q[i]`.
-    Angle(usize),
+    /// `rc_s`, `rc_c`: the sine and cosine of the coordinate `q[i]` (none without a reduced
+    /// coordinate, where no expression is written over them).
+    Angle(Option<usize>),
     /// `rc_s`, `rc_c`, `rc_ds`, `rc_dc` from the start's angle, sine and cosine slots and
     /// `delta` (`model::start_offsets`).
     Offsets([usize; 3]),
@@ -72,7 +73,8 @@ pub fn method(
         let line = match *p {
             Preamble::Slice(n) => uses("k")
                 .then(|| format!("let k = &k[..{n}]; // one bounds check for all constant loads")),
-            Preamble::Angle(i) => match (uses("rc_s"), uses("rc_c")) {
+            Preamble::Angle(None) => None,
+            Preamble::Angle(Some(i)) => match (uses("rc_s"), uses("rc_c")) {
                 (true, true) => Some(format!("let (rc_s, rc_c) = q[{i}].sin_cos();")),
                 (true, false) => Some(format!("let rc_s = q[{i}].sin();")),
                 (false, true) => Some(format!("let rc_c = q[{i}].cos();")),
@@ -133,7 +135,7 @@ mod tests {
     fn keeps_only_what_the_body_reads() {
         let (args, lines) = method(
             &[("k", "&[f64]"), ("q", "&[f64]"), ("qd", "&[f64]")],
-            &[Preamble::Slice(9), Preamble::Angle(1)],
+            &[Preamble::Slice(9), Preamble::Angle(Some(1))],
             vec!["let x = rc_c * k[3];".into(), "x".into()],
         );
         assert_eq!(args, "k: &[f64], q: &[f64], _qd: &[f64]");

@@ -38,7 +38,7 @@ mod tests {
 
     #[test]
     fn names_as_people_write_them_print_with_subscripts() {
-        let t = "theta";
+        let t = Some("theta");
         assert_eq!(latex_name("m1", t), "m_{\\mathrm{1}}");
         assert_eq!(latex_name("mA", t), "m_{\\mathrm{A}}");
         assert_eq!(latex_name("yB", t), "y_{\\mathrm{B}}");

@@ -167,7 +167,9 @@ pub(super) fn reduced_code(
     scope: &Scope,
     hoisted: &mut Hoisted,
 ) -> Result<ReducedCode, StepError> {
-    let theta = d.theta().to_string();
+    let theta = (d.theta())
+        .ok_or_else(|| StepError::Missing("the fast path's reduced coordinate".into()))?
+        .to_string();
     let idx = |s: &str| {
         scope
             .constants

@@ -112,7 +112,9 @@ fn context_without(
     restitutions.finish(&[("p", "&[f64]"), OUT], &from_p);
     general.finish(n_constants, d.reduced, &locals);
     if let Some(code) = reduction.as_mut() {
-        code.finish(n_constants, np, d.reduced, &locals);
+        let reduced = (d.reduced)
+            .ok_or_else(|| StepError::Missing("the fast path's reduced coordinate".into()))?;
+        code.finish(n_constants, np, reduced, &locals);
     }
     if let Some(code) = tangents.as_mut() {
         code.finish(n_constants, d.reduced, &locals);

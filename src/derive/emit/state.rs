@@ -5,7 +5,7 @@
 use super::code::{Code, K, Locals, OUT, Q, QD, coordinate_local, out_lines};
 use super::lower::{Hoisted, Scope, lower, unbound};
 use super::method::Preamble;
-use crate::derive::algebra::to_sc_expr;
+use crate::derive::algebra::to_sc_over;
 use crate::derive::expr::Expr;
 use crate::derive::types::{ContactRow, Derivation, StepError};
 use serde::Serialize;
@@ -48,7 +48,7 @@ impl FullStateCode {
 
     /// Each method's arguments and lines; `n` is the length of `k`, `reduced` the index of the
     /// reduced coordinate.
-    pub(super) fn finish(&mut self, n: usize, reduced: usize, locals: &Locals) {
+    pub(super) fn finish(&mut self, n: usize, reduced: Option<usize>, locals: &Locals) {
         let (slice, angle) = (Preamble::Slice(n), Preamble::Angle(reduced));
         let params = Preamble::Names(&locals.params, "k");
         let state = [slice, angle, params, Preamble::State(&locals.coords)];
@@ -111,7 +111,7 @@ pub(super) fn drawing_code(
     let mut exprs: Vec<Expr> = d
         .body_pose
         .iter()
-        .flat_map(|pose| pose.iter().map(|e| to_sc_expr(e, theta)))
+        .flat_map(|pose| pose.iter().map(|e| to_sc_over(e, theta)))
         .collect();
     let mut infos = Vec::new();
     let mut first = 0;
@@ -150,9 +150,9 @@ pub(super) fn full_state_code(
     scope: &Scope,
     hoisted: &mut Hoisted,
 ) -> Result<FullStateCode, StepError> {
-    let theta = d.theta().to_string();
+    let theta = d.theta();
     let full_scope = state_scope(d, scope);
-    let sc = |e: &Expr| to_sc_expr(e, &theta);
+    let sc = |e: &Expr| to_sc_over(e, theta);
     let single = |prefix: &str, exprs: &[Expr], scope: &Scope, hoisted: &mut Hoisted| {
         let mut code = Code::default();
         let out = code.push_body(lower(exprs, scope, Some(hoisted), prefix));
@@ -254,10 +254,10 @@ fn per_contact(
     scope: &Scope,
     hoisted: &mut Hoisted,
 ) -> Code {
-    let theta = d.theta().to_string();
+    let theta = d.theta();
     let picked: Vec<Option<Expr>> = d.contacts.iter().map(pick).collect();
     let exprs: Vec<Expr> = (picked.iter().flatten())
-        .map(|e| to_sc_expr(e, &theta))
+        .map(|e| to_sc_over(e, theta))
         .collect();
     let mut code = Code::default();
     let out = code.push_body(lower(&exprs, scope, Some(hoisted), prefix));
@@ -279,8 +279,8 @@ fn contact_code(
     full_scope: &Scope,
     hoisted: &mut Hoisted,
 ) -> Result<ContactCode, StepError> {
-    let theta = d.theta().to_string();
-    let sc = |e: &Expr| to_sc_expr(e, &theta);
+    let theta = d.theta();
+    let sc = |e: &Expr| to_sc_over(e, theta);
     let nc = d.coords.len();
     let single = |prefix: &str, exprs: &[Expr], hoisted: &mut Hoisted| {
         let mut code = Code::default();

@@ -6,7 +6,7 @@ use super::code::{Code, K, Locals, OUT, Q, QD};
 use super::lower::{Hoisted, Scope, lower, unbound};
 use super::method::Preamble;
 use super::state::state_scope;
-use crate::derive::algebra::to_sc_expr;
+use crate::derive::algebra::to_sc_over;
 use crate::derive::expr::Expr;
 use crate::derive::types::{Derivation, StepError, Tangents};
 use serde::Serialize;
@@ -26,7 +26,7 @@ impl TangentsCode {
 
     /// Each method's arguments and lines; `n` is the length of `k`, `reduced` the index of the
     /// reduced coordinate.
-    pub(super) fn finish(&mut self, n: usize, reduced: usize, locals: &Locals) {
+    pub(super) fn finish(&mut self, n: usize, reduced: Option<usize>, locals: &Locals) {
         let (slice, params) = (Preamble::Slice(n), Preamble::Names(&locals.params, "k"));
         let state = [
             slice,
@@ -61,7 +61,7 @@ pub(super) fn tangents_code(
     scope: &Scope,
     hoisted: &mut Hoisted,
 ) -> Result<TangentsCode, StepError> {
-    let theta = d.theta().to_string();
+    let theta = d.theta();
     let mut full_scope = state_scope(d, scope);
     for i in 0..d.contacts.len() {
         (full_scope.locals).insert(format!("rc_f{i}"), format!("forces[{i}]"));
@@ -69,7 +69,7 @@ pub(super) fn tangents_code(
     for j in 0..d.frictions.len() {
         (full_scope.locals).insert(format!("rc_fr{j}"), format!("fr[{j}]"));
     }
-    let rows: Vec<Expr> = t.rows.iter().map(|e| to_sc_expr(e, &theta)).collect();
+    let rows: Vec<Expr> = t.rows.iter().map(|e| to_sc_over(e, theta)).collect();
     for (exprs, scope, what) in [
         (&rows, &full_scope, "the tangents depend on"),
         (&t.initial, scope, "the initial tangents depend on"),

@@ -2,7 +2,7 @@
 //! fit the page, and spec text escaped for LaTeX.
 
 use super::common::{COMMAND, one_line, spec_path};
-use crate::derive::algebra::from_sc;
+use crate::derive::algebra::{from_sc, from_sc_over};
 use crate::derive::dimensionless::SEPARATION_SENSITIVITY;
 use crate::derive::expr::Expr;
 use crate::derive::present;
@@ -54,16 +54,20 @@ fn base_and_subscript(s: &str) -> (&str, Option<&str>) {
 
 /// LaTeX spelling of a symbol: `m1` -> `m_{1}`, `mA` -> `m_{A}`, `ell` -> `\ell`,
 /// `theta0` -> `\theta_{0}`, `dot_theta` -> `\dot{\theta}`, `dot_xA` -> `\dot{x}_{A}` (the dot
-/// over the letter, the subscript after it).
-pub fn latex_name(s: &str, theta: &str) -> String {
-    match s {
-        "rc_s" => return format!("\\sin {}", latex_name(theta, theta)),
-        "rc_c" => return format!("\\cos {}", latex_name(theta, theta)),
-        "rc_thi" => return format!("{}_{{\\mathrm{{i}}}}", latex_name(theta, theta)),
-        "rc_wi" => return format!("\\dot{{{}}}_{{\\mathrm{{i}}}}", latex_name(theta, theta)),
-        "rc_si" => return format!("\\sin {}_{{\\mathrm{{i}}}}", latex_name(theta, theta)),
-        "rc_ci" => return format!("\\cos {}_{{\\mathrm{{i}}}}", latex_name(theta, theta)),
-        _ => {}
+/// over the letter, the subscript after it). The reduced motion's symbols (`rc_s` for
+/// `sin(theta)`, ...) are spelled over the reduced coordinate `theta`, where there is one.
+pub fn latex_name(s: &str, theta: Option<&str>) -> String {
+    if let Some(theta) = theta {
+        let t = latex_name(theta, None);
+        match s {
+            "rc_s" => return format!("\\sin {t}"),
+            "rc_c" => return format!("\\cos {t}"),
+            "rc_thi" => return format!("{t}_{{\\mathrm{{i}}}}"),
+            "rc_wi" => return format!("\\dot{{{t}}}_{{\\mathrm{{i}}}}"),
+            "rc_si" => return format!("\\sin {t}_{{\\mathrm{{i}}}}"),
+            "rc_ci" => return format!("\\cos {t}_{{\\mathrm{{i}}}}"),
+            _ => {}
+        }
     }
     for (prefix, accent) in [("ddot_", "ddot"), ("dot_", "dot")] {
         if let Some(rest) = s.strip_prefix(prefix) {
@@ -205,16 +209,16 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> Result<TexContext, Step
     let steps = d.steps.as_ref().ok_or_else(|| {
         StepError::Missing("the steps were not presented before the LaTeX".into())
     })?;
-    let theta = d.theta().to_string();
+    let theta = d.theta();
     let name = |s: &str| match s
         .strip_prefix("rc_fr")
         .and_then(|j| j.parse::<usize>().ok())
         .and_then(|j| d.frictions.get(j))
     {
         Some(f) => format!("F_{{\\mathrm{{{}}}}}", tex_text(&f.named.name)),
-        None => latex_name(s, &theta),
+        None => latex_name(s, theta),
     };
-    let sc = |e: &Expr| from_sc(e, &theta);
+    let sc = |e: &Expr| from_sc_over(e, theta);
     let mut eqs = Vec::new();
     for (c, e, row) in d.contacts.iter().filter(|c| c.closed).filter_map(|c| {
         let e = c.eliminates.as_ref()?;
@@ -319,7 +323,7 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> Result<TexContext, Step
         }
     }
     let (dim_groups, dim_scales, dim_results) = match &d.dimensionless {
-        Some(dim) => tex_dimensionless(dim, &theta, &name),
+        Some(dim) => tex_dimensionless(dim, theta, &name),
         None => (Vec::new(), String::new(), Vec::new()),
     };
     Ok(TexContext {
@@ -351,8 +355,8 @@ const GRADIENT_HEAD: usize = 6;
 /// in the phase's coordinates and its bias, with what the runtime solves while a set of them is
 /// closed.
 fn constraint_equations(d: &Derivation, name: &dyn Fn(&str) -> String, eqs: &mut Vec<Equation>) {
-    let theta = d.theta().to_string();
-    let sc = |e: &Expr| from_sc(e, &theta);
+    let theta = d.theta();
+    let sc = |e: &Expr| from_sc_over(e, theta);
     let open: Vec<(&ContactRow, &Expr)> = (d.contacts.iter().zip(&d.restitutions))
         .filter(|(c, _)| !c.closed)
         .collect();
@@ -480,7 +484,7 @@ fn inline_unit(unit: &Expr, name: &dyn Fn(&str) -> String) -> String {
 /// numbered results (the paper's number beside each that the spec gives one for).
 fn tex_dimensionless(
     dim: &Dimensionless,
-    theta: &str,
+    theta: Option<&str>,
     name: &dyn Fn(&str) -> String,
 ) -> (Vec<TexParam>, String, Vec<Equation>) {
     let groups = (dim.groups.iter())
@@ -490,6 +494,16 @@ fn tex_dimensionless(
             unit: format!("solved for ${}$", name(&g.solves)),
         })
         .collect();
+    // The results are the fast path's, which keeps the reduced coordinate: a system without
+    // one has none to write.
+    let Some(theta) = theta else {
+        let scales = format!(
+            "Time is in units of $T = {}$ and forces in units of ${}$.",
+            dim.time.to_latex(name),
+            dim.force.to_latex(name),
+        );
+        return (groups, scales, Vec::new());
+    };
     let scales = format!(
         "Time is in units of $T = {}$ and forces in units of ${}$. Each result below is written \
          in the groups and ${}$ alone; its form was chosen by the derivation tool among \
@@ -573,8 +587,10 @@ fn reduced_equations(
             ))),
         }
     };
-    let theta = d.theta().to_string();
-    let sc = |e: &Expr| from_sc(e, &theta);
+    let theta = d
+        .theta()
+        .ok_or_else(|| StepError::Missing("the fast path's reduced coordinate".into()))?;
+    let sc = |e: &Expr| from_sc(e, theta);
     for ((j, &ci), momentum) in d.cyclic.iter().enumerate().zip(&steps.momenta) {
         let c = &d.coords[ci];
         let conserved = r

@@ -3,6 +3,7 @@
 
 use super::run::PhaseRun;
 use crate::results::{Halt, Zeno};
+use crate::solve::SolveError;
 use crate::solve::impact::{Impact, Part};
 use crate::solve::unreduced::End;
 
@@ -67,9 +68,10 @@ impl<'m> Motion<'m> {
         self.phases.last().map_or(0.0, PhaseRun::t_end)
     }
 
-    /// `theta_dot` at the end of the last phase (rad/s).
-    pub fn end_angular_velocity(&self) -> f64 {
-        self.phases.last().map_or(0.0, PhaseRun::theta_dot_end)
+    /// `theta_dot` at the end of the last phase (rad/s); an error without a reduced
+    /// coordinate.
+    pub fn end_angular_velocity(&self) -> Result<f64, SolveError> {
+        self.phases.last().map_or(Ok(0.0), PhaseRun::theta_dot_end)
     }
 
     /// Why the last phase ended.

@@ -96,19 +96,21 @@ impl<'m> PhaseRun<'m> {
 
     /// The reduced angle at the end of the phase (rad): `theta_i - delta_end` on the fast path
     /// (the reduced coordinate of [`ReducedRun::end_state`]), the end state's otherwise.
-    pub fn theta_end(&self) -> f64 {
-        match self {
+    /// A system without a reduced coordinate has none: `SystemError::NoReducedCoordinate`.
+    pub fn theta_end(&self) -> Result<f64, SolveError> {
+        Ok(match self {
             PhaseRun::Reduced(r) => r.system.theta_initial() - r.mesh.delta_end,
-            PhaseRun::Integrated(r) => r.run.state_end.q[r.bound.info().reduced_index],
-        }
+            PhaseRun::Integrated(r) => r.run.state_end.q[r.bound.reduced()?.0],
+        })
     }
 
-    /// `theta_dot` at the end of the phase (rad/s).
-    pub fn theta_dot_end(&self) -> f64 {
-        match self {
+    /// `theta_dot` at the end of the phase (rad/s); as [`PhaseRun::theta_end`] without a
+    /// reduced coordinate.
+    pub fn theta_dot_end(&self) -> Result<f64, SolveError> {
+        Ok(match self {
             PhaseRun::Reduced(r) => r.theta_dot_end(),
-            PhaseRun::Integrated(r) => r.run.state_end.qd[r.bound.info().reduced_index],
-        }
+            PhaseRun::Integrated(r) => r.run.state_end.qd[r.bound.reduced()?.0],
+        })
     }
 
     /// Work done by friction from release to the end of the phase (J, `<= 0`; zero without

@@ -142,7 +142,7 @@ impl<'m> Walker<'m> {
             return Ok(Next::Stop(None));
         };
         let end_state = last.full_end_state()?;
-        let end = derivatives(&sens, general.info().reduced_index, &end_state.qd);
+        let end = derivatives(&sens, general.reduced()?.0, &end_state.qd);
         let dt = end.as_ref().ok().map(|e| e.t.clone());
         ends.push(end);
         if motion.complete() {

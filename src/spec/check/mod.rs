@@ -251,16 +251,48 @@ impl Checker<'_> {
                 format!("`{}` is not a parameter", s.gravity),
             ));
         }
-        if !names.coords.contains(&s.reduced) {
-            return Err(self.err(
-                &Field::key("reduced"),
-                format!("`{}` is not a coordinate", s.reduced),
-            ));
+        if let Some(r) = &s.reduced
+            && !names.coords.contains(r)
+        {
+            return Err(self.err(&Field::key("reduced"), format!("`{r}` is not a coordinate")));
         }
-        if !names.points.contains(&s.falling_point) {
+        if let Some(p) = &s.falling_point
+            && !names.points.contains(p)
+        {
             return Err(self.err(
                 &Field::key("falling_point"),
-                format!("`{}` is not one of the points", s.falling_point),
+                format!("`{p}` is not one of the points"),
+            ));
+        }
+        self.check_ends()
+    }
+
+    /// The motion's end needs what it is measured by: `end_angle` is a value of the `reduced`
+    /// coordinate, and a landing there is told from a support holding the body up by the
+    /// `falling_point`'s height; a fast phase (a contact that `eliminates` a coordinate) keeps
+    /// the reduced coordinate and falls to the end angle.
+    fn check_ends(&self) -> Result<(), SpecError> {
+        let s = self.spec;
+        if s.end_angle.is_some() {
+            for (what, given) in [
+                ("reduced", s.reduced.is_some()),
+                ("falling_point", s.falling_point.is_some()),
+            ] {
+                if !given {
+                    return Err(self.err(
+                        &Field::key("end_angle"),
+                        format!("an `end_angle` needs `{what}` too"),
+                    ));
+                }
+            }
+        }
+        if let Some(i) = s.contacts.iter().position(|c| c.eliminates.is_some())
+            && (s.reduced.is_none() || s.end_angle.is_none())
+        {
+            return Err(self.err(
+                &Field::key("contacts").i(i).k("eliminates"),
+                "a contact that eliminates a coordinate gives a fast phase, which keeps the                  `reduced` coordinate and falls to the `end_angle`: give both"
+                    .into(),
             ));
         }
         Ok(())
@@ -346,7 +378,7 @@ impl Checker<'_> {
                 if !names.coords.contains(e) {
                     return Err(self.err(&f, format!("`{e}` is not a coordinate")));
                 }
-                if *e == s.reduced {
+                if s.reduced.as_ref() == Some(e) {
                     return Err(self.err(
                         &f,
                         format!(
