@@ -16,14 +16,10 @@ pub(super) struct Trial<'a> {
     pub(super) rtol: f64,
 }
 
-/// The earliest root among the crossed event functions (none crossed: `None`), as an offset
-/// from the step's start. Each root is first found on the step's continuous extension
-/// `dense`, then checked by one genuine step to it (the event's state is the integrator's
-/// own): where the event function's value there over its slope on the extension puts the
-/// genuine root within [`EXTENSION_SHARE`] of `rtol` of the event's time, the extension's root
-/// is the event's time. Else one more genuine step to the Newton step from it is checked the
-/// same way; where that too is not close enough, the root is closed in on with genuine
-/// re-steps to adjacent floats ([`genuine_root`]).
+/// The earliest root among the crossed event functions (none crossed: `None`), to adjacent
+/// floats of genuine re-steps from the step's start (each trial a step to `t + x`, not the
+/// interpolant: the event's state is the integrator's own). The step's continuous extension
+/// `dense` gives each root's first estimate ([`bracket`] then closes in on it with few trials).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn locate<P: OdeProblem>(
     problem: &mut P,
@@ -48,7 +44,6 @@ pub(super) fn locate<P: OdeProblem>(
             Ok(g[idx])
         };
         let estimate = illinois(&mut on_extension, (0.0, g0[idx]), (h, g1[idx]))?;
-        let slope = extension_slope(&mut on_extension, estimate, h)?;
         let mut genuine = |x: f64| -> Result<f64, SolveError> {
             st.step(problem, t, y, x)?;
             st.end_derivative(problem)?;
@@ -57,70 +52,21 @@ pub(super) fn locate<P: OdeProblem>(
             check_finite("event function", t + x, &g)?;
             Ok(g[idx])
         };
-        // One genuine step to the extension's root; where it is not close enough, one more to
-        // the Newton step from it along the extension's slope; else the bracketed search.
-        let close = |x: f64, at: f64| {
-            at == 0.0 || (at / slope).abs() <= EXTENSION_SHARE * rtol * (t + x).abs()
-        };
-        let (mut x, mut known, mut root) = (estimate, (estimate, f64::NAN), None);
-        for _ in 0..2 {
-            if !(x > 0.0 && x < h) {
-                break;
-            }
-            let at = genuine(x)?;
-            known = (x, at);
-            if close(x, at) {
-                root = Some(x);
-                break;
-            }
-            x -= at / slope;
-        }
-        let root = match root {
-            Some(x) => x,
-            None => genuine_root(&mut genuine, known, step, (g0[idx], g1[idx]))?,
-        };
+        // Close in on the genuine root: around the extension's at the local error's distance,
+        // then around the secant root of that bracket at a few ulps.
+        let local = rtol.max(f64::EPSILON) * h;
+        let (a, b) = bracket(&mut genuine, estimate, local, (0.0, g0[idx]), (h, g1[idx]))?;
+        let secant = (a.0 * b.1 - b.0 * a.1) / (b.1 - a.1);
+        let ulps = 4.0 * f64::EPSILON * secant.abs();
+        let (a, b) = bracket(&mut genuine, secant, ulps, a, b)?;
+        // To two ulps of the event's time `t + x`, the most it can hold.
+        let root = illinois_to(genuine, a, b, 2.0 * f64::EPSILON * (t + h).abs())?;
         if best.is_none_or(|(tb, ib)| root < tb || (root == tb && idx < ib)) {
             best = Some((root, idx));
         }
     }
     Ok(best)
 }
-
-/// The slope of `f` (an event function on a step's continuous extension, a polynomial in
-/// time) at `x` in `[0, h]`, by a central difference a millionth of the step wide, one-sided
-/// at an end.
-fn extension_slope<E>(mut f: impl FnMut(f64) -> Result<f64, E>, x: f64, h: f64) -> Result<f64, E> {
-    let d = 1e-6 * h;
-    let (a, b) = ((x - d).max(0.0), (x + d).min(h));
-    Ok((f(b)? - f(a)?) / (b - a))
-}
-
-/// The root `x` of `genuine` (the event function after a genuine step to `x` from the step's
-/// start) near the extension's `estimate` (with its value there, NaN where not evaluated),
-/// inside the step whose ends have the values `ends`, to two ulps of the event's time `t + x`:
-/// around the estimate at the local error's distance, then around the secant root of that
-/// bracket at a few ulps, then Illinois.
-fn genuine_root(
-    mut genuine: impl FnMut(f64) -> Result<f64, SolveError>,
-    (estimate, at): Point,
-    Trial { t, h, rtol, .. }: Trial,
-    (g0, g1): (f64, f64),
-) -> Result<f64, SolveError> {
-    let local = rtol.max(f64::EPSILON) * h;
-    let known = (!at.is_nan()).then_some(at);
-    let (a, b) = bracket(&mut genuine, (estimate, known), local, (0.0, g0), (h, g1))?;
-    let secant = (a.0 * b.1 - b.0 * a.1) / (b.1 - a.1);
-    let ulps = 4.0 * f64::EPSILON * secant.abs();
-    let (a, b) = bracket(&mut genuine, (secant, None), ulps, a, b)?;
-    // To two ulps of the event's time `t + x`, the most it can hold.
-    illinois_to(genuine, a, b, 2.0 * f64::EPSILON * (t + h).abs())
-}
-
-/// The share of the run's relative tolerance within which the genuine root must lie of the
-/// extension's (to first order) for the extension's to be the event's time: a hundredth, so that
-/// the event's time, and what follows from its state, stay well within the tolerance of the
-/// genuine root's.
-pub(super) const EXTENSION_SHARE: f64 = 0.01;
 
 /// A point and the function's value there.
 type Point = (f64, f64);
@@ -137,10 +83,10 @@ const BRACKET_LOOKS: usize = 16;
 /// sign, `f(b')` across zero from it or zero), found by looking at distances from the estimate
 /// growing from `delta` (at least an ulp of it), on the side where the root lies. `a < b`, and
 /// `fa` and `fb` differ in sign; an estimate outside `(a, b)` (or not a number) leaves the
-/// bracket as it is. `known`: `f(estimate)` where the caller has it.
+/// bracket as it is.
 pub(super) fn bracket<E>(
     mut f: impl FnMut(f64) -> Result<f64, E>,
-    (estimate, known): (f64, Option<f64>),
+    estimate: f64,
     delta: f64,
     (a, fa): Point,
     (b, fb): Point,
@@ -148,11 +94,7 @@ pub(super) fn bracket<E>(
     if !(estimate > a && estimate < b) {
         return Ok(((a, fa), (b, fb)));
     }
-    let fx = match known {
-        Some(v) => v,
-        None => f(estimate)?,
-    };
-    let (mut x, mut fx) = (estimate, fx);
+    let (mut x, mut fx) = (estimate, f(estimate)?);
     let below = changes_sign(fa, fx);
     let mut delta = delta
         .max(f64::EPSILON * estimate.abs())

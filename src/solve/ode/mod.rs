@@ -13,15 +13,10 @@
 //! control (exponent `1/order`), the starting step, the reuse of the derivative at the new
 //! point as the next step's first stage, and the event location.
 //!
-//! Events are located on the dense output and checked by re-stepping: once an event function
-//! changes sign over an accepted step `[t_n, t_n + h]`, its root `tau` is found by the Illinois
-//! method on the step's continuous extension, and one genuine step of the method from `y_n` to
-//! `tau` gives the event's state. Where the event function there, over its slope, puts the
-//! genuine root within a hundredth of `rtol` (relative) of the event's time, `tau` stands; else a
-//! Newton step along that slope gets one more genuine step, and where that too is not close
-//! enough the root of `g(step(y_n, tau))` is bracketed and refined on genuine steps to adjacent
-//! floats. The event's state is therefore always a genuine step's, as accurate as any step,
-//! and the final step is truncated to the event.
+//! Events are located by re-stepping: once an event function changes sign over an accepted step
+//! `[t_n, t_n + h]`, its root `tau` is found by the Illinois method on `g(step(y_n, tau))`, where
+//! each trial is a genuine step of the method from `y_n`, not the interpolant. The event time and
+//! state are therefore as accurate as any step, and the final step is truncated to the event.
 
 use crate::solve::SolveError;
 use crate::solve::roots::changes_sign;
@@ -106,10 +101,7 @@ pub struct OdeOptions {
 /// | 1e-12 | 854 / 308  | 536 / 335 | 356 / 242    |
 /// | 1e-13 | 1322 / 368 | 830 / 408 | 506 / 233    |
 ///
-/// (Counted before events were found on the dense output, 2026-11-28, which cut an event's
-/// genuine trial steps from 6–14 to 1–2: the `step_counts_of_both_methods` test prints the
-/// counts since, and still holds the crossover, DOPRI5 and DOP853 now tying on the pendulum
-/// at 1e-10.) At 1e-10 and above DOPRI5 was cheaper on two of the three; below it DOP853 is cheaper on the
+/// At 1e-10 and above DOPRI5 is cheaper on two of the three; below it DOP853 is cheaper on the
 /// oscillator and the pendulum at every tolerance measured, and on the rod and cube except at
 /// 5e-11 and 2e-11 (by 6 % and 4 %, within the spread of the event location's trial count),
 /// by 14 % to 54 % from 1e-11 down. DOP853 takes 1.4 to 12 times fewer accepted steps (more,

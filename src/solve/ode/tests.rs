@@ -326,13 +326,12 @@ fn step_counts_of_both_methods() {
                 continue;
             }
             // Where DOP853 is chosen it costs fewer evaluations on both problems; where
-            // DOPRI5 is, it costs no more on the pendulum (the oscillator favours DOP853
-            // from 1e-9 on; at 1e-10, with events found on the dense output, the two tie on
-            // the pendulum: 247 each).
+            // DOPRI5 is, it costs fewer on the pendulum (the oscillator favours DOP853
+            // from 1e-9 on).
             match Method::for_rtol(rtol) {
                 Method::Dop853 => assert!(evals[1] < evals[0], "{name} {rtol:e}: {evals:?}"),
                 Method::Dopri5 if pendulum => {
-                    assert!(evals[0] <= evals[1], "{name} {rtol:e}: {evals:?}")
+                    assert!(evals[0] < evals[1], "{name} {rtol:e}: {evals:?}")
                 }
                 Method::Dopri5 => {}
             }
@@ -626,61 +625,4 @@ fn riders_follow_the_steps_without_steering_them() {
             );
         }
     }
-}
-
-/// Events found on the continuous extension: across tolerances and both methods, the
-/// oscillator's event (`y' = -1/2` at `t = 2 pi / 3`) is within its share of the tolerance
-/// of the exact time (and of the genuine root, found by bracketing genuine steps), and costs
-/// at most two genuine trial steps where the extension is accurate, never the bracket's six
-/// or more.
-#[test]
-fn events_on_the_extension_agree_with_the_genuine_root_in_at_most_two_trials() {
-    let exact = 2.0 * std::f64::consts::PI / 3.0;
-    let mut cheap = 0;
-    for method in METHODS {
-        for rtol in [1e-8, 1e-10, 1e-12, 1e-13] {
-            let opts = options(rtol, Vec::new(), 10.0);
-            let sol = integrate(method, &mut Oscillator, 0.0, &[0.0, 1.0], &opts).unwrap();
-            let ev = sol.event.clone().unwrap();
-            // The genuine root: bisected on genuine steps from the crossing step's start.
-            let last = sol.steps.last().unwrap();
-            let mut st = Stages::new(method.tableau(), 2);
-            let mut genuine = |x: f64| {
-                Oscillator.rhs(last.t0, &last.y0, &mut st.k[0]).unwrap();
-                st.step(&mut Oscillator, last.t0, &last.y0, x).unwrap();
-                st.y1[1] + 0.5
-            };
-            let (mut a, mut b) = (0.0, 2.0 * last.h);
-            for _ in 0..200 {
-                let m = 0.5 * (a + b);
-                if genuine(m) > 0.0 { a = m } else { b = m }
-            }
-            let genuine_root = last.t0 + a;
-            let (to_exact, to_genuine) = ((ev.t - exact).abs(), (ev.t - genuine_root).abs());
-            assert!(
-                to_genuine <= 2.0 * events::EXTENSION_SHARE * rtol * exact,
-                "{method:?} {rtol:e}: {to_genuine:e}"
-            );
-            assert!(
-                to_exact <= 10.0 * rtol * exact,
-                "{method:?} {rtol:e}: {to_exact:e}"
-            );
-            // The event's state is a genuine step's: its event value is that of the step.
-            assert!(
-                (ev.y[1] + 0.5).abs() <= rtol,
-                "{method:?} {rtol:e}: {:e}",
-                ev.y[1] + 0.5
-            );
-            assert!(
-                sol.event_trials <= 8,
-                "{method:?} {rtol:e}: {}",
-                sol.event_trials
-            );
-            cheap += usize::from(sol.event_trials <= 2);
-        }
-    }
-    assert!(
-        cheap >= 6,
-        "only {cheap} of 8 events were found in two trials or fewer"
-    );
 }
