@@ -75,7 +75,9 @@ impl Plan<'_> {
             (ode.t_end - t_quad).abs()
         };
         let (dt_max, dy_max, nodes) =
-            path_deviation(first, ode, first.system.bound().reduced()?.0, work)?;
+            // The integrated state is the general model's: its reduced coordinate's index
+            // there (the fast phase's own model orders its coordinates otherwise).
+            path_deviation(first, ode, walker.general.reduced()?.0, work)?;
         let steps = ode.steps();
         let event = ended_at(ode, info);
         let meaning = Meaning::CrossCheckTime {

@@ -7,7 +7,8 @@
 //!
 //! Axes are named by the model's own parameters or by ratios of two of them
 //! ([`crate::axes`]: `a_over_ell`, and `n` for `m2_over_m1`); every other parameter is fixed
-//! (`--set`, default 1). The CSV's first line says how each parameter was set.
+//! (`--set`; no value is assumed: a parameter on no axis and not set is an error naming it). The
+//! CSV's first line says how each parameter was set.
 
 #[cfg(feature = "cli")]
 pub mod heatmap;

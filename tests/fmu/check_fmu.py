@@ -284,9 +284,11 @@ def tape(fmu, run, tapes, stop):
     # In value-reference order: the angle, its rate, the contacts' forces, the points.
     outputs = [v.name for v in md.modelVariables
                if v.causality == "output" and v.type == "Real"]
-    # The run's name of each output: the angle and its rate are theta and theta_dot in
-    # theta_series, a point's x and y are in its trajectory, a force has its own name.
-    pairs = {outputs[0]: "theta", outputs[1]: "theta_dot"}
+    # The run's name of each output: the angle and its rate are theta_series' first two columns
+    # after t (named by the model's reduced coordinate, `th` and `th_dot` for the sled), a
+    # point's x and y are in its trajectory, a force has its own name.
+    angle = [c["name"] for c in data["series"]["theta_series"]["columns"]][1:3]
+    pairs = {outputs[0]: angle[0], outputs[1]: angle[1]}
     worst = 0.0
     for name in outputs:
         ours = pairs.get(name, name)
