@@ -410,8 +410,8 @@ fn quadratic_roots(c: &[f64], lo: f64, hi: f64, out: &mut [f64; MAX_DEGREE]) -> 
 /// `[lo, hi]`. A sufficient test, cheap next to isolating roots: `false` says nothing, and the
 /// caller then looks for roots. `false` too past [`MAX_DEGREE`] or for a value that is not
 /// finite. Two stages: first Taylor's formula at `hi` with a bound of the curvature
-/// ([`positive_by_curvature`], `O(N)` flops), which decides every floor push of the per-point
-/// route; where it cannot, the Bernstein form ([`positive_by_bernstein`], `O(N^2)`).
+/// (`positive_by_curvature`, `O(N)` flops), which decides every floor push of the per-point
+/// route; where it cannot, the Bernstein form (`positive_by_bernstein`, `O(N^2)`).
 #[inline]
 pub fn positive_on<const N: usize>(coeffs: &[f64; N], lo: f64, hi: f64) -> bool {
     if N == 0 || N > MAX_DEGREE || lo.partial_cmp(&hi).is_none_or(|o| o.is_gt()) {
