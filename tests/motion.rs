@@ -364,7 +364,8 @@ fn the_svg_has_no_script_and_a_bounded_size() {
 #[test]
 fn every_shipped_scene_draws_its_rod_through_the_tip() {
     // The drawing comes from the spec through the derivation: in every phase of every shipped
-    // scene the rod's segment is as long as the rod and one of its ends is the `tip` point.
+    // scene the rod's segment is as long as the rod and one of its ends is the `tip` point
+    // (every scene with a rod: the rocking block has none).
     let mut scenes: Vec<PathBuf> = fs::read_dir(manifest().join("scenes"))
         .unwrap()
         .map(|e| e.unwrap().path())
@@ -374,7 +375,10 @@ fn every_shipped_scene_draws_its_rod_through_the_tip() {
     for path in scenes {
         let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
         let info = scene.info();
-        let tip = info.points.iter().position(|p| p.name == "tip").unwrap();
+        let Some(tip) = info.points.iter().position(|p| p.name == "tip") else {
+            assert_eq!(info.name, "rocking_block", "{}: no tip", path.display());
+            continue;
+        };
         let mut want = vec![Quantity::Trajectory(tip)];
         if Quantity::FloorImpact.available(info) {
             want.push(Quantity::FloorImpact);

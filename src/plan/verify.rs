@@ -75,7 +75,7 @@ impl Plan<'_> {
             (ode.t_end - t_quad).abs()
         };
         let (dt_max, dy_max, nodes) =
-            path_deviation(first, ode, first.system.bound().reduced()?.0, work)?;
+            path_deviation(first, ode, walker.general.reduced()?.0, work)?;
         let steps = ode.steps();
         let event = ended_at(ode, info);
         let meaning = Meaning::CrossCheckTime {

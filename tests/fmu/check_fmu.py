@@ -284,12 +284,12 @@ def tape(fmu, run, tapes, stop):
     # In value-reference order: the angle, its rate, the contacts' forces, the points.
     outputs = [v.name for v in md.modelVariables
                if v.causality == "output" and v.type == "Real"]
-    # The run's name of each output: the angle and its rate are theta and theta_dot in
-    # theta_series, a point's x and y are in its trajectory, a force has its own name.
-    pairs = {outputs[0]: "theta", outputs[1]: "theta_dot"}
+    # The run's name of each output: the angle and its rate are named by the coordinate in
+    # theta_series as in the FMU (`th`, `th_dot`), a point's x and y are in its trajectory, a
+    # force has its own name.
     worst = 0.0
     for name in outputs:
-        ours = pairs.get(name, name)
+        ours = name
         want = trajectory(data, ours) if "." in ours else series.get(ours)
         assert want is not None, f"the run has no series of {name}"
         err = np.max(np.abs(r[name] - want) / np.maximum(1.0, np.abs(want)))
