@@ -4,7 +4,8 @@
 //! the fixed set of 1,000 points of `examples/per_point.rs` on both compiled copies of the
 //! per-point route, and the paper's whole scene
 //! (`scenes/paper.yaml`, every quantity, 1000 samples per series) without writing files, and a
-//! run through ten impacts (`rod_cube_liftoff` bouncing at restitution 1/2), and the forward
+//! run through ten impacts (`rod_cube_liftoff` bouncing at restitution 1/2) beside ten strikes
+//! of the rocking block (impacts with friction at both corners), and the forward
 //! sensitivities of integrated runs against the same runs without them (`rod_cube_friction`'s
 //! scene to the landing, `rod_cube_spring` to the separation).
 //!
@@ -212,7 +213,8 @@ fn integrated(c: &mut Criterion) {
 /// Through impacts: the paper's rod and cube with every support a contact
 /// (`rod_cube_liftoff`, restitution 1/2) run to `until` = 0.5543 s at a tolerance of 1e-12:
 /// the rod lands at 0.18705 s and bounces ten times on its upper end before then (the issue's
-/// target is 1 ms for ten impacts). Each phase after the landing is integrated.
+/// target is 1 ms for ten impacts). Each phase after the landing is integrated. Beside it, ten
+/// strikes of the rocking block (impacts with friction at both corners, target 1 ms too).
 fn impacts(c: &mut Criterion) {
     let liftoff = rodcube::models::find("rod_cube_liftoff").expect("rod_cube_liftoff is generated");
     let mut p = PAPER.to_vec();
@@ -224,9 +226,31 @@ fn impacts(c: &mut Criterion) {
     let run = plan::run(&request).expect("the point solves");
     let count = run.impacts.as_ref().map_or(0, Vec::len);
     assert_eq!(count, 10, "the benchmark's run has ten impacts");
+    // Housner's rocking block of scenes/rocking.yaml (friction 0.7 at both corners, plastic
+    // strikes), to `until` = 2.18 s: its tenth strike is at 2.1577 s, the eleventh at 2.2055 s.
+    let rocking = rodcube::models::find("rocking_block").expect("rocking_block is generated");
+    let p = [
+        ("m", 1.0),
+        ("w", 0.4),
+        ("h", 1.0),
+        ("phi0", 0.2),
+        ("g", 9.81),
+        ("mu", 0.7),
+        ("e", 0.0),
+    ];
+    let strikes = Request::new(rocking, &p[..])
+        .with_want(&[Quantity::Impacts])
+        .with_tolerance(1e-12)
+        .with_until(Some(2.18));
+    let run = plan::run(&strikes).expect("the block rocks");
+    let count = run.impacts.as_ref().map_or(0, Vec::len);
+    assert_eq!(count, 10, "the benchmark's rocking has ten strikes");
     let mut g = c.benchmark_group("impacts");
     g.bench_function("rod_cube_liftoff_e0.5_ten_impacts", |b| {
         b.iter(|| plan::run(black_box(&request)).expect("the point solves"))
+    });
+    g.bench_function("rocking_block_ten_strikes", |b| {
+        b.iter(|| plan::run(black_box(&strikes)).expect("the block rocks"))
     });
     g.finish();
 }

@@ -513,6 +513,15 @@ fn run_in(dir: &std::path::Path, args: &[&str]) -> std::process::Output {
         .expect("rodcube runs")
 }
 
+/// `rodcube ARGS` in `dir`, which must be refused as an invalid scene or spec (exit status 3),
+/// and its stderr.
+fn refused(dir: &std::path::Path, args: &[&str]) -> String {
+    let run = run_in(dir, args);
+    let err = String::from_utf8_lossy(&run.stderr).into_owned();
+    assert_eq!(run.status.code(), Some(3), "rodcube {args:?}: {err}");
+    err
+}
+
 /// `rodcube ARGS` in `dir`, which must succeed, and its stdout read as JSON (results.json alone
 /// with `--json`).
 fn run_json(dir: &std::path::Path, args: &[&str]) -> serde_json::Value {
@@ -797,12 +806,10 @@ fn pi_is_a_constant_in_expressions() {
     // `pi` is no name to declare.
     let taken = spec.replace("{name: W, meaning", "{name: pi, meaning");
     std::fs::write(dir.join("taken.yaml"), taken).expect("spec");
-    let run = run_in(
+    let err = refused(
         &dir,
         &["run", "scene.yaml", "--spec", "taken.yaml", "--out", "o2"],
     );
-    assert_eq!(run.status.code(), Some(3));
-    let err = String::from_utf8_lossy(&run.stderr);
     assert!(err.contains("`pi` is the constant"), "{err}");
 }
 
@@ -962,12 +969,10 @@ fn a_spec_without_an_angle_an_end_or_a_falling_point_runs_to_its_scenes_until() 
     // `until`, with exit status 3 and nothing written.
     let endless = BALL_SCENE.replace("until: 1.2\n", "");
     std::fs::write(dir.join("endless.yaml"), endless).expect("scene");
-    let refused = run_in(
+    let stderr = refused(
         &dir,
         &["run", "endless.yaml", "--spec", "ball.yaml", "--out", "o3"],
     );
-    let stderr = String::from_utf8_lossy(&refused.stderr);
-    assert_eq!(refused.status.code(), Some(3), "{stderr}");
     assert!(stderr.contains("endless.yaml:1:"), "{stderr}");
     assert!(
         stderr.contains("error[structure]: until: ") && stderr.contains("no end angle"),
@@ -977,12 +982,10 @@ fn a_spec_without_an_angle_an_end_or_a_falling_point_runs_to_its_scenes_until() 
     // And what is measured in an angle the system does not have is refused by name.
     let angled = BALL_SCENE.replace("want: [impacts,", "want: [theta_series, impacts,");
     std::fs::write(dir.join("angled.yaml"), angled).expect("scene");
-    let refused = run_in(
+    let stderr = refused(
         &dir,
         &["run", "angled.yaml", "--spec", "ball.yaml", "--out", "o4"],
     );
-    let stderr = String::from_utf8_lossy(&refused.stderr);
-    assert_eq!(refused.status.code(), Some(3), "{stderr}");
     assert!(
         stderr.contains("want[0]") && stderr.contains("no reduced coordinate"),
         "{stderr}"

@@ -692,6 +692,9 @@ pub fn combinations(sys: &Bound, options: &Options, t: f64) -> Result<Vec<Active
             why: format!("more than {MAX_COMBINATIONS} combinations of contact states to try"),
         })?;
     let mut out: Vec<Active> = Vec::new();
+    // The canonical form of each set kept, made once (comparing against forms made again for
+    // every earlier set allocated quadratically in the count).
+    let mut seen: Vec<Active> = Vec::new();
     for mut index in 0..total {
         let mut pick = |l: usize| {
             let k = index % l;
@@ -715,7 +718,8 @@ pub fn combinations(sys: &Bound, options: &Options, t: f64) -> Result<Vec<Active
                 .collect(),
         };
         let c = canonical(&active);
-        if !out.iter().any(|o| canonical(o) == c) {
+        if !seen.contains(&c) {
+            seen.push(c);
             out.push(active);
         }
     }
