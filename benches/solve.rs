@@ -228,17 +228,9 @@ fn impacts(c: &mut Criterion) {
     assert_eq!(count, 10, "the benchmark's run has ten impacts");
     // Housner's rocking block of scenes/rocking.yaml (friction 0.7 at both corners, plastic
     // strikes), to `until` = 2.18 s: its tenth strike is at 2.1577 s, the eleventh at 2.2055 s.
-    let rocking = rodcube::models::find("rocking_block").expect("rocking_block is generated");
-    let p = [
-        ("m", 1.0),
-        ("w", 0.4),
-        ("h", 1.0),
-        ("phi0", 0.2),
-        ("g", 9.81),
-        ("mu", 0.7),
-        ("e", 0.0),
-    ];
-    let strikes = Request::new(rocking, &p[..])
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/rocking.yaml");
+    let rocking = Scene::load(Path::new(scene)).expect("the scene loads");
+    let strikes = Request::new(rocking.model, rocking.parameters)
         .with_want(&[Quantity::Impacts])
         .with_tolerance(1e-12)
         .with_until(Some(2.18));

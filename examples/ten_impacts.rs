@@ -16,19 +16,9 @@
 
 use rodcube::plan::{self, Request};
 use rodcube::quantity::Quantity;
+use rodcube::scene::Scene;
 use std::process::ExitCode;
 use std::time::Instant;
-
-/// The rocking block of `scenes/rocking.yaml`.
-const ROCKING: [(&str, f64); 7] = [
-    ("m", 1.0),
-    ("w", 0.4),
-    ("h", 1.0),
-    ("phi0", 0.2),
-    ("g", 9.81),
-    ("mu", 0.7),
-    ("e", 0.0),
-];
 
 /// The paper's rod and cube, and the restitution of both ends.
 const PARAMETERS: [(&str, f64); 6] = [
@@ -57,15 +47,25 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let (name, parameters, until): (&str, &[(&str, f64)], f64) = match rocking {
-        true => ("rocking_block", &ROCKING, 2.18),
-        false => ("rod_cube_liftoff", &PARAMETERS, 0.5543),
+    let request = if rocking {
+        // The rocking block of `scenes/rocking.yaml`, its parameters read from the scene.
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/rocking.yaml");
+        match Scene::load(std::path::Path::new(path)) {
+            Ok(scene) => Request::new(scene.model, scene.parameters),
+            Err(e) => {
+                eprintln!("{e}");
+                return ExitCode::FAILURE;
+            }
+        }
+    } else {
+        let Some(model) = rodcube::models::find("rod_cube_liftoff") else {
+            eprintln!("rod_cube_liftoff is not generated");
+            return ExitCode::FAILURE;
+        };
+        Request::new(model, &PARAMETERS[..])
     };
-    let Some(model) = rodcube::models::find(name) else {
-        eprintln!("{name} is not generated");
-        return ExitCode::FAILURE;
-    };
-    let request = Request::new(model, parameters)
+    let until = if rocking { 2.18 } else { 0.5543 };
+    let request = request
         .with_want(&[Quantity::Impacts])
         .with_tolerance(1e-12)
         .with_until(Some(until));

@@ -29,8 +29,9 @@ const W: f64 = 0.4;
 const H: f64 = 1.0;
 const PHI0: f64 = 0.2;
 
-fn bound(mu: f64, e: f64) -> Bound<'static> {
-    let p = [
+/// The block's parameters with friction `mu` and restitution `e`.
+fn parameters(mu: f64, e: f64) -> [(&'static str, f64); 7] {
+    [
         ("m", M),
         ("w", W),
         ("h", H),
@@ -38,8 +39,11 @@ fn bound(mu: f64, e: f64) -> Bound<'static> {
         ("g", G),
         ("mu", mu),
         ("e", e),
-    ];
-    Bound::new(find("rocking_block").unwrap(), &p).unwrap()
+    ]
+}
+
+fn bound(mu: f64, e: f64) -> Bound<'static> {
+    Bound::new(find("rocking_block").unwrap(), &parameters(mu, e)).unwrap()
 }
 
 fn walker(mu: f64, e: f64, until: f64) -> Walker<'static> {
@@ -179,22 +183,11 @@ fn friction_holds_at_the_pivot_and_at_the_strike() {
     // Along the rocking: the pivot's |F| / N, and at release Newton–Euler about the corner:
     // phi'' = -m g R sin(alpha - phi0) / I_O, the centre's acceleration phi'' z x r (r from the
     // pivot to the centre), F = m a_x, N = m (g + a_y).
-    let request = Request::new(
-        find("rocking_block").unwrap(),
-        &[
-            ("m", M),
-            ("w", W),
-            ("h", H),
-            ("phi0", PHI0),
-            ("g", G),
-            ("mu", mu),
-            ("e", 0.0),
-        ][..],
-    )
-    .with_want(&[Quantity::FrictionSeries(0), Quantity::FrictionSeries(1)])
-    .with_tolerance(1e-10)
-    .with_samples(400)
-    .with_until(Some(1.5));
+    let request = Request::new(find("rocking_block").unwrap(), &parameters(mu, 0.0)[..])
+        .with_want(&[Quantity::FrictionSeries(0), Quantity::FrictionSeries(1)])
+        .with_tolerance(1e-10)
+        .with_samples(400)
+        .with_until(Some(1.5));
     let run = plan::run(&request).unwrap();
     let (alpha, r, _) = geometry();
     let phi_dd = -M * G * r * (alpha - PHI0).sin() / (M * (W * W + H * H) / 3.0);
@@ -362,26 +355,15 @@ fn series_are_named_by_the_blocks_own_angle_phi() {
     // The block's reduced coordinate is `phi`: its series and the angle column beside each
     // force and friction carry that name, with the rate and acceleration named after it, and
     // the angle column holds the coordinate itself (the release tilt first).
-    let request = Request::new(
-        find("rocking_block").unwrap(),
-        &[
-            ("m", M),
-            ("w", W),
-            ("h", H),
-            ("phi0", PHI0),
-            ("g", G),
-            ("mu", 0.7),
-            ("e", 0.0),
-        ][..],
-    )
-    .with_want(&[
-        Quantity::ThetaSeries,
-        Quantity::ForceSeries(0),
-        Quantity::FrictionSeries(1),
-    ])
-    .with_tolerance(1e-10)
-    .with_samples(50)
-    .with_until(Some(0.5));
+    let request = Request::new(find("rocking_block").unwrap(), &parameters(0.7, 0.0)[..])
+        .with_want(&[
+            Quantity::ThetaSeries,
+            Quantity::ForceSeries(0),
+            Quantity::FrictionSeries(1),
+        ])
+        .with_tolerance(1e-10)
+        .with_samples(50)
+        .with_until(Some(0.5));
     let run = plan::run(&request).unwrap();
     let names = |key: &str| -> Vec<String> {
         (run.series[key].columns.iter())
