@@ -17,7 +17,7 @@ use proptest::prelude::*;
 use rodcube::models::{all, find};
 use rodcube::plan::{self, Request};
 use rodcube::quantity::Quantity;
-use rodcube::results::Work;
+use rodcube::results::{Halt, Work, Zeno};
 use rodcube::solve::SolveError;
 use rodcube::solve::impact::{ContactLaw, FrictionLaw, Part, Sign, resolve};
 use rodcube::solve::phases::{Motion, Route, Walker};
@@ -89,9 +89,21 @@ fn quarter(a: f64) -> f64 {
     Gauss::new(20).integrate(f, 0.0, 1.0, 8)
 }
 
+/// The amplitude `A` a swing that leaves upright at `omega` reaches:
+/// `cos(alpha - A) - cos(alpha) = 2 sin(alpha - A/2) sin(A/2) = omega^2 / k`, by fixed-point
+/// iteration on `A = 2 asin(omega^2 / (2 k sin(alpha - A/2)))` (no cancellation for small
+/// swings).
+fn amplitude(omega_sq: f64) -> f64 {
+    let (alpha, _, k) = geometry();
+    let mut a = omega_sq / (k * alpha.sin());
+    for _ in 0..60 {
+        a = 2.0 * (omega_sq / (2.0 * k * (alpha - 0.5 * a).sin())).asin();
+    }
+    a
+}
+
 /// The strike times by hand, plastic and sticking: `t_1 = T(phi0)`, then each half-swing
-/// `2 T(A_i)` with `A_i` the amplitude `omega_i = r^i omega_0` reaches:
-/// `cos(alpha - A) = cos(alpha) + omega^2 / k`.
+/// `2 T(A_i)` with `A_i` the amplitude `omega_i = r^i omega_0` reaches ([`amplitude`]).
 fn hand_strikes(count: usize) -> Vec<f64> {
     let (alpha, _, k) = geometry();
     let omega0_sq = k * ((alpha - PHI0).cos() - alpha.cos());
@@ -99,9 +111,8 @@ fn hand_strikes(count: usize) -> Vec<f64> {
     let mut omega_sq = omega0_sq;
     for _ in 1..count {
         omega_sq *= housner().powi(2);
-        let amplitude = alpha - (alpha.cos() + omega_sq / k).acos();
         let last = t[t.len() - 1];
-        t.push(last + 2.0 * quarter(amplitude));
+        t.push(last + 2.0 * quarter(amplitude(omega_sq)));
     }
     t
 }
@@ -160,6 +171,40 @@ fn every_strike_keeps_housners_ratio_at_the_energy_integrals_times() {
             "lost by hand",
         );
     }
+}
+
+#[test]
+fn the_block_comes_to_rest_where_its_strikes_accumulate() {
+    // The strikes shrink by Housner's ratio each; their times sum to a finite limit, where
+    // the block stands on both corners at rest. By hand: the energy integral's half-swings
+    // summed until they no longer change the sum (400 strikes, the last some 1e-40 s).
+    let hand = hand_strikes(400);
+    let limit = hand[hand.len() - 1];
+    let w = walker(1.0, 0.0, 4.0);
+    let motion = w.motion(&mut Work::default()).unwrap();
+    let Some(Halt::AtRest { t, .. }) = &motion.halted else {
+        panic!("not at rest: {:?}", motion.halted);
+    };
+    close(*t, limit, 1e-10, "the time the block comes to rest");
+    let (last, strikes) = motion.impacts.split_last().unwrap();
+    close(
+        last.zeno.unwrap(),
+        limit,
+        1e-10,
+        "the accumulation time listed",
+    );
+    assert!(strikes.iter().all(|s| s.zeno.is_none()));
+    assert!(strikes.len() > 20, "{} strikes resolved", strikes.len());
+    for (k, at) in motion.impacts.iter().enumerate() {
+        close(at.t, hand[k], 1e-10, &format!("strike {k}'s time"));
+    }
+    // Both corners held closed by the impact that closes the sequence, the block at rest.
+    assert_eq!(last.parts, [Part::Bilateral, Part::Bilateral]);
+    assert!(last.impact.after.qd().iter().all(|v| v.abs() < 1e-15));
+    let [Zeno::Unresolved { contacts, .. }] = motion.notes.as_slice() else {
+        panic!("{:?}", motion.notes);
+    };
+    assert_eq!(contacts.len(), 2, "both corners named: {contacts:?}");
 }
 
 #[test]

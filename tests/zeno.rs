@@ -133,9 +133,23 @@ fn the_bounces_accumulate_at_the_closed_form_and_every_impact_time_moves_as_it_s
             );
         }
     }
-    // The limit is extrapolated: its time has a note, not a number.
-    let key = format!("sensitivities.impact_{}_time", impacts.len());
-    assert!(res.notes.contains_key(&key), "{key}");
+    // The limit's derivatives: the closed form `t_1 (1 + e) / (1 - e)` differentiated, in `e`
+    // `2 t_1 / (1 - e)^2`, in `H` and `g` as `t_1`'s (`t / (2H)`, `-t / (2g)`).
+    let n = impacts.len();
+    let d = |p: &str| res.sensitivities[&format!("d(impact_{n}_time)/d({p})")].value;
+    for (p, want) in [
+        ("e", 2.0 * t1 / (1.0 - e).powi(2)),
+        ("H", zeno / (2.0 * h)),
+        ("g", -zeno / (2.0 * G)),
+        ("R", 0.0),
+        ("m", 0.0),
+    ] {
+        assert!(
+            (d(p) - want).abs() <= 1e-7 * zeno.max(want.abs()),
+            "the limit, d/d{p}: {} vs {want}",
+            d(p)
+        );
+    }
 }
 
 #[test]

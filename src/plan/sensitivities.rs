@@ -237,9 +237,18 @@ impl<'m> Plan<'m> {
             let key = format!("impact_{}_time", k + 1);
             let found = match self.sensitive() {
                 Err(gap) => Err(gap),
-                Ok(_) if ran.zeno => Err(SensitivityGap::PastZeno),
                 Ok(sensitive) => match impact_events(&sensitive.motion).get(k) {
-                    Some(at) if at.zeno => Err(SensitivityGap::PastZeno),
+                    Some(at) if at.zeno != ran.zeno => Err(SensitivityGap::RoutesDisagree),
+                    Some(at) if at.zeno => match sensitive.accumulation.get(&k) {
+                        Some(d)
+                            if at.closing == ran.closing
+                                && (at.t - ran.t).abs() <= agree * ran.t =>
+                        {
+                            Ok(d.clone())
+                        }
+                        Some(_) => Err(SensitivityGap::RoutesDisagree),
+                        None => Err(SensitivityGap::PastZeno),
+                    },
                     Some(at)
                         if at.closing != ran.closing || (at.t - ran.t).abs() > agree * ran.t =>
                     {
@@ -411,7 +420,6 @@ fn impact_events(motion: &Motion) -> Vec<ImpactEvent> {
 fn stop_gap(stop: &Option<Stop>) -> SensitivityGap {
     match stop {
         Some(Stop::Impact(_)) => SensitivityGap::PastImpact,
-        Some(Stop::Zeno) => SensitivityGap::PastZeno,
         Some(Stop::Grazing) => SensitivityGap::Grazing,
         Some(Stop::Failed(_)) => SensitivityGap::IntegrationFailed,
         None => SensitivityGap::RoutesDisagree,

@@ -300,32 +300,61 @@ fn until_words(until: &UntilNote) -> String {
 fn zeno_words(zeno: &Zeno) -> String {
     match zeno {
         Zeno::Limit {
-            contact,
+            contacts,
             bounces,
             ratio,
             t_limit,
             t,
         } => format!(
-            "contact `{contact}` bounced {bounces} times with intervals shrinking by a steady \
-             ratio {ratio:.4} (Zeno): the rest, summed as a geometric series, accumulate at \
-             t = {t_limit:.12} s, where the impact that closes the sequence is listed (the \
-             bounce at t = {t:.12} s made plastic); the contact is held closed from that bounce"
+            "{} {bounces} times with intervals shrinking by a steady ratio {ratio:.4} (Zeno): \
+             the rest, summed as a geometric series, accumulate at t = {t_limit:.12} s, where \
+             the impact that closes the sequence is listed (the impact at t = {t:.12} s made \
+             plastic); {} closed from that impact",
+            sequence_words(contacts),
+            closed_words(contacts),
         ),
         Zeno::Unresolved {
-            contact,
+            contacts,
             t,
             rise,
             open_gap,
             bounces,
             t_limit,
         } => format!(
-            "contact `{contact}` bounced {bounces} times, the last at t = {t:.12} s by \
-             {rise:.3e} of the length scale, below the {open_gap:e} at which a gap counts as \
-             open: the bounces from there (a converging Zeno sequence) are summed as a \
-             geometric series in its restitution, which accumulates at t = {t_limit:.12} s, \
-             where the impact that closes the sequence is listed (that bounce made plastic); \
-             the contact is held closed from that bounce"
+            "{} {bounces} times, the last at t = {t:.12} s lifting a contact by {rise:.3e} of \
+             the length scale, below the {open_gap:e} at which a gap counts as open: the \
+             impacts from there (a converging Zeno sequence) are summed as a geometric series \
+             in the impacts' gains, which accumulates at t = {t_limit:.12} s, where the impact \
+             that closes the sequence is listed (that impact made plastic); {} closed from \
+             that impact",
+            sequence_words(contacts),
+            closed_words(contacts),
         ),
+    }
+}
+
+/// Who made a converging sequence: one contact bouncing, or contacts striking in turn.
+fn sequence_words(contacts: &[String]) -> String {
+    match contacts {
+        [one] => format!("contact `{one}` bounced"),
+        _ => format!("contacts {} struck in turn", names_words(contacts)),
+    }
+}
+
+/// What the impact closing a sequence holds closed.
+fn closed_words(contacts: &[String]) -> String {
+    match contacts {
+        [one] => format!("`{one}` is held"),
+        _ => format!("{} are held", names_words(contacts)),
+    }
+}
+
+/// `a`, `b` and `c`.
+fn names_words(names: &[String]) -> String {
+    let quoted: Vec<String> = names.iter().map(|n| format!("`{n}`")).collect();
+    match quoted.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+        _ => quoted.join(""),
     }
 }
 
@@ -441,8 +470,9 @@ pub fn sensitivity_gap(gap: SensitivityGap) -> &'static str {
              restitution given by an expression of the parameters, or redundant contacts)"
         }
         SensitivityGap::PastZeno => {
-            "no sensitivity: the result is, or comes after, the limit of a converging (Zeno) \
-             sequence of bounces, whose accumulation time is extrapolated, not differentiated"
+            "no sensitivity: the result is the limit of a converging (Zeno) sequence of \
+             bounces, and the sequence's last times do not give its derivatives (fewer than \
+             four impacts resolved, or a geometric series through them does not fit it)"
         }
         SensitivityGap::Grazing => {
             "no sensitivity: an event on the way is grazing (its function's rate is zero \

@@ -37,11 +37,11 @@ pub enum Zeno {
     /// The intervals between bounces shrank by a steady ratio, and their limit was within the
     /// run's tolerance of a bounce.
     Limit {
-        /// The contact that bounced.
-        contact: String,
-        /// How many times it bounced.
+        /// The contacts that closed in it: one that bounced, or two that struck in turn.
+        contacts: Vec<String>,
+        /// How many impacts of the sequence were resolved one by one.
         bounces: usize,
-        /// The ratio of successive intervals.
+        /// The mean ratio of successive intervals.
         ratio: f64,
         /// The limit of the bounces' times (s from release).
         t_limit: f64,
@@ -49,11 +49,12 @@ pub enum Zeno {
         t: f64,
     },
     /// A bounce too small to open the gap: the rest of the sequence summed as a geometric
-    /// series (each flight `e` times the one before) and taken as one plastic impact at its
-    /// limit.
+    /// series (each period's flights the impacts' gains times the one's before) and taken as
+    /// one plastic impact at its limit.
     Unresolved {
-        /// The contact that would bounce.
-        contact: String,
+        /// The contacts of the sequence: the one that would bounce, or the two that strike in
+        /// turn (the one that would lift first).
+        contacts: Vec<String>,
         /// When (s from release).
         t: f64,
         /// How far it would rise, relative to the length scale.
@@ -259,8 +260,9 @@ pub enum SensitivityGap {
     /// The result comes after an impact whose map has no derivatives (a restitution given by
     /// an expression of the parameters, or redundant contacts taking part).
     PastImpact,
-    /// The result is, or comes after, the limit of a converging (Zeno) sequence of bounces,
-    /// whose accumulation time is extrapolated, not differentiated.
+    /// The result is the limit of a converging (Zeno) sequence of bounces whose last times
+    /// do not give its accumulation time's derivatives (fewer than four impacts resolved, or
+    /// a geometric series through them that does not fit the accumulation time).
     PastZeno,
     /// An event on the way to the result is grazing (its function's rate is zero there), where
     /// the time does not move smoothly with the parameters.

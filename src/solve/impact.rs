@@ -231,6 +231,75 @@ pub fn resolve_with(
     problem.impact(sys, state, chosen, t, &taking)
 }
 
+/// The impact that closes a converging sequence of impacts of two contacts or more (a block
+/// rocking to rest on two corners), its contacts `parts` [`Part::Bilateral`]: each held closed
+/// plastically (its normal velocity after zero), each friction under the law `frictions` it
+/// obeyed in the sequence's last impact (stuck, or sliding its way), and no impulse at a
+/// friction that did not act there. Its impulses stand for the sequence's impacts still to
+/// come, summed (a normal one may be of either sign); those impacts change the velocities by
+/// less than the run resolves, and friction acts again in the motion after, as the run decides
+/// it. A contact left to decide ([`Part::Unilateral`]) is refused: only the sequence's
+/// contacts take part.
+pub fn close_sequence(
+    sys: &Bound,
+    state: &State,
+    parts: &[Part],
+    frictions: &[FrictionLaw],
+    t: f64,
+) -> Result<Impact, SolveError> {
+    let plastic = vec![0.0; parts.len()];
+    let mut problem = Problem::at(sys, state, parts, &plastic)?;
+    let info = problem.info;
+    let taking: Vec<usize> = (0..parts.len())
+        .filter(|&i| parts[i] != Part::None)
+        .collect();
+    let indeterminate = |why: &str| SolveError::Indeterminate {
+        model: info.name,
+        t,
+        contacts: names(info, &taking),
+        why: why.into(),
+    };
+    if parts.contains(&Part::Unilateral) {
+        return Err(indeterminate(
+            "a converging sequence of impacts ends while a contact outside it takes part",
+        ));
+    }
+    let law = |j: usize| frictions.get(j).copied().unwrap_or(FrictionLaw::Out);
+    // A friction that did not act takes no impulse: it `slides` under a coefficient of zero.
+    let modes = (0..problem.mu.len())
+        .map(|j| match law(j) {
+            FrictionLaw::Stick => Mode::Stick,
+            FrictionLaw::Slide(sign) => Mode::Slide(sign.value()),
+            FrictionLaw::Out => Mode::Slide(1.0),
+        })
+        .collect();
+    for (j, mu) in problem.mu.iter_mut().enumerate() {
+        if law(j) == FrictionLaw::Out {
+            *mu = 0.0;
+        }
+    }
+    let active = Active {
+        closed: parts.iter().map(|p| *p == Part::Bilateral).collect(),
+        modes,
+    };
+    let mut solution = (problem.solve(active)).ok_or_else(|| {
+        indeterminate("the contacts of a converging sequence cannot all be held closed at once")
+    })?;
+    // Held closed with no way left to move, the system is at rest but for the rounding of the
+    // solve: at rest exactly (so that the contacts decided after see no motion).
+    let before = problem.qd.iter().fold(problem.speed, |a, v| a.max(v.abs()));
+    if (solution.qd.iter()).all(|v| v.abs() <= IMPACT_TOLERANCE * before) {
+        solution.qd.fill(0.0);
+    }
+    let mut impact = problem.impact(sys, state, solution, t, &taking)?;
+    for (j, out) in impact.friction_laws.iter_mut().enumerate() {
+        if law(j) == FrictionLaw::Out {
+            *out = FrictionLaw::Out;
+        }
+    }
+    Ok(impact)
+}
+
 /// The contacts `idx` by name, comma-separated.
 fn names(info: &ModelInfo, idx: &[usize]) -> String {
     (idx.iter().filter_map(|&i| info.contacts.get(i)))

@@ -15,8 +15,9 @@
 //!
 //! `reduced.rs` holds a phase on the fast path ([`ReducedRun`], [`phase_end`]); `run.rs` a
 //! phase on either route ([`PhaseRun`]); `motion.rs` the [`Motion`] with its [`ImpactAt`]s;
-//! `walker.rs` the [`Walker`] that solves it; `sensitive.rs` the motion with the forward
-//! sensitivities of its phases' ends ([`SensitiveMotion`]).
+//! `walker.rs` the [`Walker`] that solves it; `zeno.rs` converging sequences of impacts and
+//! their accumulation time; `sensitive.rs` the motion with the forward sensitivities of its
+//! phases' ends ([`SensitiveMotion`]).
 //!
 //! [`contacts::decide`]: crate::solve::contacts::decide
 //! [`impact::resolve`]: crate::solve::impact::resolve
@@ -26,6 +27,7 @@ mod reduced;
 mod run;
 mod sensitive;
 mod walker;
+mod zeno;
 
 pub use motion::{ImpactAt, Motion};
 pub use reduced::{GAP_CELLS, ReducedEnd, ReducedRun, phase_end};
@@ -33,7 +35,8 @@ pub use run::{IntegratedRun, PhaseRun};
 pub use sensitive::{EndDerivatives, SensitiveMotion, Stop};
 pub use walker::{
     LANDING_TOLERANCE, MAX_FALL_TIMES, MAX_IMPACTS, MAX_PHASES, PhaseStart, Route, Walker,
-    ZENO_RATIO_SPREAD, ZENO_RATIOS, fall_time_scale, phase_parameters,
+    fall_time_scale, phase_parameters,
 };
+pub use zeno::{ZENO_AGREE, ZENO_RATIO_SPREAD, ZENO_RATIOS};
 
 pub use crate::solve::unreduced::End;

@@ -2,10 +2,14 @@
 //! every phase integrated with `S = dy/dp` riding along ([`forward`]), `S` carried across each
 //! phase boundary by the jump of the accelerations there and across each impact by its
 //! saltation matrix ([`saltation`]), and each end's time, angle and rate differentiated in every
-//! parameter. The accumulation time of a converging (Zeno) sequence is extrapolated, not
-//! differentiated: the motion with sensitivities stops there.
+//! parameter. The accumulation time of a converging (Zeno) sequence is differentiated through
+//! the geometric series over its last four impacts' times ([`zeno::extrapolate_derivatives`]),
+//! and the motion goes on through the impact that closes it as through any other.
 
+use super::zeno::{self, ZENO_AGREE};
 use super::{MAX_PHASES, Motion, PhaseStart, Route, Walker};
+use std::collections::BTreeMap;
+
 use crate::results::Work;
 use crate::solve::SolveError;
 use crate::solve::contacts;
@@ -37,6 +41,11 @@ pub struct SensitiveMotion<'m> {
     pub ends: Vec<Result<EndDerivatives, Grazing>>,
     /// Why the motion stopped before its end, if it did: the phases after are not solved.
     pub stop: Option<Stop>,
+    /// Per impact of [`SensitiveMotion::motion`] that closes a converging (Zeno) sequence (its
+    /// index in `motion.impacts`): `d t_limit/dp` of its accumulation time, where the
+    /// sequence's last four times give it (a geometric series through them agrees with the
+    /// accumulation time to [`ZENO_AGREE`] of the time left).
+    pub accumulation: BTreeMap<usize, Vec<f64>>,
 }
 
 /// Why the motion with sensitivities stopped before its end.
@@ -44,9 +53,6 @@ pub struct SensitiveMotion<'m> {
 pub enum Stop {
     /// At an impact whose map has no derivatives (why: the gap).
     Impact(SaltationGap),
-    /// At the impact that closes a converging (Zeno) sequence of bounces (its accumulation
-    /// time is extrapolated, not differentiated).
-    Zeno,
     /// At a grazing event, past which `S` is not defined.
     Grazing,
     /// A later phase failed (the first phase's error is the motion's).
@@ -93,8 +99,8 @@ impl<'m> Walker<'m> {
     /// [`Model::tangents`](crate::model::Model::tangents) is
     /// [`SystemError::NoTangents`](crate::system::SystemError::NoTangents), as is any error
     /// of the first phase). It goes on through impacts as the run does, and stops early
-    /// ([`SensitiveMotion::stop`]) at an impact whose map has no derivatives, at the limit of a
-    /// converging (Zeno) sequence, at a grazing event, or where a later phase fails.
+    /// ([`SensitiveMotion::stop`]) at an impact whose map has no derivatives, at a grazing
+    /// event, or where a later phase fails.
     pub fn sensitive_motion(&self, work: &mut Work) -> Result<SensitiveMotion<'m>, SolveError> {
         let walker = Walker {
             route: Route::Integrated,
@@ -106,9 +112,10 @@ impl<'m> Walker<'m> {
         let mut s = Forward::new(general)?.initial(general)?;
         let (run, mut sens) = walker.integrate_sensitive(&start, s, work)?;
         let mut ends = Vec::new();
+        let mut accumulation = BTreeMap::new();
         let mut motion = Motion::starting(run, opened, walker.until.is_some());
         loop {
-            let next = walker.next_sensitive(&mut motion, &mut ends, sens);
+            let next = walker.next_sensitive(&mut motion, &mut ends, &mut accumulation, sens);
             let stop = match next {
                 Ok(Next::Go(next, s_next)) => {
                     (start, s) = (next, s_next);
@@ -124,7 +131,12 @@ impl<'m> Walker<'m> {
                 Ok(Next::Stop(stop)) => stop,
                 Err(e) => Some(Stop::Failed(e)),
             };
-            return Ok(SensitiveMotion { motion, ends, stop });
+            return Ok(SensitiveMotion {
+                motion,
+                ends,
+                stop,
+                accumulation,
+            });
         }
     }
 
@@ -135,6 +147,7 @@ impl<'m> Walker<'m> {
         &self,
         motion: &mut Motion<'m>,
         ends: &mut Vec<Result<EndDerivatives, Grazing>>,
+        accumulation: &mut BTreeMap<usize, Vec<f64>>,
         sens: EndSensitivity,
     ) -> Result<Next, SolveError> {
         let general = &self.general;
@@ -156,7 +169,7 @@ impl<'m> Walker<'m> {
             return Err(SolveError::TooManyPhases { limit: MAX_PHASES });
         }
         if let Some(End::Contact(i)) = motion.last_end() {
-            return self.sensitive_impact(motion, i, (end_state, sens, dt));
+            return self.sensitive_impact(motion, i, (end_state, sens, dt), ends, accumulation);
         }
         let next = match self.after(last) {
             Ok(next) => next,
@@ -166,7 +179,7 @@ impl<'m> Walker<'m> {
                 let Some(j) = info.contacts.iter().position(|c| c.name == contact) else {
                     return Err(e);
                 };
-                return self.sensitive_impact(motion, j, (end_state, sens, dt));
+                return self.sensitive_impact(motion, j, (end_state, sens, dt), ends, accumulation);
             }
             Err(e) => return Err(e),
         };
@@ -179,25 +192,30 @@ impl<'m> Walker<'m> {
 
     /// The impact where contact `closing` closes at the end of `motion`'s last phase (its
     /// state there, its sensitivities and `dt/dp` of its end in `before`), resolved as the run
-    /// resolves it and added to `motion`, and `S` carried across it by its saltation matrix.
+    /// resolves it and added to `motion`, and `S` carried across it by its saltation matrix;
+    /// where it closes a converging sequence, its accumulation time's derivatives into
+    /// `accumulation` (from the derivatives of the ends so far, `ends`).
     fn sensitive_impact(
         &self,
         motion: &mut Motion<'m>,
         closing: usize,
         before: (crate::system::State, EndSensitivity, Vec<f64>),
+        ends: &[Result<EndDerivatives, Grazing>],
+        accumulation: &mut BTreeMap<usize, Vec<f64>>,
     ) -> Result<Next, SolveError> {
         let (state, sens, dt) = before;
         let friction_work = motion.phases.last().map_or(0.0, |p| p.friction_work());
-        let Some(start) = self.through_impact(motion, closing, friction_work)? else {
+        let through = self.through_impact(motion, closing, friction_work)?;
+        let Some((k, at)) = motion.impacts.iter().enumerate().next_back() else {
+            return Ok(Next::Stop(None));
+        };
+        if let Some(d) = accumulation_derivatives(&motion.impacts, ends, &dt, self.tol) {
+            accumulation.insert(k, d);
+        }
+        let Some(start) = through else {
             // Halted: too many impacts, or at rest after it.
             return Ok(Next::Stop(None));
         };
-        let Some(at) = motion.impacts.last() else {
-            return Ok(Next::Stop(None));
-        };
-        if at.zeno.is_some() {
-            return Ok(Next::Stop(Some(Stop::Zeno)));
-        }
         let after = contacts::dynamics(&self.general, &start.state, &start.active, start.t)?;
         let laws = saltation::laws(&at.impact);
         let crossing = Crossing {
@@ -214,4 +232,32 @@ impl<'m> Walker<'m> {
             Err(gap) => Next::Stop(Some(Stop::Impact(gap))),
         })
     }
+}
+
+/// `d t_limit/dp` of the accumulation time of the converging sequence that the last of
+/// `impacts` closes (`dt` the derivatives of its own time, `ends` those of every phase's end
+/// before it): the geometric series through the sequence's last four times
+/// ([`zeno::extrapolate_derivatives`]), where that series agrees with the accumulation time
+/// listed to [`ZENO_AGREE`] of the time left (or to `tol` of the time); `None` for an impact
+/// that closes no sequence, one with fewer than four times, or one the series does not fit.
+fn accumulation_derivatives(
+    impacts: &[super::ImpactAt],
+    ends: &[Result<EndDerivatives, Grazing>],
+    dt: &[f64],
+    tol: f64,
+) -> Option<Vec<f64>> {
+    let (last, before) = impacts.split_last()?;
+    let t_limit = last.zeno?;
+    let sequence = zeno::sequence(before, last.closing, last.t);
+    let (series, _) = zeno::extrapolate(&sequence.times)?;
+    let left = t_limit - last.t;
+    if (series - t_limit).abs() > (ZENO_AGREE * left).max(tol * t_limit) {
+        return None;
+    }
+    let [a, b, c] = *sequence.listed.last_chunk::<3>()?;
+    let of = |i: usize| -> Option<&[f64]> {
+        let end = ends.get(before[i].phase)?.as_ref().ok()?;
+        Some(end.t.as_slice())
+    };
+    zeno::extrapolate_derivatives(&sequence.times, [of(a)?, of(b)?, of(c)?, dt])
 }

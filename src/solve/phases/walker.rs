@@ -7,6 +7,7 @@
 use super::motion::{ImpactAt, Motion};
 use super::reduced::{ReducedEnd, ReducedRun, phase_end};
 use super::run::{IntegratedRun, PhaseRun};
+use super::zeno::{self, Flight};
 use crate::model::{Model, ModelInfo};
 use crate::results::{Halt, Work, Zeno};
 use crate::solve::SolveError;
@@ -28,16 +29,6 @@ pub const MAX_PHASES: usize = 16;
 /// Most impacts in one run. A run that reaches it stops there with a note (a bouncing sequence
 /// that neither converges as Zeno's nor comes to rest).
 pub const MAX_IMPACTS: usize = 1000;
-
-/// Bounces at one contact whose intervals shrink by a steady ratio (the last
-/// [`ZENO_RATIOS`] ratios below one and within this fraction of each other) converge: once the
-/// time left to their limit, `dt r / (1 - r)`, is within the run's tolerance of the time from
-/// release, the rest of them is summed as a geometric series: one plastic impact, listed at
-/// their limit.
-pub const ZENO_RATIO_SPREAD: f64 = 0.1;
-
-/// How many successive interval ratios must agree before bounces count as converging.
-pub const ZENO_RATIOS: usize = 3;
 
 /// An integrated phase that has not reached an event after this many free-fall times of its
 /// falling point is reported as [`SolveError::NoEvent`]. Generous: a light rod that pushes a
@@ -493,8 +484,10 @@ impl<'m> Walker<'m> {
 
     /// The impact that ends the motion's last phase, where contact `closing` closed: every
     /// contact closed then, `closing` and any other open one that touches while approaching take
-    /// part, with their frictions (`impact::resolve_with`). Bounces
-    /// converging as Zeno's (`zeno_limit`) are closed by a plastic impact, with a note.
+    /// part, with their frictions (`impact::resolve_with`). A sequence converging as Zeno's
+    /// (its times, [`zeno::limit`], or a flight too small to resolve,
+    /// [`Walker::unresolved_bounce`]) is closed by an impact that holds its contacts closed,
+    /// listed at the sequence's accumulation time, with a note.
     pub fn impact(&self, motion: &mut Motion<'m>, closing: usize) -> Result<ImpactAt, SolveError> {
         let general = &self.general;
         let info = general.info();
@@ -512,37 +505,46 @@ impl<'m> Walker<'m> {
                 }
             })
             .collect();
-        let name = info.contacts[closing].name;
-        let mut restitution = general.restitutions().to_vec();
-        let limit = zeno_limit(&motion.impacts, closing, t, self.tol);
-        if limit.is_some() {
-            restitution[closing] = 0.0;
-        }
-        let mut impact = impact::resolve_with(general, &state, &parts, &restitution, t)?;
-        let mut accumulation = None;
-        if let Some((ratio, t_limit, bounces)) = limit {
-            accumulation = Some(t_limit);
+        let names = |of: &[usize]| -> Vec<String> {
+            (of.iter())
+                .map(|&c| info.contacts[c].name.to_string())
+                .collect()
+        };
+        let mut impact = impact::resolve(general, &state, &parts, t)?;
+        let mut parts = parts;
+        let mut zeno = None;
+        if let Some(limit) = zeno::limit(&motion.impacts, closing, t, self.tol) {
+            impact = close(general, &state, &mut parts, &limit.contacts, &impact, t)?;
+            zeno = Some(limit.t_limit);
             motion.notes.push(Zeno::Limit {
-                contact: name.to_string(),
-                bounces,
-                ratio,
-                t_limit,
+                contacts: names(&limit.contacts),
+                bounces: limit.bounces,
+                ratio: limit.ratio,
+                t_limit: limit.t_limit,
                 t,
             });
-        } else if let Some((rise, flight)) = self.unresolved_bounce(&impact, &parts, closing, t)? {
-            // The bounces left, each `e` times the one before (the pull back constant over
-            // them, as under gravity): their flights sum to `flight / (1 - e)`.
-            let left = flight / (1.0 - restitution[closing]).max(f64::EPSILON);
-            restitution[closing] = 0.0;
-            impact = impact::resolve_with(general, &state, &parts, &restitution, t)?;
-            accumulation = Some(t + left);
+        } else if let Some(bounce) =
+            self.unresolved_bounce(&impact, &parts, closing, t, motion.impacts.last())?
+        {
+            // The rest of the sequence summed: one impact holding its contacts closed.
+            let sequence = zeno::sequence(&motion.impacts, closing, t);
+            let mut held = sequence.contacts.clone();
+            if !held.contains(&bounce.contact) {
+                held.push(bounce.contact);
+            }
+            impact = close(general, &state, &mut parts, &held, &impact, t)?;
+            zeno = Some(t + bounce.left);
+            let lifted = info.contacts[bounce.contact].name.to_string();
+            let others = names(&sequence.contacts)
+                .into_iter()
+                .filter(|n| *n != lifted);
             motion.notes.push(Zeno::Unresolved {
-                contact: name.to_string(),
+                contacts: std::iter::once(lifted.clone()).chain(others).collect(),
                 t,
-                rise,
+                rise: bounce.rise,
                 open_gap: DECIDE_TOLERANCE,
-                bounces: sequence_times(&motion.impacts, closing, t).len(),
-                t_limit: t + left,
+                bounces: sequence.times.len(),
+                t_limit: t + bounce.left,
             });
         }
         Ok(ImpactAt {
@@ -551,45 +553,73 @@ impl<'m> Walker<'m> {
             closing,
             parts,
             impact,
-            zeno: accumulation,
+            zeno,
         })
     }
 
-    /// How high (relative to the system's length scale) contact `closing` would rise after
-    /// `impact`, where that is below [`DECIDE_TOLERANCE`] (the gap at which a contact counts as
-    /// open), and for how long (s): its normal velocity after squared over twice its normal
-    /// acceleration pulling it back, and twice the velocity over that acceleration, with it
-    /// open and the other contacts decided at the state after. `None` for a contact that stays
-    /// closed (its velocity after within [`impact::IMPACT_TOLERANCE`] of its approach speed),
-    /// is not pulled back, or rises clear.
+    /// The flight that `impact` (where contact `closing` closed at `t`, after `previous`)
+    /// starts, where it is too small to resolve: the contact that took part and leaves fastest
+    /// would rise less than [`DECIDE_TOLERANCE`] (relative to the system's length scale) under
+    /// its normal acceleration pulling it back, with the other contacts decided at the state
+    /// after. The time left to the sequence's limit ([`zeno::time_left`]) treats the flights
+    /// to come as repeating this one: the same contact bouncing, or, where another contact
+    /// lifts, the two in turn, the previous impact (where the lifted contact closed and lifted
+    /// `closing`) giving the other half of the period. `None` where no contact leaves faster
+    /// than rounding, none is pulled back, it rises clear, or the period is not known.
     fn unresolved_bounce(
         &self,
         impact: &Impact,
         parts: &[Part],
         closing: usize,
         t: f64,
-    ) -> Result<Option<(f64, f64)>, SolveError> {
-        let u = impact.normal_velocity_after[closing];
+        previous: Option<&ImpactAt>,
+    ) -> Result<Option<Bounce>, SolveError> {
         // A plastic contact's velocity after is zero but for rounding: no bounce to sum (its
-        // flight, `2 u / pull`, would be rounding over rounding).
-        let rounding = impact::IMPACT_TOLERANCE * impact.normal_velocity_before[closing].abs();
-        if u <= rounding {
+        // flight would be rounding over rounding).
+        let approach = -impact.normal_velocity_before[closing];
+        let rounding = impact::IMPACT_TOLERANCE * approach.abs();
+        let Some((c, lift)) = fastest_lift(impact, parts, rounding) else {
             return Ok(None);
-        }
+        };
         let state = &impact.after;
         let (active, _) = self.decide_after(state, parts, t)?;
-        let pull = -contacts::dynamics(&self.general, state, &active, t)?.normal_acc[closing];
+        let pull = -contacts::dynamics(&self.general, state, &active, t)?.normal_acc[c];
         if pull <= 0.0 {
             return Ok(None);
         }
-        let info = self.general.info();
-        let scale = if info.contacts[closing].gap_unit == "m" {
+        let scale = if self.general.info().contacts[c].gap_unit == "m" {
             self.general.length_scale(state)?
         } else {
             1.0
         };
-        let rise = u * u / (2.0 * pull) / scale;
-        Ok((rise < DECIDE_TOLERANCE).then_some((rise, 2.0 * u / pull)))
+        let rise = lift * lift / (2.0 * pull) / scale;
+        if rise >= DECIDE_TOLERANCE {
+            return Ok(None);
+        }
+        let now = Flight {
+            lift,
+            approach,
+            pull,
+        };
+        let before = match previous {
+            _ if c == closing => None,
+            // Two contacts in turn: `c` closed at the previous impact and lifted `closing`,
+            // which flew until now.
+            Some(p) if p.closing == c && t > p.t => {
+                let lift = p.impact.normal_velocity_after[closing];
+                Some(Flight {
+                    lift,
+                    approach: -p.impact.normal_velocity_before[c],
+                    pull: 2.0 * lift / (t - p.t),
+                })
+            }
+            _ => return Ok(None),
+        };
+        Ok(zeno::time_left(now, before).map(|left| Bounce {
+            contact: c,
+            rise,
+            left,
+        }))
     }
 
     /// What follows an impact at the end of `run`: the contacts decided again at the state
@@ -693,36 +723,48 @@ fn approaching_touches(sys: &Bound, state: &State) -> Result<Vec<bool>, SolveErr
         .collect())
 }
 
-/// Whether the bounces at contact `closing` before an impact at `t` converge as Zeno's: the
-/// last [`ZENO_RATIOS`] ratios of successive intervals between impacts at that contact are
-/// below one and agree within [`ZENO_RATIO_SPREAD`], and the time left to their limit is within
-/// `tol` of `t`. Returns the ratio, the limit's time and the bounces counted.
-fn zeno_limit(impacts: &[ImpactAt], closing: usize, t: f64, tol: f64) -> Option<(f64, f64, usize)> {
-    let times = sequence_times(impacts, closing, t);
-    if times.len() < ZENO_RATIOS + 2 {
-        return None;
+/// The impact at `state` (at `t`) that closes a converging sequence whose contacts are `held`,
+/// in place of `resolved` (the impact as it would be): one contact's bounce made plastic, or,
+/// for two contacts or more, each of them held closed, each friction under its law in
+/// `resolved` ([`impact::close_sequence`]; `parts` marks them [`Part::Bilateral`]).
+fn close(
+    sys: &Bound,
+    state: &State,
+    parts: &mut [Part],
+    held: &[usize],
+    resolved: &Impact,
+    t: f64,
+) -> Result<Impact, SolveError> {
+    if let [one] = held {
+        let mut restitution = sys.restitutions().to_vec();
+        restitution[*one] = 0.0;
+        return impact::resolve_with(sys, state, parts, &restitution, t);
     }
-    let dt: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
-    let ratios: Vec<f64> = dt.windows(2).map(|w| w[1] / w[0]).collect();
-    let recent = &ratios[ratios.len() - ZENO_RATIOS..];
-    let r = recent[recent.len() - 1];
-    let steady = recent
-        .iter()
-        .all(|q| *q > 0.0 && *q < 1.0 && (q - r).abs() <= ZENO_RATIO_SPREAD * r);
-    let left = dt[dt.len() - 1] * r / (1.0 - r);
-    (steady && left <= tol * t).then_some((r, t + left, times.len()))
+    for &c in held {
+        if parts[c] == Part::Unilateral {
+            parts[c] = Part::Bilateral;
+        }
+    }
+    impact::close_sequence(sys, state, parts, &resolved.friction_laws, t)
 }
 
-/// The times of the impacts at contact `closing` that end `impacts` (one after another, no
-/// other contact's between), and `t`'s: the bounces of a sequence so far.
-fn sequence_times(impacts: &[ImpactAt], closing: usize, t: f64) -> Vec<f64> {
-    let mut times: Vec<f64> = (impacts.iter().rev())
-        .take_while(|i| i.closing == closing)
-        .map(|i| i.t)
-        .collect();
-    times.reverse();
-    times.push(t);
-    times
+/// The contact that takes part in `impact` and leaves it fastest, faster than `rounding`, with
+/// its normal velocity after.
+fn fastest_lift(impact: &Impact, parts: &[Part], rounding: f64) -> Option<(usize, f64)> {
+    (impact.normal_velocity_after.iter().enumerate())
+        .filter(|&(c, &u)| parts[c] == Part::Unilateral && u > rounding)
+        .map(|(c, &u)| (c, u))
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+}
+
+/// A flight too small to resolve ([`Walker::unresolved_bounce`]).
+struct Bounce {
+    /// The contact that would lift.
+    contact: usize,
+    /// How far it would rise, relative to the length scale.
+    rise: f64,
+    /// The time left to the sequence's limit (s).
+    left: f64,
 }
 
 /// A phase's error with the phase's start time added to the time it names (the integrator
