@@ -699,8 +699,9 @@ int rodcube_sensitivities(struct rodcube_solver *solver,
  * with `rodcube_results_json`, `rodcube_results_len` or `rodcube_results_copy`, as often as
  * wanted without solving again, and release them with `rodcube_results_free`. A refused
  * scene fails with a `RODCUBE_ERR_SCENE_*` code (the kind of its first problem; the message
- * lists every problem with its line and column), a failed solve with its code from the
- * solver group.
+ * lists every problem with its line and column; a planner refusal of one of the scene's
+ * values is placed at its field the same way), a failed solve with its code from the
+ * solver group. The run is the one `rodcube run` makes.
  *
  * # Safety
  * `scene_yaml` is a NUL-terminated string; `results` points to a writable pointer; `err` is

@@ -24,9 +24,9 @@
 //! a new variant does not compile until it has a code here (and thereby in the header).
 
 use crate::model::{Model, ModelInfo};
-use crate::plan::{self, PlanError};
+use crate::plan::PlanError;
 use crate::results::{Note, SensitivityGap};
-use crate::scene::{Kind, Scene, SceneError};
+use crate::scene::{Kind, RunError, SceneError, Source};
 use crate::solve::SolveError;
 use crate::solve::lean::{LeanPoint, LeanSolver};
 use crate::solve::sensitivity::SensitivityWork;
@@ -545,6 +545,15 @@ impl From<SensitivityGap> for Failure {
     }
 }
 
+impl From<RunError> for Failure {
+    fn from(e: RunError) -> Self {
+        match e {
+            RunError::Scene(e) => e.into(),
+            RunError::Solve { error, .. } => error.into(),
+        }
+    }
+}
+
 impl From<SceneError> for Failure {
     fn from(e: SceneError) -> Self {
         let code = e
@@ -1004,8 +1013,9 @@ pub unsafe extern "C" fn rodcube_sensitivities(
 /// with `rodcube_results_json`, `rodcube_results_len` or `rodcube_results_copy`, as often as
 /// wanted without solving again, and release them with `rodcube_results_free`. A refused
 /// scene fails with a `RODCUBE_ERR_SCENE_*` code (the kind of its first problem; the message
-/// lists every problem with its line and column), a failed solve with its code from the
-/// solver group.
+/// lists every problem with its line and column; a planner refusal of one of the scene's
+/// values is placed at its field the same way), a failed solve with its code from the
+/// solver group. The run is the one `rodcube run` makes.
 ///
 /// # Safety
 /// `scene_yaml` is a NUL-terminated string; `results` points to a writable pointer; `err` is
@@ -1022,9 +1032,10 @@ pub unsafe extern "C" fn rodcube_run_scene(
         guarded(err, err_len, || {
             let slot = out_handle(results, "the results' out pointer")?;
             let yaml = text(scene_yaml, "the scene")?;
-            let scene = Scene::parse(yaml, Path::new("<scene>"), crate::models::all())?;
-            let request = scene.request();
-            let run = plan::run(&request)?;
+            let (_, run) = crate::scene::run(Source::Text {
+                text: yaml,
+                file: Path::new("<scene>"),
+            })?;
             let json = crate::report::json::to_string(&run)
                 .map_err(|e| failure(RODCUBE_ERR_JSON, e.to_string()))?;
             let json = CString::new(json).map_err(|e| failure(RODCUBE_ERR_JSON, e.to_string()))?;

@@ -4,10 +4,8 @@
 
 use clap::{Args, Parser, Subcommand};
 use rodcube::io::{OutDir, check_name};
-use rodcube::plan::{self, PlanError};
 use rodcube::report;
-use rodcube::results::RunResults;
-use rodcube::scene::{Scene, SceneError};
+use rodcube::scene::{RunError, Scene, SceneError, Source};
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -203,15 +201,14 @@ const PAPER_SCENE: &str = include_str!("../scenes/paper.yaml");
 /// file it was built from, so its messages and its output directory, `out/paper/`, are the
 /// same as the file's).
 fn load_scene(path: Option<&PathBuf>) -> Result<Scene, Failure> {
-    match path {
-        Some(path) => Scene::load(path),
-        None => Scene::parse(
-            PAPER_SCENE,
-            std::path::Path::new("scenes/paper.yaml"),
-            rodcube::models::all(),
-        ),
-    }
-    .map_err(Failure::Scene)
+    let source = match path {
+        Some(path) => Source::File(path),
+        None => Source::Text {
+            text: PAPER_SCENE,
+            file: std::path::Path::new("scenes/paper.yaml"),
+        },
+    };
+    Scene::read(source).map_err(Failure::Scene)
 }
 
 /// Why a command failed; each kind has its exit status.
@@ -228,6 +225,19 @@ enum Failure {
     /// An input file is invalid: a model spec or a sweep's points (its message names the file
     /// and the line).
     Invalid(anyhow::Error),
+}
+
+impl From<RunError> for Failure {
+    /// A scene's refusal (the planner's of its values included, placed at their field) is
+    /// [`Failure::Scene`], a failed solve [`Failure::Solve`] naming the scene's file.
+    fn from(e: RunError) -> Self {
+        match e {
+            RunError::Scene(e) => Failure::Scene(e),
+            RunError::Solve { file, error } => Failure::Solve(
+                anyhow::Error::from(error).context(format!("solving {} failed", file.display())),
+            ),
+        }
+    }
 }
 
 impl Failure {
@@ -418,7 +428,7 @@ fn run(args: RunArgs) -> Result<(), Failure> {
     };
     // Before solving, so an unwritable output fails at once.
     let out = OutDir::create(&out_dir).map_err(|e| Failure::Output(e.into()))?;
-    let results = solve(&scene)?;
+    let results = scene.run().map_err(Failure::from)?;
     let text = if args.json {
         report::json::to_string(&results).map_err(|e| Failure::Output(e.into()))?
     } else {
@@ -452,23 +462,6 @@ fn default_out_dir(scene: &Scene) -> Result<PathBuf, Failure> {
         )
     })?;
     Ok(PathBuf::from("out").join(stem))
-}
-
-/// The one call into the planner ([`rodcube::plan::run`]).
-fn solve(scene: &Scene) -> Result<RunResults, Failure> {
-    let request = scene.request();
-    plan::run(&request).map_err(|e| planner_failure(scene, e))
-}
-
-/// A planner error as a failure: those about the scene's own values placed at their field in
-/// the file ([`Scene::plan_error`]), the others a failed solve.
-fn planner_failure(scene: &Scene, error: PlanError) -> Failure {
-    match scene.plan_error(&error) {
-        Some(placed) => Failure::Scene(placed),
-        None => Failure::Solve(
-            anyhow::Error::from(error).context(format!("solving {} failed", scene.file.display())),
-        ),
-    }
 }
 
 /// `rodcube fmu`: every refusal (an unknown model, a missing library, an output directory

@@ -26,6 +26,7 @@
 use crate::model::{Model, ModelInfo};
 use crate::plan::PlanError;
 use crate::quantity::Quantity;
+use crate::results::RunResults;
 use crate::system::{SystemError, check_value, failed_requirements};
 use crate::yaml::{At, Document, Mark, Problem, ReadError, excerpt, parse_path};
 use annotate_snippets::{Level, Origin, Renderer};
@@ -243,6 +244,48 @@ impl fmt::Display for SceneError {
 
 impl std::error::Error for SceneError {}
 
+/// Where a scene comes from: a file, or YAML text named in messages as if it were `file`.
+#[derive(Debug, Clone, Copy)]
+pub enum Source<'a> {
+    /// A scene file, read by [`Scene::load`].
+    File(&'a Path),
+    /// Scene text, validated by [`Scene::parse`]; `file` names it in messages (`<scene>`,
+    /// `<yaml>`, or the file it was built from).
+    Text {
+        /// The YAML text.
+        text: &'a str,
+        /// Its name in messages.
+        file: &'a Path,
+    },
+}
+
+/// Why a scene gave no results: the scene itself, every problem placed at its file, line,
+/// column and field (planner refusals of its values included), or the solve.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RunError {
+    /// The scene is invalid, or the planner refused one of its values (placed at its field by
+    /// the same rules as the loader's).
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// The solve failed; `error` says why, `file` is the scene's.
+    #[error("solving {} failed: {error}", file.display())]
+    Solve {
+        /// The scene's file, as given.
+        file: PathBuf,
+        /// The planner's error.
+        error: PlanError,
+    },
+}
+
+/// Reads the scene of `source` against the registry ([`crate::models::all`]) and runs it
+/// ([`Scene::run`]): the one path from a scene to its results of the command line's
+/// `rodcube run`, the C interface's `rodcube_run_scene` and the Python package's `run`.
+pub fn run(source: Source<'_>) -> Result<(Scene, RunResults), RunError> {
+    let scene = Scene::read(source)?;
+    let results = scene.run()?;
+    Ok((scene, results))
+}
+
 /// The scene's keys as written, before any check against a model.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields, expecting = "a mapping of scene keys")]
@@ -282,6 +325,15 @@ impl Scene {
                 })
             })?;
         Scene::parse(&text, path, registry)
+    }
+
+    /// Reads and validates the scene of `source` against the registry
+    /// ([`crate::models::all`]).
+    pub fn read(source: Source<'_>) -> Result<Scene, SceneError> {
+        match source {
+            Source::File(path) => Scene::load(path),
+            Source::Text { text, file } => Scene::parse(text, file, crate::models::all()),
+        }
     }
 
     /// Validates scene text; `file` is only used in messages.
@@ -336,6 +388,19 @@ impl Scene {
             .with_tolerance(self.tolerance)
             .with_samples(self.samples)
             .with_until(self.until)
+    }
+
+    /// Solves the scene ([`crate::plan::run`] on its [`Scene::request`]). A planner error
+    /// about the scene's own values is placed at its field in the file, as the loader places
+    /// its own ([`RunError::Scene`]); any other is [`RunError::Solve`].
+    pub fn run(&self) -> Result<RunResults, RunError> {
+        crate::plan::run(&self.request()).map_err(|error| match self.plan_error(&error) {
+            Some(placed) => RunError::Scene(placed),
+            None => RunError::Solve {
+                file: self.file.clone(),
+                error,
+            },
+        })
     }
 
     /// Parameters by name.
@@ -394,7 +459,7 @@ impl Scene {
     /// A planner error about this scene's own values, placed at its field in the file
     /// (parameters, wanted quantities, tolerance, end time, samples); `None` for the errors
     /// of the solve itself. The scene was validated against the same rules, so these are rare.
-    pub fn plan_error(&self, error: &PlanError) -> Option<SceneError> {
+    fn plan_error(&self, error: &PlanError) -> Option<SceneError> {
         let message = error.to_string();
         let at = |field: String, kind| Some(self.error_at(&field, kind, message.clone()));
         match error {

@@ -24,7 +24,8 @@
   ``RodcubeError`` naming the file, and nothing of the directory is loaded.
 - ``derivation(model)``: the model's derivation (carried by the package for every model compiled
   into it; a tape holds no derivation), which a notebook shows
-  as Markdown with LaTeX, every step numbered as in ``generated/<model>.tex``; its
+  as Markdown with LaTeX, every step numbered as in ``generated/<model>.tex`` (its texts and
+  equations from the JSON record's ``write_up``); its
   ``expressions`` are the derived expressions as strings, ``steps`` the steps, ``latex`` the
   write-up. ``derivation_models()`` names the models it knows.
 - ``run(scene)``: a scene (a path, YAML text or a dict) run as ``rodcube run`` runs it; the

@@ -171,11 +171,15 @@ class Step(NamedTuple):
     section: str
     title: str
     latex: str
+    """The step's LaTeX from the JSON record: its equation's lines, or the parameters table's
+    rows."""
+    tag: Optional[str]
+    """The equation's number, for the results without units."""
 
 class Derivation:
     """A model's derivation as the derivation tool wrote it (`generated/<model>.tex` and
     `.json`, carried by the package): a notebook shows it as Markdown with LaTeX, every step
-    numbered as in the `.tex`."""
+    numbered as in the `.tex`, its texts and equations from the JSON record's `write_up`."""
 
     model: str
     latex: str

@@ -1,6 +1,7 @@
 """rodcube in notebooks: ``derivation(model)``, the model's derivation rendered as Markdown with
-LaTeX (every step numbered in the order of ``generated/<model>.tex``, the equations with the
-write-up's own tags) and its expressions as strings; ``run(scene)``, a scene run as ``rodcube
+LaTeX (every step numbered in the order of ``generated/<model>.tex``, its texts and equations
+from ``generated/<model>.json``'s ``write_up``, the context the ``.tex`` is rendered from, with
+the write-up's own tags) and its expressions as strings; ``run(scene)``, a scene run as ``rodcube
 run`` runs it, whose result shows its tables, checks and the animated ``motion.svg`` as HTML,
 and gives ``to_frame()`` where pandas is installed.
 
@@ -44,49 +45,10 @@ class Step(NamedTuple):
     title: str
     """The step's heading (LaTeX text)."""
     latex: str
-    """The step's body, as in the ``.tex`` (equations, tables, paragraphs)."""
-
-
-_HEADING = re.compile(r"\\(section|subsection)\*\{")
-
-
-def _braced(text: str, start: int) -> tuple[str, int]:
-    """The text inside the braces opening at ``start - 1``, and the index after the closing one."""
-    depth = 1
-    i = start
-    while i < len(text) and depth:
-        if text[i] == "\\":
-            i += 2
-            continue
-        depth += {"{": 1, "}": -1}.get(text[i], 0)
-        i += 1
-    return text[start : i - 1], i
-
-
-def _blocks(tex: str) -> list[tuple[str, str, str]]:
-    """The document's headed blocks in order: ``(section or subsection, title, body)``."""
-    body = tex.split("\\begin{document}", 1)[-1].split("\\end{document}", 1)[0]
-    found = list(_HEADING.finditer(body))
-    blocks = []
-    for k, match in enumerate(found):
-        title, after = _braced(body, match.end())
-        end = found[k + 1].start() if k + 1 < len(found) else len(body)
-        blocks.append((match.group(1), title, body[after:end].strip("\n")))
-    return blocks
-
-
-def _steps(tex: str) -> tuple[list[Step], list[tuple[str, str]]]:
-    """The steps of a write-up, and its sections with their own text (before their first step)."""
-    steps: list[Step] = []
-    sections: list[tuple[str, str]] = []
-    section = ""
-    for kind, title, body in _blocks(tex):
-        if kind == "section":
-            section = title
-            sections.append((title, body))
-        else:
-            steps.append(Step(len(steps) + 1, section, title, body))
-    return steps, sections
+    """The step's LaTeX from the JSON record: its equation's lines (joined by ``\\\\``), or the
+    parameters table's rows."""
+    tag: Optional[str] = None
+    """The equation's number (``(1)\\quad\\text{paper (9)}``), for the results without units."""
 
 
 def _text(latex: str) -> str:
@@ -102,91 +64,68 @@ def _text(latex: str) -> str:
         t = t.replace("\\^{}", "^").replace("---", "\u2014").replace("--", "\u2013")
         # Code spans show backslashes: `rod\_cube` is `rod_cube`.
         t = re.sub(r"`[^`]*`", lambda m: m.group(0).replace("\\_", "_"), t)
-        t = re.sub(r"\\(footnotesize|sloppy|noindent|small|normalsize)\b\s*", "", t)
         parts[i] = t.replace("~", " ")
     return "$".join(parts)
 
 
-_TAG = re.compile(r"\\tag\*?\{")
-
-
 def _tag_text(tag: str) -> str:
     """A tag's text without math delimiters (a ``$`` would end the display in Markdown):
-    ``$(1)\\quad\\text{paper (9)}$`` is ``(1) paper (9)``, with an em space."""
+    ``(1)\\quad\\text{paper (9)}`` is ``(1) paper (9)``, with an em space."""
     tag = tag.strip().strip("$")
     tag = re.sub(r"\\text\{([^{}]*)\}", r"\1", tag)
     return re.sub(r"\\q?quad\s*", "\u2003", tag)
 
 
-def _without_tags(content: str) -> tuple[str, list[str]]:
-    """A display's content without its ``\\tag``s, and their texts."""
-    tags = []
-    while match := _TAG.search(content):
-        text, after = _braced(content, match.end())
-        tags.append(_tag_text(text))
-        content = content[: match.start()] + content[after:]
-    return content, tags
-
-
-def _display(kind: str, content: str) -> str:
-    """A display equation as ``$$ ... $$`` for MathJax; a multi-line one is ``gathered``, its tag
-    kept (as text) after it."""
-    content, tags = _without_tags(content)
-    content = content.strip()
-    tag = "".join(f" \\tag*{{{t}}}" for t in tags)
-    if kind == "multline*":
+def _display(equation: Mapping[str, Any]) -> str:
+    """An equation of the record's write-up as ``$$ ... $$`` for MathJax; a multi-line one is
+    ``gathered``, its tag kept (as text) after it."""
+    content = equation["latex"].strip()
+    tag = f" \\tag*{{{_tag_text(equation['tag'])}}}" if equation.get("tag") else ""
+    if equation["env"] == "multline*":
         content = f"\\begin{{gathered}}\n{content}\n\\end{{gathered}}"
     return f"$$\n{content}{tag}\n$$"
 
 
-_HEADERS = {"Parameters": ("symbol", "meaning", "unit")}
-
-
-def _table(rows: list[str], title: str) -> str:
-    """A ``tabular``'s rows as a Markdown table."""
-    cells = [[_text(c.strip()) for c in row.split(" & ")] for row in rows]
-    width = max(len(c) for c in cells)
-    header = _HEADERS.get(title, ("", "meaning", "")[:width] if width == 3 else ("",) * width)
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * width]
-    lines += ["| " + " | ".join(c + [""] * (width - len(c))) + " |" for c in cells]
+def _table(rows: list[Mapping[str, str]], header: tuple[str, str, str]) -> str:
+    """A table of the record's write-up (``symbol``, ``meaning``, ``unit`` per row) as Markdown."""
+    cells = [[_text(f"${r['symbol']}$"), _text(r["meaning"]), _text(r["unit"])] for r in rows]
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(c) + " |" for c in cells]
     return "\n".join(lines)
 
 
-_ENVIRONMENT = re.compile(r"\\begin\{(equation\*|multline\*|tabular)\}(\{[^\n]*\})?\n(.*?)\\end\{\1\}", re.S)
+def _tabular_rows(rows: list[Mapping[str, str]]) -> str:
+    """A table's rows as the ``.tex`` writes them."""
+    return "\n".join(f"${r['symbol']}$ & {r['meaning']} & {r['unit']} \\\\" for r in rows)
 
 
-def _markdown_body(latex: str, title: str) -> str:
-    """A block's body as Markdown: its paragraphs, display equations and tables."""
-    out = []
-    position = 0
-    for match in _ENVIRONMENT.finditer(latex):
-        text = latex[position : match.start()].strip()
-        if text:
-            out.append(_text(text))
-        kind, content = match.group(1), match.group(3)
-        if kind == "tabular":
-            rows = [r.strip() for r in content.split("\\\\") if r.strip()]
-            out.append(_table(rows, title))
-        else:
-            out.append(_display(kind, content))
-        position = match.end()
-    rest = latex[position:].strip()
-    if rest:
-        out.append(_text(rest))
-    return "\n\n".join(out)
+_MODEL, _PARAMETERS, _RESULTS, _TANGENTS = ("Model \\texttt{{{}}}", "Parameters", "Results without units", "Partial derivatives")
+"""The write-up's own headings, as ``templates/model.tex.tera`` writes them."""
 
 
 class Derivation:
-    """A model's derivation as the derivation tool wrote it (``generated/<model>.tex`` and
-    ``.json``): shown in a notebook as Markdown with LaTeX, every step numbered as in the
-    ``.tex``; ``expressions`` gives the derived expressions as strings."""
+    """A model's derivation as the derivation tool wrote it: shown in a notebook as Markdown
+    with LaTeX, every step numbered as in ``generated/<model>.tex``, its texts and equations
+    from ``generated/<model>.json`` (``write_up``, the context the ``.tex`` is rendered from);
+    ``expressions`` gives the derived expressions as strings."""
 
     def __init__(self, model: str):
         tex, record = derivation_sources(model)
         self.model = model
         self.latex = tex
         self.record: dict[str, Any] = json.loads(record)
-        self.steps, self._sections = _steps(tex)
+        self.steps = self._steps()
+
+    def _steps(self) -> list[Step]:
+        """The write-up's steps, numbered: the parameters, the equations, the results without
+        units."""
+        w = self.record["write_up"]
+        model = _MODEL.format(w["name"])
+        steps = [Step(1, model, _PARAMETERS, _tabular_rows(w["params"]))]
+        steps += [Step(len(steps) + k + 1, model, e["title"], e["latex"]) for k, e in enumerate(w["equations"])]
+        if w["groups"]:
+            steps += [Step(len(steps) + k + 1, _RESULTS, e["title"], e["latex"], e["tag"]) for k, e in enumerate(w["results"])]
+        return steps
 
     @property
     def expressions(self) -> dict[str, str]:
@@ -207,17 +146,22 @@ class Derivation:
         raise RodcubeError(f"model `{self.model}` has no expression `{name}`; it has: {', '.join(names)}")
 
     def _repr_markdown_(self) -> str:
-        out = []
-        steps = iter(self.steps)
-        pending = next(steps, None)
-        for title, text in self._sections:
-            out.append(f"## {_text(title)}")
-            if text:
-                out.append(_markdown_body(text, title))
-            while pending is not None and pending.section == title:
-                out.append(f"### {pending.number}. {_text(pending.title)}")
-                out.append(_markdown_body(pending.latex, pending.title))
-                pending = next(steps, None)
+        w = self.record["write_up"]
+        number = iter(self.steps)
+
+        def step(title: str, body: str) -> list[str]:
+            return [f"### {next(number).number}. {_text(title)}", body]
+
+        out = [f"## {_text(_MODEL.format(w['name']))}", _text(w["intro"])]
+        out += step(_PARAMETERS, _table(w["params"], ("symbol", "meaning", "unit")))
+        for e in w["equations"]:
+            out += step(e["title"], _display(e))
+        if w["groups"]:
+            out += [f"## {_RESULTS}", _table(w["groups"], ("", "meaning", "")), _text(w["scales"])]
+            for e in w["results"]:
+                out += step(e["title"], _display(e))
+        if w["tangents"]:
+            out += [f"## {_TANGENTS}", _text(w["tangents"])]
         return "\n\n".join(out) + "\n"
 
     def __repr__(self) -> str:

@@ -7,7 +7,7 @@
 use pyo3::prelude::*;
 use rodcube::models::{Entry, Provenance, TapeRoute};
 use rodcube::report::{self, motion};
-use rodcube::scene::Scene;
+use rodcube::scene::Source;
 use std::path::Path;
 
 use crate::error;
@@ -70,8 +70,9 @@ pub fn result_order() -> Vec<&'static str> {
 
 /// Runs a scene: the file at `path`, or else `text` (a YAML scene, named `name` in messages).
 /// Returns `results.json`'s text and `motion.svg`'s (`None` unless the scene wants a
-/// trajectory). Errors are `RodcubeError` with the command line's messages: a scene's problems
-/// with file, line, column and field, a failed solve with the scene's file.
+/// trajectory). The run is `rodcube run`'s ([`rodcube::scene::run`]), and so are the messages
+/// of its errors (`RodcubeError`): a scene's problems with file, line, column and field, a
+/// failed solve with the scene's file.
 #[pyfunction]
 #[pyo3(signature = (text, path, name))]
 pub fn run_scene(
@@ -80,19 +81,15 @@ pub fn run_scene(
     path: Option<&str>,
     name: &str,
 ) -> PyResult<(String, Option<String>)> {
-    let scene = match (path, text) {
-        (Some(path), _) => Scene::load(Path::new(path)),
-        (None, Some(text)) => Scene::parse(text, Path::new(name), rodcube::models::all()),
+    let source = match (path, text) {
+        (Some(path), _) => Source::File(Path::new(path)),
+        (None, Some(text)) => Source::Text {
+            text,
+            file: Path::new(name),
+        },
         (None, None) => return Err(error("give a scene: a path, YAML text or a dict")),
-    }
-    .map_err(error)?;
-    let request = scene.request();
-    let results =
-        py.detach(|| rodcube::plan::run(&request))
-            .map_err(|e| match scene.plan_error(&e) {
-                Some(placed) => error(placed),
-                None => error(format!("solving {} failed: {e}", scene.file.display())),
-            })?;
+    };
+    let (_, results) = py.detach(|| rodcube::scene::run(source)).map_err(error)?;
     let json = report::json::to_string(&results).map_err(error)?;
     let svg = (results.drawing.as_ref()).map(|d| motion::svg(&motion::Animation::build(d)));
     Ok((json, svg))

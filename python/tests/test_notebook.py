@@ -71,6 +71,31 @@ def test_the_derivation_renders_every_step_numbered_as_in_the_tex():
             assert "$" not in display, (model, display[:80])
 
 
+def test_every_equation_and_text_shown_comes_from_the_json_record(monkeypatch):
+    for model in rodcube.derivation_models():
+        d = rodcube.derivation(model)
+        md = d._repr_markdown_()
+        w = d.record["write_up"]
+        # The displays in order are the record's equations, then its results, each tagged.
+        shown = re.findall(r"\$\$\n(.*?)\n\$\$", md, re.S)
+        equations = w["equations"] + (w["results"] if w["groups"] else [])
+        assert len(shown) == len(equations), model
+        for display, e in zip(shown, equations):
+            assert e["latex"].strip() in display, (model, e["title"])
+            assert ("\\tag*{" in display) == bool(e["tag"]), (model, e["title"])
+        assert [s.latex for s in d.steps[1:]] == [e["latex"] for e in equations], model
+    # A record whose write-up says something else is what is shown: the .tex is not read.
+    tex, record = rodcube._notebook.derivation_sources("rod_cube_closed")
+    changed = json.loads(record)
+    for k, e in enumerate(changed["write_up"]["equations"] + changed["write_up"]["results"]):
+        e["latex"] = f"x_{{{k}}} = {k}"
+    changed["write_up"]["intro"] = "An intro of the record's own."
+    monkeypatch.setattr(rodcube._notebook, "derivation_sources", lambda model: (tex, json.dumps(changed)))
+    md = rodcube.derivation("rod_cube_closed")._repr_markdown_()
+    assert "An intro of the record's own." in md and "x_{0} = 0" in md
+    assert "\\frac{\\dot{\\theta}^2}{g/\\ell}" in tex and "\\frac{\\dot{\\theta}^2}{g/\\ell}" not in md
+
+
 def test_the_derivation_hands_out_its_expressions():
     d = rodcube.derivation("rod_cube_closed")
     condition = d.expression("separation_condition")

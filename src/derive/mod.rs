@@ -497,11 +497,13 @@ fn render_phase(
     let (rust, tape) = rust_and_tape(&template, c, d, phases)?;
     let tex_ctx = emit::tex_context(c, d).map_err(|e| refused(c, &d.name, e))?;
     let tex = render(root, "model.tex.tera", &tex_ctx)?;
-    let json =
-        serde_json::to_string_pretty(&emit::json_record(c, d)).map_err(|e| Error::Template {
+    let json = emit::json_record(c, d, &tex_ctx)
+        .and_then(|record| serde_json::to_string_pretty(&record))
+        .map_err(|e| Error::Template {
             template: "json record".into(),
             message: e.to_string(),
-        })? + "\n";
+        })?
+        + "\n";
     Ok(vec![
         Rendered {
             path: PathBuf::from(format!("generated/{}.rs", d.name)),

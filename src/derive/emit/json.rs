@@ -1,6 +1,7 @@
 //! The JSON writer: the machine-readable record of a model (`generated/<model>.json`).
 
 use super::common::{COMMAND, spec_path};
+use super::tex::TexContext;
 use crate::derive::algebra::from_sc_over;
 use crate::derive::expr::Expr;
 use crate::derive::present;
@@ -8,8 +9,13 @@ use crate::derive::spec::Checked;
 use crate::derive::types::{Derivation, Dimensionless};
 use std::collections::BTreeMap;
 
-/// The machine-readable record (`generated/<model>.json`).
-pub fn json_record(checked: &Checked, d: &Derivation) -> serde_json::Value {
+/// The machine-readable record (`generated/<model>.json`), with `write_up`, the context of the
+/// LaTeX write-up (`generated/<model>.tex`) it is rendered from.
+pub fn json_record(
+    checked: &Checked,
+    d: &Derivation,
+    write_up: &TexContext,
+) -> Result<serde_json::Value, serde_json::Error> {
     let theta = d.theta();
     let infix = |e: &Expr| from_sc_over(e, theta).to_infix();
     let mut expressions = BTreeMap::new();
@@ -108,7 +114,8 @@ pub fn json_record(checked: &Checked, d: &Derivation) -> serde_json::Value {
             })
             .collect();
     }
-    record
+    record["write_up"] = serde_json::to_value(write_up)?;
+    Ok(record)
 }
 
 /// The JSON record's `dimensionless` block: groups, scales, and each result's form, unit and

@@ -185,24 +185,37 @@ pub struct TexParam {
     unit: String,
 }
 
-/// Context of the LaTeX template.
+/// Context of the LaTeX template, which the JSON record carries too (`write_up`) for the Python
+/// package's notebook helpers: every text and equation of the write-up is here, the template
+/// adds only its layout and headings.
 #[derive(Debug, Clone, Serialize)]
 pub struct TexContext {
     command: String,
     name: String,
     description: String,
     spec: String,
+    /// The model section's paragraph: its description and where it was derived from.
+    intro: String,
     params: Vec<TexParam>,
     equations: Vec<Equation>,
     /// The dimensionless groups (`n = m_2/m_1`) with their meanings.
     groups: Vec<TexParam>,
-    /// The scales and the rule of the presentation forms, in words.
+    /// The scales and the rule of the presentation forms, in words (and that there are no
+    /// results to write this way, where there are none).
     scales: String,
     /// The results without units, numbered.
     results: Vec<Equation>,
-    /// Whether the model carries its tangents (`Model::tangents`), which are not printed.
-    tangents: bool,
+    /// Where the model carries its tangents (`Model::tangents`), which are not printed: the
+    /// paragraph that says so.
+    tangents: Option<String>,
 }
+
+/// The paragraph of a model that carries its tangents.
+const TANGENTS: &str = "The model also carries the partial derivatives of its equations of \
+                        motion, of its contacts' and\nfrictions' rows and of its initial state in \
+                        its coordinates, velocities and parameters, derived\nsymbolically from \
+                        the expressions above for the forward sensitivities of the integrated \
+                        route;\nthey are not printed here.";
 
 /// Builds the LaTeX context: the derivation's steps as displayed equations.
 pub fn tex_context(checked: &Checked, d: &Derivation) -> Result<TexContext, StepError> {
@@ -326,11 +339,17 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> Result<TexContext, Step
         Some(dim) => tex_dimensionless(dim, theta, &name),
         None => (Vec::new(), String::new(), Vec::new()),
     };
+    let description = tex_text(&d.description);
+    let spec = tex_text(&spec_path(checked));
     Ok(TexContext {
         command: COMMAND.into(),
         name: tex_text(&d.name),
-        description: tex_text(&d.description),
-        spec: tex_text(&spec_path(checked)),
+        intro: format!(
+            "{description} Derived from \\texttt{{{spec}}} by Symbolica; every expression \
+             below was\nproduced by the derivation tool, none was typed by hand."
+        ),
+        description,
+        spec,
         params: d
             .params
             .iter()
@@ -344,7 +363,7 @@ pub fn tex_context(checked: &Checked, d: &Derivation) -> Result<TexContext, Step
         groups: dim_groups,
         scales: dim_scales,
         results: dim_results,
-        tangents: d.tangents.is_some(),
+        tangents: d.tangents.as_ref().map(|_| TANGENTS.to_string()),
     })
 }
 
@@ -502,9 +521,9 @@ fn tex_dimensionless(
             dim.time.to_latex(name),
             dim.force.to_latex(name),
         );
-        return (groups, scales, Vec::new());
+        return (groups, scales + NO_RESULTS, Vec::new());
     };
-    let scales = format!(
+    let mut scales = format!(
         "Time is in units of $T = {}$ and forces in units of ${}$. Each result below is written \
          in the groups and ${}$ alone; its form was chosen by the derivation tool among \
          candidates by {}.",
@@ -556,8 +575,14 @@ fn tex_dimensionless(
         });
         results.push(eq);
     }
+    if results.is_empty() {
+        scales.push_str(NO_RESULTS);
+    }
     (groups, scales, results)
 }
+
+/// What the scales' paragraph adds where there are no results to write without units.
+const NO_RESULTS: &str = " The integrated route has no closed-form results to write this way.";
 
 /// `text` with its first letter upper case.
 fn upper_first(text: &str) -> String {
