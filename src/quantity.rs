@@ -310,16 +310,18 @@ impl Quantity {
     /// starts at release, the linearised angle one with a separation polynomial, the impacts a
     /// unilateral contact the model does not eliminate (one that can close), and an indexed
     /// quantity an index the model has. What is measured in the reduced coordinate (its
-    /// series, the angles and times where contacts end, the sensitivities of those) needs one,
-    /// the motion to the floor an end angle, and the point mass's fall a falling point.
+    /// series, the angles and times where contacts end) needs one, the sensitivities one or
+    /// impacts (whose times they differentiate), the motion to the floor an end angle, and the
+    /// point mass's fall a falling point.
     pub fn available(&self, info: &ModelInfo) -> bool {
         let angle = info.reduced_index.is_some();
         let separates = angle && info.contacts.first().is_some_and(|c| !c.bilateral);
         let release = info.phases.iter().find(|p| p.release);
+        let impacts = (info.contacts.iter()).any(|c| !c.closed && !c.bilateral);
         match self {
             Quantity::SeparationAngle | Quantity::SeparationTime => separates,
             Quantity::ContactEnd => angle && !info.contacts.is_empty(),
-            Quantity::Impacts => (info.contacts.iter()).any(|c| !c.closed && !c.bilateral),
+            Quantity::Impacts => impacts,
             Quantity::LinearisedSeparationAngle => {
                 separates && release.is_some_and(|p| p.separation_degree > 0)
             }
@@ -327,7 +329,8 @@ impl Quantity {
             Quantity::ForceSeries(i) => *i < info.contacts.len(),
             Quantity::FrictionSeries(i) => *i < info.frictions.len(),
             Quantity::Trajectory(i) => *i < info.points.len(),
-            Quantity::Sensitivities | Quantity::ThetaSeries => angle,
+            Quantity::ThetaSeries => angle,
+            Quantity::Sensitivities => angle || impacts,
             Quantity::FloorImpact => info.end_angle.is_some(),
             Quantity::PointMassFallTime => info.falling_point_index.is_some(),
             Quantity::Checks => true,

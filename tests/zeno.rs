@@ -1,10 +1,10 @@
-//! A disk dropped on a floor with restitution `e` (tests/specs/bouncing_disk.yaml, derived at
-//! test time into its tape) against the closed forms of a body bouncing under constant gravity,
-//! dropped from `H` (docs/PHYSICS.md): `t_1 = sqrt(2 H/g)`, the n-th impact at
+//! A ball dropped on a floor with restitution `e` (tests/specs/ball.yaml, derived at test time
+//! into its tape) against the closed forms of a body bouncing under constant gravity, its
+//! lowest point dropped from `h = H - R` (docs/PHYSICS.md): `t_1 = sqrt(2 h/g)`, the n-th impact at
 //! `t_n = t_1 + 2 t_1 sum_{k=1}^{n-1} e^k`, the bounces accumulating (Zeno) at
 //! `t_1 (1 + e)/(1 - e)`. The run lists the impact that closes the sequence at that time and the
-//! disk comes to rest there; every impact's time has its sensitivities, which are the closed
-//! form's derivatives in `e`, `H` and `g`, and the run's own central differences.
+//! ball comes to rest there; every impact's time has its sensitivities, which are the closed
+//! form's derivatives in `e`, `H`, `R` and `g`, and the run's own central differences.
 #![cfg(feature = "derive")]
 
 use rodcube::model::Model;
@@ -13,23 +13,23 @@ use rodcube::quantity::Quantity;
 use rodcube::results::{Halt, Note, RunResults, UntilNote};
 use std::collections::BTreeMap;
 
-const SPEC: &str = include_str!("specs/bouncing_disk.yaml");
+const SPEC: &str = include_str!("specs/ball.yaml");
 
-/// The disk's model, derived from its spec into a tape by `rodcube derive --tapes-into` (no
+/// The ball's model, derived from its spec into a tape by `rodcube derive --tapes-into` (no
 /// model of it is compiled in) and loaded, once for the tests here.
-fn disk() -> &'static dyn Model {
+fn ball() -> &'static dyn Model {
     static DISK: std::sync::OnceLock<&'static rodcube::tape::TapeModel> =
         std::sync::OnceLock::new();
     *DISK.get_or_init(derive)
 }
 
 fn derive() -> &'static rodcube::tape::TapeModel {
-    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("zeno_disk");
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("zeno_ball");
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("a temporary directory");
-    std::fs::write(dir.join("bouncing_disk.yaml"), SPEC).expect("spec");
+    std::fs::write(dir.join("ball.yaml"), SPEC).expect("spec");
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_rodcube"))
-        .args(["derive", "--tapes-into", "models", "bouncing_disk.yaml"])
+        .args(["derive", "--tapes-into", "models", "ball.yaml"])
         .current_dir(&dir)
         .output()
         .expect("rodcube runs");
@@ -38,17 +38,19 @@ fn derive() -> &'static rodcube::tape::TapeModel {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    rodcube::tape::load_file(&dir.join("models/bouncing_disk.tape.json")).expect("its tape")
+    rodcube::tape::load_file(&dir.join("models/ball.tape.json")).expect("its tape")
 }
 
 const G: f64 = 9.81;
+/// The ball's radius: its centre starts at `H = h + R`.
+const R: f64 = 0.1;
 
 fn parameters(h: f64, e: f64, u: f64) -> BTreeMap<String, f64> {
     [
         ("m", 1.0),
-        ("R", 0.1),
-        ("H", h),
-        ("u", u),
+        ("R", R),
+        ("H", h + R),
+        ("v0", u),
         ("g", G),
         ("e", e),
     ]
@@ -76,13 +78,13 @@ fn closed_form(n: usize, h: f64, e: f64) -> (f64, f64, f64) {
 
 #[test]
 fn the_bounces_accumulate_at_the_closed_form_and_every_impact_time_moves_as_it_says() {
-    let model = disk();
+    let model = ball();
     let (h, e) = (1.0, 0.9);
     let want = [Quantity::Impacts, Quantity::Sensitivities];
     let res = run(model, &parameters(h, e, 0.0), &want);
     let impacts = res.impacts.as_ref().expect("impacts");
     let (last, bounces) = impacts.split_last().expect("impacts");
-    // The limit: listed at the accumulation time, marked, and the disk at rest from then on.
+    // The limit: listed at the accumulation time, marked, and the ball at rest from then on.
     let t1 = (2.0 * h / G).sqrt();
     let zeno = t1 * (1.0 + e) / (1.0 - e);
     assert!(last.zeno_limit && bounces.iter().all(|b| !b.zeno_limit));
@@ -123,7 +125,7 @@ fn the_bounces_accumulate_at_the_closed_form_and_every_impact_time_moves_as_it_s
             ("e", dt_de),
             ("H", dt_dh),
             ("g", -t / (2.0 * G)),
-            ("R", 0.0),
+            ("R", -dt_dh),
             ("m", 0.0),
         ] {
             assert!(
@@ -141,7 +143,7 @@ fn the_bounces_accumulate_at_the_closed_form_and_every_impact_time_moves_as_it_s
         ("e", 2.0 * t1 / (1.0 - e).powi(2)),
         ("H", zeno / (2.0 * h)),
         ("g", -zeno / (2.0 * G)),
-        ("R", 0.0),
+        ("R", -zeno / (2.0 * h)),
         ("m", 0.0),
     ] {
         assert!(
@@ -154,7 +156,7 @@ fn the_bounces_accumulate_at_the_closed_form_and_every_impact_time_moves_as_it_s
 
 #[test]
 fn impact_time_sensitivities_match_central_differences_of_the_run() {
-    let model = disk();
+    let model = ball();
     // Sideways too: the floor, frictionless, leaves that motion alone.
     let (h, e, u) = (0.7, 0.6, 0.3);
     let want = [Quantity::Impacts, Quantity::Sensitivities];

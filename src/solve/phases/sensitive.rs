@@ -22,9 +22,9 @@ use crate::solve::unreduced::{End, EndSensitivity};
 pub struct EndDerivatives {
     /// `d t_end/dp` (the absolute time from release).
     pub t: Vec<f64>,
-    /// `d theta_end/dp`, the reduced coordinate at the end.
+    /// `d theta_end/dp`, the reduced coordinate at the end (empty for a system with none).
     pub theta: Vec<f64>,
-    /// `d theta_dot_end/dp`, its rate at the end (before any jump there).
+    /// `d theta_dot_end/dp`, its rate at the end (before any jump there; empty likewise).
     pub theta_dot: Vec<f64>,
     /// `dt/dp` of each switch of the friction modes inside the phase, in order (absolute
     /// times, as `t`).
@@ -60,23 +60,21 @@ pub enum Stop {
 }
 
 /// The derivatives of a phase's end from its sensitivities (`reduced`: the reduced
-/// coordinate's index; `qd` the velocities at the end).
+/// coordinate's index, where the system has one; `qd` the velocities at the end).
 fn derivatives(
     sens: &EndSensitivity,
-    reduced: usize,
+    reduced: Option<usize>,
     qd: &[f64],
 ) -> Result<EndDerivatives, Grazing> {
     let dt = sens.dt.clone()?;
     let switches = (sens.switches.iter().cloned()).collect::<Result<Vec<_>, _>>()?;
     let n = qd.len();
-    let (theta, theta_dot) = (sens.s.chunks_exact(2 * n).zip(&dt))
-        .map(|(col, dt)| {
-            (
-                col[reduced] + qd[reduced] * dt,
-                col[n + reduced] + sens.qdd[reduced] * dt,
-            )
-        })
-        .unzip();
+    let (theta, theta_dot) = match reduced {
+        Some(r) => (sens.s.chunks_exact(2 * n).zip(&dt))
+            .map(|(col, dt)| (col[r] + qd[r] * dt, col[n + r] + sens.qdd[r] * dt))
+            .unzip(),
+        None => (Vec::new(), Vec::new()),
+    };
     Ok(EndDerivatives {
         t: dt,
         theta,
@@ -155,7 +153,8 @@ impl<'m> Walker<'m> {
             return Ok(Next::Stop(None));
         };
         let end_state = last.full_end_state()?;
-        let end = derivatives(&sens, general.reduced()?.0, &end_state.qd);
+        let reduced = general.info().reduced_index;
+        let end = derivatives(&sens, reduced, &end_state.qd);
         let dt = end.as_ref().ok().map(|e| e.t.clone());
         ends.push(end);
         if motion.complete() {
