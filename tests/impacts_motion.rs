@@ -290,7 +290,7 @@ fn a_run_says_it_reached_its_end_and_refuses_a_bad_one() {
     }
     // A system with no end angle (the rocking block) has no end of its own: a request without
     // `until` is refused before anything is solved, naming what it needs.
-    let block = rodcube::models::find("rocking_block").unwrap();
+    let block = find("rocking_block").unwrap();
     let p = [
         ("m", 1.0),
         ("w", 0.4),
