@@ -107,7 +107,8 @@ fn polish(
     (window, slack): (f64, f64),
     (mut a, mut b): (Point, Point),
 ) -> Result<Polished, SolveError> {
-    if !(slope * (b.1 - a.1) > 0.0) {
+    let runs = slope * (b.1 - a.1);
+    if runs.is_nan() || runs <= 0.0 {
         return Ok(Polished::Bracket(x0, a, b));
     }
     let mut x = x0 + 0.5 * window;

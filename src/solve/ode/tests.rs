@@ -415,7 +415,7 @@ fn an_event_in_the_first_step() {
         assert_eq!((sol.accepted, sol.steps.len()), (1, 1), "{method}");
         // Past the root, within a hundredth of `rtol` of the time integrated (3e-5) from it.
         let late = ev.t - 3e-5;
-        let bound = super::events::EXTENSION_SHARE * 1e-6 * 3e-5;
+        let bound = events::EXTENSION_SHARE * 1e-6 * 3e-5;
         assert!(late >= 0.0 && late <= bound, "{method}: {}", ev.t);
         let mid = sol.interpolate(1.5e-5).unwrap()[0];
         assert!((mid - 1.5e-5).abs() < 1e-18, "{method}: {mid}");
@@ -700,7 +700,7 @@ fn events_on_the_extension_end_past_the_genuine_root_within_the_steps_share() {
                     let last = sol.steps.last().unwrap();
                     let late = last.h - genuine_root(method, &sol, level);
                     let ulps = 4.0 * f64::EPSILON * ev.t.abs();
-                    let bound = super::events::EXTENSION_SHARE * rtol * (ev.t - t0) + ulps;
+                    let bound = events::EXTENSION_SHARE * rtol * (ev.t - t0) + ulps;
                     assert!(
                         late >= -ulps && late <= bound,
                         "{case}: {late:e} > {bound:e}"
