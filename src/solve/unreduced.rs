@@ -682,6 +682,20 @@ impl OdeProblem for Problem<'_, '_> {
         self.watches.len()
     }
 
+    /// A gap or edge margin past its zero is an overlap, which the contact decision after the
+    /// event tolerates only within [`DECIDE_TOLERANCE`] (of the system's length for one in
+    /// metres): half of that. Past their zeros the others are what the event means and what
+    /// follows it expects (a force below zero opens, a slip past zero has stopped, a stuck
+    /// friction beyond `mu N` breaks, the angle past the floor has landed), however far.
+    fn event_slack(&self, index: usize) -> f64 {
+        let info = self.sys.info();
+        match self.watches.get(index) {
+            Some(Watch::Gap(i)) if info.contacts[*i].gap_unit != "m" => 0.5 * DECIDE_TOLERANCE,
+            Some(Watch::Gap(_) | Watch::Edge(_)) => 0.5 * self.arm_at,
+            _ => f64::INFINITY,
+        }
+    }
+
     fn events(&mut self, t: f64, z: &[f64], _dz: &[f64], g: &mut [f64]) -> Result<(), SolveError> {
         self.load(z);
         if !(self.last_valid && self.last_z == z) {

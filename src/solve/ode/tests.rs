@@ -326,12 +326,13 @@ fn step_counts_of_both_methods() {
                 continue;
             }
             // Where DOP853 is chosen it costs fewer evaluations on both problems; where
-            // DOPRI5 is, it costs fewer on the pendulum (the oscillator favours DOP853
-            // from 1e-9 on).
+            // DOPRI5 is, it costs no more on the pendulum (the oscillator favours DOP853
+            // from 1e-9 on; at 1e-10, with events found on the dense output, the two tie on
+            // the pendulum: 247 each).
             match Method::for_rtol(rtol) {
                 Method::Dop853 => assert!(evals[1] < evals[0], "{name} {rtol:e}: {evals:?}"),
                 Method::Dopri5 if pendulum => {
-                    assert!(evals[0] < evals[1], "{name} {rtol:e}: {evals:?}")
+                    assert!(evals[0] <= evals[1], "{name} {rtol:e}: {evals:?}")
                 }
                 Method::Dopri5 => {}
             }
@@ -412,7 +413,10 @@ fn an_event_in_the_first_step() {
         .unwrap();
         let ev = sol.event.clone().unwrap();
         assert_eq!((sol.accepted, sol.steps.len()), (1, 1), "{method}");
-        assert!((ev.t - 3e-5).abs() < 1e-18, "{method}: {}", ev.t);
+        // Past the root, within a hundredth of `rtol` of the time integrated (3e-5) from it.
+        let late = ev.t - 3e-5;
+        let bound = events::EXTENSION_SHARE * 1e-6 * 3e-5;
+        assert!(late >= 0.0 && late <= bound, "{method}: {}", ev.t);
         let mid = sol.interpolate(1.5e-5).unwrap()[0];
         assert!((mid - 1.5e-5).abs() < 1e-18, "{method}: {mid}");
     }
@@ -623,6 +627,118 @@ fn riders_follow_the_steps_without_steering_them() {
                 "{method} at {t}: {s} off by {}",
                 s + t * (w * t).sin()
             );
+        }
+    }
+}
+
+/// The oscillator `y'' = -y` from `y = 0, y' = 1` with the event `y' = level` (first at
+/// `acos(level)`), and how far past its zero the problem lets the event be (`slack`).
+struct Level {
+    level: f64,
+    slack: f64,
+}
+
+impl OdeProblem for Level {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SolveError> {
+        Oscillator.rhs(t, y, dy)
+    }
+    fn n_events(&self) -> usize {
+        1
+    }
+    fn events(&mut self, _t: f64, y: &[f64], _dy: &[f64], g: &mut [f64]) -> Result<(), SolveError> {
+        g[0] = y[1] - self.level;
+        Ok(())
+    }
+    fn event_slack(&self, _index: usize) -> f64 {
+        self.slack
+    }
+}
+
+/// The genuine root of `Level`'s event in the solution's last (crossing) step, as an offset
+/// from its start: bisected on genuine steps of `method` from there, to the last bit.
+fn genuine_root(method: Method, sol: &OdeSolution, level: f64) -> f64 {
+    let last = sol.steps.last().unwrap();
+    let mut st = Stages::new(method.tableau(), 2);
+    let mut p = Level { level, slack: 0.0 };
+    p.rhs(last.t0, &last.y0, &mut st.k[0]).unwrap();
+    let (mut a, mut b) = (0.0, 2.0 * last.h);
+    for _ in 0..200 {
+        let m = 0.5 * (a + b);
+        st.step(&mut p, last.t0, &last.y0, m).unwrap();
+        if st.y1[1] - level > 0.0 { a = m } else { b = m }
+    }
+    b
+}
+
+/// Events found on the continuous extension, across both methods, tolerances from 1e-6 to
+/// 1e-13, event levels over the oscillator's swing and clocks starting at 0 and at 1000 s:
+/// the event's state (a genuine step's) is always past the event function's zero, as the
+/// bracketed search leaves it (what the rod and cube's contact decision after a force's zero
+/// needs: a run whose extension's root lay 8e-9 s before the force's zero, accepted by a
+/// window relative to its 18.5 s clock, found no consistent contacts there); its time lies
+/// within a hundredth of `rtol` of the time integrated past the genuine root, never the clock's
+/// share; and most events take one or two trials.
+#[test]
+fn events_on_the_extension_end_past_the_genuine_root_within_the_steps_share() {
+    let (mut events, mut cheap) = (0, 0);
+    for method in METHODS {
+        for rtol in [1e-6, 1e-8, 1e-10, 1e-12, 1e-13] {
+            for t0 in [0.0, 1000.0] {
+                for level in [-0.9, -0.5, -0.1, 0.3, 0.7] {
+                    let opts = options(rtol, Vec::new(), t0 + 10.0);
+                    let mut p = Level {
+                        level,
+                        slack: f64::INFINITY,
+                    };
+                    let sol = integrate(method, &mut p, t0, &[0.0, 1.0], &opts).unwrap();
+                    let ev = sol.event.clone().unwrap();
+                    let case = format!("{method} rtol {rtol:e} t0 {t0} level {level}");
+                    assert!(ev.y[1] - level <= 0.0, "{case}: {:e}", ev.y[1] - level);
+                    let last = sol.steps.last().unwrap();
+                    let late = last.h - genuine_root(method, &sol, level);
+                    let ulps = 4.0 * f64::EPSILON * ev.t.abs();
+                    let bound = events::EXTENSION_SHARE * rtol * (ev.t - t0) + ulps;
+                    assert!(
+                        late >= -ulps && late <= bound,
+                        "{case}: {late:e} > {bound:e}"
+                    );
+                    let exact = t0 + level.acos();
+                    assert!((ev.t - exact).abs() <= 10.0 * rtol * (ev.t - t0), "{case}");
+                    events += 1;
+                    cheap += usize::from(sol.event_trials <= 2);
+                }
+            }
+        }
+    }
+    assert!(
+        4 * cheap >= 3 * events,
+        "only {cheap} of {events} events in two trials or fewer"
+    );
+}
+
+/// A problem that tolerates nothing past an event function's zero (slack 0) gets every event
+/// bracketed on genuine steps to adjacent floats (unless a trial lands on the zero): the same
+/// side of the zero, within ulps of the genuine root (the default's hundredth of `rtol` of the
+/// time is far more at 1e-8).
+#[test]
+fn no_slack_brackets_every_event_on_genuine_steps() {
+    for method in METHODS {
+        for rtol in [1e-8, 1e-12] {
+            let level = -0.5;
+            let mut p = Level { level, slack: 0.0 };
+            let opts = options(rtol, Vec::new(), 10.0);
+            let sol = integrate(method, &mut p, 0.0, &[0.0, 1.0], &opts).unwrap();
+            let ev = sol.event.clone().unwrap();
+            assert!(ev.y[1] - level <= 0.0, "{method} {rtol:e}");
+            let late = sol.steps.last().unwrap().h - genuine_root(method, &sol, level);
+            let ulps = 4.0 * f64::EPSILON * ev.t.abs();
+            assert!(late.abs() <= ulps, "{method} {rtol:e}: {late:e}");
+            // Two trials only where the Newton step's lands on the zero exactly.
+            let exact = ev.y[1] == level;
+            assert!(sol.event_trials >= 3 || exact, "{method} {rtol:e}");
         }
     }
 }
