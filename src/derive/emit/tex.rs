@@ -200,7 +200,7 @@ pub struct TexContext {
     scales: String,
     /// The results without units, numbered.
     results: Vec<Equation>,
-    /// Whether the model carries its tangents (`Model::tangents`), which are not printed.
+    /// Whether the model carries its tangents (`Tangents::tangent_rows`), which are not printed.
     tangents: bool,
 }
 
@@ -377,7 +377,7 @@ fn constraint_equations(d: &Derivation, name: &dyn Fn(&str) -> String, eqs: &mut
                 tex_text(&c.name),
                 tex_text(&c.meaning),
                 kind,
-                tex_text(&c.gap_unit),
+                tex_text(c.gap_kind.unit()),
                 tex_text(&c.force_unit)
             ),
             format!("g_{{{}}} = ", k + 1),

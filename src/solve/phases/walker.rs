@@ -7,7 +7,7 @@
 use super::motion::{ImpactAt, Motion};
 use super::reduced::{ReducedEnd, ReducedRun, phase_end};
 use super::run::{IntegratedRun, PhaseRun};
-use crate::model::{Model, ModelInfo};
+use crate::model::{GapKind, Model, ModelInfo};
 use crate::results::{Halt, Work, Zeno};
 use crate::solve::SolveError;
 use crate::solve::contacts::{
@@ -583,10 +583,9 @@ impl<'m> Walker<'m> {
             return Ok(None);
         }
         let info = self.general.info();
-        let scale = if info.contacts[closing].gap_unit == "m" {
-            self.general.length_scale(state)?
-        } else {
-            1.0
+        let scale = match info.contacts[closing].gap {
+            GapKind::Length => self.general.length_scale(state)?,
+            GapKind::Angle => 1.0,
         };
         let rise = u * u / (2.0 * pull) / scale;
         Ok((rise < DECIDE_TOLERANCE).then_some((rise, 2.0 * u / pull)))
@@ -686,7 +685,7 @@ fn approaching_touches(sys: &Bound, state: &State) -> Result<Vec<bool>, SolveErr
     let length = sys.length_scale(state)?;
     Ok((info.contacts.iter().enumerate())
         .map(|(i, c)| {
-            let scale = if c.gap_unit == "m" { length } else { 1.0 };
+            let scale = c.gap.scale(length);
             let v = contacts::normal_velocity(&jac[i * n..(i + 1) * n], state);
             !c.closed && !c.bilateral && gaps[i] <= DECIDE_TOLERANCE * scale && v < 0.0
         })
