@@ -5,8 +5,9 @@
 // some of it unused.
 #[allow(unused_imports)]
 use crate::model::{
-    ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo,
-    Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
+    ContactInfo, FrictionInfo, GapKind, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo,
+    Partials, PhaseInfo, Reduced, Reduction, ReductionInfo, RequirementInfo, ShapeInfo, ShapeKind,
+    TangentPoint, Tangents, start_offsets,
 };
 
 /// A uniform rod leaning on a fixed cylinder, its foot sliding on a frictionless floor, released from rest.
@@ -50,13 +51,15 @@ static INFO: ModelInfo = ModelInfo {
         },
     ],
     requirements: &[
-        NamedInfo {
+        RequirementInfo {
             name: "leans_forward",
             meaning: "the rod must lean towards the cylinder (th0 < pi/2)",
+            parameters: &[3],
         },
-        NamedInfo {
+        RequirementInfo {
             name: "touches_the_rod",
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
+            parameters: &[1, 2, 3],
         },
     ],
     n_constants: 22,
@@ -69,7 +72,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "cylinder_push",
             meaning: "push of the cylinder on the rod, normal to the rod, positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: true,
@@ -80,7 +83,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "floor_normal",
             meaning: "the floor's upward push on the rod's foot, positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: false,
@@ -470,24 +473,24 @@ impl Model for FixedCylinder {
         sizes[6] = r;
     }
 
-    fn has_tangents(&self) -> bool {
-        true
+    fn tangents(&self) -> Option<&dyn Tangents> {
+        Some(self)
     }
 
-    /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities (`qdd`, `forces`, `fr` held fixed), row-major.
+    fn reduction(&self) -> Option<&dyn Reduction> {
+        None
+    }
+}
+
+impl Tangents for FixedCylinder {
+    /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities at the point `at` (its accelerations and forces held fixed), row-major.
     ///
     /// 9 rows (3 + 3 x 2 + 2 x 0) by 11 columns (2 x 3 + 5), differentiated symbolically from the expressions of `equations`, `constraints`, `friction`, `gaps` and `edges`.
-    #[allow(clippy::too_many_arguments)]
-    fn tangents(
-        &self,
-        k: &[f64],
-        q: &[f64],
-        qd: &[f64],
-        qdd: &[f64],
-        forces: &[f64],
-        _fr: &[f64],
-        out: &mut [f64],
-    ) {
+    fn tangent_rows(&self, k: &[f64], at: &TangentPoint<'_>, out: &mut [f64]) {
+        let q = at.q;
+        let qd = at.qd;
+        let qdd = at.qdd;
+        let forces = at.forces;
         let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
@@ -563,9 +566,5 @@ impl Model for FixedCylinder {
         out[2] = -k[20];
         out[3] = k[21];
         out[13] = 1.0;
-    }
-
-    fn reduction(&self) -> Option<&dyn Reduction> {
-        None
     }
 }

@@ -5,8 +5,9 @@
 // some of it unused.
 #[allow(unused_imports)]
 use crate::model::{
-    ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo,
-    Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
+    ContactInfo, FrictionInfo, GapKind, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo,
+    Partials, PhaseInfo, Reduced, Reduction, ReductionInfo, RequirementInfo, ShapeInfo, ShapeKind,
+    TangentPoint, Tangents, start_offsets,
 };
 
 /// Phase of `fixed_cylinder` with cylinder_push, floor_normal closed: A uniform rod leaning on a fixed cylinder, its foot sliding on a frictionless floor, released from rest.
@@ -50,13 +51,15 @@ static INFO: ModelInfo = ModelInfo {
         },
     ],
     requirements: &[
-        NamedInfo {
+        RequirementInfo {
             name: "leans_forward",
             meaning: "the rod must lean towards the cylinder (th0 < pi/2)",
+            parameters: &[3],
         },
-        NamedInfo {
+        RequirementInfo {
             name: "touches_the_rod",
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
+            parameters: &[1, 2, 3],
         },
     ],
     n_constants: 37,
@@ -69,7 +72,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "cylinder_push",
             meaning: "push of the cylinder on the rod, normal to the rod, positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: true,
@@ -80,7 +83,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "floor_normal",
             meaning: "the floor's upward push on the rod's foot, positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: false,
@@ -488,6 +491,10 @@ impl Model for FixedCylinderClosed {
         sizes[6] = r;
     }
 
+    fn tangents(&self) -> Option<&dyn Tangents> {
+        None
+    }
+
     fn reduction(&self) -> Option<&dyn Reduction> {
         Some(self)
     }
@@ -622,10 +629,27 @@ impl Reduction for FixedCylinderClosed {
     /// The coefficients, constant term first, of the fall polynomial `P(s) = (sin(theta_i) - s) / theta_dot^2` in `s = sin(theta)`.
     fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
 
-    fn has_partials(&self) -> bool {
-        true
+    fn partials(&self) -> Option<&dyn Partials> {
+        Some(self)
     }
 
+    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
+    fn full_state(
+        &self,
+        k: &[f64],
+        _t: f64,
+        delta: f64,
+        theta_dot: f64,
+        q: &mut [f64],
+        qd: &mut [f64],
+    ) {
+        let k = &k[..37]; // one bounds check for all constant loads
+        q[0] = k[3] - delta;
+        qd[0] = theta_dot;
+    }
+}
+
+impl Partials for FixedCylinderClosed {
     /// `[dF/dtheta, dF/dp_1, ...]` at `sin(theta)`, `cos(theta)`, of the separation condition `F = 0` divided by the coefficient that leaves the parameters in the fewest terms (the implicit-function theorem's `d theta_sep/dp = -F_p / F_theta` is the same for any factor).
     fn separation_partials(&self, _k: &[f64], _rc_s: f64, _rc_c: f64, _out: &mut [f64]) {}
 
@@ -688,19 +712,4 @@ impl Reduction for FixedCylinderClosed {
 
     /// `dP_j/dp` of the fall polynomial's coefficients, parameter by parameter (`j` fastest).
     fn fall_partials(&self, _k: &[f64], _out: &mut [f64]) {}
-
-    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
-    fn full_state(
-        &self,
-        k: &[f64],
-        _t: f64,
-        delta: f64,
-        theta_dot: f64,
-        q: &mut [f64],
-        qd: &mut [f64],
-    ) {
-        let k = &k[..37]; // one bounds check for all constant loads
-        q[0] = k[3] - delta;
-        qd[0] = theta_dot;
-    }
 }

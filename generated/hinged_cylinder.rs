@@ -5,8 +5,9 @@
 // some of it unused.
 #[allow(unused_imports)]
 use crate::model::{
-    ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo,
-    Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
+    ContactInfo, FrictionInfo, GapKind, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo,
+    Partials, PhaseInfo, Reduced, Reduction, ReductionInfo, RequirementInfo, ShapeInfo, ShapeKind,
+    TangentPoint, Tangents, start_offsets,
 };
 
 /// A uniform rod hinged at its foot, leaning on a cylinder that slides without spinning on a frictionless floor, released from rest.
@@ -56,13 +57,15 @@ static INFO: ModelInfo = ModelInfo {
         },
     ],
     requirements: &[
-        NamedInfo {
+        RequirementInfo {
             name: "leans_forward",
             meaning: "the rod must lean towards the cylinder (th0 < pi/2)",
+            parameters: &[4],
         },
-        NamedInfo {
+        RequirementInfo {
             name: "touches_the_rod",
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
+            parameters: &[2, 3, 4],
         },
     ],
     n_constants: 29,
@@ -75,7 +78,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "contact_force",
             meaning: "horizontal push of the rod on the cylinder, positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: true,
@@ -86,7 +89,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "hinge_horizontal",
             meaning: "horizontal force of the hinge on the rod (along +x)",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: true,
             edge: false,
@@ -97,7 +100,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "hinge_vertical",
             meaning: "vertical force of the hinge on the rod (along +y)",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: true,
             edge: false,
@@ -531,24 +534,24 @@ impl Model for HingedCylinder {
         sizes[6] = r;
     }
 
-    fn has_tangents(&self) -> bool {
-        true
+    fn tangents(&self) -> Option<&dyn Tangents> {
+        Some(self)
     }
 
-    /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities (`qdd`, `forces`, `fr` held fixed), row-major.
+    fn reduction(&self) -> Option<&dyn Reduction> {
+        None
+    }
+}
+
+impl Tangents for HingedCylinder {
+    /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities at the point `at` (its accelerations and forces held fixed), row-major.
     ///
     /// 13 rows (4 + 3 x 3 + 2 x 0) by 14 columns (2 x 4 + 6), differentiated symbolically from the expressions of `equations`, `constraints`, `friction`, `gaps` and `edges`.
-    #[allow(clippy::too_many_arguments)]
-    fn tangents(
-        &self,
-        k: &[f64],
-        q: &[f64],
-        qd: &[f64],
-        qdd: &[f64],
-        forces: &[f64],
-        _fr: &[f64],
-        out: &mut [f64],
-    ) {
+    fn tangent_rows(&self, k: &[f64], at: &TangentPoint<'_>, out: &mut [f64]) {
+        let q = at.q;
+        let qd = at.qd;
+        let qdd = at.qdd;
+        let forces = at.forces;
         let k = &k[..29]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
@@ -650,9 +653,5 @@ impl Model for HingedCylinder {
         out[16] = 1.0;
         out[21] = k[27];
         out[22] = -k[28];
-    }
-
-    fn reduction(&self) -> Option<&dyn Reduction> {
-        None
     }
 }

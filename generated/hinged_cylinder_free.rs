@@ -5,8 +5,9 @@
 // some of it unused.
 #[allow(unused_imports)]
 use crate::model::{
-    ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo,
-    Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
+    ContactInfo, FrictionInfo, GapKind, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo,
+    Partials, PhaseInfo, Reduced, Reduction, ReductionInfo, RequirementInfo, ShapeInfo, ShapeKind,
+    TangentPoint, Tangents, start_offsets,
 };
 
 /// Phase of `hinged_cylinder` with hinge_horizontal, hinge_vertical closed: A uniform rod hinged at its foot, leaning on a cylinder that slides without spinning on a frictionless floor, released from rest.
@@ -80,13 +81,15 @@ static INFO: ModelInfo = ModelInfo {
         },
     ],
     requirements: &[
-        NamedInfo {
+        RequirementInfo {
             name: "leans_forward",
             meaning: "the rod must lean towards the cylinder (th0 < pi/2)",
+            parameters: &[4],
         },
-        NamedInfo {
+        RequirementInfo {
             name: "touches_the_rod",
             meaning: "the cylinder must touch the rod itself at release (R cot(th0/2) < ell)",
+            parameters: &[2, 3, 4],
         },
     ],
     n_constants: 27,
@@ -99,7 +102,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "contact_force",
             meaning: "horizontal push of the rod on the cylinder, positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: true,
@@ -110,7 +113,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "hinge_horizontal",
             meaning: "horizontal force of the hinge on the rod (along +x)",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: true,
             edge: false,
@@ -121,7 +124,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "hinge_vertical",
             meaning: "vertical force of the hinge on the rod (along +y)",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: true,
             edge: false,
@@ -478,6 +481,10 @@ impl Model for HingedCylinderFree {
         sizes[6] = r;
     }
 
+    fn tangents(&self) -> Option<&dyn Tangents> {
+        None
+    }
+
     fn reduction(&self) -> Option<&dyn Reduction> {
         Some(self)
     }
@@ -540,10 +547,31 @@ impl Reduction for HingedCylinderFree {
     /// The coefficients, constant term first, of the fall polynomial `P(s) = (sin(theta_i) - s) / theta_dot^2` in `s = sin(theta)`.
     fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
 
-    fn has_partials(&self) -> bool {
-        true
+    fn partials(&self) -> Option<&dyn Partials> {
+        Some(self)
     }
 
+    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
+    fn full_state(
+        &self,
+        k: &[f64],
+        t: f64,
+        delta: f64,
+        theta_dot: f64,
+        q: &mut [f64],
+        qd: &mut [f64],
+    ) {
+        let k = &k[..27]; // one bounds check for all constant loads
+        let xc_0 = k[7];
+        let rc_t = t;
+        q[0] = k[6] - delta;
+        qd[0] = theta_dot;
+        q[1] = xc_0 + (k[26] * rc_t);
+        qd[1] = k[26];
+    }
+}
+
+impl Partials for HingedCylinderFree {
     /// `[dF/dtheta, dF/dp_1, ...]` at `sin(theta)`, `cos(theta)`, of the separation condition `F = 0` divided by the coefficient that leaves the parameters in the fewest terms (the implicit-function theorem's `d theta_sep/dp = -F_p / F_theta` is the same for any factor).
     fn separation_partials(&self, _k: &[f64], _rc_s: f64, _rc_c: f64, _out: &mut [f64]) {}
 
@@ -585,23 +613,4 @@ impl Reduction for HingedCylinderFree {
 
     /// `dP_j/dp` of the fall polynomial's coefficients, parameter by parameter (`j` fastest).
     fn fall_partials(&self, _k: &[f64], _out: &mut [f64]) {}
-
-    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
-    fn full_state(
-        &self,
-        k: &[f64],
-        t: f64,
-        delta: f64,
-        theta_dot: f64,
-        q: &mut [f64],
-        qd: &mut [f64],
-    ) {
-        let k = &k[..27]; // one bounds check for all constant loads
-        let xc_0 = k[7];
-        let rc_t = t;
-        q[0] = k[6] - delta;
-        qd[0] = theta_dot;
-        q[1] = xc_0 + (k[26] * rc_t);
-        qd[1] = k[26];
-    }
 }

@@ -5,8 +5,9 @@
 // some of it unused.
 #[allow(unused_imports)]
 use crate::model::{
-    ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo,
-    Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
+    ContactInfo, FrictionInfo, GapKind, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo,
+    Partials, PhaseInfo, Reduced, Reduction, ReductionInfo, RequirementInfo, ShapeInfo, ShapeKind,
+    TangentPoint, Tangents, start_offsets,
 };
 
 /// Phase of `hinged_rod` with contact_force, hinge_horizontal, hinge_vertical closed: A uniform rod hinged at its foot, leaning on a free cube on a frictionless floor.
@@ -49,9 +50,10 @@ static INFO: ModelInfo = ModelInfo {
             positive: true,
         },
     ],
-    requirements: &[NamedInfo {
+    requirements: &[RequirementInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
+        parameters: &[2, 3],
     }],
     n_constants: 32,
     coordinates: &["theta"],
@@ -63,7 +65,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "contact_force",
             meaning: "push of the rod's tip on the cube, positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: false,
@@ -74,7 +76,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "hinge_horizontal",
             meaning: "horizontal force of the hinge on the rod (along +x)",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: true,
             edge: false,
@@ -85,7 +87,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "hinge_vertical",
             meaning: "vertical force of the hinge on the rod (along +y)",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: true,
             edge: false,
@@ -408,6 +410,10 @@ impl Model for HingedRodClosed {
         sizes[7] = a;
     }
 
+    fn tangents(&self) -> Option<&dyn Tangents> {
+        None
+    }
+
     fn reduction(&self) -> Option<&dyn Reduction> {
         Some(self)
     }
@@ -517,10 +523,27 @@ impl Reduction for HingedRodClosed {
         out[2] = k[31];
     }
 
-    fn has_partials(&self) -> bool {
-        true
+    fn partials(&self) -> Option<&dyn Partials> {
+        Some(self)
     }
 
+    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
+    fn full_state(
+        &self,
+        k: &[f64],
+        _t: f64,
+        delta: f64,
+        theta_dot: f64,
+        q: &mut [f64],
+        qd: &mut [f64],
+    ) {
+        let k = &k[..32]; // one bounds check for all constant loads
+        q[0] = k[5] - delta;
+        qd[0] = theta_dot;
+    }
+}
+
+impl Partials for HingedRodClosed {
     /// `[dF/dtheta, dF/dp_1, ...]` at `sin(theta)`, `cos(theta)`, of the separation condition `F = 0` divided by the coefficient that leaves the parameters in the fewest terms (the implicit-function theorem's `d theta_sep/dp = -F_p / F_theta` is the same for any factor).
     fn separation_partials(&self, k: &[f64], rc_s: f64, rc_c: f64, out: &mut [f64]) {
         let k = &k[..32]; // one bounds check for all constant loads
@@ -589,20 +612,5 @@ impl Reduction for HingedRodClosed {
         out[12] = -ell / 3.0 / (g * g);
         out[13] = 0.0;
         out[14] = -ell * m2 / (g * g) / m1;
-    }
-
-    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
-    fn full_state(
-        &self,
-        k: &[f64],
-        _t: f64,
-        delta: f64,
-        theta_dot: f64,
-        q: &mut [f64],
-        qd: &mut [f64],
-    ) {
-        let k = &k[..32]; // one bounds check for all constant loads
-        q[0] = k[5] - delta;
-        qd[0] = theta_dot;
     }
 }

@@ -5,8 +5,9 @@
 // some of it unused.
 #[allow(unused_imports)]
 use crate::model::{
-    ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo,
-    Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
+    ContactInfo, FrictionInfo, GapKind, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo,
+    Partials, PhaseInfo, Reduced, Reduction, ReductionInfo, RequirementInfo, ShapeInfo, ShapeKind,
+    TangentPoint, Tangents, start_offsets,
 };
 
 /// Phase of `hinged_rod_spring` with contact_force, hinge_horizontal, hinge_vertical closed: A uniform rod hinged at its foot, leaning on a cube that a horizontal spring ties to a fixed wall, on a frictionless floor, released from rest.
@@ -55,9 +56,10 @@ static INFO: ModelInfo = ModelInfo {
             positive: true,
         },
     ],
-    requirements: &[NamedInfo {
+    requirements: &[RequirementInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
+        parameters: &[2, 3],
     }],
     n_constants: 41,
     coordinates: &["theta"],
@@ -69,7 +71,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "contact_force",
             meaning: "push of the rod's tip on the cube, positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: false,
@@ -80,7 +82,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "hinge_horizontal",
             meaning: "horizontal force of the hinge on the rod (along +x)",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: true,
             edge: false,
@@ -91,7 +93,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "hinge_vertical",
             meaning: "vertical force of the hinge on the rod (along +y)",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: true,
             edge: false,
@@ -444,6 +446,10 @@ impl Model for HingedRodSpringClosed {
         sizes[7] = a;
     }
 
+    fn tangents(&self) -> Option<&dyn Tangents> {
+        None
+    }
+
     fn reduction(&self) -> Option<&dyn Reduction> {
         Some(self)
     }
@@ -540,10 +546,27 @@ impl Reduction for HingedRodSpringClosed {
     /// The coefficients, constant term first, of the fall polynomial `P(s) = (sin(theta_i) - s) / theta_dot^2` in `s = sin(theta)`.
     fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
 
-    fn has_partials(&self) -> bool {
-        true
+    fn partials(&self) -> Option<&dyn Partials> {
+        Some(self)
     }
 
+    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
+    fn full_state(
+        &self,
+        k: &[f64],
+        _t: f64,
+        delta: f64,
+        theta_dot: f64,
+        q: &mut [f64],
+        qd: &mut [f64],
+    ) {
+        let k = &k[..41]; // one bounds check for all constant loads
+        q[0] = k[6] - delta;
+        qd[0] = theta_dot;
+    }
+}
+
+impl Partials for HingedRodSpringClosed {
     /// `[dF/dtheta, dF/dp_1, ...]` at `sin(theta)`, `cos(theta)`, of the separation condition `F = 0` divided by the coefficient that leaves the parameters in the fewest terms (the implicit-function theorem's `d theta_sep/dp = -F_p / F_theta` is the same for any factor).
     fn separation_partials(&self, _k: &[f64], _rc_s: f64, _rc_c: f64, _out: &mut [f64]) {}
 
@@ -630,19 +653,4 @@ impl Reduction for HingedRodSpringClosed {
 
     /// `dP_j/dp` of the fall polynomial's coefficients, parameter by parameter (`j` fastest).
     fn fall_partials(&self, _k: &[f64], _out: &mut [f64]) {}
-
-    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
-    fn full_state(
-        &self,
-        k: &[f64],
-        _t: f64,
-        delta: f64,
-        theta_dot: f64,
-        q: &mut [f64],
-        qd: &mut [f64],
-    ) {
-        let k = &k[..41]; // one bounds check for all constant loads
-        q[0] = k[6] - delta;
-        qd[0] = theta_dot;
-    }
 }

@@ -5,8 +5,9 @@
 // some of it unused.
 #[allow(unused_imports)]
 use crate::model::{
-    ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo,
-    Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
+    ContactInfo, FrictionInfo, GapKind, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo,
+    Partials, PhaseInfo, Reduced, Reduction, ReductionInfo, RequirementInfo, ShapeInfo, ShapeKind,
+    TangentPoint, Tangents, start_offsets,
 };
 
 /// A uniform ladder sliding down a fixed wall on a floor, with Coulomb friction at both, released from rest.
@@ -55,9 +56,10 @@ static INFO: ModelInfo = ModelInfo {
             positive: false,
         },
     ],
-    requirements: &[NamedInfo {
+    requirements: &[RequirementInfo {
         name: "ladder_leans",
         meaning: "the top must start below the ladder's length (a < ell)",
+        parameters: &[1, 2],
     }],
     n_constants: 27,
     coordinates: &["x1", "y1", "theta"],
@@ -69,7 +71,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "wall_push",
             meaning: "push of the wall on the ladder's top (along -x), positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: false,
@@ -80,7 +82,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "floor_normal",
             meaning: "the floor's upward push on the ladder's foot, positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: false,
@@ -442,24 +444,25 @@ impl Model for LadderFriction {
         sizes[7] = k[15];
     }
 
-    fn has_tangents(&self) -> bool {
-        true
+    fn tangents(&self) -> Option<&dyn Tangents> {
+        Some(self)
     }
 
-    /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities (`qdd`, `forces`, `fr` held fixed), row-major.
+    fn reduction(&self) -> Option<&dyn Reduction> {
+        None
+    }
+}
+
+impl Tangents for LadderFriction {
+    /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities at the point `at` (its accelerations and forces held fixed), row-major.
     ///
     /// 13 rows (3 + 3 x 2 + 2 x 2) by 12 columns (2 x 3 + 6), differentiated symbolically from the expressions of `equations`, `constraints`, `friction`, `gaps` and `edges`.
-    #[allow(clippy::too_many_arguments)]
-    fn tangents(
-        &self,
-        k: &[f64],
-        q: &[f64],
-        qd: &[f64],
-        qdd: &[f64],
-        forces: &[f64],
-        fr: &[f64],
-        out: &mut [f64],
-    ) {
+    fn tangent_rows(&self, k: &[f64], at: &TangentPoint<'_>, out: &mut [f64]) {
+        let q = at.q;
+        let qd = at.qd;
+        let qdd = at.qdd;
+        let forces = at.forces;
+        let fr = at.friction;
         let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
@@ -521,9 +524,5 @@ impl Model for LadderFriction {
         out[2] = -k[24];
         out[13] = -k[25];
         out[14] = k[26];
-    }
-
-    fn reduction(&self) -> Option<&dyn Reduction> {
-        None
     }
 }

@@ -5,8 +5,9 @@
 // some of it unused.
 #[allow(unused_imports)]
 use crate::model::{
-    ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo,
-    Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
+    ContactInfo, FrictionInfo, GapKind, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo,
+    Partials, PhaseInfo, Reduced, Reduction, ReductionInfo, RequirementInfo, ShapeInfo, ShapeKind,
+    TangentPoint, Tangents, start_offsets,
 };
 
 /// Phase of `loaded_rod` with contact_force, floor_normal closed: A uniform rod with a point load at its upper end, leaning on a free cube on a frictionless floor, released from rest.
@@ -55,9 +56,10 @@ static INFO: ModelInfo = ModelInfo {
             positive: true,
         },
     ],
-    requirements: &[NamedInfo {
+    requirements: &[RequirementInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
+        parameters: &[3, 4],
     }],
     n_constants: 46,
     coordinates: &["x1", "theta"],
@@ -69,7 +71,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "contact_force",
             meaning: "push of the rod's tip on the cube, positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: false,
@@ -80,7 +82,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "floor_normal",
             meaning: "the floor's upward push on the rod's foot, positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: false,
@@ -534,6 +536,10 @@ impl Model for LoadedRodClosed {
         sizes[7] = a;
     }
 
+    fn tangents(&self) -> Option<&dyn Tangents> {
+        None
+    }
+
     fn reduction(&self) -> Option<&dyn Reduction> {
         Some(self)
     }
@@ -720,10 +726,31 @@ impl Reduction for LoadedRodClosed {
         out[2] = -k[42];
     }
 
-    fn has_partials(&self) -> bool {
-        true
+    fn partials(&self) -> Option<&dyn Partials> {
+        Some(self)
     }
 
+    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
+    fn full_state(
+        &self,
+        k: &[f64],
+        _t: f64,
+        delta: f64,
+        theta_dot: f64,
+        q: &mut [f64],
+        qd: &mut [f64],
+    ) {
+        let k = &k[..46]; // one bounds check for all constant loads
+        let (rc_s, _, _, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
+        let rc_w = theta_dot;
+        q[1] = k[6] - delta;
+        qd[1] = theta_dot;
+        q[0] = k[10] + (k[43] * rc_dc);
+        qd[0] = k[43] * rc_s * rc_w;
+    }
+}
+
+impl Partials for LoadedRodClosed {
     /// `[dF/dtheta, dF/dp_1, ...]` at `sin(theta)`, `cos(theta)`, of the separation condition `F = 0` divided by the coefficient that leaves the parameters in the fewest terms (the implicit-function theorem's `d theta_sep/dp = -F_p / F_theta` is the same for any factor).
     fn separation_partials(&self, k: &[f64], rc_s: f64, rc_c: f64, out: &mut [f64]) {
         let k = &k[..46]; // one bounds check for all constant loads
@@ -948,24 +975,5 @@ impl Reduction for LoadedRodClosed {
             / (g * g)
             / dt0
             / dt5;
-    }
-
-    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
-    fn full_state(
-        &self,
-        k: &[f64],
-        _t: f64,
-        delta: f64,
-        theta_dot: f64,
-        q: &mut [f64],
-        qd: &mut [f64],
-    ) {
-        let k = &k[..46]; // one bounds check for all constant loads
-        let (rc_s, _, _, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
-        let rc_w = theta_dot;
-        q[1] = k[6] - delta;
-        qd[1] = theta_dot;
-        q[0] = k[10] + (k[43] * rc_dc);
-        qd[0] = k[43] * rc_s * rc_w;
     }
 }

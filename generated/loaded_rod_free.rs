@@ -5,8 +5,9 @@
 // some of it unused.
 #[allow(unused_imports)]
 use crate::model::{
-    ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo,
-    Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
+    ContactInfo, FrictionInfo, GapKind, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo,
+    Partials, PhaseInfo, Reduced, Reduction, ReductionInfo, RequirementInfo, ShapeInfo, ShapeKind,
+    TangentPoint, Tangents, start_offsets,
 };
 
 /// Phase of `loaded_rod` with floor_normal closed: A uniform rod with a point load at its upper end, leaning on a free cube on a frictionless floor, released from rest.
@@ -91,9 +92,10 @@ static INFO: ModelInfo = ModelInfo {
             positive: false,
         },
     ],
-    requirements: &[NamedInfo {
+    requirements: &[RequirementInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
+        parameters: &[3, 4],
     }],
     n_constants: 47,
     coordinates: &["x1", "theta", "x2"],
@@ -105,7 +107,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "contact_force",
             meaning: "push of the rod's tip on the cube, positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: false,
@@ -116,7 +118,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "floor_normal",
             meaning: "the floor's upward push on the rod's foot, positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: false,
@@ -566,6 +568,10 @@ impl Model for LoadedRodFree {
         sizes[7] = a;
     }
 
+    fn tangents(&self) -> Option<&dyn Tangents> {
+        None
+    }
+
     fn reduction(&self) -> Option<&dyn Reduction> {
         Some(self)
     }
@@ -676,10 +682,36 @@ impl Reduction for LoadedRodFree {
     /// The coefficients, constant term first, of the fall polynomial `P(s) = (sin(theta_i) - s) / theta_dot^2` in `s = sin(theta)`.
     fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
 
-    fn has_partials(&self) -> bool {
-        true
+    fn partials(&self) -> Option<&dyn Partials> {
+        Some(self)
     }
 
+    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
+    fn full_state(
+        &self,
+        k: &[f64],
+        t: f64,
+        delta: f64,
+        theta_dot: f64,
+        q: &mut [f64],
+        qd: &mut [f64],
+    ) {
+        let k = &k[..47]; // one bounds check for all constant loads
+        let x1_0 = k[6];
+        let x2_0 = k[8];
+        let (rc_s, _, _, rc_dc) = start_offsets(k[7], k[12], k[13], delta);
+        let rc_t = t;
+        let rc_w = theta_dot;
+        q[1] = k[7] - delta;
+        qd[1] = theta_dot;
+        q[0] = x1_0 + (k[18] * rc_dc) + (k[43] * rc_t);
+        qd[0] = k[43] + (k[18] * rc_s * rc_w);
+        q[2] = x2_0 + (k[44] * rc_t);
+        qd[2] = k[44];
+    }
+}
+
+impl Partials for LoadedRodFree {
     /// `[dF/dtheta, dF/dp_1, ...]` at `sin(theta)`, `cos(theta)`, of the separation condition `F = 0` divided by the coefficient that leaves the parameters in the fewest terms (the implicit-function theorem's `d theta_sep/dp = -F_p / F_theta` is the same for any factor).
     fn separation_partials(&self, _k: &[f64], _rc_s: f64, _rc_c: f64, _out: &mut [f64]) {}
 
@@ -799,28 +831,4 @@ impl Reduction for LoadedRodFree {
 
     /// `dP_j/dp` of the fall polynomial's coefficients, parameter by parameter (`j` fastest).
     fn fall_partials(&self, _k: &[f64], _out: &mut [f64]) {}
-
-    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
-    fn full_state(
-        &self,
-        k: &[f64],
-        t: f64,
-        delta: f64,
-        theta_dot: f64,
-        q: &mut [f64],
-        qd: &mut [f64],
-    ) {
-        let k = &k[..47]; // one bounds check for all constant loads
-        let x1_0 = k[6];
-        let x2_0 = k[8];
-        let (rc_s, _, _, rc_dc) = start_offsets(k[7], k[12], k[13], delta);
-        let rc_t = t;
-        let rc_w = theta_dot;
-        q[1] = k[7] - delta;
-        qd[1] = theta_dot;
-        q[0] = x1_0 + (k[18] * rc_dc) + (k[43] * rc_t);
-        qd[0] = k[43] + (k[18] * rc_s * rc_w);
-        q[2] = x2_0 + (k[44] * rc_t);
-        qd[2] = k[44];
-    }
 }

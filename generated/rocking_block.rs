@@ -5,8 +5,9 @@
 // some of it unused.
 #[allow(unused_imports)]
 use crate::model::{
-    ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo,
-    Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
+    ContactInfo, FrictionInfo, GapKind, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo,
+    Partials, PhaseInfo, Reduced, Reduction, ReductionInfo, RequirementInfo, ShapeInfo, ShapeKind,
+    TangentPoint, Tangents, start_offsets,
 };
 
 /// A rigid block rocking on a floor with friction and restitution at its two bottom corners, released from rest tilted onto its left corner.
@@ -61,9 +62,10 @@ static INFO: ModelInfo = ModelInfo {
             positive: false,
         },
     ],
-    requirements: &[NamedInfo {
+    requirements: &[RequirementInfo {
         name: "falls_back",
         meaning: "the tilt must be below the block's slenderness angle atan(w/h) so that it falls back (phi0 < atan(w/h))",
+        parameters: &[1, 2, 3],
     }],
     n_constants: 22,
     coordinates: &["x", "y", "phi"],
@@ -75,7 +77,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "left_corner",
             meaning: "the floor's upward push on the block's left bottom corner, positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: false,
@@ -86,7 +88,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "right_corner",
             meaning: "the floor's upward push on the block's right bottom corner, positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: false,
@@ -425,24 +427,25 @@ impl Model for RockingBlock {
         sizes[3] = h;
     }
 
-    fn has_tangents(&self) -> bool {
-        true
+    fn tangents(&self) -> Option<&dyn Tangents> {
+        Some(self)
     }
 
-    /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities (`qdd`, `forces`, `fr` held fixed), row-major.
+    fn reduction(&self) -> Option<&dyn Reduction> {
+        None
+    }
+}
+
+impl Tangents for RockingBlock {
+    /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities at the point `at` (its accelerations and forces held fixed), row-major.
     ///
     /// 13 rows (3 + 3 x 2 + 2 x 2) by 13 columns (2 x 3 + 7), differentiated symbolically from the expressions of `equations`, `constraints`, `friction`, `gaps` and `edges`.
-    #[allow(clippy::too_many_arguments)]
-    fn tangents(
-        &self,
-        k: &[f64],
-        q: &[f64],
-        qd: &[f64],
-        qdd: &[f64],
-        forces: &[f64],
-        fr: &[f64],
-        out: &mut [f64],
-    ) {
+    fn tangent_rows(&self, k: &[f64], at: &TangentPoint<'_>, out: &mut [f64]) {
+        let q = at.q;
+        let qd = at.qd;
+        let qdd = at.qdd;
+        let forces = at.forces;
+        let fr = at.friction;
         let k = &k[..22]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m = k[0];
@@ -525,9 +528,5 @@ impl Model for RockingBlock {
         out[9] = k[18];
         out[10] = -k[21];
         out[17] = 1.0;
-    }
-
-    fn reduction(&self) -> Option<&dyn Reduction> {
-        None
     }
 }

@@ -5,8 +5,9 @@
 // some of it unused.
 #[allow(unused_imports)]
 use crate::model::{
-    ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo,
-    Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
+    ContactInfo, FrictionInfo, GapKind, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo,
+    Partials, PhaseInfo, Reduced, Reduction, ReductionInfo, RequirementInfo, ShapeInfo, ShapeKind,
+    TangentPoint, Tangents, start_offsets,
 };
 
 /// A uniform rod leaning on a free cube on a frictionless floor, released from rest.
@@ -49,9 +50,10 @@ static INFO: ModelInfo = ModelInfo {
             positive: true,
         },
     ],
-    requirements: &[NamedInfo {
+    requirements: &[RequirementInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
+        parameters: &[2, 3],
     }],
     n_constants: 28,
     coordinates: &["x1", "y1", "theta", "x2"],
@@ -63,7 +65,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "contact_force",
             meaning: "push of the rod's tip on the cube, positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: false,
@@ -74,7 +76,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "floor_normal",
             meaning: "the floor's upward push on the rod's foot, positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: false,
@@ -475,24 +477,24 @@ impl Model for RodCube {
         sizes[7] = a;
     }
 
-    fn has_tangents(&self) -> bool {
-        true
+    fn tangents(&self) -> Option<&dyn Tangents> {
+        Some(self)
     }
 
-    /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities (`qdd`, `forces`, `fr` held fixed), row-major.
+    fn reduction(&self) -> Option<&dyn Reduction> {
+        None
+    }
+}
+
+impl Tangents for RodCube {
+    /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities at the point `at` (its accelerations and forces held fixed), row-major.
     ///
     /// 10 rows (4 + 3 x 2 + 2 x 0) by 13 columns (2 x 4 + 5), differentiated symbolically from the expressions of `equations`, `constraints`, `friction`, `gaps` and `edges`.
-    #[allow(clippy::too_many_arguments)]
-    fn tangents(
-        &self,
-        k: &[f64],
-        q: &[f64],
-        qd: &[f64],
-        qdd: &[f64],
-        forces: &[f64],
-        _fr: &[f64],
-        out: &mut [f64],
-    ) {
+    fn tangent_rows(&self, k: &[f64], at: &TangentPoint<'_>, out: &mut [f64]) {
+        let q = at.q;
+        let qd = at.qd;
+        let qdd = at.qdd;
+        let forces = at.forces;
         let k = &k[..28]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
@@ -547,9 +549,5 @@ impl Model for RodCube {
         out[13] = k[25];
         out[17] = k[26];
         out[18] = k[27];
-    }
-
-    fn reduction(&self) -> Option<&dyn Reduction> {
-        None
     }
 }

@@ -5,8 +5,9 @@
 // some of it unused.
 #[allow(unused_imports)]
 use crate::model::{
-    ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo,
-    Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
+    ContactInfo, FrictionInfo, GapKind, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo,
+    Partials, PhaseInfo, Reduced, Reduction, ReductionInfo, RequirementInfo, ShapeInfo, ShapeKind,
+    TangentPoint, Tangents, start_offsets,
 };
 
 /// A uniform ladder sliding down a fixed frictionless wall on a frictionless floor.
@@ -43,9 +44,10 @@ static INFO: ModelInfo = ModelInfo {
             positive: true,
         },
     ],
-    requirements: &[NamedInfo {
+    requirements: &[RequirementInfo {
         name: "ladder_leans",
         meaning: "the top must start below the ladder's length (a < ell)",
+        parameters: &[1, 2],
     }],
     n_constants: 25,
     coordinates: &["x1", "y1", "theta"],
@@ -57,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "contact_force",
             meaning: "push of the wall on the ladder, positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: false,
@@ -68,7 +70,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "floor_normal",
             meaning: "the floor's upward push on the ladder's foot, positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: false,
@@ -431,24 +433,24 @@ impl Model for WallLadder {
         sizes[7] = k[13];
     }
 
-    fn has_tangents(&self) -> bool {
-        true
+    fn tangents(&self) -> Option<&dyn Tangents> {
+        Some(self)
     }
 
-    /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities (`qdd`, `forces`, `fr` held fixed), row-major.
+    fn reduction(&self) -> Option<&dyn Reduction> {
+        None
+    }
+}
+
+impl Tangents for WallLadder {
+    /// The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities at the point `at` (its accelerations and forces held fixed), row-major.
     ///
     /// 9 rows (3 + 3 x 2 + 2 x 0) by 10 columns (2 x 3 + 4), differentiated symbolically from the expressions of `equations`, `constraints`, `friction`, `gaps` and `edges`.
-    #[allow(clippy::too_many_arguments)]
-    fn tangents(
-        &self,
-        k: &[f64],
-        q: &[f64],
-        qd: &[f64],
-        qdd: &[f64],
-        forces: &[f64],
-        _fr: &[f64],
-        out: &mut [f64],
-    ) {
+    fn tangent_rows(&self, k: &[f64], at: &TangentPoint<'_>, out: &mut [f64]) {
+        let q = at.q;
+        let qd = at.qd;
+        let qdd = at.qdd;
+        let forces = at.forces;
         let k = &k[..25]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
@@ -500,9 +502,5 @@ impl Model for WallLadder {
         out[2] = -k[22];
         out[9] = -k[23];
         out[10] = k[24];
-    }
-
-    fn reduction(&self) -> Option<&dyn Reduction> {
-        None
     }
 }

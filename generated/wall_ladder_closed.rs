@@ -5,8 +5,9 @@
 // some of it unused.
 #[allow(unused_imports)]
 use crate::model::{
-    ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo,
-    Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
+    ContactInfo, FrictionInfo, GapKind, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo,
+    Partials, PhaseInfo, Reduced, Reduction, ReductionInfo, RequirementInfo, ShapeInfo, ShapeKind,
+    TangentPoint, Tangents, start_offsets,
 };
 
 /// Phase of `wall_ladder` with contact_force, floor_normal closed: A uniform ladder sliding down a fixed frictionless wall on a frictionless floor.
@@ -43,9 +44,10 @@ static INFO: ModelInfo = ModelInfo {
             positive: true,
         },
     ],
-    requirements: &[NamedInfo {
+    requirements: &[RequirementInfo {
         name: "ladder_leans",
         meaning: "the top must start below the ladder's length (a < ell)",
+        parameters: &[1, 2],
     }],
     n_constants: 20,
     coordinates: &["theta"],
@@ -57,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "contact_force",
             meaning: "push of the wall on the ladder, positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: false,
@@ -68,7 +70,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "floor_normal",
             meaning: "the floor's upward push on the ladder's foot, positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: false,
@@ -355,6 +357,10 @@ impl Model for WallLadderClosed {
         sizes[7] = k[19];
     }
 
+    fn tangents(&self) -> Option<&dyn Tangents> {
+        None
+    }
+
     fn reduction(&self) -> Option<&dyn Reduction> {
         Some(self)
     }
@@ -446,10 +452,27 @@ impl Reduction for WallLadderClosed {
         out[0] = k[18];
     }
 
-    fn has_partials(&self) -> bool {
-        true
+    fn partials(&self) -> Option<&dyn Partials> {
+        Some(self)
     }
 
+    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
+    fn full_state(
+        &self,
+        k: &[f64],
+        _t: f64,
+        delta: f64,
+        theta_dot: f64,
+        q: &mut [f64],
+        qd: &mut [f64],
+    ) {
+        let k = &k[..20]; // one bounds check for all constant loads
+        q[0] = k[4] - delta;
+        qd[0] = theta_dot;
+    }
+}
+
+impl Partials for WallLadderClosed {
     /// `[dF/dtheta, dF/dp_1, ...]` at `sin(theta)`, `cos(theta)`, of the separation condition `F = 0` divided by the coefficient that leaves the parameters in the fewest terms (the implicit-function theorem's `d theta_sep/dp = -F_p / F_theta` is the same for any factor).
     fn separation_partials(&self, k: &[f64], rc_s: f64, rc_c: f64, out: &mut [f64]) {
         let k = &k[..20]; // one bounds check for all constant loads
@@ -494,20 +517,5 @@ impl Reduction for WallLadderClosed {
         out[1] = 1.0 / 3.0 / g;
         out[2] = 0.0;
         out[3] = -ell / 3.0 / (g * g);
-    }
-
-    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
-    fn full_state(
-        &self,
-        k: &[f64],
-        _t: f64,
-        delta: f64,
-        theta_dot: f64,
-        q: &mut [f64],
-        qd: &mut [f64],
-    ) {
-        let k = &k[..20]; // one bounds check for all constant loads
-        q[0] = k[4] - delta;
-        qd[0] = theta_dot;
     }
 }

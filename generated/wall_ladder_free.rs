@@ -5,8 +5,9 @@
 // some of it unused.
 #[allow(unused_imports)]
 use crate::model::{
-    ContactInfo, FrictionInfo, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo,
-    Reduced, Reduction, ReductionInfo, ShapeInfo, ShapeKind, start_offsets,
+    ContactInfo, FrictionInfo, GapKind, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo,
+    Partials, PhaseInfo, Reduced, Reduction, ReductionInfo, RequirementInfo, ShapeInfo, ShapeKind,
+    TangentPoint, Tangents, start_offsets,
 };
 
 /// Phase of `wall_ladder` with floor_normal closed: A uniform ladder sliding down a fixed frictionless wall on a frictionless floor.
@@ -67,9 +68,10 @@ static INFO: ModelInfo = ModelInfo {
             positive: false,
         },
     ],
-    requirements: &[NamedInfo {
+    requirements: &[RequirementInfo {
         name: "ladder_leans",
         meaning: "the top must start below the ladder's length (a < ell)",
+        parameters: &[1, 2],
     }],
     n_constants: 30,
     coordinates: &["x1", "theta"],
@@ -81,7 +83,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "contact_force",
             meaning: "push of the wall on the ladder, positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: false,
@@ -92,7 +94,7 @@ static INFO: ModelInfo = ModelInfo {
         ContactInfo {
             name: "floor_normal",
             meaning: "the floor's upward push on the ladder's foot, positive while they touch",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: false,
@@ -430,6 +432,10 @@ impl Model for WallLadderFree {
         sizes[7] = k[29];
     }
 
+    fn tangents(&self) -> Option<&dyn Tangents> {
+        None
+    }
+
     fn reduction(&self) -> Option<&dyn Reduction> {
         Some(self)
     }
@@ -525,10 +531,33 @@ impl Reduction for WallLadderFree {
     /// The coefficients, constant term first, of the fall polynomial `P(s) = (sin(theta_i) - s) / theta_dot^2` in `s = sin(theta)`.
     fn fall_polynomial(&self, _k: &[f64], _out: &mut [f64]) {}
 
-    fn has_partials(&self) -> bool {
-        true
+    fn partials(&self) -> Option<&dyn Partials> {
+        Some(self)
     }
 
+    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
+    fn full_state(
+        &self,
+        k: &[f64],
+        t: f64,
+        delta: f64,
+        theta_dot: f64,
+        q: &mut [f64],
+        qd: &mut [f64],
+    ) {
+        let k = &k[..30]; // one bounds check for all constant loads
+        let x1_0 = k[4];
+        let (rc_s, _, _, rc_dc) = start_offsets(k[5], k[8], k[9], delta);
+        let rc_t = t;
+        let rc_w = theta_dot;
+        q[1] = k[5] - delta;
+        qd[1] = theta_dot;
+        q[0] = x1_0 + (k[12] * rc_dc) + (k[28] * rc_t);
+        qd[0] = k[28] + (k[12] * rc_s * rc_w);
+    }
+}
+
+impl Partials for WallLadderFree {
     /// `[dF/dtheta, dF/dp_1, ...]` at `sin(theta)`, `cos(theta)`, of the separation condition `F = 0` divided by the coefficient that leaves the parameters in the fewest terms (the implicit-function theorem's `d theta_sep/dp = -F_p / F_theta` is the same for any factor).
     fn separation_partials(&self, _k: &[f64], _rc_s: f64, _rc_c: f64, _out: &mut [f64]) {}
 
@@ -570,25 +599,4 @@ impl Reduction for WallLadderFree {
 
     /// `dP_j/dp` of the fall polynomial's coefficients, parameter by parameter (`j` fastest).
     fn fall_partials(&self, _k: &[f64], _out: &mut [f64]) {}
-
-    /// The full state on the reduced motion: `theta = theta_i - delta`, its rate, and the cyclic coordinates from their conserved momenta.
-    fn full_state(
-        &self,
-        k: &[f64],
-        t: f64,
-        delta: f64,
-        theta_dot: f64,
-        q: &mut [f64],
-        qd: &mut [f64],
-    ) {
-        let k = &k[..30]; // one bounds check for all constant loads
-        let x1_0 = k[4];
-        let (rc_s, _, _, rc_dc) = start_offsets(k[5], k[8], k[9], delta);
-        let rc_t = t;
-        let rc_w = theta_dot;
-        q[1] = k[5] - delta;
-        qd[1] = theta_dot;
-        q[0] = x1_0 + (k[12] * rc_dc) + (k[28] * rc_t);
-        qd[0] = k[28] + (k[12] * rc_s * rc_w);
-    }
 }

@@ -1142,6 +1142,7 @@ mod tests {
             SensitivityGap::NoPartials,
             SensitivityGap::NoFallPolynomial,
             SensitivityGap::DoubleRoot,
+            SensitivityGap::NoUnit,
         ] {
             let Failure(code, message) = gap.into();
             assert_eq!(code, RODCUBE_ERR_NO_SENSITIVITY, "{gap:?}");

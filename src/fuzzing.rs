@@ -496,6 +496,7 @@ fn edit_digit(r: &mut Reader, v: &mut serde_json::Value) -> Result<(), String> {
 /// most `tape::MAX_LENGTH`, so that any caller can size it), on inputs made from its prepared
 /// constants.
 pub fn exercise(model: &dyn crate::model::Model) {
+    use crate::model::TangentPoint;
     use crate::tape::MAX_LENGTH;
     let info = model.info();
     let (n, np, m) = (
@@ -572,9 +573,17 @@ pub fn exercise(model: &dyn crate::model::Model) {
     model.monitors_full(&k, &q, &qd, &forces, &mut out(info.monitors.len()));
     model.to_full(&k, &q, &qd, &mut out(ns), &mut out(ns));
     model.drawing(&k, &q, &mut vec![[0.0; 3]; nb], &mut out(sizes));
-    let _ = model.has_tangents();
-    model.tangents(&k, &q, &qd, &qdd, &forces, &fr, &mut out(tangents));
-    model.initial_tangents(&k, &mut out(initial_tangents));
+    if let Some(t) = model.tangents() {
+        let at = TangentPoint {
+            q: &q,
+            qd: &qd,
+            qdd: &qdd,
+            forces: &forces,
+            friction: &fr,
+        };
+        t.tangent_rows(&k, &at, &mut out(tangents));
+        t.initial_tangents(&k, &mut out(initial_tangents));
+    }
     let _ = model.lean_start(&p);
     let (Some(red), Some(layout)) = (model.reduction(), info.reduction.as_ref()) else {
         return;
@@ -589,10 +598,11 @@ pub fn exercise(model: &dyn crate::model::Model) {
     red.fall_polynomial(&k, &mut out(fall));
     let mut lean = out(info.n_constants);
     red.prepare_lean(&p, &mut lean);
-    let _ = red.has_partials();
-    red.separation_partials(&k, 0.2, 0.9, &mut out(np + 1));
-    red.theta_dot_sq_partials(&k, 0.2, 0.9, &mut out(np));
-    red.start_partials(&k, &mut out(np));
-    red.fall_partials(&k, &mut out(checked("fall_partials", fall.checked_mul(np))));
+    if let Some(d) = red.partials() {
+        d.separation_partials(&k, 0.2, 0.9, &mut out(np + 1));
+        d.theta_dot_sq_partials(&k, 0.2, 0.9, &mut out(np));
+        d.start_partials(&k, &mut out(np));
+        d.fall_partials(&k, &mut out(checked("fall_partials", fall.checked_mul(np))));
+    }
     red.full_state(&k, 0.05, 0.1, -0.3, &mut out(n), &mut out(n));
 }

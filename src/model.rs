@@ -41,7 +41,7 @@ pub struct ParamInfo {
     pub positive: bool,
 }
 
-/// A named quantity emitted by the generator (force, point, monitor or requirement).
+/// A named quantity emitted by the generator (force or point).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct NamedInfo {
     /// Identifier used in results, CSV columns and JSON keys.
@@ -95,6 +95,48 @@ pub struct ShapeInfo {
     pub first: usize,
 }
 
+/// What a contact's gap measures, from the spec's units: its tolerances scale with the
+/// system's length for a distance and not for an angle.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GapKind {
+    /// A distance, in metres (its force in newtons).
+    Length,
+    /// An angle, in radians (its force a torque, in newton metres).
+    Angle,
+}
+
+impl GapKind {
+    /// The unit of such a gap: `m` or `rad`.
+    pub const fn unit(self) -> &'static str {
+        match self {
+            GapKind::Length => "m",
+            GapKind::Angle => "rad",
+        }
+    }
+
+    /// What a tolerance on such a gap, given relative to the system's `length`, is in the
+    /// gap's unit: `length` times it for a distance, itself for an angle.
+    pub fn scale(self, length: f64) -> f64 {
+        match self {
+            GapKind::Length => length,
+            GapKind::Angle => 1.0,
+        }
+    }
+}
+
+/// A requirement on the parameters: a margin, formed from some of them, that must be strictly
+/// positive.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RequirementInfo {
+    /// Identifier used in messages and reports.
+    pub name: &'static str,
+    /// What it means, for people.
+    pub meaning: &'static str,
+    /// Indices in [`ModelInfo::parameters`] of the parameters its margin is formed from,
+    /// ascending (the derivation reads them off the spec's expression).
+    pub parameters: &'static [usize],
+}
+
 /// A contact of the system: a unilateral constraint `gap(q) >= 0` (or a bilateral one,
 /// `gap(q) = 0` for good) whose force is its Lagrange multiplier. Every model of a system lists
 /// the same contacts, in the spec's order; [`ContactInfo::closed`] says whether this model
@@ -105,8 +147,8 @@ pub struct ContactInfo {
     pub name: &'static str,
     /// What its force is, with its sign convention.
     pub meaning: &'static str,
-    /// Unit of its gap (`m`).
-    pub gap_unit: &'static str,
+    /// What its gap measures: a distance (in `m`) or an angle (in `rad`).
+    pub gap: GapKind,
     /// Unit of its force, conjugate to the gap (`N`; `N m` for a gap in radians).
     pub unit: &'static str,
     /// A joint: always closed, its force of either sign.
@@ -210,7 +252,7 @@ pub struct ModelInfo {
     /// Parameters in the order every function expects them.
     pub parameters: &'static [ParamInfo],
     /// Requirements on the parameters, each a margin that must be strictly positive.
-    pub requirements: &'static [NamedInfo],
+    pub requirements: &'static [RequirementInfo],
     /// Length of the prepared-constant vector `k`.
     pub n_constants: usize,
     /// Generalized coordinates of this model (the system's, without those it eliminates).
@@ -468,51 +510,10 @@ pub trait Model: Send + Sync {
     /// `poses.len()` is the number of bodies, `sizes.len()` [`ModelInfo::drawing_sizes`].
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]);
 
-    /// Whether the model has [`Model::tangents`] and [`Model::initial_tangents`] (every
-    /// generated general model does: the integrated phases' forward sensitivities need them; a
-    /// fast phase or a hand-written test model has none).
-    fn has_tangents(&self) -> bool {
-        false
-    }
-
-    /// Partial derivatives over `x = [q, qd, p]` (`2 n + np` columns, `np` the parameters of
-    /// [`ModelInfo::parameters`] in order; row-major) of these rows, at a state with
-    /// accelerations `qdd`, every contact's force `forces` (one per contact, zero where open)
-    /// and every friction's force `fr` (one per friction), each of `qdd`, `forces` and `fr`
-    /// held fixed:
-    ///
-    /// 1. `n` rows: the equations of motion's residual `M qdd - F - J^T forces - T^T fr`
-    ///    ([`Model::equations`], [`Model::constraints`], [`Model::friction`]);
-    /// 2. one row per contact: its normal acceleration `J qdd + bias`;
-    /// 3. one row per friction: its slip acceleration `T qdd + c`;
-    /// 4. one row per contact: its gap ([`Model::gaps`]; a zero row where it is zero);
-    /// 5. one row per contact: its edge margin ([`Model::edges`]; a zero row without an edge);
-    /// 6. one row per friction: its slip velocity `T qd`.
-    ///
-    /// `out.len()` is `(n + 3 m + 2 nf) (2 n + np)` with `m` contacts and `nf` frictions.
-    /// The parameters' columns are total derivatives through `k` (which must be
-    /// [`Model::prepare`]'s for the same parameters). A friction coefficient's column is zero
-    /// (the friction forces are held): it acts through a sliding friction's law
-    /// `f = -s mu lambda`, which the caller differentiates. Writes nothing where
-    /// [`Model::has_tangents`] is false.
-    #[allow(clippy::too_many_arguments)]
-    fn tangents(
-        &self,
-        _k: &[f64],
-        _q: &[f64],
-        _qd: &[f64],
-        _qdd: &[f64],
-        _forces: &[f64],
-        _fr: &[f64],
-        _out: &mut [f64],
-    ) {
-    }
-
-    /// `d(initial state)/dp`: `2 n` rows over the parameters (`np` columns, row-major), rows
-    /// `0..n` the coordinates' `dq_i/dp`, rows `n..2 n` the velocities' `dqd_i/dp` (grouped, not
-    /// interleaved as [`Model::initial_state`] assigns them). Writes nothing where
-    /// [`Model::has_tangents`] is false.
-    fn initial_tangents(&self, _k: &[f64], _out: &mut [f64]) {}
+    /// The forward-sensitivity rows of the model, if it has them (every generated general
+    /// model does: the integrated phases' forward sensitivities need them; a fast phase or a
+    /// hand-written test model has none).
+    fn tangents(&self) -> Option<&dyn Tangents>;
 
     /// The fast path, if the model has one ([`ModelInfo::reduction`] describes it).
     fn reduction(&self) -> Option<&dyn Reduction>;
@@ -556,28 +557,9 @@ pub trait Reduction: Send + Sync {
     /// nothing for a phase without one.
     fn fall_polynomial(&self, k: &[f64], out: &mut [f64]);
 
-    /// Whether this fast path has the partial derivatives below (every generated one does; a
-    /// hand-written test phase may not, and then has no sensitivities).
-    fn has_partials(&self) -> bool {
-        false
-    }
-
-    /// `[dF/dtheta, dF/dp_1, ...]` (`out.len() == 1 + parameters`) at the angle of sine `s` and
-    /// cosine `c`, of the separation condition `F = 0` divided by a coefficient (any nonzero
-    /// factor gives the same `d theta_sep/dp = -F_p / F_theta` at the separation). Writes
-    /// nothing for a phase without a separation polynomial.
-    fn separation_partials(&self, _k: &[f64], _s: f64, _c: f64, _out: &mut [f64]) {}
-
-    /// `d(theta_dot^2)/dp` for every parameter (`out.len() == parameters`) at the fixed angle
-    /// of sine `s` and cosine `c`.
-    fn theta_dot_sq_partials(&self, _k: &[f64], _s: f64, _c: f64, _out: &mut [f64]) {}
-
-    /// `d(sin theta_i)/dp` for every parameter (`out.len() == parameters`).
-    fn start_partials(&self, _k: &[f64], _out: &mut [f64]) {}
-
-    /// `dP_j/dp_i` of the fall polynomial's coefficients, parameter by parameter with `j`
-    /// fastest (`out.len() == parameters * (fall_degree + 1)`). Writes nothing without one.
-    fn fall_partials(&self, _k: &[f64], _out: &mut [f64]) {}
+    /// The partial derivatives behind the fast path's sensitivities, if it has them (every
+    /// generated one does; a hand-written test phase may not, and then has no sensitivities).
+    fn partials(&self) -> Option<&dyn Partials>;
 
     /// [`Model::prepare`] for the per-point solver: copies the parameters into `k` and computes
     /// only the constants of [`ReductionInfo::lean_constants`] (the start's sine, cosine and rate,
@@ -595,6 +577,77 @@ pub trait Reduction: Send + Sync {
         q: &mut [f64],
         qd: &mut [f64],
     );
+}
+
+/// The state at which [`Tangents::tangent_rows`] differentiates a model's rows: the full
+/// state, its accelerations and the forces, each held fixed.
+#[derive(Debug, Clone, Copy)]
+pub struct TangentPoint<'a> {
+    /// The coordinates, one per [`ModelInfo::coordinates`].
+    pub q: &'a [f64],
+    /// The velocities.
+    pub qd: &'a [f64],
+    /// The accelerations.
+    pub qdd: &'a [f64],
+    /// Every contact's force, one per contact of [`ModelInfo::contacts`] (zero where open).
+    pub forces: &'a [f64],
+    /// Every friction's force, one per friction of [`ModelInfo::frictions`].
+    pub friction: &'a [f64],
+}
+
+/// A general model's forward-sensitivity rows ([`Model::tangents`]): partial derivatives of
+/// its rows and of its initial state over the state and the parameters.
+///
+/// The same contract as [`Model`]'s: every slice at the length [`ModelInfo`] gives it.
+pub trait Tangents: Send + Sync {
+    /// Partial derivatives over `x = [q, qd, p]` (`2 n + np` columns, `np` the parameters of
+    /// [`ModelInfo::parameters`] in order; row-major) of these rows, at the point `at` (the
+    /// state, the accelerations `qdd`, every contact's force and every friction's force `fr`,
+    /// each of `qdd`, the forces and `fr` held fixed):
+    ///
+    /// 1. `n` rows: the equations of motion's residual `M qdd - F - J^T forces - T^T fr`
+    ///    ([`Model::equations`], [`Model::constraints`], [`Model::friction`]);
+    /// 2. one row per contact: its normal acceleration `J qdd + bias`;
+    /// 3. one row per friction: its slip acceleration `T qdd + c`;
+    /// 4. one row per contact: its gap ([`Model::gaps`]; a zero row where it is zero);
+    /// 5. one row per contact: its edge margin ([`Model::edges`]; a zero row without an edge);
+    /// 6. one row per friction: its slip velocity `T qd`.
+    ///
+    /// `out.len()` is `(n + 3 m + 2 nf) (2 n + np)` with `m` contacts and `nf` frictions.
+    /// The parameters' columns are total derivatives through `k` (which must be
+    /// [`Model::prepare`]'s for the same parameters). A friction coefficient's column is zero
+    /// (the friction forces are held): it acts through a sliding friction's law
+    /// `f = -s mu lambda`, which the caller differentiates.
+    fn tangent_rows(&self, k: &[f64], at: &TangentPoint<'_>, out: &mut [f64]);
+
+    /// `d(initial state)/dp`: `2 n` rows over the parameters (`np` columns, row-major), rows
+    /// `0..n` the coordinates' `dq_i/dp`, rows `n..2 n` the velocities' `dqd_i/dp` (grouped, not
+    /// interleaved as [`Model::initial_state`] assigns them).
+    fn initial_tangents(&self, k: &[f64], out: &mut [f64]);
+}
+
+/// The partial derivatives behind a fast path's sensitivities ([`Reduction::partials`]), read
+/// from `k`'s parameters alone.
+///
+/// The same contract as [`Model`]'s: every slice at the length [`ModelInfo`] and
+/// [`ReductionInfo`] give it.
+pub trait Partials: Send + Sync {
+    /// `[dF/dtheta, dF/dp_1, ...]` (`out.len() == 1 + parameters`) at the angle of sine `s` and
+    /// cosine `c`, of the separation condition `F = 0` divided by a coefficient (any nonzero
+    /// factor gives the same `d theta_sep/dp = -F_p / F_theta` at the separation). Writes
+    /// nothing for a phase without a separation polynomial.
+    fn separation_partials(&self, k: &[f64], s: f64, c: f64, out: &mut [f64]);
+
+    /// `d(theta_dot^2)/dp` for every parameter (`out.len() == parameters`) at the fixed angle
+    /// of sine `s` and cosine `c`.
+    fn theta_dot_sq_partials(&self, k: &[f64], s: f64, c: f64, out: &mut [f64]);
+
+    /// `d(sin theta_i)/dp` for every parameter (`out.len() == parameters`).
+    fn start_partials(&self, k: &[f64], out: &mut [f64]);
+
+    /// `dP_j/dp_i` of the fall polynomial's coefficients, parameter by parameter with `j`
+    /// fastest (`out.len() == parameters * (fall_degree + 1)`). Writes nothing without one.
+    fn fall_partials(&self, k: &[f64], out: &mut [f64]);
 }
 
 /// The quick test of a model's parameter values (the full check with its messages is

@@ -23,10 +23,11 @@
 //! message` ([`Diagnostic::headline`]) or, rendered by annotate-snippets, rustc-style with the
 //! line and the token underlined.
 
-use crate::model::{Model, ModelInfo};
+use crate::model::{Model, ModelInfo, RequirementInfo};
 use crate::plan::PlanError;
 use crate::quantity::Quantity;
 use crate::results::RunResults;
+use crate::spec::expr::Expr;
 use crate::system::{SystemError, check_value, failed_requirements};
 use crate::yaml::{At, Document, Mark, Problem, ReadError, excerpt, parse_path};
 use annotate_snippets::{Level, Origin, Renderer};
@@ -444,15 +445,14 @@ impl Scene {
         SceneError::one(ctx.diag(kind, &field, At::Key, message.into()))
     }
 
-    /// A failed requirement of this scene's model (named `name`, demanding `meaning`), placed
-    /// at the first parameter it names that the file gives.
-    pub fn requirement_error(
-        &self,
-        name: &str,
-        meaning: &str,
-        message: impl Into<String>,
-    ) -> SceneError {
-        let involved = involved_parameters(name, meaning, self.info());
+    /// A failed requirement of this scene's model (named `name`), placed at the first in the
+    /// file of the parameters its margin reads ([`RequirementInfo::parameters`]).
+    pub fn requirement_error(&self, name: &str, message: impl Into<String>) -> SceneError {
+        let info = self.info();
+        let involved = (info.requirements.iter())
+            .find(|r| r.name == name)
+            .map(|r| requirement_parameters(r, info))
+            .unwrap_or_default();
         self.error_at_parameters(&involved, Kind::Requirement, message)
     }
 
@@ -463,8 +463,8 @@ impl Scene {
         let message = error.to_string();
         let at = |field: String, kind| Some(self.error_at(&field, kind, message.clone()));
         match error {
-            PlanError::System(SystemError::Requirement { name, meaning, .. }) => {
-                Some(self.requirement_error(name, meaning, message.clone()))
+            PlanError::System(SystemError::Requirement { name, .. }) => {
+                Some(self.requirement_error(name, message.clone()))
             }
             PlanError::System(SystemError::NotFinite { name, .. }) => {
                 at(format!("parameters.{name}"), Kind::NotFinite)
@@ -924,7 +924,7 @@ impl Ctx<'_> {
             let involved = match &e {
                 SystemError::Restitution { contact, .. } => (info.contacts.iter())
                     .find(|c| c.name == *contact)
-                    .map(|c| involved_parameters("", c.restitution, info))
+                    .map(|c| expression_parameters(c.restitution, info))
                     .unwrap_or_default(),
                 _ => Vec::new(),
             };
@@ -961,7 +961,7 @@ impl Ctx<'_> {
             };
             for (r, margin) in failed {
                 {
-                    let involved = involved_parameters(r.name, r.meaning, info);
+                    let involved = requirement_parameters(r, info);
                     let field =
                         self.first_in_file(involved.iter().map(|n| format!("parameters.{n}")));
                     let field = if field.is_empty() {
@@ -1022,17 +1022,23 @@ fn unavailable_reason(q: Quantity, info: &ModelInfo) -> &'static str {
     }
 }
 
-/// Parameters named (as whole words) in a requirement's name or meaning, in model order.
-fn involved_parameters(name: &str, meaning: &str, info: &ModelInfo) -> Vec<&'static str> {
-    let words: HashSet<&str> = name
-        .split(|c: char| !c.is_alphanumeric())
-        .chain(meaning.split(|c: char| !c.is_alphanumeric()))
-        .filter(|w| !w.is_empty())
-        .collect();
-    info.parameters
-        .iter()
+/// The names of the parameters a requirement's margin reads, in model order.
+fn requirement_parameters(r: &RequirementInfo, info: &ModelInfo) -> Vec<&'static str> {
+    (r.parameters.iter())
+        .filter_map(|&i| info.parameters.get(i).map(|p| p.name))
+        .collect()
+}
+
+/// The parameters an expression of the model's spec reads (a contact's restitution), in model
+/// order; none where the text does not parse (the model's own code evaluates it).
+fn expression_parameters(text: &str, info: &ModelInfo) -> Vec<&'static str> {
+    let Ok(e) = Expr::parse(text) else {
+        return Vec::new();
+    };
+    let read = e.symbols();
+    (info.parameters.iter())
         .map(|p| p.name)
-        .filter(|n| words.contains(n))
+        .filter(|n| read.contains(*n))
         .collect()
 }
 

@@ -3,7 +3,8 @@
 //! (its own `derivations/` and a copy of `templates/`) so that nothing in the tree is touched.
 //! Specs in the retired schema (`contact:`, `forces:`, `scenery:`, a friction's `normal:`, a
 //! potential's `acts_on:`) are refused saying what replaced them; the contacts' own mistakes
-//! (a gap of no coordinate or of no consistent unit, two contacts of one name, a friction at a
+//! (a gap of no coordinate, of no consistent unit or in a unit that is neither a length nor an
+//! angle, two contacts of one name, a friction at a
 //! contact that does not exist or a bilateral one, an obstacle that moves) each name their field.
 #![cfg(feature = "derive")]
 
@@ -277,6 +278,22 @@ fn a_gap_without_a_consistent_unit_is_refused() {
         ("gap: -x1 - theta", "gap"),
         "contacts[0].gap",
         &["the gap of contact `push` has no consistent unit"],
+    );
+}
+
+#[test]
+fn a_gap_that_is_neither_a_length_nor_an_angle_is_refused() {
+    // An area: the runtime scales a gap's tolerances as a length or not at all (an angle).
+    let text = edit(
+        "gap: -x1 - ell*cos(theta)",
+        "gap: -x1*ell - ell^2*cos(theta)",
+    );
+    refused(
+        "gap_area",
+        &text,
+        ("gap: -x1*ell", "gap"),
+        "contacts[0].gap",
+        &["contact `push` is in m^2", "a length (m) or an angle (rad)"],
     );
 }
 

@@ -905,7 +905,11 @@ mod calls {
             ),
             (
                 "another version",
-                paper.replacen("\"version\": 1,", "\"version\": 0,", 1),
+                paper.replacen(
+                    &format!("\"version\": {},", rodcube::tape::VERSION),
+                    &format!("\"version\": {},", rodcube::tape::VERSION - 1),
+                    1,
+                ),
                 RODCUBE_ERR_TAPE_VERSION,
                 "cargo derive",
             ),

@@ -16,7 +16,7 @@ use rodcube::reference::{Family, Inputs, Reference, RootRoute, TimeRoute, relati
 use rodcube::results::{RunResults, Work};
 use rodcube::solve::SolveError;
 use rodcube::solve::contacts::{
-    Active, Mode, Moment, Options, contact_options, decide, dynamics, friction_options,
+    Active, Mode, Moment, Options, Sign, contact_options, decide, dynamics, friction_options,
 };
 use rodcube::solve::ode::Method;
 use rodcube::solve::phases::{End, PhaseRun, PhaseStart, Route, Walker};
@@ -180,7 +180,7 @@ fn the_forces_and_the_friction_balance_each_body_by_hand() {
             let mode = if v1 == 0.0 {
                 Mode::Stick
             } else {
-                Mode::Slide(v1.signum())
+                Mode::Slide(Sign::of(v1))
             };
             let active = Active {
                 closed: vec![true, true],
@@ -195,7 +195,7 @@ fn the_forces_and_the_friction_balance_each_body_by_hand() {
             // Torques about the centre: the foot at -(ell/2)(c, s), the tip at +(ell/2)(c, s).
             let torque = -0.5 * ell * c * floor + 0.5 * ell * s * friction + 0.5 * ell * s * push;
             let coulomb = match mode {
-                Mode::Slide(sign) => friction + sign * mu * floor,
+                Mode::Slide(sign) => friction + sign.value() * mu * floor,
                 Mode::Stick => x1dd,
             };
             let residuals = [
@@ -378,7 +378,7 @@ fn a_sliding_foot_past_painleves_bound_has_no_consistent_motion() {
     let state = free_rod_state(theta, -1.0, 0.0);
     let below = decide_free_rod(0.9 * bound, &state).unwrap();
     assert_eq!(below.closed, [false, true]);
-    assert_eq!(below.modes, [Mode::Slide(-1.0)]);
+    assert_eq!(below.modes, [Mode::Slide(Sign::Minus)]);
     match decide_free_rod(1.1 * bound, &state) {
         Err(SolveError::Indeterminate { why, contacts, .. }) => {
             assert!(why.contains("no set of closed contacts"), "{why}");
@@ -416,7 +416,7 @@ fn a_sliding_rod_that_reaches_painleves_singularity_is_a_typed_error() {
     let walker = walker(1.8, 1e-10, 1e-12);
     let active = decide_free_rod(1.8, &state).unwrap();
     assert_eq!(active.closed, [false, true]);
-    assert_eq!(active.modes, [Mode::Slide(-1.0)]);
+    assert_eq!(active.modes, [Mode::Slide(Sign::Minus)]);
     let start = PhaseStart {
         frictions: friction_options(&walker.general, &state).unwrap(),
         state,

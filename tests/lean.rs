@@ -11,7 +11,7 @@ mod common;
 
 use common::paper::ROD_CUBE;
 use common::tweaked::{Fault, Tweaked};
-use rodcube::model::{Model, ModelInfo, Reduced, Reduction, ReductionInfo};
+use rodcube::model::{Model, ModelInfo, Partials, Reduced, Reduction, ReductionInfo, Tangents};
 use rodcube::reference::{Family, Inputs, Reference, RootRoute, TimeRoute, relative_error};
 use rodcube::solve::SolveError;
 use rodcube::solve::lean::LeanSolver;
@@ -494,6 +494,10 @@ impl Model for FloorLetsGo {
         ROD_CUBE.forces_full(k, q, qd, qdd, out);
         out[1] = self.floor_force(k, q[1].sin());
     }
+    fn tangents(&self) -> Option<&dyn Tangents> {
+        None
+    }
+
     fn reduction(&self) -> Option<&dyn Reduction> {
         Some(self)
     }
@@ -522,6 +526,10 @@ impl Reduction for FloorLetsGo {
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
         ROD_CUBE.prepare_lean(p, k)
     }
+    fn partials(&self) -> Option<&dyn Partials> {
+        None
+    }
+
     fn full_state(
         &self,
         k: &[f64],

@@ -8,7 +8,7 @@ mod common;
 
 use common::paper::{GENERAL, MODELS, paper};
 use common::tweaked::{NAN_FORCE, registry};
-use rodcube::model::{Model, ModelInfo, Reduced, Reduction};
+use rodcube::model::{Model, ModelInfo, Partials, Reduced, Reduction, Tangents};
 use rodcube::plan::drawing::{PhaseInput, record};
 use rodcube::plan::{self, PlanError, Request};
 use rodcube::quantity::Quantity;
@@ -34,6 +34,10 @@ impl Model for MasslessCube {
         // The cube's row and column of the mass matrix (x2 is the last of four coordinates).
         mass[15] = 0.0;
     }
+    fn tangents(&self) -> Option<&dyn Tangents> {
+        None
+    }
+
     fn reduction(&self) -> Option<&dyn Reduction> {
         None
     }
@@ -223,6 +227,10 @@ impl Model for OneContact {
         Self::first(out, |both| self.base.edges(k, q, both))
     }
     fn monitors_full(&self, _k: &[f64], _q: &[f64], _qd: &[f64], _f: &[f64], _out: &mut [f64]) {}
+    fn tangents(&self) -> Option<&dyn Tangents> {
+        None
+    }
+
     fn reduction(&self) -> Option<&dyn Reduction> {
         Some(self)
     }
@@ -247,6 +255,10 @@ impl Reduction for OneContact {
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
         self.red().prepare_lean(p, k)
     }
+    fn partials(&self) -> Option<&dyn Partials> {
+        None
+    }
+
     fn full_state(
         &self,
         k: &[f64],
@@ -371,6 +383,10 @@ impl Model for NoReducedCoordinate {
             }))
         })
     }
+    fn tangents(&self) -> Option<&dyn Tangents> {
+        None
+    }
+
     fn reduction(&self) -> Option<&dyn Reduction> {
         None
     }

@@ -19,7 +19,8 @@ use rodcube::plan::{self, Request};
 use rodcube::quantity::Quantity;
 use rodcube::results::{Halt, Work, Zeno};
 use rodcube::solve::SolveError;
-use rodcube::solve::impact::{ContactLaw, FrictionLaw, Part, Sign, resolve};
+use rodcube::solve::contacts::Sign;
+use rodcube::solve::impact::{ContactLaw, FrictionLaw, Part, resolve};
 use rodcube::solve::phases::{Motion, Route, Walker};
 use rodcube::system::{Bound, State};
 

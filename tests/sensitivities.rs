@@ -175,7 +175,7 @@ fn generated_partials_match_differences_of_the_generated_functions() {
         let (Some(red), Some(layout)) = (m.reduction(), m.info().reduction.as_ref()) else {
             continue;
         };
-        assert!(red.has_partials(), "{}", m.info().name);
+        let partials = (red.partials()).unwrap_or_else(|| panic!("{}: no partials", m.info().name));
         let p = plausible(m);
         let Ok(sys) = rodcube::system::System::from_values(m, &p) else {
             continue;
@@ -199,9 +199,9 @@ fn generated_partials_match_differences_of_the_generated_functions() {
         let mut k = vec![0.0; n];
         m.prepare(&p, &mut k);
         let (mut w, mut si, mut fall) = (vec![0.0; np], vec![0.0; np], vec![0.0; np * degree]);
-        red.theta_dot_sq_partials(&k, s, c, &mut w);
-        red.start_partials(&k, &mut si);
-        red.fall_partials(&k, &mut fall);
+        partials.theta_dot_sq_partials(&k, s, c, &mut w);
+        partials.start_partials(&k, &mut si);
+        partials.fall_partials(&k, &mut fall);
         let base = values(&p);
         for i in 0..np {
             let h = 1e-5 * p[i].abs().max(1e-3);

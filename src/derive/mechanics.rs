@@ -39,6 +39,7 @@ use super::reduction::Reducer;
 use super::setup::{Setup, setup, ties};
 use super::spec::{Checked, Spec};
 use super::tangents;
+use crate::spec::units::Unit;
 use std::collections::BTreeMap;
 
 /// The phases a spec derives: its general model first, then every set of eliminable contacts
@@ -332,13 +333,23 @@ fn contact_rows(checked: &Checked, atoms: &[ContactAtoms]) -> Result<Vec<Contact
         let (gap_unit, force_unit) = checked
             .contact_units(j)
             .map_err(|e| at(&[key("contacts"), FieldStep::Index(j)], e.message))?;
+        let gap = match gap_unit {
+            u if u == Unit::METRE => GapKind::Length,
+            u if u.is_dimensionless() => GapKind::Angle,
+            u => {
+                return Err(at(
+                    &[key("contacts"), FieldStep::Index(j), key("gap")],
+                    format!("a gap in {u} is neither a length (m) nor an angle (rad)"),
+                ));
+            }
+        };
         let opt = |x: &Option<A>, what: &str| -> Result<Option<Expr>, DeriveError> {
             x.as_ref().map(|e| to_expr(e, what)).transpose()
         };
         out.push(ContactRow {
             name: c.name.clone(),
             meaning: c.meaning.clone(),
-            gap_unit,
+            gap_kind: gap,
             force_unit,
             bilateral: c.bilateral,
             eliminates: c.eliminates.clone(),

@@ -1,9 +1,9 @@
 //! Stage 8 of the derivation, the general model's tangents: the partial derivatives of its
 //! rows over `x = [q, qd, p]` that the integrated route's forward sensitivities need
-//! (`Model::tangents`), and those of its initial state over the parameters
-//! (`Model::initial_tangents`).
+//! (`Tangents::tangent_rows`), and those of its initial state over the parameters
+//! (`Tangents::initial_tangents`).
 //!
-//! The rows are those `Model::tangents` documents: the residual `M qdd - F - J^T f - T^T fr`
+//! The rows are those `Tangents::tangent_rows` documents: the residual `M qdd - F - J^T f - T^T fr`
 //! of the equations of motion, with the accelerations `ddot_<q>`, the contacts' forces
 //! `rc_f<i>` and the frictions' forces `rc_fr<j>` as symbols held fixed; each contact's normal
 //! acceleration `J qdd + bias`; each friction's slip acceleration `T qdd + bias`; each contact's

@@ -10,7 +10,7 @@
 //! elimination, the rest open, reduced to one coordinate).
 
 use super::expr::Expr;
-pub use crate::model::ShapeKind;
+pub use crate::model::{GapKind, ShapeKind};
 use std::collections::{BTreeMap, BTreeSet};
 
 /// A derivation step that failed, before it is placed at a spec field ([`DeriveError`]) or
@@ -287,8 +287,8 @@ pub struct ContactRow {
     pub name: String,
     /// What its force is.
     pub meaning: String,
-    /// The unit of its gap (`m`) and of its force (`N`).
-    pub gap_unit: String,
+    /// What its gap measures (a length, in `m`, or an angle, in `rad`).
+    pub gap_kind: GapKind,
     /// The unit of its force, conjugate to the gap.
     pub force_unit: String,
     /// A joint: always closed, its force of either sign.
@@ -379,7 +379,7 @@ pub struct Partials {
 }
 
 /// The partial derivatives of the general model's rows over `x = [q, qd, p]` (the layout of
-/// `Model::tangents`), each row-major.
+/// `Tangents::tangent_rows`), each row-major.
 #[derive(Debug, Clone, Default)]
 pub struct Tangents {
     /// `(n + 3 m + 2 nf) (2 n + np)` entries over the state, the accelerations `ddot_<q>`, the
@@ -388,7 +388,7 @@ pub struct Tangents {
     /// frictions' slip accelerations, the gaps, the edge margins and the slip velocities.
     pub rows: Vec<Expr>,
     /// `2 n np` entries over the parameters: the `n` rows `d q_0/dp`, then the `n` rows
-    /// `d qd_0/dp` of the initial state (`Model::initial_tangents`).
+    /// `d qd_0/dp` of the initial state (`Tangents::initial_tangents`).
     pub initial: Vec<Expr>,
 }
 

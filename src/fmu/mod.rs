@@ -18,7 +18,7 @@ mod zip;
 
 use crate::model::{ModelInfo, ParamInfo};
 use crate::report::motion::xml as escape;
-use crate::spec::units::Unit;
+use crate::spec::units::{AngularUnit, Unit};
 use std::fmt::Write;
 
 /// The FMI 2.0 co-simulation functions a library must export (all of them, the unsupported
@@ -200,13 +200,12 @@ const FIXED: &str = "fixed: a length or an angle (the geometry or the release st
 /// friction or restitution coefficient) only weighs the forces, tunable. A unit rodcube
 /// cannot read counts as fixed.
 pub fn tunable(p: &ParamInfo) -> bool {
-    let Ok(unit) = Unit::parse(p.unit) else {
+    let Ok(unit) = AngularUnit::parse(p.unit) else {
         return false;
     };
-    let angle = p.unit.split([' ', '/', '^', '*']).any(|part| part == "rad");
     let (length, speed) = (Unit::integers(0, 1, 0), Unit::integers(0, 1, -1));
-    let (pure, rate) = (Unit::DIMENSIONLESS, Unit::integers(0, 0, -1));
-    let geometric = unit == length || unit == speed || (angle && (unit == pure || unit == rate));
+    let geometric = (unit.rad().is_zero() && (unit.si() == length || unit.si() == speed))
+        || unit.is_angle_or_rate();
     !geometric
 }
 
@@ -354,7 +353,7 @@ fn has_unit(unit: &str) -> bool {
 }
 
 /// `<UnitDefinitions>`: each unit the variables use, with its exponents of kg, m and s where
-/// they are integers (and `rad="1"` for an angle).
+/// they are integers, and of the radian (`rad="1"` for an angle or an angular rate).
 fn unit_definitions(x: &mut String, vars: &[Variable]) {
     let mut units: Vec<&str> = vars
         .iter()
@@ -369,15 +368,14 @@ fn unit_definitions(x: &mut String, vars: &[Variable]) {
     let _ = writeln!(x, "  <UnitDefinitions>");
     for u in units {
         let mut base = String::new();
-        if let Ok(parsed) = Unit::parse(u) {
-            for (name, e) in [("kg", parsed.kg()), ("m", parsed.m()), ("s", parsed.s())] {
+        if let Ok(parsed) = AngularUnit::parse(u) {
+            let si = parsed.si();
+            let exponents = [("kg", si.kg()), ("m", si.m()), ("s", si.s())];
+            for (name, e) in exponents.into_iter().chain([("rad", parsed.rad())]) {
                 if !e.is_zero() && e.is_integer() {
                     let _ = write!(base, r#" {name}="{}""#, e.num());
                 }
             }
-        }
-        if u.split([' ', '/', '^']).any(|part| part == "rad") {
-            base.push_str(r#" rad="1""#);
         }
         let _ = writeln!(
             x,

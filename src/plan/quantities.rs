@@ -4,7 +4,7 @@
 
 use super::drawing::{PhaseInput, record};
 use super::{Plan, column, phase_labels, scalar};
-use crate::model::ModelInfo;
+use crate::model::{GapKind, ModelInfo};
 use crate::quantity::Quantity;
 use crate::results::{
     ContactImpulse, Held, ImpactRecord, Label, LabelValue, Meaning, Note, RunResults, Series,
@@ -220,7 +220,7 @@ fn impact_record(info: &ModelInfo, at: &ImpactAt) -> ImpactRecord {
         .collect();
     let per_contact = (taking.iter())
         .map(|&i| {
-            let angular = info.contacts.get(i).is_some_and(|c| c.gap_unit != "m");
+            let angular = (info.contacts.get(i)).is_some_and(|c| c.gap == GapKind::Angle);
             ContactImpulse {
                 contact: name(i),
                 normal_velocity_before: at.impact.normal_velocity_before[i],

@@ -20,7 +20,7 @@ use crate::solve::phases::{End, Motion, SensitiveMotion, Stop};
 use crate::solve::prior::{PRIOR_TOL, Prior};
 use crate::solve::quadrature::ACCEPT;
 use crate::solve::sensitivity::{self, SensitivityWork, SeparationPoint};
-use crate::spec::units::Unit;
+use crate::spec::units::{AngularUnit, UnitError};
 use crate::system::SystemError;
 
 /// A result the sensitivities are of: its key, unit and whether it is an angle.
@@ -36,29 +36,11 @@ fn note_key(key: &str) -> String {
 }
 
 /// `result` over `parameter` as a unit: `rad/kg`, `s^3/m`, `rad s^2/m`, `rad s/m` (an angular
-/// rate over an acceleration).
-pub fn per(result: &str, parameter: &str) -> String {
-    let parsed = |u: &str| Unit::parse(u).ok();
-    // An angle (`rad`) or an angular rate (`rad/s`) keeps its `rad`, which the unit algebra
-    // drops as dimensionless.
-    let (angle, result_unit) = match result.strip_prefix("rad") {
-        Some("") => (true, parsed("1")),
-        Some(rate) if rate.starts_with('/') => (true, parsed(&format!("1{rate}"))),
-        _ => (false, parsed(result)),
-    };
-    let quotient = result_unit
-        .zip(parsed(parameter))
-        .and_then(|(r, p)| r.checked_div(p).ok());
-    let Some(q) = quotient else {
-        return format!("{result}/({parameter})");
-    };
-    let text = q.to_string();
-    match (angle, text.strip_prefix("1/")) {
-        (false, _) => text,
-        (true, _) if text == "1" => "rad".into(),
-        (true, Some(below)) => format!("rad/{below}"),
-        (true, None) => format!("rad {text}"),
-    }
+/// rate over an acceleration), `1` (an angle over an angle). The radian is kept as a factor
+/// ([`AngularUnit`]), which the SI algebra drops as dimensionless.
+pub fn per(result: &str, parameter: &str) -> Result<String, UnitError> {
+    let quotient = AngularUnit::parse(result)?.checked_div(AngularUnit::parse(parameter)?)?;
+    Ok(quotient.to_string())
 }
 
 /// The relative difference of an event's time on the integrated route that carries the
@@ -159,8 +141,8 @@ impl<'m> Plan<'m> {
                 Some(found) => (found, false),
                 None => (self.integrated_derivatives(target, *source)?, true),
             };
-            match found {
-                Ok(d) => self.record(target, (x, &d), integrated, out),
+            match found.and_then(|d| self.record(target, (x, &d), integrated, out)) {
+                Ok(()) => {}
                 Err(gap) => {
                     out.notes
                         .insert(note_key(&target.key), Note::NoSensitivity(gap));
@@ -262,17 +244,16 @@ impl<'m> Plan<'m> {
                 },
             };
             let t_run = ran.t;
-            match found {
-                Ok(d) => {
-                    let target = Target {
-                        key,
-                        unit: "s",
-                        angle: false,
-                    };
-                    self.record(&target, (t_run, &d), true, out);
-                }
+            let target = Target {
+                key,
+                unit: "s",
+                angle: false,
+            };
+            match found.and_then(|d| self.record(&target, (t_run, &d), true, out)) {
+                Ok(()) => {}
                 Err(gap) => {
-                    out.notes.insert(note_key(&key), Note::NoSensitivity(gap));
+                    out.notes
+                        .insert(note_key(&target.key), Note::NoSensitivity(gap));
                 }
             }
         }
@@ -304,11 +285,23 @@ impl<'m> Plan<'m> {
 
     /// `d(target)/dp` and its elasticity for every parameter, from `x` and its derivatives
     /// (`integrated`: by the integrated route).
-    fn record(&self, target: &Target, x: (f64, &[f64]), integrated: bool, out: &mut RunResults) {
+    /// [`SensitivityGap::NoUnit`], recording nothing, where a unit cannot be formed.
+    fn record(
+        &self,
+        target: &Target,
+        x: (f64, &[f64]),
+        integrated: bool,
+        out: &mut RunResults,
+    ) -> Result<(), SensitivityGap> {
         let (x, dx) = x;
         let info = self.general().info();
         let p = self.general().p();
-        for ((param, &value), &d) in info.parameters.iter().zip(p).zip(dx) {
+        let units = (info.parameters.iter())
+            .map(|param| per(target.unit, param.unit))
+            .collect::<Result<Vec<String>, _>>()
+            .map_err(|_| SensitivityGap::NoUnit)?;
+        let each = info.parameters.iter().zip(p).zip(dx).zip(units);
+        for (((param, &value), &d), unit) in each {
             let entry = |value: f64, unit: String, elasticity: bool| Sensitivity {
                 value,
                 unit,
@@ -319,13 +312,14 @@ impl<'m> Plan<'m> {
             };
             out.sensitivities.insert(
                 format!("d({})/d({})", target.key, param.name),
-                entry(d, per(target.unit, param.unit), false),
+                entry(d, unit, false),
             );
             out.sensitivities.insert(
                 format!("elasticity({};{})", target.key, param.name),
                 entry(value / x * d, "1".into(), true),
             );
         }
+        Ok(())
     }
 
     /// The first contact's separation on the fast phase the motion starts on with its

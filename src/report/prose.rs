@@ -495,6 +495,10 @@ pub fn sensitivity_gap(gap: SensitivityGap) -> &'static str {
             "no sensitivity: the separation is a double root of its condition, where the angle \
              does not move smoothly with the parameters"
         }
+        SensitivityGap::NoUnit => {
+            "no sensitivity: its unit cannot be formed from the result's and a parameter's \
+             (a unit that does not read as one, or powers that overflow)"
+        }
     }
 }
 

@@ -280,4 +280,7 @@ pub enum SensitivityGap {
     NoFallPolynomial,
     /// The separation is a double root of its condition.
     DoubleRoot,
+    /// The result's unit over a parameter's cannot be formed (a parameter's unit that does not
+    /// read as a unit, or a quotient whose powers overflow).
+    NoUnit,
 }

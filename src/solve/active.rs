@@ -11,12 +11,48 @@ use crate::solve::SolveError;
 /// still count as zero when a contact's state is decided.
 pub const DECIDE_TOLERANCE: f64 = 1e-9;
 
+/// A sign of a slip: the direction a friction slides in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Sign {
+    /// Slipping along its slip row (`T qd > 0`).
+    Plus,
+    /// Slipping against it.
+    Minus,
+}
+
+impl Sign {
+    /// `+1` or `-1`.
+    pub fn value(self) -> f64 {
+        match self {
+            Sign::Plus => 1.0,
+            Sign::Minus => -1.0,
+        }
+    }
+
+    /// The sign of `x` as `f64::signum` gives it: `Plus` for `+0`, `Minus` for `-0` (a NaN by
+    /// its sign bit).
+    pub fn of(x: f64) -> Sign {
+        if x.is_sign_negative() {
+            Sign::Minus
+        } else {
+            Sign::Plus
+        }
+    }
+
+    /// The other way.
+    pub fn flip(self) -> Sign {
+        match self {
+            Sign::Plus => Sign::Minus,
+            Sign::Minus => Sign::Plus,
+        }
+    }
+}
+
 /// How a friction contact moves.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Mode {
-    /// Sliding with the slip velocity's sign `+1` or `-1`; the friction force is
-    /// `-sign mu N`.
-    Slide(f64),
+    /// Sliding with the slip velocity's sign; the friction force is `-sign mu N`.
+    Slide(Sign),
     /// Stuck: the slip velocity stays zero, the friction force is what keeps it so.
     Stick,
 }
@@ -25,8 +61,8 @@ impl Mode {
     /// `slides +`, `slides -` or `sticks`.
     pub fn describe(self) -> &'static str {
         match self {
-            Mode::Slide(s) if s > 0.0 => "slides +",
-            Mode::Slide(_) => "slides -",
+            Mode::Slide(Sign::Plus) => "slides +",
+            Mode::Slide(Sign::Minus) => "slides -",
             Mode::Stick => "sticks",
         }
     }
@@ -47,7 +83,7 @@ impl Active {
     pub fn of_model(info: &ModelInfo) -> Active {
         Active {
             closed: info.contacts.iter().map(|c| c.closed).collect(),
-            modes: vec![Mode::Slide(1.0); info.frictions.len()],
+            modes: vec![Mode::Slide(Sign::Plus); info.frictions.len()],
         }
     }
 

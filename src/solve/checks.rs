@@ -245,11 +245,7 @@ pub fn constraint_drift(
     for (state, closed) in states.iter().zip(rows) {
         let gaps = sys.gaps(state)?;
         for i in (0..m).filter(|&i| closed.get(i) == Some(&true) && !info.contacts[i].closed) {
-            let scale = if info.contacts[i].gap_unit == "m" {
-                length
-            } else {
-                1.0
-            };
+            let scale = info.contacts[i].gap.scale(length);
             let d = (gaps[i] / scale).abs();
             worst[i] = Some(match worst[i] {
                 Some(w) if d.is_nan() || w.is_nan() => f64::NAN,

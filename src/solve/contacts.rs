@@ -26,7 +26,7 @@
 
 use crate::model::ModelInfo;
 use crate::solve::SolveError;
-pub use crate::solve::active::{Active, DECIDE_TOLERANCE, Mode, check_active};
+pub use crate::solve::active::{Active, DECIDE_TOLERANCE, Mode, Sign, check_active};
 use crate::solve::linear;
 use crate::solve::rest;
 use crate::system::{Bound, State};
@@ -255,7 +255,7 @@ pub fn tangent_into(
                 Mode::Stick => -r[n + m + j],
                 Mode::Slide(sign) => {
                     let lambda = work.out.forces[info.frictions[j].contact_index];
-                    -sign * lambda * x[2 * n + info.frictions[j].coefficient_index]
+                    -sign.value() * lambda * x[2 * n + info.frictions[j].coefficient_index]
                 }
             });
         }
@@ -425,7 +425,7 @@ fn assemble(work: &mut DynamicsWork, info: &ModelInfo, active: &Active, dim: usi
                 let contact = info.frictions[j].contact_index;
                 a[r * dim + r] = 1.0;
                 if let Some(col) = kkt.iter().position(|&i| i == contact) {
-                    a[r * dim + n + col] = sign * mu[j];
+                    a[r * dim + n + col] = sign.value() * mu[j];
                 }
             }
             Mode::Stick => {
@@ -455,18 +455,22 @@ pub enum FrictionOption {
     /// It is at rest: it may stick or slide either way.
     AtRest,
     /// Its slip stopped while sliding with this sign: it sticks or slides back.
-    Stopped(f64),
+    Stopped(Sign),
     /// Its stuck friction reached `mu N`: it slides with this sign, against the friction that
     /// held it.
-    Breaks(f64),
+    Breaks(Sign),
 }
 
 impl FrictionOption {
     fn modes(&self) -> Vec<Mode> {
         match *self {
             FrictionOption::Keep(m) => vec![m],
-            FrictionOption::AtRest => vec![Mode::Stick, Mode::Slide(1.0), Mode::Slide(-1.0)],
-            FrictionOption::Stopped(s) => vec![Mode::Stick, Mode::Slide(-s)],
+            FrictionOption::AtRest => vec![
+                Mode::Stick,
+                Mode::Slide(Sign::Plus),
+                Mode::Slide(Sign::Minus),
+            ],
+            FrictionOption::Stopped(s) => vec![Mode::Stick, Mode::Slide(s.flip())],
             FrictionOption::Breaks(s) => vec![Mode::Slide(s)],
         }
     }
@@ -496,7 +500,7 @@ pub fn friction_options(sys: &Bound, state: &State) -> Result<Vec<FrictionOption
             if v == 0.0 || v.abs() <= REST * size {
                 FrictionOption::AtRest
             } else {
-                FrictionOption::Keep(Mode::Slide(v.signum()))
+                FrictionOption::Keep(Mode::Slide(Sign::of(v)))
             }
         })
         .collect())
@@ -563,13 +567,13 @@ pub fn contact_options(
             continue;
         }
         let gap = gaps[i];
-        let tol = at.touching(i) * if c.gap_unit == "m" { length } else { 1.0 };
+        let tol = at.touching(i) * c.gap.scale(length);
         if !gap.is_finite() || gap < -tol {
             return Err(SolveError::Overlap {
                 model: info.name,
                 contact: c.name,
                 gap,
-                unit: c.gap_unit,
+                unit: c.gap.unit(),
                 t: at.t(),
             });
         }
@@ -653,7 +657,7 @@ fn consistent(
                         + STICK_ROUNDING * force_scale
             }
             (FrictionOption::Breaks(_), Mode::Slide(_)) => true,
-            (_, Mode::Slide(s)) => s * d.slip_acc[j] > 0.0,
+            (_, Mode::Slide(s)) => s.value() * d.slip_acc[j] > 0.0,
         };
         if !ok {
             return false;

@@ -67,7 +67,7 @@ impl Forward {
     /// For `sys`'s model, which must have [`Model::tangents`](crate::model::Model::tangents).
     pub fn new(sys: &Bound) -> Result<Forward, SolveError> {
         let info = sys.info();
-        if !sys.model().has_tangents() {
+        if sys.model().tangents().is_none() {
             return Err(SystemError::NoTangents { model: info.name }.into());
         }
         Ok(Forward {

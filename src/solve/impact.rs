@@ -26,7 +26,9 @@
 
 use crate::model::ModelInfo;
 use crate::solve::SolveError;
-use crate::solve::contacts::{Active, ContactOption, FrictionOption, Mode, Options, combinations};
+use crate::solve::contacts::{
+    Active, ContactOption, FrictionOption, Mode, Options, Sign, combinations,
+};
 use crate::solve::linear;
 use crate::system::{Bound, State, SystemError, check_restitutions};
 use nalgebra::{DMatrix, DVector};
@@ -51,29 +53,6 @@ pub enum Part {
     Unilateral,
     /// A closed bilateral contact.
     Bilateral,
-}
-
-/// A sign of a slip: the direction a friction slides in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Sign {
-    /// Slipping along its slip row (`T qd > 0`).
-    Plus,
-    /// Slipping against it.
-    Minus,
-}
-
-impl Sign {
-    /// `+1` or `-1`.
-    pub fn value(self) -> f64 {
-        match self {
-            Sign::Plus => 1.0,
-            Sign::Minus => -1.0,
-        }
-    }
-
-    fn of(s: f64) -> Sign {
-        if s > 0.0 { Sign::Plus } else { Sign::Minus }
-    }
 }
 
 /// The law that held at one contact across an impact. With every contact's and friction's law
@@ -269,8 +248,8 @@ pub fn close_sequence(
     let modes = (0..problem.mu.len())
         .map(|j| match law(j) {
             FrictionLaw::Stick => Mode::Stick,
-            FrictionLaw::Slide(sign) => Mode::Slide(sign.value()),
-            FrictionLaw::Out => Mode::Slide(1.0),
+            FrictionLaw::Slide(sign) => Mode::Slide(sign),
+            FrictionLaw::Out => Mode::Slide(Sign::Plus),
         })
         .collect();
     for (j, mu) in problem.mu.iter_mut().enumerate() {
@@ -453,7 +432,7 @@ impl<'a> Problem<'a> {
                     a[r * dim + r] = 1.0;
                     let contact = self.info.frictions[j].contact_index;
                     let col = rows.iter().position(|&i| i == contact)?;
-                    a[r * dim + n + col] = s * self.mu[j];
+                    a[r * dim + n + col] = s.value() * self.mu[j];
                 }
             }
         }
@@ -500,7 +479,7 @@ impl<'a> Problem<'a> {
                         let normal = s.impulse[self.info.frictions[j].contact_index];
                         s.friction_impulse[j].abs() <= self.mu[j] * normal.max(0.0) + zero_impulse
                     }
-                    Mode::Slide(sign) => sign * dot(self.trow(j)) >= -zero_speed,
+                    Mode::Slide(sign) => sign.value() * dot(self.trow(j)) >= -zero_speed,
                 });
         contacts_hold && frictions_hold
     }
@@ -530,7 +509,7 @@ impl<'a> Problem<'a> {
             .map(|j| match (self.acts(&s.active, j), s.active.modes[j]) {
                 (false, _) => FrictionLaw::Out,
                 (true, Mode::Stick) => FrictionLaw::Stick,
-                (true, Mode::Slide(sign)) => FrictionLaw::Slide(Sign::of(sign)),
+                (true, Mode::Slide(sign)) => FrictionLaw::Slide(sign),
             })
             .collect();
         let half_work = |p: &[f64], a: &[f64], b: &[f64]| -> f64 {

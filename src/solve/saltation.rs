@@ -29,7 +29,8 @@
 //! partials, which is [`SaltationGap::Restitution`], never a guess.
 
 use crate::solve::SolveError;
-use crate::solve::impact::{ContactLaw, FrictionLaw, Impact, Sign};
+use crate::solve::contacts::Sign;
+use crate::solve::impact::{ContactLaw, FrictionLaw, Impact};
 use crate::solve::linear;
 use crate::system::{Bound, State};
 

@@ -1,5 +1,5 @@
 //! Exact sensitivities of a fast phase's separation: `d theta_sep/dp` and `d t_sep/dp` for
-//! every parameter, from the generated partial derivatives (`Reduction::separation_partials`,
+//! every parameter, from the generated partial derivatives (`Partials::separation_partials`,
 //! `start_partials`, `fall_partials`).
 //!
 //! The angle follows from the implicit-function theorem on the separation condition
@@ -82,16 +82,15 @@ pub fn separation(
     time: &mut [f64],
 ) -> Result<Result<(), SensitivityGap>, SolveError> {
     let np = at.parameters;
-    if !at.red.has_partials() {
+    let Some(partials) = at.red.partials() else {
         return Ok(Err(SensitivityGap::NoPartials));
-    }
+    };
     if at.drop <= 0.0 {
         return Ok(Err(SensitivityGap::AtRelease));
     }
     work.partials.resize(np + 1, f64::NAN);
     let cos_sep = ((1.0 - at.sin_sep) * (1.0 + at.sin_sep)).sqrt();
-    at.red
-        .separation_partials(at.k, at.sin_sep, cos_sep, &mut work.partials);
+    partials.separation_partials(at.k, at.sin_sep, cos_sep, &mut work.partials);
     let f_theta = work.partials[0];
     if f_theta.is_nan() {
         return Ok(Err(SensitivityGap::NoPartials));
@@ -109,8 +108,8 @@ pub fn separation(
     let degree = at.fall.len();
     work.start.resize(np, 0.0);
     work.fall.resize(np * degree, 0.0);
-    at.red.start_partials(at.k, &mut work.start);
-    at.red.fall_partials(at.k, &mut work.fall);
+    partials.start_partials(at.k, &mut work.start);
+    partials.fall_partials(at.k, &mut work.fall);
     let e = at.scale;
     let v_sep = v_at_drop(e, at.drop);
     // The moving upper limit (`sinh^2 v_sep = drop / e` exactly, no transcendental call).

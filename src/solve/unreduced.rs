@@ -33,11 +33,12 @@
 //! integrator's tolerance is therefore never set below [`CONDITION_SAFETY`]` * eps * cond(M)`
 //! at the start, and the tolerance actually used is reported in [`UnreducedRun::rtol`].
 
+use crate::model::GapKind;
 use crate::results::Work;
 use crate::solve::SolveError;
 use crate::solve::contacts::{
     self, Active, ContactOption, DECIDE_TOLERANCE, Dynamics, DynamicsWork, FrictionOption, Mode,
-    Options,
+    Options, Sign,
 };
 use crate::solve::forward::{self, Forward, Grazing, Measured};
 use crate::solve::ode::{
@@ -420,7 +421,7 @@ impl Problem<'_, '_> {
                     // mode's sign from its first instant: a step that carries the slip out and
                     // back across zero is then a crossing, not a start at zero and an end past it.
                     match self.active.modes[j] {
-                        Mode::Slide(sign) if v == 0.0 => sign * f64::MIN_POSITIVE,
+                        Mode::Slide(sign) if v == 0.0 => sign.value() * f64::MIN_POSITIVE,
                         _ => v,
                     }
                 }
@@ -488,7 +489,7 @@ impl Problem<'_, '_> {
             .map(|j| match (w, self.active.modes[j]) {
                 (Watch::Slip(k), Mode::Slide(s)) if k == j => FrictionOption::Stopped(s),
                 (Watch::Stuck(k), Mode::Stick) if k == j => {
-                    FrictionOption::Breaks(-held.fr[j].signum())
+                    FrictionOption::Breaks(Sign::of(-held.fr[j]))
                 }
                 (_, mode) => FrictionOption::Keep(mode),
             })
@@ -690,7 +691,9 @@ impl OdeProblem for Problem<'_, '_> {
     fn event_slack(&self, index: usize) -> f64 {
         let info = self.sys.info();
         match self.watches.get(index) {
-            Some(Watch::Gap(i)) if info.contacts[*i].gap_unit != "m" => 0.5 * DECIDE_TOLERANCE,
+            Some(Watch::Gap(i)) if info.contacts[*i].gap == GapKind::Angle => {
+                0.5 * DECIDE_TOLERANCE
+            }
             Some(Watch::Gap(_) | Watch::Edge(_)) => 0.5 * self.arm_at,
             _ => f64::INFINITY,
         }

@@ -33,17 +33,17 @@ pub struct Checked {
     pub spec: Spec,
     /// Where it came from.
     pub file: PathBuf,
-    /// Each contact's gap unit and its force's unit (conjugate to the gap), in the spec's
-    /// order.
-    pub units: Vec<(String, String)>,
+    /// Each contact's gap unit (a length, `m`, or an angle, dimensionless) and its force's
+    /// unit (conjugate to the gap), in the spec's order.
+    pub units: Vec<(units::Unit, String)>,
     /// The spec's text as read (its digest is recorded in the model's tape).
     pub text: String,
 }
 
 impl Checked {
-    /// The gap unit and force unit of contact `j` (`("m", "N")`); an error at `contacts[j]`
-    /// for an index past the spec's contacts.
-    pub fn contact_units(&self, j: usize) -> Result<(String, String), SpecError> {
+    /// The gap unit and force unit of contact `j` (`(Unit::METRE, "N")`); an error at
+    /// `contacts[j]` for an index past the spec's contacts.
+    pub fn contact_units(&self, j: usize) -> Result<(units::Unit, String), SpecError> {
         self.units.get(j).cloned().ok_or_else(|| SpecError {
             file: self.file.clone(),
             line: 0,

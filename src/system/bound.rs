@@ -7,7 +7,7 @@ use super::parameters::{
     check_parameters, describe, ordered_values, prepare_constants, restitutions,
 };
 use super::state::{Points, State, finite, zeroed};
-use crate::model::{Model, ModelInfo};
+use crate::model::{Model, ModelInfo, TangentPoint};
 use std::collections::BTreeMap;
 
 /// A model with a validated parameter set and its prepared constants.
@@ -392,7 +392,7 @@ impl<'m> Bound<'m> {
 
     /// The partial derivatives of the dynamics' rows over `[q, qd, p]` at a state with its
     /// accelerations, contact forces and friction forces held fixed
-    /// ([`Model::tangents`](crate::model::Model::tangents) gives the rows), row-major with
+    /// ([`Tangents::tangent_rows`](crate::model::Tangents::tangent_rows) gives the rows), row-major with
     /// `2 n + np` columns, into `out` (resized).
     pub fn tangents_into(
         &self,
@@ -404,9 +404,9 @@ impl<'m> Bound<'m> {
     ) -> Result<(), SystemError> {
         self.check_state(state)?;
         let info = self.info();
-        if !self.model.has_tangents() {
+        let Some(tangents) = self.model.tangents() else {
             return Err(SystemError::NoTangents { model: info.name });
-        }
+        };
         self.check_length("qdd", self.n_coordinates(), qdd.len())?;
         self.check_length("forces", info.contacts.len(), forces.len())?;
         self.check_length("fr", info.frictions.len(), fr.len())?;
@@ -415,19 +415,25 @@ impl<'m> Bound<'m> {
         finite("fr", fr)?;
         let cols = 2 * self.n_coordinates() + info.parameters.len();
         zeroed(out, self.tangent_rows() * cols);
-        self.model
-            .tangents(&self.k, &state.q, &state.qd, qdd, forces, fr, out);
+        let at = TangentPoint {
+            q: &state.q,
+            qd: &state.qd,
+            qdd,
+            forces,
+            friction: fr,
+        };
+        tangents.tangent_rows(&self.k, &at, out);
         Ok(())
     }
 
     /// `d(initial state)/dp`: `2 n` rows (`q`, then `qd`) over the parameters, row-major.
     pub fn initial_tangents(&self) -> Result<Vec<f64>, SystemError> {
         let info = self.info();
-        if !self.model.has_tangents() {
+        let Some(tangents) = self.model.tangents() else {
             return Err(SystemError::NoTangents { model: info.name });
-        }
+        };
         let mut out = vec![0.0; 2 * self.n_coordinates() * info.parameters.len()];
-        self.model.initial_tangents(&self.k, &mut out);
+        tangents.initial_tangents(&self.k, &mut out);
         Ok(out)
     }
 

@@ -97,7 +97,7 @@ pub fn failed_requirements<'a>(
     model: &dyn Model,
     p: &[f64],
     margins: &'a mut [f64],
-) -> Result<impl Iterator<Item = (&'static crate::model::NamedInfo, f64)> + 'a, SystemError> {
+) -> Result<impl Iterator<Item = (&'static crate::model::RequirementInfo, f64)> + 'a, SystemError> {
     let info = model.info();
     check_count(info, p)?;
     if margins.len() != info.requirements.len() {

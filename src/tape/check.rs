@@ -25,7 +25,7 @@ pub enum Method {
     MonitorsFull,
     ToFull,
     Drawing,
-    Tangents,
+    TangentRows,
     InitialTangents,
     Reduced,
     ThetaDotSqSc,
@@ -183,8 +183,8 @@ pub const METHODS: &[Signature] = &[
         &[(A::Poses, L::BodyTriples), (A::Sizes, L::Sizes)],
     ),
     sig(
-        Method::Tangents,
-        "tangents",
+        Method::TangentRows,
+        "tangent_rows",
         &[
             (A::K, L::Constants),
             (A::Q, L::Coords),

@@ -1,4 +1,5 @@
-//! The tape's evaluator: [`TapeModel`] implements [`Model`] and [`Reduction`] by running each
+//! The tape's evaluator: [`TapeModel`] implements [`Model`], [`Reduction`], [`Tangents`] and
+//! [`Partials`] by running each
 //! method's checked program on a register file, with the same `f64` operations in the same
 //! order as the generated Rust, so both routes give equal results to the bit.
 //!
@@ -6,7 +7,9 @@
 //! (sized once; no allocation per call).
 
 use super::check::{Method, Op, Program};
-use crate::model::{Model, ModelInfo, Reduced, Reduction, start_offsets};
+use crate::model::{
+    Model, ModelInfo, Partials, Reduced, Reduction, TangentPoint, Tangents, start_offsets,
+};
 use std::cell::RefCell;
 
 thread_local! {
@@ -218,30 +221,9 @@ impl Model for TapeModel {
         );
     }
 
-    fn has_tangents(&self) -> bool {
-        self.program(Method::Tangents).is_some() && self.program(Method::InitialTangents).is_some()
-    }
-
-    fn tangents(
-        &self,
-        k: &[f64],
-        q: &[f64],
-        qd: &[f64],
-        qdd: &[f64],
-        forces: &[f64],
-        fr: &[f64],
-        out: &mut [f64],
-    ) {
-        self.call(
-            Method::Tangents,
-            &[k, q, qd, qdd, forces, fr],
-            &mut [out],
-            None,
-        );
-    }
-
-    fn initial_tangents(&self, k: &[f64], out: &mut [f64]) {
-        self.call(Method::InitialTangents, &[k], &mut [out], None);
+    fn tangents(&self) -> Option<&dyn Tangents> {
+        let has = |m| self.program(m).is_some();
+        (has(Method::TangentRows) && has(Method::InitialTangents)).then_some(self as &dyn Tangents)
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
@@ -280,10 +262,40 @@ impl Reduction for TapeModel {
         self.call(Method::FallPolynomial, &[k], &mut [out], None);
     }
 
-    fn has_partials(&self) -> bool {
-        self.program(Method::SeparationPartials).is_some()
+    fn partials(&self) -> Option<&dyn Partials> {
+        (self.program(Method::SeparationPartials).is_some()).then_some(self as &dyn Partials)
     }
 
+    fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
+        self.call(Method::PrepareLean, &[p], &mut [k], None);
+    }
+
+    fn full_state(
+        &self,
+        k: &[f64],
+        t: f64,
+        delta: f64,
+        theta_dot: f64,
+        q: &mut [f64],
+        qd: &mut [f64],
+    ) {
+        let ins: &[&[f64]] = &[k, &[t], &[delta], &[theta_dot]];
+        self.call(Method::FullState, ins, &mut [q, qd], None);
+    }
+}
+
+impl Tangents for TapeModel {
+    fn tangent_rows(&self, k: &[f64], at: &TangentPoint<'_>, out: &mut [f64]) {
+        let ins: &[&[f64]] = &[k, at.q, at.qd, at.qdd, at.forces, at.friction];
+        self.call(Method::TangentRows, ins, &mut [out], None);
+    }
+
+    fn initial_tangents(&self, k: &[f64], out: &mut [f64]) {
+        self.call(Method::InitialTangents, &[k], &mut [out], None);
+    }
+}
+
+impl Partials for TapeModel {
     fn separation_partials(&self, k: &[f64], s: f64, c: f64, out: &mut [f64]) {
         self.call(
             Method::SeparationPartials,
@@ -308,23 +320,6 @@ impl Reduction for TapeModel {
 
     fn fall_partials(&self, k: &[f64], out: &mut [f64]) {
         self.call(Method::FallPartials, &[k], &mut [out], None);
-    }
-
-    fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
-        self.call(Method::PrepareLean, &[p], &mut [k], None);
-    }
-
-    fn full_state(
-        &self,
-        k: &[f64],
-        t: f64,
-        delta: f64,
-        theta_dot: f64,
-        q: &mut [f64],
-        qd: &mut [f64],
-    ) {
-        let ins: &[&[f64]] = &[k, &[t], &[delta], &[theta_dot]];
-        self.call(Method::FullState, ins, &mut [q, qd], None);
     }
 }
 

@@ -15,7 +15,7 @@ pub const FORMAT: &str = "rodcube-tape";
 
 /// The version of the format this build reads and writes. A tape of another version is
 /// refused with the command that regenerates it.
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
 
 /// A whole tape file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -3,10 +3,11 @@
 //! `&'static dyn Model`).
 
 use crate::model::{
-    ContactInfo, FrictionInfo, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo,
-    ReductionInfo, ShapeInfo, ShapeKind,
+    ContactInfo, FrictionInfo, GapKind, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo,
+    ReductionInfo, RequirementInfo, ShapeInfo, ShapeKind,
 };
 use crate::spec::is_identifier;
+use crate::spec::units::AngularUnit;
 use serde::{Deserialize, Serialize};
 
 /// The most prepared constants a tape's model may have (a bound on what a caller allocates).
@@ -22,7 +23,7 @@ pub struct Info {
     pub spec: String,
     pub system: String,
     pub parameters: Vec<Param>,
-    pub requirements: Vec<Named>,
+    pub requirements: Vec<Requirement>,
     pub n_constants: usize,
     pub coordinates: Vec<String>,
     pub system_coordinates: Vec<String>,
@@ -64,6 +65,15 @@ pub struct Named {
 #[allow(missing_docs)]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
+pub struct Requirement {
+    pub name: String,
+    pub meaning: String,
+    pub parameters: Vec<usize>,
+}
+
+#[allow(missing_docs)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Monitor {
     pub name: String,
     pub meaning: String,
@@ -76,7 +86,7 @@ pub struct Monitor {
 pub struct Contact {
     pub name: String,
     pub meaning: String,
-    pub gap_unit: String,
+    pub gap: Gap,
     pub unit: String,
     pub bilateral: bool,
     pub edge: bool,
@@ -93,6 +103,13 @@ pub struct Friction {
     pub meaning: String,
     pub coefficient_index: usize,
     pub contact_index: usize,
+}
+
+#[allow(missing_docs)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Gap {
+    Length,
+    Angle,
 }
 
 #[allow(missing_docs)]
@@ -138,8 +155,8 @@ pub struct Reduction {
 impl Info {
     /// What is inconsistent in it, if anything: a model, system or parameter name that is not an
     /// identifier (programs find models and bind parameters by these names, and the C interface
-    /// hands them out as C strings), a parameter named twice, or an index past the list it
-    /// points into.
+    /// hands them out as C strings), a parameter named twice or with a unit that does not read
+    /// as one, or an index past the list it points into.
     pub fn check(&self) -> Result<(), String> {
         for (what, name) in [("name", &self.name), ("system", &self.system)] {
             if !is_identifier(name) {
@@ -155,6 +172,12 @@ impl Info {
             }
             if self.parameters[..i].iter().any(|q| q.name == p.name) {
                 return Err(format!("parameter `{}` is named twice", p.name));
+            }
+            if let Err(e) = AngularUnit::parse(&p.unit) {
+                return Err(format!(
+                    "parameter `{}` has the unit {:?}: {e}",
+                    p.name, p.unit
+                ));
             }
         }
         let n = self.coordinates.len();
@@ -180,6 +203,11 @@ impl Info {
         }
         if self.end_angle.is_some() && self.reduced_index.is_none() {
             return Err("`end_angle` is given without a `reduced_index` it is a value of".into());
+        }
+        for r in &self.requirements {
+            for &p in &r.parameters {
+                within("requirements.parameters", p, self.parameters.len())?;
+            }
         }
         for f in &self.frictions {
             within(
@@ -257,7 +285,11 @@ impl Info {
                 unit: s(&p.unit),
                 positive: p.positive,
             }),
-            requirements: list(&self.requirements, named),
+            requirements: list(&self.requirements, |r| RequirementInfo {
+                name: s(&r.name),
+                meaning: s(&r.meaning),
+                parameters: list(&r.parameters, |&p| p),
+            }),
             n_constants: self.n_constants,
             coordinates: list(&self.coordinates, |c| s(c)),
             system_coordinates: list(&self.system_coordinates, |c| s(c)),
@@ -267,7 +299,10 @@ impl Info {
             contacts: list(&self.contacts, |c| ContactInfo {
                 name: s(&c.name),
                 meaning: s(&c.meaning),
-                gap_unit: s(&c.gap_unit),
+                gap: match c.gap {
+                    Gap::Length => GapKind::Length,
+                    Gap::Angle => GapKind::Angle,
+                },
                 unit: s(&c.unit),
                 bilateral: c.bilateral,
                 edge: c.edge,

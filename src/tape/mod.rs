@@ -194,11 +194,11 @@ pub fn parse(text: &str, file: &str) -> Result<TapeModel, TapeError> {
             return Err(missing(m));
         }
     }
-    if has(check::Method::Tangents) != has(check::Method::InitialTangents) {
-        let m = if has(check::Method::Tangents) {
+    if has(check::Method::TangentRows) != has(check::Method::InitialTangents) {
+        let m = if has(check::Method::TangentRows) {
             check::Method::InitialTangents
         } else {
-            check::Method::Tangents
+            check::Method::TangentRows
         };
         return Err(missing(m));
     }

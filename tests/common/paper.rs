@@ -11,8 +11,8 @@
 //! that the tests compare with the generated one.
 
 use rodcube::model::{
-    ContactInfo, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, PhaseInfo, Reduced,
-    Reduction, ReductionInfo, ShapeInfo, ShapeKind,
+    ContactInfo, GapKind, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, Partials, PhaseInfo,
+    Reduced, Reduction, ReductionInfo, RequirementInfo, ShapeInfo, ShapeKind, Tangents,
 };
 
 const fn param(
@@ -33,6 +33,15 @@ const fn named(name: &'static str, meaning: &'static str) -> NamedInfo {
     NamedInfo { name, meaning }
 }
 
+/// The paper's one requirement, `a < ell`, over `ell` and `a` (parameters 2 and 3).
+const fn a_below_ell(meaning: &'static str) -> RequirementInfo {
+    RequirementInfo {
+        name: "a_below_ell",
+        meaning,
+        parameters: &[2, 3],
+    }
+}
+
 const fn monitor(name: &'static str, meaning: &'static str, unit: &'static str) -> MonitorInfo {
     MonitorInfo {
         name,
@@ -48,7 +57,7 @@ const fn contacts(tip: bool, floor: bool) -> [ContactInfo; 2] {
         ContactInfo {
             name: "contact_force",
             meaning: "push of the rod on the cube (N), positive while touching, eq. (16)",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: false,
@@ -59,7 +68,7 @@ const fn contacts(tip: bool, floor: bool) -> [ContactInfo; 2] {
         ContactInfo {
             name: "floor_normal",
             meaning: "floor reaction on the rod's foot (N), m1 (g + y_cm'')",
-            gap_unit: "m",
+            gap: GapKind::Length,
             unit: "N",
             bilateral: false,
             edge: false,
@@ -184,8 +193,7 @@ static RC_INFO: ModelInfo = ModelInfo {
         param("a", "cube side", "m", true),
         param("g", "gravitational acceleration", "m/s^2", true),
     ],
-    requirements: &[named(
-        "a_below_ell",
+    requirements: &[a_below_ell(
         "the cube is lower than the rod is long: (ell - a) / ell > 0",
     )],
     n_constants: 12,
@@ -348,6 +356,10 @@ impl Model for RodCube {
         draw(k, rod, x1 + ell * th.cos(), poses, sizes);
     }
 
+    fn tangents(&self) -> Option<&dyn Tangents> {
+        None
+    }
+
     fn reduction(&self) -> Option<&dyn Reduction> {
         Some(self)
     }
@@ -415,6 +427,10 @@ impl Reduction for RodCube {
         out.copy_from_slice(&[ell / (3.0 * g), 0.0, -ell * k[RC_MU] / (4.0 * g)]);
     }
 
+    fn partials(&self) -> Option<&dyn Partials> {
+        None
+    }
+
     fn full_state(
         &self,
         k: &[f64],
@@ -477,7 +493,7 @@ static FR_INFO: ModelInfo = ModelInfo {
         ),
         param("x2_dot_0", "cube velocity at separation", "m/s", false),
     ],
-    requirements: &[named("a_below_ell", "(ell - a) / ell > 0")],
+    requirements: &[a_below_ell("(ell - a) / ell > 0")],
     n_constants: 18,
     coordinates: &["x1", "theta", "x2"],
     system_coordinates: SYSTEM_COORDINATES,
@@ -628,6 +644,10 @@ impl Model for FreeRod {
         draw(k, rod, q[2], poses, sizes);
     }
 
+    fn tangents(&self) -> Option<&dyn Tangents> {
+        None
+    }
+
     fn reduction(&self) -> Option<&dyn Reduction> {
         Some(self)
     }
@@ -668,6 +688,10 @@ impl Reduction for FreeRod {
 
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
         self.prepare(p, k);
+    }
+
+    fn partials(&self) -> Option<&dyn Partials> {
+        None
     }
 
     fn full_state(
@@ -714,8 +738,7 @@ static GEN_INFO: ModelInfo = ModelInfo {
         param("a", "cube side", "m", true),
         param("g", "gravitational acceleration", "m/s^2", true),
     ],
-    requirements: &[named(
-        "a_below_ell",
+    requirements: &[a_below_ell(
         "the cube is lower than the rod is long: (ell - a) / ell > 0",
     )],
     n_constants: 6,
@@ -866,6 +889,10 @@ impl Model for General {
         let (x1, y1, th, ell) = (q[0], q[1], q[2], k[2]);
         let rod = [x1 + 0.5 * ell * th.cos(), y1 + 0.5 * ell * th.sin(), th];
         draw(k, rod, q[3], poses, sizes);
+    }
+
+    fn tangents(&self) -> Option<&dyn Tangents> {
+        None
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {

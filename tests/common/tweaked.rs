@@ -3,7 +3,7 @@
 //! models never reach. A tweaked fast phase runs in its system through a registry that holds
 //! it in place of the original ([`registry`]).
 
-use rodcube::model::{Model, ModelInfo, Reduced, Reduction, ReductionInfo};
+use rodcube::model::{Model, ModelInfo, Partials, Reduced, Reduction, ReductionInfo, Tangents};
 use std::collections::HashMap;
 use std::sync::{Mutex, OnceLock};
 
@@ -93,6 +93,10 @@ impl Model for Tweaked {
             *v += self.monitor_shift;
         }
     }
+    fn tangents(&self) -> Option<&dyn Tangents> {
+        None
+    }
+
     fn reduction(&self) -> Option<&dyn Reduction> {
         Some(self)
     }
@@ -136,6 +140,10 @@ impl Reduction for Tweaked {
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
         self.reduction.prepare_lean(p, k)
     }
+    fn partials(&self) -> Option<&dyn Partials> {
+        None
+    }
+
     fn full_state(
         &self,
         k: &[f64],

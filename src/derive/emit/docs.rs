@@ -291,7 +291,8 @@ pub(super) fn reduction_docs(d: &Derivation, r: &Reduction) -> Docs {
     docs
 }
 
-/// The doc comments of the general model `d`'s `Model::tangents` and `Model::initial_tangents`.
+/// The doc comments of the general model `d`'s `Tangents::tangent_rows` and
+/// `Tangents::initial_tangents`.
 pub(super) fn tangents_docs(d: &Derivation) -> Docs {
     let (n, np) = (d.coords.len(), d.params.len());
     let (m, nf) = (d.contacts.len(), d.frictions.len());
@@ -299,7 +300,7 @@ pub(super) fn tangents_docs(d: &Derivation) -> Docs {
     docs.insert(
         "tangents",
         doc(
-            "The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities (`qdd`, `forces`, `fr` held fixed), row-major.",
+            "The partial derivatives over `[q, qd, p]` of the residual `M qdd - F - J^T forces - T^T fr`, the contacts' normal accelerations, the frictions' slip accelerations, the gaps, the edge margins and the slip velocities at the point `at` (its accelerations and forces held fixed), row-major.",
             vec![format!(
                 "{} rows ({n} + 3 x {m} + 2 x {nf}) by {} columns (2 x {n} + {np}), differentiated symbolically from the expressions of `equations`, `constraints`, `friction`, `gaps` and `edges`.",
                 n + 3 * m + 2 * nf,

@@ -20,6 +20,14 @@ struct Monitor {
     unit: String,
 }
 
+/// A requirement's name, meaning and the indices of the parameters its margin reads.
+#[derive(Debug, Clone, Serialize)]
+struct Requirement {
+    name: String,
+    meaning: String,
+    parameters: Vec<usize>,
+}
+
 #[derive(Debug, Clone, Serialize)]
 struct Param {
     name: String,
@@ -51,7 +59,7 @@ pub(super) struct StaticInfo {
     description_literal: String,
     spec: String,
     params: Vec<Param>,
-    requirements_info: Vec<Named>,
+    requirements_info: Vec<Requirement>,
     n_params: usize,
     coordinates: Vec<String>,
     n_coordinates: usize,
@@ -115,10 +123,10 @@ pub(super) fn static_info(
                 .and_then(|s| s.restitution.as_ref())
                 .map_or_else(|| "0".to_string(), |e| e.text());
             format!(
-                "ContactInfo {{ name: {:?}, meaning: {:?}, gap_unit: {:?}, unit: {:?}, bilateral: {}, edge: {}, eliminates: {:?}, closed: {}, restitution: {:?} }}",
+                "ContactInfo {{ name: {:?}, meaning: {:?}, gap: GapKind::{:?}, unit: {:?}, bilateral: {}, edge: {}, eliminates: {:?}, closed: {}, restitution: {:?} }}",
                 c.name,
                 c.meaning,
-                c.gap_unit,
+                c.gap_kind,
                 c.force_unit,
                 c.bilateral,
                 c.edge.is_some(),
@@ -160,10 +168,16 @@ pub(super) fn static_info(
                 positive: p.positive,
             })
             .collect(),
-        requirements_info: (spec.requirements.iter())
-            .map(|r| Named {
-                name: r.name.clone(),
-                meaning: lit(&r.meaning),
+        requirements_info: (spec.requirements.iter().zip(&d.requirements))
+            .map(|(r, e)| {
+                let read = e.symbols();
+                Requirement {
+                    name: r.name.clone(),
+                    meaning: lit(&r.meaning),
+                    parameters: (0..np)
+                        .filter(|&i| read.contains(&d.params[i].name))
+                        .collect(),
+                }
             })
             .collect(),
         n_params: np,

@@ -46,7 +46,7 @@ pub fn json_record(
             let mut v = serde_json::json!({
                 "name": c.name,
                 "meaning": c.meaning,
-                "gap_unit": c.gap_unit,
+                "gap_unit": c.gap_kind.unit(),
                 "force_unit": c.force_unit,
                 "bilateral": c.bilateral,
                 "eliminates": c.eliminates,

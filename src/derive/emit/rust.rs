@@ -35,7 +35,7 @@ pub struct RustContext {
     #[serde(flatten)]
     general: FullStateCode,
     reduction: Option<ReducedCode>,
-    /// The general model's `Model::tangents` and `Model::initial_tangents`.
+    /// The general model's `Tangents::tangent_rows` and `Tangents::initial_tangents`.
     tangents: Option<TangentsCode>,
     /// Each method's doc comment, by the method's name.
     docs: Docs,

@@ -1,8 +1,9 @@
-//! The general model's tangents ([`Tangents`]): `Model::tangents`, the partial derivatives of
-//! its rows over `[q, qd, p]` at given accelerations and forces, and `Model::initial_tangents`,
+//! The general model's tangents ([`Tangents`]): `Tangents::tangent_rows`, the partial
+//! derivatives of its rows over `[q, qd, p]` at a `TangentPoint` (the state, the accelerations
+//! and the forces), and `Tangents::initial_tangents`,
 //! those of its initial state over the parameters (parameter-only: hoisted into `k`).
 
-use super::code::{Code, K, Locals, OUT, Q, QD};
+use super::code::{Code, K, Locals, OUT};
 use super::lower::{Hoisted, Scope, lower, unbound};
 use super::method::Preamble;
 use super::state::state_scope;
@@ -28,16 +29,25 @@ impl TangentsCode {
     /// reduced coordinate.
     pub(super) fn finish(&mut self, n: usize, reduced: Option<usize>, locals: &Locals) {
         let (slice, params) = (Preamble::Slice(n), Preamble::Names(&locals.params, "k"));
-        let state = [
-            slice,
-            Preamble::Angle(reduced),
-            params,
-            Preamble::State(&locals.coords),
-        ];
-        let qdd = ("qdd", "&[f64]");
-        let forces = ("forces", "&[f64]");
-        let fr = ("fr", "&[f64]");
-        (self.tangents).finish(&[K, Q, QD, qdd, forces, fr, OUT], &state);
+        // The point's fields by the names the body reads, each only where it is read.
+        let point = [
+            ("q", "at.q"),
+            ("qd", "at.qd"),
+            ("qdd", "at.qdd"),
+            ("forces", "at.forces"),
+            ("fr", "at.friction"),
+        ]
+        .map(|(name, field)| Preamble::Let(name, field));
+        let state = (point.into_iter())
+            .chain([
+                slice,
+                Preamble::Angle(reduced),
+                params,
+                Preamble::State(&locals.coords),
+            ])
+            .collect::<Vec<_>>();
+        let at = ("at", "&TangentPoint<'_>");
+        (self.tangents).finish(&[K, at, OUT], &state);
         (self.initial_tangents).finish(&[K, OUT], &[slice, params]);
     }
 }

@@ -16,7 +16,7 @@ use syn::{BinOp, Expr, ImplItem, Item, Lit, Pat, Stmt, UnOp};
 
 /// Methods of the generated code that are not programs: the model's description and its
 /// capabilities, which the tape's info and its list of methods say.
-const NOT_PROGRAMS: &[&str] = &["info", "reduction", "has_tangents", "has_partials"];
+const NOT_PROGRAMS: &[&str] = &["info", "reduction", "tangents", "partials"];
 
 /// The named constants of `std::f64::consts` the generated code may use.
 const CONSTS: &[(&str, f64)] = &[
@@ -165,6 +165,19 @@ enum Binding {
     Scalar(Arg),
     /// The contact a `force_polynomial` matches on.
     Contact,
+    /// A `&TangentPoint` argument: its fields' slices, in [`POINT_FIELDS`]' order.
+    Point([Arg; 5]),
+}
+
+/// The fields of a `TangentPoint`, in the order the tape's arguments give them.
+const POINT_FIELDS: [&str; 5] = ["q", "qd", "qdd", "forces", "friction"];
+
+/// Whether a parameter's type is a reference to a `TangentPoint`.
+fn is_point(ty: &syn::Type) -> bool {
+    let syn::Type::Reference(r) = ty else {
+        return false;
+    };
+    matches!(&*r.elem, syn::Type::Path(p) if last_segment(&p.path) == "TangentPoint")
 }
 
 /// The compiler of one method.
@@ -240,9 +253,22 @@ impl Compiler<'_> {
                 self.names.insert(pname, Binding::Contact);
                 continue;
             }
-            let b = args
-                .next()
-                .ok_or("more parameters than the trait's method has")?;
+            let mut next = || {
+                args.next()
+                    .ok_or("more parameters than the trait's method has")
+            };
+            let b = if is_point(&t.ty) {
+                let mut fields = [Arg::Out; 5];
+                for f in &mut fields {
+                    match next()? {
+                        Binding::Slice(a) => *f = a,
+                        _ => return Err("a `TangentPoint` of something other than slices".into()),
+                    }
+                }
+                Binding::Point(fields)
+            } else {
+                next()?
+            };
             self.names.insert(pname, b);
         }
         Ok(())
@@ -324,6 +350,23 @@ impl Compiler<'_> {
                 {
                     return Err("a reference to something other than a range of a slice".into());
                 }
+                Ok(())
+            }
+            // `let q = at.q;`: a field of a `TangentPoint` argument, a slice.
+            Pat::Ident(id) if matches!(&**init, Expr::Field(_)) => {
+                let Expr::Field(f) = &**init else {
+                    return Err("a field".into());
+                };
+                let point = name_of(&f.base).and_then(|n| self.names.get(&n).copied());
+                let (Some(Binding::Point(args)), syn::Member::Named(field)) = (point, &f.member)
+                else {
+                    return Err("a field of something other than a `TangentPoint`".into());
+                };
+                let i = (POINT_FIELDS.iter().position(|x| field == x)).ok_or_else(|| {
+                    format!("a field `{field}` that `TangentPoint` does not have")
+                })?;
+                self.names
+                    .insert(id.ident.to_string(), Binding::Slice(args[i]));
                 Ok(())
             }
             Pat::Ident(id) => {

@@ -205,8 +205,8 @@ pub struct TexContext {
     scales: String,
     /// The results without units, numbered.
     results: Vec<Equation>,
-    /// Where the model carries its tangents (`Model::tangents`), which are not printed: the
-    /// paragraph that says so.
+    /// Where the model carries its tangents (`Tangents::tangent_rows`), which are not
+    /// printed: the paragraph that says so.
     tangents: Option<String>,
 }
 
@@ -396,7 +396,7 @@ fn constraint_equations(d: &Derivation, name: &dyn Fn(&str) -> String, eqs: &mut
                 tex_text(&c.name),
                 tex_text(&c.meaning),
                 kind,
-                tex_text(&c.gap_unit),
+                tex_text(c.gap_kind.unit()),
                 tex_text(&c.force_unit)
             ),
             format!("g_{{{}}} = ", k + 1),

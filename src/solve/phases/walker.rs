@@ -8,7 +8,7 @@ use super::motion::{ImpactAt, Motion};
 use super::reduced::{ReducedEnd, ReducedRun, phase_end};
 use super::run::{IntegratedRun, PhaseRun};
 use super::zeno::{self, Flight};
-use crate::model::{Model, ModelInfo};
+use crate::model::{GapKind, Model, ModelInfo};
 use crate::results::{Halt, Work, Zeno};
 use crate::solve::SolveError;
 use crate::solve::contacts::{
@@ -587,10 +587,9 @@ impl<'m> Walker<'m> {
         if pull <= 0.0 {
             return Ok(None);
         }
-        let scale = if self.general.info().contacts[c].gap_unit == "m" {
-            self.general.length_scale(state)?
-        } else {
-            1.0
+        let scale = match self.general.info().contacts[c].gap {
+            GapKind::Length => self.general.length_scale(state)?,
+            GapKind::Angle => 1.0,
         };
         let rise = lift * lift / (2.0 * pull) / scale;
         if rise >= DECIDE_TOLERANCE {
@@ -716,7 +715,7 @@ fn approaching_touches(sys: &Bound, state: &State) -> Result<Vec<bool>, SolveErr
     let length = sys.length_scale(state)?;
     Ok((info.contacts.iter().enumerate())
         .map(|(i, c)| {
-            let scale = if c.gap_unit == "m" { length } else { 1.0 };
+            let scale = c.gap.scale(length);
             let v = contacts::normal_velocity(&jac[i * n..(i + 1) * n], state);
             !c.closed && !c.bilateral && gaps[i] <= DECIDE_TOLERANCE * scale && v < 0.0
         })

@@ -46,9 +46,9 @@ impl Checker<'_> {
 
     /// The units the mechanics needs: bodies' masses in kg, inertias in kg m^2, positions in
     /// m, potentials in J, and every contact's gap in one unit, whose force is conjugate to it
-    /// (N for a gap in metres, N m for one in radians). Returns each contact's gap and force
-    /// unit, as printed.
-    pub(in crate::spec) fn contact_units(&self) -> Result<Vec<(String, String)>, SpecError> {
+    /// (N for a gap in metres, N m for one in radians): a gap is a length (m) or an angle
+    /// (dimensionless). Returns each contact's gap unit and its force unit, as printed.
+    pub(in crate::spec) fn contact_units(&self) -> Result<Vec<(Unit, String)>, SpecError> {
         let s = self.spec;
         let units = self.symbol_units()?;
         let lookup = |n: &str| units.get(n).copied();
@@ -108,6 +108,16 @@ impl Checker<'_> {
                 })
             };
             let gap_unit = consistent("gap", &c.gap)?;
+            if gap_unit != Unit::METRE && !gap_unit.is_dimensionless() {
+                return Err(self.err(
+                    &field.k("gap"),
+                    format!(
+                        "the gap of contact `{}` is in {gap_unit}: a gap is a length (m) or \
+                         an angle (rad)",
+                        c.name
+                    ),
+                ));
+            }
             let force_unit = conjugate_force_unit(gap_unit)
                 .map_err(|err| self.err(&field.k("gap"), format!("contact `{}`: {err}", c.name)))?;
             if let Some(edge) = &c.edge {
@@ -127,7 +137,7 @@ impl Checker<'_> {
             } else {
                 force_unit.to_string()
             };
-            out.push((gap_unit.to_string(), force));
+            out.push((gap_unit, force));
         }
         Ok(out)
     }

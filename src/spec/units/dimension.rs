@@ -253,7 +253,7 @@ fn reading_cost(factors: &[(&str, Exponent)]) -> usize {
 }
 
 /// Writes `name` with the power `e` (`m`, `m^2`, `s^-1`, `m^(1/2)`, `s^(-1/2)`).
-fn write_factor(f: &mut fmt::Formatter<'_>, name: &str, e: Exponent) -> fmt::Result {
+pub(super) fn write_factor(f: &mut fmt::Formatter<'_>, name: &str, e: Exponent) -> fmt::Result {
     if e == Exponent::ONE {
         write!(f, "{name}")
     } else if e.is_integer() {

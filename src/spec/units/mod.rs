@@ -6,7 +6,9 @@
 //! Radians (and steradians) are dimensionless, as in SI: `rad` parses to the dimensionless unit
 //! [`Unit::DIMENSIONLESS`], so an angle and a pure number have the same [`Unit`]. The
 //! trigonometric functions take a dimensionless argument (an angle in radians or a ratio), and
-//! the inverse ones give an angle, which is dimensionless too.
+//! the inverse ones give an angle, which is dimensionless too. Where a unit is reported rather
+//! than checked (a sensitivity's unit, an FMU's unit definitions), [`AngularUnit`] keeps the
+//! radian as a factor of its own.
 //!
 //! Only the base units that mechanics uses are supported: kg, m and s. The other SI base units
 //! (A, K, mol, cd) are refused by [`Unit::parse`] with a message saying so.
@@ -31,11 +33,13 @@
 //! # Ok::<(), rodcube::spec::units::UnitError>(())
 //! ```
 
+mod angular;
 mod dimension;
 mod infer;
 mod parse;
 #[cfg(test)]
 mod tests;
 
+pub use angular::AngularUnit;
 pub use dimension::{Exponent, SumMismatch, Unit, UnitError, conjugate_force_unit};
 pub use infer::{expect_unit, unit_of};

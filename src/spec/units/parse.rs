@@ -1,6 +1,8 @@
-//! The reader of unit strings as specs write them ([`Unit::parse`]): `kg m^2`, `m/s^2`,
-//! `kg/(m s^2)`, refused with the character where the problem is.
+//! The reader of unit strings as specs write them ([`Unit::parse`], and [`AngularUnit::parse`]
+//! keeping the radian): `kg m^2`, `m/s^2`, `kg/(m s^2)`, refused with the character where the
+//! problem is.
 
+use super::angular::AngularUnit;
 use super::dimension::{Exponent, Unit, UnitError, overflow};
 
 impl Unit {
@@ -19,6 +21,13 @@ impl Unit {
     /// one `/`, and `/` followed by a product without parentheses (`N/m s`, which readers take
     /// either way).
     pub fn parse(text: &str) -> Result<Unit, UnitError> {
+        AngularUnit::parse(text).map(AngularUnit::si)
+    }
+}
+
+impl AngularUnit {
+    /// Reads a unit string as [`Unit::parse`] does, keeping the power of `rad`.
+    pub fn parse(text: &str) -> Result<AngularUnit, UnitError> {
         if text.trim().is_empty() {
             return Err(UnitError::Empty);
         }
@@ -130,7 +139,7 @@ impl UnitParser<'_> {
     }
 
     /// Factors joined by whitespace or a product sign; stops before `/`, `)` or the end.
-    fn product(&mut self) -> Result<Unit, UnitError> {
+    fn product(&mut self) -> Result<AngularUnit, UnitError> {
         let mut unit = self.factor()?;
         loop {
             let spaced = self.ws();
@@ -148,7 +157,7 @@ impl UnitParser<'_> {
     }
 
     /// A symbol or `1`, with an optional power.
-    fn factor(&mut self) -> Result<Unit, UnitError> {
+    fn factor(&mut self) -> Result<AngularUnit, UnitError> {
         let start = self.i;
         let base = match self.peek() {
             Some(c) if c.is_alphabetic() => {
@@ -177,7 +186,7 @@ impl UnitParser<'_> {
                         ),
                     ));
                 }
-                Unit::DIMENSIONLESS
+                AngularUnit::from(Unit::DIMENSIONLESS)
             }
             Some('(') => {
                 return Err(self.syntax(
@@ -201,12 +210,13 @@ impl UnitParser<'_> {
         base.checked_pow(power).map_err(|_| self.too_large())
     }
 
-    fn symbol(&self, symbol: &str, start: usize) -> Result<Unit, UnitError> {
-        Ok(match symbol {
+    fn symbol(&self, symbol: &str, start: usize) -> Result<AngularUnit, UnitError> {
+        Ok(AngularUnit::from(match symbol {
             "kg" => Unit::KILOGRAM,
             "m" => Unit::METRE,
             "s" => Unit::SECOND,
-            "rad" | "sr" => Unit::DIMENSIONLESS,
+            "rad" => return Ok(AngularUnit::RADIAN),
+            "sr" => Unit::DIMENSIONLESS,
             "N" => Unit::NEWTON,
             "J" => Unit::JOULE,
             "W" => Unit::integers(1, 2, -3),
@@ -226,7 +236,7 @@ impl UnitParser<'_> {
                     symbol: symbol.to_string(),
                 });
             }
-        })
+        }))
     }
 
     /// `2`, `-1`, `+3`, `(1/2)`, `(-3/2)`, `(2)`.

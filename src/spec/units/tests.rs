@@ -361,6 +361,50 @@ fn conjugate_forces() {
     );
 }
 
+#[test]
+fn angular_units_keep_the_radian() {
+    let a = |t: &str| AngularUnit::parse(t).unwrap_or_else(|e| panic!("{t}: {e}"));
+    // The radian's power is kept apart from the SI unit, which is the same as `Unit::parse`'s.
+    for (text, rad) in [
+        ("rad", 1),
+        ("rad/s", 1),
+        ("m", 0),
+        ("rad^2 m", 2),
+        ("s/rad", -1),
+    ] {
+        assert_eq!(a(text).rad(), Exponent::integer(rad), "{text}");
+        assert_eq!(a(text).si(), u(text), "{text}");
+    }
+    assert!(a("rad").is_angle_or_rate() && a("rad/s").is_angle_or_rate());
+    assert!(!a("1").is_angle_or_rate() && !a("1/s").is_angle_or_rate());
+    assert!(!a("rad/m").is_angle_or_rate() && !a("rad^2").is_angle_or_rate());
+    // Quotients, as a sensitivity's unit is formed, and what they print.
+    let per = |r: &str, p: &str| a(r).checked_div(a(p)).map(|q| q.to_string());
+    for (r, p, want) in [
+        ("rad", "kg", "rad/kg"),
+        ("rad", "m/s^2", "rad s^2/m"),
+        ("rad/s", "m/s^2", "rad s/m"),
+        ("s", "m/s^2", "s^3/m"),
+        ("rad", "rad", "1"),
+        ("s", "rad", "s/rad"),
+        ("m/s", "rad", "m/(s rad)"),
+        ("1", "rad^2", "1/rad^2"),
+        ("N m", "kg", "m^2/s^2"),
+    ] {
+        assert_eq!(per(r, p), Ok(want.to_string()), "{r} / {p}");
+    }
+}
+
+proptest! {
+    /// Whatever powers of kg, m, s and rad, the printed unit reads back to the same unit.
+    #[test]
+    fn angular_units_read_back(kg in -3i64..=3, m in -3i64..=3, s in -3i64..=3, rad in -3i64..=3) {
+        let unit = AngularUnit::new(Unit::integers(kg, m, s), Exponent::integer(rad));
+        let text = unit.to_string();
+        prop_assert_eq!(AngularUnit::parse(&text), Ok(unit), "{}", text);
+    }
+}
+
 /// The units of a spec's symbols: parameters and coordinates as declared, obstacle symbols
 /// in m, friction forces in N, each contact's force conjugate to its gap.
 fn scope(spec: &crate::spec::Spec) -> BTreeMap<String, Unit> {
