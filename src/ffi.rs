@@ -102,8 +102,7 @@ pub const RODCUBE_ERR_TOLERANCE: c_int = 203;
 pub const RODCUBE_ERR_TOO_FEW_SAMPLES: c_int = 204;
 /// More samples per series than accepted.
 pub const RODCUBE_ERR_TOO_MANY_SAMPLES: c_int = 205;
-/// The run's end time (`until`) is not a positive finite time, or is missing for a model with
-/// no end angle.
+/// The run's end time (`until`) is not a positive finite time.
 pub const RODCUBE_ERR_UNTIL: c_int = 206;
 
 /// Group: a solver failed (codes 301 to 399).
@@ -436,7 +435,7 @@ fn plan_code(e: &PlanError) -> c_int {
         PlanError::BadTolerance { .. } => RODCUBE_ERR_TOLERANCE,
         PlanError::TooFewSamples { .. } => RODCUBE_ERR_TOO_FEW_SAMPLES,
         PlanError::TooManySamples { .. } => RODCUBE_ERR_TOO_MANY_SAMPLES,
-        PlanError::BadUntil { .. } | PlanError::NeedsUntil { .. } => RODCUBE_ERR_UNTIL,
+        PlanError::BadUntil { .. } => RODCUBE_ERR_UNTIL,
         PlanError::System(e) => system_code(e),
         PlanError::Solve(e) => solve_code(e),
         PlanError::NonFinite { .. } => RODCUBE_ERR_RESULT_NOT_FINITE,

@@ -481,7 +481,6 @@ impl Scene {
             PlanError::Unavailable { .. } => at("want".into(), Kind::UnavailableQuantity),
             PlanError::BadTolerance { .. } => at("tolerance".into(), Kind::OutOfRange),
             PlanError::BadUntil { .. } => at("until".into(), Kind::OutOfRange),
-            PlanError::NeedsUntil { .. } => at("until".into(), Kind::Structure),
             PlanError::TooFewSamples { .. } | PlanError::TooManySamples { .. } => {
                 at("samples".into(), Kind::OutOfRange)
             }

@@ -288,27 +288,6 @@ fn a_run_says_it_reached_its_end_and_refuses_a_bad_one() {
             "{until}: {err:?}"
         );
     }
-    // A system with no end angle (the rocking block) has no end of its own: a request without
-    // `until` is refused before anything is solved, naming what it needs.
-    let block = find("rocking_block").unwrap();
-    let p = [
-        ("m", 1.0),
-        ("w", 0.4),
-        ("h", 1.0),
-        ("phi0", 0.2),
-        ("g", 9.81),
-        ("mu", 0.7),
-        ("e", 0.0),
-    ];
-    let err =
-        plan::run(&Request::new(block, p.as_slice()).with_want(&[Quantity::Impacts])).unwrap_err();
-    assert_eq!(
-        err,
-        PlanError::NeedsUntil {
-            model: "rocking_block"
-        }
-    );
-    assert!(err.to_string().contains("`until`"), "{err}");
 }
 
 #[test]

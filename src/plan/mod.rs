@@ -245,14 +245,6 @@ pub enum PlanError {
         /// The tolerance given.
         tolerance: f64,
     },
-    /// No `until` for a model with no end angle (nothing else ends its motion).
-    #[error(
-        "model `{model}` has no end angle, so its motion has no end of its own: the request needs `until`, the time to run it to"
-    )]
-    NeedsUntil {
-        /// The model.
-        model: &'static str,
-    },
     /// `until` is not a positive, finite time.
     #[error("until {until} s: the run's end must be a positive, finite time from release")]
     BadUntil {
@@ -322,9 +314,6 @@ fn wanted(request: &Request) -> Result<Vec<Quantity>, PlanError> {
         && !(until > 0.0 && until.is_finite())
     {
         return Err(PlanError::BadUntil { until });
-    }
-    if request.until.is_none() && info.end_angle.is_none() {
-        return Err(PlanError::NeedsUntil { model: info.name });
     }
     let needs_samples = want.iter().any(|q| {
         matches!(
