@@ -1142,6 +1142,7 @@ mod tests {
             SensitivityGap::NoFallPolynomial,
             SensitivityGap::DoubleRoot,
             SensitivityGap::NoUnit,
+            SensitivityGap::OneSided,
         ] {
             let Failure(code, message) = gap.into();
             assert_eq!(code, RODCUBE_ERR_NO_SENSITIVITY, "{gap:?}");

@@ -430,8 +430,8 @@ fn the_rocking_blocks_rest_time_moves_as_differences_say() {
         }
         if name == "e" {
             // At e = 0 the derivative is the plastic law's; any e above adds a bounce of the
-            // striking corner at every strike, a motion of other events (as in
-            // `rocking_strikes_agree`, which leaves `e` out too).
+            // striking corner at every strike, a motion of other events: the planner refuses
+            // it (`a_plastic_restitution_has_no_derivative_after_its_impact`).
             continue;
         }
         let h = 1e-4 * p[name];
@@ -445,6 +445,39 @@ fn the_rocking_blocks_rest_time_moves_as_differences_say() {
             (d[j] - diff).abs() <= 1e-6 * diff.abs().max(t / p[name]),
             "d t_rest/d {name}: {} vs differences {diff}",
             d[j]
+        );
+    }
+}
+
+#[test]
+fn a_plastic_restitution_has_no_derivative_after_its_impact() {
+    // The rocking block's corners strike plastically (e = 0). Any e > 0 makes each strike
+    // bounce (its rest time's one-sided differences in e are 10.95 where the plastic law's
+    // saltation gives 52.95): every result after the first strike has a note for `e`, and its
+    // derivatives in the other parameters.
+    let (model, p) = scene("rocking");
+    let want = [Quantity::Impacts, Quantity::Sensitivities];
+    let request = Request::new(model, &p)
+        .with_want(&want)
+        .with_until(Some(1.0));
+    let res = plan::run(&request).expect("runs");
+    let n = res.impacts.as_ref().expect("impacts").len();
+    assert!(n >= 2, "{n} strikes");
+    // The first strike's time does not depend on e: it comes before any bounce.
+    assert!(res.sensitivities.contains_key("d(impact_1_time)/d(e)"));
+    for i in 2..=n {
+        let key = format!("d(impact_{i}_time)/d(e)");
+        assert!(!res.sensitivities.contains_key(&key), "{key}");
+        assert_eq!(
+            res.notes.get(&format!("sensitivities.{key}")),
+            Some(&rodcube::results::Note::NoSensitivity(
+                rodcube::results::SensitivityGap::OneSided
+            )),
+            "{key}"
+        );
+        assert!(
+            res.sensitivities
+                .contains_key(&format!("d(impact_{i}_time)/d(w)"))
         );
     }
 }

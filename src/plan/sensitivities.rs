@@ -64,7 +64,8 @@ enum Source {
 }
 
 /// The derivatives of one result, or why there are none.
-type Derivatives = Result<Vec<f64>, SensitivityGap>;
+/// A result's derivatives from the integrated route, with the result's time (s from release).
+type Timed = Result<(Vec<f64>, f64), SensitivityGap>;
 
 impl<'m> Plan<'m> {
     /// The sensitivities of every wanted result that has them, and notes for the others.
@@ -137,11 +138,12 @@ impl<'m> Plan<'m> {
                 (Some(Err(gap)), true) => Some(Err(*gap)),
                 _ => None,
             };
+            // The fast path's results come before any impact.
             let (found, integrated) = match exact {
-                Some(found) => (found, false),
+                Some(found) => (found.map(|d| (d, f64::NEG_INFINITY)), false),
                 None => (self.integrated_derivatives(target, *source)?, true),
             };
-            match found.and_then(|d| self.record(target, (x, &d), integrated, out)) {
+            match found.and_then(|(d, t)| self.record(target, (x, &d, t), integrated, out)) {
                 Ok(()) => {}
                 Err(gap) => {
                     out.notes
@@ -158,7 +160,7 @@ impl<'m> Plan<'m> {
         &mut self,
         target: &Target,
         source: Source,
-    ) -> Result<Derivatives, SolveError> {
+    ) -> Result<Timed, SolveError> {
         let general = self.general().clone();
         let contact = match source {
             Source::Separation => 0,
@@ -203,9 +205,9 @@ impl<'m> Plan<'m> {
         }
         Ok(match &sensitive.ends[k] {
             Err(_) => Err(SensitivityGap::Grazing),
-            Ok(d) if target.key == "impact_angular_velocity" => Ok(d.theta_dot.clone()),
-            Ok(d) if target.angle => Ok(d.theta.clone()),
-            Ok(d) => Ok(d.t.clone()),
+            Ok(d) if target.key == "impact_angular_velocity" => Ok((d.theta_dot.clone(), t)),
+            Ok(d) if target.angle => Ok((d.theta.clone(), t)),
+            Ok(d) => Ok((d.t.clone(), t)),
         })
     }
 
@@ -249,7 +251,7 @@ impl<'m> Plan<'m> {
                 unit: "s",
                 angle: false,
             };
-            match found.and_then(|d| self.record(&target, (t_run, &d), true, out)) {
+            match found.and_then(|d| self.record(&target, (t_run, &d, t_run), true, out)) {
                 Ok(()) => {}
                 Err(gap) => {
                     out.notes
@@ -283,17 +285,23 @@ impl<'m> Plan<'m> {
         }
     }
 
-    /// `d(target)/dp` and its elasticity for every parameter, from `x` and its derivatives
-    /// (`integrated`: by the integrated route).
+    /// `d(target)/dp` and its elasticity for every parameter, from `x`, its derivatives and
+    /// its time `t` (`integrated`: by the integrated route); a parameter whose derivatives an
+    /// impact before `t` left one-sided ([`SensitiveMotion::one_sided`]) gets a note under
+    /// `sensitivities.d(<target>)/d(<p>)` instead.
     /// [`SensitivityGap::NoUnit`], recording nothing, where a unit cannot be formed.
     fn record(
         &self,
         target: &Target,
-        x: (f64, &[f64]),
+        x: (f64, &[f64], f64),
         integrated: bool,
         out: &mut RunResults,
     ) -> Result<(), SensitivityGap> {
-        let (x, dx) = x;
+        let (x, dx, t) = x;
+        let one_sided = |j: usize| match &self.sensitive {
+            Some(Ok(s)) => s.one_sided.get(&j).is_some_and(|&at| at < t),
+            _ => false,
+        };
         let info = self.general().info();
         let p = self.general().p();
         let units = (info.parameters.iter())
@@ -301,7 +309,13 @@ impl<'m> Plan<'m> {
             .collect::<Result<Vec<String>, _>>()
             .map_err(|_| SensitivityGap::NoUnit)?;
         let each = info.parameters.iter().zip(p).zip(dx).zip(units);
-        for (((param, &value), &d), unit) in each {
+        for (j, (((param, &value), &d), unit)) in each.enumerate() {
+            let key = format!("d({})/d({})", target.key, param.name);
+            if one_sided(j) {
+                let gap = Note::NoSensitivity(SensitivityGap::OneSided);
+                out.notes.insert(note_key(&key), gap);
+                continue;
+            }
             let entry = |value: f64, unit: String, elasticity: bool| Sensitivity {
                 value,
                 unit,
@@ -310,10 +324,7 @@ impl<'m> Plan<'m> {
                 elasticity,
                 integrated,
             };
-            out.sensitivities.insert(
-                format!("d({})/d({})", target.key, param.name),
-                entry(d, unit, false),
-            );
+            out.sensitivities.insert(key, entry(d, unit, false));
             out.sensitivities.insert(
                 format!("elasticity({};{})", target.key, param.name),
                 entry(value / x * d, "1".into(), true),

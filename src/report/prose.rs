@@ -499,6 +499,11 @@ pub fn sensitivity_gap(gap: SensitivityGap) -> &'static str {
             "no sensitivity: its unit cannot be formed from the result's and a parameter's \
              (a unit that does not read as one, or powers that overflow)"
         }
+        SensitivityGap::OneSided => {
+            "no sensitivity in this parameter: it is the restitution of a contact that struck \
+             plastically (zero) before the result, and any value above zero makes the contact \
+             bounce, a motion of other events: the derivative is one-sided"
+        }
     }
 }
 

@@ -283,4 +283,9 @@ pub enum SensitivityGap {
     /// The result's unit over a parameter's cannot be formed (a parameter's unit that does not
     /// read as a unit, or a quotient whose powers overflow).
     NoUnit,
+    /// The parameter is the coefficient of restitution of a contact that struck plastically
+    /// (it is zero) before the result: any value above zero makes that contact bounce, a
+    /// motion of other events, so the derivative in it is one-sided and not the plastic
+    /// law's.
+    OneSided,
 }

@@ -112,6 +112,30 @@ fn restitution_partials(sys: &Bound) -> Result<Vec<f64>, SaltationGap> {
     Ok(out)
 }
 
+/// The parameters (by index) whose derivatives `impact` leaves one-sided: the coefficient of
+/// restitution of a contact that approached and obeyed Newton's law is zero there (plastic)
+/// and moves with them. Any coefficient above zero makes that contact bounce, a motion of
+/// other events, which the saltation of the plastic law does not describe; below zero there is
+/// none. Empty where the restitutions have no partials ([`SaltationGap::Restitution`]).
+pub fn one_sided(sys: &Bound, impact: &Impact) -> Vec<usize> {
+    let Ok(de) = restitution_partials(sys) else {
+        return Vec::new();
+    };
+    let np = sys.info().parameters.len();
+    let restitution = sys.restitutions();
+    let plastic = |i: usize| {
+        impact.laws.get(i) == Some(&ContactLaw::Restitution)
+            && impact
+                .normal_velocity_before
+                .get(i)
+                .is_some_and(|v| *v < 0.0)
+            && restitution.get(i) == Some(&0.0)
+    };
+    (0..np)
+        .filter(|&p| (0..restitution.len()).any(|i| plastic(i) && de[i * np + p] != 0.0))
+        .collect()
+}
+
 /// The model's tangent rows at `state` with `qdd`, contact `forces` and friction forces `fr`,
 /// less the same rows at zero: the partial derivatives of the rows' parts linear in them.
 fn linear_partials(

@@ -46,6 +46,10 @@ pub struct SensitiveMotion<'m> {
     /// sequence's last four times give it (a geometric series through them agrees with the
     /// accumulation time to [`ZENO_AGREE`] of the time left).
     pub accumulation: BTreeMap<usize, Vec<f64>>,
+    /// Per parameter (by index) whose derivatives an impact left one-sided (a plastic contact
+    /// whose restitution is that parameter, [`saltation::one_sided`]): the time of the first
+    /// such impact (s from release). What comes after it has no derivative in that parameter.
+    pub one_sided: BTreeMap<usize, f64>,
 }
 
 /// Why the motion with sensitivities stopped before its end.
@@ -129,11 +133,18 @@ impl<'m> Walker<'m> {
                 Ok(Next::Stop(stop)) => stop,
                 Err(e) => Some(Stop::Failed(e)),
             };
+            let mut one_sided = BTreeMap::new();
+            for at in &motion.impacts {
+                for p in saltation::one_sided(general, &at.impact) {
+                    one_sided.entry(p).or_insert(at.t);
+                }
+            }
             return Ok(SensitiveMotion {
                 motion,
                 ends,
                 stop,
                 accumulation,
+                one_sided,
             });
         }
     }
