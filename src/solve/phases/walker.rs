@@ -485,8 +485,8 @@ impl<'m> Walker<'m> {
     /// The impact that ends the motion's last phase, where contact `closing` closed: every
     /// contact closed then, `closing` and any other open one that touches while approaching take
     /// part, with their frictions (`impact::resolve_with`). A sequence converging as Zeno's
-    /// (its times, [`zeno::limit`], or a flight too small to resolve,
-    /// [`Walker::unresolved_bounce`]) is closed by an impact that holds its contacts closed,
+    /// (its times, `zeno::limit`, or a flight too small to resolve,
+    /// `Walker::unresolved_bounce`) is closed by an impact that holds its contacts closed,
     /// listed at the sequence's accumulation time, with a note.
     pub fn impact(&self, motion: &mut Motion<'m>, closing: usize) -> Result<ImpactAt, SolveError> {
         let general = &self.general;
