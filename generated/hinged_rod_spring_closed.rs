@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 41,
+    n_constants: 42,
     coordinates: &["theta"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced_index: Some(0),
@@ -205,59 +205,58 @@ impl Model for HingedRodSpringClosed {
         k[14] = ell * g * m1 / 2.0;
         // k[15] = k/2
         k[15] = k_param / 2.0;
-        // k[16] = ell*cos(asin(a/ell))
-        k[16] = ell * (a / ell).asin().cos();
-        // k[17] = ell^2*m1/3
-        k[17] = (ell * ell) * m1 / 3.0;
-        // k[18] = ell^2*m2
-        k[18] = (ell * ell) * m2;
-        // k[19] = ell*k
-        k[19] = ell * k_param;
-        // k[20] = 2*ell*k*cos(asin(a/ell))
-        k[20] = 2.0 * ell * k_param * (a / ell).asin().cos();
-        // k[21] = ell*m1 + 2*ell*m2
-        k[21] = (ell * m1) + (2.0 * ell * m2);
-        // k[22] = 2*ell*k
-        k[22] = 2.0 * ell * k_param;
-        // k[23] = g*m1
-        k[23] = g * m1;
-        // k[24] = ell*m1/2
-        k[24] = ell * m1 / 2.0;
-        // k[25] = 3/ell
-        k[25] = 3.0 / ell;
-        // k[26] = 3*m2
-        k[26] = 3.0 * m2;
-        // k[27] = 2*ell*k*rc_ci - 2*ell*k*cos(asin(a/ell))
-        k[27] = (2.0 * ell * k_param * k[9]) - (2.0 * ell * k_param * (a / ell).asin().cos());
-        // k[28] = 3/(2*ell)
-        k[28] = 3.0 / 2.0 / ell;
-        // k[29] = 2*ell*k*m1
-        k[29] = 2.0 * ell * k_param * m1;
-        // k[30] = 2*ell*k*m1*rc_ci - 2*ell*k*m1*cos(asin(a/ell))
-        k[30] =
-            (2.0 * ell * k_param * m1 * k[9]) - (2.0 * ell * k_param * m1 * (a / ell).asin().cos());
-        // k[31] = 12*ell*k*m2*rc_ci - 12*ell*k*m2*cos(asin(a/ell))
-        k[31] = (12.0 * ell * k_param * m2 * k[9])
-            - (12.0 * ell * k_param * m2 * (a / ell).asin().cos());
-        // k[32] = 6*ell*k*m2
-        k[32] = 6.0 * ell * k_param * m2;
-        // k[33] = 6*ell*k*m2*rc_ci - 6*ell*k*m2*cos(asin(a/ell))
-        k[33] =
-            (6.0 * ell * k_param * m2 * k[9]) - (6.0 * ell * k_param * m2 * (a / ell).asin().cos());
-        // k[34] = 6*g*m1*m2
-        k[34] = 6.0 * g * m1 * m2;
-        // k[35] = 3*g*m1*m2
-        k[35] = 3.0 * g * m1 * m2;
-        // k[36] = g*m1^2
-        k[36] = g * (m1 * m1);
-        // k[37] = ell*k*cos(asin(a/ell))
-        k[37] = ell * k_param * (a / ell).asin().cos();
-        // k[38] = ell*m2
-        k[38] = ell * m2;
-        // k[39] = (ell*m1 + 2*ell*m2)/2
-        k[39] = ((ell * m1) + (2.0 * ell * m2)) / 2.0;
-        // k[40] = a/2
-        k[40] = a / 2.0;
+        // k[16] = cos(asin(a/ell))
+        k[16] = k[6].cos();
+        // k[17] = ell*cos(asin(a/ell))
+        k[17] = ell * k[16];
+        // k[18] = ell^2*m1/3
+        k[18] = (ell * ell) * m1 / 3.0;
+        // k[19] = ell^2*m2
+        k[19] = (ell * ell) * m2;
+        // k[20] = ell*k
+        k[20] = ell * k_param;
+        // k[21] = 2*ell*k*cos(asin(a/ell))
+        k[21] = 2.0 * ell * k_param * k[16];
+        // k[22] = ell*m1 + 2*ell*m2
+        k[22] = (ell * m1) + (2.0 * ell * m2);
+        // k[23] = 2*ell*k
+        k[23] = 2.0 * ell * k_param;
+        // k[24] = g*m1
+        k[24] = g * m1;
+        // k[25] = ell*m1/2
+        k[25] = ell * m1 / 2.0;
+        // k[26] = 3/ell
+        k[26] = 3.0 / ell;
+        // k[27] = 3*m2
+        k[27] = 3.0 * m2;
+        // k[28] = 2*ell*k*rc_ci - 2*ell*k*cos(asin(a/ell))
+        k[28] = (2.0 * ell * k_param * k[9]) - (2.0 * ell * k_param * k[16]);
+        // k[29] = 3/(2*ell)
+        k[29] = 3.0 / 2.0 / ell;
+        // k[30] = 2*ell*k*m1
+        k[30] = 2.0 * ell * k_param * m1;
+        // k[31] = 2*ell*k*m1*rc_ci - 2*ell*k*m1*cos(asin(a/ell))
+        k[31] = (2.0 * ell * k_param * m1 * k[9]) - (2.0 * ell * k_param * m1 * k[16]);
+        // k[32] = 12*ell*k*m2*rc_ci - 12*ell*k*m2*cos(asin(a/ell))
+        k[32] = (12.0 * ell * k_param * m2 * k[9]) - (12.0 * ell * k_param * m2 * k[16]);
+        // k[33] = 6*ell*k*m2
+        k[33] = 6.0 * ell * k_param * m2;
+        // k[34] = 6*ell*k*m2*rc_ci - 6*ell*k*m2*cos(asin(a/ell))
+        k[34] = (6.0 * ell * k_param * m2 * k[9]) - (6.0 * ell * k_param * m2 * k[16]);
+        // k[35] = 6*g*m1*m2
+        k[35] = 6.0 * g * m1 * m2;
+        // k[36] = 3*g*m1*m2
+        k[36] = 3.0 * g * m1 * m2;
+        // k[37] = g*m1^2
+        k[37] = g * (m1 * m1);
+        // k[38] = ell*k*cos(asin(a/ell))
+        k[38] = ell * k_param * k[16];
+        // k[39] = ell*m2
+        k[39] = ell * m2;
+        // k[40] = (ell*m1 + 2*ell*m2)/2
+        k[40] = ((ell * m1) + (2.0 * ell * m2)) / 2.0;
+        // k[41] = a/2
+        k[41] = a / 2.0;
     }
 
     /// The state at release, over the parameters.
@@ -265,7 +264,7 @@ impl Model for HingedRodSpringClosed {
     /// - `theta = asin(a/ell)`
     /// - `dot_theta = 0.0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         q[0] = k[6];
         qd[0] = 0.0;
     }
@@ -281,7 +280,7 @@ impl Model for HingedRodSpringClosed {
     /// - `cube_x = ell*cos(theta)`
     /// - `cube_y = 0`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ell = k[2];
         let theta_dot = qd[0];
@@ -302,7 +301,7 @@ impl Model for HingedRodSpringClosed {
     /// - `T = dot_theta^2*ell^2*m1/6 + dot_theta^2*ell^2*m2*sin(theta)^2/2`
     /// - `V = a*g*m2/2 + ell*g*m1*sin(theta)/2 + k*(ell*cos(theta) - ell*cos(asin(a/ell)))^2/2`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ell = k[2];
         let theta_dot = qd[0];
@@ -310,7 +309,7 @@ impl Model for HingedRodSpringClosed {
         ((k[11] * et0) + (k[12] * et0 * (rc_s * rc_s)))
             + (k[13]
                 + (k[14] * rc_s)
-                + (k[15] * ((-k[16] + (ell * rc_c)) * (-k[16] + (ell * rc_c)))))
+                + (k[15] * ((-k[17] + (ell * rc_c)) * (-k[17] + (ell * rc_c)))))
     }
 
     /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
@@ -323,13 +322,13 @@ impl Model for HingedRodSpringClosed {
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
     /// - `L = T - V = -(a*g*m2/2 + ell*g*m1*sin(theta)/2 + k*(ell*cos(theta) - ell*cos(asin(a/ell)))^2/2) + dot_theta^2*ell^2*m1/6 + dot_theta^2*ell^2*m2*sin(theta)^2/2`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ell = k[2];
         let theta_dot = qd[0];
-        mass[0] = k[17] + (k[18] * (rc_s * rc_s));
-        rhs[0] = -(k[14] * rc_c) + (k[19] * (-k[16] + (ell * rc_c)) * rc_s)
-            - (k[18] * (theta_dot * theta_dot) * rc_s * rc_c);
+        mass[0] = k[18] + (k[19] * (rc_s * rc_s));
+        rhs[0] = -(k[14] * rc_c) + (k[20] * (-k[17] + (ell * rc_c)) * rc_s)
+            - (k[19] * (theta_dot * theta_dot) * rc_s * rc_c);
     }
 
     /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
@@ -338,7 +337,7 @@ impl Model for HingedRodSpringClosed {
     /// - `hinge_horizontal`: 182 characters, written out in `generated/hinged_rod_spring_closed.tex`
     /// - `hinge_vertical = ddot_theta*ell*m1*cos(theta)/2 + g*m1 - dot_theta^2*ell*m1*sin(theta)/2`
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let m2 = k[1];
         let ell = k[2];
@@ -346,11 +345,11 @@ impl Model for HingedRodSpringClosed {
         let theta_dot = qd[0];
         let theta_ddot = qdd[0];
         let ft0 = theta_dot * theta_dot;
-        out[0] = (k_param * (-k[16] + (ell * rc_c)))
+        out[0] = (k_param * (-k[17] + (ell * rc_c)))
             + (m2 * (-(ell * theta_ddot * rc_s) - (ell * ft0 * rc_c)));
         out[1] =
-            -(k[20] + (k[21] * theta_ddot * rc_s) - (k[22] * rc_c) + (k[21] * ft0 * rc_c)) / 2.0;
-        out[2] = k[23] + (k[24] * theta_ddot * rc_c) - (k[24] * ft0 * rc_s);
+            -(k[21] + (k[22] * theta_ddot * rc_s) - (k[23] * rc_c) + (k[22] * ft0 * rc_c)) / 2.0;
+        out[2] = k[24] + (k[25] * theta_ddot * rc_c) - (k[25] * ft0 * rc_s);
     }
 
     /// Each contact's gap `g(q)`, `>= 0` while apart (zero for a contact held closed).
@@ -410,7 +409,7 @@ impl Model for HingedRodSpringClosed {
     /// - `x2 = ell*cos(theta)`
     /// - `dot_x2 = -(dot_theta*ell*sin(theta))`
     fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ell = k[2];
         let theta = q[0];
@@ -427,13 +426,13 @@ impl Model for HingedRodSpringClosed {
 
     /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ell = k[2];
         let a = k[3];
         let theta = q[0];
         poses[0] = [k[10] * rc_c, k[10] * rc_s, theta];
-        poses[1] = [k[40] + (ell * rc_c), k[40], 0.0];
+        poses[1] = [k[41] + (ell * rc_c), k[41], 0.0];
         sizes[0] = -k[10];
         sizes[1] = 0.0;
         sizes[2] = k[10];
@@ -455,25 +454,25 @@ impl Reduction for HingedRodSpringClosed {
     /// - `theta_dot^2`: 187 characters, written out in `generated/hinged_rod_spring_closed.tex`
     /// - `theta_ddot`: 420 characters, written out in `generated/hinged_rod_spring_closed.tex`
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         let m1 = k[0];
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let rt0 = rc_dc * rc_dc;
         let rt1 = rc_s * rc_s;
-        let rt2 = m1 + (k[26] * rt1); // m1 + 3*m2*rc_s^2
+        let rt2 = m1 + (k[27] * rt1); // m1 + 3*m2*rc_s^2
         let rt3 = rc_s.powi(3);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: -k[25] * (-(k[27] * rc_dc) + (k[19] * rt0) - (k[23] * rc_ds)) / rt2,
-            theta_ddot: -k[28]
-                * ((k[29] * rc_s * rc_dc) - (k[30] * rc_s) + (k[31] * rc_s * rc_c * rc_dc)
-                    - (k[32] * rc_s * rc_c * rt0)
-                    + (k[32] * rt3 * rc_dc)
-                    - (k[33] * rt3)
-                    + (k[34] * rc_s * rc_c * rc_ds)
-                    + (k[35] * rt1 * rc_c)
-                    + (k[36] * rc_c))
+            theta_dot_sq: -k[26] * (-(k[28] * rc_dc) + (k[20] * rt0) - (k[24] * rc_ds)) / rt2,
+            theta_ddot: -k[29]
+                * ((k[30] * rc_s * rc_dc) - (k[31] * rc_s) + (k[32] * rc_s * rc_c * rc_dc)
+                    - (k[33] * rc_s * rc_c * rt0)
+                    + (k[33] * rt3 * rc_dc)
+                    - (k[34] * rt3)
+                    + (k[35] * rc_s * rc_c * rc_ds)
+                    + (k[36] * rt1 * rc_c)
+                    + (k[37] * rc_c))
                 / (rt2 * rt2),
         }
     }
@@ -482,10 +481,10 @@ impl Reduction for HingedRodSpringClosed {
     ///
     /// - `theta_dot^2`: 187 characters, written out in `generated/hinged_rod_spring_closed.tex`
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         let m1 = k[0];
-        -k[25] * (-(k[27] * rc_dc) + (k[19] * (rc_dc * rc_dc)) - (k[23] * rc_ds))
-            / (m1 + (k[26] * (rc_s * rc_s)))
+        -k[26] * (-(k[28] * rc_dc) + (k[20] * (rc_dc * rc_dc)) - (k[24] * rc_ds))
+            / (m1 + (k[27] * (rc_s * rc_s)))
     }
 
     /// Each contact's force on the reduced motion (zero for a contact open in the phase).
@@ -494,27 +493,27 @@ impl Reduction for HingedRodSpringClosed {
     /// - `hinge_horizontal`: 773 characters, written out in `generated/hinged_rod_spring_closed.tex`
     /// - `hinge_vertical`: 682 characters, written out in `generated/hinged_rod_spring_closed.tex`
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         let m1 = k[0];
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let rt0 = rc_dc * rc_dc;
         let rt1 = rc_s * rc_s;
-        let rt2 = m1 + (k[26] * rt1); // m1 + 3*m2*rc_s^2
+        let rt2 = m1 + (k[27] * rt1); // m1 + 3*m2*rc_s^2
         let rt3 = rc_s.powi(3);
-        let rc_w2 = -k[25] * (-(k[27] * rc_dc) + (k[19] * rt0) - (k[23] * rc_ds)) / rt2;
-        let rc_acc = -k[28]
-            * ((k[29] * rc_s * rc_dc) - (k[30] * rc_s) + (k[31] * rc_s * rc_c * rc_dc)
-                - (k[32] * rc_s * rc_c * rt0)
-                + (k[32] * rt3 * rc_dc)
-                - (k[33] * rt3)
-                + (k[34] * rc_s * rc_c * rc_ds)
-                + (k[35] * rt1 * rc_c)
-                + (k[36] * rc_c))
+        let rc_w2 = -k[26] * (-(k[28] * rc_dc) + (k[20] * rt0) - (k[24] * rc_ds)) / rt2;
+        let rc_acc = -k[29]
+            * ((k[30] * rc_s * rc_dc) - (k[31] * rc_s) + (k[32] * rc_s * rc_c * rc_dc)
+                - (k[33] * rc_s * rc_c * rt0)
+                + (k[33] * rt3 * rc_dc)
+                - (k[34] * rt3)
+                + (k[35] * rc_s * rc_c * rc_ds)
+                + (k[36] * rt1 * rc_c)
+                + (k[37] * rc_c))
             / (rt2 * rt2);
-        let ft0 = k[19] * rc_c; // ell*k*rc_c
-        out[0] = -k[37] + ft0 - (k[38] * rc_s * rc_acc) - (k[38] * rc_c * rc_w2);
-        out[1] = -k[37] + ft0 - (k[39] * rc_s * rc_acc) - (k[39] * rc_c * rc_w2);
-        out[2] = k[23] - (k[24] * rc_s * rc_w2) + (k[24] * rc_c * rc_acc);
+        let ft0 = k[20] * rc_c; // ell*k*rc_c
+        out[0] = -k[38] + ft0 - (k[39] * rc_s * rc_acc) - (k[39] * rc_c * rc_w2);
+        out[1] = -k[38] + ft0 - (k[40] * rc_s * rc_acc) - (k[40] * rc_c * rc_w2);
+        out[2] = k[24] - (k[25] * rc_s * rc_w2) + (k[25] * rc_c * rc_acc);
     }
 
     /// The coefficients, constant term first, of a contact's force zero as a polynomial in `sin(theta)`, where it is one.
@@ -526,7 +525,7 @@ impl Reduction for HingedRodSpringClosed {
         let p = &p[..6];
         let ell = p[2];
         let a = p[3];
-        let k = &mut k[..41]; // one bounds check for all constant stores
+        let k = &mut k[..42]; // one bounds check for all constant stores
         k[..6].copy_from_slice(p);
         // k[7] = rc_wi = 0.0
         k[7] = 0.0;
@@ -549,7 +548,7 @@ impl Reduction for HingedRodSpringClosed {
 
     /// `d(theta_dot^2)/dp` for each parameter at a fixed angle given by `sin(theta)`, `cos(theta)`.
     fn theta_dot_sq_partials(&self, k: &[f64], rc_s: f64, rc_c: f64, out: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         let m1 = k[0];
         let m2 = k[1];
         let ell = k[2];
@@ -617,7 +616,7 @@ impl Reduction for HingedRodSpringClosed {
 
     /// `d(sin theta_i)/dp` for each parameter.
     fn start_partials(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         let ell = k[2];
         let a = k[3];
         out[0] = 0.0;
@@ -641,7 +640,7 @@ impl Reduction for HingedRodSpringClosed {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..42]; // one bounds check for all constant loads
         q[0] = k[6] - delta;
         qd[0] = theta_dot;
     }

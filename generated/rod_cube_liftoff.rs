@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 29,
+    n_constants: 30,
     coordinates: &["x1", "y1", "theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced_index: Some(2),
@@ -207,27 +207,28 @@ impl Model for RodCubeLiftoff {
         k[17] = a / 2.0;
         // k[18] = ell*m1
         k[18] = ell * m1;
-        // k[19] = ell^2/12
-        k[19] = (ell * ell) / 12.0;
-        // k[20] = ell^2/4
-        k[20] = (ell * ell) / 4.0;
-        // k[21] = ell*g/2
-        k[21] = ell * g / 2.0;
-        // k[22] = ell*m1/6
-        k[22] = ell * m1 / 6.0;
-        // k[23] = g*m1/2
-        k[23] = g * m1 / 2.0;
-        // k[24] = 2*ell
-        k[24] = 2.0 * ell;
-        // k[25] = a/(ell^2*(1 - a^2/ell^2)^(1/2))
-        k[25] = a / (ell * ell) / (1.0 - ((a * a) / (ell * ell))).sqrt();
-        // k[26] = 1/(ell*(1 - a^2/ell^2)^(1/2))
-        k[26] = 1.0 / ell / (1.0 - ((a * a) / (ell * ell))).sqrt();
-        // k[27] = ell/((a + ell)*(-a + ell))^(1/2)
-        k[27] = ell / ((a + ell) * (-a + ell)).sqrt();
-        // k[28] = (-a + ell - (a + ell))/(2*((a + ell)*(-a + ell))^(1/2))
-        let h28_t0 = a + ell;
-        k[28] = (-a + ell - h28_t0) / 2.0 / (h28_t0 * (-a + ell)).sqrt();
+        // k[19] = ell^2/3
+        k[19] = (ell * ell) / 3.0;
+        // k[20] = ell*g/2
+        k[20] = ell * g / 2.0;
+        // k[21] = 2*ell*m1/3
+        k[21] = 2.0 * ell * m1 / 3.0;
+        // k[22] = g*m1/2
+        k[22] = g * m1 / 2.0;
+        // k[23] = 2*ell
+        k[23] = 2.0 * ell;
+        // k[24] = ((1 + a/ell)*(1 - a/ell))^(1/2)
+        k[24] = ((1.0 + (a / ell)) * (1.0 - (a / ell))).sqrt();
+        // k[25] = a/(ell^2*((1 + a/ell)*(1 - a/ell))^(1/2))
+        k[25] = a / (ell * ell) / k[24];
+        // k[26] = 1/(ell*((1 + a/ell)*(1 - a/ell))^(1/2))
+        k[26] = 1.0 / ell / k[24];
+        // k[27] = ((a + ell)*(-a + ell))^(1/2)
+        k[27] = ((a + ell) * (-a + ell)).sqrt();
+        // k[28] = ell/((a + ell)*(-a + ell))^(1/2)
+        k[28] = ell / k[27];
+        // k[29] = (-a + ell - (a + ell))/(2*((a + ell)*(-a + ell))^(1/2))
+        k[29] = (-a + ell - (a + ell)) / 2.0 / k[27];
     }
 
     /// The state at release, over the parameters.
@@ -241,7 +242,7 @@ impl Model for RodCubeLiftoff {
     /// - `x2 = sqrt((ell - a)*(ell + a))`
     /// - `dot_x2 = 0.0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = 0.0;
@@ -263,7 +264,7 @@ impl Model for RodCubeLiftoff {
     /// - `cube_x = x2`
     /// - `cube_y = 0`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let x1 = q[0];
@@ -294,7 +295,7 @@ impl Model for RodCubeLiftoff {
     /// - `T = -dot_theta*dot_x1*ell*m1*sin(theta)/2 + dot_theta*dot_y1*ell*m1*cos(theta)/2 + dot_theta^2*ell^2*m1/6 + dot_x1^2*m1/2 + dot_x2^2*m2/2 + dot_y1^2*m1/2`
     /// - `V = a*g*m2/2 + ell*g*m1*sin(theta)/2 + g*m1*y1`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let x1_dot = qd[0];
         let y1 = q[1];
@@ -315,7 +316,7 @@ impl Model for RodCubeLiftoff {
     /// - `p_x1 = -dot_theta*ell*m1*sin(theta)/2 + dot_x1*m1`
     /// - `p_x2 = dot_x2*m2`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let m1 = k[0];
         let m2 = k[1];
@@ -331,7 +332,7 @@ impl Model for RodCubeLiftoff {
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
     /// - `L = T - V`: 196 characters, written out in `generated/rod_cube_liftoff.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let m2 = k[1];
@@ -376,7 +377,7 @@ impl Model for RodCubeLiftoff {
     /// - `floor_normal = y1`
     /// - `tip_floor = ell*sin(theta) + y1`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let x1 = q[0];
@@ -389,7 +390,7 @@ impl Model for RodCubeLiftoff {
 
     /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let theta_dot = qd[2];
@@ -429,7 +430,7 @@ impl Model for RodCubeLiftoff {
     ///
     /// - `cube_does_not_tip = a*g*m2/2 - rc_f0*(-a/2 + ell*sin(theta) + y1)`
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let ell = k[2];
         let y1 = q[1];
@@ -467,7 +468,7 @@ impl Model for RodCubeLiftoff {
 
     /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let a = k[3];
         let x1 = q[0];
@@ -504,7 +505,7 @@ impl Model for RodCubeLiftoff {
         _fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let ell = k[2];
@@ -515,8 +516,6 @@ impl Model for RodCubeLiftoff {
         let theta_ddot = qdd[2];
         let x2_ddot = qdd[3];
         let xt0 = theta_dot * theta_dot;
-        let xt1 = rc_s * rc_s;
-        let xt2 = rc_c * rc_c;
         out.fill(0.0);
         out[2] = -(k[9] * theta_ddot * rc_c) + (k[9] * xt0 * rc_s);
         out[6] = -k[18] * theta_dot * rc_c;
@@ -531,20 +530,20 @@ impl Model for RodCubeLiftoff {
             - (k[9] * y1_ddot * rc_s)
             - (k[14] * rc_s)
             - ((ell * forces[0] * rc_c) - (ell * forces[2] * rc_s));
-        out[36] = (theta_ddot * (k[19] + (k[20] * xt1) + (k[20] * xt2))) - (k[8] * x1_ddot * rc_s)
+        out[36] = (k[19] * theta_ddot) - (k[8] * x1_ddot * rc_s)
             + (k[8] * y1_ddot * rc_c)
-            + (k[21] * rc_c);
-        out[38] = (theta_ddot * (k[22] + (k[9] * xt1) + (k[9] * xt2))) - (k[11] * x1_ddot * rc_s)
+            + (k[20] * rc_c);
+        out[38] = (k[21] * theta_ddot) - (k[11] * x1_ddot * rc_s)
             + (k[11] * y1_ddot * rc_c)
-            + (k[23] * rc_c)
+            + (k[22] * rc_c)
             - ((forces[0] * rc_s) + (forces[2] * rc_c));
         out[40] = k[9] * rc_c;
         out[51] = x2_ddot;
         out[58] = (ell * theta_ddot * rc_c) - (ell * xt0 * rc_s);
-        out[62] = k[24] * theta_dot * rc_c;
+        out[62] = k[23] * theta_dot * rc_c;
         out[66] = (theta_ddot * rc_s) + (xt0 * rc_c);
         out[86] = -(ell * theta_ddot * rc_s) - (ell * xt0 * rc_c);
-        out[90] = -k[24] * theta_dot * rc_s;
+        out[90] = -k[23] * theta_dot * rc_s;
         out[94] = (theta_ddot * rc_c) - (xt0 * rc_s);
         out[98] = -1.0;
         out[100] = ell * rc_s;
@@ -558,12 +557,12 @@ impl Model for RodCubeLiftoff {
 
     /// `d(initial state)/dp`: the rows `d q_0/dp`, then `d qd_0/dp`, by the parameters.
     fn initial_tangents(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         out.fill(0.0);
         out[14] = -k[25];
         out[15] = k[26];
-        out[20] = k[27];
-        out[21] = k[28];
+        out[20] = k[28];
+        out[21] = k[29];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
