@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 35,
+    n_constants: 32,
     coordinates: &["x1", "y1", "theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced_index: Some(2),
@@ -207,44 +207,44 @@ impl Model for HingedRodSpring {
         k[16] = g * m1;
         // k[17] = k/2
         k[17] = k_param / 2.0;
-        // k[18] = cos(asin(a/ell))
-        k[18] = k[6].cos();
-        // k[19] = ell*cos(asin(a/ell))
-        k[19] = ell * k[18];
-        // k[20] = ell^2*m1/3
-        k[20] = (ell * ell) * m1 / 3.0;
-        // k[21] = a/2
-        k[21] = a / 2.0;
-        // k[22] = ell*m1
-        k[22] = ell * m1;
-        // k[23] = ell^2/3
-        k[23] = (ell * ell) / 3.0;
-        // k[24] = ell*g/2
-        k[24] = ell * g / 2.0;
-        // k[25] = 2*ell*m1/3
-        k[25] = 2.0 * ell * m1 / 3.0;
-        // k[26] = g*m1/2
-        k[26] = g * m1 / 2.0;
-        // k[27] = sin(asin(a/ell))
-        k[27] = k[6].sin();
-        // k[28] = k*(-a*sin(asin(a/ell))/(ell*((1 - a/ell)*(1 + a/ell))^(1/2)) - cos(asin(a/ell)))
-        k[28] = k_param * (-(a * k[27] / ell / k[7]) - k[18]);
-        // k[29] = k*sin(asin(a/ell))/((1 - a/ell)*(1 + a/ell))^(1/2)
-        k[29] = k_param * k[27] / k[7];
-        // k[30] = 2*ell
-        k[30] = 2.0 * ell;
-        // k[31] = a/(ell^2*((1 - a/ell)*(1 + a/ell))^(1/2))
-        k[31] = a / (ell * ell) / k[7];
-        // k[32] = 1/(ell*((1 - a/ell)*(1 + a/ell))^(1/2))
-        k[32] = 1.0 / ell / k[7];
-        // k[33] = ell*(a*(1 + a/ell)/ell^2 - a*(1 - a/ell)/ell^2)/(2*((1 - a/ell)*(1 + a/ell))^(1/2)) + ((1 - a/ell)*(1 + a/ell))^(1/2)
-        k[33] = (ell
+        // k[18] = ell^2*m1/3
+        k[18] = (ell * ell) * m1 / 3.0;
+        // k[19] = a/2
+        k[19] = a / 2.0;
+        // k[20] = ell*m1
+        k[20] = ell * m1;
+        // k[21] = ell^2/3
+        k[21] = (ell * ell) / 3.0;
+        // k[22] = ell*g/2
+        k[22] = ell * g / 2.0;
+        // k[23] = 2*ell*m1/3
+        k[23] = 2.0 * ell * m1 / 3.0;
+        // k[24] = g*m1/2
+        k[24] = g * m1 / 2.0;
+        // k[25] = k*(-ell*(a*(1 + a/ell)/ell^2 - a*(1 - a/ell)/ell^2)/(2*((1 - a/ell)*(1 + a/ell))^(1/2)) - ((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[25] = k_param
+            * (-(ell
+                * ((a * (1.0 + (a / ell)) / (ell * ell)) - (a * (1.0 - (a / ell)) / (ell * ell)))
+                / 2.0
+                / k[7])
+                - k[7]);
+        // k[26] = ell*k*(-(1 + a/ell)/ell + (1 - a/ell)/ell)/(2*((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[26] =
+            ell * k_param * (-((1.0 + (a / ell)) / ell) + ((1.0 - (a / ell)) / ell)) / 2.0 / k[7];
+        // k[27] = 2*ell
+        k[27] = 2.0 * ell;
+        // k[28] = a/(ell^2*((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[28] = a / (ell * ell) / k[7];
+        // k[29] = 1/(ell*((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[29] = 1.0 / ell / k[7];
+        // k[30] = ell*(a*(1 + a/ell)/ell^2 - a*(1 - a/ell)/ell^2)/(2*((1 - a/ell)*(1 + a/ell))^(1/2)) + ((1 - a/ell)*(1 + a/ell))^(1/2)
+        k[30] = (ell
             * ((a * (1.0 + (a / ell)) / (ell * ell)) - (a * (1.0 - (a / ell)) / (ell * ell)))
             / 2.0
             / k[7])
             + k[7];
-        // k[34] = ell*(-(1 + a/ell)/ell + (1 - a/ell)/ell)/(2*((1 - a/ell)*(1 + a/ell))^(1/2))
-        k[34] = ell * (-((1.0 + (a / ell)) / ell) + ((1.0 - (a / ell)) / ell)) / 2.0 / k[7];
+        // k[31] = ell*(-(1 + a/ell)/ell + (1 - a/ell)/ell)/(2*((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[31] = ell * (-((1.0 + (a / ell)) / ell) + ((1.0 - (a / ell)) / ell)) / 2.0 / k[7];
     }
 
     /// The state at release, over the parameters.
@@ -258,7 +258,7 @@ impl Model for HingedRodSpring {
     /// - `x2 = ell*((1 - a/ell)*(1 + a/ell))^(1/2)`
     /// - `dot_x2 = 0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = 0.0;
@@ -280,7 +280,7 @@ impl Model for HingedRodSpring {
     /// - `cube_x = x2`
     /// - `cube_y = 0`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let x1 = q[0];
@@ -309,9 +309,9 @@ impl Model for HingedRodSpring {
     /// The total energy `E = T + V`.
     ///
     /// - `T = -dot_theta*dot_x1*ell*m1*sin(theta)/2 + dot_theta*dot_y1*ell*m1*cos(theta)/2 + dot_theta^2*ell^2*m1/6 + dot_x1^2*m1/2 + dot_x2^2*m2/2 + dot_y1^2*m1/2`
-    /// - `V = a*g*m2/2 + ell*g*m1*sin(theta)/2 + g*m1*y1 + k*(-ell*cos(asin(a/ell)) + x2)^2/2`
+    /// - `V = a*g*m2/2 + ell*g*m1*sin(theta)/2 + g*m1*y1 + k*(-ell*((1 + a/ell)*(1 - a/ell))^(1/2) + x2)^2/2`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let x1_dot = qd[0];
         let y1 = q[1];
@@ -325,14 +325,14 @@ impl Model for HingedRodSpring {
             + (k[12] * (x1_dot * x1_dot))
             + (k[13] * (x2_dot * x2_dot))
             + (k[12] * (y1_dot * y1_dot)))
-            + (k[14] + (k[15] * rc_s) + (k[16] * y1) + (k[17] * ((-k[19] + x2) * (-k[19] + x2))))
+            + (k[14] + (k[15] * rc_s) + (k[16] * y1) + (k[17] * ((-k[8] + x2) * (-k[8] + x2))))
     }
 
     /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
     ///
     /// - `p_x1 = -dot_theta*ell*m1*sin(theta)/2 + dot_x1*m1`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let m1 = k[0];
         let x1_dot = qd[0];
@@ -343,9 +343,9 @@ impl Model for HingedRodSpring {
     /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
     ///
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
-    /// - `L = T - V`: 233 characters, written out in `generated/hinged_rod_spring.tex`
+    /// - `L = T - V`: 248 characters, written out in `generated/hinged_rod_spring.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let m2 = k[1];
@@ -365,7 +365,7 @@ impl Model for HingedRodSpring {
         mass[7] = 0.0;
         mass[8] = qt0;
         mass[9] = qt1;
-        mass[10] = k[20];
+        mass[10] = k[18];
         mass[11] = 0.0;
         mass[12] = 0.0;
         mass[13] = 0.0;
@@ -374,7 +374,7 @@ impl Model for HingedRodSpring {
         rhs[0] = k[10] * qt2 * rc_c;
         rhs[1] = -k[16] + (k[10] * qt2 * rc_s);
         rhs[2] = -k[15] * rc_c;
-        rhs[3] = -k_param * (-k[19] + x2);
+        rhs[3] = -k_param * (-k[8] + x2);
     }
 
     /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
@@ -392,7 +392,7 @@ impl Model for HingedRodSpring {
     /// - `hinge_horizontal = x1`
     /// - `hinge_vertical = y1`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let rc_c = q[2].cos();
         let ell = k[2];
         let x1 = q[0];
@@ -405,7 +405,7 @@ impl Model for HingedRodSpring {
 
     /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let theta_dot = qd[2];
@@ -484,7 +484,7 @@ impl Model for HingedRodSpring {
 
     /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let a = k[3];
         let x1 = q[0];
@@ -492,7 +492,7 @@ impl Model for HingedRodSpring {
         let theta = q[2];
         let x2 = q[3];
         poses[0] = [(k[9] * rc_c) + x1, (k[9] * rc_s) + y1, theta];
-        poses[1] = [k[21] + x2, k[21], 0.0];
+        poses[1] = [k[19] + x2, k[19], 0.0];
         sizes[0] = -k[9];
         sizes[1] = 0.0;
         sizes[2] = k[9];
@@ -521,7 +521,7 @@ impl Model for HingedRodSpring {
         _fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let ell = k[2];
@@ -536,11 +536,11 @@ impl Model for HingedRodSpring {
         let xt0 = theta_dot * theta_dot;
         out.fill(0.0);
         out[2] = -(k[10] * theta_ddot * rc_c) + (k[10] * xt0 * rc_s);
-        out[6] = -k[22] * theta_dot * rc_c;
+        out[6] = -k[20] * theta_dot * rc_c;
         out[8] = -(k[9] * theta_ddot * rc_s) + x1_ddot - (k[9] * xt0 * rc_c);
         out[10] = -(k[12] * theta_ddot * rc_s) - (k[12] * xt0 * rc_c);
         out[16] = -(k[10] * theta_ddot * rc_s) - (k[10] * xt0 * rc_c);
-        out[20] = -k[22] * theta_dot * rc_s;
+        out[20] = -k[20] * theta_dot * rc_s;
         out[22] = (k[9] * theta_ddot * rc_c) + y1_ddot - (-g + (k[9] * xt0 * rc_s));
         out[24] = (k[12] * theta_ddot * rc_c) - (k[12] * xt0 * rc_s);
         out[26] = m1;
@@ -548,21 +548,21 @@ impl Model for HingedRodSpring {
             - (k[10] * y1_ddot * rc_s)
             - (k[15] * rc_s)
             - (ell * forces[0] * rc_c);
-        out[36] = (k[23] * theta_ddot) - (k[9] * x1_ddot * rc_s)
+        out[36] = (k[21] * theta_ddot) - (k[9] * x1_ddot * rc_s)
             + (k[9] * y1_ddot * rc_c)
-            + (k[24] * rc_c);
-        out[38] = (k[25] * theta_ddot) - (k[12] * x1_ddot * rc_s)
+            + (k[22] * rc_c);
+        out[38] = (k[23] * theta_ddot) - (k[12] * x1_ddot * rc_s)
             + (k[12] * y1_ddot * rc_c)
-            + (k[26] * rc_c)
+            + (k[24] * rc_c)
             - (forces[0] * rc_s);
         out[40] = k[10] * rc_c;
         out[45] = k_param;
         out[51] = x2_ddot;
-        out[52] = k[28];
-        out[53] = k[29];
-        out[55] = -k[19] + x2;
+        out[52] = k[25];
+        out[53] = -k[26];
+        out[55] = -k[8] + x2;
         out[58] = (ell * theta_ddot * rc_c) - (ell * xt0 * rc_s);
-        out[62] = k[30] * theta_dot * rc_c;
+        out[62] = k[27] * theta_dot * rc_c;
         out[66] = (theta_ddot * rc_s) + (xt0 * rc_c);
         out[98] = -1.0;
         out[100] = ell * rc_s;
@@ -574,12 +574,12 @@ impl Model for HingedRodSpring {
 
     /// `d(initial state)/dp`: the rows `d q_0/dp`, then `d qd_0/dp`, by the parameters.
     fn initial_tangents(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         out.fill(0.0);
-        out[14] = -k[31];
-        out[15] = k[32];
-        out[20] = k[33];
-        out[21] = k[34];
+        out[14] = -k[28];
+        out[15] = k[29];
+        out[20] = k[30];
+        out[21] = k[31];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {

@@ -205,52 +205,52 @@ impl Model for HingedRodSpringClosed {
         k[14] = ell * g * m1 / 2.0;
         // k[15] = k/2
         k[15] = k_param / 2.0;
-        // k[16] = cos(asin(a/ell))
-        k[16] = k[6].cos();
-        // k[17] = ell*cos(asin(a/ell))
-        k[17] = ell * k[16];
-        // k[18] = ell^2*m1/3
-        k[18] = (ell * ell) * m1 / 3.0;
-        // k[19] = ell^2*m2
-        k[19] = (ell * ell) * m2;
-        // k[20] = ell*k
-        k[20] = ell * k_param;
-        // k[21] = 2*ell*k*cos(asin(a/ell))
-        k[21] = 2.0 * ell * k_param * k[16];
-        // k[22] = ell*m1 + 2*ell*m2
-        k[22] = (ell * m1) + (2.0 * ell * m2);
-        // k[23] = 2*ell*k
-        k[23] = 2.0 * ell * k_param;
-        // k[24] = g*m1
-        k[24] = g * m1;
-        // k[25] = ell*m1/2
-        k[25] = ell * m1 / 2.0;
-        // k[26] = 3/ell
-        k[26] = 3.0 / ell;
-        // k[27] = 3*m2
-        k[27] = 3.0 * m2;
-        // k[28] = 2*ell*k*rc_ci - 2*ell*k*cos(asin(a/ell))
-        k[28] = (2.0 * ell * k_param * k[9]) - (2.0 * ell * k_param * k[16]);
+        // k[16] = ell*((1 - a/ell)*(1 + a/ell))^(1/2)
+        k[16] = ell * k[9];
+        // k[17] = ell^2*m1/3
+        k[17] = (ell * ell) * m1 / 3.0;
+        // k[18] = ell^2*m2
+        k[18] = (ell * ell) * m2;
+        // k[19] = ell*k
+        k[19] = ell * k_param;
+        // k[20] = 2*ell*k*((1 - a/ell)*(1 + a/ell))^(1/2)
+        k[20] = 2.0 * ell * k_param * k[9];
+        // k[21] = ell*m1 + 2*ell*m2
+        k[21] = (ell * m1) + (2.0 * ell * m2);
+        // k[22] = 2*ell*k
+        k[22] = 2.0 * ell * k_param;
+        // k[23] = g*m1
+        k[23] = g * m1;
+        // k[24] = ell*m1/2
+        k[24] = ell * m1 / 2.0;
+        // k[25] = 3/ell
+        k[25] = 3.0 / ell;
+        // k[26] = 3*m2
+        k[26] = 3.0 * m2;
+        // k[27] = (1 - a^2/ell^2)^(1/2)
+        k[27] = (1.0 - ((a * a) / (ell * ell))).sqrt();
+        // k[28] = 2*ell*k*rc_ci - 2*ell*k*(1 - a^2/ell^2)^(1/2)
+        k[28] = (2.0 * ell * k_param * k[9]) - (2.0 * ell * k_param * k[27]);
         // k[29] = 3/(2*ell)
         k[29] = 3.0 / 2.0 / ell;
         // k[30] = 2*ell*k*m1
         k[30] = 2.0 * ell * k_param * m1;
-        // k[31] = 2*ell*k*m1*rc_ci - 2*ell*k*m1*cos(asin(a/ell))
-        k[31] = (2.0 * ell * k_param * m1 * k[9]) - (2.0 * ell * k_param * m1 * k[16]);
-        // k[32] = 12*ell*k*m2*rc_ci - 12*ell*k*m2*cos(asin(a/ell))
-        k[32] = (12.0 * ell * k_param * m2 * k[9]) - (12.0 * ell * k_param * m2 * k[16]);
+        // k[31] = 2*ell*k*m1*rc_ci - 2*ell*k*m1*(1 - a^2/ell^2)^(1/2)
+        k[31] = (2.0 * ell * k_param * m1 * k[9]) - (2.0 * ell * k_param * m1 * k[27]);
+        // k[32] = 12*ell*k*m2*rc_ci - 12*ell*k*m2*(1 - a^2/ell^2)^(1/2)
+        k[32] = (12.0 * ell * k_param * m2 * k[9]) - (12.0 * ell * k_param * m2 * k[27]);
         // k[33] = 6*ell*k*m2
         k[33] = 6.0 * ell * k_param * m2;
-        // k[34] = 6*ell*k*m2*rc_ci - 6*ell*k*m2*cos(asin(a/ell))
-        k[34] = (6.0 * ell * k_param * m2 * k[9]) - (6.0 * ell * k_param * m2 * k[16]);
+        // k[34] = 6*ell*k*m2*rc_ci - 6*ell*k*m2*(1 - a^2/ell^2)^(1/2)
+        k[34] = (6.0 * ell * k_param * m2 * k[9]) - (6.0 * ell * k_param * m2 * k[27]);
         // k[35] = 6*g*m1*m2
         k[35] = 6.0 * g * m1 * m2;
         // k[36] = 3*g*m1*m2
         k[36] = 3.0 * g * m1 * m2;
         // k[37] = g*m1^2
         k[37] = g * (m1 * m1);
-        // k[38] = ell*k*cos(asin(a/ell))
-        k[38] = ell * k_param * k[16];
+        // k[38] = ell*k*(1 - a^2/ell^2)^(1/2)
+        k[38] = ell * k_param * k[27];
         // k[39] = ell*m2
         k[39] = ell * m2;
         // k[40] = (ell*m1 + 2*ell*m2)/2
@@ -299,7 +299,7 @@ impl Model for HingedRodSpringClosed {
     /// The total energy `E = T + V`.
     ///
     /// - `T = dot_theta^2*ell^2*m1/6 + dot_theta^2*ell^2*m2*sin(theta)^2/2`
-    /// - `V = a*g*m2/2 + ell*g*m1*sin(theta)/2 + k*(ell*cos(theta) - ell*cos(asin(a/ell)))^2/2`
+    /// - `V = a*g*m2/2 + ell*g*m1*sin(theta)/2 + k*(ell*cos(theta) - ell*((1 + a/ell)*(1 - a/ell))^(1/2))^2/2`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
         let k = &k[..42]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
@@ -309,7 +309,7 @@ impl Model for HingedRodSpringClosed {
         ((k[11] * et0) + (k[12] * et0 * (rc_s * rc_s)))
             + (k[13]
                 + (k[14] * rc_s)
-                + (k[15] * ((-k[17] + (ell * rc_c)) * (-k[17] + (ell * rc_c)))))
+                + (k[15] * ((-k[16] + (ell * rc_c)) * (-k[16] + (ell * rc_c)))))
     }
 
     /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
@@ -320,21 +320,21 @@ impl Model for HingedRodSpringClosed {
     /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
     ///
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
-    /// - `L = T - V = -(a*g*m2/2 + ell*g*m1*sin(theta)/2 + k*(ell*cos(theta) - ell*cos(asin(a/ell)))^2/2) + dot_theta^2*ell^2*m1/6 + dot_theta^2*ell^2*m2*sin(theta)^2/2`
+    /// - `L = T - V`: 161 characters, written out in `generated/hinged_rod_spring_closed.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
         let k = &k[..42]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ell = k[2];
         let theta_dot = qd[0];
-        mass[0] = k[18] + (k[19] * (rc_s * rc_s));
-        rhs[0] = -(k[14] * rc_c) + (k[20] * (-k[17] + (ell * rc_c)) * rc_s)
-            - (k[19] * (theta_dot * theta_dot) * rc_s * rc_c);
+        mass[0] = k[17] + (k[18] * (rc_s * rc_s));
+        rhs[0] = -(k[14] * rc_c) + (k[19] * (-k[16] + (ell * rc_c)) * rc_s)
+            - (k[18] * (theta_dot * theta_dot) * rc_s * rc_c);
     }
 
     /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
     ///
-    /// - `contact_force = k*(ell*cos(theta) - ell*cos(asin(a/ell))) + m2*(-ddot_theta*ell*sin(theta) - dot_theta^2*ell*cos(theta))`
-    /// - `hinge_horizontal`: 182 characters, written out in `generated/hinged_rod_spring_closed.tex`
+    /// - `contact_force = k*(ell*cos(theta) - ell*((1 + a/ell)*(1 - a/ell))^(1/2)) + m2*(-ddot_theta*ell*sin(theta) - dot_theta^2*ell*cos(theta))`
+    /// - `hinge_horizontal`: 197 characters, written out in `generated/hinged_rod_spring_closed.tex`
     /// - `hinge_vertical = ddot_theta*ell*m1*cos(theta)/2 + g*m1 - dot_theta^2*ell*m1*sin(theta)/2`
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
         let k = &k[..42]; // one bounds check for all constant loads
@@ -345,11 +345,11 @@ impl Model for HingedRodSpringClosed {
         let theta_dot = qd[0];
         let theta_ddot = qdd[0];
         let ft0 = theta_dot * theta_dot;
-        out[0] = (k_param * (-k[17] + (ell * rc_c)))
+        out[0] = (k_param * (-k[16] + (ell * rc_c)))
             + (m2 * (-(ell * theta_ddot * rc_s) - (ell * ft0 * rc_c)));
         out[1] =
-            -(k[21] + (k[22] * theta_ddot * rc_s) - (k[23] * rc_c) + (k[22] * ft0 * rc_c)) / 2.0;
-        out[2] = k[24] + (k[25] * theta_ddot * rc_c) - (k[25] * ft0 * rc_s);
+            -(k[20] + (k[21] * theta_ddot * rc_s) - (k[22] * rc_c) + (k[21] * ft0 * rc_c)) / 2.0;
+        out[2] = k[23] + (k[24] * theta_ddot * rc_c) - (k[24] * ft0 * rc_s);
     }
 
     /// Each contact's gap `g(q)`, `>= 0` while apart (zero for a contact held closed).
@@ -451,20 +451,20 @@ impl Model for HingedRodSpringClosed {
 impl Reduction for HingedRodSpringClosed {
     /// The reduced motion at `theta = theta_i - delta`: `theta_dot^2` from the energy integral, and `theta_ddot`.
     ///
-    /// - `theta_dot^2`: 187 characters, written out in `generated/hinged_rod_spring_closed.tex`
-    /// - `theta_ddot`: 420 characters, written out in `generated/hinged_rod_spring_closed.tex`
+    /// - `theta_dot^2 = 3*(a*g*m1 - ell*g*m1*sin(theta) + a^2*k - 2*ell^2*k + 2*ell^2*k*cos(theta)*(1 - a^2/ell^2)^(1/2) + ell^2*k*sin(theta)^2)/(ell^2*(m1 + 3*m2*sin(theta)^2))`
+    /// - `theta_ddot`: 396 characters, written out in `generated/hinged_rod_spring_closed.tex`
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
         let k = &k[..42]; // one bounds check for all constant loads
         let m1 = k[0];
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let rt0 = rc_dc * rc_dc;
         let rt1 = rc_s * rc_s;
-        let rt2 = m1 + (k[27] * rt1); // m1 + 3*m2*rc_s^2
+        let rt2 = m1 + (k[26] * rt1); // m1 + 3*m2*rc_s^2
         let rt3 = rc_s.powi(3);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: -k[26] * (-(k[28] * rc_dc) + (k[20] * rt0) - (k[24] * rc_ds)) / rt2,
+            theta_dot_sq: -k[25] * (-(k[28] * rc_dc) + (k[19] * rt0) - (k[23] * rc_ds)) / rt2,
             theta_ddot: -k[29]
                 * ((k[30] * rc_s * rc_dc) - (k[31] * rc_s) + (k[32] * rc_s * rc_c * rc_dc)
                     - (k[33] * rc_s * rc_c * rt0)
@@ -479,28 +479,28 @@ impl Reduction for HingedRodSpringClosed {
 
     /// `theta_dot^2` over `sin(theta)`, `cos(theta)` and their drops from the start (the per-point solver's integrand).
     ///
-    /// - `theta_dot^2`: 187 characters, written out in `generated/hinged_rod_spring_closed.tex`
+    /// - `theta_dot^2 = 3*(a*g*m1 - ell*g*m1*sin(theta) + a^2*k - 2*ell^2*k + 2*ell^2*k*cos(theta)*(1 - a^2/ell^2)^(1/2) + ell^2*k*sin(theta)^2)/(ell^2*(m1 + 3*m2*sin(theta)^2))`
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
         let k = &k[..42]; // one bounds check for all constant loads
         let m1 = k[0];
-        -k[26] * (-(k[28] * rc_dc) + (k[20] * (rc_dc * rc_dc)) - (k[24] * rc_ds))
-            / (m1 + (k[27] * (rc_s * rc_s)))
+        -k[25] * (-(k[28] * rc_dc) + (k[19] * (rc_dc * rc_dc)) - (k[23] * rc_ds))
+            / (m1 + (k[26] * (rc_s * rc_s)))
     }
 
     /// Each contact's force on the reduced motion (zero for a contact open in the phase).
     ///
-    /// - `contact_force`: 386 characters, written out in `generated/hinged_rod_spring_closed.tex`
-    /// - `hinge_horizontal`: 773 characters, written out in `generated/hinged_rod_spring_closed.tex`
-    /// - `hinge_vertical`: 682 characters, written out in `generated/hinged_rod_spring_closed.tex`
+    /// - `contact_force`: 362 characters, written out in `generated/hinged_rod_spring_closed.tex`
+    /// - `hinge_horizontal`: 692 characters, written out in `generated/hinged_rod_spring_closed.tex`
+    /// - `hinge_vertical`: 591 characters, written out in `generated/hinged_rod_spring_closed.tex`
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
         let k = &k[..42]; // one bounds check for all constant loads
         let m1 = k[0];
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let rt0 = rc_dc * rc_dc;
         let rt1 = rc_s * rc_s;
-        let rt2 = m1 + (k[27] * rt1); // m1 + 3*m2*rc_s^2
+        let rt2 = m1 + (k[26] * rt1); // m1 + 3*m2*rc_s^2
         let rt3 = rc_s.powi(3);
-        let rc_w2 = -k[26] * (-(k[28] * rc_dc) + (k[20] * rt0) - (k[24] * rc_ds)) / rt2;
+        let rc_w2 = -k[25] * (-(k[28] * rc_dc) + (k[19] * rt0) - (k[23] * rc_ds)) / rt2;
         let rc_acc = -k[29]
             * ((k[30] * rc_s * rc_dc) - (k[31] * rc_s) + (k[32] * rc_s * rc_c * rc_dc)
                 - (k[33] * rc_s * rc_c * rt0)
@@ -510,10 +510,10 @@ impl Reduction for HingedRodSpringClosed {
                 + (k[36] * rt1 * rc_c)
                 + (k[37] * rc_c))
             / (rt2 * rt2);
-        let ft0 = k[20] * rc_c; // ell*k*rc_c
+        let ft0 = k[19] * rc_c; // ell*k*rc_c
         out[0] = -k[38] + ft0 - (k[39] * rc_s * rc_acc) - (k[39] * rc_c * rc_w2);
         out[1] = -k[38] + ft0 - (k[40] * rc_s * rc_acc) - (k[40] * rc_c * rc_w2);
-        out[2] = k[24] - (k[25] * rc_s * rc_w2) + (k[25] * rc_c * rc_acc);
+        out[2] = k[23] - (k[24] * rc_s * rc_w2) + (k[24] * rc_c * rc_acc);
     }
 
     /// The coefficients, constant term first, of a contact's force zero as a polynomial in `sin(theta)`, where it is one.
@@ -559,59 +559,56 @@ impl Reduction for HingedRodSpringClosed {
         let dt1 = rc_s.powi(3);
         let dt2 = a * a;
         let dt3 = ell * ell;
-        let dt4 = a / ell;
-        let dt5 = dt4.asin();
-        let dt6 = dt5.cos();
-        let dt7 = rc_c * rc_c;
-        let dt8 = 1.0 + dt4;
-        let dt9 = 1.0 - dt4;
-        let dt10 = dt8 * dt9;
-        let dt11 = dt10.sqrt();
-        let dt12 = m1 + (3.0 * m2 * dt0);
-        let dt13 = dt5.sin();
-        let dt14 = 1.0 - (dt2 / dt3);
-        let dt15 = dt14.sqrt();
+        let dt4 = 1.0 - (dt2 / dt3);
+        let dt5 = dt4.sqrt();
+        let dt6 = rc_c * rc_c;
+        let dt7 = 1.0 + (a / ell);
+        let dt8 = 1.0 - (a / ell);
+        let dt9 = dt7 * dt8;
+        let dt10 = dt9.sqrt();
+        let dt11 = m1 + (3.0 * m2 * dt0);
         out[0] = 3.0
             * ((3.0 * a * g * m2 * dt0) - (3.0 * ell * g * m2 * dt1) + (dt2 * k_param)
                 - (dt3 * k_param)
-                - (2.0 * dt3 * k_param * rc_c * dt6)
-                + (dt3 * k_param * dt7)
-                + (2.0 * dt3 * k_param * dt11 * dt6))
+                - (2.0 * dt3 * k_param * rc_c * dt5)
+                + (dt3 * k_param * dt6)
+                + (2.0 * dt3 * k_param * dt10 * dt5))
             / dt3
-            / (dt12 * dt12);
+            / (dt11 * dt11);
         out[1] = 9.0
             * (-(a * g * m1 * dt0) + (ell * g * m1 * dt1) + (dt2 * k_param * dt0)
                 - (dt3 * k_param * dt0)
-                - (2.0 * dt3 * k_param * dt0 * rc_c * dt6)
-                + (dt3 * k_param * dt0 * dt7)
-                + (2.0 * dt3 * k_param * dt0 * dt11 * dt6))
+                - (2.0 * dt3 * k_param * dt0 * rc_c * dt5)
+                + (dt3 * k_param * dt0 * dt6)
+                + (2.0 * dt3 * k_param * dt0 * dt10 * dt5))
             / dt3
-            / (dt12 * dt12);
+            / (dt11 * dt11);
         out[2] = 3.0
-            * ((2.0 * a * ell * k_param * rc_c * dt11 * dt13)
-                - (2.0 * a * ell * k_param * dt8 * dt9 * dt13)
-                - (2.0 * a * g * m1 * dt11 * dt15)
-                + (ell * g * m1 * rc_s * dt11 * dt15)
-                + (2.0 * dt2 * k_param * dt11 * dt15)
-                - (2.0 * dt2 * k_param * dt15 * dt6))
+            * (-(2.0 * a * g * m1 * dt10 * dt5)
+                + (ell * g * m1 * rc_s * dt10 * dt5)
+                + (2.0 * dt2 * k_param * rc_c * dt10)
+                - (2.0 * dt2 * k_param * dt7 * dt8)
+                - (2.0 * dt2 * k_param * dt4)
+                + (2.0 * dt2 * k_param * dt10 * dt5))
             / ell.powi(3)
-            / dt11
-            / dt15
-            / dt12;
-        out[3] = -3.0
-            * ((2.0 * a * k_param * dt11 * dt15) - (2.0 * a * k_param * dt15 * dt6)
-                + (2.0 * ell * k_param * rc_c * dt11 * dt13)
-                - (2.0 * ell * k_param * dt8 * dt9 * dt13)
-                - (g * m1 * dt11 * dt15))
+            / dt10
+            / dt5
+            / dt11;
+        out[3] = 3.0
+            * (-(2.0 * a * k_param * rc_c * dt10)
+                + (2.0 * a * k_param * dt7 * dt8)
+                + (2.0 * a * k_param * dt4)
+                - (2.0 * a * k_param * dt10 * dt5)
+                + (g * m1 * dt10 * dt5))
             / dt3
-            / dt11
-            / dt15
-            / dt12;
-        out[4] = -3.0 * (-(a * m1) + (ell * m1 * rc_s)) / dt3 / dt12;
+            / dt10
+            / dt5
+            / dt11;
+        out[4] = -3.0 * (-(a * m1) + (ell * m1 * rc_s)) / dt3 / dt11;
         out[5] = -3.0
-            * (dt2 - dt3 - (2.0 * dt3 * rc_c * dt6) + (dt3 * dt7) + (2.0 * dt3 * dt11 * dt6))
+            * (dt2 - dt3 - (2.0 * dt3 * rc_c * dt5) + (dt3 * dt6) + (2.0 * dt3 * dt10 * dt5))
             / dt3
-            / dt12;
+            / dt11;
     }
 
     /// `d(sin theta_i)/dp` for each parameter.
