@@ -141,7 +141,8 @@ fn key(magnitude: &Expr) -> String {
     ordered(&magnitude.tidy()).to_infix()
 }
 
-/// `e` with the terms of every sum and the factors of every product sorted by their infix text.
+/// `e` with the terms of every sum and the factors of every product sorted by their infix text,
+/// and `sqrt(x)` (as a spec writes it) read as `x^(1/2)` (as Symbolica writes it).
 fn ordered(e: &Expr) -> Expr {
     let sorted = |v: &Vec<Expr>| {
         let mut v: Vec<Expr> = v.iter().map(ordered).collect();
@@ -152,6 +153,9 @@ fn ordered(e: &Expr) -> Expr {
         Expr::Add(v) => Expr::Add(sorted(v)),
         Expr::Mul(v) => Expr::Mul(sorted(v)),
         Expr::Pow(b, x) => Expr::Pow(Box::new(ordered(b)), Box::new(ordered(x))),
+        Expr::Fun(f, v) if f == "sqrt" && v.len() == 1 => {
+            Expr::Pow(Box::new(ordered(&v[0])), Box::new(Expr::Rational(1, 2)))
+        }
         Expr::Fun(f, v) => Expr::Fun(f.clone(), v.iter().map(ordered).collect()),
         _ => e.clone(),
     }
@@ -603,5 +607,22 @@ mod tests {
             .filter(|(_, e)| e.symbols().contains(&root))
             .count();
         assert_eq!(reading, 2, "{:?} {body:?}", h.entries);
+    }
+
+    #[test]
+    fn a_root_written_as_sqrt_and_as_a_half_power_takes_one_slot() {
+        let mut scope = Scope::default();
+        for (i, name) in ["a", "ell"].into_iter().enumerate() {
+            scope.constants.insert(name.into(), i);
+        }
+        scope.locals.insert("s".into(), "s".into());
+        let exprs = [
+            "sqrt((ell - a)*(ell + a))*s",
+            "((a + ell)*(-a + ell))^(1/2)*s^2",
+        ]
+        .map(|t| Expr::parse(t).unwrap().tidy());
+        let mut h = Hoisted::new(2);
+        let body = lower(&exprs, &scope, Some(&mut h), "");
+        assert_eq!(h.entries.len(), 1, "{:?} {body:?}", h.entries);
     }
 }
