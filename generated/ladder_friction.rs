@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "ladder_leans",
         meaning: "the top must start below the ladder's length (a < ell)",
     }],
-    n_constants: 28,
+    n_constants: 27,
     coordinates: &["x1", "y1", "theta"],
     system_coordinates: &["x1", "y1", "theta"],
     reduced_index: Some(2),
@@ -203,18 +203,16 @@ impl Model for LadderFriction {
         k[20] = g * m1 / 2.0;
         // k[21] = 2*ell
         k[21] = 2.0 * ell;
-        // k[22] = ((a + ell)*(-a + ell))^(1/2)
-        k[22] = ((a + ell) * (-a + ell)).sqrt();
-        // k[23] = ell/((a + ell)*(-a + ell))^(1/2)
-        k[23] = ell / k[22];
-        // k[24] = (-a + ell - (a + ell))/(2*((a + ell)*(-a + ell))^(1/2))
-        k[24] = (-a + ell - (a + ell)) / 2.0 / k[22];
-        // k[25] = ((1 + a/ell)*(1 - a/ell))^(1/2)
-        k[25] = ((1.0 + (a / ell)) * (1.0 - (a / ell))).sqrt();
-        // k[26] = a/(ell^2*((1 + a/ell)*(1 - a/ell))^(1/2))
-        k[26] = a / (ell * ell) / k[25];
-        // k[27] = 1/(ell*((1 + a/ell)*(1 - a/ell))^(1/2))
-        k[27] = 1.0 / ell / k[25];
+        // k[22] = ell/sqrt((ell - a)*(ell + a))
+        k[22] = ell / k[6];
+        // k[23] = (-a + ell - (a + ell))/(2*sqrt((ell - a)*(ell + a)))
+        k[23] = (-a + ell - (a + ell)) / 2.0 / k[6];
+        // k[24] = ((1 + a/ell)*(1 - a/ell))^(1/2)
+        k[24] = ((1.0 + (a / ell)) * (1.0 - (a / ell))).sqrt();
+        // k[25] = a/(ell^2*((1 + a/ell)*(1 - a/ell))^(1/2))
+        k[25] = a / (ell * ell) / k[24];
+        // k[26] = 1/(ell*((1 + a/ell)*(1 - a/ell))^(1/2))
+        k[26] = 1.0 / ell / k[24];
     }
 
     /// The state at release, over the parameters.
@@ -226,7 +224,7 @@ impl Model for LadderFriction {
     /// - `theta = asin(a/ell)`
     /// - `dot_theta = 0.0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..28]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         q[0] = -k[6];
         qd[0] = 0.0;
         q[1] = 0.0;
@@ -244,7 +242,7 @@ impl Model for LadderFriction {
     /// - `rod_centre_x = ell*cos(theta)/2 + x1`
     /// - `rod_centre_y = ell*sin(theta)/2 + y1`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..28]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[1];
         let x1 = q[0];
@@ -271,7 +269,7 @@ impl Model for LadderFriction {
     /// - `T = -dot_theta*dot_x1*ell*m1*sin(theta)/2 + dot_theta*dot_y1*ell*m1*cos(theta)/2 + dot_theta^2*ell^2*m1/6 + dot_x1^2*m1/2 + dot_y1^2*m1/2`
     /// - `V = ell*g*m1*sin(theta)/2 + g*m1*y1`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..28]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let x1_dot = qd[0];
         let y1 = q[1];
@@ -289,7 +287,7 @@ impl Model for LadderFriction {
     ///
     /// - `p_x1 = -dot_theta*ell*m1*sin(theta)/2 + dot_x1*m1`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..28]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let m1 = k[0];
         let x1_dot = qd[0];
@@ -302,7 +300,7 @@ impl Model for LadderFriction {
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
     /// - `L = T - V`: 169 characters, written out in `generated/ladder_friction.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..28]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let theta_dot = qd[2];
@@ -336,7 +334,7 @@ impl Model for LadderFriction {
     /// - `wall_push = -ell*cos(theta) - x1`
     /// - `floor_normal = y1`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..28]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let rc_c = q[2].cos();
         let ell = k[1];
         let x1 = q[0];
@@ -347,7 +345,7 @@ impl Model for LadderFriction {
 
     /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..28]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[1];
         let theta_dot = qd[2];
@@ -374,7 +372,7 @@ impl Model for LadderFriction {
     /// - `v_floor_friction = dot_x1`
     /// - `v_wall_friction = dot_theta*ell*cos(theta) + dot_y1`
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..28]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[1];
         let theta_dot = qd[2];
@@ -426,7 +424,7 @@ impl Model for LadderFriction {
 
     /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..28]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let x1 = q[0];
         let y1 = q[1];
@@ -461,7 +459,7 @@ impl Model for LadderFriction {
         fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..28]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let ell = k[1];
@@ -514,12 +512,12 @@ impl Model for LadderFriction {
 
     /// `d(initial state)/dp`: the rows `d q_0/dp`, then `d qd_0/dp`, by the parameters.
     fn initial_tangents(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..28]; // one bounds check for all constant loads
+        let k = &k[..27]; // one bounds check for all constant loads
         out.fill(0.0);
-        out[1] = -k[23];
-        out[2] = -k[24];
-        out[13] = -k[26];
-        out[14] = k[27];
+        out[1] = -k[22];
+        out[2] = -k[23];
+        out[13] = -k[25];
+        out[14] = k[26];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {

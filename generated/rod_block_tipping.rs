@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the block must be lower than the rod is long (h < ell)",
     }],
-    n_constants: 37,
+    n_constants: 36,
     coordinates: &["x1", "y1", "theta", "xb", "yb", "phi"],
     system_coordinates: &["x1", "y1", "theta", "xb", "yb", "phi"],
     reduced_index: Some(2),
@@ -267,12 +267,10 @@ impl Model for RodBlockTipping {
         k[32] = h / (ell * ell) / k[31];
         // k[33] = 1/(ell*((1 + h/ell)*(1 - h/ell))^(1/2))
         k[33] = 1.0 / ell / k[31];
-        // k[34] = ((ell + h)*(ell - h))^(1/2)
-        k[34] = ((ell + h) * (ell - h)).sqrt();
-        // k[35] = ell/((ell + h)*(ell - h))^(1/2)
-        k[35] = ell / k[34];
-        // k[36] = (ell - h - (ell + h))/(2*((ell + h)*(ell - h))^(1/2))
-        k[36] = (ell - h - (ell + h)) / 2.0 / k[34];
+        // k[34] = ell/sqrt((ell - h)*(ell + h))
+        k[34] = ell / k[7];
+        // k[35] = (ell - h - (ell + h))/(2*sqrt((ell - h)*(ell + h)))
+        k[35] = (ell - h - (ell + h)) / 2.0 / k[7];
     }
 
     /// The state at release, over the parameters.
@@ -290,7 +288,7 @@ impl Model for RodBlockTipping {
     /// - `phi = 0.0`
     /// - `dot_phi = 0.0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = 0.0;
@@ -320,7 +318,7 @@ impl Model for RodBlockTipping {
     /// - `far_edge_x = h*sin(phi)/2 + w*cos(phi)/2 + xb`
     /// - `far_edge_y = -h*cos(phi)/2 + w*sin(phi)/2 + yb`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let x1 = q[0];
@@ -370,7 +368,7 @@ impl Model for RodBlockTipping {
     /// - `T`: 209 characters, written out in `generated/rod_block_tipping.tex`
     /// - `V = ell*g*m1*sin(theta)/2 + g*m1*y1 + g*m2*yb`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let x1_dot = qd[0];
         let y1 = q[1];
@@ -397,7 +395,7 @@ impl Model for RodBlockTipping {
     /// - `p_xb = dot_xb*m2`
     /// - `p_phi = dot_phi*m2*w^2/12 + dot_phi*h^2*m2/12`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let m1 = k[0];
         let m2 = k[1];
@@ -415,7 +413,7 @@ impl Model for RodBlockTipping {
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
     /// - `L = T - V`: 255 characters, written out in `generated/rod_block_tipping.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let m2 = k[1];
@@ -486,7 +484,7 @@ impl Model for RodBlockTipping {
     /// - `floor_normal = y1`
     /// - `tip_floor = ell*sin(theta) + y1`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let x1 = q[0];
@@ -507,7 +505,7 @@ impl Model for RodBlockTipping {
 
     /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let x1 = q[0];
@@ -582,7 +580,7 @@ impl Model for RodBlockTipping {
     ///
     /// - `contact_force = ell*sin(phi)*cos(theta) - ell*sin(theta)*cos(phi) + h/2 + x1*sin(phi) - xb*sin(phi) - y1*cos(phi) + yb*cos(phi)`
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let x1 = q[0];
@@ -662,7 +660,7 @@ impl Model for RodBlockTipping {
 
     /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let w = k[3];
         let h = k[4];
@@ -702,7 +700,7 @@ impl Model for RodBlockTipping {
         _fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let m2 = k[1];
@@ -891,13 +889,13 @@ impl Model for RodBlockTipping {
 
     /// `d(initial state)/dp`: the rows `d q_0/dp`, then `d qd_0/dp`, by the parameters.
     fn initial_tangents(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..37]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         out.fill(0.0);
         out[14] = -k[32];
         out[16] = k[33];
-        out[20] = k[35];
+        out[20] = k[34];
         out[21] = 1.0 / 2.0;
-        out[22] = k[36];
+        out[22] = k[35];
         out[28] = 1.0 / 2.0;
     }
 

@@ -59,7 +59,7 @@ static INFO: ModelInfo = ModelInfo {
         name: "rod_leans",
         meaning: "the cube must be lower than the rod is long (a < ell)",
     }],
-    n_constants: 30,
+    n_constants: 29,
     coordinates: &["x1", "y1", "theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced_index: Some(2),
@@ -223,12 +223,10 @@ impl Model for RodCubeLiftoff {
         k[25] = a / (ell * ell) / k[24];
         // k[26] = 1/(ell*((1 + a/ell)*(1 - a/ell))^(1/2))
         k[26] = 1.0 / ell / k[24];
-        // k[27] = ((a + ell)*(-a + ell))^(1/2)
-        k[27] = ((a + ell) * (-a + ell)).sqrt();
-        // k[28] = ell/((a + ell)*(-a + ell))^(1/2)
-        k[28] = ell / k[27];
-        // k[29] = (-a + ell - (a + ell))/(2*((a + ell)*(-a + ell))^(1/2))
-        k[29] = (-a + ell - (a + ell)) / 2.0 / k[27];
+        // k[27] = ell/sqrt((ell - a)*(ell + a))
+        k[27] = ell / k[7];
+        // k[28] = (-a + ell - (a + ell))/(2*sqrt((ell - a)*(ell + a)))
+        k[28] = (-a + ell - (a + ell)) / 2.0 / k[7];
     }
 
     /// The state at release, over the parameters.
@@ -242,7 +240,7 @@ impl Model for RodCubeLiftoff {
     /// - `x2 = sqrt((ell - a)*(ell + a))`
     /// - `dot_x2 = 0.0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..29]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = 0.0;
@@ -264,7 +262,7 @@ impl Model for RodCubeLiftoff {
     /// - `cube_x = x2`
     /// - `cube_y = 0`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..29]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let x1 = q[0];
@@ -295,7 +293,7 @@ impl Model for RodCubeLiftoff {
     /// - `T = -dot_theta*dot_x1*ell*m1*sin(theta)/2 + dot_theta*dot_y1*ell*m1*cos(theta)/2 + dot_theta^2*ell^2*m1/6 + dot_x1^2*m1/2 + dot_x2^2*m2/2 + dot_y1^2*m1/2`
     /// - `V = a*g*m2/2 + ell*g*m1*sin(theta)/2 + g*m1*y1`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..29]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let x1_dot = qd[0];
         let y1 = q[1];
@@ -316,7 +314,7 @@ impl Model for RodCubeLiftoff {
     /// - `p_x1 = -dot_theta*ell*m1*sin(theta)/2 + dot_x1*m1`
     /// - `p_x2 = dot_x2*m2`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..29]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let m1 = k[0];
         let m2 = k[1];
@@ -332,7 +330,7 @@ impl Model for RodCubeLiftoff {
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
     /// - `L = T - V`: 196 characters, written out in `generated/rod_cube_liftoff.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..29]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let m2 = k[1];
@@ -377,7 +375,7 @@ impl Model for RodCubeLiftoff {
     /// - `floor_normal = y1`
     /// - `tip_floor = ell*sin(theta) + y1`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..29]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let x1 = q[0];
@@ -390,7 +388,7 @@ impl Model for RodCubeLiftoff {
 
     /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..29]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let theta_dot = qd[2];
@@ -430,7 +428,7 @@ impl Model for RodCubeLiftoff {
     ///
     /// - `cube_does_not_tip = a*g*m2/2 - rc_f0*(-a/2 + ell*sin(theta) + y1)`
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..29]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let ell = k[2];
         let y1 = q[1];
@@ -468,7 +466,7 @@ impl Model for RodCubeLiftoff {
 
     /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..29]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let a = k[3];
         let x1 = q[0];
@@ -505,7 +503,7 @@ impl Model for RodCubeLiftoff {
         _fr: &[f64],
         out: &mut [f64],
     ) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..29]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let ell = k[2];
@@ -557,12 +555,12 @@ impl Model for RodCubeLiftoff {
 
     /// `d(initial state)/dp`: the rows `d q_0/dp`, then `d qd_0/dp`, by the parameters.
     fn initial_tangents(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..30]; // one bounds check for all constant loads
+        let k = &k[..29]; // one bounds check for all constant loads
         out.fill(0.0);
         out[14] = -k[25];
         out[15] = k[26];
-        out[20] = k[28];
-        out[21] = k[29];
+        out[20] = k[27];
+        out[21] = k[28];
     }
 
     fn reduction(&self) -> Option<&dyn Reduction> {
