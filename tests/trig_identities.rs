@@ -10,30 +10,15 @@
 //! admissible parameters, but in the models `KNOWN` lists with why.
 #![cfg(feature = "derive")]
 
+mod common;
+
+use common::derived::phases_in;
+use common::numbers::Uniform;
+
 use rodcube::derive::cas;
 use rodcube::derive::expr::Expr;
 use rodcube::derive::mechanics::{self, Derivation, from_sc};
-use rodcube::derive::{derive_all, on_cas_thread, spec};
-use std::path::Path;
-
-/// Every phase of the specs in `dir` (under the crate's root).
-fn phases_in(dir: &str) -> Vec<Derivation> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join(dir);
-    let mut paths: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| e.expect("entry").path())
-        .filter(|p| p.extension().is_some_and(|x| x == "yaml"))
-        .collect();
-    paths.sort();
-    let checked: Vec<_> = (paths.iter())
-        .map(|p| spec::load(p).unwrap_or_else(|e| panic!("{e}")))
-        .collect();
-    derive_all(&checked)
-        .unwrap_or_else(|e| panic!("{e}"))
-        .into_iter()
-        .flat_map(|(phases, _)| phases)
-        .collect()
-}
+use rodcube::derive::on_cas_thread;
 
 fn call(f: &str, x: &Expr) -> Expr {
     Expr::Fun(f.into(), vec![x.clone()])
@@ -267,19 +252,6 @@ fn two_rods_kinetic_energy_and_right_rod_s_equation_are_the_textbook_forms_shown
     );
 }
 
-/// A small deterministic generator of numbers in `[0, 1)` (SplitMix64).
-struct Numbers(u64);
-
-impl Numbers {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        (z ^ (z >> 31)) as f64 / 2f64.powi(64)
-    }
-}
-
 /// Models known to hold two slots of one value, of kinds this fixes (one form of a
 /// root or an inverse trigonometric pair, read once) do not reach, with why; each must still
 /// hold one (the test fails when one is fixed, so that it leaves this list).
@@ -310,7 +282,7 @@ const KNOWN: &[(&str, &str)] = &[
 
 #[test]
 fn no_two_derived_constants_of_a_compiled_model_hold_one_value() {
-    let mut numbers = Numbers(47);
+    let mut numbers = Uniform(47);
     let mut found = Vec::new();
     let mut still_known = Vec::new();
     for model in rodcube::models::compiled() {

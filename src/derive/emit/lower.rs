@@ -584,13 +584,19 @@ mod tests {
         assert!(body.outputs[0].contains("t0"), "{body:?}");
     }
 
-    #[test]
-    fn a_root_two_constants_hold_in_either_order_takes_one_slot() {
+    /// The parameters `a`, `ell` in `k[0]`, `k[1]` and a local `s`.
+    fn a_ell_scope() -> Scope {
         let mut scope = Scope::default();
         for (i, name) in ["a", "ell"].into_iter().enumerate() {
             scope.constants.insert(name.into(), i);
         }
         scope.locals.insert("s".into(), "s".into());
+        scope
+    }
+
+    #[test]
+    fn a_root_two_constants_hold_in_either_order_takes_one_slot() {
+        let scope = a_ell_scope();
         let exprs = [
             "ell*((1 - a/ell)*(1 + a/ell))^(1/2)*s",
             "a/(ell^2*((1 + a/ell)*(1 - a/ell))^(1/2))*s^2",
@@ -611,11 +617,7 @@ mod tests {
 
     #[test]
     fn a_root_written_as_sqrt_and_as_a_half_power_takes_one_slot() {
-        let mut scope = Scope::default();
-        for (i, name) in ["a", "ell"].into_iter().enumerate() {
-            scope.constants.insert(name.into(), i);
-        }
-        scope.locals.insert("s".into(), "s".into());
+        let scope = a_ell_scope();
         let exprs = [
             "sqrt((ell - a)*(ell + a))*s",
             "((a + ell)*(-a + ell))^(1/2)*s^2",
