@@ -62,7 +62,7 @@ static INFO: ModelInfo = ModelInfo {
             parameters: &[1, 2, 3],
         },
     ],
-    n_constants: 22,
+    n_constants: 23,
     coordinates: &["x1", "y1", "theta"],
     system_coordinates: &["x1", "y1", "theta"],
     reduced_index: Some(2),
@@ -183,44 +183,42 @@ impl Model for FixedCylinder {
         let th0 = p[3];
         let g = p[4];
         k[..5].copy_from_slice(p);
-        // k[5] = R/sin(th0) + R*cos(th0)/sin(th0)
-        k[5] = (r / th0.sin()) + (r * th0.cos() / th0.sin());
-        // k[6] = ell/2
-        k[6] = ell / 2.0;
-        // k[7] = 2*R
-        k[7] = 2.0 * r;
-        // k[8] = ell*m1/2
-        k[8] = ell * m1 / 2.0;
-        // k[9] = ell^2*m1/6
-        k[9] = (ell * ell) * m1 / 6.0;
-        // k[10] = m1/2
-        k[10] = m1 / 2.0;
-        // k[11] = ell*g*m1/2
-        k[11] = ell * g * m1 / 2.0;
-        // k[12] = g*m1
-        k[12] = g * m1;
-        // k[13] = ell^2*m1/3
-        k[13] = (ell * ell) * m1 / 3.0;
-        // k[14] = ell*m1
-        k[14] = ell * m1;
-        // k[15] = ell^2/12
-        k[15] = (ell * ell) / 12.0;
-        // k[16] = ell^2/4
-        k[16] = (ell * ell) / 4.0;
-        // k[17] = ell*g/2
-        k[17] = ell * g / 2.0;
-        // k[18] = ell*m1/6
-        k[18] = ell * m1 / 6.0;
-        // k[19] = g*m1/2
-        k[19] = g * m1 / 2.0;
-        // k[20] = 1/sin(th0) + cos(th0)/sin(th0)
-        let h20_t0 = 1.0 / th0.sin();
-        k[20] = h20_t0 + (th0.cos() / th0.sin());
-        // k[21] = R + R*cos(th0)/sin(th0)^2 + R*cos(th0)^2/sin(th0)^2
-        let h21_t0 = th0.cos();
-        k[21] = r
-            + (r * h21_t0 / (th0.sin() * th0.sin()))
-            + (r * (h21_t0 * h21_t0) / (th0.sin() * th0.sin()));
+        // k[5] = sin(th0)
+        k[5] = th0.sin();
+        // k[6] = cos(th0)
+        k[6] = th0.cos();
+        // k[7] = R/sin(th0) + R*cos(th0)/sin(th0)
+        k[7] = (r / k[5]) + (r * k[6] / k[5]);
+        // k[8] = ell/2
+        k[8] = ell / 2.0;
+        // k[9] = 2*R
+        k[9] = 2.0 * r;
+        // k[10] = ell*m1/2
+        k[10] = ell * m1 / 2.0;
+        // k[11] = ell^2*m1/6
+        k[11] = (ell * ell) * m1 / 6.0;
+        // k[12] = m1/2
+        k[12] = m1 / 2.0;
+        // k[13] = ell*g*m1/2
+        k[13] = ell * g * m1 / 2.0;
+        // k[14] = g*m1
+        k[14] = g * m1;
+        // k[15] = ell^2*m1/3
+        k[15] = (ell * ell) * m1 / 3.0;
+        // k[16] = ell*m1
+        k[16] = ell * m1;
+        // k[17] = ell^2/3
+        k[17] = (ell * ell) / 3.0;
+        // k[18] = ell*g/2
+        k[18] = ell * g / 2.0;
+        // k[19] = 2*ell*m1/3
+        k[19] = 2.0 * ell * m1 / 3.0;
+        // k[20] = g*m1/2
+        k[20] = g * m1 / 2.0;
+        // k[21] = 1/sin(th0) + cos(th0)/sin(th0)
+        k[21] = (1.0 / k[5]) + (k[6] / k[5]);
+        // k[22] = R/sin(th0)^2 + R*cos(th0)/sin(th0)^2
+        k[22] = (r / (k[5] * k[5])) + (r * k[6] / (k[5] * k[5]));
     }
 
     /// The state at release, over the parameters.
@@ -232,9 +230,9 @@ impl Model for FixedCylinder {
     /// - `theta = th0`
     /// - `dot_theta = 0.0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..23]; // one bounds check for all constant loads
         let th0 = k[3];
-        q[0] = -k[5];
+        q[0] = -k[7];
         qd[0] = 0.0;
         q[1] = 0.0;
         qd[1] = 0.0;
@@ -253,7 +251,7 @@ impl Model for FixedCylinder {
     /// - `touch_x = R*sin(theta)*cos(theta) + x1*sin(theta)^2 - y1*sin(theta)*cos(theta)`
     /// - `touch_y = R*sin(theta)^2 - x1*sin(theta)*cos(theta) + y1*cos(theta)^2`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..23]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[1];
         let r = k[2];
@@ -271,10 +269,10 @@ impl Model for FixedCylinder {
             -(ell * theta_dot * rc_s) + x1_dot,
             (ell * theta_dot * rc_c) + y1_dot,
         ];
-        pos[2] = [(k[6] * rc_c) + x1, (k[6] * rc_s) + y1];
+        pos[2] = [(k[8] * rc_c) + x1, (k[8] * rc_s) + y1];
         vel[2] = [
-            -(k[6] * theta_dot * rc_s) + x1_dot,
-            (k[6] * theta_dot * rc_c) + y1_dot,
+            -(k[8] * theta_dot * rc_s) + x1_dot,
+            (k[8] * theta_dot * rc_c) + y1_dot,
         ];
         pos[3] = [
             (r * rc_s * rc_c) + (x1 * pt0) - (y1 * rc_s * rc_c),
@@ -288,7 +286,7 @@ impl Model for FixedCylinder {
                 - (theta_dot * y1 * pt1)
                 + (x1_dot * pt0)
                 - (y1_dot * rc_s * rc_c),
-            (k[7] * theta_dot * rc_s * rc_c) + (theta_dot * x1 * pt0)
+            (k[9] * theta_dot * rc_s * rc_c) + (theta_dot * x1 * pt0)
                 - (theta_dot * x1 * pt1)
                 - (2.0 * theta_dot * y1 * rc_s * rc_c)
                 - (x1_dot * rc_s * rc_c)
@@ -301,30 +299,30 @@ impl Model for FixedCylinder {
     /// - `T = -dot_theta*dot_x1*ell*m1*sin(theta)/2 + dot_theta*dot_y1*ell*m1*cos(theta)/2 + dot_theta^2*ell^2*m1/6 + dot_x1^2*m1/2 + dot_y1^2*m1/2`
     /// - `V = ell*g*m1*sin(theta)/2 + g*m1*y1`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..23]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let x1_dot = qd[0];
         let y1 = q[1];
         let y1_dot = qd[1];
         let theta_dot = qd[2];
-        (-(k[8] * theta_dot * x1_dot * rc_s)
-            + (k[8] * theta_dot * y1_dot * rc_c)
-            + (k[9] * (theta_dot * theta_dot))
-            + (k[10] * (x1_dot * x1_dot))
-            + (k[10] * (y1_dot * y1_dot)))
-            + ((k[11] * rc_s) + (k[12] * y1))
+        (-(k[10] * theta_dot * x1_dot * rc_s)
+            + (k[10] * theta_dot * y1_dot * rc_c)
+            + (k[11] * (theta_dot * theta_dot))
+            + (k[12] * (x1_dot * x1_dot))
+            + (k[12] * (y1_dot * y1_dot)))
+            + ((k[13] * rc_s) + (k[14] * y1))
     }
 
     /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
     ///
     /// - `p_x1 = -dot_theta*ell*m1*sin(theta)/2 + dot_x1*m1`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..23]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let m1 = k[0];
         let x1_dot = qd[0];
         let theta_dot = qd[2];
-        out[0] = -(k[8] * theta_dot * rc_s) + (m1 * x1_dot);
+        out[0] = -(k[10] * theta_dot * rc_s) + (m1 * x1_dot);
     }
 
     /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
@@ -332,12 +330,12 @@ impl Model for FixedCylinder {
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
     /// - `L = T - V`: 169 characters, written out in `generated/fixed_cylinder.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..23]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let theta_dot = qd[2];
-        let qt0 = -k[8] * rc_s; // -(ell*m1*rc_s/2)
-        let qt1 = k[8] * rc_c; // ell*m1*rc_c/2
+        let qt0 = -k[10] * rc_s; // -(ell*m1*rc_s/2)
+        let qt1 = k[10] * rc_c; // ell*m1*rc_c/2
         let qt2 = theta_dot * theta_dot;
         mass[0] = m1;
         mass[1] = 0.0;
@@ -347,10 +345,10 @@ impl Model for FixedCylinder {
         mass[5] = qt1;
         mass[6] = qt0;
         mass[7] = qt1;
-        mass[8] = k[13];
-        rhs[0] = k[8] * qt2 * rc_c;
-        rhs[1] = -k[12] + (k[8] * qt2 * rc_s);
-        rhs[2] = -k[11] * rc_c;
+        mass[8] = k[15];
+        rhs[0] = k[10] * qt2 * rc_c;
+        rhs[1] = -k[14] + (k[10] * qt2 * rc_s);
+        rhs[2] = -k[13] * rc_c;
     }
 
     /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
@@ -366,7 +364,7 @@ impl Model for FixedCylinder {
     /// - `cylinder_push = -R - R*cos(theta) - x1*sin(theta) + y1*cos(theta)`
     /// - `floor_normal = y1`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..23]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let r = k[2];
         let x1 = q[0];
@@ -377,7 +375,7 @@ impl Model for FixedCylinder {
 
     /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..23]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let r = k[2];
         let x1 = q[0];
@@ -404,7 +402,7 @@ impl Model for FixedCylinder {
     ///
     /// - `cylinder_push = -R*sin(theta) + ell + x1*cos(theta) + y1*sin(theta)`
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..23]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[1];
         let r = k[2];
@@ -457,16 +455,16 @@ impl Model for FixedCylinder {
 
     /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..23]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let r = k[2];
         let x1 = q[0];
         let y1 = q[1];
         let theta = q[2];
-        poses[0] = [(k[6] * rc_c) + x1, (k[6] * rc_s) + y1, theta];
-        sizes[0] = -k[6];
+        poses[0] = [(k[8] * rc_c) + x1, (k[8] * rc_s) + y1, theta];
+        sizes[0] = -k[8];
         sizes[1] = 0.0;
-        sizes[2] = k[6];
+        sizes[2] = k[8];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = r;
@@ -491,7 +489,7 @@ impl Tangents for FixedCylinder {
         let qd = at.qd;
         let qdd = at.qdd;
         let forces = at.forces;
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..23]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let r = k[2];
@@ -508,31 +506,31 @@ impl Tangents for FixedCylinder {
         let xt1 = theta_dot * theta_dot;
         let xt2 = forces[0] * rc_s;
         let xt3 = (r * rc_c) + (x1 * rc_s) - (y1 * rc_c);
-        let xt4 = rc_s * rc_s;
-        let xt5 = rc_c * rc_c;
-        let xt6 = -rc_s;
+        let xt4 = -rc_s;
         out.fill(0.0);
-        out[2] = -(k[8] * theta_ddot * rc_c) + xt0 + (k[8] * xt1 * rc_s);
-        out[5] = -k[14] * theta_dot * rc_c;
-        out[6] = -(k[6] * theta_ddot * rc_s) + x1_ddot - (k[6] * xt1 * rc_c);
-        out[7] = -(k[10] * theta_ddot * rc_s) - (k[10] * xt1 * rc_c);
-        out[13] = -(k[8] * theta_ddot * rc_s) + xt2 - (k[8] * xt1 * rc_c);
-        out[16] = -k[14] * theta_dot * rc_s;
-        out[17] = (k[6] * theta_ddot * rc_c) + y1_ddot - (-g + (k[6] * xt1 * rc_s));
-        out[18] = (k[10] * theta_ddot * rc_c) - (k[10] * xt1 * rc_s);
+        out[2] = -(k[10] * theta_ddot * rc_c) + xt0 + (k[10] * xt1 * rc_s);
+        out[5] = -k[16] * theta_dot * rc_c;
+        out[6] = -(k[8] * theta_ddot * rc_s) + x1_ddot - (k[8] * xt1 * rc_c);
+        out[7] = -(k[12] * theta_ddot * rc_s) - (k[12] * xt1 * rc_c);
+        out[13] = -(k[10] * theta_ddot * rc_s) + xt2 - (k[10] * xt1 * rc_c);
+        out[16] = -k[16] * theta_dot * rc_s;
+        out[17] = (k[8] * theta_ddot * rc_c) + y1_ddot - (-g + (k[8] * xt1 * rc_s));
+        out[18] = (k[12] * theta_ddot * rc_c) - (k[12] * xt1 * rc_s);
         out[21] = m1;
         out[22] = xt0;
         out[23] = xt2;
-        out[24] =
-            -(k[8] * x1_ddot * rc_c) - (k[8] * y1_ddot * rc_s) - (k[11] * rc_s) - (forces[0] * xt3);
-        out[28] = (theta_ddot * (k[15] + (k[16] * xt4) + (k[16] * xt5))) - (k[6] * x1_ddot * rc_s)
-            + (k[6] * y1_ddot * rc_c)
-            + (k[17] * rc_c);
-        out[29] = (theta_ddot * (k[18] + (k[8] * xt4) + (k[8] * xt5))) - (k[10] * x1_ddot * rc_s)
-            + (k[10] * y1_ddot * rc_c)
-            + (k[19] * rc_c);
+        out[24] = -(k[10] * x1_ddot * rc_c)
+            - (k[10] * y1_ddot * rc_s)
+            - (k[13] * rc_s)
+            - (forces[0] * xt3);
+        out[28] = (k[17] * theta_ddot) - (k[8] * x1_ddot * rc_s)
+            + (k[8] * y1_ddot * rc_c)
+            + (k[18] * rc_c);
+        out[29] = (k[19] * theta_ddot) - (k[12] * x1_ddot * rc_s)
+            + (k[12] * y1_ddot * rc_c)
+            + (k[20] * rc_c);
         out[30] = -forces[0] * rc_s;
-        out[32] = k[8] * rc_c;
+        out[32] = k[10] * rc_c;
         out[33] = -(theta_ddot * rc_c) + (xt1 * rc_s);
         out[34] = -(theta_ddot * rc_s) - (xt1 * rc_c);
         out[35] = -(r * xt1 * rc_s) + (theta_ddot * xt3) - (x1_ddot * rc_c) - (y1_ddot * rc_s)
@@ -542,12 +540,12 @@ impl Tangents for FixedCylinder {
             + (xt1 * y1 * rc_s);
         out[36] = -2.0 * theta_dot * rc_c;
         out[37] = -2.0 * theta_dot * rc_s;
-        out[38] = (k[7] * theta_dot * rc_c) + (2.0 * theta_dot * x1 * rc_s)
+        out[38] = (k[9] * theta_dot * rc_c) + (2.0 * theta_dot * x1 * rc_s)
             - (2.0 * theta_dot * y1 * rc_c)
             - (2.0 * x1_dot * rc_c)
             - (2.0 * y1_dot * rc_s);
         out[41] = (theta_ddot * rc_s) + (xt1 * rc_c);
-        out[55] = xt6;
+        out[55] = xt4;
         out[56] = rc_c;
         out[57] = (r * rc_s) - (x1 * rc_c) - (y1 * rc_s);
         out[63] = -1.0 - rc_c;
@@ -556,15 +554,15 @@ impl Tangents for FixedCylinder {
         out[78] = rc_s;
         out[79] = -(r * rc_c) - (x1 * rc_s) + (y1 * rc_c);
         out[84] = 1.0;
-        out[85] = xt6;
+        out[85] = xt4;
     }
 
     /// `d(initial state)/dp`: the rows `d q_0/dp`, then `d qd_0/dp`, by the parameters.
     fn initial_tangents(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..23]; // one bounds check for all constant loads
         out.fill(0.0);
-        out[2] = -k[20];
-        out[3] = k[21];
+        out[2] = -k[21];
+        out[3] = k[22];
         out[13] = 1.0;
     }
 }

@@ -194,30 +194,30 @@ impl Model for FixedCylinderClosed {
         Reduction::prepare_lean(self, p, k);
         // k[8] = ell/2
         k[8] = ell / 2.0;
-        // k[9] = 2*R
-        k[9] = 2.0 * r;
-        // k[10] = R*ell*m1/2
-        k[10] = r * ell * m1 / 2.0;
-        // k[11] = R^2*m1/2 + ell^2*m1/6
-        k[11] = ((r * r) * m1 / 2.0) + ((ell * ell) * m1 / 6.0);
-        // k[12] = R^2*m1
-        k[12] = (r * r) * m1;
-        // k[13] = R^2*m1/2
-        k[13] = (r * r) * m1 / 2.0;
-        // k[14] = ell*g*m1/2
-        k[14] = ell * g * m1 / 2.0;
-        // k[15] = R^2*m1 + ell^2*m1/3
-        k[15] = ((r * r) * m1) + ((ell * ell) * m1 / 3.0);
-        // k[16] = R*ell*m1
-        k[16] = r * ell * m1;
-        // k[17] = 2*R^2*m1
-        k[17] = 2.0 * (r * r) * m1;
-        // k[18] = 5*R^2*m1
-        k[18] = 5.0 * (r * r) * m1;
-        // k[19] = 4*R^2*m1
-        k[19] = 4.0 * (r * r) * m1;
-        // k[20] = ell*m1/2
-        k[20] = ell * m1 / 2.0;
+        // k[9] = R*ell*m1/2
+        k[9] = r * ell * m1 / 2.0;
+        // k[10] = R^2*m1/2 + ell^2*m1/6
+        k[10] = ((r * r) * m1 / 2.0) + ((ell * ell) * m1 / 6.0);
+        // k[11] = R^2*m1
+        k[11] = (r * r) * m1;
+        // k[12] = R^2*m1/2
+        k[12] = (r * r) * m1 / 2.0;
+        // k[13] = ell*g*m1/2
+        k[13] = ell * g * m1 / 2.0;
+        // k[14] = R^2*m1 + ell^2*m1/3
+        k[14] = ((r * r) * m1) + ((ell * ell) * m1 / 3.0);
+        // k[15] = R*ell*m1
+        k[15] = r * ell * m1;
+        // k[16] = 2*R^2*m1
+        k[16] = 2.0 * (r * r) * m1;
+        // k[17] = 5*R^2*m1
+        k[17] = 5.0 * (r * r) * m1;
+        // k[18] = 4*R^2*m1
+        k[18] = 4.0 * (r * r) * m1;
+        // k[19] = ell*m1/2
+        k[19] = ell * m1 / 2.0;
+        // k[20] = 2*R
+        k[20] = 2.0 * r;
         // k[21] = 2*R*m1
         k[21] = 2.0 * r * m1;
         // k[22] = 4*R*m1
@@ -271,7 +271,7 @@ impl Model for FixedCylinderClosed {
     /// - `tip_y = ell*sin(theta)`
     /// - `rod_centre_x = -R/sin(theta) - R*cos(theta)/sin(theta) + ell*cos(theta)/2`
     /// - `rod_centre_y = ell*sin(theta)/2`
-    /// - `touch_x = R*sin(theta)*cos(theta) - R*sin(theta)^2/sin(theta) - R*sin(theta)^2*cos(theta)/sin(theta)`
+    /// - `touch_x = -(R*sin(theta))`
     /// - `touch_y = R*cos(theta) + R`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
         let k = &k[..37]; // one bounds check for all constant loads
@@ -279,38 +279,24 @@ impl Model for FixedCylinderClosed {
         let ell = k[1];
         let r = k[2];
         let theta_dot = qd[0];
-        let pt0 = rc_s * rc_s;
-        let pt1 = r * theta_dot;
-        let pt2 = r * theta_dot * rc_c / pt0;
-        let pt3 = rc_c * rc_c;
-        let pt4 = r * theta_dot * pt3 / pt0;
+        let pt0 = r * theta_dot / (rc_s * rc_s);
+        let pt1 = r * theta_dot * rc_c / (rc_s * rc_s);
         pos[0] = [-(r / rc_s) - (r * rc_c / rc_s), 0.0];
-        vel[0] = [pt1 + pt2 + pt4, 0.0];
+        vel[0] = [pt0 + pt1, 0.0];
         pos[1] = [-(r / rc_s) - (r * rc_c / rc_s) + (ell * rc_c), ell * rc_s];
-        vel[1] = [
-            pt1 + pt2 + pt4 - (ell * theta_dot * rc_s),
-            ell * theta_dot * rc_c,
-        ];
+        vel[1] = [pt0 + pt1 - (ell * theta_dot * rc_s), ell * theta_dot * rc_c];
         pos[2] = [-(r / rc_s) - (r * rc_c / rc_s) + (k[8] * rc_c), k[8] * rc_s];
         vel[2] = [
-            pt1 + pt2 + pt4 - (k[8] * theta_dot * rc_s),
+            pt0 + pt1 - (k[8] * theta_dot * rc_s),
             k[8] * theta_dot * rc_c,
         ];
-        pos[3] = [
-            (r * rc_s * rc_c) - (r * pt0 / rc_s) - (r * pt0 * rc_c / rc_s),
-            r + (r * rc_c),
-        ];
-        vel[3] = [
-            -(r * theta_dot * pt3) - (k[9] * theta_dot * rc_c)
-                + (r * theta_dot * pt0 * rc_c / pt0)
-                + (r * theta_dot * pt0 * pt3 / pt0),
-            -r * theta_dot * rc_s,
-        ];
+        pos[3] = [-r * rc_s, r + (r * rc_c)];
+        vel[3] = [-r * theta_dot * rc_c, -r * theta_dot * rc_s];
     }
 
     /// The total energy `E = T + V`.
     ///
-    /// - `T`: 423 characters, written out in `generated/fixed_cylinder_closed.tex`
+    /// - `T`: 327 characters, written out in `generated/fixed_cylinder_closed.tex`
     /// - `V = ell*g*m1*sin(theta)/2`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
         let k = &k[..37]; // one bounds check for all constant loads
@@ -318,14 +304,13 @@ impl Model for FixedCylinderClosed {
         let theta_dot = qd[0];
         let et0 = theta_dot * theta_dot;
         let et1 = rc_c * rc_c;
-        (-(k[10] * et0 * rc_s) - (k[10] * et0 * rc_c / rc_s) - (k[10] * et0 * et1 / rc_s)
-            + (k[11] * et0)
-            + (k[12] * et0 * rc_c / (rc_s * rc_s))
-            + (k[12] * et0 * et1 / (rc_s * rc_s))
-            + (k[13] * et0 * et1 / rc_s.powi(4))
-            + (k[12] * et0 * rc_c.powi(3) / rc_s.powi(4))
-            + (k[13] * et0 * rc_c.powi(4) / rc_s.powi(4)))
-            + (k[14] * rc_s)
+        (-(k[9] * et0 / rc_s) - (k[9] * et0 * rc_c / rc_s)
+            + (k[10] * et0)
+            + (k[11] * et0 * rc_c / rc_s.powi(4))
+            + (k[11] * et0 * et1 / (rc_s * rc_s))
+            + (k[12] * et0 * et1 / rc_s.powi(4))
+            + (k[12] * et0 * rc_c.powi(4) / rc_s.powi(4)))
+            + (k[13] * rc_s)
     }
 
     /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
@@ -336,39 +321,35 @@ impl Model for FixedCylinderClosed {
     /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
     ///
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
-    /// - `L = T - V`: 447 characters, written out in `generated/fixed_cylinder_closed.tex`
+    /// - `L = T - V`: 351 characters, written out in `generated/fixed_cylinder_closed.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
         let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let theta_dot = qd[0];
         let qt0 = rc_c * rc_c;
-        let qt1 = rc_c.powi(3);
-        let qt2 = rc_c.powi(4);
-        let qt3 = theta_dot * theta_dot;
-        mass[0] = k[15] - (k[16] * rc_s) - (k[16] * rc_c / rc_s) - (k[16] * qt0 / rc_s)
-            + (k[17] * rc_c / (rc_s * rc_s))
-            + (k[17] * qt0 / (rc_s * rc_s))
-            + (k[12] * qt0 / rc_s.powi(4))
-            + (k[17] * qt1 / rc_s.powi(4))
-            + (k[12] * qt2 / rc_s.powi(4));
-        rhs[0] = -(k[10] * qt3)
-            - (k[10] * qt3 * rc_c)
-            - (k[10] * qt3 * qt0 / (rc_s * rc_s))
-            - (k[10] * qt3 * qt1 / (rc_s * rc_s))
-            - (k[14] * rc_c)
-            + (k[12] * qt3 / rc_s)
-            + (k[17] * qt3 * rc_c / rc_s)
-            + (k[12] * qt3 * rc_c / rc_s.powi(3))
-            + (k[18] * qt3 * qt0 / rc_s.powi(3))
-            + (k[19] * qt3 * qt1 / rc_s.powi(3))
-            + (k[17] * qt3 * qt1 / rc_s.powi(5))
-            + (k[19] * qt3 * qt2 / rc_s.powi(5))
-            + (k[17] * qt3 * rc_c.powi(5) / rc_s.powi(5));
+        let qt1 = rc_c.powi(4);
+        let qt2 = theta_dot * theta_dot;
+        let qt3 = rc_c.powi(3);
+        mass[0] = k[14] - (k[15] / rc_s) - (k[15] * rc_c / rc_s)
+            + (k[16] * rc_c / rc_s.powi(4))
+            + (k[16] * qt0 / (rc_s * rc_s))
+            + (k[11] * qt0 / rc_s.powi(4))
+            + (k[11] * qt1 / rc_s.powi(4));
+        rhs[0] =
+            -(k[9] * qt2 / (rc_s * rc_s)) - (k[9] * qt2 * rc_c / (rc_s * rc_s)) - (k[13] * rc_c)
+                + (k[11] * qt2 / rc_s)
+                + (k[16] * qt2 * rc_c / rc_s)
+                + (k[11] * qt2 * rc_c / rc_s.powi(3))
+                + (k[17] * qt2 * qt0 / rc_s.powi(3))
+                + (k[18] * qt2 * qt3 / rc_s.powi(3))
+                + (k[16] * qt2 * qt3 / rc_s.powi(5))
+                + (k[18] * qt2 * qt1 / rc_s.powi(5))
+                + (k[16] * qt2 * rc_c.powi(5) / rc_s.powi(5));
     }
 
     /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
     ///
-    /// - `cylinder_push`: 336 characters, written out in `generated/fixed_cylinder_closed.tex`
+    /// - `cylinder_push`: 266 characters, written out in `generated/fixed_cylinder_closed.tex`
     /// - `floor_normal`: 271 characters, written out in `generated/fixed_cylinder_closed.tex`
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
         let k = &k[..37]; // one bounds check for all constant loads
@@ -377,26 +358,22 @@ impl Model for FixedCylinderClosed {
         let r = k[2];
         let theta_dot = qd[0];
         let theta_ddot = qdd[0];
-        let ft0 = rc_c * rc_c;
-        let ft1 = theta_dot * theta_dot;
-        let ft2 = rc_c.powi(3);
-        out[0] = -(-(k[20] * theta_ddot * rc_s)
+        let ft0 = theta_dot * theta_dot;
+        let ft1 = rc_c * rc_c;
+        out[0] = -(-(k[19] * theta_ddot * rc_s)
             + (m1
-                * ((r * theta_ddot)
-                    + (r * theta_ddot * rc_c / (rc_s * rc_s))
-                    + (r * theta_ddot * ft0 / (rc_s * rc_s))
-                    - (r * ft1 / rc_s)
-                    - (k[9] * ft1 * rc_c / rc_s)
-                    - (k[9] * ft1 * ft0 / rc_s.powi(3))
-                    - (k[9] * ft1 * ft2 / rc_s.powi(3))))
-            - (k[20] * ft1 * rc_c))
+                * ((r * theta_ddot / (rc_s * rc_s)) + (r * theta_ddot * rc_c / (rc_s * rc_s))
+                    - (r * ft0 / rc_s)
+                    - (k[20] * ft0 * rc_c / rc_s.powi(3))
+                    - (k[20] * ft0 * ft1 / rc_s.powi(3))))
+            - (k[19] * ft0 * rc_c))
             / rc_s;
-        out[1] = ((k[21] * theta_ddot * rc_s * ft0) + (k[21] * theta_ddot * rc_s * rc_c)
-            - (k[21] * ft1 * (rc_s * rc_s) * rc_c)
-            - (k[22] * ft1 * ft0)
-            - (k[22] * ft1 * ft2)
+        out[1] = ((k[21] * theta_ddot * rc_s * ft1) + (k[21] * theta_ddot * rc_s * rc_c)
+            - (k[21] * ft0 * (rc_s * rc_s) * rc_c)
+            - (k[22] * ft0 * ft1)
+            - (k[22] * ft0 * rc_c.powi(3))
             + (k[23] * rc_s.powi(4))
-            - (k[24] * ft1 * rc_s.powi(3)))
+            - (k[24] * ft0 * rc_s.powi(3)))
             / 2.0
             / rc_s.powi(4);
     }
@@ -419,13 +396,13 @@ impl Model for FixedCylinderClosed {
 
     /// Each contact's edge margin, `>= 0` while the contact point is on the edge (infinite without one).
     ///
-    /// - `cylinder_push = -R*sin(theta) - R*cos(theta)/sin(theta) - R*cos(theta)^2/sin(theta) + ell`
+    /// - `cylinder_push = -R/sin(theta) - R*cos(theta)/sin(theta) + ell`
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
         let k = &k[..37]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ell = k[1];
         let r = k[2];
-        out[0] = ell - (r * rc_s) - (r * rc_c / rc_s) - (r * (rc_c * rc_c) / rc_s);
+        out[0] = ell - (r / rc_s) - (r * rc_c / rc_s);
         out[1] = f64::INFINITY;
     }
 
@@ -450,7 +427,7 @@ impl Model for FixedCylinderClosed {
     /// The system's state (its general model's) that this phase's state stands for.
     ///
     /// - `x1 = -R/sin(theta) - R*cos(theta)/sin(theta)`
-    /// - `dot_x1 = R*dot_theta + R*dot_theta*cos(theta)/sin(theta)^2 + R*dot_theta*cos(theta)^2/sin(theta)^2`
+    /// - `dot_x1 = R*dot_theta/sin(theta)^2 + R*dot_theta*cos(theta)/sin(theta)^2`
     /// - `y1 = 0`
     /// - `dot_y1 = 0`
     /// - `theta = theta`
@@ -462,9 +439,7 @@ impl Model for FixedCylinderClosed {
         let theta = q[0];
         let theta_dot = qd[0];
         q_full[0] = -(r / rc_s) - (r * rc_c / rc_s);
-        qd_full[0] = (r * theta_dot)
-            + (r * theta_dot * rc_c / (rc_s * rc_s))
-            + (r * theta_dot * (rc_c * rc_c) / (rc_s * rc_s));
+        qd_full[0] = (r * theta_dot / (rc_s * rc_s)) + (r * theta_dot * rc_c / (rc_s * rc_s));
         q_full[1] = 0.0;
         qd_full[1] = 0.0;
         q_full[2] = theta;
@@ -595,8 +570,8 @@ impl Reduction for FixedCylinderClosed {
             - (k[35] * ft0 * rc_acc / rc_s.powi(3))
             + (k[21] * ft0 * rc_w2 / rc_s.powi(4))
             + (k[21] * ft1 * rc_w2 / rc_s.powi(4))
-            + (k[20] * rc_acc)
-            + (k[20] * rc_c * rc_w2 / rc_s);
+            + (k[19] * rc_acc)
+            + (k[19] * rc_c * rc_w2 / rc_s);
         out[1] = k[36] + (k[35] * rc_c * rc_acc / rc_s)
             - (k[35] * rc_c * rc_w2 / (rc_s * rc_s))
             - (k[21] * ft0 * rc_w2 / (rc_s * rc_s))
@@ -604,8 +579,8 @@ impl Reduction for FixedCylinderClosed {
             + (k[35] * ft1 * rc_acc / rc_s.powi(3))
             - (k[21] * ft1 * rc_w2 / rc_s.powi(4))
             - (k[21] * rc_c.powi(4) * rc_w2 / rc_s.powi(4))
-            - (k[20] * rc_s * rc_w2)
-            - (k[20] * ft0 * rc_w2 / rc_s);
+            - (k[19] * rc_s * rc_w2)
+            - (k[19] * ft0 * rc_w2 / rc_s);
     }
 
     /// The coefficients, constant term first, of a contact's force zero as a polynomial in `sin(theta)`, where it is one.

@@ -68,7 +68,7 @@ static INFO: ModelInfo = ModelInfo {
             parameters: &[2, 3, 4],
         },
     ],
-    n_constants: 29,
+    n_constants: 30,
     coordinates: &["x1", "y1", "theta", "xc"],
     system_coordinates: &["x1", "y1", "theta", "xc"],
     reduced_index: Some(2),
@@ -203,56 +203,54 @@ impl Model for HingedCylinder {
         let th0 = p[4];
         let g = p[5];
         k[..6].copy_from_slice(p);
-        // k[6] = R/sin(th0) + R*cos(th0)/sin(th0)
-        k[6] = (r / th0.sin()) + (r * th0.cos() / th0.sin());
-        // k[7] = ell/2
-        k[7] = ell / 2.0;
-        // k[8] = ell*m1/2
-        k[8] = ell * m1 / 2.0;
-        // k[9] = ell^2*m1/6
-        k[9] = (ell * ell) * m1 / 6.0;
-        // k[10] = m1/2
-        k[10] = m1 / 2.0;
-        // k[11] = m2/2
-        k[11] = m2 / 2.0;
-        // k[12] = R*g*m2
-        k[12] = r * g * m2;
-        // k[13] = ell*g*m1/2
-        k[13] = ell * g * m1 / 2.0;
-        // k[14] = g*m1
-        k[14] = g * m1;
-        // k[15] = ell^2*m1/3
-        k[15] = (ell * ell) * m1 / 3.0;
-        // k[16] = 2*R
-        k[16] = 2.0 * r;
-        // k[17] = ell*m1
-        k[17] = ell * m1;
-        // k[18] = ell^2/12
-        k[18] = (ell * ell) / 12.0;
-        // k[19] = ell^2/4
-        k[19] = (ell * ell) / 4.0;
-        // k[20] = ell*g/2
-        k[20] = ell * g / 2.0;
-        // k[21] = ell*m1/6
-        k[21] = ell * m1 / 6.0;
-        // k[22] = g*m1/2
-        k[22] = g * m1 / 2.0;
-        // k[23] = 5*R
-        k[23] = 5.0 * r;
-        // k[24] = 8*R
-        k[24] = 8.0 * r;
-        // k[25] = 6*R
-        k[25] = 6.0 * r;
-        // k[26] = 4*R
-        k[26] = 4.0 * r;
-        // k[27] = 1/sin(th0) + cos(th0)/sin(th0)
-        let h27_t0 = 1.0 / th0.sin();
-        k[27] = h27_t0 + (th0.cos() / th0.sin());
-        // k[28] = R + R*cos(th0)/sin(th0)^2 + R*cos(th0)^2/sin(th0)^2
-        let h28_t0 = th0.cos();
-        k[28] = r
-            + (r * h28_t0 / (th0.sin() * th0.sin()))
-            + (r * (h28_t0 * h28_t0) / (th0.sin() * th0.sin()));
+        // k[6] = sin(th0)
+        k[6] = th0.sin();
+        // k[7] = cos(th0)
+        k[7] = th0.cos();
+        // k[8] = R/sin(th0) + R*cos(th0)/sin(th0)
+        k[8] = (r / k[6]) + (r * k[7] / k[6]);
+        // k[9] = ell/2
+        k[9] = ell / 2.0;
+        // k[10] = ell*m1/2
+        k[10] = ell * m1 / 2.0;
+        // k[11] = ell^2*m1/6
+        k[11] = (ell * ell) * m1 / 6.0;
+        // k[12] = m1/2
+        k[12] = m1 / 2.0;
+        // k[13] = m2/2
+        k[13] = m2 / 2.0;
+        // k[14] = R*g*m2
+        k[14] = r * g * m2;
+        // k[15] = ell*g*m1/2
+        k[15] = ell * g * m1 / 2.0;
+        // k[16] = g*m1
+        k[16] = g * m1;
+        // k[17] = ell^2*m1/3
+        k[17] = (ell * ell) * m1 / 3.0;
+        // k[18] = 2*R
+        k[18] = 2.0 * r;
+        // k[19] = ell*m1
+        k[19] = ell * m1;
+        // k[20] = ell^2/3
+        k[20] = (ell * ell) / 3.0;
+        // k[21] = ell*g/2
+        k[21] = ell * g / 2.0;
+        // k[22] = 2*ell*m1/3
+        k[22] = 2.0 * ell * m1 / 3.0;
+        // k[23] = g*m1/2
+        k[23] = g * m1 / 2.0;
+        // k[24] = 5*R
+        k[24] = 5.0 * r;
+        // k[25] = 8*R
+        k[25] = 8.0 * r;
+        // k[26] = 6*R
+        k[26] = 6.0 * r;
+        // k[27] = 4*R
+        k[27] = 4.0 * r;
+        // k[28] = 1/sin(th0) + cos(th0)/sin(th0)
+        k[28] = (1.0 / k[6]) + (k[7] / k[6]);
+        // k[29] = R/sin(th0)^2 + R*cos(th0)/sin(th0)^2
+        k[29] = (r / (k[6] * k[6])) + (r * k[7] / (k[6] * k[6]));
     }
 
     /// The state at release, over the parameters.
@@ -266,7 +264,7 @@ impl Model for HingedCylinder {
     /// - `xc = R/sin(th0) + R*cos(th0)/sin(th0)`
     /// - `dot_xc = 0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let th0 = k[4];
         q[0] = 0.0;
         qd[0] = 0.0;
@@ -274,7 +272,7 @@ impl Model for HingedCylinder {
         qd[1] = 0.0;
         q[2] = th0;
         qd[2] = 0.0;
-        q[3] = k[6];
+        q[3] = k[8];
         qd[3] = 0.0;
     }
 
@@ -289,7 +287,7 @@ impl Model for HingedCylinder {
     /// - `axis_x = xc`
     /// - `axis_y = R`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let r = k[3];
@@ -307,10 +305,10 @@ impl Model for HingedCylinder {
             -(ell * theta_dot * rc_s) + x1_dot,
             (ell * theta_dot * rc_c) + y1_dot,
         ];
-        pos[2] = [(k[7] * rc_c) + x1, (k[7] * rc_s) + y1];
+        pos[2] = [(k[9] * rc_c) + x1, (k[9] * rc_s) + y1];
         vel[2] = [
-            -(k[7] * theta_dot * rc_s) + x1_dot,
-            (k[7] * theta_dot * rc_c) + y1_dot,
+            -(k[9] * theta_dot * rc_s) + x1_dot,
+            (k[9] * theta_dot * rc_c) + y1_dot,
         ];
         pos[3] = [xc, r];
         vel[3] = [xc_dot, 0.0];
@@ -321,20 +319,20 @@ impl Model for HingedCylinder {
     /// - `T = -dot_theta*dot_x1*ell*m1*sin(theta)/2 + dot_theta*dot_y1*ell*m1*cos(theta)/2 + dot_theta^2*ell^2*m1/6 + dot_x1^2*m1/2 + dot_xc^2*m2/2 + dot_y1^2*m1/2`
     /// - `V = R*g*m2 + ell*g*m1*sin(theta)/2 + g*m1*y1`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let x1_dot = qd[0];
         let y1 = q[1];
         let y1_dot = qd[1];
         let theta_dot = qd[2];
         let xc_dot = qd[3];
-        (-(k[8] * theta_dot * x1_dot * rc_s)
-            + (k[8] * theta_dot * y1_dot * rc_c)
-            + (k[9] * (theta_dot * theta_dot))
-            + (k[10] * (x1_dot * x1_dot))
-            + (k[11] * (xc_dot * xc_dot))
-            + (k[10] * (y1_dot * y1_dot)))
-            + (k[12] + (k[13] * rc_s) + (k[14] * y1))
+        (-(k[10] * theta_dot * x1_dot * rc_s)
+            + (k[10] * theta_dot * y1_dot * rc_c)
+            + (k[11] * (theta_dot * theta_dot))
+            + (k[12] * (x1_dot * x1_dot))
+            + (k[13] * (xc_dot * xc_dot))
+            + (k[12] * (y1_dot * y1_dot)))
+            + (k[14] + (k[15] * rc_s) + (k[16] * y1))
     }
 
     /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
@@ -342,14 +340,14 @@ impl Model for HingedCylinder {
     /// - `p_x1 = -dot_theta*ell*m1*sin(theta)/2 + dot_x1*m1`
     /// - `p_xc = dot_xc*m2`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let m1 = k[0];
         let m2 = k[1];
         let x1_dot = qd[0];
         let theta_dot = qd[2];
         let xc_dot = qd[3];
-        out[0] = -(k[8] * theta_dot * rc_s) + (m1 * x1_dot);
+        out[0] = -(k[10] * theta_dot * rc_s) + (m1 * x1_dot);
         out[1] = m2 * xc_dot;
     }
 
@@ -358,13 +356,13 @@ impl Model for HingedCylinder {
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
     /// - `L = T - V`: 194 characters, written out in `generated/hinged_cylinder.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let m2 = k[1];
         let theta_dot = qd[2];
-        let qt0 = -k[8] * rc_s; // -(ell*m1*rc_s/2)
-        let qt1 = k[8] * rc_c; // ell*m1*rc_c/2
+        let qt0 = -k[10] * rc_s; // -(ell*m1*rc_s/2)
+        let qt1 = k[10] * rc_c; // ell*m1*rc_c/2
         let qt2 = theta_dot * theta_dot;
         mass[0] = m1;
         mass[1] = 0.0;
@@ -376,15 +374,15 @@ impl Model for HingedCylinder {
         mass[7] = 0.0;
         mass[8] = qt0;
         mass[9] = qt1;
-        mass[10] = k[15];
+        mass[10] = k[17];
         mass[11] = 0.0;
         mass[12] = 0.0;
         mass[13] = 0.0;
         mass[14] = 0.0;
         mass[15] = m2;
-        rhs[0] = k[8] * qt2 * rc_c;
-        rhs[1] = -k[14] + (k[8] * qt2 * rc_s);
-        rhs[2] = -k[13] * rc_c;
+        rhs[0] = k[10] * qt2 * rc_c;
+        rhs[1] = -k[16] + (k[10] * qt2 * rc_s);
+        rhs[2] = -k[15] * rc_c;
         rhs[3] = 0.0;
     }
 
@@ -403,7 +401,7 @@ impl Model for HingedCylinder {
     /// - `hinge_horizontal = x1`
     /// - `hinge_vertical = y1`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let r = k[3];
         let x1 = q[0];
@@ -416,20 +414,16 @@ impl Model for HingedCylinder {
 
     /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let r = k[3];
         let y1 = q[1];
         let y1_dot = qd[1];
         let theta_dot = qd[2];
-        let jt0 = rc_c * rc_c;
-        let jt1 = theta_dot * theta_dot;
-        let jt2 = rc_c.powi(3);
+        let jt0 = theta_dot * theta_dot;
         jac[0] = -1.0;
         jac[1] = rc_c / rc_s;
-        jac[2] = r + (r * rc_c / (rc_s * rc_s)) + (r * jt0 / (rc_s * rc_s))
-            - y1
-            - (y1 * jt0 / (rc_s * rc_s));
+        jac[2] = (r / (rc_s * rc_s)) + (r * rc_c / (rc_s * rc_s)) - (y1 / (rc_s * rc_s));
         jac[3] = 1.0;
         jac[4] = 1.0;
         jac[5] = 0.0;
@@ -439,14 +433,11 @@ impl Model for HingedCylinder {
         jac[9] = 1.0;
         jac[10] = 0.0;
         jac[11] = 0.0;
-        bias[0] = -(r * jt1 / rc_s)
-            - (k[16] * jt1 * rc_c / rc_s)
-            - (k[16] * jt1 * jt0 / rc_s.powi(3))
-            - (k[16] * jt1 * jt2 / rc_s.powi(3))
-            - (2.0 * theta_dot * y1_dot)
-            - (2.0 * theta_dot * y1_dot * jt0 / (rc_s * rc_s))
-            + (2.0 * jt1 * y1 * rc_c / rc_s)
-            + (2.0 * jt1 * y1 * jt2 / rc_s.powi(3));
+        bias[0] = -(r * jt0 / rc_s)
+            - (k[18] * jt0 * rc_c / rc_s.powi(3))
+            - (k[18] * jt0 * (rc_c * rc_c) / rc_s.powi(3))
+            - (2.0 * theta_dot * y1_dot / (rc_s * rc_s))
+            + (2.0 * jt0 * y1 * rc_c / rc_s.powi(3));
         bias[1] = 0.0;
         bias[2] = 0.0;
     }
@@ -455,7 +446,7 @@ impl Model for HingedCylinder {
     ///
     /// - `contact_force = -R*sin(theta) + ell + x1*cos(theta) - xc*cos(theta) + y1*sin(theta)`
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let r = k[3];
@@ -516,18 +507,18 @@ impl Model for HingedCylinder {
 
     /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let r = k[3];
         let x1 = q[0];
         let y1 = q[1];
         let theta = q[2];
         let xc = q[3];
-        poses[0] = [(k[7] * rc_c) + x1, (k[7] * rc_s) + y1, theta];
+        poses[0] = [(k[9] * rc_c) + x1, (k[9] * rc_s) + y1, theta];
         poses[1] = [xc, r, 0.0];
-        sizes[0] = -k[7];
+        sizes[0] = -k[9];
         sizes[1] = 0.0;
-        sizes[2] = k[7];
+        sizes[2] = k[9];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
@@ -552,7 +543,7 @@ impl Tangents for HingedCylinder {
         let qd = at.qd;
         let qdd = at.qdd;
         let forces = at.forces;
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let r = k[3];
@@ -567,73 +558,63 @@ impl Tangents for HingedCylinder {
         let xc = q[3];
         let xc_ddot = qdd[3];
         let xt0 = theta_dot * theta_dot;
-        let xt1 = rc_c * rc_c;
-        let xt2 = rc_s * rc_s;
-        let xt3 = -1.0 - (xt1 / xt2);
-        let xt4 = rc_c.powi(3);
-        let xt5 = -(r / rc_s)
-            - (k[16] * rc_c / rc_s)
-            - (k[16] * xt1 / rc_s.powi(3))
-            - (k[16] * xt4 / rc_s.powi(3))
-            + (2.0 * y1 * rc_c / rc_s)
-            + (2.0 * y1 * xt4 / rc_s.powi(3)); // -R/rc_s - 2*R*rc_c/rc_s - 2*R*rc_c^2/rc_s^3 - 2*R*rc_c^3/rc_s^3 + 2*y1*rc_c/rc_s + 2*y1*rc_c^3/rc_s^3
-        let xt6 = 1.0 + (rc_c / xt2) + (xt1 / xt2);
-        let xt7 = rc_c.powi(4);
+        let xt1 = -1.0 / (rc_s * rc_s);
+        let xt2 = rc_c * rc_c;
+        let xt3 = -(r / rc_s) - (k[18] * rc_c / rc_s.powi(3)) - (k[18] * xt2 / rc_s.powi(3))
+            + (2.0 * y1 * rc_c / rc_s.powi(3)); // -R/rc_s - 2*R*rc_c/rc_s^3 - 2*R*rc_c^2/rc_s^3 + 2*y1*rc_c/rc_s^3
+        let xt4 = 1.0 / rc_s.powi(2);
+        let xt5 = xt4 + (rc_c / (rc_s * rc_s));
+        let xt6 = rc_c.powi(4);
         out.fill(0.0);
-        out[2] = -(k[8] * theta_ddot * rc_c) + (k[8] * xt0 * rc_s);
-        out[6] = -k[17] * theta_dot * rc_c;
-        out[8] = -(k[7] * theta_ddot * rc_s) + x1_ddot - (k[7] * xt0 * rc_c);
-        out[10] = -(k[10] * theta_ddot * rc_s) - (k[10] * xt0 * rc_c);
-        out[16] = -(k[8] * theta_ddot * rc_s)
-            - (-forces[0] - (forces[0] * xt1 / xt2))
-            - (k[8] * xt0 * rc_c);
-        out[20] = -k[17] * theta_dot * rc_s;
-        out[22] = (k[7] * theta_ddot * rc_c) + y1_ddot - (-g + (k[7] * xt0 * rc_s));
-        out[24] = (k[10] * theta_ddot * rc_c) - (k[10] * xt0 * rc_s);
+        out[2] = -(k[10] * theta_ddot * rc_c) + (k[10] * xt0 * rc_s);
+        out[6] = -k[19] * theta_dot * rc_c;
+        out[8] = -(k[9] * theta_ddot * rc_s) + x1_ddot - (k[9] * xt0 * rc_c);
+        out[10] = -(k[12] * theta_ddot * rc_s) - (k[12] * xt0 * rc_c);
+        out[16] =
+            -(k[10] * theta_ddot * rc_s) - (-forces[0] / (rc_s * rc_s)) - (k[10] * xt0 * rc_c);
+        out[20] = -k[19] * theta_dot * rc_s;
+        out[22] = (k[9] * theta_ddot * rc_c) + y1_ddot - (-g + (k[9] * xt0 * rc_s));
+        out[24] = (k[12] * theta_ddot * rc_c) - (k[12] * xt0 * rc_s);
         out[27] = m1;
-        out[29] = -forces[0] * xt3;
-        out[30] =
-            -(k[8] * x1_ddot * rc_c) - (k[8] * y1_ddot * rc_s) - (k[13] * rc_s) - (forces[0] * xt5);
-        out[36] = (theta_ddot * (k[18] + (k[19] * xt2) + (k[19] * xt1))) - (k[7] * x1_ddot * rc_s)
-            + (k[7] * y1_ddot * rc_c)
-            + (k[20] * rc_c);
-        out[38] = (theta_ddot * (k[21] + (k[8] * xt2) + (k[8] * xt1))) - (k[10] * x1_ddot * rc_s)
-            + (k[10] * y1_ddot * rc_c)
-            + (k[22] * rc_c);
-        out[39] = -forces[0] * xt6;
-        out[41] = k[8] * rc_c;
+        out[29] = -forces[0] * xt1;
+        out[30] = -(k[10] * x1_ddot * rc_c)
+            - (k[10] * y1_ddot * rc_s)
+            - (k[15] * rc_s)
+            - (forces[0] * xt3);
+        out[36] = (k[20] * theta_ddot) - (k[9] * x1_ddot * rc_s)
+            + (k[9] * y1_ddot * rc_c)
+            + (k[21] * rc_c);
+        out[38] = (k[22] * theta_ddot) - (k[12] * x1_ddot * rc_s)
+            + (k[12] * y1_ddot * rc_c)
+            + (k[23] * rc_c);
+        out[39] = -forces[0] * xt5;
+        out[41] = k[10] * rc_c;
         out[51] = xc_ddot;
-        out[57] = (theta_ddot * xt3) + (2.0 * xt0 * rc_c / rc_s) + (2.0 * xt0 * xt4 / rc_s.powi(3));
-        out[58] = (k[16] * xt0)
-            + (k[23] * xt0 * rc_c / xt2)
-            + (k[24] * xt0 * xt1 / xt2)
-            + (k[25] * xt0 * xt4 / rc_s.powi(4))
-            + (k[25] * xt0 * xt7 / rc_s.powi(4))
-            + (theta_ddot * xt5)
-            - y1_ddot
-            - (y1_ddot * xt1 / xt2)
-            + (4.0 * theta_dot * y1_dot * rc_c / rc_s)
-            + (4.0 * theta_dot * y1_dot * xt4 / rc_s.powi(3))
+        out[57] = (theta_ddot * xt1) + (2.0 * xt0 * rc_c / rc_s.powi(3));
+        out[58] = (k[18] * xt0)
+            + (k[24] * xt0 * rc_c / (rc_s * rc_s))
+            + (k[25] * xt0 * xt2 / (rc_s * rc_s))
+            + (k[26] * xt0 * rc_c.powi(3) / rc_s.powi(4))
+            + (k[26] * xt0 * xt6 / rc_s.powi(4))
+            + (theta_ddot * xt3)
+            - (y1_ddot / (rc_s * rc_s))
+            + (4.0 * theta_dot * y1_dot * rc_c / rc_s.powi(3))
             - (2.0 * xt0 * y1)
-            - (8.0 * xt0 * y1 * xt1 / xt2)
-            - (6.0 * xt0 * y1 * xt7 / rc_s.powi(4));
-        out[61] = -(2.0 * theta_dot) - (2.0 * theta_dot * xt1 / xt2);
-        out[62] = -(k[16] * theta_dot / rc_s)
-            - (k[26] * theta_dot * rc_c / rc_s)
-            - (k[26] * theta_dot * xt1 / rc_s.powi(3))
-            - (k[26] * theta_dot * xt4 / rc_s.powi(3))
-            + (4.0 * theta_dot * y1 * rc_c / rc_s)
-            + (4.0 * theta_dot * y1 * xt4 / rc_s.powi(3))
-            - (2.0 * y1_dot)
-            - (2.0 * y1_dot * xt1 / xt2);
-        out[67] = (theta_ddot * xt6)
+            - (8.0 * xt0 * y1 * xt2 / (rc_s * rc_s))
+            - (6.0 * xt0 * y1 * xt6 / rc_s.powi(4));
+        out[61] = -2.0 * theta_dot / (rc_s * rc_s);
+        out[62] = -(k[18] * theta_dot / rc_s)
+            - (k[27] * theta_dot * rc_c / rc_s.powi(3))
+            - (k[27] * theta_dot * xt2 / rc_s.powi(3))
+            + (4.0 * theta_dot * y1 * rc_c / rc_s.powi(3))
+            - (2.0 * y1_dot / (rc_s * rc_s));
+        out[67] = (theta_ddot * xt5)
             - (xt0 / rc_s)
-            - (2.0 * xt0 * rc_c / rc_s)
-            - (2.0 * xt0 * xt1 / rc_s.powi(3))
-            - (2.0 * xt0 * xt4 / rc_s.powi(3));
+            - (2.0 * xt0 * rc_c / rc_s.powi(3))
+            - (2.0 * xt0 * xt2 / rc_s.powi(3));
         out[98] = -1.0;
         out[99] = rc_c / rc_s;
-        out[100] = r + (r * rc_c / xt2) + (r * xt1 / xt2) - y1 - (y1 * xt1 / xt2);
+        out[100] = (r / (rc_s * rc_s)) + (r * rc_c / (rc_s * rc_s)) - (y1 / (rc_s * rc_s));
         out[101] = 1.0;
         out[109] = -(1.0 / rc_s) - (rc_c / rc_s);
         out[112] = 1.0;
@@ -648,10 +629,10 @@ impl Tangents for HingedCylinder {
 
     /// `d(initial state)/dp`: the rows `d q_0/dp`, then `d qd_0/dp`, by the parameters.
     fn initial_tangents(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..29]; // one bounds check for all constant loads
+        let k = &k[..30]; // one bounds check for all constant loads
         out.fill(0.0);
         out[16] = 1.0;
-        out[21] = k[27];
-        out[22] = -k[28];
+        out[21] = k[28];
+        out[22] = -k[29];
     }
 }

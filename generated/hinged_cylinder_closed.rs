@@ -301,16 +301,14 @@ impl Model for HingedCylinderClosed {
         vel[2] = [-k[9] * theta_dot * rc_s, k[9] * theta_dot * rc_c];
         pos[3] = [(r / rc_s) + (r * rc_c / rc_s), r];
         vel[3] = [
-            -(r * theta_dot)
-                - (r * theta_dot * rc_c / (rc_s * rc_s))
-                - (r * theta_dot * (rc_c * rc_c) / (rc_s * rc_s)),
+            -(r * theta_dot / (rc_s * rc_s)) - (r * theta_dot * rc_c / (rc_s * rc_s)),
             0.0,
         ];
     }
 
     /// The total energy `E = T + V`.
     ///
-    /// - `T`: 286 characters, written out in `generated/hinged_cylinder_closed.tex`
+    /// - `T`: 239 characters, written out in `generated/hinged_cylinder_closed.tex`
     /// - `V = R*g*m2 + ell*g*m1*sin(theta)/2`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
         let k = &k[..35]; // one bounds check for all constant loads
@@ -319,10 +317,9 @@ impl Model for HingedCylinderClosed {
         let et0 = theta_dot * theta_dot;
         let et1 = rc_c * rc_c;
         ((k[10] * et0)
-            + (k[11] * et0 * rc_c / (rc_s * rc_s))
+            + (k[11] * et0 * rc_c / rc_s.powi(4))
             + (k[11] * et0 * et1 / (rc_s * rc_s))
             + (k[12] * et0 * et1 / rc_s.powi(4))
-            + (k[11] * et0 * rc_c.powi(3) / rc_s.powi(4))
             + (k[12] * et0 * rc_c.powi(4) / rc_s.powi(4)))
             + (k[13] + (k[14] * rc_s))
     }
@@ -335,35 +332,34 @@ impl Model for HingedCylinderClosed {
     /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
     ///
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
-    /// - `L = T - V`: 322 characters, written out in `generated/hinged_cylinder_closed.tex`
+    /// - `L = T - V`: 275 characters, written out in `generated/hinged_cylinder_closed.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
         let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let theta_dot = qd[0];
         let qt0 = rc_c * rc_c;
-        let qt1 = rc_c.powi(3);
-        let qt2 = rc_c.powi(4);
-        let qt3 = theta_dot * theta_dot;
+        let qt1 = rc_c.powi(4);
+        let qt2 = theta_dot * theta_dot;
+        let qt3 = rc_c.powi(3);
         mass[0] = k[15]
-            + (k[16] * rc_c / (rc_s * rc_s))
+            + (k[16] * rc_c / rc_s.powi(4))
             + (k[16] * qt0 / (rc_s * rc_s))
             + (k[11] * qt0 / rc_s.powi(4))
-            + (k[16] * qt1 / rc_s.powi(4))
-            + (k[11] * qt2 / rc_s.powi(4));
+            + (k[11] * qt1 / rc_s.powi(4));
         rhs[0] = -(k[14] * rc_c)
-            + (k[11] * qt3 / rc_s)
-            + (k[16] * qt3 * rc_c / rc_s)
-            + (k[11] * qt3 * rc_c / rc_s.powi(3))
-            + (k[17] * qt3 * qt0 / rc_s.powi(3))
-            + (k[18] * qt3 * qt1 / rc_s.powi(3))
-            + (k[16] * qt3 * qt1 / rc_s.powi(5))
-            + (k[18] * qt3 * qt2 / rc_s.powi(5))
-            + (k[16] * qt3 * rc_c.powi(5) / rc_s.powi(5));
+            + (k[11] * qt2 / rc_s)
+            + (k[16] * qt2 * rc_c / rc_s)
+            + (k[11] * qt2 * rc_c / rc_s.powi(3))
+            + (k[17] * qt2 * qt0 / rc_s.powi(3))
+            + (k[18] * qt2 * qt3 / rc_s.powi(3))
+            + (k[16] * qt2 * qt3 / rc_s.powi(5))
+            + (k[18] * qt2 * qt1 / rc_s.powi(5))
+            + (k[16] * qt2 * rc_c.powi(5) / rc_s.powi(5));
     }
 
     /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
     ///
-    /// - `contact_force`: 253 characters, written out in `generated/hinged_cylinder_closed.tex`
+    /// - `contact_force`: 183 characters, written out in `generated/hinged_cylinder_closed.tex`
     /// - `hinge_horizontal`: 270 characters, written out in `generated/hinged_cylinder_closed.tex`
     /// - `hinge_vertical`: 315 characters, written out in `generated/hinged_cylinder_closed.tex`
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
@@ -374,34 +370,32 @@ impl Model for HingedCylinderClosed {
         let theta_dot = qd[0];
         let theta_ddot = qdd[0];
         let ft0 = rc_s * rc_s;
-        let ft1 = rc_c * rc_c;
-        let ft2 = theta_dot * theta_dot;
-        let ft3 = rc_c.powi(3);
-        let ft4 = k[20] * theta_ddot * rc_s * rc_c; // 2*R*m2*ddot_theta*rc_s*rc_c
-        let ft5 = rc_s.powi(4);
+        let ft1 = theta_dot * theta_dot;
+        let ft2 = rc_c * rc_c;
+        let ft3 = k[20] * theta_ddot * rc_s * rc_c; // 2*R*m2*ddot_theta*rc_s*rc_c
+        let ft4 = rc_s.powi(4);
         out[0] = m2
-            * (-(r * theta_ddot) - (r * theta_ddot * rc_c / ft0) - (r * theta_ddot * ft1 / ft0)
-                + (r * ft2 / rc_s)
-                + (k[19] * ft2 * rc_c / rc_s)
-                + (k[19] * ft2 * ft1 / rc_s.powi(3))
-                + (k[19] * ft2 * ft3 / rc_s.powi(3)));
-        out[1] = -(ft4 + (k[20] * theta_ddot * rc_s)
-            - (k[20] * ft2 * ft0)
-            - (k[21] * ft2 * rc_c)
-            - (k[21] * ft2 * ft1)
-            + (k[22] * theta_ddot * ft5)
-            + (k[22] * ft2 * rc_s.powi(3) * rc_c))
+            * (-(r * theta_ddot / ft0) - (r * theta_ddot * rc_c / ft0)
+                + (r * ft1 / rc_s)
+                + (k[19] * ft1 * rc_c / rc_s.powi(3))
+                + (k[19] * ft1 * ft2 / rc_s.powi(3)));
+        out[1] = -(ft3 + (k[20] * theta_ddot * rc_s)
+            - (k[20] * ft1 * ft0)
+            - (k[21] * ft1 * rc_c)
+            - (k[21] * ft1 * ft2)
+            + (k[22] * theta_ddot * ft4)
+            + (k[22] * ft1 * rc_s.powi(3) * rc_c))
             / 2.0
             / rc_s.powi(3);
-        out[2] = ((k[20] * theta_ddot * rc_s * ft1) + ft4
-            - (k[20] * ft2 * ft0 * rc_c)
-            - (k[21] * ft2 * ft1)
-            - (k[21] * ft2 * ft3)
-            + (k[22] * theta_ddot * ft5 * rc_c)
-            + (k[23] * ft5)
-            - (k[22] * ft2 * rc_s.powi(5)))
+        out[2] = ((k[20] * theta_ddot * rc_s * ft2) + ft3
+            - (k[20] * ft1 * ft0 * rc_c)
+            - (k[21] * ft1 * ft2)
+            - (k[21] * ft1 * rc_c.powi(3))
+            + (k[22] * theta_ddot * ft4 * rc_c)
+            + (k[23] * ft4)
+            - (k[22] * ft1 * rc_s.powi(5)))
             / 2.0
-            / ft5;
+            / ft4;
     }
 
     /// Each contact's gap `g(q)`, `>= 0` while apart (zero for a contact held closed).
@@ -425,13 +419,13 @@ impl Model for HingedCylinderClosed {
 
     /// Each contact's edge margin, `>= 0` while the contact point is on the edge (infinite without one).
     ///
-    /// - `contact_force = -R*sin(theta) - R*cos(theta)/sin(theta) - R*cos(theta)^2/sin(theta) + ell`
+    /// - `contact_force = -R/sin(theta) - R*cos(theta)/sin(theta) + ell`
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
         let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ell = k[2];
         let r = k[3];
-        out[0] = ell - (r * rc_s) - (r * rc_c / rc_s) - (r * (rc_c * rc_c) / rc_s);
+        out[0] = ell - (r / rc_s) - (r * rc_c / rc_s);
         out[1] = f64::INFINITY;
         out[2] = f64::INFINITY;
     }
@@ -463,7 +457,7 @@ impl Model for HingedCylinderClosed {
     /// - `theta = theta`
     /// - `dot_theta = dot_theta`
     /// - `xc = R/sin(theta) + R*cos(theta)/sin(theta)`
-    /// - `dot_xc = -R*dot_theta - R*dot_theta*cos(theta)/sin(theta)^2 - R*dot_theta*cos(theta)^2/sin(theta)^2`
+    /// - `dot_xc = -R*dot_theta/sin(theta)^2 - R*dot_theta*cos(theta)/sin(theta)^2`
     fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
         let k = &k[..35]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
@@ -477,9 +471,7 @@ impl Model for HingedCylinderClosed {
         q_full[2] = theta;
         qd_full[2] = theta_dot;
         q_full[3] = (r / rc_s) + (r * rc_c / rc_s);
-        qd_full[3] = -(r * theta_dot)
-            - (r * theta_dot * rc_c / (rc_s * rc_s))
-            - (r * theta_dot * (rc_c * rc_c) / (rc_s * rc_s));
+        qd_full[3] = -(r * theta_dot / (rc_s * rc_s)) - (r * theta_dot * rc_c / (rc_s * rc_s));
     }
 
     /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.

@@ -390,18 +390,16 @@ impl Model for HingedCylinderFree {
         let (rc_s, rc_c) = q[0].sin_cos();
         let r = k[3];
         let theta_dot = qd[0];
-        let jt0 = rc_c * rc_c;
-        let jt1 = theta_dot * theta_dot;
-        jac[0] = r + (r * rc_c / (rc_s * rc_s)) + (r * jt0 / (rc_s * rc_s));
+        let jt0 = theta_dot * theta_dot;
+        jac[0] = (r / (rc_s * rc_s)) + (r * rc_c / (rc_s * rc_s));
         jac[1] = 1.0;
         jac[2] = 0.0;
         jac[3] = 0.0;
         jac[4] = 0.0;
         jac[5] = 0.0;
-        bias[0] = -(r * jt1 / rc_s)
-            - (k[21] * jt1 * rc_c / rc_s)
-            - (k[21] * jt1 * jt0 / rc_s.powi(3))
-            - (k[21] * jt1 * rc_c.powi(3) / rc_s.powi(3));
+        bias[0] = -(r * jt0 / rc_s)
+            - (k[21] * jt0 * rc_c / rc_s.powi(3))
+            - (k[21] * jt0 * (rc_c * rc_c) / rc_s.powi(3));
         bias[1] = 0.0;
         bias[2] = 0.0;
     }

@@ -61,7 +61,7 @@ static INFO: ModelInfo = ModelInfo {
         meaning: "the cube must be lower than the rod is long (a < ell)",
         parameters: &[2, 3],
     }],
-    n_constants: 33,
+    n_constants: 32,
     coordinates: &["x1", "y1", "theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced_index: Some(2),
@@ -186,68 +186,67 @@ impl Model for HingedRodSpring {
         k[..6].copy_from_slice(p);
         // k[6] = asin(a/ell)
         k[6] = (a / ell).asin();
-        // k[7] = ell*((1 - a/ell)*(1 + a/ell))^(1/2)
+        // k[7] = ((1 - a/ell)*(1 + a/ell))^(1/2)
         let h7_t0 = a / ell;
-        k[7] = ell * ((1.0 - h7_t0) * (1.0 + h7_t0)).sqrt();
-        // k[8] = ell/2
-        k[8] = ell / 2.0;
-        // k[9] = ell*m1/2
-        k[9] = ell * m1 / 2.0;
-        // k[10] = ell^2*m1/6
-        k[10] = (ell * ell) * m1 / 6.0;
-        // k[11] = m1/2
-        k[11] = m1 / 2.0;
-        // k[12] = m2/2
-        k[12] = m2 / 2.0;
-        // k[13] = a*g*m2/2
-        k[13] = a * g * m2 / 2.0;
-        // k[14] = ell*g*m1/2
-        k[14] = ell * g * m1 / 2.0;
-        // k[15] = g*m1
-        k[15] = g * m1;
-        // k[16] = k/2
-        k[16] = k_param / 2.0;
-        // k[17] = ell*cos(asin(a/ell))
-        k[17] = ell * (a / ell).asin().cos();
+        k[7] = ((1.0 - h7_t0) * (1.0 + h7_t0)).sqrt();
+        // k[8] = ell*((1 - a/ell)*(1 + a/ell))^(1/2)
+        k[8] = ell * k[7];
+        // k[9] = ell/2
+        k[9] = ell / 2.0;
+        // k[10] = ell*m1/2
+        k[10] = ell * m1 / 2.0;
+        // k[11] = ell^2*m1/6
+        k[11] = (ell * ell) * m1 / 6.0;
+        // k[12] = m1/2
+        k[12] = m1 / 2.0;
+        // k[13] = m2/2
+        k[13] = m2 / 2.0;
+        // k[14] = a*g*m2/2
+        k[14] = a * g * m2 / 2.0;
+        // k[15] = ell*g*m1/2
+        k[15] = ell * g * m1 / 2.0;
+        // k[16] = g*m1
+        k[16] = g * m1;
+        // k[17] = k/2
+        k[17] = k_param / 2.0;
         // k[18] = ell^2*m1/3
         k[18] = (ell * ell) * m1 / 3.0;
         // k[19] = a/2
         k[19] = a / 2.0;
         // k[20] = ell*m1
         k[20] = ell * m1;
-        // k[21] = ell^2/12
-        k[21] = (ell * ell) / 12.0;
-        // k[22] = ell^2/4
-        k[22] = (ell * ell) / 4.0;
-        // k[23] = ell*g/2
-        k[23] = ell * g / 2.0;
-        // k[24] = ell*m1/6
-        k[24] = ell * m1 / 6.0;
-        // k[25] = g*m1/2
-        k[25] = g * m1 / 2.0;
-        // k[26] = k*(-a*sin(asin(a/ell))/(ell*(1 - a^2/ell^2)^(1/2)) - cos(asin(a/ell)))
-        let h26_t0 = (a / ell).asin();
-        k[26] = k_param
-            * (-(a * h26_t0.sin() / ell / (1.0 - ((a * a) / (ell * ell))).sqrt()) - h26_t0.cos());
-        // k[27] = k*sin(asin(a/ell))/(1 - a^2/ell^2)^(1/2)
-        k[27] = k_param * (a / ell).asin().sin() / (1.0 - ((a * a) / (ell * ell))).sqrt();
-        // k[28] = 2*ell
-        k[28] = 2.0 * ell;
-        // k[29] = a/(ell^2*(1 - a^2/ell^2)^(1/2))
-        k[29] = a / (ell * ell) / (1.0 - ((a * a) / (ell * ell))).sqrt();
-        // k[30] = 1/(ell*(1 - a^2/ell^2)^(1/2))
-        k[30] = 1.0 / ell / (1.0 - ((a * a) / (ell * ell))).sqrt();
-        // k[31] = ell*(a*(1 + a/ell)/ell^2 - a*(1 - a/ell)/ell^2)/(2*((1 + a/ell)*(1 - a/ell))^(1/2)) + ((1 + a/ell)*(1 - a/ell))^(1/2)
-        let h31_t0 = 1.0 + (a / ell);
-        let h31_t1 = 1.0 - (a / ell);
-        let h31_t2 = h31_t0 * h31_t1;
-        k[31] =
-            (ell * ((a * h31_t0 / (ell * ell)) - (a * h31_t1 / (ell * ell))) / 2.0 / h31_t2.sqrt())
-                + h31_t2.sqrt();
-        // k[32] = ell*(-(1 + a/ell)/ell + (1 - a/ell)/ell)/(2*((1 + a/ell)*(1 - a/ell))^(1/2))
-        let h32_t0 = 1.0 + (a / ell);
-        let h32_t1 = 1.0 - (a / ell);
-        k[32] = ell * (-(h32_t0 / ell) + (h32_t1 / ell)) / 2.0 / (h32_t0 * h32_t1).sqrt();
+        // k[21] = ell^2/3
+        k[21] = (ell * ell) / 3.0;
+        // k[22] = ell*g/2
+        k[22] = ell * g / 2.0;
+        // k[23] = 2*ell*m1/3
+        k[23] = 2.0 * ell * m1 / 3.0;
+        // k[24] = g*m1/2
+        k[24] = g * m1 / 2.0;
+        // k[25] = k*(-ell*(a*(1 + a/ell)/ell^2 - a*(1 - a/ell)/ell^2)/(2*((1 - a/ell)*(1 + a/ell))^(1/2)) - ((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[25] = k_param
+            * (-(ell
+                * ((a * (1.0 + (a / ell)) / (ell * ell)) - (a * (1.0 - (a / ell)) / (ell * ell)))
+                / 2.0
+                / k[7])
+                - k[7]);
+        // k[26] = ell*k*(-(1 + a/ell)/ell + (1 - a/ell)/ell)/(2*((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[26] =
+            ell * k_param * (-((1.0 + (a / ell)) / ell) + ((1.0 - (a / ell)) / ell)) / 2.0 / k[7];
+        // k[27] = 2*ell
+        k[27] = 2.0 * ell;
+        // k[28] = a/(ell^2*((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[28] = a / (ell * ell) / k[7];
+        // k[29] = 1/(ell*((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[29] = 1.0 / ell / k[7];
+        // k[30] = ell*(a*(1 + a/ell)/ell^2 - a*(1 - a/ell)/ell^2)/(2*((1 - a/ell)*(1 + a/ell))^(1/2)) + ((1 - a/ell)*(1 + a/ell))^(1/2)
+        k[30] = (ell
+            * ((a * (1.0 + (a / ell)) / (ell * ell)) - (a * (1.0 - (a / ell)) / (ell * ell)))
+            / 2.0
+            / k[7])
+            + k[7];
+        // k[31] = ell*(-(1 + a/ell)/ell + (1 - a/ell)/ell)/(2*((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[31] = ell * (-((1.0 + (a / ell)) / ell) + ((1.0 - (a / ell)) / ell)) / 2.0 / k[7];
     }
 
     /// The state at release, over the parameters.
@@ -261,14 +260,14 @@ impl Model for HingedRodSpring {
     /// - `x2 = ell*((1 - a/ell)*(1 + a/ell))^(1/2)`
     /// - `dot_x2 = 0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = 0.0;
         qd[1] = 0.0;
         q[2] = k[6];
         qd[2] = 0.0;
-        q[3] = k[7];
+        q[3] = k[8];
         qd[3] = 0.0;
     }
 
@@ -283,7 +282,7 @@ impl Model for HingedRodSpring {
     /// - `cube_x = x2`
     /// - `cube_y = 0`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let x1 = q[0];
@@ -300,10 +299,10 @@ impl Model for HingedRodSpring {
             -(ell * theta_dot * rc_s) + x1_dot,
             (ell * theta_dot * rc_c) + y1_dot,
         ];
-        pos[2] = [(k[8] * rc_c) + x1, (k[8] * rc_s) + y1];
+        pos[2] = [(k[9] * rc_c) + x1, (k[9] * rc_s) + y1];
         vel[2] = [
-            -(k[8] * theta_dot * rc_s) + x1_dot,
-            (k[8] * theta_dot * rc_c) + y1_dot,
+            -(k[9] * theta_dot * rc_s) + x1_dot,
+            (k[9] * theta_dot * rc_c) + y1_dot,
         ];
         pos[3] = [x2, 0.0];
         vel[3] = [x2_dot, 0.0];
@@ -312,9 +311,9 @@ impl Model for HingedRodSpring {
     /// The total energy `E = T + V`.
     ///
     /// - `T = -dot_theta*dot_x1*ell*m1*sin(theta)/2 + dot_theta*dot_y1*ell*m1*cos(theta)/2 + dot_theta^2*ell^2*m1/6 + dot_x1^2*m1/2 + dot_x2^2*m2/2 + dot_y1^2*m1/2`
-    /// - `V = a*g*m2/2 + ell*g*m1*sin(theta)/2 + g*m1*y1 + k*(-ell*cos(asin(a/ell)) + x2)^2/2`
+    /// - `V = a*g*m2/2 + ell*g*m1*sin(theta)/2 + g*m1*y1 + k*(-ell*((1 + a/ell)*(1 - a/ell))^(1/2) + x2)^2/2`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let x1_dot = qd[0];
         let y1 = q[1];
@@ -322,41 +321,41 @@ impl Model for HingedRodSpring {
         let theta_dot = qd[2];
         let x2 = q[3];
         let x2_dot = qd[3];
-        (-(k[9] * theta_dot * x1_dot * rc_s)
-            + (k[9] * theta_dot * y1_dot * rc_c)
-            + (k[10] * (theta_dot * theta_dot))
-            + (k[11] * (x1_dot * x1_dot))
-            + (k[12] * (x2_dot * x2_dot))
-            + (k[11] * (y1_dot * y1_dot)))
-            + (k[13] + (k[14] * rc_s) + (k[15] * y1) + (k[16] * ((-k[17] + x2) * (-k[17] + x2))))
+        (-(k[10] * theta_dot * x1_dot * rc_s)
+            + (k[10] * theta_dot * y1_dot * rc_c)
+            + (k[11] * (theta_dot * theta_dot))
+            + (k[12] * (x1_dot * x1_dot))
+            + (k[13] * (x2_dot * x2_dot))
+            + (k[12] * (y1_dot * y1_dot)))
+            + (k[14] + (k[15] * rc_s) + (k[16] * y1) + (k[17] * ((-k[8] + x2) * (-k[8] + x2))))
     }
 
     /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
     ///
     /// - `p_x1 = -dot_theta*ell*m1*sin(theta)/2 + dot_x1*m1`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let m1 = k[0];
         let x1_dot = qd[0];
         let theta_dot = qd[2];
-        out[0] = -(k[9] * theta_dot * rc_s) + (m1 * x1_dot);
+        out[0] = -(k[10] * theta_dot * rc_s) + (m1 * x1_dot);
     }
 
     /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
     ///
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
-    /// - `L = T - V`: 233 characters, written out in `generated/hinged_rod_spring.tex`
+    /// - `L = T - V`: 248 characters, written out in `generated/hinged_rod_spring.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let m2 = k[1];
         let k_param = k[5];
         let theta_dot = qd[2];
         let x2 = q[3];
-        let qt0 = -k[9] * rc_s; // -(ell*m1*rc_s/2)
-        let qt1 = k[9] * rc_c; // ell*m1*rc_c/2
+        let qt0 = -k[10] * rc_s; // -(ell*m1*rc_s/2)
+        let qt1 = k[10] * rc_c; // ell*m1*rc_c/2
         let qt2 = theta_dot * theta_dot;
         mass[0] = m1;
         mass[1] = 0.0;
@@ -374,10 +373,10 @@ impl Model for HingedRodSpring {
         mass[13] = 0.0;
         mass[14] = 0.0;
         mass[15] = m2;
-        rhs[0] = k[9] * qt2 * rc_c;
-        rhs[1] = -k[15] + (k[9] * qt2 * rc_s);
-        rhs[2] = -k[14] * rc_c;
-        rhs[3] = -k_param * (-k[17] + x2);
+        rhs[0] = k[10] * qt2 * rc_c;
+        rhs[1] = -k[16] + (k[10] * qt2 * rc_s);
+        rhs[2] = -k[15] * rc_c;
+        rhs[3] = -k_param * (-k[8] + x2);
     }
 
     /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
@@ -395,7 +394,7 @@ impl Model for HingedRodSpring {
     /// - `hinge_horizontal = x1`
     /// - `hinge_vertical = y1`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let rc_c = q[2].cos();
         let ell = k[2];
         let x1 = q[0];
@@ -408,7 +407,7 @@ impl Model for HingedRodSpring {
 
     /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let theta_dot = qd[2];
@@ -487,18 +486,18 @@ impl Model for HingedRodSpring {
 
     /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let a = k[3];
         let x1 = q[0];
         let y1 = q[1];
         let theta = q[2];
         let x2 = q[3];
-        poses[0] = [(k[8] * rc_c) + x1, (k[8] * rc_s) + y1, theta];
+        poses[0] = [(k[9] * rc_c) + x1, (k[9] * rc_s) + y1, theta];
         poses[1] = [k[19] + x2, k[19], 0.0];
-        sizes[0] = -k[8];
+        sizes[0] = -k[9];
         sizes[1] = 0.0;
-        sizes[2] = k[8];
+        sizes[2] = k[9];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
@@ -524,7 +523,7 @@ impl Tangents for HingedRodSpring {
         let qd = at.qd;
         let qdd = at.qdd;
         let forces = at.forces;
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let ell = k[2];
@@ -537,37 +536,35 @@ impl Tangents for HingedRodSpring {
         let x2 = q[3];
         let x2_ddot = qdd[3];
         let xt0 = theta_dot * theta_dot;
-        let xt1 = rc_s * rc_s;
-        let xt2 = rc_c * rc_c;
         out.fill(0.0);
-        out[2] = -(k[9] * theta_ddot * rc_c) + (k[9] * xt0 * rc_s);
+        out[2] = -(k[10] * theta_ddot * rc_c) + (k[10] * xt0 * rc_s);
         out[6] = -k[20] * theta_dot * rc_c;
-        out[8] = -(k[8] * theta_ddot * rc_s) + x1_ddot - (k[8] * xt0 * rc_c);
-        out[10] = -(k[11] * theta_ddot * rc_s) - (k[11] * xt0 * rc_c);
-        out[16] = -(k[9] * theta_ddot * rc_s) - (k[9] * xt0 * rc_c);
+        out[8] = -(k[9] * theta_ddot * rc_s) + x1_ddot - (k[9] * xt0 * rc_c);
+        out[10] = -(k[12] * theta_ddot * rc_s) - (k[12] * xt0 * rc_c);
+        out[16] = -(k[10] * theta_ddot * rc_s) - (k[10] * xt0 * rc_c);
         out[20] = -k[20] * theta_dot * rc_s;
-        out[22] = (k[8] * theta_ddot * rc_c) + y1_ddot - (-g + (k[8] * xt0 * rc_s));
-        out[24] = (k[11] * theta_ddot * rc_c) - (k[11] * xt0 * rc_s);
+        out[22] = (k[9] * theta_ddot * rc_c) + y1_ddot - (-g + (k[9] * xt0 * rc_s));
+        out[24] = (k[12] * theta_ddot * rc_c) - (k[12] * xt0 * rc_s);
         out[26] = m1;
-        out[30] = -(k[9] * x1_ddot * rc_c)
-            - (k[9] * y1_ddot * rc_s)
-            - (k[14] * rc_s)
+        out[30] = -(k[10] * x1_ddot * rc_c)
+            - (k[10] * y1_ddot * rc_s)
+            - (k[15] * rc_s)
             - (ell * forces[0] * rc_c);
-        out[36] = (theta_ddot * (k[21] + (k[22] * xt1) + (k[22] * xt2))) - (k[8] * x1_ddot * rc_s)
-            + (k[8] * y1_ddot * rc_c)
-            + (k[23] * rc_c);
-        out[38] = (theta_ddot * (k[24] + (k[9] * xt1) + (k[9] * xt2))) - (k[11] * x1_ddot * rc_s)
-            + (k[11] * y1_ddot * rc_c)
-            + (k[25] * rc_c)
+        out[36] = (k[21] * theta_ddot) - (k[9] * x1_ddot * rc_s)
+            + (k[9] * y1_ddot * rc_c)
+            + (k[22] * rc_c);
+        out[38] = (k[23] * theta_ddot) - (k[12] * x1_ddot * rc_s)
+            + (k[12] * y1_ddot * rc_c)
+            + (k[24] * rc_c)
             - (forces[0] * rc_s);
-        out[40] = k[9] * rc_c;
+        out[40] = k[10] * rc_c;
         out[45] = k_param;
         out[51] = x2_ddot;
-        out[52] = k[26];
-        out[53] = k[27];
-        out[55] = -k[17] + x2;
+        out[52] = k[25];
+        out[53] = -k[26];
+        out[55] = -k[8] + x2;
         out[58] = (ell * theta_ddot * rc_c) - (ell * xt0 * rc_s);
-        out[62] = k[28] * theta_dot * rc_c;
+        out[62] = k[27] * theta_dot * rc_c;
         out[66] = (theta_ddot * rc_s) + (xt0 * rc_c);
         out[98] = -1.0;
         out[100] = ell * rc_s;
@@ -579,11 +576,11 @@ impl Tangents for HingedRodSpring {
 
     /// `d(initial state)/dp`: the rows `d q_0/dp`, then `d qd_0/dp`, by the parameters.
     fn initial_tangents(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..33]; // one bounds check for all constant loads
+        let k = &k[..32]; // one bounds check for all constant loads
         out.fill(0.0);
-        out[14] = -k[29];
-        out[15] = k[30];
-        out[20] = k[31];
-        out[21] = k[32];
+        out[14] = -k[28];
+        out[15] = k[29];
+        out[20] = k[30];
+        out[21] = k[31];
     }
 }

@@ -61,7 +61,7 @@ static INFO: ModelInfo = ModelInfo {
         meaning: "the cube must be lower than the rod is long (a < ell)",
         parameters: &[2, 3],
     }],
-    n_constants: 41,
+    n_constants: 36,
     coordinates: &["theta"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced_index: Some(0),
@@ -207,16 +207,16 @@ impl Model for HingedRodSpringClosed {
         k[14] = ell * g * m1 / 2.0;
         // k[15] = k/2
         k[15] = k_param / 2.0;
-        // k[16] = ell*cos(asin(a/ell))
-        k[16] = ell * (a / ell).asin().cos();
+        // k[16] = ell*((1 - a/ell)*(1 + a/ell))^(1/2)
+        k[16] = ell * k[9];
         // k[17] = ell^2*m1/3
         k[17] = (ell * ell) * m1 / 3.0;
         // k[18] = ell^2*m2
         k[18] = (ell * ell) * m2;
         // k[19] = ell*k
         k[19] = ell * k_param;
-        // k[20] = 2*ell*k*cos(asin(a/ell))
-        k[20] = 2.0 * ell * k_param * (a / ell).asin().cos();
+        // k[20] = 2*ell*k*((1 - a/ell)*(1 + a/ell))^(1/2)
+        k[20] = 2.0 * ell * k_param * k[9];
         // k[21] = ell*m1 + 2*ell*m2
         k[21] = (ell * m1) + (2.0 * ell * m2);
         // k[22] = 2*ell*k
@@ -229,37 +229,24 @@ impl Model for HingedRodSpringClosed {
         k[25] = 3.0 / ell;
         // k[26] = 3*m2
         k[26] = 3.0 * m2;
-        // k[27] = 2*ell*k*rc_ci - 2*ell*k*cos(asin(a/ell))
-        k[27] = (2.0 * ell * k_param * k[9]) - (2.0 * ell * k_param * (a / ell).asin().cos());
-        // k[28] = 3/(2*ell)
-        k[28] = 3.0 / 2.0 / ell;
-        // k[29] = 2*ell*k*m1
-        k[29] = 2.0 * ell * k_param * m1;
-        // k[30] = 2*ell*k*m1*rc_ci - 2*ell*k*m1*cos(asin(a/ell))
-        k[30] =
-            (2.0 * ell * k_param * m1 * k[9]) - (2.0 * ell * k_param * m1 * (a / ell).asin().cos());
-        // k[31] = 12*ell*k*m2*rc_ci - 12*ell*k*m2*cos(asin(a/ell))
-        k[31] = (12.0 * ell * k_param * m2 * k[9])
-            - (12.0 * ell * k_param * m2 * (a / ell).asin().cos());
-        // k[32] = 6*ell*k*m2
-        k[32] = 6.0 * ell * k_param * m2;
-        // k[33] = 6*ell*k*m2*rc_ci - 6*ell*k*m2*cos(asin(a/ell))
-        k[33] =
-            (6.0 * ell * k_param * m2 * k[9]) - (6.0 * ell * k_param * m2 * (a / ell).asin().cos());
-        // k[34] = 6*g*m1*m2
-        k[34] = 6.0 * g * m1 * m2;
-        // k[35] = 3*g*m1*m2
-        k[35] = 3.0 * g * m1 * m2;
-        // k[36] = g*m1^2
-        k[36] = g * (m1 * m1);
-        // k[37] = ell*k*cos(asin(a/ell))
-        k[37] = ell * k_param * (a / ell).asin().cos();
-        // k[38] = ell*m2
-        k[38] = ell * m2;
-        // k[39] = (ell*m1 + 2*ell*m2)/2
-        k[39] = ((ell * m1) + (2.0 * ell * m2)) / 2.0;
-        // k[40] = a/2
-        k[40] = a / 2.0;
+        // k[27] = 3/(2*ell)
+        k[27] = 3.0 / 2.0 / ell;
+        // k[28] = 2*ell*k*m1
+        k[28] = 2.0 * ell * k_param * m1;
+        // k[29] = 6*ell*k*m2
+        k[29] = 6.0 * ell * k_param * m2;
+        // k[30] = 6*g*m1*m2
+        k[30] = 6.0 * g * m1 * m2;
+        // k[31] = 3*g*m1*m2
+        k[31] = 3.0 * g * m1 * m2;
+        // k[32] = g*m1^2
+        k[32] = g * (m1 * m1);
+        // k[33] = ell*m2
+        k[33] = ell * m2;
+        // k[34] = (ell*m1 + 2*ell*m2)/2
+        k[34] = ((ell * m1) + (2.0 * ell * m2)) / 2.0;
+        // k[35] = a/2
+        k[35] = a / 2.0;
     }
 
     /// The state at release, over the parameters.
@@ -267,7 +254,7 @@ impl Model for HingedRodSpringClosed {
     /// - `theta = asin(a/ell)`
     /// - `dot_theta = 0.0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         q[0] = k[6];
         qd[0] = 0.0;
     }
@@ -283,7 +270,7 @@ impl Model for HingedRodSpringClosed {
     /// - `cube_x = ell*cos(theta)`
     /// - `cube_y = 0`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ell = k[2];
         let theta_dot = qd[0];
@@ -302,9 +289,9 @@ impl Model for HingedRodSpringClosed {
     /// The total energy `E = T + V`.
     ///
     /// - `T = dot_theta^2*ell^2*m1/6 + dot_theta^2*ell^2*m2*sin(theta)^2/2`
-    /// - `V = a*g*m2/2 + ell*g*m1*sin(theta)/2 + k*(ell*cos(theta) - ell*cos(asin(a/ell)))^2/2`
+    /// - `V = a*g*m2/2 + ell*g*m1*sin(theta)/2 + k*(ell*cos(theta) - ell*((1 + a/ell)*(1 - a/ell))^(1/2))^2/2`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ell = k[2];
         let theta_dot = qd[0];
@@ -323,9 +310,9 @@ impl Model for HingedRodSpringClosed {
     /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
     ///
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
-    /// - `L = T - V = -(a*g*m2/2 + ell*g*m1*sin(theta)/2 + k*(ell*cos(theta) - ell*cos(asin(a/ell)))^2/2) + dot_theta^2*ell^2*m1/6 + dot_theta^2*ell^2*m2*sin(theta)^2/2`
+    /// - `L = T - V`: 161 characters, written out in `generated/hinged_rod_spring_closed.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ell = k[2];
         let theta_dot = qd[0];
@@ -336,11 +323,11 @@ impl Model for HingedRodSpringClosed {
 
     /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
     ///
-    /// - `contact_force = k*(ell*cos(theta) - ell*cos(asin(a/ell))) + m2*(-ddot_theta*ell*sin(theta) - dot_theta^2*ell*cos(theta))`
-    /// - `hinge_horizontal`: 182 characters, written out in `generated/hinged_rod_spring_closed.tex`
+    /// - `contact_force = k*(ell*cos(theta) - ell*((1 + a/ell)*(1 - a/ell))^(1/2)) + m2*(-ddot_theta*ell*sin(theta) - dot_theta^2*ell*cos(theta))`
+    /// - `hinge_horizontal`: 197 characters, written out in `generated/hinged_rod_spring_closed.tex`
     /// - `hinge_vertical = ddot_theta*ell*m1*cos(theta)/2 + g*m1 - dot_theta^2*ell*m1*sin(theta)/2`
     fn forces_full(&self, k: &[f64], q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let m2 = k[1];
         let ell = k[2];
@@ -412,7 +399,7 @@ impl Model for HingedRodSpringClosed {
     /// - `x2 = ell*cos(theta)`
     /// - `dot_x2 = -(dot_theta*ell*sin(theta))`
     fn to_full(&self, k: &[f64], q: &[f64], qd: &[f64], q_full: &mut [f64], qd_full: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ell = k[2];
         let theta = q[0];
@@ -429,13 +416,13 @@ impl Model for HingedRodSpringClosed {
 
     /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[0].sin_cos();
         let ell = k[2];
         let a = k[3];
         let theta = q[0];
         poses[0] = [k[10] * rc_c, k[10] * rc_s, theta];
-        poses[1] = [k[40] + (ell * rc_c), k[40], 0.0];
+        poses[1] = [k[35] + (ell * rc_c), k[35], 0.0];
         sizes[0] = -k[10];
         sizes[1] = 0.0;
         sizes[2] = k[10];
@@ -458,68 +445,60 @@ impl Model for HingedRodSpringClosed {
 impl Reduction for HingedRodSpringClosed {
     /// The reduced motion at `theta = theta_i - delta`: `theta_dot^2` from the energy integral, and `theta_ddot`.
     ///
-    /// - `theta_dot^2`: 187 characters, written out in `generated/hinged_rod_spring_closed.tex`
-    /// - `theta_ddot`: 420 characters, written out in `generated/hinged_rod_spring_closed.tex`
+    /// - `theta_dot^2 = 3*(a*g*m1 - ell*g*m1*sin(theta) + a^2*k - 2*ell^2*k + 2*ell^2*k*cos(theta)*(1 - a^2/ell^2)^(1/2) + ell^2*k*sin(theta)^2)/(ell^2*(m1 + 3*m2*sin(theta)^2))`
+    /// - `theta_ddot`: 396 characters, written out in `generated/hinged_rod_spring_closed.tex`
     fn reduced(&self, k: &[f64], delta: f64) -> Reduced {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let m1 = k[0];
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let rt0 = rc_dc * rc_dc;
         let rt1 = rc_s * rc_s;
         let rt2 = m1 + (k[26] * rt1); // m1 + 3*m2*rc_s^2
-        let rt3 = rc_s.powi(3);
         Reduced {
             sin: rc_s,
             cos: rc_c,
-            theta_dot_sq: -k[25] * (-(k[27] * rc_dc) + (k[19] * rt0) - (k[23] * rc_ds)) / rt2,
-            theta_ddot: -k[28]
-                * ((k[29] * rc_s * rc_dc) - (k[30] * rc_s) + (k[31] * rc_s * rc_c * rc_dc)
-                    - (k[32] * rc_s * rc_c * rt0)
-                    + (k[32] * rt3 * rc_dc)
-                    - (k[33] * rt3)
-                    + (k[34] * rc_s * rc_c * rc_ds)
-                    + (k[35] * rt1 * rc_c)
-                    + (k[36] * rc_c))
+            theta_dot_sq: -k[25] * ((k[19] * rt0) - (k[23] * rc_ds)) / rt2,
+            theta_ddot: -k[27]
+                * ((k[28] * rc_s * rc_dc) - (k[29] * rc_s * rc_c * rt0)
+                    + (k[29] * rc_s.powi(3) * rc_dc)
+                    + (k[30] * rc_s * rc_c * rc_ds)
+                    + (k[31] * rt1 * rc_c)
+                    + (k[32] * rc_c))
                 / (rt2 * rt2),
         }
     }
 
     /// `theta_dot^2` over `sin(theta)`, `cos(theta)` and their drops from the start (the per-point solver's integrand).
     ///
-    /// - `theta_dot^2`: 187 characters, written out in `generated/hinged_rod_spring_closed.tex`
+    /// - `theta_dot^2 = 3*(a*g*m1 - ell*g*m1*sin(theta) + a^2*k - 2*ell^2*k + 2*ell^2*k*cos(theta)*(1 - a^2/ell^2)^(1/2) + ell^2*k*sin(theta)^2)/(ell^2*(m1 + 3*m2*sin(theta)^2))`
     fn theta_dot_sq_sc(&self, k: &[f64], rc_s: f64, _rc_c: f64, rc_ds: f64, rc_dc: f64) -> f64 {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let m1 = k[0];
-        -k[25] * (-(k[27] * rc_dc) + (k[19] * (rc_dc * rc_dc)) - (k[23] * rc_ds))
-            / (m1 + (k[26] * (rc_s * rc_s)))
+        -k[25] * ((k[19] * (rc_dc * rc_dc)) - (k[23] * rc_ds)) / (m1 + (k[26] * (rc_s * rc_s)))
     }
 
     /// Each contact's force on the reduced motion (zero for a contact open in the phase).
     ///
-    /// - `contact_force`: 386 characters, written out in `generated/hinged_rod_spring_closed.tex`
-    /// - `hinge_horizontal`: 773 characters, written out in `generated/hinged_rod_spring_closed.tex`
-    /// - `hinge_vertical`: 682 characters, written out in `generated/hinged_rod_spring_closed.tex`
+    /// - `contact_force`: 362 characters, written out in `generated/hinged_rod_spring_closed.tex`
+    /// - `hinge_horizontal`: 692 characters, written out in `generated/hinged_rod_spring_closed.tex`
+    /// - `hinge_vertical`: 591 characters, written out in `generated/hinged_rod_spring_closed.tex`
     fn forces(&self, k: &[f64], delta: f64, out: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let m1 = k[0];
         let (rc_s, rc_c, rc_ds, rc_dc) = start_offsets(k[6], k[8], k[9], delta);
         let rt0 = rc_dc * rc_dc;
         let rt1 = rc_s * rc_s;
         let rt2 = m1 + (k[26] * rt1); // m1 + 3*m2*rc_s^2
-        let rt3 = rc_s.powi(3);
-        let rc_w2 = -k[25] * (-(k[27] * rc_dc) + (k[19] * rt0) - (k[23] * rc_ds)) / rt2;
-        let rc_acc = -k[28]
-            * ((k[29] * rc_s * rc_dc) - (k[30] * rc_s) + (k[31] * rc_s * rc_c * rc_dc)
-                - (k[32] * rc_s * rc_c * rt0)
-                + (k[32] * rt3 * rc_dc)
-                - (k[33] * rt3)
-                + (k[34] * rc_s * rc_c * rc_ds)
-                + (k[35] * rt1 * rc_c)
-                + (k[36] * rc_c))
+        let rc_w2 = -k[25] * ((k[19] * rt0) - (k[23] * rc_ds)) / rt2;
+        let rc_acc = -k[27]
+            * ((k[28] * rc_s * rc_dc) - (k[29] * rc_s * rc_c * rt0)
+                + (k[29] * rc_s.powi(3) * rc_dc)
+                + (k[30] * rc_s * rc_c * rc_ds)
+                + (k[31] * rt1 * rc_c)
+                + (k[32] * rc_c))
             / (rt2 * rt2);
-        let ft0 = k[19] * rc_c; // ell*k*rc_c
-        out[0] = -k[37] + ft0 - (k[38] * rc_s * rc_acc) - (k[38] * rc_c * rc_w2);
-        out[1] = -k[37] + ft0 - (k[39] * rc_s * rc_acc) - (k[39] * rc_c * rc_w2);
+        out[0] = -(k[19] * rc_dc) - (k[33] * rc_s * rc_acc) - (k[33] * rc_c * rc_w2);
+        out[1] = -(k[19] * rc_dc) - (k[34] * rc_s * rc_acc) - (k[34] * rc_c * rc_w2);
         out[2] = k[23] - (k[24] * rc_s * rc_w2) + (k[24] * rc_c * rc_acc);
     }
 
@@ -532,7 +511,7 @@ impl Reduction for HingedRodSpringClosed {
         let p = &p[..6];
         let ell = p[2];
         let a = p[3];
-        let k = &mut k[..41]; // one bounds check for all constant stores
+        let k = &mut k[..36]; // one bounds check for all constant stores
         k[..6].copy_from_slice(p);
         // k[7] = rc_wi = 0.0
         k[7] = 0.0;
@@ -560,7 +539,7 @@ impl Reduction for HingedRodSpringClosed {
         q: &mut [f64],
         qd: &mut [f64],
     ) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         q[0] = k[6] - delta;
         qd[0] = theta_dot;
     }
@@ -572,7 +551,7 @@ impl Partials for HingedRodSpringClosed {
 
     /// `d(theta_dot^2)/dp` for each parameter at a fixed angle given by `sin(theta)`, `cos(theta)`.
     fn theta_dot_sq_partials(&self, k: &[f64], rc_s: f64, rc_c: f64, out: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let m1 = k[0];
         let m2 = k[1];
         let ell = k[2];
@@ -583,64 +562,43 @@ impl Partials for HingedRodSpringClosed {
         let dt1 = rc_s.powi(3);
         let dt2 = a * a;
         let dt3 = ell * ell;
-        let dt4 = a / ell;
-        let dt5 = dt4.asin();
-        let dt6 = dt5.cos();
-        let dt7 = rc_c * rc_c;
-        let dt8 = 1.0 + dt4;
-        let dt9 = 1.0 - dt4;
-        let dt10 = dt8 * dt9;
-        let dt11 = dt10.sqrt();
-        let dt12 = m1 + (3.0 * m2 * dt0);
-        let dt13 = dt5.sin();
-        let dt14 = 1.0 - (dt2 / dt3);
-        let dt15 = dt14.sqrt();
+        let dt4 = (1.0 + (a / ell)) * (1.0 - (a / ell));
+        let dt5 = dt4.sqrt();
+        let dt6 = rc_c * rc_c;
+        let dt7 = m1 + (3.0 * m2 * dt0);
         out[0] = 3.0
-            * ((3.0 * a * g * m2 * dt0) - (3.0 * ell * g * m2 * dt1) + (dt2 * k_param)
-                - (dt3 * k_param)
-                - (2.0 * dt3 * k_param * rc_c * dt6)
-                + (dt3 * k_param * dt7)
-                + (2.0 * dt3 * k_param * dt11 * dt6))
+            * ((3.0 * a * g * m2 * dt0) - (3.0 * ell * g * m2 * dt1) - (dt2 * k_param)
+                + (dt3 * k_param)
+                - (2.0 * dt3 * k_param * rc_c * dt5)
+                + (dt3 * k_param * dt6))
             / dt3
-            / (dt12 * dt12);
+            / (dt7 * dt7);
         out[1] = 9.0
-            * (-(a * g * m1 * dt0) + (ell * g * m1 * dt1) + (dt2 * k_param * dt0)
-                - (dt3 * k_param * dt0)
-                - (2.0 * dt3 * k_param * dt0 * rc_c * dt6)
-                + (dt3 * k_param * dt0 * dt7)
-                + (2.0 * dt3 * k_param * dt0 * dt11 * dt6))
+            * (-(a * g * m1 * dt0) + (ell * g * m1 * dt1) - (dt2 * k_param * dt0)
+                + (dt3 * k_param * dt0)
+                - (2.0 * dt3 * k_param * dt0 * rc_c * dt5)
+                + (dt3 * k_param * dt0 * dt6))
             / dt3
-            / (dt12 * dt12);
+            / (dt7 * dt7);
         out[2] = 3.0
-            * ((2.0 * a * ell * k_param * rc_c * dt11 * dt13)
-                - (2.0 * a * ell * k_param * dt8 * dt9 * dt13)
-                - (2.0 * a * g * m1 * dt11 * dt15)
-                + (ell * g * m1 * rc_s * dt11 * dt15)
-                + (2.0 * dt2 * k_param * dt11 * dt15)
-                - (2.0 * dt2 * k_param * dt15 * dt6))
+            * (-(2.0 * a * g * m1 * dt5)
+                + (ell * g * m1 * rc_s * dt5)
+                + (2.0 * dt2 * k_param * rc_c)
+                - (2.0 * dt2 * k_param * dt5))
             / ell.powi(3)
-            / dt11
-            / dt15
-            / dt12;
-        out[3] = -3.0
-            * ((2.0 * a * k_param * dt11 * dt15) - (2.0 * a * k_param * dt15 * dt6)
-                + (2.0 * ell * k_param * rc_c * dt11 * dt13)
-                - (2.0 * ell * k_param * dt8 * dt9 * dt13)
-                - (g * m1 * dt11 * dt15))
+            / dt5
+            / dt7;
+        out[3] = 3.0 * (-(2.0 * a * k_param * rc_c) + (2.0 * a * k_param * dt5) + (g * m1 * dt5))
             / dt3
-            / dt11
-            / dt15
-            / dt12;
-        out[4] = -3.0 * (-(a * m1) + (ell * m1 * rc_s)) / dt3 / dt12;
-        out[5] = -3.0
-            * (dt2 - dt3 - (2.0 * dt3 * rc_c * dt6) + (dt3 * dt7) + (2.0 * dt3 * dt11 * dt6))
-            / dt3
-            / dt12;
+            / dt5
+            / dt7;
+        out[4] = -3.0 * (-(a * m1) + (ell * m1 * rc_s)) / dt3 / dt7;
+        out[5] = -3.0 * (-dt2 + dt3 - (2.0 * dt3 * rc_c * dt5) + (dt3 * dt6)) / dt3 / dt7;
     }
 
     /// `d(sin theta_i)/dp` for each parameter.
     fn start_partials(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let ell = k[2];
         let a = k[3];
         out[0] = 0.0;

@@ -195,27 +195,26 @@ impl Model for LadderFriction {
         k[15] = 0.0 + ell;
         // k[16] = ell*m1
         k[16] = ell * m1;
-        // k[17] = ell^2/12
-        k[17] = (ell * ell) / 12.0;
-        // k[18] = ell^2/4
-        k[18] = (ell * ell) / 4.0;
-        // k[19] = ell*g/2
-        k[19] = ell * g / 2.0;
-        // k[20] = ell*m1/6
-        k[20] = ell * m1 / 6.0;
-        // k[21] = g*m1/2
-        k[21] = g * m1 / 2.0;
-        // k[22] = 2*ell
-        k[22] = 2.0 * ell;
-        // k[23] = ell/((a + ell)*(-a + ell))^(1/2)
-        k[23] = ell / ((a + ell) * (-a + ell)).sqrt();
-        // k[24] = (-a + ell - (a + ell))/(2*((a + ell)*(-a + ell))^(1/2))
-        let h24_t0 = a + ell;
-        k[24] = (-a + ell - h24_t0) / 2.0 / (h24_t0 * (-a + ell)).sqrt();
-        // k[25] = a/(ell^2*(1 - a^2/ell^2)^(1/2))
-        k[25] = a / (ell * ell) / (1.0 - ((a * a) / (ell * ell))).sqrt();
-        // k[26] = 1/(ell*(1 - a^2/ell^2)^(1/2))
-        k[26] = 1.0 / ell / (1.0 - ((a * a) / (ell * ell))).sqrt();
+        // k[17] = ell^2/3
+        k[17] = (ell * ell) / 3.0;
+        // k[18] = ell*g/2
+        k[18] = ell * g / 2.0;
+        // k[19] = 2*ell*m1/3
+        k[19] = 2.0 * ell * m1 / 3.0;
+        // k[20] = g*m1/2
+        k[20] = g * m1 / 2.0;
+        // k[21] = 2*ell
+        k[21] = 2.0 * ell;
+        // k[22] = ell/sqrt((ell - a)*(ell + a))
+        k[22] = ell / k[6];
+        // k[23] = (-a + ell - (a + ell))/(2*sqrt((ell - a)*(ell + a)))
+        k[23] = (-a + ell - (a + ell)) / 2.0 / k[6];
+        // k[24] = ((1 + a/ell)*(1 - a/ell))^(1/2)
+        k[24] = ((1.0 + (a / ell)) * (1.0 - (a / ell))).sqrt();
+        // k[25] = a/(ell^2*((1 + a/ell)*(1 - a/ell))^(1/2))
+        k[25] = a / (ell * ell) / k[24];
+        // k[26] = 1/(ell*((1 + a/ell)*(1 - a/ell))^(1/2))
+        k[26] = 1.0 / ell / k[24];
     }
 
     /// The state at release, over the parameters.
@@ -473,8 +472,6 @@ impl Tangents for LadderFriction {
         let theta_dot = qd[2];
         let theta_ddot = qdd[2];
         let xt0 = theta_dot * theta_dot;
-        let xt1 = rc_s * rc_s;
-        let xt2 = rc_c * rc_c;
         out.fill(0.0);
         out[2] = -(k[9] * theta_ddot * rc_c) + (k[9] * xt0 * rc_s);
         out[5] = -k[16] * theta_dot * rc_c;
@@ -490,20 +487,20 @@ impl Tangents for LadderFriction {
             - (k[12] * rc_s)
             - (ell * forces[0] * rc_c)
             + (ell * fr[1] * rc_s);
-        out[30] = (theta_ddot * (k[17] + (k[18] * xt1) + (k[18] * xt2))) - (k[8] * x1_ddot * rc_s)
+        out[30] = (k[17] * theta_ddot) - (k[8] * x1_ddot * rc_s)
             + (k[8] * y1_ddot * rc_c)
-            + (k[19] * rc_c);
-        out[31] = (theta_ddot * (k[20] + (k[9] * xt1) + (k[9] * xt2))) - (k[11] * x1_ddot * rc_s)
+            + (k[18] * rc_c);
+        out[31] = (k[19] * theta_ddot) - (k[11] * x1_ddot * rc_s)
             + (k[11] * y1_ddot * rc_c)
-            + (k[21] * rc_c)
+            + (k[20] * rc_c)
             - (forces[0] * rc_s)
             - (fr[1] * rc_c);
         out[33] = k[9] * rc_c;
         out[38] = (ell * theta_ddot * rc_c) - (ell * xt0 * rc_s);
-        out[41] = k[22] * theta_dot * rc_c;
+        out[41] = k[21] * theta_dot * rc_c;
         out[43] = (theta_ddot * rc_s) + (xt0 * rc_c);
         out[74] = -(ell * theta_ddot * rc_s) - (ell * xt0 * rc_c);
-        out[77] = -k[22] * theta_dot * rc_s;
+        out[77] = -k[21] * theta_dot * rc_s;
         out[79] = (theta_ddot * rc_c) - (xt0 * rc_s);
         out[84] = -1.0;
         out[86] = ell * rc_s;
@@ -520,8 +517,8 @@ impl Tangents for LadderFriction {
     fn initial_tangents(&self, k: &[f64], out: &mut [f64]) {
         let k = &k[..27]; // one bounds check for all constant loads
         out.fill(0.0);
-        out[1] = -k[23];
-        out[2] = -k[24];
+        out[1] = -k[22];
+        out[2] = -k[23];
         out[13] = -k[25];
         out[14] = k[26];
     }

@@ -61,7 +61,7 @@ static INFO: ModelInfo = ModelInfo {
         meaning: "the cube must be lower than the rod is long (a < ell)",
         parameters: &[3, 4],
     }],
-    n_constants: 41,
+    n_constants: 39,
     coordinates: &["x1", "y1", "theta", "x2"],
     system_coordinates: &["x1", "y1", "theta", "x2"],
     reduced_index: Some(2),
@@ -189,99 +189,99 @@ impl Model for LoadedRod {
         k[..6].copy_from_slice(p);
         // k[6] = asin(a/ell)
         k[6] = (a / ell).asin();
-        // k[7] = ell*((1 - a/ell)*(1 + a/ell))^(1/2)
+        // k[7] = ((1 - a/ell)*(1 + a/ell))^(1/2)
         let h7_t0 = a / ell;
-        k[7] = ell * ((1.0 - h7_t0) * (1.0 + h7_t0)).sqrt();
-        // k[8] = ell/2
-        k[8] = ell / 2.0;
-        // k[9] = ell*m1/(2*(m1 + m3)) + ell*m3/(m1 + m3)
-        k[9] = (ell * m1 / 2.0 / (m1 + m3)) + (ell * m3 / (m1 + m3));
-        // k[10] = 3*ell*m1*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3)
-        k[10] = (3.0 * ell * m1 * m3 / 2.0 / (m1 + m3))
+        k[7] = ((1.0 - h7_t0) * (1.0 + h7_t0)).sqrt();
+        // k[8] = ell*((1 - a/ell)*(1 + a/ell))^(1/2)
+        k[8] = ell * k[7];
+        // k[9] = ell/2
+        k[9] = ell / 2.0;
+        // k[10] = ell*m1/(2*(m1 + m3)) + ell*m3/(m1 + m3)
+        k[10] = (ell * m1 / 2.0 / (m1 + m3)) + (ell * m3 / (m1 + m3));
+        // k[11] = 3*ell*m1*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3)
+        k[11] = (3.0 * ell * m1 * m3 / 2.0 / (m1 + m3))
             + (ell * (m1 * m1) / 2.0 / (m1 + m3))
             + (ell * (m3 * m3) / (m1 + m3));
-        // k[11] = ell^2*m1/24 + ell^2*m1*m3/(8*(m1 + m3)) + ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*(2*m1*m3 + m1^2 + m3^2))
-        let h11_t0 = ell * ell;
-        let h11_t1 = m3 * m3;
-        let h11_t2 = m1 * m1;
-        k[11] = (h11_t0 * m1 / 24.0)
-            + (h11_t0 * m1 * m3 / 8.0 / (m1 + m3))
-            + (h11_t0 * m1 * h11_t1 / ((2.0 * m1 * m3) + h11_t2 + h11_t1))
-            + (5.0 * h11_t0 * h11_t2 * m3 / 8.0 / ((2.0 * m1 * m3) + h11_t2 + h11_t1))
-            + (h11_t0 * m1.powi(3) / 8.0 / ((2.0 * m1 * m3) + h11_t2 + h11_t1))
-            + (h11_t0 * m3.powi(3) / 2.0 / ((2.0 * m1 * m3) + h11_t2 + h11_t1));
-        // k[12] = m1/2 + m3/2
-        k[12] = (m1 / 2.0) + (m3 / 2.0);
-        // k[13] = m2/2
-        k[13] = m2 / 2.0;
-        // k[14] = a*g*m2/2
-        k[14] = a * g * m2 / 2.0;
-        // k[15] = 3*ell*g*m1*m3/(2*(m1 + m3)) + ell*g*m1^2/(2*(m1 + m3)) + ell*g*m3^2/(m1 + m3)
-        k[15] = (3.0 * ell * g * m1 * m3 / 2.0 / (m1 + m3))
+        // k[12] = ell^2*m1/24 + ell^2*m1*m3/(8*(m1 + m3)) + ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(8*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*(2*m1*m3 + m1^2 + m3^2))
+        let h12_t0 = ell * ell;
+        let h12_t1 = m3 * m3;
+        let h12_t2 = m1 * m1;
+        k[12] = (h12_t0 * m1 / 24.0)
+            + (h12_t0 * m1 * m3 / 8.0 / (m1 + m3))
+            + (h12_t0 * m1 * h12_t1 / ((2.0 * m1 * m3) + h12_t2 + h12_t1))
+            + (5.0 * h12_t0 * h12_t2 * m3 / 8.0 / ((2.0 * m1 * m3) + h12_t2 + h12_t1))
+            + (h12_t0 * m1.powi(3) / 8.0 / ((2.0 * m1 * m3) + h12_t2 + h12_t1))
+            + (h12_t0 * m3.powi(3) / 2.0 / ((2.0 * m1 * m3) + h12_t2 + h12_t1));
+        // k[13] = m1/2 + m3/2
+        k[13] = (m1 / 2.0) + (m3 / 2.0);
+        // k[14] = m2/2
+        k[14] = m2 / 2.0;
+        // k[15] = a*g*m2/2
+        k[15] = a * g * m2 / 2.0;
+        // k[16] = 3*ell*g*m1*m3/(2*(m1 + m3)) + ell*g*m1^2/(2*(m1 + m3)) + ell*g*m3^2/(m1 + m3)
+        k[16] = (3.0 * ell * g * m1 * m3 / 2.0 / (m1 + m3))
             + (ell * g * (m1 * m1) / 2.0 / (m1 + m3))
             + (ell * g * (m3 * m3) / (m1 + m3));
-        // k[16] = g*m1 + g*m3
-        k[16] = (g * m1) + (g * m3);
-        // k[17] = m1 + m3
-        k[17] = m1 + m3;
-        // k[18] = ell^2*m1/12 + ell^2*m1*m3/(4*(m1 + m3)) + 2*ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*m1*m3 + m1^2 + m3^2)
-        let h18_t0 = ell * ell;
-        let h18_t1 = m3 * m3;
-        let h18_t2 = m1 * m1;
-        k[18] = (h18_t0 * m1 / 12.0)
-            + (h18_t0 * m1 * m3 / 4.0 / (m1 + m3))
-            + (2.0 * h18_t0 * m1 * h18_t1 / ((2.0 * m1 * m3) + h18_t2 + h18_t1))
-            + (5.0 * h18_t0 * h18_t2 * m3 / 4.0 / ((2.0 * m1 * m3) + h18_t2 + h18_t1))
-            + (h18_t0 * m1.powi(3) / 4.0 / ((2.0 * m1 * m3) + h18_t2 + h18_t1))
-            + (h18_t0 * m3.powi(3) / ((2.0 * m1 * m3) + h18_t2 + h18_t1));
-        // k[19] = a/2
-        k[19] = a / 2.0;
-        // k[20] = ell*(m1/2 + m3)/(m1 + m3)
-        k[20] = ell * ((m1 / 2.0) + m3) / (m1 + m3);
-        // k[21] = ell*m1/(2*(m1 + m3))
-        k[21] = ell * m1 / (2.0 * (m1 + m3));
-        // k[22] = 3*ell*m1*m3/(m1 + m3) + ell*m1^2/(m1 + m3) + 2*ell*m3^2/(m1 + m3)
-        k[22] = (3.0 * ell * m1 * m3 / (m1 + m3))
+        // k[17] = g*m1 + g*m3
+        k[17] = (g * m1) + (g * m3);
+        // k[18] = m1 + m3
+        k[18] = m1 + m3;
+        // k[19] = ell^2*m1/12 + ell^2*m1*m3/(4*(m1 + m3)) + 2*ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell^2*m1^2*m3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m1^3/(4*(2*m1*m3 + m1^2 + m3^2)) + ell^2*m3^3/(2*m1*m3 + m1^2 + m3^2)
+        let h19_t0 = ell * ell;
+        let h19_t1 = m3 * m3;
+        let h19_t2 = m1 * m1;
+        k[19] = (h19_t0 * m1 / 12.0)
+            + (h19_t0 * m1 * m3 / 4.0 / (m1 + m3))
+            + (2.0 * h19_t0 * m1 * h19_t1 / ((2.0 * m1 * m3) + h19_t2 + h19_t1))
+            + (5.0 * h19_t0 * h19_t2 * m3 / 4.0 / ((2.0 * m1 * m3) + h19_t2 + h19_t1))
+            + (h19_t0 * m1.powi(3) / 4.0 / ((2.0 * m1 * m3) + h19_t2 + h19_t1))
+            + (h19_t0 * m3.powi(3) / ((2.0 * m1 * m3) + h19_t2 + h19_t1));
+        // k[20] = a/2
+        k[20] = a / 2.0;
+        // k[21] = ell*(m1/2 + m3)/(m1 + m3)
+        k[21] = ell * ((m1 / 2.0) + m3) / (m1 + m3);
+        // k[22] = ell*m1/(2*(m1 + m3))
+        k[22] = ell * m1 / (2.0 * (m1 + m3));
+        // k[23] = 3*ell*m1*m3/(m1 + m3) + ell*m1^2/(m1 + m3) + 2*ell*m3^2/(m1 + m3)
+        k[23] = (3.0 * ell * m1 * m3 / (m1 + m3))
             + (ell * (m1 * m1) / (m1 + m3))
             + (2.0 * ell * (m3 * m3) / (m1 + m3));
-        // k[23] = 3*ell*m1*m3/(2*(m1 + m3)^2) - ell*m1/(m1 + m3) - 3*ell*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)^2) + ell*m3^2/(m1 + m3)^2
-        let h23_t0 = m1 + m3;
-        k[23] = (3.0 * ell * m1 * m3 / 2.0 / (h23_t0 * h23_t0))
-            - (ell * m1 / h23_t0)
-            - (3.0 * ell * m3 / 2.0 / h23_t0)
-            + (ell * (m1 * m1) / 2.0 / (h23_t0 * h23_t0))
-            + (ell * (m3 * m3) / (h23_t0 * h23_t0));
-        // k[24] = 3*ell*m1*m3/(2*(m1 + m3)^2) - 3*ell*m1/(2*(m1 + m3)) - 2*ell*m3/(m1 + m3) + ell*m1^2/(2*(m1 + m3)^2) + ell*m3^2/(m1 + m3)^2
+        // k[24] = 3*ell*m1*m3/(2*(m1 + m3)^2) - ell*m1/(m1 + m3) - 3*ell*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)^2) + ell*m3^2/(m1 + m3)^2
         let h24_t0 = m1 + m3;
         k[24] = (3.0 * ell * m1 * m3 / 2.0 / (h24_t0 * h24_t0))
-            - (3.0 * ell * m1 / 2.0 / h24_t0)
-            - (2.0 * ell * m3 / h24_t0)
+            - (ell * m1 / h24_t0)
+            - (3.0 * ell * m3 / 2.0 / h24_t0)
             + (ell * (m1 * m1) / 2.0 / (h24_t0 * h24_t0))
             + (ell * (m3 * m3) / (h24_t0 * h24_t0));
-        // k[25] = 3*m1*m3/(2*(m1 + m3)) + m1^2/(2*(m1 + m3)) + m3^2/(m1 + m3)
-        k[25] = (3.0 * m1 * m3 / 2.0 / (m1 + m3))
+        // k[25] = 3*ell*m1*m3/(2*(m1 + m3)^2) - 3*ell*m1/(2*(m1 + m3)) - 2*ell*m3/(m1 + m3) + ell*m1^2/(2*(m1 + m3)^2) + ell*m3^2/(m1 + m3)^2
+        let h25_t0 = m1 + m3;
+        k[25] = (3.0 * ell * m1 * m3 / 2.0 / (h25_t0 * h25_t0))
+            - (3.0 * ell * m1 / 2.0 / h25_t0)
+            - (2.0 * ell * m3 / h25_t0)
+            + (ell * (m1 * m1) / 2.0 / (h25_t0 * h25_t0))
+            + (ell * (m3 * m3) / (h25_t0 * h25_t0));
+        // k[26] = 3*m1*m3/(2*(m1 + m3)) + m1^2/(2*(m1 + m3)) + m3^2/(m1 + m3)
+        k[26] = (3.0 * m1 * m3 / 2.0 / (m1 + m3))
             + ((m1 * m1) / 2.0 / (m1 + m3))
             + ((m3 * m3) / (m1 + m3));
-        // k[26] = -m1 - m3
-        k[26] = -m1 - m3;
-        // k[27] = ell^2/12 - ell^2*m1*m3/(4*(m1 + m3)^2) + ell^2*m3/(4*(m1 + m3))
-        let h27_t0 = ell * ell;
-        let h27_t1 = m1 + m3;
-        k[27] = (h27_t0 / 12.0) - (h27_t0 * m1 * m3 / 4.0 / (h27_t1 * h27_t1))
-            + (h27_t0 * m3 / 4.0 / h27_t1);
-        // k[28] = 5*ell^2*m1*m3/(2*(2*m1*m3 + m1^2 + m3^2)) - 2*ell^2*m1*m3^2*(2*m1 + 2*m3)/(2*m1*m3 + m1^2 + m3^2)^2 - 5*ell^2*m1^2*m3*(2*m1 + 2*m3)/(4*(2*m1*m3 + m1^2 + m3^2)^2) + 3*ell^2*m1^2/(4*(2*m1*m3 + m1^2 + m3^2)) - ell^2*m1^3*(2*m1 + 2*m3)/(4*(2*m1*m3 + m1^2 + m3^2)^2) + 2*ell^2*m3^2/(2*m1*m3 + m1^2 + m3^2) - ell^2*m3^3*(2*m1 + 2*m3)/(2*m1*m3 + m1^2 + m3^2)^2
+        // k[27] = -m1 - m3
+        k[27] = -m1 - m3;
+        // k[28] = ell^2/12 - ell^2*m1*m3/(4*(m1 + m3)^2) + 5*ell^2*m1*m3/(2*(2*m1*m3 + m1^2 + m3^2)) - 2*(2*m1 + 2*m3)*ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2)^2 + ell^2*m3/(4*(m1 + m3)) - 5*(2*m1 + 2*m3)*ell^2*m1^2*m3/(4*(2*m1*m3 + m1^2 + m3^2)^2) + 3*ell^2*m1^2/(4*(2*m1*m3 + m1^2 + m3^2)) - (2*m1 + 2*m3)*ell^2*m1^3/(4*(2*m1*m3 + m1^2 + m3^2)^2) + 2*ell^2*m3^2/(2*m1*m3 + m1^2 + m3^2) - (2*m1 + 2*m3)*ell^2*m3^3/(2*m1*m3 + m1^2 + m3^2)^2
         let h28_t0 = ell * ell;
-        let h28_t1 = m1 * m1;
-        let h28_t2 = m3 * m3;
-        let h28_t3 = (2.0 * m1 * m3) + h28_t1 + h28_t2;
-        let h28_t4 = (2.0 * m1) + (2.0 * m3);
-        k[28] = (5.0 * h28_t0 * m1 * m3 / 2.0 / h28_t3)
-            - (2.0 * h28_t0 * m1 * h28_t2 * h28_t4 / (h28_t3 * h28_t3))
-            - (5.0 * h28_t0 * h28_t1 * m3 * h28_t4 / 4.0 / (h28_t3 * h28_t3))
-            + (3.0 * h28_t0 * h28_t1 / 4.0 / h28_t3)
-            - (h28_t0 * m1.powi(3) * h28_t4 / 4.0 / (h28_t3 * h28_t3))
-            + (2.0 * h28_t0 * h28_t2 / h28_t3)
-            - (h28_t0 * m3.powi(3) * h28_t4 / (h28_t3 * h28_t3));
+        let h28_t1 = m1 + m3;
+        let h28_t2 = m1 * m1;
+        let h28_t3 = m3 * m3;
+        let h28_t4 = (2.0 * m1 * m3) + h28_t2 + h28_t3;
+        let h28_t5 = (2.0 * m1) + (2.0 * m3);
+        k[28] = (h28_t0 / 12.0) - (h28_t0 * m1 * m3 / 4.0 / (h28_t1 * h28_t1))
+            + (5.0 * h28_t0 * m1 * m3 / 2.0 / h28_t4)
+            - (2.0 * h28_t5 * h28_t0 * m1 * h28_t3 / (h28_t4 * h28_t4))
+            + (h28_t0 * m3 / 4.0 / h28_t1)
+            - (5.0 * h28_t5 * h28_t0 * h28_t2 * m3 / 4.0 / (h28_t4 * h28_t4))
+            + (3.0 * h28_t0 * h28_t2 / 4.0 / h28_t4)
+            - (h28_t5 * h28_t0 * m1.powi(3) / 4.0 / (h28_t4 * h28_t4))
+            + (2.0 * h28_t0 * h28_t3 / h28_t4)
+            - (h28_t5 * h28_t0 * m3.powi(3) / (h28_t4 * h28_t4));
         // k[29] = 3*ell*g*m1*m3/(2*(m1 + m3)^2) - ell*g*m1/(m1 + m3) - 3*ell*g*m3/(2*(m1 + m3)) + ell*g*m1^2/(2*(m1 + m3)^2) + ell*g*m3^2/(m1 + m3)^2
         let h29_t0 = m1 + m3;
         k[29] = (3.0 * ell * g * m1 * m3 / 2.0 / (h29_t0 * h29_t0))
@@ -289,60 +289,55 @@ impl Model for LoadedRod {
             - (3.0 * ell * g * m3 / 2.0 / h29_t0)
             + (ell * g * (m1 * m1) / 2.0 / (h29_t0 * h29_t0))
             + (ell * g * (m3 * m3) / (h29_t0 * h29_t0));
-        // k[30] = ell^2*m1*m3/(4*(m1 + m3)^2) - ell^2*m1/(4*(m1 + m3))
+        // k[30] = ell^2*m1*m3/(4*(m1 + m3)^2) - 4*ell^2*m1*m3/(2*m1*m3 + m1^2 + m3^2) + 2*(2*m1 + 2*m3)*ell^2*m1*m3^2/(2*m1*m3 + m1^2 + m3^2)^2 - ell^2*m1/(4*(m1 + m3)) + 5*(2*m1 + 2*m3)*ell^2*m1^2*m3/(4*(2*m1*m3 + m1^2 + m3^2)^2) - 5*ell^2*m1^2/(4*(2*m1*m3 + m1^2 + m3^2)) + (2*m1 + 2*m3)*ell^2*m1^3/(4*(2*m1*m3 + m1^2 + m3^2)^2) - 3*ell^2*m3^2/(2*m1*m3 + m1^2 + m3^2) + (2*m1 + 2*m3)*ell^2*m3^3/(2*m1*m3 + m1^2 + m3^2)^2
         let h30_t0 = ell * ell;
         let h30_t1 = m1 + m3;
-        k[30] = (h30_t0 * m1 * m3 / 4.0 / (h30_t1 * h30_t1)) - (h30_t0 * m1 / 4.0 / h30_t1);
-        // k[31] = 4*ell^2*m1*m3/(2*m1*m3 + m1^2 + m3^2) - 2*ell^2*m1*m3^2*(2*m1 + 2*m3)/(2*m1*m3 + m1^2 + m3^2)^2 - 5*ell^2*m1^2*m3*(2*m1 + 2*m3)/(4*(2*m1*m3 + m1^2 + m3^2)^2) + 5*ell^2*m1^2/(4*(2*m1*m3 + m1^2 + m3^2)) - ell^2*m1^3*(2*m1 + 2*m3)/(4*(2*m1*m3 + m1^2 + m3^2)^2) + 3*ell^2*m3^2/(2*m1*m3 + m1^2 + m3^2) - ell^2*m3^3*(2*m1 + 2*m3)/(2*m1*m3 + m1^2 + m3^2)^2
-        let h31_t0 = ell * ell;
-        let h31_t1 = m1 * m1;
-        let h31_t2 = m3 * m3;
-        let h31_t3 = (2.0 * m1 * m3) + h31_t1 + h31_t2;
-        let h31_t4 = (2.0 * m1) + (2.0 * m3);
-        k[31] = (4.0 * h31_t0 * m1 * m3 / h31_t3)
-            - (2.0 * h31_t0 * m1 * h31_t2 * h31_t4 / (h31_t3 * h31_t3))
-            - (5.0 * h31_t0 * h31_t1 * m3 * h31_t4 / 4.0 / (h31_t3 * h31_t3))
-            + (5.0 * h31_t0 * h31_t1 / 4.0 / h31_t3)
-            - (h31_t0 * m1.powi(3) * h31_t4 / 4.0 / (h31_t3 * h31_t3))
-            + (3.0 * h31_t0 * h31_t2 / h31_t3)
-            - (h31_t0 * m3.powi(3) * h31_t4 / (h31_t3 * h31_t3));
-        // k[32] = 3*ell*g*m1*m3/(2*(m1 + m3)^2) - 3*ell*g*m1/(2*(m1 + m3)) - 2*ell*g*m3/(m1 + m3) + ell*g*m1^2/(2*(m1 + m3)^2) + ell*g*m3^2/(m1 + m3)^2
-        let h32_t0 = m1 + m3;
-        k[32] = (3.0 * ell * g * m1 * m3 / 2.0 / (h32_t0 * h32_t0))
-            - (3.0 * ell * g * m1 / 2.0 / h32_t0)
-            - (2.0 * ell * g * m3 / h32_t0)
-            + (ell * g * (m1 * m1) / 2.0 / (h32_t0 * h32_t0))
-            + (ell * g * (m3 * m3) / (h32_t0 * h32_t0));
-        // k[33] = ell*m1/6 + ell*m1*m3/(2*(m1 + m3))
-        k[33] = (ell * m1 / 6.0) + (ell * m1 * m3 / 2.0 / (m1 + m3));
-        // k[34] = 4*ell*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell*m1^2*m3/(2*(2*m1*m3 + m1^2 + m3^2)) + ell*m1^3/(2*(2*m1*m3 + m1^2 + m3^2)) + 2*ell*m3^3/(2*m1*m3 + m1^2 + m3^2)
-        let h34_t0 = m3 * m3;
-        let h34_t1 = m1 * m1;
-        k[34] = (4.0 * ell * m1 * h34_t0 / ((2.0 * m1 * m3) + h34_t1 + h34_t0))
-            + (5.0 * ell * h34_t1 * m3 / 2.0 / ((2.0 * m1 * m3) + h34_t1 + h34_t0))
-            + (ell * m1.powi(3) / 2.0 / ((2.0 * m1 * m3) + h34_t1 + h34_t0))
-            + (2.0 * ell * m3.powi(3) / ((2.0 * m1 * m3) + h34_t1 + h34_t0));
-        // k[35] = 3*g*m1*m3/(2*(m1 + m3)) + g*m1^2/(2*(m1 + m3)) + g*m3^2/(m1 + m3)
-        k[35] = (3.0 * g * m1 * m3 / 2.0 / (m1 + m3))
+        let h30_t2 = m1 * m1;
+        let h30_t3 = m3 * m3;
+        let h30_t4 = (2.0 * m1 * m3) + h30_t2 + h30_t3;
+        let h30_t5 = (2.0 * m1) + (2.0 * m3);
+        k[30] = (h30_t0 * m1 * m3 / 4.0 / (h30_t1 * h30_t1)) - (4.0 * h30_t0 * m1 * m3 / h30_t4)
+            + (2.0 * h30_t5 * h30_t0 * m1 * h30_t3 / (h30_t4 * h30_t4))
+            - (h30_t0 * m1 / 4.0 / h30_t1)
+            + (5.0 * h30_t5 * h30_t0 * h30_t2 * m3 / 4.0 / (h30_t4 * h30_t4))
+            - (5.0 * h30_t0 * h30_t2 / 4.0 / h30_t4)
+            + (h30_t5 * h30_t0 * m1.powi(3) / 4.0 / (h30_t4 * h30_t4))
+            - (3.0 * h30_t0 * h30_t3 / h30_t4)
+            + (h30_t5 * h30_t0 * m3.powi(3) / (h30_t4 * h30_t4));
+        // k[31] = 3*ell*g*m1*m3/(2*(m1 + m3)^2) - 3*ell*g*m1/(2*(m1 + m3)) - 2*ell*g*m3/(m1 + m3) + ell*g*m1^2/(2*(m1 + m3)^2) + ell*g*m3^2/(m1 + m3)^2
+        let h31_t0 = m1 + m3;
+        k[31] = (3.0 * ell * g * m1 * m3 / 2.0 / (h31_t0 * h31_t0))
+            - (3.0 * ell * g * m1 / 2.0 / h31_t0)
+            - (2.0 * ell * g * m3 / h31_t0)
+            + (ell * g * (m1 * m1) / 2.0 / (h31_t0 * h31_t0))
+            + (ell * g * (m3 * m3) / (h31_t0 * h31_t0));
+        // k[32] = ell*m1/6 + ell*m1*m3/(2*(m1 + m3)) + 4*ell*m1*m3^2/(2*m1*m3 + m1^2 + m3^2) + 5*ell*m1^2*m3/(2*(2*m1*m3 + m1^2 + m3^2)) + ell*m1^3/(2*(2*m1*m3 + m1^2 + m3^2)) + 2*ell*m3^3/(2*m1*m3 + m1^2 + m3^2)
+        let h32_t0 = m3 * m3;
+        let h32_t1 = m1 * m1;
+        k[32] = (ell * m1 / 6.0)
+            + (ell * m1 * m3 / 2.0 / (m1 + m3))
+            + (4.0 * ell * m1 * h32_t0 / ((2.0 * m1 * m3) + h32_t1 + h32_t0))
+            + (5.0 * ell * h32_t1 * m3 / 2.0 / ((2.0 * m1 * m3) + h32_t1 + h32_t0))
+            + (ell * m1.powi(3) / 2.0 / ((2.0 * m1 * m3) + h32_t1 + h32_t0))
+            + (2.0 * ell * m3.powi(3) / ((2.0 * m1 * m3) + h32_t1 + h32_t0));
+        // k[33] = 3*g*m1*m3/(2*(m1 + m3)) + g*m1^2/(2*(m1 + m3)) + g*m3^2/(m1 + m3)
+        k[33] = (3.0 * g * m1 * m3 / 2.0 / (m1 + m3))
             + (g * (m1 * m1) / 2.0 / (m1 + m3))
             + (g * (m3 * m3) / (m1 + m3));
-        // k[36] = 2*ell
-        k[36] = 2.0 * ell;
-        // k[37] = a/(ell^2*(1 - a^2/ell^2)^(1/2))
-        k[37] = a / (ell * ell) / (1.0 - ((a * a) / (ell * ell))).sqrt();
-        // k[38] = 1/(ell*(1 - a^2/ell^2)^(1/2))
-        k[38] = 1.0 / ell / (1.0 - ((a * a) / (ell * ell))).sqrt();
-        // k[39] = ell*(a*(1 + a/ell)/ell^2 - a*(1 - a/ell)/ell^2)/(2*((1 + a/ell)*(1 - a/ell))^(1/2)) + ((1 + a/ell)*(1 - a/ell))^(1/2)
-        let h39_t0 = 1.0 + (a / ell);
-        let h39_t1 = 1.0 - (a / ell);
-        let h39_t2 = h39_t0 * h39_t1;
-        k[39] =
-            (ell * ((a * h39_t0 / (ell * ell)) - (a * h39_t1 / (ell * ell))) / 2.0 / h39_t2.sqrt())
-                + h39_t2.sqrt();
-        // k[40] = ell*(-(1 + a/ell)/ell + (1 - a/ell)/ell)/(2*((1 + a/ell)*(1 - a/ell))^(1/2))
-        let h40_t0 = 1.0 + (a / ell);
-        let h40_t1 = 1.0 - (a / ell);
-        k[40] = ell * (-(h40_t0 / ell) + (h40_t1 / ell)) / 2.0 / (h40_t0 * h40_t1).sqrt();
+        // k[34] = 2*ell
+        k[34] = 2.0 * ell;
+        // k[35] = a/(ell^2*((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[35] = a / (ell * ell) / k[7];
+        // k[36] = 1/(ell*((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[36] = 1.0 / ell / k[7];
+        // k[37] = ell*(a*(1 + a/ell)/ell^2 - a*(1 - a/ell)/ell^2)/(2*((1 - a/ell)*(1 + a/ell))^(1/2)) + ((1 - a/ell)*(1 + a/ell))^(1/2)
+        k[37] = (ell
+            * ((a * (1.0 + (a / ell)) / (ell * ell)) - (a * (1.0 - (a / ell)) / (ell * ell)))
+            / 2.0
+            / k[7])
+            + k[7];
+        // k[38] = ell*(-(1 + a/ell)/ell + (1 - a/ell)/ell)/(2*((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[38] = ell * (-((1.0 + (a / ell)) / ell) + ((1.0 - (a / ell)) / ell)) / 2.0 / k[7];
     }
 
     /// The state at release, over the parameters.
@@ -356,14 +351,14 @@ impl Model for LoadedRod {
     /// - `x2 = ell*((1 - a/ell)*(1 + a/ell))^(1/2)`
     /// - `dot_x2 = 0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = 0.0;
         qd[1] = 0.0;
         q[2] = k[6];
         qd[2] = 0.0;
-        q[3] = k[7];
+        q[3] = k[8];
         qd[3] = 0.0;
     }
 
@@ -380,7 +375,7 @@ impl Model for LoadedRod {
     /// - `cube_x = x2`
     /// - `cube_y = 0`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[3];
         let x1 = q[0];
@@ -397,15 +392,15 @@ impl Model for LoadedRod {
             -(ell * theta_dot * rc_s) + x1_dot,
             (ell * theta_dot * rc_c) + y1_dot,
         ];
-        pos[2] = [(k[8] * rc_c) + x1, (k[8] * rc_s) + y1];
+        pos[2] = [(k[9] * rc_c) + x1, (k[9] * rc_s) + y1];
         vel[2] = [
-            -(k[8] * theta_dot * rc_s) + x1_dot,
-            (k[8] * theta_dot * rc_c) + y1_dot,
-        ];
-        pos[3] = [(k[9] * rc_c) + x1, (k[9] * rc_s) + y1];
-        vel[3] = [
             -(k[9] * theta_dot * rc_s) + x1_dot,
             (k[9] * theta_dot * rc_c) + y1_dot,
+        ];
+        pos[3] = [(k[10] * rc_c) + x1, (k[10] * rc_s) + y1];
+        vel[3] = [
+            -(k[10] * theta_dot * rc_s) + x1_dot,
+            (k[10] * theta_dot * rc_c) + y1_dot,
         ];
         pos[4] = [x2, 0.0];
         vel[4] = [x2_dot, 0.0];
@@ -416,20 +411,20 @@ impl Model for LoadedRod {
     /// - `T`: 676 characters, written out in `generated/loaded_rod.tex`
     /// - `V = a*g*m2/2 + 3*ell*g*m1*m3*sin(theta)/(2*(m1 + m3)) + ell*g*m1^2*sin(theta)/(2*(m1 + m3)) + ell*g*m3^2*sin(theta)/(m1 + m3) + g*m1*y1 + g*m3*y1`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let x1_dot = qd[0];
         let y1 = q[1];
         let y1_dot = qd[1];
         let theta_dot = qd[2];
         let x2_dot = qd[3];
-        (-(k[10] * theta_dot * x1_dot * rc_s)
-            + (k[10] * theta_dot * y1_dot * rc_c)
-            + (k[11] * (theta_dot * theta_dot))
-            + (k[12] * (x1_dot * x1_dot))
-            + (k[13] * (x2_dot * x2_dot))
-            + (k[12] * (y1_dot * y1_dot)))
-            + (k[14] + (k[15] * rc_s) + (k[16] * y1))
+        (-(k[11] * theta_dot * x1_dot * rc_s)
+            + (k[11] * theta_dot * y1_dot * rc_c)
+            + (k[12] * (theta_dot * theta_dot))
+            + (k[13] * (x1_dot * x1_dot))
+            + (k[14] * (x2_dot * x2_dot))
+            + (k[13] * (y1_dot * y1_dot)))
+            + (k[15] + (k[16] * rc_s) + (k[17] * y1))
     }
 
     /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
@@ -437,13 +432,13 @@ impl Model for LoadedRod {
     /// - `p_x1 = -3*dot_theta*ell*m1*m3*sin(theta)/(2*(m1 + m3)) - dot_theta*ell*m1^2*sin(theta)/(2*(m1 + m3)) - dot_theta*ell*m3^2*sin(theta)/(m1 + m3) + dot_x1*m1 + dot_x1*m3`
     /// - `p_x2 = dot_x2*m2`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let m2 = k[1];
         let x1_dot = qd[0];
         let theta_dot = qd[2];
         let x2_dot = qd[3];
-        out[0] = -(k[10] * theta_dot * rc_s) + (k[17] * x1_dot);
+        out[0] = -(k[11] * theta_dot * rc_s) + (k[18] * x1_dot);
         out[1] = m2 * x2_dot;
     }
 
@@ -452,32 +447,32 @@ impl Model for LoadedRod {
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
     /// - `L = T - V`: 822 characters, written out in `generated/loaded_rod.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m2 = k[1];
         let theta_dot = qd[2];
-        let qt0 = -k[10] * rc_s; // -((3*ell*m1*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3))*rc_s)
-        let qt1 = k[10] * rc_c; // (3*ell*m1*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3))*rc_c
+        let qt0 = -k[11] * rc_s; // -((3*ell*m1*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3))*rc_s)
+        let qt1 = k[11] * rc_c; // (3*ell*m1*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3))*rc_c
         let qt2 = theta_dot * theta_dot;
-        mass[0] = k[17];
+        mass[0] = k[18];
         mass[1] = 0.0;
         mass[2] = qt0;
         mass[3] = 0.0;
         mass[4] = 0.0;
-        mass[5] = k[17];
+        mass[5] = k[18];
         mass[6] = qt1;
         mass[7] = 0.0;
         mass[8] = qt0;
         mass[9] = qt1;
-        mass[10] = k[18];
+        mass[10] = k[19];
         mass[11] = 0.0;
         mass[12] = 0.0;
         mass[13] = 0.0;
         mass[14] = 0.0;
         mass[15] = m2;
-        rhs[0] = k[10] * qt2 * rc_c;
-        rhs[1] = -k[16] + (k[10] * qt2 * rc_s);
-        rhs[2] = -k[15] * rc_c;
+        rhs[0] = k[11] * qt2 * rc_c;
+        rhs[1] = -k[17] + (k[11] * qt2 * rc_s);
+        rhs[2] = -k[16] * rc_c;
         rhs[3] = 0.0;
     }
 
@@ -494,7 +489,7 @@ impl Model for LoadedRod {
     /// - `contact_force = -ell*cos(theta) - x1 + x2`
     /// - `floor_normal = y1`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         let rc_c = q[2].cos();
         let ell = k[3];
         let x1 = q[0];
@@ -506,7 +501,7 @@ impl Model for LoadedRod {
 
     /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[3];
         let theta_dot = qd[2];
@@ -539,10 +534,10 @@ impl Model for LoadedRod {
     ///
     /// - `cube_does_not_tip = a*g*m2/2 - rc_f0*(-a/2 + ell*sin(theta))`
     fn monitors_full(&self, k: &[f64], q: &[f64], _qd: &[f64], forces: &[f64], out: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let ell = k[3];
-        out[0] = k[14] - (forces[0] * (-k[19] + (ell * rc_s)));
+        out[0] = k[15] - (forces[0] * (-k[20] + (ell * rc_s)));
     }
 
     /// The system's state (its general model's) that this phase's state stands for.
@@ -576,18 +571,18 @@ impl Model for LoadedRod {
 
     /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let a = k[4];
         let x1 = q[0];
         let y1 = q[1];
         let theta = q[2];
         let x2 = q[3];
-        poses[0] = [(k[9] * rc_c) + x1, (k[9] * rc_s) + y1, theta];
-        poses[1] = [k[19] + x2, k[19], 0.0];
-        sizes[0] = -k[20];
+        poses[0] = [(k[10] * rc_c) + x1, (k[10] * rc_s) + y1, theta];
+        poses[1] = [k[20] + x2, k[20], 0.0];
+        sizes[0] = -k[21];
         sizes[1] = 0.0;
-        sizes[2] = k[21];
+        sizes[2] = k[22];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
@@ -613,7 +608,7 @@ impl Tangents for LoadedRod {
         let qd = at.qd;
         let qdd = at.qdd;
         let forces = at.forces;
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[3];
         let g = k[5];
@@ -622,47 +617,37 @@ impl Tangents for LoadedRod {
         let theta_dot = qd[2];
         let theta_ddot = qdd[2];
         let x2_ddot = qdd[3];
-        let xt0 = -k[10] * rc_c; // -((3*ell*m1*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3))*rc_c)
+        let xt0 = -k[11] * rc_c; // -((3*ell*m1*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3))*rc_c)
         let xt1 = theta_dot * theta_dot;
-        let xt2 = k[23] * rc_s; // (3*ell*m1*m3/(2*(m1 + m3)^2) - ell*m1/(m1 + m3) - 3*ell*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)^2) + ell*m3^2/(m1 + m3)^2)*rc_s
-        let xt3 = k[24] * rc_s; // (3*ell*m1*m3/(2*(m1 + m3)^2) - 3*ell*m1/(2*(m1 + m3)) - 2*ell*m3/(m1 + m3) + ell*m1^2/(2*(m1 + m3)^2) + ell*m3^2/(m1 + m3)^2)*rc_s
-        let xt4 = -k[25] * rc_s; // -((3*m1*m3/(2*(m1 + m3)) + m1^2/(2*(m1 + m3)) + m3^2/(m1 + m3))*rc_s)
-        let xt5 = -k[10] * rc_s; // -((3*ell*m1*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3))*rc_s)
-        let xt6 = -k[23] * rc_c; // -((3*ell*m1*m3/(2*(m1 + m3)^2) - ell*m1/(m1 + m3) - 3*ell*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)^2) + ell*m3^2/(m1 + m3)^2)*rc_c)
-        let xt7 = -k[24] * rc_c; // -((3*ell*m1*m3/(2*(m1 + m3)^2) - 3*ell*m1/(2*(m1 + m3)) - 2*ell*m3/(m1 + m3) + ell*m1^2/(2*(m1 + m3)^2) + ell*m3^2/(m1 + m3)^2)*rc_c)
-        let xt8 = k[25] * rc_c; // (3*m1*m3/(2*(m1 + m3)) + m1^2/(2*(m1 + m3)) + m3^2/(m1 + m3))*rc_c
-        let xt9 = rc_s * rc_s;
-        let xt10 = rc_c * rc_c;
+        let xt2 = k[24] * rc_s; // (3*ell*m1*m3/(2*(m1 + m3)^2) - ell*m1/(m1 + m3) - 3*ell*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)^2) + ell*m3^2/(m1 + m3)^2)*rc_s
+        let xt3 = k[25] * rc_s; // (3*ell*m1*m3/(2*(m1 + m3)^2) - 3*ell*m1/(2*(m1 + m3)) - 2*ell*m3/(m1 + m3) + ell*m1^2/(2*(m1 + m3)^2) + ell*m3^2/(m1 + m3)^2)*rc_s
+        let xt4 = -k[26] * rc_s; // -((3*m1*m3/(2*(m1 + m3)) + m1^2/(2*(m1 + m3)) + m3^2/(m1 + m3))*rc_s)
+        let xt5 = -k[11] * rc_s; // -((3*ell*m1*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)) + ell*m3^2/(m1 + m3))*rc_s)
+        let xt6 = -k[24] * rc_c; // -((3*ell*m1*m3/(2*(m1 + m3)^2) - ell*m1/(m1 + m3) - 3*ell*m3/(2*(m1 + m3)) + ell*m1^2/(2*(m1 + m3)^2) + ell*m3^2/(m1 + m3)^2)*rc_c)
+        let xt7 = -k[25] * rc_c; // -((3*ell*m1*m3/(2*(m1 + m3)^2) - 3*ell*m1/(2*(m1 + m3)) - 2*ell*m3/(m1 + m3) + ell*m1^2/(2*(m1 + m3)^2) + ell*m3^2/(m1 + m3)^2)*rc_c)
+        let xt8 = k[26] * rc_c; // (3*m1*m3/(2*(m1 + m3)) + m1^2/(2*(m1 + m3)) + m3^2/(m1 + m3))*rc_c
         out.fill(0.0);
-        out[2] = (theta_ddot * xt0) - (-k[10] * xt1 * rc_s);
-        out[6] = -k[22] * theta_dot * rc_c;
-        out[8] = (theta_ddot * xt2) + x1_ddot - (-k[23] * xt1 * rc_c);
-        out[10] = (theta_ddot * xt3) + x1_ddot - (-k[24] * xt1 * rc_c);
-        out[11] = (theta_ddot * xt4) - (k[25] * xt1 * rc_c);
-        out[16] = (theta_ddot * xt5) - (k[10] * xt1 * rc_c);
-        out[20] = -k[22] * theta_dot * rc_s;
-        out[22] = (theta_ddot * xt6) + y1_ddot - (-g - (k[23] * xt1 * rc_s));
-        out[24] = (theta_ddot * xt7) + y1_ddot - (-g - (k[24] * xt1 * rc_s));
-        out[25] = (theta_ddot * xt8) - (k[25] * xt1 * rc_s);
-        out[27] = -k[26];
-        out[30] = (x1_ddot * xt0) + (y1_ddot * xt5) - (ell * forces[0] * rc_c) - (k[15] * rc_s);
-        out[36] = (theta_ddot * (k[27] + (k[28] * xt9) + (k[28] * xt10)))
-            + (x1_ddot * xt2)
-            + (y1_ddot * xt6)
-            - (k[29] * rc_c);
-        out[38] = (theta_ddot * (-k[30] + (k[31] * xt9) + (k[31] * xt10)))
-            + (x1_ddot * xt3)
-            + (y1_ddot * xt7)
-            - (k[32] * rc_c);
-        out[39] = (theta_ddot * (k[33] + (k[34] * xt9) + (k[34] * xt10)))
-            + (x1_ddot * xt4)
-            + (y1_ddot * xt8)
+        out[2] = (theta_ddot * xt0) - (-k[11] * xt1 * rc_s);
+        out[6] = -k[23] * theta_dot * rc_c;
+        out[8] = (theta_ddot * xt2) + x1_ddot - (-k[24] * xt1 * rc_c);
+        out[10] = (theta_ddot * xt3) + x1_ddot - (-k[25] * xt1 * rc_c);
+        out[11] = (theta_ddot * xt4) - (k[26] * xt1 * rc_c);
+        out[16] = (theta_ddot * xt5) - (k[11] * xt1 * rc_c);
+        out[20] = -k[23] * theta_dot * rc_s;
+        out[22] = (theta_ddot * xt6) + y1_ddot - (-g - (k[24] * xt1 * rc_s));
+        out[24] = (theta_ddot * xt7) + y1_ddot - (-g - (k[25] * xt1 * rc_s));
+        out[25] = (theta_ddot * xt8) - (k[26] * xt1 * rc_s);
+        out[27] = -k[27];
+        out[30] = (x1_ddot * xt0) + (y1_ddot * xt5) - (ell * forces[0] * rc_c) - (k[16] * rc_s);
+        out[36] = (k[28] * theta_ddot) + (x1_ddot * xt2) + (y1_ddot * xt6) - (k[29] * rc_c);
+        out[38] = -(k[30] * theta_ddot) + (x1_ddot * xt3) + (y1_ddot * xt7) - (k[31] * rc_c);
+        out[39] = (k[32] * theta_ddot) + (x1_ddot * xt4) + (y1_ddot * xt8)
             - (forces[0] * rc_s)
-            - (-k[35] * rc_c);
-        out[41] = k[10] * rc_c;
+            - (-k[33] * rc_c);
+        out[41] = k[11] * rc_c;
         out[51] = x2_ddot;
         out[58] = (ell * theta_ddot * rc_c) - (ell * xt1 * rc_s);
-        out[62] = k[36] * theta_dot * rc_c;
+        out[62] = k[34] * theta_dot * rc_c;
         out[67] = (theta_ddot * rc_s) + (xt1 * rc_c);
         out[84] = -1.0;
         out[86] = ell * rc_s;
@@ -673,11 +658,11 @@ impl Tangents for LoadedRod {
 
     /// `d(initial state)/dp`: the rows `d q_0/dp`, then `d qd_0/dp`, by the parameters.
     fn initial_tangents(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..41]; // one bounds check for all constant loads
+        let k = &k[..39]; // one bounds check for all constant loads
         out.fill(0.0);
-        out[15] = -k[37];
-        out[16] = k[38];
-        out[21] = k[39];
-        out[22] = k[40];
+        out[15] = -k[35];
+        out[16] = k[36];
+        out[21] = k[37];
+        out[22] = k[38];
     }
 }

@@ -67,7 +67,7 @@ static INFO: ModelInfo = ModelInfo {
         meaning: "the tilt must be below the block's slenderness angle atan(w/h) so that it falls back (phi0 < atan(w/h))",
         parameters: &[1, 2, 3],
     }],
-    n_constants: 22,
+    n_constants: 23,
     coordinates: &["x", "y", "phi"],
     system_coordinates: &["x", "y", "phi"],
     reduced_index: Some(2),
@@ -175,36 +175,38 @@ impl Model for RockingBlock {
         let phi0 = p[3];
         let g = p[4];
         k[..7].copy_from_slice(p);
-        // k[7] = w*cos(phi0)/2 - h*sin(phi0)/2
-        k[7] = (w * phi0.cos() / 2.0) - (h * phi0.sin() / 2.0);
-        // k[8] = w*sin(phi0)/2 + h*cos(phi0)/2
-        k[8] = (w * phi0.sin() / 2.0) + (h * phi0.cos() / 2.0);
-        // k[9] = h/2
-        k[9] = h / 2.0;
-        // k[10] = w/2
-        k[10] = w / 2.0;
-        // k[11] = m*w^2/24 + h^2*m/24
-        k[11] = (m * (w * w) / 24.0) + ((h * h) * m / 24.0);
-        // k[12] = m/2
-        k[12] = m / 2.0;
-        // k[13] = g*m
-        k[13] = g * m;
-        // k[14] = m*w^2/12 + h^2*m/12
-        k[14] = (m * (w * w) / 12.0) + ((h * h) * m / 12.0);
-        // k[15] = h^2/12 + w^2/12
-        k[15] = ((h * h) / 12.0) + ((w * w) / 12.0);
-        // k[16] = m*w/6
-        k[16] = m * w / 6.0;
-        // k[17] = h*m/6
-        k[17] = h * m / 6.0;
-        // k[18] = cos(phi0)/2
-        k[18] = phi0.cos() / 2.0;
-        // k[19] = sin(phi0)/2
-        k[19] = phi0.sin() / 2.0;
-        // k[20] = h*cos(phi0)/2 + w*sin(phi0)/2
-        k[20] = (h * phi0.cos() / 2.0) + (w * phi0.sin() / 2.0);
-        // k[21] = h*sin(phi0)/2 - w*cos(phi0)/2
-        k[21] = (h * phi0.sin() / 2.0) - (w * phi0.cos() / 2.0);
+        // k[7] = cos(phi0)
+        k[7] = phi0.cos();
+        // k[8] = sin(phi0)
+        k[8] = phi0.sin();
+        // k[9] = w*cos(phi0)/2 - h*sin(phi0)/2
+        k[9] = (w * k[7] / 2.0) - (h * k[8] / 2.0);
+        // k[10] = w*sin(phi0)/2 + h*cos(phi0)/2
+        k[10] = (w * k[8] / 2.0) + (h * k[7] / 2.0);
+        // k[11] = h/2
+        k[11] = h / 2.0;
+        // k[12] = w/2
+        k[12] = w / 2.0;
+        // k[13] = m*w^2/24 + h^2*m/24
+        k[13] = (m * (w * w) / 24.0) + ((h * h) * m / 24.0);
+        // k[14] = m/2
+        k[14] = m / 2.0;
+        // k[15] = g*m
+        k[15] = g * m;
+        // k[16] = m*w^2/12 + h^2*m/12
+        k[16] = (m * (w * w) / 12.0) + ((h * h) * m / 12.0);
+        // k[17] = h^2/12 + w^2/12
+        k[17] = ((h * h) / 12.0) + ((w * w) / 12.0);
+        // k[18] = m*w/6
+        k[18] = m * w / 6.0;
+        // k[19] = h*m/6
+        k[19] = h * m / 6.0;
+        // k[20] = cos(phi0)/2
+        k[20] = k[7] / 2.0;
+        // k[21] = sin(phi0)/2
+        k[21] = k[8] / 2.0;
+        // k[22] = h*sin(phi0)/2 - w*cos(phi0)/2
+        k[22] = (h * k[8] / 2.0) - (w * k[7] / 2.0);
     }
 
     /// The state at release, over the parameters.
@@ -216,11 +218,11 @@ impl Model for RockingBlock {
     /// - `phi = phi0`
     /// - `dot_phi = 0.0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..23]; // one bounds check for all constant loads
         let phi0 = k[3];
-        q[0] = k[7];
+        q[0] = k[9];
         qd[0] = 0.0;
-        q[1] = k[8];
+        q[1] = k[10];
         qd[1] = 0.0;
         q[2] = phi0;
         qd[2] = 0.0;
@@ -235,33 +237,33 @@ impl Model for RockingBlock {
     /// - `right_bottom_x = h*sin(phi)/2 + w*cos(phi)/2 + x`
     /// - `right_bottom_y = -h*cos(phi)/2 + w*sin(phi)/2 + y`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..23]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let x = q[0];
         let x_dot = qd[0];
         let y = q[1];
         let y_dot = qd[1];
         let phi_dot = qd[2];
-        let pt0 = k[9] * rc_s; // h*rc_s/2
-        let pt1 = k[9] * phi_dot * rc_c; // h*dot_phi*rc_c/2
-        let pt2 = k[9] * phi_dot * rc_s; // h*dot_phi*rc_s/2
+        let pt0 = k[11] * rc_s; // h*rc_s/2
+        let pt1 = k[11] * phi_dot * rc_c; // h*dot_phi*rc_c/2
+        let pt2 = k[11] * phi_dot * rc_s; // h*dot_phi*rc_s/2
         pos[0] = [x, y];
         vel[0] = [x_dot, y_dot];
         pos[1] = [
-            pt0 - (k[10] * rc_c) + x,
-            -(k[9] * rc_c) - (k[10] * rc_s) + y,
+            pt0 - (k[12] * rc_c) + x,
+            -(k[11] * rc_c) - (k[12] * rc_s) + y,
         ];
         vel[1] = [
-            pt1 + (k[10] * phi_dot * rc_s) + x_dot,
-            pt2 - (k[10] * phi_dot * rc_c) + y_dot,
+            pt1 + (k[12] * phi_dot * rc_s) + x_dot,
+            pt2 - (k[12] * phi_dot * rc_c) + y_dot,
         ];
         pos[2] = [
-            pt0 + (k[10] * rc_c) + x,
-            -(k[9] * rc_c) + (k[10] * rc_s) + y,
+            pt0 + (k[12] * rc_c) + x,
+            -(k[11] * rc_c) + (k[12] * rc_s) + y,
         ];
         vel[2] = [
-            pt1 - (k[10] * phi_dot * rc_s) + x_dot,
-            pt2 + (k[10] * phi_dot * rc_c) + y_dot,
+            pt1 - (k[12] * phi_dot * rc_s) + x_dot,
+            pt2 + (k[12] * phi_dot * rc_c) + y_dot,
         ];
     }
 
@@ -270,20 +272,20 @@ impl Model for RockingBlock {
     /// - `T = dot_phi^2*m*w^2/24 + dot_phi^2*h^2*m/24 + dot_x^2*m/2 + dot_y^2*m/2`
     /// - `V = g*m*y`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..23]; // one bounds check for all constant loads
         let x_dot = qd[0];
         let y = q[1];
         let y_dot = qd[1];
         let phi_dot = qd[2];
-        ((k[11] * (phi_dot * phi_dot)) + (k[12] * (x_dot * x_dot)) + (k[12] * (y_dot * y_dot)))
-            + (k[13] * y)
+        ((k[13] * (phi_dot * phi_dot)) + (k[14] * (x_dot * x_dot)) + (k[14] * (y_dot * y_dot)))
+            + (k[15] * y)
     }
 
     /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
     ///
     /// - `p_x = dot_x*m`
     fn momenta(&self, k: &[f64], _q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..23]; // one bounds check for all constant loads
         let m = k[0];
         let x_dot = qd[0];
         out[0] = m * x_dot;
@@ -294,7 +296,7 @@ impl Model for RockingBlock {
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
     /// - `L = T - V = -g*m*y + dot_phi^2*m*w^2/24 + dot_phi^2*h^2*m/24 + dot_x^2*m/2 + dot_y^2*m/2`
     fn equations(&self, k: &[f64], _q: &[f64], _qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..23]; // one bounds check for all constant loads
         let m = k[0];
         mass[0] = m;
         mass[1] = 0.0;
@@ -304,9 +306,9 @@ impl Model for RockingBlock {
         mass[5] = 0.0;
         mass[6] = 0.0;
         mass[7] = 0.0;
-        mass[8] = k[14];
+        mass[8] = k[16];
         rhs[0] = 0.0;
-        rhs[1] = -k[13];
+        rhs[1] = -k[15];
         rhs[2] = 0.0;
     }
 
@@ -323,29 +325,29 @@ impl Model for RockingBlock {
     /// - `left_corner = -h*cos(phi)/2 - w*sin(phi)/2 + y`
     /// - `right_corner = -h*cos(phi)/2 + w*sin(phi)/2 + y`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..23]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let y = q[1];
-        out[0] = -(k[9] * rc_c) - (k[10] * rc_s) + y;
-        out[1] = -(k[9] * rc_c) + (k[10] * rc_s) + y;
+        out[0] = -(k[11] * rc_c) - (k[12] * rc_s) + y;
+        out[1] = -(k[11] * rc_c) + (k[12] * rc_s) + y;
     }
 
     /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..23]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let phi_dot = qd[2];
-        let jt0 = k[9] * rc_s; // h*rc_s/2
+        let jt0 = k[11] * rc_s; // h*rc_s/2
         let jt1 = phi_dot * phi_dot;
-        let jt2 = k[9] * jt1 * rc_c; // h*dot_phi^2*rc_c/2
+        let jt2 = k[11] * jt1 * rc_c; // h*dot_phi^2*rc_c/2
         jac[0] = 0.0;
         jac[1] = 1.0;
-        jac[2] = jt0 - (k[10] * rc_c);
+        jac[2] = jt0 - (k[12] * rc_c);
         jac[3] = 0.0;
         jac[4] = 1.0;
-        jac[5] = jt0 + (k[10] * rc_c);
-        bias[0] = jt2 + (k[10] * jt1 * rc_s);
-        bias[1] = jt2 - (k[10] * jt1 * rc_s);
+        jac[5] = jt0 + (k[12] * rc_c);
+        bias[0] = jt2 + (k[12] * jt1 * rc_s);
+        bias[1] = jt2 - (k[12] * jt1 * rc_s);
     }
 
     /// Each contact's edge margin, `>= 0` while the contact point is on the edge (infinite without one).
@@ -361,19 +363,19 @@ impl Model for RockingBlock {
     /// - `v_left_friction = dot_phi*h*cos(phi)/2 + dot_phi*w*sin(phi)/2 + dot_x`
     /// - `v_right_friction = dot_phi*h*cos(phi)/2 - dot_phi*w*sin(phi)/2 + dot_x`
     fn friction(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..23]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let phi_dot = qd[2];
-        let st0 = k[9] * rc_c; // h*rc_c/2
+        let st0 = k[11] * rc_c; // h*rc_c/2
         let st1 = phi_dot * phi_dot;
         jac[0] = 1.0;
         jac[1] = 0.0;
-        jac[2] = st0 + (k[10] * rc_s);
+        jac[2] = st0 + (k[12] * rc_s);
         jac[3] = 1.0;
         jac[4] = 0.0;
-        jac[5] = st0 - (k[10] * rc_s);
-        bias[0] = -(k[9] * st1 * rc_s) + (k[10] * st1 * rc_c);
-        bias[1] = -(k[9] * st1 * rc_s) - (k[10] * st1 * rc_c);
+        jac[5] = st0 - (k[12] * rc_s);
+        bias[0] = -(k[11] * st1 * rc_s) + (k[12] * st1 * rc_c);
+        bias[1] = -(k[11] * st1 * rc_s) - (k[12] * st1 * rc_c);
     }
 
     /// The monitors over the state and the contacts' forces `rc_f<i>`.
@@ -414,7 +416,7 @@ impl Model for RockingBlock {
 
     /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..23]; // one bounds check for all constant loads
         let w = k[1];
         let h = k[2];
         let x = q[0];
@@ -446,7 +448,7 @@ impl Tangents for RockingBlock {
         let qdd = at.qdd;
         let forces = at.forces;
         let fr = at.friction;
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..23]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m = k[0];
         let w = k[1];
@@ -456,11 +458,11 @@ impl Tangents for RockingBlock {
         let y_ddot = qdd[1];
         let phi_dot = qd[2];
         let phi_ddot = qdd[2];
-        let xt0 = k[9] * rc_c; // h*rc_c/2
-        let xt1 = xt0 + (k[10] * rc_s); // h*rc_c/2 + w*rc_s/2
-        let xt2 = xt0 - (k[10] * rc_s); // h*rc_c/2 - w*rc_s/2
-        let xt3 = k[9] * rc_s; // h*rc_s/2
-        let xt4 = k[10] * rc_c; // w*rc_c/2
+        let xt0 = k[11] * rc_c; // h*rc_c/2
+        let xt1 = xt0 + (k[12] * rc_s); // h*rc_c/2 + w*rc_s/2
+        let xt2 = xt0 - (k[12] * rc_s); // h*rc_c/2 - w*rc_s/2
+        let xt3 = k[11] * rc_s; // h*rc_s/2
+        let xt4 = k[12] * rc_c; // w*rc_c/2
         let xt5 = -xt3 + xt4;
         let xt6 = -xt3 - xt4;
         let xt7 = phi_dot * phi_dot;
@@ -474,26 +476,26 @@ impl Tangents for RockingBlock {
         out[19] = g + y_ddot;
         out[23] = m;
         out[28] = -((forces[0] * xt1) + (forces[1] * xt2)) - ((fr[0] * xt5) + (fr[1] * xt6));
-        out[32] = k[15] * phi_ddot;
-        out[33] = (k[16] * phi_ddot)
+        out[32] = k[17] * phi_ddot;
+        out[33] = (k[18] * phi_ddot)
             - ((fr[0] * rc_s / 2.0) - (fr[1] * rc_s / 2.0))
             - (-(forces[0] * rc_c / 2.0) + (forces[1] * rc_c / 2.0));
-        out[34] = (k[17] * phi_ddot)
+        out[34] = (k[19] * phi_ddot)
             - ((forces[0] * rc_s / 2.0) + (forces[1] * rc_s / 2.0))
             - ((fr[0] * rc_c / 2.0) + (fr[1] * rc_c / 2.0));
-        out[41] = (phi_ddot * xt1) - (k[9] * xt7 * rc_s) + (k[10] * xt7 * rc_c);
+        out[41] = (phi_ddot * xt1) - (k[11] * xt7 * rc_s) + (k[12] * xt7 * rc_c);
         out[44] = xt8 + (w * phi_dot * rc_s);
         out[46] = -(phi_ddot * rc_c / 2.0) + (xt7 * rc_s / 2.0);
         out[47] = xt9;
-        out[54] = (phi_ddot * xt2) - (k[9] * xt7 * rc_s) - (k[10] * xt7 * rc_c);
+        out[54] = (phi_ddot * xt2) - (k[11] * xt7 * rc_s) - (k[12] * xt7 * rc_c);
         out[57] = xt8 - (w * phi_dot * rc_s);
         out[59] = xt10;
         out[60] = xt9;
-        out[67] = (phi_ddot * xt5) - (k[9] * xt7 * rc_c) - (k[10] * xt7 * rc_s);
+        out[67] = (phi_ddot * xt5) - (k[11] * xt7 * rc_c) - (k[12] * xt7 * rc_s);
         out[70] = -(h * phi_dot * rc_s) + (w * phi_dot * rc_c);
         out[72] = xt9;
         out[73] = xt10;
-        out[80] = (phi_ddot * xt6) - (k[9] * xt7 * rc_c) + (k[10] * xt7 * rc_s);
+        out[80] = (phi_ddot * xt6) - (k[11] * xt7 * rc_c) + (k[12] * xt7 * rc_s);
         out[83] = -(h * phi_dot * rc_s) - (w * phi_dot * rc_c);
         out[85] = -(phi_ddot * rc_s / 2.0) - (xt7 * rc_c / 2.0);
         out[86] = xt10;
@@ -519,14 +521,14 @@ impl Tangents for RockingBlock {
 
     /// `d(initial state)/dp`: the rows `d q_0/dp`, then `d qd_0/dp`, by the parameters.
     fn initial_tangents(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..22]; // one bounds check for all constant loads
+        let k = &k[..23]; // one bounds check for all constant loads
         out.fill(0.0);
-        out[1] = k[18];
-        out[2] = -k[19];
-        out[3] = -k[20];
-        out[8] = k[19];
-        out[9] = k[18];
-        out[10] = -k[21];
+        out[1] = k[20];
+        out[2] = -k[21];
+        out[3] = -k[10];
+        out[8] = k[21];
+        out[9] = k[20];
+        out[10] = -k[22];
         out[17] = 1.0;
     }
 }

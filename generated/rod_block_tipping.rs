@@ -61,7 +61,7 @@ static INFO: ModelInfo = ModelInfo {
         meaning: "the block must be lower than the rod is long (h < ell)",
         parameters: &[2, 4],
     }],
-    n_constants: 35,
+    n_constants: 36,
     coordinates: &["x1", "y1", "theta", "xb", "yb", "phi"],
     system_coordinates: &["x1", "y1", "theta", "xb", "yb", "phi"],
     reduced_index: Some(2),
@@ -215,46 +215,46 @@ impl Model for RodBlockTipping {
         k[..6].copy_from_slice(p);
         // k[6] = asin(h/ell)
         k[6] = (h / ell).asin();
-        // k[7] = sqrt((ell - h)*(ell + h)) + w/2
-        k[7] = ((ell - h) * (ell + h)).sqrt() + (w / 2.0);
-        // k[8] = h/2
-        k[8] = h / 2.0;
-        // k[9] = ell/2
-        k[9] = ell / 2.0;
-        // k[10] = w/2
-        k[10] = w / 2.0;
-        // k[11] = ell*m1/2
-        k[11] = ell * m1 / 2.0;
-        // k[12] = m2*w^2/24 + h^2*m2/24
-        k[12] = (m2 * (w * w) / 24.0) + ((h * h) * m2 / 24.0);
-        // k[13] = ell^2*m1/6
-        k[13] = (ell * ell) * m1 / 6.0;
-        // k[14] = m1/2
-        k[14] = m1 / 2.0;
-        // k[15] = m2/2
-        k[15] = m2 / 2.0;
-        // k[16] = ell*g*m1/2
-        k[16] = ell * g * m1 / 2.0;
-        // k[17] = g*m1
-        k[17] = g * m1;
-        // k[18] = g*m2
-        k[18] = g * m2;
-        // k[19] = m2*w^2/12 + h^2*m2/12
-        k[19] = (m2 * (w * w) / 12.0) + ((h * h) * m2 / 12.0);
-        // k[20] = ell^2*m1/3
-        k[20] = (ell * ell) * m1 / 3.0;
-        // k[21] = 2*ell
-        k[21] = 2.0 * ell;
-        // k[22] = ell*m1
-        k[22] = ell * m1;
-        // k[23] = ell^2/12
-        k[23] = (ell * ell) / 12.0;
-        // k[24] = ell^2/4
-        k[24] = (ell * ell) / 4.0;
+        // k[7] = sqrt((ell - h)*(ell + h))
+        k[7] = ((ell - h) * (ell + h)).sqrt();
+        // k[8] = sqrt((ell - h)*(ell + h)) + w/2
+        k[8] = k[7] + (w / 2.0);
+        // k[9] = h/2
+        k[9] = h / 2.0;
+        // k[10] = ell/2
+        k[10] = ell / 2.0;
+        // k[11] = w/2
+        k[11] = w / 2.0;
+        // k[12] = ell*m1/2
+        k[12] = ell * m1 / 2.0;
+        // k[13] = m2*w^2/24 + h^2*m2/24
+        k[13] = (m2 * (w * w) / 24.0) + ((h * h) * m2 / 24.0);
+        // k[14] = ell^2*m1/6
+        k[14] = (ell * ell) * m1 / 6.0;
+        // k[15] = m1/2
+        k[15] = m1 / 2.0;
+        // k[16] = m2/2
+        k[16] = m2 / 2.0;
+        // k[17] = ell*g*m1/2
+        k[17] = ell * g * m1 / 2.0;
+        // k[18] = g*m1
+        k[18] = g * m1;
+        // k[19] = g*m2
+        k[19] = g * m2;
+        // k[20] = m2*w^2/12 + h^2*m2/12
+        k[20] = (m2 * (w * w) / 12.0) + ((h * h) * m2 / 12.0);
+        // k[21] = ell^2*m1/3
+        k[21] = (ell * ell) * m1 / 3.0;
+        // k[22] = 2*ell
+        k[22] = 2.0 * ell;
+        // k[23] = ell*m1
+        k[23] = ell * m1;
+        // k[24] = ell^2/3
+        k[24] = (ell * ell) / 3.0;
         // k[25] = ell*g/2
         k[25] = ell * g / 2.0;
-        // k[26] = ell*m1/6
-        k[26] = ell * m1 / 6.0;
+        // k[26] = 2*ell*m1/3
+        k[26] = 2.0 * ell * m1 / 3.0;
         // k[27] = g*m1/2
         k[27] = g * m1 / 2.0;
         // k[28] = h^2/12 + w^2/12
@@ -263,15 +263,16 @@ impl Model for RodBlockTipping {
         k[29] = m2 * w / 6.0;
         // k[30] = h*m2/6
         k[30] = h * m2 / 6.0;
-        // k[31] = h/(ell^2*(1 - h^2/ell^2)^(1/2))
-        k[31] = h / (ell * ell) / (1.0 - ((h * h) / (ell * ell))).sqrt();
-        // k[32] = 1/(ell*(1 - h^2/ell^2)^(1/2))
-        k[32] = 1.0 / ell / (1.0 - ((h * h) / (ell * ell))).sqrt();
-        // k[33] = ell/((ell + h)*(ell - h))^(1/2)
-        k[33] = ell / ((ell + h) * (ell - h)).sqrt();
-        // k[34] = (ell - h - (ell + h))/(2*((ell + h)*(ell - h))^(1/2))
-        let h34_t0 = ell + h;
-        k[34] = (ell - h - h34_t0) / 2.0 / (h34_t0 * (ell - h)).sqrt();
+        // k[31] = ((1 + h/ell)*(1 - h/ell))^(1/2)
+        k[31] = ((1.0 + (h / ell)) * (1.0 - (h / ell))).sqrt();
+        // k[32] = h/(ell^2*((1 + h/ell)*(1 - h/ell))^(1/2))
+        k[32] = h / (ell * ell) / k[31];
+        // k[33] = 1/(ell*((1 + h/ell)*(1 - h/ell))^(1/2))
+        k[33] = 1.0 / ell / k[31];
+        // k[34] = ell/sqrt((ell - h)*(ell + h))
+        k[34] = ell / k[7];
+        // k[35] = (ell - h - (ell + h))/(2*sqrt((ell - h)*(ell + h)))
+        k[35] = (ell - h - (ell + h)) / 2.0 / k[7];
     }
 
     /// The state at release, over the parameters.
@@ -289,16 +290,16 @@ impl Model for RodBlockTipping {
     /// - `phi = 0.0`
     /// - `dot_phi = 0.0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         q[0] = 0.0;
         qd[0] = 0.0;
         q[1] = 0.0;
         qd[1] = 0.0;
         q[2] = k[6];
         qd[2] = 0.0;
-        q[3] = k[7];
+        q[3] = k[8];
         qd[3] = 0.0;
-        q[4] = k[8];
+        q[4] = k[9];
         qd[4] = 0.0;
         q[5] = 0.0;
         qd[5] = 0.0;
@@ -319,7 +320,7 @@ impl Model for RodBlockTipping {
     /// - `far_edge_x = h*sin(phi)/2 + w*cos(phi)/2 + xb`
     /// - `far_edge_y = -h*cos(phi)/2 + w*sin(phi)/2 + yb`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let x1 = q[0];
@@ -334,10 +335,10 @@ impl Model for RodBlockTipping {
         let phi = q[5];
         let phi_dot = qd[5];
         let pt0 = phi.sin();
-        let pt1 = k[8] * pt0; // h*sin(phi)/2
+        let pt1 = k[9] * pt0; // h*sin(phi)/2
         let pt2 = phi.cos();
-        let pt3 = k[8] * phi_dot * pt2; // h*dot_phi*cos(phi)/2
-        let pt4 = k[8] * phi_dot * pt0; // h*dot_phi*sin(phi)/2
+        let pt3 = k[9] * phi_dot * pt2; // h*dot_phi*cos(phi)/2
+        let pt4 = k[9] * phi_dot * pt0; // h*dot_phi*sin(phi)/2
         pos[0] = [x1, y1];
         vel[0] = [x1_dot, y1_dot];
         pos[1] = [(ell * rc_c) + x1, (ell * rc_s) + y1];
@@ -345,22 +346,22 @@ impl Model for RodBlockTipping {
             -(ell * theta_dot * rc_s) + x1_dot,
             (ell * theta_dot * rc_c) + y1_dot,
         ];
-        pos[2] = [(k[9] * rc_c) + x1, (k[9] * rc_s) + y1];
+        pos[2] = [(k[10] * rc_c) + x1, (k[10] * rc_s) + y1];
         vel[2] = [
-            -(k[9] * theta_dot * rc_s) + x1_dot,
-            (k[9] * theta_dot * rc_c) + y1_dot,
+            -(k[10] * theta_dot * rc_s) + x1_dot,
+            (k[10] * theta_dot * rc_c) + y1_dot,
         ];
         pos[3] = [xb, yb];
         vel[3] = [xb_dot, yb_dot];
-        pos[4] = [pt1 - (k[10] * pt2) + xb, -(k[8] * pt2) - (k[10] * pt0) + yb];
+        pos[4] = [pt1 - (k[11] * pt2) + xb, -(k[9] * pt2) - (k[11] * pt0) + yb];
         vel[4] = [
-            pt3 + (k[10] * phi_dot * pt0) + xb_dot,
-            pt4 - (k[10] * phi_dot * pt2) + yb_dot,
+            pt3 + (k[11] * phi_dot * pt0) + xb_dot,
+            pt4 - (k[11] * phi_dot * pt2) + yb_dot,
         ];
-        pos[5] = [pt1 + (k[10] * pt2) + xb, -(k[8] * pt2) + (k[10] * pt0) + yb];
+        pos[5] = [pt1 + (k[11] * pt2) + xb, -(k[9] * pt2) + (k[11] * pt0) + yb];
         vel[5] = [
-            pt3 - (k[10] * phi_dot * pt0) + xb_dot,
-            pt4 + (k[10] * phi_dot * pt2) + yb_dot,
+            pt3 - (k[11] * phi_dot * pt0) + xb_dot,
+            pt4 + (k[11] * phi_dot * pt2) + yb_dot,
         ];
     }
 
@@ -369,7 +370,7 @@ impl Model for RodBlockTipping {
     /// - `T`: 209 characters, written out in `generated/rod_block_tipping.tex`
     /// - `V = ell*g*m1*sin(theta)/2 + g*m1*y1 + g*m2*yb`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let x1_dot = qd[0];
         let y1 = q[1];
@@ -379,15 +380,15 @@ impl Model for RodBlockTipping {
         let yb = q[4];
         let yb_dot = qd[4];
         let phi_dot = qd[5];
-        (-(k[11] * theta_dot * x1_dot * rc_s)
-            + (k[11] * theta_dot * y1_dot * rc_c)
-            + (k[12] * (phi_dot * phi_dot))
-            + (k[13] * (theta_dot * theta_dot))
-            + (k[14] * (x1_dot * x1_dot))
-            + (k[15] * (xb_dot * xb_dot))
-            + (k[14] * (y1_dot * y1_dot))
-            + (k[15] * (yb_dot * yb_dot)))
-            + ((k[16] * rc_s) + (k[17] * y1) + (k[18] * yb))
+        (-(k[12] * theta_dot * x1_dot * rc_s)
+            + (k[12] * theta_dot * y1_dot * rc_c)
+            + (k[13] * (phi_dot * phi_dot))
+            + (k[14] * (theta_dot * theta_dot))
+            + (k[15] * (x1_dot * x1_dot))
+            + (k[16] * (xb_dot * xb_dot))
+            + (k[15] * (y1_dot * y1_dot))
+            + (k[16] * (yb_dot * yb_dot)))
+            + ((k[17] * rc_s) + (k[18] * y1) + (k[19] * yb))
     }
 
     /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
@@ -396,7 +397,7 @@ impl Model for RodBlockTipping {
     /// - `p_xb = dot_xb*m2`
     /// - `p_phi = dot_phi*m2*w^2/12 + dot_phi*h^2*m2/12`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let m1 = k[0];
         let m2 = k[1];
@@ -404,9 +405,9 @@ impl Model for RodBlockTipping {
         let theta_dot = qd[2];
         let xb_dot = qd[3];
         let phi_dot = qd[5];
-        out[0] = -(k[11] * theta_dot * rc_s) + (m1 * x1_dot);
+        out[0] = -(k[12] * theta_dot * rc_s) + (m1 * x1_dot);
         out[1] = m2 * xb_dot;
-        out[2] = k[19] * phi_dot;
+        out[2] = k[20] * phi_dot;
     }
 
     /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
@@ -414,13 +415,13 @@ impl Model for RodBlockTipping {
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
     /// - `L = T - V`: 255 characters, written out in `generated/rod_block_tipping.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let m2 = k[1];
         let theta_dot = qd[2];
-        let qt0 = -k[11] * rc_s; // -(ell*m1*rc_s/2)
-        let qt1 = k[11] * rc_c; // ell*m1*rc_c/2
+        let qt0 = -k[12] * rc_s; // -(ell*m1*rc_s/2)
+        let qt1 = k[12] * rc_c; // ell*m1*rc_c/2
         let qt2 = theta_dot * theta_dot;
         mass[0] = m1;
         mass[1] = 0.0;
@@ -436,7 +437,7 @@ impl Model for RodBlockTipping {
         mass[11] = 0.0;
         mass[12] = qt0;
         mass[13] = qt1;
-        mass[14] = k[20];
+        mass[14] = k[21];
         mass[15] = 0.0;
         mass[16] = 0.0;
         mass[17] = 0.0;
@@ -457,12 +458,12 @@ impl Model for RodBlockTipping {
         mass[32] = 0.0;
         mass[33] = 0.0;
         mass[34] = 0.0;
-        mass[35] = k[19];
-        rhs[0] = k[11] * qt2 * rc_c;
-        rhs[1] = -k[17] + (k[11] * qt2 * rc_s);
-        rhs[2] = -k[16] * rc_c;
+        mass[35] = k[20];
+        rhs[0] = k[12] * qt2 * rc_c;
+        rhs[1] = -k[18] + (k[12] * qt2 * rc_s);
+        rhs[2] = -k[17] * rc_c;
         rhs[3] = 0.0;
-        rhs[4] = -k[18];
+        rhs[4] = -k[19];
         rhs[5] = 0.0;
     }
 
@@ -485,7 +486,7 @@ impl Model for RodBlockTipping {
     /// - `floor_normal = y1`
     /// - `tip_floor = ell*sin(theta) + y1`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let x1 = q[0];
@@ -495,18 +496,18 @@ impl Model for RodBlockTipping {
         let phi = q[5];
         let gt0 = phi.sin();
         let gt1 = phi.cos();
-        out[0] = -k[10] - (ell * gt0 * rc_s) - (ell * gt1 * rc_c) - (x1 * gt1) + (xb * gt1)
+        out[0] = -k[11] - (ell * gt0 * rc_s) - (ell * gt1 * rc_c) - (x1 * gt1) + (xb * gt1)
             - (y1 * gt0)
             + (yb * gt0);
-        out[1] = -(k[8] * gt1) - (k[10] * gt0) + yb;
-        out[2] = -(k[8] * gt1) + (k[10] * gt0) + yb;
+        out[1] = -(k[9] * gt1) - (k[11] * gt0) + yb;
+        out[2] = -(k[9] * gt1) + (k[11] * gt0) + yb;
         out[3] = y1;
         out[4] = (ell * rc_s) + y1;
     }
 
     /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let x1 = q[0];
@@ -522,10 +523,10 @@ impl Model for RodBlockTipping {
         let phi_dot = qd[5];
         let jt0 = phi.cos();
         let jt1 = phi.sin();
-        let jt2 = k[8] * jt1; // h*sin(phi)/2
+        let jt2 = k[9] * jt1; // h*sin(phi)/2
         let jt3 = phi_dot * phi_dot;
         let jt4 = theta_dot * theta_dot;
-        let jt5 = k[8] * jt3 * jt0; // h*dot_phi^2*cos(phi)/2
+        let jt5 = k[9] * jt3 * jt0; // h*dot_phi^2*cos(phi)/2
         jac[0] = -jt0;
         jac[1] = -jt1;
         jac[2] = -(ell * jt1 * rc_c) + (ell * rc_s * jt0);
@@ -538,13 +539,13 @@ impl Model for RodBlockTipping {
         jac[8] = 0.0;
         jac[9] = 0.0;
         jac[10] = 1.0;
-        jac[11] = jt2 - (k[10] * jt0);
+        jac[11] = jt2 - (k[11] * jt0);
         jac[12] = 0.0;
         jac[13] = 0.0;
         jac[14] = 0.0;
         jac[15] = 0.0;
         jac[16] = 1.0;
-        jac[17] = jt2 + (k[10] * jt0);
+        jac[17] = jt2 + (k[11] * jt0);
         jac[18] = 0.0;
         jac[19] = 1.0;
         jac[20] = 0.0;
@@ -557,8 +558,8 @@ impl Model for RodBlockTipping {
         jac[27] = 0.0;
         jac[28] = 0.0;
         jac[29] = 0.0;
-        bias[0] = -(k[21] * phi_dot * theta_dot * jt1 * rc_s)
-            - (k[21] * phi_dot * theta_dot * jt0 * rc_c)
+        bias[0] = -(k[22] * phi_dot * theta_dot * jt1 * rc_s)
+            - (k[22] * phi_dot * theta_dot * jt0 * rc_c)
             + (2.0 * phi_dot * x1_dot * jt1)
             - (2.0 * phi_dot * xb_dot * jt1)
             - (2.0 * phi_dot * y1_dot * jt0)
@@ -571,8 +572,8 @@ impl Model for RodBlockTipping {
             - (jt3 * yb * jt1)
             + (ell * jt4 * jt1 * rc_s)
             + (ell * jt4 * jt0 * rc_c);
-        bias[1] = jt5 + (k[10] * jt3 * jt1);
-        bias[2] = jt5 - (k[10] * jt3 * jt1);
+        bias[1] = jt5 + (k[11] * jt3 * jt1);
+        bias[2] = jt5 - (k[11] * jt3 * jt1);
         bias[3] = 0.0;
         bias[4] = -ell * jt4 * rc_s;
     }
@@ -581,7 +582,7 @@ impl Model for RodBlockTipping {
     ///
     /// - `contact_force = ell*sin(phi)*cos(theta) - ell*sin(theta)*cos(phi) + h/2 + x1*sin(phi) - xb*sin(phi) - y1*cos(phi) + yb*cos(phi)`
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let x1 = q[0];
@@ -592,7 +593,7 @@ impl Model for RodBlockTipping {
         let et0 = phi.sin();
         let et1 = phi.cos();
         out[0] =
-            k[8] + (ell * et0 * rc_c) - (ell * rc_s * et1) + (x1 * et0) - (xb * et0) - (y1 * et1)
+            k[9] + (ell * et0 * rc_c) - (ell * rc_s * et1) + (x1 * et0) - (xb * et0) - (y1 * et1)
                 + (yb * et1);
         out[1] = f64::INFINITY;
         out[2] = f64::INFINITY;
@@ -661,7 +662,7 @@ impl Model for RodBlockTipping {
 
     /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let w = k[3];
         let h = k[4];
@@ -671,11 +672,11 @@ impl Model for RodBlockTipping {
         let xb = q[3];
         let yb = q[4];
         let phi = q[5];
-        poses[0] = [(k[9] * rc_c) + x1, (k[9] * rc_s) + y1, theta];
+        poses[0] = [(k[10] * rc_c) + x1, (k[10] * rc_s) + y1, theta];
         poses[1] = [xb, yb, phi];
-        sizes[0] = -k[9];
+        sizes[0] = -k[10];
         sizes[1] = 0.0;
-        sizes[2] = k[9];
+        sizes[2] = k[10];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
@@ -701,7 +702,7 @@ impl Tangents for RodBlockTipping {
         let qd = at.qd;
         let qdd = at.qdd;
         let forces = at.forces;
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let m2 = k[1];
@@ -736,133 +737,129 @@ impl Tangents for RodBlockTipping {
         let xt7 = xt5 + xt6;
         let xt8 = -xt5 - xt6;
         let xt9 = -forces[0] * xt8;
-        let xt10 = rc_s * rc_s;
-        let xt11 = rc_c * rc_c;
-        let xt12 = -(xt1 * rc_c) + (rc_s * xt3);
-        let xt13 = forces[0] * xt1;
-        let xt14 = -forces[0] * xt3;
-        let xt15 = xt5 + xt6 + (x1 * xt3) - (xb * xt3) + (y1 * xt1) - (yb * xt1);
-        let xt16 = k[8] * xt3; // h*cos(phi)/2
-        let xt17 = xt16 + (k[10] * xt1); // h*cos(phi)/2 + w*sin(phi)/2
-        let xt18 = xt16 - (k[10] * xt1); // h*cos(phi)/2 - w*sin(phi)/2
-        let xt19 = (xt1 * rc_c) - (rc_s * xt3);
-        let xt20 = phi_dot * phi_dot;
-        let xt21 = h * phi_dot * xt3;
-        let xt22 = (phi_ddot * xt1 / 2.0) + (xt20 * xt3 / 2.0);
-        let xt23 = -xt3;
-        let xt24 = -xt1;
-        let xt25 = k[8] * xt1; // h*sin(phi)/2
-        let xt26 = -xt3 / 2.0;
+        let xt10 = -(xt1 * rc_c) + (rc_s * xt3);
+        let xt11 = forces[0] * xt1;
+        let xt12 = -forces[0] * xt3;
+        let xt13 = xt5 + xt6 + (x1 * xt3) - (xb * xt3) + (y1 * xt1) - (yb * xt1);
+        let xt14 = k[9] * xt3; // h*cos(phi)/2
+        let xt15 = xt14 + (k[11] * xt1); // h*cos(phi)/2 + w*sin(phi)/2
+        let xt16 = xt14 - (k[11] * xt1); // h*cos(phi)/2 - w*sin(phi)/2
+        let xt17 = (xt1 * rc_c) - (rc_s * xt3);
+        let xt18 = phi_dot * phi_dot;
+        let xt19 = h * phi_dot * xt3;
+        let xt20 = (phi_ddot * xt1 / 2.0) + (xt18 * xt3 / 2.0);
+        let xt21 = -xt3;
+        let xt22 = -xt1;
+        let xt23 = k[9] * xt1; // h*sin(phi)/2
+        let xt24 = -xt3 / 2.0;
         out.fill(0.0);
-        out[2] = -(k[11] * theta_ddot * rc_c) + (k[11] * xt0 * rc_s);
+        out[2] = -(k[12] * theta_ddot * rc_c) + (k[12] * xt0 * rc_s);
         out[5] = xt2;
-        out[8] = -k[22] * theta_dot * rc_c;
-        out[12] = -(k[9] * theta_ddot * rc_s) + x1_ddot - (k[9] * xt0 * rc_c);
-        out[14] = -(k[14] * theta_ddot * rc_s) - (k[14] * xt0 * rc_c);
-        out[20] = -(k[11] * theta_ddot * rc_s) - (k[11] * xt0 * rc_c);
+        out[8] = -k[23] * theta_dot * rc_c;
+        out[12] = -(k[10] * theta_ddot * rc_s) + x1_ddot - (k[10] * xt0 * rc_c);
+        out[14] = -(k[15] * theta_ddot * rc_s) - (k[15] * xt0 * rc_c);
+        out[20] = -(k[12] * theta_ddot * rc_s) - (k[12] * xt0 * rc_c);
         out[23] = xt4;
-        out[26] = -k[22] * theta_dot * rc_s;
-        out[30] = (k[9] * theta_ddot * rc_c) + y1_ddot - (-g + (k[9] * xt0 * rc_s));
-        out[32] = (k[14] * theta_ddot * rc_c) - (k[14] * xt0 * rc_s);
+        out[26] = -k[23] * theta_dot * rc_s;
+        out[30] = (k[10] * theta_ddot * rc_c) + y1_ddot - (-g + (k[10] * xt0 * rc_s));
+        out[32] = (k[15] * theta_ddot * rc_c) - (k[15] * xt0 * rc_s);
         out[35] = m1;
-        out[38] = -(k[11] * x1_ddot * rc_c)
-            - (k[11] * y1_ddot * rc_s)
-            - (k[16] * rc_s)
+        out[38] = -(k[12] * x1_ddot * rc_c)
+            - (k[12] * y1_ddot * rc_s)
+            - (k[17] * rc_s)
             - (-(ell * forces[4] * rc_s) + (forces[0] * xt7));
         out[41] = xt9;
-        out[48] = (theta_ddot * (k[23] + (k[24] * xt10) + (k[24] * xt11)))
-            - (k[9] * x1_ddot * rc_s)
-            + (k[9] * y1_ddot * rc_c)
+        out[48] = (k[24] * theta_ddot) - (k[10] * x1_ddot * rc_s)
+            + (k[10] * y1_ddot * rc_c)
             + (k[25] * rc_c);
-        out[50] = (theta_ddot * (k[26] + (k[11] * xt10) + (k[11] * xt11)))
-            - (k[14] * x1_ddot * rc_s)
-            + (k[14] * y1_ddot * rc_c)
+        out[50] = (k[26] * theta_ddot) - (k[15] * x1_ddot * rc_s)
+            + (k[15] * y1_ddot * rc_c)
             + (k[27] * rc_c)
-            - ((forces[0] * xt12) + (forces[4] * rc_c));
-        out[53] = k[11] * rc_c;
-        out[59] = xt13;
+            - ((forces[0] * xt10) + (forces[4] * rc_c));
+        out[53] = k[12] * rc_c;
+        out[59] = xt11;
         out[67] = xb_ddot;
-        out[77] = xt14;
+        out[77] = xt12;
         out[85] = g + yb_ddot;
         out[89] = m2;
         out[90] = xt2;
         out[91] = xt4;
         out[92] = xt9;
-        out[93] = xt13;
-        out[94] = xt14;
-        out[95] = -((forces[0] * xt15) + (forces[1] * xt17) + (forces[2] * xt18));
+        out[93] = xt11;
+        out[94] = xt12;
+        out[95] = -((forces[0] * xt13) + (forces[1] * xt15) + (forces[2] * xt16));
         out[103] = k[28] * phi_ddot;
-        out[104] = -forces[0] * xt19;
+        out[104] = -forces[0] * xt17;
         out[105] = (k[29] * phi_ddot) - (-(forces[1] * xt3 / 2.0) + (forces[2] * xt3 / 2.0));
         out[106] = (k[30] * phi_ddot) - ((forces[1] * xt1 / 2.0) + (forces[2] * xt1 / 2.0));
-        out[108] = (phi_ddot * xt1) + (xt20 * xt3);
-        out[109] = -(phi_ddot * xt3) + (xt20 * xt1);
+        out[108] = (phi_ddot * xt1) + (xt18 * xt3);
+        out[109] = -(phi_ddot * xt3) + (xt18 * xt1);
         out[110] = (phi_ddot * xt8) + (theta_ddot * xt7)
-            - (k[21] * phi_dot * theta_dot * xt1 * rc_c)
-            + (k[21] * phi_dot * theta_dot * rc_s * xt3)
-            + (ell * xt20 * xt1 * rc_c)
-            - (ell * xt20 * rc_s * xt3)
+            - (k[22] * phi_dot * theta_dot * xt1 * rc_c)
+            + (k[22] * phi_dot * theta_dot * rc_s * xt3)
+            + (ell * xt18 * xt1 * rc_c)
+            - (ell * xt18 * rc_s * xt3)
             + (ell * xt0 * xt1 * rc_c)
             - (ell * xt0 * rc_s * xt3);
-        out[111] = -(phi_ddot * xt1) - (xt20 * xt3);
-        out[112] = (phi_ddot * xt3) - (xt20 * xt1);
-        out[113] = (phi_ddot * xt15) + (theta_ddot * xt8) + (x1_ddot * xt1)
+        out[111] = -(phi_ddot * xt1) - (xt18 * xt3);
+        out[112] = (phi_ddot * xt3) - (xt18 * xt1);
+        out[113] = (phi_ddot * xt13) + (theta_ddot * xt8) + (x1_ddot * xt1)
             - (xb_ddot * xt1)
             - (y1_ddot * xt3)
             + (yb_ddot * xt3)
-            + (k[21] * phi_dot * theta_dot * xt1 * rc_c)
-            - (k[21] * phi_dot * theta_dot * rc_s * xt3)
+            + (k[22] * phi_dot * theta_dot * xt1 * rc_c)
+            - (k[22] * phi_dot * theta_dot * rc_s * xt3)
             + (2.0 * phi_dot * x1_dot * xt3)
             - (2.0 * phi_dot * xb_dot * xt3)
             + (2.0 * phi_dot * y1_dot * xt1)
             - (2.0 * phi_dot * yb_dot * xt1)
-            - (ell * xt20 * xt1 * rc_c)
-            + (ell * xt20 * rc_s * xt3)
-            - (xt20 * x1 * xt1)
-            + (xt20 * xb * xt1)
-            + (xt20 * y1 * xt3)
-            - (xt20 * yb * xt3)
+            - (ell * xt18 * xt1 * rc_c)
+            + (ell * xt18 * rc_s * xt3)
+            - (xt18 * x1 * xt1)
+            + (xt18 * xb * xt1)
+            + (xt18 * y1 * xt3)
+            - (xt18 * yb * xt3)
             - (ell * xt0 * xt1 * rc_c)
             + (ell * xt0 * rc_s * xt3);
         out[114] = 2.0 * phi_dot * xt1;
         out[115] = -2.0 * phi_dot * xt3;
-        out[116] = -(k[21] * phi_dot * xt1 * rc_s) - (k[21] * phi_dot * xt3 * rc_c)
-            + (k[21] * theta_dot * xt1 * rc_s)
-            + (k[21] * theta_dot * xt3 * rc_c);
+        out[116] = -(k[22] * phi_dot * xt1 * rc_s) - (k[22] * phi_dot * xt3 * rc_c)
+            + (k[22] * theta_dot * xt1 * rc_s)
+            + (k[22] * theta_dot * xt3 * rc_c);
         out[117] = -2.0 * phi_dot * xt1;
         out[118] = 2.0 * phi_dot * xt3;
-        out[119] = (k[21] * phi_dot * xt1 * rc_s)
-            + (k[21] * phi_dot * xt3 * rc_c)
+        out[119] = (k[22] * phi_dot * xt1 * rc_s)
+            + (k[22] * phi_dot * xt3 * rc_c)
             + (2.0 * phi_dot * x1 * xt3)
             - (2.0 * phi_dot * xb * xt3)
             + (2.0 * phi_dot * y1 * xt1)
             - (2.0 * phi_dot * yb * xt1)
-            - (k[21] * theta_dot * xt1 * rc_s)
-            - (k[21] * theta_dot * xt3 * rc_c)
+            - (k[22] * theta_dot * xt1 * rc_s)
+            - (k[22] * theta_dot * xt3 * rc_c)
             + (2.0 * x1_dot * xt1)
             - (2.0 * xb_dot * xt1)
             - (2.0 * y1_dot * xt3)
             + (2.0 * yb_dot * xt3);
-        out[122] = (phi_ddot * xt19) + (theta_ddot * xt12)
+        out[122] = (phi_ddot * xt17) + (theta_ddot * xt10)
             - (2.0 * phi_dot * theta_dot * xt1 * rc_s)
             - (2.0 * phi_dot * theta_dot * xt3 * rc_c)
-            + (xt20 * xt1 * rc_s)
-            + (xt20 * xt3 * rc_c)
+            + (xt18 * xt1 * rc_s)
+            + (xt18 * xt3 * rc_c)
             + (xt0 * xt1 * rc_s)
             + (xt0 * xt3 * rc_c);
-        out[131] = (phi_ddot * xt17) - (k[8] * xt20 * xt1) + (k[10] * xt20 * xt3);
-        out[137] = xt21 + (w * phi_dot * xt1);
-        out[141] = -(phi_ddot * xt3 / 2.0) + (xt20 * xt1 / 2.0);
-        out[142] = xt22;
-        out[149] = (phi_ddot * xt18) - (k[8] * xt20 * xt1) - (k[10] * xt20 * xt3);
-        out[155] = xt21 - (w * phi_dot * xt1);
-        out[159] = (phi_ddot * xt3 / 2.0) - (xt20 * xt1 / 2.0);
-        out[160] = xt22;
+        out[131] = (phi_ddot * xt15) - (k[9] * xt18 * xt1) + (k[11] * xt18 * xt3);
+        out[137] = xt19 + (w * phi_dot * xt1);
+        out[141] = -(phi_ddot * xt3 / 2.0) + (xt18 * xt1 / 2.0);
+        out[142] = xt20;
+        out[149] = (phi_ddot * xt16) - (k[9] * xt18 * xt1) - (k[11] * xt18 * xt3);
+        out[155] = xt19 - (w * phi_dot * xt1);
+        out[159] = (phi_ddot * xt3 / 2.0) - (xt18 * xt1 / 2.0);
+        out[160] = xt20;
         out[182] = -(ell * theta_ddot * rc_s) - (ell * xt0 * rc_c);
-        out[188] = -k[21] * theta_dot * rc_s;
+        out[188] = -k[22] * theta_dot * rc_s;
         out[194] = (theta_ddot * rc_c) - (xt0 * rc_s);
-        out[198] = xt23;
-        out[199] = xt24;
+        out[198] = xt21;
+        out[199] = xt22;
         out[200] = -(ell * xt1 * rc_c) + (ell * rc_s * xt3);
         out[201] = xt3;
         out[202] = xt1;
@@ -871,36 +868,36 @@ impl Tangents for RodBlockTipping {
         out[212] = -(xt1 * rc_s) - (xt3 * rc_c);
         out[213] = -1.0 / 2.0;
         out[220] = 1.0;
-        out[221] = xt25 - (k[10] * xt3);
+        out[221] = xt23 - (k[11] * xt3);
         out[231] = -xt1 / 2.0;
-        out[232] = xt26;
+        out[232] = xt24;
         out[238] = 1.0;
-        out[239] = xt25 + (k[10] * xt3);
+        out[239] = xt23 + (k[11] * xt3);
         out[249] = xt1 / 2.0;
-        out[250] = xt26;
+        out[250] = xt24;
         out[253] = 1.0;
         out[271] = 1.0;
         out[272] = ell * rc_c;
         out[284] = rc_s;
         out[288] = xt1;
-        out[289] = xt23;
+        out[289] = xt21;
         out[290] = xt8;
-        out[291] = xt24;
+        out[291] = xt22;
         out[292] = xt3;
-        out[293] = xt15;
-        out[302] = xt19;
+        out[293] = xt13;
+        out[302] = xt17;
         out[304] = 1.0 / 2.0;
     }
 
     /// `d(initial state)/dp`: the rows `d q_0/dp`, then `d qd_0/dp`, by the parameters.
     fn initial_tangents(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..35]; // one bounds check for all constant loads
+        let k = &k[..36]; // one bounds check for all constant loads
         out.fill(0.0);
-        out[14] = -k[31];
-        out[16] = k[32];
-        out[20] = k[33];
+        out[14] = -k[32];
+        out[16] = k[33];
+        out[20] = k[34];
         out[21] = 1.0 / 2.0;
-        out[22] = k[34];
+        out[22] = k[35];
         out[28] = 1.0 / 2.0;
     }
 }

@@ -178,58 +178,55 @@ impl Model for RodCube {
         k[..5].copy_from_slice(p);
         // k[5] = asin(a/ell)
         k[5] = (a / ell).asin();
-        // k[6] = ell*((1 - a/ell)*(1 + a/ell))^(1/2)
+        // k[6] = ((1 - a/ell)*(1 + a/ell))^(1/2)
         let h6_t0 = a / ell;
-        k[6] = ell * ((1.0 - h6_t0) * (1.0 + h6_t0)).sqrt();
-        // k[7] = ell/2
-        k[7] = ell / 2.0;
-        // k[8] = ell*m1/2
-        k[8] = ell * m1 / 2.0;
-        // k[9] = ell^2*m1/6
-        k[9] = (ell * ell) * m1 / 6.0;
-        // k[10] = m1/2
-        k[10] = m1 / 2.0;
-        // k[11] = m2/2
-        k[11] = m2 / 2.0;
-        // k[12] = a*g*m2/2
-        k[12] = a * g * m2 / 2.0;
-        // k[13] = ell*g*m1/2
-        k[13] = ell * g * m1 / 2.0;
-        // k[14] = g*m1
-        k[14] = g * m1;
-        // k[15] = ell^2*m1/3
-        k[15] = (ell * ell) * m1 / 3.0;
-        // k[16] = a/2
-        k[16] = a / 2.0;
-        // k[17] = ell*m1
-        k[17] = ell * m1;
-        // k[18] = ell^2/12
-        k[18] = (ell * ell) / 12.0;
-        // k[19] = ell^2/4
-        k[19] = (ell * ell) / 4.0;
+        k[6] = ((1.0 - h6_t0) * (1.0 + h6_t0)).sqrt();
+        // k[7] = ell*((1 - a/ell)*(1 + a/ell))^(1/2)
+        k[7] = ell * k[6];
+        // k[8] = ell/2
+        k[8] = ell / 2.0;
+        // k[9] = ell*m1/2
+        k[9] = ell * m1 / 2.0;
+        // k[10] = ell^2*m1/6
+        k[10] = (ell * ell) * m1 / 6.0;
+        // k[11] = m1/2
+        k[11] = m1 / 2.0;
+        // k[12] = m2/2
+        k[12] = m2 / 2.0;
+        // k[13] = a*g*m2/2
+        k[13] = a * g * m2 / 2.0;
+        // k[14] = ell*g*m1/2
+        k[14] = ell * g * m1 / 2.0;
+        // k[15] = g*m1
+        k[15] = g * m1;
+        // k[16] = ell^2*m1/3
+        k[16] = (ell * ell) * m1 / 3.0;
+        // k[17] = a/2
+        k[17] = a / 2.0;
+        // k[18] = ell*m1
+        k[18] = ell * m1;
+        // k[19] = ell^2/3
+        k[19] = (ell * ell) / 3.0;
         // k[20] = ell*g/2
         k[20] = ell * g / 2.0;
-        // k[21] = ell*m1/6
-        k[21] = ell * m1 / 6.0;
+        // k[21] = 2*ell*m1/3
+        k[21] = 2.0 * ell * m1 / 3.0;
         // k[22] = g*m1/2
         k[22] = g * m1 / 2.0;
         // k[23] = 2*ell
         k[23] = 2.0 * ell;
-        // k[24] = a/(ell^2*(1 - a^2/ell^2)^(1/2))
-        k[24] = a / (ell * ell) / (1.0 - ((a * a) / (ell * ell))).sqrt();
-        // k[25] = 1/(ell*(1 - a^2/ell^2)^(1/2))
-        k[25] = 1.0 / ell / (1.0 - ((a * a) / (ell * ell))).sqrt();
-        // k[26] = ell*(a*(1 + a/ell)/ell^2 - a*(1 - a/ell)/ell^2)/(2*((1 + a/ell)*(1 - a/ell))^(1/2)) + ((1 + a/ell)*(1 - a/ell))^(1/2)
-        let h26_t0 = 1.0 + (a / ell);
-        let h26_t1 = 1.0 - (a / ell);
-        let h26_t2 = h26_t0 * h26_t1;
-        k[26] =
-            (ell * ((a * h26_t0 / (ell * ell)) - (a * h26_t1 / (ell * ell))) / 2.0 / h26_t2.sqrt())
-                + h26_t2.sqrt();
-        // k[27] = ell*(-(1 + a/ell)/ell + (1 - a/ell)/ell)/(2*((1 + a/ell)*(1 - a/ell))^(1/2))
-        let h27_t0 = 1.0 + (a / ell);
-        let h27_t1 = 1.0 - (a / ell);
-        k[27] = ell * (-(h27_t0 / ell) + (h27_t1 / ell)) / 2.0 / (h27_t0 * h27_t1).sqrt();
+        // k[24] = a/(ell^2*((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[24] = a / (ell * ell) / k[6];
+        // k[25] = 1/(ell*((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[25] = 1.0 / ell / k[6];
+        // k[26] = ell*(a*(1 + a/ell)/ell^2 - a*(1 - a/ell)/ell^2)/(2*((1 - a/ell)*(1 + a/ell))^(1/2)) + ((1 - a/ell)*(1 + a/ell))^(1/2)
+        k[26] = (ell
+            * ((a * (1.0 + (a / ell)) / (ell * ell)) - (a * (1.0 - (a / ell)) / (ell * ell)))
+            / 2.0
+            / k[6])
+            + k[6];
+        // k[27] = ell*(-(1 + a/ell)/ell + (1 - a/ell)/ell)/(2*((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[27] = ell * (-((1.0 + (a / ell)) / ell) + ((1.0 - (a / ell)) / ell)) / 2.0 / k[6];
     }
 
     /// The state at release, over the parameters.
@@ -250,7 +247,7 @@ impl Model for RodCube {
         qd[1] = 0.0;
         q[2] = k[5];
         qd[2] = 0.0;
-        q[3] = k[6];
+        q[3] = k[7];
         qd[3] = 0.0;
     }
 
@@ -282,10 +279,10 @@ impl Model for RodCube {
             -(ell * theta_dot * rc_s) + x1_dot,
             (ell * theta_dot * rc_c) + y1_dot,
         ];
-        pos[2] = [(k[7] * rc_c) + x1, (k[7] * rc_s) + y1];
+        pos[2] = [(k[8] * rc_c) + x1, (k[8] * rc_s) + y1];
         vel[2] = [
-            -(k[7] * theta_dot * rc_s) + x1_dot,
-            (k[7] * theta_dot * rc_c) + y1_dot,
+            -(k[8] * theta_dot * rc_s) + x1_dot,
+            (k[8] * theta_dot * rc_c) + y1_dot,
         ];
         pos[3] = [x2, 0.0];
         vel[3] = [x2_dot, 0.0];
@@ -303,13 +300,13 @@ impl Model for RodCube {
         let y1_dot = qd[1];
         let theta_dot = qd[2];
         let x2_dot = qd[3];
-        (-(k[8] * theta_dot * x1_dot * rc_s)
-            + (k[8] * theta_dot * y1_dot * rc_c)
-            + (k[9] * (theta_dot * theta_dot))
-            + (k[10] * (x1_dot * x1_dot))
-            + (k[11] * (x2_dot * x2_dot))
-            + (k[10] * (y1_dot * y1_dot)))
-            + (k[12] + (k[13] * rc_s) + (k[14] * y1))
+        (-(k[9] * theta_dot * x1_dot * rc_s)
+            + (k[9] * theta_dot * y1_dot * rc_c)
+            + (k[10] * (theta_dot * theta_dot))
+            + (k[11] * (x1_dot * x1_dot))
+            + (k[12] * (x2_dot * x2_dot))
+            + (k[11] * (y1_dot * y1_dot)))
+            + (k[13] + (k[14] * rc_s) + (k[15] * y1))
     }
 
     /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
@@ -324,7 +321,7 @@ impl Model for RodCube {
         let x1_dot = qd[0];
         let theta_dot = qd[2];
         let x2_dot = qd[3];
-        out[0] = -(k[8] * theta_dot * rc_s) + (m1 * x1_dot);
+        out[0] = -(k[9] * theta_dot * rc_s) + (m1 * x1_dot);
         out[1] = m2 * x2_dot;
     }
 
@@ -338,8 +335,8 @@ impl Model for RodCube {
         let m1 = k[0];
         let m2 = k[1];
         let theta_dot = qd[2];
-        let qt0 = -k[8] * rc_s; // -(ell*m1*rc_s/2)
-        let qt1 = k[8] * rc_c; // ell*m1*rc_c/2
+        let qt0 = -k[9] * rc_s; // -(ell*m1*rc_s/2)
+        let qt1 = k[9] * rc_c; // ell*m1*rc_c/2
         let qt2 = theta_dot * theta_dot;
         mass[0] = m1;
         mass[1] = 0.0;
@@ -351,15 +348,15 @@ impl Model for RodCube {
         mass[7] = 0.0;
         mass[8] = qt0;
         mass[9] = qt1;
-        mass[10] = k[15];
+        mass[10] = k[16];
         mass[11] = 0.0;
         mass[12] = 0.0;
         mass[13] = 0.0;
         mass[14] = 0.0;
         mass[15] = m2;
-        rhs[0] = k[8] * qt2 * rc_c;
-        rhs[1] = -k[14] + (k[8] * qt2 * rc_s);
-        rhs[2] = -k[13] * rc_c;
+        rhs[0] = k[9] * qt2 * rc_c;
+        rhs[1] = -k[15] + (k[9] * qt2 * rc_s);
+        rhs[2] = -k[14] * rc_c;
         rhs[3] = 0.0;
     }
 
@@ -424,7 +421,7 @@ impl Model for RodCube {
         let k = &k[..28]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let ell = k[2];
-        out[0] = k[12] - (forces[0] * (-k[16] + (ell * rc_s)));
+        out[0] = k[13] - (forces[0] * (-k[17] + (ell * rc_s)));
     }
 
     /// The system's state (its general model's) that this phase's state stands for.
@@ -465,11 +462,11 @@ impl Model for RodCube {
         let y1 = q[1];
         let theta = q[2];
         let x2 = q[3];
-        poses[0] = [(k[7] * rc_c) + x1, (k[7] * rc_s) + y1, theta];
-        poses[1] = [k[16] + x2, k[16], 0.0];
-        sizes[0] = -k[7];
+        poses[0] = [(k[8] * rc_c) + x1, (k[8] * rc_s) + y1, theta];
+        poses[1] = [k[17] + x2, k[17], 0.0];
+        sizes[0] = -k[8];
         sizes[1] = 0.0;
-        sizes[2] = k[7];
+        sizes[2] = k[8];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
@@ -506,30 +503,28 @@ impl Tangents for RodCube {
         let theta_ddot = qdd[2];
         let x2_ddot = qdd[3];
         let xt0 = theta_dot * theta_dot;
-        let xt1 = rc_s * rc_s;
-        let xt2 = rc_c * rc_c;
         out.fill(0.0);
-        out[2] = -(k[8] * theta_ddot * rc_c) + (k[8] * xt0 * rc_s);
-        out[6] = -k[17] * theta_dot * rc_c;
-        out[8] = -(k[7] * theta_ddot * rc_s) + x1_ddot - (k[7] * xt0 * rc_c);
-        out[10] = -(k[10] * theta_ddot * rc_s) - (k[10] * xt0 * rc_c);
-        out[15] = -(k[8] * theta_ddot * rc_s) - (k[8] * xt0 * rc_c);
-        out[19] = -k[17] * theta_dot * rc_s;
-        out[21] = (k[7] * theta_ddot * rc_c) + y1_ddot - (-g + (k[7] * xt0 * rc_s));
-        out[23] = (k[10] * theta_ddot * rc_c) - (k[10] * xt0 * rc_s);
+        out[2] = -(k[9] * theta_ddot * rc_c) + (k[9] * xt0 * rc_s);
+        out[6] = -k[18] * theta_dot * rc_c;
+        out[8] = -(k[8] * theta_ddot * rc_s) + x1_ddot - (k[8] * xt0 * rc_c);
+        out[10] = -(k[11] * theta_ddot * rc_s) - (k[11] * xt0 * rc_c);
+        out[15] = -(k[9] * theta_ddot * rc_s) - (k[9] * xt0 * rc_c);
+        out[19] = -k[18] * theta_dot * rc_s;
+        out[21] = (k[8] * theta_ddot * rc_c) + y1_ddot - (-g + (k[8] * xt0 * rc_s));
+        out[23] = (k[11] * theta_ddot * rc_c) - (k[11] * xt0 * rc_s);
         out[25] = m1;
-        out[28] = -(k[8] * x1_ddot * rc_c)
-            - (k[8] * y1_ddot * rc_s)
-            - (k[13] * rc_s)
+        out[28] = -(k[9] * x1_ddot * rc_c)
+            - (k[9] * y1_ddot * rc_s)
+            - (k[14] * rc_s)
             - (ell * forces[0] * rc_c);
-        out[34] = (theta_ddot * (k[18] + (k[19] * xt1) + (k[19] * xt2))) - (k[7] * x1_ddot * rc_s)
-            + (k[7] * y1_ddot * rc_c)
+        out[34] = (k[19] * theta_ddot) - (k[8] * x1_ddot * rc_s)
+            + (k[8] * y1_ddot * rc_c)
             + (k[20] * rc_c);
-        out[36] = (theta_ddot * (k[21] + (k[8] * xt1) + (k[8] * xt2))) - (k[10] * x1_ddot * rc_s)
-            + (k[10] * y1_ddot * rc_c)
+        out[36] = (k[21] * theta_ddot) - (k[11] * x1_ddot * rc_s)
+            + (k[11] * y1_ddot * rc_c)
             + (k[22] * rc_c)
             - (forces[0] * rc_s);
-        out[38] = k[8] * rc_c;
+        out[38] = k[9] * rc_c;
         out[48] = x2_ddot;
         out[54] = (ell * theta_ddot * rc_c) - (ell * xt0 * rc_s);
         out[58] = k[23] * theta_dot * rc_c;

@@ -176,58 +176,55 @@ impl Model for RodCubeFriction {
         k[..6].copy_from_slice(p);
         // k[6] = asin(a/ell)
         k[6] = (a / ell).asin();
-        // k[7] = ell*((1 - a/ell)*(1 + a/ell))^(1/2)
+        // k[7] = ((1 - a/ell)*(1 + a/ell))^(1/2)
         let h7_t0 = a / ell;
-        k[7] = ell * ((1.0 - h7_t0) * (1.0 + h7_t0)).sqrt();
-        // k[8] = ell/2
-        k[8] = ell / 2.0;
-        // k[9] = ell*m1/2
-        k[9] = ell * m1 / 2.0;
-        // k[10] = ell^2*m1/6
-        k[10] = (ell * ell) * m1 / 6.0;
-        // k[11] = m1/2
-        k[11] = m1 / 2.0;
-        // k[12] = m2/2
-        k[12] = m2 / 2.0;
-        // k[13] = a*g*m2/2
-        k[13] = a * g * m2 / 2.0;
-        // k[14] = ell*g*m1/2
-        k[14] = ell * g * m1 / 2.0;
-        // k[15] = g*m1
-        k[15] = g * m1;
-        // k[16] = ell^2*m1/3
-        k[16] = (ell * ell) * m1 / 3.0;
-        // k[17] = a/2
-        k[17] = a / 2.0;
-        // k[18] = ell*m1
-        k[18] = ell * m1;
-        // k[19] = ell^2/12
-        k[19] = (ell * ell) / 12.0;
-        // k[20] = ell^2/4
-        k[20] = (ell * ell) / 4.0;
+        k[7] = ((1.0 - h7_t0) * (1.0 + h7_t0)).sqrt();
+        // k[8] = ell*((1 - a/ell)*(1 + a/ell))^(1/2)
+        k[8] = ell * k[7];
+        // k[9] = ell/2
+        k[9] = ell / 2.0;
+        // k[10] = ell*m1/2
+        k[10] = ell * m1 / 2.0;
+        // k[11] = ell^2*m1/6
+        k[11] = (ell * ell) * m1 / 6.0;
+        // k[12] = m1/2
+        k[12] = m1 / 2.0;
+        // k[13] = m2/2
+        k[13] = m2 / 2.0;
+        // k[14] = a*g*m2/2
+        k[14] = a * g * m2 / 2.0;
+        // k[15] = ell*g*m1/2
+        k[15] = ell * g * m1 / 2.0;
+        // k[16] = g*m1
+        k[16] = g * m1;
+        // k[17] = ell^2*m1/3
+        k[17] = (ell * ell) * m1 / 3.0;
+        // k[18] = a/2
+        k[18] = a / 2.0;
+        // k[19] = ell*m1
+        k[19] = ell * m1;
+        // k[20] = ell^2/3
+        k[20] = (ell * ell) / 3.0;
         // k[21] = ell*g/2
         k[21] = ell * g / 2.0;
-        // k[22] = ell*m1/6
-        k[22] = ell * m1 / 6.0;
+        // k[22] = 2*ell*m1/3
+        k[22] = 2.0 * ell * m1 / 3.0;
         // k[23] = g*m1/2
         k[23] = g * m1 / 2.0;
         // k[24] = 2*ell
         k[24] = 2.0 * ell;
-        // k[25] = a/(ell^2*(1 - a^2/ell^2)^(1/2))
-        k[25] = a / (ell * ell) / (1.0 - ((a * a) / (ell * ell))).sqrt();
-        // k[26] = 1/(ell*(1 - a^2/ell^2)^(1/2))
-        k[26] = 1.0 / ell / (1.0 - ((a * a) / (ell * ell))).sqrt();
-        // k[27] = ell*(a*(1 + a/ell)/ell^2 - a*(1 - a/ell)/ell^2)/(2*((1 + a/ell)*(1 - a/ell))^(1/2)) + ((1 + a/ell)*(1 - a/ell))^(1/2)
-        let h27_t0 = 1.0 + (a / ell);
-        let h27_t1 = 1.0 - (a / ell);
-        let h27_t2 = h27_t0 * h27_t1;
-        k[27] =
-            (ell * ((a * h27_t0 / (ell * ell)) - (a * h27_t1 / (ell * ell))) / 2.0 / h27_t2.sqrt())
-                + h27_t2.sqrt();
-        // k[28] = ell*(-(1 + a/ell)/ell + (1 - a/ell)/ell)/(2*((1 + a/ell)*(1 - a/ell))^(1/2))
-        let h28_t0 = 1.0 + (a / ell);
-        let h28_t1 = 1.0 - (a / ell);
-        k[28] = ell * (-(h28_t0 / ell) + (h28_t1 / ell)) / 2.0 / (h28_t0 * h28_t1).sqrt();
+        // k[25] = a/(ell^2*((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[25] = a / (ell * ell) / k[7];
+        // k[26] = 1/(ell*((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[26] = 1.0 / ell / k[7];
+        // k[27] = ell*(a*(1 + a/ell)/ell^2 - a*(1 - a/ell)/ell^2)/(2*((1 - a/ell)*(1 + a/ell))^(1/2)) + ((1 - a/ell)*(1 + a/ell))^(1/2)
+        k[27] = (ell
+            * ((a * (1.0 + (a / ell)) / (ell * ell)) - (a * (1.0 - (a / ell)) / (ell * ell)))
+            / 2.0
+            / k[7])
+            + k[7];
+        // k[28] = ell*(-(1 + a/ell)/ell + (1 - a/ell)/ell)/(2*((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[28] = ell * (-((1.0 + (a / ell)) / ell) + ((1.0 - (a / ell)) / ell)) / 2.0 / k[7];
     }
 
     /// The state at release, over the parameters.
@@ -248,7 +245,7 @@ impl Model for RodCubeFriction {
         qd[1] = 0.0;
         q[2] = k[6];
         qd[2] = 0.0;
-        q[3] = k[7];
+        q[3] = k[8];
         qd[3] = 0.0;
     }
 
@@ -280,10 +277,10 @@ impl Model for RodCubeFriction {
             -(ell * theta_dot * rc_s) + x1_dot,
             (ell * theta_dot * rc_c) + y1_dot,
         ];
-        pos[2] = [(k[8] * rc_c) + x1, (k[8] * rc_s) + y1];
+        pos[2] = [(k[9] * rc_c) + x1, (k[9] * rc_s) + y1];
         vel[2] = [
-            -(k[8] * theta_dot * rc_s) + x1_dot,
-            (k[8] * theta_dot * rc_c) + y1_dot,
+            -(k[9] * theta_dot * rc_s) + x1_dot,
+            (k[9] * theta_dot * rc_c) + y1_dot,
         ];
         pos[3] = [x2, 0.0];
         vel[3] = [x2_dot, 0.0];
@@ -301,13 +298,13 @@ impl Model for RodCubeFriction {
         let y1_dot = qd[1];
         let theta_dot = qd[2];
         let x2_dot = qd[3];
-        (-(k[9] * theta_dot * x1_dot * rc_s)
-            + (k[9] * theta_dot * y1_dot * rc_c)
-            + (k[10] * (theta_dot * theta_dot))
-            + (k[11] * (x1_dot * x1_dot))
-            + (k[12] * (x2_dot * x2_dot))
-            + (k[11] * (y1_dot * y1_dot)))
-            + (k[13] + (k[14] * rc_s) + (k[15] * y1))
+        (-(k[10] * theta_dot * x1_dot * rc_s)
+            + (k[10] * theta_dot * y1_dot * rc_c)
+            + (k[11] * (theta_dot * theta_dot))
+            + (k[12] * (x1_dot * x1_dot))
+            + (k[13] * (x2_dot * x2_dot))
+            + (k[12] * (y1_dot * y1_dot)))
+            + (k[14] + (k[15] * rc_s) + (k[16] * y1))
     }
 
     /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
@@ -322,7 +319,7 @@ impl Model for RodCubeFriction {
         let x1_dot = qd[0];
         let theta_dot = qd[2];
         let x2_dot = qd[3];
-        out[0] = -(k[9] * theta_dot * rc_s) + (m1 * x1_dot);
+        out[0] = -(k[10] * theta_dot * rc_s) + (m1 * x1_dot);
         out[1] = m2 * x2_dot;
     }
 
@@ -336,8 +333,8 @@ impl Model for RodCubeFriction {
         let m1 = k[0];
         let m2 = k[1];
         let theta_dot = qd[2];
-        let qt0 = -k[9] * rc_s; // -(ell*m1*rc_s/2)
-        let qt1 = k[9] * rc_c; // ell*m1*rc_c/2
+        let qt0 = -k[10] * rc_s; // -(ell*m1*rc_s/2)
+        let qt1 = k[10] * rc_c; // ell*m1*rc_c/2
         let qt2 = theta_dot * theta_dot;
         mass[0] = m1;
         mass[1] = 0.0;
@@ -349,15 +346,15 @@ impl Model for RodCubeFriction {
         mass[7] = 0.0;
         mass[8] = qt0;
         mass[9] = qt1;
-        mass[10] = k[16];
+        mass[10] = k[17];
         mass[11] = 0.0;
         mass[12] = 0.0;
         mass[13] = 0.0;
         mass[14] = 0.0;
         mass[15] = m2;
-        rhs[0] = k[9] * qt2 * rc_c;
-        rhs[1] = -k[15] + (k[9] * qt2 * rc_s);
-        rhs[2] = -k[14] * rc_c;
+        rhs[0] = k[10] * qt2 * rc_c;
+        rhs[1] = -k[16] + (k[10] * qt2 * rc_s);
+        rhs[2] = -k[15] * rc_c;
         rhs[3] = 0.0;
     }
 
@@ -428,7 +425,7 @@ impl Model for RodCubeFriction {
         let k = &k[..29]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let ell = k[2];
-        out[0] = k[13] - (forces[0] * (-k[17] + (ell * rc_s)));
+        out[0] = k[14] - (forces[0] * (-k[18] + (ell * rc_s)));
     }
 
     /// The system's state (its general model's) that this phase's state stands for.
@@ -469,11 +466,11 @@ impl Model for RodCubeFriction {
         let y1 = q[1];
         let theta = q[2];
         let x2 = q[3];
-        poses[0] = [(k[8] * rc_c) + x1, (k[8] * rc_s) + y1, theta];
-        poses[1] = [k[17] + x2, k[17], 0.0];
-        sizes[0] = -k[8];
+        poses[0] = [(k[9] * rc_c) + x1, (k[9] * rc_s) + y1, theta];
+        poses[1] = [k[18] + x2, k[18], 0.0];
+        sizes[0] = -k[9];
         sizes[1] = 0.0;
-        sizes[2] = k[8];
+        sizes[2] = k[9];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
@@ -510,30 +507,28 @@ impl Tangents for RodCubeFriction {
         let theta_ddot = qdd[2];
         let x2_ddot = qdd[3];
         let xt0 = theta_dot * theta_dot;
-        let xt1 = rc_s * rc_s;
-        let xt2 = rc_c * rc_c;
         out.fill(0.0);
-        out[2] = -(k[9] * theta_ddot * rc_c) + (k[9] * xt0 * rc_s);
-        out[6] = -k[18] * theta_dot * rc_c;
-        out[8] = -(k[8] * theta_ddot * rc_s) + x1_ddot - (k[8] * xt0 * rc_c);
-        out[10] = -(k[11] * theta_ddot * rc_s) - (k[11] * xt0 * rc_c);
-        out[16] = -(k[9] * theta_ddot * rc_s) - (k[9] * xt0 * rc_c);
-        out[20] = -k[18] * theta_dot * rc_s;
-        out[22] = (k[8] * theta_ddot * rc_c) + y1_ddot - (-g + (k[8] * xt0 * rc_s));
-        out[24] = (k[11] * theta_ddot * rc_c) - (k[11] * xt0 * rc_s);
+        out[2] = -(k[10] * theta_ddot * rc_c) + (k[10] * xt0 * rc_s);
+        out[6] = -k[19] * theta_dot * rc_c;
+        out[8] = -(k[9] * theta_ddot * rc_s) + x1_ddot - (k[9] * xt0 * rc_c);
+        out[10] = -(k[12] * theta_ddot * rc_s) - (k[12] * xt0 * rc_c);
+        out[16] = -(k[10] * theta_ddot * rc_s) - (k[10] * xt0 * rc_c);
+        out[20] = -k[19] * theta_dot * rc_s;
+        out[22] = (k[9] * theta_ddot * rc_c) + y1_ddot - (-g + (k[9] * xt0 * rc_s));
+        out[24] = (k[12] * theta_ddot * rc_c) - (k[12] * xt0 * rc_s);
         out[26] = m1;
-        out[30] = -(k[9] * x1_ddot * rc_c)
-            - (k[9] * y1_ddot * rc_s)
-            - (k[14] * rc_s)
+        out[30] = -(k[10] * x1_ddot * rc_c)
+            - (k[10] * y1_ddot * rc_s)
+            - (k[15] * rc_s)
             - (ell * forces[0] * rc_c);
-        out[36] = (theta_ddot * (k[19] + (k[20] * xt1) + (k[20] * xt2))) - (k[8] * x1_ddot * rc_s)
-            + (k[8] * y1_ddot * rc_c)
+        out[36] = (k[20] * theta_ddot) - (k[9] * x1_ddot * rc_s)
+            + (k[9] * y1_ddot * rc_c)
             + (k[21] * rc_c);
-        out[38] = (theta_ddot * (k[22] + (k[9] * xt1) + (k[9] * xt2))) - (k[11] * x1_ddot * rc_s)
-            + (k[11] * y1_ddot * rc_c)
+        out[38] = (k[22] * theta_ddot) - (k[12] * x1_ddot * rc_s)
+            + (k[12] * y1_ddot * rc_c)
             + (k[23] * rc_c)
             - (forces[0] * rc_s);
-        out[40] = k[9] * rc_c;
+        out[40] = k[10] * rc_c;
         out[51] = x2_ddot;
         out[58] = (ell * theta_ddot * rc_c) - (ell * xt0 * rc_s);
         out[62] = k[24] * theta_dot * rc_c;

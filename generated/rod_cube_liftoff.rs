@@ -209,27 +209,26 @@ impl Model for RodCubeLiftoff {
         k[17] = a / 2.0;
         // k[18] = ell*m1
         k[18] = ell * m1;
-        // k[19] = ell^2/12
-        k[19] = (ell * ell) / 12.0;
-        // k[20] = ell^2/4
-        k[20] = (ell * ell) / 4.0;
-        // k[21] = ell*g/2
-        k[21] = ell * g / 2.0;
-        // k[22] = ell*m1/6
-        k[22] = ell * m1 / 6.0;
-        // k[23] = g*m1/2
-        k[23] = g * m1 / 2.0;
-        // k[24] = 2*ell
-        k[24] = 2.0 * ell;
-        // k[25] = a/(ell^2*(1 - a^2/ell^2)^(1/2))
-        k[25] = a / (ell * ell) / (1.0 - ((a * a) / (ell * ell))).sqrt();
-        // k[26] = 1/(ell*(1 - a^2/ell^2)^(1/2))
-        k[26] = 1.0 / ell / (1.0 - ((a * a) / (ell * ell))).sqrt();
-        // k[27] = ell/((a + ell)*(-a + ell))^(1/2)
-        k[27] = ell / ((a + ell) * (-a + ell)).sqrt();
-        // k[28] = (-a + ell - (a + ell))/(2*((a + ell)*(-a + ell))^(1/2))
-        let h28_t0 = a + ell;
-        k[28] = (-a + ell - h28_t0) / 2.0 / (h28_t0 * (-a + ell)).sqrt();
+        // k[19] = ell^2/3
+        k[19] = (ell * ell) / 3.0;
+        // k[20] = ell*g/2
+        k[20] = ell * g / 2.0;
+        // k[21] = 2*ell*m1/3
+        k[21] = 2.0 * ell * m1 / 3.0;
+        // k[22] = g*m1/2
+        k[22] = g * m1 / 2.0;
+        // k[23] = 2*ell
+        k[23] = 2.0 * ell;
+        // k[24] = ((1 + a/ell)*(1 - a/ell))^(1/2)
+        k[24] = ((1.0 + (a / ell)) * (1.0 - (a / ell))).sqrt();
+        // k[25] = a/(ell^2*((1 + a/ell)*(1 - a/ell))^(1/2))
+        k[25] = a / (ell * ell) / k[24];
+        // k[26] = 1/(ell*((1 + a/ell)*(1 - a/ell))^(1/2))
+        k[26] = 1.0 / ell / k[24];
+        // k[27] = ell/sqrt((ell - a)*(ell + a))
+        k[27] = ell / k[7];
+        // k[28] = (-a + ell - (a + ell))/(2*sqrt((ell - a)*(ell + a)))
+        k[28] = (-a + ell - (a + ell)) / 2.0 / k[7];
     }
 
     /// The state at release, over the parameters.
@@ -517,8 +516,6 @@ impl Tangents for RodCubeLiftoff {
         let theta_ddot = qdd[2];
         let x2_ddot = qdd[3];
         let xt0 = theta_dot * theta_dot;
-        let xt1 = rc_s * rc_s;
-        let xt2 = rc_c * rc_c;
         out.fill(0.0);
         out[2] = -(k[9] * theta_ddot * rc_c) + (k[9] * xt0 * rc_s);
         out[6] = -k[18] * theta_dot * rc_c;
@@ -533,20 +530,20 @@ impl Tangents for RodCubeLiftoff {
             - (k[9] * y1_ddot * rc_s)
             - (k[14] * rc_s)
             - ((ell * forces[0] * rc_c) - (ell * forces[2] * rc_s));
-        out[36] = (theta_ddot * (k[19] + (k[20] * xt1) + (k[20] * xt2))) - (k[8] * x1_ddot * rc_s)
+        out[36] = (k[19] * theta_ddot) - (k[8] * x1_ddot * rc_s)
             + (k[8] * y1_ddot * rc_c)
-            + (k[21] * rc_c);
-        out[38] = (theta_ddot * (k[22] + (k[9] * xt1) + (k[9] * xt2))) - (k[11] * x1_ddot * rc_s)
+            + (k[20] * rc_c);
+        out[38] = (k[21] * theta_ddot) - (k[11] * x1_ddot * rc_s)
             + (k[11] * y1_ddot * rc_c)
-            + (k[23] * rc_c)
+            + (k[22] * rc_c)
             - ((forces[0] * rc_s) + (forces[2] * rc_c));
         out[40] = k[9] * rc_c;
         out[51] = x2_ddot;
         out[58] = (ell * theta_ddot * rc_c) - (ell * xt0 * rc_s);
-        out[62] = k[24] * theta_dot * rc_c;
+        out[62] = k[23] * theta_dot * rc_c;
         out[66] = (theta_ddot * rc_s) + (xt0 * rc_c);
         out[86] = -(ell * theta_ddot * rc_s) - (ell * xt0 * rc_c);
-        out[90] = -k[24] * theta_dot * rc_s;
+        out[90] = -k[23] * theta_dot * rc_s;
         out[94] = (theta_ddot * rc_c) - (xt0 * rc_s);
         out[98] = -1.0;
         out[100] = ell * rc_s;

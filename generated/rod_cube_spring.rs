@@ -168,66 +168,63 @@ impl Model for RodCubeSpring {
         k[..6].copy_from_slice(p);
         // k[6] = asin(a/ell)
         k[6] = (a / ell).asin();
-        // k[7] = ell*((1 - a/ell)*(1 + a/ell))^(1/2)
+        // k[7] = ((1 - a/ell)*(1 + a/ell))^(1/2)
         let h7_t0 = a / ell;
-        k[7] = ell * ((1.0 - h7_t0) * (1.0 + h7_t0)).sqrt();
-        // k[8] = ell/2
-        k[8] = ell / 2.0;
-        // k[9] = ell*m1/2
-        k[9] = ell * m1 / 2.0;
-        // k[10] = ell^2*m1/6
-        k[10] = (ell * ell) * m1 / 6.0;
-        // k[11] = m1/2
-        k[11] = m1 / 2.0;
-        // k[12] = m2/2
-        k[12] = m2 / 2.0;
-        // k[13] = a*g*m2/2
-        k[13] = a * g * m2 / 2.0;
-        // k[14] = ell*g*m1/2
-        k[14] = ell * g * m1 / 2.0;
-        // k[15] = g*m1
-        k[15] = g * m1;
-        // k[16] = k/2
-        k[16] = k_param / 2.0;
-        // k[17] = (-a^2 + ell^2)^(1/2)
-        k[17] = (-(a * a) + (ell * ell)).sqrt();
-        // k[18] = ell^2*m1/3
-        k[18] = (ell * ell) * m1 / 3.0;
-        // k[19] = a/2
-        k[19] = a / 2.0;
-        // k[20] = ell*m1
-        k[20] = ell * m1;
-        // k[21] = ell^2/12
-        k[21] = (ell * ell) / 12.0;
-        // k[22] = ell^2/4
-        k[22] = (ell * ell) / 4.0;
+        k[7] = ((1.0 - h7_t0) * (1.0 + h7_t0)).sqrt();
+        // k[8] = ell*((1 - a/ell)*(1 + a/ell))^(1/2)
+        k[8] = ell * k[7];
+        // k[9] = ell/2
+        k[9] = ell / 2.0;
+        // k[10] = ell*m1/2
+        k[10] = ell * m1 / 2.0;
+        // k[11] = ell^2*m1/6
+        k[11] = (ell * ell) * m1 / 6.0;
+        // k[12] = m1/2
+        k[12] = m1 / 2.0;
+        // k[13] = m2/2
+        k[13] = m2 / 2.0;
+        // k[14] = a*g*m2/2
+        k[14] = a * g * m2 / 2.0;
+        // k[15] = ell*g*m1/2
+        k[15] = ell * g * m1 / 2.0;
+        // k[16] = g*m1
+        k[16] = g * m1;
+        // k[17] = k/2
+        k[17] = k_param / 2.0;
+        // k[18] = (-a^2 + ell^2)^(1/2)
+        k[18] = (-(a * a) + (ell * ell)).sqrt();
+        // k[19] = ell^2*m1/3
+        k[19] = (ell * ell) * m1 / 3.0;
+        // k[20] = a/2
+        k[20] = a / 2.0;
+        // k[21] = ell*m1
+        k[21] = ell * m1;
+        // k[22] = ell^2/3
+        k[22] = (ell * ell) / 3.0;
         // k[23] = ell*g/2
         k[23] = ell * g / 2.0;
-        // k[24] = ell*m1/6
-        k[24] = ell * m1 / 6.0;
+        // k[24] = 2*ell*m1/3
+        k[24] = 2.0 * ell * m1 / 3.0;
         // k[25] = g*m1/2
         k[25] = g * m1 / 2.0;
         // k[26] = ell*k/(-a^2 + ell^2)^(1/2)
-        k[26] = ell * k_param / (-(a * a) + (ell * ell)).sqrt();
+        k[26] = ell * k_param / k[18];
         // k[27] = a*k/(-a^2 + ell^2)^(1/2)
-        k[27] = a * k_param / (-(a * a) + (ell * ell)).sqrt();
+        k[27] = a * k_param / k[18];
         // k[28] = 2*ell
         k[28] = 2.0 * ell;
-        // k[29] = a/(ell^2*(1 - a^2/ell^2)^(1/2))
-        k[29] = a / (ell * ell) / (1.0 - ((a * a) / (ell * ell))).sqrt();
-        // k[30] = 1/(ell*(1 - a^2/ell^2)^(1/2))
-        k[30] = 1.0 / ell / (1.0 - ((a * a) / (ell * ell))).sqrt();
-        // k[31] = ell*(a*(1 + a/ell)/ell^2 - a*(1 - a/ell)/ell^2)/(2*((1 + a/ell)*(1 - a/ell))^(1/2)) + ((1 + a/ell)*(1 - a/ell))^(1/2)
-        let h31_t0 = 1.0 + (a / ell);
-        let h31_t1 = 1.0 - (a / ell);
-        let h31_t2 = h31_t0 * h31_t1;
-        k[31] =
-            (ell * ((a * h31_t0 / (ell * ell)) - (a * h31_t1 / (ell * ell))) / 2.0 / h31_t2.sqrt())
-                + h31_t2.sqrt();
-        // k[32] = ell*(-(1 + a/ell)/ell + (1 - a/ell)/ell)/(2*((1 + a/ell)*(1 - a/ell))^(1/2))
-        let h32_t0 = 1.0 + (a / ell);
-        let h32_t1 = 1.0 - (a / ell);
-        k[32] = ell * (-(h32_t0 / ell) + (h32_t1 / ell)) / 2.0 / (h32_t0 * h32_t1).sqrt();
+        // k[29] = a/(ell^2*((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[29] = a / (ell * ell) / k[7];
+        // k[30] = 1/(ell*((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[30] = 1.0 / ell / k[7];
+        // k[31] = ell*(a*(1 + a/ell)/ell^2 - a*(1 - a/ell)/ell^2)/(2*((1 - a/ell)*(1 + a/ell))^(1/2)) + ((1 - a/ell)*(1 + a/ell))^(1/2)
+        k[31] = (ell
+            * ((a * (1.0 + (a / ell)) / (ell * ell)) - (a * (1.0 - (a / ell)) / (ell * ell)))
+            / 2.0
+            / k[7])
+            + k[7];
+        // k[32] = ell*(-(1 + a/ell)/ell + (1 - a/ell)/ell)/(2*((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[32] = ell * (-((1.0 + (a / ell)) / ell) + ((1.0 - (a / ell)) / ell)) / 2.0 / k[7];
     }
 
     /// The state at release, over the parameters.
@@ -248,7 +245,7 @@ impl Model for RodCubeSpring {
         qd[1] = 0.0;
         q[2] = k[6];
         qd[2] = 0.0;
-        q[3] = k[7];
+        q[3] = k[8];
         qd[3] = 0.0;
     }
 
@@ -280,10 +277,10 @@ impl Model for RodCubeSpring {
             -(ell * theta_dot * rc_s) + x1_dot,
             (ell * theta_dot * rc_c) + y1_dot,
         ];
-        pos[2] = [(k[8] * rc_c) + x1, (k[8] * rc_s) + y1];
+        pos[2] = [(k[9] * rc_c) + x1, (k[9] * rc_s) + y1];
         vel[2] = [
-            -(k[8] * theta_dot * rc_s) + x1_dot,
-            (k[8] * theta_dot * rc_c) + y1_dot,
+            -(k[9] * theta_dot * rc_s) + x1_dot,
+            (k[9] * theta_dot * rc_c) + y1_dot,
         ];
         pos[3] = [x2, 0.0];
         vel[3] = [x2_dot, 0.0];
@@ -302,13 +299,13 @@ impl Model for RodCubeSpring {
         let theta_dot = qd[2];
         let x2 = q[3];
         let x2_dot = qd[3];
-        (-(k[9] * theta_dot * x1_dot * rc_s)
-            + (k[9] * theta_dot * y1_dot * rc_c)
-            + (k[10] * (theta_dot * theta_dot))
-            + (k[11] * (x1_dot * x1_dot))
-            + (k[12] * (x2_dot * x2_dot))
-            + (k[11] * (y1_dot * y1_dot)))
-            + (k[13] + (k[14] * rc_s) + (k[15] * y1) + (k[16] * ((-k[17] + x2) * (-k[17] + x2))))
+        (-(k[10] * theta_dot * x1_dot * rc_s)
+            + (k[10] * theta_dot * y1_dot * rc_c)
+            + (k[11] * (theta_dot * theta_dot))
+            + (k[12] * (x1_dot * x1_dot))
+            + (k[13] * (x2_dot * x2_dot))
+            + (k[12] * (y1_dot * y1_dot)))
+            + (k[14] + (k[15] * rc_s) + (k[16] * y1) + (k[17] * ((-k[18] + x2) * (-k[18] + x2))))
     }
 
     /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
@@ -320,7 +317,7 @@ impl Model for RodCubeSpring {
         let m1 = k[0];
         let x1_dot = qd[0];
         let theta_dot = qd[2];
-        out[0] = -(k[9] * theta_dot * rc_s) + (m1 * x1_dot);
+        out[0] = -(k[10] * theta_dot * rc_s) + (m1 * x1_dot);
     }
 
     /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
@@ -335,8 +332,8 @@ impl Model for RodCubeSpring {
         let k_param = k[5];
         let theta_dot = qd[2];
         let x2 = q[3];
-        let qt0 = -k[9] * rc_s; // -(ell*m1*rc_s/2)
-        let qt1 = k[9] * rc_c; // ell*m1*rc_c/2
+        let qt0 = -k[10] * rc_s; // -(ell*m1*rc_s/2)
+        let qt1 = k[10] * rc_c; // ell*m1*rc_c/2
         let qt2 = theta_dot * theta_dot;
         mass[0] = m1;
         mass[1] = 0.0;
@@ -348,16 +345,16 @@ impl Model for RodCubeSpring {
         mass[7] = 0.0;
         mass[8] = qt0;
         mass[9] = qt1;
-        mass[10] = k[18];
+        mass[10] = k[19];
         mass[11] = 0.0;
         mass[12] = 0.0;
         mass[13] = 0.0;
         mass[14] = 0.0;
         mass[15] = m2;
-        rhs[0] = k[9] * qt2 * rc_c;
-        rhs[1] = -k[15] + (k[9] * qt2 * rc_s);
-        rhs[2] = -k[14] * rc_c;
-        rhs[3] = -k_param * (-k[17] + x2);
+        rhs[0] = k[10] * qt2 * rc_c;
+        rhs[1] = -k[16] + (k[10] * qt2 * rc_s);
+        rhs[2] = -k[15] * rc_c;
+        rhs[3] = -k_param * (-k[18] + x2);
     }
 
     /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
@@ -465,11 +462,11 @@ impl Model for RodCubeSpring {
         let y1 = q[1];
         let theta = q[2];
         let x2 = q[3];
-        poses[0] = [(k[8] * rc_c) + x1, (k[8] * rc_s) + y1, theta];
-        poses[1] = [k[19] + x2, k[19], 0.0];
-        sizes[0] = -k[8];
+        poses[0] = [(k[9] * rc_c) + x1, (k[9] * rc_s) + y1, theta];
+        poses[1] = [k[20] + x2, k[20], 0.0];
+        sizes[0] = -k[9];
         sizes[1] = 0.0;
-        sizes[2] = k[8];
+        sizes[2] = k[9];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
@@ -508,35 +505,33 @@ impl Tangents for RodCubeSpring {
         let x2 = q[3];
         let x2_ddot = qdd[3];
         let xt0 = theta_dot * theta_dot;
-        let xt1 = rc_s * rc_s;
-        let xt2 = rc_c * rc_c;
         out.fill(0.0);
-        out[2] = -(k[9] * theta_ddot * rc_c) + (k[9] * xt0 * rc_s);
-        out[6] = -k[20] * theta_dot * rc_c;
-        out[8] = -(k[8] * theta_ddot * rc_s) + x1_ddot - (k[8] * xt0 * rc_c);
-        out[10] = -(k[11] * theta_ddot * rc_s) - (k[11] * xt0 * rc_c);
-        out[16] = -(k[9] * theta_ddot * rc_s) - (k[9] * xt0 * rc_c);
-        out[20] = -k[20] * theta_dot * rc_s;
-        out[22] = (k[8] * theta_ddot * rc_c) + y1_ddot - (-g + (k[8] * xt0 * rc_s));
-        out[24] = (k[11] * theta_ddot * rc_c) - (k[11] * xt0 * rc_s);
+        out[2] = -(k[10] * theta_ddot * rc_c) + (k[10] * xt0 * rc_s);
+        out[6] = -k[21] * theta_dot * rc_c;
+        out[8] = -(k[9] * theta_ddot * rc_s) + x1_ddot - (k[9] * xt0 * rc_c);
+        out[10] = -(k[12] * theta_ddot * rc_s) - (k[12] * xt0 * rc_c);
+        out[16] = -(k[10] * theta_ddot * rc_s) - (k[10] * xt0 * rc_c);
+        out[20] = -k[21] * theta_dot * rc_s;
+        out[22] = (k[9] * theta_ddot * rc_c) + y1_ddot - (-g + (k[9] * xt0 * rc_s));
+        out[24] = (k[12] * theta_ddot * rc_c) - (k[12] * xt0 * rc_s);
         out[26] = m1;
-        out[30] = -(k[9] * x1_ddot * rc_c)
-            - (k[9] * y1_ddot * rc_s)
-            - (k[14] * rc_s)
+        out[30] = -(k[10] * x1_ddot * rc_c)
+            - (k[10] * y1_ddot * rc_s)
+            - (k[15] * rc_s)
             - (ell * forces[0] * rc_c);
-        out[36] = (theta_ddot * (k[21] + (k[22] * xt1) + (k[22] * xt2))) - (k[8] * x1_ddot * rc_s)
-            + (k[8] * y1_ddot * rc_c)
+        out[36] = (k[22] * theta_ddot) - (k[9] * x1_ddot * rc_s)
+            + (k[9] * y1_ddot * rc_c)
             + (k[23] * rc_c);
-        out[38] = (theta_ddot * (k[24] + (k[9] * xt1) + (k[9] * xt2))) - (k[11] * x1_ddot * rc_s)
-            + (k[11] * y1_ddot * rc_c)
+        out[38] = (k[24] * theta_ddot) - (k[12] * x1_ddot * rc_s)
+            + (k[12] * y1_ddot * rc_c)
             + (k[25] * rc_c)
             - (forces[0] * rc_s);
-        out[40] = k[9] * rc_c;
+        out[40] = k[10] * rc_c;
         out[45] = k_param;
         out[51] = x2_ddot;
         out[52] = -k[26];
         out[53] = k[27];
-        out[55] = -k[17] + x2;
+        out[55] = -k[18] + x2;
         out[58] = (ell * theta_ddot * rc_c) - (ell * xt0 * rc_s);
         out[62] = k[28] * theta_dot * rc_c;
         out[66] = (theta_ddot * rc_s) + (xt0 * rc_c);

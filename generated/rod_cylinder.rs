@@ -68,7 +68,7 @@ static INFO: ModelInfo = ModelInfo {
             parameters: &[2, 3, 4],
         },
     ],
-    n_constants: 25,
+    n_constants: 26,
     coordinates: &["x1", "y1", "theta", "xc"],
     system_coordinates: &["x1", "y1", "theta", "xc"],
     reduced_index: Some(2),
@@ -186,48 +186,46 @@ impl Model for RodCylinder {
         let th0 = p[4];
         let g = p[5];
         k[..6].copy_from_slice(p);
-        // k[6] = R/sin(th0) + R*cos(th0)/sin(th0)
-        k[6] = (r / th0.sin()) + (r * th0.cos() / th0.sin());
-        // k[7] = ell/2
-        k[7] = ell / 2.0;
-        // k[8] = 2*R
-        k[8] = 2.0 * r;
-        // k[9] = ell*m1/2
-        k[9] = ell * m1 / 2.0;
-        // k[10] = ell^2*m1/6
-        k[10] = (ell * ell) * m1 / 6.0;
-        // k[11] = m1/2
-        k[11] = m1 / 2.0;
-        // k[12] = m2/2
-        k[12] = m2 / 2.0;
-        // k[13] = R*g*m2
-        k[13] = r * g * m2;
-        // k[14] = ell*g*m1/2
-        k[14] = ell * g * m1 / 2.0;
-        // k[15] = g*m1
-        k[15] = g * m1;
-        // k[16] = ell^2*m1/3
-        k[16] = (ell * ell) * m1 / 3.0;
-        // k[17] = ell*m1
-        k[17] = ell * m1;
-        // k[18] = ell^2/12
-        k[18] = (ell * ell) / 12.0;
-        // k[19] = ell^2/4
-        k[19] = (ell * ell) / 4.0;
-        // k[20] = ell*g/2
-        k[20] = ell * g / 2.0;
-        // k[21] = ell*m1/6
-        k[21] = ell * m1 / 6.0;
-        // k[22] = g*m1/2
-        k[22] = g * m1 / 2.0;
-        // k[23] = 1/sin(th0) + cos(th0)/sin(th0)
-        let h23_t0 = 1.0 / th0.sin();
-        k[23] = h23_t0 + (th0.cos() / th0.sin());
-        // k[24] = R + R*cos(th0)/sin(th0)^2 + R*cos(th0)^2/sin(th0)^2
-        let h24_t0 = th0.cos();
-        k[24] = r
-            + (r * h24_t0 / (th0.sin() * th0.sin()))
-            + (r * (h24_t0 * h24_t0) / (th0.sin() * th0.sin()));
+        // k[6] = sin(th0)
+        k[6] = th0.sin();
+        // k[7] = cos(th0)
+        k[7] = th0.cos();
+        // k[8] = R/sin(th0) + R*cos(th0)/sin(th0)
+        k[8] = (r / k[6]) + (r * k[7] / k[6]);
+        // k[9] = ell/2
+        k[9] = ell / 2.0;
+        // k[10] = 2*R
+        k[10] = 2.0 * r;
+        // k[11] = ell*m1/2
+        k[11] = ell * m1 / 2.0;
+        // k[12] = ell^2*m1/6
+        k[12] = (ell * ell) * m1 / 6.0;
+        // k[13] = m1/2
+        k[13] = m1 / 2.0;
+        // k[14] = m2/2
+        k[14] = m2 / 2.0;
+        // k[15] = R*g*m2
+        k[15] = r * g * m2;
+        // k[16] = ell*g*m1/2
+        k[16] = ell * g * m1 / 2.0;
+        // k[17] = g*m1
+        k[17] = g * m1;
+        // k[18] = ell^2*m1/3
+        k[18] = (ell * ell) * m1 / 3.0;
+        // k[19] = ell*m1
+        k[19] = ell * m1;
+        // k[20] = ell^2/3
+        k[20] = (ell * ell) / 3.0;
+        // k[21] = ell*g/2
+        k[21] = ell * g / 2.0;
+        // k[22] = 2*ell*m1/3
+        k[22] = 2.0 * ell * m1 / 3.0;
+        // k[23] = g*m1/2
+        k[23] = g * m1 / 2.0;
+        // k[24] = 1/sin(th0) + cos(th0)/sin(th0)
+        k[24] = (1.0 / k[6]) + (k[7] / k[6]);
+        // k[25] = R/sin(th0)^2 + R*cos(th0)/sin(th0)^2
+        k[25] = (r / (k[6] * k[6])) + (r * k[7] / (k[6] * k[6]));
     }
 
     /// The state at release, over the parameters.
@@ -241,7 +239,7 @@ impl Model for RodCylinder {
     /// - `xc = R/sin(th0) + R*cos(th0)/sin(th0)`
     /// - `dot_xc = 0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
-        let k = &k[..25]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let th0 = k[4];
         q[0] = 0.0;
         qd[0] = 0.0;
@@ -249,7 +247,7 @@ impl Model for RodCylinder {
         qd[1] = 0.0;
         q[2] = th0;
         qd[2] = 0.0;
-        q[3] = k[6];
+        q[3] = k[8];
         qd[3] = 0.0;
     }
 
@@ -266,7 +264,7 @@ impl Model for RodCylinder {
     /// - `touch_x = R*sin(theta)*cos(theta) + x1*sin(theta)^2 + xc*cos(theta)^2 - y1*sin(theta)*cos(theta)`
     /// - `touch_y = R*sin(theta)^2 - x1*sin(theta)*cos(theta) + xc*sin(theta)*cos(theta) + y1*cos(theta)^2`
     fn points(&self, k: &[f64], q: &[f64], qd: &[f64], pos: &mut [[f64; 2]], vel: &mut [[f64; 2]]) {
-        let k = &k[..25]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let r = k[3];
@@ -286,10 +284,10 @@ impl Model for RodCylinder {
             -(ell * theta_dot * rc_s) + x1_dot,
             (ell * theta_dot * rc_c) + y1_dot,
         ];
-        pos[2] = [(k[7] * rc_c) + x1, (k[7] * rc_s) + y1];
+        pos[2] = [(k[9] * rc_c) + x1, (k[9] * rc_s) + y1];
         vel[2] = [
-            -(k[7] * theta_dot * rc_s) + x1_dot,
-            (k[7] * theta_dot * rc_c) + y1_dot,
+            -(k[9] * theta_dot * rc_s) + x1_dot,
+            (k[9] * theta_dot * rc_c) + y1_dot,
         ];
         pos[3] = [xc, r];
         vel[3] = [xc_dot, 0.0];
@@ -305,7 +303,7 @@ impl Model for RodCylinder {
                 + (x1_dot * pt0)
                 + (xc_dot * pt1)
                 - (y1_dot * rc_s * rc_c),
-            (k[8] * theta_dot * rc_s * rc_c) + (theta_dot * x1 * pt0)
+            (k[10] * theta_dot * rc_s * rc_c) + (theta_dot * x1 * pt0)
                 - (theta_dot * x1 * pt1)
                 - (theta_dot * xc * pt0)
                 + (theta_dot * xc * pt1)
@@ -321,20 +319,20 @@ impl Model for RodCylinder {
     /// - `T = -dot_theta*dot_x1*ell*m1*sin(theta)/2 + dot_theta*dot_y1*ell*m1*cos(theta)/2 + dot_theta^2*ell^2*m1/6 + dot_x1^2*m1/2 + dot_xc^2*m2/2 + dot_y1^2*m1/2`
     /// - `V = R*g*m2 + ell*g*m1*sin(theta)/2 + g*m1*y1`
     fn energy(&self, k: &[f64], q: &[f64], qd: &[f64]) -> f64 {
-        let k = &k[..25]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let x1_dot = qd[0];
         let y1 = q[1];
         let y1_dot = qd[1];
         let theta_dot = qd[2];
         let xc_dot = qd[3];
-        (-(k[9] * theta_dot * x1_dot * rc_s)
-            + (k[9] * theta_dot * y1_dot * rc_c)
-            + (k[10] * (theta_dot * theta_dot))
-            + (k[11] * (x1_dot * x1_dot))
-            + (k[12] * (xc_dot * xc_dot))
-            + (k[11] * (y1_dot * y1_dot)))
-            + (k[13] + (k[14] * rc_s) + (k[15] * y1))
+        (-(k[11] * theta_dot * x1_dot * rc_s)
+            + (k[11] * theta_dot * y1_dot * rc_c)
+            + (k[12] * (theta_dot * theta_dot))
+            + (k[13] * (x1_dot * x1_dot))
+            + (k[14] * (xc_dot * xc_dot))
+            + (k[13] * (y1_dot * y1_dot)))
+            + (k[15] + (k[16] * rc_s) + (k[17] * y1))
     }
 
     /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
@@ -342,14 +340,14 @@ impl Model for RodCylinder {
     /// - `p_x1 = -dot_theta*ell*m1*sin(theta)/2 + dot_x1*m1`
     /// - `p_xc = dot_xc*m2`
     fn momenta(&self, k: &[f64], q: &[f64], qd: &[f64], out: &mut [f64]) {
-        let k = &k[..25]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let rc_s = q[2].sin();
         let m1 = k[0];
         let m2 = k[1];
         let x1_dot = qd[0];
         let theta_dot = qd[2];
         let xc_dot = qd[3];
-        out[0] = -(k[9] * theta_dot * rc_s) + (m1 * x1_dot);
+        out[0] = -(k[11] * theta_dot * rc_s) + (m1 * x1_dot);
         out[1] = m2 * xc_dot;
     }
 
@@ -358,13 +356,13 @@ impl Model for RodCylinder {
     /// They are the Euler-Lagrange equations `d/dt dL/d(dot_q) - dL/dq = 0` of
     /// - `L = T - V`: 194 characters, written out in `generated/rod_cylinder.tex`
     fn equations(&self, k: &[f64], q: &[f64], qd: &[f64], mass: &mut [f64], rhs: &mut [f64]) {
-        let k = &k[..25]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let m2 = k[1];
         let theta_dot = qd[2];
-        let qt0 = -k[9] * rc_s; // -(ell*m1*rc_s/2)
-        let qt1 = k[9] * rc_c; // ell*m1*rc_c/2
+        let qt0 = -k[11] * rc_s; // -(ell*m1*rc_s/2)
+        let qt1 = k[11] * rc_c; // ell*m1*rc_c/2
         let qt2 = theta_dot * theta_dot;
         mass[0] = m1;
         mass[1] = 0.0;
@@ -376,15 +374,15 @@ impl Model for RodCylinder {
         mass[7] = 0.0;
         mass[8] = qt0;
         mass[9] = qt1;
-        mass[10] = k[16];
+        mass[10] = k[18];
         mass[11] = 0.0;
         mass[12] = 0.0;
         mass[13] = 0.0;
         mass[14] = 0.0;
         mass[15] = m2;
-        rhs[0] = k[9] * qt2 * rc_c;
-        rhs[1] = -k[15] + (k[9] * qt2 * rc_s);
-        rhs[2] = -k[14] * rc_c;
+        rhs[0] = k[11] * qt2 * rc_c;
+        rhs[1] = -k[17] + (k[11] * qt2 * rc_s);
+        rhs[2] = -k[16] * rc_c;
         rhs[3] = 0.0;
     }
 
@@ -401,7 +399,7 @@ impl Model for RodCylinder {
     /// - `contact_force = -R - R*cos(theta) - x1*sin(theta) + xc*sin(theta) + y1*cos(theta)`
     /// - `floor_normal = y1`
     fn gaps(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..25]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let r = k[3];
         let x1 = q[0];
@@ -413,7 +411,7 @@ impl Model for RodCylinder {
 
     /// Each contact's constraint row: `jac` holds `J = dg/dq`, `bias` holds `dJ/dt qd`, so that `g'' = J qdd + bias`.
     fn constraints(&self, k: &[f64], q: &[f64], qd: &[f64], jac: &mut [f64], bias: &mut [f64]) {
-        let k = &k[..25]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let r = k[3];
         let x1 = q[0];
@@ -445,7 +443,7 @@ impl Model for RodCylinder {
     ///
     /// - `contact_force = -R*sin(theta) + ell + x1*cos(theta) - xc*cos(theta) + y1*sin(theta)`
     fn edges(&self, k: &[f64], q: &[f64], out: &mut [f64]) {
-        let k = &k[..25]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let ell = k[2];
         let r = k[3];
@@ -505,18 +503,18 @@ impl Model for RodCylinder {
 
     /// Each body's pose `[x, y, angle]` (centre of mass and orientation) over the state, and the shapes' sizes over the parameters.
     fn drawing(&self, k: &[f64], q: &[f64], poses: &mut [[f64; 3]], sizes: &mut [f64]) {
-        let k = &k[..25]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let r = k[3];
         let x1 = q[0];
         let y1 = q[1];
         let theta = q[2];
         let xc = q[3];
-        poses[0] = [(k[7] * rc_c) + x1, (k[7] * rc_s) + y1, theta];
+        poses[0] = [(k[9] * rc_c) + x1, (k[9] * rc_s) + y1, theta];
         poses[1] = [xc, r, 0.0];
-        sizes[0] = -k[7];
+        sizes[0] = -k[9];
         sizes[1] = 0.0;
-        sizes[2] = k[7];
+        sizes[2] = k[9];
         sizes[3] = 0.0;
         sizes[4] = 0.0;
         sizes[5] = 0.0;
@@ -541,7 +539,7 @@ impl Tangents for RodCylinder {
         let qd = at.qd;
         let qdd = at.qdd;
         let forces = at.forces;
-        let k = &k[..25]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let r = k[3];
@@ -562,33 +560,33 @@ impl Tangents for RodCylinder {
         let xt2 = forces[0] * rc_s;
         let xt3 = (r * rc_c) + (x1 * rc_s) - (xc * rc_s) - (y1 * rc_c);
         let xt4 = -forces[0] * rc_c;
-        let xt5 = rc_s * rc_s;
-        let xt6 = rc_c * rc_c;
-        let xt7 = -rc_s;
-        let xt8 = -rc_c;
+        let xt5 = -rc_s;
+        let xt6 = -rc_c;
         out.fill(0.0);
-        out[2] = -(k[9] * theta_ddot * rc_c) + xt0 + (k[9] * xt1 * rc_s);
-        out[6] = -k[17] * theta_dot * rc_c;
-        out[8] = -(k[7] * theta_ddot * rc_s) + x1_ddot - (k[7] * xt1 * rc_c);
-        out[10] = -(k[11] * theta_ddot * rc_s) - (k[11] * xt1 * rc_c);
-        out[16] = -(k[9] * theta_ddot * rc_s) + xt2 - (k[9] * xt1 * rc_c);
-        out[20] = -k[17] * theta_dot * rc_s;
-        out[22] = (k[7] * theta_ddot * rc_c) + y1_ddot - (-g + (k[7] * xt1 * rc_s));
-        out[24] = (k[11] * theta_ddot * rc_c) - (k[11] * xt1 * rc_s);
+        out[2] = -(k[11] * theta_ddot * rc_c) + xt0 + (k[11] * xt1 * rc_s);
+        out[6] = -k[19] * theta_dot * rc_c;
+        out[8] = -(k[9] * theta_ddot * rc_s) + x1_ddot - (k[9] * xt1 * rc_c);
+        out[10] = -(k[13] * theta_ddot * rc_s) - (k[13] * xt1 * rc_c);
+        out[16] = -(k[11] * theta_ddot * rc_s) + xt2 - (k[11] * xt1 * rc_c);
+        out[20] = -k[19] * theta_dot * rc_s;
+        out[22] = (k[9] * theta_ddot * rc_c) + y1_ddot - (-g + (k[9] * xt1 * rc_s));
+        out[24] = (k[13] * theta_ddot * rc_c) - (k[13] * xt1 * rc_s);
         out[27] = m1;
         out[28] = xt0;
         out[29] = xt2;
-        out[30] =
-            -(k[9] * x1_ddot * rc_c) - (k[9] * y1_ddot * rc_s) - (k[14] * rc_s) - (forces[0] * xt3);
+        out[30] = -(k[11] * x1_ddot * rc_c)
+            - (k[11] * y1_ddot * rc_s)
+            - (k[16] * rc_s)
+            - (forces[0] * xt3);
         out[31] = xt4;
-        out[36] = (theta_ddot * (k[18] + (k[19] * xt5) + (k[19] * xt6))) - (k[7] * x1_ddot * rc_s)
-            + (k[7] * y1_ddot * rc_c)
-            + (k[20] * rc_c);
-        out[38] = (theta_ddot * (k[21] + (k[9] * xt5) + (k[9] * xt6))) - (k[11] * x1_ddot * rc_s)
-            + (k[11] * y1_ddot * rc_c)
-            + (k[22] * rc_c);
+        out[36] = (k[20] * theta_ddot) - (k[9] * x1_ddot * rc_s)
+            + (k[9] * y1_ddot * rc_c)
+            + (k[21] * rc_c);
+        out[38] = (k[22] * theta_ddot) - (k[13] * x1_ddot * rc_s)
+            + (k[13] * y1_ddot * rc_c)
+            + (k[23] * rc_c);
         out[39] = -forces[0] * rc_s;
-        out[41] = k[9] * rc_c;
+        out[41] = k[11] * rc_c;
         out[44] = xt4;
         out[51] = xc_ddot;
         out[56] = -(theta_ddot * rc_c) + (xt1 * rc_s);
@@ -604,7 +602,7 @@ impl Tangents for RodCylinder {
         out[59] = (theta_ddot * rc_c) - (xt1 * rc_s);
         out[60] = -2.0 * theta_dot * rc_c;
         out[61] = -2.0 * theta_dot * rc_s;
-        out[62] = (k[8] * theta_dot * rc_c) + (2.0 * theta_dot * x1 * rc_s)
+        out[62] = (k[10] * theta_dot * rc_c) + (2.0 * theta_dot * x1 * rc_s)
             - (2.0 * theta_dot * xc * rc_s)
             - (2.0 * theta_dot * y1 * rc_c)
             - (2.0 * x1_dot * rc_c)
@@ -612,7 +610,7 @@ impl Tangents for RodCylinder {
             - (2.0 * y1_dot * rc_s);
         out[63] = 2.0 * theta_dot * rc_c;
         out[67] = (theta_ddot * rc_s) + (xt1 * rc_c);
-        out[84] = xt7;
+        out[84] = xt5;
         out[85] = rc_c;
         out[86] = (r * rc_s) - (x1 * rc_c) + (xc * rc_c) - (y1 * rc_s);
         out[87] = rc_s;
@@ -621,17 +619,17 @@ impl Tangents for RodCylinder {
         out[112] = rc_c;
         out[113] = rc_s;
         out[114] = -(r * rc_c) - (x1 * rc_s) + (xc * rc_s) + (y1 * rc_c);
-        out[115] = xt8;
+        out[115] = xt6;
         out[122] = 1.0;
-        out[123] = xt7;
+        out[123] = xt5;
     }
 
     /// `d(initial state)/dp`: the rows `d q_0/dp`, then `d qd_0/dp`, by the parameters.
     fn initial_tangents(&self, k: &[f64], out: &mut [f64]) {
-        let k = &k[..25]; // one bounds check for all constant loads
+        let k = &k[..26]; // one bounds check for all constant loads
         out.fill(0.0);
         out[16] = 1.0;
-        out[21] = k[23];
-        out[22] = -k[24];
+        out[21] = k[24];
+        out[22] = -k[25];
     }
 }

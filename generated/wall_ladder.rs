@@ -165,56 +165,53 @@ impl Model for WallLadder {
         let a = p[2];
         let g = p[3];
         k[..4].copy_from_slice(p);
-        // k[4] = ell*((1 - a/ell)*(1 + a/ell))^(1/2)
+        // k[4] = ((1 - a/ell)*(1 + a/ell))^(1/2)
         let h4_t0 = a / ell;
-        k[4] = ell * ((1.0 - h4_t0) * (1.0 + h4_t0)).sqrt();
-        // k[5] = asin(a/ell)
-        k[5] = (a / ell).asin();
-        // k[6] = ell/2
-        k[6] = ell / 2.0;
-        // k[7] = ell*m1/2
-        k[7] = ell * m1 / 2.0;
-        // k[8] = ell^2*m1/6
-        k[8] = (ell * ell) * m1 / 6.0;
-        // k[9] = m1/2
-        k[9] = m1 / 2.0;
-        // k[10] = ell*g*m1/2
-        k[10] = ell * g * m1 / 2.0;
-        // k[11] = g*m1
-        k[11] = g * m1;
-        // k[12] = ell^2*m1/3
-        k[12] = (ell * ell) * m1 / 3.0;
-        // k[13] = 0.0 + ell
-        k[13] = 0.0 + ell;
-        // k[14] = ell*m1
-        k[14] = ell * m1;
-        // k[15] = ell^2/12
-        k[15] = (ell * ell) / 12.0;
-        // k[16] = ell^2/4
-        k[16] = (ell * ell) / 4.0;
+        k[4] = ((1.0 - h4_t0) * (1.0 + h4_t0)).sqrt();
+        // k[5] = ell*((1 - a/ell)*(1 + a/ell))^(1/2)
+        k[5] = ell * k[4];
+        // k[6] = asin(a/ell)
+        k[6] = (a / ell).asin();
+        // k[7] = ell/2
+        k[7] = ell / 2.0;
+        // k[8] = ell*m1/2
+        k[8] = ell * m1 / 2.0;
+        // k[9] = ell^2*m1/6
+        k[9] = (ell * ell) * m1 / 6.0;
+        // k[10] = m1/2
+        k[10] = m1 / 2.0;
+        // k[11] = ell*g*m1/2
+        k[11] = ell * g * m1 / 2.0;
+        // k[12] = g*m1
+        k[12] = g * m1;
+        // k[13] = ell^2*m1/3
+        k[13] = (ell * ell) * m1 / 3.0;
+        // k[14] = 0.0 + ell
+        k[14] = 0.0 + ell;
+        // k[15] = ell*m1
+        k[15] = ell * m1;
+        // k[16] = ell^2/3
+        k[16] = (ell * ell) / 3.0;
         // k[17] = ell*g/2
         k[17] = ell * g / 2.0;
-        // k[18] = ell*m1/6
-        k[18] = ell * m1 / 6.0;
+        // k[18] = 2*ell*m1/3
+        k[18] = 2.0 * ell * m1 / 3.0;
         // k[19] = g*m1/2
         k[19] = g * m1 / 2.0;
         // k[20] = 2*ell
         k[20] = 2.0 * ell;
-        // k[21] = ell*(a*(1 + a/ell)/ell^2 - a*(1 - a/ell)/ell^2)/(2*((1 + a/ell)*(1 - a/ell))^(1/2)) + ((1 + a/ell)*(1 - a/ell))^(1/2)
-        let h21_t0 = 1.0 + (a / ell);
-        let h21_t1 = 1.0 - (a / ell);
-        let h21_t2 = h21_t0 * h21_t1;
-        k[21] =
-            (ell * ((a * h21_t0 / (ell * ell)) - (a * h21_t1 / (ell * ell))) / 2.0 / h21_t2.sqrt())
-                + h21_t2.sqrt();
-        // k[22] = ell*(-(1 + a/ell)/ell + (1 - a/ell)/ell)/(2*((1 + a/ell)*(1 - a/ell))^(1/2))
-        let h22_t0 = 1.0 + (a / ell);
-        let h22_t1 = 1.0 - (a / ell);
-        k[22] = ell * (-(h22_t0 / ell) + (h22_t1 / ell)) / 2.0 / (h22_t0 * h22_t1).sqrt();
-        // k[23] = a/(ell^2*(1 - a^2/ell^2)^(1/2))
-        k[23] = a / (ell * ell) / (1.0 - ((a * a) / (ell * ell))).sqrt();
-        // k[24] = 1/(ell*(1 - a^2/ell^2)^(1/2))
-        k[24] = 1.0 / ell / (1.0 - ((a * a) / (ell * ell))).sqrt();
+        // k[21] = ell*(a*(1 + a/ell)/ell^2 - a*(1 - a/ell)/ell^2)/(2*((1 - a/ell)*(1 + a/ell))^(1/2)) + ((1 - a/ell)*(1 + a/ell))^(1/2)
+        k[21] = (ell
+            * ((a * (1.0 + (a / ell)) / (ell * ell)) - (a * (1.0 - (a / ell)) / (ell * ell)))
+            / 2.0
+            / k[4])
+            + k[4];
+        // k[22] = ell*(-(1 + a/ell)/ell + (1 - a/ell)/ell)/(2*((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[22] = ell * (-((1.0 + (a / ell)) / ell) + ((1.0 - (a / ell)) / ell)) / 2.0 / k[4];
+        // k[23] = a/(ell^2*((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[23] = a / (ell * ell) / k[4];
+        // k[24] = 1/(ell*((1 - a/ell)*(1 + a/ell))^(1/2))
+        k[24] = 1.0 / ell / k[4];
     }
 
     /// The state at release, over the parameters.
@@ -227,11 +224,11 @@ impl Model for WallLadder {
     /// - `dot_theta = 0.0`
     fn initial_state(&self, k: &[f64], q: &mut [f64], qd: &mut [f64]) {
         let k = &k[..25]; // one bounds check for all constant loads
-        q[0] = -k[4];
+        q[0] = -k[5];
         qd[0] = 0.0;
         q[1] = 0.0;
         qd[1] = 0.0;
-        q[2] = k[5];
+        q[2] = k[6];
         qd[2] = 0.0;
     }
 
@@ -261,10 +258,10 @@ impl Model for WallLadder {
             -(ell * theta_dot * rc_s) + x1_dot,
             (ell * theta_dot * rc_c) + y1_dot,
         ];
-        pos[2] = [(k[6] * rc_c) + x1, (k[6] * rc_s) + y1];
+        pos[2] = [(k[7] * rc_c) + x1, (k[7] * rc_s) + y1];
         vel[2] = [
-            -(k[6] * theta_dot * rc_s) + x1_dot,
-            (k[6] * theta_dot * rc_c) + y1_dot,
+            -(k[7] * theta_dot * rc_s) + x1_dot,
+            (k[7] * theta_dot * rc_c) + y1_dot,
         ];
         pos[3] = [0.0, 0.0];
         vel[3] = [0.0, 0.0];
@@ -281,12 +278,12 @@ impl Model for WallLadder {
         let y1 = q[1];
         let y1_dot = qd[1];
         let theta_dot = qd[2];
-        (-(k[7] * theta_dot * x1_dot * rc_s)
-            + (k[7] * theta_dot * y1_dot * rc_c)
-            + (k[8] * (theta_dot * theta_dot))
-            + (k[9] * (x1_dot * x1_dot))
-            + (k[9] * (y1_dot * y1_dot)))
-            + ((k[10] * rc_s) + (k[11] * y1))
+        (-(k[8] * theta_dot * x1_dot * rc_s)
+            + (k[8] * theta_dot * y1_dot * rc_c)
+            + (k[9] * (theta_dot * theta_dot))
+            + (k[10] * (x1_dot * x1_dot))
+            + (k[10] * (y1_dot * y1_dot)))
+            + ((k[11] * rc_s) + (k[12] * y1))
     }
 
     /// The momenta `p_c = dL/d(dot_c)` of the cyclic coordinates, conserved.
@@ -298,7 +295,7 @@ impl Model for WallLadder {
         let m1 = k[0];
         let x1_dot = qd[0];
         let theta_dot = qd[2];
-        out[0] = -(k[7] * theta_dot * rc_s) + (m1 * x1_dot);
+        out[0] = -(k[8] * theta_dot * rc_s) + (m1 * x1_dot);
     }
 
     /// The equations of motion `M(q) qdd = F(q, qd)` (`mass` is `M` row by row, `rhs` is `F`).
@@ -310,8 +307,8 @@ impl Model for WallLadder {
         let (rc_s, rc_c) = q[2].sin_cos();
         let m1 = k[0];
         let theta_dot = qd[2];
-        let qt0 = -k[7] * rc_s; // -(ell*m1*rc_s/2)
-        let qt1 = k[7] * rc_c; // ell*m1*rc_c/2
+        let qt0 = -k[8] * rc_s; // -(ell*m1*rc_s/2)
+        let qt1 = k[8] * rc_c; // ell*m1*rc_c/2
         let qt2 = theta_dot * theta_dot;
         mass[0] = m1;
         mass[1] = 0.0;
@@ -321,10 +318,10 @@ impl Model for WallLadder {
         mass[5] = qt1;
         mass[6] = qt0;
         mass[7] = qt1;
-        mass[8] = k[12];
-        rhs[0] = k[7] * qt2 * rc_c;
-        rhs[1] = -k[11] + (k[7] * qt2 * rc_s);
-        rhs[2] = -k[10] * rc_c;
+        mass[8] = k[13];
+        rhs[0] = k[8] * qt2 * rc_c;
+        rhs[1] = -k[12] + (k[8] * qt2 * rc_s);
+        rhs[2] = -k[11] * rc_c;
     }
 
     /// Each contact's force: in closed form for a contact this phase holds closed, zero for the others (their forces are solved by the runtime).
@@ -422,15 +419,15 @@ impl Model for WallLadder {
         let y1 = q[1];
         let theta = q[2];
         let dt0 = 0.0 + 0.0;
-        poses[0] = [(k[6] * rc_c) + x1, (k[6] * rc_s) + y1, theta];
-        sizes[0] = -k[6];
+        poses[0] = [(k[7] * rc_c) + x1, (k[7] * rc_s) + y1, theta];
+        sizes[0] = -k[7];
         sizes[1] = 0.0;
-        sizes[2] = k[6];
+        sizes[2] = k[7];
         sizes[3] = 0.0;
         sizes[4] = dt0;
         sizes[5] = dt0;
         sizes[6] = dt0;
-        sizes[7] = k[13];
+        sizes[7] = k[14];
     }
 
     fn tangents(&self) -> Option<&dyn Tangents> {
@@ -461,30 +458,28 @@ impl Tangents for WallLadder {
         let theta_dot = qd[2];
         let theta_ddot = qdd[2];
         let xt0 = theta_dot * theta_dot;
-        let xt1 = rc_s * rc_s;
-        let xt2 = rc_c * rc_c;
         out.fill(0.0);
-        out[2] = -(k[7] * theta_ddot * rc_c) + (k[7] * xt0 * rc_s);
-        out[5] = -k[14] * theta_dot * rc_c;
-        out[6] = -(k[6] * theta_ddot * rc_s) + x1_ddot - (k[6] * xt0 * rc_c);
-        out[7] = -(k[9] * theta_ddot * rc_s) - (k[9] * xt0 * rc_c);
-        out[12] = -(k[7] * theta_ddot * rc_s) - (k[7] * xt0 * rc_c);
-        out[15] = -k[14] * theta_dot * rc_s;
-        out[16] = (k[6] * theta_ddot * rc_c) + y1_ddot - (-g + (k[6] * xt0 * rc_s));
-        out[17] = (k[9] * theta_ddot * rc_c) - (k[9] * xt0 * rc_s);
+        out[2] = -(k[8] * theta_ddot * rc_c) + (k[8] * xt0 * rc_s);
+        out[5] = -k[15] * theta_dot * rc_c;
+        out[6] = -(k[7] * theta_ddot * rc_s) + x1_ddot - (k[7] * xt0 * rc_c);
+        out[7] = -(k[10] * theta_ddot * rc_s) - (k[10] * xt0 * rc_c);
+        out[12] = -(k[8] * theta_ddot * rc_s) - (k[8] * xt0 * rc_c);
+        out[15] = -k[15] * theta_dot * rc_s;
+        out[16] = (k[7] * theta_ddot * rc_c) + y1_ddot - (-g + (k[7] * xt0 * rc_s));
+        out[17] = (k[10] * theta_ddot * rc_c) - (k[10] * xt0 * rc_s);
         out[19] = m1;
-        out[22] = -(k[7] * x1_ddot * rc_c)
-            - (k[7] * y1_ddot * rc_s)
-            - (k[10] * rc_s)
+        out[22] = -(k[8] * x1_ddot * rc_c)
+            - (k[8] * y1_ddot * rc_s)
+            - (k[11] * rc_s)
             - (ell * forces[0] * rc_c);
-        out[26] = (theta_ddot * (k[15] + (k[16] * xt1) + (k[16] * xt2))) - (k[6] * x1_ddot * rc_s)
-            + (k[6] * y1_ddot * rc_c)
+        out[26] = (k[16] * theta_ddot) - (k[7] * x1_ddot * rc_s)
+            + (k[7] * y1_ddot * rc_c)
             + (k[17] * rc_c);
-        out[27] = (theta_ddot * (k[18] + (k[7] * xt1) + (k[7] * xt2))) - (k[9] * x1_ddot * rc_s)
-            + (k[9] * y1_ddot * rc_c)
+        out[27] = (k[18] * theta_ddot) - (k[10] * x1_ddot * rc_s)
+            + (k[10] * y1_ddot * rc_c)
             + (k[19] * rc_c)
             - (forces[0] * rc_s);
-        out[29] = k[7] * rc_c;
+        out[29] = k[8] * rc_c;
         out[32] = (ell * theta_ddot * rc_c) - (ell * xt0 * rc_s);
         out[35] = k[20] * theta_dot * rc_c;
         out[37] = (theta_ddot * rc_s) + (xt0 * rc_c);

@@ -1,6 +1,7 @@
 //! The library runs all Symbolica work on one thread: callers on many threads at once all get
 //! their results (restricted Symbolica would abort the process if two threads used it), and
-//! every job runs on the same dedicated thread, never on the caller's.
+//! every job runs on the same dedicated thread, never on the caller's; a job there that waits
+//! on another job there gets an error instead of waiting for ever.
 #![cfg(feature = "derive")]
 
 use rodcube::derive::{cas, expr::Expr, on_cas_thread};
@@ -47,6 +48,22 @@ fn concurrent_callers_share_one_cas_thread() {
 fn a_panicking_job_does_not_take_the_worker_down() {
     let failed = on_cas_thread(|| -> u32 { panic!("deliberate") });
     assert!(failed.is_err());
+    let after = on_cas_thread(|| cas::expr(&cas::d(&cas::var("y"), "y")));
+    assert_eq!(after.unwrap().unwrap(), Expr::int(1));
+}
+
+#[test]
+fn a_job_that_waits_on_another_job_gets_an_error_not_a_hang() {
+    // The worker runs one job at a time: a job that queued a second and waited for it would
+    // wait for ever (holding the inter-process lock); both ways in refuse instead.
+    let nested = on_cas_thread(|| {
+        let call = on_cas_thread(|| 1).map_err(|e| e.to_string());
+        let derive = rodcube::derive::derive_all(&[]).map_err(|e| e.to_string());
+        (call, derive.map(|v| v.len()))
+    })
+    .expect("the outer job runs");
+    assert!(nested.0.is_err(), "nested on_cas_thread: {:?}", nested.0);
+    assert!(nested.1.is_err(), "nested derive_all: {:?}", nested.1);
     let after = on_cas_thread(|| cas::expr(&cas::d(&cas::var("y"), "y")));
     assert_eq!(after.unwrap().unwrap(), Expr::int(1));
 }

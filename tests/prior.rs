@@ -7,29 +7,12 @@
 
 mod common;
 
+use common::numbers::Uniform;
 use common::paper::ROD_CUBE;
 use rodcube::model::{Model, start_offsets};
 use rodcube::reference::{Family, Inputs, Reference, RootRoute, TimeRoute, relative_error};
 use rodcube::solve::lean::LeanSolver;
 use rodcube::system::System;
-
-/// Deterministic uniform numbers in [0, 1) (SplitMix64).
-struct Uniform(u64);
-
-impl Uniform {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        (z ^ (z >> 31)) as f64 / 2f64.powi(64)
-    }
-
-    /// `10^x`, `x` uniform in `[lo, hi)`.
-    fn log(&mut self, lo: f64, hi: f64) -> f64 {
-        10f64.powf(lo + (hi - lo) * self.next())
-    }
-}
 
 fn model(name: &str) -> &'static dyn Model {
     rodcube::models::find(name).expect("generated model")

@@ -7,33 +7,16 @@
 //! strings.
 #![cfg(feature = "derive")]
 
+mod common;
+
+use common::derived::phases_in;
+
 use rodcube::derive::cas;
 use rodcube::derive::expr::Expr;
-use rodcube::derive::mechanics::{self, Derivation, to_sc_expr};
+use rodcube::derive::mechanics::{self, to_sc_expr};
+use rodcube::derive::on_cas_thread;
 use rodcube::derive::present::operations;
 use rodcube::derive::steps::Shown;
-use rodcube::derive::{derive_all, on_cas_thread, spec};
-use std::path::Path;
-
-/// Every phase of every spec in `derivations/`.
-fn all_phases() -> Vec<Derivation> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("derivations");
-    let mut paths: Vec<_> = std::fs::read_dir(&dir)
-        .expect("derivations/")
-        .map(|e| e.expect("entry").path())
-        .filter(|p| p.extension().is_some_and(|x| x == "yaml"))
-        .collect();
-    paths.sort();
-    let checked: Vec<_> = paths
-        .iter()
-        .map(|p| spec::load(p).unwrap_or_else(|e| panic!("{e}")))
-        .collect();
-    derive_all(&checked)
-        .unwrap_or_else(|e| panic!("{e}"))
-        .into_iter()
-        .flat_map(|(phases, _)| phases)
-        .collect()
-}
 
 fn parse(text: &str) -> Expr {
     let e = Expr::parse(text).unwrap_or_else(|e| panic!("test formula `{text}`: {}", e.message));
@@ -72,7 +55,7 @@ fn assert_grouped(what: &str, shown: &Shown, expected: &str, terms: usize) {
 
 #[test]
 fn rod_cube_s_contact_phase_steps_are_the_hand_derivation_grouped_in_the_velocities() {
-    let phases = all_phases();
+    let phases = phases_in("derivations");
     let d = phases
         .iter()
         .find(|d| d.name == "rod_cube_closed")
@@ -116,7 +99,7 @@ fn rod_cube_s_contact_phase_steps_are_the_hand_derivation_grouped_in_the_velocit
 /// `(x1 + l cos/2, y1 + l sin/2)` with its own rotation `m1 l^2/12`, the cube at `x2` alone.
 #[test]
 fn rod_cube_s_general_steps_are_the_hand_derivation_grouped_in_the_velocities() {
-    let phases = all_phases();
+    let phases = phases_in("derivations");
     let d = phases
         .iter()
         .find(|d| d.name == "rod_cube")
@@ -170,7 +153,7 @@ fn rod_cube_s_general_steps_are_the_hand_derivation_grouped_in_the_velocities() 
 
 #[test]
 fn every_shown_step_equals_the_derived_one_and_is_no_longer() {
-    for d in all_phases() {
+    for d in phases_in("derivations") {
         let steps = d
             .steps
             .as_ref()

@@ -7,10 +7,25 @@
 use super::cas::{self, A};
 use super::expr::{Expr, gcd, product, sum};
 use super::types::{Constant, DeriveError, StepError, at};
+use std::collections::{BTreeMap, BTreeSet};
 
 /// A Symbolica atom as an expression, or the error of the step `what`.
 pub fn to_expr(a: &A, what: &str) -> Result<Expr, DeriveError> {
     cas::expr(a).map_err(|m| at(&[], format!("{what}: {m}")))
+}
+
+/// `sqrt(1 - x^2)^sign` (`sign` 1 or -1) in the one form the derivation writes it,
+/// `((1 - x)(1 + x))^(1/2)`: no cancellation in `1 - x^2` as `x -> 1`, and one root wherever
+/// it appears (`cos(asin(x))`, the derivative of `asin(x)`), so the lowering shares it.
+pub fn root_of_one_minus_square(x: &Expr, sign: i128) -> Expr {
+    let minus_x = Expr::Mul(vec![Expr::int(-1), x.clone()]);
+    Expr::Pow(
+        Box::new(Expr::Mul(vec![
+            Expr::Add(vec![Expr::int(1), minus_x]),
+            Expr::Add(vec![Expr::int(1), x.clone()]),
+        ])),
+        Box::new(Expr::Rational(sign, 2)),
+    )
 }
 
 /// `sin(asin(x)) = x`, `cos(asin(x)) = sqrt(1 - x^2)` and the like, applied bottom-up.
@@ -27,17 +42,7 @@ pub fn simplify_inverse_trig(e: &Expr) -> Expr {
             let args = rec(args);
             if let Some(Expr::Fun(g, inner)) = args.first() {
                 let x = inner[0].clone();
-                // sqrt((1 - x)(1 + x)): no cancellation in 1 - x^2 as x -> 1.
-                let one_minus_sq = || {
-                    let minus_x = Expr::Mul(vec![Expr::int(-1), x.clone()]);
-                    Expr::Pow(
-                        Box::new(Expr::Mul(vec![
-                            Expr::Add(vec![Expr::int(1), minus_x]),
-                            Expr::Add(vec![Expr::int(1), x.clone()]),
-                        ])),
-                        Box::new(Expr::Rational(1, 2)),
-                    )
-                };
+                let one_minus_sq = || root_of_one_minus_square(&x, 1);
                 match (f.as_str(), g.as_str()) {
                     ("sin", "asin") | ("cos", "acos") => return x,
                     ("cos", "asin") | ("sin", "acos") => return one_minus_sq(),
@@ -56,40 +61,83 @@ pub fn reduce_cos_sq(a: &A) -> A {
     thread_local! {
         /// The rules `rc_c^k -> rc_c^(k mod 2) (1 - rc_s^2)^(k div 2)`, highest `k` first, made
         /// once per thread (only the Symbolica thread calls this).
-        static RULES: Vec<(A, A)> = (2..=12).rev().map(cos_power_rule).collect();
+        static RULES: Vec<(A, A)> = cos_power_rules("rc_s", "rc_c");
     }
-    RULES.with(|rules| {
-        let mut cur = cas::expand(a);
-        for _ in 0..16 {
-            let mut next = cur.clone();
-            for (pat, rep) in rules {
-                next = cas::subs(&next, pat, rep);
-            }
-            next = cas::expand(&next);
-            if next == cur {
-                break;
-            }
-            cur = next;
-        }
-        cur
-    })
+    RULES.with(|rules| rewritten(a, rules))
 }
 
-/// The pattern `rc_c^k` and its replacement `rc_c^(k mod 2) (1 - rc_s^2)^(k div 2)`.
-fn cos_power_rule(k: i128) -> (A, A) {
+/// `a` expanded and rewritten by `rules` until nothing changes (at most 16 rounds).
+fn rewritten(a: &A, rules: &[(A, A)]) -> A {
+    let mut cur = cas::expand(a);
+    for _ in 0..16 {
+        let mut next = cur.clone();
+        for (pat, rep) in rules {
+            next = cas::subs(&next, pat, rep);
+        }
+        next = cas::expand(&next);
+        if next == cur {
+            break;
+        }
+        cur = next;
+    }
+    cur
+}
+
+/// The rules `c^k -> c^(k mod 2) (1 - s^2)^(k div 2)` for `k` from 12 down to 2.
+fn cos_power_rules(s: &str, c: &str) -> Vec<(A, A)> {
+    (2..=12).rev().map(|k| cos_power_rule(s, c, k)).collect()
+}
+
+/// The pattern `c^k` and its replacement `c^(k mod 2) (1 - s^2)^(k div 2)`.
+fn cos_power_rule(s: &str, c: &str, k: i128) -> (A, A) {
     let pow = |base: &str, n: i128| Expr::Pow(Box::new(Expr::sym(base)), Box::new(Expr::int(n)));
     let one_minus_s2 = Expr::Add(vec![
         Expr::int(1),
-        Expr::Mul(vec![Expr::int(-1), pow("rc_s", 2)]),
+        Expr::Mul(vec![Expr::int(-1), pow(s, 2)]),
     ]);
     let rep = Expr::Mul(vec![
-        pow("rc_c", k % 2),
+        pow(c, k % 2),
         Expr::Pow(Box::new(one_minus_s2), Box::new(Expr::int(k / 2))),
     ]);
-    (cas::atom(&pow("rc_c", k)), cas::atom(&rep))
+    (cas::atom(&pow(c, k)), cas::atom(&rep))
 }
 
-/// A term of a sum as `coefficient * rest * rc_s^sin * rc_c^cos`, for [`pythagoras`].
+/// `e` with `sin(x)`, `cos(x)` of every argument `x` replaced by the symbols `rc_ts<i>`,
+/// `rc_tc<i>` (`i` the argument's place in `arguments`, which collects them as they are met).
+fn trig_symbols(e: &Expr, arguments: &mut Vec<Expr>) -> Expr {
+    let mut rec = |v: &Vec<Expr>| v.iter().map(|x| trig_symbols(x, arguments)).collect();
+    match e {
+        Expr::Fun(f, args) if args.len() == 1 && (f == "sin" || f == "cos") => {
+            let i = match arguments.iter().position(|a| *a == args[0]) {
+                Some(i) => i,
+                None => {
+                    arguments.push(args[0].clone());
+                    arguments.len() - 1
+                }
+            };
+            Expr::Sym(format!("rc_t{}{i}", if f == "sin" { 's' } else { 'c' }))
+        }
+        Expr::Add(v) => Expr::Add(rec(v)),
+        Expr::Mul(v) => Expr::Mul(rec(v)),
+        Expr::Pow(b, x) => Expr::Pow(
+            Box::new(trig_symbols(b, arguments)),
+            Box::new(trig_symbols(x, arguments)),
+        ),
+        Expr::Fun(f, v) => Expr::Fun(f.clone(), rec(v)),
+        _ => e.clone(),
+    }
+}
+
+/// The powers of `sin(x)` and `cos(x)` of one argument `x` in a term, for [`pythagoras`]
+/// (`x` is `None` for the internal `rc_s = sin(theta)`, `rc_c = cos(theta)`).
+#[derive(Debug, Clone, PartialEq)]
+struct Trig {
+    argument: Option<Expr>,
+    sin: i128,
+    cos: i128,
+}
+
+/// A term of a sum as `coefficient * rest * prod_x sin(x)^a cos(x)^b`, for [`pythagoras`].
 #[derive(Debug, Clone)]
 struct Term {
     /// The term as written, kept while no rule rewrote it.
@@ -98,8 +146,30 @@ struct Term {
     coefficient: (i128, i128),
     /// Its other factors, sorted by their infix text.
     rest: Vec<Expr>,
-    sin: i128,
-    cos: i128,
+    /// Its integer powers (of either sign) of `sin` and `cos`, by their argument's infix
+    /// text (`""` for `rc_s`, `rc_c`); none with both powers zero.
+    trig: BTreeMap<String, Trig>,
+}
+
+/// `(argument's key, argument, whether it is a sine, power)` when `f` is an integer power of
+/// a sine or cosine (`rc_s`, `rc_c`, or a call of one argument).
+fn trig_power(f: &Expr) -> Option<(String, Option<Expr>, bool, i128)> {
+    let (base, power) = match f {
+        Expr::Pow(b, x) => (&**b, x.as_integer().filter(|&n| n != 0)?),
+        f => (f, 1),
+    };
+    match base {
+        Expr::Sym(s) if s == "rc_s" || s == "rc_c" => {
+            Some((String::new(), None, s == "rc_s", power))
+        }
+        Expr::Fun(name, args) if args.len() == 1 && (name == "sin" || name == "cos") => Some((
+            args[0].to_infix(),
+            Some(args[0].clone()),
+            name == "sin",
+            power,
+        )),
+        _ => None,
+    }
 }
 
 impl Term {
@@ -112,26 +182,32 @@ impl Term {
             written: Some(t.clone()),
             coefficient: (1, 1),
             rest: Vec::new(),
-            sin: 0,
-            cos: 0,
+            trig: BTreeMap::new(),
         };
         for f in factors {
-            let power = |name: &str| match &f {
-                Expr::Sym(s) if s == name => Some(1),
-                Expr::Pow(b, x) if **b == Expr::sym(name) => x.as_integer().filter(|&n| n > 0),
-                _ => None,
-            };
             let (n, d) = term.coefficient;
-            match (&f, power("rc_s"), power("rc_c")) {
-                (_, Some(k), _) => term.sin += k,
-                (_, _, Some(k)) => term.cos += k,
-                (Expr::Rational(a, b), _, _) => match n.checked_mul(*a).zip(d.checked_mul(*b)) {
+            if let Some((key, argument, is_sin, k)) = trig_power(&f) {
+                let entry = term.trig.entry(key).or_insert(Trig {
+                    argument,
+                    sin: 0,
+                    cos: 0,
+                });
+                *(if is_sin {
+                    &mut entry.sin
+                } else {
+                    &mut entry.cos
+                }) += k;
+                continue;
+            }
+            match &f {
+                Expr::Rational(a, b) => match n.checked_mul(*a).zip(d.checked_mul(*b)) {
                     Some(c) => term.coefficient = c,
                     None => term.rest.push(f.clone()),
                 },
                 _ => term.rest.push(f.clone()),
             }
         }
+        term.trig.retain(|_, t| (t.sin, t.cos) != (0, 0));
         term.rest.sort_by_cached_key(Expr::to_infix);
         term
     }
@@ -142,13 +218,18 @@ impl Term {
         a.checked_mul(d) == c.checked_mul(b).and_then(|x| x.checked_mul(sign))
     }
 
-    /// The one term that `self + other` is by `sin^2 + cos^2 = 1`, if it is one:
-    /// `X sin^2 + X cos^2 = X`, `X - X cos^2 = X sin^2`, `X - X sin^2 = X cos^2`.
+    /// The powers `(sin, cos)` of the argument `key` (zero where the term has none).
+    fn powers(&self, key: &str) -> (i128, i128) {
+        self.trig.get(key).map_or((0, 0), |t| (t.sin, t.cos))
+    }
+
+    /// The one term that `self + other` is by `sin^2 + cos^2 = 1` of one argument, if it is
+    /// one: `X sin^2 + X cos^2 = X`, `X - X cos^2 = X sin^2`, `X - X sin^2 = X cos^2`.
     fn combined(&self, other: &Term) -> Option<Term> {
         if self.rest != other.rest {
             return None;
         }
-        if (self.sin, self.cos) == (other.sin, other.cos) {
+        if self.trig == other.trig {
             // Like terms, which a join above can leave: their coefficients add.
             let ((a, b), (c, d)) = (self.coefficient, other.coefficient);
             let n = a.checked_mul(d)?.checked_add(c.checked_mul(b)?)?;
@@ -160,22 +241,35 @@ impl Term {
                 ..self.clone()
             });
         }
-        let (sin, cos) =
-            if self.scales(other, 1) && self.sin == other.sin + 2 && other.cos == self.cos + 2 {
-                (other.sin, self.cos)
-            } else if self.scales(other, -1) && other.sin == self.sin && other.cos == self.cos + 2 {
-                (self.sin + 2, self.cos)
-            } else if self.scales(other, -1) && other.cos == self.cos && other.sin == self.sin + 2 {
-                (self.sin, self.cos + 2)
-            } else {
-                return None;
-            };
+        // The terms must differ in the powers of one argument only.
+        let keys: BTreeSet<&String> = self.trig.keys().chain(other.trig.keys()).collect();
+        let mut differing = keys
+            .into_iter()
+            .filter(|k| self.powers(k) != other.powers(k));
+        let key = differing.next()?;
+        if differing.next().is_some() {
+            return None;
+        }
+        let ((s1, c1), (s2, c2)) = (self.powers(key), other.powers(key));
+        let (sin, cos) = if self.scales(other, 1) && s1 == s2 + 2 && c2 == c1 + 2 {
+            (s2, c1)
+        } else if self.scales(other, -1) && s2 == s1 && c2 == c1 + 2 {
+            (s1 + 2, c1)
+        } else if self.scales(other, -1) && c2 == c1 && s2 == s1 + 2 {
+            (s1, c1 + 2)
+        } else {
+            return None;
+        };
+        let argument =
+            (self.trig.get(key).or_else(|| other.trig.get(key))).map(|t| t.argument.clone())?;
+        let mut trig = self.trig.clone();
+        trig.insert(key.clone(), Trig { argument, sin, cos });
+        trig.retain(|_, t| (t.sin, t.cos) != (0, 0));
         Some(Term {
             written: None,
             coefficient: self.coefficient,
             rest: self.rest.clone(),
-            sin,
-            cos,
+            trig,
         })
     }
 
@@ -186,20 +280,34 @@ impl Term {
         let (n, d) = self.coefficient;
         let mut factors = vec![Expr::Rational(n, d)];
         factors.extend(self.rest);
-        for (name, k) in [("rc_s", self.sin), ("rc_c", self.cos)] {
-            if k > 0 {
-                factors.push(Expr::Pow(Box::new(Expr::sym(name)), Box::new(Expr::int(k))));
+        for t in self.trig.into_values() {
+            for (is_sin, k) in [(true, t.sin), (false, t.cos)] {
+                if k == 0 {
+                    continue;
+                }
+                let base = match (&t.argument, is_sin) {
+                    (None, true) => Expr::sym("rc_s"),
+                    (None, false) => Expr::sym("rc_c"),
+                    (Some(x), true) => Expr::Fun("sin".into(), vec![x.clone()]),
+                    (Some(x), false) => Expr::Fun("cos".into(), vec![x.clone()]),
+                };
+                factors.push(match k {
+                    1 => base,
+                    k => Expr::Pow(Box::new(base), Box::new(Expr::int(k))),
+                });
             }
         }
         Expr::Mul(factors).tidy()
     }
 }
 
-/// `sin^2 + cos^2 = 1` applied to the terms of every sum in `e` (over `rc_s`, `rc_c`) where it
-/// joins two terms into one: `X sin^2 + X cos^2 = X`, `X - X cos^2 = X sin^2` and
-/// `X - X sin^2 = X cos^2`, `X` the same factors and coefficient in both (and like terms that
-/// a join leaves are added). Nothing is expanded,
-/// and no term is rewritten that no other joins, so no `1 - sin^2` cancels where `cos^2` was.
+/// `sin^2 + cos^2 = 1` applied to the terms of every sum in `e` where it joins two terms into
+/// one, for `theta` (`rc_s`, `rc_c`) and for every argument of a `sin` or `cos` call alike:
+/// `X sin^2 + X cos^2 = X`, `X - X cos^2 = X sin^2` and `X - X sin^2 = X cos^2`, `X` the same
+/// factors and coefficient in both (integer powers of either sign of the sine and cosine
+/// included, so `R + R cos^2/sin^2` is `R/sin^2`), and like terms that a join leaves are added.
+/// Nothing is expanded, and no term is rewritten that no other joins, so no `1 - sin^2` cancels
+/// where `cos^2` was.
 pub fn pythagoras(e: &Expr) -> Expr {
     let rec = |v: &Vec<Expr>| v.iter().map(pythagoras).collect::<Vec<_>>();
     match e {
@@ -227,14 +335,12 @@ pub fn pythagoras(e: &Expr) -> Expr {
     }
 }
 
-/// `e` (over `sin(theta)`, `cos(theta)`) with [`pythagoras`] applied, checked by Symbolica to
-/// be equal to `e` (their difference zero modulo `sin^2 + cos^2 = 1`); an error naming `what`
-/// if it is not, or if the check could not be made.
+/// `e` (over `sin(theta)`, `cos(theta)` where the phase reduces to `theta`, and any other
+/// angle) with [`pythagoras`] applied, checked by Symbolica to be equal to `e` (their
+/// difference zero modulo `sin^2 + cos^2 = 1`); an error naming `what` if it is not, or if the
+/// check could not be made.
 pub fn with_pythagoras(e: &Expr, theta: Option<&str>, what: &str) -> Result<Expr, DeriveError> {
-    let Some(theta) = theta else {
-        return Ok(e.clone());
-    };
-    let sc = to_sc_expr(e, theta);
+    let sc = to_sc_over(e, theta);
     let simpler = pythagoras(&sc);
     if simpler == sc {
         return Ok(e.clone());
@@ -244,7 +350,7 @@ pub fn with_pythagoras(e: &Expr, theta: Option<&str>, what: &str) -> Result<Expr
         Expr::Mul(vec![Expr::int(-1), sc.clone()]),
     ]);
     match is_zero_trig(&cas::atom(&difference)) {
-        Ok(true) => Ok(from_sc(&simpler, theta)),
+        Ok(true) => Ok(from_sc_over(&simpler, theta)),
         Ok(false) => Err(at(
             &[],
             format!(
@@ -258,13 +364,22 @@ pub fn with_pythagoras(e: &Expr, theta: Option<&str>, what: &str) -> Result<Expr
 }
 
 /// Whether a rational expression of `rc_s`, `rc_c` (and anything else) is zero modulo
-/// `sin^2 + cos^2 = 1`.
+/// `sin^2 + cos^2 = 1`, of `theta` (`rc_s`, `rc_c`) and of every other argument that a
+/// `sin` or `cos` call in it has.
 pub fn is_zero_trig(a: &A) -> Result<bool, StepError> {
     let t = cas::together(a);
     let e = cas::expr(&t)?;
     let (num, _) = e.num_den();
-    let n = cas::atom(&product(num));
-    Ok(cas::is_zero(&reduce_cos_sq(&n)))
+    let mut arguments = Vec::new();
+    let numerator = trig_symbols(&product(num), &mut arguments);
+    let mut n = reduce_cos_sq(&cas::atom(&numerator));
+    for i in 0..arguments.len() {
+        n = rewritten(
+            &n,
+            &cos_power_rules(&format!("rc_ts{i}"), &format!("rc_tc{i}")),
+        );
+    }
+    Ok(cas::is_zero(&n))
 }
 
 /// Replaces `sin(theta)`, `cos(theta)` by `rc_s`, `rc_c`.

@@ -120,6 +120,22 @@ pub enum Error {
 
 type Job = Box<dyn FnOnce() + Send>;
 
+thread_local! {
+    /// Whether this thread is the Symbolica worker.
+    static ON_WORKER: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// An error, not a wait without end, for a job on the Symbolica worker that queues another job
+/// and waits for it (the worker runs one job at a time, so the second would never start).
+fn off_worker() -> Result<(), Error> {
+    if ON_WORKER.with(std::cell::Cell::get) {
+        return Err(Error::Worker(
+            "a job on the Symbolica thread waited on another job there (a bug)".into(),
+        ));
+    }
+    Ok(())
+}
+
 /// Runs `f` on the one thread of this process that may call Symbolica, and waits for it.
 ///
 /// Restricted Symbolica aborts the process when a second thread touches it, so every symbolic
@@ -127,6 +143,7 @@ type Job = Box<dyn FnOnce() + Send>;
 pub fn on_cas_thread<R: Send + 'static>(
     f: impl FnOnce() -> R + Send + 'static,
 ) -> Result<R, Error> {
+    off_worker()?;
     static WORKER: OnceLock<Mutex<Sender<Job>>> = OnceLock::new();
     let sender = WORKER.get_or_init(|| {
         let (tx, rx) = channel::<Job>();
@@ -136,6 +153,7 @@ pub fn on_cas_thread<R: Send + 'static>(
                 // Restricted Symbolica also aborts when a second *process* uses it at the
                 // same time: hold a lock file while this worker lives, waiting for any other.
                 let _lock = cas_process_lock();
+                ON_WORKER.with(|w| w.set(true));
                 for job in rx {
                     // A panicking job must not take the worker down with it.
                     let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(job));
@@ -274,6 +292,7 @@ pub fn derive_each(
     checked: &[Checked],
     mut each: impl FnMut(usize, Vec<Derivation>, Duration) -> Result<(), Error>,
 ) -> Result<(), Error> {
+    off_worker()?;
     let owned: Vec<Checked> = checked.to_vec();
     let (tx, rx) = channel();
     std::thread::scope(|scope| {

@@ -474,9 +474,10 @@ impl<'a> Presenter<'a> {
     }
 }
 
-/// `sin^2 + cos^2 = 1` applied to every expression of `d` over the full state, as the
-/// generated code and the JSON record print them (each checked equal by
-/// [`with_pythagoras`]): `k T sin^2 + k T cos^2` is `k T`. Run after the steps
+/// `sin^2 + cos^2 = 1` applied to every expression of `d` over the full state, its initial
+/// state and its tangents, of every angle, as the generated code and the JSON record print
+/// them (each checked equal by [`with_pythagoras`]): `k T sin^2 + k T cos^2` is `k T`. Run
+/// after the steps
 /// ([`super::steps`]), which show the expressions as derived.
 pub fn with_identities(d: &mut Derivation) -> Result<(), DeriveError> {
     let theta = d.theta().map(str::to_string);
@@ -516,6 +517,13 @@ pub fn with_identities(d: &mut Derivation) -> Result<(), DeriveError> {
     }
     for state in &mut d.to_full {
         all(state, "full state")?;
+    }
+    for initial in &mut d.initial {
+        all(initial, "initial state")?;
+    }
+    if let Some(t) = &mut d.tangents {
+        all(&mut t.rows, "tangent")?;
+        all(&mut t.initial, "initial tangent")?;
     }
     Ok(())
 }

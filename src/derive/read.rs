@@ -2,6 +2,7 @@
 //! field, with the obstacles' symbols (`cylinder_x`, `cylinder_r`, ...) replaced by their
 //! values over the parameters, so that later stages see parameters and coordinates only.
 
+use super::algebra::simplify_inverse_trig;
 use super::expr::Expr;
 use super::spec::{ShapeSpec, Spec, Text, obstacle_symbols};
 use super::types::{DeriveError, FieldStep, Shape, ShapeKind, at, entry, key};
@@ -57,9 +58,11 @@ pub struct Parsed {
     pub shapes: Vec<Shape>,
 }
 
-/// Parses one expression of the spec, its error placed at `path`.
+/// Parses one expression of the spec, its error placed at `path`, with `cos(asin(x))` and the
+/// like in the one form the derivation writes them ([`simplify_inverse_trig`]), so that no
+/// later stage, and no constant the lowering hoists, holds a second form of the same value.
 pub fn parse_text(t: &Text, path: &[FieldStep]) -> Result<Expr, DeriveError> {
-    Expr::parse(&t.text()).map_err(|e| at(path, e.message))
+    (Expr::parse(&t.text()).map(|e| simplify_inverse_trig(&e))).map_err(|e| at(path, e.message))
 }
 
 /// `e` with every symbol of `values` replaced by its value.

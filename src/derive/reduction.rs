@@ -99,8 +99,12 @@ impl Reducer<'_> {
         for (c, row) in self.spec.contacts.iter().zip(contacts) {
             match &row.force {
                 None => forces_reduced.push(cas::num(0)),
-                Some(f) => match self.reduced_force(f, &red.cyc_vel, &cyc_acc)? {
-                    Ok(r) => forces_reduced.push(r),
+                Some(f) => match self.reduced_force(
+                    &start_values_read(f, &red.constants),
+                    &red.cyc_vel,
+                    &cyc_acc,
+                )? {
+                    Ok(r) => forces_reduced.push(start_as_drops(&r)?),
                     Err(why) => {
                         return Ok(Err(Unreducible::Force {
                             contact: c.name.clone(),
@@ -304,6 +308,7 @@ impl Reducer<'_> {
             cas::subs_var(&out, &format!("dot_{theta}"), &w)
         };
         let total = self.lag.kinetic.clone() + self.lag.potential.clone();
+        let total = start_values_read(&total, &constants);
         let e_red = cas::expand(&reduce_state(&total));
         let e_red = cas::expand(&cas::together(&e_red));
         let inertia = reduce_cos_sq(&cas::expand(&cas::d(&cas::d(&e_red, "rc_w"), "rc_w")));
@@ -515,6 +520,45 @@ impl Reducer<'_> {
         }
         Ok(plain)
     }
+}
+
+/// `a` with each start constant that is a root or a call (`rc_ci = ((1 - x)(1 + x))^(1/2)`
+/// for a start `asin(x)`, `rc_thi = asin(x)`) read as its symbol where `a` holds its value in
+/// the same form, or expanded: a spring unstretched at the start (`ell*cos(asin(a/ell))`)
+/// then leaves no `rc_ci - root`, zero at every point, in the potential's drop, and no second
+/// slot of `rc_ci`'s value in the forces.
+fn start_values_read(a: &A, constants: &[Constant]) -> A {
+    let mut out = a.clone();
+    for c in constants {
+        let root_or_call = match &c.value {
+            Expr::Fun(..) => true,
+            Expr::Pow(_, x) => x.as_integer().is_none(),
+            _ => false,
+        };
+        if root_or_call {
+            // As written, and expanded (as an expanded force holds it).
+            let value = cas::atom(&c.value);
+            out = cas::subs(&out, &value, &cas::var(&c.symbol));
+            out = cas::subs(&out, &cas::expand(&value), &cas::var(&c.symbol));
+        }
+    }
+    out
+}
+
+/// A reduced force with the start's sine and cosine written as their value now plus the drop
+/// (`rc_si = rc_s + rc_ds`, `rc_ci = rc_c + rc_dc`), so that a difference from the start
+/// cancels symbolically. A spring unstretched at the start pushes with `k ell (rc_c - rc_ci)`:
+/// formed as written, a nearly flat rod (`theta_i = 1e-7`) loses that push (`1e-14` of
+/// `k ell`) to the rounding of `cos` (`1e-16`), and the contact's end moved by `3e-6`; as
+/// `-k ell rc_dc` it keeps every digit.
+fn start_as_drops(force: &A) -> Result<A, DeriveError> {
+    let now_plus_drop = |now: &str, drop: &str| cas::var(now) + cas::var(drop);
+    let out = cas::subs_var(force, "rc_ci", &now_plus_drop("rc_c", "rc_dc"));
+    let out = cas::subs_var(&out, "rc_si", &now_plus_drop("rc_s", "rc_ds"));
+    collect_over(
+        &cas::expand(&out),
+        &["rc_s", "rc_c", "rc_ds", "rc_dc", "rc_w2", "rc_acc"],
+    )
 }
 
 /// Each reduction constant's value over the parameters alone, in the constants' order (the

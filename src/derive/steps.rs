@@ -14,7 +14,7 @@
 //! `sin^2 + cos^2 = 1`; a condition `= 0` up to its constant factor) before it can be shown; one
 //! that is not is not shown, and the step is shown as derived with the reason.
 
-use super::algebra::{is_zero_trig, to_sc_over};
+use super::algebra::{is_zero_trig, pythagoras, to_sc_over};
 use super::cas::{self, A};
 use super::expr::{Expr, product, sum};
 use super::present::{Presenter, Shape, operations};
@@ -94,7 +94,9 @@ fn show(e: &Expr, form: impl Fn(&A) -> Result<Expr, StepError>) -> Shown {
 /// products, then the part without either; within each, in the order of `motion`, higher
 /// powers first.
 fn in_motion(presenter: &Presenter, a: &A, motion: &[String]) -> Result<Expr, StepError> {
-    let expanded = cas::expr(&cas::expand(a))?;
+    // `sin^2 + cos^2 = 1` joins terms of every angle first: the presenter applies it to
+    // `theta`'s alone (checked with the whole grouped form below).
+    let expanded = pythagoras(&cas::expr(&cas::expand(a))?);
     let terms = match expanded {
         Expr::Add(v) => v,
         t => vec![t],

@@ -12,7 +12,7 @@
 //! call, so that its derivative in `theta` is `cos(theta)`), with nothing brought together or
 //! expanded: the lowering shares what the entries have in common.
 
-use super::algebra::to_expr;
+use super::algebra::{root_of_one_minus_square, to_expr};
 use super::cas::{self, A};
 use super::expr::Expr;
 use super::types::{Derivation, DeriveError, Tangents};
@@ -83,8 +83,8 @@ fn outer(f: &str, args: &[Expr]) -> Option<Expr> {
         "sin" => call("cos"),
         "cos" => minus(call("sin")),
         "tan" => Expr::Add(vec![one(), pow(call("tan"), 2, 1)]),
-        "asin" => pow(Expr::Add(vec![one(), minus(u_sq())]), -1, 2),
-        "acos" => minus(pow(Expr::Add(vec![one(), minus(u_sq())]), -1, 2)),
+        "asin" => root_of_one_minus_square(u, -1),
+        "acos" => minus(root_of_one_minus_square(u, -1)),
         "atan" => pow(Expr::Add(vec![one(), u_sq()]), -1, 1),
         "sqrt" => Expr::Mul(vec![Expr::Rational(1, 2), pow(call("sqrt"), -1, 1)]),
         "exp" => call("exp"),

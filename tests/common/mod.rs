@@ -1,6 +1,7 @@
 //! Shared test support: the paper's models typed by hand (`paper`), a wrapper that tweaks one
 //! of their functions (`tweaked`), used until and alongside the generated models, and references
-//! for the models with several contacts derived by hand, independently of the crate (`hand`).
+//! for the models with several contacts derived by hand, independently of the crate (`hand`),
+//! seeded random numbers (`numbers`) and every phase of a folder of specs derived (`derived`).
 #![allow(dead_code)]
 
 /// `Model` methods that only call the same method of another model: in an `impl Model`,
@@ -97,6 +98,9 @@ macro_rules! forward_model {
     };
 }
 
+#[cfg(feature = "derive")]
+pub mod derived;
 pub mod hand;
+pub mod numbers;
 pub mod paper;
 pub mod tweaked;

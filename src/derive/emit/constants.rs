@@ -3,7 +3,7 @@
 //! per-point solver reads (`prepare_lean`) and the named constants nothing reads.
 
 use super::code::{Code, parameter_local};
-use super::lower::{Hoisted, Scope, lower};
+use super::lower::{Hoisted, Scope, hoisted_slot, lower};
 use super::reduced::{ReducedCode, missing_constant};
 use crate::derive::expr::Expr;
 use crate::derive::types::{Derivation, Reduction, StepError};
@@ -36,21 +36,14 @@ pub(super) fn prepare_code(
             if !indices.contains(&slot) {
                 let c = &r.constants[j];
                 let prefix = format!("c{j}_");
-                bind_constant(
-                    &mut prepare,
-                    slot,
-                    Some(&c.symbol),
-                    &c.value,
-                    scope,
-                    &prefix,
-                );
+                bind_constant(&mut prepare, slot, &c.symbol, &c.value, scope, &prefix);
             }
         }
         lean_indices = indices;
     }
     for (i, e) in &hoisted.entries {
         if !lean_indices.contains(i) {
-            bind_constant(&mut prepare, *i, None, e, scope, &format!("h{i}_"));
+            bind_hoisted(&mut prepare, *i, e, scope, hoisted);
         }
     }
     if let Ok(r) = &d.reduction {
@@ -104,7 +97,7 @@ pub(super) fn constant_layout(
         bind_constant(
             &mut prepare,
             slot,
-            Some(&c.symbol),
+            &c.symbol,
             &c.value,
             &scope,
             &format!("c{j}_"),
@@ -124,20 +117,32 @@ fn alias(value: &Expr, scope: &Scope) -> Option<usize> {
     }
 }
 
-/// `k[idx] = <value>;`, with the value's shared subexpressions as `let`s named by `prefix`,
-/// after a comment saying what it holds in the spec's own symbols (`// k[20] = m1/2 + m2/2`).
-/// A named constant (a start value, say) is introduced by its name: `// k[7] = rc_si = a/ell`.
+/// `k[idx] = <value>;` for the hoisted constant `value` (which may read earlier hoisted slots),
+/// after a comment saying what it holds in the spec's own symbols.
+fn bind_hoisted(code: &mut Code, idx: usize, value: &Expr, scope: &Scope, hoisted: &Hoisted) {
+    let holds = hoisted.defined(value).tidy().to_infix();
+    bind(code, idx, &holds, value, scope, &format!("h{idx}_"));
+}
+
+/// `k[idx] = <value>;` for the named constant `name` (a start value, say), introduced by its
+/// name: `// k[7] = rc_si = a/ell`.
 fn bind_constant(
     code: &mut Code,
     idx: usize,
-    name: Option<&str>,
+    name: &str,
     value: &Expr,
     scope: &Scope,
     prefix: &str,
 ) {
-    let named = name.map_or(String::new(), |n| format!("{n} = "));
-    code.stmts
-        .push(format!("// k[{idx}] = {named}{}", value.tidy().to_infix()));
+    let holds = format!("{name} = {}", value.tidy().to_infix());
+    bind(code, idx, &holds, value, scope, prefix);
+}
+
+/// `// k[idx] = <holds>` (what the slot holds in the spec's own symbols,
+/// `// k[20] = m1/2 + m2/2`) and the lines that compute `value` into `k[idx]`, its shared
+/// subexpressions as `let`s named by `prefix`.
+fn bind(code: &mut Code, idx: usize, holds: &str, value: &Expr, scope: &Scope, prefix: &str) {
+    code.stmts.push(format!("// k[{idx}] = {holds}"));
     let out = code.push_body(lower(std::slice::from_ref(value), scope, None, prefix));
     code.bind(&format!("k[{idx}]"), out[0].clone());
 }
@@ -190,7 +195,7 @@ fn lean_prepare(
         if needed.insert(i)
             && let Some(e) = definition(i)
         {
-            stack.extend(e.symbols().iter().filter_map(|s| index(s)));
+            stack.extend((e.symbols().iter()).filter_map(|s| index(s).or_else(|| hoisted_slot(s))));
         }
     }
     let mut lean = Code::default();
@@ -200,7 +205,7 @@ fn lean_prepare(
             bind_constant(
                 &mut lean,
                 slot,
-                Some(&c.symbol),
+                &c.symbol,
                 &c.value,
                 scope,
                 &format!("c{j}_"),
@@ -209,7 +214,7 @@ fn lean_prepare(
     }
     for (i, e) in &hoisted.entries {
         if needed.contains(i) {
-            bind_constant(&mut lean, *i, None, e, scope, &format!("h{i}_"));
+            bind_hoisted(&mut lean, *i, e, scope, hoisted);
         }
     }
     Ok((lean, needed.into_iter().filter(|&i| i >= np).collect()))

@@ -57,8 +57,7 @@ impl Hoisted {
     pub fn defined(&self, e: &Expr) -> Expr {
         let rec = |v: &Vec<Expr>| v.iter().map(|x| self.defined(x)).collect();
         match e {
-            Expr::Sym(s) => (s.strip_prefix("rc_k"))
-                .and_then(|i| i.parse::<usize>().ok())
+            Expr::Sym(s) => (hoisted_slot(s))
                 .and_then(|i| self.definitions.get(&i))
                 .map_or_else(|| e.clone(), |d| self.defined(d)),
             Expr::Add(v) => Expr::Add(rec(v)),
@@ -88,20 +87,78 @@ impl Hoisted {
         {
             return (neg, magnitude);
         }
-        let (i, held_negated) = *self.by_key.entry(key(&magnitude)).or_insert_with(|| {
-            let i = self.next;
-            self.next += 1;
-            self.entries.push((i, magnitude.clone()));
-            self.definitions.insert(i, magnitude);
-            (i, false)
-        });
-        (neg != held_negated, Expr::Sym(format!("rc_k{i}")))
+        let key = key(&magnitude);
+        if let Some(&(i, held_negated)) = self.by_key.get(&key) {
+            return (neg != held_negated, Expr::Sym(format!("rc_k{i}")));
+        }
+        // The roots and calls inside a new constant take slots of their own first (so that one
+        // another constant holds too, in the same form, is computed once and read by both).
+        let definition = self.calls_apart(&magnitude, scope, true);
+        let i = self.next;
+        self.next += 1;
+        self.entries.push((i, definition.clone()));
+        self.definitions.insert(i, definition);
+        self.by_key.insert(key, (i, false));
+        (neg, Expr::Sym(format!("rc_k{i}")))
+    }
+
+    /// `e` (over constants only) with each root (a power whose exponent is no integer, a
+    /// negative one read as the reciprocal of the positive one) and each function call below
+    /// its top read from a slot of its own.
+    fn calls_apart(&mut self, e: &Expr, scope: &Scope, top: bool) -> Expr {
+        let mut rec = |x: &Expr| self.calls_apart(x, scope, false);
+        match e {
+            Expr::Pow(b, x) if x.as_integer().is_none() && reads_negative(x) => {
+                let root = Expr::Pow(b.clone(), Box::new(negated(x)));
+                Expr::Pow(Box::new(rec(&root)), Box::new(Expr::int(-1)))
+            }
+            Expr::Pow(_, x) if !top && x.as_integer().is_none() => self.read(e, scope),
+            Expr::Fun(..) if !top => self.read(e, scope),
+            Expr::Pow(b, x) => Expr::Pow(Box::new(rec(b)), Box::new(rec(x))),
+            Expr::Fun(f, args) => Expr::Fun(f.clone(), args.iter().map(rec).collect()),
+            Expr::Add(v) => Expr::Add(v.iter().map(rec).collect()),
+            Expr::Mul(v) => Expr::Mul(v.iter().map(rec).collect()),
+            _ => e.clone(),
+        }
+    }
+
+    /// The constant `e` as the symbol that reads it, signed.
+    fn read(&mut self, e: &Expr, scope: &Scope) -> Expr {
+        let (neg, x) = self.constant(e, scope);
+        with_sign(neg, x)
     }
 }
 
-/// The key two constants share when they are equal up to flattening and folded numbers.
+/// The slot `rc_k<i>` names, if it names one.
+pub fn hoisted_slot(symbol: &str) -> Option<usize> {
+    symbol.strip_prefix("rc_k")?.parse().ok()
+}
+
+/// The key two constants share when they are equal up to flattening, folded numbers and the
+/// order of the terms of a sum and the factors of a product (`(1 + x)*(1 - x)` and
+/// `(1 - x)*(1 + x)` take one slot).
 fn key(magnitude: &Expr) -> String {
-    magnitude.tidy().to_infix()
+    ordered(&magnitude.tidy()).to_infix()
+}
+
+/// `e` with the terms of every sum and the factors of every product sorted by their infix text,
+/// and `sqrt(x)` (as a spec writes it) read as `x^(1/2)` (as Symbolica writes it).
+fn ordered(e: &Expr) -> Expr {
+    let sorted = |v: &Vec<Expr>| {
+        let mut v: Vec<Expr> = v.iter().map(ordered).collect();
+        v.sort_by_cached_key(Expr::to_infix);
+        v
+    };
+    match e {
+        Expr::Add(v) => Expr::Add(sorted(v)),
+        Expr::Mul(v) => Expr::Mul(sorted(v)),
+        Expr::Pow(b, x) => Expr::Pow(Box::new(ordered(b)), Box::new(ordered(x))),
+        Expr::Fun(f, v) if f == "sqrt" && v.len() == 1 => {
+            Expr::Pow(Box::new(ordered(&v[0])), Box::new(Expr::Rational(1, 2)))
+        }
+        Expr::Fun(f, v) => Expr::Fun(f.clone(), v.iter().map(ordered).collect()),
+        _ => e.clone(),
+    }
 }
 
 /// Whether `e` reads as negative: a negative number, a product with an odd number of negative
@@ -404,7 +461,7 @@ fn emit_node(
         Expr::Float(x) => float_literal(*x),
         Expr::Sym(s) if s == crate::derive::expr::PI => "std::f64::consts::PI".to_string(),
         Expr::Sym(s) => {
-            if let Some(i) = s.strip_prefix("rc_k").and_then(|i| i.parse::<usize>().ok()) {
+            if let Some(i) = hoisted_slot(s) {
                 format!("k[{i}]")
             } else if let Some(i) = scope.constants.get(s) {
                 match scope.named.get(i) {
@@ -525,5 +582,49 @@ mod tests {
         assert_eq!(h.len(), 3);
         assert_eq!(body.lets.len(), 1, "{body:?}");
         assert!(body.outputs[0].contains("t0"), "{body:?}");
+    }
+
+    /// The parameters `a`, `ell` in `k[0]`, `k[1]` and a local `s`.
+    fn a_ell_scope() -> Scope {
+        let mut scope = Scope::default();
+        for (i, name) in ["a", "ell"].into_iter().enumerate() {
+            scope.constants.insert(name.into(), i);
+        }
+        scope.locals.insert("s".into(), "s".into());
+        scope
+    }
+
+    #[test]
+    fn a_root_two_constants_hold_in_either_order_takes_one_slot() {
+        let scope = a_ell_scope();
+        let exprs = [
+            "ell*((1 - a/ell)*(1 + a/ell))^(1/2)*s",
+            "a/(ell^2*((1 + a/ell)*(1 - a/ell))^(1/2))*s^2",
+        ]
+        .map(|t| Expr::parse(t).unwrap().tidy());
+        let mut h = Hoisted::new(2);
+        let body = lower(&exprs, &scope, Some(&mut h), "");
+        let roots: Vec<_> = (h.entries.iter())
+            .filter(|(_, e)| matches!(e, Expr::Pow(_, x) if **x == Expr::Rational(1, 2)))
+            .collect();
+        assert_eq!(roots.len(), 1, "{:?}", h.entries);
+        let root = format!("rc_k{}", roots[0].0);
+        let reading = (h.entries.iter())
+            .filter(|(_, e)| e.symbols().contains(&root))
+            .count();
+        assert_eq!(reading, 2, "{:?} {body:?}", h.entries);
+    }
+
+    #[test]
+    fn a_root_written_as_sqrt_and_as_a_half_power_takes_one_slot() {
+        let scope = a_ell_scope();
+        let exprs = [
+            "sqrt((ell - a)*(ell + a))*s",
+            "((a + ell)*(-a + ell))^(1/2)*s^2",
+        ]
+        .map(|t| Expr::parse(t).unwrap().tidy());
+        let mut h = Hoisted::new(2);
+        let body = lower(&exprs, &scope, Some(&mut h), "");
+        assert_eq!(h.entries.len(), 1, "{:?} {body:?}", h.entries);
     }
 }
