@@ -16,7 +16,7 @@ use rodcube::plan::{self, Request};
 use rodcube::quantity::Quantity;
 use rodcube::report;
 use rodcube::scene::Scene;
-use rodcube::solve::lean::LeanSolver;
+use rodcube::solve::fast::lean::LeanSolver;
 use rodcube::solve::phases::Route;
 use std::hint::black_box;
 use std::path::Path;

@@ -12,7 +12,7 @@ use rodcube::model::Model;
 use rodcube::models;
 use rodcube::plan;
 use rodcube::scene::Scene;
-use rodcube::solve::contacts::{self, DynamicsWork, Moment, Options};
+use rodcube::solve::integrated::contacts::{self, DynamicsWork, Moment, Options};
 use rodcube::system::Bound;
 use rodcube::tape::{self, TapeModel};
 use std::hint::black_box;

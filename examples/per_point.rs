@@ -13,8 +13,8 @@
 //! every parameter, `LeanSolver::sensitivities`, their sum added to the printed one).
 
 use rodcube::models;
-use rodcube::solve::lean::LeanSolver;
-use rodcube::solve::sensitivity::SensitivityWork;
+use rodcube::solve::fast::lean::LeanSolver;
+use rodcube::solve::fast::sensitivity::SensitivityWork;
 use std::process::ExitCode;
 
 #[path = "common/per_point_set.rs"]

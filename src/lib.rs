@@ -23,12 +23,12 @@
 //! # Ok::<(), rodcube::plan::PlanError>(())
 //! ```
 //!
-//! For many points, [`solve::lean::LeanSolver`] gives the separation angle and time alone,
+//! For many points, [`solve::fast::lean::LeanSolver`] gives the separation angle and time alone,
 //! reusing its buffers (no allocation per point, under a microsecond per point for the paper's
 //! model; `rodcube sweep` calls it):
 //!
 //! ```
-//! use rodcube::{models, solve::lean::LeanSolver};
+//! use rodcube::{models, solve::fast::lean::LeanSolver};
 //!
 //! let model = models::find("rod_cube").expect("generated model");
 //! let names: Vec<&str> = model.info().parameters.iter().map(|p| p.name).collect();

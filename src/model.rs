@@ -532,7 +532,7 @@ pub trait Reduction: Send + Sync {
     /// `theta_dot^2` alone, at the angle given by its sine `s` and cosine `c` and their drops from
     /// the start, `ds = sin(theta_i) - s` and `dc = cos(theta_i) - c`: no trigonometric call and
     /// no `theta_ddot`. This is the integrand of the per-point solver
-    /// [`LeanSolver`](crate::solve::lean::LeanSolver), which parametrises the motion by
+    /// [`LeanSolver`](crate::solve::fast::lean::LeanSolver), which parametrises the motion by
     /// `sin(theta)` and forms `ds` and `dc` exactly. Equal to
     /// `reduced(k, delta).theta_dot_sq` at the same angle.
     fn theta_dot_sq_sc(&self, k: &[f64], s: f64, c: f64, ds: f64, dc: f64) -> f64;

@@ -8,8 +8,8 @@
 use rodcube::accuracy::{self, Budget, Measured, Row, integrated, methods, plot};
 use rodcube::reference::{Family, relative_error, to_f64};
 use rodcube::report::table::Layout;
-use rodcube::solve::lean::LeanSolver;
-use rodcube::solve::ode::Method;
+use rodcube::solve::fast::lean::LeanSolver;
+use rodcube::solve::integrated::ode::Method;
 use rodcube::system::System;
 use std::cell::RefCell;
 use std::time::Duration;

@@ -11,7 +11,7 @@ use rodcube::model::Model;
 use rodcube::plan::{self, PlanError, Request};
 use rodcube::quantity::Quantity;
 use rodcube::solve::SolveError;
-use rodcube::solve::lean::LeanSolver;
+use rodcube::solve::fast::lean::LeanSolver;
 use rodcube::solve::phases::Route;
 use rodcube::system::{Bound, State, System, SystemError};
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -671,9 +671,9 @@ fn every_model_refuses_parameters_of_another_count_or_not_finite() {
 
 #[test]
 fn the_solvers_refuse_a_state_of_another_length() {
-    use rodcube::solve::contacts::{self, Active, Moment, Options};
+    use rodcube::solve::integrated::contacts::{self, Active, Moment, Options};
     use rodcube::solve::phases::{self, PhaseStart, Walker};
-    use rodcube::solve::{checks, rest, series::PhaseSamples, unreduced};
+    use rodcube::solve::{checks, integrated::rest, integrated::unreduced, series::PhaseSamples};
     let input = |r: &Result<(), SolveError>, what: &str| {
         assert!(
             matches!(r, Err(SolveError::Input(SystemError::Length { .. }))),

@@ -9,7 +9,7 @@
 //! `rodcube_models_load` and solved and run from C (`examples/c/tapes.c` too) to the paper's
 //! closed forms, while a corrupted tape is refused with its code and a message naming it.
 
-use rodcube::solve::lean::LeanSolver;
+use rodcube::solve::fast::lean::LeanSolver;
 use std::path::Path;
 use std::process::Command;
 
@@ -57,7 +57,7 @@ fn the_c_example_prints_the_rust_solvers_numbers() {
     let mut solver = LeanSolver::new(model).unwrap();
     let point = solver.solve(&PAPER).unwrap();
     let (mut d_angle, mut d_time) = ([0.0; 5], [0.0; 5]);
-    let mut work = rodcube::solve::sensitivity::SensitivityWork::default();
+    let mut work = rodcube::solve::fast::sensitivity::SensitivityWork::default();
     (solver.sensitivities(&PAPER, &point, &mut work, &mut d_angle, &mut d_time))
         .unwrap()
         .unwrap();
@@ -704,8 +704,8 @@ mod calls {
     /// codes and leave the arrays as they were.
     #[test]
     fn sensitivities_are_the_per_point_solvers() {
-        use rodcube::solve::lean::LeanSolver;
-        use rodcube::solve::sensitivity::SensitivityWork;
+        use rodcube::solve::fast::lean::LeanSolver;
+        use rodcube::solve::fast::sensitivity::SensitivityWork;
         let model = rodcube::models::find("rod_cube").unwrap();
         let mut rust = LeanSolver::new(model).unwrap();
         let s = solver("rod_cube").unwrap();

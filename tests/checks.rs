@@ -13,10 +13,10 @@ use rodcube::quantity::Quantity;
 use rodcube::results::{CheckKind, Work};
 use rodcube::solve::SolveError;
 use rodcube::solve::checks::{self, Conserved};
-use rodcube::solve::contacts::Active;
+use rodcube::solve::integrated::contacts::Active;
+use rodcube::solve::integrated::unreduced::{self, Start};
 use rodcube::solve::phases::{End, PhaseRun, ReducedRun, Route, Walker, phase_end};
 use rodcube::solve::series::{sample, sample_forces};
-use rodcube::solve::unreduced::{self, Start};
 use rodcube::system::{Bound, State, System, SystemError};
 
 fn walker(registry: &'static [&'static dyn Model], route: Route) -> Walker<'static> {

@@ -19,7 +19,7 @@ use rodcube::plan::{PlanError, Request, run};
 use rodcube::quantity::Quantity;
 use rodcube::results::{RunResults, Work};
 use rodcube::solve::SolveError;
-use rodcube::solve::ode::Method;
+use rodcube::solve::integrated::ode::Method;
 use rodcube::solve::phases::{End, Route, Walker};
 use rodcube::system::Bound;
 

@@ -323,7 +323,7 @@ fn the_sensitive_motion_goes_through_every_impact_and_its_times_move_as_differen
 /// their frictions' laws (`stick`: sticking at every strike, else sliding at some), against
 /// fourth-order central differences of the run.
 fn rocking_strikes_agree(mu: f64, until: f64, count: usize, stick: bool) {
-    use rodcube::solve::impact::FrictionLaw;
+    use rodcube::solve::integrated::impact::FrictionLaw;
     let (model, mut p) = scene("rocking");
     *p.get_mut("mu").expect("mu") = mu;
     let mut w = walker(model, &p);
@@ -357,7 +357,10 @@ fn impact_times_agree(
         &BTreeMap<String, f64>,
         f64,
     ),
-    ends: &[Result<rodcube::solve::phases::EndDerivatives, rodcube::solve::forward::Grazing>],
+    ends: &[Result<
+        rodcube::solve::phases::EndDerivatives,
+        rodcube::solve::integrated::forward::Grazing,
+    >],
     impacts: &[rodcube::solve::phases::ImpactAt],
     names: &[&str],
 ) {

@@ -15,10 +15,10 @@ use rodcube::quantity::Quantity;
 use rodcube::reference::{Family, Inputs, Reference, RootRoute, TimeRoute, relative_error};
 use rodcube::results::{RunResults, Work};
 use rodcube::solve::SolveError;
-use rodcube::solve::contacts::{
+use rodcube::solve::integrated::contacts::{
     Active, Mode, Moment, Options, Sign, contact_options, decide, dynamics, friction_options,
 };
-use rodcube::solve::ode::Method;
+use rodcube::solve::integrated::ode::Method;
 use rodcube::solve::phases::{End, PhaseRun, PhaseStart, Route, Walker};
 use rodcube::system::{Bound, State, SystemError};
 

@@ -13,7 +13,7 @@ use rodcube::models::find;
 use rodcube::plan::{Request, run};
 use rodcube::quantity::Quantity;
 use rodcube::results::RunResults;
-use rodcube::solve::contacts::{Active, dynamics};
+use rodcube::solve::integrated::contacts::{Active, dynamics};
 use rodcube::solve::phases::Route;
 use rodcube::system::{Bound, State};
 
@@ -428,6 +428,6 @@ fn a_hinged_rod_on_a_cylinder_takes_the_fast_path_to_its_edge() {
         assert_eq!(fast.work.ode_steps, 0);
     }
     // Its per-point solver is refused with the reason, not given a wrong answer.
-    let err = rodcube::solve::lean::LeanSolver::new(model("hinged_cylinder")).unwrap_err();
+    let err = rodcube::solve::fast::lean::LeanSolver::new(model("hinged_cylinder")).unwrap_err();
     assert!(err.to_string().contains("edge"), "{err}");
 }

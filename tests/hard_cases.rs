@@ -8,7 +8,7 @@ use rodcube::model::Model;
 use rodcube::plan::{self, PlanError, Request};
 use rodcube::quantity::Quantity;
 use rodcube::reference::{Family, Inputs, Reference, RootRoute, TimeRoute, relative_error};
-use rodcube::solve::lean::LeanSolver;
+use rodcube::solve::fast::lean::LeanSolver;
 use rodcube::system::SystemError;
 
 #[path = "common/grid.rs"]

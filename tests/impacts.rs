@@ -1,4 +1,4 @@
-//! Impacts (`solve::impact`) against hand impulse–momentum balances solved here by
+//! Impacts (`solve::integrated::impact`) against hand impulse–momentum balances solved here by
 //! Newton–Euler in world coordinates (each body's centre and angle, the rod's inertia
 //! `m ell^2 / 12`), sharing no code with the models:
 //! - the rod of `fixed_cylinder` (R = 0.2, th0 = 1.2) leaves the cylinder at release, falls on
@@ -15,7 +15,7 @@ mod common;
 use common::hand::solve_linear;
 use rodcube::models::{all, find};
 use rodcube::results::Work;
-use rodcube::solve::impact::{Part, resolve};
+use rodcube::solve::integrated::impact::{Part, resolve};
 use rodcube::solve::phases::{End, Route, Walker};
 use rodcube::system::{Bound, State, SystemError};
 

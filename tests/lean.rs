@@ -1,4 +1,4 @@
-//! The sweep's per-point solver (`rodcube::solve::lean`): it agrees with the hand-typed paper
+//! The sweep's per-point solver (`rodcube::solve::fast::lean`): it agrees with the hand-typed paper
 //! model (which uses the trait's default `theta_dot_sq_sc` through `reduced`), with fixed rule
 //! pairs and with a much finer setting; its schedule spends fewer
 //! evaluations where short panels allow; it solves a system by its release fast phase and
@@ -14,9 +14,9 @@ use common::tweaked::{Fault, Tweaked};
 use rodcube::model::{Model, ModelInfo, Partials, Reduced, Reduction, ReductionInfo, Tangents};
 use rodcube::reference::{Family, Inputs, Reference, RootRoute, TimeRoute, relative_error};
 use rodcube::solve::SolveError;
-use rodcube::solve::lean::LeanSolver;
-use rodcube::solve::prior::PRIOR_MAX_NODES;
-use rodcube::solve::quadrature::{RuleStep, SCHEDULE};
+use rodcube::solve::fast::lean::LeanSolver;
+use rodcube::solve::fast::prior::PRIOR_MAX_NODES;
+use rodcube::solve::fast::quadrature::{RuleStep, SCHEDULE};
 use rodcube::system::SystemError;
 use std::sync::LazyLock;
 

@@ -5,9 +5,9 @@
 
 use rodcube::results::Work;
 use rodcube::solve::SolveError;
-use rodcube::solve::ode::{OdeOptions, OdeProblem, dopri5};
-use rodcube::solve::quadrature::TimeMesh;
-use rodcube::solve::separation::separation;
+use rodcube::solve::fast::quadrature::TimeMesh;
+use rodcube::solve::fast::separation::separation;
+use rodcube::solve::integrated::ode::{OdeOptions, OdeProblem, dopri5};
 use rodcube::solve::series::delta_at_time;
 use rodcube::system::System;
 

@@ -10,13 +10,13 @@ use common::paper::{FREE_ROD, GENERAL, ROD_CUBE, paper, ratios};
 use rodcube::results::{CheckKind, Work};
 use rodcube::solve::SolveError;
 use rodcube::solve::checks::{self, Conserved, free_momenta};
-use rodcube::solve::contacts::{self, Active};
-use rodcube::solve::ode::{self, Method, OdeOptions, OdeProblem};
+use rodcube::solve::fast::quadrature::TimeMesh;
+use rodcube::solve::fast::separation::separation;
+use rodcube::solve::integrated::contacts::{self, Active};
+use rodcube::solve::integrated::ode::{self, Method, OdeOptions, OdeProblem};
+use rodcube::solve::integrated::unreduced::{End, Start, UnreducedRun, integrate, motion_scales};
 use rodcube::solve::phases::fall_time_scale;
-use rodcube::solve::quadrature::TimeMesh;
-use rodcube::solve::separation::separation;
 use rodcube::solve::series::{delta_at_time, theta_dot_at};
-use rodcube::solve::unreduced::{End, Start, UnreducedRun, integrate, motion_scales};
 use rodcube::system::{Bound, State, System};
 
 /// Index of `theta` in the general model's coordinates.

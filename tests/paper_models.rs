@@ -6,7 +6,7 @@
 mod common;
 
 use common::paper::{FREE_ROD, GENERAL, ROD_CUBE, paper, ratios};
-use rodcube::solve::contacts::{self, Active};
+use rodcube::solve::integrated::contacts::{self, Active};
 use rodcube::system::{Bound, State, System};
 
 fn close(a: f64, b: f64, rel: f64) -> bool {

@@ -10,9 +10,9 @@ use rodcube::model::Model;
 use rodcube::reference::{Family, Inputs, Reference, RootRoute, TimeRoute, to_f64};
 use rodcube::results::Work;
 use rodcube::solve::SolveError;
-use rodcube::solve::contacts::Active;
+use rodcube::solve::integrated::contacts::Active;
+use rodcube::solve::integrated::unreduced::{Start, integrate};
 use rodcube::solve::phases::{End, Motion, Route, Walker, phase_parameters};
-use rodcube::solve::unreduced::{Start, integrate};
 use rodcube::system::Bound;
 
 fn walker(registry: &'static [&'static dyn Model]) -> Walker<'static> {

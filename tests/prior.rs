@@ -1,4 +1,4 @@
-//! The fall polynomial and the a-priori rule of the per-point solver (`rodcube::solve::prior`):
+//! The fall polynomial and the a-priori rule of the per-point solver (`rodcube::solve::fast::prior`):
 //! the generated `P(s) = (sin theta_i - s) / theta_dot^2` equals the ratio of the generated
 //! `theta_dot^2` and, for the paper's model, the ratio from eq. (9) typed by hand; the lean
 //! preparation fills the constants it lists exactly as the full one; and the a-priori rule
@@ -11,7 +11,7 @@ use common::numbers::Uniform;
 use common::paper::ROD_CUBE;
 use rodcube::model::{Model, start_offsets};
 use rodcube::reference::{Family, Inputs, Reference, RootRoute, TimeRoute, relative_error};
-use rodcube::solve::lean::LeanSolver;
+use rodcube::solve::fast::lean::LeanSolver;
 use rodcube::system::System;
 
 fn model(name: &str) -> &'static dyn Model {
@@ -91,7 +91,7 @@ fn the_fall_polynomial_is_the_drop_over_theta_dot_squared() {
                     delta,
                 );
                 let w2 = sys.reduction().theta_dot_sq_sc(k, s, c, ds, dc);
-                let from_fall = ds / rodcube::solve::poly::horner(fall, s);
+                let from_fall = ds / rodcube::solve::fast::poly::horner(fall, s);
                 assert!(
                     ((from_fall - w2) / w2).abs() < 1e-12,
                     "{name} {p:?} delta {delta}: {from_fall} vs {w2}"

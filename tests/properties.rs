@@ -14,10 +14,10 @@ use rodcube::reference::{Inputs, Reference, RootRoute, TimeRoute, relative_error
 use rodcube::results::{CheckKind, Work};
 use rodcube::solve::SolveError;
 use rodcube::solve::checks::{self, Conserved};
-use rodcube::solve::contacts::DECIDE_TOLERANCE;
-use rodcube::solve::lean::LeanSolver;
+use rodcube::solve::fast::lean::LeanSolver;
+use rodcube::solve::fast::quadrature::TimeMesh;
+use rodcube::solve::integrated::contacts::DECIDE_TOLERANCE;
 use rodcube::solve::phases::{End, PhaseRun, ReducedEnd, ReducedRun};
-use rodcube::solve::quadrature::TimeMesh;
 use rodcube::system::{Bound, System};
 
 /// Parameter values for `model` from uniforms `u` (one per parameter) and `spread`, which

@@ -7,8 +7,8 @@ mod common;
 use common::paper::{FREE_ROD, ROD_CUBE, paper, ratios};
 use gauss_quad::{FiniteAboveNegOneF64, GaussJacobi, GaussLegendre};
 use rodcube::results::Work;
-use rodcube::solve::quadrature::{Control, Fall, RuleStep, TimeMesh, integrate};
-use rodcube::solve::separation::separation;
+use rodcube::solve::fast::quadrature::{Control, Fall, RuleStep, TimeMesh, integrate};
+use rodcube::solve::fast::separation::separation;
 use rodcube::system::System;
 
 /// `h(delta) = sqrt(delta / theta_dot^2)`, smooth when the start is not near upright.

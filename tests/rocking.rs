@@ -1,5 +1,5 @@
 //! Housner's rocking block (`rocking_block`) through its strikes, impacts with friction
-//! (`solve::impact`), against references worked out here by hand, sharing no code with the
+//! (`solve::integrated::impact`), against references worked out here by hand, sharing no code with the
 //! model:
 //! - the angular velocity ratio at every strike, `1 - (3/2) sin^2(alpha)`, `alpha = atan(w/h)`
 //!   (angular momentum about the new corner), and the strike times by the corner pendulum's
@@ -19,8 +19,8 @@ use rodcube::plan::{self, Request};
 use rodcube::quantity::Quantity;
 use rodcube::results::{Halt, Work, Zeno};
 use rodcube::solve::SolveError;
-use rodcube::solve::contacts::Sign;
-use rodcube::solve::impact::{ContactLaw, FrictionLaw, Part, resolve};
+use rodcube::solve::integrated::contacts::Sign;
+use rodcube::solve::integrated::impact::{ContactLaw, FrictionLaw, Part, resolve};
 use rodcube::solve::phases::{Motion, Route, Walker};
 use rodcube::system::{Bound, State};
 

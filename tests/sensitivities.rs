@@ -6,8 +6,8 @@
 use rodcube::model::Model;
 use rodcube::reference::{self, Family, Inputs};
 use rodcube::results::SensitivityGap;
-use rodcube::solve::lean::{LeanPoint, LeanSolver};
-use rodcube::solve::sensitivity::SensitivityWork;
+use rodcube::solve::fast::lean::{LeanPoint, LeanSolver};
+use rodcube::solve::fast::sensitivity::SensitivityWork;
 
 #[path = "common/grid.rs"]
 mod grid;

@@ -7,9 +7,9 @@
 use rodcube::plan::{self, Request};
 use rodcube::quantity::Quantity;
 use rodcube::results::SensitivityGap;
-use rodcube::solve::lean::LeanSolver;
-use rodcube::solve::prior::{PRIOR_TOL, Prior};
-use rodcube::solve::sensitivity::{self, SensitivityWork, SeparationPoint};
+use rodcube::solve::fast::lean::LeanSolver;
+use rodcube::solve::fast::prior::{PRIOR_TOL, Prior};
+use rodcube::solve::fast::sensitivity::{self, SensitivityWork, SeparationPoint};
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

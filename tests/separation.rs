@@ -6,8 +6,8 @@ mod common;
 use common::paper::{ROD_CUBE, paper, ratios};
 use common::tweaked::NEVER_SEPARATES;
 use rodcube::results::Work;
-use rodcube::solve::poly::real_roots;
-use rodcube::solve::separation::{
+use rodcube::solve::fast::poly::real_roots;
+use rodcube::solve::fast::separation::{
     Separation, SeparationOutcome, linearised_separation, separation,
 };
 use rodcube::system::System;

@@ -7,12 +7,12 @@ use common::paper::{FREE_ROD, GENERAL, MODELS, ROD_CUBE, paper, ratios};
 use rodcube::model::Model;
 use rodcube::results::Work;
 use rodcube::solve::SolveError;
-use rodcube::solve::contacts::Active;
+use rodcube::solve::fast::quadrature::TimeMesh;
+use rodcube::solve::fast::separation::separation;
+use rodcube::solve::integrated::contacts::Active;
+use rodcube::solve::integrated::unreduced::{End, Start, integrate};
 use rodcube::solve::phases::{Route, Walker};
-use rodcube::solve::quadrature::TimeMesh;
-use rodcube::solve::separation::separation;
 use rodcube::solve::series::sample_phase;
-use rodcube::solve::unreduced::{End, Start, integrate};
 use rodcube::system::{Bound, System};
 
 fn contact_mesh(sys: &System) -> TimeMesh {

@@ -21,8 +21,8 @@ use rodcube::plan::{self, Parameters, Request};
 use rodcube::quantity::Quantity;
 use rodcube::report::prose;
 use rodcube::results::Note;
-use rodcube::solve::lean::LeanSolver;
-use rodcube::solve::sensitivity::SensitivityWork;
+use rodcube::solve::fast::lean::LeanSolver;
+use rodcube::solve::fast::sensitivity::SensitivityWork;
 use rodcube::sweep::{Points, planned};
 
 mod notebook;

@@ -8,7 +8,7 @@ use super::settings::pick;
 use super::{AccuracyError, Budget, Measured, Measurement, Row, measure};
 use crate::model::Model;
 use crate::results::Work;
-use crate::solve::ode::Method;
+use crate::solve::integrated::ode::Method;
 use crate::solve::phases::{End, PhaseRun, Route, Walker};
 use crate::system::Bound;
 

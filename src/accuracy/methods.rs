@@ -8,16 +8,16 @@
 use super::AccuracyError;
 use crate::results::{SensitivityGap, Work};
 use crate::solve::SolveError;
-use crate::solve::contacts::Active;
-use crate::solve::lean::LeanSolver;
-use crate::solve::ode::{Method, OdeOptions, OdeProblem, dopri5};
+use crate::solve::fast::lean::LeanSolver;
+use crate::solve::fast::poly::horner;
+use crate::solve::fast::quadrature::{TimeMesh, gauss_legendre_rule};
+use crate::solve::fast::sensitivity::SensitivityWork;
+use crate::solve::fast::separation::{linearised_separation, separation};
+use crate::solve::integrated::contacts::Active;
+use crate::solve::integrated::ode::{Method, OdeOptions, OdeProblem, dopri5};
+use crate::solve::integrated::unreduced;
 use crate::solve::phases::{End, Route, Walker};
-use crate::solve::poly::horner;
-use crate::solve::quadrature::{TimeMesh, gauss_legendre_rule};
-use crate::solve::sensitivity::SensitivityWork;
-use crate::solve::separation::{linearised_separation, separation};
 use crate::solve::series::sample_phase;
-use crate::solve::unreduced;
 use crate::system::{Bound, System};
 use gauss_quad::{FiniteAboveNegOneF64, GaussJacobi};
 use std::collections::BinaryHeap;
@@ -170,7 +170,7 @@ pub fn time_default(sys: &System, delta: f64, tol: f64) -> Outcome<f64> {
 }
 
 /// The set-up of the per-point route for a relative error `tol`: the sweeps' solver with its
-/// a-priori rule ([`prior`](crate::solve::prior): nodes chosen from where the integrand is
+/// a-priori rule ([`prior`](crate::solve::fast::prior): nodes chosen from where the integrand is
 /// singular, without an error estimate) made for `tol`.
 pub fn per_point_solver(
     sys: &System<'static>,
@@ -525,7 +525,7 @@ fn reduced_ode(
     delta: f64,
     rtol: f64,
     t_max: f64,
-) -> Result<(crate::solve::ode::OdeSolution, u64), AccuracyError> {
+) -> Result<(crate::solve::integrated::ode::OdeSolution, u64), AccuracyError> {
     let mut problem = Reduced {
         sys,
         end: delta,

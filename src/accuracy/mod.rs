@@ -18,7 +18,7 @@ pub mod table;
 pub use error::AccuracyError;
 
 use crate::reference::{self, Family, Inputs, Reference, RootRoute, TimeRoute};
-use crate::solve::ode::Method;
+use crate::solve::integrated::ode::Method;
 use crate::system::System;
 use astro_float::BigFloat;
 use indicatif::ProgressBar;
@@ -561,7 +561,7 @@ fn run_case(
     let m = crate::models::find(model)
         .ok_or_else(|| failed(AccuracyError::NoModel { name: model.into() }))?;
     // The phase the reference describes: the contact closed from release.
-    let m = crate::solve::lean::release_phase(m).map_err(|e| failed(e.into()))?;
+    let m = crate::solve::fast::lean::release_phase(m).map_err(|e| failed(e.into()))?;
     let sys = System::from_values(m, &parameters(family, case)).map_err(|e| failed(e.into()))?;
     let delta = methods::delta_sep(&sys).map_err(failed)?;
     let point = Point {

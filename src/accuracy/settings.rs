@@ -4,9 +4,9 @@
 
 use super::methods::{self, Outcome, Samples};
 use super::{AccuracyError, Budget, Measurement, QUICK_SERIES_SAMPLES, SERIES_SAMPLES, measure};
-use crate::solve::lean::LeanSolver;
-use crate::solve::prior::PRIOR_TOL;
-use crate::solve::sensitivity::SensitivityWork;
+use crate::solve::fast::lean::LeanSolver;
+use crate::solve::fast::prior::PRIOR_TOL;
+use crate::solve::fast::sensitivity::SensitivityWork;
 use crate::system::System;
 
 /// One case as a method sees it: the validated system, the end of its phase (`delta_sep`, from

@@ -48,13 +48,13 @@ use crate::model::Model;
 use crate::quantity::Quantity;
 use crate::results::{Column, Meaning, RunResults, Scalar, SensitivityGap, Work};
 use crate::solve::SolveError;
+use crate::solve::fast::quadrature::TimeMesh;
+use crate::solve::integrated::unreduced::{self, UnreducedRun};
 use crate::solve::phases::{
     End, Motion, PhaseRun, PhaseStart, ReducedEnd, ReducedRun, Route, SensitiveMotion, Walker,
     phase_end,
 };
-use crate::solve::quadrature::TimeMesh;
 use crate::solve::series::PhaseSamples;
-use crate::solve::unreduced::{self, UnreducedRun};
 use crate::system::{Bound, System, SystemError};
 use std::collections::BTreeMap;
 

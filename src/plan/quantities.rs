@@ -11,9 +11,9 @@ use crate::results::{
     Stretch, Unlanded, UntilNote,
 };
 use crate::solve::SolveError;
-use crate::solve::impact::Part;
+use crate::solve::fast::separation::{SeparationOutcome, linearised_separation};
+use crate::solve::integrated::impact::Part;
 use crate::solve::phases::{End, ImpactAt, LANDING_TOLERANCE, Motion, PhaseRun};
-use crate::solve::separation::{SeparationOutcome, linearised_separation};
 use crate::solve::series::{PhaseSamples, sample_at, sample_forces, sample_friction};
 use crate::system::Bound;
 

@@ -2,7 +2,7 @@
 //! `(p/x) dx/dp` of every wanted result that has them, for every parameter: the separation
 //! angle and time, every contact's end (time and angle), the floor impact (time and angular
 //! velocity). The first contact's separation on the fast phase the motion starts on has them
-//! from the fast path's generated partial derivatives (`solve::sensitivity`); every other
+//! from the fast path's generated partial derivatives (`solve::fast::sensitivity`); every other
 //! from the motion integrated with its forward sensitivities (`Walker::sensitive_motion`),
 //! whose event is held to the run's: the same contact ending by the same cause, at a time
 //! within [`ROUTES_AGREE`]; every impact's time (`impact_<i>_time`, `i` from 1) from the same
@@ -16,10 +16,10 @@ use crate::model::start_offsets;
 use crate::quantity::Quantity;
 use crate::results::{Note, RunResults, Sensitivity, SensitivityGap};
 use crate::solve::SolveError;
+use crate::solve::fast::prior::{PRIOR_TOL, Prior};
+use crate::solve::fast::quadrature::ACCEPT;
+use crate::solve::fast::sensitivity::{self, SensitivityWork, SeparationPoint};
 use crate::solve::phases::{End, Motion, SensitiveMotion, Stop};
-use crate::solve::prior::{PRIOR_TOL, Prior};
-use crate::solve::quadrature::ACCEPT;
-use crate::solve::sensitivity::{self, SensitivityWork, SeparationPoint};
 use crate::spec::units::{AngularUnit, UnitError};
 use crate::system::SystemError;
 

@@ -5,9 +5,9 @@ use super::{Plan, scalar};
 use crate::results::{CheckKind, CheckPhase, Meaning, Note, PhaseEnd, RunResults, Work};
 use crate::solve::SolveError;
 use crate::solve::checks::{self, Conserved, free_momenta};
+use crate::solve::integrated::unreduced::UnreducedRun;
 use crate::solve::phases::{End, PhaseRun};
 use crate::solve::series::{sample_forces, theta_dot_at};
-use crate::solve::unreduced::UnreducedRun;
 
 /// The event that ended an integrated run, its contact named.
 fn ended_at(run: &UnreducedRun, info: &crate::model::ModelInfo) -> PhaseEnd {

@@ -24,7 +24,7 @@
 
 use crate::results::{Check, CheckKind, CheckPhase, CheckSubject};
 use crate::solve::SolveError;
-use crate::solve::impact::Impact;
+use crate::solve::integrated::impact::Impact;
 use crate::solve::series::PhaseSamples;
 use crate::system::{Bound, State, SystemError};
 use nalgebra::DMatrix;

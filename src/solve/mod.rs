@@ -1,37 +1,33 @@
-//! Numerical solvers for any [`Model`](crate::model::Model): separation root, time quadrature,
-//! `theta(t)` series, the unreduced ODE cross-check, phase chaining and physical checks.
+//! Numerical solvers for any [`Model`](crate::model::Model), in three rooms by route, with what
+//! they share beside them.
 //!
-//! Data flows one way: [`separation`] finds where a phase ends, [`quadrature`] builds `t(theta)`
-//! on that phase and [`inversion`] inverts it, [`phases`] chains a phase to the next model,
-//! [`unreduced`] integrates `M(q) qdd = F(q, qd)` with the generic [`ode`] integrator,
-//! [`series`] samples a phase at uniform times, and [`checks`] turns sampled motion into
-//! pass/fail margins. At one state, [`active`] holds which contacts are closed, [`rest`] whether
-//! such a set stays at rest and [`contacts`] decides it.
+//! - [`fast`]: the energy integral's route, for a phase with one coordinate left: where it
+//!   ends ([`fast::separation`], over [`fast::poly`]), `t(theta)` by [`fast::quadrature`] and
+//!   its inverse ([`fast::inversion`]), the per-point solvers ([`fast::lean`], with
+//!   [`fast::prior`]'s certified bounds) and their parameter derivatives
+//!   ([`fast::sensitivity`]).
+//! - [`integrated`]: the general model's route, `M(q) qdd = F(q, qd)` with the contacts' forces:
+//!   the [`integrated::ode`] integrator, one phase of it ([`integrated::unreduced`]), the
+//!   contacts' dynamics and the choice of the active set ([`integrated::contacts`], with
+//!   [`integrated::active`] and [`integrated::rest`]), impacts ([`integrated::impact`]) and
+//!   forward sensitivities ([`integrated::forward`], [`integrated::saltation`]).
+//! - [`phases`]: the walk from release through phases and impacts, each phase on the fast route
+//!   where it has one and integrated otherwise.
+//! - Shared: [`roots`] (the one bracketed root finder), [`linear`] (small dense solves),
+//!   [`series`] (a phase sampled at uniform times) and [`checks`] (sampled motion turned into
+//!   pass/fail margins).
 //!
 //! Architecture invariant: nothing here panics or returns NaN on bad numbers; every failure is
 //! a [`SolveError`] carrying the offending values. Every evaluation is counted in a
 //! [`Work`](crate::results::Work) passed down by the caller.
 
-pub mod active;
 pub mod checks;
-pub mod contacts;
-pub mod forward;
-pub mod impact;
-pub mod inversion;
-pub mod lean;
+pub mod fast;
+pub mod integrated;
 pub mod linear;
-pub mod ode;
 pub mod phases;
-pub mod poly;
-pub mod prior;
-pub mod quadrature;
-pub mod rest;
 pub mod roots;
-pub mod saltation;
-pub mod sensitivity;
-pub mod separation;
 pub mod series;
-pub mod unreduced;
 
 /// Deterministic uniform numbers in `[0, 1)` for the unit tests (xorshift64 from `state`).
 #[cfg(test)]

@@ -1,6 +1,6 @@
 //! Samples of a phase at uniform times. On the fast path `theta(t)` comes from inverting the
-//! quadrature `t(v)` (the variable `v` of [`quadrature`](crate::solve::quadrature); the
-//! inversion is [`inversion`](crate::solve::inversion)'s); on the integrated route from the
+//! quadrature `t(v)` (the variable `v` of [`quadrature`](crate::solve::fast::quadrature); the
+//! inversion is [`inversion`](crate::solve::fast::inversion)'s); on the integrated route from the
 //! integrator's dense output.
 //!
 //! The first-order form of the energy integral (the paper's eq. 17,
@@ -11,10 +11,10 @@
 
 use crate::results::Work;
 use crate::solve::SolveError;
-use crate::solve::inversion::invert;
-pub use crate::solve::inversion::{delta_at_time, theta_dot_at};
+use crate::solve::fast::inversion::invert;
+pub use crate::solve::fast::inversion::{delta_at_time, theta_dot_at};
+use crate::solve::fast::quadrature::TimeMesh;
 use crate::solve::phases::{IntegratedRun, PhaseRun};
-use crate::solve::quadrature::TimeMesh;
 use crate::system::{Bound, State, System};
 
 /// Samples of one phase, uniform in time from its start to its end (both included).

@@ -1,5 +1,5 @@
 //! `rodcube sweep`: separation angle and time over a grid or a list of points, on every core,
-//! with the lean per-point solver ([`crate::solve::lean::LeanSolver`]); more quantities per
+//! with the lean per-point solver ([`crate::solve::fast::lean::LeanSolver`]); more quantities per
 //! point through the planner ([`planned`], which also sweeps any model's scalar results
 //! alone: the Python package's engine); CSV out, and heat maps of a two-axis grid. Without
 //! the feature `cli` (the feature `sweep` alone) the module holds the points, their axes and
@@ -25,8 +25,8 @@ use {
     crate::plan::{self, Request},
     crate::report::prose,
     crate::results::Note,
-    crate::solve::lean::{LeanPoint, LeanSolver},
-    crate::solve::sensitivity::SensitivityWork,
+    crate::solve::fast::lean::{LeanPoint, LeanSolver},
+    crate::solve::fast::sensitivity::SensitivityWork,
     indicatif::{ProgressBar, ProgressStyle},
     std::path::Path,
 };

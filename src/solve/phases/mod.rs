@@ -19,8 +19,8 @@
 //! their accumulation time; `sensitive.rs` the motion with the forward sensitivities of its
 //! phases' ends ([`SensitiveMotion`]).
 //!
-//! [`contacts::decide`]: crate::solve::contacts::decide
-//! [`impact::resolve`]: crate::solve::impact::resolve
+//! [`contacts::decide`]: fn@crate::solve::integrated::contacts::decide
+//! [`impact::resolve`]: crate::solve::integrated::impact::resolve
 
 mod motion;
 mod reduced;
@@ -39,4 +39,4 @@ pub use walker::{
 };
 pub use zeno::{ZENO_AGREE, ZENO_RATIO_SPREAD, ZENO_RATIOS};
 
-pub use crate::solve::unreduced::End;
+pub use crate::solve::integrated::unreduced::End;

@@ -4,8 +4,8 @@
 use super::run::PhaseRun;
 use crate::results::{Halt, Zeno};
 use crate::solve::SolveError;
-use crate::solve::impact::{Impact, Part};
-use crate::solve::unreduced::End;
+use crate::solve::integrated::impact::{Impact, Part};
+use crate::solve::integrated::unreduced::End;
 
 /// An impact between two phases of a motion.
 #[derive(Debug, Clone, PartialEq)]

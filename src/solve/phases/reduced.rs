@@ -4,12 +4,12 @@
 
 use crate::results::Work;
 use crate::solve::SolveError;
-use crate::solve::contacts::DECIDE_TOLERANCE;
-use crate::solve::inversion::theta_dot_at;
-use crate::solve::quadrature::TimeMesh;
+use crate::solve::fast::inversion::theta_dot_at;
+use crate::solve::fast::quadrature::TimeMesh;
+use crate::solve::fast::separation::{Separation, SeparationOutcome, edge, force_zero};
+use crate::solve::integrated::contacts::DECIDE_TOLERANCE;
+use crate::solve::integrated::unreduced::End;
 use crate::solve::roots::{self, changes_sign};
-use crate::solve::separation::{Separation, SeparationOutcome, edge, force_zero};
-use crate::solve::unreduced::End;
 use crate::system::{State, System};
 
 /// Cells of the grid, uniform in the fast path's time variable, on which an open contact's gap

@@ -3,8 +3,8 @@
 
 use super::reduced::ReducedRun;
 use crate::solve::SolveError;
-use crate::solve::contacts::Active;
-use crate::solve::unreduced::{End, UnreducedRun};
+use crate::solve::integrated::contacts::Active;
+use crate::solve::integrated::unreduced::{End, UnreducedRun};
 use crate::system::{Bound, State};
 
 /// A phase solved by integrating the general model's equations.

@@ -12,10 +12,10 @@ use std::collections::BTreeMap;
 
 use crate::results::Work;
 use crate::solve::SolveError;
-use crate::solve::contacts;
-use crate::solve::forward::{self, Forward, Grazing};
-use crate::solve::saltation::{self, Crossing, SaltationGap};
-use crate::solve::unreduced::{End, EndSensitivity};
+use crate::solve::integrated::contacts;
+use crate::solve::integrated::forward::{self, Forward, Grazing};
+use crate::solve::integrated::saltation::{self, Crossing, SaltationGap};
+use crate::solve::integrated::unreduced::{End, EndSensitivity};
 
 /// How one phase's end moves with the parameters (one value per parameter each).
 #[derive(Debug, Clone, PartialEq)]

@@ -11,15 +11,15 @@ use super::zeno::{self, Flight};
 use crate::model::{GapKind, Model, ModelInfo};
 use crate::results::{Halt, Work, Zeno};
 use crate::solve::SolveError;
-use crate::solve::contacts::{
+use crate::solve::fast::inversion::delta_at_time;
+use crate::solve::fast::quadrature::TimeMesh;
+use crate::solve::integrated::contacts::{
     self, Active, ContactOption, DECIDE_TOLERANCE, FrictionOption, Moment, Options,
     contact_options, friction_options,
 };
-use crate::solve::impact::{self, Impact, Part};
-use crate::solve::inversion::delta_at_time;
-use crate::solve::ode::Method;
-use crate::solve::quadrature::TimeMesh;
-use crate::solve::unreduced::{self, End, EndSensitivity, Start, motion_scales};
+use crate::solve::integrated::impact::{self, Impact, Part};
+use crate::solve::integrated::ode::Method;
+use crate::solve::integrated::unreduced::{self, End, EndSensitivity, Start, motion_scales};
 use crate::system::{Bound, State, System, SystemError};
 
 /// Most phases chained between two impacts (or from release to the first) before giving up:

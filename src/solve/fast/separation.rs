@@ -9,7 +9,7 @@
 
 use crate::results::Work;
 use crate::solve::SolveError;
-use crate::solve::poly;
+use crate::solve::fast::poly;
 use crate::solve::roots::{self, changes_sign};
 use crate::system::System;
 

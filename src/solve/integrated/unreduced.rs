@@ -1,5 +1,5 @@
 //! The integrated route: a model's equations `M(q) qdd = F(q, qd) + J^T lambda + T^T f`
-//! integrated with the generic [`ode`](crate::solve::ode) integrator from a state, with a set of
+//! integrated with the generic [`ode`](crate::solve::integrated::ode) integrator from a state, with a set of
 //! closed contacts, until an event ends the phase: a closed contact's force reaching zero (it
 //! would have to pull, so it opens), an open contact's gap closing (the bodies meet), a closed
 //! contact running off its edge, or the reduced angle reaching the floor. It is the route of
@@ -36,12 +36,12 @@
 use crate::model::GapKind;
 use crate::results::Work;
 use crate::solve::SolveError;
-use crate::solve::contacts::{
+use crate::solve::integrated::contacts::{
     self, Active, ContactOption, DECIDE_TOLERANCE, Dynamics, DynamicsWork, FrictionOption, Mode,
     Options, Sign,
 };
-use crate::solve::forward::{self, Forward, Grazing, Measured};
-use crate::solve::ode::{
+use crate::solve::integrated::forward::{self, Forward, Grazing, Measured};
+use crate::solve::integrated::ode::{
     Event, Method, OdeOptions, OdeProblem, OdeSolution, integrate as ode_integrate,
 };
 use crate::system::{Bound, State};

@@ -1,6 +1,6 @@
 //! The one time quadrature: `t = integral d(theta) / |theta_dot|` along a falling phase, used by
 //! the planner ([`TimeMesh`]), the per-point solver and the sweeps
-//! ([`lean`](crate::solve::lean)) and the accuracy report.
+//! ([`lean`](crate::solve::fast::lean)) and the accuracy report.
 //!
 //! # The substitution
 //! The fall is parametrised by `s = sin(theta)`, which is monotone on a phase
@@ -40,7 +40,7 @@
 //! `((l0 + l1) + l2) + l3` are the same operations in both copies and no fused multiply-add is
 //! used, so both give the same bits (tested in `tests/prior.rs`). The
 //! per-point solver chooses its rules for such phases a priori
-//! ([`prior`](crate::solve::prior)); the verified pairs below serve everything else.
+//! ([`prior`](crate::solve::fast::prior)); the verified pairs below serve everything else.
 //!
 //! # Error control
 //! Each panel is integrated by two Gauss–Legendre rules chosen by the panel's length from a

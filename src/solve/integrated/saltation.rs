@@ -18,7 +18,7 @@
 //! cancel whatever the velocities. A friction coefficient is a parameter (`dmu_j` its column).
 //!
 //! The impact happens at `t*(p)`, where `dt*/dp` comes from the closing gap's event
-//! ([`crate::solve::forward`]). Just before it the state's total derivative is
+//! ([`crate::solve::integrated::forward`]). Just before it the state's total derivative is
 //! `D- = S- + f- dt*`, `f = (qd, qdd)` the state's rate; just after, `D+ = G_y D- + G_p`, and
 //! `S+ = D+ - f+ dt*`: `S+_q = S-_q + (qd- - qd+) dt*` (positions are continuous) and
 //! `S+_qd = dqd+ [D-] - qdd+ dt*`, which is `S+ = G_y S- + G_p + (G_y f- - f+) dt*` (Aizerman &
@@ -29,8 +29,8 @@
 //! partials, which is [`SaltationGap::Restitution`], never a guess.
 
 use crate::solve::SolveError;
-use crate::solve::contacts::Sign;
-use crate::solve::impact::{ContactLaw, FrictionLaw, Impact};
+use crate::solve::integrated::contacts::Sign;
+use crate::solve::integrated::impact::{ContactLaw, FrictionLaw, Impact};
 use crate::solve::linear;
 use crate::system::{Bound, State};
 

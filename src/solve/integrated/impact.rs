@@ -26,7 +26,7 @@
 
 use crate::model::ModelInfo;
 use crate::solve::SolveError;
-use crate::solve::contacts::{
+use crate::solve::integrated::contacts::{
     Active, ContactOption, FrictionOption, Mode, Options, Sign, combinations,
 };
 use crate::solve::linear;

@@ -4,7 +4,7 @@
 
 use super::hyperbolic::{AnyReach, SERIES_REACH, Series, SinhSq};
 use super::rules::{HalfRule, LANES, Lane};
-use crate::solve::poly::horner;
+use crate::solve::fast::poly::horner;
 
 /// `sinh^2 v` just past the start where [`Fall::new`] asks whether the phase falls.
 pub(super) const FALL_CHECK_SH2: f64 = 1e-8;

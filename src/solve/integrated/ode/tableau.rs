@@ -118,7 +118,7 @@ pub(super) const DOP853: Tableau = Tableau {
 #[allow(clippy::excessive_precision)]
 pub(super) mod dop853_coefficients {
     /// Nodes.
-    pub(in crate::solve::ode) const C: [f64; 16] = [
+    pub(in crate::solve::integrated::ode) const C: [f64; 16] = [
         0.0,
         0.526001519587677318785587544488e-01,
         0.789002279381515978178381316732e-01,
@@ -138,7 +138,7 @@ pub(super) mod dop853_coefficients {
     ];
 
     /// Weights of the eighth-order solution.
-    pub(in crate::solve::ode) const B: [f64; 12] = [
+    pub(in crate::solve::integrated::ode) const B: [f64; 12] = [
         5.42937341165687622380535766363e-2,
         0.0,
         0.0,
@@ -154,14 +154,14 @@ pub(super) mod dop853_coefficients {
     ];
 
     /// The third-order embedded weights `bhh1, bhh2, bhh3` (at stages 0, 8 and 11).
-    pub(in crate::solve::ode) const BHH: [f64; 3] = [
+    pub(in crate::solve::integrated::ode) const BHH: [f64; 3] = [
         0.244094488188976377952755905512,
         0.733846688281611857341361741547,
         0.220588235294117647058823529412e-1,
     ];
 
     /// Weights of the fifth-order error estimate (`er1..er12`).
-    pub(in crate::solve::ode) const E5: [f64; 12] = [
+    pub(in crate::solve::integrated::ode) const E5: [f64; 12] = [
         0.1312004499419488073250102996e-01,
         0.0,
         0.0,
@@ -177,7 +177,7 @@ pub(super) mod dop853_coefficients {
     ];
 
     /// Weights of the third-order error estimate (`b - bhh`).
-    pub(in crate::solve::ode) const E3: [f64; 12] = [
+    pub(in crate::solve::integrated::ode) const E3: [f64; 12] = [
         B[0] - BHH[0],
         0.0,
         0.0,
@@ -193,7 +193,7 @@ pub(super) mod dop853_coefficients {
     ];
 
     /// The Runge–Kutta matrix by rows (row `s` has `s` entries), `B` as row 12.
-    pub(in crate::solve::ode) const A: [&[f64]; 16] = [
+    pub(in crate::solve::integrated::ode) const A: [&[f64]; 16] = [
         &[],
         &[5.26001519587677318785587544488e-2],
         &[
@@ -333,7 +333,7 @@ pub(super) mod dop853_coefficients {
     ];
 
     /// `contd8`'s `d4*..d7*` (the last four dense-output coefficients), over all 16 stages.
-    pub(in crate::solve::ode) const D: [&[f64]; 4] = [
+    pub(in crate::solve::integrated::ode) const D: [&[f64]; 4] = [
         &[
             -0.84289382761090128651353491142e+01,
             0.0,

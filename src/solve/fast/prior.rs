@@ -1,5 +1,5 @@
 //! The a-priori rule: for a phase with a fall polynomial `P` of degree at most 2, the time
-//! integrand `2 sqrt(P(s) / (1 + s))` (see [`quadrature`](crate::solve::quadrature)) is
+//! integrand `2 sqrt(P(s) / (1 + s))` (see [`quadrature`](crate::solve::fast::quadrature)) is
 //! singular only where `P(s) = 0` and at `s = -1`, so where its singularities lie in the
 //! variable `v` is known before any evaluation, and with it how many Gauss–Legendre nodes a
 //! panel needs.
@@ -19,14 +19,14 @@
 //! [`PRIOR_MAX_NODES`] is halved. From rest the first panel `[0, b]` is half of the symmetric
 //! rule on `[-b, b]` and costs half its nodes.
 //!
-//! This replaces the verified pair of rules of [`integrate`](crate::solve::quadrature::integrate)
+//! This replaces the verified pair of rules of [`integrate`](crate::solve::fast::quadrature::integrate)
 //! by a bound: its margin was set by comparing with the verified quadrature and the 256-bit
 //! reference (`tests/hard_cases.rs`, `tests/prior.rs`) over every model with a fall polynomial
 //! and the hard-case ranges of `n` and `a/ell`. Models whose fall polynomial has a higher degree,
 //! or that have none, take the verified route.
 
 use crate::solve::SolveError;
-use crate::solve::quadrature::{Fall, HalfRule, half_rule};
+use crate::solve::fast::quadrature::{Fall, HalfRule, half_rule};
 use std::f64::consts::FRAC_PI_2;
 
 /// Most nodes of a panel's rule before it is halved.

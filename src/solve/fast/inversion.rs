@@ -1,12 +1,12 @@
 //! A fast phase's motion at a given time or angle: the angle fallen at a time, by inverting
-//! the quadrature `t(v)` (the variable `v` of [`quadrature`](crate::solve::quadrature)) with
+//! the quadrature `t(v)` (the variable `v` of [`quadrature`](crate::solve::fast::quadrature)) with
 //! safeguarded Newton, `dt/dv` being the quadrature integrand itself, and the rate at an angle
 //! from the energy integral. `solve::phases` places events with them and `solve::series` samples
 //! phases with them (and re-exports them).
 
 use crate::results::Work;
 use crate::solve::SolveError;
-use crate::solve::quadrature::TimeMesh;
+use crate::solve::fast::quadrature::TimeMesh;
 use crate::system::System;
 
 /// `theta_dot` at `delta` on a falling phase: `-sqrt(theta_dot^2)`, and exactly the initial rate

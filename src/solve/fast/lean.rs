@@ -8,7 +8,7 @@
 //! Where the model has a fall polynomial of degree at most 2 (rod_cube, hinged_rod, loaded_rod,
 //! wall_ladder), the solver prepares only the constants it reads
 //! ([`Reduction::prepare_lean`]) and takes the node
-//! counts a priori from the integrand's singularities ([`prior`](crate::solve::prior)): about
+//! counts a priori from the integrand's singularities ([`prior`](crate::solve::fast::prior)): about
 //! 7 evaluations per point instead of 19, at `2^-53` relative. Such a point is first solved on
 //! an unchecked route ([`LeanRoute::lean_point`], implemented here for every model type): its
 //! inputs come from [`Model::lean_start`] (a default trait method, so each model's copy is
@@ -31,14 +31,14 @@ use crate::model::PhaseInfo;
 use crate::model::{LeanStart, Model, ModelInfo, Reduction, ReductionInfo, positive_finite};
 use crate::results::{SensitivityGap, Work};
 use crate::solve::SolveError;
-use crate::solve::phases::{End, phase_end};
-use crate::solve::poly::horner;
-use crate::solve::poly::{self, MAX_DEGREE};
-use crate::solve::prior::{PRIOR_TOL, Prior, Singularities, integrate_prior, prior_panels};
-use crate::solve::quadrature::{
+use crate::solve::fast::poly::horner;
+use crate::solve::fast::poly::{self, MAX_DEGREE};
+use crate::solve::fast::prior::{PRIOR_TOL, Prior, Singularities, integrate_prior, prior_panels};
+use crate::solve::fast::quadrature::{
     self, ACCEPT, Control, Fall, FallIntegrand, HalfRule, PanelSum, RuleStep, SCHEDULE, v_at_drop,
 };
-use crate::solve::sensitivity::{self, SensitivityWork, SeparationPoint};
+use crate::solve::fast::sensitivity::{self, SensitivityWork, SeparationPoint};
+use crate::solve::phases::{End, phase_end};
 use crate::system::{System, SystemError, check_parameters, ordered_values, prepare_constants};
 
 /// The fast phase a system starts in (its release phase), looked up in the registry; a model
@@ -135,7 +135,7 @@ impl<'m> LeanSolver<'m> {
     /// A solver with the default schedule [`SCHEDULE`] and tolerance [`ACCEPT`]. The model must
     /// have a contact whose separation polynomial has degree at most [`MAX_DEGREE`]. Where the
     /// model has a fall polynomial of degree at most 2, the time is integrated by the a-priori
-    /// rule of [`prior`](crate::solve::prior) to `2^-53` relative, else by the verified pair
+    /// rule of [`prior`](crate::solve::fast::prior) to `2^-53` relative, else by the verified pair
     /// of rules.
     pub fn new(model: &'m dyn Model) -> Result<Self, SolveError> {
         let mut solver = Self::with_schedule(model, &SCHEDULE, ACCEPT)?;
@@ -658,7 +658,7 @@ mod tests {
     use super::{LeanPoint, LeanRoute};
     use crate::model::Model;
     use crate::models::generated::rod_cube_closed::RodCubeClosed;
-    use crate::solve::prior::{PRIOR_TOL, Prior};
+    use crate::solve::fast::prior::{PRIOR_TOL, Prior};
 
     #[test]
     fn a_model_types_route_is_the_dyn_route() {

@@ -3,13 +3,13 @@
 //! times of its events.
 //!
 //! Along a stretch with one active set, `qdd(q, qd, p)` is the contact system's solution
-//! ([`contacts::dynamics`]); differentiated along a direction `xi = (dq, dqd, dp)`, it is the
+//! ([`contacts::dynamics()`]); differentiated along a direction `xi = (dq, dqd, dp)`, it is the
 //! same system with the partial derivatives of its rows as right-hand side
 //! ([`contacts::tangent_into`], the rows' partials generated symbolically:
 //! [`Model::tangents`](crate::model::Model::tangents)). Column `j` of `S` then obeys
 //! `d/dt S_q = S_qd`, `d/dt S_qd = d qdd` along `xi = (S_q, S_qd, e_j)`. The columns ride along
 //! on the integrator's steps without steering them
-//! ([`OdeOptions::controlled`](crate::solve::ode::OdeOptions::controlled)): the state, its
+//! ([`OdeOptions::controlled`](crate::solve::integrated::ode::OdeOptions::controlled)): the state, its
 //! steps and its events are those of the integration without sensitivities, bit for bit.
 //!
 //! An event `g(y, p) = 0` ends a stretch at `t_e`; the implicit-function theorem gives
@@ -20,7 +20,7 @@
 
 use crate::model::ModelInfo;
 use crate::solve::SolveError;
-use crate::solve::contacts::{self, Active, DynamicsWork, Tangent, TangentAt};
+use crate::solve::integrated::contacts::{self, Active, DynamicsWork, Tangent, TangentAt};
 use crate::system::{Bound, State, SystemError};
 
 /// What an event function measures, for its time's derivatives.

@@ -7,7 +7,7 @@ use super::integrand::{FALL_CHECK_SH2, FallIntegrand, panel_frame};
 use super::rules::{Control, HalfRule};
 use crate::model::{Reduction, ReductionInfo, start_offsets};
 use crate::solve::SolveError;
-use crate::solve::poly::horner;
+use crate::solve::fast::poly::horner;
 use crate::system::System;
 
 /// Largest `h x` at which a panel's node `mid - h x` is formed by the addition theorem (its

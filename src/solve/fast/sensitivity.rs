@@ -24,9 +24,9 @@
 use crate::model::Reduction;
 use crate::results::SensitivityGap;
 use crate::solve::SolveError;
-use crate::solve::poly::horner;
-use crate::solve::prior::{Prior, Singularities, prior_panels};
-use crate::solve::quadrature::{HalfRule, MAX_PANELS, half_rule, v_at_drop};
+use crate::solve::fast::poly::horner;
+use crate::solve::fast::prior::{Prior, Singularities, prior_panels};
+use crate::solve::fast::quadrature::{HalfRule, MAX_PANELS, half_rule, v_at_drop};
 
 /// The separation of one fast phase from rest, as the solvers found it.
 #[derive(Clone, Copy)]

@@ -10,7 +10,7 @@
 
 use crate::model::ModelInfo;
 use crate::solve::SolveError;
-use crate::solve::active::{Active, DECIDE_TOLERANCE, Mode, check_active};
+use crate::solve::integrated::active::{Active, DECIDE_TOLERANCE, Mode, check_active};
 use crate::system::{Bound, State};
 use nalgebra::{DMatrix, DVector};
 
