@@ -7,10 +7,10 @@
 //! that shares no code with the quadrature.
 //!
 //! The contacts' forces and the frictions' are solved with the accelerations at every
-//! evaluation ([`contacts::dynamics`]). With Coulomb friction the integration goes in segments,
+//! evaluation ([`contacts::dynamics()`]). With Coulomb friction the integration goes in segments,
 //! one per combination of friction modes: a segment ends where a sliding contact's slip
 //! velocity reaches zero or a stuck contact's friction reaches `mu N`, both located as events;
-//! the next segment's modes are the one consistent choice there ([`contacts::decide`]). The work
+//! the next segment's modes are the one consistent choice there ([`contacts::decide()`]). The work
 //! done by friction is integrated with the motion (the last component of the ODE state), so
 //! that the energy check can hold `E(t) - E(0)` to it.
 //!
@@ -801,7 +801,7 @@ pub fn motion_scales(
 pub struct Start {
     /// The state.
     pub state: State,
-    /// The closed contacts and friction modes there (see [`contacts::decide`]).
+    /// The closed contacts and friction modes there (see [`contacts::decide()`]).
     pub active: Active,
     /// The friction options it was decided from (their slips' offsets start the slip events).
     pub frictions: Vec<FrictionOption>,
