@@ -10,8 +10,9 @@ use rodcube::io::write_atomic;
 use rodcube::models;
 use rodcube::plan::{Request, run};
 use rodcube::quantity::Quantity::{SeparationAngle, SeparationTime};
+use rodcube::results::EndCause;
 use rodcube::results::Work;
-use rodcube::solve::phases::{End, PhaseRun, Route, Walker};
+use rodcube::solve::phases::{PhaseRun, Route, Walker};
 use rodcube::system::Bound;
 use std::error::Error;
 use std::path::PathBuf;
@@ -66,15 +67,15 @@ fn solve(mu: f64) -> Result<Point, Box<dyn Error>> {
         "foot {}; {}",
         steps.join(", then "),
         match end {
-            End::Force(0) => "leaves the cube",
-            End::Force(_) => "the foot lifts off the floor",
+            EndCause::Force(c) if c.index == 0 => "leaves the cube",
+            EndCause::Force(_) => "the foot lifts off the floor",
             _ => "stays on the cube",
         }
     );
     Ok(Point {
         mu,
         regime,
-        separation: match end == End::Force(0) {
+        separation: match end.is_force_of(0) {
             true => Some((run.t_end(), run.theta_end()?.to_degrees())),
             false => None,
         },

@@ -105,7 +105,10 @@ fn a_slack_spring_gives_the_papers_separation() {
         println!("k = 1e-12, tolerance {tol:e}: t_sep = {t:.15} s, {rel:.2e} from the paper");
         assert!(rel < bound, "{t} vs {PAPER_T_SEP}: {rel:e}");
         assert_eq!(value(&r, "contact_end_time"), t);
-        assert_eq!(r.labels["contact_end_cause"].value.as_word(), Some("force"));
+        assert_eq!(
+            rodcube::report::prose::label(&r.labels["contact_end_cause"].value),
+            "force"
+        );
         // Eq. (14) with n = 3, r = 1/4: sin(theta_sep) = 0.166957...
         let s = value(&r, "separation_angle").sin();
         let eq14 = 3.0 * s.powi(3) - 48.0 * s + 8.0;
@@ -265,7 +268,10 @@ fn the_cylinder_runs_off_the_rods_end_where_r_cot_half_theta_is_ell() {
         ],
         Route::Fastest,
     );
-    assert_eq!(r.labels["contact_end_cause"].value.as_word(), Some("edge"));
+    assert_eq!(
+        rodcube::report::prose::label(&r.labels["contact_end_cause"].value),
+        "edge"
+    );
     let want = 2.0 * (0.2f64).atan();
     let theta = value(&r, "contact_end_angle");
     assert!(((theta - want) / want).abs() < 1e-12, "{theta} vs {want}");
@@ -306,16 +312,16 @@ fn a_steep_rod_on_a_small_cylinder_leaves_it_at_release_and_meets_it_again() {
         Route::Fastest,
     );
     assert_eq!(
-        got.labels["contact_end_cause"].value.as_word(),
-        Some("force")
+        rodcube::report::prose::label(&got.labels["contact_end_cause"].value),
+        "force"
     );
     assert_eq!(value(&got, "contact_end_time"), 0.0);
     assert_eq!(value(&got, "contact_end_angle"), th0);
     // Only the rod alone on the floor runs (on the fast path), until it meets the cylinder.
     assert_eq!(got.work.phases, vec!["rod_cylinder_free"]);
     assert_eq!(
-        got.labels["floor_normal_end_cause"].value.as_word(),
-        Some("contact")
+        rodcube::report::prose::label(&got.labels["floor_normal_end_cause"].value),
+        "contact"
     );
     assert!(
         rodcube::report::prose::note(&got.notes["floor_impact"]).contains("the bodies meet"),
@@ -405,12 +411,12 @@ fn a_hinged_rod_on_a_cylinder_takes_the_fast_path_to_its_edge() {
         let fast = ask("hinged_cylinder", &params, &want, Route::Fastest);
         let slow = ask("hinged_cylinder", &params, &want, Route::Integrated);
         assert_eq!(
-            fast.labels["contact_end_cause"].value.as_word(),
-            Some("edge")
+            rodcube::report::prose::label(&fast.labels["contact_end_cause"].value),
+            "edge"
         );
         assert_eq!(
-            slow.labels["contact_end_cause"].value.as_word(),
-            Some("edge")
+            rodcube::report::prose::label(&slow.labels["contact_end_cause"].value),
+            "edge"
         );
         let edge = 2.0 * (r / 1.0f64).atan();
         let theta = value(&fast, "contact_end_angle");

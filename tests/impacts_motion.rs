@@ -15,8 +15,9 @@ use common::hand::Gauss;
 use rodcube::models::{all, find};
 use rodcube::plan::{self, PlanError, Request};
 use rodcube::quantity::Quantity;
+use rodcube::results::EndCause;
 use rodcube::results::Work;
-use rodcube::solve::phases::{End, MAX_IMPACTS, Motion, Route, Walker};
+use rodcube::solve::phases::{MAX_IMPACTS, Motion, Route, Walker};
 use rodcube::system::Bound;
 
 const G: f64 = 9.81;
@@ -77,7 +78,7 @@ fn the_rod_landing_flat_obeys_the_hand_impulse_balance_at_every_restitution() {
     for e in [0.0, 0.5, 1.0] {
         let walker = liftoff_walker(e, 0.2);
         let motion = walker.motion(&mut Work::default()).unwrap();
-        assert_eq!(motion.last_end(), Some(End::Until), "e = {e}");
+        assert_eq!(motion.last_end(), Some(EndCause::Until), "e = {e}");
         assert_eq!(motion.impacts.len(), 1, "e = {e}: one landing before 0.2 s");
         let at = &motion.impacts[0];
         let names = ["contact_force", "floor_normal", "tip_floor"];

@@ -13,11 +13,12 @@ use rodcube::plan::drawing::{PhaseInput, record};
 use rodcube::plan::{self, PlanError, Request};
 use rodcube::quantity::Quantity;
 use rodcube::report::motion::Animation;
+use rodcube::results::EndCause;
 use rodcube::results::Work;
 use rodcube::solve::SolveError;
 use rodcube::solve::fast::quadrature::TimeMesh;
 use rodcube::solve::fast::separation::{SeparationOutcome, edge, first_zero, force_zero};
-use rodcube::solve::phases::{End, PhaseRun, ReducedEnd, ReducedRun, Route, Walker};
+use rodcube::solve::phases::{PhaseRun, ReducedEnd, ReducedRun, Route, Walker};
 use rodcube::solve::series::{PhaseSamples, sample_friction, theta_dot_at};
 use rodcube::system::{Bound, State, System, SystemError};
 use std::sync::OnceLock;
@@ -298,7 +299,7 @@ fn a_friction_whose_contact_the_phase_lacks_is_a_mismatch_not_zero() {
         system,
         t_start: 0.0,
         end: ReducedEnd {
-            end: End::Floor,
+            end: EndCause::Floor,
             at: None,
             delta: 0.2,
         },
@@ -329,7 +330,7 @@ fn a_frame_the_model_refuses_is_dropped_with_a_note() {
         bound: &bound,
         samples: &samples,
         t_start: 0.0,
-        end: End::Floor,
+        end: EndCause::Floor,
     };
     let animation = Animation::build(&record(&[input], Some("tip")));
     assert_eq!(animation.frames.len(), 2);
@@ -352,7 +353,7 @@ fn a_frame_the_model_refuses_is_dropped_with_a_note() {
         bound: &bound,
         samples: &bad,
         t_start: 0.0,
-        end: End::Floor,
+        end: EndCause::Floor,
     };
     let animation = Animation::build(&record(&[input], None));
     assert!(animation.shapes.is_empty() && animation.frames.is_empty());

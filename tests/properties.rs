@@ -11,13 +11,14 @@ use rodcube::model::Model;
 use rodcube::plan::{self, DEFAULT_TOLERANCE, PlanError, Request};
 use rodcube::quantity::Quantity;
 use rodcube::reference::{Inputs, Reference, RootRoute, TimeRoute, relative_error};
+use rodcube::results::EndCause;
 use rodcube::results::{CheckKind, Work};
 use rodcube::solve::SolveError;
 use rodcube::solve::checks::{self, Conserved};
 use rodcube::solve::fast::lean::LeanSolver;
 use rodcube::solve::fast::quadrature::TimeMesh;
 use rodcube::solve::integrated::contacts::DECIDE_TOLERANCE;
-use rodcube::solve::phases::{End, PhaseRun, ReducedEnd, ReducedRun};
+use rodcube::solve::phases::{PhaseRun, ReducedEnd, ReducedRun};
 use rodcube::system::{Bound, System};
 
 /// Parameter values for `model` from uniforms `u` (one per parameter) and `spread`, which
@@ -219,7 +220,7 @@ fn check_fast_phase(model: &'static dyn Model, u: &[f64], spread: u8) -> Result<
         mesh.duration
     );
     let end = ReducedEnd {
-        end: End::Floor,
+        end: EndCause::Floor,
         at: None,
         delta,
     };

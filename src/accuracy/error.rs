@@ -3,9 +3,9 @@
 //! numbers. A failed setting's message becomes its row's note in the report.
 
 use crate::reference::ReferenceError;
+use crate::results::EndCause;
 use crate::results::SensitivityGap;
 use crate::solve::SolveError;
-use crate::solve::phases::End;
 use crate::system::SystemError;
 
 /// Why the report, a reference or a method failed.
@@ -141,10 +141,13 @@ pub enum AccuracyError {
     #[error("the phase ended before the first contact's force vanished")]
     ForceNotVanished,
     /// A phase of the integrated routes ended otherwise than by its first contact's end.
-    #[error("the phase ended by {end:?} before the first contact ended")]
+    #[error(
+        "the phase ended at {} before the first contact ended",
+        crate::report::prose::event_words(*end)
+    )]
     EndedBefore {
         /// How it ended.
-        end: End,
+        end: EndCause,
     },
     /// A series sample's time lies outside the dense output.
     #[error("time outside the solution")]
@@ -188,13 +191,17 @@ impl AccuracyError {
 #[cfg(test)]
 mod tests {
     use super::AccuracyError as E;
-    use crate::solve::phases::End;
+    use crate::results::EndCause;
 
     /// Each method's message is the text its report note had when it was a string.
     #[test]
     fn accuracy_error_messages_are_the_notes_they_replace() {
         let (w2, delta, total, error, j) = (-1.5e-3, 2.5e-7, 1.234_567_89e-2, 3.2e-9, 7);
-        let end = End::Force(1);
+        let wall = crate::results::ContactId {
+            index: 1,
+            name: "wall",
+        };
+        let end = EndCause::Force(wall);
         let cases = [
             (E::NoSeparation, "no separation".to_string()),
             (E::NoRoot, "no root".into()),
@@ -233,7 +240,9 @@ mod tests {
             ),
             (
                 E::EndedBefore { end },
-                format!("the phase ended by {end:?} before the first contact ended"),
+                "the phase ended at contact `wall`'s force crossing zero before the first contact \
+                 ended"
+                    .into(),
             ),
             (
                 E::OutsideSolution { t: 1.0 },

@@ -7,9 +7,10 @@
 use super::settings::pick;
 use super::{AccuracyError, Budget, Measured, Measurement, Row, measure};
 use crate::model::Model;
+use crate::results::EndCause;
 use crate::results::Work;
 use crate::solve::integrated::ode::Method;
-use crate::solve::phases::{End, PhaseRun, Route, Walker};
+use crate::solve::phases::{PhaseRun, Route, Walker};
 use crate::system::Bound;
 
 /// A model of the integrated routes and the scene it is measured on.
@@ -166,7 +167,7 @@ pub fn contact_end(walker: &Walker, method: Option<Method>) -> Result<(f64, Work
 /// edge).
 fn first_contact_ended(run: &PhaseRun) -> Result<(), AccuracyError> {
     match run.end() {
-        End::Force(0) | End::Edge(0) => Ok(()),
+        EndCause::Force(c) | EndCause::Edge(c) if c.index == 0 => Ok(()),
         end => Err(AccuracyError::EndedBefore { end }),
     }
 }

@@ -16,7 +16,7 @@ use crate::solve::fast::separation::{linearised_separation, separation};
 use crate::solve::integrated::contacts::Active;
 use crate::solve::integrated::ode::{Method, OdeOptions, OdeProblem, dopri5};
 use crate::solve::integrated::unreduced;
-use crate::solve::phases::{End, Route, Walker};
+use crate::solve::phases::{Route, Walker};
 use crate::solve::series::sample_phase;
 use crate::system::{Bound, System};
 use gauss_quad::{FiniteAboveNegOneF64, GaussJacobi};
@@ -240,7 +240,7 @@ pub fn sensitivities_forward(sys: &System, rtol: f64) -> Outcome<Vec<f64>> {
     let mut work = Work::default();
     let motion = walker.sensitive_motion(&mut work)?;
     let k = (motion.motion.phases.iter())
-        .position(|p| p.end() == End::Force(0))
+        .position(|p| p.end().is_force_of(0))
         .ok_or(AccuracyError::ForceNotVanished)?;
     let ends = motion.ends[k]
         .as_ref()
@@ -571,7 +571,7 @@ pub fn time_unreduced(sys: &System, rtol: f64, t_max: f64) -> Outcome<f64> {
         t_max,
         &mut work,
     )?;
-    if run.end != End::Force(0) {
+    if !run.end.is_force_of(0) {
         return Err(AccuracyError::ForceNotVanished);
     }
     Ok((run.t_end, work.ode_evaluations))

@@ -16,9 +16,10 @@
 use super::{RESOURCES, Resources, Role, Variable, guid, variables};
 use crate::model::Model;
 use crate::plan::{DEFAULT_TOLERANCE, ODE_RTOL_FACTOR, ODE_RTOL_FLOOR};
+use crate::report::prose;
 use crate::results::Work;
 use crate::solve::SolveError;
-use crate::solve::phases::{End, Motion, PhaseRun, Route, Walker};
+use crate::solve::phases::{Motion, PhaseRun, Route, Walker};
 use crate::solve::series::{full_state_at, sample_at, sample_forces};
 use crate::system::{Bound, check_value};
 use std::ffi::{CStr, CString, c_char, c_int, c_uint, c_void};
@@ -405,17 +406,11 @@ fn same_time(a: f64, b: f64) -> bool {
 impl Sim {
     /// How the motion ended, for a message.
     fn ending(&self) -> String {
-        let info = self.walker.general.info();
-        let contact = |i: usize| info.contacts.get(i).map_or("a contact", |c| c.name);
         if let Some(halt) = &self.motion.halted {
-            return format!("halted: {halt:?}");
+            return format!("halted: {}", prose::halt_words(halt));
         }
         match self.motion.last_end() {
-            Some(End::Floor) => "it reached the floor".into(),
-            Some(End::Until) => "the stop time".into(),
-            Some(End::Edge(i)) => format!("{} ran off its edge", contact(i)),
-            Some(End::Contact(i)) => format!("{} closed", contact(i)),
-            Some(End::Force(i)) => format!("{} opened", contact(i)),
+            Some(end) => prose::event_words(end),
             None => "no phase".into(),
         }
     }

@@ -2,8 +2,7 @@
 //! generated drawing ([`record`]), kept in [`RunResults::drawing`](crate::results::RunResults)
 //! as plain data, from which `report::motion` computes the animation.
 
-use crate::results::{Drawing, DrawnPhase, DrawnSample, PhaseEnd, Pose};
-use crate::solve::phases::End;
+use crate::results::{Drawing, DrawnPhase, DrawnSample, EndCause, Pose};
 use crate::solve::series::PhaseSamples;
 use crate::system::Bound;
 
@@ -16,7 +15,7 @@ pub struct PhaseInput<'a, 'm> {
     /// When it starts (s from release).
     pub t_start: f64,
     /// Why it ended.
-    pub end: End,
+    pub end: EndCause,
 }
 
 /// The drawing of the phases, in order, with the path of the point named `traced` (looked up
@@ -54,18 +53,7 @@ fn phase(phase: &PhaseInput, traced: Option<&str>) -> DrawnPhase {
     let bound = phase.bound;
     let info = bound.info();
     let point = traced.and_then(|name| bound.point_index(name));
-    let name = |c: usize| {
-        (info.contacts.get(c))
-            .map_or("a contact", |c| c.name)
-            .to_string()
-    };
-    let end = match phase.end {
-        End::Force(c) => PhaseEnd::Force(name(c)),
-        End::Edge(c) => PhaseEnd::Edge(name(c)),
-        End::Contact(c) => PhaseEnd::Contact(name(c)),
-        End::Floor => PhaseEnd::Floor,
-        End::Until => PhaseEnd::Until,
-    };
+    let end = phase.end;
     let samples = (phase.samples.t.iter().zip(&phase.samples.states))
         .map(|(&t, state)| {
             let pose = bound.drawing(state).and_then(|(poses, _)| {

@@ -46,13 +46,13 @@ mod verify;
 
 use crate::model::Model;
 use crate::quantity::Quantity;
+use crate::results::EndCause;
 use crate::results::{Column, Meaning, RunResults, Scalar, SensitivityGap, Work};
 use crate::solve::SolveError;
 use crate::solve::fast::quadrature::TimeMesh;
 use crate::solve::integrated::unreduced::{self, UnreducedRun};
 use crate::solve::phases::{
-    End, Motion, PhaseRun, PhaseStart, ReducedEnd, ReducedRun, Route, SensitiveMotion, Walker,
-    phase_end,
+    Motion, PhaseRun, PhaseStart, ReducedEnd, ReducedRun, Route, SensitiveMotion, Walker, phase_end,
 };
 use crate::solve::series::PhaseSamples;
 use crate::system::{Bound, System, SystemError};
@@ -578,7 +578,7 @@ impl<'m> Plan<'m> {
             Some(sys) => {
                 let end = self.end()?;
                 match (end.end, &self.floor_mesh) {
-                    (End::Floor, Some(mesh)) => {
+                    (EndCause::Floor, Some(mesh)) => {
                         self.work.phases.push(sys.name().to_string());
                         ReducedRun {
                             system: sys,
@@ -674,7 +674,8 @@ impl<'m> Plan<'m> {
         ) {
             (
                 Some(ReducedEnd {
-                    end: End::Floor, ..
+                    end: EndCause::Floor,
+                    ..
                 }),
                 Some(r),
             ) => Some(r.mesh.clone()),

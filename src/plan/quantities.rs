@@ -7,13 +7,13 @@ use super::{Plan, column, phase_labels, scalar};
 use crate::model::{GapKind, ModelInfo};
 use crate::quantity::Quantity;
 use crate::results::{
-    ContactImpulse, Held, ImpactRecord, Label, LabelValue, Meaning, Note, RunResults, Series,
-    Stretch, Unlanded, UntilNote,
+    ContactId, ContactImpulse, EndCause, Held, ImpactRecord, Label, LabelValue, Meaning, Note,
+    RunResults, Series, Stretch, Unlanded, UntilNote,
 };
 use crate::solve::SolveError;
 use crate::solve::fast::separation::{SeparationOutcome, linearised_separation};
 use crate::solve::integrated::impact::Part;
-use crate::solve::phases::{End, ImpactAt, LANDING_TOLERANCE, Motion, PhaseRun};
+use crate::solve::phases::{ImpactAt, LANDING_TOLERANCE, Motion, PhaseRun};
 use crate::solve::series::{PhaseSamples, sample_at, sample_forces, sample_friction};
 use crate::system::Bound;
 
@@ -28,8 +28,9 @@ pub(super) enum Fate {
         t: f64,
         /// The reduced angle then (rad).
         theta: f64,
-        /// `force`, `edge`, `contact` or `impact`.
-        cause: &'static str,
+        /// Its own force or edge, another contact closing (where the run ends at its first
+        /// impact), or an impact elsewhere.
+        cause: EndCause,
     },
     /// It held to the end of the motion, which ended as `until` says.
     Held {
@@ -52,13 +53,15 @@ pub(super) fn fate(motion: &Motion, general: &Bound, i: usize) -> Result<Option<
         return Ok(Some(Fate::Ended {
             t: 0.0,
             theta,
-            cause: "force",
+            cause: EndCause::Force(contact_id(general, first, i)?),
         }));
     }
     // A run that ends where a contact closes with the body on the floor (the floor under the
     // rod's end a contact) ends at its landing: the contacts still closed held to it.
     let landed = match (motion.through_impacts, motion.phases.last()) {
-        (false, Some(last)) if matches!(last.end(), End::Contact(_)) => is_landing(general, last)?,
+        (false, Some(last)) if matches!(last.end(), EndCause::Contact(_)) => {
+            is_landing(general, last)?
+        }
         _ => false,
     };
     fate_along(motion, general, i, landed)
@@ -74,6 +77,15 @@ fn closed_in(general: &Bound, phase: &PhaseRun, i: usize) -> Result<bool, SolveE
             phase,
             format!("it lists {} contact(s), not contact {i}", closed.len()),
         )
+    })
+}
+
+/// Contact `i` of `general`'s system; one it does not have is a [`SolveError::PhaseMismatch`]
+/// of `phase`.
+fn contact_id(general: &Bound, phase: &PhaseRun, i: usize) -> Result<ContactId, SolveError> {
+    ContactId::of(general.info(), i).ok_or_else(|| {
+        let why = format!("a fate is asked of contact {i}, which the system does not have");
+        mismatch(general, phase, why)
     })
 }
 
@@ -94,20 +106,14 @@ fn fate_along(
     i: usize,
     landed: bool,
 ) -> Result<Option<Fate>, SolveError> {
-    let info = general.info();
     let Some(first) = motion.phases.first() else {
         return Ok(None);
     };
     if !closed_in(general, first, i)? {
         return Ok(Some(Fate::NeverClosed));
     }
+    let me = contact_id(general, first, i)?;
     for (k, phase) in motion.phases.iter().enumerate() {
-        let name = |j: usize| {
-            (info.contacts.get(j).map(|c| c.name.to_string())).ok_or_else(|| {
-                let why = format!("it ends at contact {j}, which the system does not have");
-                mismatch(general, phase, why)
-            })
-        };
         let ended = |cause| -> Result<Fate, SolveError> {
             Ok(Fate::Ended {
                 t: phase.t_end(),
@@ -116,18 +122,19 @@ fn fate_along(
             })
         };
         match phase.end() {
-            End::Force(j) if j == i => return Ok(Some(ended("force")?)),
-            End::Edge(j) if j == i => return Ok(Some(ended("edge")?)),
-            End::Contact(j) if !motion.through_impacts && landed => {
+            end @ (EndCause::Force(c) | EndCause::Edge(c)) if c == me => {
+                return Ok(Some(ended(end)?));
+            }
+            EndCause::Contact(j) if !motion.through_impacts && landed => {
                 return Ok(Some(Fate::Held {
                     until: Held::Lands {
-                        contact: name(j)?,
+                        contact: j.name.to_string(),
                         t: phase.t_end(),
                     },
                 }));
             }
-            End::Contact(_) if !motion.through_impacts => return Ok(Some(ended("contact")?)),
-            End::Contact(_) => {
+            end @ EndCause::Contact(_) if !motion.through_impacts => return Ok(Some(ended(end)?)),
+            EndCause::Contact(_) => {
                 // An impact: it may have separated this contact.
                 let Some(next) = motion.phases.get(k + 1) else {
                     return Ok((motion.halted.as_ref()).map(|why| Fate::Held {
@@ -135,15 +142,15 @@ fn fate_along(
                     }));
                 };
                 if !closed_in(general, next, i)? {
-                    return Ok(Some(ended("impact")?));
+                    return Ok(Some(ended(EndCause::Impact)?));
                 }
             }
-            End::Until => {
+            EndCause::Until => {
                 return Ok(Some(Fate::Held {
                     until: Held::RunsEnd { t: phase.t_end() },
                 }));
             }
-            End::Floor => {
+            EndCause::Floor => {
                 return Ok(Some(Fate::Held {
                     until: Held::Floor {
                         angle: general.reduced()?.1.to_string(),
@@ -151,15 +158,19 @@ fn fate_along(
                     },
                 }));
             }
-            End::Edge(j) => {
+            EndCause::Edge(j) => {
                 return Ok(Some(Fate::Held {
                     until: Held::Edge {
-                        contact: name(j)?,
+                        contact: j.name.to_string(),
                         t: phase.t_end(),
                     },
                 }));
             }
-            End::Force(_) => {
+            EndCause::Impact => {
+                let why = "it ends at an impact elsewhere, which ends a contact, not a phase";
+                return Err(mismatch(general, phase, why.into()));
+            }
+            EndCause::Force(_) => {
                 // Another contact opened; the decision there may have opened this one too.
                 let Some(next) = motion.phases.get(k + 1) else {
                     return Ok((motion.halted.as_ref()).map(|why| Fate::Held {
@@ -167,7 +178,7 @@ fn fate_along(
                     }));
                 };
                 if !closed_in(general, next, i)? {
-                    return Ok(Some(ended("force")?));
+                    return Ok(Some(ended(EndCause::Force(me))?));
                 }
             }
         }
@@ -180,10 +191,10 @@ fn fate_along(
 /// length).
 fn is_landing(general: &Bound, phase: &PhaseRun) -> Result<bool, SolveError> {
     match phase.end() {
-        End::Floor => Ok(true),
+        EndCause::Floor => Ok(true),
         // Without a falling point the system names no body that lands: a contact that closes
         // is an impact.
-        End::Contact(_) => match general.info().falling_point_index {
+        EndCause::Contact(_) => match general.info().falling_point_index {
             Some(falling) => {
                 let state = phase.full_end_state()?;
                 let height = general.points(&state)?.pos[falling][1];
@@ -276,7 +287,7 @@ impl Plan<'_> {
             None
         };
         if let Some(end) = end
-            && end.end == End::Force(0)
+            && end.end.is_force_of(0)
             && let Some(at) = end.at
         {
             let angle = self.general().reduced()?.1.to_string();
@@ -293,7 +304,7 @@ impl Plan<'_> {
             Fate::Ended {
                 t,
                 theta,
-                cause: "force",
+                cause: EndCause::Force(_),
             } => {
                 if q == Quantity::SeparationAngle {
                     let angle = self.general().reduced()?.1.to_string();
@@ -318,7 +329,7 @@ impl Plan<'_> {
         match fate {
             Fate::Ended { cause, .. } => Note::NoSeparationEnded {
                 contact,
-                cause: cause.to_string(),
+                cause: *cause,
             },
             Fate::Held { until } => Note::NoSeparationHolds {
                 contact,
@@ -362,22 +373,22 @@ impl Plan<'_> {
             for key in keys {
                 match &fate {
                     Fate::Ended { t, theta, cause } => {
-                        let (contact, cause) = (name.to_string(), cause.to_string());
+                        let contact = name.to_string();
                         let meaning = Meaning::ContactEndTime {
                             contact: contact.clone(),
-                            cause: cause.clone(),
+                            cause: *cause,
                         };
                         scalar(out, &format!("{key}_time"), *t, "s", meaning);
                         let meaning = Meaning::ContactEndAngle {
                             angle: self.general().reduced()?.1.to_string(),
                             contact: contact.clone(),
-                            cause: cause.clone(),
+                            cause: *cause,
                         };
                         scalar(out, &format!("{key}_angle"), *theta, "rad", meaning);
                         out.labels.insert(
                             format!("{key}_cause"),
                             Label {
-                                value: LabelValue::Word(cause),
+                                value: LabelValue::Cause(*cause),
                                 meaning: Meaning::ContactEndCause { contact },
                             },
                         );
@@ -673,12 +684,11 @@ impl Plan<'_> {
                 },
             );
         }
-        let name = |j: usize| info.contacts.get(j).map_or("a contact", |c| c.name);
         let Some(landing) = landing(motion, &general)?.map(|k| &motion.phases[k]) else {
             let end = match motion.last_end() {
-                Some(End::Edge(j)) => Unlanded::Edge(name(j).to_string()),
-                Some(End::Contact(j)) => Unlanded::Contact(name(j).to_string()),
-                Some(End::Until) => Unlanded::Until,
+                Some(end @ (EndCause::Edge(_) | EndCause::Contact(_) | EndCause::Until)) => {
+                    Unlanded::At(end)
+                }
                 _ => match &motion.halted {
                     Some(why) => Unlanded::Halted(why.clone()),
                     None => Unlanded::Ended,
@@ -719,8 +729,8 @@ impl Plan<'_> {
         let motion = slot.insert(motion);
         let info = walker.general.info();
         let mut list = motion.impacts.clone();
-        if let (false, Some(End::Contact(i))) = (motion.through_impacts, motion.last_end()) {
-            match walker.impact(motion, i) {
+        if let (false, Some(EndCause::Contact(i))) = (motion.through_impacts, motion.last_end()) {
+            match walker.impact(motion, i.index) {
                 Ok(at) => list.push(at),
                 Err(e @ SolveError::ImpactGainsEnergy { .. }) => {
                     out.notes
@@ -751,10 +761,10 @@ impl Plan<'_> {
             let (t, impacts) = (motion.end_time(), motion.impacts.len());
             let note = match (&motion.halted, motion.last_end()) {
                 (Some(why), _) => UntilNote::Halted(why.clone()),
-                (None, Some(End::Until)) => UntilNote::Reached { t, impacts },
+                (None, Some(EndCause::Until)) => UntilNote::Reached { t, impacts },
                 (None, end) => UntilNote::EndedBefore {
                     t,
-                    cause: end.map_or("", |e| e.cause()).to_string(),
+                    cause: end,
                     until,
                     impacts,
                 },

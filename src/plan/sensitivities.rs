@@ -14,12 +14,13 @@ use super::quantities::{Fate, fate, landing};
 use super::{DEFAULT_TOLERANCE, ODE_RTOL_FACTOR, Plan};
 use crate::model::start_offsets;
 use crate::quantity::Quantity;
+use crate::results::EndCause;
 use crate::results::{Note, RunResults, Sensitivity, SensitivityGap};
 use crate::solve::SolveError;
 use crate::solve::fast::prior::{PRIOR_TOL, Prior};
 use crate::solve::fast::quadrature::ACCEPT;
 use crate::solve::fast::sensitivity::{self, SensitivityWork, SeparationPoint};
-use crate::solve::phases::{End, Motion, SensitiveMotion, Stop};
+use crate::solve::phases::{Motion, SensitiveMotion, Stop};
 use crate::spec::units::{AngularUnit, UnitError};
 use crate::system::SystemError;
 
@@ -170,7 +171,7 @@ impl<'m> Plan<'m> {
         // The run's own event: a contact's end, or the landing.
         let run_event = if source == Source::Floor {
             let motion = self.complete()?;
-            landing(motion, &general)?.map(|k| (motion.phases[k].t_end(), "floor"))
+            landing(motion, &general)?.map(|k| (motion.phases[k].t_end(), EndCause::Floor))
         } else {
             match self.fate(contact)? {
                 Fate::Ended { t: 0.0, .. } => return Ok(Err(SensitivityGap::AtRelease)),
@@ -187,7 +188,7 @@ impl<'m> Plan<'m> {
             Err(gap) => return Ok(Err(gap)),
         };
         let event = if source == Source::Floor {
-            landing(&sensitive.motion, &general)?.map(|k| (k, "floor"))
+            landing(&sensitive.motion, &general)?.map(|k| (k, EndCause::Floor))
         } else {
             match fate(&sensitive.motion, &general, contact)? {
                 Some(Fate::Ended { t, cause, .. }) => (sensitive.motion.phases.iter())
@@ -340,7 +341,9 @@ impl<'m> Plan<'m> {
         &mut self,
     ) -> Result<Option<Result<Found, SensitivityGap>>, SolveError> {
         let Fate::Ended {
-            t, cause: "force", ..
+            t,
+            cause: EndCause::Force(_),
+            ..
         } = self.fate(0)?
         else {
             return Ok(None);
@@ -352,7 +355,7 @@ impl<'m> Plan<'m> {
             return Ok(None);
         };
         let end = self.end()?;
-        let (End::Force(0), Some(at)) = (end.end, end.at) else {
+        let (true, Some(at)) = (end.end.is_force_of(0), end.at) else {
             // The first contact separates on a later phase, which is integrated.
             return Ok(None);
         };
@@ -410,10 +413,10 @@ fn impact_events(motion: &Motion) -> Vec<ImpactEvent> {
             phase: i.phase,
         })
         .collect();
-    if let (false, Some(End::Contact(closing))) = (motion.through_impacts, motion.last_end()) {
+    if let (false, Some(EndCause::Contact(closing))) = (motion.through_impacts, motion.last_end()) {
         events.push(ImpactEvent {
             t: motion.end_time(),
-            closing,
+            closing: closing.index,
             zeno: false,
             phase: motion.phases.len() - 1,
         });

@@ -2,28 +2,12 @@
 //! integrated with the same contacts closed, and the physical checks of every phase.
 
 use super::{Plan, scalar};
-use crate::results::{CheckKind, CheckPhase, Meaning, Note, PhaseEnd, RunResults, Work};
+use crate::results::{CheckKind, CheckPhase, Meaning, Note, RunResults, Work};
 use crate::solve::SolveError;
 use crate::solve::checks::{self, Conserved, free_momenta};
 use crate::solve::integrated::unreduced::UnreducedRun;
-use crate::solve::phases::{End, PhaseRun};
+use crate::solve::phases::PhaseRun;
 use crate::solve::series::{sample_forces, theta_dot_at};
-
-/// The event that ended an integrated run, its contact named.
-fn ended_at(run: &UnreducedRun, info: &crate::model::ModelInfo) -> PhaseEnd {
-    let name = |i: usize| {
-        (info.contacts.get(i))
-            .map_or("a contact", |c| c.name)
-            .to_string()
-    };
-    match run.end {
-        End::Force(i) => PhaseEnd::Force(name(i)),
-        End::Edge(i) => PhaseEnd::Edge(name(i)),
-        End::Contact(i) => PhaseEnd::Contact(name(i)),
-        End::Floor => PhaseEnd::Floor,
-        End::Until => PhaseEnd::Until,
-    }
-}
 
 impl Plan<'_> {
     /// The fast path's first phase against the general model integrated from release with the
@@ -64,7 +48,7 @@ impl Plan<'_> {
         let same = ode.end == first.end.end;
         if !same {
             let note = Note::CrossCheckDisagrees {
-                integrated: ended_at(ode, info),
+                integrated: ode.end,
                 fast: format!("{:?}", first.end.end),
             };
             out.notes.insert("cross_check".into(), note);
@@ -79,11 +63,11 @@ impl Plan<'_> {
             // there (the fast phase's own model orders its coordinates otherwise).
             path_deviation(first, ode, walker.general.reduced()?.0, work)?;
         let steps = ode.steps();
-        let event = ended_at(ode, info);
+        let event = ode.end;
         let meaning = Meaning::CrossCheckTime {
             method: ode.method.name().to_string(),
             steps,
-            event: event.clone(),
+            event,
         };
         scalar(out, "cross_check_time", ode.t_end, "s", meaning);
         let meaning = Meaning::CrossCheckRelativeDifference {

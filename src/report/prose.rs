@@ -5,7 +5,7 @@
 //! are all here.
 
 use crate::results::{
-    Check, CheckKind, CheckPhase, CheckSubject, Halt, Held, LabelValue, Meaning, Note, PhaseEnd,
+    Check, CheckKind, CheckPhase, CheckSubject, EndCause, Halt, Held, LabelValue, Meaning, Note,
     Sensitivity, SensitivityGap, TapeReason, Unlanded, UntilNote, Zeno, format_number,
 };
 
@@ -25,7 +25,7 @@ pub fn check_phase(phase: &CheckPhase) -> String {
 /// `<modes> from t = <t> s`, joined by `; `.
 pub fn label(value: &LabelValue) -> String {
     match value {
-        LabelValue::Word(word) => word.clone(),
+        LabelValue::Cause(cause) => cause_keyword(*cause).into(),
         LabelValue::Stretches(stretches) => (stretches.iter())
             .map(|s| format!("{} from t = {} s", s.modes, format_number(s.from, 6)))
             .collect::<Vec<_>>()
@@ -144,7 +144,7 @@ pub fn note(note: &Note) -> String {
         Note::NoSeparationEnded { contact, cause } => format!(
             "no separation: contact `{contact}` ended before its force vanished ({}; \
              `contact_end` says when)",
-            cause_words(cause)
+            cause_words(*cause)
         ),
         Note::NoSeparationHolds { contact, held } => {
             format!(
@@ -163,7 +163,7 @@ pub fn note(note: &Note) -> String {
         Note::CrossCheckDisagrees { integrated, fast } => format!(
             "the integrated route ended at {}, the fast path at {fast}: they disagree on the \
              first event",
-            event_words(integrated)
+            event_words(*integrated)
         ),
         Note::NoLanding { t, path, end } => no_landing(*t, &path.join(" -> "), end),
         Note::FirstImpactEnds { t } => format!(
@@ -180,27 +180,43 @@ pub fn note(note: &Note) -> String {
     }
 }
 
-/// What a contact's end cause (`force`, `edge`, `impact`, `contact`) means.
-pub fn cause_words(cause: &str) -> &'static str {
+/// An end's one-word name, as `<contact>_end_cause` and results.json write it: `force`,
+/// `edge`, `contact`, `impact`, `floor` or `until`.
+pub fn cause_keyword(cause: EndCause) -> &'static str {
     match cause {
-        "force" => "its force reached zero (it would have had to pull)",
-        "edge" => "its contact point ran off a body",
-        "impact" => "the impulses of an impact elsewhere moved it away",
-        _ => {
-            "another contact closed there: the bodies meet, and the run ends at its first impact \
-             unless it is given a time to go on to (`until`)"
-        }
+        EndCause::Force(_) => "force",
+        EndCause::Edge(_) => "edge",
+        EndCause::Contact(_) => "contact",
+        EndCause::Impact => "impact",
+        EndCause::Floor => "floor",
+        EndCause::Until => "until",
     }
 }
 
-/// An event that ends a phase, in words (the cross-check's).
-fn event_words(end: &PhaseEnd) -> String {
+/// What a contact's end cause means.
+pub fn cause_words(cause: EndCause) -> &'static str {
+    match cause {
+        EndCause::Force(_) => "its force reached zero (it would have had to pull)",
+        EndCause::Edge(_) => "its contact point ran off a body",
+        EndCause::Impact => "the impulses of an impact elsewhere moved it away",
+        EndCause::Contact(_) => {
+            "another contact closed there: the bodies meet, and the run ends at its first impact \
+             unless it is given a time to go on to (`until`)"
+        }
+        EndCause::Floor => "the body reached the floor",
+        EndCause::Until => "the run reached its end (`until`)",
+    }
+}
+
+/// An event that ends a phase, in words (the cross-check's, an FMU's log).
+pub fn event_words(end: EndCause) -> String {
     match end {
-        PhaseEnd::Force(name) => format!("contact `{name}`'s force crossing zero"),
-        PhaseEnd::Edge(name) => format!("contact `{name}`'s edge"),
-        PhaseEnd::Contact(name) => format!("contact `{name}` closing"),
-        PhaseEnd::Floor => "the floor".into(),
-        PhaseEnd::Until => "the run's end".into(),
+        EndCause::Force(c) => format!("contact `{}`'s force crossing zero", c.name),
+        EndCause::Edge(c) => format!("contact `{}`'s edge", c.name),
+        EndCause::Contact(c) => format!("contact `{}` closing", c.name),
+        EndCause::Impact => "an impact elsewhere".into(),
+        EndCause::Floor => "the floor".into(),
+        EndCause::Until => "the run's end".into(),
     }
 }
 
@@ -254,16 +270,21 @@ pub fn end_angle_words(angle: &str, end_angle: f64) -> String {
 fn no_landing(t: f64, path: &str, end: &Unlanded) -> String {
     let at = format_number(t, 6);
     match end {
-        Unlanded::Edge(contact) => format!(
-            "contact `{contact}` ran off an edge at t = {at} s ({path}); the motion after that is \
-             not modelled"
+        Unlanded::At(EndCause::Edge(c)) => format!(
+            "contact `{}` ran off an edge at t = {at} s ({path}); the motion after that is not \
+             modelled",
+            c.name
         ),
-        Unlanded::Contact(contact) => format!(
-            "contact `{contact}` closed at t = {at} s ({path}): the bodies meet, and the run ends \
-             at its first impact unless the scene gives a time to go on to (`until`)"
+        Unlanded::At(EndCause::Contact(c)) => format!(
+            "contact `{}` closed at t = {at} s ({path}): the bodies meet, and the run ends at its \
+             first impact unless the scene gives a time to go on to (`until`)",
+            c.name
         ),
-        Unlanded::Until => {
+        Unlanded::At(EndCause::Until) => {
             format!("the run reached its end at t = {at} s before the body landed ({path})")
+        }
+        Unlanded::At(EndCause::Force(_) | EndCause::Impact | EndCause::Floor) => {
+            format!("the motion ended before the floor ({path})")
         }
         Unlanded::Halted(halt) => format!(
             "the motion ended before the floor: {} ({path})",
@@ -288,9 +309,10 @@ fn until_words(until: &UntilNote) -> String {
             until,
             impacts,
         } => format!(
-            "the motion ended at t = {} s ({cause}), before the run's end (`until` = {} s), \
-             after {impacts} impact(s)",
+            "the motion ended at t = {} s ({}), before the run's end (`until` = {} s), after \
+             {impacts} impact(s)",
             format_number(*t, 6),
+            cause.map_or("", cause_keyword),
             format_number(*until, 6)
         ),
     }
@@ -370,7 +392,7 @@ pub fn meaning(meaning: &Meaning) -> String {
         }
         Meaning::ContactEndTime { contact, cause } => format!(
             "time from release until contact `{contact}` ends: {}",
-            cause_words(cause)
+            cause_words(*cause)
         ),
         Meaning::ContactEndAngle {
             angle,
@@ -378,7 +400,7 @@ pub fn meaning(meaning: &Meaning) -> String {
             cause,
         } => format!(
             "`{angle}` where contact `{contact}` ends: {}",
-            cause_words(cause)
+            cause_words(*cause)
         ),
         Meaning::ContactEndCause { contact } => format!(
             "why contact `{contact}` ended: `force` (its force reached zero), `edge` (its point \
@@ -423,7 +445,7 @@ pub fn meaning(meaning: &Meaning) -> String {
             event,
         } => format!(
             "the general model ({method}, {steps} steps) integrated to {}",
-            event_words(event)
+            event_words(*event)
         ),
         Meaning::CrossCheckRelativeDifference {
             event,
@@ -433,7 +455,7 @@ pub fn meaning(meaning: &Meaning) -> String {
         } => format!(
             "|t_ode - t_quadrature| / t_quadrature at {} (quadrature: {t_quad:.15e} s; ODE rtol \
              {rtol:.1e}, mass-matrix condition {condition:.1e})",
-            event_words(event)
+            event_words(*event)
         ),
         Meaning::CrossCheckRtol => "relative tolerance the integrator ran with: the one asked, \
                                     raised to 10 eps cond(M) when the mass matrix is \

@@ -1,22 +1,8 @@
 //! The bodies' motion as the model draws it: plain numbers per solved phase and sample, from
 //! which `report::motion` computes the animation.
 
+use super::EndCause;
 use crate::model::ShapeInfo;
-
-/// Why a solved phase ended, as the drawing of the motion tells it (a contact by its name).
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum PhaseEnd {
-    /// The named contact's force reached zero: it opened.
-    Force(String),
-    /// The named contact's point ran off the edge of a body.
-    Edge(String),
-    /// The named contact's gap closed: an impact.
-    Contact(String),
-    /// The reduced angle reached the model's end angle.
-    Floor,
-    /// The run reached its end time.
-    Until,
-}
 
 /// The drawing's numbers at one sample: every body's pose and the traced point.
 #[derive(Debug, Clone, PartialEq)]
@@ -46,7 +32,7 @@ pub struct DrawnPhase {
     /// When it starts (s from release).
     pub t_start: f64,
     /// Why it ended.
-    pub end: PhaseEnd,
+    pub end: EndCause,
     /// Its samples, in order.
     pub samples: Vec<DrawnSample>,
 }

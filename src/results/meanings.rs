@@ -1,7 +1,7 @@
 //! What each scalar and word-valued result is, as data: the quantity with the names and
 //! numbers its sentence gives (`report::prose::meaning` writes the sentence).
 
-use super::PhaseEnd;
+use super::EndCause;
 
 /// What a result in [`RunResults::results`](super::RunResults) or
 /// [`RunResults::labels`](super::RunResults) is. `angle` is always the name of the model's
@@ -21,8 +21,8 @@ pub enum Meaning {
     ContactEndTime {
         /// The contact.
         contact: String,
-        /// Why it ended (`force`, `edge`, `contact`, `impact`).
-        cause: String,
+        /// Why it ended.
+        cause: EndCause,
     },
     /// The reduced angle where a contact ends.
     ContactEndAngle {
@@ -30,8 +30,8 @@ pub enum Meaning {
         angle: String,
         /// The contact.
         contact: String,
-        /// Why it ended (`force`, `edge`, `contact`, `impact`).
-        cause: String,
+        /// Why it ended.
+        cause: EndCause,
     },
     /// Why a contact ended, a word (a label).
     ContactEndCause {
@@ -86,12 +86,12 @@ pub enum Meaning {
         /// Its steps.
         steps: u64,
         /// The event.
-        event: PhaseEnd,
+        event: EndCause,
     },
     /// The cross-check's event time against the quadrature's, relative.
     CrossCheckRelativeDifference {
         /// The event.
-        event: PhaseEnd,
+        event: EndCause,
         /// The quadrature's time (s).
         t_quad: f64,
         /// The integrator's relative tolerance.

@@ -7,10 +7,12 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 
 mod drawing;
+mod ends;
 mod meanings;
 mod notes;
 
-pub use drawing::{Drawing, DrawnPhase, DrawnSample, PhaseEnd, Pose};
+pub use drawing::{Drawing, DrawnPhase, DrawnSample, Pose};
+pub use ends::{ContactId, EndCause};
 pub use meanings::Meaning;
 pub use notes::{Halt, Held, Note, SensitivityGap, TapeReason, Unlanded, UntilNote, Zeno};
 
@@ -38,21 +40,11 @@ pub struct Label {
 /// What a [`Label`] says.
 #[derive(Debug, Clone, PartialEq)]
 pub enum LabelValue {
-    /// One word (why a contact ended: `force`, `edge`, ...).
-    Word(String),
+    /// Why a contact ended (the report writes it as one word: `force`, `edge`, ...).
+    Cause(EndCause),
     /// The active sets over a span, in order: each stretch's start and its closed contacts
     /// and friction modes in words.
     Stretches(Vec<Stretch>),
-}
-
-impl LabelValue {
-    /// The word, if the label is one.
-    pub fn as_word(&self) -> Option<&str> {
-        match self {
-            LabelValue::Word(w) => Some(w),
-            LabelValue::Stretches(_) => None,
-        }
-    }
 }
 
 /// One stretch of a motion with one active set.

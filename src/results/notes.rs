@@ -2,7 +2,7 @@
 //! value and how the motion was followed, each a [`Note`] of names, keywords and numbers
 //! (`report::prose` writes the sentence).
 
-use super::PhaseEnd;
+use super::EndCause;
 
 /// Why the motion stopped before its end (the solver's halt).
 #[derive(Debug, Clone, PartialEq)]
@@ -104,12 +104,9 @@ pub enum Held {
 /// How the motion ended before the body landed.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Unlanded {
-    /// The named contact ran off an edge.
-    Edge(String),
-    /// The named contact closed, where the run ends at its first impact.
-    Contact(String),
-    /// The run reached its end time.
-    Until,
+    /// The motion's last phase ended this way (an edge, a contact closing where the run ends at
+    /// its first impact, the run's end).
+    At(EndCause),
     /// The motion was halted.
     Halted(Halt),
     /// The motion ended otherwise.
@@ -132,8 +129,8 @@ pub enum UntilNote {
     EndedBefore {
         /// When (s from release).
         t: f64,
-        /// Why, as a keyword (`force`, `edge`, `contact`, `floor`; empty when unknown).
-        cause: String,
+        /// Why, where the last phase says.
+        cause: Option<EndCause>,
         /// The run's end (s).
         until: f64,
         /// The impacts on the way.
@@ -148,13 +145,13 @@ pub enum Note {
     /// A refusal: the error's message (the cross-check's matrix too ill-conditioned, an
     /// impact with friction).
     Refused(String),
-    /// The first contact ended by another cause than its force (a keyword: `edge`,
-    /// `contact`, `impact`), so it does not separate.
+    /// The first contact ended by another cause than its force (its edge, another contact
+    /// closing, an impact), so it does not separate.
     NoSeparationEnded {
         /// The contact.
         contact: String,
         /// Why it ended.
-        cause: String,
+        cause: EndCause,
     },
     /// The first contact held, so it does not separate.
     NoSeparationHolds {
@@ -185,7 +182,7 @@ pub enum Note {
     /// The cross-check's integrated route ended at another event than the fast path.
     CrossCheckDisagrees {
         /// The integrated route's event.
-        integrated: PhaseEnd,
+        integrated: EndCause,
         /// The fast path's event, in the solver's debug form (`Force(0)`).
         fast: String,
     },

@@ -4,7 +4,7 @@
 //! keyframes and the slow-motion factor that time it.
 
 use crate::model::ShapeKind;
-use crate::results::{Drawing, DrawnPhase, PhaseEnd};
+use crate::results::{Drawing, DrawnPhase, EndCause};
 
 /// Most keyframes of the animation: frames are thinned to about this many, evenly in time
 /// (every phase's first and last frame kept).
@@ -141,15 +141,15 @@ fn from_phases(drawing: &Drawing, first: &DrawnPhase) -> Animation {
             t_start: phase.t_start,
         });
         add_frames(&mut anim, phase, index);
-        if let PhaseEnd::Contact(name) = &phase.end
-            && let Some(mark) = impact_mark(&anim, phase, index, name)
+        if let EndCause::Contact(c) = phase.end
+            && let Some(mark) = impact_mark(&anim, phase, index, c.name)
         {
             anim.impacts.push(mark);
         }
-        let cause = match &phase.end {
-            PhaseEnd::Force(name) => Some(format!("{name} lets go")),
-            PhaseEnd::Edge(name) => Some(format!("{name} runs off an edge")),
-            PhaseEnd::Contact(_) | PhaseEnd::Floor | PhaseEnd::Until => None,
+        let cause = match phase.end {
+            EndCause::Force(c) => Some(format!("{} lets go", c.name)),
+            EndCause::Edge(c) => Some(format!("{} runs off an edge", c.name)),
+            EndCause::Contact(_) | EndCause::Impact | EndCause::Floor | EndCause::Until => None,
         };
         if anim.contact_end.is_none()
             && let Some(cause) = cause

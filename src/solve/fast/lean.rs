@@ -29,6 +29,7 @@
 
 use crate::model::PhaseInfo;
 use crate::model::{LeanStart, Model, ModelInfo, Reduction, ReductionInfo, positive_finite};
+use crate::results::EndCause;
 use crate::results::{SensitivityGap, Work};
 use crate::solve::SolveError;
 use crate::solve::fast::poly::horner;
@@ -38,7 +39,7 @@ use crate::solve::fast::quadrature::{
     self, ACCEPT, Control, Fall, FallIntegrand, HalfRule, PanelSum, RuleStep, SCHEDULE, v_at_drop,
 };
 use crate::solve::fast::sensitivity::{self, SensitivityWork, SeparationPoint};
-use crate::solve::phases::{End, phase_end};
+use crate::solve::phases::phase_end;
 use crate::system::{System, SystemError, check_parameters, ordered_values, prepare_constants};
 
 /// The fast phase a system starts in (its release phase), looked up in the registry; a model
@@ -373,20 +374,19 @@ impl<'m> LeanSolver<'m> {
         let mut work = Work::default();
         let end = phase_end(&sys, &mut work)?;
         self.evals += work.polynomial_evals;
-        let name = |i: usize| self.info.contacts.get(i).map_or("a contact", |c| c.name);
         match end.end {
-            End::Force(0) => {}
-            End::Force(i) if end.delta == 0.0 => {
+            EndCause::Force(c) if c.index == 0 => {}
+            EndCause::Force(c) if end.delta == 0.0 => {
                 return Err(SolveError::NotThisPhase {
                     model: self.info.name,
-                    contact: name(i),
+                    contact: c.name,
                     why: "would have to pull",
                 });
             }
-            End::Force(i) => {
+            EndCause::Force(c) => {
                 return Err(SolveError::NotThisPhase {
                     model: self.info.name,
-                    contact: name(i),
+                    contact: c.name,
                     why: "lets go before the separation",
                 });
             }

@@ -35,6 +35,7 @@
 
 use crate::model::GapKind;
 use crate::results::Work;
+use crate::results::{ContactId, EndCause};
 use crate::solve::SolveError;
 use crate::solve::integrated::contacts::{
     self, Active, ContactOption, DECIDE_TOLERANCE, Dynamics, DynamicsWork, FrictionOption, Mode,
@@ -79,42 +80,6 @@ pub fn mass_condition(sys: &Bound, state: &State) -> Result<f64, SolveError> {
     } else {
         f64::INFINITY
     })
-}
-
-/// Why a phase ended (integrated or on the fast path).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum End {
-    /// A closed contact's force reached zero: it opens (the first contact's is the separation).
-    Force(usize),
-    /// A closed contact's point ran off the edge of a body.
-    Edge(usize),
-    /// An open contact's gap closed: the bodies meet.
-    Contact(usize),
-    /// The reduced angle reached the model's end angle (the rod lies on the floor).
-    Floor,
-    /// The run reached the time it was asked to go on to (a scene's `until`).
-    Until,
-}
-
-impl End {
-    /// `"force"`, `"edge"`, `"contact"`, `"floor"` or `"until"`.
-    pub fn cause(self) -> &'static str {
-        match self {
-            End::Force(_) => "force",
-            End::Edge(_) => "edge",
-            End::Contact(_) => "contact",
-            End::Floor => "floor",
-            End::Until => "until",
-        }
-    }
-
-    /// The contact the event is about (none at the floor or the run's end).
-    pub fn contact(self) -> Option<usize> {
-        match self {
-            End::Force(i) | End::Edge(i) | End::Contact(i) => Some(i),
-            End::Floor | End::Until => None,
-        }
-    }
 }
 
 /// What an event function measures.
@@ -174,7 +139,7 @@ pub struct UnreducedRun {
     /// Condition number of the mass matrix at the start.
     pub condition: f64,
     /// Which event ended it.
-    pub end: End,
+    pub end: EndCause,
     /// Time of that event (s from the phase's start).
     pub t_end: f64,
     /// The state there.
@@ -434,6 +399,16 @@ impl Problem<'_, '_> {
         Ok(())
     }
 
+    /// Contact `i` of the system, as an end names it.
+    fn contact(&self, i: usize) -> Result<ContactId, SolveError> {
+        let info = self.sys.info();
+        ContactId::of(info, i).ok_or_else(|| SolveError::PhaseMismatch {
+            system: info.system,
+            name: info.name,
+            why: format!("an event watches contact {i}, which the system does not have"),
+        })
+    }
+
     /// What an event ends: the run (at `until`, the run's end time, or at a contact's event) or
     /// only the segment, at the friction watch whose switch goes on with it. `y` is the state
     /// there (for the error of an event no watch has).
@@ -442,20 +417,20 @@ impl Problem<'_, '_> {
         until: bool,
         event: &Event,
         y: &[f64],
-    ) -> Result<Result<End, Watch>, SolveError> {
+    ) -> Result<Result<EndCause, Watch>, SolveError> {
         if until {
-            return Ok(Ok(End::Until));
+            return Ok(Ok(EndCause::Until));
         }
         Ok(match self.watches.get(event.index).copied() {
-            Some(Watch::Force(i)) => Ok(End::Force(i)),
-            Some(Watch::Gap(i)) => Ok(End::Contact(i)),
-            Some(Watch::Edge(i)) => Ok(End::Edge(i)),
-            Some(Watch::Floor { .. }) => Ok(End::Floor),
+            Some(Watch::Force(i)) => Ok(EndCause::Force(self.contact(i)?)),
+            Some(Watch::Gap(i)) => Ok(EndCause::Contact(self.contact(i)?)),
+            Some(Watch::Edge(i)) => Ok(EndCause::Edge(self.contact(i)?)),
+            Some(Watch::Floor { .. }) => Ok(EndCause::Floor),
             // A friction's switch located where the reduced angle is already at or past the
             // end angle: the two roots coincide to the located time's ulps (a ladder lying flat
             // against the wall's foot stops its foot's slip, `ell sin(theta) theta'`, exactly at
             // the floor), and the run ends at the floor, past which the model describes nothing.
-            Some(_) if self.floor_reached(y) => Ok(End::Floor),
+            Some(_) if self.floor_reached(y) => Ok(EndCause::Floor),
             Some(watch) => Err(watch),
             None => {
                 return Err(SolveError::OdeNonFinite {
@@ -808,7 +783,7 @@ pub struct Start {
     /// Work done by friction before the start (J).
     pub friction_work: f64,
     /// Where the run is asked to stop (s from this start) if no event comes first: it then
-    /// ends there with [`End::Until`]. `None`: only an event ends it.
+    /// ends there with [`EndCause::Until`]. `None`: only an event ends it.
     pub stop_at: Option<f64>,
     /// Keep every step's continuous extension, for sampling the run between its steps
     /// ([`UnreducedRun::state_at`]; [`OdeOptions::dense_output`]).
@@ -863,7 +838,7 @@ fn until_event(solution: &OdeSolution, stop_at: Option<f64>) -> Option<Event> {
 /// magnitudes of the motion `y - y0` for the absolute tolerances; without them the control is
 /// relative to the largest deviation seen. `t_max` bounds the search: reaching it is
 /// [`SolveError::NoEvent`], unless the start's `stop_at` comes first (the run then ends there,
-/// [`End::Until`]).
+/// [`EndCause::Until`]).
 pub fn integrate(
     sys: &Bound,
     start: &Start,
@@ -967,14 +942,22 @@ pub fn integrate_with(
         let watch = match problem.ending(until, &event, &y)? {
             Ok(end) => {
                 let measured = match end {
-                    End::Force(i) => Measured::Force(i),
-                    End::Contact(i) => Measured::Gap(i),
-                    End::Edge(i) => Measured::Edge(i),
-                    End::Floor => match problem.floor {
+                    EndCause::Force(c) => Measured::Force(c.index),
+                    EndCause::Contact(c) => Measured::Gap(c.index),
+                    EndCause::Edge(c) => Measured::Edge(c.index),
+                    // An impact elsewhere ends a contact's hold, never an integrated run.
+                    EndCause::Impact => {
+                        return Err(SolveError::PhaseMismatch {
+                            system: problem.sys.info().system,
+                            name: problem.sys.info().name,
+                            why: "an integrated run ended at an impact elsewhere".into(),
+                        });
+                    }
+                    EndCause::Floor => match problem.floor {
                         Some((coordinate, _)) => Measured::Coordinate(coordinate),
                         None => Measured::Clock,
                     },
-                    End::Until => Measured::Clock,
+                    EndCause::Until => Measured::Clock,
                 };
                 let at = (&state, event.t, &problem.active);
                 let sensitivity = match problem.riders.take() {

@@ -38,5 +38,3 @@ pub use walker::{
     fall_time_scale, phase_parameters,
 };
 pub use zeno::{ZENO_AGREE, ZENO_RATIO_SPREAD, ZENO_RATIOS};
-
-pub use crate::solve::integrated::unreduced::End;

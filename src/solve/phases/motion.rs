@@ -2,10 +2,10 @@
 //! ([`ImpactAt`]), why it halted and its notes.
 
 use super::run::PhaseRun;
+use crate::results::EndCause;
 use crate::results::{Halt, Zeno};
 use crate::solve::SolveError;
 use crate::solve::integrated::impact::{Impact, Part};
-use crate::solve::integrated::unreduced::End;
 
 /// An impact between two phases of a motion.
 #[derive(Debug, Clone, PartialEq)]
@@ -75,17 +75,17 @@ impl<'m> Motion<'m> {
     }
 
     /// Why the last phase ended.
-    pub fn last_end(&self) -> Option<End> {
+    pub fn last_end(&self) -> Option<EndCause> {
         self.phases.last().map(PhaseRun::end)
     }
 
     /// Whether the motion goes on after a phase that ended by `end`: after a contact that
     /// opens, and after one that closes where the run goes on through impacts.
-    pub fn goes_on_after(&self, end: End) -> bool {
+    pub fn goes_on_after(&self, end: EndCause) -> bool {
         match end {
-            End::Force(_) => true,
-            End::Contact(_) => self.through_impacts,
-            End::Edge(_) | End::Floor | End::Until => false,
+            EndCause::Force(_) => true,
+            EndCause::Contact(_) => self.through_impacts,
+            EndCause::Edge(_) | EndCause::Impact | EndCause::Floor | EndCause::Until => false,
         }
     }
 

@@ -3,12 +3,12 @@
 //! contacts' gaps to close along it ([`ReducedRun::with_end`]).
 
 use crate::results::Work;
+use crate::results::{ContactId, EndCause};
 use crate::solve::SolveError;
 use crate::solve::fast::inversion::theta_dot_at;
 use crate::solve::fast::quadrature::TimeMesh;
 use crate::solve::fast::separation::{Separation, SeparationOutcome, edge, force_zero};
 use crate::solve::integrated::contacts::DECIDE_TOLERANCE;
-use crate::solve::integrated::unreduced::End;
 use crate::solve::roots::{self, changes_sign};
 use crate::system::{State, System};
 
@@ -21,7 +21,7 @@ pub const GAP_CELLS: usize = 64;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ReducedEnd {
     /// Why.
-    pub end: End,
+    pub end: EndCause,
     /// The angle where a contact ends (`None` at the floor).
     pub at: Option<Separation>,
     /// The angle fallen at the end.
@@ -35,8 +35,8 @@ pub struct ReducedEnd {
 pub fn phase_end(sys: &System, work: &mut Work) -> Result<ReducedEnd, SolveError> {
     let info = sys.info();
     let at_start = sys.forces(0.0)?;
-    let mut found: Option<(End, Separation)> = None;
-    let mut consider = |end: End, outcome: SeparationOutcome| {
+    let mut found: Option<(EndCause, Separation)> = None;
+    let mut consider = |end: EndCause, outcome: SeparationOutcome| {
         if let SeparationOutcome::Separates(s) = outcome
             && found.is_none_or(|(_, f)| s.delta < f.delta)
         {
@@ -58,7 +58,10 @@ pub fn phase_end(sys: &System, work: &mut Work) -> Result<ReducedEnd, SolveError
         if at_start[i] < 0.0 {
             let theta = sys.theta_initial();
             return Ok(ReducedEnd {
-                end: End::Force(i),
+                end: EndCause::Force(ContactId {
+                    index: i,
+                    name: c.name,
+                }),
                 at: Some(Separation {
                     sin_theta: theta.sin(),
                     theta,
@@ -67,11 +70,23 @@ pub fn phase_end(sys: &System, work: &mut Work) -> Result<ReducedEnd, SolveError
                 delta: 0.0,
             });
         }
-        consider(End::Force(i), force_zero(sys, i, work)?);
+        consider(
+            EndCause::Force(ContactId {
+                index: i,
+                name: c.name,
+            }),
+            force_zero(sys, i, work)?,
+        );
     }
     for (i, c) in info.contacts.iter().enumerate() {
         if c.closed && c.edge {
-            consider(End::Edge(i), edge(sys, i, work)?);
+            consider(
+                EndCause::Edge(ContactId {
+                    index: i,
+                    name: c.name,
+                }),
+                edge(sys, i, work)?,
+            );
         }
     }
     Ok(match found {
@@ -81,7 +96,7 @@ pub fn phase_end(sys: &System, work: &mut Work) -> Result<ReducedEnd, SolveError
             delta: at.delta,
         },
         None => ReducedEnd {
-            end: End::Floor,
+            end: EndCause::Floor,
             at: None,
             delta: sys.delta_to_floor(),
         },
@@ -127,7 +142,7 @@ impl<'m> ReducedRun<'m> {
             mesh = TimeMesh::build(&sys, delta, tol, work)?;
             let theta = sys.theta_initial() - delta;
             end = ReducedEnd {
-                end: End::Contact(i),
+                end: EndCause::Contact(i),
                 at: Some(Separation {
                     sin_theta: theta.sin(),
                     theta,
@@ -148,7 +163,7 @@ impl<'m> ReducedRun<'m> {
     /// The separation that ends it, if its first contact's force reached zero.
     pub fn separation(&self) -> Option<Separation> {
         match self.end.end {
-            End::Force(0) => self.end.at,
+            end if end.is_force_of(0) => self.end.at,
             _ => None,
         }
     }
@@ -176,10 +191,14 @@ fn first_gap_closing(
     sys: &System,
     mesh: &TimeMesh,
     work: &mut Work,
-) -> Result<Option<(usize, f64)>, SolveError> {
+) -> Result<Option<(ContactId, f64)>, SolveError> {
     let info = sys.info();
-    let open: Vec<usize> = (0..info.contacts.len())
-        .filter(|&i| !info.contacts[i].closed)
+    let open: Vec<ContactId> = (info.contacts.iter().enumerate())
+        .filter(|(_, c)| !c.closed)
+        .map(|(index, c)| ContactId {
+            index,
+            name: c.name,
+        })
         .collect();
     if open.is_empty() {
         return Ok(None);
@@ -189,11 +208,11 @@ fn first_gap_closing(
         Ok(sys.full_state(t, delta, theta_dot_at(sys, delta))?)
     };
     let tol = DECIDE_TOLERANCE * sys.length_scale(&state_at(0.0, work)?)?;
-    let mut best: Option<(usize, f64)> = None;
+    let mut best: Option<(ContactId, f64)> = None;
     for &i in &open {
         let mut gap = |delta: f64| -> Result<f64, SolveError> {
             let mut w = Work::default();
-            let g = sys.gaps(&state_at(delta, &mut w)?)?[i];
+            let g = sys.gaps(&state_at(delta, &mut w)?)?[i.index];
             work.integrand_evals += w.integrand_evals;
             Ok(g)
         };

@@ -2,9 +2,10 @@
 //! integrated ([`IntegratedRun`]), and what both answer: times, end, end state, closed contacts.
 
 use super::reduced::ReducedRun;
+use crate::results::EndCause;
 use crate::solve::SolveError;
 use crate::solve::integrated::contacts::Active;
-use crate::solve::integrated::unreduced::{End, UnreducedRun};
+use crate::solve::integrated::unreduced::UnreducedRun;
 use crate::system::{Bound, State};
 
 /// A phase solved by integrating the general model's equations.
@@ -74,7 +75,7 @@ impl<'m> PhaseRun<'m> {
     }
 
     /// Why the phase ended.
-    pub fn end(&self) -> End {
+    pub fn end(&self) -> EndCause {
         match self {
             PhaseRun::Reduced(r) => r.end.end,
             PhaseRun::Integrated(r) => r.run.end,

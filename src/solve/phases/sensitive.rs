@@ -8,6 +8,7 @@
 
 use super::zeno::{self, ZENO_AGREE};
 use super::{MAX_PHASES, Motion, PhaseStart, Route, Walker};
+use crate::results::EndCause;
 use std::collections::BTreeMap;
 
 use crate::results::Work;
@@ -15,7 +16,7 @@ use crate::solve::SolveError;
 use crate::solve::integrated::contacts;
 use crate::solve::integrated::forward::{self, Forward, Grazing};
 use crate::solve::integrated::saltation::{self, Crossing, SaltationGap};
-use crate::solve::integrated::unreduced::{End, EndSensitivity};
+use crate::solve::integrated::unreduced::EndSensitivity;
 
 /// How one phase's end moves with the parameters (one value per parameter each).
 #[derive(Debug, Clone, PartialEq)]
@@ -178,8 +179,14 @@ impl<'m> Walker<'m> {
         if since >= MAX_PHASES {
             return Err(SolveError::TooManyPhases { limit: MAX_PHASES });
         }
-        if let Some(End::Contact(i)) = motion.last_end() {
-            return self.sensitive_impact(motion, i, (end_state, sens, dt), ends, accumulation);
+        if let Some(EndCause::Contact(i)) = motion.last_end() {
+            return self.sensitive_impact(
+                motion,
+                i.index,
+                (end_state, sens, dt),
+                ends,
+                accumulation,
+            );
         }
         let next = match self.after(last) {
             Ok(next) => next,

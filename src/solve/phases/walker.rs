@@ -9,6 +9,7 @@ use super::reduced::{ReducedEnd, ReducedRun, phase_end};
 use super::run::{IntegratedRun, PhaseRun};
 use super::zeno::{self, Flight};
 use crate::model::{GapKind, Model, ModelInfo};
+use crate::results::EndCause;
 use crate::results::{Halt, Work, Zeno};
 use crate::solve::SolveError;
 use crate::solve::fast::inversion::delta_at_time;
@@ -19,7 +20,7 @@ use crate::solve::integrated::contacts::{
 };
 use crate::solve::integrated::impact::{self, Impact, Part};
 use crate::solve::integrated::ode::Method;
-use crate::solve::integrated::unreduced::{self, End, EndSensitivity, Start, motion_scales};
+use crate::solve::integrated::unreduced::{self, EndSensitivity, Start, motion_scales};
 use crate::system::{Bound, State, System, SystemError};
 
 /// Most phases chained between two impacts (or from release to the first) before giving up:
@@ -165,8 +166,8 @@ impl<'m> Walker<'m> {
             drift,
         };
         let mut contacts = contact_options(&self.general, &state, at)?;
-        if let End::Force(i) = run.end()
-            && let Some(c) = contacts.get_mut(i)
+        if let EndCause::Force(i) = run.end()
+            && let Some(c) = contacts.get_mut(i.index)
         {
             *c = ContactOption::Opens;
         }
@@ -260,7 +261,7 @@ impl<'m> Walker<'m> {
     }
 
     /// A fast phase that runs past the run's end ([`Walker::until`]) cut there: its mesh to the
-    /// angle fallen at that time, ended by [`End::Until`].
+    /// angle fallen at that time, ended by [`EndCause::Until`].
     fn cut(&self, run: ReducedRun<'m>, work: &mut Work) -> Result<ReducedRun<'m>, SolveError> {
         let Some(until) = self.until else {
             return Ok(run);
@@ -273,7 +274,7 @@ impl<'m> Walker<'m> {
         let mesh = TimeMesh::build(&run.system, delta, self.tol, work)?;
         Ok(ReducedRun {
             end: ReducedEnd {
-                end: End::Until,
+                end: EndCause::Until,
                 at: None,
                 delta,
             },
@@ -354,7 +355,7 @@ impl<'m> Walker<'m> {
         let run =
             unreduced::integrate_with(&bound, &from, self.rtol, method, Some(&scales), t_max, work)
                 .map_err(|e| at_time(e, start.t))?;
-        if run.end == End::Floor {
+        if run.end == EndCause::Floor {
             self.landed(&run.state_end, start.t + run.t_end)?;
         }
         let phase = PhaseRun::Integrated(IntegratedRun {
@@ -419,7 +420,7 @@ impl<'m> Walker<'m> {
             return Err(SolveError::TooManyPhases { limit: MAX_PHASES });
         }
         let start = match end {
-            End::Contact(i) => self.through_impact(motion, i, friction_work)?,
+            EndCause::Contact(i) => self.through_impact(motion, i.index, friction_work)?,
             _ => match self.after(last_phase(motion)?) {
                 Ok(start) => Some(start),
                 // Another contact closes at the very moment this one opened (within the
