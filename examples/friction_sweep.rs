@@ -58,10 +58,10 @@ fn solve(mu: f64) -> Result<Point, Box<dyn Error>> {
         return Err("the contact phase with friction is integrated".into());
     };
     // The foot's friction is the model's only one: its mode in each stretch of the phase.
-    let modes: Vec<(f64, &str)> = (phase.run.segments.iter())
-        .map(|s| (phase.t_start + s.t_start, s.active.modes[0].describe()))
+    let modes: Vec<(f64, String)> = (phase.run.segments.iter())
+        .map(|s| (phase.t_start + s.t_start, s.active.modes[0].to_string()))
         .collect();
-    let steps: Vec<&str> = modes.iter().map(|(_, m)| *m).collect();
+    let steps: Vec<&str> = modes.iter().map(|(_, m)| m.as_str()).collect();
     let end = run.end();
     let regime = format!(
         "foot {}; {}",

@@ -538,7 +538,7 @@ impl<'m> Plan<'m> {
                         format!(
                             "the motion does not start in the system's release fast phase: at \
                              release {}",
-                            start.active.describe(info)
+                            start.active.set(info)
                         )
                     } else {
                         info.route_note.to_string()

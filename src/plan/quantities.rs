@@ -430,7 +430,7 @@ impl Plan<'_> {
             Meaning::ContactEndFrictionWork,
         );
         let sequence = (phases.iter().flat_map(|p| p.stretches()))
-            .map(|(from, modes)| Stretch { from, modes })
+            .map(|(from, set)| Stretch { from, set })
             .collect();
         out.labels.insert(
             "contact_end_contact_modes".into(),

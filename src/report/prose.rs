@@ -4,9 +4,12 @@
 //! value ([`note`]). Results carry only names and numbers; the words
 //! are all here.
 
+use std::fmt;
+
 use crate::results::{
-    Check, CheckKind, CheckPhase, CheckSubject, EndCause, Halt, Held, LabelValue, Meaning, Note,
-    Sensitivity, SensitivityGap, TapeReason, Unlanded, UntilNote, Zeno, format_number,
+    Check, CheckKind, CheckPhase, CheckSubject, ContactSet, EndCause, Halt, Held, Holding,
+    Indeterminacy, LabelValue, Meaning, Mode, Note, Sensitivity, SensitivityGap, Sign, TapeReason,
+    Unlanded, UntilNote, Zeno, format_number,
 };
 
 /// Where a check ran, as the table's group heading and results.json's `phase` name it:
@@ -27,7 +30,7 @@ pub fn label(value: &LabelValue) -> String {
     match value {
         LabelValue::Cause(cause) => cause_keyword(*cause).into(),
         LabelValue::Stretches(stretches) => (stretches.iter())
-            .map(|s| format!("{} from t = {} s", s.modes, format_number(s.from, 6)))
+            .map(|s| format!("{} from t = {} s", s.set, format_number(s.from, 6)))
             .collect::<Vec<_>>()
             .join("; "),
     }
@@ -220,6 +223,118 @@ pub fn event_words(end: EndCause) -> String {
     }
 }
 
+/// `slides +`, `slides -` or `sticks`.
+impl fmt::Display for Mode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Mode::Slide(Sign::Plus) => "slides +",
+            Mode::Slide(Sign::Minus) => "slides -",
+            Mode::Stick => "sticks",
+        })
+    }
+}
+
+/// `contact_force, floor_normal closed; floor_friction sticks` (`nothing closed` when no
+/// contact is).
+impl fmt::Display for ContactSet {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.closed.is_empty() {
+            f.write_str("nothing closed")?;
+        } else {
+            write!(f, "{} closed", self.closed.join(", "))?;
+        }
+        for (k, (name, mode)) in self.frictions.iter().enumerate() {
+            write!(f, "{}{name} {mode}", if k == 0 { "; " } else { ", " })?;
+        }
+        Ok(())
+    }
+}
+
+/// How supports hold a system at rest, before the set that holds it: `redundantly, with`,
+/// `with` or `in equilibrium, with`.
+impl fmt::Display for Holding {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Holding::Redundantly => "redundantly, with",
+            Holding::Pinned => "with",
+            Holding::InEquilibrium => "in equilibrium, with",
+        })
+    }
+}
+
+/// Why no single set was decided, in words (the message of `SolveError::Indeterminate`).
+impl fmt::Display for Indeterminacy {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let sets = |sets: &[ContactSet], sep: &str| {
+            (sets.iter().map(ContactSet::to_string))
+                .collect::<Vec<_>>()
+                .join(sep)
+        };
+        match self {
+            Indeterminacy::TooManyCombinations { limit } => {
+                write!(f, "more than {limit} combinations of contact states to try")
+            }
+            Indeterminacy::NoneConsistent { singular } => {
+                f.write_str(
+                    "no set of closed contacts and friction modes is consistent: a contact would \
+                     have to pull, or sticking needs more than mu N while no sliding direction \
+                     accelerates the slip (Painlevé's inconsistency)",
+                )?;
+                if !singular.is_empty() {
+                    write!(
+                        f,
+                        "; the equations are singular with {}",
+                        sets(singular, "; with ")
+                    )?;
+                }
+                Ok(())
+            }
+            Indeterminacy::SeveralMotions { sets: found, of } => write!(
+                f,
+                "{} of {of} consistent sets of closed contacts and friction modes give different \
+                 motions ({}): rigid bodies with Coulomb friction do not determine the motion here \
+                 (Painlevé's indeterminacy)",
+                found.len(),
+                sets(found, "; ")
+            ),
+            Indeterminacy::PainleveSingularity { set, q, floor } => write!(
+                f,
+                "with {set} the sliding equations approach a singularity at q = {q:?} (their \
+                 determinant fell to {floor:e} of the frictionless one): the normal force stops \
+                 resisting the sliding (Painlevé's paradox), and rigid bodies with Coulomb \
+                 friction have no answer from here"
+            ),
+            Indeterminacy::RestSingular => f.write_str(
+                "the support rows pin every coordinate, yet their normal equations are singular: \
+                 whether the supports hold the system at rest is not decided",
+            ),
+            Indeterminacy::RestTooLarge { limit } => write!(
+                f,
+                "the redundant supports' forces form a family too large to search (more than \
+                 {limit} vertices): whether they hold the system at rest is not decided"
+            ),
+            Indeterminacy::ImpactTooManyContacts { limit } => {
+                write!(f, "more than {limit} contacts take part in one impact")
+            }
+            Indeterminacy::ImpactNoImpulses => f.write_str(
+                "no set of impulses satisfies Newton's law and Coulomb's friction cone with the \
+                 contacts pushing",
+            ),
+            Indeterminacy::ImpactSeveral { count } => write!(
+                f,
+                "{count} sets of impulses satisfy Newton's law and Coulomb's friction cone with \
+                 different velocities after"
+            ),
+            Indeterminacy::ZenoOutsideContact => f.write_str(
+                "a converging sequence of impacts ends while a contact outside it takes part",
+            ),
+            Indeterminacy::ZenoCannotHold => f.write_str(
+                "the contacts of a converging sequence cannot all be held closed at once",
+            ),
+        }
+    }
+}
+
 /// Why the motion was halted.
 pub fn halt_words(halt: &Halt) -> String {
     match halt {
@@ -233,8 +348,8 @@ pub fn halt_words(halt: &Halt) -> String {
             "the run stopped at its impact number {number} at t = {t} s: the bounces neither \
              came to rest nor converged"
         ),
-        Halt::AtRest { t, how } => format!(
-            "the system comes to rest at the impact at t = {} s, held {how}, and stays so",
+        Halt::AtRest { t, held, set } => format!(
+            "the system comes to rest at the impact at t = {} s, held {held} {set}, and stays so",
             format_number(*t, 9)
         ),
     }

@@ -126,7 +126,8 @@ fn label_cell(value: &LabelValue, layout: &Layout) -> String {
         LabelValue::Stretches(stretches)
             if !layout.verbose && stretches.len() > MAX_STRETCHES_LISTED =>
         {
-            let modes: Vec<&str> = stretches.iter().map(|s| s.modes.as_str()).collect();
+            let sets: Vec<String> = stretches.iter().map(|s| s.set.to_string()).collect();
+            let modes: Vec<&str> = sets.iter().map(String::as_str).collect();
             let budget = layout.width.map(|w| 3 * w.saturating_sub(40).max(20));
             format!(
                 "{} ({} stretches; --verbose: when each began)",

@@ -6,11 +6,13 @@ use crate::quantity::Quantity;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
+mod decisions;
 mod drawing;
 mod ends;
 mod meanings;
 mod notes;
 
+pub use decisions::{ContactSet, Holding, Indeterminacy, Mode, Sign};
 pub use drawing::{Drawing, DrawnPhase, DrawnSample, Pose};
 pub use ends::{ContactId, EndCause};
 pub use meanings::Meaning;
@@ -52,8 +54,8 @@ pub enum LabelValue {
 pub struct Stretch {
     /// Its start (s from release).
     pub from: f64,
-    /// Its closed contacts and friction modes, in words.
-    pub modes: String,
+    /// Its closed contacts and friction modes.
+    pub set: ContactSet,
 }
 
 /// One column of a series.

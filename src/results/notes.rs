@@ -2,7 +2,7 @@
 //! value and how the motion was followed, each a [`Note`] of names, keywords and numbers
 //! (`report::prose` writes the sentence).
 
-use super::EndCause;
+use super::{ContactSet, EndCause, Holding};
 
 /// Why the motion stopped before its end (the solver's halt).
 #[derive(Debug, Clone, PartialEq)]
@@ -26,8 +26,10 @@ pub enum Halt {
     AtRest {
         /// When (s from release).
         t: f64,
-        /// The supports that hold it, as the solver names them.
-        how: String,
+        /// How the supports hold it.
+        held: Holding,
+        /// The supports that hold it.
+        set: ContactSet,
     },
 }
 

@@ -40,6 +40,7 @@ pub(crate) fn uniform(mut state: u64) -> impl FnMut() -> f64 {
     }
 }
 
+use crate::results::{ContactSet, Holding, Indeterminacy};
 use crate::system::SystemError;
 
 /// Everything that can go wrong while solving a validated [`System`](crate::system::System).
@@ -213,16 +214,16 @@ pub enum SolveError {
     },
     /// No single consistent set of closed contacts and friction modes (a contact that would
     /// have to pull, Painlevé's paradox of friction, or several sets with different motions).
-    #[error("model `{model}` at t = {t:e} s ({contacts}): {why}")]
+    #[error("model `{model}` at t = {t:e} s ({}): {why}", contacts.join(", "))]
     Indeterminate {
         /// Model name.
         model: &'static str,
         /// Time from release.
         t: f64,
-        /// The contacts concerned, comma-separated.
-        contacts: String,
-        /// What was found.
-        why: String,
+        /// The contacts and frictions concerned.
+        contacts: Vec<&'static str>,
+        /// What was found (its words: `report::prose`), boxed to keep the error small.
+        why: Box<Indeterminacy>,
     },
     /// The reduced angle reaches its end angle with the body above the floor.
     #[error(
@@ -254,15 +255,17 @@ pub enum SolveError {
     },
     /// The supports hold the system at rest: nothing moves, so no contact ends.
     #[error(
-        "model `{model}` at t = {t:e} s: the system stays at rest, held {how} (each within its law: contacts push, stuck frictions within mu N); nothing moves from here, so no contact ends and there is no motion to report"
+        "model `{model}` at t = {t:e} s: the system stays at rest, held {held} {set} (each within its law: contacts push, stuck frictions within mu N); nothing moves from here, so no contact ends and there is no motion to report"
     )]
     AtRest {
         /// Model name.
         model: &'static str,
         /// Time from release (s).
         t: f64,
-        /// The supports that hold it, in words.
-        how: String,
+        /// How the supports hold it (its words: `report::prose`).
+        held: Holding,
+        /// The supports that hold it.
+        set: ContactSet,
     },
     /// Bodies that overlap where a phase starts (a gap below zero).
     #[error(
@@ -297,15 +300,16 @@ pub enum SolveError {
     /// An impact whose impulses would create kinetic energy (Newton's law of restitution
     /// with friction can, for some geometries): the law does not describe it.
     #[error(
-        "model `{model}` at t = {t:e} s ({contacts}): the impulses of Newton's law of restitution with Coulomb friction would create {gained:e} J of kinetic energy (of {kinetic:e} J before the impact), so this law does not describe the impact; rodcube stops rather than continue with it"
+        "model `{model}` at t = {t:e} s ({}): the impulses of Newton's law of restitution with Coulomb friction would create {gained:e} J of kinetic energy (of {kinetic:e} J before the impact), so this law does not describe the impact; rodcube stops rather than continue with it",
+        contacts.join(", ")
     )]
     ImpactGainsEnergy {
         /// Model name.
         model: &'static str,
         /// Time from release (s).
         t: f64,
-        /// The contacts taking part, comma-separated.
-        contacts: String,
+        /// The contacts taking part.
+        contacts: Vec<&'static str>,
         /// The kinetic energy the impulses would create (J).
         gained: f64,
         /// The kinetic energy before the impact (J).
@@ -326,15 +330,15 @@ pub enum SolveError {
     /// The closed contacts' constraints and the mass matrix form a singular system
     /// (contacts that are redundant, or a mass matrix that is not invertible).
     #[error(
-        "model `{model}` at t = {t:e} s: the equations with {closed} closed are singular at q = {q:?} (redundant contacts, or a singular mass matrix)"
+        "model `{model}` at t = {t:e} s: the equations with {closed} are singular at q = {q:?} (redundant contacts, or a singular mass matrix)"
     )]
     SingularContacts {
         /// Model name.
         model: &'static str,
         /// Time.
         t: f64,
-        /// The closed contacts, comma-separated.
-        closed: String,
+        /// The closed contacts and friction modes.
+        closed: ContactSet,
         /// Coordinates.
         q: Vec<f64>,
     },

@@ -25,6 +25,7 @@
 //! whose derivative is the saltation of the sensitivities.
 
 use crate::model::ModelInfo;
+use crate::results::Indeterminacy;
 use crate::solve::SolveError;
 use crate::solve::integrated::contacts::{
     Active, ContactOption, FrictionOption, Mode, Options, Sign, combinations,
@@ -164,17 +165,17 @@ pub fn resolve_with(
     let taking: Vec<usize> = (0..parts.len())
         .filter(|&i| parts[i] != Part::None)
         .collect();
-    let indeterminate = |why: String| SolveError::Indeterminate {
+    let indeterminate = |why: Indeterminacy| SolveError::Indeterminate {
         model: info.name,
         t,
         contacts: names(info, &taking),
-        why,
+        why: Box::new(why),
     };
     let unilateral = parts.iter().filter(|p| **p == Part::Unilateral).count();
     if unilateral > MAX_IMPACT_CONTACTS {
-        return Err(indeterminate(format!(
-            "more than {MAX_IMPACT_CONTACTS} contacts take part in one impact"
-        )));
+        return Err(indeterminate(Indeterminacy::ImpactTooManyContacts {
+            limit: MAX_IMPACT_CONTACTS,
+        }));
     }
     let mut found: Vec<Solution> = Vec::new();
     for active in combinations(sys, &problem.options(), t)? {
@@ -192,9 +193,7 @@ pub fn resolve_with(
             .count()
     };
     let Some(best) = (0..found.len()).max_by_key(|&k| (stuck(&found[k]), usize::MAX - k)) else {
-        return Err(indeterminate(
-            "no set of impulses satisfies Newton's law and Coulomb's friction cone with the contacts pushing".into(),
-        ));
+        return Err(indeterminate(Indeterminacy::ImpactNoImpulses));
     };
     let chosen = found.swap_remove(best);
     let scale = chosen.qd.iter().fold(problem.speed, |a, v| a.max(v.abs()));
@@ -202,10 +201,9 @@ pub fn resolve_with(
         (s.qd.iter().zip(chosen.qd.iter())).any(|(a, b)| (a - b).abs() > IMPACT_TOLERANCE * scale)
     };
     if found.iter().any(differ) {
-        return Err(indeterminate(format!(
-            "{} sets of impulses satisfy Newton's law and Coulomb's friction cone with different velocities after",
-            found.len() + 1
-        )));
+        return Err(indeterminate(Indeterminacy::ImpactSeveral {
+            count: found.len() + 1,
+        }));
     }
     problem.impact(sys, state, chosen, t, &taking)
 }
@@ -232,16 +230,14 @@ pub fn close_sequence(
     let taking: Vec<usize> = (0..parts.len())
         .filter(|&i| parts[i] != Part::None)
         .collect();
-    let indeterminate = |why: &str| SolveError::Indeterminate {
+    let indeterminate = |why: Indeterminacy| SolveError::Indeterminate {
         model: info.name,
         t,
         contacts: names(info, &taking),
-        why: why.into(),
+        why: Box::new(why),
     };
     if parts.contains(&Part::Unilateral) {
-        return Err(indeterminate(
-            "a converging sequence of impacts ends while a contact outside it takes part",
-        ));
+        return Err(indeterminate(Indeterminacy::ZenoOutsideContact));
     }
     let law = |j: usize| frictions.get(j).copied().unwrap_or(FrictionLaw::Out);
     // A friction that did not act takes no impulse: it `slides` under a coefficient of zero.
@@ -261,9 +257,8 @@ pub fn close_sequence(
         closed: parts.iter().map(|p| *p == Part::Bilateral).collect(),
         modes,
     };
-    let mut solution = (problem.solve(active)).ok_or_else(|| {
-        indeterminate("the contacts of a converging sequence cannot all be held closed at once")
-    })?;
+    let mut solution =
+        (problem.solve(active)).ok_or_else(|| indeterminate(Indeterminacy::ZenoCannotHold))?;
     // Held closed with no way left to move, the system is at rest but for the rounding of the
     // solve: at rest exactly (so that the contacts decided after see no motion).
     let before = problem.qd.iter().fold(problem.speed, |a, v| a.max(v.abs()));
@@ -280,11 +275,10 @@ pub fn close_sequence(
 }
 
 /// The contacts `idx` by name, comma-separated.
-fn names(info: &ModelInfo, idx: &[usize]) -> String {
+fn names(info: &ModelInfo, idx: &[usize]) -> Vec<&'static str> {
     (idx.iter().filter_map(|&i| info.contacts.get(i)))
         .map(|c| c.name)
-        .collect::<Vec<_>>()
-        .join(", ")
+        .collect()
 }
 
 impl<'a> Problem<'a> {

@@ -9,6 +9,7 @@
 //! vertices.
 
 use crate::model::ModelInfo;
+use crate::results::Indeterminacy;
 use crate::solve::SolveError;
 use crate::solve::integrated::active::{Active, DECIDE_TOLERANCE, Mode, check_active};
 use crate::system::{Bound, State};
@@ -104,22 +105,18 @@ pub fn holds(
     let g = stacked(sys, state, &kkt, &acting)?;
     let (_, rhs) = sys.equations(state)?;
     let q = DVector::from_vec(rhs);
-    let undecided = |why: String| SolveError::Indeterminate {
+    let undecided = |why: Indeterminacy| SolveError::Indeterminate {
         model: info.name,
         t,
-        contacts: active.describe(info),
-        why,
+        contacts: active.closed_names(info),
+        why: Box::new(why),
     };
     // Least-norm particular solution y = G (G^T G)^-1 (-Q) and the null space of G^T. `pins`
     // found G of full column rank, so G^T G is regular unless rounding made it exactly
     // singular.
     let gtg = g.transpose() * &g;
     let Some(w) = gtg.lu().solve(&(-&q)) else {
-        return Err(undecided(
-            "the support rows pin every coordinate, yet their normal equations are singular: \
-             whether the supports hold the system at rest is not decided"
-                .into(),
-        ));
+        return Err(undecided(Indeterminacy::RestSingular));
     };
     let particular = &g * w;
     let null = null_space(&g.transpose());
@@ -135,10 +132,9 @@ pub fn holds(
         Search::Found(y) => y,
         Search::Infeasible => return Ok(None),
         Search::TooLarge => {
-            return Err(undecided(format!(
-                "the redundant supports' forces form a family too large to search (more than \
-                 {MAX_VERTICES} vertices): whether they hold the system at rest is not decided"
-            )));
+            return Err(undecided(Indeterminacy::RestTooLarge {
+                limit: MAX_VERTICES,
+            }));
         }
     };
     let mut forces = vec![0.0; info.contacts.len()];

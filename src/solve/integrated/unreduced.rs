@@ -35,7 +35,7 @@
 
 use crate::model::GapKind;
 use crate::results::Work;
-use crate::results::{ContactId, EndCause};
+use crate::results::{ContactId, ContactSet, EndCause};
 use crate::solve::SolveError;
 use crate::solve::integrated::contacts::{
     self, Active, ContactOption, DECIDE_TOLERANCE, Dynamics, DynamicsWork, FrictionOption, Mode,
@@ -243,9 +243,9 @@ impl UnreducedRun {
             .collect()
     }
 
-    /// When each segment started, with its active set described.
-    pub fn switches<'a>(&'a self, sys: &'a Bound) -> impl Iterator<Item = (f64, String)> + 'a {
-        (self.segments.iter()).map(move |s| (s.t_start, s.active.describe(sys.info())))
+    /// When each segment started, with its active set by name.
+    pub fn switches<'a>(&'a self, sys: &'a Bound) -> impl Iterator<Item = (f64, ContactSet)> + 'a {
+        (self.segments.iter()).map(move |s| (s.t_start, s.active.set(sys.info())))
     }
 
     /// Every step taken (accepted, rejected and event trials).

@@ -2,7 +2,7 @@
 //! integrated ([`IntegratedRun`]), and what both answer: times, end, end state, closed contacts.
 
 use super::reduced::ReducedRun;
-use crate::results::EndCause;
+use crate::results::{ContactSet, EndCause};
 use crate::solve::SolveError;
 use crate::solve::integrated::contacts::Active;
 use crate::solve::integrated::unreduced::UnreducedRun;
@@ -147,12 +147,12 @@ impl<'m> PhaseRun<'m> {
     }
 
     /// The active sets over the phase: each stretch's start (s from release) and its closed
-    /// contacts and friction modes in words.
-    pub fn stretches(&self) -> Vec<(f64, String)> {
+    /// contacts and friction modes.
+    pub fn stretches(&self) -> Vec<(f64, ContactSet)> {
         match self {
             PhaseRun::Reduced(r) => {
                 let info = r.system.info();
-                vec![(r.t_start, Active::of_model(info).describe(info))]
+                vec![(r.t_start, Active::of_model(info).set(info))]
             }
             PhaseRun::Integrated(r) => (r.run)
                 .switches(&r.bound)

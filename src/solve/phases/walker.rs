@@ -474,9 +474,9 @@ impl<'m> Walker<'m> {
             Ok(start) => Ok(Some(start)),
             // An impact that leaves the system at rest ends its motion.
             // At the accumulation time where the impact closed a converging sequence.
-            Err(SolveError::AtRest { t, how, .. }) => {
+            Err(SolveError::AtRest { t, held, set, .. }) => {
                 let t = (motion.impacts.last()).map_or(t, |i| i.zeno.unwrap_or(t));
-                motion.halted = Some(Halt::AtRest { t, how });
+                motion.halted = Some(Halt::AtRest { t, held, set });
                 Ok(None)
             }
             Err(e) => Err(e),

@@ -2,12 +2,13 @@
 //! slide: the options at a state, every combination of them, and the choice among the
 //! consistent ones.
 
-use super::dynamics::{Dynamics, DynamicsWork, Rows, closed_list, dynamics, solve_filled};
+use super::dynamics::{Dynamics, DynamicsWork, Rows, dynamics, solve_filled};
 use super::{
     Active, DECIDE_TOLERANCE, MAX_COMBINATIONS, Mode, PAINLEVE_FLOOR, REST, STICK_ROUNDING, Sign,
     check_active,
 };
 use crate::model::ModelInfo;
+use crate::results::{ContactSet, Holding, Indeterminacy};
 use crate::solve::SolveError;
 use crate::solve::integrated::rest;
 use crate::system::{Bound, State};
@@ -279,13 +280,11 @@ pub fn combinations(sys: &Bound, options: &Options, t: f64) -> Result<Vec<Active
         .ok_or_else(|| SolveError::Indeterminate {
             model: info.name,
             t,
-            contacts: info
-                .contacts
-                .iter()
-                .map(|c| c.name)
-                .collect::<Vec<_>>()
-                .join(", "),
-            why: format!("more than {MAX_COMBINATIONS} combinations of contact states to try"),
+            contacts: info.contacts.iter().map(|c| c.name).collect(),
+            why: Indeterminacy::TooManyCombinations {
+                limit: MAX_COMBINATIONS,
+            }
+            .into(),
         })?;
     let mut out: Vec<Active> = Vec::new();
     // The canonical form of each set kept, made once (comparing against forms made again for
@@ -341,7 +340,7 @@ pub fn decide(sys: &Bound, state: &State, options: &Options, t: f64) -> Result<A
         });
     }
     let mut found: Vec<(Active, Dynamics)> = Vec::new();
-    let mut singular: Vec<String> = Vec::new();
+    let mut singular: Vec<ContactSet> = Vec::new();
     // The model's matrices at the state, and its inverse mass matrix once one is needed, are
     // shared by every set tried.
     let mut work = DynamicsWork::default();
@@ -356,14 +355,14 @@ pub fn decide(sys: &Bound, state: &State, options: &Options, t: f64) -> Result<A
             Err(SolveError::SingularContacts { .. })
                 if rest::holds(sys, state, &active, t)?.is_some() =>
             {
-                return Err(at_rest(info, &active, t, "redundantly, with"));
+                return Err(at_rest(info, &active, t, Holding::Redundantly));
             }
             // Other singular sets (Painlevé's singularity exactly, or redundant contacts that
             // cannot hold) are not a motion; the error says so if no set is. Nothing is lost
             // where another set is consistent: a set whose rows are redundant describes the
             // motion of a smaller set (one redundant row left open), which is tried on its own.
             Err(SolveError::SingularContacts { .. }) => {
-                singular.push(active.describe(info));
+                singular.push(active.set(info));
                 continue;
             }
             Err(e) => return Err(e),
@@ -379,12 +378,12 @@ pub fn decide(sys: &Bound, state: &State, options: &Options, t: f64) -> Result<A
             found.push((active, d.clone()));
         }
     }
-    let active = pick(info, options, found, &singular, t)?;
+    let active = pick(info, options, found, singular, t)?;
     if rest::pins(sys, state, &active)? {
-        return Err(at_rest(info, &active, t, "with"));
+        return Err(at_rest(info, &active, t, Holding::Pinned));
     }
     if in_equilibrium(sys, state, &active, t)? {
-        return Err(at_rest(info, &active, t, "in equilibrium, with"));
+        return Err(at_rest(info, &active, t, Holding::InEquilibrium));
     }
     Ok(active)
 }
@@ -492,11 +491,12 @@ fn in_equilibrium(sys: &Bound, state: &State, active: &Active, t: f64) -> Result
 }
 
 /// The outcome of a system its supports hold at rest.
-fn at_rest(info: &ModelInfo, active: &Active, t: f64, how: &str) -> SolveError {
+fn at_rest(info: &ModelInfo, active: &Active, t: f64, held: Holding) -> SolveError {
     SolveError::AtRest {
         model: info.name,
         t,
-        how: format!("{how} {}", active.describe(info)),
+        held,
+        set: active.set(info),
     }
 }
 
@@ -505,16 +505,15 @@ fn pick(
     info: &ModelInfo,
     options: &Options,
     mut found: Vec<(Active, Dynamics)>,
-    singular: &[String],
+    singular: Vec<ContactSet>,
     t: f64,
 ) -> Result<Active, SolveError> {
     let concerned = || {
-        let names: Vec<&str> = (info.contacts.iter().zip(&options.contacts))
+        (info.contacts.iter().zip(&options.contacts))
             .filter(|(_, o)| !matches!(o, ContactOption::Keep(false)))
             .map(|(c, _)| c.name)
             .chain(info.frictions.iter().map(|f| f.name))
-            .collect();
-        names.join(", ")
+            .collect()
     };
     let stuck = |a: &Active| {
         (0..a.modes.len())
@@ -529,19 +528,7 @@ fn pick(
             model: info.name,
             t,
             contacts: concerned(),
-            why: format!(
-                "no set of closed contacts and friction modes is consistent: a contact would \
-                 have to pull, or sticking needs more than mu N while no sliding direction \
-                 accelerates the slip (Painlevé's inconsistency){}",
-                if singular.is_empty() {
-                    String::new()
-                } else {
-                    format!(
-                        "; the equations are singular with {}",
-                        singular.join("; with ")
-                    )
-                }
-            ),
+            why: Indeterminacy::NoneConsistent { singular }.into(),
         });
     };
     let scale = d0
@@ -563,17 +550,11 @@ fn pick(
         model: info.name,
         t,
         contacts: concerned(),
-        why: format!(
-            "{} of {all} consistent sets of closed contacts and friction modes give different \
-             motions ({}): rigid bodies with Coulomb friction do not determine the motion here \
-             (Painlevé's indeterminacy)",
-            found.len(),
-            found
-                .iter()
-                .map(|(a, _)| a.describe(info))
-                .collect::<Vec<_>>()
-                .join("; ")
-        ),
+        why: Indeterminacy::SeveralMotions {
+            sets: found.iter().map(|(a, _)| a.set(info)).collect(),
+            of: all,
+        }
+        .into(),
     })
 }
 
@@ -583,14 +564,12 @@ pub fn painleve_error(sys: &Bound, state: &State, active: &Active, t: f64) -> So
     SolveError::Indeterminate {
         model: info.name,
         t,
-        contacts: closed_list(info, &active.closed),
-        why: format!(
-            "with {} the sliding equations approach a singularity at q = {:?} (their \
-             determinant fell to {PAINLEVE_FLOOR:e} of the frictionless one): the normal force \
-             stops resisting the sliding (Painlevé's paradox), and rigid bodies with Coulomb \
-             friction have no answer from here",
-            active.describe(info),
-            state.q
-        ),
+        contacts: active.closed_names(info),
+        why: Indeterminacy::PainleveSingularity {
+            set: active.set(info),
+            q: state.q.clone(),
+            floor: PAINLEVE_FLOOR,
+        }
+        .into(),
     }
 }

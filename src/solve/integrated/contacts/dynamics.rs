@@ -73,19 +73,6 @@ impl Rows {
     }
 }
 
-/// The names of the closed contacts, for messages.
-pub(super) fn closed_list(info: &ModelInfo, closed: &[bool]) -> String {
-    let names: Vec<&str> = (info.contacts.iter().zip(closed))
-        .filter(|(_, c)| **c)
-        .map(|(c, _)| c.name)
-        .collect();
-    if names.is_empty() {
-        "no contact".into()
-    } else {
-        names.join(", ")
-    }
-}
-
 /// Solves for the accelerations, the contacts' forces and the friction forces at `state` in
 /// the active set `active`. `t` (from release) labels errors.
 pub fn dynamics(
@@ -222,7 +209,7 @@ pub fn tangent_into(
             SolveError::SingularContacts {
                 model: info.name,
                 t,
-                closed: closed_list(info, &active.closed),
+                closed: active.set(info),
                 q: state.q.clone(),
             }
         })?;
@@ -283,7 +270,7 @@ pub(super) fn solve_filled(
     let singular = || SolveError::SingularContacts {
         model: info.name,
         t,
-        closed: closed_list(info, &active.closed),
+        closed: active.set(info),
         q: state.q.clone(),
     };
     let det = linear::solve_in_place(&mut work.a, dim, &mut work.x).map_err(|_| singular())?;
