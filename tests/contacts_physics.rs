@@ -13,6 +13,7 @@ use common::hand::{
     cube_tipping_ratio, ladder_frictionless_separation, liftoff_floor_push, separation_sin,
     sin_drop, solve_linear,
 };
+use common::paper::PAPER_T_SEP;
 use rodcube::model::Model;
 use rodcube::models::{all, find};
 use rodcube::plan::{PlanError, Request, run};
@@ -23,10 +24,6 @@ use rodcube::solve::SolveError;
 use rodcube::solve::integrated::ode::Method;
 use rodcube::solve::phases::{Route, Walker};
 use rodcube::system::Bound;
-
-/// The paper's separation time (scenes/paper.yaml: m1 = 1, m2 = 3, ell = 1, a = 0.25,
-/// g = 9.81) to 15 digits, held to the 256-bit reference by `tests/hard_cases.rs`.
-const PAPER_T_SEP: f64 = 0.108493254170856;
 
 /// The paper's parameters (scenes/paper.yaml, scenes/liftoff.yaml).
 const PAPER: [(&str, f64); 5] = [

@@ -8,6 +8,9 @@
 //! consistent motion and says so, and a rod spun fast enough that the floor would have to pull
 //! lifts its foot.
 
+mod common;
+
+use common::paper::PAPER_T_SEP;
 use rodcube::model::Model;
 use rodcube::models::{all, find};
 use rodcube::plan::{Request, run};
@@ -21,10 +24,6 @@ use rodcube::solve::integrated::contacts::{
 use rodcube::solve::integrated::ode::Method;
 use rodcube::solve::phases::{PhaseRun, PhaseStart, Route, Walker};
 use rodcube::system::{Bound, State, SystemError};
-
-/// The paper's separation time (g = 9.81) to 15 digits, held to the 256-bit reference by
-/// `tests/hard_cases.rs` (`the_quoted_paper_separation_time_is_the_references`).
-const PAPER_T_SEP: f64 = 0.108493254170856;
 
 /// The active set of the contact phase: both contacts closed, the foot's friction in `mode`.
 fn both_closed(mode: &str) -> String {
@@ -386,7 +385,10 @@ fn a_sliding_foot_past_painleves_bound_has_no_consistent_motion() {
     assert_eq!(below.modes, [Mode::Slide(Sign::Minus)]);
     match decide_free_rod(1.1 * bound, &state) {
         Err(SolveError::Indeterminate { why, contacts, .. }) => {
-            assert!(matches!(*why, Indeterminacy::NoneConsistent { .. }), "{why}");
+            assert!(
+                matches!(*why, Indeterminacy::NoneConsistent { .. }),
+                "{why}"
+            );
             let words = why.to_string();
             assert!(words.contains("no set of closed contacts"), "{words}");
             assert!(words.contains("Painlevé"), "{words}");

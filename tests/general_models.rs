@@ -8,6 +8,7 @@
 
 mod common;
 
+use common::paper::PAPER_T_SEP;
 use rodcube::model::Model;
 use rodcube::models::find;
 use rodcube::plan::{Request, run};
@@ -16,10 +17,6 @@ use rodcube::results::RunResults;
 use rodcube::solve::integrated::contacts::{Active, dynamics};
 use rodcube::solve::phases::Route;
 use rodcube::system::{Bound, State};
-
-/// The paper's separation time (g = 9.81) to 15 digits, held to the 256-bit reference by
-/// `tests/hard_cases.rs` (`the_quoted_paper_separation_time_is_the_references`).
-const PAPER_T_SEP: f64 = 0.108493254170856;
 
 fn model(name: &str) -> &'static dyn Model {
     find(name).unwrap_or_else(|| panic!("{name} was not generated"))

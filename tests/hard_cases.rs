@@ -4,6 +4,9 @@
 //! finite, the limits of PHYSICS.md hold, the separation is monotonic in `n` and `a/ell`, energy
 //! is conserved to the tolerance asked, and `a >= ell` is a clear error.
 
+mod common;
+
+use common::paper::PAPER_T_SEP;
 use rodcube::model::Model;
 use rodcube::plan::{self, PlanError, Request};
 use rodcube::quantity::Quantity;
@@ -323,12 +326,11 @@ fn the_sweep_range_is_accurate_to_1e_13() {
 }
 
 /// The paper's separation time (`m1 = 1`, `m2 = 3`, `ell = 1`, `a = 0.25`, `g = 9.81`), to the
-/// 15 digits other tests quote as `PAPER_T_SEP` (`tests/general_models.rs`, `friction.rs`,
-/// `contacts_physics.rs`): here it is held to the 256-bit reference, which shares no code
-/// with the generated models, and to the paper's own 0.108 s.
+/// 15 digits the other tests quote as `common::paper::PAPER_T_SEP`: here it is held to the
+/// 256-bit reference, which shares no code with the generated models, and to the paper's own
+/// 0.108 s.
 #[test]
 fn the_quoted_paper_separation_time_is_the_references() {
-    const PAPER_T_SEP: f64 = 0.108493254170856;
     let inputs = Inputs {
         family: Family::RodCube,
         m1: 1.0,

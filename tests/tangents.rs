@@ -4,6 +4,10 @@
 //! constants again), at random parameters near each system's scene and random states near its
 //! initial state. Also: every general model has tangents, and no fast phase has them.
 
+mod common;
+
+use common::numbers::Uniform;
+
 use rodcube::model::{Model, TangentPoint};
 use rodcube::scene::Scene;
 use rodcube::system::Bound;
@@ -26,19 +30,6 @@ const UNSCENED: &[(&str, &[(&str, f64)])] = &[(
 /// Points of parameters, and states at each, per model.
 const POINTS: usize = 3;
 const STATES: usize = 3;
-
-/// xorshift64*: a deterministic, dependency-free generator of uniform numbers in `(lo, hi)`.
-struct Rng(u64);
-
-impl Rng {
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        let bits = self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11;
-        lo + (hi - lo) * ((bits as f64 + 0.5) / (1u64 << 53) as f64)
-    }
-}
 
 /// The parameters of each system's scene (the first scene of any of its models, by name), and
 /// those of [`UNSCENED`].
@@ -135,14 +126,18 @@ fn compare(what: &str, got: &[f64], want: &[Vec<f64>], values: &[f64], columns: 
 }
 
 /// A random parameter point near `base` that the model accepts.
-fn parameters<'m>(model: &'m dyn Model, base: &BTreeMap<String, f64>, rng: &mut Rng) -> Bound<'m> {
+fn parameters<'m>(
+    model: &'m dyn Model,
+    base: &BTreeMap<String, f64>,
+    rng: &mut Uniform,
+) -> Bound<'m> {
     let info = model.info();
     for _ in 0..100 {
         let p: Vec<f64> = (info.parameters.iter())
             .map(|p| {
                 let value = base.get(p.name).copied();
                 let value = value.unwrap_or_else(|| panic!("{}: no `{}`", info.name, p.name));
-                value * rng.uniform(0.95, 1.05)
+                value * rng.between(0.95, 1.05)
             })
             .collect();
         if let Ok(bound) = Bound::from_values(model, &p) {
@@ -153,7 +148,7 @@ fn parameters<'m>(model: &'m dyn Model, base: &BTreeMap<String, f64>, rng: &mut 
 }
 
 /// Checks `model`'s tangents and initial tangents at one parameter point.
-fn check_point(model: &dyn Model, bound: &Bound, rng: &mut Rng) {
+fn check_point(model: &dyn Model, bound: &Bound, rng: &mut Uniform) {
     let info = model.info();
     let (n, m, nf, np) = (
         info.coordinates.len(),
@@ -192,11 +187,11 @@ fn check_point(model: &dyn Model, bound: &Bound, rng: &mut Rng) {
     compare(&format!("{} initial", info.name), &got, &want, &values, np);
 
     for s in 0..STATES {
-        let q: Vec<f64> = q0.iter().map(|x| x + rng.uniform(-0.05, 0.05)).collect();
-        let qd: Vec<f64> = (0..n).map(|_| rng.uniform(-1.0, 1.0)).collect();
-        let qdd: Vec<f64> = (0..n).map(|_| rng.uniform(-5.0, 5.0)).collect();
-        let forces: Vec<f64> = (0..m).map(|_| rng.uniform(-10.0, 10.0)).collect();
-        let fr: Vec<f64> = (0..nf).map(|_| rng.uniform(-3.0, 3.0)).collect();
+        let q: Vec<f64> = q0.iter().map(|x| x + rng.between(-0.05, 0.05)).collect();
+        let qd: Vec<f64> = (0..n).map(|_| rng.between(-1.0, 1.0)).collect();
+        let qdd: Vec<f64> = (0..n).map(|_| rng.between(-5.0, 5.0)).collect();
+        let forces: Vec<f64> = (0..m).map(|_| rng.between(-10.0, 10.0)).collect();
+        let fr: Vec<f64> = (0..nf).map(|_| rng.between(-3.0, 3.0)).collect();
         let rows = Rows {
             model,
             qdd: &qdd,
@@ -249,7 +244,7 @@ fn every_general_model_has_tangents_and_no_fast_phase_has() {
 #[test]
 fn tangents_match_central_differences_of_the_models_functions() {
     let scenes = scene_parameters();
-    let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
+    let mut rng = Uniform(0x9E37_79B9_7F4A_7C15);
     let mut checked = 0;
     for model in rodcube::models::all()
         .iter()

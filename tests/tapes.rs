@@ -5,25 +5,10 @@
 mod common;
 
 use common::hand::Gauss;
+use common::numbers::Uniform;
 use rodcube::model::{Model, Reduction, TangentPoint};
 use rodcube::models;
 use rodcube::tape::{self, TapeError};
-
-/// A small deterministic generator (xorshift), so failures reproduce.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    fn vec(&mut self, n: usize, lo: f64, hi: f64) -> Vec<f64> {
-        (0..n).map(|_| lo + (hi - lo) * self.next()).collect()
-    }
-}
 
 fn same(a: &[f64], b: &[f64]) -> bool {
     a.len() == b.len()
@@ -42,7 +27,7 @@ fn both(name: &str, what: &str, len: usize, mut f: impl FnMut(bool, &mut [f64]))
     assert!(same(&a, &b), "{name}.{what}: compiled {a:?}\n tape {b:?}");
 }
 
-fn check_model(compiled: &dyn Model, taped: &dyn Model, rng: &mut Rng) {
+fn check_model(compiled: &dyn Model, taped: &dyn Model, rng: &mut Uniform) {
     let info = compiled.info();
     let name = info.name;
     assert_eq!(
@@ -161,7 +146,7 @@ fn check_reduction(
     taped: &dyn Reduction,
     p: &[f64],
     k: &[f64],
-    rng: &mut Rng,
+    rng: &mut Uniform,
     info: &rodcube::model::ModelInfo,
 ) {
     let pick = |tape: bool| if tape { taped } else { compiled };
@@ -220,7 +205,7 @@ fn check_reduction(
 
 #[test]
 fn every_compiled_model_and_its_tape_agree_to_the_bit_in_every_method() {
-    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    let mut rng = Uniform(0x9e37_79b9_7f4a_7c15);
     let mut checked = 0;
     for &compiled in models::compiled() {
         let name = compiled.info().name;
@@ -856,7 +841,7 @@ fn edited_tapes_are_refused_or_run_every_method_without_a_panic() {
     let paper = (compiled.iter())
         .position(|m| m.info().name == "rod_cube")
         .expect("rod_cube is compiled") as u8;
-    let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+    let mut rng = Uniform(0x2545_f491_4f6c_dd1d);
     let mut byte = move || (rng.next() * 256.0) as u8;
     let mut inputs = Vec::new();
     for (model, count) in std::iter::once((

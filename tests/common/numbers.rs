@@ -13,6 +13,16 @@ impl Uniform {
         (z ^ (z >> 31)) as f64 / 2f64.powi(64)
     }
 
+    /// A number uniform in `[lo, hi)`.
+    pub fn between(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.next()
+    }
+
+    /// `n` numbers uniform in `[lo, hi)`.
+    pub fn vec(&mut self, n: usize, lo: f64, hi: f64) -> Vec<f64> {
+        (0..n).map(|_| self.between(lo, hi)).collect()
+    }
+
     /// `10^x`, `x` uniform in `[lo, hi)`.
     pub fn log(&mut self, lo: f64, hi: f64) -> f64 {
         10f64.powf(lo + (hi - lo) * self.next())

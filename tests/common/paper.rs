@@ -10,6 +10,11 @@
 //! `theta_dot_sq_sc` recovers `delta` from the drops and calls `reduced`, an independent route
 //! that the tests compare with the generated one.
 
+/// The paper's separation time (`scenes/paper.yaml`: `m1 = 1`, `m2 = 3`, `ell = 1`, `a = 0.25`,
+/// `g = 9.81`) to 15 digits, held to the 256-bit reference and to the paper's 0.108 s by
+/// `tests/hard_cases.rs` (`the_quoted_paper_separation_time_is_the_references`).
+pub const PAPER_T_SEP: f64 = 0.108493254170856;
+
 use rodcube::model::{
     ContactInfo, GapKind, Model, ModelInfo, MonitorInfo, NamedInfo, ParamInfo, Partials, PhaseInfo,
     Reduced, Reduction, ReductionInfo, RequirementInfo, ShapeInfo, ShapeKind, Tangents,
