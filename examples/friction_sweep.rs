@@ -12,7 +12,7 @@ use rodcube::plan::{Request, run};
 use rodcube::quantity::Quantity::{SeparationAngle, SeparationTime};
 use rodcube::results::EndCause;
 use rodcube::results::Work;
-use rodcube::solve::phases::{PhaseRun, Route, Walker};
+use rodcube::solve::phases::{PhaseRun, Walker};
 use rodcube::system::Bound;
 use std::error::Error;
 use std::path::PathBuf;
@@ -41,15 +41,7 @@ fn solve(mu: f64) -> Result<Point, Box<dyn Error>> {
     let model = models::find("rod_cube_friction").ok_or("rod_cube_friction was not generated")?;
     let mut params = PAPER.to_vec();
     params.push(("mu", mu));
-    let walker = Walker {
-        general: Bound::new(model, &params)?,
-        registry: models::all(),
-        tol: 1e-12,
-        rtol: 1e-13,
-        route: Route::Fastest,
-        until: None,
-        dense_output: true,
-    };
+    let walker = Walker::new(Bound::new(model, &params)?, models::all(), 1e-12, 1e-13);
     // The contact phase: the first phase from release (the foot's friction acts, so the general
     // model is integrated with both contacts closed), to its first event.
     let (start, _) = walker.release()?;

@@ -796,15 +796,7 @@ fn the_solvers_refuse_a_state_of_another_length() {
                 "{name}: {r:?}"
             );
         }
-        let walker = Walker {
-            general: bound.clone(),
-            registry: rodcube::models::all(),
-            tol: 1e-10,
-            rtol: 1e-12,
-            route: Route::Fastest,
-            until: None,
-            dense_output: true,
-        };
+        let walker = Walker::new(bound.clone(), rodcube::models::all(), 1e-10, 1e-12);
         let start = PhaseStart {
             state: bad.clone(),
             active: active.clone(),

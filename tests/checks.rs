@@ -20,15 +20,13 @@ use rodcube::solve::series::{sample, sample_forces};
 use rodcube::system::{Bound, State, System, SystemError};
 
 fn walker(registry: &'static [&'static dyn Model], route: Route) -> Walker<'static> {
-    Walker {
-        general: Bound::new(&GENERAL, &paper(9.81)).unwrap(),
+    Walker::new(
+        Bound::new(&GENERAL, &paper(9.81)).unwrap(),
         registry,
-        tol: 1e-12,
-        rtol: 1e-12,
-        route,
-        until: None,
-        dense_output: true,
-    }
+        1e-12,
+        1e-12,
+    )
+    .with_route(route)
 }
 
 /// The release phase of the hand-typed system with `registry`'s release model.
@@ -132,15 +130,7 @@ fn energy_drift_is_judged_against_the_motion_not_a_constant_potential() {
     let mut p = paper(9.81);
     p[1].1 = 1e6;
     let sys = Bound::new(&ROD_CUBE, &p).unwrap();
-    let w = Walker {
-        general: Bound::new(&GENERAL, &p).unwrap(),
-        registry: MODELS,
-        tol: 1e-12,
-        rtol: 1e-12,
-        route: Route::Fastest,
-        until: None,
-        dense_output: true,
-    };
+    let w = Walker::new(Bound::new(&GENERAL, &p).unwrap(), MODELS, 1e-12, 1e-12);
     let (start, _) = w.release().unwrap();
     let phase = w.solve(&start, &mut Work::default()).unwrap();
     assert_eq!(phase.bound().info().name, sys.info().name);

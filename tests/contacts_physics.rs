@@ -109,15 +109,13 @@ fn contact(system: &str, name: &str) -> usize {
 }
 
 fn walker(name: &str, params: &[(&str, f64)], route: Route) -> Walker<'static> {
-    Walker {
-        general: Bound::new(model(name), params).unwrap(),
-        registry: all(),
-        tol: 1e-12,
-        rtol: 1e-13,
-        route,
-        until: None,
-        dense_output: true,
-    }
+    Walker::new(
+        Bound::new(model(name), params).unwrap(),
+        all(),
+        1e-12,
+        1e-13,
+    )
+    .with_route(route)
 }
 
 // =============================================================================================

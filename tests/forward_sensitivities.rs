@@ -233,15 +233,9 @@ fn a_contacts_end_after_the_first_phase_agrees_with_differences() {
 fn walker(model: &'static dyn rodcube::model::Model, p: &BTreeMap<String, f64>) -> Walker<'static> {
     let pairs: Vec<(&str, f64)> = p.iter().map(|(k, v)| (k.as_str(), *v)).collect();
     let general = Bound::new(model, &pairs).expect("valid parameters");
-    Walker {
-        general,
-        registry: models::all(),
-        tol: TOL,
-        rtol: TOL,
-        route: Route::Integrated,
-        until: None,
-        dense_output: false,
-    }
+    Walker::new(general, models::all(), TOL, TOL)
+        .with_route(Route::Integrated)
+        .with_dense_output(false)
 }
 
 /// The absolute times of the stick/slip switches inside the motion's phases.

@@ -22,7 +22,7 @@ use rodcube::solve::integrated::contacts::{
     Active, Mode, Moment, Options, Sign, contact_options, decide, dynamics, friction_options,
 };
 use rodcube::solve::integrated::ode::Method;
-use rodcube::solve::phases::{PhaseRun, PhaseStart, Route, Walker};
+use rodcube::solve::phases::{PhaseRun, PhaseStart, Walker};
 use rodcube::system::{Bound, State, SystemError};
 
 /// The active set of the contact phase: both contacts closed, the foot's friction in `mode`.
@@ -85,15 +85,12 @@ const SEPARATION: &[Quantity] = &[
 
 /// The walker of `rod_cube_friction` with the paper's rod and cube and friction `mu`.
 fn walker(mu: f64, tol: f64, rtol: f64) -> Walker<'static> {
-    Walker {
-        general: Bound::new(model("rod_cube_friction"), &paper(mu)).unwrap(),
-        registry: all(),
+    Walker::new(
+        Bound::new(model("rod_cube_friction"), &paper(mu)).unwrap(),
+        all(),
         tol,
         rtol,
-        route: Route::Fastest,
-        until: None,
-        dense_output: true,
-    }
+    )
 }
 
 /// The contact phase (both contacts closed from release) at friction `mu`, solved to its end.

@@ -30,15 +30,8 @@ const TH0: f64 = 1.2;
 fn strike() -> (Bound<'static>, State, f64) {
     let model = find("fixed_cylinder").unwrap();
     let params = [("m1", M), ("ell", ELL), ("R", R), ("th0", TH0), ("g", G)];
-    let w = Walker {
-        general: Bound::new(model, &params).unwrap(),
-        registry: all(),
-        tol: 1e-12,
-        rtol: 1e-13,
-        route: Route::Integrated,
-        until: None,
-        dense_output: true,
-    };
+    let w = Walker::new(Bound::new(model, &params).unwrap(), all(), 1e-12, 1e-13)
+        .with_route(Route::Integrated);
     let (start, opened) = w.release().unwrap();
     assert_eq!(opened, [0], "the cylinder opens at release");
     let run = w.integrate(&start, &mut Work::default()).unwrap();

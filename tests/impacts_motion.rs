@@ -17,7 +17,7 @@ use rodcube::plan::{self, PlanError, Request};
 use rodcube::quantity::Quantity;
 use rodcube::results::EndCause;
 use rodcube::results::Work;
-use rodcube::solve::phases::{MAX_IMPACTS, Motion, Route, Walker};
+use rodcube::solve::phases::{MAX_IMPACTS, Motion, Walker};
 use rodcube::system::Bound;
 
 const G: f64 = 9.81;
@@ -33,15 +33,13 @@ const PAPER: [(&str, f64); 5] = [
 fn liftoff_walker(e: f64, until: f64) -> Walker<'static> {
     let mut params = PAPER.to_vec();
     params.push(("e", e));
-    Walker {
-        general: Bound::new(find("rod_cube_liftoff").unwrap(), &params).unwrap(),
-        registry: all(),
-        tol: 1e-12,
-        rtol: 1e-13,
-        route: Route::Fastest,
-        until: Some(until),
-        dense_output: true,
-    }
+    Walker::new(
+        Bound::new(find("rod_cube_liftoff").unwrap(), &params).unwrap(),
+        all(),
+        1e-12,
+        1e-13,
+    )
+    .with_until(Some(until))
 }
 
 fn close(a: f64, b: f64, tol: f64, what: &str) {
@@ -202,15 +200,8 @@ fn the_rod_that_left_the_cylinder_strikes_it_again_and_goes_on() {
         ("th0", 1.2),
         ("g", G),
     ];
-    let walker = Walker {
-        general: Bound::new(model, &params).unwrap(),
-        registry: all(),
-        tol: 1e-12,
-        rtol: 1e-13,
-        route: Route::Fastest,
-        until: Some(1.0),
-        dense_output: true,
-    };
+    let walker =
+        Walker::new(Bound::new(model, &params).unwrap(), all(), 1e-12, 1e-13).with_until(Some(1.0));
     let motion = walker.motion(&mut Work::default()).unwrap();
     assert_eq!(
         motion.opened_at_release,
@@ -308,15 +299,13 @@ fn a_block_that_tipped_comes_down_on_its_near_edge_by_the_hand_impulse() {
         ("h", h),
         ("g", G),
     ];
-    let walker = Walker {
-        general: Bound::new(find("rod_block_tipping").unwrap(), &params).unwrap(),
-        registry: all(),
-        tol: 1e-12,
-        rtol: 1e-13,
-        route: Route::Fastest,
-        until: Some(0.6),
-        dense_output: true,
-    };
+    let walker = Walker::new(
+        Bound::new(find("rod_block_tipping").unwrap(), &params).unwrap(),
+        all(),
+        1e-12,
+        1e-13,
+    )
+    .with_until(Some(0.6));
     let motion = walker.motion(&mut Work::default()).unwrap();
     let info = walker.general.info();
     let index = |name: &str| info.contacts.iter().position(|c| c.name == name).unwrap();

@@ -18,7 +18,7 @@ use rodcube::results::Work;
 use rodcube::solve::SolveError;
 use rodcube::solve::fast::quadrature::TimeMesh;
 use rodcube::solve::fast::separation::{SeparationOutcome, edge, first_zero, force_zero};
-use rodcube::solve::phases::{PhaseRun, ReducedEnd, ReducedRun, Route, Walker};
+use rodcube::solve::phases::{PhaseRun, ReducedEnd, ReducedRun, Walker};
 use rodcube::solve::series::{PhaseSamples, sample_friction, theta_dot_at};
 use rodcube::system::{Bound, State, System, SystemError};
 use std::sync::OnceLock;
@@ -51,15 +51,7 @@ impl Model for MasslessCube {
 #[test]
 fn a_mass_matrix_without_an_inverse_is_an_error_not_a_guess() {
     let general = Bound::new(&MasslessCube, &paper(9.81)).unwrap();
-    let walker = Walker {
-        general,
-        registry: MODELS,
-        tol: 1e-10,
-        rtol: 1e-12,
-        route: Route::Fastest,
-        until: None,
-        dense_output: true,
-    };
+    let walker = Walker::new(general, MODELS, 1e-10, 1e-12);
     match walker.release() {
         Err(SolveError::SingularMassMatrix { t, q }) => {
             assert_eq!(t, 0.0);

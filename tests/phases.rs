@@ -17,15 +17,12 @@ use rodcube::solve::phases::{Motion, Route, Walker, phase_parameters};
 use rodcube::system::Bound;
 
 fn walker(registry: &'static [&'static dyn Model]) -> Walker<'static> {
-    Walker {
-        general: Bound::new(&GENERAL, &paper(9.81)).unwrap(),
+    Walker::new(
+        Bound::new(&GENERAL, &paper(9.81)).unwrap(),
         registry,
-        tol: 1e-13,
-        rtol: 1e-13,
-        route: Route::Fastest,
-        until: None,
-        dense_output: true,
-    }
+        1e-13,
+        1e-13,
+    )
 }
 
 fn paper_motion(work: &mut Work) -> Motion<'static> {
@@ -202,12 +199,10 @@ fn ode_agrees_on_the_free_phase() {
     let theta_dot = run.state_end.qd()[GENERAL.info().reduced_index.unwrap()];
     assert!(((theta_dot - fr.theta_dot_end().unwrap()) / fr.theta_dot_end().unwrap()).abs() < 1e-9);
     // The walker's own integrated route gives the same phase.
-    let integrated = Walker {
-        route: Route::Integrated,
-        until: None,
-        dense_output: true,
-        ..w.clone()
-    };
+    let integrated = (w.clone())
+        .with_route(Route::Integrated)
+        .with_until(None)
+        .with_dense_output(true);
     let next = integrated.after(&motion.phases[0]).unwrap();
     let phase = integrated.solve(&next, &mut Work::default()).unwrap();
     assert!(phase.reduced().is_none());
@@ -263,10 +258,7 @@ fn a_missing_phase_model_is_a_typed_error() {
 fn an_integrated_run_without_a_segment_has_no_closed_set() {
     // The integrator ends every run with a segment; one emptied by hand is refused, not read as
     // "no contact closed".
-    let w = Walker {
-        route: Route::Integrated,
-        ..walker(MODELS)
-    };
+    let w = walker(MODELS).with_route(Route::Integrated);
     let mut work = Work::default();
     let (release, _) = w.release().unwrap();
     let mut phase = w.solve(&release, &mut work).unwrap();

@@ -21,7 +21,7 @@ use rodcube::results::{Halt, Work, Zeno};
 use rodcube::solve::SolveError;
 use rodcube::solve::integrated::contacts::Sign;
 use rodcube::solve::integrated::impact::{ContactLaw, FrictionLaw, Part, resolve};
-use rodcube::solve::phases::{Motion, Route, Walker};
+use rodcube::solve::phases::{Motion, Walker};
 use rodcube::system::{Bound, State};
 
 const G: f64 = 9.81;
@@ -48,15 +48,9 @@ fn bound(mu: f64, e: f64) -> Bound<'static> {
 }
 
 fn walker(mu: f64, e: f64, until: f64) -> Walker<'static> {
-    Walker {
-        general: bound(mu, e),
-        registry: all(),
-        tol: 1e-12,
-        rtol: 1e-13,
-        route: Route::Fastest,
-        until: Some(until),
-        dense_output: false,
-    }
+    Walker::new(bound(mu, e), all(), 1e-12, 1e-13)
+        .with_until(Some(until))
+        .with_dense_output(false)
 }
 
 fn close(a: f64, b: f64, tol: f64, what: &str) {

@@ -82,15 +82,8 @@ fn series_agrees_with_the_ode_dense_output() {
         };
         // Absolute tolerances from the motion's own scales (the foot's height, held at zero,
         // carries only rounding).
-        let walker = Walker {
-            general: general.clone(),
-            registry: MODELS,
-            tol: 1e-13,
-            rtol: 1e-13,
-            route: Route::Integrated,
-            until: None,
-            dense_output: true,
-        };
+        let walker =
+            Walker::new(general.clone(), MODELS, 1e-13, 1e-13).with_route(Route::Integrated);
         let scales = walker.scales(&start.state, &start.active).unwrap();
         let run = integrate(
             &general,

@@ -139,15 +139,7 @@ fn walker(
     rtol: f64,
 ) -> Result<Walker<'static>, AccuracyError> {
     let general = Bound::new(model, m.parameters)?;
-    Ok(Walker {
-        general,
-        registry: crate::models::all(),
-        tol: REFERENCE_RTOL,
-        rtol,
-        route,
-        until: None,
-        dense_output: true,
-    })
+    Ok(Walker::new(general, crate::models::all(), REFERENCE_RTOL, rtol).with_route(route))
 }
 
 /// The end of the first contact's phase from release by `method` (its time, the steps and

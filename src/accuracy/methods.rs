@@ -228,15 +228,14 @@ pub fn sensitivities_forward(sys: &System, rtol: f64) -> Outcome<Vec<f64>> {
         system: info.system,
         name: info.system,
     })?;
-    let walker = Walker {
-        general: Bound::from_values(model, sys.p())?,
-        registry: crate::models::all(),
-        tol: rtol,
+    let walker = Walker::new(
+        Bound::from_values(model, sys.p())?,
+        crate::models::all(),
         rtol,
-        route: Route::Integrated,
-        until: None,
-        dense_output: false,
-    };
+        rtol,
+    )
+    .with_route(Route::Integrated)
+    .with_dense_output(false);
     let mut work = Work::default();
     let motion = walker.sensitive_motion(&mut work)?;
     let k = (motion.motion.phases.iter())

@@ -19,7 +19,7 @@ use crate::plan::{DEFAULT_TOLERANCE, ODE_RTOL_FACTOR, ODE_RTOL_FLOOR};
 use crate::report::prose;
 use crate::results::Work;
 use crate::solve::SolveError;
-use crate::solve::phases::{Motion, PhaseRun, Route, Walker};
+use crate::solve::phases::{Motion, PhaseRun, Walker};
 use crate::solve::series::{full_state_at, sample_at, sample_forces};
 use crate::system::{Bound, check_value};
 use std::ffi::{CStr, CString, c_char, c_int, c_uint, c_void};
@@ -150,15 +150,13 @@ impl Instance {
             }
             None => None,
         };
-        let walker = Walker {
+        let walker = Walker::new(
             general,
-            registry: self.registry,
-            tol: self.tolerance,
-            rtol: (self.tolerance * ODE_RTOL_FACTOR).max(ODE_RTOL_FLOOR),
-            route: Route::Fastest,
-            until,
-            dense_output: true,
-        };
+            self.registry,
+            self.tolerance,
+            (self.tolerance * ODE_RTOL_FACTOR).max(ODE_RTOL_FLOOR),
+        )
+        .with_until(until);
         let mut work = Work::default();
         let first = walker.release().and_then(|(start, opened)| {
             let run = walker.solve(&start, &mut work)?;

@@ -346,15 +346,15 @@ pub fn run(request: &Request) -> Result<RunResults, PlanError> {
         Parameters::Values(v) => Bound::from_values(request.model, v)?,
         Parameters::Named(v) => Bound::new(request.model, v)?,
     };
-    let walker = Walker {
-        general: bound,
-        registry: request.registry,
-        tol: request.tolerance,
-        rtol: (request.tolerance * ODE_RTOL_FACTOR).max(ODE_RTOL_FLOOR),
-        route: request.route,
-        until: request.until,
-        dense_output: want.iter().any(Quantity::samples_motion),
-    };
+    let walker = Walker::new(
+        bound,
+        request.registry,
+        request.tolerance,
+        (request.tolerance * ODE_RTOL_FACTOR).max(ODE_RTOL_FLOOR),
+    )
+    .with_route(request.route)
+    .with_until(request.until)
+    .with_dense_output(want.iter().any(Quantity::samples_motion));
     let mut plan = Plan::new(walker, request.samples);
     let mut out = RunResults {
         model: info.name.to_string(),

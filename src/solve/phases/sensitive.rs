@@ -105,11 +105,9 @@ impl<'m> Walker<'m> {
     /// ([`SensitiveMotion::stop`]) at an impact whose map has no derivatives, at a grazing
     /// event, or where a later phase fails.
     pub fn sensitive_motion(&self, work: &mut Work) -> Result<SensitiveMotion<'m>, SolveError> {
-        let walker = Walker {
-            route: Route::Integrated,
-            dense_output: false,
-            ..self.clone()
-        };
+        let walker = (self.clone())
+            .with_route(Route::Integrated)
+            .with_dense_output(false);
         let general = &walker.general;
         let (mut start, opened) = walker.release()?;
         let mut s = Forward::new(general)?.initial(general)?;

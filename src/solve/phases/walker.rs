@@ -121,6 +121,46 @@ pub struct PhaseStart {
 }
 
 impl<'m> Walker<'m> {
+    /// A walker of `general`'s system, its fast phases looked up in `registry`, the quadrature
+    /// at `tol` and the integrator at `rtol`: on the fastest route, to the first event that ends
+    /// the motion (no `until`), keeping every integrated step's continuous extension. The
+    /// `with_*` methods change one setting each.
+    pub fn new(
+        general: Bound<'m>,
+        registry: &'m [&'m dyn Model],
+        tol: f64,
+        rtol: f64,
+    ) -> Walker<'m> {
+        Walker {
+            general,
+            registry,
+            tol,
+            rtol,
+            route: Route::Fastest,
+            until: None,
+            dense_output: true,
+        }
+    }
+
+    /// The same walker on `route`.
+    pub fn with_route(mut self, route: Route) -> Walker<'m> {
+        self.route = route;
+        self
+    }
+
+    /// The same walker going on to `until` (s from release) through impacts, or (`None`) to
+    /// the first event that ends the motion.
+    pub fn with_until(mut self, until: Option<f64>) -> Walker<'m> {
+        self.until = until;
+        self
+    }
+
+    /// The same walker keeping (or not) every integrated step's continuous extension.
+    pub fn with_dense_output(mut self, dense_output: bool) -> Walker<'m> {
+        self.dense_output = dense_output;
+        self
+    }
+
     /// The release: the system's initial state and the contacts that stay closed there (the
     /// acceleration-level complementarity problem), with those that touched but opened.
     pub fn release(&self) -> Result<(PhaseStart, Vec<usize>), SolveError> {
