@@ -441,8 +441,8 @@ struct Plan<'m> {
     work: Work,
     /// The release state and closed contacts, with the contacts that opened at once.
     release: Option<(PhaseStart, Vec<usize>)>,
-    /// The fast phase the motion starts on, where it has one.
-    fast: Option<Option<System<'m>>>,
+    /// The fast phase the motion starts on, once asked: where it has one.
+    fast: Asked<Option<System<'m>>>,
     /// Where that fast phase ends, by its roots alone.
     end: Option<ReducedEnd>,
     /// The motion, as far as it has been solved.
@@ -458,6 +458,14 @@ struct Plan<'m> {
     ode: Option<UnreducedRun>,
     /// The motion integrated with its forward sensitivities, or why there is none.
     sensitive: Option<Result<SensitiveMotion<'m>, SensitivityGap>>,
+}
+
+/// A question the plan answers once: not asked yet, or its answer (which may itself be "none").
+enum Asked<T> {
+    /// Not asked yet.
+    NotYet,
+    /// The answer.
+    Answered(T),
 }
 
 fn scalar(out: &mut RunResults, key: &str, value: f64, unit: &'static str, meaning: Meaning) {
@@ -486,7 +494,7 @@ impl<'m> Plan<'m> {
             samples,
             work: Work::default(),
             release: None,
-            fast: None,
+            fast: Asked::NotYet,
             end: None,
             motion: None,
             floor_mesh: None,
@@ -513,12 +521,12 @@ impl<'m> Plan<'m> {
 
     /// The fast phase the motion starts on, where the release's closed contacts have one.
     fn fast(&mut self) -> Result<Option<System<'m>>, SolveError> {
-        if let Some(fast) = &self.fast {
+        if let Asked::Answered(fast) = &self.fast {
             return Ok(fast.clone());
         }
         let start = self.release()?.0.clone();
         let fast = self.walker.fast_phase(&start)?;
-        self.fast = Some(fast.clone());
+        self.fast = Asked::Answered(fast.clone());
         Ok(fast)
     }
 

@@ -49,7 +49,7 @@ impl Plan<'_> {
         if !same {
             let note = Note::CrossCheckDisagrees {
                 integrated: ode.end,
-                fast: format!("{:?}", first.end.end),
+                fast: first.end.end,
             };
             out.notes.insert("cross_check".into(), note);
         }

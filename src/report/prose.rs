@@ -164,9 +164,10 @@ pub fn note(note: &Note) -> String {
         Note::Holds { contact, held } => format!("contact `{contact}` holds {}", held_words(held)),
         Note::OpenAtRelease { contact } => format!("contact `{contact}` is open at release"),
         Note::CrossCheckDisagrees { integrated, fast } => format!(
-            "the integrated route ended at {}, the fast path at {fast}: they disagree on the \
-             first event",
-            event_words(*integrated)
+            "the integrated route ended at {}, the fast path at {}: they disagree on the first \
+             event",
+            event_words(*integrated),
+            event_words(*fast)
         ),
         Note::NoLanding { t, path, end } => no_landing(*t, &path.join(" -> "), end),
         Note::FirstImpactEnds { t } => format!(

@@ -185,8 +185,8 @@ pub enum Note {
     CrossCheckDisagrees {
         /// The integrated route's event.
         integrated: EndCause,
-        /// The fast path's event, in the solver's debug form (`Force(0)`).
-        fast: String,
+        /// The fast path's event.
+        fast: EndCause,
     },
     /// The body did not land.
     NoLanding {
