@@ -574,14 +574,7 @@ fn a_light_cube_stays_pushed_by_a_nearly_flat_hinged_rod_on_a_stiff_spring() {
         None,
         "the hand push vanishes"
     );
-    let p = [
-        ("m1", m1),
-        ("m2", m2),
-        ("ell", ell),
-        ("a", a),
-        ("g", g),
-        ("k", k),
-    ];
+    let p = hand.parameters();
     let want = [Quantity::ContactEnd, Quantity::FloorImpact];
     let r = ask("hinged_rod_spring", &p, &want, 1e-10, Route::Fastest);
     assert!(
@@ -896,6 +889,18 @@ struct HingedSpring {
 }
 
 impl HingedSpring {
+    /// The model's parameters, as `hinged_rod_spring` names them.
+    fn parameters(&self) -> [(&'static str, f64); 6] {
+        [
+            ("m1", self.m1),
+            ("m2", self.m2),
+            ("ell", self.ell),
+            ("a", self.a),
+            ("g", self.g),
+            ("k", self.k),
+        ]
+    }
+
     fn theta0(&self) -> f64 {
         (self.a / self.ell).asin()
     }
@@ -1086,14 +1091,7 @@ fn a_low_rod_hands_its_light_cube_over_to_the_general_model() {
     };
     let th_sep = hand.first_zero(|t| hand.solve(t).1).expect("separates");
     let t_sep = hand.time_to(th_sep);
-    let p = [
-        ("m1", m1),
-        ("m2", m2),
-        ("ell", ell),
-        ("a", a),
-        ("g", g),
-        ("k", k),
-    ];
+    let p = hand.parameters();
     let want = [Quantity::ContactEnd, Quantity::FloorImpact];
     let r = ask("hinged_rod_spring", &p, &want, 1e-12, Route::Fastest);
     close(
