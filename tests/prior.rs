@@ -1,9 +1,9 @@
-//! The fall polynomial and the a-priori rule of the per-point solver (`rodcube::solve::fast::prior`):
-//! the generated `P(s) = (sin theta_i - s) / theta_dot^2` equals the ratio of the generated
-//! `theta_dot^2` and, for the paper's model, the ratio from eq. (9) typed by hand; the lean
-//! preparation fills the constants it lists exactly as the full one; and the a-priori rule
-//! agrees with the verified pair of rules, and with the 256-bit reference to 1e-15, across the
-//! hard-case ranges of every model that has a fall polynomial.
+//! The fall polynomial and the a-priori rule of the per-point solver
+//! (`rodcube::solve::fast::prior`): the generated `P(s) = (sin theta_i - s) / theta_dot^2` equals
+//! the ratio of the generated `theta_dot^2` and, for the paper's model, the ratio from eq. (9)
+//! typed by hand; the lean preparation fills the constants it lists exactly as the full one; and
+//! the a-priori rule agrees with the verified pair of rules, and with the 256-bit reference to
+//! 1e-15, across the hard-case ranges of every model that has a fall polynomial.
 
 mod common;
 

@@ -1,6 +1,6 @@
 //! Housner's rocking block (`rocking_block`) through its strikes, impacts with friction
-//! (`solve::integrated::impact`), against references worked out here by hand, sharing no code with the
-//! model:
+//! (`solve::integrated::impact`), against references worked out here by hand, sharing no code with
+//! the model:
 //! - the angular velocity ratio at every strike, `1 - (3/2) sin^2(alpha)`, `alpha = atan(w/h)`
 //!   (angular momentum about the new corner), and the strike times by the corner pendulum's
 //!   energy integral (Gauss–Legendre of `tests/common/hand.rs`);

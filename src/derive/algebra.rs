@@ -539,8 +539,9 @@ pub fn coefficients_in_s(a: &A, what: &str) -> Result<Option<Vec<Expr>>, DeriveE
 }
 
 /// The fall polynomial `(sin theta_i - s) / theta_dot^2` in `s = rc_s`, where it is one (see
-/// [`Reduction::fall`](super::types::Reduction::fall)); `None` for a phase that does not start from rest, whose potential
-/// has a `cos(theta)` term, or whose inertia is no polynomial in `sin(theta)`.
+/// [`Reduction::fall`](super::types::Reduction::fall)); `None` for a phase that does not start from
+/// rest, whose potential has a `cos(theta)` term, or whose inertia is no polynomial in
+/// `sin(theta)`.
 pub fn fall_polynomial(
     wsq: &A,
     coords: &[String],

@@ -186,9 +186,9 @@ fn fate_along(
     Ok(None)
 }
 
-/// Whether `phase` (of the system whose general model is `general`) ends where the body lands: at the model's end angle, or where a contact
-/// closes with the falling point on the floor (within [`LANDING_TOLERANCE`] of the system's
-/// length).
+/// Whether `phase` (of the system whose general model is `general`) ends where the body lands: at
+/// the model's end angle, or where a contact closes with the falling point on the floor (within
+/// [`LANDING_TOLERANCE`] of the system's length).
 fn is_landing(general: &Bound, phase: &PhaseRun) -> Result<bool, SolveError> {
     match phase.end() {
         EndCause::Floor => Ok(true),

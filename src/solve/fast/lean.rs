@@ -24,8 +24,8 @@
 //! turns it off for comparison).
 //!
 //! `rodcube accuracy` and the tests in `tests/hard_cases.rs` check the result against the
-//! high-precision reference (`rodcube::reference`, feature `cli`) across `n = m2/m1` from 1e-12 to 1e12 and
-//! `a/ell` from 1e-10 to `1 - 1e-9`.
+//! high-precision reference (`rodcube::reference`, feature `cli`) across `n = m2/m1` from 1e-12 to
+//! 1e12 and `a/ell` from 1e-10 to `1 - 1e-9`.
 
 use crate::model::PhaseInfo;
 use crate::model::{LeanStart, Model, ModelInfo, Reduction, ReductionInfo, positive_finite};

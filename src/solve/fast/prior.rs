@@ -19,11 +19,12 @@
 //! [`PRIOR_MAX_NODES`] is halved. From rest the first panel `[0, b]` is half of the symmetric
 //! rule on `[-b, b]` and costs half its nodes.
 //!
-//! This replaces the verified pair of rules of [`integrate`](crate::solve::fast::quadrature::integrate)
-//! by a bound: its margin was set by comparing with the verified quadrature and the 256-bit
-//! reference (`tests/hard_cases.rs`, `tests/prior.rs`) over every model with a fall polynomial
-//! and the hard-case ranges of `n` and `a/ell`. Models whose fall polynomial has a higher degree,
-//! or that have none, take the verified route.
+//! This replaces the verified pair of rules of
+//! [`integrate`](crate::solve::fast::quadrature::integrate) by a bound: its margin was set by
+//! comparing with the verified quadrature and the 256-bit reference (`tests/hard_cases.rs`,
+//! `tests/prior.rs`) over every model with a fall polynomial and the hard-case ranges of `n` and
+//! `a/ell`. Models whose fall polynomial has a higher degree, or that have none, take the verified
+//! route.
 
 use crate::solve::SolveError;
 use crate::solve::fast::quadrature::{Fall, HalfRule, half_rule};

@@ -1,8 +1,8 @@
 //! The active set of contacts and friction at one state ([`Active`]): which contacts are
 //! closed and how each friction contact moves ([`Mode`]), with its check against a model
 //! ([`check_active`]) and the tolerance by which it is decided ([`DECIDE_TOLERANCE`]). The
-//! decision itself is `solve::integrated::contacts`' (which re-exports these), and `solve::integrated::rest` examines
-//! an active set for equilibrium; both import it from here.
+//! decision itself is `solve::integrated::contacts`' (which re-exports these), and
+//! `solve::integrated::rest` examines an active set for equilibrium; both import it from here.
 
 pub use crate::results::{Mode, Sign};
 

@@ -9,8 +9,8 @@
 //! [`Model::tangents`](crate::model::Model::tangents)). Column `j` of `S` then obeys
 //! `d/dt S_q = S_qd`, `d/dt S_qd = d qdd` along `xi = (S_q, S_qd, e_j)`. The columns ride along
 //! on the integrator's steps without steering them
-//! ([`OdeOptions::controlled`](crate::solve::integrated::ode::OdeOptions::controlled)): the state, its
-//! steps and its events are those of the integration without sensitivities, bit for bit.
+//! ([`OdeOptions::controlled`](crate::solve::integrated::ode::OdeOptions::controlled)): the state,
+//! its steps and its events are those of the integration without sensitivities, bit for bit.
 //!
 //! An event `g(y, p) = 0` ends a stretch at `t_e`; the implicit-function theorem gives
 //! `dt_e/dp = -(g_y S + g_p) / (dg/dt)`, `dg/dt` being `g`'s derivative along the motion (the

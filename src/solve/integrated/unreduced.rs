@@ -1,10 +1,10 @@
 //! The integrated route: a model's equations `M(q) qdd = F(q, qd) + J^T lambda + T^T f`
-//! integrated with the generic [`ode`](crate::solve::integrated::ode) integrator from a state, with a set of
-//! closed contacts, until an event ends the phase: a closed contact's force reaching zero (it
-//! would have to pull, so it opens), an open contact's gap closing (the bodies meet), a closed
-//! contact running off its edge, or the reduced angle reaching the floor. It is the route of
-//! every phase without a fast path, and for the others an independent route to the same events
-//! that shares no code with the quadrature.
+//! integrated with the generic [`ode`](crate::solve::integrated::ode) integrator from a state, with
+//! a set of closed contacts, until an event ends the phase: a closed contact's force reaching zero
+//! (it would have to pull, so it opens), an open contact's gap closing (the bodies meet), a closed
+//! contact running off its edge, or the reduced angle reaching the floor. It is the route of every
+//! phase without a fast path, and for the others an independent route to the same events that
+//! shares no code with the quadrature.
 //!
 //! The contacts' forces and the frictions' are solved with the accelerations at every
 //! evaluation ([`contacts::dynamics()`]). With Coulomb friction the integration goes in segments,

@@ -340,8 +340,9 @@ impl<'a> Fall<'a> {
     /// the nodes `mid +- h x` share one exponential: `sinh(mid +- h x)` and `cosh(mid +- h x)`
     /// follow from those of `mid` and of `h x` by the addition theorems. The difference
     /// `sinh(mid - h x)` loses up to a factor `exp(2 h x)` to cancellation, so beyond
-    /// `h x = ADDITION_REACH` (a factor 2) that node takes its own exponential. Iterations do not depend on each other but through the sum, so the divisions and
-    /// roots of different nodes overlap.
+    /// `h x = ADDITION_REACH` (a factor 2) that node takes its own exponential. Iterations do not
+    /// depend on each other but through the sum, so the divisions and roots of different nodes
+    /// overlap.
     pub(crate) fn panel(&self, rule: &HalfRule, a: f64, b: f64) -> Result<(f64, u64), SolveError> {
         if !self.fall.is_empty() {
             return self.panel_fall(rule, a, b);

@@ -12,7 +12,8 @@
 //! - sliding with slip sign `s`: `f_j + s mu_j lambda_j = 0`, `lambda_j` the force of its
 //!   contact; sticking: `T_j qdd + c_j = 0` (the slip velocity stays zero).
 //!
-//! A contact the model eliminates has its force in closed form ([`Bound::forces_full`](crate::system::Bound::forces_full)).
+//! A contact the model eliminates has its force in closed form
+//! ([`Bound::forces_full`](crate::system::Bound::forces_full)).
 //!
 //! Which contacts are closed is a linear complementarity problem at the acceleration level:
 //! among the contacts that touch without moving apart (gap and normal velocity zero), find the
@@ -21,7 +22,8 @@
 //! ([`MAX_COMBINATIONS`] with the frictions' modes). Frictionless rigid bodies give one
 //! acceleration; with friction a contact at rest that can stick does stick (the rule of the
 //! rigid-body literature), and no consistent choice, or several with as many stuck contacts and
-//! different motions (Painlevé), is [`SolveError::Indeterminate`](crate::solve::SolveError::Indeterminate), naming the time and the
+//! different motions (Painlevé), is
+//! [`SolveError::Indeterminate`](crate::solve::SolveError::Indeterminate), naming the time and the
 //! contacts, never a guess.
 //!
 //! [`dynamics`](mod@dynamics) solves one set; [`decide`](mod@decide) chooses the set.

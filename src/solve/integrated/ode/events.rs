@@ -78,9 +78,10 @@ pub(super) fn locate<P: OdeProblem>(
 /// The share of `rtol` times the time integrated to an event (at most the step's size) within
 /// which the genuine root must lie before a trial past it for that trial to be the event: a
 /// hundredth, so that the event's time stays well within the tolerance of the genuine root's
-/// (`tests/ode.rs` holds the rod and cube's separation to 1e-12 at `rtol` 1e-10). Not relative to the clock: a run's time since the clock's
-/// zero is no measure of how well one step's extension is known (a segment that starts 17.5 s
-/// in, on steps of 0.04 s, would allow four hundred times more).
+/// (`tests/ode.rs` holds the rod and cube's separation to 1e-12 at `rtol` 1e-10). Not relative to
+/// the clock: a run's time since the clock's zero is no measure of how well one step's extension is
+/// known (a segment that starts 17.5 s in, on steps of 0.04 s, would allow four hundred times
+/// more).
 pub(super) const EXTENSION_SHARE: f64 = 0.01;
 
 /// What [`polish`] found.

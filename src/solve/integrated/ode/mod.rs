@@ -62,9 +62,9 @@ pub trait OdeProblem {
     /// How far past its zero, in its own units, event function `index` may be at a located
     /// event and still be taken as there (what the problem's next decision tolerates): a root
     /// taken from the continuous extension stands only where the genuine step's value there
-    /// is past the crossing by at most this (and within the tolerance's share in time). The default, infinity, leaves the time bound alone; zero
-    /// makes every event bracketed on genuine steps to adjacent floats (unless a trial lands on
-    /// the zero).
+    /// is past the crossing by at most this (and within the tolerance's share in time). The
+    /// default, infinity, leaves the time bound alone; zero makes every event bracketed on genuine
+    /// steps to adjacent floats (unless a trial lands on the zero).
     fn event_slack(&self, _index: usize) -> f64 {
         f64::INFINITY
     }
