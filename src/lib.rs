@@ -12,13 +12,16 @@
 //! use rodcube::{models, plan::{self, Request}, quantity::Quantity};
 //!
 //! let model = models::find("rod_cube").expect("generated model");
-//! let request = Request::new(model, [("m1", 1.0), ("m2", 3.0), ("ell", 1.0), ("a", 0.25), ("g",
-//!     9.81)]) .with_want(&[Quantity::SeparationAngle, Quantity::SeparationTime]); let results =
-//!     plan::run(&request)?; let theta_sep = results.separation_angle().expect("the paper's rod
-//!     separates"); let t_sep = results.separation_time().expect("wanted");
-//!     assert!((theta_sep.to_degrees() - 9.61).abs() < 0.005); assert!((t_sep - 0.1085).abs() <
-//!     5e-4); assert_eq!(results.work.integrand_evals > 0, true); # Ok::<(),
-//!     rodcube::plan::PlanError>(())
+//! let paper = [("m1", 1.0), ("m2", 3.0), ("ell", 1.0), ("a", 0.25), ("g", 9.81)];
+//! let request = Request::new(model, paper)
+//!     .with_want(&[Quantity::SeparationAngle, Quantity::SeparationTime]);
+//! let results = plan::run(&request)?;
+//! let theta_sep = results.separation_angle().expect("the paper's rod separates");
+//! let t_sep = results.separation_time().expect("wanted");
+//! assert!((theta_sep.to_degrees() - 9.61).abs() < 0.005);
+//! assert!((t_sep - 0.1085).abs() < 5e-4);
+//! assert_eq!(results.work.integrand_evals > 0, true);
+//! # Ok::<(), rodcube::plan::PlanError>(())
 //! ```
 //!
 //! For many points, [`solve::fast::lean::LeanSolver`] gives the separation angle and time alone,
