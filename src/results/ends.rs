@@ -42,14 +42,6 @@ pub enum EndCause {
 }
 
 impl EndCause {
-    /// The contact the end is about (none at an impact elsewhere, the floor or the run's end).
-    pub fn contact(self) -> Option<ContactId> {
-        match self {
-            EndCause::Force(c) | EndCause::Edge(c) | EndCause::Contact(c) => Some(c),
-            EndCause::Impact | EndCause::Floor | EndCause::Until => None,
-        }
-    }
-
     /// Whether contact `index`'s force ended it.
     pub fn is_force_of(self, index: usize) -> bool {
         matches!(self, EndCause::Force(c) if c.index == index)

@@ -165,12 +165,7 @@ pub fn resolve_with(
     let taking: Vec<usize> = (0..parts.len())
         .filter(|&i| parts[i] != Part::None)
         .collect();
-    let indeterminate = |why: Indeterminacy| SolveError::Indeterminate {
-        model: info.name,
-        t,
-        contacts: names(info, &taking),
-        why: Box::new(why),
-    };
+    let indeterminate = |why| undecided(info, &taking, t, why);
     let unilateral = parts.iter().filter(|p| **p == Part::Unilateral).count();
     if unilateral > MAX_IMPACT_CONTACTS {
         return Err(indeterminate(Indeterminacy::ImpactTooManyContacts {
@@ -230,12 +225,7 @@ pub fn close_sequence(
     let taking: Vec<usize> = (0..parts.len())
         .filter(|&i| parts[i] != Part::None)
         .collect();
-    let indeterminate = |why: Indeterminacy| SolveError::Indeterminate {
-        model: info.name,
-        t,
-        contacts: names(info, &taking),
-        why: Box::new(why),
-    };
+    let indeterminate = |why| undecided(info, &taking, t, why);
     if parts.contains(&Part::Unilateral) {
         return Err(indeterminate(Indeterminacy::ZenoOutsideContact));
     }
@@ -275,6 +265,16 @@ pub fn close_sequence(
 }
 
 /// The contacts `idx` by name, comma-separated.
+/// An impact of the contacts `taking` at `t` that no single set of impulses decides, and why.
+fn undecided(info: &ModelInfo, taking: &[usize], t: f64, why: Indeterminacy) -> SolveError {
+    SolveError::Indeterminate {
+        model: info.name,
+        t,
+        contacts: names(info, taking),
+        why: Box::new(why),
+    }
+}
+
 fn names(info: &ModelInfo, idx: &[usize]) -> Vec<&'static str> {
     (idx.iter().filter_map(|&i| info.contacts.get(i)))
         .map(|c| c.name)
