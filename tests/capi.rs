@@ -18,6 +18,8 @@ const PAPER: [f64; 5] = [1.0, 3.0, 1.0, 0.25, 9.81];
 #[test]
 fn the_c_example_prints_the_rust_solvers_numbers() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    // Not the test run's target directory; tests/library_only.rs checks the library in this
+    // one too, reusing the build scripts and proc macros compiled here.
     let target = Path::new(env!("CARGO_TARGET_TMPDIR")).join("capi");
     // cargo test puts its own target directories on LD_LIBRARY_PATH, which the dynamic loader
     // searches before the programs' run path: a `librodcube.so` left there by another build

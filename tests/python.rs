@@ -50,7 +50,10 @@ fn build_wheel(python: &Path, root: &Path, tmp: &Path, dir: &Path) -> PathBuf {
     if dir.exists() {
         std::fs::remove_dir_all(dir).expect("remove the old wheels");
     }
-    // With its own target directory (not the test run's).
+    // With its own target directory: not the test run's (whose lock `cargo test` may hold), nor
+    // the one tests/capi.rs builds the C library in: the rodcube crate is a cdylib, whose files
+    // cargo names without a hash, so this build's copy of it (other features) would replace that
+    // one's.
     let target = tmp.join("target");
     run(
         python,
