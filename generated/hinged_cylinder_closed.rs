@@ -596,7 +596,7 @@ impl Reduction for HingedCylinderClosed {
     fn force_polynomial(&self, _k: &[f64], _contact: usize, _out: &mut [f64]) {}
 
     /// The constants of `prepare` that the per-point solver reads, and only those.
-    #[inline]
+    #[inline(always)]
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
         let p = &p[..6];
         let th0 = p[4];

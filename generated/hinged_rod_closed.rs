@@ -486,7 +486,7 @@ impl Reduction for HingedRodClosed {
     }
 
     /// The constants of `prepare` that the per-point solver reads, and only those.
-    #[inline]
+    #[inline(always)]
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
         let p = &p[..5];
         let m1 = p[0];

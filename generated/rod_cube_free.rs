@@ -566,7 +566,7 @@ impl Reduction for RodCubeFree {
     }
 
     /// The constants of `prepare` that the per-point solver reads, and only those.
-    #[inline]
+    #[inline(always)]
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
         let p = &p[..11];
         let m1 = p[0];

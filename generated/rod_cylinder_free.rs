@@ -612,7 +612,7 @@ impl Reduction for RodCylinderFree {
     }
 
     /// The constants of `prepare` that the per-point solver reads, and only those.
-    #[inline]
+    #[inline(always)]
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
         let p = &p[..12];
         let m1 = p[0];

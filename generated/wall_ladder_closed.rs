@@ -423,7 +423,7 @@ impl Reduction for WallLadderClosed {
     }
 
     /// The constants of `prepare` that the per-point solver reads, and only those.
-    #[inline]
+    #[inline(always)]
     fn prepare_lean(&self, p: &[f64], k: &mut [f64]) {
         let p = &p[..4];
         let ell = p[1];

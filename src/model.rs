@@ -383,22 +383,16 @@ pub trait Model: Send + Sync {
     /// [`check_parameters`](crate::system::check_parameters) (so that the full check would accept
     /// them too), the model holds every contact of its system closed, has a fast path whose first
     /// contact's force is a polynomial of degree at most 3 and whose other closed unilateral
-    /// contacts' forces are polynomials too, and a fall polynomial of degree at most 2; `None` says
-    /// nothing about why (the checked route then decides and names it). A default method, so that
-    /// each model's copy calls its own generated functions directly and the compiler can fuse them
-    /// (no constant vector in memory, no virtual call).
+    /// contacts' forces are polynomials too, a fall polynomial of degree at most 2 and at most
+    /// [`LEAN_MAX_CONSTANTS`] constants; `None` says nothing about why (the checked route then
+    /// decides and names it). A default method, so that each model's copy calls its own
+    /// generated functions directly and the compiler fuses them: the generated
+    /// [`Reduction::prepare_lean`] is always inlined, so the constants' scratch on the stack
+    /// lives in registers (its zeros are never stored, no constant makes a trip through memory
+    /// and there is no virtual call); a model whose functions cannot be inlined (one loaded
+    /// from a tape) zeroes the scratch once per call.
     #[inline(always)]
     fn lean_start(&self, p: &[f64]) -> Option<LeanStart> {
-        self.lean_start_in(p, &mut [0.0; LEAN_MAX_CONSTANTS])
-    }
-
-    /// [`Model::lean_start`] with the scratch of the constants `k` supplied by the caller
-    /// (`None` where it is shorter than [`ModelInfo::n_constants`]), so that a solver of many
-    /// points zeroes none: what `k` holds on entry is never read, as
-    /// [`Reduction::prepare_lean`] writes every constant the route reads (tests/lean.rs checks
-    /// it, for every model, against a `k` of NaNs).
-    #[inline(always)]
-    fn lean_start_in(&self, p: &[f64], k: &mut [f64]) -> Option<LeanStart> {
         let info = self.info();
         let layout = info.reduction.as_ref()?;
         let sep_len = layout.separation_degree() + 1;
@@ -409,7 +403,8 @@ pub trait Model: Send + Sync {
             return None;
         }
         let red = self.reduction()?;
-        let k = k.get_mut(..info.n_constants)?;
+        let mut scratch = [0.0; LEAN_MAX_CONSTANTS];
+        let k = scratch.get_mut(..info.n_constants)?;
         red.prepare_lean(p, k);
         let (mut separation, mut fall) = ([0.0; 4], [0.0; 3]);
         red.force_polynomial(k, 0, separation.get_mut(..sep_len)?);

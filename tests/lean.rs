@@ -376,22 +376,32 @@ fn the_lean_start_is_the_prepared_start_or_nothing() {
                 assert_eq!(row[..poly.len()], poly[..], "{} contact {i}", info.name);
                 assert!(row[poly.len()..].iter().all(|&c| c == 0.0));
             }
-            // The same from a scratch of NaNs (a solver's, left by other points): what it
-            // holds on entry is never read.
-            let mut scratch = vec![f64::NAN; info.n_constants];
-            let again = model.lean_start_in(&p, &mut scratch);
-            assert_eq!(
-                format!("{again:?}"),
-                format!("{:?}", Some(start)),
-                "{}",
-                info.name
-            );
-            assert_eq!(
-                model.lean_start_in(&p, &mut scratch[1..]),
-                None,
-                "{}",
-                info.name
-            );
+            // prepare_lean writes every constant the start's polynomials read: from a scratch
+            // of NaNs they are the same.
+            let mut lean = vec![f64::NAN; info.n_constants];
+            red.prepare_lean(&p, &mut lean);
+            let mut again = vec![0.0; sep.len()];
+            red.force_polynomial(&lean, 0, &mut again);
+            assert_eq!(again, sep, "{}", info.name);
+            let mut again = vec![0.0; fall.len()];
+            red.fall_polynomial(&lean, &mut again);
+            assert_eq!(again, fall, "{}", info.name);
+            for &i in &others {
+                let (mut from_lean, mut from_full) = (
+                    vec![0.0; layout.force_degrees[i] + 1],
+                    vec![0.0; layout.force_degrees[i] + 1],
+                );
+                red.force_polynomial(&lean, i, &mut from_lean);
+                red.force_polynomial(&k, i, &mut from_full);
+                assert_eq!(from_lean, from_full, "{} contact {i}", info.name);
+            }
+            for i in [
+                layout.k_sin_initial,
+                layout.k_cos_initial,
+                layout.k_theta_dot_initial,
+            ] {
+                assert_eq!(lean[i], k[i], "{} constant {i}", info.name);
+            }
             served += 1;
             // What the quick test cannot pass: a value not positive and finite, a wrong count.
             for bad in [f64::NAN, f64::INFINITY, 0.0, -1.0] {

@@ -268,16 +268,16 @@ impl<'m> LeanSolver<'m> {
                 // SAFETY: `wide` is set only where the CPU has AVX2 (`has_avx2`).
                 unsafe {
                     self.model
-                        .lean_point_avx2(p, &mut self.k, prior, self.sin_end, &mut self.evals)
+                        .lean_point_avx2(p, prior, self.sin_end, &mut self.evals)
                 }
             } else {
                 self.model
-                    .lean_point(p, &mut self.k, prior, self.sin_end, &mut self.evals)
+                    .lean_point(p, prior, self.sin_end, &mut self.evals)
             };
             #[cfg(not(target_arch = "x86_64"))]
             let quick = self
                 .model
-                .lean_point(p, &mut self.k, prior, self.sin_end, &mut self.evals);
+                .lean_point(p, prior, self.sin_end, &mut self.evals);
             if let Some(point) = quick {
                 return Ok(point);
             }
@@ -508,11 +508,10 @@ impl<'m> LeanSolver<'m> {
 /// inlined too.
 pub trait LeanRoute {
     /// The route for the parameters `p`, to `prior`'s tolerance, with the root's bracket's low
-    /// end at `sin_end`; `k` is the constants' scratch ([`Model::lean_start_in`]).
+    /// end at `sin_end`.
     fn lean_point(
         &self,
         p: &[f64],
-        k: &mut [f64],
         prior: &Prior,
         sin_end: f64,
         evals: &mut u64,
@@ -528,7 +527,6 @@ pub trait LeanRoute {
     unsafe fn lean_point_avx2(
         &self,
         p: &[f64],
-        k: &mut [f64],
         prior: &Prior,
         sin_end: f64,
         evals: &mut u64,
@@ -540,13 +538,16 @@ impl<M: Model + ?Sized> LeanRoute for M {
     fn lean_point(
         &self,
         p: &[f64],
-        k: &mut [f64],
         prior: &Prior,
         sin_end: f64,
         evals: &mut u64,
     ) -> Option<LeanPoint> {
-        let start = self.lean_start_in(p, k)?;
-        quick_route(&start, prior, sin_end, evals, |f, rule, a, b| {
+        // Matched by reference, not moved out of the `Option` by `?` (a copy of the start).
+        let start = self.lean_start(p);
+        let Some(start) = &start else {
+            return None;
+        };
+        quick_route(start, prior, sin_end, evals, |f, rule, a, b| {
             f.panel(rule, a, b, a == 0.0)
         })
     }
@@ -559,13 +560,15 @@ impl<M: Model + ?Sized> LeanRoute for M {
     unsafe fn lean_point_avx2(
         &self,
         p: &[f64],
-        k: &mut [f64],
         prior: &Prior,
         sin_end: f64,
         evals: &mut u64,
     ) -> Option<LeanPoint> {
-        let start = self.lean_start_in(p, k)?;
-        quick_route(&start, prior, sin_end, evals, |f, rule, a, b| {
+        let start = self.lean_start(p);
+        let Some(start) = &start else {
+            return None;
+        };
+        quick_route(start, prior, sin_end, evals, |f, rule, a, b| {
             f.panel_avx2(rule, a, b, a == 0.0)
         })
     }
@@ -680,17 +683,15 @@ mod tests {
         ] {
             let p = [1.0, m2, 1.0, a, 9.81];
             let (mut e1, mut e2) = (0, 0);
-            let mut k = vec![f64::NAN; dynamic.info().n_constants];
-            let typed = RodCubeClosed.lean_point(&p, &mut k, &prior, sin_end, &mut e1);
-            let erased = dynamic.lean_point(&p, &mut k, &prior, sin_end, &mut e2);
+            let typed = RodCubeClosed.lean_point(&p, &prior, sin_end, &mut e1);
+            let erased = dynamic.lean_point(&p, &prior, sin_end, &mut e2);
             assert_eq!(typed, erased, "{p:?}");
             assert_eq!(e1, e2, "{p:?}");
             #[cfg(target_arch = "x86_64")]
             if std::arch::is_x86_feature_detected!("avx2") {
                 let mut e3 = 0;
                 // SAFETY: the CPU has AVX2.
-                let wide =
-                    unsafe { RodCubeClosed.lean_point_avx2(&p, &mut k, &prior, sin_end, &mut e3) };
+                let wide = unsafe { RodCubeClosed.lean_point_avx2(&p, &prior, sin_end, &mut e3) };
                 assert_eq!(wide, erased, "{p:?}");
                 assert_eq!(e3, e2, "{p:?}");
             }

@@ -2,7 +2,7 @@
 //! ([`Fall`]): its constants, the checks that it falls, the integrand at a node, one rule on a
 //! panel, and the maps between `v`, the drop of `sin(theta)` and the angle fallen.
 
-use super::hyperbolic::{sinh_cosh, sinh_sq};
+use super::hyperbolic::{ln_1p, sinh_cosh, sinh_sq};
 use super::integrand::{FALL_CHECK_SH2, FallIntegrand, panel_frame};
 use super::rules::{Control, HalfRule};
 use crate::model::{Reduction, ReductionInfo, start_offsets};
@@ -24,12 +24,12 @@ struct Node {
 }
 
 /// `v` where `sin(theta)` has dropped by `drop >= 0` from a start of scale `e`:
-/// `asinh(sqrt(q))`, `q = drop / e`, as `log1p(x + q / (1 + sqrt(1 + q)))`, exact for small and
-/// large `q` without `hypot`.
+/// `asinh(sqrt(q))`, `q = drop / e`, as `log1p(x + q / (1 + sqrt(1 + q)))` (the inlined
+/// [`ln_1p`]), exact for small and large `q` without `hypot`.
 #[inline]
 pub fn v_at_drop(e: f64, drop: f64) -> f64 {
     let q = drop.max(0.0) / e;
-    (q.sqrt() + q / (1.0 + (1.0 + q).sqrt())).ln_1p()
+    ln_1p(q.sqrt() + q / (1.0 + (1.0 + q).sqrt()))
 }
 
 /// A falling phase in the variable `v` of the module docs: what the integrand needs.

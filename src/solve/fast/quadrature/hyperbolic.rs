@@ -1,6 +1,7 @@
 //! `sinh^2`, `sinh` and `cosh` at the quadrature's nodes, to a few ulps and without a
 //! library call where a series serves: [`sinh_sq`] one node at a time, [`SinhSq`] several in
-//! the same arithmetic (the lanes of a vector register), [`sinh_cosh`] both from one `exp_m1`.
+//! the same arithmetic (the lanes of a vector register), [`sinh_cosh`] both from one `exp_m1`,
+//! and [`ln_1p`], the logarithm behind the panel's end `v = asinh(sqrt(q))`, inlined.
 
 /// Largest `|y|` at which `sinh(y)^2` is taken from the series of [`sinh_ratio_series`] rather
 /// than from one `exp` (a library call costing several times the series' nine multiply-adds).
@@ -104,6 +105,64 @@ pub(super) fn sinh_cosh(x: f64) -> (f64, f64) {
     (0.5 * (em + em * inv), 0.5 * (1.0 + em + inv))
 }
 
+/// `ln(1 + x)` for `x >= 0` within an ulp, inlined into its caller (the per-point route takes
+/// it once per point, for the end of the fall's panel, where the system library's `log1p` is a
+/// call costing about twice this). The classical reduction (P. T. P. Tang's and fdlibm's): `u =
+/// 1 + x` rounded and `c = (x - (u - 1)) / u` the part of `x` the rounding lost; `u = 2^k m` with
+/// `m` in `[sqrt(2)/2, sqrt(2))` and `f = m - 1` exact; `ln(1 + f) = 2 atanh(s)`, `s = f / (2 +
+/// f)`, as `f - f^2/2 + s (f^2/2 + R(s^2))` with `R` the minimax polynomial of degree 7 of
+/// [`LN_1P_R`] (error below `2^-58.45` on the range); `ln 2` split in two so that `k ln2_hi` is
+/// exact. Below `sqrt(2) - 1`, `f = x` with nothing lost. A NaN, a negative `x` or `u` from
+/// `2^53` on take the library's `ln_1p`. Tested against it in
+/// `ln_1p_is_the_librarys_within_an_ulp`.
+#[inline(always)]
+pub(super) fn ln_1p(x: f64) -> f64 {
+    const LN2_HI: f64 = 6.931_471_803_691_238_164_90e-1;
+    const LN2_LO: f64 = 1.908_214_929_270_587_700_02e-10;
+    if !(x >= 0.0 && x < 9.007_199_254_740_992e15) {
+        return x.ln_1p();
+    }
+    let (k, f, c) = if x < std::f64::consts::SQRT_2 - 1.0 {
+        (0.0, x, 0.0)
+    } else {
+        let u = 1.0 + x;
+        // The part of `x` that `u` lost, over `u` (exact to first order: ln(u + d) = ln u +
+        // d / u).
+        let lost = if u < 2.0 {
+            x - (u - 1.0)
+        } else {
+            1.0 - (u - x)
+        };
+        let bits = u.to_bits();
+        let mut k = (bits >> 52) as i64 - 1023;
+        let mut m = f64::from_bits((bits & 0x000f_ffff_ffff_ffff) | 0x3ff0_0000_0000_0000);
+        if m >= std::f64::consts::SQRT_2 {
+            m *= 0.5;
+            k += 1;
+        }
+        (k as f64, m - 1.0, lost / u)
+    };
+    let s = f / (2.0 + f);
+    let z = s * s;
+    let [r1, r2, r3, r4, r5, r6, r7] = LN_1P_R;
+    let r = z * (r1 + z * (r2 + z * (r3 + z * (r4 + z * (r5 + z * (r6 + z * r7))))));
+    let hfsq = 0.5 * f * f;
+    k * LN2_HI - ((hfsq - (s * (hfsq + r) + (k * LN2_LO + c))) - f)
+}
+
+/// The coefficients of `R(z)` in [`ln_1p`], `2 atanh(s) = 2s + s R(s^2)` approximately:
+/// `R(z) = z (r1 + r2 z + ... + r7 z^6)`, minimax on `z` in `[0, 0.1716^2]` (fdlibm's `Lp1` to
+/// `Lp7`; near `2/3, 2/5, 2/7, ...`, the series' own).
+const LN_1P_R: [f64; 7] = [
+    6.666_666_666_666_735_130e-1,
+    3.999_999_999_940_941_908e-1,
+    2.857_142_874_366_239_149e-1,
+    2.222_219_843_214_978_396e-1,
+    1.818_357_216_161_805_012e-1,
+    1.531_383_769_920_937_332e-1,
+    1.479_819_860_511_658_591e-1,
+];
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -131,6 +190,46 @@ mod tests {
             "worst {:.2} ulps",
             worst / f64::EPSILON
         );
+    }
+
+    #[test]
+    fn ln_1p_is_the_librarys_within_an_ulp() {
+        // Every octave from 1e-300 to 2^60, densely near the reduction's seams (sqrt(2) - 1,
+        // where u reaches 2, powers of two times sqrt(2)), and random mantissas: within one
+        // ulp of the library's correctly rounded-or-nearly result, and equal past 2^53.
+        let mut x: f64 = 1e-300;
+        let mut worst = 0.0f64;
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut check = |x: f64| {
+            let (got, want) = (ln_1p(x), x.ln_1p());
+            let ulp = f64::from_bits(want.to_bits() + 1) - want;
+            worst = worst.max((got - want).abs() / ulp);
+        };
+        while x < 1.2e18 {
+            for _ in 0..64 {
+                seed ^= seed << 13;
+                seed ^= seed >> 7;
+                seed ^= seed << 17;
+                let frac = (seed >> 11) as f64 / (1u64 << 53) as f64;
+                check(x * (1.0 + frac));
+            }
+            x *= 2.0;
+        }
+        for seam in [
+            std::f64::consts::SQRT_2 - 1.0,
+            1.0,
+            std::f64::consts::SQRT_2 * 2.0 - 1.0,
+            std::f64::consts::SQRT_2 * 1024.0 - 1.0,
+        ] {
+            for i in -2000..=2000 {
+                check(seam * (1.0 + i as f64 * f64::EPSILON));
+            }
+        }
+        assert!(worst <= 1.0, "worst {worst} ulps");
+        for x in [0.0, 9.007_199_254_740_992e15, 1e300, f64::INFINITY] {
+            assert_eq!(ln_1p(x), x.ln_1p(), "{x}");
+        }
+        assert!(ln_1p(f64::NAN).is_nan() && ln_1p(-0.5) == (-0.5f64).ln_1p());
     }
 
     #[test]
