@@ -63,7 +63,9 @@ pub fn reduce_cos_sq(a: &A) -> A {
         /// once per thread (only the Symbolica thread calls this).
         static RULES: Vec<(A, A)> = cos_power_rules("rc_s", "rc_c");
     }
-    RULES.with(|rules| rewritten(a, rules))
+    cas::memo(cas::Memo::CosSquares, a, |a| {
+        RULES.with(|rules| rewritten(a, rules))
+    })
 }
 
 /// `a` expanded and rewritten by `rules` until nothing changes (at most 16 rounds).
@@ -374,12 +376,22 @@ pub fn is_zero_trig(a: &A) -> Result<bool, StepError> {
     let numerator = trig_symbols(&product(num), &mut arguments);
     let mut n = reduce_cos_sq(&cas::atom(&numerator));
     for i in 0..arguments.len() {
-        n = rewritten(
-            &n,
-            &cos_power_rules(&format!("rc_ts{i}"), &format!("rc_tc{i}")),
-        );
+        n = ARGUMENT_RULES.with(|rules| {
+            let mut rules = rules.borrow_mut();
+            while rules.len() <= i {
+                let j = rules.len();
+                rules.push(cos_power_rules(&format!("rc_ts{j}"), &format!("rc_tc{j}")));
+            }
+            rewritten(&n, &rules[i])
+        });
     }
     Ok(cas::is_zero(&n))
+}
+
+thread_local! {
+    /// The rules of [`cos_power_rules`] for the `i`-th other argument (`rc_ts<i>`, `rc_tc<i>`)
+    /// at index `i`, made once per thread (only the Symbolica thread calls this).
+    static ARGUMENT_RULES: std::cell::RefCell<Vec<Vec<(A, A)>>> = Default::default();
 }
 
 /// Replaces `sin(theta)`, `cos(theta)` by `rc_s`, `rc_c`.

@@ -158,20 +158,32 @@ pub fn expand(a: &A) -> A {
     a.expand()
 }
 
-/// Most results a memo of [`together`] or [`factor`] keeps before it starts afresh.
+/// Most results a memo keeps before it starts afresh.
 const MEMO_CAPACITY: usize = 20_000;
 
+/// The operations whose results are remembered by their input ([`memo`]).
+#[derive(Debug, Clone, Copy)]
+pub enum Memo {
+    /// [`together`].
+    Together = 0,
+    /// [`factor`].
+    Factor = 1,
+    /// `algebra::reduce_cos_sq`.
+    CosSquares = 2,
+}
+
 thread_local! {
-    /// Results of [`together`] and [`factor`] by their input: the presentation asks for the
-    /// same rational normalisations and factorisations many times over (every candidate form
-    /// of a result, every phase of a spec). The derivation runs on one thread, so the memo is
-    /// that thread's.
-    static MEMO: std::cell::RefCell<[std::collections::HashMap<A, A>; 2]> =
+    /// Results of [`together`], [`factor`] and `algebra::reduce_cos_sq` by their input: the
+    /// presentation asks for the same rational normalisations, factorisations and
+    /// `sin^2 + cos^2 = 1` rewritings many times over (every candidate form of a result,
+    /// every phase of a spec). The derivation runs on one thread, so the memo is that thread's.
+    static MEMO: std::cell::RefCell<[std::collections::HashMap<A, A>; 3]> =
         std::cell::RefCell::new(Default::default());
 }
 
-/// `op(a)`, remembered in memo `slot`.
-fn memo(slot: usize, a: &A, op: impl FnOnce(&A) -> A) -> A {
+/// `op(a)`, remembered in the memo of `which` (`op` must be that operation).
+pub fn memo(which: Memo, a: &A, op: impl FnOnce(&A) -> A) -> A {
+    let slot = which as usize;
     if let Some(hit) = MEMO.with(|m| m.borrow()[slot].get(a).cloned()) {
         return hit;
     }
@@ -188,12 +200,12 @@ fn memo(slot: usize, a: &A, op: impl FnOnce(&A) -> A) -> A {
 
 /// One rational function `numerator / denominator` with common factors cancelled.
 pub fn together(a: &A) -> A {
-    memo(0, a, |a| a.together())
+    memo(Memo::Together, a, |a| a.together())
 }
 
 /// Factorised form.
 pub fn factor(a: &A) -> A {
-    memo(1, a, |a| a.factor())
+    memo(Memo::Factor, a, |a| a.factor())
 }
 
 /// Replaces every occurrence of a pattern (a symbol or a function call) by `value`.

@@ -25,7 +25,7 @@
 
 use super::algebra::{is_zero_trig, reduce_cos_sq, with_pythagoras};
 use super::cas::{self, A};
-use super::expr::{Expr, product, sum};
+use super::expr::{Expr, PI, product, sum};
 use super::types::{Derivation, DeriveError, StepError};
 
 /// A candidate form ranked: operations, characters, order made, the form, and the constant
@@ -60,7 +60,11 @@ pub struct Form {
 
 /// Operations in the printed form: `+ - * / ^` and function calls.
 pub fn operations(e: &Expr) -> usize {
-    let text = e.to_infix();
+    operations_in(&e.to_infix())
+}
+
+/// [`operations`] of a form's infix text.
+fn operations_in(text: &str) -> usize {
     let mut n = text.chars().filter(|c| "+-*/^".contains(*c)).count();
     let bytes = text.as_bytes();
     for i in 1..bytes.len() {
@@ -78,11 +82,8 @@ struct Order<'a> {
 
 impl Order<'_> {
     fn rank(&self, e: &Expr) -> (usize, usize, String) {
-        let syms = e.symbols();
-        let first = syms
-            .iter()
-            .filter_map(|s| self.symbols.iter().position(|o| o == s))
-            .min()
+        let first = (self.symbols.iter())
+            .position(|o| o != PI && e.mentions(o))
             .unwrap_or(self.symbols.len());
         let text = e.to_infix();
         (first, text.len(), text)
@@ -90,8 +91,7 @@ impl Order<'_> {
 }
 
 fn has_theta(e: &Expr) -> bool {
-    let s = e.symbols();
-    s.contains("rc_s") || s.contains("rc_c")
+    e.mentions("rc_s") || e.mentions("rc_c")
 }
 
 /// The degree of a monomial in `rc_s` and `rc_c` (sine first: `sin^a cos^b` as `(a + b, b)`).
@@ -121,6 +121,9 @@ type Collected = (Vec<Expr>, (i128, i128), Vec<Expr>);
 
 /// A factor and its integer power (negative below the line).
 type Factor = (Expr, i128);
+
+/// Denominator sums divided by a theta-free factor: (the factor, the sum, the sum divided).
+type Divided = Vec<(Expr, Expr, Expr)>;
 
 /// A factorised expression: a rational number and factors.
 struct Factored {
@@ -170,6 +173,9 @@ fn reduced(n: i128, d: i128) -> (i128, i128) {
 /// Writes a presentation form of `a`, see the module's documentation.
 pub struct Presenter<'a> {
     order: Order<'a>,
+    /// [`arrange_coefficient`](Self::arrange_coefficient)'s results by its input: the same
+    /// coefficients recur in every candidate of a result and in many results.
+    coefficients: std::cell::RefCell<std::collections::HashMap<A, Vec<Expr>>>,
 }
 
 impl<'a> Presenter<'a> {
@@ -177,21 +183,26 @@ impl<'a> Presenter<'a> {
     pub fn new(symbols: &'a [String]) -> Self {
         Presenter {
             order: Order { symbols },
+            coefficients: Default::default(),
         }
     }
 
     /// The presentation form of `a` (over `rc_s`, `rc_c` and theta-free symbols), checked equal
     /// to it.
     pub fn present(&self, a: &A, shape: Shape) -> Result<Form, StepError> {
-        let mut candidates = vec![self.factored(a, shape, shape)?];
+        let parts = self.parts(a)?;
+        let mut candidates = vec![self.arranged(&parts, shape, shape)?];
         if shape == Shape::Fraction {
             // The numerator's sums also as polynomials (highest power first), which can spare
             // a leading minus sign.
-            candidates.push(self.factored(a, Shape::Fraction, Shape::Polynomial)?);
-            let moved = (candidates.iter())
-                .map(|c| self.moved_into_denominator(c))
-                .collect::<Result<Vec<_>, _>>()?;
-            candidates.extend(moved.into_iter().flatten());
+            candidates.push(self.arranged(&parts, Shape::Fraction, Shape::Polynomial)?);
+            // Both share their denominator and theta-free factors: each sum divided once.
+            let mut divided = Divided::default();
+            let mut moved = Vec::new();
+            for c in &candidates {
+                moved.extend(self.moved_into_denominator(c, &mut divided)?);
+            }
+            candidates.extend(moved);
         }
         let count = candidates.len();
         // Ranked by the rule (fewest operations, then fewest characters; the first made wins a
@@ -204,7 +215,8 @@ impl<'a> Presenter<'a> {
                     Shape::Fraction => (1, 1),
                 };
                 let e = self.assemble(&f);
-                (operations(&e), e.to_infix().len(), i, e, dropped)
+                let text = e.to_infix();
+                (operations_in(&text), text.len(), i, e, dropped)
             })
             .collect();
         ranked.sort_by_key(|r| (r.0, r.1, r.2));
@@ -230,9 +242,9 @@ impl<'a> Presenter<'a> {
         })
     }
 
-    /// Candidate (1): together, `sin^2 + cos^2 = 1`, factor, sums collected and signed, the
-    /// denominator's as `shape` says, the numerator's as `top` says.
-    fn factored(&self, a: &A, shape: Shape, top: Shape) -> Result<Factored, StepError> {
+    /// The factors of `a` as Symbolica gives them: together, `sin^2 + cos^2 = 1` applied to
+    /// the numerator and the denominator, each factored (what candidates (1) arrange).
+    fn parts(&self, a: &A) -> Result<Factored, StepError> {
         let t = cas::expr(&cas::together(a))?;
         let (num, den) = t.num_den();
         let mut out = Factored {
@@ -243,24 +255,38 @@ impl<'a> Presenter<'a> {
             let p = reduce_cos_sq(&cas::atom(&product(part)));
             factors_of(&cas::expr(&cas::factor(&p))?, sign, &mut out)?;
         }
-        let mut factors = Vec::new();
-        for (base, k) in std::mem::take(&mut out.factors) {
+        Ok(out)
+    }
+
+    /// Candidate (1): the [`parts`](Self::parts) of a result with its sums collected and
+    /// signed, the denominator's as `shape` says, the numerator's as `top` says.
+    fn arranged(&self, parts: &Factored, shape: Shape, top: Shape) -> Result<Factored, StepError> {
+        let mut out = Factored {
+            coefficient: parts.coefficient,
+            factors: Vec::with_capacity(parts.factors.len()),
+        };
+        for (base, k) in &parts.factors {
+            let k = *k;
             if !matches!(base, Expr::Add(_)) {
-                factors.push((self.arrange_product(&base), k));
+                out.factors.push((self.arrange_product(base), k));
                 continue;
             }
-            let (negative, arranged) = self.arrange_sum(&base, if k > 0 { top } else { shape })?;
+            let (negative, arranged) = self.arrange_sum(base, if k > 0 { top } else { shape })?;
             if negative && k % 2 != 0 {
                 out.coefficient.0 = -out.coefficient.0;
             }
-            factors.push((arranged, k));
+            out.factors.push((arranged, k));
         }
-        out.factors = factors;
         Ok(out)
     }
 
     /// Candidates (2): a theta-free factor of the numerator moved into the denominator's sum.
-    fn moved_into_denominator(&self, f: &Factored) -> Result<Vec<Factored>, StepError> {
+    /// `divided` keeps each denominator divided so far, by what it was divided by.
+    fn moved_into_denominator(
+        &self,
+        f: &Factored,
+        divided: &mut Divided,
+    ) -> Result<Vec<Factored>, StepError> {
         let below: Vec<&Factor> = f.factors.iter().filter(|x| x.1 < 0).collect();
         let [(d_sum, d_pow)] = below.as_slice() else {
             return Ok(Vec::new());
@@ -298,22 +324,11 @@ impl<'a> Presenter<'a> {
                         .chain(chosen.iter().map(|x| x.0.clone()))
                         .collect(),
                 );
-                let by_a = cas::atom(&by);
-                let mut new_terms = Vec::new();
-                for t in terms {
-                    let (theta, coefficient): (Vec<Expr>, Vec<Expr>) = match t {
-                        Expr::Mul(v) => v.iter().cloned().partition(has_theta),
-                        t if has_theta(t) => (vec![t.clone()], Vec::new()),
-                        t => (Vec::new(), vec![t.clone()]),
-                    };
-                    let c = cas::together(&(cas::atom(&product(coefficient)) / by_a.clone()));
-                    let c = self.arrange_coefficient(&c)?;
-                    new_terms.push(product(c.into_iter().chain(theta).collect()));
-                }
+                let new_sum = self.divided_sum(d_sum, terms, by, divided)?;
                 let mut factors: Vec<Factor> = Vec::new();
                 for x in &f.factors {
                     if x.1 < 0 {
-                        factors.push((sum(new_terms.clone()), x.1));
+                        factors.push((new_sum.clone(), x.1));
                     } else if let Some(c) = chosen.iter().find(|c| c.0 == x.0) {
                         factors.push((c.0.clone(), x.1 - k));
                     } else {
@@ -329,8 +344,49 @@ impl<'a> Presenter<'a> {
         Ok(out)
     }
 
+    /// The sum `d_sum` (its `terms`) with each term's theta-free coefficient divided by `by`,
+    /// taken from `divided` when that sum was divided by `by` before.
+    fn divided_sum(
+        &self,
+        d_sum: &Expr,
+        terms: &[Expr],
+        by: Expr,
+        divided: &mut Divided,
+    ) -> Result<Expr, StepError> {
+        if let Some((_, _, done)) = (divided.iter()).find(|(b, s, _)| *b == by && s == d_sum) {
+            return Ok(done.clone());
+        }
+        let by_a = cas::atom(&by);
+        let mut new_terms = Vec::with_capacity(terms.len());
+        for t in terms {
+            let (theta, coefficient): (Vec<Expr>, Vec<Expr>) = match t {
+                Expr::Mul(v) => v.iter().cloned().partition(has_theta),
+                t if has_theta(t) => (vec![t.clone()], Vec::new()),
+                t => (Vec::new(), vec![t.clone()]),
+            };
+            let c = cas::together(&(cas::atom(&product(coefficient)) / by_a.clone()));
+            let c = self.arrange_coefficient(&c)?;
+            new_terms.push(product(c.into_iter().chain(theta).collect()));
+        }
+        let done = sum(new_terms);
+        divided.push((by, d_sum.clone(), done.clone()));
+        Ok(done)
+    }
+
     /// A theta-free coefficient as ordered factors (number first).
     fn arrange_coefficient(&self, c: &A) -> Result<Vec<Expr>, StepError> {
+        if let Some(done) = self.coefficients.borrow().get(c) {
+            return Ok(done.clone());
+        }
+        let done = self.arrange_coefficient_anew(c)?;
+        self.coefficients
+            .borrow_mut()
+            .insert(c.clone(), done.clone());
+        Ok(done)
+    }
+
+    /// [`arrange_coefficient`](Self::arrange_coefficient), computed.
+    fn arrange_coefficient_anew(&self, c: &A) -> Result<Vec<Expr>, StepError> {
         let mut f = Factored {
             coefficient: (1, 1),
             factors: Vec::new(),
@@ -372,7 +428,7 @@ impl<'a> Presenter<'a> {
         let class = match (has_theta(b), matches!(b, Expr::Add(_))) {
             (false, false) => 0,
             (false, true) => 1,
-            (true, false) if b.symbols().contains("rc_s") => 2,
+            (true, false) if b.mentions("rc_s") => 2,
             (true, false) => 3,
             (true, true) => 4,
         };

@@ -279,16 +279,16 @@ impl Expr {
             Expr::Add(v) => wrap(out, parent > 1, |o| {
                 write_signed_sum(o, v, |o, mag| mag.infix(o, 2));
             }),
-            Expr::Mul(_) => {
-                let (neg, mag) = self.split_sign();
-                if neg {
+            Expr::Mul(v) => {
+                if self.negative_factors() {
+                    let (_, mag) = self.split_sign();
                     wrap(out, parent > 1, |o| {
                         o.push('-');
                         mag.infix(o, 3);
                     });
                     return;
                 }
-                let (num, den) = self.num_den();
+                let (num, den) = parts_num_den(v);
                 wrap(out, parent > 2, |o| {
                     if num.is_empty() {
                         o.push('1');
@@ -301,25 +301,11 @@ impl Expr {
                     }
                     if !den.is_empty() {
                         o.push('/');
-                        let d = product(den);
-                        d.infix(o, 4);
+                        parts_infix(&den, o);
                     }
                 });
             }
-            Expr::Pow(b, e) => {
-                if let Some(-1) = e.as_integer() {
-                    wrap(out, parent > 2, |o| {
-                        o.push_str("1/");
-                        b.infix(o, 4);
-                    });
-                    return;
-                }
-                wrap(out, parent > 4, |o| {
-                    b.infix(o, 5);
-                    o.push('^');
-                    e.infix(o, 5);
-                });
-            }
+            Expr::Pow(b, e) => pow_infix(b, e, out, parent),
             Expr::Fun(f, args) => {
                 out.push_str(f);
                 out.push('(');
@@ -331,6 +317,48 @@ impl Expr {
                 }
                 out.push(')');
             }
+        }
+    }
+
+    /// Whether this is a negative number (a factor whose sign [`split_sign`](Self::split_sign)
+    /// splits off).
+    fn is_negative_number(&self) -> bool {
+        match self {
+            Expr::Rational(n, _) => *n < 0,
+            Expr::Float(x) => *x < 0.0,
+            _ => false,
+        }
+    }
+
+    /// Whether a product has an odd number of negative number factors (the sign
+    /// [`split_sign`](Self::split_sign) splits off it).
+    fn negative_factors(&self) -> bool {
+        let Expr::Mul(v) = self else {
+            return false;
+        };
+        v.iter().filter(|f| f.is_negative_number()).count() % 2 == 1
+    }
+
+    /// [`split_sign`](Self::split_sign), borrowing the term where nothing is split off it.
+    fn split_sign_borrowed(&self) -> (bool, std::borrow::Cow<'_, Expr>) {
+        let unchanged = match self {
+            Expr::Mul(v) => v.len() > 1 && !v.iter().any(Expr::is_negative_number),
+            e => !e.is_negative_number(),
+        };
+        if unchanged {
+            return (false, std::borrow::Cow::Borrowed(self));
+        }
+        let (neg, mag) = self.split_sign();
+        (neg, std::borrow::Cow::Owned(mag))
+    }
+
+    /// Whether a symbol named `name` occurs in the expression.
+    pub fn mentions(&self, name: &str) -> bool {
+        match self {
+            Expr::Sym(s) => s == name,
+            Expr::Add(v) | Expr::Mul(v) | Expr::Fun(_, v) => v.iter().any(|e| e.mentions(name)),
+            Expr::Pow(b, e) => b.mentions(name) || e.mentions(name),
+            _ => false,
         }
     }
 
@@ -366,34 +394,13 @@ impl Expr {
     /// Splits a product into numerator and denominator factors (negative powers and the
     /// denominators of rational constants go below the line).
     pub fn num_den(&self) -> (Vec<Expr>, Vec<Expr>) {
-        let factors: Vec<Expr> = match self {
-            Expr::Mul(v) => v.clone(),
-            e => vec![e.clone()],
+        let factors = match self {
+            Expr::Mul(v) => v.as_slice(),
+            e => std::slice::from_ref(e),
         };
-        let mut num = Vec::new();
-        let mut den = Vec::new();
-        for f in factors {
-            match &f {
-                Expr::Pow(b, e) => match e.as_integer() {
-                    Some(-1) => den.push((**b).clone()),
-                    Some(n) if n < 0 => den.push(Expr::Pow(b.clone(), Box::new(Expr::int(-n)))),
-                    _ => match &**e {
-                        Expr::Rational(n, d) if *n < 0 => {
-                            den.push(Expr::Pow(b.clone(), Box::new(Expr::Rational(-n, *d))))
-                        }
-                        _ => num.push(f.clone()),
-                    },
-                },
-                Expr::Rational(n, d) if *d != 1 => {
-                    if *n != 1 {
-                        num.push(Expr::int(*n));
-                    }
-                    den.push(Expr::int(*d));
-                }
-                _ => num.push(f.clone()),
-            }
-        }
-        (num, den)
+        let (num, den) = parts_num_den(factors);
+        let owned = |v: Vec<Part<'_>>| v.iter().map(Part::owned).collect();
+        (owned(num), owned(den))
     }
 }
 
@@ -405,7 +412,7 @@ pub fn write_signed_sum(
     mut term: impl FnMut(&mut String, &Expr),
 ) {
     for (i, t) in terms.iter().enumerate() {
-        let (neg, mag) = t.split_sign();
+        let (neg, mag) = t.split_sign_borrowed();
         if i == 0 {
             if neg {
                 out.push('-');
@@ -415,6 +422,107 @@ pub fn write_signed_sum(
         }
         term(out, &mag);
     }
+}
+
+/// A factor as [`Expr::num_den`] files it, borrowed from the product it is in.
+enum Part<'a> {
+    /// The factor itself (or, below the line, the base of a power `-1`).
+    Is(&'a Expr),
+    /// A power below the line, its exponent's sign flipped.
+    Pow(&'a Expr, Expr),
+    /// An integer: a rational constant's numerator or denominator.
+    Int(i128),
+}
+
+impl Part<'_> {
+    fn infix(&self, out: &mut String, parent: u8) {
+        match self {
+            Part::Is(e) => e.infix(out, parent),
+            Part::Pow(b, e) => pow_infix(b, e, out, parent),
+            Part::Int(n) => Expr::int(*n).infix(out, parent),
+        }
+    }
+
+    fn owned(&self) -> Expr {
+        match self {
+            Part::Is(e) => (*e).clone(),
+            Part::Pow(b, e) => Expr::Pow(Box::new((*b).clone()), Box::new(e.clone())),
+            Part::Int(n) => Expr::int(*n),
+        }
+    }
+}
+
+/// [`Expr::num_den`] of the product of `factors`, borrowing them.
+fn parts_num_den(factors: &[Expr]) -> (Vec<Part<'_>>, Vec<Part<'_>>) {
+    let mut num = Vec::new();
+    let mut den = Vec::new();
+    for f in factors {
+        match f {
+            Expr::Pow(b, e) => match e.as_integer() {
+                Some(-1) => den.push(Part::Is(b)),
+                Some(n) if n < 0 => den.push(Part::Pow(b, Expr::int(-n))),
+                _ => match &**e {
+                    Expr::Rational(n, d) if *n < 0 => {
+                        den.push(Part::Pow(b, Expr::Rational(-n, *d)))
+                    }
+                    _ => num.push(Part::Is(f)),
+                },
+            },
+            Expr::Rational(n, d) if *d != 1 => {
+                if *n != 1 {
+                    num.push(Part::Int(*n));
+                }
+                den.push(Part::Int(*d));
+            }
+            _ => num.push(Part::Is(f)),
+        }
+    }
+    (num, den)
+}
+
+/// The denominator `den` of a product as infix below its `/`: what `product(den)` prints
+/// at precedence 4. Factors that all stay above the line of that product are written as they
+/// are; any other product is made and printed.
+fn parts_infix(den: &[Part<'_>], out: &mut String) {
+    if let [one] = den {
+        return one.infix(out, 4);
+    }
+    // Every factor here is printed as a factor of the numerator of `product(den)`: no negative
+    // number (no sign to split off) and nothing that `num_den` puts below the line.
+    let plain = den.iter().all(|p| match p {
+        Part::Is(Expr::Rational(_, d)) if *d != 1 => false,
+        Part::Is(Expr::Pow(_, x)) => !x.is_negative_number(),
+        Part::Is(e) => !e.is_negative_number(),
+        Part::Pow(..) => true,
+        Part::Int(n) => *n >= 0,
+    });
+    if !plain || den.is_empty() {
+        return product(den.iter().map(Part::owned).collect()).infix(out, 4);
+    }
+    wrap(out, true, |o| {
+        for (i, f) in den.iter().enumerate() {
+            if i > 0 {
+                o.push('*');
+            }
+            f.infix(o, 3);
+        }
+    });
+}
+
+/// `b ^ e` as infix at precedence `parent`.
+fn pow_infix(b: &Expr, e: &Expr, out: &mut String, parent: u8) {
+    if let Some(-1) = e.as_integer() {
+        wrap(out, parent > 2, |o| {
+            o.push_str("1/");
+            b.infix(o, 4);
+        });
+        return;
+    }
+    wrap(out, parent > 4, |o| {
+        b.infix(o, 5);
+        o.push('^');
+        e.infix(o, 5);
+    });
 }
 
 /// A product of factors, simplified for 0 and 1 factors.
@@ -710,5 +818,93 @@ mod tests {
         assert_eq!(err.offset, 4);
         assert!(Expr::parse("sin(x").is_err());
         assert!(Expr::parse("x y").is_err());
+    }
+
+    #[test]
+    fn infix_of_signs_powers_and_denominators() {
+        let (x, y, z) = (Expr::sym("x"), Expr::sym("y"), Expr::sym("z"));
+        let pow = |b: &Expr, k: Expr| Expr::Pow(Box::new(b.clone()), Box::new(k));
+        let s = Expr::Add(vec![x.clone(), Expr::Mul(vec![Expr::int(-2), y.clone()])]);
+        // Each printed as the printer has always printed it (checked against its earlier,
+        // cloning form); the borrowed path and its fallbacks are all reached.
+        let cases: Vec<(Expr, &str)> = vec![
+            (Expr::Mul(vec![Expr::int(-3), x.clone()]), "-(3*x)"),
+            (
+                Expr::Mul(vec![Expr::int(-2), Expr::int(-3), x.clone()]),
+                "(-2)*(-3)*x",
+            ),
+            (
+                Expr::Mul(vec![
+                    Expr::Rational(3, 4),
+                    x.clone(),
+                    pow(&y, Expr::int(-1)),
+                ]),
+                "3*x/(4*y)",
+            ),
+            (
+                Expr::Mul(vec![
+                    x.clone(),
+                    pow(&s, Expr::int(-2)),
+                    pow(&z, Expr::int(-1)),
+                ]),
+                "x/((x - 2*y)^2*z)",
+            ),
+            (
+                Expr::Mul(vec![
+                    x.clone(),
+                    pow(&y, Expr::Rational(-1, 2)),
+                    pow(&Expr::int(-2), Expr::int(-1)),
+                ]),
+                "x/(-(y^(1/2)*2))",
+            ),
+            (
+                Expr::Mul(vec![
+                    x.clone(),
+                    pow(&pow(&y, Expr::int(-2)), Expr::int(-1)),
+                    pow(&z, Expr::int(-3)),
+                ]),
+                "x/(z^3/y^2)",
+            ),
+            (
+                Expr::Mul(vec![
+                    pow(&x, Expr::int(-1)),
+                    pow(&Expr::Rational(1, 2), Expr::int(-1)),
+                ]),
+                "1/(x/2)",
+            ),
+            (Expr::Mul(vec![pow(&x, Expr::int(-1))]), "1/x"),
+            (Expr::Mul(vec![Expr::Rational(-1, 3)]), "-(1/3)"),
+            (Expr::Mul(vec![]), "1"),
+            (
+                Expr::Add(vec![
+                    Expr::Mul(vec![Expr::int(-1), x.clone()]),
+                    Expr::Mul(vec![Expr::Float(-0.5), y.clone(), pow(&s, Expr::int(-1))]),
+                    Expr::Mul(vec![Expr::int(-1), Expr::int(-1), z.clone()]),
+                    Expr::Mul(vec![z.clone()]),
+                    Expr::Rational(-5, 2),
+                ]),
+                "-x - 0.5*y/(x - 2*y) + z + z - 5/2",
+            ),
+            (pow(&s, Expr::int(-1)), "1/(x - 2*y)"),
+            (
+                Expr::Mul(vec![
+                    Expr::Rational(2, 3),
+                    pow(&s, Expr::int(-1)),
+                    pow(&x, Expr::Rational(1, 2)),
+                ]),
+                "2*x^(1/2)/(3*(x - 2*y))",
+            ),
+            (
+                Expr::Mul(vec![
+                    Expr::Rational(5, 3),
+                    pow(&x, Expr::int(-2)),
+                    Expr::Float(-1.5),
+                ]),
+                "-(5*1.5/(3*x^2))",
+            ),
+        ];
+        for (e, want) in cases {
+            assert_eq!(e.to_infix(), want, "{e:?}");
+        }
     }
 }
