@@ -625,8 +625,8 @@ pub fn render_all(root: &Path, specs: &[PathBuf]) -> Result<(Vec<Rendered>, Timi
     };
     // Every symbol of every spec first, in one order: the output then does not depend on
     // which specs were selected (Symbolica orders terms by when a symbol was first defined).
-    let specs: Vec<&spec::Spec> = all.iter().chain(&selected).map(|c| &c.spec).collect();
-    let symbols = mechanics::canonical_symbols(&specs);
+    let every: Vec<&spec::Spec> = all.iter().chain(&selected).map(|c| &c.spec).collect();
+    let symbols = mechanics::canonical_symbols(&every);
     on_cas_thread(move || cas::declare(&symbols))?;
     let mut out = Vec::new();
     let mut timings = Vec::new();
