@@ -433,7 +433,7 @@ pub fn positive_on<const N: usize>(coeffs: &[f64; N], lo: f64, hi: f64) -> bool 
 /// for any value that is not finite (a NaN fails the comparison).
 #[inline]
 fn positive_by_signs(c: &[f64], lo: f64, hi: f64) -> bool {
-    if !(lo >= 0.0) {
+    if lo.is_nan() || lo < 0.0 {
         return false;
     }
     let (mut least, mut size) = (0.0, 0.0);

@@ -25,7 +25,7 @@ struct Node {
 
 /// `v` where `sin(theta)` has dropped by `drop >= 0` from a start of scale `e`:
 /// `asinh(sqrt(q))`, `q = drop / e`, as `log1p(x + q / (1 + sqrt(1 + q)))` (the inlined
-/// [`ln_1p`]), exact for small and large `q` without `hypot`.
+/// `hyperbolic::ln_1p`), exact for small and large `q` without `hypot`.
 #[inline]
 pub fn v_at_drop(e: f64, drop: f64) -> f64 {
     let q = drop.max(0.0) / e;
