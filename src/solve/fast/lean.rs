@@ -542,14 +542,13 @@ impl<M: Model + ?Sized> LeanRoute for M {
         sin_end: f64,
         evals: &mut u64,
     ) -> Option<LeanPoint> {
-        // Matched by reference, not moved out of the `Option` by `?` (a copy of the start).
-        let start = self.lean_start(p);
-        let Some(start) = &start else {
-            return None;
-        };
-        quick_route(start, prior, sin_end, evals, |f, rule, a, b| {
-            f.panel(rule, a, b, a == 0.0)
-        })
+        quick_route(
+            &self.lean_start(p),
+            prior,
+            sin_end,
+            evals,
+            |f, rule, a, b| f.panel(rule, a, b, a == 0.0),
+        )
     }
 
     /// The body repeats `lean_point`'s with the panel's AVX2 build named: calling
@@ -564,13 +563,13 @@ impl<M: Model + ?Sized> LeanRoute for M {
         sin_end: f64,
         evals: &mut u64,
     ) -> Option<LeanPoint> {
-        let start = self.lean_start(p);
-        let Some(start) = &start else {
-            return None;
-        };
-        quick_route(start, prior, sin_end, evals, |f, rule, a, b| {
-            f.panel_avx2(rule, a, b, a == 0.0)
-        })
+        quick_route(
+            &self.lean_start(p),
+            prior,
+            sin_end,
+            evals,
+            |f, rule, a, b| f.panel_avx2(rule, a, b, a == 0.0),
+        )
     }
 }
 
@@ -585,18 +584,22 @@ fn has_avx2() -> bool {
 /// The unchecked route from a point's start ([`Model::lean_start`]) with nothing but numbers
 /// in between: the separation polynomial's root ([`poly::largest_root`]) in `(sin_end,
 /// sin(theta_i))`, the fall's integrand ([`FallIntegrand`]) and the a-priori plan
-/// ([`prior_panels`]), each the one copy the checked route also uses. `None` on anything short
+/// ([`prior_panels`]), each the one copy the checked route also uses. `None` without a start (`Model::lean_start` gave none) and on anything short
 /// of a phase that falls from rest to a separation inside it with positive finite values at
 /// every node: the checked route ([`LeanSolver::solve`]) then solves the point again and names
 /// what failed. Called from [`LeanRoute::lean_point`], once per compiled copy of the route.
 #[inline(always)]
 pub(crate) fn quick_route(
-    start: &LeanStart,
+    start: &Option<LeanStart>,
     prior: &Prior,
     sin_end: f64,
     evals: &mut u64,
     rule_on: impl Fn(&FallIntegrand, &HalfRule, f64, f64) -> PanelSum,
 ) -> Option<LeanPoint> {
+    // Matched by reference, not moved out of the `Option` by `?` (a copy of the start).
+    let Some(start) = start else {
+        return None;
+    };
     let (si, ci) = (start.sin_initial, start.cos_initial);
     // Every coefficient finite, by one test (`0 c` is 0 exactly when `c` is finite; no
     // iterator adapter, which each copy of the route would call out of line).
