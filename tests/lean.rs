@@ -465,16 +465,16 @@ fn a_system_is_solved_by_its_release_phase_and_other_phases_are_refused() {
 /// with the linear polynomial `P`: a floor that lets the foot go where `P` vanishes.
 struct FloorLetsGo {
     /// `P`'s coefficients, lowest degree first.
-    floor: [f64; 2],
+    floor: [f64; 3],
     info: &'static ModelInfo,
 }
 
-/// `rod_cube_closed`'s description with the floor's force polynomial of degree 1.
+/// `rod_cube_closed`'s description with the floor's force polynomial of degree 2.
 static FLOOR_INFO: LazyLock<ModelInfo> = LazyLock::new(|| {
     let base = ROD_CUBE.info();
     ModelInfo {
         reduction: base.reduction.map(|r| ReductionInfo {
-            force_degrees: &[3, 1],
+            force_degrees: &[3, 2],
             ..r
         }),
         ..*base
@@ -482,7 +482,7 @@ static FLOOR_INFO: LazyLock<ModelInfo> = LazyLock::new(|| {
 });
 
 impl FloorLetsGo {
-    fn new(floor: [f64; 2]) -> FloorLetsGo {
+    fn new(floor: [f64; 3]) -> FloorLetsGo {
         FloorLetsGo {
             floor,
             info: &FLOOR_INFO,
@@ -490,7 +490,8 @@ impl FloorLetsGo {
     }
 
     fn floor_force(&self, k: &[f64], s: f64) -> f64 {
-        k[0] * k[4] * (self.floor[0] + self.floor[1] * s)
+        let [c0, c1, c2] = self.floor;
+        k[0] * k[4] * (c0 + s * (c1 + s * c2))
     }
 }
 
@@ -561,11 +562,22 @@ fn another_contact_that_lets_go_first_is_not_this_phase() {
     let paper = solver.solve(&PAPER).unwrap();
     assert!((paper.separation_angle.sin() - 0.167).abs() < 1e-3);
     // A floor that lets go at sin(theta) = 0.1, after the separation: the same answer.
-    let after = FloorLetsGo::new([-0.1, 1.0]);
+    let after = FloorLetsGo::new([-0.1, 1.0, 0.0]);
     let out = LeanSolver::new(&after).unwrap().solve(&PAPER).unwrap();
     assert_eq!(out, paper);
+    // A floor whose push comes within 1e-15 of zero at sin(theta) = 0.2 and pushes again:
+    // too close for `positive_on`'s bounds, so the route asks the root finder, which finds
+    // no sign change (the same answer).
+    let grazes = FloorLetsGo::new([0.04 + 1e-15, -0.4, 1.0]);
+    let out = LeanSolver::new(&grazes).unwrap().solve(&PAPER).unwrap();
+    assert_eq!(out, paper);
+    assert!(!rodcube::solve::fast::poly::positive_on(
+        &[0.04 + 1e-15, -0.4, 1.0],
+        0.167,
+        0.25
+    ));
     // At sin(theta) = 0.2, before it: the phase the solver solves ends with the foot lifting.
-    let before = FloorLetsGo::new([-0.2, 1.0]);
+    let before = FloorLetsGo::new([-0.2, 1.0, 0.0]);
     match LeanSolver::new(&before).unwrap().solve(&PAPER) {
         Err(SolveError::NotThisPhase {
             model,
@@ -578,7 +590,7 @@ fn another_contact_that_lets_go_first_is_not_this_phase() {
         other => panic!("{other:?}"),
     }
     // A floor that would have to pull from the start (P < 0 on the whole phase).
-    let pulls = FloorLetsGo::new([-1.0, 1.0]);
+    let pulls = FloorLetsGo::new([-1.0, 1.0, 0.0]);
     match LeanSolver::new(&pulls).unwrap().solve(&PAPER) {
         Err(SolveError::NotThisPhase {
             model,

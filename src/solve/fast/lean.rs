@@ -611,18 +611,15 @@ pub(crate) fn quick_route(
     let (sep, fall) = (&start.separation[..], &start.fall[..]);
     // Every closed contact pushes at release (each polynomial has its force's sign), and no
     // other one lets go before the separation.
-    // (A NaN is no push: `partial_cmp` is `None`, not `Greater`.)
-    let pushes = |p: &[f64]| horner(p, si).partial_cmp(&0.0) == Some(std::cmp::Ordering::Greater);
-    if !pushes(sep) {
+    if !pushes(sep, si) {
         return None;
     }
     let s = poly::largest_root(sep, sin_end, si, evals)??;
     for other in start.others.iter().take(start.n_others) {
         // Certainly positive on [s, si] (so at release too), else pushing at release and no
-        // root in between.
-        if !poly::positive_on(other, s, si)
-            && (!pushes(other) || poly::largest_root(other, s, si, evals)?.is_some())
-        {
+        // root in between (out of line: `positive_on` decides every push of the per-point
+        // set, mostly by its first stage).
+        if !poly::positive_on(other, s, si) && !pushes_until(other, s, si, evals)? {
             return None;
         }
     }
@@ -657,6 +654,22 @@ pub(crate) fn quick_route(
         sines: [si, ci, s, drop],
         fall: Some(start.fall),
     })
+}
+
+/// Whether the force polynomial `p` pushes at `x` (a NaN is no push: `partial_cmp` is `None`,
+/// not `Greater`).
+#[inline(always)]
+fn pushes(p: &[f64], x: f64) -> bool {
+    horner(p, x).partial_cmp(&0.0) == Some(std::cmp::Ordering::Greater)
+}
+
+/// Whether a push `other` that [`poly::positive_on`] could not certify on `[s, si]` pushes at
+/// release and has no root in between (`None` past the root finder's degree). Out of line:
+/// the rare path.
+#[cold]
+#[inline(never)]
+fn pushes_until(other: &[f64], s: f64, si: f64, evals: &mut u64) -> Option<bool> {
+    Some(pushes(other, si) && poly::largest_root(other, s, si, evals)?.is_none())
 }
 
 #[cfg(test)]

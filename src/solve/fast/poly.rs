@@ -414,15 +414,22 @@ fn quadratic_roots(c: &[f64], lo: f64, hi: f64, out: &mut [f64; MAX_DEGREE]) -> 
 /// 813 of the 1,000 floor pushes of `examples/per_point.rs`' set); Taylor's formula at `hi`
 /// with a bound of the curvature (`positive_by_curvature`, `O(N)` flops), which decides
 /// every floor push of the per-point route; the Bernstein form (`positive_by_bernstein`,
-/// `O(N^2)`).
+/// `O(N^2)`). Only the first is inlined into the caller: the others are one call out of line
+/// (inlined, their set-up was hoisted into the per-point route and spilled around it, 39
+/// instructions a point more over `examples/per_point.rs`' set).
 #[inline]
 pub fn positive_on<const N: usize>(coeffs: &[f64; N], lo: f64, hi: f64) -> bool {
     if N == 0 || N > MAX_DEGREE || lo.partial_cmp(&hi).is_none_or(|o| o.is_gt()) {
         return false;
     }
-    positive_by_signs(coeffs, lo, hi)
-        || positive_by_curvature(coeffs, lo, hi)
-        || positive_by_bernstein(coeffs, lo, hi)
+    positive_by_signs(coeffs, lo, hi) || positive_past_signs(coeffs, lo, hi)
+}
+
+/// The stages of [`positive_on`] after the first, out of line.
+#[cold]
+#[inline(never)]
+fn positive_past_signs<const N: usize>(coeffs: &[f64; N], lo: f64, hi: f64) -> bool {
+    positive_by_curvature(coeffs, lo, hi) || positive_by_bernstein(coeffs, lo, hi)
 }
 
 /// The first stage of [`positive_on`] (`lo <= hi`, `coeffs` not empty): for `0 <= lo`, each
