@@ -1063,6 +1063,79 @@ fn hinged_rod_spring_fast_and_integrated_routes_agree() {
     }
 }
 
+/// A rod lying almost flat (`a/ell = 1e-8`) on a stiff spring (`k = 5000`): the spring's
+/// stretch `ell (cos theta - cos theta_i)` is `3e-17 ell`, below the rounding of the cube's
+/// place `x2 ~ ell` that the integrated general model carries, yet its force shifts the
+/// separation by `1.6e-7` relative (against `k = 50`). The fast path (the energy integral in
+/// `theta`) agrees with the hand Newton–Euler reference, which forms the stretch without
+/// cancellation; the cross-check's integrated route misses it by that much, and the run says
+/// so in a note instead of letting the two routes' difference pass unremarked.
+#[test]
+fn a_nearly_flat_rod_on_a_stiff_spring_is_solved_in_theta_and_the_cross_check_says_it_is_apart() {
+    let hand = HingedSpring {
+        m1: 1.0,
+        m2: 3.0,
+        ell: 1.0,
+        a: 1e-8,
+        g: G,
+        k: 5000.0,
+    };
+    let th_sep = hand.first_zero(|t| hand.solve(t).1).expect("separates");
+    let t_sep = hand.time_to(th_sep);
+    // The spring's share is physical: the same rod without it separates 1.6e-7 away.
+    let soft = HingedSpring { k: 0.0, ..hand };
+    let th_soft = soft.first_zero(|t| soft.solve(t).1).expect("separates");
+    let shift = (th_soft - th_sep).abs() / th_sep;
+    assert!(
+        shift > 1e-7,
+        "the spring shifts the separation by {shift:e}"
+    );
+    let want = [
+        Quantity::SeparationAngle,
+        Quantity::SeparationTime,
+        Quantity::CrossCheck,
+    ];
+    let r = ask(
+        "hinged_rod_spring",
+        &hand.parameters(),
+        &want,
+        1e-12,
+        Route::Fastest,
+    );
+    // The hand reference bisects to the last bit; its time is 20-point Gauss on 16 panels.
+    close(
+        value(&r, "separation_angle"),
+        th_sep,
+        1e-11,
+        "theta_sep vs hand",
+    );
+    close(value(&r, "separation_time"), t_sep, 1e-11, "t_sep vs hand");
+    let apart = value(&r, "cross_check_relative_difference");
+    let rtol = value(&r, "cross_check_rtol");
+    assert!(apart > 1e-8, "the integrated route is {apart:e} apart");
+    match r.notes.get("cross_check") {
+        Some(rodcube::results::Note::CrossCheckApart { relative, rtol: r2 }) => {
+            assert_eq!((*relative, *r2), (apart, rtol));
+        }
+        other => panic!("{other:?}"),
+    }
+    let words = rodcube::report::prose::note(&r.notes["cross_check"]);
+    assert!(words.contains("ill-conditioned"), "{words}");
+    // At the scene's a = 0.25 the two routes agree and nothing is said.
+    let scene = ask(
+        "hinged_rod_spring",
+        &spring_params(50.0),
+        &want,
+        1e-12,
+        Route::Fastest,
+    );
+    assert!(
+        !scene.notes.contains_key("cross_check"),
+        "{:?}",
+        scene.notes
+    );
+}
+
 /// A rod leaning low (`a/ell = 2.3e-4`) on a light cube (`m2 = 1.6e-3 m1`) held by a spring: the
 /// fast phase ends where the push vanishes, and the general model takes over there with the
 /// contact open. The handover state is formed from the fast phase's angle; the general

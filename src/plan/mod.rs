@@ -37,7 +37,11 @@
 //! [`unreduced::CONDITION_SAFETY`]). Series: `theta_series` (`t, theta, theta_dot,
 //! theta_ddot`), `<contact>_series` (`t, theta, <contact>`), `<point>_trajectory`
 //! (`t, x, y, vx, vy`). A wanted quantity without a value (e.g. no separation, or a mass matrix
-//! too ill-conditioned for the cross-check) is explained in [`RunResults::notes`] under its key.
+//! too ill-conditioned for the cross-check) is explained in [`RunResults::notes`] under its key,
+//! and so is a cross-check whose event time lies further from the fast path's than
+//! [`CROSS_CHECK_APART`](crate::results::CROSS_CHECK_APART) times its tolerance
+//! ([`Note::CrossCheckApart`](crate::results::Note::CrossCheckApart)): one route is then
+//! ill-conditioned, e.g. the general model carrying a motion of `1e-16` of its coordinates.
 
 pub mod drawing;
 mod quantities;

@@ -2,7 +2,7 @@
 //! integrated with the same contacts closed, and the physical checks of every phase.
 
 use super::{Plan, scalar};
-use crate::results::{CheckKind, CheckPhase, Meaning, Note, RunResults, Work};
+use crate::results::{CROSS_CHECK_APART, CheckKind, CheckPhase, Meaning, Note, RunResults, Work};
 use crate::solve::SolveError;
 use crate::solve::checks::{self, Conserved, free_momenta};
 use crate::solve::integrated::unreduced::UnreducedRun;
@@ -58,6 +58,15 @@ impl Plan<'_> {
         } else {
             (ode.t_end - t_quad).abs()
         };
+        // The same event, reached at times further apart than the integrator's tolerance
+        // explains (a NaN is not apart: the figures below show it).
+        if same && rel > CROSS_CHECK_APART * ode.rtol {
+            let note = Note::CrossCheckApart {
+                relative: rel,
+                rtol: ode.rtol,
+            };
+            out.notes.insert("cross_check".into(), note);
+        }
         let (dt_max, dy_max, nodes) =
             // The integrated state is the general model's: its reduced coordinate's index
             // there (the fast phase's own model orders its coordinates otherwise).

@@ -7,9 +7,9 @@
 use std::fmt;
 
 use crate::results::{
-    Check, CheckKind, CheckPhase, CheckSubject, ContactSet, EndCause, Halt, Held, Holding,
-    Indeterminacy, LabelValue, Meaning, Mode, Note, Sensitivity, SensitivityGap, Sign, TapeReason,
-    Unlanded, UntilNote, Zeno, format_number,
+    CROSS_CHECK_APART, Check, CheckKind, CheckPhase, CheckSubject, ContactSet, EndCause, Halt,
+    Held, Holding, Indeterminacy, LabelValue, Meaning, Mode, Note, Sensitivity, SensitivityGap,
+    Sign, TapeReason, Unlanded, UntilNote, Zeno, format_number,
 };
 
 /// Where a check ran, as the table's group heading and results.json's `phase` name it:
@@ -168,6 +168,15 @@ pub fn note(note: &Note) -> String {
              event",
             event_words(*integrated),
             event_words(*fast)
+        ),
+        Note::CrossCheckApart { relative, rtol } => format!(
+            "the integrated route reached the same event {} (relative) from the fast path's \
+             time, over {} times the tolerance it ran with ({}): one of the two routes is \
+             ill-conditioned at these parameters, so their digits beyond that difference are \
+             not confirmed",
+            format_number(*relative, 3),
+            format_number(CROSS_CHECK_APART, 3),
+            format_number(*rtol, 3)
         ),
         Note::NoLanding { t, path, end } => no_landing(*t, &path.join(" -> "), end),
         Note::FirstImpactEnds { t } => format!(

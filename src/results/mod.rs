@@ -16,7 +16,9 @@ pub use decisions::{ContactSet, Holding, Indeterminacy, Mode, Sign};
 pub use drawing::{Drawing, DrawnPhase, DrawnSample, Pose};
 pub use ends::{ContactId, EndCause};
 pub use meanings::Meaning;
-pub use notes::{Halt, Held, Note, SensitivityGap, TapeReason, Unlanded, UntilNote, Zeno};
+pub use notes::{
+    CROSS_CHECK_APART, Halt, Held, Note, SensitivityGap, TapeReason, Unlanded, UntilNote, Zeno,
+};
 
 /// A scalar result with its unit.
 #[derive(Debug, Clone, PartialEq, Serialize)]

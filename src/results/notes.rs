@@ -4,6 +4,12 @@
 
 use super::{ContactSet, EndCause, Holding};
 
+/// How many times the integrator's own relative tolerance the cross-check's event time may lie
+/// from the fast path's before [`Note::CrossCheckApart`] says so. Over `tests/plan.rs`' grid of
+/// extreme mass ratios, angles at release and tolerances the two agree within 1.1 times that
+/// tolerance (raised to the mass matrix's conditioning floor); a hundredfold is no rounding.
+pub const CROSS_CHECK_APART: f64 = 100.0;
+
 /// Why the motion stopped before its end (the solver's halt).
 #[derive(Debug, Clone, PartialEq)]
 pub enum Halt {
@@ -187,6 +193,16 @@ pub enum Note {
         integrated: EndCause,
         /// The fast path's event.
         fast: EndCause,
+    },
+    /// The cross-check's integrated route reached the fast path's event at a time further from
+    /// the fast path's than [`CROSS_CHECK_APART`] times the tolerance the integrator ran
+    /// with: one of the two routes is ill-conditioned at these parameters.
+    CrossCheckApart {
+        /// `|t_ode - t_quadrature| / t_quadrature`.
+        relative: f64,
+        /// The integrator's relative tolerance (the one asked, raised to the mass matrix's
+        /// conditioning floor).
+        rtol: f64,
     },
     /// The body did not land.
     NoLanding {
