@@ -1136,6 +1136,70 @@ fn a_nearly_flat_rod_on_a_stiff_spring_is_solved_in_theta_and_the_cross_check_sa
     );
 }
 
+/// `rod_cube_spring`, which has no fast path, with the rod lying almost flat: its integrated
+/// separation against the 40-digit reference of `docs/references/flat_spring_separation.py`
+/// (the Lagrangian written out by hand and integrated by mpmath's Taylor series; its figures
+/// are copied here). On a stiff spring (`a/ell = 1e-8`, `k = 5000`) the spring's stretch is
+/// below the last digit of the cube's place and the run misses it: a note says so, with an
+/// uncertainty that covers the actual error. On a weak one (`a/ell = 1.3e-9`, `k = 0.002`) the
+/// run is within its tolerance and nothing is said. At the scene's `a = 0.25`, nothing either.
+#[test]
+fn a_nearly_flat_rod_on_the_integrated_route_says_when_the_state_cannot_hold_its_spring() {
+    let stiff = [
+        ("m1", 1.0),
+        ("m2", 3.0),
+        ("ell", 1.0),
+        ("a", 1e-8),
+        ("g", G),
+        ("k", 5000.0),
+    ];
+    let want = [Quantity::SeparationAngle, Quantity::SeparationTime];
+    let r = ask("rod_cube_spring", &stiff, &want, 1e-12, Route::Fastest);
+    assert!(r.work.ode_steps > 0, "rod_cube_spring has no fast path");
+    let (t_ref, theta_ref) = (2.128_502_939_755_632e-5, 6.666_666_404_483_539e-9);
+    let error = (value(&r, "separation_time") - t_ref).abs() / t_ref;
+    assert!(error > 1e-8, "the run misses the spring by {error:e}");
+    let Some(rodcube::results::Note::ForceUnresolved {
+        contact, fraction, ..
+    }) = r.notes.get("contact_force_resolution")
+    else {
+        panic!("{:?}", r.notes);
+    };
+    assert_eq!(contact, "contact_force");
+    println!("stiff: error {error:.3e}, uncertainty {fraction:.3e}");
+    assert!(
+        error <= 2.0 * fraction && *fraction <= 100.0 * error,
+        "uncertainty {fraction:e} against the error {error:e}"
+    );
+    let theta_error = (value(&r, "separation_angle") - theta_ref).abs() / theta_ref;
+    assert!(theta_error <= 2.0 * fraction, "{theta_error:e}");
+    // A weak spring on a longer rod: within the tolerance asked, and no note.
+    let weak = [
+        ("m1", 2.970_473_351_180_773),
+        ("m2", 0.043_363_860_016_020_34),
+        ("ell", 22.353_462_479_335_995),
+        ("a", 2.920_356_798_726_687e-8),
+        ("g", 11.139_619_251_114_76),
+        ("k", 0.002_036_987_677_333_674_5),
+    ];
+    let r = ask("rod_cube_spring", &weak, &want, 1e-10, Route::Fastest);
+    let t_ref = 3.413_434_118_076_044e-5;
+    let error = (value(&r, "separation_time") - t_ref).abs() / t_ref;
+    println!("weak: error {error:.3e}");
+    assert!(error < 1e-10, "{error:e}");
+    assert!(r.notes.is_empty(), "{:?}", r.notes);
+    let scene = [
+        ("m1", 1.0),
+        ("m2", 3.0),
+        ("ell", 1.0),
+        ("a", 0.25),
+        ("g", G),
+        ("k", 50.0),
+    ];
+    let r = ask("rod_cube_spring", &scene, &want, 1e-12, Route::Fastest);
+    assert!(r.notes.is_empty(), "{:?}", r.notes);
+}
+
 /// A rod leaning low (`a/ell = 2.3e-4`) on a light cube (`m2 = 1.6e-3 m1`) held by a spring: the
 /// fast phase ends where the push vanishes, and the general model takes over there with the
 /// contact open. The handover state is formed from the fast phase's angle; the general

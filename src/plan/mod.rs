@@ -41,7 +41,9 @@
 //! and so is a cross-check whose event time lies further from the fast path's than
 //! [`CROSS_CHECK_APART`](crate::results::CROSS_CHECK_APART) times its tolerance
 //! ([`Note::CrossCheckApart`](crate::results::Note::CrossCheckApart)): one route is then
-//! ill-conditioned, e.g. the general model carrying a motion of `1e-16` of its coordinates.
+//! ill-conditioned, e.g. the general model carrying a motion of `1e-16` of its coordinates; an
+//! integrated phase whose end's time that rounding makes uncertain beyond the tolerance is noted
+//! under `<contact>_resolution` ([`Note::ForceUnresolved`](crate::results::Note::ForceUnresolved)).
 
 pub mod drawing;
 mod quantities;
@@ -379,6 +381,7 @@ pub fn run(request: &Request) -> Result<RunResults, PlanError> {
         plan.drawing(&want, &mut out)?;
     }
     plan.motion_notes(&mut out);
+    plan.resolution_notes(&mut out)?;
     provenance_notes(info.name, &mut out);
     out.work = plan.work;
     check_finite(&out)?;

@@ -2,9 +2,12 @@
 //! integrated with the same contacts closed, and the physical checks of every phase.
 
 use super::{Plan, scalar};
-use crate::results::{CROSS_CHECK_APART, CheckKind, CheckPhase, Meaning, Note, RunResults, Work};
+use crate::results::{
+    CROSS_CHECK_APART, CheckKind, CheckPhase, FORCE_UNRESOLVED, Meaning, Note, RunResults, Work,
+};
 use crate::solve::SolveError;
 use crate::solve::checks::{self, Conserved, free_momenta};
+use crate::solve::integrated::resolution;
 use crate::solve::integrated::unreduced::UnreducedRun;
 use crate::solve::phases::PhaseRun;
 use crate::solve::series::{sample_forces, theta_dot_at};
@@ -92,6 +95,37 @@ impl Plan<'_> {
         scalar(out, "cross_check_time_deviation", dt_max, "s", meaning);
         let meaning = Meaning::CrossCheckStateDeviation { nodes };
         scalar(out, "cross_check_state_deviation", dy_max, "1", meaning);
+        Ok(())
+    }
+
+    /// For every integrated phase solved that ended at a contact's force reaching zero, where
+    /// the rounding of the state there makes the end's time uncertain by more than
+    /// [`FORCE_UNRESOLVED`] times the phase's tolerance ([`resolution::force_resolution`]): a
+    /// note under `<contact>_resolution`. Over the test suite's runs the largest such ratio is 5.3.
+    pub(super) fn resolution_notes(&self, out: &mut RunResults) -> Result<(), SolveError> {
+        let Some(motion) = &self.motion else {
+            return Ok(());
+        };
+        for run in &motion.phases {
+            let PhaseRun::Integrated(phase) = run else {
+                continue;
+            };
+            let Some((contact, fraction)) = resolution::force_resolution(&phase.bound, &phase.run)?
+            else {
+                continue;
+            };
+            let rtol = phase.run.rtol;
+            if fraction > FORCE_UNRESOLVED * rtol {
+                let note = Note::ForceUnresolved {
+                    contact: contact.name.to_string(),
+                    t: phase.t_start + phase.run.t_end,
+                    fraction,
+                    rtol,
+                };
+                out.notes
+                    .insert(format!("{}_resolution", contact.name), note);
+            }
+        }
         Ok(())
     }
 

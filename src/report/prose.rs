@@ -7,9 +7,9 @@
 use std::fmt;
 
 use crate::results::{
-    CROSS_CHECK_APART, Check, CheckKind, CheckPhase, CheckSubject, ContactSet, EndCause, Halt,
-    Held, Holding, Indeterminacy, LabelValue, Meaning, Mode, Note, Sensitivity, SensitivityGap,
-    Sign, TapeReason, Unlanded, UntilNote, Zeno, format_number,
+    CROSS_CHECK_APART, Check, CheckKind, CheckPhase, CheckSubject, ContactSet, EndCause,
+    FORCE_UNRESOLVED, Halt, Held, Holding, Indeterminacy, LabelValue, Meaning, Mode, Note,
+    Sensitivity, SensitivityGap, Sign, TapeReason, Unlanded, UntilNote, Zeno, format_number,
 };
 
 /// Where a check ran, as the table's group heading and results.json's `phase` name it:
@@ -176,6 +176,21 @@ pub fn note(note: &Note) -> String {
              not confirmed",
             format_number(*relative, 3),
             format_number(CROSS_CHECK_APART, 3),
+            format_number(*rtol, 3)
+        ),
+        Note::ForceUnresolved {
+            contact,
+            t,
+            fraction,
+            rtol,
+        } => format!(
+            "contact `{contact}` lets go at t = {} s on the integrated route, but the rounding of \
+             the state there makes that time uncertain by about {} (relative), over {} times \
+             the integrator's tolerance ({}): the force is a difference of nearly equal \
+             coordinates (e.g. a spring stretched by less than their last digits)",
+            format_number(*t, 6),
+            format_number(*fraction, 3),
+            format_number(FORCE_UNRESOLVED, 3),
             format_number(*rtol, 3)
         ),
         Note::NoLanding { t, path, end } => no_landing(*t, &path.join(" -> "), end),

@@ -10,6 +10,12 @@ use super::{ContactSet, EndCause, Holding};
 /// tolerance (raised to the mass matrix's conditioning floor); a hundredfold is no rounding.
 pub const CROSS_CHECK_APART: f64 = 100.0;
 
+/// How many times an integrated phase's relative tolerance the rounding of its state may make
+/// the time of the force's zero that ended it uncertain before [`Note::ForceUnresolved`] says
+/// so (the planner runs the integrator at a hundredth of the tolerance asked, so this is the
+/// tolerance asked).
+pub const FORCE_UNRESOLVED: f64 = 100.0;
+
 /// Why the motion stopped before its end (the solver's halt).
 #[derive(Debug, Clone, PartialEq)]
 pub enum Halt {
@@ -202,6 +208,19 @@ pub enum Note {
         relative: f64,
         /// The integrator's relative tolerance (the one asked, raised to the mass matrix's
         /// conditioning floor).
+        rtol: f64,
+    },
+    /// An integrated phase ended at a contact's force reaching zero, but the rounding of its
+    /// state makes that time uncertain by more than [`FORCE_UNRESOLVED`] times the phase's
+    /// tolerance.
+    ForceUnresolved {
+        /// The contact.
+        contact: String,
+        /// When the phase ended (s from release).
+        t: f64,
+        /// The relative uncertainty of that time.
+        fraction: f64,
+        /// The phase's relative tolerance.
         rtol: f64,
     },
     /// The body did not land.
