@@ -43,7 +43,7 @@
 //! ([`Note::CrossCheckApart`](crate::results::Note::CrossCheckApart)): one route is then
 //! ill-conditioned, e.g. the general model carrying a motion of `1e-16` of its coordinates; an
 //! integrated phase whose end's time that rounding makes uncertain beyond the tolerance is noted
-//! under `<contact>_resolution` ([`Note::ForceUnresolved`](crate::results::Note::ForceUnresolved)).
+//! under `<contact>_resolution` ([`Note::EndUnresolved`](crate::results::Note::EndUnresolved)).
 
 pub mod drawing;
 mod quantities;

@@ -7,9 +7,9 @@
 use std::fmt;
 
 use crate::results::{
-    CROSS_CHECK_APART, Check, CheckKind, CheckPhase, CheckSubject, ContactSet, EndCause,
-    FORCE_UNRESOLVED, Halt, Held, Holding, Indeterminacy, LabelValue, Meaning, Mode, Note,
-    Sensitivity, SensitivityGap, Sign, TapeReason, Unlanded, UntilNote, Zeno, format_number,
+    CROSS_CHECK_APART, Check, CheckKind, CheckPhase, CheckSubject, ContactSet, END_UNRESOLVED,
+    EndCause, Halt, Held, Holding, Indeterminacy, LabelValue, Meaning, Mode, Note, Sensitivity,
+    SensitivityGap, Sign, TapeReason, Unlanded, UntilNote, Zeno, format_number,
 };
 
 /// Where a check ran, as the table's group heading and results.json's `phase` name it:
@@ -178,19 +178,20 @@ pub fn note(note: &Note) -> String {
             format_number(CROSS_CHECK_APART, 3),
             format_number(*rtol, 3)
         ),
-        Note::ForceUnresolved {
-            contact,
+        Note::EndUnresolved {
+            end,
             t,
             fraction,
             rtol,
         } => format!(
-            "contact `{contact}` lets go at t = {} s on the integrated route, but the rounding of \
-             the state there makes that time uncertain by about {} (relative), over {} times \
-             the integrator's tolerance ({}): the force is a difference of nearly equal \
-             coordinates (e.g. a spring stretched by less than their last digits)",
+            "the integrated route ends at {} at t = {} s, but the rounding of the state there \
+             makes that time uncertain by about {} (relative), over {} times the integrator's \
+             tolerance ({}): what it measures is a difference of nearly equal coordinates \
+             (e.g. a spring stretched by less than their last digits)",
+            event_words(*end),
             format_number(*t, 6),
             format_number(*fraction, 3),
-            format_number(FORCE_UNRESOLVED, 3),
+            format_number(END_UNRESOLVED, 3),
             format_number(*rtol, 3)
         ),
         Note::NoLanding { t, path, end } => no_landing(*t, &path.join(" -> "), end),

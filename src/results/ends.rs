@@ -46,4 +46,12 @@ impl EndCause {
     pub fn is_force_of(self, index: usize) -> bool {
         matches!(self, EndCause::Force(c) if c.index == index)
     }
+
+    /// The contact whose event it is (its force, its edge, its gap closing), if any.
+    pub fn contact(self) -> Option<ContactId> {
+        match self {
+            EndCause::Force(c) | EndCause::Edge(c) | EndCause::Contact(c) => Some(c),
+            EndCause::Impact | EndCause::Floor | EndCause::Until => None,
+        }
+    }
 }

@@ -17,7 +17,7 @@ pub use drawing::{Drawing, DrawnPhase, DrawnSample, Pose};
 pub use ends::{ContactId, EndCause};
 pub use meanings::Meaning;
 pub use notes::{
-    CROSS_CHECK_APART, FORCE_UNRESOLVED, Halt, Held, Note, SensitivityGap, TapeReason, Unlanded,
+    CROSS_CHECK_APART, END_UNRESOLVED, Halt, Held, Note, SensitivityGap, TapeReason, Unlanded,
     UntilNote, Zeno,
 };
 

@@ -11,10 +11,10 @@ use super::{ContactSet, EndCause, Holding};
 pub const CROSS_CHECK_APART: f64 = 100.0;
 
 /// How many times an integrated phase's relative tolerance the rounding of its state may make
-/// the time of the force's zero that ended it uncertain before [`Note::ForceUnresolved`] says
+/// the time of the contact's event that ended it uncertain before [`Note::EndUnresolved`] says
 /// so (the planner runs the integrator at a hundredth of the tolerance asked, so this is the
 /// tolerance asked).
-pub const FORCE_UNRESOLVED: f64 = 100.0;
+pub const END_UNRESOLVED: f64 = 100.0;
 
 /// Why the motion stopped before its end (the solver's halt).
 #[derive(Debug, Clone, PartialEq)]
@@ -210,12 +210,12 @@ pub enum Note {
         /// conditioning floor).
         rtol: f64,
     },
-    /// An integrated phase ended at a contact's force reaching zero, but the rounding of its
-    /// state makes that time uncertain by more than [`FORCE_UNRESOLVED`] times the phase's
-    /// tolerance.
-    ForceUnresolved {
-        /// The contact.
-        contact: String,
+    /// An integrated phase ended at a contact's event (its force reaching zero, its gap
+    /// closing, its edge reached), but the rounding of its state makes that time uncertain by
+    /// more than [`END_UNRESOLVED`] times the phase's tolerance.
+    EndUnresolved {
+        /// The event.
+        end: EndCause,
         /// When the phase ended (s from release).
         t: f64,
         /// The relative uncertainty of that time.
