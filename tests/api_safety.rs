@@ -912,3 +912,52 @@ fn every_system_and_per_point_solver_refuses_bad_parameters_with_a_typed_error()
         assert!(matches!(r, Err(SolveError::Parameters(_))), "{name}: {r:?}");
     }
 }
+
+/// `resolution::end_resolution` on a run the integrator made gives a number, and on hand-made
+/// wrecks of it (no segment, a segment start shorter than the state, an end state of another
+/// length) a typed error, never a panic.
+#[test]
+fn an_end_resolution_of_a_broken_run_is_a_typed_error() {
+    use rodcube::solve::integrated::contacts::{self, Moment, Options};
+    use rodcube::solve::integrated::{resolution, unreduced};
+    let model = rodcube::models::find("rod_cube_liftoff").expect("generated");
+    let bound = bound_of(model);
+    let state = bound.initial_state();
+    let options = Options {
+        contacts: contacts::contact_options(&bound, &state, Moment::Release).expect("options"),
+        frictions: contacts::friction_options(&bound, &state).expect("options"),
+    };
+    let active = contacts::decide(&bound, &state, &options, 0.0).expect("decided");
+    let start = unreduced::Start {
+        state,
+        active,
+        frictions: vec![],
+        friction_work: 0.0,
+        stop_at: None,
+        dense_output: false,
+        sensitivity: None,
+    };
+    let mut work = rodcube::results::Work::default();
+    let run = unreduced::integrate(&bound, &start, 1e-10, None, 10.0, &mut work)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let Ok(Some((end, fraction))) = resolution::end_resolution(&bound, &run) else {
+        panic!(
+            "{:?} {:?} {:?}",
+            resolution::end_resolution(&bound, &run),
+            run.end,
+            start.active
+        );
+    };
+    assert_eq!(end, run.end);
+    assert!(fraction > 0.0 && fraction < 1e-12, "{fraction:e}");
+    let mut empty = run.clone();
+    empty.segments.clear();
+    let mut short = run.clone();
+    short.segments[0].y0.truncate(1);
+    let mut lopsided = run.clone();
+    lopsided.state_end = State::new(vec![0.1; 1], vec![0.0; 1]).expect("finite");
+    for (what, wreck) in [("empty", empty), ("short", short), ("lopsided", lopsided)] {
+        let r = unpanicked(what, || resolution::end_resolution(&bound, &wreck));
+        assert!(r.is_err(), "{what}: {r:?}");
+    }
+}

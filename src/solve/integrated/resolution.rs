@@ -47,7 +47,10 @@ pub fn end_resolution(
         info.contacts.len(),
         info.frictions.len(),
     );
-    let start = State::new(first.y0[..n].to_vec(), first.y0[n..2 * n].to_vec())?;
+    let (Some(q0), Some(qd0)) = (first.y0.get(..n), first.y0.get(n..2 * n)) else {
+        return Err(no_segment(run));
+    };
+    let start = State::new(q0.to_vec(), qd0.to_vec())?;
     let values = match measure {
         Measure::Force => contacts::dynamics(sys, &start, &first.active, first.t_start)?.forces,
         Measure::Gap => sys.gaps(&start)?,
@@ -120,8 +123,9 @@ enum Measure {
     Edge,
 }
 
-/// The error of a run that holds no segment, or none with a step, at its end (the integrator
-/// ends every run it returns with one; only a run built by hand can lack it).
+/// The error of a run that holds no segment, none with a step at its end, or a segment start
+/// shorter than its state (the integrator ends every run it returns with a whole one; only a
+/// run built by hand can lack it).
 fn no_segment(run: &UnreducedRun) -> SolveError {
     SolveError::Inversion {
         target: run.t_end,
