@@ -12,8 +12,8 @@ pub const CROSS_CHECK_APART: f64 = 100.0;
 
 /// How many times an integrated phase's relative tolerance the rounding of its state may make
 /// the time of the contact's event that ended it uncertain before [`Note::EndUnresolved`] says
-/// so (the planner runs the integrator at a hundredth of the tolerance asked, so this is the
-/// tolerance asked).
+/// so (the planner runs the integrator at a hundredth of the tolerance asked, never below
+/// `1e-13`, so this is the tolerance asked or `1e-11`, whichever is larger).
 pub const END_UNRESOLVED: f64 = 100.0;
 
 /// Why the motion stopped before its end (the solver's halt).
