@@ -148,6 +148,7 @@ static INFO: ModelInfo = ModelInfo {
         k_sin_initial: 6,
         k_cos_initial: 7,
         force_degrees: &[0, 0],
+        pushes_proven: &[false, false],
         fall_degree: None,
         lean_constants: &[5, 6, 7],
     }),

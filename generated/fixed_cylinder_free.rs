@@ -172,6 +172,7 @@ static INFO: ModelInfo = ModelInfo {
         k_sin_initial: 9,
         k_cos_initial: 10,
         force_degrees: &[0, 2],
+        pushes_proven: &[false, false],
         fall_degree: None,
         lean_constants: &[9, 10, 12, 26, 27, 29],
     }),

@@ -165,6 +165,7 @@ static INFO: ModelInfo = ModelInfo {
         k_sin_initial: 7,
         k_cos_initial: 8,
         force_degrees: &[0, 0, 0],
+        pushes_proven: &[false, false, false],
         fall_degree: None,
         lean_constants: &[6, 7, 8],
     }),

@@ -189,6 +189,7 @@ static INFO: ModelInfo = ModelInfo {
         k_sin_initial: 10,
         k_cos_initial: 11,
         force_degrees: &[0, 0, 0],
+        pushes_proven: &[false, false, false],
         fall_degree: None,
         lean_constants: &[10, 11],
     }),

@@ -156,6 +156,7 @@ static INFO: ModelInfo = ModelInfo {
         k_sin_initial: 7,
         k_cos_initial: 8,
         force_degrees: &[3, 0, 0],
+        pushes_proven: &[false, false, false],
         fall_degree: Some(2),
         lean_constants: &[6, 7, 8, 21, 28, 29, 30, 31],
     }),

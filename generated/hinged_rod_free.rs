@@ -180,6 +180,7 @@ static INFO: ModelInfo = ModelInfo {
         k_sin_initial: 9,
         k_cos_initial: 10,
         force_degrees: &[0, 0, 0],
+        pushes_proven: &[false, false, false],
         fall_degree: None,
         lean_constants: &[9, 10],
     }),

@@ -150,6 +150,7 @@ static INFO: ModelInfo = ModelInfo {
         k_sin_initial: 8,
         k_cos_initial: 9,
         force_degrees: &[0, 0, 0],
+        pushes_proven: &[false, false, false],
         fall_degree: None,
         lean_constants: &[7, 8, 9],
     }),

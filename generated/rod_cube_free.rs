@@ -181,6 +181,7 @@ static INFO: ModelInfo = ModelInfo {
         k_sin_initial: 11,
         k_cos_initial: 12,
         force_degrees: &[0, 2],
+        pushes_proven: &[false, false],
         fall_degree: None,
         lean_constants: &[11, 12, 15, 31, 32, 34],
     }),

@@ -135,6 +135,7 @@ static INFO: ModelInfo = ModelInfo {
         k_sin_initial: 6,
         k_cos_initial: 7,
         force_degrees: &[1, 2],
+        pushes_proven: &[false, false],
         fall_degree: Some(0),
         lean_constants: &[5, 6, 7, 16, 17, 18],
     }),

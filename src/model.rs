@@ -217,6 +217,11 @@ pub struct ReductionInfo {
     /// ([`Reduction::force_polynomial`]); 0 where there is none (an open or bilateral contact,
     /// or a force whose zero is found as a bracketed root of [`Reduction::forces`]).
     pub force_degrees: &'static [usize],
+    /// Per contact, whether the derivation proved its push positive over the whole phase
+    /// (`0 <= sin(theta) <= sin(theta_i)`) for every admissible parameter (the proof is in the
+    /// model's LaTeX): [`Model::lean_start`] then leaves its force polynomial out, and the
+    /// per-point route does not certify it point by point. Never the first contact.
+    pub pushes_proven: &'static [bool],
     /// Degree of the fall polynomial [`Reduction::fall_polynomial`], where the phase has one.
     pub fall_degree: Option<usize>,
     /// Indices in `k` (beyond the parameters) that [`Reduction::prepare_lean`] fills: the start's
@@ -415,7 +420,7 @@ pub trait Model: Send + Sync {
             if !c.closed {
                 return None;
             }
-            if c.bilateral {
+            if c.bilateral || *layout.pushes_proven.get(i)? {
                 continue;
             }
             let degree = *layout.force_degrees.get(i)?;

@@ -506,8 +506,8 @@ mod calls {
                 "a < ell",
             ),
             (
-                "m2 = 1e300",
-                solve(s, &p(1, 1e300)),
+                "m2 = 1e308",
+                solve(s, &p(1, 1e308)),
                 RODCUBE_ERR_PARAM_BAD_CONSTANT,
                 "non-finite constant",
             ),

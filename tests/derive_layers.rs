@@ -15,6 +15,7 @@ const DERIVE: &[&str] = &[
     "types",
     "cas",
     "algebra",
+    "positivity",
     "read",
     "setup",
     "lagrangian",

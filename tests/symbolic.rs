@@ -10,6 +10,8 @@
 use rodcube::derive::cas;
 use rodcube::derive::expr::Expr;
 use rodcube::derive::mechanics::{self, Derivation, Reduction};
+use rodcube::derive::positivity::push_proof;
+use rodcube::derive::types::ProofStep;
 use rodcube::derive::{derive_all, on_cas_thread, spec};
 use std::path::Path;
 
@@ -298,6 +300,155 @@ fn rod_cube_floor_push_is_the_hand_quartic() {
         ],
     );
     assert_positive_multiple("floor coefficients", &poly, &numerator, MASSES);
+}
+
+/// The derivation proves the floor's push positive over the contact phase for every mass
+/// (`derive::positivity`), as by hand: with `s^4 <= s^2` and `sin(theta_i) <= 1` the quartic is
+/// above `4 M^2 - 6 M (m1 + 4 m2) s + 3 (m1^2 + 10 m1 m2 + 12 m2^2) s^2` (`M = m1 + m2`), whose
+/// `4 a c - b^2 = M^2 (12 m1^2 + 192 m1 m2)` is positive. The contact on the cube, whose zero
+/// ends the phase, gets no proof.
+#[test]
+fn rod_cube_floor_push_is_proved_positive_as_by_hand() {
+    let d = derive("rod_cube");
+    let r = red(&d);
+    assert!(r.push_proofs[0].is_none());
+    let proof = r.push_proofs[1]
+        .as_ref()
+        .expect("the floor's push is proved positive");
+    let [a, b, c] = &proof.bound;
+    assert_equivalent("a", a, &parse("4*(m1 + m2)^2"));
+    assert_equivalent("b", b, &parse("-6*(m1 + m2)*(m1 + 4*m2)"));
+    assert_equivalent("c", c, &parse("3*(m1^2 + 10*m1*m2 + 12*m2^2)"));
+    let ProofStep::Discriminant(disc) = &proof.step else {
+        panic!(
+            "the floor's push is proved by a discriminant: {:?}",
+            proof.step
+        );
+    };
+    assert_equivalent(
+        "4 a c - b^2",
+        disc,
+        &parse("(m1 + m2)^2*(12*m1^2 + 192*m1*m2)"),
+    );
+}
+
+/// `derive::positivity::push_proof` on pushes written by hand: what it proves holds, and a
+/// push that reaches zero on `0 <= s <= sin(theta_i)`, or whose sign turns on a parameter of
+/// unknown sign, is refused.
+#[test]
+fn the_push_prover_claims_only_what_holds() {
+    // (coefficients, lowest degree first; what the proof must be: None for a refusal).
+    let cases: &[(&[&str], Option<&str>)] = &[
+        (&["m1", "0", "m2"], Some("signs")),
+        (&["4*m1", "-4*m1", "2*m1"], Some("discriminant")),
+        (&["2*m1", "-m1", "-m1/2"], Some("ends")),
+        // sin(theta_i) - s is zero at the start.
+        (&["rc_si", "-1"], None),
+        // 1 - 3 s + s^2: a root at 0.38.
+        (&["1", "-3", "1"], None),
+        // (1 - 3 s)^2: a double root at 1/3.
+        (&["1", "-6", "9"], None),
+        // m1 - m2 s: negative for m2 > m1.
+        (&["m1", "-m2"], None),
+        // x of unknown sign.
+        (&["1", "x"], None),
+        // 2 - s^3 - s^4 is 0 at s = 1.
+        (&["2", "0", "0", "-1", "-1"], None),
+        // 3 - rc_si s - s^4 >= 3 - s - s^2 >= 1: concave, least at an end.
+        (&["3", "-rc_si", "0", "0", "-1"], Some("ends")),
+    ];
+    let cases: Vec<(Vec<Expr>, Option<&'static str>)> = (cases.iter())
+        .map(|(c, want)| (c.iter().map(|t| parse(t)).collect(), *want))
+        .collect();
+    let got = on_cas_thread(move || {
+        let pos = vec!["m1".to_string(), "m2".to_string()];
+        (cases.iter())
+            .map(|(c, want)| {
+                let proof = push_proof(c, &pos).unwrap_or_else(|e| panic!("{e:?}"));
+                let kind = proof.map(|p| match p.step {
+                    ProofStep::Signs => "signs",
+                    ProofStep::Ends(_) => "ends",
+                    ProofStep::Discriminant(_) => "discriminant",
+                });
+                (format!("{c:?}"), kind, *want)
+            })
+            .collect::<Vec<_>>()
+    })
+    .expect("the Symbolica worker");
+    for (c, kind, want) in got {
+        assert_eq!(kind, want, "{c}");
+    }
+}
+
+/// Over random pushes `sum c_k m^i sin(theta_i)^j s^k` with small integer `c_k`, every one the
+/// prover proves is positive at every point of a grid of `0 <= s <= sin(theta_i) <= 1` and
+/// masses from 1e-3 to 1e3 (a soundness check against plain evaluation); some are proved.
+#[test]
+fn every_push_the_prover_proves_is_positive_where_evaluated() {
+    let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut next = move |n: u64| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state % n
+    };
+    let mut polys = Vec::new();
+    for _ in 0..400 {
+        let degree = 1 + next(4) as usize;
+        let coefficients: Vec<Expr> = (0..=degree)
+            .map(|k| {
+                let c = next(13) as i128 - 6 + i128::from(k == 0) * 6;
+                let mass = ["", "*m1", "*m1^2"][next(3) as usize];
+                let start = ["", "*rc_si", "*rc_si^2", "*rc_ci"][next(4) as usize];
+                parse(&format!("{c}{mass}{start}"))
+            })
+            .collect();
+        polys.push(coefficients);
+    }
+    let checked = polys.clone();
+    let proofs = on_cas_thread(move || {
+        let pos = vec!["m1".to_string()];
+        (polys.iter())
+            .map(|c| {
+                push_proof(c, &pos)
+                    .unwrap_or_else(|e| panic!("{e:?}"))
+                    .is_some()
+            })
+            .collect::<Vec<_>>()
+    })
+    .expect("the Symbolica worker");
+    let mut proved = 0;
+    for (c, proof) in checked.iter().zip(proofs) {
+        if !proof {
+            continue;
+        }
+        proved += 1;
+        for m1 in [1e-3, 0.5, 1.0, 7.0, 1e3] {
+            for i in 0..=20 {
+                let si = f64::from(i) / 20.0;
+                let ci = ((1.0 - si) * (1.0 + si)).sqrt();
+                for j in 0..=40 {
+                    let s = si * f64::from(j) / 40.0;
+                    let value: f64 = (c.iter().enumerate())
+                        .map(|(k, e)| {
+                            let at = |name: &str| match name {
+                                "m1" => Some(m1),
+                                "rc_si" => Some(si),
+                                "rc_ci" => Some(ci),
+                                _ => None,
+                            };
+                            e.eval(&at) * s.powi(k as i32)
+                        })
+                        .sum();
+                    assert!(
+                        value > 0.0,
+                        "{c:?} at m1 = {m1}, si = {si}, s = {s}: {value}"
+                    );
+                }
+            }
+        }
+    }
+    assert!(proved >= 20, "only {proved} of 400 proved");
 }
 
 #[test]

@@ -7,7 +7,8 @@
 //! 1. shared by every stage, below them all: [`types`] (what the stages hand each other, the
 //!    presentation's results included, and the layer's errors: [`types::StepError`] of a step,
 //!    [`types::DeriveError`] placed at a spec field), [`cas`] (the only module that calls
-//!    Symbolica) and [`algebra`] (trigonometric rewriting and polynomial helpers);
+//!    Symbolica), [`algebra`] (trigonometric rewriting and polynomial helpers) and
+//!    [`positivity`] (proofs that a push stays positive over a phase);
 //! 2. the stages of the derivation proper, a file each: [`read`] (the spec's expressions) →
 //!    [`setup`] → [`lagrangian`] → [`equations`] → [`constraints`] → [`reduction`] →
 //!    [`partials`] → [`forces`] → [`tangents`] (the general model's, for the forward
@@ -30,6 +31,7 @@ pub mod forces;
 pub mod lagrangian;
 pub mod mechanics;
 pub mod partials;
+pub mod positivity;
 pub mod present;
 pub mod read;
 pub mod reduction;

@@ -23,9 +23,12 @@ use super::constraints::ContactAtoms;
 use super::equations::Equations;
 use super::expr::{Expr, product};
 use super::lagrangian::Lagrangian;
+use super::positivity::push_proof;
 use super::setup::Setup;
 use super::spec::Spec;
-use super::types::{Constant, DeriveError, Partials, Reduction, Separation, Unreducible, at, key};
+use super::types::{
+    Constant, DeriveError, Partials, PushProof, Reduction, Separation, Unreducible, at, key,
+};
 use std::collections::BTreeMap;
 
 /// Stage 6, the reduction: the fast path of a phase, from its Lagrangian and equations.
@@ -123,6 +126,7 @@ impl Reducer<'_> {
                 _ => None,
             });
         }
+        let push_proofs = self.push_proofs(&force_polynomials)?;
         let fall = fall_polynomial(&red.wsq, &self.st.coords, self.theta())?;
         let plain = self.plain_forms(&red, contacts, &forces_reduced, &force_polynomials)?;
         Ok(Ok(Reduction {
@@ -139,6 +143,7 @@ impl Reducer<'_> {
                 .collect::<Result<_, _>>()?,
             constants: red.constants,
             force_polynomials,
+            push_proofs,
             fall,
             plain,
             partials: Partials::default(),
@@ -476,6 +481,28 @@ impl Reducer<'_> {
             })),
             None => Ok(Err(Unreducible::DegreeAbove16)),
         }
+    }
+
+    /// Per contact, the proof that its push stays positive over the phase
+    /// ([`push_proof`]), for every closed contact but the first (whose force's zero ends the
+    /// phase) with a force polynomial. The proof holds for `s = sin(theta) >= 0`: a phase whose
+    /// end angle is negative or unknown gets none.
+    fn push_proofs(
+        &self,
+        force_polynomials: &[Option<Separation>],
+    ) -> Result<Vec<Option<PushProof>>, DeriveError> {
+        let above_flat = self
+            .spec
+            .end_angle
+            .is_some_and(|e| (0.0..std::f64::consts::FRAC_PI_2).contains(&e));
+        let mut proofs = Vec::with_capacity(force_polynomials.len());
+        for (i, p) in force_polynomials.iter().enumerate() {
+            proofs.push(match p {
+                Some(sep) if i > 0 && above_flat => push_proof(&sep.coefficients, &self.positive)?,
+                _ => None,
+            });
+        }
+        Ok(proofs)
     }
 
     /// A reduced expression with `theta_dot^2` and `theta_ddot` substituted.

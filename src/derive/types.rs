@@ -236,6 +236,29 @@ pub struct Separation {
     pub polynomial: Expr,
 }
 
+/// How a [`PushProof`]'s quadratic bound is shown positive on `0 <= s <= 1`.
+#[derive(Debug, Clone)]
+pub enum ProofStep {
+    /// `a > 0`, `b >= 0` and `c >= 0`.
+    Signs,
+    /// `a > 0`, `c <= 0` and the value at `s = 1`, `a + b + c` (expanded), `> 0`.
+    Ends(Expr),
+    /// `a > 0` and `4 a c - b^2` (expanded) `> 0`: no real root.
+    Discriminant(Expr),
+}
+
+/// A proof that a closed contact's push is positive for `0 <= s = sin(theta) <=
+/// sin(theta_i)` and every admissible parameter: a quadratic `a + b s + c s^2` below its
+/// force polynomial there, and why that quadratic is positive (each sign that of an expanded
+/// polynomial in the positive parameters whose terms all have it).
+#[derive(Debug, Clone)]
+pub struct PushProof {
+    /// `[a, b, c]`, expanded.
+    pub bound: [Expr; 3],
+    /// Why the bound is positive.
+    pub step: ProofStep,
+}
+
 /// A parameter of a derived model.
 #[derive(Debug, Clone)]
 pub struct Param {
@@ -349,6 +372,10 @@ pub struct Reduction {
     /// Per contact: its force's zero as a polynomial in `sin(theta)`, where it is one (else the
     /// runtime finds that zero numerically, from the reduced force).
     pub force_polynomials: Vec<Option<Separation>>,
+    /// Per contact: the proof that its push stays positive over the whole phase for every
+    /// admissible parameter ([`positivity`](super::positivity)), where the derivation found one
+    /// (never for the first contact, whose force's zero ends the phase).
+    pub push_proofs: Vec<Option<PushProof>>,
     /// Coefficients in `sin(theta)` (lowest degree first, over constants) of the fall
     /// polynomial `P(s) = (sin theta_i - s) / theta_dot^2`, where that ratio is a polynomial in
     /// `s` alone: the phase starts from rest, its potential is linear in `sin(theta)` and its

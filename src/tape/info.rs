@@ -148,6 +148,9 @@ pub struct Reduction {
     pub k_sin_initial: usize,
     pub k_cos_initial: usize,
     pub force_degrees: Vec<usize>,
+    /// Empty in a tape written before the field was: no push proven.
+    #[serde(default)]
+    pub pushes_proven: Vec<bool>,
     pub fall_degree: Option<usize>,
     pub lean_constants: Vec<usize>,
 }
@@ -259,6 +262,20 @@ impl Info {
                     self.contacts.len()
                 ));
             }
+            if !r.pushes_proven.is_empty() && r.pushes_proven.len() != self.contacts.len() {
+                return Err(format!(
+                    "`pushes_proven` has {} entries for {} contacts",
+                    r.pushes_proven.len(),
+                    self.contacts.len()
+                ));
+            }
+            if r.pushes_proven.first() == Some(&true) {
+                return Err(
+                    "`pushes_proven` proves the first contact's push, whose zero \
+                            ends the phase"
+                        .into(),
+                );
+            }
         }
         Ok(())
     }
@@ -347,6 +364,11 @@ impl Info {
                 k_sin_initial: r.k_sin_initial,
                 k_cos_initial: r.k_cos_initial,
                 force_degrees: list(&r.force_degrees, |&d| d),
+                pushes_proven: if r.pushes_proven.is_empty() {
+                    list(&self.contacts, |_| false)
+                } else {
+                    list(&r.pushes_proven, |&b| b)
+                },
                 fall_degree: r.fall_degree,
                 lean_constants: list(&r.lean_constants, |&c| c),
             }),

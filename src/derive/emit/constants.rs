@@ -187,7 +187,12 @@ fn lean_prepare(
     // (an `asin`) is left to the full `prepare`.
     let mut stack = vec![code.k_sin_initial, code.k_cos_initial, wi];
     let fall = code.fall.stmts.iter().chain(&code.fall.outputs);
-    for line in code.polynomial_lines.iter().flatten().chain(fall) {
+    // A push the derivation proved positive is not certified point by point: its
+    // polynomial is no part of the lean start.
+    let certified = (code.polynomial_lines.iter().zip(&r.push_proofs))
+        .filter(|(_, proof)| proof.is_none())
+        .flat_map(|(lines, _)| lines);
+    for line in certified.chain(fall) {
         stack.extend(k_indices(line));
     }
     let mut needed = BTreeSet::new();

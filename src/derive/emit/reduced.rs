@@ -150,8 +150,9 @@ pub(super) fn reduction_info(
         .map(|p| p.as_ref().map_or(0, |s| s.coefficients.len() - 1))
         .collect();
     debug_assert_eq!(degrees.len(), d.contacts.len());
+    let proven: Vec<bool> = r.push_proofs.iter().map(Option::is_some).collect();
     Ok(format!(
-        "ReductionInfo {{ k_theta_initial: {}, k_theta_dot_initial: {wi}, k_sin_initial: {}, k_cos_initial: {}, force_degrees: &{degrees:?}, fall_degree: {:?}, lean_constants: &{:?} }}",
+        "ReductionInfo {{ k_theta_initial: {}, k_theta_dot_initial: {wi}, k_sin_initial: {}, k_cos_initial: {}, force_degrees: &{degrees:?}, pushes_proven: &{proven:?}, fall_degree: {:?}, lean_constants: &{:?} }}",
         code.k_theta_initial,
         code.k_sin_initial,
         code.k_cos_initial,

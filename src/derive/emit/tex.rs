@@ -6,11 +6,13 @@ use crate::derive::algebra::{from_sc, from_sc_over};
 use crate::derive::dimensionless::SEPARATION_SENSITIVITY;
 use crate::derive::expr::Expr;
 use crate::derive::present;
+use crate::derive::read::substitute;
 use crate::derive::spec::Checked;
 use crate::derive::types::{
-    ContactRow, Derivation, Dimensionless, Reduction, Shown, StepError, Steps,
+    ContactRow, Derivation, Dimensionless, ProofStep, Reduction, Shown, StepError, Steps,
 };
 use serde::Serialize;
+use std::collections::BTreeMap;
 
 /// `text` as LaTeX text on one line: every character TeX would read as a command or as
 /// markup is escaped, so spec text is printed, never run.
@@ -696,5 +698,90 @@ fn reduced_equations(
             name,
         ));
     }
+    push_proofs(d, r, theta, name, eqs);
     Ok(())
+}
+
+/// The proofs that a closed contact's push stays positive over the phase
+/// ([`positivity`](crate::derive::positivity)): its force polynomial, the quadratic below it
+/// and why that quadratic is positive.
+fn push_proofs(
+    d: &Derivation,
+    r: &Reduction,
+    theta: &str,
+    name: &dyn Fn(&str) -> String,
+    eqs: &mut Vec<Equation>,
+) {
+    let sin_start = Expr::Fun("sin".into(), vec![Expr::sym(&format!("{theta}_i"))]);
+    let start = BTreeMap::from([("rc_si".to_string(), sin_start)]);
+    let over_angle = |e: &Expr| from_sc(&substitute(e, &start), theta);
+    let proven = d
+        .contacts
+        .iter()
+        .zip(&r.force_polynomials)
+        .zip(&r.push_proofs);
+    for ((c, poly), proof) in proven {
+        let (Some(poly), Some(proof)) = (poly, proof) else {
+            continue;
+        };
+        let contact = tex_text(&c.name);
+        eqs.push(display(
+            &format!(
+                "Force \\texttt{{{contact}}} as a polynomial $P$ in $\\sin\\theta$ (positive \
+                 factors removed; its sign the force's)"
+            ),
+            "P = ".into(),
+            4,
+            &over_angle(&poly.polynomial),
+            None,
+            name,
+        ));
+        let [a, b, c2] = &proof.bound;
+        let below = "A quadratic below it, $P \\ge a + b \\sin\\theta + c \\sin^2\\theta$ for \
+                     $0 \\le \\sin\\theta \\le \\sin\\theta_i \\le 1$ ($\\sin\\theta_i$ and \
+                     $\\cos\\theta_i$ at most 1 in a negative term, $\\sin\\theta_i$ at least \
+                     $\\sin\\theta$ in a positive one, $\\sin^k\\theta \\le \\sin^2\\theta$ for \
+                     $k > 2$)";
+        for (title, lhs, e) in [
+            (below, "a = ", a),
+            ("Its coefficient $b$", "b = ", b),
+            ("Its coefficient $c$", "c = ", c2),
+        ] {
+            eqs.push(display(title, lhs.into(), 4, e, None, name));
+        }
+        let positive_over_phase = "so the push stays positive over the phase for every \
+                                   parameter (the per-point solver does not certify it point by \
+                                   point)";
+        let (title, lhs, e) = match &proof.step {
+            ProofStep::Signs => {
+                eqs.push(Equation {
+                    title: format!("Its coefficients' signs, term by term: {positive_over_phase}"),
+                    env: "equation*",
+                    latex: "a > 0, \\quad b \\ge 0, \\quad c \\ge 0".into(),
+                    tag: None,
+                    small: false,
+                });
+                continue;
+            }
+            ProofStep::Ends(e) => (
+                format!(
+                    "The quadratic is concave or straight, so least at an end: $a > 0$ term by \
+                     term, and so is its value at $\\sin\\theta = 1$, {positive_over_phase}"
+                ),
+                "a + b + c = ",
+                e,
+            ),
+            ProofStep::Discriminant(e) => (
+                format!(
+                    "The quadratic has no real root: $a > 0$ and $4ac - b^2 > 0$ term by term, \
+                     {positive_over_phase}"
+                ),
+                "4 a c - b^2 = ",
+                e,
+            ),
+        };
+        let mut eq = display(&title, lhs.into(), 8, e, None, name);
+        eq.latex.push_str(" > 0");
+        eqs.push(eq);
+    }
 }

@@ -72,9 +72,6 @@ pub struct LeanPoint {
     /// `sin(theta_i)`, `cos(theta_i)`, `sin(theta_sep)` and the drop `sin(theta_i) -
     /// sin(theta_sep)`, from which [`LeanPoint::delta`] is formed when asked.
     sines: [f64; 4],
-    /// The fall polynomial (padded with zeros to degree 2) where the a-priori route solved
-    /// the point, which the sensitivities reuse; `None` from the checked route.
-    fall: Option<[f64; 3]>,
 }
 
 impl LeanPoint {
@@ -253,13 +250,18 @@ impl<'m> LeanSolver<'m> {
         self.model
     }
 
-    /// Validates `p` (in the model's parameter order) exactly as
-    /// [`System::from_values`](crate::system::System::from_values) does, then solves.
+    /// Validates the values of `p` (in the model's parameter order) and the model's
+    /// requirements exactly as [`System::from_values`](crate::system::System::from_values)
+    /// does, then solves.
     ///
     /// With the a-priori rule the point is first solved from [`Model::lean_start`] (only the
     /// constants it reads, nothing checked but numbers); a point that fails that way is
     /// validated, and solved again from the lean constants and then from every constant, so
-    /// that its error is the one the full preparation reports.
+    /// that its error is the one the full preparation reports. So a constant the separation
+    /// reads that is not finite is the full preparation's [`SystemError::BadConstant`]; one
+    /// it does not read is not formed, and the point is solved where the full model is
+    /// refused (a cube of `1e300` kg: the floor's push, which the derivation proved positive,
+    /// has `m2^2` among its constants).
     #[inline]
     pub fn solve(&mut self, p: &[f64]) -> Result<LeanPoint, SolveError> {
         if let Some(prior) = &self.prior {
@@ -310,22 +312,13 @@ impl<'m> LeanSolver<'m> {
         }
         let [sin_initial, cos_initial, sin_sep, drop] = point.sines;
         // The partial derivatives read the parameters alone; the fall polynomial comes from
-        // the a-priori route where it solved the point, else from the lean constants.
-        match &point.fall {
-            Some(fall) => {
-                self.k[..np].copy_from_slice(p);
-                let len = self.layout.fall_degree.map_or(0, |d| d + 1).min(3);
-                self.fall.clear();
-                self.fall.extend_from_slice(&fall[..len]);
-            }
-            None => {
-                self.red.prepare_lean(p, &mut self.k);
-                self.fall.clear();
-                if let Some(degree) = self.layout.fall_degree {
-                    self.fall.resize(degree + 1, 0.0);
-                    self.red.fall_polynomial(&self.k, &mut self.fall);
-                }
-            }
+        // the lean constants (formed again here rather than kept in every point: the point's
+        // copies cost each solve more than this costs a sensitivity).
+        self.red.prepare_lean(p, &mut self.k);
+        self.fall.clear();
+        if let Some(degree) = self.layout.fall_degree {
+            self.fall.resize(degree + 1, 0.0);
+            self.red.fall_polynomial(&self.k, &mut self.fall);
         }
         let at = SeparationPoint {
             red: self.red,
@@ -406,7 +399,6 @@ impl<'m> LeanSolver<'m> {
                 separation_angle: si.asin(),
                 separation_time: 0.0,
                 sines: [si, self.k[self.layout.k_cos_initial], si, 0.0],
-                fall: None,
             });
         }
         let s = end.at.map_or(f64::NAN, |a| a.sin_theta);
@@ -440,7 +432,6 @@ impl<'m> LeanSolver<'m> {
             separation_angle: s.asin(),
             separation_time,
             sines: [si, ci, s, drop],
-            fall: None,
         };
         // The phase's end for messages, formed only for one.
         let delta_end = || point(f64::NAN).delta();
@@ -652,7 +643,6 @@ pub(crate) fn quick_route(
         separation_angle: s.asin(),
         separation_time: t,
         sines: [si, ci, s, drop],
-        fall: Some(start.fall),
     })
 }
 
@@ -721,7 +711,6 @@ mod tests {
             separation_angle: s.asin(),
             separation_time: 0.0,
             sines: [si, ((1.0 - si) * (1.0 + si)).sqrt(), s, si - s],
-            fall: None,
         }
     }
 
