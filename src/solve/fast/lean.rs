@@ -69,9 +69,10 @@ pub struct LeanPoint {
     pub separation_angle: f64,
     /// Time from release to separation (s).
     pub separation_time: f64,
-    /// `sin(theta_i)`, `cos(theta_i)`, `sin(theta_sep)` and the drop `sin(theta_i) -
-    /// sin(theta_sep)`, from which [`LeanPoint::delta`] is formed when asked.
-    sines: [f64; 4],
+    /// `sin(theta_i)`, `cos(theta_i)` and `sin(theta_sep)`, from which [`LeanPoint::delta`] is
+    /// formed when asked (with the drop `sin(theta_i) - sin(theta_sep)`, exact where the two
+    /// are within a factor of two, by Sterbenz's lemma, and formed as every route forms it).
+    sines: [f64; 3],
 }
 
 impl LeanPoint {
@@ -80,7 +81,8 @@ impl LeanPoint {
     /// `sin delta = (s_i - s)(s_i + s) / (s_i c + c_i s)` from the drop, without the
     /// cancellation of `theta_i - theta_sep` or of `s_i c - c_i s` when `delta` is small.
     pub fn delta(&self) -> f64 {
-        let [si, ci, s, drop] = self.sines;
+        let [si, ci, s] = self.sines;
+        let drop = si - s;
         let c = ((1.0 - s) * (1.0 + s)).sqrt();
         // sin(theta_i + theta_sep): the identity's denominator; near zero (theta_sep near
         // -theta_i, delta far from small) the plain difference is as accurate.
@@ -310,7 +312,8 @@ impl<'m> LeanSolver<'m> {
                 }));
             }
         }
-        let [sin_initial, cos_initial, sin_sep, drop] = point.sines;
+        let [sin_initial, cos_initial, sin_sep] = point.sines;
+        let drop = sin_initial - sin_sep;
         // The partial derivatives read the parameters alone; the fall polynomial comes from
         // the lean constants (formed again here rather than kept in every point: the point's
         // copies cost each solve more than this costs a sensitivity).
@@ -398,7 +401,7 @@ impl<'m> LeanSolver<'m> {
             return Ok(LeanPoint {
                 separation_angle: si.asin(),
                 separation_time: 0.0,
-                sines: [si, self.k[self.layout.k_cos_initial], si, 0.0],
+                sines: [si, self.k[self.layout.k_cos_initial], si],
             });
         }
         let s = end.at.map_or(f64::NAN, |a| a.sin_theta);
@@ -431,7 +434,7 @@ impl<'m> LeanSolver<'m> {
         let point = |separation_time| LeanPoint {
             separation_angle: s.asin(),
             separation_time,
-            sines: [si, ci, s, drop],
+            sines: [si, ci, s],
         };
         // The phase's end for messages, formed only for one.
         let delta_end = || point(f64::NAN).delta();
@@ -642,7 +645,7 @@ pub(crate) fn quick_route(
     Some(LeanPoint {
         separation_angle: s.asin(),
         separation_time: t,
-        sines: [si, ci, s, drop],
+        sines: [si, ci, s],
     })
 }
 
@@ -710,7 +713,7 @@ mod tests {
         LeanPoint {
             separation_angle: s.asin(),
             separation_time: 0.0,
-            sines: [si, ((1.0 - si) * (1.0 + si)).sqrt(), s, si - s],
+            sines: [si, ((1.0 - si) * (1.0 + si)).sqrt(), s],
         }
     }
 
