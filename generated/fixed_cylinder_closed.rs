@@ -149,6 +149,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 7,
         force_degrees: &[0, 0],
         pushes_proven: &[false, false],
+        release_push_proven: false,
         fall_degree: None,
         lean_constants: &[5, 6, 7],
     }),

@@ -173,6 +173,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 10,
         force_degrees: &[0, 2],
         pushes_proven: &[false, false],
+        release_push_proven: false,
         fall_degree: None,
         lean_constants: &[9, 10, 12, 26, 27, 29],
     }),

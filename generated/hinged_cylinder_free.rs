@@ -190,6 +190,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 11,
         force_degrees: &[0, 0, 0],
         pushes_proven: &[false, false, false],
+        release_push_proven: false,
         fall_degree: None,
         lean_constants: &[10, 11],
     }),

@@ -157,6 +157,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 8,
         force_degrees: &[3, 0, 0],
         pushes_proven: &[false, false, false],
+        release_push_proven: true,
         fall_degree: Some(2),
         lean_constants: &[6, 7, 8, 21, 28, 29, 30, 31],
     }),

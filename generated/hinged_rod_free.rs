@@ -181,6 +181,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 10,
         force_degrees: &[0, 0, 0],
         pushes_proven: &[false, false, false],
+        release_push_proven: false,
         fall_degree: None,
         lean_constants: &[9, 10],
     }),

@@ -156,6 +156,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 9,
         force_degrees: &[3, 4],
         pushes_proven: &[false, true],
+        release_push_proven: true,
         fall_degree: Some(2),
         lean_constants: &[7, 8, 9, 28, 35, 36, 41, 42],
     }),

@@ -192,6 +192,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 13,
         force_degrees: &[0, 2],
         pushes_proven: &[false, false],
+        release_push_proven: false,
         fall_degree: None,
         lean_constants: &[12, 13, 16, 40, 41, 42],
     }),

@@ -146,6 +146,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 8,
         force_degrees: &[3, 4],
         pushes_proven: &[false, true],
+        release_push_proven: true,
         fall_degree: Some(2),
         lean_constants: &[6, 7, 8, 26, 32, 33, 38, 39],
     }),

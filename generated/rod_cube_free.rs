@@ -182,6 +182,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 12,
         force_degrees: &[0, 2],
         pushes_proven: &[false, false],
+        release_push_proven: false,
         fall_degree: None,
         lean_constants: &[11, 12, 15, 31, 32, 34],
     }),

@@ -136,6 +136,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 7,
         force_degrees: &[1, 2],
         pushes_proven: &[false, false],
+        release_push_proven: true,
         fall_degree: Some(0),
         lean_constants: &[5, 6, 7, 16, 17, 18],
     }),

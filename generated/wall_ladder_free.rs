@@ -160,6 +160,7 @@ static INFO: ModelInfo = ModelInfo {
         k_cos_initial: 9,
         force_degrees: &[0, 2],
         pushes_proven: &[false, false],
+        release_push_proven: false,
         fall_degree: None,
         lean_constants: &[8, 9, 11, 24, 25, 27],
     }),

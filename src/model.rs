@@ -222,6 +222,10 @@ pub struct ReductionInfo {
     /// model's LaTeX): [`Model::lean_start`] then leaves its force polynomial out, and the
     /// per-point route does not certify it point by point. Never the first contact.
     pub pushes_proven: &'static [bool],
+    /// Whether the derivation proved that the first contact pushes at release
+    /// (`0 < sin(theta_i) <= 1`) for every admissible parameter (the proof is in the model's
+    /// LaTeX): [`Model::lean_start`] then does not evaluate its polynomial there.
+    pub release_push_proven: bool,
     /// Degree of the fall polynomial [`Reduction::fall_polynomial`], where the phase has one.
     pub fall_degree: Option<usize>,
     /// Indices in `k` (beyond the parameters) that [`Reduction::prepare_lean`] fills: the start's
@@ -389,7 +393,8 @@ pub trait Model: Send + Sync {
     /// them too), the model holds every contact of its system closed, has a fast path whose first
     /// contact's force is a polynomial of degree at most 3 and whose other closed unilateral
     /// contacts' forces are polynomials too, a fall polynomial of degree at most 2 and at most
-    /// [`LEAN_MAX_CONSTANTS`] constants; `None` says nothing about why (the checked route then
+    /// [`LEAN_MAX_CONSTANTS`] constants, and its first contact pushes at release (evaluated
+    /// unless [`ReductionInfo::release_push_proven`]); `None` says nothing about why (the checked route then
     /// decides and names it). A default method, so that each model's copy calls its own
     /// generated functions directly and the compiler fuses them: the generated
     /// [`Reduction::prepare_lean`] is always inlined, so the constants' scratch on the stack
@@ -414,6 +419,15 @@ pub trait Model: Send + Sync {
         let (mut separation, mut fall) = ([0.0; 4], [0.0; 3]);
         red.force_polynomial(k, 0, separation.get_mut(..sep_len)?);
         red.fall_polynomial(k, fall.get_mut(..fall_len)?);
+        let sin_initial = *k.get(layout.k_sin_initial)?;
+        // The first contact pushes at release, unless the derivation proved it does for every
+        // parameter (a NaN is no push: `partial_cmp` is `None`, not `Greater`).
+        if !layout.release_push_proven
+            && horner(&separation, sin_initial).partial_cmp(&0.0)
+                != Some(std::cmp::Ordering::Greater)
+        {
+            return None;
+        }
         let mut others = [[0.0; LEAN_OTHER_COEFFICIENTS]; LEAN_MAX_OTHERS];
         let mut n_others = 0;
         for (i, c) in info.contacts.iter().enumerate().skip(1) {
@@ -429,7 +443,7 @@ pub trait Model: Send + Sync {
             n_others += 1;
         }
         Some(LeanStart {
-            sin_initial: *k.get(layout.k_sin_initial)?,
+            sin_initial,
             cos_initial: *k.get(layout.k_cos_initial)?,
             theta_dot_initial: *k.get(layout.k_theta_dot_initial)?,
             separation,
@@ -670,6 +684,14 @@ pub(crate) fn parameters_pass<M: Model + ?Sized>(
     }
     model.requirements(p, margins);
     margins.iter().all(|&m| m > 0.0)
+}
+
+/// `p(x)` by Horner's rule (coefficients lowest degree first), with separate multiplies and
+/// adds (without a hardware FMA target feature `f64::mul_add` is a library call several times
+/// slower than the arithmetic). The crate's one copy (`solve::fast::poly` re-exports it).
+#[inline]
+pub fn horner(coeffs: &[f64], x: f64) -> f64 {
+    coeffs.iter().rev().fold(0.0, |acc, &c| acc * x + c)
 }
 
 /// Whether `v` is positive and finite, by one integer comparison: as bits, the positive finite

@@ -634,7 +634,9 @@ fn the_comparison_can_fail() {
 }
 
 /// Every push the derivation proved positive over its phase (`ReductionInfo::pushes_proven`,
-/// `derive::positivity`) is positive where the generated code evaluates it: the contact's force
+/// `derive::positivity`), and every first contact it proved to push at release
+/// (`release_push_proven`, checked at `delta = 0`), is positive where the generated code
+/// evaluates it: the contact's force
 /// from the reduced motion (`Reduction::forces`, not the polynomial the proof read) and its
 /// force polynomial, at 2,000 admissible parameter points per model (each parameter from 1e-3
 /// to 1e3, log-uniform, kept where the model's requirements pass) and 50 angles each from
@@ -643,7 +645,7 @@ fn the_comparison_can_fail() {
 #[test]
 fn every_push_proved_positive_is_positive_where_the_force_is_evaluated() {
     let mut rng = Rng(0x9_05e);
-    let mut proved = Vec::new();
+    let (mut proved, mut at_release) = (Vec::new(), Vec::new());
     for &model in rodcube::models::all() {
         let info = model.info();
         let (Some(layout), Some(red)) = (info.reduction, model.reduction()) else {
@@ -652,10 +654,15 @@ fn every_push_proved_positive_is_positive_where_the_force_is_evaluated() {
         let contacts: Vec<usize> = (0..info.contacts.len())
             .filter(|&i| layout.pushes_proven[i])
             .collect();
-        if contacts.is_empty() {
+        if contacts.is_empty() && !layout.release_push_proven {
             continue;
         }
-        proved.push(info.name);
+        if !contacts.is_empty() {
+            proved.push(info.name);
+        }
+        if layout.release_push_proven {
+            at_release.push(info.name);
+        }
         let (np, nc) = (info.parameters.len(), info.contacts.len());
         let mut margins = vec![0.0; info.requirements.len()];
         let (mut k, mut forces) = (vec![0.0; info.n_constants], vec![0.0; nc]);
@@ -668,6 +675,20 @@ fn every_push_proved_positive_is_positive_where_the_force_is_evaluated() {
             points += 1;
             model.prepare(&p, &mut k);
             let (theta_i, si) = (k[layout.k_theta_initial], k[layout.k_sin_initial]);
+            if layout.release_push_proven {
+                // The first contact at release: its force and its polynomial at sin(theta_i).
+                red.forces(&k, 0.0, &mut forces);
+                let mut poly = vec![0.0; layout.force_degrees[0] + 1];
+                red.force_polynomial(&k, 0, &mut poly);
+                let value = poly.iter().rev().fold(0.0, |acc, &a| acc * si + a);
+                assert!(
+                    forces[0] > 0.0 && value > 0.0,
+                    "{}: contact {} at release, p = {p:?}: force {}, polynomial {value}",
+                    info.name,
+                    info.contacts[0].name,
+                    forces[0]
+                );
+            }
             for j in 0..=50 {
                 let s = si * f64::from(j) / 50.0;
                 let delta = theta_i - s.asin();
@@ -688,4 +709,13 @@ fn every_push_proved_positive_is_positive_where_the_force_is_evaluated() {
         }
     }
     assert_eq!(proved, ["loaded_rod_closed", "rod_cube_closed"]);
+    assert_eq!(
+        at_release,
+        [
+            "hinged_rod_closed",
+            "loaded_rod_closed",
+            "rod_cube_closed",
+            "wall_ladder_closed"
+        ]
+    );
 }

@@ -326,6 +326,31 @@ fn a_constant_that_overflows_gets_the_full_preparations_error() {
 }
 
 #[test]
+fn a_first_contact_that_would_pull_at_release_gets_no_lean_start() {
+    // The hand model has no proof that its first contact pushes at release, so
+    // `Model::lean_start` evaluates the separation polynomial there: one that is -1 (the
+    // contact would pull) gives no start, and the checked route decides and names what is
+    // wrong (this polynomial has no root: no separation).
+    assert!(!ROD_CUBE.info().reduction.unwrap().release_push_proven);
+    assert!(ROD_CUBE.lean_start(&PAPER).is_some());
+    let pulls = Tweaked {
+        base: &ROD_CUBE,
+        reduction: &ROD_CUBE,
+        polynomial: Some(&[-1.0, 0.0, 0.0, 0.0]),
+        monitor_shift: 0.0,
+        nan_force: false,
+        theta_dot_sq: Fault::None,
+    };
+    assert!(pulls.lean_start(&PAPER).is_none());
+    match LeanSolver::new(&pulls).unwrap().solve(&PAPER) {
+        Err(SolveError::NoSeparation { coefficients, .. }) => {
+            assert_eq!(coefficients, [-1.0, 0.0, 0.0, 0.0]);
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
 fn a_cube_too_heavy_for_the_full_model_is_solved_at_the_fixed_cubes_separation() {
     // m2 = 1e300 kg: the full preparation's constants overflow (the floor's push has m2^2,
     // and the acceleration g m2), so the full model is refused; the separation reads none of
@@ -514,6 +539,7 @@ static FLOOR_INFO: LazyLock<ModelInfo> = LazyLock::new(|| {
         reduction: base.reduction.map(|r| ReductionInfo {
             force_degrees: &[3, 2],
             pushes_proven: &[false, false],
+            release_push_proven: false,
             ..r
         }),
         ..*base

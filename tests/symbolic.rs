@@ -10,7 +10,7 @@
 use rodcube::derive::cas;
 use rodcube::derive::expr::Expr;
 use rodcube::derive::mechanics::{self, Derivation, Reduction};
-use rodcube::derive::positivity::push_proof;
+use rodcube::derive::positivity::{push_proof, release_proof};
 use rodcube::derive::types::ProofStep;
 use rodcube::derive::{derive_all, on_cas_thread, spec};
 use std::path::Path;
@@ -332,6 +332,67 @@ fn rod_cube_floor_push_is_proved_positive_as_by_hand() {
     );
 }
 
+/// The tip pushes on the cube at release for every mass (`derive::positivity::release_proof`):
+/// eq. (14)'s polynomial at `s = sin(theta_i)` is `sin(theta_i) (4 (m1 + m2) - 3 m1
+/// sin(theta_i)^2)`, concave in `sin(theta_i)` and `m1 + 4 m2 > 0` at `sin(theta_i) = 1`.
+#[test]
+fn rod_cube_tip_is_proved_to_push_at_release() {
+    let d = derive("rod_cube");
+    let release = red(&d)
+        .release_proof
+        .as_ref()
+        .expect("the tip pushes at release");
+    assert_eq!(release.power, 1);
+    assert_equivalent(
+        "R",
+        &release.polynomial,
+        &parse("4*(m1 + m2) - 3*m1*rc_s^2"),
+    );
+    let ProofStep::Ends(end) = &release.proof.step else {
+        panic!("concave: {:?}", release.proof.step);
+    };
+    assert_equivalent("a + b + c", end, &parse("m1 + 4*m2"));
+}
+
+/// `derive::positivity::release_proof` on hand-written polynomials: proved where the value at
+/// `s = sin(theta_i)` is positive for `0 < sin(theta_i) <= 1`, refused where it is not.
+#[test]
+fn the_release_prover_claims_only_what_holds() {
+    let cases: &[(&[&str], Option<usize>)] = &[
+        // 12 M s - 8 M si - 3 m1 s^3 at s = si: si (4 M - 3 m1 si^2).
+        (
+            &["-8*(m1 + m2)*rc_si", "12*(m1 + m2)", "0", "-3*m1"],
+            Some(1),
+        ),
+        // rc_si - 2 s at s = si: -si.
+        (&["rc_si", "-2"], None),
+        // 1 - 2 s: zero at si = 1/2.
+        (&["1", "-2"], None),
+        // m1 - m2 s: negative where m2 si > m1.
+        (&["m1", "-m2"], None),
+        // 2 - s^2 - s^4: zero at si = 1.
+        (&["2", "0", "-1", "0", "-1"], None),
+        // s^2 (m1 + rc_ci): si^2 (m1 + ci), ci = cos(theta_i) >= 0.
+        (&["0", "0", "m1 + rc_ci"], Some(2)),
+    ];
+    let cases: Vec<(Vec<Expr>, Option<usize>)> = (cases.iter())
+        .map(|(c, want)| (c.iter().map(|t| parse(t)).collect(), *want))
+        .collect();
+    let got = on_cas_thread(move || {
+        let pos = vec!["m1".to_string(), "m2".to_string()];
+        (cases.iter())
+            .map(|(c, want)| {
+                let proof = release_proof(c, &pos).unwrap_or_else(|e| panic!("{e:?}"));
+                (format!("{c:?}"), proof.map(|p| p.power), *want)
+            })
+            .collect::<Vec<_>>()
+    })
+    .expect("the Symbolica worker");
+    for (c, power, want) in got {
+        assert_eq!(power, want, "{c}");
+    }
+}
+
 /// `derive::positivity::push_proof` on pushes written by hand: what it proves holds, and a
 /// push that reaches zero on `0 <= s <= sin(theta_i)`, or whose sign turns on a parameter of
 /// unknown sign, is refused.
@@ -381,7 +442,8 @@ fn the_push_prover_claims_only_what_holds() {
 }
 
 /// Over random pushes `sum c_k m^i sin(theta_i)^j s^k` with small integer `c_k`, every one the
-/// prover proves is positive at every point of a grid of `0 <= s <= sin(theta_i) <= 1` and
+/// prover proves is positive (and every one it proves to push at release is positive at `s =
+/// sin(theta_i)` for `0 < sin(theta_i) <= 1`) at every point of a grid of `0 <= s <= sin(theta_i) <= 1` and
 /// masses from 1e-3 to 1e3 (a soundness check against plain evaluation); some are proved.
 #[test]
 fn every_push_the_prover_proves_is_positive_where_evaluated() {
@@ -410,15 +472,39 @@ fn every_push_the_prover_proves_is_positive_where_evaluated() {
         let pos = vec!["m1".to_string()];
         (polys.iter())
             .map(|c| {
-                push_proof(c, &pos)
-                    .unwrap_or_else(|e| panic!("{e:?}"))
-                    .is_some()
+                let over_phase = push_proof(c, &pos).unwrap_or_else(|e| panic!("{e:?}"));
+                let at_release = release_proof(c, &pos).unwrap_or_else(|e| panic!("{e:?}"));
+                (over_phase.is_some(), at_release.is_some())
             })
             .collect::<Vec<_>>()
     })
     .expect("the Symbolica worker");
-    let mut proved = 0;
-    for (c, proof) in checked.iter().zip(proofs) {
+    let value = |c: &[Expr], m1: f64, si: f64, s: f64| -> f64 {
+        let ci = ((1.0 - si) * (1.0 + si)).sqrt();
+        (c.iter().enumerate())
+            .map(|(k, e)| {
+                let at = |name: &str| match name {
+                    "m1" => Some(m1),
+                    "rc_si" => Some(si),
+                    "rc_ci" => Some(ci),
+                    _ => None,
+                };
+                e.eval(&at) * s.powi(k as i32)
+            })
+            .sum()
+    };
+    let (mut proved, mut at_release) = (0, 0);
+    for (c, (proof, release)) in checked.iter().zip(proofs) {
+        if release {
+            at_release += 1;
+            for m1 in [1e-3, 0.5, 1.0, 7.0, 1e3] {
+                for i in 1..=40 {
+                    let si = f64::from(i) / 40.0;
+                    let v = value(c, m1, si, si);
+                    assert!(v > 0.0, "{c:?} at release, m1 = {m1}, si = {si}: {v}");
+                }
+            }
+        }
         if !proof {
             continue;
         }
@@ -426,29 +512,19 @@ fn every_push_the_prover_proves_is_positive_where_evaluated() {
         for m1 in [1e-3, 0.5, 1.0, 7.0, 1e3] {
             for i in 0..=20 {
                 let si = f64::from(i) / 20.0;
-                let ci = ((1.0 - si) * (1.0 + si)).sqrt();
                 for j in 0..=40 {
                     let s = si * f64::from(j) / 40.0;
-                    let value: f64 = (c.iter().enumerate())
-                        .map(|(k, e)| {
-                            let at = |name: &str| match name {
-                                "m1" => Some(m1),
-                                "rc_si" => Some(si),
-                                "rc_ci" => Some(ci),
-                                _ => None,
-                            };
-                            e.eval(&at) * s.powi(k as i32)
-                        })
-                        .sum();
-                    assert!(
-                        value > 0.0,
-                        "{c:?} at m1 = {m1}, si = {si}, s = {s}: {value}"
-                    );
+                    let v = value(c, m1, si, s);
+                    assert!(v > 0.0, "{c:?} at m1 = {m1}, si = {si}, s = {s}: {v}");
                 }
             }
         }
     }
     assert!(proved >= 20, "only {proved} of 400 proved");
+    assert!(
+        at_release >= 20,
+        "only {at_release} of 400 proved at release"
+    );
 }
 
 #[test]

@@ -4,6 +4,7 @@
 //! <= 1`, whose positivity on `[0, 1]` is then read off signs of polynomials in the positive
 //! parameters, term by term. Where it succeeds the per-point route need not certify that push
 //! point by point; where it does not, nothing is claimed and the runtime certifies as before.
+//! [`release_proof`] shows the same way that the first contact pushes at release.
 //!
 //! The bound, monomial by monomial (`r` a positive number times positive parameters):
 //! - `-r si^i ci^j s^k >= -r s^min(k, 2)`: `si = sin(theta_i)` and `ci = cos(theta_i)` lie in
@@ -16,10 +17,10 @@
 //! `4 a c - b^2 > 0` (no real root). Each sign is that of an expanded polynomial all of whose
 //! terms have it, the parameters being positive. The test is sufficient, not necessary.
 
-use super::algebra::to_expr;
+use super::algebra::{coefficients_in_s, to_expr};
 use super::cas;
 use super::expr::Expr;
-use super::types::{DeriveError, ProofStep, PushProof};
+use super::types::{DeriveError, ProofStep, PushProof, ReleaseProof};
 
 /// The spec's symbols for `sin(theta_i)` and `cos(theta_i)` in a force polynomial's
 /// coefficients, both in `[0, 1]` on a phase that starts between flat and upright.
@@ -95,6 +96,49 @@ pub fn push_proof(coefficients: &[Expr], pos: &[String]) -> Result<Option<PushPr
     Ok(Some(PushProof {
         bound: [a, b, c],
         step,
+    }))
+}
+
+/// The proof that the polynomial with `coefficients` (as for [`push_proof`]) is positive at
+/// `s = sin(theta_i)` for `0 < sin(theta_i) <= 1` and every admissible parameter: its value
+/// there, a polynomial in `sin(theta_i)`, is `sin(theta_i)^m R`, and [`push_proof`] shows `R`
+/// positive on `[0, 1]` (with no `sin(theta_i)` left in `R`'s coefficients, its bound holds
+/// there). `None` where that cannot be shown.
+pub fn release_proof(
+    coefficients: &[Expr],
+    pos: &[String],
+) -> Result<Option<ReleaseProof>, DeriveError> {
+    let sin_start = cas::var(SIN_START);
+    let mut power = cas::num(1);
+    let mut at_start = cas::num(0);
+    for c in coefficients {
+        at_start += cas::atom(c) * power.clone();
+        power *= sin_start.clone();
+    }
+    // The value at release as a polynomial in `sin(theta_i)`, written in `rc_s`.
+    let at_start = cas::subs_var(&cas::expand(&at_start), SIN_START, &cas::var("rc_s"));
+    let Some(mut factor) = coefficients_in_s(&at_start, "push at release")? else {
+        return Ok(None);
+    };
+    let power = factor.iter().take_while(|c| c.is_zero()).count();
+    factor.drain(..power);
+    if factor.is_empty() {
+        return Ok(None);
+    }
+    let Some(proof) = push_proof(&factor, pos)? else {
+        return Ok(None);
+    };
+    let mut polynomial = cas::num(0);
+    for (k, c) in factor.iter().enumerate() {
+        let power = (0..k).fold(cas::num(1), |acc, _| acc * cas::var("rc_s"));
+        polynomial += cas::atom(c) * power;
+    }
+    let polynomial = to_expr(&cas::expand(&polynomial), "push at release")?;
+    Ok(Some(ReleaseProof {
+        power,
+        factor,
+        polynomial,
+        proof,
     }))
 }
 

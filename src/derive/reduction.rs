@@ -23,11 +23,12 @@ use super::constraints::ContactAtoms;
 use super::equations::Equations;
 use super::expr::{Expr, product};
 use super::lagrangian::Lagrangian;
-use super::positivity::push_proof;
+use super::positivity::{push_proof, release_proof};
 use super::setup::Setup;
 use super::spec::Spec;
 use super::types::{
-    Constant, DeriveError, Partials, PushProof, Reduction, Separation, Unreducible, at, key,
+    Constant, DeriveError, Partials, PushProof, Reduction, ReleaseProof, Separation, Unreducible,
+    at, key,
 };
 use std::collections::BTreeMap;
 
@@ -126,7 +127,7 @@ impl Reducer<'_> {
                 _ => None,
             });
         }
-        let push_proofs = self.push_proofs(&force_polynomials)?;
+        let (push_proofs, release_proof) = self.push_proofs(&force_polynomials)?;
         let fall = fall_polynomial(&red.wsq, &self.st.coords, self.theta())?;
         let plain = self.plain_forms(&red, contacts, &forces_reduced, &force_polynomials)?;
         Ok(Ok(Reduction {
@@ -144,6 +145,7 @@ impl Reducer<'_> {
             constants: red.constants,
             force_polynomials,
             push_proofs,
+            release_proof,
             fall,
             plain,
             partials: Partials::default(),
@@ -485,12 +487,13 @@ impl Reducer<'_> {
 
     /// Per contact, the proof that its push stays positive over the phase
     /// ([`push_proof`]), for every closed contact but the first (whose force's zero ends the
-    /// phase) with a force polynomial. The proof holds for `s = sin(theta) >= 0`: a phase whose
-    /// end angle is negative or unknown gets none.
+    /// phase) with a force polynomial; and the proof that the first pushes at release
+    /// ([`release_proof`]). Both hold for `s = sin(theta) >= 0` (so `sin(theta_i) > 0` where
+    /// the phase falls): a phase whose end angle is negative or unknown gets none.
     fn push_proofs(
         &self,
         force_polynomials: &[Option<Separation>],
-    ) -> Result<Vec<Option<PushProof>>, DeriveError> {
+    ) -> Result<(Vec<Option<PushProof>>, Option<ReleaseProof>), DeriveError> {
         let above_flat = self
             .spec
             .end_angle
@@ -502,7 +505,11 @@ impl Reducer<'_> {
                 _ => None,
             });
         }
-        Ok(proofs)
+        let release = match force_polynomials.first() {
+            Some(Some(sep)) if above_flat => release_proof(&sep.coefficients, &self.positive)?,
+            _ => None,
+        };
+        Ok((proofs, release))
     }
 
     /// A reduced expression with `theta_dot^2` and `theta_ddot` substituted.

@@ -259,6 +259,22 @@ pub struct PushProof {
     pub step: ProofStep,
 }
 
+/// A proof that the first contact pushes at release for every admissible parameter: its
+/// force polynomial at `s = sin(theta_i)` is `sin(theta_i)^power R(sin(theta_i))`, and `R` is
+/// positive on `0 <= sin(theta_i) <= 1` by `proof` (a [`PushProof`] of `R`, whose coefficients
+/// hold no `sin(theta_i)`).
+#[derive(Debug, Clone)]
+pub struct ReleaseProof {
+    /// The power of `sin(theta_i) > 0` factored out.
+    pub power: usize,
+    /// `R`'s coefficients in `sin(theta_i)`, lowest degree first.
+    pub factor: Vec<Expr>,
+    /// `R` itself, expanded, over `rc_s` standing for `sin(theta_i)`.
+    pub polynomial: Expr,
+    /// Why `R` is positive.
+    pub proof: PushProof,
+}
+
 /// A parameter of a derived model.
 #[derive(Debug, Clone)]
 pub struct Param {
@@ -376,6 +392,9 @@ pub struct Reduction {
     /// admissible parameter ([`positivity`](super::positivity)), where the derivation found one
     /// (never for the first contact, whose force's zero ends the phase).
     pub push_proofs: Vec<Option<PushProof>>,
+    /// The proof that the first contact pushes at release for every admissible parameter,
+    /// where the derivation found one.
+    pub release_proof: Option<ReleaseProof>,
     /// Coefficients in `sin(theta)` (lowest degree first, over constants) of the fall
     /// polynomial `P(s) = (sin theta_i - s) / theta_dot^2`, where that ratio is a polynomial in
     /// `s` alone: the phase starts from rest, its potential is linear in `sin(theta)` and its

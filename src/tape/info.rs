@@ -151,6 +151,9 @@ pub struct Reduction {
     /// Empty in a tape written before the field was: no push proven.
     #[serde(default)]
     pub pushes_proven: Vec<bool>,
+    /// False in a tape written before the field was.
+    #[serde(default)]
+    pub release_push_proven: bool,
     pub fall_degree: Option<usize>,
     pub lean_constants: Vec<usize>,
 }
@@ -369,6 +372,7 @@ impl Info {
                 } else {
                     list(&r.pushes_proven, |&b| b)
                 },
+                release_push_proven: r.release_push_proven,
                 fall_degree: r.fall_degree,
                 lean_constants: list(&r.lean_constants, |&c| c),
             }),

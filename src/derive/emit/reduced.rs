@@ -152,10 +152,11 @@ pub(super) fn reduction_info(
     debug_assert_eq!(degrees.len(), d.contacts.len());
     let proven: Vec<bool> = r.push_proofs.iter().map(Option::is_some).collect();
     Ok(format!(
-        "ReductionInfo {{ k_theta_initial: {}, k_theta_dot_initial: {wi}, k_sin_initial: {}, k_cos_initial: {}, force_degrees: &{degrees:?}, pushes_proven: &{proven:?}, fall_degree: {:?}, lean_constants: &{:?} }}",
+        "ReductionInfo {{ k_theta_initial: {}, k_theta_dot_initial: {wi}, k_sin_initial: {}, k_cos_initial: {}, force_degrees: &{degrees:?}, pushes_proven: &{proven:?}, release_push_proven: {}, fall_degree: {:?}, lean_constants: &{:?} }}",
         code.k_theta_initial,
         code.k_sin_initial,
         code.k_cos_initial,
+        r.release_proof.is_some(),
         r.fall.as_ref().map(|f| f.len() - 1),
         code.lean_constants
     ))

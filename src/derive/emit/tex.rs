@@ -9,7 +9,7 @@ use crate::derive::present;
 use crate::derive::read::substitute;
 use crate::derive::spec::Checked;
 use crate::derive::types::{
-    ContactRow, Derivation, Dimensionless, ProofStep, Reduction, Shown, StepError, Steps,
+    ContactRow, Derivation, Dimensionless, ProofStep, PushProof, Reduction, Shown, StepError, Steps,
 };
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -702,9 +702,9 @@ fn reduced_equations(
     Ok(())
 }
 
-/// The proofs that a closed contact's push stays positive over the phase
-/// ([`positivity`](crate::derive::positivity)): its force polynomial, the quadratic below it
-/// and why that quadratic is positive.
+/// The proofs that the first contact pushes at release and that another closed contact's push
+/// stays positive over the phase ([`positivity`](crate::derive::positivity)): the force
+/// polynomial, the quadratic below it and why that quadratic is positive.
 fn push_proofs(
     d: &Derivation,
     r: &Reduction,
@@ -713,11 +713,37 @@ fn push_proofs(
     eqs: &mut Vec<Equation>,
 ) {
     let sin_start = Expr::Fun("sin".into(), vec![Expr::sym(&format!("{theta}_i"))]);
-    let start = BTreeMap::from([("rc_si".to_string(), sin_start)]);
+    let start = BTreeMap::from([("rc_si".to_string(), sin_start.clone())]);
     let over_angle = |e: &Expr| from_sc(&substitute(e, &start), theta);
-    let proven = d
-        .contacts
-        .iter()
+    let unchecked = "the per-point solver does not check it point by point";
+    if let (Some(first), Some(release)) = (d.contacts.first(), &r.release_proof) {
+        // R in sin(theta_i): written over `rc_s`, shown over the start's sine.
+        let s_is_start = BTreeMap::from([("rc_s".to_string(), sin_start.clone())]);
+        let factor = &release.polynomial;
+        let power = match release.power {
+            0 => String::new(),
+            1 => "\\sin\\theta_i\\,".into(),
+            m => format!("\\sin^{{{m}}}\\theta_i\\,"),
+        };
+        eqs.push(display(
+            &format!(
+                "Force \\texttt{{{}}} at release: its polynomial at $\\sin\\theta = \\sin\\theta_i$ \
+                 is ${power} R$, with",
+                tex_text(&first.name)
+            ),
+            "R = ".into(),
+            4,
+            &over_angle(&substitute(factor, &s_is_start)),
+            None,
+            name,
+        ));
+        let below = "A quadratic below $R$ for $0 \\le \\sin\\theta_i \\le 1$, $R \\ge a + b \\sin\\theta_i + c \\sin^2\\theta_i$ \
+                     ($\\cos\\theta_i$ at most 1 in a negative term, $\\sin^k\\theta_i \\le \\sin^2\\theta_i$ for \
+                     $k > 2$)";
+        let outcome = format!("so it pushes at release for every parameter ({unchecked})");
+        quadratic_proof(&release.proof, below, "\\sin\\theta_i", &outcome, name, eqs);
+    }
+    let proven = (d.contacts.iter())
         .zip(&r.force_polynomials)
         .zip(&r.push_proofs);
     for ((c, poly), proof) in proven {
@@ -736,52 +762,64 @@ fn push_proofs(
             None,
             name,
         ));
-        let [a, b, c2] = &proof.bound;
         let below = "A quadratic below it, $P \\ge a + b \\sin\\theta + c \\sin^2\\theta$ for \
                      $0 \\le \\sin\\theta \\le \\sin\\theta_i \\le 1$ ($\\sin\\theta_i$ and \
                      $\\cos\\theta_i$ at most 1 in a negative term, $\\sin\\theta_i$ at least \
                      $\\sin\\theta$ in a positive one, $\\sin^k\\theta \\le \\sin^2\\theta$ for \
                      $k > 2$)";
-        for (title, lhs, e) in [
-            (below, "a = ", a),
-            ("Its coefficient $b$", "b = ", b),
-            ("Its coefficient $c$", "c = ", c2),
-        ] {
-            eqs.push(display(title, lhs.into(), 4, e, None, name));
-        }
-        let positive_over_phase = "so the push stays positive over the phase for every \
-                                   parameter (the per-point solver does not certify it point by \
-                                   point)";
-        let (title, lhs, e) = match &proof.step {
-            ProofStep::Signs => {
-                eqs.push(Equation {
-                    title: format!("Its coefficients' signs, term by term: {positive_over_phase}"),
-                    env: "equation*",
-                    latex: "a > 0, \\quad b \\ge 0, \\quad c \\ge 0".into(),
-                    tag: None,
-                    small: false,
-                });
-                continue;
-            }
-            ProofStep::Ends(e) => (
-                format!(
-                    "The quadratic is concave or straight, so least at an end: $a > 0$ term by \
-                     term, and so is its value at $\\sin\\theta = 1$, {positive_over_phase}"
-                ),
-                "a + b + c = ",
-                e,
-            ),
-            ProofStep::Discriminant(e) => (
-                format!(
-                    "The quadratic has no real root: $a > 0$ and $4ac - b^2 > 0$ term by term, \
-                     {positive_over_phase}"
-                ),
-                "4 a c - b^2 = ",
-                e,
-            ),
-        };
-        let mut eq = display(&title, lhs.into(), 8, e, None, name);
-        eq.latex.push_str(" > 0");
-        eqs.push(eq);
+        let outcome =
+            format!("so the push stays positive over the phase for every parameter ({unchecked})");
+        quadratic_proof(proof, below, "\\sin\\theta", &outcome, name, eqs);
     }
+}
+
+/// A [`PushProof`]'s quadratic `a + b x + c x^2` (`x` printed as `x`) under the title `below`,
+/// and why it is positive, ending with `outcome`.
+fn quadratic_proof(
+    proof: &PushProof,
+    below: &str,
+    x: &str,
+    outcome: &str,
+    name: &dyn Fn(&str) -> String,
+    eqs: &mut Vec<Equation>,
+) {
+    let [a, b, c] = &proof.bound;
+    for (title, lhs, e) in [
+        (below, "a = ", a),
+        ("Its coefficient $b$", "b = ", b),
+        ("Its coefficient $c$", "c = ", c),
+    ] {
+        eqs.push(display(title, lhs.into(), 4, e, None, name));
+    }
+    let (title, lhs, e) = match &proof.step {
+        ProofStep::Signs => {
+            eqs.push(Equation {
+                title: format!("Its coefficients' signs, term by term, {outcome}"),
+                env: "equation*",
+                latex: "a > 0, \\quad b \\ge 0, \\quad c \\ge 0".into(),
+                tag: None,
+                small: false,
+            });
+            return;
+        }
+        ProofStep::Ends(e) => (
+            format!(
+                "The quadratic is concave or straight, so least at an end: $a > 0$ term by term, \
+                 and so is its value at ${x} = 1$, {outcome}"
+            ),
+            "a + b + c = ",
+            e,
+        ),
+        ProofStep::Discriminant(e) => (
+            format!(
+                "The quadratic has no real root: $a > 0$ and $4ac - b^2 > 0$ term by term, \
+                 {outcome}"
+            ),
+            "4 a c - b^2 = ",
+            e,
+        ),
+    };
+    let mut eq = display(&title, lhs.into(), 8, e, None, name);
+    eq.latex.push_str(" > 0");
+    eqs.push(eq);
 }

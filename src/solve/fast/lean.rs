@@ -12,10 +12,14 @@
 //! 7 evaluations per point instead of 19, at `2^-53` relative. Such a point is first solved on
 //! an unchecked route ([`LeanRoute::lean_point`], implemented here for every model type): its
 //! inputs come from [`Model::lean_start`] (a default trait method, so each model's copy is
-//! compiled with its generated functions inlined: the parameters' quick test and the start and
-//! polynomials), then the same root, integrand and plan with nothing but numbers between them
-//! (no error values built). Anything short of a clean solve there (a parameter the quick
-//! test does not pass, a value not finite, no root, a phase that does not fall, too many panels)
+//! compiled with its generated functions inlined: the parameters' quick test, the start and
+//! polynomials, and whether the first contact pushes at release, unless the derivation proved
+//! it does), then the same root, integrand and plan with nothing but numbers between them (no
+//! error values built); the other contacts' pushes are certified on the way, but those the
+//! derivation proved positive over the phase (`derive::positivity`, written out in the model's
+//! LaTeX). Anything short of a clean solve there (a parameter the quick test does not pass, a
+//! first contact that does not push at release, a value not finite, no root, another contact
+//! that lets go first, a phase that does not fall, too many panels)
 //! sends the point through the checked route (`LeanSolver::checked`), which solves it again and
 //! names what failed; so the unchecked route never decides an error. The unchecked route has a
 //! second compiled copy, [`LeanRoute::lean_point_avx2`], the same source built for AVX2 (4-wide
@@ -603,11 +607,10 @@ pub(crate) fn quick_route(
         return None;
     }
     let (sep, fall) = (&start.separation[..], &start.fall[..]);
-    // Every closed contact pushes at release (each polynomial has its force's sign), and no
-    // other one lets go before the separation.
-    if !pushes(sep, si) {
-        return None;
-    }
+    // The first contact pushes at release (`Model::lean_start` tested it, or the derivation
+    // proved it); no other closed contact lets go before the separation (each polynomial has
+    // its force's sign). The release test in the route rather than the start cost 34
+    // instructions a point of `examples/per_point.rs`, in spills around it.
     let s = poly::largest_root(sep, sin_end, si, evals)??;
     for other in start.others.iter().take(start.n_others) {
         // Certainly positive on [s, si] (so at release too), else pushing at release and no

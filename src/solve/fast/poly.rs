@@ -545,13 +545,10 @@ fn positive_by_bernstein<const N: usize>(coeffs: &[f64; N], lo: f64, hi: f64) ->
 /// place of that size).
 pub const BERNSTEIN_MARGIN: f64 = 1e-12;
 
-/// `p(x)` by Horner's rule (coefficients lowest degree first), with separate multiplies and
-/// adds (without a hardware FMA target feature `f64::mul_add` is a library call several times
-/// slower than the arithmetic).
-#[inline]
-pub fn horner(coeffs: &[f64], x: f64) -> f64 {
-    coeffs.iter().rev().fold(0.0, |acc, &c| acc * x + c)
-}
+/// `p(x)` by Horner's rule, [`model::horner`](crate::model::horner): it lives with the model
+/// contract, whose [`Model::lean_start`](crate::model::Model::lean_start) evaluates the
+/// separation polynomial at release.
+pub use crate::model::horner;
 
 /// `p(x)` with a reliable sign: plain Horner, redone by [`horner_compensated`] when the result
 /// is within the plain evaluation's rounding bound `4 (d+1) eps sum |c_i| |x|^i` of zero (the
