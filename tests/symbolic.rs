@@ -375,22 +375,30 @@ fn the_release_prover_claims_only_what_holds() {
         // s^2 (m1 + rc_ci): si^2 (m1 + ci), ci = cos(theta_i) >= 0.
         (&["0", "0", "m1 + rc_ci"], Some(2)),
     ];
-    let cases: Vec<(Vec<Expr>, Option<usize>)> = (cases.iter())
-        .map(|(c, want)| (c.iter().map(|t| parse(t)).collect(), *want))
-        .collect();
-    let got = on_cas_thread(move || {
-        let pos = vec!["m1".to_string(), "m2".to_string()];
-        (cases.iter())
-            .map(|(c, want)| {
-                let proof = release_proof(c, &pos).unwrap_or_else(|e| panic!("{e:?}"));
-                (format!("{c:?}"), proof.map(|p| p.power), *want)
-            })
-            .collect::<Vec<_>>()
-    })
-    .expect("the Symbolica worker");
-    for (c, power, want) in got {
-        assert_eq!(power, want, "{c}");
+    let powers = on_cases(cases.iter().map(|c| c.0), |c, pos| {
+        release_proof(c, pos)
+            .unwrap_or_else(|e| panic!("{e:?}"))
+            .map(|p| p.power)
+    });
+    for ((c, want), power) in cases.iter().zip(powers) {
+        assert_eq!(power, *want, "{c:?}");
     }
+}
+
+/// `prove` on each case's coefficients (parsed), on the Symbolica thread, with `m1` and `m2`
+/// the positive symbols.
+fn on_cases<'a, T: Send + 'static>(
+    cases: impl Iterator<Item = &'a [&'a str]>,
+    prove: fn(&[Expr], &[String]) -> T,
+) -> Vec<T> {
+    let cases: Vec<Vec<Expr>> = cases
+        .map(|c| c.iter().map(|t| parse(t)).collect())
+        .collect();
+    on_cas_thread(move || {
+        let pos = vec!["m1".to_string(), "m2".to_string()];
+        cases.iter().map(|c| prove(c, &pos)).collect::<Vec<_>>()
+    })
+    .expect("the Symbolica worker")
 }
 
 /// `derive::positivity::push_proof` on pushes written by hand: what it proves holds, and a
@@ -418,33 +426,24 @@ fn the_push_prover_claims_only_what_holds() {
         // 3 - rc_si s - s^4 >= 3 - s - s^2 >= 1: concave, least at an end.
         (&["3", "-rc_si", "0", "0", "-1"], Some("ends")),
     ];
-    let cases: Vec<(Vec<Expr>, Option<&'static str>)> = (cases.iter())
-        .map(|(c, want)| (c.iter().map(|t| parse(t)).collect(), *want))
-        .collect();
-    let got = on_cas_thread(move || {
-        let pos = vec!["m1".to_string(), "m2".to_string()];
-        (cases.iter())
-            .map(|(c, want)| {
-                let proof = push_proof(c, &pos).unwrap_or_else(|e| panic!("{e:?}"));
-                let kind = proof.map(|p| match p.step {
-                    ProofStep::Signs => "signs",
-                    ProofStep::Ends(_) => "ends",
-                    ProofStep::Discriminant(_) => "discriminant",
-                });
-                (format!("{c:?}"), kind, *want)
-            })
-            .collect::<Vec<_>>()
-    })
-    .expect("the Symbolica worker");
-    for (c, kind, want) in got {
-        assert_eq!(kind, want, "{c}");
+    let kinds = on_cases(cases.iter().map(|c| c.0), |c, pos| {
+        let proof = push_proof(c, pos).unwrap_or_else(|e| panic!("{e:?}"));
+        proof.map(|p| match p.step {
+            ProofStep::Signs => "signs",
+            ProofStep::Ends(_) => "ends",
+            ProofStep::Discriminant(_) => "discriminant",
+        })
+    });
+    for ((c, want), kind) in cases.iter().zip(kinds) {
+        assert_eq!(kind, *want, "{c:?}");
     }
 }
 
 /// Over random pushes `sum c_k m^i sin(theta_i)^j s^k` with small integer `c_k`, every one the
-/// prover proves is positive (and every one it proves to push at release is positive at `s =
-/// sin(theta_i)` for `0 < sin(theta_i) <= 1`) at every point of a grid of `0 <= s <= sin(theta_i) <= 1` and
-/// masses from 1e-3 to 1e3 (a soundness check against plain evaluation); some are proved.
+/// prover proves is positive at every point of a grid of `0 <= s <= sin(theta_i) <= 1` and
+/// masses from 1e-3 to 1e3, and every one it proves to push at release is positive at `s =
+/// sin(theta_i)` for `0 < sin(theta_i) <= 1` (a soundness check against plain evaluation);
+/// some of each are proved.
 #[test]
 fn every_push_the_prover_proves_is_positive_where_evaluated() {
     let mut state = 0x9e37_79b9_7f4a_7c15_u64;
