@@ -30,9 +30,9 @@ const COS_START: &str = "rc_ci";
 /// The proof that the polynomial with `coefficients` (in `s`, lowest degree first, over the
 /// parameters and `rc_si`, `rc_ci`, the start's sine and cosine) is positive for
 /// `0 <= s <= sin(theta_i)` and every admissible parameter, the symbols in `pos` being
-/// strictly positive; `None` where the
-/// test above cannot show it (a symbol of unknown sign, a term that is no monomial, a bound
-/// too weak). The caller must know that `s >= 0` on the phase (its end angle is at least 0).
+/// strictly positive; `None` where the test above cannot show it (a symbol of unknown sign, a
+/// term that is no monomial, a bound too weak). The caller must know that `s >= 0` on the
+/// phase (its end angle is at least 0).
 pub fn push_proof(coefficients: &[Expr], pos: &[String]) -> Result<Option<PushProof>, DeriveError> {
     let mut bound: [Vec<Expr>; 3] = Default::default();
     for (k, c) in coefficients.iter().enumerate() {
@@ -137,7 +137,6 @@ pub fn release_proof(
     let polynomial = to_expr(&cas::expand(&polynomial), "push at release")?;
     Ok(Some(ReleaseProof {
         power,
-        factor,
         polynomial,
         proof,
     }))

@@ -267,9 +267,7 @@ pub struct PushProof {
 pub struct ReleaseProof {
     /// The power of `sin(theta_i) > 0` factored out.
     pub power: usize,
-    /// `R`'s coefficients in `sin(theta_i)`, lowest degree first.
-    pub factor: Vec<Expr>,
-    /// `R` itself, expanded, over `rc_s` standing for `sin(theta_i)`.
+    /// `R`, expanded, over `rc_s` standing for `sin(theta_i)`.
     pub polynomial: Expr,
     /// Why `R` is positive.
     pub proof: PushProof,
