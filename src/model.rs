@@ -421,11 +421,8 @@ pub trait Model: Send + Sync {
         red.fall_polynomial(k, fall.get_mut(..fall_len)?);
         let sin_initial = *k.get(layout.k_sin_initial)?;
         // The first contact pushes at release, unless the derivation proved it does for every
-        // parameter (a NaN is no push: `partial_cmp` is `None`, not `Greater`).
-        if !layout.release_push_proven
-            && horner(&separation, sin_initial).partial_cmp(&0.0)
-                != Some(std::cmp::Ordering::Greater)
-        {
+        // parameter.
+        if !layout.release_push_proven && !pushes(&separation, sin_initial) {
             return None;
         }
         let mut others = [[0.0; LEAN_OTHER_COEFFICIENTS]; LEAN_MAX_OTHERS];
@@ -692,6 +689,13 @@ pub(crate) fn parameters_pass<M: Model + ?Sized>(
 #[inline]
 pub fn horner(coeffs: &[f64], x: f64) -> f64 {
     coeffs.iter().rev().fold(0.0, |acc, &c| acc * x + c)
+}
+
+/// Whether the force polynomial `p` pushes at `x` (a NaN is no push: `partial_cmp` is `None`,
+/// not `Greater`).
+#[inline(always)]
+pub(crate) fn pushes(p: &[f64], x: f64) -> bool {
+    horner(p, x).partial_cmp(&0.0) == Some(std::cmp::Ordering::Greater)
 }
 
 /// Whether `v` is positive and finite, by one integer comparison: as bits, the positive finite

@@ -32,11 +32,12 @@
 //! 1e12 and `a/ell` from 1e-10 to `1 - 1e-9`.
 
 use crate::model::PhaseInfo;
-use crate::model::{LeanStart, Model, ModelInfo, Reduction, ReductionInfo, positive_finite};
+use crate::model::{
+    LeanStart, Model, ModelInfo, Reduction, ReductionInfo, positive_finite, pushes,
+};
 use crate::results::EndCause;
 use crate::results::{SensitivityGap, Work};
 use crate::solve::SolveError;
-use crate::solve::fast::poly::horner;
 use crate::solve::fast::poly::{self, MAX_DEGREE};
 use crate::solve::fast::prior::{PRIOR_TOL, Prior, Singularities, integrate_prior, prior_panels};
 use crate::solve::fast::quadrature::{
@@ -650,13 +651,6 @@ pub(crate) fn quick_route(
         separation_time: t,
         sines: [si, ci, s],
     })
-}
-
-/// Whether the force polynomial `p` pushes at `x` (a NaN is no push: `partial_cmp` is `None`,
-/// not `Greater`).
-#[inline(always)]
-fn pushes(p: &[f64], x: f64) -> bool {
-    horner(p, x).partial_cmp(&0.0) == Some(std::cmp::Ordering::Greater)
 }
 
 /// Whether a push `other` that [`poly::positive_on`] could not certify on `[s, si]` pushes at
